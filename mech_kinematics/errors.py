@@ -1,0 +1,56 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""Errors and warnings raised by the scene loader and the solver."""
+
+from __future__ import annotations
+
+
+class MechKinematicsError(ValueError):
+    """Base class of every error this package raises on bad input."""
+
+
+class SceneError(MechKinematicsError):
+    """A scene file or scene description is invalid.
+
+    The message names the file (when there is one), the key and the reason,
+    e.g. ``four_bar.yaml: dyads[0].links[1].length: expected a positive
+    length, got -80``.
+
+    Attributes
+    ----------
+    where : tuple of (object, str) or None
+        The scene element at fault and its field, when the error is raised on
+        an element already built, so that a loader can name the file's key.
+    """
+
+    def __init__(self, msg: str, where: tuple[object, str] | None = None) -> None:
+        super().__init__(msg)
+        self.where = where
+
+
+class AssemblyError(MechKinematicsError):
+    """The mechanism cannot be solved at a given crank angle.
+
+    Raised when a dyad cannot close (circles that do not meet, a guide out of
+    reach) or is singular (its two links in line, a slider pin on its pivot).
+
+    Attributes
+    ----------
+    dyad : str
+        Label of the dyad that failed, e.g. ``RRR C``.
+    angle : float
+        The crank angle, rad.
+    reason : str
+        The violated condition.
+    """
+
+    def __init__(self, dyad: str, angle: float, reason: str) -> None:
+        self.dyad = dyad
+        self.angle = angle
+        self.reason = reason
+        msg = f'{dyad} cannot be solved at crank angle {angle:.17g} rad: {reason}'
+        super().__init__(msg)
+
+
+class NearSingularWarning(UserWarning):
+    """The mechanism is close to a singular position; results lose accuracy."""

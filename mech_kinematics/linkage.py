@@ -1,0 +1,907 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""Analytic position, velocity and acceleration of planar linkages.
+
+A mechanism is a driving crank followed by dyads (RRR, RRP, RPR) and points
+carried rigidly by links, solved one after another in closed form: no
+iteration anywhere. Points are complex numbers ``x + iy`` internally, so a
+rigid rotation is a product and every formula is the same for one crank angle
+(Python ``complex`` and :mod:`math`, cheap enough for a node's tick) and for
+an array of crank angles (NumPy, for cycles and plots).
+
+Everything here is SI: metres, radians, seconds. Angles are counter-clockwise
+from +x; angular velocities and accelerations are positive counter-clockwise.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from enum import IntEnum
+from functools import cached_property
+import math
+import re
+from typing import Any, Union
+import warnings
+
+import numpy as np
+import numpy.typing as npt
+
+from .errors import AssemblyError, NearSingularWarning, SceneError
+
+__all__ = [
+    'Branch', 'CarriedPoint', 'Crank', 'JointState', 'Link', 'NEAR_SINGULAR', 'PointState',
+    'RPR', 'RRP', 'RRR', 'SINGULAR', 'Scene', 'State', 'solve',
+]
+
+#: A dyad whose near-singularity measure falls below this is flagged as
+#: near-singular (:class:`NearSingularWarning`); its velocities lose about
+#: ``-log10(measure)`` digits and its accelerations up to three times that.
+NEAR_SINGULAR = 1e-3
+#: At or below this measure a dyad is treated as singular and not solved.
+SINGULAR = 1e-12
+
+IDENTIFIER = re.compile(r'[A-Za-z_][A-Za-z0-9_]*\Z')
+
+Number = Union[float, npt.NDArray[np.float64]]
+Vector = Union[complex, npt.NDArray[np.complex128]]
+
+
+class Branch(IntEnum):
+    """Assembly branch of a dyad.
+
+    For an RRR dyad ``PLUS`` takes the new pin to the left of the directed
+    line from the first link's start to the second's; for an RRP dyad it takes
+    the larger slider coordinate.
+    """
+
+    PLUS = 1
+    MINUS = -1
+
+
+def _check_name(name: str, what: str) -> None:
+    if not isinstance(name, str) or not IDENTIFIER.match(name):
+        msg = f'Expected {what} to be an identifier ([A-Za-z_][A-Za-z0-9_]*), got {name!r}'
+        raise SceneError(msg)
+
+
+def _check_finite(value: float, what: str) -> None:
+    if not math.isfinite(value):
+        msg = f'Expected {what} to be a finite number, got {value!r}'
+        raise SceneError(msg)
+
+
+def _check_length(value: float, what: str) -> None:
+    if not (math.isfinite(value) and value > 0.0):
+        msg = f'Expected {what} to be a positive length, got {value!r} m'
+        raise SceneError(msg)
+
+
+@dataclass(frozen=True)
+class Crank:
+    """The driving crank: a link turning about a ground point.
+
+    Parameters
+    ----------
+    link : str
+        Name of the crank link (a revolute joint).
+    center : str
+        Ground point it turns about.
+    point : str
+        The point at its tip.
+    length : float
+        Crank length, m.
+    angle : float
+        Crank angle at time zero, rad.
+    speed : float
+        Default angular velocity, rad/s, + CCW.
+    accel : float
+        Default angular acceleration, rad/s^2, + CCW.
+    """
+
+    link: str
+    center: str
+    point: str
+    length: float
+    angle: float = 0.0
+    speed: float = 0.0
+    accel: float = 0.0
+
+    def __post_init__(self) -> None:
+        _check_name(self.link, 'the crank link name')
+        _check_name(self.center, 'the crank center')
+        _check_name(self.point, 'the crank point')
+        _check_length(self.length, f'crank "{self.link}" length')
+        _check_finite(self.angle, 'the crank angle')
+        _check_finite(self.speed, 'the crank speed')
+        _check_finite(self.accel, 'the crank acceleration')
+
+
+@dataclass(frozen=True)
+class Link:
+    """A binary link of a dyad, from a known point to the dyad's new point."""
+
+    name: str
+    start: str
+    length: float
+
+    def __post_init__(self) -> None:
+        _check_name(self.name, 'a link name')
+        _check_name(self.start, f'the start point of link "{self.name}"')
+        _check_length(self.length, f'link "{self.name}" length')
+
+
+@dataclass(frozen=True)
+class RRR:
+    """Two links meeting at a new pin ``point``."""
+
+    point: str
+    links: tuple[Link, Link]
+    branch: Branch = Branch.PLUS
+
+    def __post_init__(self) -> None:
+        _check_name(self.point, 'an RRR point')
+        if len(self.links) != 2:
+            msg = f'Expected RRR "{self.point}" to have 2 links, got {len(self.links)}'
+            raise SceneError(msg)
+        object.__setattr__(self, 'branch', Branch(self.branch))
+
+
+@dataclass(frozen=True)
+class RRP:
+    """A link ending in a slider ``point`` on a fixed straight guide."""
+
+    point: str
+    link: Link
+    through: str
+    guide_angle: float
+    slider: str
+    branch: Branch = Branch.PLUS
+
+    def __post_init__(self) -> None:
+        _check_name(self.point, 'an RRP point')
+        _check_name(self.through, f'the guide point of RRP "{self.point}"')
+        _check_name(self.slider, f'the slider of RRP "{self.point}"')
+        _check_finite(self.guide_angle, f'the guide angle of RRP "{self.point}"')
+        object.__setattr__(self, 'branch', Branch(self.branch))
+
+
+@dataclass(frozen=True)
+class RPR:
+    """A slotted ``link`` turning about ground point ``center``, through pin ``through``."""
+
+    link: str
+    center: str
+    through: str
+    slider: str
+
+    def __post_init__(self) -> None:
+        _check_name(self.link, 'an RPR link')
+        _check_name(self.center, f'the center of RPR "{self.link}"')
+        _check_name(self.through, f'the pin of RPR "{self.link}"')
+        _check_name(self.slider, f'the slider of RPR "{self.link}"')
+
+
+@dataclass(frozen=True)
+class CarriedPoint:
+    """A point carried rigidly by ``link``.
+
+    It lies at ``local`` (m) in the frame with origin at ``origin`` and x-axis
+    toward ``xaxis``, both points on that link. The scene format's
+    ``{from: F, toward: T, distance: d}`` is ``origin=F, xaxis=T,
+    local=(d, 0)``.
+    """
+
+    name: str
+    link: str
+    origin: str
+    xaxis: str
+    local: tuple[float, float]
+
+    def __post_init__(self) -> None:
+        _check_name(self.name, 'a carried point name')
+        _check_name(self.link, f'the link of point "{self.name}"')
+        _check_name(self.origin, f'the origin of point "{self.name}"')
+        _check_name(self.xaxis, f'the x-axis point of point "{self.name}"')
+        for value in self.local:
+            _check_finite(value, f'the local coordinates of point "{self.name}"')
+
+
+Dyad = Union[RRR, RRP, RPR]
+
+
+# --- the steps of a solve -------------------------------------------------
+
+
+class _Context:
+    """Values known so far in one solve; complex numbers or complex arrays."""
+
+    __slots__ = ('angle', 'vector', 'points', 'links', 'sliders', 'measures', 'valid',
+                 'failures')
+
+    def __init__(self, angle: Any, vector: bool) -> None:
+        self.angle = angle
+        self.vector = vector
+        self.points: dict[str, tuple[Any, Any, Any]] = {}
+        self.links: dict[str, tuple[Any, Any, Any]] = {}
+        self.sliders: dict[str, tuple[Any, Any, Any]] = {}
+        self.measures: dict[str, Any] = {}
+        self.valid: Any = True
+        self.failures: dict[str, Any] = {}
+
+    def check(self, ok: Any, label: str, reason: Any) -> None:
+        """Stop a scalar solve where ``ok`` fails; mask the entries of a vector solve."""
+        if not self.vector:
+            if not ok:
+                raise AssemblyError(label, self.angle, reason())
+            return
+        if not ok.all():
+            failed = ~ok & self.valid
+            self.valid = self.valid & ok
+            if failed.any():
+                previous = self.failures.get(label)
+                self.failures[label] = failed if previous is None else previous | failed
+
+
+def _dot(a: Any, b: Any) -> Any:
+    return a.real * b.real + a.imag * b.imag
+
+
+def _cross(a: Any, b: Any) -> Any:
+    return a.real * b.imag - a.imag * b.real
+
+
+class _CrankStep:
+    def __init__(self, crank: Crank, center: complex) -> None:
+        self.link = crank.link
+        self.point = crank.point
+        self.center = center
+        self.length = crank.length
+        self.uses: tuple[str, ...] = (crank.center,)
+
+    def run(self, ctx: _Context, theta: Any, omega: Any, alpha: Any) -> None:
+        if ctx.vector:
+            e = np.cos(theta) + 1j * np.sin(theta)
+        else:
+            e = complex(math.cos(theta), math.sin(theta))
+        r = self.length * e
+        ctx.points[self.point] = (self.center + r, 1j * omega * r, (1j * alpha - omega * omega) * r)
+        ctx.links[self.link] = (e, omega, alpha)
+
+
+class _RRRStep:
+    def __init__(self, dyad: RRR) -> None:
+        first, second = dyad.links
+        self.label = f'RRR {dyad.point}'
+        self.key = dyad.point
+        self.point = dyad.point
+        self.start1, self.start2 = first.start, second.start
+        self.link1, self.link2 = first.name, second.name
+        self.l1, self.l2 = first.length, second.length
+        self.branch = int(dyad.branch)
+        self.uses = (first.start, second.start)
+
+    def run(self, ctx: _Context) -> None:
+        l1, l2 = self.l1, self.l2
+        p1, v1, a1 = ctx.points[self.start1]
+        p2, v2, a2 = ctx.points[self.start2]
+        d = p2 - p1
+        dist = abs(d)
+        lsum = l1 + l2
+        ldiff = l1 - l2
+        # 4 * dist^2 * h^2 as a product of factors: no cancellation near toggle.
+        k = (lsum + dist) * (lsum - dist) * (dist + ldiff) * (dist - ldiff)
+        ctx.check(k > 0.0, self.label, lambda: (
+            f'the circles about {self.start1} (radius {l1:.17g} m) and {self.start2} '
+            f'(radius {l2:.17g} m) do not meet: expected |{ldiff:.17g}| < |{self.start1}'
+            f'{self.start2}| < {lsum:.17g} m, got |{self.start1}{self.start2}| = '
+            f'{dist:.17g} m'))
+        root = np.sqrt(k) if ctx.vector else math.sqrt(k)
+        # sin of the angle between the two links (the transmission angle).
+        measure = root / (2.0 * l1 * l2)
+        ctx.check(measure > SINGULAR, self.label, lambda: (
+            f'links {self.link1} and {self.link2} are in line (singular): expected the sine '
+            f'of the angle between them > {SINGULAR:g}, got {measure:.3g}'))
+        ctx.measures[self.key] = measure
+        half = 0.5 / dist
+        shared = ldiff * lsum
+        height = self.branch * root * half
+        u = d * (1.0 / dist)
+        r1 = ((shared + dist * dist) * half + 1j * height) * u
+        r2 = ((shared - dist * dist) * half + 1j * height) * u
+        den = 0.5 * self.branch * root  # cross(r1, r2)
+        dv = v2 - v1
+        w1 = _dot(dv, r2) / den
+        w2 = _dot(dv, r1) / den
+        da = a2 - a1 + w1 * w1 * r1 - w2 * w2 * r2
+        al1 = _dot(da, r2) / den
+        al2 = _dot(da, r1) / den
+        ctx.points[self.point] = (p1 + r1, v1 + 1j * w1 * r1, a1 + (1j * al1 - w1 * w1) * r1)
+        ctx.links[self.link1] = (r1 * (1.0 / l1), w1, al1)
+        ctx.links[self.link2] = (r2 * (1.0 / l2), w2, al2)
+
+
+class _RRPStep:
+    def __init__(self, dyad: RRP, through: complex) -> None:
+        self.label = f'RRP {dyad.point}'
+        self.key = dyad.point
+        self.point = dyad.point
+        self.start = dyad.link.start
+        self.link = dyad.link.name
+        self.length = dyad.link.length
+        self.slider = dyad.slider
+        self.through = through
+        self.u = complex(math.cos(dyad.guide_angle), math.sin(dyad.guide_angle))
+        self.branch = int(dyad.branch)
+        self.uses = (dyad.link.start,)
+
+    def run(self, ctx: _Context) -> None:
+        length, u = self.length, self.u
+        q, vq, aq = ctx.points[self.start]
+        w = q - self.through
+        along = _dot(w, u)
+        offset = _cross(u, w)  # signed distance of the start point from the guide
+        k = (length - offset) * (length + offset)
+        ctx.check(k > 0.0, self.label, lambda: (
+            f'the guide is out of reach of link {self.link}: expected the distance of '
+            f'{self.start} from the guide < {length:.17g} m, got {abs(offset):.17g} m'))
+        root = np.sqrt(k) if ctx.vector else math.sqrt(k)
+        # sin of the angle between the rod and the guide's normal.
+        measure = root / length
+        ctx.check(measure > SINGULAR, self.label, lambda: (
+            f'link {self.link} is perpendicular to the guide (singular): expected the sine of '
+            f'its angle to the guide normal > {SINGULAR:g}, got {measure:.3g}'))
+        ctx.measures[self.key] = measure
+        den = self.branch * root  # dot(u, r)
+        s = along + den
+        r = (den - 1j * offset) * u
+        sd = _dot(vq, r) / den
+        omega = -_cross(u, vq) / den
+        rest = aq - omega * omega * r
+        sdd = _dot(rest, r) / den
+        alpha = -_cross(u, rest) / den
+        ctx.points[self.point] = (self.through + s * u, sd * u, sdd * u)
+        ctx.links[self.link] = (r * (1.0 / length), omega, alpha)
+        ctx.sliders[self.slider] = (s, sd, sdd)
+
+
+class _RPRStep:
+    def __init__(self, dyad: RPR, center: complex, size: float) -> None:
+        self.label = f'RPR {dyad.link}'
+        self.key = dyad.link
+        self.link = dyad.link
+        self.through = dyad.through
+        self.slider = dyad.slider
+        self.center = center
+        self.size = size
+        self.uses = (dyad.through,)
+
+    def run(self, ctx: _Context) -> None:
+        b, vb, ab = ctx.points[self.through]
+        d = b - self.center
+        s = abs(d)
+        # the slider coordinate relative to the mechanism's size.
+        measure = s / self.size
+        ctx.check(measure > SINGULAR, self.label, lambda: (
+            f'the pin {self.through} is on the pivot (singular): expected its distance '
+            f'from the pivot > {SINGULAR * self.size:.3g} m, got {s:.3g} m'))
+        ctx.measures[self.key] = measure
+        e = d * (1.0 / s)
+        sd = _dot(vb, e)
+        omega = _cross(e, vb) / s
+        sdd = _dot(ab, e) + s * omega * omega
+        # the Coriolis component 2 * omega * sd sits in the transverse balance.
+        alpha = (_cross(e, ab) - 2.0 * sd * omega) / s
+        ctx.links[self.link] = (e, omega, alpha)
+        ctx.sliders[self.slider] = (s, sd, sdd)
+
+
+class _CarryStep:
+    def __init__(self, point: CarriedPoint, base: str, local: complex) -> None:
+        self.point = point.name
+        self.link = point.link
+        self.base = base  # the origin of the link's frame
+        self.local = local
+        self.uses = (base,)
+
+    def run(self, ctx: _Context) -> None:
+        e, omega, alpha = ctx.links[self.link]
+        p, v, a = ctx.points[self.base]
+        r = e * self.local
+        ctx.points[self.point] = (p + r, v + 1j * omega * r, a + (1j * alpha - omega * omega) * r)
+
+
+Step = Union[_RRRStep, _RRPStep, _RPRStep, _CarryStep]
+
+
+@dataclass(frozen=True)
+class _Plan:
+    """A scene compiled to an ordered list of steps."""
+
+    crank: _CrankStep
+    steps: tuple[Step, ...]
+    ground: dict[str, complex]
+    joint_types: dict[str, str]
+    output_joints: tuple[str, ...]
+    output_points: tuple[str, ...]
+
+
+def _compile(scene: Scene, joints: tuple[str, ...] | None,
+             points: tuple[str, ...] | None) -> _Plan:
+    """Order the scene's steps by dependency and keep those the outputs need."""
+    kinds: dict[str, str] = {}
+
+    def define(name: str, kind: str, where: tuple[object, str]) -> None:
+        if name in kinds:
+            msg = f'Expected every name to be used once, got "{name}" twice'
+            raise SceneError(msg, where)
+        kinds[name] = kind
+
+    ground = {}
+    for name, (x, y) in scene.ground.items():
+        _check_name(name, 'a ground point name')
+        _check_finite(x, f'ground point "{name}" x')
+        _check_finite(y, f'ground point "{name}" y')
+        define(name, 'point', (scene, f'ground.{name}'))
+        ground[name] = complex(x, y)
+    crank = scene.input
+    if crank.center not in ground:
+        msg = f'Expected the crank center to be a ground point, got "{crank.center}"'
+        raise SceneError(msg, (crank, 'center'))
+    define(crank.link, 'link', (crank, 'link'))
+    define(crank.point, 'point', (crank, 'point'))
+    joint_types = {crank.link: 'revolute'}
+    for dyad in scene.dyads:
+        if isinstance(dyad, RRR):
+            define(dyad.point, 'point', (dyad, 'point'))
+            for link in dyad.links:
+                define(link.name, 'link', (link, 'name'))
+                joint_types[link.name] = 'revolute'
+        elif isinstance(dyad, RRP):
+            define(dyad.point, 'point', (dyad, 'point'))
+            define(dyad.link.name, 'link', (dyad.link, 'name'))
+            define(dyad.slider, 'slider', (dyad, 'slider'))
+            joint_types[dyad.link.name] = 'revolute'
+            joint_types[dyad.slider] = 'prismatic'
+        else:
+            define(dyad.link, 'link', (dyad, 'link'))
+            define(dyad.slider, 'slider', (dyad, 'slider'))
+            joint_types[dyad.link] = 'revolute'
+            joint_types[dyad.slider] = 'prismatic'
+    for carried in scene.points:
+        define(carried.name, 'point', (carried, 'name'))
+
+    size = max([crank.length]
+               + [abs(a - b) for a in ground.values() for b in ground.values()]
+               + [link.length for d in scene.dyads if isinstance(d, RRR) for link in d.links]
+               + [d.link.length for d in scene.dyads if isinstance(d, RRP)])
+
+    # Local coordinates of the points fixed on each link, in the frame at the
+    # link's start with x along the link; and the slot pin of each RPR lever.
+    local: dict[str, dict[str, complex]] = {crank.link: {crank.center: 0j,
+                                                        crank.point: complex(crank.length)}}
+    slot: dict[str, tuple[str, str]] = {}
+    known = set(ground) | {crank.point}
+    pending: list[Dyad | CarriedPoint] = [*scene.dyads, *scene.points]
+    steps: list[Step] = []
+    produces: dict[str, int] = {}  # point or link -> index of its step
+
+    def need_point(name: str, what: str, where: tuple[object, str]) -> bool:
+        if name not in kinds:
+            msg = f'Expected {what} to be a known point, got unknown "{name}"'
+            raise SceneError(msg, where)
+        if kinds[name] != 'point':
+            msg = f'Expected {what} to be a point, got {kinds[name]} "{name}"'
+            raise SceneError(msg, where)
+        return name in known
+
+    def need_ground(name: str, what: str, where: tuple[object, str]) -> None:
+        need_point(name, what, where)
+        if name not in ground:
+            msg = f'Expected {what} to be a ground point, got moving point "{name}"'
+            raise SceneError(msg, where)
+
+    def place(item: Dyad | CarriedPoint) -> bool:
+        if isinstance(item, RRR):
+            ready = [need_point(link.start, f'the start of link "{link.name}"', (link, 'start'))
+                     for link in item.links]
+            if not all(ready):
+                return False
+            steps.append(_RRRStep(item))
+            for link in item.links:
+                local[link.name] = {link.start: 0j, item.point: complex(link.length)}
+                produces[link.name] = len(steps) - 1
+            produces[item.point] = len(steps) - 1
+            known.add(item.point)
+        elif isinstance(item, RRP):
+            need_ground(item.through, f'the guide point of RRP "{item.point}"',
+                        (item, 'through'))
+            if not need_point(item.link.start, f'the start of link "{item.link.name}"',
+                              (item.link, 'start')):
+                return False
+            steps.append(_RRPStep(item, ground[item.through]))
+            local[item.link.name] = {item.link.start: 0j, item.point: complex(item.link.length)}
+            produces[item.link.name] = produces[item.point] = len(steps) - 1
+            known.add(item.point)
+        elif isinstance(item, RPR):
+            need_ground(item.center, f'the center of RPR "{item.link}"', (item, 'center'))
+            if not need_point(item.through, f'the pin of RPR "{item.link}"', (item, 'through')):
+                return False
+            steps.append(_RPRStep(item, ground[item.center], size))
+            local[item.link] = {item.center: 0j}
+            slot[item.link] = (item.center, item.through)
+            produces[item.link] = len(steps) - 1
+        else:
+            what = f'the link of point "{item.name}"'
+            if item.link not in kinds or kinds[item.link] != 'link':
+                got = f'unknown "{item.link}"' if item.link not in kinds else \
+                    f'{kinds[item.link]} "{item.link}"'
+                msg = f'Expected {what} to be a link, got {got}'
+                raise SceneError(msg, (item, 'link'))
+            ready = [need_point(item.origin, f'the origin of point "{item.name}"',
+                                (item, 'origin')),
+                     need_point(item.xaxis, f'the x-axis point of point "{item.name}"',
+                                (item, 'xaxis'))]
+            if item.link not in local or not all(ready):
+                return False
+            fixed = local[item.link]
+            if item.origin not in fixed:
+                msg = (f'Expected the origin of point "{item.name}" to be a point fixed on link '
+                       f'"{item.link}" (one of {", ".join(fixed)}), got "{item.origin}"')
+                raise SceneError(msg, (item, 'origin'))
+            if item.xaxis in fixed:
+                axis = fixed[item.xaxis] - fixed[item.origin]
+                if axis == 0:
+                    msg = (f'Expected the origin and x-axis points of point "{item.name}" to be '
+                           f'apart, got "{item.origin}" and "{item.xaxis}" coinciding')
+                    raise SceneError(msg, (item, 'xaxis'))
+                axis /= abs(axis)
+            elif slot.get(item.link) == (item.origin, item.xaxis):
+                axis = 1 + 0j  # from the lever's pivot toward its slot pin
+            else:
+                msg = (f'Expected the x-axis point of point "{item.name}" to be a point on link '
+                       f'"{item.link}", got "{item.xaxis}"')
+                raise SceneError(msg, (item, 'xaxis'))
+            offset = fixed[item.origin] + complex(*item.local) * axis
+            fixed[item.name] = offset
+            base = next(name for name, at in fixed.items() if at == 0)
+            steps.append(_CarryStep(item, base, offset))
+            produces[item.name] = len(steps) - 1
+            known.add(item.name)
+        return True
+
+    while pending:
+        for index, item in enumerate(pending):
+            if place(item):
+                del pending[index]
+                break
+        else:
+            names = [item.point if isinstance(item, (RRR, RRP)) else
+                     item.link if isinstance(item, RPR) else item.name for item in pending]
+            msg = f'Expected the dyads and points to be solvable in order, got a cycle among {names}'
+            raise SceneError(msg, (pending[0], ''))
+
+    order = [*ground, crank.point, *(name for step in steps
+                                     for name in _step_points(step))]
+    all_joints = tuple(joint_types)
+    out_joints = all_joints if joints is None else tuple(joints)
+    out_points = tuple(order) if points is None else tuple(points)
+    for name in out_joints:
+        if kinds.get(name) not in ('link', 'slider'):
+            got = f'unknown "{name}"' if name not in kinds else f'{kinds[name]} "{name}"'
+            msg = f'Expected outputs.joints to list links and sliders, got {got}'
+            raise SceneError(msg, (scene, 'outputs.joints'))
+    for name in out_points:
+        if kinds.get(name) != 'point':
+            got = f'unknown "{name}"' if name not in kinds else f'{kinds[name]} "{name}"'
+            msg = f'Expected outputs.points to list points, got {got}'
+            raise SceneError(msg, (scene, 'outputs.points'))
+
+    # Keep only the steps that the outputs depend on.
+    needed: set[int] = set()
+    todo = [produces[name] for name in (*out_joints, *out_points) if name in produces]
+    for name in out_joints:
+        if kinds[name] == 'slider':
+            todo.extend(i for i, s in enumerate(steps)
+                        if getattr(s, 'slider', None) == name)
+    while todo:
+        index = todo.pop()
+        if index in needed:
+            continue
+        needed.add(index)
+        step = steps[index]
+        todo.extend(produces[name] for name in step.uses if name in produces)
+        if isinstance(step, _CarryStep):
+            todo.append(produces[step.link])
+    kept = tuple(step for index, step in enumerate(steps) if index in needed)
+    return _Plan(_CrankStep(crank, ground[crank.center]), kept, ground,
+                 {name: joint_types[name] for name in out_joints}, out_joints, out_points)
+
+
+def _step_points(step: Step) -> tuple[str, ...]:
+    return () if isinstance(step, _RPRStep) else (step.point,)
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A planar mechanism: ground points, the driving crank, dyads, carried points.
+
+    Construction validates names and dependencies and checks that the
+    mechanism assembles at ``input.angle``; a failure raises
+    :class:`SceneError`.
+
+    Parameters
+    ----------
+    name : str
+        Identifier of the scene.
+    ground : mapping of str to (float, float)
+        Fixed points, m.
+    input : Crank
+        The driving crank.
+    dyads : tuple of RRR, RRP or RPR
+        The dyads, solved in dependency order (file order where free).
+    points : tuple of CarriedPoint
+        Points carried rigidly by links.
+    output_joints, output_points : tuple of str or None
+        What to compute and report; ``None`` means everything.
+    description : str
+        Free text.
+    """
+
+    name: str
+    ground: Mapping[str, tuple[float, float]]
+    input: Crank
+    dyads: tuple[Dyad, ...] = ()
+    points: tuple[CarriedPoint, ...] = ()
+    outputs_joints: tuple[str, ...] | None = None
+    outputs_points: tuple[str, ...] | None = None
+    description: str = ''
+    _plan: _Plan = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        _check_name(self.name, 'the scene name')
+        object.__setattr__(self, 'dyads', tuple(self.dyads))
+        object.__setattr__(self, 'points', tuple(self.points))
+        full = _compile(self, None, None)
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter('ignore', NearSingularWarning)
+                _run(full, self.input.angle, self.input.speed, self.input.accel)
+        except AssemblyError as error:
+            msg = (f'Expected the mechanism to assemble at the initial crank angle '
+                   f'{math.degrees(self.input.angle):.6g} deg, got {error.dyad}: {error.reason}')
+            raise SceneError(msg, (self.input, 'angle')) from None
+        if self.outputs_joints is None and self.outputs_points is None:
+            plan = full
+        else:
+            plan = _compile(self, self.outputs_joints, self.outputs_points)
+        object.__setattr__(self, '_plan', plan)
+
+    @property
+    def output_joints(self) -> tuple[str, ...]:
+        """Names of the joints reported, in order."""
+        return self._plan.output_joints
+
+    @property
+    def output_points(self) -> tuple[str, ...]:
+        """Names of the points reported, in order."""
+        return self._plan.output_points
+
+    @property
+    def joint_types(self) -> dict[str, str]:
+        """Joint name -> ``'revolute'`` or ``'prismatic'``, for the reported joints."""
+        return dict(self._plan.joint_types)
+
+
+class JointState:
+    """Position, velocity and acceleration of one joint.
+
+    ``position`` is the link's absolute angle (rad, wrapped to (-pi, pi]) for a
+    revolute joint and the slider coordinate (m) for a prismatic one; floats
+    for one crank angle, arrays of shape (n,) for n angles.
+    """
+
+    __slots__ = ('type', 'position', 'velocity', 'acceleration')
+
+    def __init__(self, type: str, position: Any, velocity: Any,  # noqa: A002
+                 acceleration: Any) -> None:
+        self.type = type
+        self.position = position
+        self.velocity = velocity
+        self.acceleration = acceleration
+
+    def __repr__(self) -> str:
+        return (f'JointState(type={self.type!r}, position={self.position!r}, '
+                f'velocity={self.velocity!r}, acceleration={self.acceleration!r})')
+
+
+@dataclass(frozen=True)
+class PointState:
+    """Position (m), velocity (m/s), acceleration (m/s^2): arrays of shape (2,) or (n, 2)."""
+
+    position: npt.NDArray[np.float64]
+    velocity: npt.NDArray[np.float64]
+    acceleration: npt.NDArray[np.float64]
+
+
+def _xy(z: Any) -> npt.NDArray[np.float64]:
+    if isinstance(z, complex):
+        return np.array((z.real, z.imag))
+    return np.stack((z.real, z.imag), axis=-1)
+
+
+@dataclass(frozen=True)
+class State:
+    """The kinematic state of a scene at one crank angle or an array of them.
+
+    Attributes
+    ----------
+    scene : str
+        Scene name.
+    angle, speed, accel : float or ndarray
+        The crank's angle (rad, as given), angular velocity (rad/s) and
+        angular acceleration (rad/s^2).
+    joints : dict of str to JointState
+        Every reported joint.
+    complex_points : dict of str to (p, v, a)
+        Every reported point as complex numbers ``x + iy`` (m, m/s, m/s^2).
+    valid : bool or ndarray of bool
+        Where the mechanism could be solved. Invalid entries of arrays are NaN.
+    singularity : dict of str to float or ndarray
+        Near-singularity measure of every solved dyad, keyed by its new point
+        (RRR, RRP) or lever (RPR): for RRR the sine of the angle between its
+        links, for RRP the sine of the rod's angle to the guide normal, for RPR
+        the slider coordinate over the mechanism's size. 0 is singular.
+    failures : dict of str to ndarray of bool
+        For arrays: per dyad label, the angles at which it could not be solved.
+    """
+
+    scene: str
+    angle: Any
+    speed: Any
+    accel: Any
+    joints: dict[str, JointState]
+    complex_points: dict[str, tuple[Any, Any, Any]]
+    valid: Any
+    singularity: dict[str, Any]
+    failures: dict[str, Any]
+
+    @cached_property
+    def points(self) -> dict[str, PointState]:
+        """Every reported point as 2-D vectors in the ground frame."""
+        return {name: PointState(_xy(p), _xy(v), _xy(a))
+                for name, (p, v, a) in self.complex_points.items()}
+
+    def as_dict(self) -> dict[str, Any]:
+        """Return the structure the ``solve`` command prints (floats or arrays)."""
+        vector = not isinstance(self.valid, bool)
+
+        def value(x: Any) -> Any:
+            return x if vector else float(x)
+
+        def pair(x: npt.NDArray[np.float64]) -> Any:
+            return x if vector else [float(x[0]), float(x[1])]
+
+        return {
+            'scene': self.scene,
+            'input': {'angle': value(self.angle), 'speed': value(self.speed),
+                      'accel': value(self.accel)},
+            'joints': {name: {'type': j.type, 'position': value(j.position),
+                              'velocity': value(j.velocity),
+                              'acceleration': value(j.acceleration)}
+                       for name, j in self.joints.items()},
+            'points': {name: {'position': pair(p.position), 'velocity': pair(p.velocity),
+                              'acceleration': pair(p.acceleration)}
+                       for name, p in self.points.items()},
+        }
+
+
+def _run(plan: _Plan, angle: Any, speed: Any, accel: Any) -> _Context:
+    """Run every step of ``plan``; the caller chose scalar or vector inputs."""
+    ctx = _Context(angle, not isinstance(angle, float))
+    zero = 0j if not ctx.vector else np.zeros(np.shape(angle), dtype=np.complex128)
+    for name, position in plan.ground.items():
+        ctx.points[name] = (position + zero, zero, zero)
+    plan.crank.run(ctx, angle, speed, accel)
+    for step in plan.steps:
+        step.run(ctx)
+    return ctx
+
+
+def _angle(e: Any, vector: bool) -> Any:
+    """Angle of unit complex ``e``, wrapped to (-pi, pi]."""
+    if vector:
+        theta = np.arctan2(e.imag, e.real)
+        return np.where(theta == -np.pi, np.pi, theta)
+    theta = math.atan2(e.imag, e.real)
+    return math.pi if theta == -math.pi else theta
+
+
+def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None,
+          accel: npt.ArrayLike | None = None) -> State:
+    """Solve ``scene`` for position, velocity and acceleration at crank ``angle``.
+
+    Parameters
+    ----------
+    scene : Scene
+        The mechanism.
+    angle : float or array_like, shape (n,)
+        Crank angle(s), rad, CCW from +x.
+    speed : float or array_like, optional
+        Crank angular velocity, rad/s, + CCW. Defaults to the scene's.
+    accel : float or array_like, optional
+        Crank angular acceleration, rad/s^2, + CCW. Defaults to the scene's.
+
+    Returns
+    -------
+    State
+        Floats for a scalar ``angle``; arrays (with ``valid`` as a mask) for an
+        array.
+
+    Raises
+    ------
+    AssemblyError
+        For a scalar ``angle`` at which a dyad cannot close or is singular.
+    """
+    plan = scene._plan
+    speed = scene.input.speed if speed is None else speed
+    accel = scene.input.accel if accel is None else accel
+    if np.ndim(angle) == 0 and np.ndim(speed) == 0 and np.ndim(accel) == 0:
+        theta, omega, alpha = float(angle), float(speed), float(accel)  # type: ignore[arg-type]
+        for value, what in ((theta, 'angle'), (omega, 'speed'), (alpha, 'accel')):
+            if not math.isfinite(value):
+                msg = f'Expected `{what}` to be finite, got {value!r}'
+                raise ValueError(msg)
+        ctx = _run(plan, theta, omega, alpha)
+        valid: Any = True
+    else:
+        theta, omega, alpha = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64)
+                                                    for x in (angle, speed, accel)))
+        if theta.ndim != 1:
+            msg = f'Expected `angle` to be a float or a 1-D array, got shape {theta.shape}'
+            raise ValueError(msg)
+        if not (np.isfinite(theta).all() and np.isfinite(omega).all()
+                and np.isfinite(alpha).all()):
+            msg = 'Expected `angle`, `speed` and `accel` to be finite'
+            raise ValueError(msg)
+        with np.errstate(all='ignore'):
+            ctx = _run(plan, theta, omega, alpha)
+        valid = np.broadcast_to(np.asarray(ctx.valid, dtype=bool), theta.shape).copy()
+    _warn_near_singular(ctx)
+    return _state(scene, plan, ctx, theta, omega, alpha, valid)
+
+
+def _warn_near_singular(ctx: _Context) -> None:
+    for key, measure in ctx.measures.items():
+        low = measure < NEAR_SINGULAR
+        if low if not ctx.vector else (low & ctx.valid).any():
+            msg = (f'dyad at "{key}" is near-singular (measure below {NEAR_SINGULAR:g}): '
+                   f'its velocities and accelerations lose accuracy')
+            warnings.warn(msg, NearSingularWarning, stacklevel=3)
+
+
+def _state(scene: Scene, plan: _Plan, ctx: _Context, theta: Any, omega: Any, alpha: Any,
+           valid: Any) -> State:
+    vector = ctx.vector
+    joints = {}
+    for name, kind in plan.joint_types.items():
+        if kind == 'revolute':
+            e, w, al = ctx.links[name]
+            joints[name] = JointState(kind, _angle(e, vector), w, al)
+        else:
+            joints[name] = JointState(kind, *ctx.sliders[name])
+    points = {name: ctx.points[name] for name in plan.output_points}
+    measures = ctx.measures
+    if vector:
+        bad = ~valid
+        nan = np.nan
+        shape = theta.shape
+        for name, joint in joints.items():
+            values = [np.where(bad, nan, np.broadcast_to(x, shape))
+                      for x in (joint.position, joint.velocity, joint.acceleration)]
+            joints[name] = JointState(joint.type, *values)
+        points = {name: tuple(np.where(bad, nan, np.broadcast_to(x, shape)) for x in pva)
+                  for name, pva in points.items()}
+        measures = {key: np.where(bad, nan, m) for key, m in measures.items()}
+    return State(scene.name, theta, omega, alpha, joints, points, valid, dict(measures),
+                 dict(ctx.failures))
