@@ -261,7 +261,9 @@ class _CrankStep:
 
     def run(self, ctx: _Context, theta: Any, omega: Any, alpha: Any) -> None:
         if ctx.vector:
-            e = np.cos(theta) + 1j * np.sin(theta)
+            e = np.empty(np.shape(theta), dtype=np.complex128)
+            np.cos(theta, out=e.real)
+            np.sin(theta, out=e.imag)
         else:
             e = complex(math.cos(theta), math.sin(theta))
         r = self.length * e
@@ -291,11 +293,12 @@ class _RRRStep:
         ldiff = l1 - l2
         # 4 * dist^2 * h^2 as a product of factors: no cancellation near toggle.
         k = (lsum + dist) * (lsum - dist) * (dist + ldiff) * (dist - ldiff)
-        ctx.check(k > 0.0, self.label, lambda: (
-            f'the circles about {self.start1} (radius {l1:.17g} m) and {self.start2} '
-            f'(radius {l2:.17g} m) do not meet: expected |{ldiff:.17g}| < |{self.start1}'
-            f'{self.start2}| < {lsum:.17g} m, got |{self.start1}{self.start2}| = '
-            f'{dist:.17g} m'))
+        if not ctx.vector:  # a vector solve catches k <= 0 in the measure's check below
+            ctx.check(k > 0.0, self.label, lambda: (
+                f'the circles about {self.start1} (radius {l1:.17g} m) and {self.start2} '
+                f'(radius {l2:.17g} m) do not meet: expected |{ldiff:.17g}| < |{self.start1}'
+                f'{self.start2}| < {lsum:.17g} m, got |{self.start1}{self.start2}| = '
+                f'{dist:.17g} m'))
         root = np.sqrt(k) if ctx.vector else math.sqrt(k)
         # sin of the angle between the two links (the transmission angle).
         measure = root / (2.0 * l1 * l2)
@@ -309,13 +312,13 @@ class _RRRStep:
         u = d * (1.0 / dist)
         r1 = ((shared + dist * dist) * half + 1j * height) * u
         r2 = ((shared - dist * dist) * half + 1j * height) * u
-        den = 0.5 * self.branch * root  # cross(r1, r2)
+        inv = 2.0 * self.branch / root  # 1 / cross(r1, r2)
         dv = v2 - v1
-        w1 = _dot(dv, r2) / den
-        w2 = _dot(dv, r1) / den
+        w1 = _dot(dv, r2) * inv
+        w2 = _dot(dv, r1) * inv
         da = a2 - a1 + w1 * w1 * r1 - w2 * w2 * r2
-        al1 = _dot(da, r2) / den
-        al2 = _dot(da, r1) / den
+        al1 = _dot(da, r2) * inv
+        al2 = _dot(da, r1) * inv
         ctx.points[self.point] = (p1 + r1, v1 + 1j * w1 * r1, a1 + (1j * al1 - w1 * w1) * r1)
         ctx.links[self.link1] = (r1 * (1.0 / l1), w1, al1)
         ctx.links[self.link2] = (r2 * (1.0 / l2), w2, al2)
@@ -342,9 +345,10 @@ class _RRPStep:
         along = _dot(w, u)
         offset = _cross(u, w)  # signed distance of the start point from the guide
         k = (length - offset) * (length + offset)
-        ctx.check(k > 0.0, self.label, lambda: (
-            f'the guide is out of reach of link {self.link}: expected the distance of '
-            f'{self.start} from the guide < {length:.17g} m, got {abs(offset):.17g} m'))
+        if not ctx.vector:  # a vector solve catches k <= 0 in the measure's check below
+            ctx.check(k > 0.0, self.label, lambda: (
+                f'the guide is out of reach of link {self.link}: expected the distance of '
+                f'{self.start} from the guide < {length:.17g} m, got {abs(offset):.17g} m'))
         root = np.sqrt(k) if ctx.vector else math.sqrt(k)
         # sin of the angle between the rod and the guide's normal.
         measure = root / length
@@ -353,13 +357,14 @@ class _RRPStep:
             f'its angle to the guide normal > {SINGULAR:g}, got {measure:.3g}'))
         ctx.measures[self.key] = measure
         den = self.branch * root  # dot(u, r)
+        inv = 1.0 / den
         s = along + den
         r = (den - 1j * offset) * u
-        sd = _dot(vq, r) / den
-        omega = -_cross(u, vq) / den
+        sd = _dot(vq, r) * inv
+        omega = _cross(vq, u) * inv
         rest = aq - omega * omega * r
-        sdd = _dot(rest, r) / den
-        alpha = -_cross(u, rest) / den
+        sdd = _dot(rest, r) * inv
+        alpha = _cross(rest, u) * inv
         ctx.points[self.point] = (self.through + s * u, sd * u, sdd * u)
         ctx.links[self.link] = (r * (1.0 / length), omega, alpha)
         ctx.sliders[self.slider] = (s, sd, sdd)
@@ -810,11 +815,10 @@ def _run(plan: _Plan, angle: Any, speed: Any, accel: Any) -> _Context:
 
 def _angle(e: Any, vector: bool) -> Any:
     """Angle of unit complex ``e``, wrapped to (-pi, pi]."""
+    # Adding 0.0 turns an imaginary part of -0.0 into +0.0, so atan2 gives +pi, never -pi.
     if vector:
-        theta = np.arctan2(e.imag, e.real)
-        return np.where(theta == -np.pi, np.pi, theta)
-    theta = math.atan2(e.imag, e.real)
-    return math.pi if theta == -math.pi else theta
+        return np.arctan2(e.imag + 0.0, e.real)
+    return math.atan2(e.imag + 0.0, e.real)
 
 
 def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None,
@@ -846,29 +850,37 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
     plan = scene._plan
     speed = scene.input.speed if speed is None else speed
     accel = scene.input.accel if accel is None else accel
-    if np.ndim(angle) == 0 and np.ndim(speed) == 0 and np.ndim(accel) == 0:
+    if _is_scalar(angle) and _is_scalar(speed) and _is_scalar(accel):
         theta, omega, alpha = float(angle), float(speed), float(accel)  # type: ignore[arg-type]
-        for value, what in ((theta, 'angle'), (omega, 'speed'), (alpha, 'accel')):
-            if not math.isfinite(value):
-                msg = f'Expected `{what}` to be finite, got {value!r}'
-                raise ValueError(msg)
+        if not (math.isfinite(theta) and math.isfinite(omega) and math.isfinite(alpha)):
+            msg = (f'Expected `angle`, `speed` and `accel` to be finite, got {theta!r}, '
+                   f'{omega!r}, {alpha!r}')
+            raise ValueError(msg)
         ctx = _run(plan, theta, omega, alpha)
         valid: Any = True
     else:
-        theta, omega, alpha = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64)
-                                                    for x in (angle, speed, accel)))
-        if theta.ndim != 1:
-            msg = f'Expected `angle` to be a float or a 1-D array, got shape {theta.shape}'
+        theta, omega, alpha = (np.asarray(x, dtype=np.float64) for x in (angle, speed, accel))
+        shape = np.broadcast_shapes(theta.shape, omega.shape, alpha.shape)
+        if len(shape) != 1:
+            msg = f'Expected `angle` to be a float or a 1-D array, got shape {shape}'
             raise ValueError(msg)
         if not (np.isfinite(theta).all() and np.isfinite(omega).all()
                 and np.isfinite(alpha).all()):
             msg = 'Expected `angle`, `speed` and `accel` to be finite'
             raise ValueError(msg)
+        theta = np.broadcast_to(theta, shape)
         with np.errstate(all='ignore'):
+            # A constant speed or acceleration stays a scalar through the steps.
             ctx = _run(plan, theta, omega, alpha)
-        valid = np.broadcast_to(np.asarray(ctx.valid, dtype=bool), theta.shape).copy()
+        omega, alpha = np.broadcast_to(omega, shape), np.broadcast_to(alpha, shape)
+        valid = np.broadcast_to(np.asarray(ctx.valid, dtype=bool), shape).copy()
     _warn_near_singular(ctx)
     return _state(scene, plan, ctx, theta, omega, alpha, valid)
+
+
+def _is_scalar(x: Any) -> bool:
+    # The cheap test first: the node's tick passes plain floats.
+    return isinstance(x, (float, int)) or np.ndim(x) == 0
 
 
 def _warn_near_singular(ctx: _Context) -> None:
@@ -893,15 +905,22 @@ def _state(scene: Scene, plan: _Plan, ctx: _Context, theta: Any, omega: Any, alp
     points = {name: ctx.points[name] for name in plan.output_points}
     measures = ctx.measures
     if vector:
-        bad = ~valid
-        nan = np.nan
         shape = theta.shape
+        bad = None if valid.all() else ~valid
+        inputs = (id(theta), id(omega), id(alpha))
+
+        def finish(x: Any) -> Any:
+            # Own every array (never the caller's inputs); invalid entries are NaN.
+            if np.shape(x) != shape or id(x) in inputs:
+                x = np.array(np.broadcast_to(x, shape))
+            if bad is not None:
+                x[bad] = np.nan
+            return x
+
         for name, joint in joints.items():
-            values = [np.where(bad, nan, np.broadcast_to(x, shape))
-                      for x in (joint.position, joint.velocity, joint.acceleration)]
-            joints[name] = JointState(joint.type, *values)
-        points = {name: tuple(np.where(bad, nan, np.broadcast_to(x, shape)) for x in pva)
-                  for name, pva in points.items()}
-        measures = {key: np.where(bad, nan, m) for key, m in measures.items()}
+            joints[name] = JointState(joint.type, finish(joint.position),
+                                      finish(joint.velocity), finish(joint.acceleration))
+        points = {name: (finish(p), finish(v), finish(a)) for name, (p, v, a) in points.items()}
+        measures = {key: finish(m) for key, m in measures.items()}
     return State(scene.name, theta, omega, alpha, joints, points, valid, dict(measures),
                  dict(ctx.failures))
