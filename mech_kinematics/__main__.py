@@ -72,7 +72,7 @@ def build_parser() -> argparse.ArgumentParser:
     solve.add_argument('--accel', type=_finite, metavar='A',
                        help="crank angular acceleration in rad/s^2, + CCW (default: the scene's)")
     solve.add_argument('--diagnostics', action='store_true',
-                       help='also print each dyad\'s near-singularity measure '
+                       help="also print each dyad's near-singularity measure "
                             '("singularity": 0 singular, 1 best)')
     solve.add_argument('--indent', type=int, default=1, metavar='N',
                        help='JSON indentation (default 1)')

@@ -11,10 +11,12 @@ is shared and noisy, so what matters is the ratios of one run.
 from __future__ import annotations
 
 import argparse
+from collections.abc import Callable
+from functools import partial
 import math
 import statistics
 import time
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
@@ -54,7 +56,7 @@ def four_bar_math(theta: float, w: float, al: float) -> tuple[float, ...]:
 
 
 def four_bar_numpy(theta: Any, w: float, al: float) -> tuple[Any, ...]:
-    """The same four-bar with NumPy over an array of crank angles."""
+    """Solve the same four-bar with NumPy over an array of crank angles."""
     a, b, c, d = 0.04, 0.15, 0.08, 0.15
     cos, sin = np.cos(theta), np.sin(theta)
     bx, by = a * cos, a * sin
@@ -83,15 +85,15 @@ def four_bar_numpy(theta: Any, w: float, al: float) -> tuple[Any, ...]:
 
 def slider_crank_math(theta: float, w: float, al: float) -> tuple[float, ...]:
     """Hand-written in-line slider-crank (piston at negative x) with :mod:`math`."""
-    r, l = 0.15, 0.6
+    r, rod = 0.15, 0.6
     s, c = math.sin(theta), math.cos(theta)
-    k = math.sqrt(l * l - r * r * s * s)
+    k = math.sqrt(rod * rod - r * r * s * s)
     x = r * c - k
     phi = math.atan2(-r * s, x - r * c)
-    wr = -r * c * w / (l * math.cos(phi))
-    v = -r * s * w - l * math.sin(phi) * wr
-    ar = (r * s * w * w - r * c * al + l * math.sin(phi) * wr * wr) / (l * math.cos(phi))
-    a = -r * c * w * w - r * s * al - l * math.cos(phi) * wr * wr - l * math.sin(phi) * ar
+    wr = -r * c * w / (rod * math.cos(phi))
+    v = -r * s * w - rod * math.sin(phi) * wr
+    ar = (r * s * w * w - r * c * al + rod * math.sin(phi) * wr * wr) / (rod * math.cos(phi))
+    a = -r * c * w * w - r * s * al - rod * math.cos(phi) * wr * wr - rod * math.sin(phi) * ar
     bx, by = r * c, r * s
     vbx, vby = -w * by, w * bx
     abx, aby = -al * by - w * w * bx, al * bx - w * w * by
@@ -99,17 +101,17 @@ def slider_crank_math(theta: float, w: float, al: float) -> tuple[float, ...]:
 
 
 def slider_crank_numpy(theta: Any, w: float, al: float) -> tuple[Any, ...]:
-    """The same slider-crank with NumPy over an array of crank angles."""
-    r, l = 0.15, 0.6
+    """Solve the same slider-crank with NumPy over an array of crank angles."""
+    r, rod = 0.15, 0.6
     s, c = np.sin(theta), np.cos(theta)
-    k = np.sqrt(l * l - r * r * s * s)
+    k = np.sqrt(rod * rod - r * r * s * s)
     x = r * c - k
     phi = np.arctan2(-r * s, x - r * c)
     cp, sp = np.cos(phi), np.sin(phi)
-    wr = -r * c * w / (l * cp)
-    v = -r * s * w - l * sp * wr
-    ar = (r * s * w * w - r * c * al + l * sp * wr * wr) / (l * cp)
-    a = -r * c * w * w - r * s * al - l * cp * wr * wr - l * sp * ar
+    wr = -r * c * w / (rod * cp)
+    v = -r * s * w - rod * sp * wr
+    ar = (r * s * w * w - r * c * al + rod * sp * wr * wr) / (rod * cp)
+    a = -r * c * w * w - r * s * al - rod * cp * wr * wr - rod * sp * ar
     bx, by = r * c, r * s
     vbx, vby = -w * by, w * bx
     abx, aby = -al * by - w * w * bx, al * bx - w * w * by
@@ -142,15 +144,15 @@ def measure(names: list[str], angles: int, repeat: int) -> list[dict[str, Any]]:
         scene = load_scene(name)
         theta, w, al = scene.input.angle, scene.input.speed, scene.input.accel
         base[name] = (
-            _median_time(lambda: scalar(theta, w, al), 2000, repeat),
-            _median_time(lambda: vector(sweep, w, al), 3, repeat) / angles,
+            _median_time(partial(scalar, theta, w, al), 2000, repeat),
+            _median_time(partial(vector, sweep, w, al), 3, repeat) / angles,
         )
     rows = []
     for name in names:
         scene = load_scene(name)
         theta = _valid_angle(scene)
-        one = _median_time(lambda: solve(scene, theta), 1000, repeat)
-        many = _median_time(lambda: solve(scene, sweep), 3, repeat) / angles
+        one = _median_time(partial(solve, scene, theta), 1000, repeat)
+        many = _median_time(partial(solve, scene, sweep), 3, repeat) / angles
         row = {'scene': name, 'single_us': one * 1e6, 'array_us': many * 1e6,
                'dyads': len(scene.dyads), 'points': len(scene.output_points)}
         rows.append(row)

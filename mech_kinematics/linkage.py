@@ -21,7 +21,7 @@ from enum import IntEnum
 from functools import cached_property
 import math
 import re
-from typing import Any, Union
+from typing import Any
 import warnings
 
 import numpy as np
@@ -43,8 +43,8 @@ SINGULAR = 1e-12
 
 IDENTIFIER = re.compile(r'[A-Za-z_][A-Za-z0-9_]*\Z')
 
-Number = Union[float, npt.NDArray[np.float64]]
-Vector = Union[complex, npt.NDArray[np.complex128]]
+Number = float | npt.NDArray[np.float64]
+Vector = complex | npt.NDArray[np.complex128]
 
 
 class Branch(IntEnum):
@@ -108,6 +108,7 @@ class Crank:
     accel: float = 0.0
 
     def __post_init__(self) -> None:
+        """Validate the fields."""
         _check_name(self.link, 'the crank link name')
         _check_name(self.center, 'the crank center')
         _check_name(self.point, 'the crank point')
@@ -126,6 +127,7 @@ class Link:
     length: float
 
     def __post_init__(self) -> None:
+        """Validate the fields."""
         _check_name(self.name, 'a link name')
         _check_name(self.start, f'the start point of link "{self.name}"')
         _check_length(self.length, f'link "{self.name}" length')
@@ -140,9 +142,11 @@ class RRR:
     branch: Branch = Branch.PLUS
 
     def __post_init__(self) -> None:
+        """Validate the fields."""
         _check_name(self.point, 'an RRR point')
-        if len(self.links) != 2:
-            msg = f'Expected RRR "{self.point}" to have 2 links, got {len(self.links)}'
+        count = len(self.links)  # anything may be passed at run time
+        if count != 2:
+            msg = f'Expected RRR "{self.point}" to have 2 links, got {count}'
             raise SceneError(msg)
         object.__setattr__(self, 'branch', Branch(self.branch))
 
@@ -159,6 +163,7 @@ class RRP:
     branch: Branch = Branch.PLUS
 
     def __post_init__(self) -> None:
+        """Validate the fields."""
         _check_name(self.point, 'an RRP point')
         _check_name(self.through, f'the guide point of RRP "{self.point}"')
         _check_name(self.slider, f'the slider of RRP "{self.point}"')
@@ -176,6 +181,7 @@ class RPR:
     slider: str
 
     def __post_init__(self) -> None:
+        """Validate the fields."""
         _check_name(self.link, 'an RPR link')
         _check_name(self.center, f'the center of RPR "{self.link}"')
         _check_name(self.through, f'the pin of RPR "{self.link}"')
@@ -199,6 +205,7 @@ class CarriedPoint:
     local: tuple[float, float]
 
     def __post_init__(self) -> None:
+        """Validate the fields."""
         _check_name(self.name, 'a carried point name')
         _check_name(self.link, f'the link of point "{self.name}"')
         _check_name(self.origin, f'the origin of point "{self.name}"')
@@ -207,7 +214,7 @@ class CarriedPoint:
             _check_finite(value, f'the local coordinates of point "{self.name}"')
 
 
-Dyad = Union[RRR, RRP, RPR]
+Dyad = RRR | RRP | RPR
 
 
 # --- the steps of a solve -------------------------------------------------
@@ -260,6 +267,7 @@ class _CrankStep:
         self.uses: tuple[str, ...] = (crank.center,)
 
     def run(self, ctx: _Context, theta: Any, omega: Any, alpha: Any) -> None:
+        e: Any
         if ctx.vector:
             e = np.empty(np.shape(theta), dtype=np.complex128)
             np.cos(theta, out=e.real)
@@ -267,7 +275,8 @@ class _CrankStep:
         else:
             e = complex(math.cos(theta), math.sin(theta))
         r = self.length * e
-        ctx.points[self.point] = (self.center + r, 1j * omega * r, (1j * alpha - omega * omega) * r)
+        ctx.points[self.point] = (self.center + r, 1j * omega * r,
+                                  (1j * alpha - omega * omega) * r)
         ctx.links[self.link] = (e, omega, alpha)
 
 
@@ -416,7 +425,7 @@ class _CarryStep:
         ctx.points[self.point] = (p + r, v + 1j * omega * r, a + (1j * alpha - omega * omega) * r)
 
 
-Step = Union[_RRRStep, _RRPStep, _RPRStep, _CarryStep]
+Step = _RRRStep | _RRPStep | _RPRStep | _CarryStep
 
 
 @dataclass(frozen=True)
@@ -483,8 +492,8 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
 
     # Local coordinates of the points fixed on each link, in the frame at the
     # link's start with x along the link; and the slot pin of each RPR lever.
-    local: dict[str, dict[str, complex]] = {crank.link: {crank.center: 0j,
-                                                        crank.point: complex(crank.length)}}
+    local: dict[str, dict[str, complex]] = {
+        crank.link: {crank.center: 0j, crank.point: complex(crank.length)}}
     slot: dict[str, tuple[str, str]] = {}
     known = set(ground) | {crank.point}
     pending: list[Dyad | CarriedPoint] = [*scene.dyads, *scene.points]
@@ -583,7 +592,7 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
         else:
             names = [item.point if isinstance(item, (RRR, RRP)) else
                      item.link if isinstance(item, RPR) else item.name for item in pending]
-            msg = f'Expected the dyads and points to be solvable in order, got a cycle among {names}'
+            msg = f'Expected dyads and points solvable in order, got a cycle among {names}'
             raise SceneError(msg, (pending[0], ''))
 
     order = [*ground, crank.point, *(name for step in steps
@@ -664,6 +673,7 @@ class Scene:
     _plan: _Plan = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
+        """Validate the fields."""
         _check_name(self.name, 'the scene name')
         object.__setattr__(self, 'dyads', tuple(self.dyads))
         object.__setattr__(self, 'points', tuple(self.points))
@@ -716,6 +726,7 @@ class JointState:
         self.acceleration = acceleration
 
     def __repr__(self) -> str:
+        """Show every field."""
         return (f'JointState(type={self.type!r}, position={self.position!r}, '
                 f'velocity={self.velocity!r}, acceleration={self.acceleration!r})')
 
@@ -847,6 +858,9 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
     AssemblyError
         For a scalar ``angle`` at which a dyad cannot close or is singular.
     """
+    theta: Any
+    omega: Any
+    alpha: Any
     plan = scene._plan
     speed = scene.input.speed if speed is None else speed
     accel = scene.input.accel if accel is None else accel

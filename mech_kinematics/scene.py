@@ -4,11 +4,12 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 import math
 import os
 from pathlib import Path
 import sys
-from typing import Any, TypedDict, Union
+from typing import Any, TypedDict, TypeVar
 
 import yaml
 
@@ -19,6 +20,8 @@ __all__ = ['load_scene', 'parse_scene', 'scene_dirs', 'scene_names', 'DEFAULT_SC
 
 #: The packaged scene that the node and ``make run`` use by default.
 DEFAULT_SCENE = 'khurmi_four_bar_ad150'
+
+T = TypeVar('T')
 
 LENGTH_UNITS = {'m': 1.0, 'mm': 1000.0}
 ANGLE_UNITS = ('deg', 'rad')
@@ -147,7 +150,8 @@ class _Keys:
     def __init__(self) -> None:
         self.paths: dict[int, tuple[str, dict[str, str]]] = {}
 
-    def build(self, where: str, fields: dict[str, str], factory: Any, **kwargs: Any) -> Any:
+    def build(self, where: str, fields: dict[str, str], factory: Callable[..., T],
+              **kwargs: Any) -> T:
         """Build ``factory(**kwargs)`` from the file's key ``where``."""
         try:
             element = factory(**kwargs)
@@ -157,7 +161,7 @@ class _Keys:
         return element
 
     def key(self, error: SceneError) -> str:
-        """The file key of the element an error names, or ``scene``."""
+        """Return the file key of the element an error names, or ``scene``."""
         if error.where is None:
             return 'scene'
         element, field = error.where
@@ -243,7 +247,7 @@ def _link(reader: _Reader, keys: _Keys, raw: Any, where: str) -> Link:
                       length=reader.length(raw, 'length', where))
 
 
-def _dyad(reader: _Reader, keys: _Keys, raw: Any, where: str) -> Union[RRR, RRP, RPR]:
+def _dyad(reader: _Reader, keys: _Keys, raw: Any, where: str) -> RRR | RRP | RPR:
     kind = reader.get(raw, 'type', where)
     if kind == 'RRR':
         _check_keys(raw, {'type', 'point', 'links', 'branch'}, where)

@@ -55,7 +55,7 @@ def assert_matches_reference(got: dict[str, Any], case: dict[str, Any]) -> None:
                             rel_tol=RTOL_REFERENCE, abs_tol=RTOL_REFERENCE)
     for name, joint in expected['joints'].items():
         assert got['joints'][name]['type'] == joint['type']
-        for quantity, kind in zip(QUANTITIES, KINDS[joint['type']]):
+        for quantity, kind in zip(QUANTITIES, KINDS[joint['type']], strict=True):
             error = got['joints'][name][quantity] - joint[quantity]
             if quantity == 'position' and joint['type'] == 'revolute':
                 error = math.remainder(error, 2 * math.pi)
