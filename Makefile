@@ -1,0 +1,73 @@
+# mech_kinematics: set-up, run and test with a local virtualenv.
+#
+#   make run     start the node on the default scene (ARGS='...' appends arguments)
+#   make test    the whole test suite (PYTEST_ARGS='-k scene' narrows it)
+#   make bench   solver benchmark
+#   make lint    ruff + flake8 + mypy --strict on the pure modules
+#   make clean   remove .venv and every build/cache artefact
+#
+# The first target that needs it creates .venv (python3 -m venv) and installs
+# requirements.txt and this package (editable).  A stamp file inside .venv
+# makes later runs skip the install until requirements.txt, setup.py or
+# setup.cfg change.  No ROS installation or sourced environment is needed:
+# the ros-* wheels set their own LD_LIBRARY_PATH (ros-wheels-bootstrapper).
+
+SHELL := /bin/bash
+.DEFAULT_GOAL := help
+
+PYTHON ?= python3
+VENV := .venv
+VPY := $(VENV)/bin/python
+ARGS ?=
+PYTEST_ARGS ?=
+
+# The stamp's name records whether the package directory existed at install
+# time, so the editable install is redone once when mech_kinematics/ appears.
+PKG_STATE := $(if $(wildcard mech_kinematics/__init__.py),pkg,nopkg)
+STAMP := $(VENV)/.mech_kinematics-installed-$(PKG_STATE)
+
+# Keep DDS discovery on the loopback interface (no multicast onto the LAN);
+# override with e.g. `make run ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET`.
+ROS_AUTOMATIC_DISCOVERY_RANGE ?= LOCALHOST
+export ROS_AUTOMATIC_DISCOVERY_RANGE
+export PIP_DISABLE_PIP_VERSION_CHECK := 1
+# A value inherited from another venv's bootstrapped Python would stop this
+# venv's ros-wheels-bootstrapper from setting LD_LIBRARY_PATH for its own libs.
+unexport _ROS_WHEELS_BOOTSTRAP_COMPLETE
+
+.PHONY: help install run test bench lint clean
+
+help:
+	@sed -n 's/^#   //p' $(firstword $(MAKEFILE_LIST))
+
+$(VPY):
+	$(PYTHON) -m venv $(VENV)
+
+$(STAMP): requirements.txt setup.py setup.cfg | $(VPY)
+	rm -f $(VENV)/.mech_kinematics-installed-*
+	$(VPY) -m pip install --quiet -r requirements.txt
+	$(VPY) -m pip install --quiet --no-build-isolation --no-deps -e .
+	touch $@
+
+install: $(STAMP)
+
+run: $(STAMP)
+	PYTHONUNBUFFERED=1 $(VPY) -m mech_kinematics run $(ARGS)
+
+test: $(STAMP)
+	$(VPY) -m pytest -q --durations=10 $(PYTEST_ARGS)
+
+bench: $(STAMP)
+	$(VPY) -m mech_kinematics bench $(ARGS)
+
+# Runs all three checkers, then fails if any of them did.
+lint: $(STAMP)
+	@status=0; \
+	echo '== ruff'; $(VPY) -m ruff check mech_kinematics test setup.py || status=1; \
+	echo '== flake8'; $(VPY) -m flake8 mech_kinematics test setup.py || status=1; \
+	echo '== mypy --strict (linkage.py scene.py errors.py)'; $(VPY) -m mypy || status=1; \
+	exit $$status
+
+clean:
+	rm -rf $(VENV) build install log dist *.egg-info .pytest_cache .mypy_cache .ruff_cache .hypothesis .benchmarks
+	find . -path ./.git -prune -o -name __pycache__ -type d -prune -exec rm -rf {} +

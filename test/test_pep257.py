@@ -1,0 +1,52 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""Docstring conventions (pydocstyle, numpy convention) over the package.
+
+As in ament_pep257, magic methods (D105) need no docstring.
+"""
+
+from pathlib import Path
+import subprocess
+import sys
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _pydocstyle(*paths, cwd=ROOT):
+    return subprocess.run(
+        [sys.executable, '-m', 'pydocstyle', '--convention=numpy', '--add-ignore=D105',
+         *map(str, paths)],
+        cwd=cwd, capture_output=True, text=True, timeout=120, check=False,
+    )
+
+
+def _sources():
+    package = ROOT / 'mech_kinematics'
+    files = sorted(package.rglob('*.py')) if package.is_dir() else []
+    return [ROOT / 'setup.py', *files]
+
+
+@pytest.mark.linter
+@pytest.mark.pep257
+def test_pep257():
+    """Every module, class and function in the package has a numpy-style docstring."""
+    sources = _sources()
+    assert all(path.is_file() for path in sources)
+    result = _pydocstyle(*sources)
+    assert result.returncode == 0, (
+        f'pydocstyle found errors:\n{result.stdout}{result.stderr}'
+    )
+
+
+@pytest.mark.linter
+@pytest.mark.pep257
+def test_pep257_checker_is_active(tmp_path):
+    """The checker reports a missing and a malformed docstring."""
+    bad = tmp_path / 'bad_doc.py'
+    bad.write_text('"""module docstring without a period"""\n\n\ndef f():\n    return 1\n')
+    result = _pydocstyle(bad, cwd=tmp_path)
+    assert result.returncode != 0
+    for code in ('D400', 'D103'):
+        assert code in result.stdout, result.stdout
