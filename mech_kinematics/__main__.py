@@ -88,6 +88,7 @@ def build_parser() -> argparse.ArgumentParser:
                               add_help=False)
     run.set_defaults(handler=lambda args: _module('live').main(args.rest))
     run.add_argument('rest', nargs=argparse.REMAINDER)
+    _module('diagram').add_parser(commands)
     return parser
 
 

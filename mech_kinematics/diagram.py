@@ -1,0 +1,1658 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""Space, velocity and acceleration diagrams of a scene, drawn from the exact solution.
+
+The geometry comes first, as plain frozen dataclasses that any front end can
+draw (matplotlib here; RViz markers elsewhere):
+
+- :func:`space_from_state`: the mechanism itself (links, ground pivots,
+  sliders and their guides);
+- :func:`velocity_polygon_from_state`: the velocity diagram of the textbooks.
+  The pole ``o`` is the image of every ground point; each point's absolute
+  velocity ends at its lower-case letter; each link contributes the relative
+  velocity of its end with respect to its start (``bc`` is ``v_CB``); a
+  slotted lever contributes the coincident point ``b'`` of the pin ``B`` and
+  the sliding velocity ``b'b``;
+- :func:`acceleration_polygon_from_state`: the acceleration diagram. Each
+  link's relative acceleration is split into its normal (centripetal)
+  component, parallel to the link and pointing to its start, ending at an
+  intermediate letter (``c_b``), and its tangential component, perpendicular
+  to the link; a slotted lever adds the Coriolis component ``2 omega v`` and
+  the sliding acceleration;
+- :func:`diagram_from_scene`: all three at one crank angle, with the link
+  values and, on request, the instant centres.
+
+Rendering (:func:`figure_from_diagram`, :func:`write_diagram`,
+:func:`write_animation`) imports matplotlib inside its functions and draws on
+an Agg canvas, so this module imports with NumPy alone. Diagrams are drawn to
+a true scale at the figure's nominal size (``1 cm = 0.1 m/s``), as in a
+textbook. ``python -m mech_kinematics diagram`` is :func:`main`.
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from enum import Enum
+import math
+from pathlib import Path
+import sys
+from typing import Any
+import warnings
+
+import numpy as np
+import numpy.typing as npt
+
+from .errors import AssemblyError, NearSingularWarning, SceneError
+from .instant_centres import (bodies_from_scene, BodyKind, full_scene,
+                              instant_centres_from_state, InstantCentres, Topology)
+from .linkage import RPR, RRP, RRR, Scene, solve, State
+
+__all__ = [
+    'Diagram', 'GuideLine', 'LinkShape', 'LinkValues', 'Pivot', 'Polygon', 'SliderShape',
+    'SliderValues', 'SpaceDiagram', 'Table', 'Vector', 'VectorKind',
+    'acceleration_polygon_from_state', 'add_parser', 'arrows_from_state', 'diagram_from_scene',
+    'figure_from_diagram', 'main', 'run', 'space_from_state', 'strokes_from_scene',
+    'tables_from_diagram', 'velocity_polygon_from_state', 'write_animation', 'write_diagram',
+]
+
+Array = npt.NDArray[np.float64]
+
+#: Letter of the pole of the velocity and acceleration diagrams.
+POLE = 'o'
+#: Samples of one crank turn used to find the stroke of a slider.
+STROKE_SAMPLES = 720
+
+
+class VectorKind(Enum):
+    """The role of a vector in a velocity or acceleration diagram."""
+
+    ABSOLUTE = 'absolute'      # from the pole to a point's letter
+    RELATIVE = 'relative'      # of a link's end with respect to its start
+    NORMAL = 'normal'          # centripetal component, parallel to the link
+    TANGENTIAL = 'tangential'  # perpendicular to the link
+    CORIOLIS = 'coriolis'      # 2 omega x v of a pin sliding in a turning slot
+    SLIP = 'slip'              # of a pin relative to the coincident point of its slot
+
+
+@dataclass(frozen=True)
+class Vector:
+    """One vector of a diagram, from letter ``tail`` to letter ``head``.
+
+    Attributes
+    ----------
+    tail, head : str
+        Letters at its ends (``'b'``, ``'c'``; ``'c_b'`` for the end of the
+        normal component of C relative to B; ``"b'"`` for the point of a
+        slotted lever coinciding with pin B).
+    start, end : ndarray, shape (2,)
+        Its ends in the diagram, in m/s or m/s^2 (the pole at the origin).
+    quantity : str
+        What it represents: ``'v_CB'``, ``'a_CB^n'``, ``"a_BB'^c"``, ...
+    kind : VectorKind
+        Its role in the diagram.
+    body : str or None
+        The link whose motion it comes from (absolute vectors: ``None``).
+    also : str
+        Another name of the same vector, e.g. ``'v_C'`` for ``v_CD`` when D is
+        on the ground; ``''`` if none.
+    """
+
+    tail: str
+    head: str
+    start: Array
+    end: Array
+    quantity: str
+    kind: VectorKind
+    body: str | None = None
+    also: str = ''
+
+    @property
+    def value(self) -> float:
+        """Magnitude, m/s or m/s^2."""
+        return float(math.hypot(*(self.end - self.start)))
+
+    @property
+    def direction_deg(self) -> float:
+        """Direction in degrees CCW from +x, in [0, 360); NaN for a zero vector."""
+        dx, dy = self.end - self.start
+        if dx == 0.0 and dy == 0.0:
+            return math.nan
+        return math.degrees(math.atan2(dy, dx)) % 360.0
+
+
+@dataclass(frozen=True)
+class Polygon:
+    """A velocity or acceleration diagram.
+
+    Attributes
+    ----------
+    quantity : str
+        ``'velocity'`` or ``'acceleration'``.
+    unit : str
+        ``'m/s'`` or ``'m/s^2'``.
+    letters : dict of str to ndarray, shape (2,)
+        Every letter's position (pole, points, coincident points, ends of
+        components), in ``unit``; ground points sit at the pole.
+    vectors : tuple of Vector
+        In construction order.
+    pole : str
+        Letter of the pole.
+    ground : tuple of str
+        Letters of the ground points (all at the pole).
+    """
+
+    quantity: str
+    unit: str
+    letters: dict[str, Array]
+    vectors: tuple[Vector, ...]
+    pole: str = POLE
+    ground: tuple[str, ...] = ()
+
+    def find(self, quantity: str) -> Vector:
+        """Return the vector representing ``quantity`` (or having it as ``also``)."""
+        for vector in self.vectors:
+            if quantity in (vector.quantity, vector.also):
+                return vector
+        msg = f'Expected a quantity drawn in the {self.quantity} diagram, got {quantity!r}'
+        raise KeyError(msg)
+
+
+@dataclass(frozen=True)
+class LinkShape:
+    """A moving link of the space diagram.
+
+    Attributes
+    ----------
+    name : str
+        The link's name.
+    kind : BodyKind
+        Crank, link or slotted lever.
+    points : tuple of str
+        Named points fixed on it.
+    outline : ndarray, shape (n, 2)
+        A segment (n = 2) through its extreme points, or the convex polygon of
+        its points (n > 2, not repeated), m. A lever's outline runs through
+        the pin in its slot.
+    """
+
+    name: str
+    kind: BodyKind
+    points: tuple[str, ...]
+    outline: Array
+
+
+@dataclass(frozen=True)
+class Pivot:
+    """A ground point carrying a revolute joint (drawn hatched)."""
+
+    point: str
+    xy: Array
+
+
+@dataclass(frozen=True)
+class SliderShape:
+    """A slider block at ``point``, sliding along direction ``angle`` (rad) on ``guide``."""
+
+    name: str
+    point: str
+    xy: Array
+    angle: float
+    guide: str
+
+
+@dataclass(frozen=True)
+class GuideLine:
+    """The fixed straight guide of an RRP slider, over its stroke, m."""
+
+    slider: str
+    start: Array
+    end: Array
+
+
+@dataclass(frozen=True)
+class SpaceDiagram:
+    """The mechanism at one instant (positions in m).
+
+    Attributes
+    ----------
+    points : dict of str to ndarray, shape (2,)
+        Every named point.
+    ground : tuple of str
+        The ground points.
+    links : tuple of LinkShape
+        Every moving link except slider blocks.
+    pivots : tuple of Pivot
+        Ground points with a pin joint.
+    sliders : tuple of SliderShape
+        Every slider block.
+    guides : tuple of GuideLine
+        Fixed guides.
+    """
+
+    points: dict[str, Array]
+    ground: tuple[str, ...]
+    links: tuple[LinkShape, ...]
+    pivots: tuple[Pivot, ...]
+    sliders: tuple[SliderShape, ...]
+    guides: tuple[GuideLine, ...]
+
+    def extent(self) -> tuple[Array, Array]:
+        """Return the lower-left and upper-right corners of everything drawn, m."""
+        xy = [*self.points.values(), *(g.start for g in self.guides),
+              *(g.end for g in self.guides)]
+        for link in self.links:
+            xy.extend(link.outline)
+        stack = np.array(xy)
+        return stack.min(axis=0), stack.max(axis=0)
+
+
+@dataclass(frozen=True)
+class LinkValues:
+    """Length (m), angle (rad), angular velocity (rad/s) and acceleration (rad/s^2) of a link.
+
+    ``length`` is ``None`` for a slotted lever (its working length is its
+    slider's coordinate).
+    """
+
+    name: str
+    points: tuple[str, ...]
+    length: float | None
+    angle: float
+    omega: float
+    alpha: float
+
+
+@dataclass(frozen=True)
+class SliderValues:
+    """Coordinate (m), velocity (m/s) and acceleration (m/s^2) of a slider."""
+
+    name: str
+    s: float
+    velocity: float
+    acceleration: float
+
+
+@dataclass(frozen=True)
+class Diagram:
+    """The three diagrams of a scene at one crank angle.
+
+    Attributes
+    ----------
+    scene : str
+        Scene name.
+    angle, speed, accel : float
+        Crank angle (rad), angular velocity (rad/s), angular acceleration
+        (rad/s^2).
+    space : SpaceDiagram
+        The mechanism.
+    velocity, acceleration : Polygon
+        The velocity and acceleration diagrams.
+    links : tuple of LinkValues
+        Every moving link.
+    sliders : tuple of SliderValues
+        Every slider.
+    instant_centres : InstantCentres or None
+        The instant centres, if requested.
+    """
+
+    scene: str
+    angle: float
+    speed: float
+    accel: float
+    space: SpaceDiagram
+    velocity: Polygon
+    acceleration: Polygon
+    links: tuple[LinkValues, ...]
+    sliders: tuple[SliderValues, ...]
+    instant_centres: InstantCentres | None = None
+
+
+# --- geometry -------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class _Edge:
+    """A link's relative motion from point ``start`` to point ``end`` (both on ``body``)."""
+
+    body: str
+    start: str
+    end: str
+    pin: str | None = None   # for a lever's coincident point: the pin in the slot
+    slider: str | None = None
+
+
+def _letters(scene: Scene, state: State) -> dict[str, str]:
+    """Lower-case letter of every point (its name where that would be ambiguous)."""
+    names = list(state.complex_points)
+    lower = [name.lower() for name in names]
+    return {name: (low if lower.count(low) == 1 and (low != POLE or name in scene.ground)
+                   else name)
+            for name, low in zip(names, lower, strict=True)}
+
+
+def _coincident(pin: str) -> str:
+    return f"{pin}'"
+
+
+def _edges(scene: Scene, state: State) -> list[_Edge]:
+    """Every link's relative motions, in the order the solver places the points."""
+    crank = scene.input
+    edges = [_Edge(crank.link, crank.center, crank.point)]
+    for dyad in scene.dyads:
+        if isinstance(dyad, RRR):
+            edges.extend(_Edge(link.name, link.start, dyad.point) for link in dyad.links)
+        elif isinstance(dyad, RRP):
+            edges.append(_Edge(dyad.link.name, dyad.link.start, dyad.point))
+        else:
+            edges.append(_Edge(dyad.link, dyad.center, _coincident(dyad.through),
+                               dyad.through, dyad.slider))
+    edges.extend(_Edge(p.link, p.origin, p.name) for p in scene.points)
+    order = {name: index for index, name in enumerate(state.complex_points)}
+
+    def rank(edge: _Edge) -> float:
+        if edge.pin is not None:
+            return order[edge.pin] + 0.5
+        return float(order[edge.end])
+
+    return sorted(edges, key=rank)
+
+
+def _check_state(scene: Scene, state: State) -> Topology:
+    if isinstance(state.valid, np.ndarray):
+        msg = f'Expected the state of one crank angle, got an array of shape {state.valid.shape}'
+        raise ValueError(msg)
+    if state.scene != scene.name:
+        msg = f'Expected a state of scene "{scene.name}", got one of "{state.scene}"'
+        raise ValueError(msg)
+    topology = bodies_from_scene(scene)
+    missing = [point for body in topology.bodies.values() for point in body.points
+               if point not in state.complex_points]
+    missing += [name for name, body in topology.bodies.items()
+                if body.kind is not BodyKind.GROUND and name not in state.joints]
+    if missing:
+        msg = (f'Expected a state with every point and joint of scene "{scene.name}" (solve '
+               f'full_scene(scene)), got one missing {sorted(set(missing))}')
+        raise ValueError(msg)
+    return topology
+
+
+def _xy(z: complex) -> Array:
+    return np.array([z.real, z.imag])
+
+
+def _sub(*names: str) -> str:
+    return ('' if all(len(n.rstrip("'")) == 1 for n in names) else ',').join(names)
+
+
+def _pin_of(scene: Scene) -> dict[str, RPR]:
+    return {_coincident(d.through): d for d in scene.dyads if isinstance(d, RPR)}
+
+
+def velocity_polygon_from_state(scene: Scene, state: State) -> Polygon:
+    """Return the velocity diagram of ``scene`` in ``state``.
+
+    Parameters
+    ----------
+    scene : Scene
+        The mechanism (not pruned by ``outputs``: see :func:`full_scene`).
+    state : State
+        Its solution at one crank angle.
+
+    Returns
+    -------
+    Polygon
+        The pole ``o`` with every ground point; for every link the relative
+        velocity ``omega x r`` of its end with respect to its start, from the
+        start's letter; for every slotted lever the coincident point ``b'``
+        and the sliding velocity ``b'b``; the absolute velocity of every
+        moving point not already drawn from a ground point.
+    """
+    _check_state(scene, state)
+    letter = _letters(scene, state)
+    pins = _pin_of(scene)
+    position = {name: complex(p) for name, (p, _, _) in state.complex_points.items()}
+    velocity = {name: complex(v) for name, (_, v, _) in state.complex_points.items()}
+    for coincident, dyad in pins.items():
+        omega = float(state.joints[dyad.link].velocity)
+        position[coincident] = position[dyad.through]
+        velocity[coincident] = 1j * omega * (position[dyad.through] - position[dyad.center])
+        letter[coincident] = _coincident(letter[dyad.through])
+    ground = tuple(letter[name] for name in scene.ground)
+    letters = {POLE: np.zeros(2)}
+    letters.update({letter[name]: _xy(v) for name, v in velocity.items()})
+    vectors: list[Vector] = []
+    drawn: set[str] = set()
+    for edge in _edges(scene, state):
+        omega = float(state.joints[edge.body].velocity)
+        r = position[edge.end] - position[edge.start]
+        start = letters[letter[edge.start]]
+        rel = 1j * omega * r
+        on_ground = edge.start in scene.ground
+        quantity = f'v_{_sub(edge.end, edge.start)}'
+        vectors.append(Vector(letter[edge.start], letter[edge.end], start,
+                              start + _xy(rel), quantity, VectorKind.RELATIVE, edge.body,
+                              f'v_{edge.end}' if on_ground else ''))
+        if on_ground:
+            drawn.add(edge.end)
+        if edge.pin is not None:
+            assert edge.slider is not None
+            dyad = pins[edge.end]
+            e = position[edge.pin] - position[dyad.center]
+            e /= abs(e)
+            slip = float(state.joints[edge.slider].velocity) * e
+            tail = letters[letter[edge.end]]
+            vectors.append(Vector(letter[edge.end], letter[edge.pin], tail, tail + _xy(slip),
+                                  f'v_{_sub(edge.pin, edge.end)}', VectorKind.SLIP,
+                                  edge.slider))
+    for name, v in velocity.items():
+        if name in scene.ground or name in drawn:
+            continue
+        vectors.append(Vector(POLE, letter[name], np.zeros(2), _xy(v), f'v_{name}',
+                              VectorKind.ABSOLUTE))
+    return Polygon('velocity', 'm/s', letters, tuple(vectors), POLE, ground)
+
+
+def acceleration_polygon_from_state(scene: Scene, state: State) -> Polygon:
+    """Return the acceleration diagram of ``scene`` in ``state``.
+
+    Parameters
+    ----------
+    scene : Scene
+        The mechanism (not pruned by ``outputs``: see :func:`full_scene`).
+    state : State
+        Its solution at one crank angle.
+
+    Returns
+    -------
+    Polygon
+        For every link, from its start's letter ``s``: the normal component
+        ``-omega^2 r`` (parallel to the link, toward its start) to the letter
+        ``e_s``, the tangential component ``alpha x r`` (perpendicular) from
+        there, and the total relative acceleration from ``s``; for every
+        slotted lever with pin B, after the components of the coincident
+        point ``b'``, the Coriolis component ``2 omega x v_slip`` to ``b_b'``
+        and the sliding acceleration from there to ``b``; the absolute
+        acceleration of every moving point not already drawn from a ground
+        point. Components are computed from the links' omega and alpha, and
+        the letters of points are the solver's point accelerations, so the
+        polygons close exactly when the solution is consistent.
+    """
+    _check_state(scene, state)
+    letter = _letters(scene, state)
+    pins = _pin_of(scene)
+    position = {name: complex(p) for name, (p, _, _) in state.complex_points.items()}
+    accel = {name: complex(a) for name, (_, _, a) in state.complex_points.items()}
+    for coincident, dyad in pins.items():
+        joint = state.joints[dyad.link]
+        omega, alpha = float(joint.velocity), float(joint.acceleration)
+        position[coincident] = position[dyad.through]
+        r = position[dyad.through] - position[dyad.center]
+        accel[coincident] = (1j * alpha - omega * omega) * r
+        letter[coincident] = _coincident(letter[dyad.through])
+    ground = tuple(letter[name] for name in scene.ground)
+    letters = {POLE: np.zeros(2)}
+    letters.update({letter[name]: _xy(a) for name, a in accel.items()})
+    vectors: list[Vector] = []
+    drawn: set[str] = set()
+    for edge in _edges(scene, state):
+        joint = state.joints[edge.body]
+        omega, alpha = float(joint.velocity), float(joint.acceleration)
+        r = position[edge.end] - position[edge.start]
+        tail, head = letter[edge.start], letter[edge.end]
+        middle = f'{head}_{tail}'
+        start = letters[tail]
+        normal = start + _xy(-omega * omega * r)
+        letters[middle] = normal
+        sub = _sub(edge.end, edge.start)
+        on_ground = edge.start in scene.ground
+        vectors.append(Vector(tail, middle, start, normal, f'a_{sub}^n', VectorKind.NORMAL,
+                              edge.body))
+        vectors.append(Vector(middle, head, normal, normal + _xy(1j * alpha * r),
+                              f'a_{sub}^t', VectorKind.TANGENTIAL, edge.body))
+        vectors.append(Vector(tail, head, start, start + _xy((1j * alpha - omega * omega) * r),
+                              f'a_{sub}', VectorKind.RELATIVE, edge.body,
+                              f'a_{edge.end}' if on_ground else ''))
+        if on_ground:
+            drawn.add(edge.end)
+        if edge.pin is not None:
+            assert edge.slider is not None
+            dyad = pins[edge.end]
+            e = r / abs(r)
+            slider = state.joints[edge.slider]
+            coriolis = 2j * omega * float(slider.velocity) * e
+            sliding = float(slider.acceleration) * e
+            pin = letter[edge.pin]
+            kink = f'{pin}_{head}'
+            corner = letters[head] + _xy(coriolis)
+            letters[kink] = corner
+            sub = _sub(edge.pin, edge.end)
+            vectors.append(Vector(head, kink, letters[head], corner, f'a_{sub}^c',
+                                  VectorKind.CORIOLIS, edge.slider))
+            vectors.append(Vector(kink, pin, corner, corner + _xy(sliding), f'a_{sub}^s',
+                                  VectorKind.SLIP, edge.slider))
+    for name, a in accel.items():
+        if name in scene.ground or name in drawn:
+            continue
+        vectors.append(Vector(POLE, letter[name], np.zeros(2), _xy(a), f'a_{name}',
+                              VectorKind.ABSOLUTE))
+    return Polygon('acceleration', 'm/s^2', letters, tuple(vectors), POLE, ground)
+
+
+def _outline(xy: Array) -> Array:
+    """Segment through collinear points, or their convex hull (counter-clockwise)."""
+    centre = xy.mean(axis=0)
+    d = xy - centre
+    size = float(np.abs(d).max()) if len(xy) else 0.0
+    _, _, vt = np.linalg.svd(d)
+    axis = vt[0]
+    across = d @ np.array([-axis[1], axis[0]])
+    if size == 0.0 or float(np.abs(across).max()) <= 1e-9 * size:
+        along = d @ axis
+        return np.array([xy[int(np.argmin(along))], xy[int(np.argmax(along))]])
+    pts = sorted(map(tuple, xy))
+
+    def turn(o: tuple[float, ...], a: tuple[float, ...], b: tuple[float, ...]) -> float:
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    lower: list[tuple[float, ...]] = []
+    upper: list[tuple[float, ...]] = []
+    for p in pts:
+        while len(lower) >= 2 and turn(lower[-2], lower[-1], p) <= 0:
+            lower.pop()
+        lower.append(p)
+    for p in reversed(pts):
+        while len(upper) >= 2 and turn(upper[-2], upper[-1], p) <= 0:
+            upper.pop()
+        upper.append(p)
+    return np.array(lower[:-1] + upper[:-1])
+
+
+def strokes_from_scene(scene: Scene,
+                       samples: int = STROKE_SAMPLES) -> dict[str, tuple[float, float]]:
+    """Return the range of every RRP slider's coordinate over one crank turn, m.
+
+    Parameters
+    ----------
+    scene : Scene
+        The mechanism.
+    samples : int
+        Crank angles sampled over the turn.
+
+    Returns
+    -------
+    dict of str to (float, float)
+        ``(s_min, s_max)`` over the angles at which the mechanism assembles.
+    """
+    scene = full_scene(scene)
+    sliders = [d.slider for d in scene.dyads if isinstance(d, RRP)]
+    if not sliders:
+        return {}
+    angles = np.linspace(0.0, 2.0 * math.pi, samples, endpoint=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore', NearSingularWarning)
+        state = solve(scene, angles)
+    strokes = {}
+    for name in sliders:
+        s = state.joints[name].position[state.valid]
+        if s.size:
+            strokes[name] = (float(s.min()), float(s.max()))
+    return strokes
+
+
+def space_from_state(scene: Scene, state: State,
+                     strokes: Mapping[str, tuple[float, float]] | None = None) -> SpaceDiagram:
+    """Return the mechanism of ``scene`` in ``state`` as shapes to draw.
+
+    Parameters
+    ----------
+    scene : Scene
+        The mechanism (not pruned by ``outputs``: see :func:`full_scene`).
+    state : State
+        Its solution at one crank angle.
+    strokes : mapping of str to (float, float), optional
+        Range of each RRP slider's coordinate, m (:func:`strokes_from_scene`),
+        over which its guide is drawn; by default a short guide around the
+        block.
+
+    Returns
+    -------
+    SpaceDiagram
+        Points, links, ground pivots, slider blocks and guides, m.
+    """
+    topology = _check_state(scene, state)
+    points = {name: _xy(complex(p)) for name, (p, _, _) in state.complex_points.items()}
+    size = max((float(np.hypot(*(a - b))) for a in points.values() for b in points.values()),
+               default=1.0) or 1.0
+    links = []
+    rpr = {d.link: d for d in scene.dyads if isinstance(d, RPR)}
+    for body in topology.bodies.values():
+        if body.kind in (BodyKind.GROUND, BodyKind.SLIDER):
+            continue
+        xy = [points[name] for name in body.points]
+        if body.name in rpr:
+            xy.append(points[rpr[body.name].through])
+        links.append(LinkShape(body.name, body.kind, body.points, _outline(np.array(xy))))
+    pinned = {point for a, b, point in topology.pins
+              if topology.ground in (a, b)}
+    pivots = tuple(Pivot(name, points[name]) for name in scene.ground if name in pinned)
+    sliders = []
+    guides = []
+    for dyad in scene.dyads:
+        if isinstance(dyad, RRP):
+            sliders.append(SliderShape(dyad.slider, dyad.point, points[dyad.point],
+                                       dyad.guide_angle, topology.ground))
+            u = np.array([math.cos(dyad.guide_angle), math.sin(dyad.guide_angle)])
+            s = float(state.joints[dyad.slider].position)
+            low, high = (strokes or {}).get(dyad.slider, (s, s))
+            pad = 0.08 * size
+            through = points[dyad.through]
+            guides.append(GuideLine(dyad.slider, through + (min(low, s) - pad) * u,
+                                    through + (max(high, s) + pad) * u))
+        elif isinstance(dyad, RPR):
+            sliders.append(SliderShape(dyad.slider, dyad.through, points[dyad.through],
+                                       float(state.joints[dyad.link].position), dyad.link))
+    return SpaceDiagram(points, tuple(scene.ground), tuple(links), pivots, tuple(sliders),
+                        tuple(guides))
+
+
+def arrows_from_state(scene: Scene, state: State, velocity_scale: float,
+                      acceleration_scale: float,
+                      points: Sequence[str] | None = None) -> tuple[Vector, ...]:
+    """Return velocity and acceleration arrows drawn on the mechanism.
+
+    Parameters
+    ----------
+    scene : Scene
+        The mechanism.
+    state : State
+        Its solution at one crank angle; it needs only the listed points.
+    velocity_scale : float
+        Arrow length per unit velocity, m per (m/s).
+    acceleration_scale : float
+        Arrow length per unit acceleration, m per (m/s^2).
+    points : sequence of str, optional
+        Points to draw arrows at; by default every moving point of ``state``.
+
+    Returns
+    -------
+    tuple of Vector
+        For each point, an :attr:`VectorKind.ABSOLUTE` velocity arrow
+        (``quantity`` ``'v_P'``) then an acceleration arrow (``'a_P'``),
+        starting at the point, in m.
+    """
+    names = [name for name in state.complex_points if name not in scene.ground] \
+        if points is None else list(points)
+    arrows = []
+    for name in names:
+        p, v, a = (complex(x) for x in state.complex_points[name])
+        start = _xy(p)
+        arrows.append(Vector(name, name, start, start + velocity_scale * _xy(v), f'v_{name}',
+                             VectorKind.ABSOLUTE))
+        arrows.append(Vector(name, name, start, start + acceleration_scale * _xy(a),
+                             f'a_{name}', VectorKind.ABSOLUTE))
+    return tuple(arrows)
+
+
+def _values(scene: Scene, state: State,
+            topology: Topology) -> tuple[tuple[LinkValues, ...], tuple[SliderValues, ...]]:
+    lengths: dict[str, float | None] = {scene.input.link: scene.input.length}
+    for dyad in scene.dyads:
+        if isinstance(dyad, RRR):
+            lengths.update((link.name, link.length) for link in dyad.links)
+        elif isinstance(dyad, RRP):
+            lengths[dyad.link.name] = dyad.link.length
+        else:
+            lengths[dyad.link] = None
+    links = []
+    sliders = []
+    for name, body in topology.bodies.items():
+        if body.kind is BodyKind.GROUND:
+            continue
+        joint = state.joints[name]
+        if body.kind is BodyKind.SLIDER:
+            sliders.append(SliderValues(name, float(joint.position), float(joint.velocity),
+                                        float(joint.acceleration)))
+        else:
+            links.append(LinkValues(name, body.points, lengths[name], float(joint.position),
+                                    float(joint.velocity), float(joint.acceleration)))
+    return tuple(links), tuple(sliders)
+
+
+def diagram_from_scene(scene: Scene, angle: float | None = None, speed: float | None = None,
+                       accel: float | None = None, *, degrees: bool = False,
+                       instant_centres: bool = False) -> Diagram:
+    """Solve ``scene`` at one crank angle and build its three diagrams.
+
+    Parameters
+    ----------
+    scene : Scene
+        The mechanism; a scene pruned by ``outputs`` is solved in full.
+    angle : float, optional
+        Crank angle, rad (degrees if ``degrees``); default the scene's.
+    speed : float, optional
+        Crank angular velocity, rad/s, + CCW; default the scene's.
+    accel : float, optional
+        Crank angular acceleration, rad/s^2, + CCW; default the scene's.
+    degrees : bool, keyword-only
+        Whether ``angle`` is in degrees.
+    instant_centres : bool, keyword-only
+        Whether to compute the instant centres too.
+
+    Returns
+    -------
+    Diagram
+        Space, velocity and acceleration diagrams and the links' values.
+
+    Raises
+    ------
+    AssemblyError
+        If the mechanism cannot be assembled at ``angle``.
+    """
+    scene = full_scene(scene)
+    if angle is None:
+        theta = scene.input.angle
+    else:
+        theta = math.radians(angle) if degrees else float(angle)
+    state = solve(scene, theta, speed, accel)
+    topology = bodies_from_scene(scene)
+    links, sliders = _values(scene, state, topology)
+    centres = instant_centres_from_state(scene, state) if instant_centres else None
+    return Diagram(scene.name, theta, float(state.speed), float(state.accel),
+                   space_from_state(scene, state, strokes_from_scene(scene)),
+                   velocity_polygon_from_state(scene, state),
+                   acceleration_polygon_from_state(scene, state), links, sliders, centres)
+
+
+# --- value tables ---------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Table:
+    """A table of text cells: a title, column headings and rows."""
+
+    title: str
+    columns: tuple[str, ...]
+    rows: tuple[tuple[str, ...], ...]
+
+
+def _g(value: float) -> str:
+    if not math.isfinite(value):
+        return '-'
+    if 1e4 <= abs(value) < 1e9:
+        return f'{value:.0f}'
+    text = f'{value:.4g}'
+    return '0' if text in ('0', '-0') else text
+
+
+def _sense(value: float) -> str:
+    return '' if value == 0.0 else (' CCW' if value > 0 else ' CW')
+
+
+def _nice_scale(required: float) -> float:
+    """Smallest of 1, 1.5, 2, 2.5, 3, 4, 5, 6, 8 times a power of ten that is >= ``required``."""
+    if not (required > 0.0 and math.isfinite(required)):
+        return 1.0
+    power = 10.0 ** math.floor(math.log10(required))
+    for step in (1.0, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0):
+        if step * power >= required * (1 - 1e-12):
+            return step * power
+    return 10.0 * power
+
+
+def _pair(tail: str, head: str) -> str:
+    """Letters of a vector: ``'bc'``, or ``'b c_b'`` where a letter is not a single one."""
+    single = all(len(x.rstrip("'")) == 1 for x in (tail, head))
+    return f'{tail}{head}' if single else f'{tail} {head}'
+
+
+def _scale_text(scale: float, unit: str) -> str:
+    return f'1 cm = {scale:g} {unit}'
+
+
+def tables_from_diagram(diagram: Diagram,
+                        scales: Mapping[str, float] | None = None) -> dict[str, Table]:
+    """Return the value tables printed under the three panels.
+
+    Parameters
+    ----------
+    diagram : Diagram
+        The diagrams.
+    scales : mapping of str to float, optional
+        Drawing scales per cm, by ``'velocity'`` and ``'acceleration'``; when
+        given, a column lists each vector's drawn length in cm.
+
+    Returns
+    -------
+    dict of str to Table
+        ``'space'`` (links: length, angle, omega, alpha; sliders; instant
+        centres if computed), ``'velocity'`` and ``'acceleration'`` (every
+        vector drawn: letters, quantity, magnitude, direction).
+    """
+    rows: list[tuple[str, ...]] = []
+    for link in diagram.links:
+        length = '-' if link.length is None else _g(link.length)
+        rows.append((link.name, ''.join(link.points) if all(len(p) == 1 for p in link.points)
+                     else ','.join(link.points), length,
+                     _g(math.degrees(link.angle)), _g(link.omega) + _sense(link.omega),
+                     _g(link.alpha) + _sense(link.alpha)))
+    for slider in diagram.sliders:
+        rows.append((slider.name, 'slider', f's = {_g(slider.s)}', '-',
+                     f'{_g(slider.velocity)} m/s', f'{_g(slider.acceleration)} m/s\u00b2'))
+    tables = {'space': Table('Links and sliders',
+                             ('link', 'points', 'length m', 'angle \u00b0', '\u03c9 rad/s',
+                              '\u03b1 rad/s\u00b2'), tuple(rows))}
+    centres = diagram.instant_centres
+    if centres is not None:
+        rows = []
+        for centre in centres:
+            if centre.point is not None:
+                x, y = _g(centre.point[0]), _g(centre.point[1])
+            else:
+                assert centre.direction is not None
+                normal = math.degrees(math.atan2(centre.direction[1], centre.direction[0]))
+                x, y = 'at infinity', f'toward {_g(normal % 180.0)}\u00b0'
+            rows.append((centres.label(centre), ' - '.join(centre.bodies), x, y))
+        tables['centres'] = Table('Instant centres', ('centre', 'links', 'x m', 'y m'),
+                                  tuple(rows))
+    for polygon in (diagram.velocity, diagram.acceleration):
+        scale = None if scales is None else scales.get(polygon.quantity)
+        unit = polygon.unit.replace('^2', '\u00b2')
+        columns: tuple[str, ...] = ('vector', 'quantity', unit, 'dir \u00b0')
+        if scale is not None:
+            columns += ('cm',)
+        rows = []
+        for vector in polygon.vectors:
+            quantity = vector.quantity + (f' = {vector.also}' if vector.also else '')
+            row: tuple[str, ...] = (_pair(vector.tail, vector.head), quantity,
+                                    _g(vector.value),
+                                    _g(vector.direction_deg) if vector.value > 0 else '-')
+            if scale is not None:
+                row += (f'{vector.value / scale:.2f}',)
+            rows.append(row)
+        title = polygon.quantity.capitalize()
+        tables[polygon.quantity] = Table(title, columns, tuple(rows))
+    return tables
+
+
+# --- rendering (matplotlib, imported inside the functions) ----------------
+
+CM = 1.0 / 2.54          # inches per cm
+PT_CM = 2.54 / 72.0      # cm per typographic point
+PANEL_W = 11.5           # cm, each of the three panels
+PANEL_H = 10.0           # cm
+PANEL_GAP = 0.9          # cm between panels
+MARGIN = 0.6             # cm, left and right
+TITLE_H = 1.8            # cm above the panels
+FOOT_H = 1.0             # cm reserved at the bottom of a panel for its scale bar
+LABEL_PAD = 0.9          # cm kept free around a drawing for its labels
+ROW_H = 0.44             # cm per table row
+DPI = 110
+FONT = 8.5               # pt, labels
+TABLE_FONT = 7.5         # pt
+
+#: Colours of the moving bodies, in Kennedy numbering order (the ground is black).
+COLOURS = ('#1f77b4', '#ff7f0e', '#2ca02c', '#d62728', '#9467bd', '#8c564b', '#e377c2',
+           '#17becf', '#bcbd22', '#7f7f7f')
+STYLE = {
+    VectorKind.RELATIVE: ('-', 1.7), VectorKind.NORMAL: ('-', 1.5),
+    VectorKind.TANGENTIAL: ('--', 1.5), VectorKind.CORIOLIS: ('-.', 1.5),
+    VectorKind.SLIP: (':', 1.8), VectorKind.ABSOLUTE: ('-', 1.1),
+}
+
+
+def _colours(scene: Scene) -> dict[str, str]:
+    bodies = bodies_from_scene(scene).bodies
+    moving = [name for name, body in bodies.items() if body.kind is not BodyKind.GROUND]
+    return {name: COLOURS[i % len(COLOURS)] for i, name in enumerate(moving)}
+
+
+def _math_letter(letter: str) -> str:
+    base, _, sub = letter.partition('_')
+    return f'{base}_{{{sub}}}' if sub else base
+
+
+def _math_quantity(text: str) -> str:
+    """``'a_CB^n = a_C'`` -> mathtext ``'$a_{CB}^{n} = a_{C}$'``."""
+    parts = []
+    for token in text.split(' = '):
+        symbol, _, rest = token.partition('_')
+        sub, _, sup = rest.partition('^')
+        parts.append(f'{symbol}_{{{sub}}}' + (f'^{{{sup}}}' if sup else ''))
+    return '$' + ' = '.join(parts) + '$'
+
+
+def _math_pair(cell: str) -> str:
+    import re
+    letters = cell.split(' ') if ' ' in cell else re.findall(r"[^']'*", cell)
+    return '$' + r'\,'.join(_math_letter(x) for x in letters) + '$'
+
+
+def _text_cm(text: str, size: float) -> tuple[float, float]:
+    """Approximate width and height of a label, cm."""
+    visible = sum(1 for ch in text if ch not in '${}\\_^') - 3 * text.count('\\,')
+    return max(visible, 1) * 0.58 * size * PT_CM + 0.1, 1.25 * size * PT_CM + 0.08
+
+
+class _Placer:
+    """Greedy placement of labels next to their anchors, avoiding lines and other labels."""
+
+    def __init__(self, ax: Any, origin: Array, scale: float, size_cm: tuple[float, float],
+                 segments: Sequence[tuple[Array, Array]], anchors: Sequence[Array]) -> None:
+        self.ax = ax
+        self.origin = origin
+        self.scale = scale
+        self.size = size_cm
+        samples = []
+        for a, b in segments:
+            a_cm, b_cm = self.cm(a), self.cm(b)
+            n = max(2, int(np.hypot(*(b_cm - a_cm)) / 0.12) + 1)
+            t = np.linspace(0.0, 1.0, n)[:, None]
+            samples.append(a_cm + t * (b_cm - a_cm))
+        self.lines = np.concatenate(samples) if samples else np.zeros((0, 2))
+        self.dots = np.array([self.cm(a) for a in anchors]) if anchors else np.zeros((0, 2))
+        self.boxes: list[tuple[float, float, float, float]] = []
+
+    def cm(self, xy: Array) -> Array:
+        return (np.asarray(xy, dtype=np.float64) - self.origin) / self.scale
+
+    def place(self, text: str, anchor: Array, prefer: Array | None = None,
+              size: float = FONT, gap: float = 0.1, **kwargs: Any) -> None:
+        w, h = _text_cm(text, size)
+        a = self.cm(anchor)
+        best: tuple[float, Array] | None = None
+        for k in range(16):
+            angle = 2.0 * math.pi * k / 16.0
+            d = np.array([math.cos(angle), math.sin(angle)])
+            # centre of a box that clears the anchor by ``gap`` in direction d
+            reach = min(abs(w / 2 / d[0]) if d[0] else math.inf,
+                        abs(h / 2 / d[1]) if d[1] else math.inf)
+            c = a + d * (reach + gap)
+            x0, x1, y0, y1 = c[0] - w / 2, c[0] + w / 2, c[1] - h / 2, c[1] + h / 2
+            cost = 0.0
+            for bx0, bx1, by0, by1 in self.boxes:
+                ox = min(x1, bx1) - max(x0, bx0)
+                oy = min(y1, by1) - max(y0, by0)
+                if ox > 0 and oy > 0:
+                    cost += 200.0 * (ox * oy + 0.1)
+            if len(self.lines):
+                inside = ((self.lines[:, 0] > x0) & (self.lines[:, 0] < x1)
+                          & (self.lines[:, 1] > y0) & (self.lines[:, 1] < y1))
+                cost += 1.0 * float(inside.sum())
+            if len(self.dots):
+                inside = ((self.dots[:, 0] > x0 - 0.05) & (self.dots[:, 0] < x1 + 0.05)
+                          & (self.dots[:, 1] > y0 - 0.05) & (self.dots[:, 1] < y1 + 0.05))
+                cost += 6.0 * float(inside.sum())
+            width, height = self.size
+            out = max(0.0, -x0) + max(0.0, x1 - width) + max(0.0, FOOT_H - y0) \
+                + max(0.0, y1 - height)
+            cost += 30.0 * out
+            if prefer is not None and np.any(prefer):
+                cost += 0.8 * (1.0 - float(d @ prefer) / float(np.hypot(*prefer)))
+            else:
+                cost += 0.05 * k / 16.0
+            if best is None or cost < best[0]:
+                best = (cost, c)
+        assert best is not None
+        c = best[1]
+        self.boxes.append((c[0] - w / 2, c[0] + w / 2, c[1] - h / 2, c[1] + h / 2))
+        xy = self.origin + c * self.scale
+        self.ax.text(xy[0], xy[1], text, ha='center', va='center', fontsize=size, zorder=6,
+                     **kwargs)
+
+
+def _frame(ax: Any, lo: Array, hi: Array, scale: float, width: float = PANEL_W,
+           height: float = PANEL_H) -> Array:
+    """Set limits for ``scale`` (units per cm) centring lo..hi; return the lower-left corner."""
+    centre = (lo + hi) / 2.0
+    centre[1] -= FOOT_H / 2.0 * scale
+    origin = centre - np.array([width, height]) / 2.0 * scale
+    ax.set_xlim(origin[0], origin[0] + width * scale)
+    ax.set_ylim(origin[1], origin[1] + height * scale)
+    ax.set_xticks([])
+    ax.set_yticks([])
+    for spine in ax.spines.values():
+        spine.set_color('#999999')
+        spine.set_linewidth(0.6)
+    return origin
+
+
+def _fit_scale(lo: Array, hi: Array, minimum: float = 0.0) -> float:
+    span = hi - lo
+    need = max(span[0] / (PANEL_W - 2 * LABEL_PAD),
+               span[1] / (PANEL_H - 2 * LABEL_PAD - FOOT_H), minimum)
+    return _nice_scale(need)
+
+
+def _scale_bar(ax: Any, origin: Array, scale: float, unit: str, length_cm: float = 2.0) -> None:
+    x0 = origin + np.array([0.5, 0.45]) * scale
+    x1 = x0 + np.array([length_cm * scale, 0.0])
+    ax.plot([x0[0], x1[0]], [x0[1], x1[1]], color='black', lw=1.2, solid_capstyle='butt')
+    for i in range(int(length_cm) + 1):
+        x = x0[0] + i * scale
+        ax.plot([x, x], [x0[1] - 0.08 * scale, x0[1] + 0.08 * scale], color='black', lw=0.8)
+    ax.text(x1[0] + 0.25 * scale, x0[1], f'scale {_scale_text(scale, unit)}', fontsize=FONT,
+            va='center', ha='left')
+
+
+def _arrow(ax: Any, start: Array, end: Array, colour: str, style: str, lw: float,
+           scale: float, zorder: float = 3) -> None:
+    """Draw a straight arrow with a solid head whatever the line style (``scale``: 1 cm)."""
+    from matplotlib.patches import Polygon as Patch
+
+    d = end - start
+    length = float(np.hypot(*d))
+    if length <= 1e-9 * scale:
+        return
+    u = d / length
+    head = min(0.28 * scale, 0.45 * length)
+    neck = end - u * head
+    n = np.array([-u[1], u[0]]) * head * 0.36
+    ax.plot([start[0], neck[0]], [start[1], neck[1]], color=colour, lw=lw, ls=style,
+            zorder=zorder, solid_capstyle='butt')
+    ax.add_patch(Patch([end, neck + n, neck - n], closed=True, facecolor=colour,
+                       edgecolor=colour, lw=0.5, zorder=zorder + 0.1))
+
+
+def _draw_pivot(ax: Any, xy: Array, unit: float) -> None:
+    from matplotlib.patches import Polygon as Patch, Rectangle
+
+    h = 0.42 * unit
+    ax.add_patch(Patch([xy, xy + [-0.3 * unit, -h], xy + [0.3 * unit, -h]], closed=True,
+                       facecolor='white', edgecolor='black', lw=0.9, zorder=1.5))
+    ax.add_patch(Rectangle((xy[0] - 0.45 * unit, xy[1] - h - 0.16 * unit), 0.9 * unit,
+                           0.16 * unit, facecolor='white', edgecolor='black', hatch='////',
+                           lw=0.6, zorder=1.5))
+
+
+def _block(xy: Array, angle: float, length: float, height: float) -> Array:
+    u = np.array([math.cos(angle), math.sin(angle)])
+    n = np.array([-u[1], u[0]])
+    return np.array([xy + sx * length / 2 * u + sy * height / 2 * n
+                     for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))])
+
+
+def _draw_mechanism(ax: Any, scene: Scene, space: SpaceDiagram, colours: Mapping[str, str],
+                    unit: float) -> None:
+    """Draw links, pins, ground pivots, sliders and guides; ``unit`` is the data size of 1 cm."""
+    from matplotlib.patches import Polygon as Patch
+
+    lengths = [float(np.hypot(*(link.outline[1] - link.outline[0]))) for link in space.links]
+    short = min([x for x in lengths if x > 0.0] or [unit])
+    block_l, block_h = min(0.9 * unit, 0.45 * short), min(0.5 * unit, 0.25 * short)
+    for guide in space.guides:
+        slider = next(s for s in space.sliders if s.name == guide.slider)
+        n = np.array([-math.sin(slider.angle), math.cos(slider.angle)])
+        for side in (-1, 1):
+            offset = side * (block_h / 2 + 0.01 * unit) * n
+            ax.plot([guide.start[0] + offset[0], guide.end[0] + offset[0]],
+                    [guide.start[1] + offset[1], guide.end[1] + offset[1]], color='#555555',
+                    lw=0.9, zorder=1)
+        length = float(np.hypot(*(guide.end - guide.start)))
+        u = (guide.end - guide.start) / length
+        ticks = int(length / (0.3 * unit))
+        for i in range(ticks + 1):
+            p = guide.start + u * i * 0.3 * unit - (block_h / 2 + 0.01 * unit) * n
+            q = p - 0.18 * unit * (n + u)
+            ax.plot([p[0], q[0]], [p[1], q[1]], color='#555555', lw=0.6, zorder=1)
+    for link in space.links:
+        colour = colours[link.name]
+        xy = link.outline
+        if len(xy) > 2:
+            ax.add_patch(Patch(xy, closed=True, facecolor=colour, alpha=0.22, edgecolor=colour,
+                               lw=2.0, zorder=2))
+        elif link.kind is BodyKind.LEVER:
+            ax.plot(xy[:, 0], xy[:, 1], color=colour, lw=5.0, zorder=2, solid_capstyle='round')
+            ax.plot(xy[:, 0], xy[:, 1], color='white', lw=1.4, zorder=2.1)
+        else:
+            ax.plot(xy[:, 0], xy[:, 1], color=colour, lw=3.0, zorder=2, solid_capstyle='round')
+    for slider in space.sliders:
+        corners = _block(slider.xy, slider.angle, block_l, block_h)
+        ax.add_patch(Patch(corners, closed=True, facecolor=colours.get(slider.name, 'white'),
+                           alpha=0.85, edgecolor='black', lw=0.9, zorder=3))
+    for pivot in space.pivots:
+        _draw_pivot(ax, pivot.xy, unit)
+    topology = bodies_from_scene(scene)
+    pinned = {point for _, _, point in topology.pins}
+    for name, xy in space.points.items():
+        if name in pinned:
+            ax.plot(*xy, marker='o', ms=5.5, mfc='white', mec='black', mew=1.0, zorder=5)
+        elif name not in space.ground:
+            ax.plot(*xy, marker='o', ms=3.5, color='black', zorder=5)
+        else:
+            ax.plot(*xy, marker='+', ms=6, color='#555555', zorder=5)
+
+
+def _crank_sense(ax: Any, scene: Scene, space: SpaceDiagram, speed: float,
+                 unit: float) -> list[tuple[Array, Array]]:
+    """Draw an arc arrow at the crank's pivot in its sense of rotation; return its chords."""
+    from matplotlib.patches import FancyArrowPatch
+
+    if speed == 0.0:
+        return []
+    c = space.points[scene.input.center]
+    p = space.points[scene.input.point]
+    theta = math.atan2(p[1] - c[1], p[0] - c[0])
+    sign = 1.0 if speed > 0 else -1.0
+    r = 0.75 * unit
+    arc = [c + r * np.array([math.cos(a), math.sin(a)])
+           for a in np.linspace(theta + sign * 0.45, theta + sign * 1.6, 6)]
+    ax.add_patch(FancyArrowPatch(tuple(arc[0]), tuple(arc[-1]),
+                                 connectionstyle=f'arc3,rad={0.45 * sign}',
+                                 arrowstyle='-|>,head_length=5,head_width=2.5', color='black',
+                                 lw=0.9, zorder=5))
+    return list(zip(arc[:-1], arc[1:], strict=True))
+
+
+def _space_panel(ax: Any, scene: Scene, diagram: Diagram, colours: Mapping[str, str]) -> float:
+    space = diagram.space
+    lo, hi = space.extent()
+    centres = diagram.instant_centres
+    near: list[Any] = []
+    far: list[Any] = []
+    if centres is not None:
+        # Show the finite centres that fit at no less than 2/5 of the mechanism's own scale;
+        # point at the others (and at those at infinity) from the edge of the panel.
+        middle = (lo + hi) / 2
+        base = _fit_scale(lo, hi)
+        finite = sorted((c for c in centres if c.point is not None),
+                        key=lambda c: float(np.hypot(*(np.asarray(c.point) - middle))))
+        for centre in finite:
+            assert centre.point is not None
+            low, high = np.minimum(lo, centre.point), np.maximum(hi, centre.point)
+            if _fit_scale(low, high) <= 2.5 * base:
+                near.append(centre)
+                lo, hi = low, high
+        far = [c for c in centres if c not in near]
+    # room for pivots below the ground points
+    scale = _fit_scale(lo, hi)
+    scale = _fit_scale(lo - [0, 0.7 * scale], hi)
+    origin = _frame(ax, lo - [0, 0.7 * scale], hi, scale)
+    _draw_mechanism(ax, scene, space, colours, scale)
+    sense = _crank_sense(ax, scene, space, diagram.speed, scale)
+    segments = sense + [(link.outline[i], link.outline[(i + 1) % len(link.outline)])
+                        for link in space.links
+                        for i in range(len(link.outline) - (len(link.outline) == 2))]
+    segments += [(g.start, g.end) for g in space.guides]
+    placer = _Placer(ax, origin, scale, (PANEL_W, PANEL_H), segments, list(space.points.values()))
+    centre_xy = (lo + hi) / 2
+    for name, xy in space.points.items():
+        placer.place(name, xy, xy - centre_xy, size=FONT + 1, fontweight='bold')
+    for link in space.links:
+        xy = link.outline
+        mid = (xy[0] + xy[1]) / 2 if len(xy) == 2 else xy.mean(axis=0)
+        placer.place(link.name, mid, None, size=FONT - 1, color=colours[link.name],
+                     style='italic', gap=0.05)
+    for slider in space.sliders:
+        placer.place(slider.name, slider.xy, None, size=FONT - 1, color='#333333',
+                     style='italic', gap=0.35)
+    if centres is not None:
+        for centre in near:
+            assert centre.point is not None
+            ax.plot(*centre.point, marker='o', ms=5, mfc='none', mec='#b00000', mew=1.1,
+                    zorder=6)
+            placer.place(f'$I_{{{centres.label(centre)[1:]}}}$', centre.point, None,
+                         size=FONT, color='#b00000')
+        middle = origin + np.array([PANEL_W, PANEL_H + FOOT_H]) / 2 * scale
+        for centre in far:
+            if centre.point is not None:
+                d = centre.point - middle
+                d = d / np.hypot(*d)
+                tag = f'$I_{{{centres.label(centre)[1:]}}}$'
+            else:
+                assert centre.direction is not None
+                d = centre.direction
+                tag = f'$I_{{{centres.label(centre)[1:]}}} \\to \\infty$'
+            half = np.array([PANEL_W - 1.6, PANEL_H - FOOT_H - 1.2]) / 2 * scale
+            t = min(half[0] / abs(d[0]) if d[0] else math.inf,
+                    half[1] / abs(d[1]) if d[1] else math.inf)
+            tip = middle + d * t
+            _arrow(ax, tip - d * 0.7 * scale, tip, '#b00000', '-', 1.0, scale, zorder=6)
+            placer.place(tag, tip - d * 0.35 * scale, None, size=FONT, color='#b00000')
+    _scale_bar(ax, origin, scale, 'm')
+    ax.set_title('Space diagram', fontsize=FONT + 2)
+    return scale
+
+
+def _polygon_panel(ax: Any, polygon: Polygon, colours: Mapping[str, str]) -> float:
+    from matplotlib.lines import Line2D
+
+    xy = np.array(list(polygon.letters.values()))
+    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    scale = _fit_scale(lo, hi)
+    origin = _frame(ax, lo, hi, scale)
+    segments = []
+    components: list[float] = []
+    for vector in polygon.vectors:
+        style, lw = STYLE[vector.kind]
+        if vector.kind in (VectorKind.NORMAL, VectorKind.TANGENTIAL):
+            components.append(vector.value)
+        if vector.kind is VectorKind.RELATIVE and polygon.quantity == 'acceleration':
+            # the closing line of a link's two components; nothing new if one is zero
+            done, components = components[-2:], []
+            if len(done) == 2 and min(done) <= 1e-9 * max(done):
+                segments.append((vector.start, vector.end))
+                continue
+        if vector.kind is VectorKind.ABSOLUTE or vector.also:
+            colour = 'black'
+            if vector.also and vector.kind is VectorKind.RELATIVE:
+                style, lw = '-', 1.7
+                colour = colours.get(vector.body or '', 'black') \
+                    if polygon.quantity == 'velocity' else 'black'
+        elif vector.kind is VectorKind.RELATIVE and polygon.quantity == 'acceleration':
+            colour, style, lw = '#666666', '-', 0.9
+        else:
+            colour = colours.get(vector.body or '', 'black')
+        _arrow(ax, vector.start, vector.end, colour, style, lw, scale)
+        segments.append((vector.start, vector.end))
+    # Labels: one per position, the point letters first; hide a component's end
+    # letter where it coincides with a point's letter.
+    # Labels: one per position, the points' letters first. The end of a
+    # component (c_b) that falls on or next to a point's letter is named in the
+    # same label, or not at all if it coincides exactly.
+    middles = {v.head for v in polygon.vectors
+               if v.kind in (VectorKind.NORMAL, VectorKind.CORIOLIS)}
+    used = {polygon.pole}
+    for vector in polygon.vectors:
+        used.update((vector.tail, vector.head))
+    groups: list[tuple[Array, list[str]]] = []
+    pole_names = [polygon.pole, *(g for g in polygon.ground if g in used)]
+    order = pole_names + [n for n in polygon.letters if n not in pole_names and n not in middles]
+    order += [n for n in polygon.letters if n in middles]
+    for name in order:
+        if name not in used:
+            continue
+        at = polygon.letters[POLE] if name in polygon.ground else polygon.letters[name]
+        near = 0.3 * scale if name in middles else 0.06 * scale
+        for where, names in groups:
+            gap = float(np.hypot(*(where - at)))
+            if gap <= near:
+                if not (name in middles and gap <= 0.06 * scale):
+                    names.append(name)
+                break
+        else:
+            groups.append((at, [name]))
+    placer = _Placer(ax, origin, scale, (PANEL_W, PANEL_H), segments,
+                     [where for where, _ in groups])
+    centre = (lo + hi) / 2
+    for where, names in groups:
+        text = ', '.join(f'${_math_letter(n)}$' for n in dict.fromkeys(names))
+        component = all(n in middles for n in names)
+        placer.place(text, where, where - centre, size=FONT + (0 if component else 1.5),
+                     color='#444444' if component else 'black')
+    ax.plot(0.0, 0.0, marker='o', ms=3.5, color='black', zorder=5)
+    unit = 'm/s' if polygon.quantity == 'velocity' else 'm/s\u00b2'
+    _scale_bar(ax, origin, scale, unit)
+    kinds = {v.kind for v in polygon.vectors}
+    handles = []
+    for kind, text in ((VectorKind.NORMAL, 'normal'), (VectorKind.TANGENTIAL, 'tangential'),
+                       (VectorKind.CORIOLIS, 'Coriolis'), (VectorKind.SLIP, 'sliding')):
+        if kind in kinds:
+            style, lw = STYLE[kind]
+            handles.append(Line2D([], [], color='#333333', ls=style, lw=lw, label=text))
+    if handles:
+        ax.legend(handles=handles, loc='lower right', fontsize=FONT - 1, frameon=False,
+                  ncol=len(handles) if len(handles) < 3 else 2, handlelength=2.2,
+                  borderaxespad=0.2, columnspacing=1.0, labelspacing=0.2)
+    title = 'Velocity diagram' if polygon.quantity == 'velocity' else 'Acceleration diagram'
+    ax.set_title(title, fontsize=FONT + 2)
+    return scale
+
+
+def _table(ax: Any, table: Table, mathcols: Sequence[int] = ()) -> None:
+    ax.axis('off')
+    rows = [list(row) for row in table.rows]
+    for row in rows:
+        for i in mathcols:
+            if i == 0:
+                row[i] = _math_pair(row[i])
+            elif i == 1:
+                row[i] = _math_quantity(row[i])
+    widths = [max([len(table.columns[i])] + [len(r[i]) for r in table.rows]) + 2
+              for i in range(len(table.columns))]
+    total = float(sum(widths))
+    drawn = ax.table(cellText=rows or [[''] * len(table.columns)], colLabels=table.columns,
+                     colWidths=[w / total for w in widths], cellLoc='center',
+                     bbox=[0.0, 0.0, 1.0, 1.0])
+    drawn.auto_set_font_size(False)
+    drawn.set_fontsize(TABLE_FONT)
+    for (r, _), cell in drawn.get_celld().items():
+        cell.set_linewidth(0.4)
+        cell.set_edgecolor('#aaaaaa')
+        if r == 0:
+            cell.set_facecolor('#eeeeee')
+    ax.set_title(table.title, fontsize=FONT, loc='left', pad=2)
+
+
+def figure_from_diagram(diagram: Diagram, scene: Scene) -> Any:
+    """Draw the three panels and the value tables on a new matplotlib figure (Agg canvas).
+
+    Parameters
+    ----------
+    diagram : Diagram
+        The diagrams (:func:`diagram_from_scene`).
+    scene : Scene
+        The scene they were built from.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Drawn to scale at its nominal size: 1 cm of the figure is what each
+        panel's scale bar says.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    scene = full_scene(scene)
+    colours = _colours(scene)
+    tables = tables_from_diagram(diagram)  # row counts; drawn again below with scales
+    space_rows = len(tables['space'].rows) + (len(tables['centres'].rows) + 2
+                                              if 'centres' in tables else 0)
+    rows = max(space_rows, len(tables['velocity'].rows), len(tables['acceleration'].rows)) + 1
+    table_h = rows * ROW_H + 0.6
+    width = 2 * MARGIN + 3 * PANEL_W + 2 * PANEL_GAP
+    height = TITLE_H + PANEL_H + 0.5 + table_h + 0.3
+    fig = Figure(figsize=(width * CM, height * CM), dpi=DPI)
+    FigureCanvasAgg(fig)
+
+    def axes(x: float, y: float, w: float, h: float) -> Any:
+        return fig.add_axes((x / width, y / height, w / width, h / height))
+
+    panel_y = height - TITLE_H - PANEL_H
+    xs = [MARGIN + i * (PANEL_W + PANEL_GAP) for i in range(3)]
+    scales = {'space': _space_panel(axes(xs[0], panel_y, PANEL_W, PANEL_H), scene, diagram,
+                                    colours),
+              'velocity': _polygon_panel(axes(xs[1], panel_y, PANEL_W, PANEL_H),
+                                         diagram.velocity, colours),
+              'acceleration': _polygon_panel(axes(xs[2], panel_y, PANEL_W, PANEL_H),
+                                             diagram.acceleration, colours)}
+    tables = tables_from_diagram(diagram, scales)
+    top = panel_y - 0.55
+    n = len(tables['space'].rows) + 1
+    _table(axes(xs[0], top - n * ROW_H, PANEL_W, n * ROW_H), tables['space'])
+    if 'centres' in tables:
+        m = len(tables['centres'].rows) + 1
+        _table(axes(xs[0] + 1.5, top - (n + m) * ROW_H - 0.9, PANEL_W - 3.0, m * ROW_H),
+               tables['centres'])
+    for x, key in ((xs[1], 'velocity'), (xs[2], 'acceleration')):
+        n = len(tables[key].rows) + 1
+        _table(axes(x, top - n * ROW_H, PANEL_W, n * ROW_H), tables[key], mathcols=(0, 1))
+    rpm = diagram.speed * 30.0 / math.pi
+    fig.text(MARGIN / width, 1.0 - 0.5 / height,
+             f'{diagram.scene}: crank angle {_g(math.degrees(diagram.angle))}\u00b0, '
+             f'\u03c9 = {_g(diagram.speed)} rad/s{_sense(diagram.speed)} ({_g(rpm)} rpm), '
+             f'\u03b1 = {_g(diagram.accel)} rad/s\u00b2   (SI units; angles CCW from +x)',
+             fontsize=FONT + 3, va='center', ha='left')
+    return fig
+
+
+def write_diagram(diagram: Diagram, scene: Scene, path: str | Path) -> Path:
+    """Draw ``diagram`` and save it to ``path`` (.png, .svg or .pdf by its suffix)."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in ('.png', '.svg', '.pdf'):
+        msg = f'Expected an output file ending in .png, .svg or .pdf, got {str(path)!r}'
+        raise ValueError(msg)
+    fig = figure_from_diagram(diagram, scene)
+    fig.savefig(path, dpi=DPI, format=suffix[1:])
+    return path
+
+
+def _cycle_angles(scene: Scene, frames: int, start: float | None = None) -> Array:
+    sense = -1.0 if scene.input.speed < 0 else 1.0
+    theta0 = scene.input.angle if start is None else start
+    return theta0 + sense * np.linspace(0.0, 2.0 * math.pi, frames, endpoint=False)
+
+
+def write_animation(scene: Scene, path: str | Path, *, frames: int = 72, fps: int = 12,
+                    speed: float | None = None, accel: float | None = None,
+                    instant_centres: bool = False, dpi: float = 100.0) -> int:
+    """Write an animated GIF of one crank turn with velocity and acceleration arrows.
+
+    Parameters
+    ----------
+    scene : Scene
+        The mechanism.
+    path : str or Path
+        Output file, ``.gif``.
+    frames : int, keyword-only
+        Crank angles over the turn, from the scene's angle in its sense of
+        rotation; angles at which the mechanism cannot be assembled are
+        skipped.
+    fps : int, keyword-only
+        Frames per second.
+    speed, accel : float, optional, keyword-only
+        Crank angular velocity (rad/s) and acceleration (rad/s^2); default the
+        scene's.
+    instant_centres : bool, keyword-only
+        Whether to mark the finite instant centres that fall in the view.
+    dpi : float, keyword-only
+        Resolution of the frame, 12 cm high and 11 cm to 18 cm wide.
+
+    Returns
+    -------
+    int
+        The number of frames written.
+
+    Raises
+    ------
+    ValueError
+        If ``path`` does not end in ``.gif``, or the mechanism assembles at
+        none of the angles.
+    """
+    from matplotlib.animation import PillowWriter
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    path = Path(path)
+    if path.suffix.lower() != '.gif':
+        msg = f'Expected an animation file ending in .gif, got {str(path)!r}'
+        raise ValueError(msg)
+    if frames < 1:
+        msg = f'Expected at least 1 frame, got {frames}'
+        raise ValueError(msg)
+    scene = full_scene(scene)
+    states = []
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore', NearSingularWarning)
+        for theta in _cycle_angles(scene, frames):
+            try:
+                states.append(solve(scene, float(theta), speed, accel))
+            except AssemblyError:
+                continue
+    if not states:
+        msg = f'Expected scene "{scene.name}" to assemble at some crank angle, got none'
+        raise ValueError(msg)
+    strokes = strokes_from_scene(scene)
+    spaces = [space_from_state(scene, state, strokes) for state in states]
+    moving = [n for n in states[0].complex_points if n not in scene.ground]
+    v_max = max(abs(complex(st.complex_points[n][1])) for st in states for n in moving)
+    a_max = max(abs(complex(st.complex_points[n][2])) for st in states for n in moving)
+    corners = [np.array(sp.extent()) for sp in spaces]
+    lo = np.min([c[0] for c in corners], axis=0)
+    hi = np.max([c[1] for c in corners], axis=0)
+    size = float(np.hypot(*(hi - lo))) or 1.0
+    # arrow lengths: the largest velocity and acceleration of the cycle span 30 % of the size
+    v_ref = _nice_scale(v_max / 3.0) if v_max > 0 else 1.0
+    a_ref = _nice_scale(a_max / 3.0) if a_max > 0 else 1.0
+    k_v = 0.3 * size / (3.0 * v_ref) if v_max > 0 else 0.0
+    k_a = 0.3 * size / (3.0 * a_ref) if a_max > 0 else 0.0
+    tips = [arrow.end for st in states for arrow in arrows_from_state(scene, st, k_v, k_a)]
+    if tips:
+        lo = np.minimum(lo, np.min(tips, axis=0))
+        hi = np.maximum(hi, np.max(tips, axis=0))
+    height = 12.0
+    extent = np.maximum(hi - lo, 1e-9 * size)
+    width = min(max(extent[0] / extent[1] * (height - 3.4) + 1.5, 11.0), 18.0)
+    span = max((hi[0] - lo[0]) / (width - 1.5), (hi[1] - lo[1]) / (height - 3.4))
+    unit = span if span > 0 else 1.0   # data length of 1 cm of the frame
+    fig = Figure(figsize=(width * CM, height * CM), dpi=dpi)
+    FigureCanvasAgg(fig)
+    ax = fig.add_axes((0.0, 0.0, 1.0, 1.0))
+    colours = _colours(scene)
+    centre = (lo + hi) / 2 + np.array([0.0, 0.6 * unit])
+    origin = centre - np.array([width, height]) / 2 * unit
+    writer = PillowWriter(fps=fps)
+    with writer.saving(fig, str(path), dpi):
+        for state, space in zip(states, spaces, strict=True):
+            ax.clear()
+            ax.set_xlim(origin[0], origin[0] + width * unit)
+            ax.set_ylim(origin[1], origin[1] + height * unit)
+            ax.axis('off')
+            _draw_mechanism(ax, scene, space, colours, 0.8 * unit)
+            for arrow in arrows_from_state(scene, state, k_v, k_a):
+                colour = '#1a9641' if arrow.quantity.startswith('v') else '#d7191c'
+                _arrow(ax, arrow.start, arrow.end, colour, '-', 1.4, 0.8 * unit, zorder=6)
+            for name, xy in space.points.items():
+                ax.text(xy[0] + 0.2 * unit, xy[1] + 0.2 * unit, name, fontsize=9,
+                        fontweight='bold', zorder=7)
+            if instant_centres:
+                centres = instant_centres_from_state(scene, state)
+                for ic in centres:
+                    if ic.point is None:
+                        continue
+                    p = ic.point
+                    if origin[0] < p[0] < origin[0] + width * unit and \
+                            origin[1] < p[1] < origin[1] + height * unit:
+                        ax.plot(*p, marker='o', ms=4, mfc='none', mec='#b00000', zorder=7)
+                        ax.text(p[0] + 0.15 * unit, p[1] - 0.35 * unit,
+                                f'$I_{{{centres.label(ic)[1:]}}}$', fontsize=7,
+                                color='#b00000')
+            theta = math.degrees(float(state.angle)) % 360.0
+            ax.text(origin[0] + 0.4 * unit, origin[1] + (height - 0.6) * unit,
+                    f'{scene.name}   crank {theta:5.1f}\u00b0', fontsize=10, va='top')
+            key = origin + np.array([0.4, 0.5]) * unit
+            _arrow(ax, key, key + [k_v * v_ref, 0.0], '#1a9641', '-', 1.4, 0.8 * unit)
+            ax.text(key[0] + k_v * v_ref + 0.2 * unit, key[1], f'v {v_ref:g} m/s',
+                    fontsize=8, va='center')
+            key = key + np.array([width / 2 * unit, 0.0])
+            _arrow(ax, key, key + [k_a * a_ref, 0.0], '#d7191c', '-', 1.4, 0.8 * unit)
+            ax.text(key[0] + k_a * a_ref + 0.2 * unit, key[1], f'a {a_ref:g} m/s\u00b2',
+                    fontsize=8, va='center')
+            writer.grab_frame()
+    return len(states)
+
+
+# --- command line ---------------------------------------------------------
+
+DIAGRAM_HELP = """\
+Draw the space, velocity and acceleration diagrams of a scene at one crank
+angle, to scale and side by side, with a table of every value drawn (SI
+units; directions in degrees CCW from +x). The output format follows the
+file name: .png, .svg or .pdf. With --animate, write an animated GIF of one
+crank turn with the velocity and acceleration of every point drawn on the
+mechanism instead. Exits with status 2 on a scene or position that cannot be
+solved.
+"""
+
+
+def _finite(text: str) -> float:
+    value = float(text)
+    if not math.isfinite(value):
+        msg = f'expected a finite number, got {text!r}'
+        raise argparse.ArgumentTypeError(msg)
+    return value
+
+
+def _positive_int(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        msg = f'expected a positive integer, got {text!r}'
+        raise argparse.ArgumentTypeError(msg)
+    return value
+
+
+def _add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument('scene', metavar='SCENE',
+                        help='path to a scene YAML, or the name of a packaged scene '
+                             '(e.g. khurmi_four_bar_ad150)')
+    parser.add_argument('-o', '--output', required=True, metavar='FILE',
+                        help='output file: .png, .svg or .pdf (.gif with --animate)')
+    parser.add_argument('--angle-deg', type=_finite, metavar='X',
+                        help="crank angle in degrees CCW from +x (default: the scene's); "
+                             'with --animate, the first frame')
+    parser.add_argument('--speed-rpm', type=_finite, metavar='N',
+                        help="signed crank speed in rpm, + CCW (default: the scene's)")
+    parser.add_argument('--accel', type=_finite, metavar='A',
+                        help='crank angular acceleration in rad/s^2, + CCW (default: the '
+                             "scene's)")
+    parser.add_argument('--instant-centres', action='store_true',
+                        help='also compute the instant centres, mark them on the space '
+                             'diagram and list them')
+    parser.add_argument('--animate', action='store_true',
+                        help='write an animated GIF of one crank turn instead')
+    parser.add_argument('--frames', type=_positive_int, default=72, metavar='N',
+                        help='frames of the animation (default 72, every 5 degrees)')
+
+
+def add_parser(commands: Any) -> argparse.ArgumentParser:
+    """Register the ``diagram`` command on ``commands`` (an argparse subparsers object).
+
+    Parameters
+    ----------
+    commands : argparse._SubParsersAction
+        What ``ArgumentParser.add_subparsers()`` returned.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The command's parser; its ``handler`` default is :func:`run`.
+    """
+    parser: argparse.ArgumentParser = commands.add_parser(
+        'diagram', help='draw velocity and acceleration diagrams',
+        description=DIAGRAM_HELP, formatter_class=argparse.RawDescriptionHelpFormatter)
+    _add_arguments(parser)
+    parser.set_defaults(handler=run)
+    return parser
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the ``diagram`` command on parsed arguments; return the exit status."""
+    from .scene import load_scene
+
+    output = Path(args.output)
+    suffixes = ('.gif',) if args.animate else ('.png', '.svg', '.pdf')
+    if output.suffix.lower() not in suffixes:
+        expected = suffixes[0] if len(suffixes) == 1 else \
+            f'{", ".join(suffixes[:-1])} or {suffixes[-1]}'
+        print(f'error: expected -o FILE ending in {expected}, got {str(output)!r}',
+              file=sys.stderr)
+        return 2
+    speed = None if args.speed_rpm is None else args.speed_rpm * math.pi / 30.0
+    try:
+        scene = load_scene(args.scene)
+        if args.animate:
+            if args.angle_deg is not None:
+                scene = _with_angle(scene, math.radians(args.angle_deg))
+            count = write_animation(scene, output, frames=args.frames, speed=speed,
+                                    accel=args.accel, instant_centres=args.instant_centres)
+            print(f'wrote {output} ({count} frames)')
+        else:
+            diagram = diagram_from_scene(scene, args.angle_deg, speed, args.accel,
+                                         degrees=True, instant_centres=args.instant_centres)
+            write_diagram(diagram, scene, output)
+            print(f'wrote {output}')
+    except (SceneError, AssemblyError, ValueError, OSError) as error:
+        print(f'error: {error}', file=sys.stderr)
+        return 2
+    return 0
+
+
+def _with_angle(scene: Scene, angle: float) -> Scene:
+    from dataclasses import replace
+
+    return replace(scene, input=replace(scene.input, angle=angle))
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run ``python -m mech_kinematics diagram`` on ``argv``; return the exit status."""
+    parser = argparse.ArgumentParser(prog='python -m mech_kinematics diagram',
+                                     description=DIAGRAM_HELP,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    _add_arguments(parser)
+    return run(parser.parse_args(None if argv is None else list(argv)))
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,355 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""Space, velocity and acceleration diagrams: geometry against the solver, files, CLI."""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import replace
+import math
+from pathlib import Path
+import struct
+import subprocess
+import sys
+import warnings
+
+import numpy as np
+import pytest
+
+import mech_kinematics as mk
+from mech_kinematics import diagram as dg
+from mech_kinematics.instant_centres import full_scene
+
+#: A diagram's vectors against the solver's values, relative to the largest
+#: letter's distance from the pole (closed-form round trip).
+RTOL_POLYGON = 1e-12
+#: Positions of the space diagram, m.
+ATOL_POSITION = 1e-12
+#: Smallest sensible PNG: the three panels need room (pixels).
+MIN_PNG_SIZE = (1200, 600)
+
+SCENES = tuple(mk.scene_names())
+SCENE_FILES = sorted((Path(__file__).resolve().parent.parent / 'config' / 'scenes')
+                     .glob('*.yaml'))
+#: Crank angles tried besides each scene's own, degrees.
+ANGLES_DEG = (20.0, 100.0, 200.0, 300.0)
+KHURMI = 'khurmi_four_bar_ad150'
+
+
+def _cases():
+    cases = []
+    for name in SCENES:
+        angles = [None, *ANGLES_DEG]
+        for index, angle in enumerate(angles):
+            cases.append(pytest.param(name, angle, id=f'{name}-{index}'))
+    return cases
+
+
+def _solved(name, angle_deg):
+    scene = full_scene(mk.load_scene(name))
+    angle = scene.input.angle if angle_deg is None else math.radians(angle_deg)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter('ignore', mk.NearSingularWarning)
+            return scene, mk.solve(scene, angle)
+    except mk.AssemblyError:
+        pytest.skip('the mechanism does not assemble at this angle')
+
+
+def _xy(z):
+    return np.array([z.real, z.imag])
+
+
+def _atol(polygon):
+    return RTOL_POLYGON * max(float(np.hypot(*xy)) for xy in polygon.letters.values())
+
+
+def _links(scene):
+    """Each link's relative motions as (link, start, end) from the scene, end not a pin."""
+    crank = scene.input
+    edges = [(crank.link, crank.center, crank.point)]
+    for dyad in scene.dyads:
+        if isinstance(dyad, mk.RRR):
+            edges += [(link.name, link.start, dyad.point) for link in dyad.links]
+        elif isinstance(dyad, mk.RRP):
+            edges.append((dyad.link.name, dyad.link.start, dyad.point))
+    edges += [(p.link, p.origin, p.name) for p in scene.points]
+    return edges
+
+
+@pytest.mark.parametrize(('name', 'angle'), _cases())
+def test_velocity_letters_are_the_solver_velocities(name, angle):
+    """Each point's letter in the velocity diagram is its solved velocity; ground is the pole."""
+    scene, state = _solved(name, angle)
+    polygon = dg.velocity_polygon_from_state(scene, state)
+    atol = _atol(polygon)
+    for point, (_, v, _) in state.complex_points.items():
+        np.testing.assert_allclose(polygon.letters[point.lower()], _xy(complex(v)), atol=atol)
+    for ground in scene.ground:
+        assert ground.lower() in polygon.ground
+    for vector in polygon.vectors:
+        if vector.kind is dg.VectorKind.ABSOLUTE:
+            np.testing.assert_allclose(vector.start, 0.0, atol=atol)
+            np.testing.assert_allclose(vector.end, polygon.letters[vector.head], atol=atol)
+
+
+@pytest.mark.parametrize(('name', 'angle'), _cases())
+def test_velocity_polygon_closes(name, angle):
+    """For each link, v_start + omega x r reaches v_end: the segment joins the two letters."""
+    scene, state = _solved(name, angle)
+    polygon = dg.velocity_polygon_from_state(scene, state)
+    atol = _atol(polygon)
+    p = {n: complex(x[0]) for n, x in state.complex_points.items()}
+    for link, start, end in _links(scene):
+        vector = polygon.find(f'v_{end}{start}' if len(end + start) == 2 else
+                              f'v_{end},{start}')
+        omega = state.joints[link].velocity
+        assert vector.kind is dg.VectorKind.RELATIVE and vector.body == link
+        expected = _xy(1j * omega * (p[end] - p[start]))
+        np.testing.assert_allclose(vector.end - vector.start, expected, atol=atol)
+        np.testing.assert_allclose(vector.start, polygon.letters[start.lower()], atol=atol)
+        np.testing.assert_allclose(vector.end, polygon.letters[end.lower()], atol=atol)
+    for dyad in scene.dyads:
+        if isinstance(dyad, mk.RPR):
+            pin = dyad.through.lower()
+            slip = polygon.find(f"v_{dyad.through}{dyad.through}'")
+            e = p[dyad.through] - p[dyad.center]
+            np.testing.assert_allclose(slip.end - slip.start,
+                                       _xy(state.joints[dyad.slider].velocity * e / abs(e)),
+                                       atol=atol)
+            np.testing.assert_allclose(slip.start, polygon.letters[f"{pin}'"], atol=atol)
+            np.testing.assert_allclose(slip.end, polygon.letters[pin], atol=atol)
+
+
+@pytest.mark.parametrize(('name', 'angle'), _cases())
+def test_acceleration_polygon_closes(name, angle):
+    """Per link a_start + normal + tangential = a_end; per slot a_b' + Coriolis + slip = a_b."""
+    scene, state = _solved(name, angle)
+    polygon = dg.acceleration_polygon_from_state(scene, state)
+    atol = _atol(polygon)
+    for point, (_, _, a) in state.complex_points.items():
+        np.testing.assert_allclose(polygon.letters[point.lower()], _xy(complex(a)), atol=atol)
+    vectors = polygon.vectors
+    for index, vector in enumerate(vectors):
+        if vector.kind is dg.VectorKind.NORMAL:
+            tangential = vectors[index + 1]
+            assert tangential.kind is dg.VectorKind.TANGENTIAL
+            np.testing.assert_allclose(vector.start, polygon.letters[vector.tail], atol=atol)
+            np.testing.assert_allclose(vector.end, tangential.start, atol=atol)
+            np.testing.assert_allclose(tangential.end, polygon.letters[tangential.head],
+                                       atol=atol)
+        if vector.kind is dg.VectorKind.CORIOLIS:
+            slip = vectors[index + 1]
+            assert slip.kind is dg.VectorKind.SLIP
+            np.testing.assert_allclose(vector.start, polygon.letters[vector.tail], atol=atol)
+            np.testing.assert_allclose(vector.end, slip.start, atol=atol)
+            np.testing.assert_allclose(slip.end, polygon.letters[slip.head], atol=atol)
+
+
+@pytest.mark.parametrize(('name', 'angle'), _cases())
+def test_acceleration_components_follow_the_textbook(name, angle):
+    """Normal: omega^2 r along the link toward its start; tangential: |alpha| r across it."""
+    scene, state = _solved(name, angle)
+    polygon = dg.acceleration_polygon_from_state(scene, state)
+    atol = _atol(polygon)
+    p = {n: complex(x[0]) for n, x in state.complex_points.items()}
+    for link, start, end in _links(scene):
+        sub = f'{end}{start}' if len(end + start) == 2 else f'{end},{start}'
+        normal, tangential = polygon.find(f'a_{sub}^n'), polygon.find(f'a_{sub}^t')
+        joint = state.joints[link]
+        r = _xy(p[end] - p[start])
+        length = float(np.hypot(*r))
+        n = normal.end - normal.start
+        t = tangential.end - tangential.start
+        np.testing.assert_allclose(normal.value, joint.velocity ** 2 * length, atol=atol)
+        np.testing.assert_allclose(n, -joint.velocity ** 2 * r, atol=atol)   # toward the start
+        np.testing.assert_allclose(tangential.value, abs(joint.acceleration) * length,
+                                   atol=atol)
+        np.testing.assert_allclose(t @ r, 0.0, atol=atol * length)          # perpendicular
+    for dyad in scene.dyads:
+        if isinstance(dyad, mk.RPR):
+            coriolis = polygon.find(f"a_{dyad.through}{dyad.through}'^c")
+            omega = state.joints[dyad.link].velocity
+            slip = state.joints[dyad.slider].velocity
+            np.testing.assert_allclose(coriolis.value, 2.0 * abs(omega * slip), atol=atol)
+            e = _xy(p[dyad.through] - p[dyad.center])
+            np.testing.assert_allclose((coriolis.end - coriolis.start) @ e, 0.0,
+                                       atol=atol * float(np.hypot(*e)))
+
+
+@pytest.mark.parametrize('name', SCENES)
+def test_space_diagram_is_the_solved_mechanism(name):
+    """Points are the solved positions; pivots, sliders and guides sit where the scene says."""
+    scene, state = _solved(name, None)
+    space = dg.space_from_state(scene, state, dg.strokes_from_scene(scene))
+    for point, (p, _, _) in state.complex_points.items():
+        np.testing.assert_allclose(space.points[point], _xy(complex(p)), atol=ATOL_POSITION)
+    assert {pivot.point for pivot in space.pivots} <= set(scene.ground)
+    assert scene.input.center in {pivot.point for pivot in space.pivots}
+    for dyad in scene.dyads:
+        if isinstance(dyad, mk.RRP):
+            guide = next(g for g in space.guides if g.slider == dyad.slider)
+            u = np.array([math.cos(dyad.guide_angle), math.sin(dyad.guide_angle)])
+            d = space.points[dyad.point] - guide.start
+            np.testing.assert_allclose(d[0] * u[1] - d[1] * u[0], 0.0, atol=ATOL_POSITION)
+            s = d @ u
+            assert 0.0 < s < float(np.hypot(*(guide.end - guide.start)))
+    names = {link.name for link in space.links}
+    assert scene.input.link in names
+
+
+def test_four_bar_matches_the_worked_example_layout():
+    """Seed 002 "Four Bar Mechanism": a, d at the pole; ab, bc, dc normal to AB, BC, DC."""
+    diagram = dg.diagram_from_scene(mk.load_scene(KHURMI))
+    velocity, points = diagram.velocity, diagram.space.points
+    assert set(velocity.ground) == {'a', 'd'}
+    for tail, head, start, end in (('a', 'b', 'A', 'B'), ('b', 'c', 'B', 'C'),
+                                   ('d', 'c', 'D', 'C')):
+        vector = next(v for v in velocity.vectors if (v.tail, v.head) == (tail, head))
+        np.testing.assert_allclose((vector.end - vector.start) @ (points[end] - points[start]),
+                                   0.0, atol=RTOL_POLYGON)
+    assert [v.quantity for v in velocity.vectors] == ['v_BA', 'v_CB', 'v_CD']
+    assert [v.quantity for v in diagram.acceleration.vectors] == [
+        'a_BA^n', 'a_BA^t', 'a_BA', 'a_CB^n', 'a_CB^t', 'a_CB', 'a_CD^n', 'a_CD^t', 'a_CD']
+
+
+def test_four_bar_table_lists_the_exact_values():
+    """The table under the seed 002 four-bar lists exact values (notes measured 5.163, 49.77).
+
+    Course notes seed 002 (VIT BMEE207L, Module 2), "Four Bar Mechanism", after
+    Khurmi & Gupta: AD = 150, AB = 40 at 120 rpm CW, BC = 150, CD = 80 mm,
+    angle BAD = 60 deg. The notes' graphical omega_CD = 5.163 rad/s and
+    alpha_CD = 49.77 rad/s^2 are off; the exact values are 4.785 and 56.88.
+    """
+    diagram = dg.diagram_from_scene(mk.load_scene(KHURMI))
+    tables = dg.tables_from_diagram(diagram, {'velocity': 0.1, 'acceleration': 1.0})
+    links = {row[0]: row for row in tables['space'].rows}
+    assert links['crank'][2:] == ('0.04', '60', '-12.57 CW', '0')
+    assert links['coupler'][2:] == ('0.15', '17.15', '1.309 CCW', '31.39 CCW')
+    assert links['rocker'][2:] == ('0.08', '80.41', '-4.785 CW', '56.88 CCW')
+    velocity = {row[0]: row[1:] for row in tables['velocity'].rows}
+    assert velocity == {'ab': ('v_BA = v_B', '0.5027', '330', '5.03'),
+                        'bc': ('v_CB', '0.1963', '107.2', '1.96'),
+                        'dc': ('v_CD = v_C', '0.3828', '350.4', '3.83')}
+    acceleration = {row[1]: row[2] for row in tables['acceleration'].rows}
+    assert acceleration == {'a_BA^n': '6.317', 'a_BA^t': '0', 'a_BA = a_B': '6.317',
+                            'a_CB^n': '0.2569', 'a_CB^t': '4.708', 'a_CB': '4.715',
+                            'a_CD^n': '1.831', 'a_CD^t': '4.551', 'a_CD = a_C': '4.905'}
+
+
+def test_instant_centres_are_tabled_on_request():
+    """--instant-centres adds the centres table: six for a four-bar, I13 off the links."""
+    scene = mk.load_scene(KHURMI)
+    assert dg.diagram_from_scene(scene).instant_centres is None
+    diagram = dg.diagram_from_scene(scene, instant_centres=True)
+    table = dg.tables_from_diagram(diagram)['centres']
+    assert [row[0] for row in table.rows] == ['I12', 'I13', 'I14', 'I23', 'I24', 'I34']
+    assert table.rows[0][2:] == ('0', '0')
+
+
+def test_slider_on_fixed_guide_centre_is_tabled_at_infinity():
+    """The ram's centre with the ground is listed at infinity, toward 90 degrees."""
+    diagram = dg.diagram_from_scene(mk.load_scene('quick_return'), instant_centres=True)
+    rows = {row[1]: row for row in dg.tables_from_diagram(diagram)['centres'].rows}
+    assert rows['ground - ram'][2:] == ('at infinity', 'toward 90\u00b0')
+
+
+def test_arrows_on_the_mechanism_are_scaled_solver_values():
+    """Animation arrows start at each point and end at p + k v and p + k a."""
+    scene, state = _solved('quick_return', None)
+    arrows = dg.arrows_from_state(scene, state, 0.1, 0.01, points=['D'])
+    p, v, a = (complex(x) for x in state.complex_points['D'])
+    assert [arrow.quantity for arrow in arrows] == ['v_D', 'a_D']
+    np.testing.assert_allclose(arrows[0].end, _xy(p + 0.1 * v), atol=ATOL_POSITION)
+    np.testing.assert_allclose(arrows[1].end, _xy(p + 0.01 * a), atol=ATOL_POSITION)
+
+
+def test_pruned_scene_is_drawn_in_full():
+    """A scene whose outputs prune points is solved in full for its diagrams."""
+    scene = replace(mk.load_scene('quick_return'), outputs_points=('D',), outputs_joints=())
+    diagram = dg.diagram_from_scene(scene)
+    assert {'b', "b'", 'c', 'd'} <= set(diagram.velocity.letters)
+
+
+def test_pruned_state_is_refused():
+    """A state pruned by outputs is refused with a message naming full_scene."""
+    scene = replace(mk.load_scene('quick_return'), outputs_points=('D',), outputs_joints=())
+    with pytest.raises(ValueError, match='full_scene'):
+        dg.velocity_polygon_from_state(scene, mk.solve(scene, scene.input.angle))
+
+
+def _png_size(path):
+    data = path.read_bytes()
+    assert data[:8] == b'\x89PNG\r\n\x1a\n' and data[12:16] == b'IHDR'
+    return struct.unpack('>II', data[16:24])
+
+
+@pytest.mark.parametrize('path', SCENE_FILES, ids=[p.stem for p in SCENE_FILES])
+def test_png_is_written_for_every_scene(path, tmp_path):
+    """Every scene file in config/scenes draws to a valid PNG of sensible size."""
+    scene = mk.load_scene(str(path))
+    out = dg.write_diagram(dg.diagram_from_scene(scene, instant_centres=True), scene,
+                           tmp_path / f'{path.stem}.png')
+    width, height = _png_size(out)
+    assert width >= MIN_PNG_SIZE[0] and height >= MIN_PNG_SIZE[1]
+    assert width < 4000 and height < 4000
+    assert out.stat().st_size > 30_000
+
+
+def test_svg_is_written(tmp_path):
+    """A .svg output is an SVG document."""
+    scene = mk.load_scene(KHURMI)
+    out = dg.write_diagram(dg.diagram_from_scene(scene), scene, tmp_path / 'four_bar.svg')
+    assert '<svg' in out.read_text()[:2000]
+
+
+def test_animation_skips_angles_that_cannot_assemble(tmp_path):
+    """The GIF has one frame per crank angle at which the mechanism assembles."""
+    from PIL import Image
+
+    path = tmp_path / 'triple_rocker.gif'
+    count = dg.write_animation(mk.load_scene('four_bar_coupler_points'), path, frames=8)
+    assert 0 < count < 8   # the triple rocker assembles within +-103.79 deg only
+    with Image.open(path) as image:
+        assert image.format == 'GIF' and image.n_frames == count
+
+
+def test_cli_writes_diagram_and_animation(tmp_path, capsys):
+    """`diagram SCENE -o FILE` writes a PNG; `--animate` a GIF; both exit 0."""
+    png, gif = tmp_path / 'd.png', tmp_path / 'a.gif'
+    assert dg.main([KHURMI, '--angle-deg', '75', '-o', str(png), '--instant-centres']) == 0
+    assert _png_size(png)[0] >= MIN_PNG_SIZE[0]
+    assert dg.main(['slider_crank_150_600', '--animate', '--frames', '3', '-o', str(gif)]) == 0
+    assert gif.read_bytes()[:6] == b'GIF89a'
+    assert 'wrote' in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(('args', 'message'), [
+    (['four_bar_coupler_points', '--angle-deg', '150', '-o', 'x.png'], 'cannot be solved'),
+    ([KHURMI, '-o', 'x.jpg'], 'expected -o FILE ending in .png, .svg or .pdf'),
+    ([KHURMI, '--animate', '-o', 'x.png'], 'expected -o FILE ending in .gif'),
+    (['no_such_scene', '-o', 'x.png'], 'no_such_scene'),
+])
+def test_cli_errors_exit_2(args, message, tmp_path, capsys, monkeypatch):
+    """Bad positions, file types and scenes print one error line and exit with status 2."""
+    monkeypatch.chdir(tmp_path)
+    assert dg.main(args) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.startswith('error: ')
+    assert not list(tmp_path.iterdir())
+
+
+def test_add_parser_registers_the_command():
+    """add_parser(commands) registers `diagram` with its handler for the lead's CLI."""
+    parser = argparse.ArgumentParser()
+    commands = parser.add_subparsers(dest='command', required=True)
+    dg.add_parser(commands)
+    args = parser.parse_args(['diagram', KHURMI, '-o', 'x.png', '--angle-deg', '30'])
+    assert args.handler is dg.run and args.angle_deg == 30.0 and not args.animate
+
+
+def test_import_needs_no_matplotlib():
+    """Importing the diagram geometry loads neither matplotlib nor rclpy."""
+    code = ('import sys, mech_kinematics.diagram, mech_kinematics.instant_centres; '
+            "assert 'matplotlib' not in sys.modules and 'rclpy' not in sys.modules")
+    subprocess.run([sys.executable, '-c', code], check=True, timeout=60)

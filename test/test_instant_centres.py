@@ -1,0 +1,189 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""Instant centres: from the velocities, by Kennedy's theorem, and the velocity check."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+import itertools
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+import mech_kinematics as mk
+from mech_kinematics.instant_centres import (bodies_from_scene, BodyKind, Centre, full_scene,
+                                             instant_centres_from_kennedy,
+                                             instant_centres_from_state)
+
+#: Homogeneous centres are unit 3-vectors in units of the mechanism's size.
+ATOL_HOMOGENEOUS = 1e-9
+#: Determinant of three unit homogeneous centres (collinearity).
+ATOL_COLLINEAR = 1e-9
+#: Velocity of a point against omega x (P - I), relative to the largest speed.
+RTOL_VELOCITY = 1e-9
+
+SCENES = tuple(mk.scene_names())
+#: Crank angles tried besides each scene's own, degrees.
+ANGLES_DEG = (0.0, 37.0, 95.0, 160.0, 215.0, 290.0)
+
+
+def _states():
+    cases = []
+    for name in SCENES:
+        scene = mk.load_scene(name)
+        angles = [scene.input.angle, *(math.radians(a) for a in ANGLES_DEG)]
+        for index, angle in enumerate(angles):
+            cases.append(pytest.param(name, angle, id=f'{name}-{index}'))
+    return cases
+
+
+def _solve(name, angle):
+    scene = full_scene(mk.load_scene(name))
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter('ignore', mk.NearSingularWarning)
+            return scene, mk.solve(scene, angle)
+    except mk.AssemblyError:
+        pytest.skip('the mechanism does not assemble at this angle')
+
+
+def _same(h1, h2):
+    return min(np.linalg.norm(h1 - h2), np.linalg.norm(h1 + h2))
+
+
+@pytest.mark.parametrize('name', SCENES)
+def test_every_pair_has_a_centre(name):
+    """The velocity method gives n (n - 1) / 2 centres, one per pair of bodies."""
+    scene, state = _solve(name, mk.load_scene(name).input.angle)
+    centres = instant_centres_from_state(scene, state)
+    n = len(centres.topology.bodies)
+    assert len(centres) == n * (n - 1) // 2
+    assert all(c.method is Centre.VELOCITY for c in centres)
+
+
+@pytest.mark.parametrize(('name', 'angle'), _states())
+def test_kennedy_agrees_with_velocities(name, angle):
+    """Kennedy's construction from positions finds every centre, equal to the velocity one."""
+    scene, state = _solve(name, angle)
+    by_velocity = instant_centres_from_state(scene, state)
+    by_kennedy = instant_centres_from_kennedy(scene, state)
+    assert len(by_kennedy) == len(by_velocity)
+    for centre in by_kennedy:
+        other = by_velocity[centre.bodies]
+        assert _same(centre.homogeneous(by_velocity.size),
+                     other.homogeneous(by_velocity.size)) < ATOL_HOMOGENEOUS, \
+            by_velocity.label(centre)
+
+
+@pytest.mark.parametrize(('name', 'angle'), _states())
+def test_three_centres_of_three_links_are_collinear(name, angle):
+    """Kennedy's theorem: the three centres of any three bodies lie on one line."""
+    scene, state = _solve(name, angle)
+    centres = instant_centres_from_state(scene, state)
+    for a, b, c in itertools.combinations(centres.topology.bodies, 3):
+        h = np.array([centres[pair].homogeneous(centres.size)
+                      for pair in ((a, b), (b, c), (a, c))])
+        assert abs(np.linalg.det(h)) < ATOL_COLLINEAR, (a, b, c)
+
+
+@pytest.mark.parametrize(('name', 'angle'), _states())
+def test_point_velocity_is_omega_times_distance_from_ground_centre(name, angle):
+    """Every point P of every link moves as omega x (P - I): |v_P| = |omega| |PI|, normal to PI."""
+    scene, state = _solve(name, angle)
+    centres = instant_centres_from_state(scene, state)
+    topology = centres.topology
+    speeds = [abs(complex(v)) for _, v, _ in state.complex_points.values()]
+    atol = RTOL_VELOCITY * max(speeds)
+    for body in topology.bodies.values():
+        if body.kind is BodyKind.GROUND:
+            continue
+        centre = centres[(topology.ground, body.name)]
+        if body.kind is BodyKind.SLIDER:
+            guide = body.guide
+            omega = 0.0 if guide == topology.ground else state.joints[guide].velocity
+        else:
+            omega = state.joints[body.name].velocity
+        for point in body.points:
+            p, v, _ = (complex(x) for x in state.complex_points[point])
+            if centre.point is None:
+                # translation: every point has the same velocity, normal to the direction
+                assert omega == 0.0
+                d = complex(*centre.direction)
+                assert abs((v * d.conjugate()).real) <= atol
+            else:
+                i = complex(*centre.point)
+                np.testing.assert_allclose(abs(v), abs(omega) * abs(p - i), atol=atol)
+                np.testing.assert_allclose([v.real, v.imag],
+                                           [(1j * omega * (p - i)).real,
+                                            (1j * omega * (p - i)).imag], atol=atol)
+
+
+def test_four_bar_centres():
+    """Four-bar ABCD: I12 = A, I23 = B, I34 = C, I14 = D, I13 = AB x DC, I24 = BC x AD."""
+    scene, state = _solve('khurmi_four_bar_ad150', mk.load_scene('khurmi_four_bar_ad150')
+                          .input.angle)
+    centres = instant_centres_from_kennedy(scene, state)
+    p = {name: complex(x[0]) for name, x in state.complex_points.items()}
+
+    def meet(a, b, c, d):
+        t = ((c - a).real * (d - c).imag - (c - a).imag * (d - c).real) / \
+            ((b - a).real * (d - c).imag - (b - a).imag * (d - c).real)
+        return a + t * (b - a)
+
+    expected = {('ground', 'crank'): p['A'], ('crank', 'coupler'): p['B'],
+                ('coupler', 'rocker'): p['C'], ('ground', 'rocker'): p['D'],
+                ('ground', 'coupler'): meet(p['A'], p['B'], p['D'], p['C']),
+                ('crank', 'rocker'): meet(p['B'], p['C'], p['A'], p['D'])}
+    assert [centres.label(c) for c in centres] == ['I12', 'I13', 'I14', 'I23', 'I24', 'I34']
+    for pair, z in expected.items():
+        np.testing.assert_allclose(centres[pair].point, [z.real, z.imag],
+                                   atol=ATOL_HOMOGENEOUS * centres.size)
+    assert centres[('ground', 'crank')].method is Centre.PIN
+    assert centres[('ground', 'coupler')].method is Centre.KENNEDY
+
+
+def test_slider_on_fixed_guide_has_ground_centre_at_infinity():
+    """A slider on a horizontal guide has its centre with the ground at infinity, vertically."""
+    scene, state = _solve('quick_return', mk.load_scene('quick_return').input.angle)
+    for centres in (instant_centres_from_state(scene, state),
+                    instant_centres_from_kennedy(scene, state)):
+        centre = centres[('ram', 'ground')]
+        assert centre.at_infinity and centre.point is None
+        np.testing.assert_allclose(abs(centre.direction[1]), 1.0, atol=ATOL_HOMOGENEOUS)
+        # the block in the slot translates relative to the lever: normal to the slot
+        slot = centres[('block', 'lever')]
+        angle = state.joints['lever'].position
+        assert slot.at_infinity
+        np.testing.assert_allclose(slot.direction @ [math.cos(angle), math.sin(angle)], 0.0,
+                                   atol=ATOL_HOMOGENEOUS)
+
+
+def test_bodies_of_the_quick_return():
+    """Bodies are numbered ground first; sliders are bodies; pins join bodies sharing a point."""
+    topology = bodies_from_scene(mk.load_scene('quick_return'))
+    assert list(topology.bodies) == ['ground', 'crank', 'lever', 'block', 'link_CD', 'ram']
+    assert [b.number for b in topology.bodies.values()] == [1, 2, 3, 4, 5, 6]
+    assert set(topology.pins) == {('ground', 'crank', 'A'), ('ground', 'lever', 'O'),
+                                  ('crank', 'block', 'B'), ('lever', 'link_CD', 'C'),
+                                  ('link_CD', 'ram', 'D')}
+    assert set(topology.slides) == {('block', 'lever'), ('ram', 'ground')}
+
+
+def test_state_of_an_array_is_refused():
+    """A state over an array of angles is refused with an "Expected ..." message."""
+    scene = mk.load_scene('khurmi_four_bar_ad150')
+    state = mk.solve(scene, np.array([1.0, 1.1]))
+    with pytest.raises(ValueError, match='Expected the state of one crank angle'):
+        instant_centres_from_state(scene, state)
+
+
+def test_pruned_state_is_refused():
+    """A state pruned by outputs misses points: the message says to solve full_scene."""
+    scene = replace(mk.load_scene('quick_return'), outputs_points=('D',), outputs_joints=())
+    state = mk.solve(scene, scene.input.angle)
+    with pytest.raises(ValueError, match='full_scene'):
+        instant_centres_from_kennedy(scene, state)
+    full = full_scene(scene)
+    assert len(instant_centres_from_state(full, mk.solve(full, scene.input.angle))) == 15
