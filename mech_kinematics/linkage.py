@@ -59,22 +59,25 @@ class Branch(IntEnum):
     MINUS = -1
 
 
-def _check_name(name: str, what: str) -> None:
+Where = tuple[object, str] | None
+
+
+def _check_name(name: str, what: str, where: Where = None) -> None:
     if not isinstance(name, str) or not IDENTIFIER.match(name):
         msg = f'Expected {what} to be an identifier ([A-Za-z_][A-Za-z0-9_]*), got {name!r}'
-        raise SceneError(msg)
+        raise SceneError(msg, where)
 
 
-def _check_finite(value: float, what: str) -> None:
+def _check_finite(value: float, what: str, where: Where = None) -> None:
     if not math.isfinite(value):
         msg = f'Expected {what} to be a finite number, got {value!r}'
-        raise SceneError(msg)
+        raise SceneError(msg, where)
 
 
-def _check_length(value: float, what: str) -> None:
+def _check_length(value: float, what: str, where: Where = None) -> None:
     if not (math.isfinite(value) and value > 0.0):
         msg = f'Expected {what} to be a positive length, got {value!r} m'
-        raise SceneError(msg)
+        raise SceneError(msg, where)
 
 
 @dataclass(frozen=True)
@@ -109,13 +112,13 @@ class Crank:
 
     def __post_init__(self) -> None:
         """Validate the fields."""
-        _check_name(self.link, 'the crank link name')
-        _check_name(self.center, 'the crank center')
-        _check_name(self.point, 'the crank point')
-        _check_length(self.length, f'crank "{self.link}" length')
-        _check_finite(self.angle, 'the crank angle')
-        _check_finite(self.speed, 'the crank speed')
-        _check_finite(self.accel, 'the crank acceleration')
+        _check_name(self.link, 'the crank link name', (self, 'link'))
+        _check_name(self.center, 'the crank center', (self, 'center'))
+        _check_name(self.point, 'the crank point', (self, 'point'))
+        _check_length(self.length, f'crank "{self.link}" length', (self, 'length'))
+        _check_finite(self.angle, 'the crank angle', (self, 'angle'))
+        _check_finite(self.speed, 'the crank speed', (self, 'speed'))
+        _check_finite(self.accel, 'the crank acceleration', (self, 'accel'))
 
 
 @dataclass(frozen=True)
@@ -128,9 +131,9 @@ class Link:
 
     def __post_init__(self) -> None:
         """Validate the fields."""
-        _check_name(self.name, 'a link name')
-        _check_name(self.start, f'the start point of link "{self.name}"')
-        _check_length(self.length, f'link "{self.name}" length')
+        _check_name(self.name, 'a link name', (self, 'name'))
+        _check_name(self.start, f'the start point of link "{self.name}"', (self, 'start'))
+        _check_length(self.length, f'link "{self.name}" length', (self, 'length'))
 
 
 @dataclass(frozen=True)
@@ -143,11 +146,11 @@ class RRR:
 
     def __post_init__(self) -> None:
         """Validate the fields."""
-        _check_name(self.point, 'an RRR point')
+        _check_name(self.point, 'an RRR point', (self, 'point'))
         count = len(self.links)  # anything may be passed at run time
         if count != 2:
             msg = f'Expected RRR "{self.point}" to have 2 links, got {count}'
-            raise SceneError(msg)
+            raise SceneError(msg, (self, 'links'))
         object.__setattr__(self, 'branch', Branch(self.branch))
 
 
@@ -164,10 +167,11 @@ class RRP:
 
     def __post_init__(self) -> None:
         """Validate the fields."""
-        _check_name(self.point, 'an RRP point')
-        _check_name(self.through, f'the guide point of RRP "{self.point}"')
-        _check_name(self.slider, f'the slider of RRP "{self.point}"')
-        _check_finite(self.guide_angle, f'the guide angle of RRP "{self.point}"')
+        _check_name(self.point, 'an RRP point', (self, 'point'))
+        _check_name(self.through, f'the guide point of RRP "{self.point}"', (self, 'through'))
+        _check_name(self.slider, f'the slider of RRP "{self.point}"', (self, 'slider'))
+        _check_finite(self.guide_angle, f'the guide angle of RRP "{self.point}"',
+                      (self, 'guide_angle'))
         object.__setattr__(self, 'branch', Branch(self.branch))
 
 
@@ -182,10 +186,10 @@ class RPR:
 
     def __post_init__(self) -> None:
         """Validate the fields."""
-        _check_name(self.link, 'an RPR link')
-        _check_name(self.center, f'the center of RPR "{self.link}"')
-        _check_name(self.through, f'the pin of RPR "{self.link}"')
-        _check_name(self.slider, f'the slider of RPR "{self.link}"')
+        _check_name(self.link, 'an RPR link', (self, 'link'))
+        _check_name(self.center, f'the center of RPR "{self.link}"', (self, 'center'))
+        _check_name(self.through, f'the pin of RPR "{self.link}"', (self, 'through'))
+        _check_name(self.slider, f'the slider of RPR "{self.link}"', (self, 'slider'))
 
 
 @dataclass(frozen=True)
@@ -206,12 +210,13 @@ class CarriedPoint:
 
     def __post_init__(self) -> None:
         """Validate the fields."""
-        _check_name(self.name, 'a carried point name')
-        _check_name(self.link, f'the link of point "{self.name}"')
-        _check_name(self.origin, f'the origin of point "{self.name}"')
-        _check_name(self.xaxis, f'the x-axis point of point "{self.name}"')
+        _check_name(self.name, 'a carried point name', (self, 'name'))
+        _check_name(self.link, f'the link of point "{self.name}"', (self, 'link'))
+        _check_name(self.origin, f'the origin of point "{self.name}"', (self, 'origin'))
+        _check_name(self.xaxis, f'the x-axis point of point "{self.name}"', (self, 'xaxis'))
         for value in self.local:
-            _check_finite(value, f'the local coordinates of point "{self.name}"')
+            _check_finite(value, f'the local coordinates of point "{self.name}"',
+                          (self, 'local'))
 
 
 Dyad = RRR | RRP | RPR
@@ -276,8 +281,15 @@ class _CrankStep:
             e = complex(math.cos(theta), math.sin(theta))
         r = self.length * e
         ctx.points[self.point] = (self.center + r, 1j * omega * r,
-                                  (1j * alpha - omega * omega) * r)
+                                  1j * alpha * r - omega * omega * r)
         ctx.links[self.link] = (e, omega, alpha)
+
+
+# Every complex product below has one real factor or a purely imaginary one
+# (``1j * x``): such products round the same way in Python's complex type and
+# in NumPy's (whose general complex product may use fused multiply-adds), so
+# the single-angle and array paths give the same bits. Norms use hypot for the
+# same reason.
 
 
 class _RRRStep:
@@ -297,7 +309,7 @@ class _RRRStep:
         p1, v1, a1 = ctx.points[self.start1]
         p2, v2, a2 = ctx.points[self.start2]
         d = p2 - p1
-        dist = abs(d)
+        dist = np.hypot(d.real, d.imag) if ctx.vector else abs(d)
         lsum = l1 + l2
         ldiff = l1 - l2
         # 4 * dist^2 * h^2 as a product of factors: no cancellation near toggle.
@@ -319,8 +331,9 @@ class _RRRStep:
         shared = ldiff * lsum
         height = self.branch * root * half
         u = d * (1.0 / dist)
-        r1 = ((shared + dist * dist) * half + 1j * height) * u
-        r2 = ((shared - dist * dist) * half + 1j * height) * u
+        across = 1j * height * u
+        r1 = (shared + dist * dist) * half * u + across
+        r2 = (shared - dist * dist) * half * u + across
         inv = 2.0 * self.branch / root  # 1 / cross(r1, r2)
         dv = v2 - v1
         w1 = _dot(dv, r2) * inv
@@ -328,7 +341,7 @@ class _RRRStep:
         da = a2 - a1 + w1 * w1 * r1 - w2 * w2 * r2
         al1 = _dot(da, r2) * inv
         al2 = _dot(da, r1) * inv
-        ctx.points[self.point] = (p1 + r1, v1 + 1j * w1 * r1, a1 + (1j * al1 - w1 * w1) * r1)
+        ctx.points[self.point] = (p1 + r1, v1 + 1j * w1 * r1, a1 + 1j * al1 * r1 - w1 * w1 * r1)
         ctx.links[self.link1] = (r1 * (1.0 / l1), w1, al1)
         ctx.links[self.link2] = (r2 * (1.0 / l2), w2, al2)
 
@@ -368,7 +381,7 @@ class _RRPStep:
         den = self.branch * root  # dot(u, r)
         inv = 1.0 / den
         s = along + den
-        r = (den - 1j * offset) * u
+        r = den * u - 1j * offset * u
         sd = _dot(vq, r) * inv
         omega = _cross(vq, u) * inv
         rest = aq - omega * omega * r
@@ -393,7 +406,7 @@ class _RPRStep:
     def run(self, ctx: _Context) -> None:
         b, vb, ab = ctx.points[self.through]
         d = b - self.center
-        s = abs(d)
+        s = np.hypot(d.real, d.imag) if ctx.vector else abs(d)
         # the slider coordinate relative to the mechanism's size.
         measure = s / self.size
         ctx.check(measure > SINGULAR, self.label, lambda: (
@@ -415,14 +428,17 @@ class _CarryStep:
         self.point = point.name
         self.link = point.link
         self.base = base  # the origin of the link's frame
-        self.local = local
+        self.along, self.across = local.real, local.imag
         self.uses = (base,)
 
     def run(self, ctx: _Context) -> None:
         e, omega, alpha = ctx.links[self.link]
         p, v, a = ctx.points[self.base]
-        r = e * self.local
-        ctx.points[self.point] = (p + r, v + 1j * omega * r, a + (1j * alpha - omega * omega) * r)
+        r = e * self.along
+        if self.across:
+            r = r + 1j * e * self.across
+        ctx.points[self.point] = (p + r, v + 1j * omega * r,
+                                  a + 1j * alpha * r - omega * omega * r)
 
 
 Step = _RRRStep | _RRPStep | _RPRStep | _CarryStep
@@ -453,9 +469,9 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
 
     ground = {}
     for name, (x, y) in scene.ground.items():
-        _check_name(name, 'a ground point name')
-        _check_finite(x, f'ground point "{name}" x')
-        _check_finite(y, f'ground point "{name}" y')
+        _check_name(name, 'a ground point name', (scene, f'ground.{name}'))
+        _check_finite(x, f'ground point "{name}" x', (scene, f'ground.{name}'))
+        _check_finite(y, f'ground point "{name}" y', (scene, f'ground.{name}'))
         define(name, 'point', (scene, f'ground.{name}'))
         ground[name] = complex(x, y)
     crank = scene.input
@@ -625,7 +641,7 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
         needed.add(index)
         step = steps[index]
         todo.extend(produces[name] for name in step.uses if name in produces)
-        if isinstance(step, _CarryStep):
+        if isinstance(step, _CarryStep) and step.link in produces:  # the crank is no step
             todo.append(produces[step.link])
     kept = tuple(step for index, step in enumerate(steps) if index in needed)
     return _Plan(_CrankStep(crank, ground[crank.center]), kept, ground,
@@ -674,7 +690,7 @@ class Scene:
 
     def __post_init__(self) -> None:
         """Validate the fields."""
-        _check_name(self.name, 'the scene name')
+        _check_name(self.name, 'the scene name', (self, 'name'))
         object.__setattr__(self, 'dyads', tuple(self.dyads))
         object.__setattr__(self, 'points', tuple(self.points))
         full = _compile(self, None, None)
@@ -826,10 +842,12 @@ def _run(plan: _Plan, angle: Any, speed: Any, accel: Any) -> _Context:
 
 def _angle(e: Any, vector: bool) -> Any:
     """Angle of unit complex ``e``, wrapped to (-pi, pi]."""
-    # Adding 0.0 turns an imaginary part of -0.0 into +0.0, so atan2 gives +pi, never -pi.
     if vector:
-        return np.arctan2(e.imag + 0.0, e.real)
-    return math.atan2(e.imag + 0.0, e.real)
+        theta = np.arctan2(e.imag, e.real)
+        theta[theta == -np.pi] = np.pi
+        return theta
+    theta = math.atan2(e.imag, e.real)
+    return math.pi if theta == -math.pi else theta
 
 
 def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None,

@@ -125,7 +125,7 @@ class _Reader:
     def point_xy(self, value: Any, where: str) -> tuple[float, float]:
         if not isinstance(value, list) or len(value) != 2:
             raise SceneError(f'{where}: expected [x, y], got {value!r}')
-        x, y = (self.number({'v': v}, 'v', where) for v in value)
+        x, y = (self.number({f'[{i}]': v}, f'[{i}]', where) for i, v in enumerate(value))
         return x / self.per_metre, y / self.per_metre
 
 
@@ -134,7 +134,9 @@ def _kind(value: Any) -> str:
 
 
 def _join(where: str, key: str) -> str:
-    return f'{where}.{key}' if where else key
+    if not where or not key:
+        return where or key
+    return f'{where}{key}' if key.startswith('[') else f'{where}.{key}'
 
 
 def _check_keys(mapping: dict[str, Any], allowed: set[str], where: str) -> None:
@@ -156,7 +158,9 @@ class _Keys:
         try:
             element = factory(**kwargs)
         except SceneError as error:
-            raise SceneError(f'{where}: {error}') from None
+            field = error.where[1] if error.where is not None else ''
+            key = _join(where, fields.get(field, field))
+            raise SceneError(f'{key}: {error}') from None
         self.paths[id(element)] = (where, fields)
         return element
 
@@ -168,8 +172,7 @@ class _Keys:
         if id(element) not in self.paths:
             return field or 'scene'
         where, fields = self.paths[id(element)]
-        mapped = fields.get(field, field)
-        return _join(where, mapped) if mapped else where
+        return _join(where, fields.get(field, field))
 
 
 def parse_scene(data: Any) -> Scene:
@@ -201,7 +204,7 @@ def parse_scene(data: Any) -> Scene:
     _check_keys(raw if isinstance(raw, dict) else {}, set(InputDict.__annotations__), 'input')
     rpm = reader.number(raw, 'speed_rpm', 'input', 0.0)
     crank = keys.build(
-        'input', {'length': 'length'}, Crank,
+        'input', {'speed': 'speed_rpm'}, Crank,
         link=reader.name(raw, 'link', 'input'), center=reader.name(raw, 'center', 'input'),
         point=reader.name(raw, 'point', 'input'), length=reader.length(raw, 'length', 'input'),
         angle=reader.angle(raw, 'angle', 'input', 0.0), speed=rpm * math.pi / 30.0,
@@ -265,7 +268,8 @@ def _dyad(reader: _Reader, keys: _Keys, raw: Any, where: str) -> RRR | RRP | RPR
         if isinstance(guide, dict):
             _check_keys(guide, {'through', 'angle'}, f'{where}.guide')
         return keys.build(
-            where, {'through': 'guide.through'}, RRP, point=reader.name(raw, 'point', where),
+            where, {'through': 'guide.through', 'guide_angle': 'guide.angle'}, RRP,
+            point=reader.name(raw, 'point', where),
             link=link, through=reader.name(guide, 'through', f'{where}.guide'),
             guide_angle=reader.angle(guide, 'angle', f'{where}.guide', 0.0),
             slider=reader.name(raw, 'slider', where), branch=reader.branch(raw, where))
@@ -283,7 +287,7 @@ def _carried(reader: _Reader, keys: _Keys, name: str, raw: Any, where: str) -> C
         raise SceneError(f'{where}: expected a mapping, got {_kind(raw)}')
     link = reader.name(raw, 'link', where)
     if 'from' in raw or 'toward' in raw or 'distance' in raw:
-        fields = {'name': '', 'origin': 'from', 'xaxis': 'toward'}
+        fields = {'name': '', 'origin': 'from', 'xaxis': 'toward', 'local': 'distance'}
         _check_keys(raw, {'link', 'from', 'toward', 'distance'}, where)
         origin = reader.name(raw, 'from', where)
         xaxis = reader.name(raw, 'toward', where)
