@@ -89,6 +89,9 @@ def build_parser() -> argparse.ArgumentParser:
     run.set_defaults(handler=lambda args: _module('live').main(args.rest))
     run.add_argument('rest', nargs=argparse.REMAINDER)
     _module('diagram').add_parser(commands)
+    _module('report').add_parser(commands)
+    _module('bag_recorder').add_parser(commands)
+    _module('plot').add_parser(commands)
     return parser
 
 

@@ -35,8 +35,9 @@ __all__ = [
 ]
 
 #: A dyad whose near-singularity measure falls below this is flagged as
-#: near-singular (:class:`NearSingularWarning`); its velocities lose about
-#: ``-log10(measure)`` digits and its accelerations up to three times that.
+#: near-singular (:class:`NearSingularWarning`); its velocities lose up to about
+#: ``2 * -log10(measure)`` digits (near a toggle the condition number grows as
+#: ``1 / measure**2``) and its accelerations up to three times ``-log10(measure)``.
 NEAR_SINGULAR = 1e-3
 #: At or below this measure a dyad is treated as singular and not solved.
 SINGULAR = 1e-12

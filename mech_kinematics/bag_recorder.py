@@ -1,0 +1,654 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""Record topics to a rosbag2 bag with no ROS install: ``python -m mech_kinematics record``.
+
+The recorder subscribes with *raw* subscriptions (the serialized CDR bytes,
+never decoded) and hands the bytes to the :mod:`rosbags` writer, the way
+``ros2 bag record`` hands them to rosbag2. What real ROS tools need to open
+the bag comes from the ROS graph and the installed interface files, as
+rosbag2 does it:
+
+- the type name (``sensor_msgs/msg/JointState``) and the offered QoS
+  profiles of the publishers (``get_publishers_info_by_topic``);
+- the type hash (``RIHS01_...``) the publishers announce;
+- the message definition: the ``.msg`` file of the type and of every type it
+  uses, from the ament index, concatenated with rosbag2's delimiters
+  (``rosbag2_cpp`` ``LocalMessageDefinitionSource``), encoding ``ros2msg``.
+
+Bag format version 8 is the default: its metadata is readable by Humble and
+later, while version 9 metadata is not readable by Humble (rosbag2#1895).
+Ctrl-C, SIGTERM or the end of ``--duration`` stop the recording, after which
+the subscriptions are destroyed and the bag is closed: every message received
+is in it.
+
+ROS is imported only when recording starts, so that the command line and the
+solver stay importable without it.
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+import importlib
+import math
+import os
+from pathlib import Path
+import re
+import signal
+import sys
+import threading
+import time
+from typing import Any
+
+from .errors import MechKinematicsError
+
+__all__ = [
+    'BAG_VERSIONS', 'BagRecorder', 'DEFAULT_BAG_VERSION', 'DEFAULT_EXECUTOR', 'DEFAULT_STORAGE',
+    'DEFAULT_TOPICS', 'EXECUTORS', 'RecorderError', 'STORAGES', 'TopicStats', 'add_parser',
+    'check_new_output', 'main', 'message_definition', 'record', 'run_command',
+]
+
+#: The node's topics (relative names: the recorder's namespace applies).
+DEFAULT_TOPICS = ('joint_states', 'joint_accelerations', 'point_accelerations', 'diagnostics')
+STORAGES = ('mcap', 'sqlite3')
+#: As ``ros2 bag record`` since Iron.
+DEFAULT_STORAGE = 'mcap'
+BAG_VERSIONS = (8, 9)
+#: Version 9 metadata is not readable by Humble (rosbag2#1895).
+DEFAULT_BAG_VERSION = 8
+NODE_NAME = 'mech_kinematics_recorder'
+#: How often the graph is searched for topics not subscribed yet, s (rosbag2: 100 ms).
+POLL_INTERVAL_S = 0.1
+#: Depth of each subscription's queue: 1 s of a 1 kHz topic.
+QUEUE_DEPTH = 1000
+#: Longest wait of one executor step, s: bounds the reaction to a signal or the deadline.
+SPIN_STEP_S = 0.05
+
+EXECUTORS = ('events', 'single')
+DEFAULT_EXECUTOR = 'events'
+
+_DELIMITER = '=' * 80 + '\n'
+# rosbag2_cpp LocalMessageDefinitionSource: the field types of a .msg file.
+_MSG_FIELD_TYPE = re.compile(r'(?:^|\n)\s*([a-zA-Z0-9_/]+)(?:\[[^\]]*\])?\s+')
+_IDL_INCLUDE = re.compile(r'(?:^|\n)#include\s+(?:"|<)([a-zA-Z0-9_/]+)\.idl(?:"|>)')
+_PRIMITIVE_TYPES = frozenset((
+    'bool', 'byte', 'char', 'float32', 'float64', 'int8', 'uint8', 'int16', 'uint16', 'int32',
+    'uint32', 'int64', 'uint64', 'string'))
+_MAX_DEPTH = 50
+
+
+class RecorderError(MechKinematicsError):
+    """A recording cannot start or cannot continue (bad output path, options, type)."""
+
+
+# -- message definitions ---------------------------------------------------------
+
+
+def _share_directory(package: str) -> Path:
+    """Return ``share/<package>`` of the first prefix whose ament index lists ``package``.
+
+    The prefixes are those of ``AMENT_PREFIX_PATH`` (a sourced ROS install or
+    workspace), then this Python environment's own prefix, where the ROS 2
+    wheels from PyPI install ``share/`` without setting ``AMENT_PREFIX_PATH``.
+    """
+    prefixes = [p for p in os.environ.get('AMENT_PREFIX_PATH', '').split(os.pathsep) if p]
+    prefixes.append(sys.prefix)
+    for prefix in prefixes:
+        marker = Path(prefix, 'share', 'ament_index', 'resource_index', 'packages', package)
+        if marker.is_file():
+            return Path(prefix, 'share', package)
+    msg = (f'Expected package "{package}" in the ament index of one of {prefixes}, '
+           f'got no such package')
+    raise RecorderError(msg)
+
+
+def _split_type(type_name: str) -> tuple[str, str, str]:
+    parts = type_name.split('/')
+    if len(parts) == 2:
+        return parts[0], 'msg', parts[1]
+    if len(parts) == 3:
+        return parts[0], parts[1], parts[2]
+    msg = f'Expected a type name such as "sensor_msgs/msg/JointState", got "{type_name}"'
+    raise RecorderError(msg)
+
+
+def message_definition(type_name: str) -> tuple[str, str]:
+    """Return ``(encoding, text)``: the full definition of ``type_name`` as rosbag2 stores it.
+
+    The text is the type's ``.msg`` file followed by the file of every type
+    it depends on, each once, after a line of 80 ``=`` and ``MSG: pkg/Type``,
+    dependencies in sorted order, depth first: the algorithm of rosbag2_cpp's
+    ``LocalMessageDefinitionSource::get_full_text``. Where a ``.msg`` file is
+    missing the ``.idl`` files are used (encoding ``ros2idl``).
+
+    Parameters
+    ----------
+    type_name : str
+        E.g. ``sensor_msgs/msg/JointState``.
+
+    Returns
+    -------
+    encoding : str
+        ``'ros2msg'`` or ``'ros2idl'``.
+    text : str
+        The definition.
+
+    Raises
+    ------
+    RecorderError
+        If the package or an interface file cannot be found.
+    """
+    try:
+        return 'ros2msg', _full_text(type_name, 'msg')
+    except RecorderError as msg_error:
+        try:
+            return 'ros2idl', _delimiter(type_name, 'idl') + _full_text(type_name, 'idl')
+        except RecorderError:
+            raise msg_error from None
+
+
+def _delimiter(type_name: str, fmt: str) -> str:
+    return f'{_DELIMITER}{fmt.upper()}: {type_name}\n'
+
+
+def _full_text(root: str, fmt: str) -> str:
+    texts: dict[str, tuple[str, list[str]]] = {}
+
+    def load(type_name: str) -> tuple[str, list[str]]:
+        if type_name not in texts:
+            package, namespace, name = _split_type(type_name)
+            path = _share_directory(package) / namespace / f'{name}.{fmt}'
+            try:
+                text = path.read_text(encoding='utf-8')
+            except OSError as error:
+                msg = (f'Expected the definition of {type_name} in {path}, got '
+                       f'{error.strerror or error}')
+                raise RecorderError(msg) from None
+            if fmt == 'msg':
+                deps = set()
+                for match in _MSG_FIELD_TYPE.finditer(text):
+                    dep = match.group(1)
+                    if dep not in _PRIMITIVE_TYPES:
+                        deps.add(dep if '/' in dep else f'{package}/{dep}')
+            else:
+                deps = {m.group(1) for m in _IDL_INCLUDE.finditer(text)}
+            texts[type_name] = (text, sorted(deps))
+        return texts[type_name]
+
+    seen: set[str] = set()
+
+    def append(type_name: str, depth: int) -> str:
+        if depth <= 0:
+            msg = f'Expected the definition of {root} to nest less deeply, got {_MAX_DEPTH} levels'
+            raise RecorderError(msg)
+        text, deps = load(type_name)
+        out = [text]
+        for dep in deps:
+            if dep not in seen:
+                seen.add(dep)
+                out.append('\n' + _delimiter(dep, fmt) + append(dep, depth - 1))
+        return ''.join(out)
+
+    return append(root, _MAX_DEPTH)
+
+
+# -- QoS -------------------------------------------------------------------------
+
+
+def _qos_from_profile(profile: Any) -> Any:
+    """Return the rosbags ``Qos`` of an rclpy ``QoSProfile``, durations as rmw reports them."""
+    from rosbags.interfaces import (Qos, QosDurability, QosHistory, QosLiveliness,
+                                    QosReliability, QosTime)
+
+    def duration(value: Any) -> QosTime:
+        # RMW_DURATION_INFINITE is {9223372036 s, 854775807 ns}, as rosbag2 writes it.
+        return QosTime(*divmod(int(value.nanoseconds), 1_000_000_000))
+
+    return Qos(QosHistory(int(profile.history)), int(profile.depth),
+               QosReliability(int(profile.reliability)), QosDurability(int(profile.durability)),
+               duration(profile.deadline), duration(profile.lifespan),
+               QosLiveliness(int(profile.liveliness)),
+               duration(profile.liveliness_lease_duration),
+               bool(profile.avoid_ros_namespace_conventions))
+
+
+def _request_qos(offers: Sequence[Any]) -> Any:
+    """Return the subscription QoS that matches every offer (rosbag2 ``adapt_request_to_offers``).
+
+    Reliable if every publisher is reliable, transient-local if every
+    publisher is; the queue is :data:`QUEUE_DEPTH` deep.
+    """
+    from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy)
+
+    reliable = bool(offers) and all(p.reliability == ReliabilityPolicy.RELIABLE for p in offers)
+    latched = bool(offers) and all(p.durability == DurabilityPolicy.TRANSIENT_LOCAL
+                                   for p in offers)
+    return QoSProfile(
+        history=HistoryPolicy.KEEP_LAST, depth=QUEUE_DEPTH,
+        reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT,
+        durability=DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE)
+
+
+def _make_executor(kind: str, context: Any) -> Any:
+    from rclpy.executors import SingleThreadedExecutor
+
+    if kind == 'events':
+        try:
+            from rclpy.experimental import EventsExecutor  # type: ignore[attr-defined]
+        except ImportError:     # rclpy before the EventsExecutor (Jazzy and older)
+            pass
+        else:
+            return EventsExecutor(context=context)
+    return SingleThreadedExecutor(context=context)
+
+
+def _message_class(type_name: str) -> Any:
+    package, namespace, name = _split_type(type_name)
+    try:
+        return getattr(importlib.import_module(f'{package}.{namespace}'), name)
+    except (ImportError, AttributeError):
+        msg = (f'Expected the Python message package of {type_name} to be installed, got no '
+               f'module {package}.{namespace} with {name}')
+        raise RecorderError(msg) from None
+
+
+# -- the recorder ----------------------------------------------------------------
+
+
+@dataclass
+class TopicStats:
+    """What happened to one requested topic."""
+
+    name: str
+    type: str = ''
+    received: int = 0
+    written: int = 0
+    error: str = ''
+
+
+@dataclass
+class _Topic:
+    stats: TopicStats
+    subscription: Any = None
+    connection: Any = None
+    failed: bool = False
+
+
+class BagRecorder:
+    """Subscribe to topics as they appear and write every message to a rosbag2 bag.
+
+    Parameters
+    ----------
+    output : path-like
+        The bag directory to create; it must not exist.
+    topics : sequence of str
+        Topic names; relative names are resolved in the recorder's namespace.
+    storage : {'mcap', 'sqlite3'}
+        Storage plugin.
+    version : {8, 9}
+        Bag format version.
+    args : list of str, optional
+        Command-line arguments for ``rclpy.init`` (``--ros-args ...``).
+    executor : {'events', 'single'}
+        ``'events'``: rclpy's ``EventsExecutor`` (about half the CPU of the
+        other at 3 kHz of messages), or ``'single'``: ``SingleThreadedExecutor``,
+        which is also used where this rclpy has no ``EventsExecutor``.
+
+    Raises
+    ------
+    RecorderError
+        If ``output`` exists or an option is out of range.
+    """
+
+    def __init__(self, output: str | os.PathLike[str], topics: Sequence[str] = DEFAULT_TOPICS,
+                 *, storage: str = DEFAULT_STORAGE, version: int = DEFAULT_BAG_VERSION,
+                 args: list[str] | None = None, executor: str = DEFAULT_EXECUTOR) -> None:
+        self.output = Path(output)
+        check_new_output(self.output)
+        if storage not in STORAGES:
+            msg = f'Expected storage to be one of {", ".join(STORAGES)}, got {storage!r}'
+            raise RecorderError(msg)
+        if version not in BAG_VERSIONS:
+            msg = f'Expected bag version to be one of {BAG_VERSIONS}, got {version!r}'
+            raise RecorderError(msg)
+        if not topics:
+            msg = 'Expected at least one topic to record, got none'
+            raise RecorderError(msg)
+        if executor not in EXECUTORS:
+            msg = f'Expected executor to be one of {", ".join(EXECUTORS)}, got {executor!r}'
+            raise RecorderError(msg)
+        self.storage = storage
+        self.version = version
+        self.executor = executor
+        self._stop = threading.Event()
+        self._rclpy_args = args
+        self._requested = list(dict.fromkeys(topics))
+        self._topics: dict[str, _Topic] = {}
+        self._node: Any = None
+        self._context: Any = None
+        self._executor: Any = None
+        self._writer: Any = None
+        #: time.monotonic() of the first subscription, None before.
+        self.recording_since: float | None = None
+        #: Seconds from the first subscription to close() (0 if nothing was subscribed).
+        self.recorded_seconds = 0.0
+
+    # -- life cycle ---------------------------------------------------------------
+
+    def open(self) -> None:
+        """Start ROS, resolve the topic names and create the bag (empty until topics appear)."""
+        import rclpy
+        from rclpy.signals import SignalHandlerOptions
+        from rosbags.rosbag2 import StoragePlugin, Writer
+        from rosbags.rosbag2.errors import WriterError
+
+        self._context = rclpy.Context()
+        # The recorder handles SIGINT and SIGTERM itself (a flag, see run()), so that a
+        # signal can never cut a write in half.
+        rclpy.init(args=self._rclpy_args, context=self._context,
+                   signal_handler_options=SignalHandlerOptions.NO)
+        try:
+            self._node = rclpy.create_node(NODE_NAME, context=self._context)
+            for name in self._requested:
+                try:
+                    resolved = self._node.resolve_topic_name(name)
+                except Exception as error:    # noqa: BLE001 - rclpy raises several kinds
+                    msg = f'Expected a valid topic name, got {name!r}: {error}'
+                    raise RecorderError(msg) from None
+                self._topics.setdefault(resolved, _Topic(TopicStats(resolved)))
+            self._executor = _make_executor(self.executor, self._context)
+            self._executor.add_node(self._node)
+            try:
+                writer = Writer(self.output, version=self.version,  # type: ignore[arg-type]
+                                storage_plugin=StoragePlugin[self.storage.upper()])
+                writer.open()
+            except WriterError as error:
+                msg = f'Expected a new bag directory, got {error}'
+                raise RecorderError(msg) from None
+            self._writer = writer
+            self._node.create_timer(POLL_INTERVAL_S, self._discover)
+        except BaseException:
+            self._shutdown_ros()
+            raise
+        self._node.get_logger().info(
+            f'recording to {self.output} ({self.storage}, bag version {self.version}); '
+            f'topics: {", ".join(self._topics)}')
+        self._discover()
+
+    def request_stop(self) -> None:
+        """Ask :meth:`run` to return (safe from a signal handler or another thread)."""
+        self._stop.set()
+
+    def run(self, duration: float | None = None) -> None:
+        """Record until :meth:`request_stop`, or ``duration`` s after the first subscription.
+
+        The duration counts from the moment the first topic is subscribed, so
+        that discovery (a few seconds for a node that is already running) and
+        waiting for topics do not shorten the recording.
+        """
+        assert self._executor is not None, 'call open() first'
+        spin_once = self._executor.spin_once
+        while not self._stop.is_set():
+            step = SPIN_STEP_S
+            if duration is not None and self.recording_since is not None:
+                remaining = self.recording_since + duration - time.monotonic()
+                if remaining <= 0:
+                    break
+                step = min(step, remaining)
+            spin_once(timeout_sec=step)
+
+    def close(self) -> list[TopicStats]:
+        """Stop receiving, close the bag (metadata.yaml included) and shut ROS down.
+
+        Returns
+        -------
+        list of TopicStats
+            Per requested topic: type, messages received and written.
+        """
+        if self.recording_since is not None:
+            self.recorded_seconds = time.monotonic() - self.recording_since
+        try:
+            if self._node is not None:
+                for topic in self._topics.values():
+                    if topic.subscription is not None:
+                        self._node.destroy_subscription(topic.subscription)
+                        topic.subscription = None
+            if self._writer is not None:
+                writer, self._writer = self._writer, None
+                for topic in self._topics.values():
+                    if topic.connection is not None:
+                        topic.stats.written = writer.counts[topic.connection.id]
+                writer.close()
+        finally:
+            self._shutdown_ros()
+        return self.stats
+
+    @property
+    def stats(self) -> list[TopicStats]:
+        """Per requested topic: type, messages received and written so far."""
+        return [topic.stats for topic in self._topics.values()]
+
+    def _shutdown_ros(self) -> None:
+        import rclpy
+
+        if self._executor is not None:
+            self._executor.shutdown(timeout_sec=1.0)
+            self._executor = None
+        if self._node is not None:
+            self._node.destroy_node()
+            self._node = None
+        if self._context is not None:
+            rclpy.try_shutdown(context=self._context)
+            self._context = None
+
+    # -- topics -------------------------------------------------------------------
+
+    def _discover(self) -> None:
+        """Subscribe to every requested topic that has publishers now (polled)."""
+        pending = [t for t in self._topics.values() if t.subscription is None and not t.failed]
+        if not pending or self._writer is None:
+            return
+        types = dict(self._node.get_topic_names_and_types())
+        for topic in pending:
+            name = topic.stats.name
+            offers = self._node.get_publishers_info_by_topic(name)
+            if name not in types or not offers:
+                continue
+            try:
+                self._subscribe(topic, types[name], offers)
+            except RecorderError as error:
+                topic.failed = True
+                topic.stats.error = str(error)
+                self._node.get_logger().error(f'not recording {name}: {error}')
+
+    def _subscribe(self, topic: _Topic, type_names: list[str], offers: list[Any]) -> None:
+        name = topic.stats.name
+        if len(type_names) != 1:
+            msg = f'Expected one type on {name}, got {", ".join(type_names)}'
+            raise RecorderError(msg)
+        type_name = type_names[0]
+        msg_class = _message_class(type_name)
+        _, text = message_definition(type_name)   # rosbags tells ros2msg from ros2idl
+        hashes = {str(info.topic_type_hash) for info in offers
+                  if info.topic_type == type_name and str(info.topic_type_hash)}
+        # Every publisher of a type announces the same hash; take it rather than recompute.
+        type_hash = min(hashes) if hashes else ''
+        profiles = [info.qos_profile for info in offers if info.topic_type == type_name]
+        if not type_hash:
+            msg = f'Expected the publishers of {name} to announce a type hash, got none'
+            raise RecorderError(msg)
+        topic.connection = self._writer.add_connection(
+            name, type_name, msgdef=text, rihs01=type_hash,
+            offered_qos_profiles=[_qos_from_profile(p) for p in profiles])
+        topic.stats.type = type_name
+        topic.subscription = self._node.create_subscription(
+            msg_class, name, self._callback(topic), _request_qos(profiles), raw=True)
+        if self.recording_since is None:
+            self.recording_since = time.monotonic()
+        self._node.get_logger().info(f'subscribed to {name} ({type_name})')
+
+    def _callback(self, topic: _Topic) -> Callable[[bytes], None]:
+        write = self._writer.write
+        connection = topic.connection
+        stats = topic.stats
+        now = self._node.get_clock().now
+
+        def on_message(data: bytes) -> None:
+            # Stamped with the node clock on receipt, as rosbag2 does (sim time if enabled).
+            stats.received += 1
+            write(connection, now().nanoseconds, data)
+
+        return on_message
+
+
+def check_new_output(path: Path) -> None:
+    """Raise :class:`RecorderError` unless ``path`` does not exist yet (never overwrite)."""
+    if path.exists() or path.is_symlink():
+        kind = 'directory' if path.is_dir() else 'file'
+        msg = (f'Expected a new bag directory, got "{path}", an existing {kind} '
+               f'(refusing to overwrite it; choose another name or remove it)')
+        raise RecorderError(msg)
+
+
+# -- command line ----------------------------------------------------------------
+
+
+def record(output: str | os.PathLike[str], topics: Sequence[str] = DEFAULT_TOPICS, *,
+           duration: float | None = None, storage: str = DEFAULT_STORAGE,
+           version: int = DEFAULT_BAG_VERSION, args: list[str] | None = None,
+           executor: str = DEFAULT_EXECUTOR) -> BagRecorder:
+    """Record ``topics`` to the new bag ``output`` until Ctrl-C, SIGTERM or ``duration`` s.
+
+    ``duration`` counts from the first subscription (see :meth:`BagRecorder.run`).
+
+    SIGINT and SIGTERM are caught while recording (in the main thread) and
+    end the recording cleanly; the bag is always closed.
+
+    Returns
+    -------
+    BagRecorder
+        Closed; its ``stats`` (per topic: type, messages received and written)
+        and ``recorded_seconds`` tell what was recorded.
+    """
+    if duration is not None and not (math.isfinite(duration) and duration > 0):
+        msg = f'Expected a positive duration in seconds, got {duration!r}'
+        raise RecorderError(msg)
+    recorder = BagRecorder(output, topics, storage=storage, version=version, args=args,
+                           executor=executor)
+    previous: dict[signal.Signals, Any] = {}
+    if threading.current_thread() is threading.main_thread():
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            previous[sig] = signal.signal(sig, lambda *_: recorder.request_stop())
+    try:
+        recorder.open()
+        try:
+            recorder.run(duration)
+        finally:
+            recorder.close()
+    finally:
+        # Restored only once the bag is closed: a second Ctrl-C cannot interrupt the close.
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+    return recorder
+
+
+def _positive_seconds(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        msg = f'expected a positive number of seconds, got {text!r}'
+        raise argparse.ArgumentTypeError(msg)
+    return value
+
+
+def _print_summary(recorder: BagRecorder) -> None:
+    stats = recorder.stats
+    width = max([len(s.name) for s in stats] + [5])
+    type_width = max([len(s.type) for s in stats] + [4])
+    print(f'recorded {recorder.recorded_seconds:.1f} s to {recorder.output} '
+          f'({recorder.storage}, bag version {recorder.version})')
+    print(f'{"topic":<{width}}  {"type":<{type_width}}  {"received":>9}  {"written":>9}')
+    for s in stats:
+        if s.type:
+            print(f'{s.name:<{width}}  {s.type:<{type_width}}  {s.received:>9}  {s.written:>9}')
+        else:
+            reason = s.error or 'never appeared'
+            print(f'{s.name:<{width}}  {"-":<{type_width}}  {"-":>9}  {"-":>9}  ({reason})')
+
+
+def run_command(args: argparse.Namespace) -> int:
+    """Handle ``record``: record, print a per-topic summary; return the exit status."""
+    output = Path(args.output)
+    rclpy_args = ['record', '--ros-args', *args.ros_args] if args.ros_args else ['record']
+    try:
+        recorder = record(output, args.topics, duration=args.duration, storage=args.storage,
+                          version=args.bag_version, args=rclpy_args, executor=args.executor)
+    except RecorderError as error:
+        print(f'error: {error}', file=sys.stderr)
+        return 2
+    _print_summary(recorder)
+    return 0
+
+
+RECORD_HELP = """\
+Record the node's topics (all four by default) to a new rosbag2 directory,
+readable by `ros2 bag info`, `ros2 bag play` and Foxglove: metadata.yaml plus
+one .mcap or .db3 file. Messages are stored as received (serialized CDR),
+stamped with the receive time. Topics not published yet are waited for and
+recorded from the moment they appear (discovering a node that is already
+running takes a few seconds). Ctrl-C, SIGTERM or the end of --duration
+(counted from the first subscription) end the recording and close the bag; a
+per-topic summary (received and written counts) is printed. An existing
+output directory is refused.
+"""
+
+
+def add_parser(subparsers: Any) -> argparse.ArgumentParser:
+    """Register the ``record`` subcommand on ``subparsers``; return its parser."""
+    parser: argparse.ArgumentParser = subparsers.add_parser(
+        'record', help="record the node's topics to a rosbag2 bag (mcap or sqlite3)",
+        description=RECORD_HELP, formatter_class=argparse.RawDescriptionHelpFormatter)
+    _add_arguments(parser)
+    parser.set_defaults(handler=run_command)
+    return parser
+
+
+def _add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument('-o', '--output', required=True, metavar='DIR',
+                        help='bag directory to create (must not exist)')
+    parser.add_argument('--topics', nargs='+', default=list(DEFAULT_TOPICS), metavar='T',
+                        help="topics to record; relative names take the recorder's namespace "
+                             f'(default: {" ".join(DEFAULT_TOPICS)})')
+    parser.add_argument('--duration', type=_positive_seconds, metavar='S',
+                        help='stop S seconds after the first topic is subscribed '
+                             '(default: at Ctrl-C or SIGTERM)')
+    parser.add_argument('--storage', choices=STORAGES, default=DEFAULT_STORAGE,
+                        help='storage plugin (default: %(default)s)')
+    parser.add_argument('--bag-version', type=int, choices=BAG_VERSIONS,
+                        default=DEFAULT_BAG_VERSION,
+                        help='rosbag2 format version; 9 is not readable by Humble '
+                             '(default: %(default)s)')
+    parser.add_argument('--executor', choices=EXECUTORS, default=DEFAULT_EXECUTOR,
+                        help='rclpy executor: events (EventsExecutor, the lighter) or single '
+                             '(SingleThreadedExecutor, used anyway where rclpy has no '
+                             'EventsExecutor) (default: %(default)s)')
+    parser.add_argument('--ros-args', nargs=argparse.REMAINDER, default=[], dest='ros_args',
+                        metavar='...', help='ROS arguments for the recorder node, e.g. '
+                                            '--ros-args -r __ns:=/robot1')
+
+
+def main(args: list[str] | None = None) -> int:
+    """Run ``record`` as a program; return the exit status."""
+    parser = argparse.ArgumentParser(prog='python -m mech_kinematics record',
+                                     description=RECORD_HELP,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    _add_arguments(parser)
+    namespace = parser.parse_args(args)
+    return run_command(namespace)
+
+
+if __name__ == '__main__':
+    sys.exit(main())

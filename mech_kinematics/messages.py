@@ -1,0 +1,164 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""ROS messages from a solved :class:`~mech_kinematics.State` (the node's output).
+
+``*_from_state`` build ordinary message objects; :class:`TickMessages` renders
+the same three messages as CDR bytes from templates, which is what the node
+publishes every tick. Both are tested to give byte-identical results.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+from builtin_interfaces.msg import Time
+from geometry_msgs.msg import Transform, Twist
+from sensor_msgs.msg import JointState
+from trajectory_msgs.msg import (JointTrajectory, JointTrajectoryPoint,
+                                 MultiDOFJointTrajectory, MultiDOFJointTrajectoryPoint)
+
+from .cdr import marker, MessageTemplate, STAMP_MARKER
+
+__all__ = [
+    'TickMessages', 'joint_state_from_state', 'joint_trajectory_from_state',
+    'multi_dof_trajectory_from_state',
+]
+
+
+def _stamp(sec: int, nanosec: int) -> Time:
+    return Time(sec=sec, nanosec=nanosec)
+
+
+def _joint_state(names: Sequence[str], frame_id: str, stamp: Time,
+                 position: list[float], velocity: list[float]) -> JointState:
+    msg = JointState(name=list(names), position=position, velocity=velocity)
+    msg.header.stamp = stamp
+    msg.header.frame_id = frame_id
+    return msg
+
+
+def _joint_trajectory(names: Sequence[str], frame_id: str, stamp: Time,
+                      values: Sequence[list[float]]) -> JointTrajectory:
+    positions, velocities, accelerations = values
+    msg = JointTrajectory(joint_names=list(names), points=[JointTrajectoryPoint(
+        positions=positions, velocities=velocities, accelerations=accelerations)])
+    msg.header.stamp = stamp
+    msg.header.frame_id = frame_id
+    return msg
+
+
+def _multi_dof(names: Sequence[str], frame_id: str, stamp: Time,
+               xy: Sequence[list[float]]) -> MultiDOFJointTrajectory:
+    """Build the point message; ``xy`` holds flat [x0, y0, x1, y1, ...] for p, v, a."""
+    p, v, a = xy
+    point = MultiDOFJointTrajectoryPoint()
+    for i in range(len(names)):
+        transform = Transform()
+        transform.translation.x, transform.translation.y = p[2 * i], p[2 * i + 1]
+        transform.rotation.w = 1.0
+        velocity = Twist()
+        velocity.linear.x, velocity.linear.y = v[2 * i], v[2 * i + 1]
+        acceleration = Twist()
+        acceleration.linear.x, acceleration.linear.y = a[2 * i], a[2 * i + 1]
+        point.transforms.append(transform)
+        point.velocities.append(velocity)
+        point.accelerations.append(acceleration)
+    msg = MultiDOFJointTrajectory(joint_names=list(names), points=[point])
+    msg.header.stamp = stamp
+    msg.header.frame_id = frame_id
+    return msg
+
+
+def _joint_values(state: Any, names: Sequence[str]) -> tuple[list[float], ...]:
+    joints = state.joints
+    return ([float(joints[n].position) for n in names],
+            [float(joints[n].velocity) for n in names],
+            [float(joints[n].acceleration) for n in names])
+
+
+def _point_values(state: Any, names: Sequence[str]) -> tuple[list[float], ...]:
+    out: tuple[list[float], ...] = ([], [], [])
+    for n in names:
+        for values, z in zip(out, state.complex_points[n], strict=True):
+            values.append(float(z.real))
+            values.append(float(z.imag))
+    return out
+
+
+def joint_state_from_state(state: Any, names: Sequence[str], frame_id: str,
+                           sec: int, nanosec: int) -> JointState:
+    """Return ``sensor_msgs/JointState``: name, position and velocity of the joints ``names``."""
+    position, velocity, _ = _joint_values(state, names)
+    return _joint_state(names, frame_id, _stamp(sec, nanosec), position, velocity)
+
+
+def joint_trajectory_from_state(state: Any, names: Sequence[str], frame_id: str,
+                                sec: int, nanosec: int) -> JointTrajectory:
+    """Return ``trajectory_msgs/JointTrajectory``: one point with positions, velocities, accels."""
+    return _joint_trajectory(names, frame_id, _stamp(sec, nanosec), _joint_values(state, names))
+
+
+def multi_dof_trajectory_from_state(state: Any, names: Sequence[str], frame_id: str,
+                                    sec: int, nanosec: int) -> MultiDOFJointTrajectory:
+    """Return ``trajectory_msgs/MultiDOFJointTrajectory``: one point, position/velocity/acceleration of every point ``names`` (z = 0, rotation identity)."""  # noqa: E501
+    return _multi_dof(names, frame_id, _stamp(sec, nanosec), _point_values(state, names))
+
+
+class TickMessages:
+    """The three state messages of a tick, rendered as CDR bytes from templates.
+
+    Parameters
+    ----------
+    joints : sequence of str
+        Joint names, in publish order.
+    points : sequence of str
+        Point names, in publish order.
+    frame_id : str
+        ``header.frame_id`` of every message.
+    """
+
+    def __init__(self, joints: Sequence[str], points: Sequence[str], frame_id: str) -> None:
+        self.joints = tuple(joints)
+        self.points = tuple(points)
+        nj, npt = len(self.joints), len(self.points)
+        stamp = _stamp(*STAMP_MARKER)
+
+        def slots(start: int, count: int) -> list[float]:
+            return [marker(i) for i in range(start, start + count)]
+
+        self._joint_state = MessageTemplate(
+            _joint_state(self.joints, frame_id, stamp, slots(0, nj), slots(nj, nj)), 2 * nj)
+        self._joint_trajectory = MessageTemplate(_joint_trajectory(
+            self.joints, frame_id, stamp, (slots(0, nj), slots(nj, nj), slots(2 * nj, nj))),
+            3 * nj)
+        self._points = MessageTemplate(_multi_dof(
+            self.points, frame_id, stamp,
+            (slots(0, 2 * npt), slots(2 * npt, 2 * npt), slots(4 * npt, 2 * npt))), 6 * npt)
+
+    def render(self, state: Any, sec: int, nanosec: int) -> tuple[bytes, bytes, bytes]:
+        """Return (joint_states, joint_accelerations, point_accelerations) as CDR bytes."""
+        joints = state.joints
+        values: list[float] = []
+        velocities: list[float] = []
+        accelerations: list[float] = []
+        for name in self.joints:
+            joint = joints[name]
+            values.append(joint.position)
+            velocities.append(joint.velocity)
+            accelerations.append(joint.acceleration)
+        values += velocities
+        joint_state = self._joint_state.render(sec, nanosec, values)
+        values += accelerations
+        joint_trajectory = self._joint_trajectory.render(sec, nanosec, values)
+        complex_points = state.complex_points
+        p: list[float] = []
+        v: list[float] = []
+        a: list[float] = []
+        for name in self.points:
+            zp, zv, za = complex_points[name]
+            p += (zp.real, zp.imag)
+            v += (zv.real, zv.imag)
+            a += (za.real, za.imag)
+        points = self._points.render(sec, nanosec, p + v + a)
+        return joint_state, joint_trajectory, points

@@ -1,0 +1,622 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""Plots of a mechanism's motion from a bag or the solver: ``python -m mech_kinematics plot``.
+
+``plot BAG -o FILE.png`` reads a bag recorded from the node (by ``record``
+or by ``ros2 bag record``; mcap or sqlite3) with :mod:`rosbags`;
+``plot --scene SCENE -o FILE.png`` solves one crank cycle. Both draw, against
+time or crank angle, in SI units:
+
+- joint angles, angular velocities and angular accelerations (revolute joints);
+- slider positions, velocities and accelerations (prismatic joints, if any);
+- the paths of the points, and the magnitudes of their velocities and
+  accelerations.
+
+Figures are built with Matplotlib's object API (``Figure``, no pyplot), so no
+display or backend choice is involved: PNG goes through Agg. Matplotlib and
+rosbags are imported inside the functions, so importing this module is cheap.
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+import math
+import os
+from pathlib import Path
+import struct
+import sys
+from typing import Any
+import warnings
+
+import numpy as np
+import numpy.typing as npt
+
+from .errors import MechKinematicsError
+
+__all__ = [
+    'DEFAULT_MAX_SAMPLES', 'DEFAULT_SAMPLES', 'Motion', 'PlotError', 'add_parser',
+    'figure_from_motion', 'main', 'motion_from_bag', 'motion_from_scene', 'plot_bag',
+    'plot_scene', 'run_command', 'save_figure',
+]
+
+Array = npt.NDArray[np.float64]
+
+#: Samples over one crank cycle for a scene (every half degree).
+DEFAULT_SAMPLES = 721
+#: Most ticks decoded from a bag (a 1 kHz minute has 60 000); more draw no differently.
+DEFAULT_MAX_SAMPLES = 20_000
+AXES = ('time', 'angle')
+#: Panel titles, by column; tests and readers rely on them.
+TITLES = {
+    'joint_position': 'Joint angles',
+    'joint_velocity': 'Joint angular velocities',
+    'joint_acceleration': 'Joint angular accelerations',
+    'point_path': 'Point paths',
+    'point_speed': 'Point speeds |v|',
+    'point_acceleration': 'Point accelerations |a|',
+    'slider_position': 'Slider positions',
+    'slider_velocity': 'Slider velocities',
+    'slider_acceleration': 'Slider accelerations',
+}
+YLABELS = {
+    'joint_position': 'angle [rad]',
+    'joint_velocity': 'angular velocity [rad/s]',
+    'joint_acceleration': 'angular acceleration [rad/s²]',
+    'point_path': 'y [m]',
+    'point_speed': 'speed [m/s]',
+    'point_acceleration': 'acceleration [m/s²]',
+    'slider_position': 'position [m]',
+    'slider_velocity': 'velocity [m/s]',
+    'slider_acceleration': 'acceleration [m/s²]',
+}
+XLABELS = {'time': 'time [s]', 'angle': 'crank angle θ [rad]', 'path': 'x [m]'}
+#: The node's topics, by message type.
+_JOINT_STATE = 'sensor_msgs/msg/JointState'
+_JOINT_TRAJECTORY = 'trajectory_msgs/msg/JointTrajectory'
+_POINT_TRAJECTORY = 'trajectory_msgs/msg/MultiDOFJointTrajectory'
+_DIAGNOSTICS = 'diagnostic_msgs/msg/DiagnosticArray'
+_TOPICS = {_JOINT_STATE: 'joint_states', _JOINT_TRAJECTORY: 'joint_accelerations',
+           _POINT_TRAJECTORY: 'point_accelerations', _DIAGNOSTICS: 'diagnostics'}
+NS_PER_S = 1_000_000_000
+
+
+class PlotError(MechKinematicsError):
+    """A plot cannot be made from the given bag or scene."""
+
+
+@dataclass(frozen=True)
+class Motion:
+    """A mechanism's kinematic state at n instants (one crank cycle or a recording).
+
+    Attributes
+    ----------
+    title : str
+        What the data are, for the figure's title.
+    crank_angle : ndarray, shape (n,)
+        Crank angle, rad.
+    time : ndarray, shape (n,) or None
+        Time from the first sample, s; None where it means nothing.
+    joint_types : dict of str to str
+        ``'revolute'`` or ``'prismatic'`` per joint, in order.
+    joints : dict of str to (ndarray, ndarray, ndarray or None)
+        Position (rad or m), velocity and acceleration (None if not
+        available), each of shape (n,).
+    points : dict of str to (ndarray, ndarray, ndarray or None)
+        Position (m), velocity (m/s) and acceleration (m/s², None if not
+        available), each of shape (n, 2).
+    """
+
+    title: str
+    crank_angle: Array
+    time: Array | None
+    joint_types: Mapping[str, str]
+    joints: Mapping[str, tuple[Array, Array, Array | None]]
+    points: Mapping[str, tuple[Array, Array, Array | None]]
+
+
+# -- from the solver -------------------------------------------------------------
+
+
+def motion_from_scene(scene: Any, *, samples: int = DEFAULT_SAMPLES,
+                      speed: float | None = None, accel: float | None = None,
+                      x: str = 'angle') -> Motion:
+    """Solve ``scene`` over one crank cycle.
+
+    Parameters
+    ----------
+    scene : Scene
+        The mechanism.
+    samples : int
+        Number of crank angles.
+    speed, accel : float, optional
+        Crank speed (rad/s) and acceleration (rad/s²); the scene's by default.
+    x : {'angle', 'time'}
+        ``'angle'``: crank angles 0 to 2π. ``'time'``: one period 2π/|speed|
+        from the scene's initial angle, turning at the constant ``speed``.
+
+    Returns
+    -------
+    Motion
+        Positions where the mechanism cannot be assembled are NaN.
+    """
+    import mech_kinematics as mk
+
+    if samples < 2:
+        msg = f'Expected at least 2 samples, got {samples}'
+        raise PlotError(msg)
+    speed = scene.input.speed if speed is None else float(speed)
+    accel = scene.input.accel if accel is None else float(accel)
+    time = None
+    if x == 'time':
+        if speed == 0.0:
+            msg = 'Expected a non-zero crank speed for a time axis, got 0 rad/s'
+            raise PlotError(msg)
+        time = np.linspace(0.0, 2.0 * math.pi / abs(speed), samples)
+        angle = scene.input.angle + speed * time
+    else:
+        angle = np.linspace(0.0, 2.0 * math.pi, samples)
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore', mk.NearSingularWarning)
+        state = mk.solve(scene, angle, speed, accel)
+    joints = {name: (j.position, j.velocity, j.acceleration) for name, j in state.joints.items()}
+    points = {name: (p.position, p.velocity, p.acceleration) for name, p in state.points.items()}
+    rpm = speed * 30.0 / math.pi
+    title = (f'{scene.name}: solver, one crank cycle at {rpm:.6g} rpm'
+             + (f', {accel:.6g} rad/s²' if accel else ''))
+    return Motion(title, np.asarray(angle, dtype=np.float64), time, scene.joint_types, joints,
+                  points)
+
+
+# -- from a bag ------------------------------------------------------------------
+
+
+def _decoder(typestore: Any, type_name: str) -> Any:
+    """Return a function that decodes CDR bytes of ``type_name`` with ``typestore``.
+
+    Unlike ``Typestore.deserialize_cdr`` it accepts bytes past the end of the
+    message: rclpy's ``serialize_message`` on Fast DDS (and so a publisher of
+    pre-serialized bytes) can leave a few, which ``rclpy``, rosbag2 and Foxglove
+    ignore and rosbags 0.11 refuses ("CDR message size mismatch").
+    """
+    msgdef = typestore.get_msgdef(type_name)
+    cls = msgdef.cls
+
+    def decode(raw: bytes | memoryview) -> Any:
+        func = msgdef.deserialize_cdr_le if raw[1] & 1 else msgdef.deserialize_cdr_be
+        return func(raw[4:], 0, cls, typestore)[0]
+
+    return decode
+
+
+def _pick(connections: Sequence[Any], type_name: str, namespace: str | None) -> Any | None:
+    found = [c for c in connections if c.msgtype == type_name
+             and c.topic.rsplit('/', 1)[-1] == _TOPICS[type_name]
+             and (namespace is None or c.topic.rsplit('/', 1)[0] == namespace.rstrip('/'))]
+    if len(found) > 1:
+        topics = ', '.join(c.topic for c in found)
+        msg = f'Expected one {_TOPICS[type_name]} topic, got {topics}: pass --namespace'
+        raise PlotError(msg)
+    return found[0] if found else None
+
+
+def motion_from_bag(path: str | os.PathLike[str], *, scene: Any = None,
+                    namespace: str | None = None,
+                    max_samples: int | None = DEFAULT_MAX_SAMPLES) -> Motion:
+    """Read the node's topics from the bag at ``path``.
+
+    Joint positions, velocities and accelerations come from
+    ``joint_accelerations`` (``joint_states`` if that is missing: no
+    accelerations then), points from ``point_accelerations``; time is the
+    messages' ``header.stamp`` from the first one. Only the ticks found on
+    both topics are kept (matched by stamp).
+
+    Parameters
+    ----------
+    path : path-like
+        A rosbag2 directory (mcap or sqlite3).
+    scene : Scene, optional
+        Tells revolute from prismatic joints and names the crank. By default
+        the scene named in the bag's ``diagnostics`` (``hardware_id``) if it is
+        a packaged scene with the same joints; otherwise every joint is taken
+        as revolute and the first joint as the crank, with a warning.
+    namespace : str, optional
+        Namespace of the node's topics, if the bag holds more than one node's.
+    max_samples : int or None
+        Keep every k-th tick so that at most this many are decoded (a figure
+        shows no more); None keeps every tick.
+
+    Raises
+    ------
+    PlotError
+        If the bag cannot be read or holds none of the node's topics.
+    """
+    from rosbags.highlevel import AnyReader, AnyReaderError
+    from rosbags.typesys import get_typestore, Stores
+
+    import mech_kinematics as mk
+
+    path = Path(path)
+    if not path.exists():
+        msg = f'Expected a bag directory, got "{path}", which does not exist'
+        raise PlotError(msg)
+    try:
+        with AnyReader([path], default_typestore=get_typestore(Stores.LATEST)) as reader:
+            picked = {t: _pick(reader.connections, t, namespace) for t in _TOPICS}
+            joints_conn = picked[_JOINT_TRAJECTORY] or picked[_JOINT_STATE]
+            points_conn = picked[_POINT_TRAJECTORY]
+            if joints_conn is None and points_conn is None:
+                topics = ', '.join(sorted({c.topic for c in reader.connections})) or 'none'
+                msg = (f"Expected the node's joint_accelerations, joint_states or "
+                       f'point_accelerations in {path}, got topics: {topics}')
+                raise PlotError(msg)
+            wanted = [c for c in (joints_conn, points_conn) if c is not None]
+            # Pass 1: the header stamps only (no decoding); keep the ticks every topic has,
+            # thinned to at most max_samples. Pass 2: decode just those.
+            stamps: dict[int, set[int]] = {c.id: set() for c in wanted}
+            for connection, _, raw in reader.messages(connections=wanted):
+                stamps[connection.id].add(_header_stamp(raw))
+            common = sorted(set.intersection(*stamps.values()))
+            step = max(1, math.ceil(len(common) / max_samples)) if max_samples else 1
+            chosen = set(common[::step])
+            decoders = {c.id: _decoder(reader.typestore, c.msgtype) for c in wanted}
+            rows: dict[int, dict[int, Any]] = {c.id: {} for c in wanted}
+            for connection, _, raw in reader.messages(connections=wanted):
+                stamp = _header_stamp(raw)
+                if stamp in chosen and stamp not in rows[connection.id]:
+                    rows[connection.id][stamp] = decoders[connection.id](raw)
+            scene_name = ''
+            diagnostics = picked[_DIAGNOSTICS]
+            if diagnostics is not None and scene is None:
+                decode = _decoder(reader.typestore, _DIAGNOSTICS)
+                for _, _, raw in reader.messages(connections=[diagnostics]):
+                    statuses = decode(raw).status
+                    scene_name = next((s.hardware_id for s in statuses if s.hardware_id), '')
+                    break
+    except (AnyReaderError, OSError, KeyError, ValueError) as error:
+        if isinstance(error, PlotError):
+            raise
+        msg = f'Expected a readable rosbag2 bag at "{path}", got {type(error).__name__}: {error}'
+        raise PlotError(msg) from None
+
+    ticks = sorted(chosen)
+    joints_msgs = [rows[joints_conn.id][t] for t in ticks] if joints_conn is not None else []
+    points_msgs = [rows[points_conn.id][t] for t in ticks] if points_conn is not None else []
+    names, joint_arrays = _joint_arrays(joints_msgs, joints_conn)
+    point_names, point_arrays = _point_arrays(points_msgs)
+    if scene is None and scene_name:
+        try:
+            candidate = mk.load_scene(scene_name)
+        except mk.SceneError:
+            candidate = None
+        if candidate is not None and set(candidate.output_joints) == set(names):
+            scene = candidate
+    if scene is not None:
+        types = {n: scene.joint_types.get(n, 'revolute') for n in names}
+        crank = scene.input.link
+    else:
+        if any(names):
+            warnings.warn(f'{path}: no scene given or named in the bag; plotting every joint '
+                          f'as revolute and "{names[0]}" as the crank', stacklevel=2)
+        types = dict.fromkeys(names, 'revolute')
+        crank = names[0] if names else ''
+    joints = {n: joint_arrays[i] for i, n in enumerate(names)}
+    points = {n: point_arrays[i] for i, n in enumerate(point_names)}
+
+    stamps_ns = np.array(ticks, dtype=np.int64)
+    crank_angle = joints[crank][0] if crank in joints else np.full(len(ticks), np.nan)
+    time = (stamps_ns - stamps_ns[0]) / NS_PER_S if len(ticks) else np.zeros(0)
+    label = scene.name if scene is not None else (scene_name or 'unknown scene')
+    title = f'{label}: recording {path.name}, {time[-1] if len(time) else 0:.3g} s'
+    return Motion(title, crank_angle, time, types, joints, points)
+
+
+_STAMP_LE = struct.Struct('<iI')
+_STAMP_BE = struct.Struct('>iI')
+
+
+def _header_stamp(raw: bytes | memoryview) -> int:
+    """Return ``header.stamp`` in ns of CDR bytes of a message whose first field is a Header."""
+    sec, nanosec = (_STAMP_LE if raw[1] & 1 else _STAMP_BE).unpack_from(raw, 4)
+    return int(sec) * NS_PER_S + int(nanosec)
+
+
+def _joint_arrays(msgs: list[Any], connection: Any) -> tuple[list[str], list[Any]]:
+    if not msgs:
+        return [], []
+    if connection.msgtype == _JOINT_TRAJECTORY:
+        names = list(msgs[0].joint_names)
+        pos = np.array([m.points[0].positions for m in msgs], dtype=np.float64)
+        vel = np.array([m.points[0].velocities for m in msgs], dtype=np.float64)
+        acc = np.array([m.points[0].accelerations for m in msgs], dtype=np.float64)
+    else:
+        names = list(msgs[0].name)
+        pos = np.array([m.position for m in msgs], dtype=np.float64)
+        vel = np.array([m.velocity for m in msgs], dtype=np.float64)
+        acc = None
+    arrays = [(pos[:, i], vel[:, i], None if acc is None else acc[:, i])
+              for i in range(len(names))]
+    return names, arrays
+
+
+def _point_arrays(msgs: list[Any]) -> tuple[list[str], list[Any]]:
+    if not msgs:
+        return [], []
+    names = list(msgs[0].joint_names)
+    values = np.array([[(t.translation.x, t.translation.y, v.linear.x, v.linear.y,
+                         a.linear.x, a.linear.y)
+                        for t, v, a in zip(m.points[0].transforms, m.points[0].velocities,
+                                           m.points[0].accelerations, strict=True)]
+                       for m in msgs], dtype=np.float64)    # (n, points, 6)
+    arrays = [(values[:, i, 0:2], values[:, i, 2:4], values[:, i, 4:6])
+              for i in range(len(names))]
+    return names, arrays
+
+
+# -- the figure ------------------------------------------------------------------
+
+
+#: A step in time longer than this many typical steps is a gap in the data: no line across it.
+GAP_FACTOR = 3.0
+
+
+def _gaps(time: Array | None, n: int) -> Any:
+    """Return a mask, shape (n - 1,): where the time step is a gap (ticks not published)."""
+    if time is None or n < 3:
+        return np.zeros(max(n - 1, 0), dtype=bool)
+    steps = np.diff(time)
+    typical = float(np.median(steps))
+    return steps > GAP_FACTOR * typical if typical > 0 else np.zeros(len(steps), dtype=bool)
+
+
+def _broken(x: Array, y: Array, gaps: Any, *, x_wraps: bool,
+            y_wraps: bool) -> tuple[Array, Array]:
+    """Insert NaN at ``gaps`` and where ``x`` or ``y`` jumps by more than π (an angle wrap).
+
+    So that no line crosses a panel where there are no data.
+    """
+    jumps = np.array(gaps, dtype=bool, copy=True)
+    if x_wraps:
+        jumps |= np.abs(np.diff(x)) > math.pi
+    if y_wraps:
+        jumps |= np.abs(np.diff(y)) > math.pi
+    if not jumps.any():
+        return x, y
+    at = np.flatnonzero(jumps) + 1
+    return np.insert(x, at, np.nan), np.insert(y, at, np.nan)
+
+
+def _angle_ticks(ax: Any) -> None:
+    ticks = np.arange(5) * (math.pi / 2)
+    ax.set_xticks(ticks, ['0', 'π/2', 'π', '3π/2', '2π'])
+    ax.set_xlim(0.0, 2.0 * math.pi)
+
+
+def figure_from_motion(motion: Motion, *, x: str = 'time') -> Any:
+    """Return a matplotlib Figure of ``motion`` against ``x`` (``'time'`` or ``'angle'``).
+
+    Columns: revolute joints (angle, angular velocity, angular acceleration),
+    points (path, speed, acceleration magnitude) and, if the mechanism has
+    any, prismatic joints (position, velocity, acceleration). Every axis is
+    labelled with its unit.
+    """
+    from matplotlib.figure import Figure
+
+    if x not in AXES:
+        msg = f'Expected x to be one of {", ".join(AXES)}, got {x!r}'
+        raise PlotError(msg)
+    if x == 'time' and motion.time is None:
+        msg = f'Expected a time axis in {motion.title!r}, got none: use x="angle"'
+        raise PlotError(msg)
+    if x == 'time':
+        xs = np.asarray(motion.time, dtype=np.float64)
+    else:
+        # Into [0, 2π]; an angle already there stays (a cycle's end is 2π, not 0).
+        angle = np.asarray(motion.crank_angle, dtype=np.float64)
+        inside = (angle >= 0.0) & (angle <= 2.0 * math.pi)
+        xs = np.where(inside, angle, np.mod(angle, 2.0 * math.pi))
+    revolute = [n for n, t in motion.joint_types.items() if t == 'revolute' and n in motion.joints]
+    prismatic = [n for n, t in motion.joint_types.items()
+                 if t == 'prismatic' and n in motion.joints]
+    moving = [n for n, (_, v, a) in motion.points.items()
+              if np.nanmax(np.abs(v), initial=0.0) > 0.0
+              or (a is not None and np.nanmax(np.abs(a), initial=0.0) > 0.0)]
+    columns = [('joint_position', 'joint_velocity', 'joint_acceleration'),
+               ('point_path', 'point_speed', 'point_acceleration')]
+    if prismatic:
+        columns.append(('slider_position', 'slider_velocity', 'slider_acceleration'))
+    gaps = _gaps(motion.time, len(motion.crank_angle))
+    fig = Figure(figsize=(6.0 * len(columns), 9.0), layout='constrained')
+    grid = fig.subplots(3, len(columns), squeeze=False)
+    fig.suptitle(motion.title)
+
+    def series(kind: str) -> list[tuple[str, Array | None, bool]]:
+        """(label, values, values wrap at ±π) per line of a panel against ``x``."""
+        if kind.startswith('joint') or kind.startswith('slider'):
+            names = revolute if kind.startswith('joint') else prismatic
+            k = ('position', 'velocity', 'acceleration').index(kind.split('_')[1])
+            return [(n, motion.joints[n][k], k == 0 and kind.startswith('joint'))
+                    for n in names]
+        k = 1 if kind == 'point_speed' else 2
+        out: list[tuple[str, Array | None, bool]] = []
+        for n in moving:
+            vector = motion.points[n][k]
+            out.append((n, None if vector is None else np.hypot(vector[:, 0], vector[:, 1]),
+                        False))
+        return out
+
+    for col, kinds in enumerate(columns):
+        for row, kind in enumerate(kinds):
+            ax = grid[row, col]
+            ax.set_title(TITLES[kind])
+            ax.set_ylabel(YLABELS[kind])
+            ax.grid(True, alpha=0.3)
+            if kind == 'point_path':
+                _draw_paths(ax, motion, gaps)
+                continue
+            ax.set_xlabel(XLABELS[x])
+            if x == 'angle':
+                _angle_ticks(ax)
+            drawn = 0
+            for label, values, wraps in series(kind):
+                if values is None:
+                    continue
+                px, py = _broken(xs, values, gaps, x_wraps=x == 'angle', y_wraps=wraps)
+                ax.plot(px, py, label=label, linewidth=1.0)
+                drawn += 1
+            if drawn:
+                _legend(ax)
+            else:
+                ax.text(0.5, 0.5, 'no data', transform=ax.transAxes, ha='center',
+                        va='center', color='0.5')
+    return fig
+
+
+def _draw_paths(ax: Any, motion: Motion, gaps: Any) -> None:
+    ax.set_xlabel(XLABELS['path'])
+    ax.set_aspect('equal', adjustable='datalim')
+    for name, (p, v, _) in motion.points.items():
+        fixed = not np.nanmax(np.abs(v), initial=0.0) > 0.0
+        finite = np.isfinite(p).all(axis=1)
+        if not finite.any():
+            continue
+        if fixed:
+            x0, y0 = p[finite][0]
+            ax.plot([x0], [y0], marker='^', color='0.3', linestyle='none')
+            ax.annotate(name, (x0, y0), textcoords='offset points', xytext=(4, -12),
+                        color='0.3')
+        else:
+            px, py = _broken(p[:, 0], p[:, 1], gaps, x_wraps=False, y_wraps=False)
+            ax.plot(px, py, label=name, linewidth=1.0)
+    if ax.get_legend_handles_labels()[0]:
+        _legend(ax)
+
+
+def _legend(ax: Any) -> None:
+    """Put the legend beside the panel, where it hides no data."""
+    ax.legend(fontsize='small', loc='upper left', bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0,
+              frameon=False)
+
+
+def save_figure(fig: Any, output: str | os.PathLike[str]) -> Path:
+    """Write ``fig`` to ``output`` (format from the suffix, PNG at 120 dpi); return the path."""
+    output = Path(output)
+    fig.savefig(output, dpi=120)
+    return output
+
+
+def plot_bag(path: str | os.PathLike[str], output: str | os.PathLike[str], *,
+             x: str = 'time', scene: Any = None, namespace: str | None = None,
+             max_samples: int | None = DEFAULT_MAX_SAMPLES) -> Any:
+    """Plot the recording at ``path`` to ``output``; return the Figure."""
+    motion = motion_from_bag(path, scene=scene, namespace=namespace, max_samples=max_samples)
+    fig = figure_from_motion(motion, x=x)
+    save_figure(fig, output)
+    return fig
+
+
+def plot_scene(scene: Any, output: str | os.PathLike[str], *, x: str = 'angle',
+               samples: int = DEFAULT_SAMPLES, speed: float | None = None,
+               accel: float | None = None) -> Any:
+    """Plot one crank cycle of ``scene`` to ``output``; return the Figure."""
+    motion = motion_from_scene(scene, samples=samples, speed=speed, accel=accel, x=x)
+    fig = figure_from_motion(motion, x=x)
+    save_figure(fig, output)
+    return fig
+
+
+# -- command line ----------------------------------------------------------------
+
+
+PLOT_HELP = """\
+Plot joint angles, angular velocities and accelerations, slider motion, point
+paths and the magnitudes of point velocities and accelerations, in SI units,
+against time or crank angle, to an image file (PNG; no display needed).
+
+  plot BAG -o FILE.png             a bag recorded from the node (mcap or sqlite3)
+  plot --scene SCENE -o FILE.png   the solver over one crank cycle
+  plot BAG --scene SCENE ...       a bag, with the scene telling sliders from
+                                   revolute joints (by default the scene named
+                                   in the bag's diagnostics is used)
+"""
+
+
+def run_command(args: argparse.Namespace) -> int:
+    """Handle ``plot``; return the exit status."""
+    import mech_kinematics as mk
+
+    if args.bag is None and args.scene is None:
+        print('error: Expected a BAG or --scene SCENE, got neither', file=sys.stderr)
+        return 2
+    output = Path(args.output)
+    if not output.parent.is_dir():
+        print(f'error: Expected an existing folder for {output}, got none', file=sys.stderr)
+        return 2
+    speed = None if args.speed_rpm is None else args.speed_rpm * math.pi / 30.0
+    try:
+        scene = None if args.scene is None else mk.load_scene(args.scene)
+        if args.bag is not None:
+            plot_bag(args.bag, output, x=args.x or 'time', scene=scene,
+                     namespace=args.namespace, max_samples=args.max_samples or None)
+        else:
+            plot_scene(scene, output, x=args.x or 'angle', samples=args.samples, speed=speed,
+                       accel=args.accel)
+    except (PlotError, mk.SceneError) as error:
+        print(f'error: {error}', file=sys.stderr)
+        return 2
+    print(f'wrote {output}')
+    return 0
+
+
+def _finite(text: str) -> float:
+    value = float(text)
+    if not math.isfinite(value):
+        msg = f'expected a finite number, got {text!r}'
+        raise argparse.ArgumentTypeError(msg)
+    return value
+
+
+def _add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument('bag', nargs='?', metavar='BAG', help='rosbag2 directory to plot')
+    parser.add_argument('-o', '--output', required=True, metavar='FILE.png',
+                        help='image to write (format from the suffix: png, svg, pdf)')
+    parser.add_argument('--scene', metavar='SCENE',
+                        help='scene file or packaged scene name: plot the solver over one '
+                             'crank cycle, or (with BAG) name the joint types')
+    parser.add_argument('--x', choices=AXES,
+                        help='horizontal axis (default: time for a bag, angle for a scene)')
+    parser.add_argument('--namespace', metavar='NS',
+                        help="namespace of the node's topics, if the bag has several")
+    parser.add_argument('--max-samples', type=int, default=DEFAULT_MAX_SAMPLES, metavar='N',
+                        help='BAG: decode at most N ticks, evenly spread; 0 for all '
+                             '(default: %(default)s)')
+    parser.add_argument('--samples', type=int, default=DEFAULT_SAMPLES, metavar='N',
+                        help='crank angles per cycle for --scene (default: %(default)s)')
+    parser.add_argument('--speed-rpm', type=_finite, metavar='N',
+                        help="crank speed for --scene, rpm (default: the scene's)")
+    parser.add_argument('--accel', type=_finite, metavar='A',
+                        help="crank acceleration for --scene, rad/s^2 (default: the scene's)")
+
+
+def add_parser(subparsers: Any) -> argparse.ArgumentParser:
+    """Register the ``plot`` subcommand on ``subparsers``; return its parser."""
+    parser: argparse.ArgumentParser = subparsers.add_parser(
+        'plot', help='plot a bag or one crank cycle of a scene to a PNG',
+        description=PLOT_HELP, formatter_class=argparse.RawDescriptionHelpFormatter)
+    _add_arguments(parser)
+    parser.set_defaults(handler=run_command)
+    return parser
+
+
+def main(args: list[str] | None = None) -> int:
+    """Run ``plot`` as a program; return the exit status."""
+    parser = argparse.ArgumentParser(prog='python -m mech_kinematics plot',
+                                     description=PLOT_HELP,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    _add_arguments(parser)
+    return run_command(parser.parse_args(args))
+
+
+if __name__ == '__main__':
+    sys.exit(main())

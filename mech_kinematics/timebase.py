@@ -1,0 +1,256 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The crank angle as an exact function of clock time (no ROS needed).
+
+The drive is a sequence of *segments*. A segment starts at a clock instant
+(integer nanoseconds) with an exact crank position, a speed and an angular
+acceleration; the speed is clamped to ``+-max_speed`` and then held. Changing
+the speed, the acceleration or the bound starts a new segment at that instant
+from the exact position there, so the angle never jumps.
+
+Positions are kept in *turns* as exact rationals. Speeds given in rpm are
+exact rationals in turns/s already (``rpm / 60``); quantities given in
+radians are divided by a rational 2*pi good to 60 digits. Inside a segment the
+position in turns is ``(n0 + n1*tau + n2*tau**2) / den`` with integers
+``n0, n1, n2, den`` and ``tau`` the integer nanoseconds since the segment
+start, so the wrap to one turn is an exact integer remainder and the only
+rounding is the final conversion of the fraction of a turn to a float angle.
+After 30 days at 10,000 rpm the angle is still within a few 1e-16 rad of the
+exact value; float seconds would have lost 1e-6 rad.
+"""
+
+from __future__ import annotations
+
+import copy
+from fractions import Fraction
+import math
+from typing import NamedTuple
+
+__all__ = ['CrankSample', 'CrankTimebase', 'TWO_PI', 'turns_from_radians']
+
+NS_PER_S = 1_000_000_000
+
+#: 2*pi as an exact rational, to 60 significant digits.
+TWO_PI = 2 * Fraction('3.14159265358979323846264338327950288419716939937510582097494')
+
+_TWO_PI_FLOAT = 2.0 * math.pi
+
+
+def turns_from_radians(value: float) -> Fraction:
+    """Return the exact float ``value`` (rad) in turns, as a rational."""
+    return Fraction(value) / TWO_PI
+
+
+def _radians(turns_per: Fraction) -> float:
+    """Return a rate in turns (per s or per s^2) as a correctly rounded float in rad."""
+    return float(turns_per * TWO_PI)
+
+
+class CrankSample(NamedTuple):
+    """The crank's state at one instant."""
+
+    angle: float
+    """Angle, rad, wrapped to (-pi, pi]."""
+    speed: float
+    """Angular velocity, rad/s, + CCW."""
+    accel: float
+    """Angular acceleration, rad/s^2 (0 while the speed is held at the bound)."""
+
+
+class _Piece:
+    """Position in turns over one stretch of a segment, as an integer polynomial in tau (ns)."""
+
+    __slots__ = ('den', 'n0', 'n1', 'n2', 'speed', 'speed_slope', 'accel')
+
+    def __init__(self, c0: Fraction, c1: Fraction, c2: Fraction,
+                 w0: Fraction, a: Fraction) -> None:
+        # turns(tau) = c0 + c1*tau + c2*tau**2 with tau in ns.
+        den = math.lcm(c0.denominator, c1.denominator, c2.denominator)
+        self.den = den
+        self.n0 = c0.numerator * (den // c0.denominator)
+        self.n1 = c1.numerator * (den // c1.denominator)
+        self.n2 = c2.numerator * (den // c2.denominator)
+        # speed(tau) = w0 + a * tau / 1e9 in rad/s, as floats.
+        self.speed = _radians(w0)
+        self.speed_slope = _radians(a) / NS_PER_S
+        self.accel = _radians(a)
+
+    def turns(self, tau: int) -> Fraction:
+        return Fraction(self.n0 + tau * (self.n1 + tau * self.n2), self.den)
+
+    def sample(self, tau: int) -> CrankSample:
+        den = self.den
+        r = (self.n0 + tau * (self.n1 + tau * self.n2)) % den
+        if 2 * r > den:         # wrap the fraction of a turn to (-1/2, 1/2]
+            r -= den
+        return CrankSample((r / den) * _TWO_PI_FLOAT,
+                           self.speed + self.speed_slope * tau, self.accel)
+
+
+class _Segment:
+    """The drive from instant ``t0`` on: accelerate at ``a``, then hold at the bound."""
+
+    __slots__ = ('t0', 'turns0', 'w0', 'a', 'w_max', 't_hold', 'ramp', 'hold', 'prev', '_ceil')
+
+    def __init__(self, t0: int, turns0: Fraction, w0: Fraction, a: Fraction,
+                 w_max: Fraction, prev: _Segment | None) -> None:
+        w0 = min(max(w0, -w_max), w_max)
+        self.t0, self.turns0, self.w0, self.a, self.w_max = t0, turns0, w0, a, w_max
+        self.prev = prev
+        zero = Fraction(0)
+        per_ns = Fraction(1, NS_PER_S)
+        # Time (ns, exact) at which the speed reaches the bound; None: never.
+        target = w_max if a > 0 else -w_max
+        t_hold: Fraction | None = None
+        if a != 0:
+            t_hold = (target - w0) / a * NS_PER_S
+        self.t_hold = t_hold
+        self.ramp = _Piece(turns0, w0 * per_ns, a * per_ns * per_ns / 2, w0, a)
+        if t_hold is None:
+            self.hold = self.ramp
+        else:
+            # Position at the bound, then straight on at the bound speed.
+            th = t_hold
+            at_hold = turns0 + w0 * th * per_ns + a * (th * per_ns) ** 2 / 2
+            c1 = target * per_ns
+            self.hold = _Piece(at_hold - c1 * th, c1, zero, target, zero)
+        # First integer instant (ns) on the hold piece.
+        self._ceil: int | None = None if t_hold is None else math.ceil(t_hold)
+
+    def piece(self, tau: int) -> _Piece:
+        if self._ceil is None or tau < self._ceil:
+            return self.ramp
+        return self.hold
+
+    def speed(self, tau: int) -> Fraction:
+        """Exact speed, turns/s."""
+        if self._ceil is None or tau < self._ceil:
+            return self.w0 + self.a * Fraction(tau, NS_PER_S)
+        return self.w_max if self.a > 0 else -self.w_max
+
+
+class CrankTimebase:
+    """Crank angle, speed and acceleration as exact functions of clock time.
+
+    Parameters
+    ----------
+    t0 : int
+        Clock instant of the start, ns. The crank is at ``angle`` there.
+    angle : float
+        Crank angle at ``t0``, rad.
+    speed_rpm : float
+        Crank speed at ``t0``, rpm, + CCW.
+    accel : float
+        Crank angular acceleration, rad/s^2.
+    max_speed_rpm : float
+        Bound on the magnitude of the speed, rpm (>= 0). An accelerating drive
+        holds its speed once it reaches ``+-max_speed_rpm``; a ``speed_rpm``
+        beyond it is clamped.
+
+    Notes
+    -----
+    :meth:`sample` is safe to call from one thread while another calls the
+    setters: a setter builds a new segment and swaps it in with one
+    assignment. Instants before the current segment's start use the segment
+    before it (one level is kept), so a sample taken just before a change is
+    still the old drive.
+    """
+
+    def __init__(self, t0: int, angle: float, speed_rpm: float, accel: float,
+                 max_speed_rpm: float) -> None:
+        for value, what in ((angle, 'angle'), (speed_rpm, 'speed_rpm'), (accel, 'accel'),
+                            (max_speed_rpm, 'max_speed_rpm')):
+            if not math.isfinite(value):
+                msg = f'Expected `{what}` to be finite, got {value!r}'
+                raise ValueError(msg)
+        if max_speed_rpm < 0:
+            msg = f'Expected `max_speed_rpm` >= 0, got {max_speed_rpm!r}'
+            raise ValueError(msg)
+        self._segment = _Segment(int(t0), turns_from_radians(angle) % 1,
+                                 Fraction(speed_rpm) / 60, turns_from_radians(accel),
+                                 Fraction(max_speed_rpm) / 60, None)
+
+    def _at(self, t: int) -> tuple[_Segment, int]:
+        seg = self._segment
+        if t < seg.t0 and seg.prev is not None:
+            seg = seg.prev
+        return seg, t - seg.t0
+
+    def sample(self, t: int) -> CrankSample:
+        """Return the crank's angle (wrapped to (-pi, pi]), speed and acceleration at ``t`` ns."""
+        seg = self._segment
+        if t < seg.t0 and seg.prev is not None:
+            seg = seg.prev
+        tau = t - seg.t0
+        ceil = seg._ceil
+        if ceil is None or tau < ceil:
+            return seg.ramp.sample(tau)
+        return seg.hold.sample(tau)
+
+    def turns(self, t: int) -> Fraction:
+        """Return the exact crank position at ``t`` ns, in turns, modulo 1."""
+        seg, tau = self._at(t)
+        return seg.piece(tau).turns(tau) % 1
+
+    def speed(self, t: int) -> Fraction:
+        """Return the exact crank speed at ``t`` ns, in turns/s."""
+        seg, tau = self._at(t)
+        return seg.speed(tau)
+
+    @property
+    def accel(self) -> float:
+        """The commanded angular acceleration, rad/s^2."""
+        return _radians(self._segment.a)
+
+    @property
+    def max_speed_rpm(self) -> float:
+        """The speed bound, rpm."""
+        return float(self._segment.w_max * 60)
+
+    def _restart(self, t: int, w0: Fraction | None, a: Fraction | None,
+                 w_max: Fraction | None) -> None:
+        t = int(t)
+        old = self._segment
+        seg, tau = self._at(t)
+        turns0 = seg.piece(tau).turns(tau) % 1
+        speed = seg.speed(tau)
+        # Keep one level of history, without touching the segment that a
+        # concurrent sample() may be reading.
+        before = copy.copy(old)
+        before.prev = None
+        self._segment = _Segment(
+            t, turns0, speed if w0 is None else w0, old.a if a is None else a,
+            old.w_max if w_max is None else w_max, before)
+
+    def update(self, t: int, speed_rpm: float | None = None, accel: float | None = None,
+               max_speed_rpm: float | None = None) -> None:
+        """From instant ``t`` (ns) on, drive with the given values; ``None`` keeps one.
+
+        The position at ``t`` is kept exactly. ``speed_rpm`` is the speed at
+        ``t`` (without it the drive goes on from its speed there); ``accel``
+        (rad/s^2) applies from ``t``; ``max_speed_rpm`` bounds the speed from
+        ``t`` on, clamping it at once if it is faster.
+        """
+        for value, what in ((speed_rpm, 'speed_rpm'), (accel, 'accel'),
+                            (max_speed_rpm, 'max_speed_rpm')):
+            if value is not None and not math.isfinite(value):
+                msg = f'Expected `{what}` to be finite, got {value!r}'
+                raise ValueError(msg)
+        if max_speed_rpm is not None and max_speed_rpm < 0:
+            msg = f'Expected `max_speed_rpm` >= 0, got {max_speed_rpm!r}'
+            raise ValueError(msg)
+        self._restart(t, None if speed_rpm is None else Fraction(speed_rpm) / 60,
+                      None if accel is None else turns_from_radians(accel),
+                      None if max_speed_rpm is None else Fraction(max_speed_rpm) / 60)
+
+    def moved(self, t_from: int, t_to: int) -> CrankTimebase:
+        """Return a copy whose drive at ``t_to`` continues this one's at ``t_from``.
+
+        For a change of time source (ROS time switched on or off), whose epoch
+        has nothing to do with the old one: the crank goes on from where it was.
+        """
+        seg, tau = self._at(int(t_from))
+        copy = object.__new__(CrankTimebase)
+        copy._segment = _Segment(int(t_to), seg.piece(tau).turns(tau) % 1, seg.speed(tau),
+                                 self._segment.a, self._segment.w_max, None)
+        return copy

@@ -1,0 +1,401 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The ``record`` command against the running node, over real DDS.
+
+Four recorders start first, as subprocesses, and wait for the node's topics;
+then the node starts at 500 Hz (``python -m mech_kinematics.kinematics_node
+--ros-args -p rate_hz:=500.0``). Two recorders stop at the end of
+``--duration`` (mcap with the EventsExecutor, sqlite3 with the
+SingleThreadedExecutor), one is stopped by SIGINT and one, writing bag format
+version 9, by SIGTERM. Every process gets a ROS domain of this module's own
+(a random ``ROS_DOMAIN_ID``, discovery on localhost only); this process never
+joins DDS itself.
+
+What the node published comes from its own diagnostics, recorded in the same
+bag: ``published_total`` counts the state messages of each topic.
+"""
+
+from dataclasses import dataclass
+import os
+from pathlib import Path
+import random
+import re
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+import yaml
+
+import mech_kinematics as mk
+from mech_kinematics import bag_recorder, plot
+
+REPO = Path(__file__).resolve().parents[1]
+NS = 1_000_000_000
+#: Values in the bag against the solver at the message's crank angle (relative; absolute
+#: tolerances are RTOL times the largest magnitude of the quantity over a cycle).
+RTOL = 1e-12
+#: Share of what the node published that each bag must hold (the target is all of it).
+MIN_RECORDED = 0.99
+RATE_HZ = 500.0
+DURATION_S = 4.0        # of the --duration recorders, from their first subscription
+STARTUP_S = 30.0        # deadline for processes to come up
+SCENE = mk.load_scene(mk.DEFAULT_SCENE)
+STATE_TOPICS = {'/joint_states': 'sensor_msgs/msg/JointState',
+                '/joint_accelerations': 'trajectory_msgs/msg/JointTrajectory',
+                '/point_accelerations': 'trajectory_msgs/msg/MultiDOFJointTrajectory'}
+TOPICS = {**STATE_TOPICS, '/diagnostics': 'diagnostic_msgs/msg/DiagnosticArray'}
+#: name -> (extra arguments, how it is stopped, bag version)
+RECORDERS = {
+    'duration_mcap': (['--storage', 'mcap', '--duration', str(DURATION_S)], None, 8),
+    'duration_sqlite3': (['--storage', 'sqlite3', '--duration', str(DURATION_S),
+                          '--executor', 'single'], None, 8),
+    'sigint_mcap': (['--storage', 'mcap'], signal.SIGINT, 8),
+    'sigterm_sqlite3_v9': (['--storage', 'sqlite3', '--bag-version', '9'], signal.SIGTERM, 9),
+}
+SUMMARY_LINE = re.compile(r'^(/\S+)\s+(\S+)\s+(\d+)\s+(\d+)$', re.MULTILINE)
+
+# A domain of this module's own (1..100 is test_kinematics_node_launch's range).
+DOMAIN_ID = str(random.SystemRandom().randint(101, 200))
+
+
+def ros_env() -> dict:
+    env = dict(os.environ, ROS_DOMAIN_ID=DOMAIN_ID, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST',
+               PYTHONUNBUFFERED='1')
+    env['PYTHONPATH'] = os.pathsep.join(filter(None, [str(REPO), env.get('PYTHONPATH')]))
+    return env
+
+
+class Process:
+    """A subprocess with its output in files."""
+
+    def __init__(self, name: str, tmp: Path, *argv: str) -> None:
+        self.name = name
+        self.out, self.err = tmp / f'{name}.out', tmp / f'{name}.err'
+        with open(self.out, 'w') as out, open(self.err, 'w') as err:
+            self.proc = subprocess.Popen([sys.executable, *argv], env=ros_env(), stdout=out,
+                                         stderr=err, cwd=tmp)
+
+    def output(self) -> str:
+        return self.out.read_text() + self.err.read_text()
+
+    def wait_for_output(self, text: str, timeout: float) -> None:
+        deadline = time.monotonic() + timeout
+        while text not in self.output():
+            if self.proc.poll() is not None or time.monotonic() > deadline:
+                pytest.fail(f'{self.name}: no {text!r} within {timeout} s:\n{self.output()}')
+            time.sleep(0.05)
+
+    def stop(self, sig=None, timeout: float = 15.0) -> int:
+        if sig is not None and self.proc.poll() is None:
+            self.proc.send_signal(sig)
+        try:
+            return self.proc.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            self.proc.wait()
+            pytest.fail(f'{self.name} did not exit within {timeout} s:\n{self.output()}')
+
+
+@dataclass
+class Recording:
+    name: str
+    path: Path
+    status: int
+    output: str
+    version: int
+
+    def summary(self) -> dict:
+        """Topic -> (type, received, written), as the recorder printed them."""
+        return {m[1]: (m[2], int(m[3]), int(m[4])) for m in SUMMARY_LINE.finditer(self.output)}
+
+
+@pytest.fixture(scope='module')
+def recordings(tmp_path_factory):
+    """Record the node with four recorders started before it; return them by name."""
+    tmp = tmp_path_factory.mktemp('recordings')
+    recorders = {}
+    try:
+        for name, (extra, _, _) in RECORDERS.items():
+            recorders[name] = Process(name, tmp, '-m', 'mech_kinematics.bag_recorder',
+                                      '-o', str(tmp / name), *extra)
+        for recorder in recorders.values():
+            recorder.wait_for_output('recording to', STARTUP_S)
+        node = Process('node', tmp, '-m', 'mech_kinematics.kinematics_node', '--ros-args',
+                       '-p', f'rate_hz:={RATE_HZ}')
+        try:
+            statuses = {name: recorders[name].stop(timeout=STARTUP_S + DURATION_S)
+                        for name, (_, sig, _) in RECORDERS.items() if sig is None}
+            for name, (_, sig, _) in RECORDERS.items():
+                if sig is not None:
+                    statuses[name] = recorders[name].stop(sig)
+        finally:
+            node_status = node.stop(signal.SIGINT)
+        assert node_status == 0, node.output()
+    finally:
+        for recorder in recorders.values():
+            if recorder.proc.poll() is None:
+                recorder.proc.kill()
+                recorder.proc.wait()
+    return {name: Recording(name, tmp / name, statuses[name], recorders[name].output(),
+                            RECORDERS[name][2]) for name in RECORDERS}
+
+
+def decoded(path: Path) -> dict:
+    """Topic -> list of (receive time ns, message) decoded with rosbags from the bag's msgdefs.
+
+    rosbags' ``deserialize_cdr`` refuses payloads with more than 3 bytes past the end
+    of the CDR data, which Fast DDS publishers of ``serialize_message`` bytes can have
+    (``rclpy``, rosbag2 and Foxglove ignore them), so the message class's own
+    deserializer is called.
+    """
+    from rosbags.highlevel import AnyReader
+
+    out: dict = {}
+    with AnyReader([path]) as reader:
+        store = reader.typestore
+        for connection, timestamp, raw in reader.messages():
+            msgdef = store.get_msgdef(connection.msgtype)
+            assert raw[:2] == b'\x00\x01', 'expected little-endian CDR'
+            msg, end = msgdef.deserialize_cdr_le(raw[4:], 0, msgdef.cls, store)
+            assert len(raw) - 4 - end < 8, 'only final padding may follow the message'
+            out.setdefault(connection.topic, []).append((timestamp, msg))
+    return out
+
+
+def stamp_ns(msg) -> int:
+    return msg.header.stamp.sec * NS + msg.header.stamp.nanosec
+
+
+@pytest.fixture(scope='module')
+def contents(recordings):
+    return {name: decoded(r.path) for name, r in recordings.items()}
+
+
+@pytest.mark.parametrize('name', RECORDERS)
+def test_recorder_exits_cleanly_with_a_summary(recordings, name):
+    """Duration, SIGINT and SIGTERM all end in exit status 0 and a per-topic summary."""
+    recording = recordings[name]
+    assert recording.status == 0, recording.output
+    assert set(recording.summary()) == set(TOPICS), recording.output
+    for topic, (type_name, received, written) in recording.summary().items():
+        assert type_name == TOPICS[topic]
+        assert received == written > 0, recording.output
+
+
+@pytest.mark.parametrize('name', RECORDERS)
+def test_bag_holds_every_message_received(recordings, contents, name):
+    """Per topic: messages in the storage == metadata count == received by the recorder."""
+    recording = recordings[name]
+    meta = yaml.safe_load((recording.path / 'metadata.yaml').read_text())
+    info = meta['rosbag2_bagfile_information']
+    counts = {t['topic_metadata']['name']: t['message_count']
+              for t in info['topics_with_message_count']}
+    for topic, (_, received, _) in recording.summary().items():
+        assert len(contents[name][topic]) == counts[topic] == received, topic
+    assert info['message_count'] == sum(counts.values())
+
+
+@pytest.mark.parametrize('name', RECORDERS)
+def test_nothing_the_node_published_is_lost(contents, name):
+    """Between two diagnostics, every topic holds >= 99 % of the node's published_total."""
+    diagnostics = []
+    for _, msg in contents[name]['/diagnostics']:
+        values = {kv.key: kv.value for status in msg.status for kv in status.values}
+        diagnostics.append((stamp_ns(msg), int(values['published_total'])))
+    assert len(diagnostics) >= 2, 'expected two diagnostics messages to bound a window'
+    (start, published_start), (end, published_end) = diagnostics[0], diagnostics[-1]
+    published = published_end - published_start
+    # The node ran (it may skip ticks when the CPUs are busy: skipped ticks publish nothing).
+    assert published >= 0.5 * RATE_HZ * (end - start) / NS
+    for topic in STATE_TOPICS:
+        stamps = np.array([stamp_ns(m) for _, m in contents[name][topic]])
+        recorded = int(((stamps > start) & (stamps <= end)).sum())
+        # Stamps and counters are read at slightly different instants: +-1 at each end.
+        assert recorded >= MIN_RECORDED * published, (topic, recorded, published)
+        assert recorded <= published + 2, (topic, recorded, published)
+
+
+def scale(quantity: np.ndarray) -> float:
+    return float(np.nanmax(np.abs(quantity)))
+
+
+def cycle():
+    state = mk.solve(SCENE, np.linspace(0, 2 * np.pi, 721))
+    joints = {n: (scale(j.position), scale(j.velocity), scale(j.acceleration))
+              for n, j in state.joints.items()}
+    points = {n: (scale(p.position), scale(p.velocity), scale(p.acceleration))
+              for n, p in state.points.items()}
+    return joints, points
+
+
+@pytest.mark.parametrize('name', ['duration_mcap', 'duration_sqlite3'])
+def test_values_agree_with_the_solver(contents, name):
+    """Decoded with rosbags, every message equals mk.solve at its crank angle (1e-12)."""
+    joint_scale, point_scale = cycle()
+    crank = SCENE.input.link
+    got: dict = {}
+    expected: dict = {}
+
+    def add(key, value, solved):
+        got.setdefault(key, []).append(value)
+        expected.setdefault(key, []).append(solved)
+
+    solved = {}
+    for _, msg in contents[name]['/joint_states']:
+        assert list(msg.name) == list(SCENE.output_joints)
+        i = list(msg.name).index(crank)
+        state = mk.solve(SCENE, msg.position[i], msg.velocity[i])
+        solved[stamp_ns(msg)] = state
+        for k, joint in enumerate(msg.name):
+            add(('joint', joint, 0), msg.position[k], state.joints[joint].position)
+            add(('joint', joint, 1), msg.velocity[k], state.joints[joint].velocity)
+    for _, msg in contents[name]['/joint_accelerations']:
+        point = msg.points[0]
+        i = list(msg.joint_names).index(crank)
+        state = mk.solve(SCENE, point.positions[i], point.velocities[i], point.accelerations[i])
+        for k, joint in enumerate(msg.joint_names):
+            add(('joint', joint, 2), point.accelerations[k], state.joints[joint].acceleration)
+    matched = 0
+    for _, msg in contents[name]['/point_accelerations']:
+        state = solved.get(stamp_ns(msg))    # the joint_states message of the same tick
+        if state is None:
+            continue
+        matched += 1
+        point = msg.points[0]
+        for k, label in enumerate(msg.joint_names):
+            p = state.points[label]
+            for kind, vector, value in ((0, point.transforms[k].translation, p.position),
+                                        (1, point.velocities[k].linear, p.velocity),
+                                        (2, point.accelerations[k].linear, p.acceleration)):
+                add(('point', label, kind), (vector.x, vector.y, vector.z),
+                    (value[0], value[1], 0.0))
+    assert matched >= 0.99 * len(contents[name]['/point_accelerations']) > 0
+    scales = {'joint': joint_scale, 'point': point_scale}
+    assert {key[:2] for key in got} == {(group, n) for group in scales for n in scales[group]}
+    for (group, element, kind), values in got.items():
+        atol = RTOL * scales[group][element][kind]
+        np.testing.assert_allclose(values, expected[group, element, kind], rtol=RTOL, atol=atol,
+                                   err_msg=f'{group} {element}, {("p", "v", "a")[kind]}')
+
+
+@pytest.mark.parametrize('name', RECORDERS)
+def test_metadata_lists_every_topic_as_ros_tools_expect(recordings, name):
+    """metadata.yaml: version, storage, and each topic's type, cdr, type hash and QoS."""
+    recording = recordings[name]
+    info = yaml.safe_load((recording.path / 'metadata.yaml').read_text())[
+        'rosbag2_bagfile_information']
+    storage = 'mcap' if 'mcap' in name else 'sqlite3'
+    assert info['version'] == recording.version
+    assert info['storage_identifier'] == storage
+    for relative in info['relative_file_paths']:
+        assert (recording.path / relative).is_file()
+    topics = {t['topic_metadata']['name']: t['topic_metadata']
+              for t in info['topics_with_message_count']}
+    assert set(topics) == set(TOPICS)
+    for topic, meta in topics.items():
+        assert meta['type'] == TOPICS[topic]
+        assert meta['serialization_format'] == 'cdr'
+        assert re.fullmatch(r'RIHS01_[0-9a-f]{64}', meta['type_description_hash'])
+        profiles = meta['offered_qos_profiles']
+        if recording.version == 8:
+            # A YAML string with numeric policies, as Humble reads it (rosbag2#1895).
+            assert isinstance(profiles, str)
+            profiles = yaml.safe_load(profiles)
+            assert profiles[0]['reliability'] == 1 and profiles[0]['durability'] == 2
+        else:
+            assert profiles[0]['reliability'] == 'reliable'
+            assert profiles[0]['durability'] == 'volatile'
+        assert profiles[0]['deadline'] == {'sec': 9223372036, 'nsec': 854775807}
+
+
+@pytest.mark.parametrize('name', ['duration_mcap', 'duration_sqlite3'])
+def test_bag_carries_the_installed_message_definitions(recordings, name):
+    """Each connection has the .msg text (ros2msg), whose RIHS01 hash is the publisher's."""
+    from rosbags.highlevel import AnyReader
+    from rosbags.interfaces import MessageDefinitionFormat
+
+    # AnyReader recomputes every type hash from the stored definition and refuses a mismatch.
+    with AnyReader([recordings[name].path]) as reader:
+        for connection in reader.connections:
+            assert connection.msgdef.format == MessageDefinitionFormat.MSG
+            text = connection.msgdef.data
+            assert text == bag_recorder.message_definition(connection.msgtype)[1]
+            assert reader.typestore.hash_rihs01(connection.msgtype) == connection.digest
+        js = next(c for c in reader.connections if c.topic == '/joint_states')
+        assert '\nMSG: std_msgs/Header\n' in js.msgdef.data
+        assert '\nMSG: builtin_interfaces/Time\n' in js.msgdef.data
+
+
+def test_mcap_is_readable_by_the_foxglove_mcap_library(recordings):
+    """Foxglove's own reader and ROS 2 decoder read every message of the mcap bag."""
+    import mcap.reader as mcap_reader
+    import mcap_ros2.decoder as mcap_ros2
+    path = recordings['duration_mcap'].path / 'duration_mcap.mcap'
+    with open(path, 'rb') as stream:
+        reader = mcap_reader.make_reader(stream, decoder_factories=[mcap_ros2.DecoderFactory()])
+        summary = reader.get_summary()
+        assert {s.encoding for s in summary.schemas.values()} == {'ros2msg'}
+        assert {c.message_encoding for c in summary.channels.values()} == {'cdr'}
+        count = sum(1 for _ in reader.iter_decoded_messages())
+    assert count == summary.statistics.message_count > 0
+
+
+@pytest.mark.parametrize('kind', ['directory', 'file'])
+def test_existing_output_is_refused_and_left_alone(tmp_path, capsys, kind):
+    """An existing output path: exit status 2, a clear message, nothing touched."""
+    target = tmp_path / 'existing'
+    if kind == 'directory':
+        target.mkdir()
+        (target / 'keep.txt').write_text('mine')
+    else:
+        target.write_text('mine')
+    status = bag_recorder.main(['-o', str(target), '--duration', '1'])
+    assert status == 2
+    err = capsys.readouterr().err
+    assert f'Expected a new bag directory, got "{target}", an existing {kind}' in err
+    assert 'refusing to overwrite' in err
+    kept = target / 'keep.txt' if kind == 'directory' else target
+    assert kept.read_text() == 'mine'
+    assert sorted(p.name for p in tmp_path.iterdir()) == ['existing']
+
+
+def test_bad_options_are_refused_before_ros_starts(tmp_path):
+    """A bad duration or storage is a usage error; no bag directory is created."""
+    with pytest.raises(bag_recorder.RecorderError, match='positive duration'):
+        bag_recorder.record(tmp_path / 'bag', duration=0.0)
+    with pytest.raises(bag_recorder.RecorderError, match='storage'):
+        bag_recorder.BagRecorder(tmp_path / 'bag', storage='rosbag1')
+    with pytest.raises(SystemExit):
+        bag_recorder.main(['-o', str(tmp_path / 'bag'), '--duration', '-1'])
+    assert not (tmp_path / 'bag').exists()
+
+
+def test_message_definition_follows_rosbag2():
+    """The root .msg text first, then each dependency once after an 80-'=' MSG: line."""
+    text = bag_recorder.message_definition('trajectory_msgs/msg/MultiDOFJointTrajectory')[1]
+    sections = text.split('\n' + '=' * 80 + '\n')
+    names = [s.split('\n', 1)[0] for s in sections[1:]]
+    assert names == ['MSG: std_msgs/Header', 'MSG: builtin_interfaces/Time',
+                     'MSG: trajectory_msgs/MultiDOFJointTrajectoryPoint',
+                     'MSG: builtin_interfaces/Duration', 'MSG: geometry_msgs/Transform',
+                     'MSG: geometry_msgs/Quaternion', 'MSG: geometry_msgs/Vector3',
+                     'MSG: geometry_msgs/Twist']
+    with pytest.raises(bag_recorder.RecorderError, match='no_such_msgs'):
+        bag_recorder.message_definition('no_such_msgs/msg/Nothing')
+
+
+def test_plot_of_a_real_recording(recordings, tmp_path):
+    """The plot of a real recording has the expected panels; the scene comes from diagnostics."""
+    out = tmp_path / 'recording.png'
+    fig = plot.plot_bag(recordings['duration_sqlite3'].path, out, x='angle')
+    assert out.read_bytes().startswith(b'\x89PNG')
+    titles = {ax.get_title() for ax in fig.axes}
+    assert titles == {'Joint angles', 'Joint angular velocities', 'Joint angular accelerations',
+                      'Point paths', 'Point speeds |v|', 'Point accelerations |a|'}
+    assert fig.get_suptitle().startswith(f'{SCENE.name}: recording duration_sqlite3')
+    for ax in fig.axes:
+        assert ax.get_xlabel() in ('crank angle θ [rad]', 'x [m]')
+        assert re.search(r'\[.+\]$', ax.get_ylabel())

@@ -1,0 +1,612 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The running node over real DDS, done by hand the way launch_testing would.
+
+The node runs as a subprocess (``python -m mech_kinematics.kinematics_node
+--ros-args ...``); this process talks to it with rclpy on a ROS domain of its
+own (a random ``ROS_DOMAIN_ID``, discovery on localhost only). One node
+process is shared by the tests of the running node; the time-source, partial
+cycle, start-up and signal tests start their own.
+"""
+
+import contextlib
+from decimal import Decimal, localcontext
+from fractions import Fraction
+import math
+import os
+from pathlib import Path
+import random
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+from builtin_interfaces.msg import Time
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+import numpy as np
+import pytest
+from rcl_interfaces.msg import Parameter as ParameterMsg
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.parameter import Parameter
+from rclpy.parameter_client import AsyncParameterClient
+from rclpy.qos import qos_profile_sensor_data, QoSProfile, ReliabilityPolicy
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState
+from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
+
+import mech_kinematics as mk
+
+REPO = Path(__file__).resolve().parents[1]
+PARAMS_FILE = REPO / 'config' / 'kinematics_node.yaml'
+NS = 1_000_000_000
+#: Relative tolerance between the published values and the solver's.
+RTOL = 1e-12
+#: Tolerance of an angle that the time base fixes exactly, rad.
+ATOL_TIMEBASE = 1e-9  # rad
+STARTUP_S = 20.0       # deadline for a node to come up and be discovered
+RATE_HZ = 200.0
+FRAME_ID = 'test_frame'
+SCENE = mk.load_scene(mk.DEFAULT_SCENE)
+RELIABLE = QoSProfile(depth=200, reliability=ReliabilityPolicy.RELIABLE)
+
+# A domain of this test session's own (set before rclpy.init, inherited by the nodes).
+os.environ['ROS_DOMAIN_ID'] = str(random.SystemRandom().randint(1, 100))
+os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+# Only 100 domains: every node here also runs in a namespace of this session's own, so
+# that another session that drew the same domain cannot mix its messages into ours.
+SESSION = f'/kt_{os.getpid()}_{random.SystemRandom().randrange(16 ** 6):06x}'
+
+
+def stamp_ns(msg) -> int:
+    return msg.header.stamp.sec * NS + msg.header.stamp.nanosec
+
+
+def wrap(angle: float) -> float:
+    """Return ``angle`` wrapped to [-pi, pi]."""
+    return math.remainder(angle, 2 * math.pi)
+
+
+def wait_for(predicate, timeout: float, what: str):
+    """Poll ``predicate`` until it is true or ``timeout`` s pass (then fail naming ``what``)."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        value = predicate()
+        if value:
+            return value
+        time.sleep(0.01)
+    pytest.fail(f'timed out after {timeout} s waiting for {what}')
+
+
+class Ros:
+    """This process's side: one rclpy context, node and executor thread for the module."""
+
+    def __init__(self) -> None:
+        self.context = rclpy.Context()
+        rclpy.init(context=self.context)
+        self.node = rclpy.create_node('kinematics_node_test', context=self.context)
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.node)
+        self._thread = threading.Thread(target=self._spin, daemon=True)
+        self._thread.start()
+
+    def _spin(self) -> None:
+        with contextlib.suppress(Exception):    # the context goes away at teardown
+            self.executor.spin()
+
+    def collect(self, msg_type, topic: str, qos=RELIABLE) -> list:
+        """Subscribe ``topic``; return the list its messages are appended to."""
+        received: list = []
+        self.node.create_subscription(msg_type, topic, received.append, qos)
+        return received
+
+    def call(self, future, timeout: float = 10.0):
+        wait_for(future.done, timeout, 'a service response')
+        return future.result()
+
+    def close(self) -> None:
+        self.executor.shutdown(timeout_sec=1.0)
+        self.node.destroy_node()
+        rclpy.try_shutdown(context=self.context)
+        self._thread.join(timeout=2.0)
+
+
+class NodeProcess:
+    """A kinematics_node subprocess with its output in files."""
+
+    def __init__(self, tmp: Path, *ros_args: str) -> None:
+        env = dict(os.environ)
+        env['PYTHONPATH'] = os.pathsep.join(filter(None, [str(REPO), env.get('PYTHONPATH')]))
+        env['PYTHONUNBUFFERED'] = '1'
+        tmp.mkdir(parents=True, exist_ok=True)
+        self.stdout_path, self.stderr_path = tmp / 'stdout.txt', tmp / 'stderr.txt'
+        with open(self.stdout_path, 'w') as out, open(self.stderr_path, 'w') as err:
+            self.proc = subprocess.Popen(
+                [sys.executable, '-m', 'mech_kinematics.kinematics_node', '--ros-args',
+                 *ros_args], env=env, stdout=out, stderr=err, cwd=tmp)
+
+    def output(self) -> str:
+        return self.stdout_path.read_text() + self.stderr_path.read_text()
+
+    def stop(self, sig=signal.SIGINT, timeout: float = 5.0) -> tuple[int, float]:
+        """Send ``sig``; return (exit status, seconds it took to exit)."""
+        start = time.monotonic()
+        if self.proc.poll() is None:
+            self.proc.send_signal(sig)
+        try:
+            status = self.proc.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            self.proc.wait()
+            pytest.fail(f'node did not exit within {timeout} s of {sig!r}:\n{self.output()}')
+        return status, time.monotonic() - start
+
+
+@pytest.fixture(scope='module')
+def ros():
+    ros = Ros()
+    yield ros
+    ros.close()
+
+
+class Running:
+    """The shared node and what this process has received from it."""
+
+    def __init__(self, ros: Ros, tmp: Path) -> None:
+        self.ros = ros
+        self.joint_states = ros.collect(JointState, f'{SESSION}/joint_states')
+        self.sensor_joint_states = ros.collect(JointState, f'{SESSION}/joint_states',
+                                               qos_profile_sensor_data)
+        self.joint_accel = ros.collect(JointTrajectory, f'{SESSION}/joint_accelerations')
+        self.point_accel = ros.collect(MultiDOFJointTrajectory,
+                                       f'{SESSION}/point_accelerations')
+        self.diagnostics = ros.collect(DiagnosticArray, f'{SESSION}/diagnostics')
+        # Integers for doubles on purpose (rclcpp#979), after the packaged params file.
+        self.process = NodeProcess(
+            tmp, '--params-file', str(PARAMS_FILE), '-r', f'__ns:={SESSION}',
+            '-p', 'rate_hz:=200', '-p', 'crank_speed_rpm:=120', '-p', f'frame_id:={FRAME_ID}')
+        self.params = AsyncParameterClient(ros.node, f'{SESSION}/mech_kinematics')
+        topics = (self.joint_states, self.sensor_joint_states, self.joint_accel,
+                  self.point_accel, self.diagnostics)
+        wait_for(lambda: all(topics) or self.process.proc.poll() is not None, STARTUP_S,
+                 'the first message on every topic')
+        assert self.process.proc.poll() is None, self.process.output()
+        assert self.params.wait_for_services(timeout_sec=STARTUP_S)
+
+    def set(self, *parameters: Parameter):
+        """Set parameters one by one; return the results."""
+        response = self.ros.call(self.params.set_parameters(list(parameters)))
+        return response.results
+
+    def get(self, *names: str):
+        response = self.ros.call(self.params.get_parameters(list(names)))
+        return [Parameter.from_parameter_msg(ParameterMsg(name=n, value=v))
+                for n, v in zip(names, response.values, strict=True)]
+
+    def set_ok(self, **values: float) -> float:
+        """Set doubles, assert they were accepted, return the monotonic time after."""
+        results = self.set(*(Parameter(k, Parameter.Type.DOUBLE, float(v))
+                             for k, v in values.items()))
+        assert all(r.successful for r in results), [r.reason for r in results]
+        return time.monotonic()
+
+    def window(self, seconds: float, since: float | None = None):
+        """Return the messages received in the next ``seconds`` (after settling past ``since``)."""
+        if since is not None:
+            time.sleep(max(0.0, since + 0.1 - time.monotonic()))
+        lists = (self.joint_states, self.joint_accel, self.point_accel)
+        starts = [len(x) for x in lists]
+        time.sleep(seconds)
+        return tuple(x[s:] for x, s in zip(lists, starts, strict=True))
+
+
+@pytest.fixture(scope='module')
+def node(ros, tmp_path_factory):
+    running = Running(ros, tmp_path_factory.mktemp('node'))
+    yield running
+    status, _ = running.process.stop(signal.SIGINT)
+    assert status == 0, running.process.output()
+
+
+def crank_index() -> int:
+    return SCENE.output_joints.index(SCENE.input.link)
+
+
+def assert_agrees_with_solver(scene, js, jt, md):
+    """One tick's three messages agree with mk.solve at the published crank angle."""
+    ci = scene.output_joints.index(scene.input.link)
+    angle, speed = js.position[ci], js.velocity[ci]
+    accel = jt.points[0].accelerations[ci]
+    state = mk.solve(scene, angle, speed, accel)
+    joints, points = scene.output_joints, scene.output_points
+    assert list(js.name) == list(joints) == list(jt.joint_names)
+    assert list(md.joint_names) == list(points)
+    expected = [state.joints[n] for n in joints]
+    got_positions = np.array(js.position)
+    exp_positions = np.array([j.position for j in expected])
+    revolute = np.array([scene.joint_types[n] == 'revolute' for n in joints])
+    # Revolute positions are angles: compare modulo 2 pi.
+    diff = np.where(revolute, np.remainder(got_positions - exp_positions + np.pi, 2 * np.pi)
+                    - np.pi, got_positions - exp_positions)
+    assert np.all(np.abs(diff) <= RTOL * np.maximum(np.abs(exp_positions), 1.0))
+    for got, attr in ((js.velocity, 'velocity'), (jt.points[0].velocities, 'velocity'),
+                      (jt.points[0].accelerations, 'acceleration')):
+        exp = np.array([getattr(j, attr) for j in expected])
+        np.testing.assert_allclose(got, exp, rtol=RTOL, atol=RTOL * np.abs(exp).max())
+    assert list(jt.points[0].positions) == list(js.position)
+    point = md.points[0]
+    for kind, got_xyz in (
+            ('position', [(t.translation.x, t.translation.y, t.translation.z)
+                          for t in point.transforms]),
+            ('velocity', [(v.linear.x, v.linear.y, v.linear.z) for v in point.velocities]),
+            ('acceleration', [(a.linear.x, a.linear.y, a.linear.z)
+                              for a in point.accelerations])):
+        exp = np.array([getattr(state.points[n], kind) for n in points])
+        got = np.array(got_xyz)
+        assert np.all(got[:, 2] == 0.0)
+        np.testing.assert_allclose(got[:, :2], exp, rtol=RTOL, atol=RTOL * np.abs(exp).max())
+    for t in point.transforms:
+        assert (t.rotation.x, t.rotation.y, t.rotation.z, t.rotation.w) == (0, 0, 0, 1)
+
+
+def ticks(js_list, jt_list, md_list):
+    """Group messages by stamp: stamp -> (js, jt, md) for the stamps seen on all three topics."""
+    jt_by = {stamp_ns(m): m for m in jt_list}
+    md_by = {stamp_ns(m): m for m in md_list}
+    return {stamp_ns(m): (m, jt_by[stamp_ns(m)], md_by[stamp_ns(m)]) for m in js_list
+            if stamp_ns(m) in jt_by and stamp_ns(m) in md_by}
+
+
+def test_every_message_agrees_with_the_solver(node):
+    """Over 2 s every tick's messages agree with mk.solve to 1e-12 and share one stamp."""
+    since = node.set_ok(crank_speed_rpm=120, crank_accel=0)
+    js_list, jt_list, md_list = node.window(2.0, since)
+    by_stamp = ticks(js_list, jt_list, md_list)
+    assert len(by_stamp) >= 0.5 * 2.0 * RATE_HZ, 'too few complete ticks received'
+    # Every stamp is on all three topics, but for the ones cut off at the window's ends.
+    stamps = [sorted(stamp_ns(m) for m in x) for x in (js_list, jt_list, md_list)]
+    inner = (max(s[0] for s in stamps), min(s[-1] for s in stamps))
+    for s in stamps:
+        assert {t for t in s if inner[0] <= t <= inner[1]} <= set(by_stamp)
+    for js, jt, md in by_stamp.values():
+        for msg in (js, jt, md):
+            assert msg.header.frame_id == FRAME_ID
+        assert len(js.name) == len(js.position) == len(js.velocity)
+        assert_agrees_with_solver(SCENE, js, jt, md)
+    # The crank follows the stamps: angle difference = omega * time difference.
+    ordered = [by_stamp[t][0] for t in sorted(by_stamp)]
+    ci = crank_index()
+    omega = 120 * math.pi / 30
+    for a, b in zip(ordered, ordered[1:], strict=False):
+        assert a.velocity[ci] == pytest.approx(omega, rel=1e-15)
+        predicted = a.position[ci] + omega * (stamp_ns(b) - stamp_ns(a)) / NS
+        assert abs(wrap(b.position[ci] - predicted)) < ATOL_TIMEBASE, (
+            f'stamps {stamp_ns(a)} {stamp_ns(b)}: angles {a.position[ci]!r} '
+            f'{b.position[ci]!r}, speeds {a.velocity[ci]!r} {b.velocity[ci]!r}')
+    spacing = np.median(np.diff(sorted(by_stamp))) / NS
+    assert spacing == pytest.approx(1 / RATE_HZ, rel=0.1)
+
+
+def test_sensor_data_subscriber_receives_joint_states(node):
+    """A best-effort SensorDataQoS subscriber gets joint_states from the reliable publisher."""
+    start = len(node.sensor_joint_states)
+    wait_for(lambda: len(node.sensor_joint_states) >= start + 20, 5.0,
+             'joint_states on a SensorDataQoS subscription')
+
+
+def test_integers_are_accepted_for_doubles(node):
+    """-p crank_speed_rpm:=120 and setting rate_hz to an integer work and store doubles."""
+    speed, rate = node.get('crank_speed_rpm', 'rate_hz')
+    assert speed.type_ == Parameter.Type.DOUBLE and speed.value == 120.0
+    assert rate.type_ == Parameter.Type.DOUBLE and rate.value == 200.0
+    results = node.set(Parameter('rate_hz', Parameter.Type.INTEGER, 250))
+    assert results[0].successful, results[0].reason
+    (rate,) = node.get('rate_hz')
+    assert rate.type_ == Parameter.Type.DOUBLE and rate.value == 250.0
+    node.set_ok(rate_hz=RATE_HZ)
+
+
+def test_speed_change_keeps_the_angle_continuous(node):
+    """Setting crank_speed_rpm while running changes the speed; the angle does not jump."""
+    since = node.set_ok(crank_speed_rpm=120, crank_accel=0)
+    time.sleep(max(0.0, since + 0.2 - time.monotonic()))
+    start = len(node.joint_states) - 10      # a few ticks before the change for sure
+    results = node.set(Parameter('crank_speed_rpm', Parameter.Type.INTEGER, -300))
+    assert results[0].successful, results[0].reason
+    time.sleep(0.5)
+    msgs = sorted(node.joint_states[start:], key=stamp_ns)
+    ci = crank_index()
+    w1, w2 = 120 * math.pi / 30, -300 * math.pi / 30
+    speeds = [m.velocity[ci] for m in msgs]
+    assert speeds[0] == pytest.approx(w1) and speeds[-1] == pytest.approx(w2)
+    changes = [i for i in range(1, len(msgs)) if speeds[i] != speeds[i - 1]]
+    assert len(changes) == 1, 'the speed changed more than once'
+    for a, b in zip(msgs, msgs[1:], strict=False):
+        dt = (stamp_ns(b) - stamp_ns(a)) / NS
+        if a.velocity[ci] == b.velocity[ci]:
+            predicted = a.position[ci] + a.velocity[ci] * dt
+            assert abs(wrap(b.position[ci] - predicted)) < ATOL_TIMEBASE
+        else:
+            # theta2 = theta1 + w1 (tc - t1) + w2 (t2 - tc): the change instant tc is in [t1, t2].
+            d = wrap(b.position[ci] - a.position[ci] - w2 * dt)
+            tc = d / (w1 - w2)          # s after t1
+            assert -1e-9 <= tc <= dt + 1e-9, 'the angle jumped at the speed change'
+    node.set_ok(crank_speed_rpm=120)
+
+
+BAD_VALUES = [
+    Parameter('crank_speed_rpm', Parameter.Type.DOUBLE, math.nan),
+    Parameter('crank_speed_rpm', Parameter.Type.DOUBLE, math.inf),
+    Parameter('crank_speed_rpm', Parameter.Type.STRING, 'fast'),
+    Parameter('crank_speed_rpm', Parameter.Type.BOOL, True),
+    Parameter('crank_speed_rpm', Parameter.Type.NOT_SET, None),
+    Parameter('crank_speed_rpm', Parameter.Type.DOUBLE, 20_000.0),   # above max_crank_speed_rpm
+    Parameter('crank_accel', Parameter.Type.DOUBLE, -math.inf),
+    Parameter('crank_accel', Parameter.Type.DOUBLE_ARRAY, [1.0]),
+    Parameter('rate_hz', Parameter.Type.INTEGER, 0),
+    Parameter('rate_hz', Parameter.Type.DOUBLE, 0.0),
+    Parameter('rate_hz', Parameter.Type.DOUBLE, -5.0),
+    Parameter('rate_hz', Parameter.Type.DOUBLE, 1e6),
+    Parameter('rate_hz', Parameter.Type.DOUBLE, math.nan),
+    Parameter('max_crank_speed_rpm', Parameter.Type.DOUBLE, -1.0),
+    Parameter('max_crank_speed_rpm', Parameter.Type.DOUBLE, 50.0),   # below |crank_speed_rpm|
+    Parameter('scene', Parameter.Type.STRING, 'slider_crank_150_600'),    # read-only
+    Parameter('frame_id', Parameter.Type.STRING, 'elsewhere'),            # read-only
+]
+
+
+def test_bad_values_are_refused_and_publishing_goes_on(node):
+    """Each bad value is refused with a reason; the parameters keep their values."""
+    names = ('crank_speed_rpm', 'crank_accel', 'rate_hz', 'max_crank_speed_rpm', 'scene',
+             'frame_id')
+    before = [p.value for p in node.get(*names)]
+    results = node.set(*BAD_VALUES)
+    for param, result in zip(BAD_VALUES, results, strict=True):
+        assert not result.successful, f'{param.name}={param.value!r} was accepted'
+        assert param.name in result.reason, result.reason
+    assert [p.value for p in node.get(*names)] == before
+    start = len(node.joint_states)
+    wait_for(lambda: len(node.joint_states) >= start + 20, 5.0, 'joint_states after refusals')
+
+
+def test_rate_change(node):
+    """Setting rate_hz while running changes the stamp spacing."""
+    since = node.set_ok(rate_hz=50)
+    js_list, _, _ = node.window(1.0, since)
+    spacing = np.median(np.diff(sorted(stamp_ns(m) for m in js_list))) / NS
+    assert spacing == pytest.approx(1 / 50, rel=0.1)
+    node.set_ok(rate_hz=RATE_HZ)
+
+
+def test_acceleration_is_held_at_the_bound(node):
+    """A positive crank_accel ramps the speed up to max_crank_speed_rpm and holds it there."""
+    since = node.set_ok(max_crank_speed_rpm=600, crank_speed_rpm=120)
+    start = len(node.joint_states)
+    node.set_ok(crank_accel=200)            # 12.6 -> 62.8 rad/s in 0.25 s
+    time.sleep(max(0.0, since + 0.7 - time.monotonic()))
+    js_list, jt_list, md_list = node.window(0.3)
+    ci = crank_index()
+    w_max = 600 * math.pi / 30
+    ramp = sorted(node.joint_states[start:], key=stamp_ns)
+    speeds = [m.velocity[ci] for m in ramp]
+    assert all(a <= b for a, b in zip(speeds, speeds[1:], strict=False)), 'the speed went down'
+    assert max(speeds) == pytest.approx(w_max, rel=1e-12)
+    assert any(12.6 < s < w_max - 1 for s in speeds), 'no ramp seen'
+    by_stamp = ticks(js_list, jt_list, md_list)
+    assert by_stamp
+    for js, jt, md in by_stamp.values():
+        assert js.velocity[ci] == pytest.approx(w_max, rel=1e-12)
+        assert jt.points[0].accelerations[ci] == 0.0
+        assert_agrees_with_solver(SCENE, js, jt, md)
+    # While ramping, the accelerations are the commanded one, and agree with the solver.
+    jt_by = {stamp_ns(m): m for m in node.joint_accel}
+    md_by = {stamp_ns(m): m for m in node.point_accel}
+    ramping = [m for m in ramp if 12.6 < m.velocity[ci] < w_max - 1
+               and stamp_ns(m) in jt_by and stamp_ns(m) in md_by]
+    assert ramping
+    for js in ramping:
+        jt = jt_by[stamp_ns(js)]
+        assert jt.points[0].accelerations[ci] == pytest.approx(200.0, rel=1e-15)
+        assert_agrees_with_solver(SCENE, js, jt, md_by[stamp_ns(js)])
+    node.set_ok(crank_accel=0)
+    node.set_ok(crank_speed_rpm=120)
+    node.set_ok(max_crank_speed_rpm=10_000)
+
+
+def test_diagnostics_report_status_and_timing(node):
+    """The diagnostics carry solver status ok, the achieved rate and the late-tick counts."""
+    start = len(node.diagnostics)
+    wait_for(lambda: len(node.diagnostics) >= start + 2, 5.0, 'diagnostics')
+    msg = node.diagnostics[-1]
+    status = {s.name: s for s in msg.status}
+    solver = status['mech_kinematics: solver']
+    timing = status['mech_kinematics: timing']
+    assert solver.level == DiagnosticStatus.OK and solver.message == 'ok'
+    solver_values = {kv.key: kv.value for kv in solver.values}
+    assert 0 < float(solver_values['worst_singularity_measure']) <= 1
+    values = {kv.key: kv.value for kv in timing.values}
+    assert float(values['achieved_rate_hz']) == pytest.approx(RATE_HZ, rel=0.3)
+    for key in ('late_ticks', 'skipped_ticks', 'late_ticks_total', 'skipped_ticks_total'):
+        assert int(values[key]) >= 0
+    assert msg.header.frame_id == FRAME_ID
+
+
+# -- nodes of their own ------------------------------------------------------------------
+
+
+def exact_angle_difference(rpm: int, dt_ns: int) -> float:
+    """Return 2 pi * rpm / 60 * dt wrapped to [-pi, pi], with exact arithmetic."""
+    turns = Fraction(rpm, 60) * Fraction(dt_ns, NS) % 1
+    with localcontext() as ctx:
+        ctx.prec = 50
+        two_pi = 2 * Decimal('3.14159265358979323846264338327950288419716939937510')
+        return wrap(float(two_pi * Decimal(turns.numerator) / Decimal(turns.denominator)))
+
+
+def test_sim_time_drives_the_angle_exactly(ros, tmp_path):
+    """With use_sim_time the ticks follow a published /clock and the angle follows it exactly."""
+    rpm = 600
+    ns_topic = f'{SESSION}/sim'
+    js_list = ros.collect(JointState, f'{ns_topic}/joint_states')
+    diag = ros.collect(DiagnosticArray, f'{ns_topic}/diagnostics')
+    # /clock remapped too, so that no other test session can drive this node's clock.
+    clock_pub = ros.node.create_publisher(Clock, f'{ns_topic}/clock', 10)
+    proc = NodeProcess(tmp_path, '-r', f'__ns:={ns_topic}', '-r', f'/clock:={ns_topic}/clock',
+                       '-p', 'use_sim_time:=true',
+                       '-p', f'crank_speed_rpm:={rpm}', '-p', 'rate_hz:=100')
+    try:
+        # No clock yet: no ticks, and diagnostics say so.
+        wait_for(lambda: diag, STARTUP_S, 'diagnostics before any /clock')
+        assert not js_list
+        assert diag[-1].status[0].level == DiagnosticStatus.STALE
+        wait_for(lambda: clock_pub.get_subscription_count() > 0, STARTUP_S, 'the /clock match')
+        t0 = 1_000 * NS + 123_456_789
+        published = set()
+        for k in range(120):
+            t = t0 + k * 10_000_000         # 10 ms of sim time per 5 ms of wall time
+            clock_pub.publish(Clock(clock=Time(sec=t // NS, nanosec=t % NS)))
+            published.add(t)
+            time.sleep(0.005)
+        wait_for(lambda: len(js_list) >= 20, 5.0, 'joint_states on sim time')
+        # Thirty days later, in one jump.
+        big = t0 + 30 * 86_400 * NS + 7
+        count = len(js_list)
+        clock_pub.publish(Clock(clock=Time(sec=big // NS, nanosec=big % NS)))
+        published.add(big)
+        wait_for(lambda: len(js_list) > count, 5.0, 'a tick after the 30-day jump')
+        time.sleep(0.3)
+        assert len(js_list) == count + 1, 'ticked without the clock moving'
+        ci = crank_index()
+        first = js_list[0]
+        for msg in js_list:
+            assert stamp_ns(msg) in published
+            assert msg.velocity[ci] == pytest.approx(rpm * math.pi / 30, rel=1e-15)
+            expected = first.position[ci] + exact_angle_difference(
+                rpm, stamp_ns(msg) - stamp_ns(first))
+            assert abs(wrap(msg.position[ci] - expected)) < ATOL_TIMEBASE
+        assert stamp_ns(js_list[-1]) == big
+        status, _ = proc.stop(signal.SIGINT)
+        assert status == 0, proc.output()
+    finally:
+        if proc.proc.poll() is None:
+            proc.proc.kill()
+        ros.node.destroy_publisher(clock_pub)
+
+
+PARTIAL_SCENE = """\
+name: partial_four_bar
+description: Crank 40, coupler 60, rocker 80, ground 150 mm, assembles only near 0 deg.
+units: {length: mm, angle: deg}
+ground:
+  A: [0, 0]
+  D: [150, 0]
+input: {link: crank, center: A, point: B, length: 40, angle: 0, speed_rpm: 120}
+dyads:
+  - type: RRR
+    point: C
+    links:
+      - {name: coupler, from: B, length: 60}
+      - {name: rocker, from: D, length: 80}
+    branch: 1
+"""
+
+
+def test_unsolvable_ticks_publish_nothing_and_the_node_carries_on(ros, tmp_path):
+    """Where the scene cannot assemble no state is published, diagnostics say why; remaps apply."""
+    scene_path = tmp_path / 'partial_four_bar.yaml'
+    scene_path.write_text(PARTIAL_SCENE)
+    scene = mk.load_scene(scene_path)
+    ns_topic = f'{SESSION}/partial'
+    remapped = ros.collect(JointState, f'{ns_topic}/remapped_states')
+    not_remapped = ros.collect(JointState, f'{ns_topic}/joint_states')
+    jt_list = ros.collect(JointTrajectory, f'{ns_topic}/joint_accelerations')
+    md_list = ros.collect(MultiDOFJointTrajectory, f'{ns_topic}/point_accelerations')
+    diag = ros.collect(DiagnosticArray, f'{ns_topic}/diagnostics')
+    proc = NodeProcess(tmp_path, '-p', f'scene:={scene_path}', '-p', 'rate_hz:=100',
+                       '-r', f'__ns:={ns_topic}', '-r', 'joint_states:=remapped_states')
+    try:
+        def saw_error():
+            return any(s.level == DiagnosticStatus.ERROR for m in diag for s in m.status)
+        wait_for(saw_error, STARTUP_S, 'a cannot-assemble status on diagnostics')
+        start = len(remapped)
+        wait_for(lambda: len(remapped) >= start + 30, 5.0, 'states after an unsolvable stretch')
+        time.sleep(0.2)
+        solver = [s for m in diag for s in m.status if s.level == DiagnosticStatus.ERROR][0]
+        assert 'cannot assemble' in solver.message and 'RRR' in solver.message
+        assert not not_remapped, 'published on joint_states despite the remap'
+        stamps = sorted(stamp_ns(m) for m in remapped)
+        assert max(np.diff(stamps)) > 0.1 * NS, 'no gap where the scene cannot assemble'
+        for js, jt, md in list(ticks(remapped, jt_list, md_list).values())[-30:]:
+            assert_agrees_with_solver(scene, js, jt, md)
+        status, _ = proc.stop(signal.SIGTERM)
+        assert status == 0, proc.output()
+    finally:
+        if proc.proc.poll() is None:
+            proc.proc.kill()
+
+
+BROKEN_SCENE = PARTIAL_SCENE.replace('angle: 0,', 'angle: 180,').replace(
+    'partial_four_bar', 'broken_four_bar')
+
+
+@pytest.mark.parametrize('case', ['unassemblable scene', 'missing scene', 'rate 0'])
+def test_bad_start_exits_non_zero_with_a_clear_message(tmp_path, case):
+    """A scene that cannot assemble (or is missing, or a bad -p) stops the node with status 1."""
+    scene_path = tmp_path / 'broken_four_bar.yaml'
+    scene_path.write_text(BROKEN_SCENE)
+    args, words = {
+        'unassemblable scene': (['-p', f'scene:={scene_path}'], ['assemble', 'broken_four_bar']),
+        'missing scene': (['-p', 'scene:=no_such_scene'], ['no_such_scene']),
+        'rate 0': (['-p', 'rate_hz:=0'], ['rate_hz']),
+    }[case]
+    proc = NodeProcess(tmp_path, *args)
+    try:
+        status = proc.proc.wait(timeout=STARTUP_S)
+    finally:
+        if proc.proc.poll() is None:
+            proc.proc.kill()
+    output = proc.output()
+    assert status == 1, output
+    assert 'Traceback' not in output
+    for word in words:
+        assert word in output
+
+
+@pytest.mark.parametrize('sig', [signal.SIGINT, signal.SIGTERM])
+def test_signal_exits_zero_within_a_second(ros, tmp_path, sig):
+    """SIGINT and SIGTERM stop the node within 1 s with status 0 and no traceback."""
+    ns_topic = f'{SESSION}/signal_{sig.name.lower()}'
+    js_list = ros.collect(JointState, f'{ns_topic}/joint_states')
+    proc = NodeProcess(tmp_path, '-r', f'__ns:={ns_topic}', '-p', 'rate_hz:=1000')
+    try:
+        wait_for(lambda: js_list, STARTUP_S, 'the first joint_states')
+        status, took = proc.stop(sig)
+    finally:
+        if proc.proc.poll() is None:
+            proc.proc.kill()
+    output = proc.output()
+    assert status == 0, output
+    assert 'Traceback' not in output
+    assert took < 1.0
+
+
+FAILING_TICK = """\
+import sys
+import mech_kinematics.kinematics_node as kn
+def fail(self, *args):
+    raise RuntimeError('injected failure')
+kn.KinematicsNode._tick = fail
+sys.exit(kn.main())
+"""
+
+
+def test_tick_thread_failure_stops_the_node_with_status_1(tmp_path):
+    """A node whose tick thread died does not linger: it logs the error and exits 1."""
+    env = dict(os.environ)
+    env['PYTHONPATH'] = os.pathsep.join(filter(None, [str(REPO), env.get('PYTHONPATH')]))
+    result = subprocess.run(
+        [sys.executable, '-c', FAILING_TICK, '--ros-args', '-r', f'__ns:={SESSION}/failing'],
+        env=env, capture_output=True, text=True, timeout=STARTUP_S, cwd=tmp_path)
+    assert result.returncode == 1, result.stdout + result.stderr
+    assert 'tick thread failed' in result.stderr and 'injected failure' in result.stderr

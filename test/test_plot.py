@@ -1,0 +1,209 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The ``plot`` command: panels, labels and values, from a scene and from a bag.
+
+The bags here are written without DDS: the node's own renderer
+(:class:`mech_kinematics.messages.TickMessages`, the bytes it publishes) and the
+rosbags writer, with the definitions the recorder stores.
+"""
+
+import math
+from pathlib import Path
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import mech_kinematics as mk
+from mech_kinematics import bag_recorder, plot
+
+REPO = Path(__file__).resolve().parents[1]
+#: Values drawn are the solver's, untouched: exact up to float64 rounding of |v|.
+RTOL = 1e-12
+PNG_MAGIC = b'\x89PNG\r\n\x1a\n'
+JOINT_PANELS = {'Joint angles', 'Joint angular velocities', 'Joint angular accelerations'}
+POINT_PANELS = {'Point paths', 'Point speeds |v|', 'Point accelerations |a|'}
+SLIDER_PANELS = {'Slider positions', 'Slider velocities', 'Slider accelerations'}
+UNITS = ('[rad]', '[rad/s]', '[rad/s²]', '[m]', '[m/s]', '[m/s²]', '[s]')
+TYPES = {'joint_states': 'sensor_msgs/msg/JointState',
+         'joint_accelerations': 'trajectory_msgs/msg/JointTrajectory',
+         'point_accelerations': 'trajectory_msgs/msg/MultiDOFJointTrajectory'}
+
+
+def panels(fig):
+    return {ax.get_title(): ax for ax in fig.axes}
+
+
+def assert_png(path: Path) -> None:
+    data = path.read_bytes()
+    assert data.startswith(PNG_MAGIC), f'{path} is not a PNG'
+    width, height = int.from_bytes(data[16:20], 'big'), int.from_bytes(data[20:24], 'big')
+    assert width >= 800 and height >= 600
+
+
+def assert_units_everywhere(fig) -> None:
+    for ax in fig.axes:
+        for label in (ax.get_xlabel(), ax.get_ylabel()):
+            assert label.endswith(UNITS), f'{ax.get_title()!r}: axis label {label!r} has no unit'
+
+
+def lines(ax) -> dict:
+    return {line.get_label(): line for line in ax.get_lines()
+            if not line.get_label().startswith('_')}
+
+
+def write_bag(path: Path, scene, angles, *, storage='mcap', topics=tuple(TYPES), dt=0.002,
+              namespaces=('',), skip=()):
+    """Write what the node would publish at ``angles`` (one tick per dt s) to a new bag."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.typesys import get_typestore, Stores
+    from rosbags.typesys.msg import get_types_from_msg
+
+    from mech_kinematics.messages import TickMessages
+
+    ticks = TickMessages(scene.output_joints, scene.output_points, 'mechanism')
+    store = get_typestore(Stores.EMPTY)
+    definitions = {}
+    for topic in topics:
+        text = bag_recorder.message_definition(TYPES[topic])[1]
+        store.register(get_types_from_msg(text, TYPES[topic]))
+        definitions[topic] = text
+    start = 1_700_000_000 * 10**9
+    with Writer(path, version=8, storage_plugin=StoragePlugin[storage.upper()]) as writer:
+        connections = {(ns, t): writer.add_connection(f'{ns}/{t}', TYPES[t],
+                                                      msgdef=definitions[t],
+                                                      rihs01=store.hash_rihs01(TYPES[t]))
+                       for ns in namespaces for t in topics}
+        for i, angle in enumerate(angles):
+            if i in skip:
+                continue
+            stamp = start + round(i * dt * 1e9)
+            state = mk.solve(scene, angle)
+            rendered = dict(zip(TYPES, ticks.render(state, *divmod(stamp, 10**9)), strict=True))
+            for (_, topic), connection in connections.items():
+                writer.write(connection, stamp, rendered[topic])
+    return path
+
+
+def test_scene_plot_has_every_panel_with_units(tmp_path):
+    """From a scene: joint and point panels, every axis labelled with a unit, a real PNG."""
+    out = tmp_path / 'four_bar.png'
+    fig = plot.plot_scene(mk.load_scene('khurmi_four_bar_ad150'), out)
+    assert set(panels(fig)) == JOINT_PANELS | POINT_PANELS
+    assert_units_everywhere(fig)
+    assert_png(out)
+    assert panels(fig)['Joint angular velocities'].get_xlabel() == 'crank angle θ [rad]'
+    assert set(lines(panels(fig)['Joint angles'])) == {'crank', 'coupler', 'rocker'}
+    # A, D are fixed: no speed line, a marker in the path panel.
+    assert set(lines(panels(fig)['Point speeds |v|'])) == {'B', 'C'}
+
+
+def test_scene_plot_values_are_the_solver_values(tmp_path):
+    """The lines drawn are mk.solve over 0..2π: angular velocities and point speeds."""
+    scene = mk.load_scene('khurmi_four_bar_ad150')
+    fig = plot.plot_scene(scene, tmp_path / 'p.png', samples=181)
+    angle = np.linspace(0.0, 2 * math.pi, 181)
+    state = mk.solve(scene, angle)
+    rocker = lines(panels(fig)['Joint angular velocities'])['rocker']
+    np.testing.assert_allclose(rocker.get_xdata(), angle, rtol=RTOL, atol=0)
+    np.testing.assert_allclose(rocker.get_ydata(), state.joints['rocker'].velocity, rtol=RTOL,
+                               atol=0)
+    speed_c = lines(panels(fig)['Point speeds |v|'])['C'].get_ydata()
+    np.testing.assert_allclose(speed_c, np.linalg.norm(state.points['C'].velocity, axis=1),
+                               rtol=RTOL, atol=0)
+
+
+def test_scene_with_sliders_adds_the_slider_column(tmp_path):
+    """A mechanism with prismatic joints gets slider panels in metres."""
+    fig = plot.plot_scene(mk.load_scene('quick_return'), tmp_path / 'qr.png', x='time')
+    assert set(panels(fig)) == JOINT_PANELS | POINT_PANELS | SLIDER_PANELS
+    assert_units_everywhere(fig)
+    assert set(lines(panels(fig)['Slider positions'])) == {'block', 'ram'}
+    assert panels(fig)['Slider velocities'].get_ylabel() == 'velocity [m/s]'
+    assert panels(fig)['Slider velocities'].get_xlabel() == 'time [s]'
+
+
+def test_scene_that_does_not_assemble_everywhere_leaves_gaps(tmp_path):
+    """A triple rocker: angles that cannot be assembled are gaps (NaN), never made-up values."""
+    scene = mk.load_scene('four_bar_coupler_points')
+    fig = plot.plot_scene(scene, tmp_path / 'fb.png', samples=361)
+    ydata = lines(panels(fig)['Joint angular velocities'])['rocker'].get_ydata()
+    state = mk.solve(scene, np.linspace(0, 2 * math.pi, 361))
+    assert np.isnan(ydata).sum() == (~state.valid).sum() > 0
+
+
+@pytest.mark.parametrize('storage', bag_recorder.STORAGES)
+def test_bag_plot_shows_the_recorded_values(tmp_path, storage):
+    """From a bag of the node's bytes (mcap and sqlite3): panels, time axis and the values."""
+    scene = mk.load_scene('khurmi_four_bar_ad150')
+    angles = scene.input.angle + scene.input.speed * 0.002 * np.arange(200)
+    bag = write_bag(tmp_path / 'bag', scene, angles, storage=storage)
+    out = tmp_path / 'bag.png'
+    assert plot.main([str(bag), '-o', str(out), '--scene', scene.name]) == 0
+    assert_png(out)
+    fig = plot.plot_bag(bag, tmp_path / 'again.png', scene=scene)
+    assert set(panels(fig)) == JOINT_PANELS | POINT_PANELS
+    assert_units_everywhere(fig)
+    accel = lines(panels(fig)['Joint angular accelerations'])['coupler']
+    np.testing.assert_allclose(accel.get_xdata(), 0.002 * np.arange(200), rtol=0, atol=1e-9)
+    expected = [mk.solve(scene, a).joints['coupler'].acceleration for a in angles]
+    np.testing.assert_allclose(accel.get_ydata(), expected, rtol=RTOL, atol=0)
+
+
+def test_bag_plot_finds_the_scene_from_diagnostics_or_warns(tmp_path):
+    """Without --scene and without diagnostics in the bag, joints are plotted as revolute."""
+    scene = mk.load_scene('khurmi_four_bar_ad150')
+    bag = write_bag(tmp_path / 'bag', scene, np.linspace(0, 1, 20), namespaces=('/robot',))
+    motion = plot.motion_from_bag(bag, scene=scene, namespace='/robot')
+    assert len(motion.time) == 20
+    with pytest.warns(UserWarning, match='no scene given'):
+        motion = plot.motion_from_bag(bag)
+    assert motion.joint_types == dict.fromkeys(scene.output_joints, 'revolute')
+
+
+def test_ticks_missing_from_a_bag_leave_a_gap_not_a_line(tmp_path):
+    """Ticks the node did not publish are a break in every line, paths included."""
+    scene = mk.load_scene('khurmi_four_bar_ad150')
+    angles = scene.input.angle + scene.input.speed * 0.002 * np.arange(300)
+    bag = write_bag(tmp_path / 'gap', scene, angles, skip=range(100, 140))
+    fig = plot.plot_bag(bag, tmp_path / 'gap.png', scene=scene)
+    for title in ('Joint angular velocities', 'Point paths'):
+        for line in lines(panels(fig)[title]).values():
+            y = np.asarray(line.get_ydata(), dtype=float)
+            assert np.isnan(y).sum() == 1 and len(y) == 260 + 1, title
+
+
+def test_bag_with_joint_states_only_has_no_acceleration_lines(tmp_path):
+    """A bag with only joint_states plots angles and velocities, and says 'no data' for α."""
+    scene = mk.load_scene('khurmi_four_bar_ad150')
+    bag = write_bag(tmp_path / 'js', scene, np.linspace(0, 1, 20), topics=('joint_states',))
+    fig = plot.plot_bag(bag, tmp_path / 'js.png', scene=scene, x='angle')
+    assert set(lines(panels(fig)['Joint angular velocities'])) == {'crank', 'coupler', 'rocker'}
+    assert not lines(panels(fig)['Joint angular accelerations'])
+    assert not lines(panels(fig)['Point speeds |v|'])
+
+
+def test_errors_are_reported_not_raised(tmp_path, capsys):
+    """No source, a missing bag, two namespaces, no such topics or scene: exit 2, a reason."""
+    assert plot.main(['-o', str(tmp_path / 'x.png')]) == 2
+    assert 'Expected a BAG or --scene' in capsys.readouterr().err
+    assert plot.main([str(tmp_path / 'nothing'), '-o', str(tmp_path / 'x.png')]) == 2
+    assert 'does not exist' in capsys.readouterr().err
+    scene = mk.load_scene('khurmi_four_bar_ad150')
+    bag = write_bag(tmp_path / 'bag', scene, [1.0, 1.1], namespaces=('/left', '/right'))
+    assert plot.main([str(bag), '-o', str(tmp_path / 'x.png')]) == 2
+    assert 'pass --namespace' in capsys.readouterr().err
+    assert plot.main([str(bag), '--namespace', '/nowhere', '-o', str(tmp_path / 'x.png')]) == 2
+    assert "Expected the node's joint_accelerations" in capsys.readouterr().err
+    assert plot.main(['--scene', 'no_such_scene', '-o', str(tmp_path / 'x.png')]) == 2
+    assert 'no_such_scene' in capsys.readouterr().err
+    assert not (tmp_path / 'x.png').exists()
+
+
+def test_importing_the_commands_pulls_in_neither_matplotlib_nor_rclpy():
+    """The command modules import matplotlib, rosbags and rclpy only when they run."""
+    code = ('import sys, mech_kinematics.plot, mech_kinematics.bag_recorder; '
+            'heavy = {"matplotlib", "rclpy", "rosbags"} & set(sys.modules); '
+            'assert not heavy, heavy')
+    subprocess.run([sys.executable, '-c', code], check=True, cwd=REPO)

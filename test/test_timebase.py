@@ -1,0 +1,194 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""Tests of mech_kinematics.timebase: the crank angle as an exact function of clock time."""
+
+from decimal import Decimal, localcontext
+from fractions import Fraction
+import math
+
+from hypothesis import example, given, strategies as st
+import pytest
+
+from mech_kinematics.timebase import CrankTimebase, TWO_PI
+
+NS = 1_000_000_000
+DAY_NS = 86_400 * NS
+#: Largest error allowed on an angle, rad: a few ulp of pi.
+ATOL_ANGLE = 4 * math.ulp(math.pi)  # rad
+#: What the issue asks for after 30 days at 10,000 rpm, rad.
+ATOL_LONG_RUN = 1e-9  # rad
+
+# pi to 70 digits, typed in independently of the module's constant.
+PI_70 = Decimal('3.141592653589793238462643383279502884197169399375105820974944592307816')
+
+
+def exact_angle(angle0: float, speed_rpm: float, t_ns: int) -> float:
+    """Return angle0 + speed * t wrapped to (-pi, pi], computed with 70-digit decimals."""
+    with localcontext() as ctx:
+        ctx.prec = 80
+        two_pi = 2 * PI_70
+        theta = Decimal(angle0) + two_pi * Decimal(speed_rpm) / 60 * Decimal(t_ns) / NS
+        theta = theta % two_pi          # in (-2 pi, 2 pi), sign of theta
+        if theta > PI_70:
+            theta -= two_pi
+        elif theta <= -PI_70:
+            theta += two_pi
+        return float(theta)
+
+
+def angle_difference(a: float, b: float) -> float:
+    """Return a - b wrapped to [-pi, pi]."""
+    return math.remainder(a - b, 2 * math.pi)
+
+
+def rpms():
+    """Crank speeds, rpm: any finite value a user may set, and a few round ones."""
+    return st.one_of(st.sampled_from([0.0, 1.0, -120.0, 10_000.0, -99_999.5]),
+                     st.floats(-100_000, 100_000, allow_nan=False))
+
+
+def instants():
+    """Clock instants, ns: from the start up to a year."""
+    return st.integers(0, 365 * DAY_NS)
+
+
+def test_starts_at_the_initial_angle():
+    """At its start instant the crank is at the given angle, wrapped to (-pi, pi]."""
+    for angle in (0.0, 1.0, -1.0, math.pi, 3 * math.pi / 2, 100.0):
+        tb = CrankTimebase(123_456, angle, 60.0, 0.0, 1000.0)
+        expected = exact_angle(angle, 0.0, 0)
+        assert abs(angle_difference(tb.sample(123_456).angle, expected)) <= ATOL_ANGLE
+        assert -math.pi < tb.sample(123_456).angle <= math.pi
+
+
+def test_thirty_days_at_ten_thousand_rpm():
+    """After 30 days at 10,000 rpm the angle is within 1e-9 rad of exact (float seconds miss by ~1e-6)."""  # noqa: E501
+    t_start = 1_780_000_000 * NS + 123_456_789      # a wall-clock epoch, ns
+    tb = CrankTimebase(t_start, 1.0, 10_000.0, 0.0, 10_000.0)
+    for extra in (0, 1, 999_999_999, 12_345_678_901):
+        t = t_start + 30 * DAY_NS + extra
+        got = tb.sample(t)
+        expected = exact_angle(1.0, 10_000.0, t - t_start)
+        assert abs(angle_difference(got.angle, expected)) < ATOL_LONG_RUN
+        assert abs(angle_difference(got.angle, expected)) <= ATOL_ANGLE
+        assert got.speed == 10_000.0 * math.pi / 30
+    naive = 1.0 + 10_000.0 * math.pi / 30 * ((30 * DAY_NS) / NS)
+    assert abs(angle_difference(naive, exact_angle(1.0, 10_000.0, 30 * DAY_NS))) > 1e-8
+
+
+@given(angle0=st.floats(-10, 10), rpm=rpms(), t=instants())
+@example(angle0=0.0, rpm=-99_999.5, t=365 * DAY_NS)
+def test_constant_speed_is_exact(angle0, rpm, t):
+    """At constant speed the angle is angle0 + omega * t, exact to a few ulp, at any instant."""
+    tb = CrankTimebase(0, angle0, rpm, 0.0, 100_000.0)
+    got = tb.sample(t)
+    assert abs(angle_difference(got.angle, exact_angle(angle0, rpm, t))) <= ATOL_ANGLE
+    assert -math.pi < got.angle <= math.pi
+    assert got.accel == 0.0
+
+
+@given(rpm=rpms(), t1=instants(), t2=instants())
+def test_turns_advance_exactly(rpm, t1, t2):
+    """The position in turns advances by exactly rpm / 60 * dt, modulo one turn."""
+    tb = CrankTimebase(0, 0.25, rpm, 0.0, 100_000.0)
+    advance = Fraction(rpm) / 60 * Fraction(t2 - t1, NS)
+    assert (tb.turns(t2) - tb.turns(t1) - advance) % 1 == 0
+
+
+@given(rpm1=rpms(), rpm2=rpms(), tc=instants(), dt=st.integers(1, 10 * NS))
+def test_speed_change_keeps_the_angle_continuous(rpm1, rpm2, tc, dt):
+    """Changing the speed at tc keeps the position there and turns at the new speed after."""
+    tb = CrankTimebase(0, 0.5, rpm1, 0.0, 100_000.0)
+    before = tb.turns(tc)
+    tb.update(tc, speed_rpm=rpm2)
+    assert tb.turns(tc) == before
+    assert tb.turns(tc - 1) == (before - Fraction(rpm1) / 60 / NS) % 1   # old drive
+    assert tb.turns(tc + dt) == (before + Fraction(rpm2) / 60 * Fraction(dt, NS)) % 1
+    assert tb.speed(tc + dt) == Fraction(rpm2) / 60
+
+
+def test_acceleration_then_hold_at_the_bound():
+    """Accelerating from rest: angle = alpha t^2 / 2 until the bound, then constant speed."""
+    alpha = 10.0                       # rad/s^2
+    tb = CrankTimebase(0, 0.0, 0.0, alpha, 600.0)       # bound 600 rpm = 20 pi rad/s
+    w_max = 600.0 * math.pi / 30
+    t_hold = w_max / alpha                               # s, about 6.28
+    for t in (0.1, 1.0, 3.0, 6.0):
+        got = tb.sample(round(t * NS))
+        expected = math.remainder(alpha * t * t / 2, 2 * math.pi)
+        assert abs(angle_difference(got.angle, expected)) < 1e-12
+        assert got.speed == pytest.approx(alpha * t, rel=1e-12)
+        assert got.accel == alpha
+    for t in (7.0, 100.0, 1e6):
+        got = tb.sample(round(t * NS))
+        expected = alpha * t_hold ** 2 / 2 + w_max * (t - t_hold)
+        assert abs(angle_difference(got.angle, math.remainder(expected, 2 * math.pi))) < 1e-6
+        assert got.speed == pytest.approx(w_max, rel=1e-15)
+        assert got.accel == 0.0
+    # The position is continuous through the hold instant.
+    t_ns = math.ceil(t_hold * NS)
+    step = tb.turns(t_ns) - tb.turns(t_ns - 1)
+    assert 0 < step < Fraction(11, 10) * 10 / NS
+
+
+def test_negative_acceleration_runs_to_the_negative_bound():
+    """A negative acceleration slows the crank, reverses it and holds it at -max."""
+    tb = CrankTimebase(0, 0.0, 300.0, -50.0, 1000.0)
+    assert tb.sample(0).speed == pytest.approx(10 * math.pi)
+    assert tb.sample(NS).speed == pytest.approx(10 * math.pi - 50.0)
+    assert tb.sample(100 * NS).speed == pytest.approx(-1000.0 * math.pi / 30, rel=1e-15)
+    assert tb.sample(100 * NS).accel == 0.0
+
+
+def test_accel_change_starts_from_the_current_speed():
+    """Setting the acceleration keeps the speed there: only its rate of change changes."""
+    tb = CrankTimebase(0, 0.0, 60.0, 0.0, 1000.0)
+    before = tb.turns(5 * NS)
+    tb.update(5 * NS, accel=2 * math.pi)         # one turn/s^2
+    assert tb.turns(5 * NS) == before
+    assert tb.speed(6 * NS) == pytest.approx(2, rel=1e-15)      # turns/s
+    assert tb.sample(6 * NS).accel == pytest.approx(2 * math.pi)
+
+
+def test_lowering_the_bound_clamps_the_speed():
+    """A bound below the current speed clamps it at once; the angle does not jump."""
+    tb = CrankTimebase(0, 0.0, 600.0, 0.0, 1000.0)
+    before = tb.turns(NS)
+    tb.update(NS, max_speed_rpm=120.0)
+    assert tb.turns(NS) == before
+    assert tb.speed(2 * NS) == 2
+    assert tb.max_speed_rpm == 120.0
+    tb.update(3 * NS, speed_rpm=-500.0)
+    assert tb.speed(4 * NS) == -2
+
+
+def test_moved_continues_on_a_new_clock():
+    """moved() gives a drive that at the new instant is where the old one was."""
+    tb = CrankTimebase(10 * NS, 0.3, 90.0, 1.0, 1000.0)
+    copy = tb.moved(20 * NS, 5)
+    assert copy.turns(5) == tb.turns(20 * NS)
+    assert copy.speed(5) == tb.speed(20 * NS)
+
+
+@pytest.mark.parametrize('kwargs, match', [
+    ({'angle': math.nan}, 'angle'),
+    ({'speed_rpm': math.inf}, 'speed_rpm'),
+    ({'accel': -math.inf}, 'accel'),
+    ({'max_speed_rpm': -1.0}, 'max_speed_rpm'),
+])
+def test_bad_values_are_refused(kwargs, match):
+    """Non-finite values and a negative bound raise ValueError naming the argument."""
+    args = {'t0': 0, 'angle': 0.0, 'speed_rpm': 1.0, 'accel': 0.0, 'max_speed_rpm': 10.0}
+    args.update(kwargs)
+    with pytest.raises(ValueError, match=match):
+        CrankTimebase(**args)
+    tb = CrankTimebase(0, 0.0, 1.0, 0.0, 10.0)
+    if 'angle' not in kwargs:
+        with pytest.raises(ValueError, match=match):
+            tb.update(1, **kwargs)
+
+
+def test_two_pi_constant():
+    """The rational 2*pi agrees with the float one to the last bit."""
+    assert float(TWO_PI) == 2 * math.pi
+    assert abs(TWO_PI - 2 * Fraction(str(PI_70))) < Fraction(1, 10 ** 58)
