@@ -84,10 +84,14 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument('--repeat', type=int, default=7, help='repeats for medians')
     bench.set_defaults(handler=lambda args: _module('bench').main(args))
 
-    run = commands.add_parser('run', help='start the node on the default scene with a live view',
-                              add_help=False)
+    run = commands.add_parser(
+        'run', help='start the node with a live console view (make run); Ctrl-C stops both',
+        description='Start kinematics_node and a live console view of what it publishes. '
+                    'Arguments after `run` go to the node, e.g. '
+                    '`run --ros-args -p scene:=quick_return -p rate_hz:=200.0`.')
     run.set_defaults(handler=lambda args: _module('live').main(args.rest))
-    run.add_argument('rest', nargs=argparse.REMAINDER)
+    run.add_argument('rest', nargs=argparse.REMAINDER, metavar='NODE_ARGS',
+                     help='arguments for the node (--ros-args ...)')
     _module('diagram').add_parser(commands)
     _module('report').add_parser(commands)
     _module('bag_recorder').add_parser(commands)
@@ -102,6 +106,11 @@ def _module(name: str) -> Any:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; return the exit status."""
+    argv = sys.argv[1:] if argv is None else argv
+    if argv[:1] == ['run'] and argv[1:2] != ['-h'] and argv[1:2] != ['--help']:
+        # Everything after `run` goes to the node untouched (`--ros-args -p ...`),
+        # which argparse's REMAINDER refuses when it starts with a dash.
+        return int(_module('live').main(argv[1:]) or 0)
     args = build_parser().parse_args(argv)
     return int(args.handler(args) or 0)
 
