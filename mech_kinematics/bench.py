@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from .linkage import Scene, solve
+from .linkage import solve
 from .scene import load_scene, scene_names
 
 # The hand-written baselines solve the packaged scenes' own geometry.
@@ -118,47 +118,46 @@ def slider_crank_numpy(theta: Any, w: float, al: float) -> tuple[Any, ...]:
     return x, phi, v, wr, a, ar, bx, by, vbx, vby, abx, aby
 
 
-def _median_time(func: Callable[[], Any], number: int, repeat: int) -> float:
-    times = []
+def _median_times(funcs: list[Callable[[], Any]], number: int,
+                  repeat: int) -> list[float]:
+    """Median time of one call of each function, the functions timed in turn.
+
+    Interleaving the repeats makes a load change on the shared machine hit
+    every function alike, so their ratios stay meaningful.
+    """
+    times: list[list[float]] = [[] for _ in funcs]
     for _ in range(repeat):
-        start = time.perf_counter()
-        for _ in range(number):
-            func()
-        times.append((time.perf_counter() - start) / number)
-    return statistics.median(times)
-
-
-def _valid_angle(scene: Scene) -> float:
-    return scene.input.angle
+        for func, samples in zip(funcs, times, strict=True):
+            start = time.perf_counter()
+            for _ in range(number):
+                func()
+            samples.append((time.perf_counter() - start) / number)
+    return [statistics.median(samples) for samples in times]
 
 
 def measure(names: list[str], angles: int, repeat: int) -> list[dict[str, Any]]:
-    """Time every scene and the baselines; return one row per scene."""
+    """Time every scene, and the hand-written baselines beside theirs; one row each."""
     sweep = np.linspace(0.0, 2.0 * math.pi, angles, endpoint=False)
     baselines = {
         FOUR_BAR: (four_bar_math, four_bar_numpy),
         SLIDER_CRANK: (slider_crank_math, slider_crank_numpy),
     }
-    base = {}
-    for name, (scalar, vector) in baselines.items():
-        scene = load_scene(name)
-        theta, w, al = scene.input.angle, scene.input.speed, scene.input.accel
-        base[name] = (
-            _median_time(partial(scalar, theta, w, al), 2000, repeat),
-            _median_time(partial(vector, sweep, w, al), 3, repeat) / angles,
-        )
     rows = []
     for name in names:
         scene = load_scene(name)
-        theta = _valid_angle(scene)
-        one = _median_time(partial(solve, scene, theta), 1000, repeat)
-        many = _median_time(partial(solve, scene, sweep), 3, repeat) / angles
-        row = {'scene': name, 'single_us': one * 1e6, 'array_us': many * 1e6,
-               'dyads': len(scene.dyads), 'points': len(scene.output_points)}
-        rows.append(row)
-    for name, (scalar, vector) in base.items():
-        rows.append({'scene': f'{name} (hand-written)', 'single_us': scalar * 1e6,
-                     'array_us': vector * 1e6, 'baseline_of': name})
+        theta, w, al = scene.input.angle, scene.input.speed, scene.input.accel
+        singles = [partial(solve, scene, theta)]
+        arrays = [partial(solve, scene, sweep)]
+        if name in baselines:
+            scalar, vector = baselines[name]
+            singles.append(partial(scalar, theta, w, al))
+            arrays.append(partial(vector, sweep, w, al))
+        one = _median_times(singles, 1000, repeat)
+        many = [t / angles for t in _median_times(arrays, 3, repeat)]
+        rows.append({'scene': name, 'single_us': one[0] * 1e6, 'array_us': many[0] * 1e6})
+        if name in baselines:
+            rows.append({'scene': f'{name} (hand-written)', 'single_us': one[1] * 1e6,
+                         'array_us': many[1] * 1e6, 'baseline_of': name})
     return rows
 
 

@@ -281,8 +281,11 @@ class _CrankStep:
         else:
             e = complex(math.cos(theta), math.sin(theta))
         r = self.length * e
-        ctx.points[self.point] = (self.center + r, 1j * omega * r,
-                                  1j * alpha * r - omega * omega * r)
+        if (not ctx.vector or alpha.ndim == 0) and alpha == 0.0:  # a constant crank speed
+            acceleration = -(omega * omega) * r
+        else:
+            acceleration = 1j * alpha * r - omega * omega * r
+        ctx.points[self.point] = (self.center + r, 1j * omega * r, acceleration)
         ctx.links[self.link] = (e, omega, alpha)
 
 
@@ -358,6 +361,7 @@ class _RRPStep:
         self.slider = dyad.slider
         self.through = through
         self.u = complex(math.cos(dyad.guide_angle), math.sin(dyad.guide_angle))
+        self.normal = 1j * self.u
         self.branch = int(dyad.branch)
         self.uses = (dyad.link.start,)
 
@@ -382,7 +386,7 @@ class _RRPStep:
         den = self.branch * root  # dot(u, r)
         inv = 1.0 / den
         s = along + den
-        r = den * u - 1j * offset * u
+        r = den * u - offset * self.normal
         sd = _dot(vq, r) * inv
         omega = _cross(vq, u) * inv
         rest = aq - omega * omega * r
@@ -832,9 +836,9 @@ class State:
 def _run(plan: _Plan, angle: Any, speed: Any, accel: Any) -> _Context:
     """Run every step of ``plan``; the caller chose scalar or vector inputs."""
     ctx = _Context(angle, not isinstance(angle, float))
-    zero = 0j if not ctx.vector else np.zeros(np.shape(angle), dtype=np.complex128)
+    # Ground points stay complex scalars in both paths: NumPy broadcasts them.
     for name, position in plan.ground.items():
-        ctx.points[name] = (position + zero, zero, zero)
+        ctx.points[name] = (position, 0j, 0j)
     plan.crank.run(ctx, angle, speed, accel)
     for step in plan.steps:
         step.run(ctx)
@@ -943,9 +947,16 @@ def _state(scene: Scene, plan: _Plan, ctx: _Context, theta: Any, omega: Any, alp
         inputs = (id(theta), id(omega), id(alpha))
 
         def finish(x: Any) -> Any:
-            # Own every array (never the caller's inputs); invalid entries are NaN.
-            if np.shape(x) != shape or id(x) in inputs:
-                x = np.array(np.broadcast_to(x, shape))
+            # A constant (a ground point, a constant crank speed) becomes a
+            # read-only broadcast view; a copy only where NaN must go in, and
+            # never the caller's own input arrays.
+            if id(x) in inputs:
+                x = np.array(x)
+            elif np.shape(x) != shape:
+                x = np.broadcast_to(x, shape)
+                if bad is None:
+                    return x
+                x = np.array(x)
             if bad is not None:
                 x[bad] = np.nan
             return x
