@@ -7,8 +7,10 @@ parameters, loads the scene once and creates the publishers; a tick thread
 wakes on absolute deadlines, takes the crank angle from the node's clock
 (:mod:`mech_kinematics.timebase`), solves, and publishes three messages
 rendered from pre-serialized templates (:mod:`mech_kinematics.messages`).
-The executor only serves the parameter services, ``/clock`` and the 1 Hz
-diagnostics.
+The executor only serves the parameter services, ``/clock``, the 1 Hz
+diagnostics and, with ``markers: true``, the RViz markers: the tick thread
+hands at most 30 samples a second to the executor, which solves the whole
+scene and publishes a ``MarkerArray`` (:mod:`mech_kinematics.markers`).
 
 Run it with ``ros2 run mech_kinematics kinematics_node`` or
 ``python -m mech_kinematics.kinematics_node [--ros-args ...]``.
@@ -27,6 +29,7 @@ import traceback
 from typing import Any
 import warnings
 
+from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor, SetParametersResult
 import rclpy
@@ -40,8 +43,14 @@ from rclpy.parameter import Parameter
 from rclpy.qos import QoSDurabilityPolicy, QoSHistoryPolicy, QoSProfile, QoSReliabilityPolicy
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
+from visualization_msgs.msg import MarkerArray
 
 import mech_kinematics as mk
+from mech_kinematics.diagram import space_from_state, strokes_from_scene
+from mech_kinematics.instant_centres import full_scene
+from mech_kinematics.markers import (DEFAULT_ACCELERATION_SCALE, DEFAULT_VELOCITY_SCALE,
+                                     marker_array_from_state, marker_size_from_space,
+                                     MarkerThrottle)
 from mech_kinematics.messages import TickMessages
 from mech_kinematics.timebase import CrankTimebase
 
@@ -55,6 +64,8 @@ RANGES = {
     'crank_accel': (-1.0e6, 1.0e6, 'rad/s^2'),
     'rate_hz': (1.0, 10_000.0, 'Hz'),
     'max_crank_speed_rpm': (0.0, 100_000.0, 'rpm'),
+    'marker_velocity_scale': (0.0, 1000.0, 'm per m/s'),
+    'marker_acceleration_scale': (0.0, 1000.0, 'm per m/s^2'),
 }
 NUMERIC = tuple(RANGES)
 DEFAULT_RATE_HZ = 100.0
@@ -163,6 +174,13 @@ class KinematicsNode(Node):
             'Crank angular acceleration, rad/s^2, + CCW, from the moment it is set; the speed '
             "is held at +-max_crank_speed_rpm. Defaults to the scene's input.accel")
         self._declare_number('rate_hz', DEFAULT_RATE_HZ, 'Publish rate, Hz')
+        markers = self.declare_parameter('markers', False, ParameterDescriptor(
+            description='Also publish visualization_msgs/MarkerArray on markers, at most 30 Hz',
+            read_only=True, dynamic_typing=True)).value
+        self._declare_number('marker_velocity_scale', DEFAULT_VELOCITY_SCALE,
+                             'Length of the velocity arrows on markers per unit velocity')
+        self._declare_number('marker_acceleration_scale', DEFAULT_ACCELERATION_SCALE,
+                             'Length of the acceleration arrows on markers per unit acceleration')
         self.add_post_set_parameters_callback(self._apply)
         self._period_ns = round(NS_PER_S / self.get_parameter('rate_hz').value)
 
@@ -177,6 +195,9 @@ class KinematicsNode(Node):
         self._pub_point_accel = self.create_publisher(
             MultiDOFJointTrajectory, 'point_accelerations', STATE_QOS)
         self._pub_diagnostics = self.create_publisher(DiagnosticArray, 'diagnostics', 10)
+        self._pub_markers = None
+        if markers:
+            self._setup_markers()
         self._diagnostics_timer = self.create_timer(
             1.0, self._publish_diagnostics, clock=Clock(clock_type=ClockType.STEADY_TIME))
         self._jump_handle = self.get_clock().create_jump_callback(
@@ -186,13 +207,28 @@ class KinematicsNode(Node):
 
         p = {name: self.get_parameter(name).value for name in
              ('scene', 'crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm', 'rate_hz',
-              'frame_id', 'use_sim_time')}
+              'frame_id', 'use_sim_time', 'markers')}
         self.get_logger().info(
             f'scene {self.scene.name!r} ({p["scene"]}): joints {list(self.scene.output_joints)}, '
             f'points {list(self.scene.output_points)}; crank_speed_rpm={p["crank_speed_rpm"]}, '
             f'crank_accel={p["crank_accel"]}, max_crank_speed_rpm={p["max_crank_speed_rpm"]}, '
             f'rate_hz={p["rate_hz"]}, frame_id={p["frame_id"]!r}, '
-            f'use_sim_time={p["use_sim_time"]}')
+            f'use_sim_time={p["use_sim_time"]}, markers={p["markers"]}')
+
+    def _setup_markers(self) -> None:
+        """Prepare the markers: the whole scene, its strokes and size, the publisher."""
+        self._marker_scene = full_scene(self.scene)
+        self._marker_strokes = strokes_from_scene(self._marker_scene)
+        try:
+            self._marker_size: float | None = marker_size_from_space(space_from_state(
+                self._marker_scene, mk.solve(self._marker_scene, self.scene.input.angle)))
+        except mk.AssemblyError:
+            self._marker_size = None    # the part beyond the outputs cannot assemble here
+        self._marker_throttle = MarkerThrottle()
+        self._marker_lock = threading.Lock()
+        self._marker_request: tuple[int, int, float, float, float] | None = None
+        self._marker_guard = self.create_guard_condition(self._publish_markers)
+        self._pub_markers = self.create_publisher(MarkerArray, 'markers', 10)
 
     def _declare_number(self, name: str, default: float, description: str) -> None:
         low, high, unit = RANGES[name]
@@ -239,6 +275,9 @@ class KinematicsNode(Node):
                     p.type_ != Parameter.Type.STRING or not p.value):
                 return SetParametersResult(successful=False, reason=(
                     f'{p.name}: expected a non-empty string, got {p.value!r}'))
+            elif p.name == 'markers' and p.type_ != Parameter.Type.BOOL:
+                return SetParametersResult(successful=False, reason=(
+                    f'markers: expected true or false, got {p.type_.name.lower()} {p.value!r}'))
         if 'crank_speed_rpm' in new or 'max_crank_speed_rpm' in new:
             speed = new['crank_speed_rpm'].value if 'crank_speed_rpm' in new else \
                 self._current('crank_speed_rpm')
@@ -395,6 +434,12 @@ class KinematicsNode(Node):
             self._pub_joint_states.publish(joint_states)
             self._pub_joint_accel.publish(joint_accel)
             self._pub_point_accel.publish(point_accel)
+            if self._pub_markers is not None and self._marker_throttle.due(
+                    self._period_ns, time.monotonic_ns()):
+                # Built in the executor's thread, so that this thread keeps its deadlines.
+                with self._marker_lock:
+                    self._marker_request = (sec, nanosec, angle, speed, accel)
+                self._marker_guard.trigger()
             if state.singularity:
                 measure = min(state.singularity.values())
         late = lateness > min(self._period_ns // 2, LATE_NS)
@@ -429,6 +474,27 @@ class KinematicsNode(Node):
             self.get_logger().warning(
                 f'near-singular pose at crank angle {angle:.6f} rad: measure {measure:.3g}',
                 throttle_duration_sec=1.0)
+
+    # -- markers ----------------------------------------------------------------
+
+    def _publish_markers(self) -> None:
+        """Publish the markers of the last sample the tick thread handed over, if any."""
+        with self._marker_lock:
+            request, self._marker_request = self._marker_request, None
+        if request is None or self._pub_markers is None:
+            return
+        sec, nanosec, angle, speed, accel = request
+        try:
+            state = mk.solve(self._marker_scene, angle, speed, accel)
+        except mk.AssemblyError:
+            return      # a part beyond the outputs cannot assemble: no markers this time
+        self._pub_markers.publish(marker_array_from_state(
+            self._marker_scene, state, frame_id=self.frame_id,
+            stamp=Time(sec=sec, nanosec=nanosec),
+            velocity_scale=self.get_parameter('marker_velocity_scale').value,
+            acceleration_scale=self.get_parameter('marker_acceleration_scale').value,
+            points=self.scene.output_points, size=self._marker_size,
+            strokes=self._marker_strokes))
 
     # -- diagnostics --------------------------------------------------------
 

@@ -1,0 +1,278 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""RViz markers: the message built from a solved scene, the throttle, and the running node.
+
+The node tests reuse the subprocess helpers of ``test_kinematics_node_launch``
+and with them its ROS domain and namespace of this test session.
+"""
+
+from __future__ import annotations
+
+import math
+import signal
+import subprocess
+import sys
+import time
+import warnings
+
+from builtin_interfaces.msg import Time
+import numpy as np
+import pytest
+from sensor_msgs.msg import JointState
+from test_kinematics_node_launch import (NodeProcess, Ros, SESSION, stamp_ns, STARTUP_S,
+                                         wait_for)
+from trajectory_msgs.msg import MultiDOFJointTrajectory
+from visualization_msgs.msg import Marker, MarkerArray
+
+import mech_kinematics as mk
+from mech_kinematics.diagram import strokes_from_scene
+from mech_kinematics.instant_centres import full_scene
+from mech_kinematics.markers import marker_array_from_state, MarkerThrottle, NAMESPACES
+
+#: Marker positions against the solver's values (a product and a sum), m.
+ATOL_POSITION = 1e-12
+#: Published doubles against the solver's at the same stamp, m.
+ATOL_PUBLISHED = 1e-12
+NS = 1_000_000_000
+MAX_RATE_HZ = 30.0
+#: Per scene: the expected (ns, type) -> count of markers.
+EXPECTED = {
+    'khurmi_four_bar_ad150': {
+        ('links', Marker.LINE_STRIP): 3, ('joints', Marker.SPHERE_LIST): 1,
+        ('velocity', Marker.ARROW): 4, ('acceleration', Marker.ARROW): 4},
+    'quick_return': {
+        ('links', Marker.LINE_STRIP): 3, ('guides', Marker.LINE_LIST): 1,
+        ('sliders', Marker.CUBE): 2, ('joints', Marker.SPHERE_LIST): 1,
+        ('velocity', Marker.ARROW): 6, ('acceleration', Marker.ARROW): 6},
+}
+STAMP = Time(sec=1234, nanosec=567_890_123)
+
+
+def _counts(array) -> dict[tuple[str, int], int]:
+    counts: dict[tuple[str, int], int] = {}
+    for m in array.markers:
+        counts[m.ns, m.type] = counts.get((m.ns, m.type), 0) + 1
+    return counts
+
+
+def _xy(point) -> np.ndarray:
+    return np.array([point.x, point.y])
+
+
+def _markers(name: str, angle: float | None = None, **kwargs):
+    """Return (scene, full scene, full state, markers) of a packaged scene at ``angle``."""
+    scene = mk.load_scene(name)
+    full = full_scene(scene)
+    angle = scene.input.angle if angle is None else angle
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore', mk.NearSingularWarning)
+        state = mk.solve(full, angle)
+    array = marker_array_from_state(full, state, frame_id='test_frame', stamp=STAMP,
+                                    points=scene.output_points, **kwargs)
+    return scene, full, state, array
+
+
+@pytest.mark.parametrize('name', sorted(EXPECTED))
+def test_count_and_types(name):
+    """Links are line strips, joints one sphere list, one v and one a arrow per output point."""
+    scene, _, _, array = _markers(name)
+    assert _counts(array) == EXPECTED[name]
+    assert len(scene.output_points) == EXPECTED[name]['velocity', Marker.ARROW]
+    assert [m.ns for m in array.markers] == sorted(
+        (m.ns for m in array.markers), key=NAMESPACES.index)
+    for m in array.markers:
+        assert m.header.frame_id == 'test_frame'
+        assert m.header.stamp == STAMP
+        assert m.action == Marker.ADD
+        assert m.scale.x > 0.0
+        assert m.color.a > 0.0
+    ids = [(m.ns, m.id) for m in array.markers]
+    assert len(set(ids)) == len(ids)
+
+
+@pytest.mark.parametrize('name', sorted(EXPECTED))
+def test_ids_do_not_depend_on_the_angle(name):
+    """Every array of a scene has the same (ns, id, type), so each replaces the last in RViz."""
+    arrays = [_markers(name, angle)[3] for angle in (0.4, 1.3, 2.9)]
+    keys = [[(m.ns, m.id, m.type) for m in a.markers] for a in arrays]
+    assert keys[0] == keys[1] == keys[2]
+
+
+@pytest.mark.parametrize('name', sorted(EXPECTED))
+@pytest.mark.parametrize('angle', [0.4, 1.3, 2.9])
+def test_arrows_start_at_the_point_and_end_at_k_times_its_value(name, angle):
+    """Arrow start = position; end = position + k_v v (velocity), + k_a a (acceleration)."""
+    k_v, k_a = 0.25, 0.003
+    scene, _, _, array = _markers(name, angle, velocity_scale=k_v, acceleration_scale=k_a)
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore', mk.NearSingularWarning)
+        points = mk.solve(scene, angle).points
+    for ns, k, value in (('velocity', k_v, 'velocity'), ('acceleration', k_a, 'acceleration')):
+        arrows = [m for m in array.markers if m.ns == ns]
+        for m, name_ in zip(arrows, scene.output_points, strict=True):
+            p = points[name_]
+            assert len(m.points) == 2
+            np.testing.assert_allclose(_xy(m.points[0]), p.position, rtol=0,
+                                       atol=ATOL_POSITION)
+            np.testing.assert_allclose(_xy(m.points[1]), p.position + k * getattr(p, value),
+                                       rtol=0, atol=ATOL_POSITION)
+            assert m.points[0].z == m.points[1].z == 0.0
+
+
+@pytest.mark.parametrize('name', sorted(EXPECTED))
+def test_links_and_joints_are_at_the_solved_points(name):
+    """Joint spheres are every point; link vertices are points of the link (levers: ends)."""
+    _, full, state, array = _markers(name, 1.3)
+    points = state.points
+    joints = next(m for m in array.markers if m.ns == 'joints')
+    assert len(joints.points) == len(joints.colors) == len(points)
+    for m, p in zip(joints.points, points.values(), strict=True):
+        np.testing.assert_allclose(_xy(m), p.position, rtol=0, atol=ATOL_POSITION)
+    known = np.array([p.position for p in points.values()])
+    for link in (m for m in array.markers if m.ns == 'links'):
+        assert len(link.points) >= 2
+        for vertex in link.points:
+            assert np.min(np.hypot(*(known - _xy(vertex)).T)) <= ATOL_POSITION
+
+
+def test_strokes_lengthen_the_guide_to_the_whole_stroke():
+    """With the sliders' strokes the guide covers every position of the ram over a turn."""
+    scene = mk.load_scene('quick_return')
+    full = full_scene(scene)
+    strokes = strokes_from_scene(full)
+    _, _, _, array = _markers('quick_return', 1.3, strokes=strokes)
+    guide = next(m for m in array.markers if m.ns == 'guides')
+    xs = sorted(p.x for p in guide.points)
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore', mk.NearSingularWarning)
+        ram = mk.solve(full, np.linspace(0.0, 2 * math.pi, 360)).points['D'].position
+    assert xs[0] <= ram[:, 0].min() and ram[:, 0].max() <= xs[-1]
+
+
+@pytest.mark.parametrize('bad', [{'velocity_scale': -1.0}, {'acceleration_scale': math.nan},
+                                 {'size': 0.0}])
+def test_bad_scales_are_refused(bad):
+    """A negative or NaN scale, or a size of 0, raises ValueError naming it."""
+    with pytest.raises(ValueError, match=next(iter(bad))):
+        _markers('khurmi_four_bar_ad150', **bad)
+
+
+def test_module_imports_without_ros():
+    """mech_kinematics.markers imports without rclpy or the message packages."""
+    code = ('import sys, mech_kinematics.markers; '
+            "assert not {'rclpy', 'visualization_msgs'} & set(sys.modules)")
+    subprocess.run([sys.executable, '-c', code], check=True, timeout=60)
+
+
+def _throttled(rate_hz: float, seconds: float, wall_per_tick_ns: int | None = None):
+    """Return the tick indices a throttle picks from ``seconds`` of ticks at ``rate_hz``."""
+    throttle = MarkerThrottle()
+    period = round(NS / rate_hz)
+    step = period if wall_per_tick_ns is None else wall_per_tick_ns
+    return [k for k in range(int(seconds * rate_hz)) if throttle.due(period, k * step)]
+
+
+@pytest.mark.parametrize('rate_hz', [1.0, 29.0, 30.0, 31.0, 100.0, 200.0, 220.0, 10_000.0])
+def test_throttle_publishes_at_most_30_hz(rate_hz):
+    """Marker ticks are at least 1/30 s apart, and as close to 30 Hz as the ticks allow."""
+    picked = _throttled(rate_hz, 4.0)
+    period = 1.0 / rate_hz
+    gaps = np.diff(picked) * period
+    assert picked[0] == 0
+    assert gaps.min() >= 1.0 / MAX_RATE_HZ - 1e-9
+    every = math.ceil(round(1 / MAX_RATE_HZ / period, 9))
+    assert gaps.max() == pytest.approx(every * period)
+
+
+def test_throttle_holds_a_fast_simulated_clock():
+    """Ticks of a simulated clock at 4x real time still give markers at most 30 Hz of wall time."""
+    rate_hz = 200.0
+    picked = _throttled(rate_hz, 8.0, wall_per_tick_ns=round(NS / rate_hz / 4))
+    wall = np.diff(picked) * (1.0 / rate_hz / 4)
+    assert wall.min() >= 1.0 / MAX_RATE_HZ - 1e-3
+
+
+# -- the running node ---------------------------------------------------------
+
+
+@pytest.fixture(scope='module')
+def ros():
+    ros = Ros()
+    yield ros
+    ros.close()
+
+
+def _publisher_types(ros: Ros, topic: str) -> list[str]:
+    return [info.topic_type for info in ros.node.get_publishers_info_by_topic(topic)]
+
+
+def test_node_publishes_markers_at_most_30_hz_stamped_like_the_state(ros, tmp_path):
+    """With markers:=true: MarkerArray on markers, <= 30 Hz at rate 200, joint_states stamps."""
+    ns_topic = f'{SESSION}/markers_on'
+    k_v = 0.2
+    js_list = ros.collect(JointState, f'{ns_topic}/joint_states')
+    md_list = ros.collect(MultiDOFJointTrajectory, f'{ns_topic}/point_accelerations')
+    received: list[tuple[float, MarkerArray]] = []
+    ros.node.create_subscription(MarkerArray, f'{ns_topic}/markers',
+                                 lambda msg: received.append((time.monotonic(), msg)), 10)
+    proc = NodeProcess(tmp_path, '-r', f'__ns:={ns_topic}', '-p', 'markers:=true',
+                       '-p', 'rate_hz:=200.0', '-p', f'marker_velocity_scale:={k_v}')
+    try:
+        wait_for(lambda: received or proc.proc.poll() is not None, STARTUP_S, 'markers')
+        assert proc.proc.poll() is None, proc.output()
+        assert _publisher_types(ros, f'{ns_topic}/markers') == [
+            'visualization_msgs/msg/MarkerArray']
+        start = len(received)
+        time.sleep(2.0)
+        window = received[start:]
+        time.sleep(0.2)         # the joint_states of the last markers' tick
+        status, _ = proc.stop(signal.SIGINT)
+        assert status == 0, proc.output()
+    finally:
+        if proc.proc.poll() is None:
+            proc.proc.kill()
+    seconds = window[-1][0] - window[0][0]
+    assert 1.8 <= seconds <= 2.2
+    assert 40 <= len(window) <= 2.0 * MAX_RATE_HZ + 2
+    stamps = [stamp_ns(msg.markers[0]) for _, msg in window]
+    assert min(np.diff(stamps)) >= NS / MAX_RATE_HZ - 2_000_000
+    assert (len(stamps) - 1) / ((stamps[-1] - stamps[0]) / NS) <= MAX_RATE_HZ
+    expected = EXPECTED['khurmi_four_bar_ad150']
+    js_stamps = {stamp_ns(m) for m in js_list}
+    points = {stamp_ns(m): m for m in md_list}
+    for _, msg in window:
+        assert _counts(msg) == expected
+        stamp = stamp_ns(msg.markers[0])
+        assert all(stamp_ns(m) == stamp for m in msg.markers)
+        assert all(m.header.frame_id == 'mechanism' for m in msg.markers)
+        assert stamp in js_stamps
+        # The velocity arrows against the point message of the same tick.
+        point = points[stamp].points[0]
+        arrows = [m for m in msg.markers if m.ns == 'velocity']
+        for m, t, v in zip(arrows, point.transforms, point.velocities, strict=True):
+            p = np.array([t.translation.x, t.translation.y])
+            np.testing.assert_allclose(_xy(m.points[0]), p, rtol=0, atol=ATOL_PUBLISHED)
+            np.testing.assert_allclose(_xy(m.points[1]), p + k_v * np.array(
+                [v.linear.x, v.linear.y]), rtol=0, atol=ATOL_PUBLISHED)
+
+
+def test_node_without_markers_has_no_markers_publisher(ros, tmp_path):
+    """With markers false (the default) the node creates no publisher on markers."""
+    ns_topic = f'{SESSION}/markers_off'
+    js_list = ros.collect(JointState, f'{ns_topic}/joint_states')
+    proc = NodeProcess(tmp_path, '-r', f'__ns:={ns_topic}', '-p', 'rate_hz:=200.0')
+    try:
+        wait_for(lambda: js_list or proc.proc.poll() is not None, STARTUP_S, 'joint_states')
+        assert proc.proc.poll() is None, proc.output()
+        # The node would create the markers publisher right after diagnostics:
+        # once that one is discovered, give discovery a moment more.
+        wait_for(lambda: _publisher_types(ros, f'{ns_topic}/diagnostics'), STARTUP_S,
+                 'the diagnostics publisher')
+        time.sleep(0.5)
+        assert _publisher_types(ros, f'{ns_topic}/markers') == []
+        assert 'markers=False' in proc.output()
+        status, _ = proc.stop(signal.SIGINT)
+        assert status == 0, proc.output()
+    finally:
+        if proc.proc.poll() is None:
+            proc.proc.kill()
