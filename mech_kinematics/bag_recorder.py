@@ -237,7 +237,7 @@ def _make_executor(kind: str, context: Any) -> Any:
         try:
             from rclpy.experimental import EventsExecutor  # type: ignore[attr-defined]
         except ImportError:     # rclpy before the EventsExecutor (Jazzy and older)
-            pass
+            pass  # fall back to the SingleThreadedExecutor below
         else:
             return EventsExecutor(context=context)
     return SingleThreadedExecutor(context=context)

@@ -96,7 +96,7 @@ def _set_timer_slack(ns: int) -> None:
         libc = ctypes.CDLL(None, use_errno=True)
         libc.prctl(29, ctypes.c_ulong(ns), 0, 0, 0)   # PR_SET_TIMERSLACK
     except (OSError, AttributeError):
-        pass
+        pass  # no prctl here: keep the default timer slack
 
 
 class TickThreadError(RuntimeError):
@@ -591,7 +591,7 @@ def main(args: list[str] | None = None) -> int:
         node.start()
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
-        pass
+        pass  # Ctrl-C or shutdown: a clean exit, status 0
     except (mk.MechKinematicsError, InvalidParameterValueException) as exc:
         get_logger(NODE_NAME).fatal(f'cannot start: {exc}')
         status = 1

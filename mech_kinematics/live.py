@@ -97,7 +97,7 @@ def main(argv: list[str] | None = None) -> int:
         while child.poll() is None:
             rclpy.spin_once(view, timeout_sec=0.2)
     except (KeyboardInterrupt, ExternalShutdownException):
-        pass
+        pass  # Ctrl-C: stop the node below
     finally:
         if view is not None:
             view.destroy_node()
