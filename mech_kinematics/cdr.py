@@ -1,6 +1,15 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""Pre-serialized ROS messages whose stamp and float64 fields are patched in place.
+"""Canonical CDR bytes of ROS messages, and templates whose float64 fields are patched in place.
+
+:func:`cdr_from_message` serializes a ``rosidl`` Python message (plain CDR,
+XCDR1, little-endian, encapsulation header ``00 01 00 00``) from the type
+information the generated class carries (``get_fields_and_field_types()`` and
+``SLOT_TYPES``). Unlike ``rclpy.serialization.serialize_message``, whose bytes
+on the Kilted wheels run past the end of the message and hold uninitialized
+memory in the alignment padding and the tail, the result has exactly the
+length of the message and zero padding: the bytes ``rosbags`` writes, which
+its strict ``deserialize_cdr`` accepts.
 
 Serializing a message object costs far more than the numbers in it change.
 :class:`MessageTemplate` serializes a message once, with a marker value in
@@ -12,25 +21,39 @@ they are (``Publisher.publish`` accepts serialized data).
 This relies on nothing but the fact that CDR stores a fixed-size field at a
 fixed offset once the lengths of every sequence and string are fixed, which
 they are here: the names and the number of joints and points never change
-while the node runs. ``test/test_kinematics_node_cdr.py`` checks that the bytes
-decode with ``rclpy.serialization.deserialize_message`` to exactly the
-message built the ordinary way.
+while the node runs. ``test/test_kinematics_node_messages.py`` checks the
+bytes against ``rosbags`` and ``rclpy``.
+
+The module imports neither ``rclpy`` nor ``rosidl_parser``: it reads the
+message classes it is given.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 import struct
 from typing import Any
 
-from rclpy.serialization import serialize_message
+__all__ = ['MessageTemplate', 'STAMP_MARKER', 'cdr_from_message', 'marker',
+           'padding_from_message']
 
-__all__ = ['MessageTemplate', 'STAMP_MARKER', 'marker']
+#: Encapsulation header of plain CDR, little-endian (CDR_LE).
+ENCAPSULATION = b'\x00\x01\x00\x00'
 
 #: Header stamp (sec, nanosec) that marks where the stamp is serialized.
 STAMP_MARKER = (0x5EC04D17, 0x2C5A7E31)
 
 _MARKER_BASE = 0x7FE5A5C35A3C0000   # a large finite float64; slot index in the low bits
+
+#: rosidl ``BasicType.typename`` -> struct format character (its size is its alignment).
+_PRIMITIVES = {
+    'boolean': '?', 'octet': 'B', 'char': 'B', 'int8': 'b', 'uint8': 'B',
+    'int16': 'h', 'uint16': 'H', 'short': 'h', 'unsigned short': 'H',
+    'int32': 'i', 'uint32': 'I', 'long': 'i', 'unsigned long': 'I',
+    'int64': 'q', 'uint64': 'Q', 'long long': 'q', 'unsigned long long': 'Q',
+    'float': 'f', 'double': 'd',
+}
+_UINT32 = struct.Struct('<I')
 
 
 def marker(index: int) -> float:
@@ -40,6 +63,117 @@ def marker(index: int) -> float:
         raise ValueError(msg)
     value: float = struct.unpack('<d', struct.pack('<Q', _MARKER_BASE + index))[0]
     return value
+
+
+class _Writer:
+    """Append CDR to ``buffer``; alignment counts from the end of the encapsulation header."""
+
+    def __init__(self) -> None:
+        self.buffer = bytearray(ENCAPSULATION)
+        self.padding: list[range] = []
+
+    def align(self, size: int) -> None:
+        pad = -(len(self.buffer) - len(ENCAPSULATION)) % size
+        if pad:
+            start = len(self.buffer)
+            self.buffer += bytes(pad)
+            self.padding.append(range(start, start + pad))
+
+    def primitives(self, typename: str, values: Sequence[Any], where: str) -> None:
+        """Write ``values`` of one primitive type, aligned to its size (nothing if empty)."""
+        if not values:
+            return
+        code = _PRIMITIVES.get(typename)
+        if code is None:
+            msg = (f'Expected a field type with a CDR encoding here, got {typename!r} '
+                   f'for {where}')
+            raise ValueError(msg)
+        if typename in ('octet', 'char'):
+            # octet is bytes of length 1 in Python, IDL char a str of length 1.
+            values = [v[0] if isinstance(v, bytes | bytearray) else
+                      ord(v) if isinstance(v, str) else v for v in values]
+        fmt = struct.Struct(f'<{len(values)}{code}')
+        self.align(struct.calcsize(code))
+        self.buffer += fmt.pack(*values)
+
+    def string(self, value: str) -> None:
+        data = value.encode()
+        self.align(4)
+        self.buffer += _UINT32.pack(len(data) + 1)
+        self.buffer += data
+        self.buffer.append(0)
+
+    def message(self, msg: Any) -> None:
+        cls = type(msg)
+        fields = cls.get_fields_and_field_types()
+        if not fields:
+            # An empty structure has one uint8 member (rosidl's
+            # structure_needs_at_least_one_member).
+            self.buffer.append(0)
+            return
+        for name, slot_type in zip(fields, cls.SLOT_TYPES, strict=True):
+            self.field(slot_type, getattr(msg, name), f'field {name!r} of {cls.__name__}')
+
+    def field(self, slot_type: Any, value: Any, where: str) -> None:
+        kind = type(slot_type).__name__
+        if kind in ('UnboundedSequence', 'BoundedSequence'):
+            self.align(4)
+            self.buffer += _UINT32.pack(len(value))
+            self.items(slot_type.value_type, value, where)
+        elif kind == 'Array':
+            self.items(slot_type.value_type, value, where)
+        else:
+            self.items(slot_type, (value,), where)
+
+    def items(self, value_type: Any, values: Iterable[Any], where: str) -> None:
+        """Write the elements of a sequence or array, or one value in a 1-tuple."""
+        kind = type(value_type).__name__
+        if kind == 'BasicType':
+            self.primitives(value_type.typename, list(values), where)
+        elif kind in ('UnboundedString', 'BoundedString'):
+            for value in values:
+                self.string(value)
+        elif kind == 'NamespacedType':
+            for value in values:
+                self.message(value)
+        else:
+            # wstring (and anything newer): its encoding cannot be checked against
+            # rclpy with the message packages installed here, so it is refused.
+            msg = f'Expected a field type with a CDR encoding here, got {kind} for {where}'
+            raise ValueError(msg)
+
+
+def cdr_from_message(msg: Any) -> bytes:
+    """Return the canonical CDR bytes of a ROS message (XCDR1, little-endian).
+
+    Parameters
+    ----------
+    msg : ROS message
+        An instance of a ``rosidl`` generated Python message class.
+
+    Returns
+    -------
+    bytes
+        Encapsulation header ``00 01 00 00`` and the message, with zero bytes
+        as alignment padding (each primitive aligned to its size, counted
+        from the end of the header) and nothing after the last member.
+
+    Raises
+    ------
+    ValueError
+        If the message has a field with no encoding here (``wstring``,
+        ``wchar``, ``long double``).
+    """
+    writer = _Writer()
+    writer.message(msg)
+    return bytes(writer.buffer)
+
+
+def padding_from_message(msg: Any) -> tuple[range, ...]:
+    """Return where :func:`cdr_from_message` put alignment padding, as ranges of byte offsets."""
+    writer = _Writer()
+    writer.message(msg)
+    return tuple(writer.padding)
 
 
 def _find_once(data: bytes, pattern: bytes, what: str) -> int:
@@ -69,13 +203,11 @@ class MessageTemplate:
     """
 
     def __init__(self, msg: Any, n_slots: int) -> None:
-        data = serialize_message(msg)
-        # Encapsulation header: 0x00 0x01 is little-endian CDR, 0x00 0x00 big-endian.
-        order = '<' if data[1] & 1 else '>'
-        self._stamp = struct.Struct(order + 'iI')
+        data = cdr_from_message(msg)
+        self._stamp = struct.Struct('<iI')
         self._stamp_offset = _find_once(data, self._stamp.pack(*STAMP_MARKER),
                                         'the header stamp marker')
-        offsets = [_find_once(data, struct.pack(order + 'd', marker(i)), f'slot {i}')
+        offsets = [_find_once(data, struct.pack('<d', marker(i)), f'slot {i}')
                    for i in range(n_slots)]
         buffer = bytearray(data)
         for offset in offsets:
@@ -96,7 +228,7 @@ class MessageTemplate:
                 if gap:
                     fmt += f'{gap}x'
                 continue
-            runs.append((struct.Struct(order + fmt).pack_into, offsets[start], start, i + 1))
+            runs.append((struct.Struct('<' + fmt).pack_into, offsets[start], start, i + 1))
             start, fmt = i + 1, ''
         self._runs = tuple(runs)
 
