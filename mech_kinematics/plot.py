@@ -176,9 +176,9 @@ def _decoder(typestore: Any, type_name: str) -> Any:
     """Return a function that decodes CDR bytes of ``type_name`` with ``typestore``.
 
     Unlike ``Typestore.deserialize_cdr`` it accepts bytes past the end of the
-    message: rclpy's ``serialize_message`` on Fast DDS (and so a publisher of
-    pre-serialized bytes) can leave a few, which ``rclpy``, rosbag2 and Foxglove
-    ignore and rosbags 0.11 refuses ("CDR message size mismatch").
+    message, as ``rclpy``, rosbag2 and Foxglove do: a bag from another publisher
+    of pre-serialized bytes (rclpy's ``serialize_message`` on Fast DDS leaves a
+    few) still plots. The node's own messages are canonical CDR.
     """
     msgdef = typestore.get_msgdef(type_name)
     cls = msgdef.cls

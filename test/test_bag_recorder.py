@@ -144,12 +144,11 @@ def recordings(tmp_path_factory):
 
 
 def decoded(path: Path) -> dict:
-    """Topic -> list of (receive time ns, message) decoded with rosbags from the bag's msgdefs.
+    """Topic -> list of (receive time ns, message), decoded strictly with rosbags.
 
-    rosbags' ``deserialize_cdr`` refuses payloads with more than 3 bytes past the end
-    of the CDR data, which Fast DDS publishers of ``serialize_message`` bytes can have
-    (``rclpy``, rosbag2 and Foxglove ignore them), so the message class's own
-    deserializer is called.
+    ``Typestore.deserialize_cdr`` refuses a payload whose length does not match
+    the message (it allows the final alignment padding only): the node publishes
+    canonical CDR, and the recorder stores the bytes exactly as received.
     """
     from rosbags.highlevel import AnyReader
 
@@ -157,10 +156,8 @@ def decoded(path: Path) -> dict:
     with AnyReader([path]) as reader:
         store = reader.typestore
         for connection, timestamp, raw in reader.messages():
-            msgdef = store.get_msgdef(connection.msgtype)
             assert raw[:2] == b'\x00\x01', 'expected little-endian CDR'
-            msg, end = msgdef.deserialize_cdr_le(raw[4:], 0, msgdef.cls, store)
-            assert len(raw) - 4 - end < 8, 'only final padding may follow the message'
+            msg = store.deserialize_cdr(raw, connection.msgtype)
             out.setdefault(connection.topic, []).append((timestamp, msg))
     return out
 
