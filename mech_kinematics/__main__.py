@@ -10,6 +10,8 @@ import math
 import sys
 from typing import Any
 
+from .cli import finite_float
+
 SOLVE_HELP = """\
 Solve a scene at one crank instant and print one JSON object: the input
 (angle rad, speed rad/s, accel rad/s^2), every output joint (type, position,
@@ -44,14 +46,6 @@ def _solve(args: argparse.Namespace) -> int:
     return 0
 
 
-def _finite(text: str) -> float:
-    value = float(text)
-    if not math.isfinite(value):
-        msg = f'expected a finite number, got {text!r}'
-        raise argparse.ArgumentTypeError(msg)
-    return value
-
-
 def build_parser() -> argparse.ArgumentParser:
     """Return the parser of ``python -m mech_kinematics``."""
     parser = argparse.ArgumentParser(
@@ -65,11 +59,11 @@ def build_parser() -> argparse.ArgumentParser:
     solve.add_argument('scene', metavar='SCENE',
                        help='path to a scene YAML, or the name of a packaged scene '
                             '(e.g. khurmi_four_bar_ad150)')
-    solve.add_argument('--angle-deg', type=_finite, metavar='X',
+    solve.add_argument('--angle-deg', type=finite_float, metavar='X',
                        help="crank angle in degrees CCW from +x (default: the scene's)")
-    solve.add_argument('--speed-rpm', type=_finite, metavar='N',
+    solve.add_argument('--speed-rpm', type=finite_float, metavar='N',
                        help="signed crank speed in rpm, + CCW (default: the scene's)")
-    solve.add_argument('--accel', type=_finite, metavar='A',
+    solve.add_argument('--accel', type=finite_float, metavar='A',
                        help="crank angular acceleration in rad/s^2, + CCW (default: the scene's)")
     solve.add_argument('--diagnostics', action='store_true',
                        help="also print each dyad's near-singularity measure "

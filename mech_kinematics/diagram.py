@@ -44,8 +44,9 @@ import warnings
 import numpy as np
 import numpy.typing as npt
 
+from .cli import finite_float, positive_int
 from .errors import AssemblyError, NearSingularWarning, SceneError
-from .instant_centres import (bodies_from_scene, BodyKind, full_scene,
+from .instant_centres import (bodies_from_scene, BodyKind, check_full_state, full_scene,
                               instant_centres_from_state, InstantCentres, Topology)
 from .linkage import RPR, RRP, RRR, Scene, solve, State
 
@@ -360,21 +361,8 @@ def _edges(scene: Scene, state: State) -> list[_Edge]:
 
 
 def _check_state(scene: Scene, state: State) -> Topology:
-    if isinstance(state.valid, np.ndarray):
-        msg = f'Expected the state of one crank angle, got an array of shape {state.valid.shape}'
-        raise ValueError(msg)
-    if state.scene != scene.name:
-        msg = f'Expected a state of scene "{scene.name}", got one of "{state.scene}"'
-        raise ValueError(msg)
     topology = bodies_from_scene(scene)
-    missing = [point for body in topology.bodies.values() for point in body.points
-               if point not in state.complex_points]
-    missing += [name for name, body in topology.bodies.items()
-                if body.kind is not BodyKind.GROUND and name not in state.joints]
-    if missing:
-        msg = (f'Expected a state with every point and joint of scene "{scene.name}" (solve '
-               f'full_scene(scene)), got one missing {sorted(set(missing))}')
-        raise ValueError(msg)
+    check_full_state(topology, scene, state)
     return topology
 
 
@@ -1547,34 +1535,18 @@ solved.
 """
 
 
-def _finite(text: str) -> float:
-    value = float(text)
-    if not math.isfinite(value):
-        msg = f'expected a finite number, got {text!r}'
-        raise argparse.ArgumentTypeError(msg)
-    return value
-
-
-def _positive_int(text: str) -> int:
-    value = int(text)
-    if value < 1:
-        msg = f'expected a positive integer, got {text!r}'
-        raise argparse.ArgumentTypeError(msg)
-    return value
-
-
 def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('scene', metavar='SCENE',
                         help='path to a scene YAML, or the name of a packaged scene '
                              '(e.g. khurmi_four_bar_ad150)')
     parser.add_argument('-o', '--output', required=True, metavar='FILE',
                         help='output file: .png, .svg or .pdf (.gif with --animate)')
-    parser.add_argument('--angle-deg', type=_finite, metavar='X',
+    parser.add_argument('--angle-deg', type=finite_float, metavar='X',
                         help="crank angle in degrees CCW from +x (default: the scene's); "
                              'with --animate, the first frame')
-    parser.add_argument('--speed-rpm', type=_finite, metavar='N',
+    parser.add_argument('--speed-rpm', type=finite_float, metavar='N',
                         help="signed crank speed in rpm, + CCW (default: the scene's)")
-    parser.add_argument('--accel', type=_finite, metavar='A',
+    parser.add_argument('--accel', type=finite_float, metavar='A',
                         help='crank angular acceleration in rad/s^2, + CCW (default: the '
                              "scene's)")
     parser.add_argument('--instant-centres', action='store_true',
@@ -1582,7 +1554,7 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                              'diagram and list them')
     parser.add_argument('--animate', action='store_true',
                         help='write an animated GIF of one crank turn instead')
-    parser.add_argument('--frames', type=_positive_int, default=72, metavar='N',
+    parser.add_argument('--frames', type=positive_int, default=72, metavar='N',
                         help='frames of the animation (default 72, every 5 degrees)')
 
 

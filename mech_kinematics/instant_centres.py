@@ -315,7 +315,8 @@ def _pairs(topology: Topology) -> list[tuple[str, str]]:
     return list(itertools.combinations(topology.bodies, 2))
 
 
-def _check_state(topology: Topology, scene: Scene, state: State) -> None:
+def check_full_state(topology: Topology, scene: Scene, state: State) -> None:
+    """Refuse anything but the state of one crank angle of the full ``scene``."""
     if isinstance(state.valid, np.ndarray):
         msg = f'Expected the state of one crank angle, got an array of shape {state.valid.shape}'
         raise ValueError(msg)
@@ -384,7 +385,7 @@ def instant_centres_from_state(scene: Scene, state: State) -> InstantCentres:
         two bodies that share no joint have the same motion.
     """
     topology = bodies_from_scene(scene)
-    _check_state(topology, scene, state)
+    check_full_state(topology, scene, state)
     size = _size(state)
     motion = {name: _body_motion(topology, state, name) for name in topology.bodies}
     positions = np.array([complex(p) for p, _, _ in state.complex_points.values()])
@@ -472,7 +473,7 @@ def instant_centres_from_kennedy(scene: Scene, state: State) -> InstantCentres:
         slider-crank), in Kennedy numbering order.
     """
     topology = bodies_from_scene(scene)
-    _check_state(topology, scene, state)
+    check_full_state(topology, scene, state)
     size = _size(state)
     known = _primary(topology, scene, state, size)
 

@@ -33,6 +33,7 @@ import warnings
 import numpy as np
 import numpy.typing as npt
 
+from .cli import finite_float
 from .errors import MechKinematicsError
 
 __all__ = [
@@ -569,14 +570,6 @@ def run_command(args: argparse.Namespace) -> int:
     return 0
 
 
-def _finite(text: str) -> float:
-    value = float(text)
-    if not math.isfinite(value):
-        msg = f'expected a finite number, got {text!r}'
-        raise argparse.ArgumentTypeError(msg)
-    return value
-
-
 def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('bag', nargs='?', metavar='BAG', help='rosbag2 directory to plot')
     parser.add_argument('-o', '--output', required=True, metavar='FILE.png',
@@ -593,9 +586,9 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                              '(default: %(default)s)')
     parser.add_argument('--samples', type=int, default=DEFAULT_SAMPLES, metavar='N',
                         help='crank angles per cycle for --scene (default: %(default)s)')
-    parser.add_argument('--speed-rpm', type=_finite, metavar='N',
+    parser.add_argument('--speed-rpm', type=finite_float, metavar='N',
                         help="crank speed for --scene, rpm (default: the scene's)")
-    parser.add_argument('--accel', type=_finite, metavar='A',
+    parser.add_argument('--accel', type=finite_float, metavar='A',
                         help="crank acceleration for --scene, rad/s^2 (default: the scene's)")
 
 
