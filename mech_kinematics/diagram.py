@@ -32,7 +32,7 @@ textbook. ``python -m mech_kinematics diagram`` is :func:`main`.
 from __future__ import annotations
 
 import argparse
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from enum import Enum
 import math
@@ -378,6 +378,40 @@ def _pin_of(scene: Scene) -> dict[str, RPR]:
     return {_coincident(d.through): d for d in scene.dyads if isinstance(d, RPR)}
 
 
+def _polygon_start(scene: Scene, state: State, index: int,
+                   coincident: Callable[[float, float, complex], complex],
+                   ) -> tuple[dict[str, str], dict[str, RPR], dict[str, complex],
+                              dict[str, complex], dict[str, Array]]:
+    """Letters, slotted-lever pins, positions and values of one polygon.
+
+    ``index`` picks velocity (1) or acceleration (2) from the solution; the
+    coincident point of every slotted lever gets ``coincident(omega, alpha, r)``
+    with ``r`` from the lever's pivot to its pin.
+    """
+    _check_state(scene, state)
+    letter = _letters(scene, state)
+    pins = _pin_of(scene)
+    position = {name: complex(pva[0]) for name, pva in state.complex_points.items()}
+    values = {name: complex(pva[index]) for name, pva in state.complex_points.items()}
+    for name, dyad in pins.items():
+        joint = state.joints[dyad.link]
+        position[name] = position[dyad.through]
+        values[name] = coincident(float(joint.velocity), float(joint.acceleration),
+                                  position[dyad.through] - position[dyad.center])
+        letter[name] = _coincident(letter[dyad.through])
+    letters = {POLE: np.zeros(2)}
+    letters.update({letter[name]: _xy(value) for name, value in values.items()})
+    return letter, pins, position, values, letters
+
+
+def _absolute_vectors(scene: Scene, values: Mapping[str, complex], letter: Mapping[str, str],
+                      drawn: set[str], symbol: str) -> list[Vector]:
+    """Absolute vectors from the pole to every moving point not drawn from a ground point."""
+    return [Vector(POLE, letter[name], np.zeros(2), _xy(value), f'{symbol}_{name}',
+                   VectorKind.ABSOLUTE)
+            for name, value in values.items() if name not in scene.ground and name not in drawn]
+
+
 def velocity_polygon_from_state(scene: Scene, state: State) -> Polygon:
     """Return the velocity diagram of ``scene`` in ``state``.
 
@@ -397,19 +431,9 @@ def velocity_polygon_from_state(scene: Scene, state: State) -> Polygon:
         and the sliding velocity ``b'b``; the absolute velocity of every
         moving point not already drawn from a ground point.
     """
-    _check_state(scene, state)
-    letter = _letters(scene, state)
-    pins = _pin_of(scene)
-    position = {name: complex(p) for name, (p, _, _) in state.complex_points.items()}
-    velocity = {name: complex(v) for name, (_, v, _) in state.complex_points.items()}
-    for coincident, dyad in pins.items():
-        omega = float(state.joints[dyad.link].velocity)
-        position[coincident] = position[dyad.through]
-        velocity[coincident] = 1j * omega * (position[dyad.through] - position[dyad.center])
-        letter[coincident] = _coincident(letter[dyad.through])
+    letter, pins, position, velocity, letters = _polygon_start(
+        scene, state, 1, lambda omega, alpha, r: 1j * omega * r)
     ground = tuple(letter[name] for name in scene.ground)
-    letters = {POLE: np.zeros(2)}
-    letters.update({letter[name]: _xy(v) for name, v in velocity.items()})
     vectors: list[Vector] = []
     drawn: set[str] = set()
     for edge in _edges(scene, state):
@@ -434,11 +458,7 @@ def velocity_polygon_from_state(scene: Scene, state: State) -> Polygon:
             vectors.append(Vector(letter[edge.end], letter[edge.pin], tail, tail + _xy(slip),
                                   f'v_{_sub(edge.pin, edge.end)}', VectorKind.SLIP,
                                   edge.slider))
-    for name, v in velocity.items():
-        if name in scene.ground or name in drawn:
-            continue
-        vectors.append(Vector(POLE, letter[name], np.zeros(2), _xy(v), f'v_{name}',
-                              VectorKind.ABSOLUTE))
+    vectors += _absolute_vectors(scene, velocity, letter, drawn, 'v')
     return Polygon('velocity', 'm/s', letters, tuple(vectors), POLE, ground)
 
 
@@ -467,21 +487,9 @@ def acceleration_polygon_from_state(scene: Scene, state: State) -> Polygon:
         the letters of points are the solver's point accelerations, so the
         polygons close exactly when the solution is consistent.
     """
-    _check_state(scene, state)
-    letter = _letters(scene, state)
-    pins = _pin_of(scene)
-    position = {name: complex(p) for name, (p, _, _) in state.complex_points.items()}
-    accel = {name: complex(a) for name, (_, _, a) in state.complex_points.items()}
-    for coincident, dyad in pins.items():
-        joint = state.joints[dyad.link]
-        omega, alpha = float(joint.velocity), float(joint.acceleration)
-        position[coincident] = position[dyad.through]
-        r = position[dyad.through] - position[dyad.center]
-        accel[coincident] = (1j * alpha - omega * omega) * r
-        letter[coincident] = _coincident(letter[dyad.through])
+    letter, _, position, accel, letters = _polygon_start(
+        scene, state, 2, lambda omega, alpha, r: (1j * alpha - omega * omega) * r)
     ground = tuple(letter[name] for name in scene.ground)
-    letters = {POLE: np.zeros(2)}
-    letters.update({letter[name]: _xy(a) for name, a in accel.items()})
     vectors: list[Vector] = []
     drawn: set[str] = set()
     for edge in _edges(scene, state):
@@ -506,7 +514,6 @@ def acceleration_polygon_from_state(scene: Scene, state: State) -> Polygon:
             drawn.add(edge.end)
         if edge.pin is not None:
             assert edge.slider is not None
-            dyad = pins[edge.end]
             e = r / abs(r)
             slider = state.joints[edge.slider]
             coriolis = 2j * omega * float(slider.velocity) * e
@@ -520,11 +527,7 @@ def acceleration_polygon_from_state(scene: Scene, state: State) -> Polygon:
                                   VectorKind.CORIOLIS, edge.slider))
             vectors.append(Vector(kink, pin, corner, corner + _xy(sliding), f'a_{sub}^s',
                                   VectorKind.SLIP, edge.slider))
-    for name, a in accel.items():
-        if name in scene.ground or name in drawn:
-            continue
-        vectors.append(Vector(POLE, letter[name], np.zeros(2), _xy(a), f'a_{name}',
-                              VectorKind.ABSOLUTE))
+    vectors += _absolute_vectors(scene, accel, letter, drawn, 'a')
     return Polygon('acceleration', 'm/s^2', letters, tuple(vectors), POLE, ground)
 
 
