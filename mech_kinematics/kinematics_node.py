@@ -156,6 +156,7 @@ class KinematicsNode(Node):
         scene_name = self.declare_parameter('scene', mk.DEFAULT_SCENE, ParameterDescriptor(
             description='Scene YAML: a path, or the name of a scene in config/scenes/',
             read_only=True)).value
+        # Loading checks that the whole mechanism assembles at its initial angle.
         self.scene = mk.load_scene(scene_name)
         self.frame_id = self.declare_parameter('frame_id', DEFAULT_FRAME_ID, ParameterDescriptor(
             description='header.frame_id of every message (the ground frame of the scene)',
@@ -184,9 +185,6 @@ class KinematicsNode(Node):
         self.add_post_set_parameters_callback(self._apply)
         self._period_ns = round(NS_PER_S / self.get_parameter('rate_hz').value)
 
-        # Check the first pose now, so that a scene that cannot be solved fails at start.
-        mk.solve(self.scene, self.scene.input.angle, self.scene.input.speed,
-                 self.scene.input.accel)
         self._messages = TickMessages(self.scene.output_joints, self.scene.output_points,
                                       self.frame_id)
         self._pub_joint_states = self.create_publisher(JointState, 'joint_states', STATE_QOS)
