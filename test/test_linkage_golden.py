@@ -35,7 +35,8 @@ POINT_KINDS = {'position': 'length', 'velocity': 'vel', 'acceleration': 'acc'}
 QUANTITIES = ('position', 'velocity', 'acceleration')
 
 
-def _cases() -> list[Any]:
+def reference_cases() -> list[Any]:
+    """Return one pytest param (scene name, case) per published reference instant."""
     params = []
     for name in REFERENCE_NAMES:
         data = json.loads((REFERENCE / f'{name}.json').read_text())
@@ -71,7 +72,7 @@ def assert_matches_reference(got: dict[str, Any], case: dict[str, Any]) -> None:
                 assert abs(error) <= bound, (name, quantity, axis)
 
 
-@pytest.mark.parametrize(('name', 'case'), _cases())
+@pytest.mark.parametrize(('name', 'case'), reference_cases())
 def test_reference_case_api(name: str, case: dict[str, Any]) -> None:
     """mk.solve meets every published 50-digit reference value to 1e-12 relative."""
     scene = mk.load_scene(SCENES / f'{name}.yaml')
@@ -81,7 +82,7 @@ def test_reference_case_api(name: str, case: dict[str, Any]) -> None:
     assert_matches_reference(got, case)
 
 
-@pytest.mark.parametrize(('name', 'case'), _cases())
+@pytest.mark.parametrize(('name', 'case'), reference_cases())
 def test_reference_case_cli(name: str, case: dict[str, Any]) -> None:
     """`solve SCENE ARGS` prints JSON equal to the reference case, args as published."""
     out = io.StringIO()

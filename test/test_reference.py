@@ -12,7 +12,6 @@ blocks.
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 import subprocess
@@ -22,14 +21,13 @@ import warnings
 import mpmath
 import numpy as np
 import pytest
+from test_linkage_golden import reference_cases
 
 import mech_kinematics as mk
 from mech_kinematics import reference as ref
 
 HERE = Path(__file__).resolve().parent
-REFERENCE = HERE / 'data' / 'reference'
 SCENES = HERE.parent / 'config' / 'scenes'
-GOLDEN_NAMES = ('khurmi_four_bar_ad150', 'slider_crank_150_600', 'steam_engine_500_2000')
 
 EPS = float(np.finfo(float).eps)
 #: From the decimal inputs as written, the reference rounded to double is the
@@ -55,15 +53,6 @@ RTOL_JET = 1e-50
 RTOL_FLOAT_MODEL = 1e-14
 
 
-def _golden_cases() -> list:
-    params = []
-    for name in GOLDEN_NAMES:
-        data = json.loads((REFERENCE / f'{name}.json').read_text())
-        for index, case in enumerate(data['cases']):
-            params.append(pytest.param(name, case, id=f'{name}-{index}'))
-    return params
-
-
 def _values(case: dict, got: dict):
     """Yield (expected, got, scale) for every published value of ``case``."""
     kinds = {'revolute': ('angle', 'angvel', 'angacc'), 'prismatic': ('length', 'vel', 'acc')}
@@ -82,7 +71,7 @@ def _values(case: dict, got: dict):
                        case['scales'][kind])
 
 
-@pytest.mark.parametrize(('name', 'case'), _golden_cases())
+@pytest.mark.parametrize(('name', 'case'), reference_cases())
 def test_golden_case_from_decimal_inputs(name, case):
     """From the inputs as written, every published value is matched to 1 ulp."""
     path = SCENES / f'{name}.yaml'
@@ -99,7 +88,7 @@ def test_golden_case_from_decimal_inputs(name, case):
         assert abs(value - expected) <= MAX_ULPS_GOLDEN * math.ulp(expected), (expected, value)
 
 
-@pytest.mark.parametrize(('name', 'case'), _golden_cases())
+@pytest.mark.parametrize(('name', 'case'), reference_cases())
 def test_golden_case_from_double_inputs(name, case):
     """From the scene's doubles, the published values agree to 1e-15 of (value + scale)."""
     scene = mk.load_scene(SCENES / f'{name}.yaml')
