@@ -42,6 +42,7 @@ MIN_RECORDED = 0.99
 RATE_HZ = 500.0
 DURATION_S = 4.0        # of the --duration recorders, from their first subscription
 STARTUP_S = 30.0        # deadline for processes to come up
+DIAGNOSTICS_WINDOW_S = 2.5  # on /diagnostics (1 Hz) long enough to hold two messages
 SCENE = mk.load_scene(mk.DEFAULT_SCENE)
 STATE_TOPICS = {'/joint_states': 'sensor_msgs/msg/JointState',
                 '/joint_accelerations': 'trajectory_msgs/msg/JointTrajectory',
@@ -130,6 +131,7 @@ def recordings(tmp_path_factory):
                         for name, (_, sig, _) in RECORDERS.items() if sig is None}
             for name, (_, sig, _) in RECORDERS.items():
                 if sig is not None:
+                    _wait_for_two_diagnostics(recorders[name])
                     statuses[name] = recorders[name].stop(sig)
         finally:
             node_status = node.stop(signal.SIGINT)
@@ -141,6 +143,20 @@ def recordings(tmp_path_factory):
                 recorder.proc.wait()
     return {name: Recording(name, tmp / name, statuses[name], recorders[name].output(),
                             RECORDERS[name][2]) for name in RECORDERS}
+
+
+def _wait_for_two_diagnostics(recorder: Process) -> None:
+    """Wait until ``recorder`` has been subscribed to /diagnostics (1 Hz) for 2.5 s.
+
+    Topics are discovered one after another, so a recorder stopped by a signal
+    right after the --duration ones may have joined /diagnostics too late to hold
+    the two messages that bound the window of ``test_nothing_..._is_lost``.
+    """
+    recorder.wait_for_output('subscribed to /diagnostics', STARTUP_S)
+    line = next(line for line in recorder.output().splitlines()
+                if 'subscribed to /diagnostics' in line)
+    subscribed = float(re.search(r'\[(\d+\.\d+)\]', line).group(1))
+    time.sleep(max(0.0, subscribed + DIAGNOSTICS_WINDOW_S - time.time()))
 
 
 def decoded(path: Path) -> dict:
