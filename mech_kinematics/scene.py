@@ -15,6 +15,7 @@ import yaml
 
 from .errors import SceneError
 from .linkage import Branch, CarriedPoint, Crank, Link, RPR, RRP, RRR, Scene
+from .units import ANGLE_UNITS, LENGTH_UNITS, rad_per_s_from_rpm
 
 __all__ = ['load_scene', 'parse_scene', 'scene_dirs', 'scene_names', 'DEFAULT_SCENE']
 
@@ -22,9 +23,6 @@ __all__ = ['load_scene', 'parse_scene', 'scene_dirs', 'scene_names', 'DEFAULT_SC
 DEFAULT_SCENE = 'khurmi_four_bar_ad150'
 
 T = TypeVar('T')
-
-LENGTH_UNITS = {'m': 1.0, 'mm': 1000.0}
-ANGLE_UNITS = ('deg', 'rad')
 
 
 class LinkDict(TypedDict):
@@ -207,7 +205,7 @@ def parse_scene(data: Any) -> Scene:
         'input', {'speed': 'speed_rpm'}, Crank,
         link=reader.name(raw, 'link', 'input'), center=reader.name(raw, 'center', 'input'),
         point=reader.name(raw, 'point', 'input'), length=reader.length(raw, 'length', 'input'),
-        angle=reader.angle(raw, 'angle', 'input', 0.0), speed=rpm * math.pi / 30.0,
+        angle=reader.angle(raw, 'angle', 'input', 0.0), speed=rad_per_s_from_rpm(rpm),
         accel=reader.number(raw, 'accel', 'input', 0.0))
 
     dyads_data = data.get('dyads', []) or []

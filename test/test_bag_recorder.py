@@ -30,7 +30,7 @@ import pytest
 import yaml
 
 import mech_kinematics as mk
-from mech_kinematics import bag_recorder, plot
+from mech_kinematics.tools import plot, record as bag_recorder
 
 REPO = Path(__file__).resolve().parents[1]
 NS = 1_000_000_000
@@ -120,7 +120,7 @@ def recordings(tmp_path_factory):
     recorders = {}
     try:
         for name, (extra, _, _) in RECORDERS.items():
-            recorders[name] = Process(name, tmp, '-m', 'mech_kinematics.bag_recorder',
+            recorders[name] = Process(name, tmp, '-m', 'mech_kinematics.tools.record',
                                       '-o', str(tmp / name), *extra)
         for recorder in recorders.values():
             recorder.wait_for_output('recording to', STARTUP_S)

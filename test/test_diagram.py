@@ -17,8 +17,9 @@ import numpy as np
 import pytest
 
 import mech_kinematics as mk
-from mech_kinematics import diagram as dg
-from mech_kinematics.instant_centres import full_scene
+from mech_kinematics.geometry import diagrams as geo
+from mech_kinematics.geometry.instant_centres import full_scene
+from mech_kinematics.tools import diagram as dg
 
 #: A diagram's vectors against the solver's values, relative to the largest
 #: letter's distance from the pole (closed-form round trip).
@@ -84,14 +85,14 @@ def _links(scene):
 def test_velocity_letters_are_the_solver_velocities(name, angle):
     """Each point's letter in the velocity diagram is its solved velocity; ground is the pole."""
     scene, state = _solved(name, angle)
-    polygon = dg.velocity_polygon_from_state(scene, state)
+    polygon = geo.velocity_polygon_from_state(scene, state)
     atol = _atol(polygon)
     for point, (_, v, _) in state.complex_points.items():
         np.testing.assert_allclose(polygon.letters[point.lower()], _xy(complex(v)), atol=atol)
     for ground in scene.ground:
         assert ground.lower() in polygon.ground
     for vector in polygon.vectors:
-        if vector.kind is dg.VectorKind.ABSOLUTE:
+        if vector.kind is geo.VectorKind.ABSOLUTE:
             np.testing.assert_allclose(vector.start, 0.0, atol=atol)
             np.testing.assert_allclose(vector.end, polygon.letters[vector.head], atol=atol)
 
@@ -100,14 +101,14 @@ def test_velocity_letters_are_the_solver_velocities(name, angle):
 def test_velocity_polygon_closes(name, angle):
     """For each link, v_start + omega x r reaches v_end: the segment joins the two letters."""
     scene, state = _solved(name, angle)
-    polygon = dg.velocity_polygon_from_state(scene, state)
+    polygon = geo.velocity_polygon_from_state(scene, state)
     atol = _atol(polygon)
     p = {n: complex(x[0]) for n, x in state.complex_points.items()}
     for link, start, end in _links(scene):
         vector = polygon.find(f'v_{end}{start}' if len(end + start) == 2 else
                               f'v_{end},{start}')
         omega = state.joints[link].velocity
-        assert vector.kind is dg.VectorKind.RELATIVE and vector.body == link
+        assert vector.kind is geo.VectorKind.RELATIVE and vector.body == link
         expected = _xy(1j * omega * (p[end] - p[start]))
         np.testing.assert_allclose(vector.end - vector.start, expected, atol=atol)
         np.testing.assert_allclose(vector.start, polygon.letters[start.lower()], atol=atol)
@@ -128,22 +129,22 @@ def test_velocity_polygon_closes(name, angle):
 def test_acceleration_polygon_closes(name, angle):
     """Per link a_start + normal + tangential = a_end; per slot a_b' + Coriolis + slip = a_b."""
     scene, state = _solved(name, angle)
-    polygon = dg.acceleration_polygon_from_state(scene, state)
+    polygon = geo.acceleration_polygon_from_state(scene, state)
     atol = _atol(polygon)
     for point, (_, _, a) in state.complex_points.items():
         np.testing.assert_allclose(polygon.letters[point.lower()], _xy(complex(a)), atol=atol)
     vectors = polygon.vectors
     for index, vector in enumerate(vectors):
-        if vector.kind is dg.VectorKind.NORMAL:
+        if vector.kind is geo.VectorKind.NORMAL:
             tangential = vectors[index + 1]
-            assert tangential.kind is dg.VectorKind.TANGENTIAL
+            assert tangential.kind is geo.VectorKind.TANGENTIAL
             np.testing.assert_allclose(vector.start, polygon.letters[vector.tail], atol=atol)
             np.testing.assert_allclose(vector.end, tangential.start, atol=atol)
             np.testing.assert_allclose(tangential.end, polygon.letters[tangential.head],
                                        atol=atol)
-        if vector.kind is dg.VectorKind.CORIOLIS:
+        if vector.kind is geo.VectorKind.CORIOLIS:
             slip = vectors[index + 1]
-            assert slip.kind is dg.VectorKind.SLIP
+            assert slip.kind is geo.VectorKind.SLIP
             np.testing.assert_allclose(vector.start, polygon.letters[vector.tail], atol=atol)
             np.testing.assert_allclose(vector.end, slip.start, atol=atol)
             np.testing.assert_allclose(slip.end, polygon.letters[slip.head], atol=atol)
@@ -153,7 +154,7 @@ def test_acceleration_polygon_closes(name, angle):
 def test_acceleration_components_follow_the_textbook(name, angle):
     """Normal: omega^2 r along the link toward its start; tangential: |alpha| r across it."""
     scene, state = _solved(name, angle)
-    polygon = dg.acceleration_polygon_from_state(scene, state)
+    polygon = geo.acceleration_polygon_from_state(scene, state)
     atol = _atol(polygon)
     p = {n: complex(x[0]) for n, x in state.complex_points.items()}
     for link, start, end in _links(scene):
@@ -184,7 +185,7 @@ def test_acceleration_components_follow_the_textbook(name, angle):
 def test_space_diagram_is_the_solved_mechanism(name):
     """Points are the solved positions; pivots, sliders and guides sit where the scene says."""
     scene, state = _solved(name, None)
-    space = dg.space_from_state(scene, state, dg.strokes_from_scene(scene))
+    space = geo.space_from_state(scene, state, geo.strokes_from_scene(scene))
     for point, (p, _, _) in state.complex_points.items():
         np.testing.assert_allclose(space.points[point], _xy(complex(p)), atol=ATOL_POSITION)
     assert {pivot.point for pivot in space.pivots} <= set(scene.ground)
@@ -203,7 +204,7 @@ def test_space_diagram_is_the_solved_mechanism(name):
 
 def test_four_bar_matches_the_worked_example_layout():
     """Seed 002 "Four Bar Mechanism": a, d at the pole; ab, bc, dc normal to AB, BC, DC."""
-    diagram = dg.diagram_from_scene(mk.load_scene(KHURMI))
+    diagram = geo.diagram_from_scene(mk.load_scene(KHURMI))
     velocity, points = diagram.velocity, diagram.space.points
     assert set(velocity.ground) == {'a', 'd'}
     for tail, head, start, end in (('a', 'b', 'A', 'B'), ('b', 'c', 'B', 'C'),
@@ -224,8 +225,8 @@ def test_four_bar_table_lists_the_exact_values():
     angle BAD = 60 deg. The notes' graphical omega_CD = 5.163 rad/s and
     alpha_CD = 49.77 rad/s^2 are off; the exact values are 4.785 and 56.88.
     """
-    diagram = dg.diagram_from_scene(mk.load_scene(KHURMI))
-    tables = dg.tables_from_diagram(diagram, {'velocity': 0.1, 'acceleration': 1.0})
+    diagram = geo.diagram_from_scene(mk.load_scene(KHURMI))
+    tables = geo.tables_from_diagram(diagram, {'velocity': 0.1, 'acceleration': 1.0})
     links = {row[0]: row for row in tables['space'].rows}
     assert links['crank'][2:] == ('0.04', '60', '-12.57 CW', '0')
     assert links['coupler'][2:] == ('0.15', '17.15', '1.309 CCW', '31.39 CCW')
@@ -243,24 +244,24 @@ def test_four_bar_table_lists_the_exact_values():
 def test_instant_centres_are_tabled_on_request():
     """--instant-centres adds the centres table: six for a four-bar, I13 off the links."""
     scene = mk.load_scene(KHURMI)
-    assert dg.diagram_from_scene(scene).instant_centres is None
-    diagram = dg.diagram_from_scene(scene, instant_centres=True)
-    table = dg.tables_from_diagram(diagram)['centres']
+    assert geo.diagram_from_scene(scene).instant_centres is None
+    diagram = geo.diagram_from_scene(scene, instant_centres=True)
+    table = geo.tables_from_diagram(diagram)['centres']
     assert [row[0] for row in table.rows] == ['I12', 'I13', 'I14', 'I23', 'I24', 'I34']
     assert table.rows[0][2:] == ('0', '0')
 
 
 def test_slider_on_fixed_guide_centre_is_tabled_at_infinity():
     """The ram's centre with the ground is listed at infinity, toward 90 degrees."""
-    diagram = dg.diagram_from_scene(mk.load_scene('quick_return'), instant_centres=True)
-    rows = {row[1]: row for row in dg.tables_from_diagram(diagram)['centres'].rows}
+    diagram = geo.diagram_from_scene(mk.load_scene('quick_return'), instant_centres=True)
+    rows = {row[1]: row for row in geo.tables_from_diagram(diagram)['centres'].rows}
     assert rows['ground - ram'][2:] == ('at infinity', 'toward 90\u00b0')
 
 
 def test_arrows_on_the_mechanism_are_scaled_solver_values():
     """Animation arrows start at each point and end at p + k v and p + k a."""
     scene, state = _solved('quick_return', None)
-    arrows = dg.arrows_from_state(scene, state, 0.1, 0.01, points=['D'])
+    arrows = geo.arrows_from_state(scene, state, 0.1, 0.01, points=['D'])
     p, v, a = (complex(x) for x in state.complex_points['D'])
     assert [arrow.quantity for arrow in arrows] == ['v_D', 'a_D']
     np.testing.assert_allclose(arrows[0].end, _xy(p + 0.1 * v), atol=ATOL_POSITION)
@@ -270,7 +271,7 @@ def test_arrows_on_the_mechanism_are_scaled_solver_values():
 def test_pruned_scene_is_drawn_in_full():
     """A scene whose outputs prune points is solved in full for its diagrams."""
     scene = replace(mk.load_scene('quick_return'), outputs_points=('D',), outputs_joints=())
-    diagram = dg.diagram_from_scene(scene)
+    diagram = geo.diagram_from_scene(scene)
     assert {'b', "b'", 'c', 'd'} <= set(diagram.velocity.letters)
 
 
@@ -278,7 +279,7 @@ def test_pruned_state_is_refused():
     """A state pruned by outputs is refused with a message naming full_scene."""
     scene = replace(mk.load_scene('quick_return'), outputs_points=('D',), outputs_joints=())
     with pytest.raises(ValueError, match='full_scene'):
-        dg.velocity_polygon_from_state(scene, mk.solve(scene, scene.input.angle))
+        geo.velocity_polygon_from_state(scene, mk.solve(scene, scene.input.angle))
 
 
 def _png_size(path):
@@ -291,7 +292,7 @@ def _png_size(path):
 def test_png_is_written_for_every_scene(path, tmp_path):
     """Every scene file in config/scenes draws to a valid PNG of sensible size."""
     scene = mk.load_scene(str(path))
-    out = dg.write_diagram(dg.diagram_from_scene(scene, instant_centres=True), scene,
+    out = dg.write_diagram(geo.diagram_from_scene(scene, instant_centres=True), scene,
                            tmp_path / f'{path.stem}.png')
     width, height = _png_size(out)
     assert width >= MIN_PNG_SIZE[0] and height >= MIN_PNG_SIZE[1]
@@ -302,7 +303,7 @@ def test_png_is_written_for_every_scene(path, tmp_path):
 def test_svg_is_written(tmp_path):
     """A .svg output is an SVG document."""
     scene = mk.load_scene(KHURMI)
-    out = dg.write_diagram(dg.diagram_from_scene(scene), scene, tmp_path / 'four_bar.svg')
+    out = dg.write_diagram(geo.diagram_from_scene(scene), scene, tmp_path / 'four_bar.svg')
     assert '<svg' in out.read_text()[:2000]
 
 
@@ -348,11 +349,12 @@ def test_add_parser_registers_the_command():
     commands = parser.add_subparsers(dest='command', required=True)
     dg.add_parser(commands)
     args = parser.parse_args(['diagram', KHURMI, '-o', 'x.png', '--angle-deg', '30'])
-    assert args.handler is dg.run and args.angle_deg == 30.0 and not args.animate
+    assert args.handler.__module__ == dg.__name__ and args.angle_deg == 30.0 and not args.animate
 
 
 def test_import_needs_no_matplotlib():
-    """Importing the diagram geometry loads neither matplotlib nor rclpy."""
-    code = ('import sys, mech_kinematics.diagram, mech_kinematics.instant_centres; '
+    """Importing the diagram geometry and its drawing tool loads neither matplotlib nor rclpy."""
+    code = ('import sys, mech_kinematics.geometry.diagrams, mech_kinematics.tools.diagram, '
+            'mech_kinematics.geometry.instant_centres; '
             "assert 'matplotlib' not in sys.modules and 'rclpy' not in sys.modules")
     subprocess.run([sys.executable, '-c', code], check=True, timeout=60)

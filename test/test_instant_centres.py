@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 import mech_kinematics as mk
-from mech_kinematics.instant_centres import (bodies_from_scene, BodyKind, Centre, full_scene,
-                                             instant_centres_from_kennedy,
-                                             instant_centres_from_state)
+from mech_kinematics.geometry.instant_centres import (bodies_from_scene, BodyKind, Centre,
+                                                      full_scene, instant_centres_from_kennedy,
+                                                      instant_centres_from_state)
 
 #: Homogeneous centres are unit 3-vectors in units of the mechanism's size.
 ATOL_HOMOGENEOUS = 1e-9

@@ -593,7 +593,7 @@ def test_signal_exits_zero_within_a_second(ros, tmp_path, sig):
 
 FAILING_TICK = """\
 import sys
-import mech_kinematics.kinematics_node as kn
+import mech_kinematics.ros.node as kn
 def fail(self, *args):
     raise RuntimeError('injected failure')
 kn.KinematicsNode._tick = fail

@@ -25,7 +25,7 @@ def test_run_shows_the_node_live_and_ctrl_c_stops_both(tmp_path):
     log = tmp_path / 'run.txt'
     with open(log, 'w') as out:
         proc = subprocess.Popen(
-            [sys.executable, '-m', 'mech_kinematics.live', '--ros-args', '-r',
+            [sys.executable, '-m', 'mech_kinematics.tools.run', '--ros-args', '-r',
              f'__ns:={namespace}', '-p', 'rate_hz:=50'],
             env=env, stdout=out, stderr=subprocess.STDOUT, cwd=tmp_path)
     try:

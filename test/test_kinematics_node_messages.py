@@ -6,7 +6,7 @@
 zero alignment padding, so that its strict ``deserialize_cdr`` accepts the
 bytes. ``rclpy.serialization.serialize_message`` on the Kilted wheels adds
 bytes past the end and leaves uninitialized memory in the padding, which is
-why :func:`mech_kinematics.cdr.cdr_from_message` exists.
+why :func:`mech_kinematics.ros.cdr.cdr_from_message` exists.
 """
 
 import importlib
@@ -25,10 +25,10 @@ from rosbags.typesys import get_typestore, Stores
 from sensor_msgs.msg import JointState
 
 import mech_kinematics as mk
-from mech_kinematics.cdr import (cdr_from_message, marker, MessageTemplate,
-                                 padding_from_message, STAMP_MARKER)
-from mech_kinematics.messages import (joint_state_from_state, joint_trajectory_from_state,
-                                      multi_dof_trajectory_from_state, TickMessages)
+from mech_kinematics.ros.cdr import (cdr_from_message, marker, MessageTemplate,
+                                     padding_from_message, STAMP_MARKER)
+from mech_kinematics.ros.messages import (joint_state_from_state, joint_trajectory_from_state,
+                                          multi_dof_trajectory_from_state, TickMessages)
 
 SCENES = mk.scene_names()
 FRAME_ID = 'mechanism'
@@ -257,8 +257,8 @@ def test_cdr_refuses_a_type_it_cannot_encode():
 
 
 def test_cdr_module_needs_no_ros():
-    """``mech_kinematics.cdr`` imports neither rclpy nor rosidl_parser."""
-    code = ('import sys, mech_kinematics.cdr; '
+    """``mech_kinematics.ros.cdr`` imports neither rclpy nor rosidl_parser."""
+    code = ('import sys, mech_kinematics.ros.cdr; '
             "assert not {'rclpy', 'rosidl_parser'} & set(sys.modules), sys.modules")
     subprocess.run([sys.executable, '-c', code], check=True, timeout=60)
 

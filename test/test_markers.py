@@ -25,9 +25,9 @@ from trajectory_msgs.msg import MultiDOFJointTrajectory
 from visualization_msgs.msg import Marker, MarkerArray
 
 import mech_kinematics as mk
-from mech_kinematics.diagram import strokes_from_scene
-from mech_kinematics.instant_centres import full_scene
-from mech_kinematics.markers import marker_array_from_state, MarkerThrottle, NAMESPACES
+from mech_kinematics.geometry.diagrams import strokes_from_scene
+from mech_kinematics.geometry.instant_centres import full_scene
+from mech_kinematics.ros.markers import marker_array_from_state, MarkerThrottle, NAMESPACES
 
 #: Marker positions against the solver's values (a product and a sum), m.
 ATOL_POSITION = 1e-12
@@ -158,8 +158,8 @@ def test_bad_scales_are_refused(bad):
 
 
 def test_module_imports_without_ros():
-    """mech_kinematics.markers imports without rclpy or the message packages."""
-    code = ('import sys, mech_kinematics.markers; '
+    """mech_kinematics.ros.markers imports without rclpy or the message packages."""
+    code = ('import sys, mech_kinematics.ros.markers; '
             "assert not {'rclpy', 'visualization_msgs'} & set(sys.modules)")
     subprocess.run([sys.executable, '-c', code], check=True, timeout=60)
 

@@ -3,7 +3,7 @@
 """The ``plot`` command: panels, labels and values, from a scene and from a bag.
 
 The bags here are written without DDS: the node's own renderer
-(:class:`mech_kinematics.messages.TickMessages`, the bytes it publishes) and the
+(:class:`mech_kinematics.ros.messages.TickMessages`, the bytes it publishes) and the
 rosbags writer, with the definitions the recorder stores.
 """
 
@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import mech_kinematics as mk
-from mech_kinematics import bag_recorder, plot
+from mech_kinematics.tools import plot, record as bag_recorder
 
 REPO = Path(__file__).resolve().parents[1]
 #: Values drawn are the solver's, untouched: exact up to float64 rounding of |v|.
@@ -60,7 +60,7 @@ def write_bag(path: Path, scene, angles, *, storage='mcap', topics=tuple(TYPES),
     from rosbags.typesys import get_typestore, Stores
     from rosbags.typesys.msg import get_types_from_msg
 
-    from mech_kinematics.messages import TickMessages
+    from mech_kinematics.ros.messages import TickMessages
 
     ticks = TickMessages(scene.output_joints, scene.output_points, 'mechanism')
     store = get_typestore(Stores.EMPTY)
@@ -203,7 +203,7 @@ def test_errors_are_reported_not_raised(tmp_path, capsys):
 
 def test_importing_the_commands_pulls_in_neither_matplotlib_nor_rclpy():
     """The command modules import matplotlib, rosbags and rclpy only when they run."""
-    code = ('import sys, mech_kinematics.plot, mech_kinematics.bag_recorder; '
+    code = ('import sys, mech_kinematics.tools.plot, mech_kinematics.tools.record; '
             'heavy = {"matplotlib", "rclpy", "rosbags"} & set(sys.modules); '
             'assert not heavy, heavy')
     subprocess.run([sys.executable, '-c', code], check=True, cwd=REPO)

@@ -25,8 +25,8 @@ import pytest
 from textbook_answers import TEXTBOOK_ANSWERS
 
 import mech_kinematics as mk
-from mech_kinematics import reference as ref
-from mech_kinematics import report
+from mech_kinematics.tools import reference as ref
+from mech_kinematics.tools import report
 
 EPS = float(np.finfo(float).eps)
 #: Our solver's worst relative error of accelerations on the work-precision
@@ -275,7 +275,7 @@ def test_add_parser_registers_report():
 
 def test_import_is_light():
     """Importing the report module loads neither matplotlib, SciPy, mpmath nor tqdm."""
-    code = ('import sys, mech_kinematics.report; '
+    code = ('import sys, mech_kinematics.tools.report; '
             "assert not {'matplotlib', 'scipy', 'mpmath', 'tqdm'} & set(sys.modules)")
     subprocess.run([sys.executable, '-c', code], check=True, timeout=60)
 
@@ -312,8 +312,8 @@ def test_quick_report_has_no_failures(quick_report):
 
 
 def test_cli_main_writes_the_smoke_report(tmp_path):
-    """`python -m mech_kinematics.report -o DIR --smoke` exits 0 and prints the path."""
-    result = subprocess.run([sys.executable, '-m', 'mech_kinematics.report', '-o',
+    """`python -m mech_kinematics.tools.report -o DIR --smoke` exits 0 and prints the path."""
+    result = subprocess.run([sys.executable, '-m', 'mech_kinematics.tools.report', '-o',
                              str(tmp_path), '--smoke', '--no-progress'],
                             capture_output=True, text=True, timeout=300, check=False)
     assert result.returncode == 0, result.stderr

@@ -1,6 +1,6 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""Tests of mech_kinematics.timebase: the crank angle as an exact function of clock time."""
+"""Tests of mech_kinematics.ros.timebase: the crank angle as an exact function of clock time."""
 
 from decimal import Decimal, localcontext
 from fractions import Fraction
@@ -9,7 +9,7 @@ import math
 from hypothesis import example, given, strategies as st
 import pytest
 
-from mech_kinematics.timebase import CrankTimebase, TWO_PI
+from mech_kinematics.ros.timebase import CrankTimebase, TWO_PI
 
 NS = 1_000_000_000
 DAY_NS = 86_400 * NS

@@ -33,13 +33,14 @@ import warnings
 import numpy as np
 import numpy.typing as npt
 
-from .cli import finite_float
-from .errors import MechKinematicsError
+from ..cli import finite_float, run_tool
+from ..errors import MechKinematicsError
+from ..units import rad_per_s_from_rpm, rpm_from_rad_per_s
 
 __all__ = [
     'DEFAULT_MAX_SAMPLES', 'DEFAULT_SAMPLES', 'Motion', 'PlotError', 'add_parser',
     'figure_from_motion', 'main', 'motion_from_bag', 'motion_from_scene', 'plot_bag',
-    'plot_scene', 'run_command', 'save_figure',
+    'plot_scene', '_handle', 'save_figure',
 ]
 
 Array = npt.NDArray[np.float64]
@@ -163,7 +164,7 @@ def motion_from_scene(scene: Any, *, samples: int = DEFAULT_SAMPLES,
         state = mk.solve(scene, angle, speed, accel)
     joints = {name: (j.position, j.velocity, j.acceleration) for name, j in state.joints.items()}
     points = {name: (p.position, p.velocity, p.acceleration) for name, p in state.points.items()}
-    rpm = speed * 30.0 / math.pi
+    rpm = rpm_from_rad_per_s(speed)
     title = (f'{scene.name}: solver, one crank cycle at {rpm:.6g} rpm'
              + (f', {accel:.6g} rad/s²' if accel else ''))
     return Motion(title, np.asarray(angle, dtype=np.float64), time, scene.joint_types, joints,
@@ -543,7 +544,7 @@ against time or crank angle, to an image file (PNG; no display needed).
 """
 
 
-def run_command(args: argparse.Namespace) -> int:
+def _handle(args: argparse.Namespace) -> int:
     """Handle ``plot``; return the exit status."""
     import mech_kinematics as mk
 
@@ -554,7 +555,7 @@ def run_command(args: argparse.Namespace) -> int:
     if not output.parent.is_dir():
         print(f'error: Expected an existing folder for {output}, got none', file=sys.stderr)
         return 2
-    speed = None if args.speed_rpm is None else args.speed_rpm * math.pi / 30.0
+    speed = None if args.speed_rpm is None else rad_per_s_from_rpm(args.speed_rpm)
     try:
         scene = None if args.scene is None else mk.load_scene(args.scene)
         if args.bag is not None:
@@ -598,17 +599,13 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         'plot', help='plot a bag or one crank cycle of a scene to a PNG',
         description=PLOT_HELP, formatter_class=argparse.RawDescriptionHelpFormatter)
     _add_arguments(parser)
-    parser.set_defaults(handler=run_command)
+    parser.set_defaults(handler=_handle)
     return parser
 
 
-def main(args: list[str] | None = None) -> int:
-    """Run ``plot`` as a program; return the exit status."""
-    parser = argparse.ArgumentParser(prog='python -m mech_kinematics plot',
-                                     description=PLOT_HELP,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
-    _add_arguments(parser)
-    return run_command(parser.parse_args(args))
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run ``plot``; return the exit status."""
+    return run_tool(add_parser, argv)
 
 
 if __name__ == '__main__':

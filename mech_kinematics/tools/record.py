@@ -41,12 +41,13 @@ import threading
 import time
 from typing import Any
 
-from .errors import MechKinematicsError
+from ..cli import run_tool
+from ..errors import MechKinematicsError
 
 __all__ = [
     'BAG_VERSIONS', 'BagRecorder', 'DEFAULT_BAG_VERSION', 'DEFAULT_EXECUTOR', 'DEFAULT_STORAGE',
     'DEFAULT_TOPICS', 'EXECUTORS', 'RecorderError', 'STORAGES', 'TopicStats', 'add_parser',
-    'check_new_output', 'main', 'message_definition', 'record', 'run_command',
+    'check_new_output', 'main', 'message_definition', 'record', '_handle',
 ]
 
 #: The node's topics (relative names: the recorder's namespace applies).
@@ -579,7 +580,7 @@ def _print_summary(recorder: BagRecorder) -> None:
             print(f'{s.name:<{width}}  {"-":<{type_width}}  {"-":>9}  {"-":>9}  ({reason})')
 
 
-def run_command(args: argparse.Namespace) -> int:
+def _handle(args: argparse.Namespace) -> int:
     """Handle ``record``: record, print a per-topic summary; return the exit status."""
     output = Path(args.output)
     rclpy_args = ['record', '--ros-args', *args.ros_args] if args.ros_args else ['record']
@@ -612,7 +613,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         'record', help="record the node's topics to a rosbag2 bag (mcap or sqlite3)",
         description=RECORD_HELP, formatter_class=argparse.RawDescriptionHelpFormatter)
     _add_arguments(parser)
-    parser.set_defaults(handler=run_command)
+    parser.set_defaults(handler=_handle)
     return parser
 
 
@@ -640,14 +641,9 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                                             '--ros-args -r __ns:=/robot1')
 
 
-def main(args: list[str] | None = None) -> int:
-    """Run ``record`` as a program; return the exit status."""
-    parser = argparse.ArgumentParser(prog='python -m mech_kinematics record',
-                                     description=RECORD_HELP,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
-    _add_arguments(parser)
-    namespace = parser.parse_args(args)
-    return run_command(namespace)
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run ``record``; return the exit status."""
+    return run_tool(add_parser, argv)
 
 
 if __name__ == '__main__':

@@ -11,7 +11,7 @@ is shared and noisy, so what matters is the ratios of one run.
 from __future__ import annotations
 
 import argparse
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from functools import partial
 import math
 import statistics
@@ -20,8 +20,9 @@ from typing import Any
 
 import numpy as np
 
-from .linkage import solve
-from .scene import load_scene, scene_names
+from ..cli import positive_int, run_tool
+from ..linkage import solve
+from ..scene import load_scene, scene_names
 
 # The hand-written baselines solve the packaged scenes' own geometry.
 FOUR_BAR = 'khurmi_four_bar_ad150'  # AD = 150, AB = 40, BC = 150, CD = 80 mm
@@ -161,10 +162,9 @@ def measure(names: list[str], angles: int, repeat: int) -> list[dict[str, Any]]:
     return rows
 
 
-def main(args: argparse.Namespace | None = None) -> int:
+def _handle(args: argparse.Namespace) -> int:
     """Print the table of ``measure`` with the ratios to the hand-written baselines."""
-    angles = getattr(args, 'angles', 100_000)
-    repeat = getattr(args, 'repeat', 7)
+    angles, repeat = args.angles, args.repeat
     rows = measure(scene_names(), angles, repeat)
     baseline = {row['baseline_of']: row for row in rows if 'baseline_of' in row}
     print(f'median of {repeat} runs; array path over {angles} angles; position, velocity '
@@ -177,3 +177,22 @@ def main(args: argparse.Namespace | None = None) -> int:
         print(f'{row["scene"]:44s} {row["single_us"]:10.2f} {ratio1:>6s} '
               f'{row["array_us"]:13.4f} {ratio2:>6s}')
     return 0
+
+
+def add_parser(subparsers: Any) -> argparse.ArgumentParser:
+    """Register the ``bench`` command on ``subparsers``; return its parser."""
+    parser: argparse.ArgumentParser = subparsers.add_parser(
+        'bench', help='time the solver on every packaged scene',
+        description='Time the single-angle and array paths of the solver on every packaged '
+                    'scene, beside hand-written closed forms of the four-bar and the '
+                    'slider-crank.')
+    parser.add_argument('--angles', type=positive_int, default=100_000,
+                        help='angles in the array path (default 1e5)')
+    parser.add_argument('--repeat', type=positive_int, default=7, help='repeats for medians')
+    parser.set_defaults(handler=_handle)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run ``bench``; return the exit status."""
+    return run_tool(add_parser, argv)

@@ -31,8 +31,8 @@ from collections.abc import Mapping, Sequence
 import math
 from typing import Any
 
-from .diagram import arrows_from_state, COLOURS, space_from_state, SpaceDiagram
-from .linkage import Scene, State
+from ..geometry.diagrams import arrows_from_state, COLOURS, space_from_state, SpaceDiagram
+from ..linkage import Scene, State
 
 __all__ = [
     'DEFAULT_ACCELERATION_SCALE', 'DEFAULT_VELOCITY_SCALE', 'MAX_RATE_HZ', 'MarkerThrottle',

@@ -38,10 +38,12 @@ import warnings
 
 import numpy as np
 
-from .errors import AssemblyError, NearSingularWarning
-from .linkage import (Branch, CarriedPoint, Crank, JointState, Link, NEAR_SINGULAR, RPR, RRP,
-                      RRR, Scene, SINGULAR, solve)
-from .scene import load_scene
+from ..cli import run_tool
+from ..errors import AssemblyError, NearSingularWarning
+from ..linkage import (Branch, CarriedPoint, Crank, JointState, Link, NEAR_SINGULAR, RPR, RRP,
+                       RRR, Scene, SINGULAR, solve)
+from ..scene import load_scene
+from ..units import rad_per_s_from_rpm
 
 __all__ = ['Case', 'CaseResult', 'MODES', 'Mode', 'add_parser', 'chain_scene', 'clock_errors',
            'evaluate_case', 'extreme_cases', 'main', 'naive_accumulate', 'naive_cumsum',
@@ -200,7 +202,7 @@ def reference_checks(mode: Mode, tick: Callable[[], None] = lambda: None
                      ) -> list[ReferenceCheck]:
     """Check the reference on the packaged scenes: residual, second route, solver."""
     from . import reference as ref_mod
-    from .scene import scene_names
+    from ..scene import scene_names
     rows = []
     names = mode.check_scenes or tuple(scene_names())
     for name in names:
@@ -255,13 +257,13 @@ def golden_checks(folder: Path | None = None) -> list[GoldenCheck]:
         for case in data['cases']:
             with mpmath.workdps(ref_mod.DPS):
                 theta = mpmath.radians(mpmath.mpf(case['angle_deg']))
-                omega = mpmath.mpf(case['speed_rpm']) * mpmath.pi / 30
+                omega = rad_per_s_from_rpm(mpmath.mpf(case['speed_rpm']), mpmath.pi)
                 alpha = mpmath.mpf(case['accel'])
             decimal = ref_mod.as_float_dict(ref_mod.reference(model, theta, omega, alpha,
                                                               values=exact))
             double = ref_mod.as_float_dict(ref_mod.reference(
                 model, math.radians(float(case['angle_deg'])),
-                float(case['speed_rpm']) * math.pi / 30.0, float(case['accel'])))
+                rad_per_s_from_rpm(float(case['speed_rpm'])), float(case['accel'])))
             for expected, got_d, got_f, scale in _golden_values(case, decimal, double):
                 count += 1
                 if expected != got_d:
@@ -687,7 +689,7 @@ def clock_errors(mode: Mode, scene_name: str = 'khurmi_four_bar_ad150',
     import mpmath
 
     from . import reference as ref_mod
-    from .timebase import CrankTimebase
+    from ..ros.timebase import CrankTimebase
     scene = load_scene(scene_name)
     model = ref_mod.Model(scene)
     theta0 = scene.input.angle
@@ -697,7 +699,7 @@ def clock_errors(mode: Mode, scene_name: str = 'khurmi_four_bar_ad150',
     with mpmath.workdps(60):
         two_pi = 2 * mpmath.pi
         for rpm in mode.clock_rpms:
-            omega = rpm * math.pi / 30.0
+            omega = rad_per_s_from_rpm(rpm)
             step = omega * dt
             # The closed form against tick-by-tick accumulation.
             brute = mode.clock_brute_ticks
@@ -853,7 +855,7 @@ def extreme_cases(mode: Mode | None = None) -> list[Case]:
     for rpm in (1e-6, 1e5):
         cases.append(Case(f'crank speed {rpm:g} rpm', base,
                           (math.radians(60),) + _spread(0.0, 3.0, extra),
-                          speed=rpm * math.pi / 30.0, accel=0.0,
+                          speed=rad_per_s_from_rpm(rpm), accel=0.0,
                           note='khurmi_four_bar_ad150'))
     # A slotted lever whose pin passes within 1e-6 (of the crank) of the pivot.
     r = 0.15
@@ -1763,7 +1765,7 @@ def run(outdir: str | os.PathLike[str], mode: str | Mode = 'full',
     out = Path(outdir)
     out.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
-    from .scene import scene_names
+    from ..scene import scene_names
     n_checks = len(mode.check_scenes or scene_names())
     total = (n_checks + 1 + 5 * len(mode.wp_mechanisms) + len(mode.clock_rpms) + 1
              + len(mode.batch_sizes) + len(mode.chain_lengths) + 1)
@@ -1837,12 +1839,9 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Run ``report`` on its own: ``python -m mech_kinematics.report -o DIR``."""
-    parser = argparse.ArgumentParser(prog='python -m mech_kinematics')
-    add_parser(parser.add_subparsers(dest='command', required=True))
-    args = parser.parse_args(['report', *(sys.argv[1:] if argv is None else argv)])
-    return int(args.handler(args) or 0)
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run ``report``; return the exit status."""
+    return run_tool(add_parser, argv)
 
 
 if __name__ == '__main__':

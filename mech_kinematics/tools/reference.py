@@ -46,7 +46,7 @@ import mpmath
 import numpy as np
 import yaml
 
-from .linkage import RPR, RRP, RRR, Scene
+from ..linkage import RPR, RRP, RRR, Scene
 
 __all__ = ['DIGITS', 'DPS', 'Jet', 'Model', 'NoAssembly', 'Reference', 'as_float_dict',
            'check_by_differences', 'compare', 'condition', 'decimal_values', 'reference']

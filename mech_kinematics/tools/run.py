@@ -1,0 +1,102 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""``make run``: start the node and show what it publishes, one line a second.
+
+``python -m mech_kinematics run [--ros-args ...]`` starts ``kinematics_node``
+as a child process (the arguments go to it unchanged, e.g. ``--ros-args -p
+scene:=slider_crank_150_600``) and subscribes to its ``joint_states`` and
+``diagnostics`` with the same ROS arguments
+(:class:`mech_kinematics.ros.live_view.LiveView`), so namespaces and remaps
+apply to both. Ctrl-C (or SIGTERM) stops the view and then the node.
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Sequence
+import os
+import signal
+import subprocess
+import sys
+from typing import Any
+
+from ..cli import run_tool
+
+__all__ = ['add_parser', 'main']
+
+STOP_TIMEOUT_S = 3.0
+
+RUN_HELP = ('Start kinematics_node and a live console view of what it publishes. '
+            'Arguments after `run` go to the node, e.g. '
+            '`run --ros-args -p scene:=quick_return -p rate_hz:=200.0`.')
+
+
+def _stop_child(child: subprocess.Popen[bytes]) -> int:
+    """Ask the node to stop (SIGINT), escalate if it does not; return its status."""
+    if child.poll() is None:
+        child.send_signal(signal.SIGINT)
+    try:
+        return child.wait(timeout=STOP_TIMEOUT_S)
+    except subprocess.TimeoutExpired:
+        child.terminate()
+        try:
+            return child.wait(timeout=STOP_TIMEOUT_S)
+        except subprocess.TimeoutExpired:
+            child.kill()
+            return child.wait()
+
+
+def _handle(args: argparse.Namespace) -> int:
+    return main(args.node_args)
+
+
+def add_parser(subparsers: Any) -> argparse.ArgumentParser:
+    """Register the ``run`` command on ``subparsers``; return its parser."""
+    parser: argparse.ArgumentParser = subparsers.add_parser(
+        'run', help='start the node with a live console view (make run); Ctrl-C stops both',
+        description=RUN_HELP)
+    parser.add_argument('node_args', nargs=argparse.REMAINDER, metavar='NODE_ARGS',
+                        help='arguments for the node (--ros-args ...)')
+    parser.set_defaults(handler=_handle)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the node and the view until Ctrl-C; return the node's exit status.
+
+    Every argument goes to the node unchanged (``argparse`` would refuse
+    ``--ros-args`` as a first argument), except a lone ``-h``/``--help``.
+    """
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv in (['-h'], ['--help']):
+        return run_tool(add_parser, argv)
+    import rclpy
+    from rclpy.executors import ExternalShutdownException
+
+    from ..ros.live_view import LiveView
+
+    command = [sys.executable, '-m', 'mech_kinematics.kinematics_node', *argv]
+    # A session of its own: Ctrl-C reaches this process only, which then stops
+    # the node exactly once.
+    child = subprocess.Popen(command, start_new_session=True,
+                             env=dict(os.environ, PYTHONUNBUFFERED='1'))
+    ros_args = argv[argv.index('--ros-args'):] if '--ros-args' in argv else []
+    rclpy.init(args=['live', *ros_args])
+    view = None
+    try:
+        view = LiveView()
+        print(f'mech_kinematics: node started (pid {child.pid}); Ctrl-C stops it.', flush=True)
+        while child.poll() is None:
+            rclpy.spin_once(view, timeout_sec=0.2)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass  # Ctrl-C: stop the node below
+    finally:
+        if view is not None:
+            view.destroy_node()
+        rclpy.try_shutdown()
+        status = _stop_child(child)
+    return status
+
+
+if __name__ == '__main__':
+    sys.exit(main())
