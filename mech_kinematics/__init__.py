@@ -13,12 +13,12 @@ NumPy and PyYAML only; nothing here imports rclpy.
 """
 
 from .errors import AssemblyError, MechKinematicsError, NearSingularWarning, SceneError
-from .linkage import (Branch, CarriedPoint, Crank, JointState, Link, NEAR_SINGULAR,
+from .linkage import (Branch, CarriedPoint, Crank, JointMotion, Link, NEAR_SINGULAR,
                       PointState, RPR, RRP, RRR, Scene, SINGULAR, solve, State)
 from .scene import DEFAULT_SCENE, load_scene, parse_scene, scene_names
 
 __all__ = [
-    'AssemblyError', 'Branch', 'CarriedPoint', 'Crank', 'DEFAULT_SCENE', 'JointState', 'Link',
+    'AssemblyError', 'Branch', 'CarriedPoint', 'Crank', 'DEFAULT_SCENE', 'JointMotion', 'Link',
     'MechKinematicsError', 'NEAR_SINGULAR', 'NearSingularWarning', 'PointState', 'RPR', 'RRP',
     'RRR', 'SINGULAR', 'Scene', 'SceneError', 'State', 'load_scene', 'parse_scene',
     'scene_names', 'solve',

@@ -30,7 +30,7 @@ import numpy.typing as npt
 from .errors import AssemblyError, NearSingularWarning, SceneError
 
 __all__ = [
-    'Branch', 'CarriedPoint', 'Crank', 'JointState', 'Link', 'NEAR_SINGULAR', 'PointState',
+    'Branch', 'CarriedPoint', 'Crank', 'JointMotion', 'Link', 'NEAR_SINGULAR', 'PointState',
     'RPR', 'RRP', 'RRR', 'SINGULAR', 'Scene', 'State', 'solve',
 ]
 
@@ -729,7 +729,7 @@ class Scene:
         return dict(self._plan.joint_types)
 
 
-class JointState:
+class JointMotion:
     """Position, velocity and acceleration of one joint.
 
     ``position`` is the link's absolute angle (rad, wrapped to (-pi, pi]) for a
@@ -739,8 +739,8 @@ class JointState:
 
     __slots__ = ('type', 'position', 'velocity', 'acceleration')
 
-    def __init__(self, type: str, position: Any, velocity: Any,  # noqa: A002
-                 acceleration: Any) -> None:
+    def __init__(self, type: str, position: Number, velocity: Number,  # noqa: A002
+                 acceleration: Number) -> None:
         self.type = type
         self.position = position
         self.velocity = velocity
@@ -748,7 +748,7 @@ class JointState:
 
     def __repr__(self) -> str:
         """Show every field."""
-        return (f'JointState(type={self.type!r}, position={self.position!r}, '
+        return (f'JointMotion(type={self.type!r}, position={self.position!r}, '
                 f'velocity={self.velocity!r}, acceleration={self.acceleration!r})')
 
 
@@ -778,7 +778,7 @@ class State:
     angle, speed, accel : float or ndarray
         The crank's angle (rad, as given), angular velocity (rad/s) and
         angular acceleration (rad/s^2).
-    joints : dict of str to JointState
+    joints : dict of str to JointMotion
         Every reported joint.
     complex_points : dict of str to (p, v, a)
         Every reported point as complex numbers ``x + iy`` (m, m/s, m/s^2).
@@ -794,14 +794,14 @@ class State:
     """
 
     scene: str
-    angle: Any
-    speed: Any
-    accel: Any
-    joints: dict[str, JointState]
-    complex_points: dict[str, tuple[Any, Any, Any]]
-    valid: Any
-    singularity: dict[str, Any]
-    failures: dict[str, Any]
+    angle: Number
+    speed: Number
+    accel: Number
+    joints: dict[str, JointMotion]
+    complex_points: dict[str, tuple[Vector, Vector, Vector]]
+    valid: bool | npt.NDArray[np.bool_]
+    singularity: dict[str, Number]
+    failures: dict[str, npt.NDArray[np.bool_]]
 
     @cached_property
     def points(self) -> dict[str, PointState]:
@@ -936,9 +936,9 @@ def _state(scene: Scene, plan: _Plan, ctx: _Context, theta: Any, omega: Any, alp
     for name, kind in plan.joint_types.items():
         if kind == 'revolute':
             e, w, al = ctx.links[name]
-            joints[name] = JointState(kind, _angle(e, vector), w, al)
+            joints[name] = JointMotion(kind, _angle(e, vector), w, al)
         else:
-            joints[name] = JointState(kind, *ctx.sliders[name])
+            joints[name] = JointMotion(kind, *ctx.sliders[name])
     points = {name: ctx.points[name] for name in plan.output_points}
     measures = ctx.measures
     if vector:
@@ -962,7 +962,7 @@ def _state(scene: Scene, plan: _Plan, ctx: _Context, theta: Any, omega: Any, alp
             return x
 
         for name, joint in joints.items():
-            joints[name] = JointState(joint.type, finish(joint.position),
+            joints[name] = JointMotion(joint.type, finish(joint.position),
                                       finish(joint.velocity), finish(joint.acceleration))
         points = {name: (finish(p), finish(v), finish(a)) for name, (p, v, a) in points.items()}
         measures = {key: finish(m) for key, m in measures.items()}

@@ -12,14 +12,12 @@ reference uses the same formulas as the solver.
 from __future__ import annotations
 
 import math
-from typing import Any, TypeVar
+from typing import Any
 
 __all__ = [
     'ANGLE_UNITS', 'LENGTH_UNITS', 'NS_PER_S', 'degrees_from_radians', 'rad_per_s_from_rpm',
     'radians_from_degrees', 'rpm_from_rad_per_s',
 ]
-
-T = TypeVar('T')
 
 #: Length units a scene may use: name -> how many of them make one metre.
 LENGTH_UNITS = {'m': 1.0, 'mm': 1000.0}
@@ -29,21 +27,21 @@ ANGLE_UNITS = ('deg', 'rad')
 NS_PER_S = 1_000_000_000
 
 
-def rad_per_s_from_rpm(rpm: T, pi: Any = math.pi) -> T:
+def rad_per_s_from_rpm(rpm: Any, pi: Any = math.pi) -> Any:
     """Return a speed in rpm (revolutions per minute) as rad/s: ``rpm * pi / 30``."""
-    return rpm * pi / 30  # type: ignore[operator, no-any-return]
+    return rpm * pi / 30
 
 
-def rpm_from_rad_per_s(speed: T, pi: Any = math.pi) -> T:
+def rpm_from_rad_per_s(speed: Any, pi: Any = math.pi) -> Any:
     """Return a speed in rad/s as rpm: ``speed * 30 / pi``."""
-    return speed * 30 / pi  # type: ignore[operator, no-any-return]
+    return speed * 30 / pi
 
 
-def radians_from_degrees(angle: T, pi: Any = math.pi) -> T:
+def radians_from_degrees(angle: Any, pi: Any = math.pi) -> Any:
     """Return an angle in degrees as radians."""
-    return angle * (pi / 180)  # type: ignore[operator, no-any-return]
+    return angle * (pi / 180)
 
 
-def degrees_from_radians(angle: T, pi: Any = math.pi) -> T:
+def degrees_from_radians(angle: Any, pi: Any = math.pi) -> Any:
     """Return an angle in radians as degrees."""
-    return angle * (180 / pi)  # type: ignore[operator, no-any-return]
+    return angle * (180 / pi)

@@ -40,7 +40,7 @@ import numpy as np
 
 from ..cli import run_tool
 from ..errors import AssemblyError, NearSingularWarning
-from ..linkage import (Branch, CarriedPoint, Crank, JointState, Link, NEAR_SINGULAR, RPR, RRP,
+from ..linkage import (Branch, CarriedPoint, Crank, JointMotion, Link, NEAR_SINGULAR, RPR, RRP,
                        RRR, Scene, SINGULAR, solve)
 from ..scene import load_scene
 from ..units import rad_per_s_from_rpm
@@ -331,7 +331,7 @@ def configurations(scene: Scene, count: int, span: tuple[float, float] | None = 
 class _State:
     """The parts of a solver State that :func:`reference.compare` reads, for the baselines."""
 
-    def __init__(self, complex_points: dict[str, Any], joints: dict[str, JointState]) -> None:
+    def __init__(self, complex_points: dict[str, Any], joints: dict[str, JointMotion]) -> None:
         self.complex_points = complex_points
         self.joints = joints
 
@@ -385,12 +385,12 @@ def _float_kinematics(model: Any, q: list[Any], theta: Any, omega: Any, alpha: A
     joints = {}
     for name, index in model.links.items():
         jet = theta_jet if index is None else jets[index]
-        joints[name] = JointState('revolute', *(np.broadcast_to(np.asarray(x, dtype=float),
+        joints[name] = JointMotion('revolute', *(np.broadcast_to(np.asarray(x, dtype=float),
                                                                 shape)
                                                 for x in (jet.c0, jet.c1, 2 * jet.c2)))
     for name, index in model.sliders.items():
         jet = jets[index]
-        joints[name] = JointState('prismatic', *(np.broadcast_to(np.asarray(x, dtype=float),
+        joints[name] = JointMotion('prismatic', *(np.broadcast_to(np.asarray(x, dtype=float),
                                                                  shape)
                                                  for x in (jet.c0, jet.c1, 2 * jet.c2)))
     return _State(out_points, joints)
@@ -520,7 +520,7 @@ def work_precision(mechanism: str, mode: Mode,
                         np.remainder(xp - x0 + np.pi, 2 * np.pi) - np.pi
                 else:
                     lo, hi = x0 - xm, xp - x0
-                joints[name] = JointState(joint.type, x0, (lo + hi) / (2 * h), (hi - lo) / (h * h))
+                joints[name] = JointMotion(joint.type, x0, (lo + hi) / (2 * h), (hi - lo) / (h * h))
             return _State(points, joints)
 
         state = differences(conf.thetas, conf.omegas)
