@@ -438,7 +438,7 @@ class _At:
     def __init__(self, state, index):
         self.points = {name: mk.PointState(*(getattr(p, q)[index] for q in QUANTITIES))
                        for name, p in state.points.items()}
-        self.joints = {name: mk.JointState(j.type, *(float(getattr(j, q)[index])
+        self.joints = {name: mk.JointMotion(j.type, *(float(getattr(j, q)[index])
                                                      for q in QUANTITIES))
                        for name, j in state.joints.items()}
 
@@ -640,7 +640,7 @@ class _Like:
 
     def __init__(self, points, joints):
         self.points = {n: mk.PointState(*pva) for n, pva in points.items()}
-        self.joints = {n: mk.JointState(t, *pva) for n, (t, pva) in joints.items()}
+        self.joints = {n: mk.JointMotion(t, *pva) for n, (t, pva) in joints.items()}
 
 
 # --- units -------------------------------------------------------------------------
