@@ -5,11 +5,13 @@
 from decimal import Decimal, localcontext
 from fractions import Fraction
 import math
+import random
 
 from hypothesis import example, given, strategies as st
 import pytest
 
-from mech_kinematics.ros.timebase import CrankTimebase, TWO_PI
+from mech_kinematics.ros.timebase import (CrankTimebase, MAX_DENOMINATOR_BITS, POSITION_BITS,
+                                          TWO_PI)
 
 NS = 1_000_000_000
 DAY_NS = 86_400 * NS
@@ -192,3 +194,38 @@ def test_two_pi_constant():
     """The rational 2*pi agrees with the float one to the last bit."""
     assert float(TWO_PI) == 2 * math.pi
     assert abs(TWO_PI - 2 * Fraction(str(PI_70))) < Fraction(1, 10 ** 58)
+
+
+def test_size_stays_bounded_under_many_changes():
+    """10,000 acceleration changes that reach the bound leave the integers bounded. See issue 12.
+
+    Each change used to add about 21 bits to every denominator (the instant the
+    bound is reached carries the acceleration's digits), so updates and samples
+    slowed down without limit.
+    """
+    rng = random.Random(12)
+    tb = CrankTimebase(0, 0.3, 100.0, 0.0, 3000.0)
+    t = 0
+    sizes = []
+    for i in range(10_000):
+        t += rng.randrange(1, 2 * NS)
+        tb.update(t, accel=rng.choice((-1.0, 1.0)) * rng.uniform(100.0, 5000.0))
+        if i % 1000 == 999:
+            sample_t = t + rng.randrange(1, 5 * NS)
+            sizes.append(max(tb._segment.ramp.den.bit_length(),
+                             tb._segment.hold.den.bit_length(),
+                             tb.turns(sample_t).denominator.bit_length()))
+    assert max(sizes) <= MAX_DENOMINATOR_BITS
+    assert max(sizes[5:]) <= max(sizes[:5]) + 16     # no growth with the history
+
+
+def test_rounding_at_the_bound_keeps_the_drive_within_its_resolution():
+    """A hold piece rounded to 2**-POSITION_BITS turn stays on the exact drive. See issue 12."""
+    tb = CrankTimebase(0, 0.1, 0.0, 7.0, 1234.5)            # reaches the bound at a ragged instant
+    w_max = Fraction(1234.5) / 60
+    a = Fraction(7.0) / TWO_PI
+    t_hold = w_max / a                                       # s, exact
+    x_hold = Fraction(0.1) / TWO_PI + a * t_hold ** 2 / 2    # turns, exact
+    for t in (int(t_hold * NS) + 1, 3600 * NS, 30 * DAY_NS):
+        exact = (x_hold + w_max * (Fraction(t, NS) - t_hold)) % 1
+        assert abs(tb.turns(t) - exact) <= Fraction(1, 2 ** POSITION_BITS)

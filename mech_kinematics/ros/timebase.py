@@ -17,6 +17,18 @@ start, so the wrap to one turn is an exact integer remainder and the only
 rounding is the final conversion of the fraction of a turn to a float angle.
 After 30 days at 10,000 rpm the angle is still within a few 1e-16 rad of the
 exact value; float seconds would have lost 1e-6 rad.
+
+The size of those integers stays bounded whatever the history. The instant
+the speed reaches its bound is a rational with the acceleration's digits in
+it; the piece that holds the speed there starts from its position rounded to
+a multiple of ``2**-POSITION_BITS`` turn, so those digits go no further.
+Without that rounding every acceleration change that reaches the bound would
+add about 21 bits to every later denominator, and the node would slow down
+without limit (issue 12). Every other denominator divides a fixed number (the
+floats' powers of two, 60, 1e9 and the digits of ``TWO_PI``); as a safety
+net, a segment start whose denominator exceeds ``2**MAX_DENOMINATOR_BITS`` is
+rounded the same way. A rounding moves the crank by at most ``2**-257`` turn
+(9e-78 rad): a billion changes stay far below any float's resolution.
 """
 
 from __future__ import annotations
@@ -26,9 +38,16 @@ from fractions import Fraction
 import math
 from typing import NamedTuple
 
-__all__ = ['CrankSample', 'CrankTimebase', 'TWO_PI', 'turns_from_radians']
+__all__ = ['CrankSample', 'CrankTimebase', 'MAX_DENOMINATOR_BITS', 'POSITION_BITS', 'TWO_PI',
+           'turns_from_radians']
 
 NS_PER_S = 1_000_000_000
+
+#: Rounded positions are multiples of ``2**-POSITION_BITS`` turn.
+POSITION_BITS = 256
+_POSITION_DEN = 1 << POSITION_BITS
+#: A segment start whose denominator has more bits than this is rounded.
+MAX_DENOMINATOR_BITS = 2048
 
 #: 2*pi as an exact rational, to 60 significant digits.
 TWO_PI = 2 * Fraction('3.14159265358979323846264338327950288419716939937510582097494')
@@ -39,6 +58,11 @@ _TWO_PI_FLOAT = 2.0 * math.pi
 def turns_from_radians(value: float) -> Fraction:
     """Return the exact float ``value`` (rad) in turns, as a rational."""
     return Fraction(value) / TWO_PI
+
+
+def _rounded(turns: Fraction) -> Fraction:
+    """Return ``turns`` rounded to the nearest multiple of ``2**-POSITION_BITS``."""
+    return Fraction(round(turns * _POSITION_DEN), _POSITION_DEN)
 
 
 def _radians(turns_per: Fraction) -> float:
@@ -95,6 +119,8 @@ class _Segment:
     def __init__(self, t0: int, turns0: Fraction, w0: Fraction, a: Fraction,
                  w_max: Fraction, prev: _Segment | None) -> None:
         w0 = min(max(w0, -w_max), w_max)
+        if turns0.denominator.bit_length() > MAX_DENOMINATOR_BITS:
+            turns0 = _rounded(turns0)
         self.t0, self.turns0, self.w0, self.a, self.w_max = t0, turns0, w0, a, w_max
         self.prev = prev
         zero = Fraction(0)
@@ -113,7 +139,7 @@ class _Segment:
             th = t_hold
             at_hold = turns0 + w0 * th * per_ns + a * (th * per_ns) ** 2 / 2
             c1 = target * per_ns
-            self.hold = _Piece(at_hold - c1 * th, c1, zero, target, zero)
+            self.hold = _Piece(_rounded(at_hold - c1 * th), c1, zero, target, zero)
         # First integer instant (ns) on the hold piece.
         self._ceil: int | None = None if t_hold is None else math.ceil(t_hold)
 
