@@ -1,16 +1,26 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""ROS 2 node ``mech_kinematics``: the kinematic state of a linkage at a fixed rate.
+"""ROS 2 node ``mech_kinematics``: the kinematic state of a linkage on an exact time grid.
 
-The node is an adapter around the pure solver. ``__init__`` declares the
-parameters, loads the scene once and creates the publishers; a tick thread
-wakes on absolute deadlines, takes the crank angle from the node's clock
-(:mod:`mech_kinematics.timebase`), solves, and publishes three messages
-rendered from pre-serialized templates (:mod:`mech_kinematics.messages`).
-The executor only serves the parameter services, ``/clock``, the 1 Hz
-diagnostics and, with ``markers: true``, the RViz markers: the tick thread
-hands at most 30 samples a second to the executor, which solves the whole
-scene and publishes a ``MarkerArray`` (:mod:`mech_kinematics.markers`).
+The node is an adapter around the pure solver. It declares the parameters of
+:mod:`~mech_kinematics.ros.parameters`, and follows the ROS 2 node lifecycle
+(configure loads the scene and creates the publishers, activate starts the
+tick thread, deactivate stops it, cleanup drops the scene); with
+``managed: false`` (the default) it configures and activates itself at start.
+
+The tick thread wakes on absolute deadlines and publishes every instant of an
+exact grid (:mod:`~mech_kinematics.ros.schedule`): tick k is stamped
+``t0 + k * period`` in integer nanoseconds, and a late wake-up catches up the
+instants it missed (or, with ``late_ticks: skip``, only the latest). For each
+instant it takes the crank from the exact time base
+(:mod:`~mech_kinematics.ros.timebase`), solves, and publishes three messages
+rendered from pre-serialized templates (:mod:`~mech_kinematics.ros.messages`).
+Parameter changes are handed to the tick thread, which applies them at the
+next instant it has not published, so a published stamp is never rewritten.
+The executor serves the parameter and lifecycle services, ``/clock``, the
+1 Hz diagnostics (:mod:`~mech_kinematics.ros.diagnostics`) and, with
+``markers: true``, the RViz markers (at most 30 a second, built in the
+executor's thread from samples the tick thread hands over).
 
 Run it with ``ros2 run mech_kinematics kinematics_node`` or
 ``python -m mech_kinematics.kinematics_node [--ros-args ...]``.
@@ -21,7 +31,6 @@ from __future__ import annotations
 import ctypes
 import gc
 import math
-import statistics
 import sys
 import threading
 import time
@@ -35,54 +44,57 @@ from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor, SetParam
 import rclpy
 from rclpy.clock import Clock, ClockType, JumpThreshold
 from rclpy.duration import Duration
-from rclpy.exceptions import InvalidParameterValueException
 from rclpy.executors import ExternalShutdownException
+from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
 from rclpy.logging import get_logger
-from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSDurabilityPolicy, QoSHistoryPolicy, QoSProfile, QoSReliabilityPolicy
+from rclpy.qos_overriding_options import QoSOverridingOptions, QoSPolicyKind
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
 from visualization_msgs.msg import MarkerArray
 
 import mech_kinematics as mk
-from .markers import (DEFAULT_ACCELERATION_SCALE, DEFAULT_VELOCITY_SCALE,
-                      marker_array_from_state, marker_size_from_space, MarkerThrottle)
+from .diagnostics import solver_status, Status, TickStats, timing_status
+from .markers import marker_array_from_state, marker_size_from_space, MarkerThrottle
 from .messages import TickMessages
+from .parameters import CATCH_UP, joint_refusal, PARAMETERS, refusal, spec
+from .schedule import period_ns_from_rate, TickGrid
 from .timebase import CrankTimebase
 from ..geometry.diagrams import space_from_state, strokes_from_scene
 from ..geometry.instant_centres import full_scene
-from ..units import rpm_from_rad_per_s
+from ..units import NS_PER_S, rpm_from_rad_per_s
 
-__all__ = ['KinematicsNode', 'TickThreadError', 'main']
+__all__ = ['KinematicsNode', 'NODE_NAME', 'TickThreadError', 'main']
 
 NODE_NAME = 'mech_kinematics'
 
-#: Allowed ranges of the numeric parameters: name -> (low, high, unit).
-RANGES = {
-    'crank_speed_rpm': (-100_000.0, 100_000.0, 'rpm'),
-    'crank_accel': (-1.0e6, 1.0e6, 'rad/s^2'),
-    'rate_hz': (1.0, 10_000.0, 'Hz'),
-    'max_crank_speed_rpm': (0.0, 100_000.0, 'rpm'),
-    'marker_velocity_scale': (0.0, 1000.0, 'm per m/s'),
-    'marker_acceleration_scale': (0.0, 1000.0, 'm per m/s^2'),
-}
-NUMERIC = tuple(RANGES)
-DEFAULT_RATE_HZ = 100.0
-DEFAULT_FRAME_ID = 'mechanism'
 #: Default bound on the crank speed (raised to the scene's speed if that is faster).
 DEFAULT_MAX_CRANK_SPEED_RPM = 10_000.0
-#: A tick that starts later than min(period / 2, LATE_NS) after its deadline is late.
+#: An instant published more than min(period / 2, LATE_NS) after it is counted late.
 LATE_NS = 1_000_000
 #: Longest single sleep of the tick thread, so that a stop is seen quickly.
 MAX_SLEEP_NS = 50_000_000
-NS_PER_S = 1_000_000_000
+#: A change of the system clock against the monotonic clock beyond this is a jump.
+CLOCK_JUMP_NS = 10_000_000
 #: Longest time another thread may hold the GIL before the tick thread gets it, s.
 SWITCH_INTERVAL_S = 0.0005
+#: How long the node looks for another node of its name before it starts publishing, s
+#: (the graph of a node that is already running takes about 2 s to arrive here).
+DUPLICATE_CHECK_S = 2.5
+#: The drive parameters, applied by the tick thread at an instant it has not published.
+DRIVE = ('crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm')
 
-STATE_QOS = QoSProfile(history=QoSHistoryPolicy.KEEP_LAST, depth=10,
+#: Publishers of the state: reliable, and deep enough for a catch-up burst.
+STATE_QOS = QoSProfile(history=QoSHistoryPolicy.KEEP_LAST, depth=1000,
                        reliability=QoSReliabilityPolicy.RELIABLE,
                        durability=QoSDurabilityPolicy.VOLATILE)
+#: Every publisher accepts ``qos_overrides./TOPIC.publisher.POLICY`` for these policies.
+QOS_OVERRIDES = QoSPolicyKind.HISTORY, QoSPolicyKind.DEPTH, QoSPolicyKind.RELIABILITY, \
+    QoSPolicyKind.DURABILITY
+
+_LEVELS = {0: DiagnosticStatus.OK, 1: DiagnosticStatus.WARN, 2: DiagnosticStatus.ERROR,
+           3: DiagnosticStatus.STALE}
 
 
 def rpm_parameter(speed: float) -> float:
@@ -99,103 +111,80 @@ def _set_timer_slack(ns: int) -> None:
         pass  # no prctl here: keep the default timer slack
 
 
+def _qos_options() -> QoSOverridingOptions:
+    return QoSOverridingOptions(policy_kinds=QOS_OVERRIDES)
+
+
+def diagnostic_status_from(status: Status) -> DiagnosticStatus:
+    """Return ``status`` as a ``diagnostic_msgs/DiagnosticStatus``."""
+    return DiagnosticStatus(level=_LEVELS[status.level], name=status.name,
+                            message=status.message, hardware_id=status.hardware_id,
+                            values=[KeyValue(key=k, value=v) for k, v in status.values])
+
+
 class TickThreadError(RuntimeError):
     """The tick thread stopped on an unexpected error (logged where it happened)."""
 
 
-class _Stats:
-    """Counters of the tick thread, read by the diagnostics timer (guarded by ``lock``)."""
-
-    def __init__(self) -> None:
-        self.lock = threading.Lock()
-        self.ticks = self.published = self.late = self.skipped = self.unsolved = 0
-        self.near_singular = 0
-        self.window_start_ns = time.monotonic_ns()
-        self.window_ticks = self.window_unsolved = self.window_near = 0
-        self.window_late = self.window_skipped = 0
-        self.lateness: list[int] = []
-        self.worst_measure = math.inf
-        self.last_error = ''
-        self.last_sample: tuple[float, float, float] | None = None
-        self.last_published_stamp = 0
-
-
-class KinematicsNode(Node):
+class KinematicsNode(LifecycleNode):
     """Publish the kinematic state of a scene on ``joint_states`` and friends at ``rate_hz``.
 
     Raises
     ------
-    mech_kinematics.SceneError
-        If the scene cannot be loaded or does not assemble.
-    rclpy.exceptions.InvalidParameterValueException
+    rclpy.exceptions.ParameterException
         If a parameter given at start is refused.
     """
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(NODE_NAME, **kwargs)
         try:
-            self._setup()
+            self._declare()
         except BaseException:
             self.destroy_node()
             raise
 
-    # -- set-up -------------------------------------------------------------
+    # -- parameters -----------------------------------------------------------
 
-    def _setup(self) -> None:
+    def _declare(self) -> None:
+        self.scene: mk.Scene | None = None
+        self.configure_error = ''
+        self.failed = False
         self._stop = threading.Event()
         self._clock_event = threading.Event()
-        self.failed = False
         self._thread: threading.Thread | None = None
-        self._stats = _Stats()
+        self._stats = TickStats()
         self._timebase: CrankTimebase | None = None
-        self._timebase_lock = threading.Lock()
+        self._last_stamp: int | None = None
+        self._last_sim: bool | None = None
+        self._pending: dict[str, Any] = {}
+        self._pending_lock = threading.Lock()
+        self._waiting_for_clock = False
+        self._rebase_from: int | None = None
+        self._publishers: list[Any] = []
+        self._pub_markers: Any = None
         self._failure_guard = self.create_guard_condition(self._on_failure)
         self.add_pre_set_parameters_callback(self._coerce_numbers)
         self.add_on_set_parameters_callback(self._validate)
-
-        scene_name = self.declare_parameter('scene', mk.DEFAULT_SCENE, ParameterDescriptor(
-            description='Scene YAML: a path, or the name of a scene in config/scenes/',
-            read_only=True)).value
-        # Loading checks that the whole mechanism assembles at its initial angle.
-        self.scene = mk.load_scene(scene_name)
-        self.frame_id = self.declare_parameter('frame_id', DEFAULT_FRAME_ID, ParameterDescriptor(
-            description='header.frame_id of every message (the ground frame of the scene)',
-            read_only=True)).value
-        scene_rpm = rpm_parameter(self.scene.input.speed)
-        self._declare_number(
-            'max_crank_speed_rpm', max(DEFAULT_MAX_CRANK_SPEED_RPM, abs(scene_rpm)),
-            'Bound on |crank speed|, rpm: an accelerating drive holds its speed there; '
-            'crank_speed_rpm may not exceed it')
-        self._declare_number(
-            'crank_speed_rpm', scene_rpm,
-            'Crank speed, rpm, + CCW, from the moment it is set (the crank angle stays '
-            "continuous). Defaults to the scene's input.speed_rpm")
-        self._declare_number(
-            'crank_accel', self.scene.input.accel,
-            'Crank angular acceleration, rad/s^2, + CCW, from the moment it is set; the speed '
-            "is held at +-max_crank_speed_rpm. Defaults to the scene's input.accel")
-        self._declare_number('rate_hz', DEFAULT_RATE_HZ, 'Publish rate, Hz')
-        markers = self.declare_parameter('markers', False, ParameterDescriptor(
-            description='Also publish visualization_msgs/MarkerArray on markers, at most 30 Hz',
-            read_only=True, dynamic_typing=True)).value
-        self._declare_number('marker_velocity_scale', DEFAULT_VELOCITY_SCALE,
-                             'Length of the velocity arrows on markers per unit velocity')
-        self._declare_number('marker_acceleration_scale', DEFAULT_ACCELERATION_SCALE,
-                             'Length of the acceleration arrows on markers per unit acceleration')
+        for p in PARAMETERS:
+            descriptor = ParameterDescriptor(
+                description=f'{p.description} [{p.unit}]' if p.unit else p.description,
+                read_only=p.read_only, dynamic_typing=True)
+            if p.low is not None and p.high is not None:
+                descriptor.floating_point_range = [
+                    FloatingPointRange(from_value=p.low, to_value=p.high)]
+            # A default of None leaves the parameter unset until the scene gives it.
+            value = self.declare_parameter(p.name, p.default, descriptor).value
+            if p.kind == 'double' and type(value) is int:
+                # -p rate_hz:=500 (rclcpp#979): store the double the parameter is.
+                self.set_parameters([Parameter(p.name, Parameter.Type.DOUBLE, float(value))])
         self.add_post_set_parameters_callback(self._apply)
-        self._period_ns = round(NS_PER_S / self.get_parameter('rate_hz').value)
-
-        self._messages = TickMessages(self.scene.output_joints, self.scene.output_points,
-                                      self.frame_id)
-        self._pub_joint_states = self.create_publisher(JointState, 'joint_states', STATE_QOS)
-        self._pub_joint_accel = self.create_publisher(
-            JointTrajectory, 'joint_accelerations', STATE_QOS)
-        self._pub_point_accel = self.create_publisher(
-            MultiDOFJointTrajectory, 'point_accelerations', STATE_QOS)
-        self._pub_diagnostics = self.create_publisher(DiagnosticArray, 'diagnostics', 10)
-        self._pub_markers = None
-        if markers:
-            self._setup_markers()
+        self.managed = bool(self.get_parameter('managed').value)
+        self.frame_id = self.get_parameter('frame_id').value
+        self._period_ns = period_ns_from_rate(self.get_parameter('rate_hz').value)
+        self._catch_up = self.get_parameter('late_ticks').value == CATCH_UP
+        self._max_behind_ns = round(self.get_parameter('max_catch_up_s').value * NS_PER_S)
+        self._pub_diagnostics = self.create_publisher(
+            DiagnosticArray, 'diagnostics', 10, qos_overriding_options=_qos_options())
         self._diagnostics_timer = self.create_timer(
             1.0, self._publish_diagnostics, clock=Clock(clock_type=ClockType.STEADY_TIME))
         self._jump_handle = self.get_clock().create_jump_callback(
@@ -203,120 +192,186 @@ class KinematicsNode(Node):
                           on_clock_change=True),
             post_callback=lambda _jump: self._clock_event.set())
 
-        p = {name: self.get_parameter(name).value for name in
-             ('scene', 'crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm', 'rate_hz',
-              'frame_id', 'use_sim_time', 'markers')}
-        self.get_logger().info(
-            f'scene {self.scene.name!r} ({p["scene"]}): joints {list(self.scene.output_joints)}, '
-            f'points {list(self.scene.output_points)}; crank_speed_rpm={p["crank_speed_rpm"]}, '
-            f'crank_accel={p["crank_accel"]}, max_crank_speed_rpm={p["max_crank_speed_rpm"]}, '
-            f'rate_hz={p["rate_hz"]}, frame_id={p["frame_id"]!r}, '
-            f'use_sim_time={p["use_sim_time"]}, markers={p["markers"]}')
+    def _value(self, name: str) -> Any:
+        return self.get_parameter(name).value
 
-    def _setup_markers(self) -> None:
+    @staticmethod
+    def _coerce_numbers(parameters: list[Parameter]) -> list[Parameter]:
+        """Turn an integer given for a double parameter into a double (rclcpp#979)."""
+        doubles = {p.name for p in PARAMETERS if p.kind == 'double'}
+        return [Parameter(p.name, Parameter.Type.DOUBLE, float(p.value))
+                if p.name in doubles and p.type_ == Parameter.Type.INTEGER else p
+                for p in parameters]
+
+    def _validate(self, parameters: list[Parameter]) -> SetParametersResult:
+        """Refuse a value of the wrong type or out of range, or one that breaks a joint rule."""
+        reason = None
+        for p in parameters:
+            if p.type_ == Parameter.Type.NOT_SET and not self.has_parameter(p.name) \
+                    and spec_default_is_none(p.name):
+                continue    # declared unset: the scene gives it at configure
+            reason = refusal(p.name, p.value)
+            if reason is not None:
+                break
+        if reason is None:
+            current = {name: self._value(name) for name in DRIVE if self.has_parameter(name)}
+            current.update((p.name, p.value) for p in parameters if p.name in DRIVE)
+            if None not in current.values():
+                reason = joint_refusal(current)
+        if reason is None:
+            return SetParametersResult(successful=True)
+        # Every refusal is logged once, with its reason, besides the service's answer.
+        self.get_logger().warning(f'parameter refused: {reason}')
+        return SetParametersResult(successful=False, reason=reason)
+
+    def _apply(self, parameters: list[Parameter]) -> None:
+        """Hand accepted values to the tick thread; it applies them at its next instant."""
+        changes = {p.name: p.value for p in parameters if p.type_ != Parameter.Type.NOT_SET}
+        if 'rate_hz' in changes:
+            self._period_ns = period_ns_from_rate(changes['rate_hz'])
+        if 'late_ticks' in changes:
+            self._catch_up = changes['late_ticks'] == CATCH_UP
+        if 'max_catch_up_s' in changes:
+            self._max_behind_ns = round(changes['max_catch_up_s'] * NS_PER_S)
+        drive = {name: float(changes[name]) for name in DRIVE if name in changes}
+        if drive:
+            with self._pending_lock:
+                self._pending.update(drive)
+            if self._thread is None:
+                self._apply_pending(None)   # not ticking: from the current instant
+        logged = ', '.join(f'{p.name}={p.value!r}' for p in parameters)
+        if self.scene is not None:
+            self.get_logger().info(f'parameters set: {logged}')
+
+    def _apply_pending(self, at_ns: int | None) -> None:
+        """Apply the pending drive changes from instant ``at_ns`` (None: the clock now)."""
+        with self._pending_lock:
+            drive, self._pending = self._pending, {}
+        if not drive or self._timebase is None:
+            return
+        if at_ns is None:
+            at_ns = self.get_clock().now().nanoseconds
+            if self._last_stamp is not None:
+                at_ns = max(at_ns, self._last_stamp + 1)
+        self._timebase.update(at_ns, speed_rpm=drive.get('crank_speed_rpm'),
+                              accel=drive.get('crank_accel'),
+                              max_speed_rpm=drive.get('max_crank_speed_rpm'))
+
+    # -- lifecycle ------------------------------------------------------------
+
+    def on_configure(self, state: LifecycleState) -> TransitionCallbackReturn:
+        """Load the scene, fill the scene's defaults, create the publishers."""
+        try:
+            self._configure()
+        except mk.MechKinematicsError as error:
+            self.configure_error = str(error)
+            self.get_logger().error(f'cannot configure: {error}')
+            return TransitionCallbackReturn.FAILURE
+        return TransitionCallbackReturn.SUCCESS
+
+    def _configure(self) -> None:
+        scene = mk.load_scene(self._value('scene'))
+        scene_rpm = rpm_parameter(scene.input.speed)
+        defaults = {
+            'max_crank_speed_rpm': max(DEFAULT_MAX_CRANK_SPEED_RPM, abs(scene_rpm)),
+            'crank_speed_rpm': scene_rpm,
+            'crank_accel': scene.input.accel,
+        }
+        unset = [Parameter(name, Parameter.Type.DOUBLE, float(value))
+                 for name, value in defaults.items() if self._value(name) is None]
+        if unset:
+            result = self.set_parameters_atomically(unset)
+            if not result.successful:
+                raise mk.SceneError(f'{scene.name}: {result.reason}')
+        self._messages = TickMessages(scene.output_joints, scene.output_points, self.frame_id)
+        self._pub_joint_states = self.create_publisher(
+            JointState, 'joint_states', STATE_QOS, qos_overriding_options=_qos_options())
+        self._pub_joint_accel = self.create_publisher(
+            JointTrajectory, 'joint_accelerations', STATE_QOS,
+            qos_overriding_options=_qos_options())
+        self._pub_point_accel = self.create_publisher(
+            MultiDOFJointTrajectory, 'point_accelerations', STATE_QOS,
+            qos_overriding_options=_qos_options())
+        self._publishers = [self._pub_joint_states, self._pub_joint_accel,
+                            self._pub_point_accel]
+        if self._value('markers'):
+            self._setup_markers(scene)
+        self.scene = scene
+        self._log_start()
+
+    def _log_start(self) -> None:
+        scene = self.scene
+        assert scene is not None
+        names = ('scene', 'crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm', 'rate_hz',
+                 'late_ticks', 'max_catch_up_s', 'frame_id', 'use_sim_time', 'markers',
+                 'managed')
+        settings = ', '.join(f'{name}={self._value(name)!r}' for name in names[1:])
+        self.get_logger().info(
+            f'scene {scene.name!r} ({self._value("scene")}): joints {list(scene.output_joints)}, '
+            f'points {list(scene.output_points)}; {settings}')
+
+    def on_activate(self, state: LifecycleState) -> TransitionCallbackReturn:
+        """Start the tick thread."""
+        self.start()
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_deactivate(self, state: LifecycleState) -> TransitionCallbackReturn:
+        """Stop the tick thread; the crank angle stays a function of the clock."""
+        self.stop()
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_cleanup(self, state: LifecycleState) -> TransitionCallbackReturn:
+        """Drop the scene and the publishers."""
+        self._teardown()
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_shutdown(self, state: LifecycleState) -> TransitionCallbackReturn:
+        """Stop ticking and drop everything."""
+        self.stop()
+        self._teardown()
+        return TransitionCallbackReturn.SUCCESS
+
+    def _teardown(self) -> None:
+        for publisher in [*self._publishers, self._pub_markers]:
+            if publisher is not None:
+                self.destroy_publisher(publisher)
+        self._publishers = []
+        self._pub_markers = None
+        self.scene = None
+
+    def _setup_markers(self, scene: mk.Scene) -> None:
         """Prepare the markers: the whole scene, its strokes and size, the publisher."""
-        self._marker_scene = full_scene(self.scene)
+        self._marker_scene = full_scene(scene)
         self._marker_strokes = strokes_from_scene(self._marker_scene)
         try:
             self._marker_size: float | None = marker_size_from_space(space_from_state(
-                self._marker_scene, mk.solve(self._marker_scene, self.scene.input.angle)))
+                self._marker_scene, mk.solve(self._marker_scene, scene.input.angle)))
         except mk.AssemblyError:
             self._marker_size = None    # the part beyond the outputs cannot assemble here
         self._marker_throttle = MarkerThrottle()
         self._marker_lock = threading.Lock()
         self._marker_request: tuple[int, int, float, float, float] | None = None
         self._marker_guard = self.create_guard_condition(self._publish_markers)
-        self._pub_markers = self.create_publisher(MarkerArray, 'markers', 10)
+        self._pub_markers = self.create_publisher(MarkerArray, 'markers', 10,
+                                                  qos_overriding_options=_qos_options())
 
-    def _declare_number(self, name: str, default: float, description: str) -> None:
-        low, high, unit = RANGES[name]
-        # dynamic_typing lets an integer through (-p rate_hz:=500, rclcpp#979);
-        # _validate refuses anything that is not a number and the value is
-        # stored as a double.
-        descriptor = ParameterDescriptor(
-            description=f'{description} [{unit}]', dynamic_typing=True,
-            floating_point_range=[FloatingPointRange(from_value=low, to_value=high)])
-        value = self.declare_parameter(name, float(default), descriptor).value
-        if type(value) is int:
-            self.set_parameters([Parameter(name, Parameter.Type.DOUBLE, float(value))])
-
-    # -- parameters ---------------------------------------------------------
-
-    @staticmethod
-    def _coerce_numbers(parameters: list[Parameter]) -> list[Parameter]:
-        """Turn an integer given for a numeric parameter into a double (rclcpp#979)."""
-        return [Parameter(p.name, Parameter.Type.DOUBLE, float(p.value))
-                if p.name in NUMERIC and p.type_ == Parameter.Type.INTEGER else p
-                for p in parameters]
-
-    def _current(self, name: str) -> Any:
-        return self.get_parameter(name).value if self.has_parameter(name) else None
-
-    def _validate(self, parameters: list[Parameter]) -> SetParametersResult:
-        """Refuse a value that is not a finite number in range, or breaks the speed bound."""
-        new = {p.name: p for p in parameters}
-        for p in parameters:
-            if p.name in NUMERIC:
-                low, high, unit = RANGES[p.name]
-                if p.type_ not in (Parameter.Type.DOUBLE, Parameter.Type.INTEGER):
-                    return SetParametersResult(successful=False, reason=(
-                        f'{p.name}: expected a number ({unit}), got {p.type_.name.lower()} '
-                        f'{p.value!r}'))
-                value = float(p.value)
-                if not math.isfinite(value):
-                    return SetParametersResult(successful=False, reason=(
-                        f'{p.name}: expected a finite number, got {value!r}'))
-                if not low <= value <= high:
-                    return SetParametersResult(successful=False, reason=(
-                        f'{p.name}: expected {low:g} <= value <= {high:g} {unit}, got {value!r}'))
-            elif p.name in ('scene', 'frame_id') and (
-                    p.type_ != Parameter.Type.STRING or not p.value):
-                return SetParametersResult(successful=False, reason=(
-                    f'{p.name}: expected a non-empty string, got {p.value!r}'))
-            elif p.name == 'markers' and p.type_ != Parameter.Type.BOOL:
-                return SetParametersResult(successful=False, reason=(
-                    f'markers: expected true or false, got {p.type_.name.lower()} {p.value!r}'))
-        if 'crank_speed_rpm' in new or 'max_crank_speed_rpm' in new:
-            speed = new['crank_speed_rpm'].value if 'crank_speed_rpm' in new else \
-                self._current('crank_speed_rpm')
-            bound = new['max_crank_speed_rpm'].value if 'max_crank_speed_rpm' in new else \
-                self._current('max_crank_speed_rpm')
-            if speed is not None and bound is not None and abs(speed) > bound:
-                return SetParametersResult(successful=False, reason=(
-                    f'crank_speed_rpm: expected |crank_speed_rpm| <= max_crank_speed_rpm '
-                    f'({float(bound):g} rpm), got {float(speed):g} rpm'))
-        return SetParametersResult(successful=True)
-
-    def _apply(self, parameters: list[Parameter]) -> None:
-        """Apply accepted values: the drive changes at the current instant, the rate at once."""
-        changes = {p.name: float(p.value) for p in parameters if p.name in NUMERIC}
-        if 'rate_hz' in changes:
-            self._period_ns = round(NS_PER_S / changes['rate_hz'])
-        drive = {key: changes.get(name) for key, name in (
-            ('speed_rpm', 'crank_speed_rpm'), ('accel', 'crank_accel'),
-            ('max_speed_rpm', 'max_crank_speed_rpm'))}
-        if any(v is not None for v in drive.values()):
-            with self._timebase_lock:
-                if self._timebase is not None:
-                    self._timebase.update(self.get_clock().now().nanoseconds, **drive)
-        changed = ', '.join(f'{p.name}={p.value!r}' for p in parameters)
-        self.get_logger().info(f'parameters set: {changed}')
-
-    # -- the tick thread ----------------------------------------------------
+    # -- the tick thread ------------------------------------------------------
 
     def start(self) -> None:
         """Start the tick thread."""
+        self._stop.clear()
         self._thread = threading.Thread(target=self._run, name='mech_kinematics_tick',
                                         daemon=True)
         self._thread.start()
 
     def stop(self) -> None:
-        """Stop the tick thread and wait for it."""
+        """Stop the tick thread and wait for it; apply what it left pending."""
         self._stop.set()
         self._clock_event.set()
-        if self._thread is not None and self._thread is not threading.current_thread():
-            self._thread.join(timeout=2.0)
-            self._thread = None
+        thread, self._thread = self._thread, None
+        if thread is not None and thread is not threading.current_thread():
+            thread.join(timeout=2.0)
+        self._apply_pending(None)
 
     def destroy_node(self) -> None:
         """Stop the tick thread, then destroy the node."""
@@ -327,11 +382,6 @@ class KinematicsNode(Node):
             handle.unregister()
             self._jump_handle = None
         super().destroy_node()
-
-    def _new_timebase(self, t: int) -> CrankTimebase:
-        get = self.get_parameter
-        return CrankTimebase(t, self.scene.input.angle, get('crank_speed_rpm').value,
-                             get('crank_accel').value, get('max_crank_speed_rpm').value)
 
     def _run(self) -> None:
         _set_timer_slack(1000)
@@ -350,136 +400,124 @@ class KinematicsNode(Node):
 
     def _loop(self) -> None:
         clock = self.get_clock()
-        stop = self._stop
+        stop, stats = self._stop, self._stats
         monotonic_ns, time_ns, sleep = time.monotonic_ns, time.time_ns, time.sleep
-        sim = False
-        previous = monotonic_ns() - self._period_ns     # deadline of the last tick
-        sim_previous: int | None = None                 # the same on the simulated clock
-        last_stamp: int | None = None
-        rebase_from: int | None = None
+        grid: TickGrid | None = None
+        offset = 0          # system clock minus monotonic clock, ns
         while not stop.is_set():
-            if clock.ros_time_is_active != sim:
-                # The time source changed and its epoch means nothing to the old
-                # one: the crank goes on from where it was, at the next tick.
-                sim = clock.ros_time_is_active
-                sim_previous = None
-                previous = monotonic_ns() - self._period_ns
-                rebase_from = last_stamp
-            period = self._period_ns
+            sim = clock.ros_time_is_active
+            if sim != self._last_sim:
+                if self._last_sim is not None and self._timebase is not None \
+                        and self._last_stamp is not None:
+                    # The time source changed and its epoch means nothing to the old
+                    # one: the crank goes on from where it was, at the next instant.
+                    self._rebase_from = self._last_stamp
+                self._last_sim = sim
+                grid = None
             if sim:
-                # Ticks follow the simulated clock: wake on every /clock update.
+                # Instants follow the simulated clock: wake on every /clock update.
                 self._clock_event.wait(MAX_SLEEP_NS / NS_PER_S)
                 self._clock_event.clear()
                 now = clock.now().nanoseconds
-                if now <= 0 or stop.is_set():
-                    continue        # no /clock received yet
-                if sim_previous is None or now < sim_previous:
-                    sim_previous = now - period     # first tick, or the clock went back
-                deadline = sim_previous + period
-                if now < deadline:
+                if stop.is_set():
+                    break
+                if now <= 0:
+                    self._wait_for_clock()
                     continue
-                missed = (now - deadline) // period
-                sim_previous = deadline + missed * period
-                if rebase_from is not None:
-                    self._rebase(rebase_from, now)
-                    rebase_from = None
-                self._tick(now, 0, missed)
-                last_stamp = now
+                self._waiting_for_clock = False
+                if grid is not None and now < grid.next_ns - grid.period_ns:
+                    stats.clock_jump()      # the simulated clock went back
+                    grid = None
+                if grid is None:
+                    grid = TickGrid.aligned(now, self._period_ns)
+                grid.set_period(self._period_ns)
+                self._publish_due(grid, now, now)
                 continue
-            # The rate may change while waiting: the deadline is always one
-            # period (the current one) after the last.
-            deadline = previous + period
-            remaining = deadline - monotonic_ns()
+            now = time_ns()
+            new_offset = now - monotonic_ns()
+            if grid is None or abs(new_offset - offset) > CLOCK_JUMP_NS:
+                if grid is not None:
+                    stats.clock_jump()
+                    self.get_logger().warning(
+                        f'the system clock jumped by {(new_offset - offset) / 1e9:+.3f} s: '
+                        'the tick grid starts again', throttle_duration_sec=1.0)
+                offset = new_offset
+                grid = TickGrid.aligned(now, self._period_ns)
+            grid.set_period(self._period_ns)
+            remaining = grid.next_ns - now
             if remaining > 0:
                 sleep(min(remaining, MAX_SLEEP_NS) / NS_PER_S)
                 continue
-            woke = monotonic_ns()
-            # ROS time with use_sim_time off is the system clock; time_ns() reads
-            # the same CLOCK_REALTIME several microseconds faster than clock.now().
-            stamp = time_ns()
-            lateness = woke - deadline
-            # Whole periods that went by are skipped: no catch-up burst.
-            missed = lateness // period
-            previous = deadline + missed * period
-            if rebase_from is not None:
-                self._rebase(rebase_from, stamp)
-                rebase_from = None
-            self._tick(stamp, lateness, missed)
-            last_stamp = stamp
+            self._publish_due(grid, now, monotonic_ns() + offset)
 
-    def _rebase(self, old: int, new: int) -> None:
-        with self._timebase_lock:
-            if self._timebase is not None:
-                self._timebase = self._timebase.moved(old, new)
+    def _wait_for_clock(self) -> None:
+        if not self._waiting_for_clock:
+            self._waiting_for_clock = True
+            self.get_logger().warning(
+                'use_sim_time is true and no /clock has been received: nothing is published '
+                'until one arrives')
 
-    def _tick(self, stamp: int, lateness: int, missed: int) -> None:
-        timebase = self._timebase
-        if timebase is None:
-            with self._timebase_lock:
-                if self._timebase is None:
-                    self._timebase = self._new_timebase(stamp)
-                timebase = self._timebase
-        angle, speed, accel = timebase.sample(stamp)
-        error = None
-        measure = math.inf
+    def _publish_due(self, grid: TickGrid, now: int, woke: int) -> None:
+        """Publish every instant ``grid`` owes at ``now`` (``woke``: when this started)."""
+        due = grid.take(now, self._max_behind_ns, self._catch_up)
+        self._stats.skip(due.skipped)
+        late_ns = min(grid.period_ns // 2, LATE_NS)
+        for stamp in due.instants:
+            if self._timebase is None:
+                self._timebase = self._new_timebase(stamp)
+            if self._rebase_from is not None:
+                self._timebase = self._timebase.moved(self._rebase_from, stamp)
+                self._rebase_from = None
+            if self._pending:
+                self._apply_pending(stamp)
+            lateness = woke - stamp
+            self._tick(stamp, lateness, lateness > late_ns)
+            self._last_stamp = stamp
+
+    def _new_timebase(self, t: int) -> CrankTimebase:
+        assert self.scene is not None
+        with self._pending_lock:
+            self._pending = {}      # the parameters hold them already
+        return CrankTimebase(t, self.scene.input.angle, self._value('crank_speed_rpm'),
+                             self._value('crank_accel'), self._value('max_crank_speed_rpm'))
+
+    def _tick(self, stamp: int, lateness: int, late: bool) -> None:
+        scene = self.scene
+        assert scene is not None and self._timebase is not None
+        angle, speed, accel = sample = self._timebase.sample(stamp)
         try:
-            state = mk.solve(self.scene, angle, speed, accel)
+            state = mk.solve(scene, angle, speed, accel)
         except mk.AssemblyError as exc:
-            error = str(exc)
-        else:
-            sec, nanosec = divmod(stamp, NS_PER_S)
-            joint_states, joint_accel, point_accel = self._messages.render(state, sec, nanosec)
-            self._pub_joint_states.publish(joint_states)
-            self._pub_joint_accel.publish(joint_accel)
-            self._pub_point_accel.publish(point_accel)
-            if self._pub_markers is not None and self._marker_throttle.due(
-                    self._period_ns, time.monotonic_ns()):
-                # Built in the executor's thread, so that this thread keeps its deadlines.
-                with self._marker_lock:
-                    self._marker_request = (sec, nanosec, angle, speed, accel)
-                self._marker_guard.trigger()
-            if state.singularity:
-                measure = min(state.singularity.values())
-        late = lateness > min(self._period_ns // 2, LATE_NS)
-        stats = self._stats
-        with stats.lock:
-            stats.ticks += 1
-            stats.window_ticks += 1
-            stats.lateness.append(lateness)
-            stats.last_sample = (angle, speed, accel)
-            if late:
-                stats.late += 1
-                stats.window_late += 1
-            if missed:
-                stats.skipped += missed
-                stats.window_skipped += missed
-            if error is None:
-                stats.published += 1
-                stats.last_published_stamp = stamp
-                if measure < stats.worst_measure:
-                    stats.worst_measure = measure
-                if measure < mk.NEAR_SINGULAR:
-                    stats.near_singular += 1
-                    stats.window_near += 1
-            else:
-                stats.unsolved += 1
-                stats.window_unsolved += 1
-                stats.last_error = error
-        if error is not None:
-            self.get_logger().warning(f'no state published: {error}',
-                                      throttle_duration_sec=1.0)
-        elif measure < mk.NEAR_SINGULAR:
+            self._stats.record(stamp, lateness, late, error=str(exc), sample=sample)
+            self.get_logger().warning(f'no state published: {exc}', throttle_duration_sec=1.0)
+            return
+        sec, nanosec = divmod(stamp, NS_PER_S)
+        joint_states, joint_accel, point_accel = self._messages.render(state, sec, nanosec)
+        self._pub_joint_states.publish(joint_states)
+        self._pub_joint_accel.publish(joint_accel)
+        self._pub_point_accel.publish(point_accel)
+        if self._pub_markers is not None and self._marker_throttle.due(
+                self._period_ns, time.monotonic_ns()):
+            # Built in the executor's thread, so that this thread keeps its deadlines.
+            with self._marker_lock:
+                self._marker_request = (sec, nanosec, angle, speed, accel)
+            self._marker_guard.trigger()
+        measure = min(state.singularity.values()) if state.singularity else math.inf
+        near = measure < mk.NEAR_SINGULAR
+        self._stats.record(stamp, lateness, late, measure=measure, near_singular=near,
+                           sample=sample)
+        if near:
             self.get_logger().warning(
                 f'near-singular pose at crank angle {angle:.6f} rad: measure {measure:.3g}',
                 throttle_duration_sec=1.0)
 
-    # -- markers ----------------------------------------------------------------
+    # -- markers --------------------------------------------------------------
 
     def _publish_markers(self) -> None:
         """Publish the markers of the last sample the tick thread handed over, if any."""
         with self._marker_lock:
             request, self._marker_request = self._marker_request, None
-        if request is None or self._pub_markers is None:
+        if request is None or self._pub_markers is None or self.scene is None:
             return
         sec, nanosec, angle, speed, accel = request
         try:
@@ -489,87 +527,58 @@ class KinematicsNode(Node):
         self._pub_markers.publish(marker_array_from_state(
             self._marker_scene, state, frame_id=self.frame_id,
             stamp=Time(sec=sec, nanosec=nanosec),
-            velocity_scale=self.get_parameter('marker_velocity_scale').value,
-            acceleration_scale=self.get_parameter('marker_acceleration_scale').value,
+            velocity_scale=self._value('marker_velocity_scale'),
+            acceleration_scale=self._value('marker_acceleration_scale'),
             points=self.scene.output_points, size=self._marker_size,
             strokes=self._marker_strokes))
 
-    # -- diagnostics --------------------------------------------------------
+    # -- diagnostics ----------------------------------------------------------
 
     def _publish_diagnostics(self) -> None:
-        stats = self._stats
-        now_mono = time.monotonic_ns()
-        with stats.lock:
-            elapsed = (now_mono - stats.window_start_ns) / NS_PER_S
-            ticks, unsolved, near = stats.window_ticks, stats.window_unsolved, stats.window_near
-            late, skipped = stats.window_late, stats.window_skipped
-            lateness = stats.lateness
-            worst, error, sample = stats.worst_measure, stats.last_error, stats.last_sample
-            totals = (stats.ticks, stats.published, stats.late, stats.skipped, stats.unsolved)
-            last_published_stamp = stats.last_published_stamp
-            stamp = self.get_clock().now().to_msg()
-            stats.window_start_ns = now_mono
-            stats.window_ticks = stats.window_unsolved = stats.window_near = 0
-            stats.window_late = stats.window_skipped = 0
-            stats.lateness = []
-            stats.worst_measure = math.inf
-        rate = self.get_parameter('rate_hz').value
-        achieved = ticks / elapsed if elapsed > 0 else 0.0
-        lateness.sort()
-
-        def quantile(q: float) -> float:
-            return lateness[min(len(lateness) - 1, int(q * len(lateness)))] / 1e3
-
-        solver = DiagnosticStatus(name=f'{self.get_name()}: solver',
-                                  hardware_id=self.scene.name)
-        if ticks == 0:
-            solver.level, solver.message = DiagnosticStatus.STALE, 'no ticks (waiting for clock)'
-        elif unsolved:
-            solver.level = DiagnosticStatus.ERROR
-            solver.message = f'cannot assemble at {unsolved} of {ticks} ticks: {error}'
-        elif near:
-            solver.level = DiagnosticStatus.WARN
-            solver.message = f'near-singular at {near} of {ticks} ticks'
+        window = self._stats.take_window()
+        name = self.get_name()
+        hardware_id = self.scene.name if self.scene is not None else self._value('scene')
+        if self.scene is None:
+            waiting = 'configure (lifecycle)'
+        elif self._thread is None:
+            waiting = 'activate (lifecycle)' if self.managed else \
+                'the start-up check for another node of this name'
+        elif self._waiting_for_clock:
+            waiting = '/clock'
         else:
-            solver.level, solver.message = DiagnosticStatus.OK, 'ok'
-        solver.values = [
-            KeyValue(key='worst_singularity_measure',
-                     value=f'{worst:.6g}' if math.isfinite(worst) else 'n/a'),
-            KeyValue(key='near_singular_threshold', value=f'{mk.NEAR_SINGULAR:g}'),
-            KeyValue(key='unsolved_ticks', value=str(unsolved)),
-            KeyValue(key='unsolved_ticks_total', value=str(totals[4])),
-            KeyValue(key='last_error', value=error),
+            waiting = ''
+        statuses = [
+            solver_status(window, name=name, hardware_id=hardware_id,
+                          near_singular=mk.NEAR_SINGULAR, waiting_for=waiting),
+            timing_status(window, name=name, hardware_id=hardware_id,
+                          rate_hz=self._value('rate_hz')),
         ]
-        if sample is not None:
-            solver.values += [KeyValue(key='crank_angle', value=repr(sample[0])),
-                              KeyValue(key='crank_speed', value=repr(sample[1])),
-                              KeyValue(key='crank_accel', value=repr(sample[2]))]
-        timing = DiagnosticStatus(name=f'{self.get_name()}: timing', hardware_id=self.scene.name)
-        if ticks and (late or skipped or achieved < 0.9 * rate):
-            timing.level = DiagnosticStatus.WARN
-            timing.message = f'{late} late and {skipped} skipped ticks in {elapsed:.2f} s'
-        else:
-            timing.level, timing.message = DiagnosticStatus.OK, 'ok'
-        timing.values = [
-            KeyValue(key='rate_hz', value=f'{rate:g}'),
-            KeyValue(key='achieved_rate_hz', value=f'{achieved:.3f}'),
-            KeyValue(key='late_ticks', value=str(late)),
-            KeyValue(key='skipped_ticks', value=str(skipped)),
-            KeyValue(key='lateness_median_us',
-                     value=f'{statistics.median(lateness) / 1e3:.1f}' if lateness else 'n/a'),
-            KeyValue(key='lateness_p99_us', value=f'{quantile(0.99):.1f}' if lateness else 'n/a'),
-            KeyValue(key='lateness_max_us', value=f'{lateness[-1] / 1e3:.1f}' if lateness
-                     else 'n/a'),
-            KeyValue(key='ticks_total', value=str(totals[0])),
-            KeyValue(key='published_total', value=str(totals[1])),
-            KeyValue(key='last_published_stamp_ns', value=str(last_published_stamp)),
-            KeyValue(key='late_ticks_total', value=str(totals[2])),
-            KeyValue(key='skipped_ticks_total', value=str(totals[3])),
-        ]
-        msg = DiagnosticArray(status=[solver, timing])
-        msg.header.stamp = stamp
+        msg = DiagnosticArray(status=[diagnostic_status_from(s) for s in statuses])
+        msg.header.stamp = self.get_clock().now().to_msg()
         msg.header.frame_id = self.frame_id
         self._pub_diagnostics.publish(msg)
+
+
+def spec_default_is_none(name: str) -> bool:
+    """Return whether parameter ``name`` stays unset until the scene gives it."""
+    try:
+        return spec(name).default is None
+    except KeyError:
+        return False
+
+
+def _duplicate_names(node: KinematicsNode, wait_s: float) -> int:
+    """Return how many other nodes share ``node``'s fully qualified name (looking ``wait_s``).
+
+    The node is spun meanwhile, so its services and diagnostics answer.
+    """
+    me = node.get_fully_qualified_name()
+    deadline = time.monotonic() + wait_s
+    while True:
+        others = node.get_fully_qualified_node_names().count(me) - 1
+        if others > 0 or time.monotonic() >= deadline:
+            return others
+        rclpy.spin_once(node, timeout_sec=0.05)
 
 
 def main(args: list[str] | None = None) -> int:
@@ -578,22 +587,39 @@ def main(args: list[str] | None = None) -> int:
     warnings.filterwarnings('ignore', category=mk.NearSingularWarning)
     # The tick thread must not wait long for the GIL when it wakes (default 5 ms).
     sys.setswitchinterval(SWITCH_INTERVAL_S)
-    rclpy.init(args=args)
+    logger = get_logger(NODE_NAME)
+    try:
+        rclpy.init(args=args)
+    except Exception as exc:     # noqa: BLE001 - rclpy's argument errors come in several kinds
+        logger.fatal(f'cannot start: bad arguments: {exc}')
+        return 1
     node = None
     status = 0
     try:
         node = KinematicsNode()
+        if not node.managed:
+            node.trigger_configure()
+            if node.scene is None:
+                logger.fatal(f'cannot start: {node.configure_error}')
+                return 1
+        # Publishers are matched meanwhile, so the wait costs subscribers little.
+        if _duplicate_names(node, DUPLICATE_CHECK_S):
+            logger.fatal(f'cannot start: another node named {node.get_fully_qualified_name()} '
+                         'is running (remap the name with -r __node:=NAME or the namespace '
+                         'with -r __ns:=/NS)')
+            return 1
+        if not node.managed:
+            node.trigger_activate()
         # Everything built so far lives as long as the node: keep it out of the
         # garbage collector's full passes, which would otherwise delay ticks.
         gc.freeze()
-        node.start()
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass  # Ctrl-C or shutdown: a clean exit, status 0
-    except (mk.MechKinematicsError, InvalidParameterValueException) as exc:
-        get_logger(NODE_NAME).fatal(f'cannot start: {exc}')
-        status = 1
     except TickThreadError:
+        status = 1
+    except Exception as exc:     # noqa: BLE001 - a start-up failure: one line, no traceback
+        logger.fatal(f'cannot start: {exc}')
         status = 1
     finally:
         if node is not None:

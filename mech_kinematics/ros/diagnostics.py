@@ -1,0 +1,219 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""What the node says on ``diagnostics``: the tick thread's counters, and statuses from them.
+
+:class:`TickStats` is filled by the tick thread and emptied once a second
+into a :class:`Window`; :func:`solver_status` and :func:`timing_status` turn a
+window into :class:`Status` records (level, message, key/values), which the
+node copies into ``diagnostic_msgs/DiagnosticStatus``. Nothing here imports
+ROS, so every message and threshold is tested on its own.
+
+Levels are those of ``diagnostic_msgs/DiagnosticStatus``: :data:`OK`,
+:data:`WARN`, :data:`ERROR`, :data:`STALE`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+import math
+import statistics
+import threading
+import time
+
+__all__ = ['ERROR', 'OK', 'STALE', 'Status', 'TIMING_WARN_FRACTION', 'TickStats', 'WARN',
+           'Window', 'solver_status', 'timing_status']
+
+OK, WARN, ERROR, STALE = 0, 1, 2, 3
+
+#: Timing turns WARN when late and skipped instants exceed this fraction of a window's.
+TIMING_WARN_FRACTION = 0.01
+
+NS_PER_S = 1_000_000_000
+
+
+@dataclass(frozen=True)
+class Status:
+    """One diagnostic status, ready to copy into ``diagnostic_msgs/DiagnosticStatus``."""
+
+    level: int
+    name: str
+    message: str
+    hardware_id: str
+    values: tuple[tuple[str, str], ...] = ()
+
+    def value(self, key: str) -> str:
+        """Return the value of ``key`` (KeyError if absent)."""
+        return dict(self.values)[key]
+
+
+@dataclass
+class Window:
+    """Counts of one diagnostics window (about a second), and totals since the start."""
+
+    elapsed_s: float = 0.0
+    instants: int = 0           # grid instants solved (published or refused)
+    published: int = 0
+    unsolved: int = 0           # refused: cannot assemble, or not trusted
+    near_singular: int = 0
+    late: int = 0
+    skipped: int = 0            # grid instants dropped
+    clock_jumps: int = 0
+    lateness_ns: list[int] = field(default_factory=list)   # sorted
+    worst_measure: float = math.inf
+    last_error: str = ''
+    last_refusal: str = ''      # 'cannot assemble' or 'not trusted'
+    last_sample: tuple[float, float, float] | None = None   # crank angle, speed, accel
+    last_published_stamp_ns: int = 0
+    totals: dict[str, int] = field(default_factory=dict)
+
+
+_TOTALS = ('instants', 'published', 'unsolved', 'late', 'skipped', 'clock_jumps')
+
+
+class TickStats:
+    """Counters the tick thread fills and the diagnostics timer empties (thread-safe)."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._totals = dict.fromkeys(_TOTALS, 0)
+        self._last_published_stamp_ns = 0
+        self._reset(time.monotonic_ns())
+
+    def _reset(self, now_mono_ns: int) -> None:
+        self._start = now_mono_ns
+        self._window = Window()
+
+    def record(self, stamp_ns: int, lateness_ns: int, late: bool, *, error: str | None = None,
+               refusal: str = 'cannot assemble', measure: float = math.inf,
+               near_singular: bool = False,
+               sample: tuple[float, float, float] | None = None) -> None:
+        """Count one grid instant: published (``error`` None) or refused with ``error``.
+
+        ``refusal`` names the kind of refusal: ``'cannot assemble'`` or
+        ``'not trusted'`` (an error bound above the tolerance).
+        """
+        with self._lock:
+            w = self._window
+            w.instants += 1
+            w.lateness_ns.append(lateness_ns)
+            w.last_sample = sample
+            if late:
+                w.late += 1
+            if error is None:
+                w.published += 1
+                self._last_published_stamp_ns = stamp_ns
+                w.worst_measure = min(w.worst_measure, measure)
+                if near_singular:
+                    w.near_singular += 1
+            else:
+                w.unsolved += 1
+                w.last_error = error
+                w.last_refusal = refusal
+
+    def skip(self, count: int) -> None:
+        """Count ``count`` grid instants dropped."""
+        if count:
+            with self._lock:
+                self._window.skipped += count
+
+    def clock_jump(self) -> None:
+        """Count a jump of the clock (the grid started again)."""
+        with self._lock:
+            self._window.clock_jumps += 1
+
+    def take_window(self, now_mono_ns: int | None = None) -> Window:
+        """Return the window since the last call (with totals) and start a new one."""
+        now = time.monotonic_ns() if now_mono_ns is None else now_mono_ns
+        with self._lock:
+            w = self._window
+            w.elapsed_s = (now - self._start) / NS_PER_S
+            for key in _TOTALS:
+                self._totals[key] += getattr(w, key)
+            w.totals = dict(self._totals)
+            w.last_published_stamp_ns = self._last_published_stamp_ns
+            self._reset(now)
+        w.lateness_ns.sort()
+        return w
+
+
+def _quantile_us(sorted_ns: Sequence[int], q: float) -> str:
+    if not sorted_ns:
+        return 'n/a'
+    return f'{sorted_ns[min(len(sorted_ns) - 1, int(q * len(sorted_ns)))] / 1e3:.1f}'
+
+
+def solver_status(window: Window, *, name: str, hardware_id: str, near_singular: float,
+                  waiting_for: str = '') -> Status:
+    """Return the solver status of ``window``.
+
+    ERROR if any instant could not be solved or was refused (with the last
+    reason), WARN if any was near-singular or the node is ``waiting_for``
+    something (e.g. ``'/clock'``), STALE if there was nothing to solve, else OK.
+    """
+    w = window
+    if waiting_for:
+        level, message = WARN, f'waiting for {waiting_for}: nothing published'
+    elif w.instants == 0:
+        level, message = STALE, 'no ticks'
+    elif w.unsolved:
+        level = ERROR
+        message = f'{w.last_refusal} at {w.unsolved} of {w.instants} ticks: {w.last_error}'
+    elif w.near_singular:
+        level, message = WARN, f'near-singular at {w.near_singular} of {w.instants} ticks'
+    else:
+        level, message = OK, 'ok'
+    values = [
+        ('worst_singularity_measure',
+         f'{w.worst_measure:.6g}' if math.isfinite(w.worst_measure) else 'n/a'),
+        ('near_singular_threshold', f'{near_singular:g}'),
+        ('unsolved_ticks', str(w.unsolved)),
+        ('unsolved_ticks_total', str(w.totals.get('unsolved', 0))),
+        ('last_error', w.last_error),
+    ]
+    if w.last_sample is not None:
+        values += [('crank_angle', repr(w.last_sample[0])),
+                   ('crank_speed', repr(w.last_sample[1])),
+                   ('crank_accel', repr(w.last_sample[2]))]
+    return Status(level, f'{name}: solver', message, hardware_id, tuple(values))
+
+
+def timing_status(window: Window, *, name: str, hardware_id: str, rate_hz: float) -> Status:
+    """Return the timing status of ``window``.
+
+    WARN only when late and skipped instants together exceed
+    :data:`TIMING_WARN_FRACTION` of the instants owed in the window (a single
+    late tick on a busy machine is not a problem), or when a clock jump
+    restarted the grid; the message says the threshold.
+    """
+    w = window
+    owed = w.instants + w.skipped
+    achieved = w.instants / w.elapsed_s if w.elapsed_s > 0 else 0.0
+    threshold = f'{TIMING_WARN_FRACTION:.0%} of ticks'
+    bad = w.late + w.skipped
+    counts = f'{w.late} late and {w.skipped} skipped of {owed} ticks in {w.elapsed_s:.2f} s'
+    if w.clock_jumps:
+        level, message = WARN, f'clock jumped {w.clock_jumps} time(s): grid restarted; {counts}'
+    elif owed and bad > TIMING_WARN_FRACTION * owed:
+        level, message = WARN, f'{counts} (above the WARN threshold of {threshold})'
+    else:
+        level, message = OK, f'ok: {counts} (WARN above {threshold})'
+    lateness = w.lateness_ns
+    values = (
+        ('rate_hz', f'{rate_hz:g}'),
+        ('achieved_rate_hz', f'{achieved:.3f}'),
+        ('late_ticks', str(w.late)),
+        ('skipped_ticks', str(w.skipped)),
+        ('warn_fraction', f'{TIMING_WARN_FRACTION:g}'),
+        ('lateness_median_us',
+         f'{statistics.median(lateness) / 1e3:.1f}' if lateness else 'n/a'),
+        ('lateness_p99_us', _quantile_us(lateness, 0.99)),
+        ('lateness_max_us', f'{lateness[-1] / 1e3:.1f}' if lateness else 'n/a'),
+        ('ticks_total', str(w.totals.get('instants', 0))),
+        ('published_total', str(w.totals.get('published', 0))),
+        ('last_published_stamp_ns', str(w.last_published_stamp_ns)),
+        ('late_ticks_total', str(w.totals.get('late', 0))),
+        ('skipped_ticks_total', str(w.totals.get('skipped', 0))),
+        ('clock_jumps_total', str(w.totals.get('clock_jumps', 0))),
+    )
+    return Status(level, f'{name}: timing', message, hardware_id, values)

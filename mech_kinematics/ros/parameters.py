@@ -1,0 +1,171 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The node's parameters: names, types, defaults, ranges and the rules a value must meet.
+
+One table (:data:`PARAMETERS`) that the node declares from, the tests and the
+launch files are checked against, and the README lists. :func:`refusal` says
+why a value is refused (``None`` if it is accepted), without rclpy, so the
+rules are tested on their own; :func:`joint_refusal` checks the rules that tie
+two parameters together.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+import math
+from typing import Any
+
+from .markers import DEFAULT_ACCELERATION_SCALE, DEFAULT_VELOCITY_SCALE
+from ..scene import DEFAULT_SCENE
+
+__all__ = ['CATCH_UP', 'LATE_TICKS', 'PARAMETERS', 'ParameterSpec', 'SKIP', 'joint_refusal',
+           'refusal', 'spec']
+
+#: ``late_ticks`` values: publish every missed grid instant, or only the latest.
+CATCH_UP = 'catch_up'
+SKIP = 'skip'
+LATE_TICKS = (CATCH_UP, SKIP)
+
+
+@dataclass(frozen=True)
+class ParameterSpec:
+    """One parameter of the node.
+
+    Attributes
+    ----------
+    name : str
+        The ROS parameter name.
+    kind : {'double', 'string', 'bool'}
+        Its type; an integer is accepted for a double (``-p rate_hz:=500``).
+    default : float, str, bool or None
+        The default; ``None`` where the scene (or another parameter) gives it.
+    description : str
+        What it means, for ``ros2 param describe``.
+    unit : str
+        Unit of a double ('' for none).
+    low, high : float or None
+        Allowed range of a double, inclusive.
+    choices : tuple of str
+        Allowed values of a string ('' for any non-empty string).
+    read_only : bool
+        Set at start only.
+    """
+
+    name: str
+    kind: str
+    default: Any
+    description: str
+    unit: str = ''
+    low: float | None = None
+    high: float | None = None
+    choices: tuple[str, ...] = ()
+    read_only: bool = False
+    may_be_empty: bool = False
+
+
+PARAMETERS = (
+    ParameterSpec('scene', 'string', DEFAULT_SCENE,
+                  'Scene YAML: a path, or the name of a scene in config/scenes/',
+                  read_only=True),
+    ParameterSpec('frame_id', 'string', 'mechanism',
+                  'header.frame_id of every message: the ground frame of the scene',
+                  read_only=True),
+    ParameterSpec('managed', 'bool', False,
+                  'Follow the ROS 2 node lifecycle: configure loads the scene, activate '
+                  'starts publishing (default: configure and activate at start)',
+                  read_only=True),
+    ParameterSpec('crank_speed_rpm', 'double', None,
+                  'Crank speed, + CCW, from the tick at which it is applied (the crank angle '
+                  "stays continuous). Defaults to the scene's input.speed_rpm",
+                  'rpm', -100_000.0, 100_000.0),
+    ParameterSpec('crank_accel', 'double', None,
+                  'Crank angular acceleration, + CCW; the speed is held at '
+                  "+-max_crank_speed_rpm. Defaults to the scene's input.accel",
+                  'rad/s^2', -1.0e6, 1.0e6),
+    ParameterSpec('max_crank_speed_rpm', 'double', None,
+                  'Bound on |crank speed|: an accelerating drive holds its speed there; '
+                  "crank_speed_rpm may not exceed it. Defaults to 10000 (or the scene's "
+                  'speed if faster)', 'rpm', 0.0, 100_000.0),
+    ParameterSpec('rate_hz', 'double', 100.0,
+                  'Publish rate: tick k is stamped t0 + k / rate_hz exactly', 'Hz', 1.0,
+                  10_000.0),
+    ParameterSpec('late_ticks', 'string', CATCH_UP,
+                  'A late wake-up publishes every grid instant it missed (catch_up, up to '
+                  'max_catch_up_s) or only the latest (skip)', choices=LATE_TICKS),
+    ParameterSpec('max_catch_up_s', 'double', 0.1,
+                  'How far behind a late wake-up still publishes missed instants; older '
+                  'ones are skipped and counted', 's', 0.0, 10.0),
+    ParameterSpec('markers', 'bool', False,
+                  'Also publish visualization_msgs/MarkerArray on markers, at most 30 Hz',
+                  read_only=True),
+    ParameterSpec('marker_velocity_scale', 'double', DEFAULT_VELOCITY_SCALE,
+                  'Length of the velocity arrows on markers per unit velocity',
+                  'm per m/s', 0.0, 1000.0),
+    ParameterSpec('marker_acceleration_scale', 'double', DEFAULT_ACCELERATION_SCALE,
+                  'Length of the acceleration arrows on markers per unit acceleration',
+                  'm per m/s^2', 0.0, 1000.0),
+)
+
+_BY_NAME = {p.name: p for p in PARAMETERS}
+
+
+def spec(name: str) -> ParameterSpec:
+    """Return the :class:`ParameterSpec` of ``name`` (KeyError if the node has none)."""
+    return _BY_NAME[name]
+
+
+def _kind_of(value: Any) -> str:
+    if isinstance(value, bool):
+        return 'bool'
+    if isinstance(value, (int, float)):
+        return 'number'
+    if isinstance(value, str):
+        return 'string'
+    return type(value).__name__
+
+
+def refusal(name: str, value: Any) -> str | None:
+    """Return why ``value`` is refused for parameter ``name``, or ``None`` if it is accepted.
+
+    Names the node does not own (``use_sim_time``, ``qos_overrides.*``) are
+    accepted here: rclpy checks them.
+    """
+    p = _BY_NAME.get(name)
+    if p is None:
+        return None
+    if p.kind == 'double':
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            return (f'{name}: expected a number ({p.unit or "no unit"}), got '
+                    f'{_kind_of(value)} {value!r}')
+        number = float(value)
+        if not math.isfinite(number):
+            return f'{name}: expected a finite number, got {number!r}'
+        if p.low is not None and p.high is not None and not p.low <= number <= p.high:
+            return (f'{name}: expected {p.low:g} <= value <= {p.high:g} {p.unit}, got '
+                    f'{number!r}').rstrip()
+        return None
+    if p.kind == 'bool':
+        if not isinstance(value, bool):
+            return f'{name}: expected true or false, got {_kind_of(value)} {value!r}'
+        return None
+    if not isinstance(value, str):
+        return f'{name}: expected a string, got {_kind_of(value)} {value!r}'
+    if p.choices and value not in p.choices:
+        return f'{name}: expected one of {", ".join(p.choices)}, got {value!r}'
+    if not value and not p.may_be_empty:
+        return f'{name}: expected a non-empty string, got {value!r}'
+    return None
+
+
+def joint_refusal(values: Mapping[str, Any]) -> str | None:
+    """Return why a set of values breaks a rule between parameters, or ``None``.
+
+    ``values`` holds the values the parameters would have (new ones merged
+    over current ones); missing names are not checked.
+    """
+    speed, bound = values.get('crank_speed_rpm'), values.get('max_crank_speed_rpm')
+    if speed is not None and bound is not None and abs(float(speed)) > float(bound):
+        return (f'crank_speed_rpm: expected |crank_speed_rpm| <= max_crank_speed_rpm '
+                f'({float(bound):g} rpm), got {float(speed):g} rpm')
+    return None

@@ -1,0 +1,86 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The node's diagnostics as a pure summary: counters, windows, levels and messages."""
+
+import math
+
+from mech_kinematics.ros.diagnostics import (ERROR, OK, solver_status, STALE, TickStats,
+                                             timing_status, TIMING_WARN_FRACTION, WARN)
+
+NS = 1_000_000_000
+NAME = {'name': 'mech_kinematics', 'hardware_id': 'four_bar'}
+
+
+def window(published=1000, late=0, skipped=0, refused=0, near=0, jumps=0):
+    stats = TickStats()
+    for k in range(published):
+        stats.record(k, 5_000, k < late, measure=0.5, near_singular=k < near,
+                     sample=(0.1, 2.0, 0.0))
+    for k in range(refused):
+        stats.record(k, 5_000, False, error='RRR C cannot be solved', sample=(0.1, 2.0, 0.0))
+    stats.skip(skipped)
+    for _ in range(jumps):
+        stats.clock_jump()
+    return stats.take_window(stats._start + NS)
+
+
+def test_ok_when_everything_is_published():
+    """A window of 1000 published ticks on time is OK for both statuses."""
+    w = window()
+    assert solver_status(w, near_singular=1e-3, **NAME).level == OK
+    timing = timing_status(w, rate_hz=1000.0, **NAME)
+    assert timing.level == OK and 'WARN above 1% of ticks' in timing.message
+    assert timing.value('achieved_rate_hz') == '1000.000'
+
+
+def test_a_few_late_ticks_do_not_warn():
+    """Late and skipped ticks at or below 1 % of the window stay OK (issue 13)."""
+    w = window(late=5, skipped=5)
+    assert 10 <= TIMING_WARN_FRACTION * (w.instants + w.skipped)
+    assert timing_status(w, rate_hz=1000.0, **NAME).level == OK
+
+
+def test_more_than_one_percent_warns_and_says_the_threshold():
+    """Above 1 % of late or skipped ticks the timing is WARN, and the message says why."""
+    timing = timing_status(window(late=8, skipped=5), rate_hz=1000.0, **NAME)
+    assert timing.level == WARN
+    assert '8 late and 5 skipped of 1005 ticks' in timing.message
+    assert 'above the WARN threshold of 1% of ticks' in timing.message
+
+
+def test_a_clock_jump_warns():
+    """A jump of the clock restarts the grid and warns."""
+    timing = timing_status(window(jumps=1), rate_hz=1000.0, **NAME)
+    assert timing.level == WARN and 'clock jumped 1 time' in timing.message
+
+
+def test_refused_ticks_are_an_error_naming_the_reason():
+    """Ticks that could not be solved make the solver status ERROR with the last reason."""
+    solver = solver_status(window(refused=3), near_singular=1e-3, **NAME)
+    assert solver.level == ERROR
+    assert solver.message == 'cannot assemble at 3 of 1003 ticks: RRR C cannot be solved'
+    assert solver.value('unsolved_ticks') == '3' and solver.value('crank_speed') == '2.0'
+
+
+def test_near_singular_warns_and_waiting_says_for_what():
+    """Near-singular ticks warn; a node waiting for /clock says so; an empty window is stale."""
+    assert solver_status(window(near=2), near_singular=1e-3, **NAME).level == WARN
+    waiting = solver_status(window(published=0), near_singular=1e-3, waiting_for='/clock',
+                            **NAME)
+    assert waiting.level == WARN and waiting.message == 'waiting for /clock: nothing published'
+    assert solver_status(window(published=0), near_singular=1e-3, **NAME).level == STALE
+
+
+def test_totals_accumulate_over_windows():
+    """Totals add up across windows while window counts start again."""
+    stats = TickStats()
+    for k in range(3):
+        stats.record(k, 0, False)
+    first = stats.take_window()
+    stats.record(3, 0, False)
+    stats.skip(2)
+    second = stats.take_window()
+    assert (first.instants, second.instants) == (3, 1)
+    assert second.totals['published'] == 4 and second.totals['skipped'] == 2
+    assert second.last_published_stamp_ns == 3
+    assert math.isinf(second.worst_measure)

@@ -1,0 +1,49 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The node's parameter table and its rules, without ROS."""
+
+import math
+
+import pytest
+
+from mech_kinematics.ros.parameters import joint_refusal, PARAMETERS, refusal, spec
+
+
+@pytest.mark.parametrize('name, value, reason', [
+    ('rate_hz', 0.0, 'rate_hz: expected 1 <= value <= 10000 Hz, got 0.0'),
+    ('rate_hz', math.nan, 'rate_hz: expected a finite number, got nan'),
+    ('rate_hz', 'fast', "rate_hz: expected a number (Hz), got string 'fast'"),
+    ('rate_hz', True, 'rate_hz: expected a number (Hz), got bool True'),
+    ('scene', 123, 'scene: expected a string, got number 123'),
+    ('scene', '', "scene: expected a non-empty string, got ''"),
+    ('frame_id', 5, 'frame_id: expected a string, got number 5'),
+    ('markers', 'yes', "markers: expected true or false, got string 'yes'"),
+    ('late_ticks', 'later', "late_ticks: expected one of catch_up, skip, got 'later'"),
+    ('max_catch_up_s', -1.0, 'max_catch_up_s: expected 0 <= value <= 10 s, got -1.0'),
+])
+def test_bad_values_are_refused_with_a_reason(name, value, reason):
+    """Each bad value gets one line naming the parameter, what it expects and what it got."""
+    assert refusal(name, value) == reason
+
+
+def test_good_values_and_foreign_names_pass():
+    """In-range values (integers for doubles too) and names the node does not own pass."""
+    assert refusal('rate_hz', 500) is None
+    assert refusal('late_ticks', 'skip') is None
+    assert refusal('use_sim_time', 'anything') is None
+
+
+def test_the_speed_may_not_exceed_its_bound():
+    """|crank_speed_rpm| > max_crank_speed_rpm is refused; equal is fine."""
+    assert joint_refusal({'crank_speed_rpm': -3000.0, 'max_crank_speed_rpm': 3000.0}) is None
+    assert 'max_crank_speed_rpm (2000 rpm), got -3000 rpm' in joint_refusal(
+        {'crank_speed_rpm': -3000.0, 'max_crank_speed_rpm': 2000.0})
+
+
+def test_every_parameter_is_described():
+    """Every parameter has a type, a description, and a range for every double."""
+    for p in PARAMETERS:
+        assert p.kind in ('double', 'string', 'bool') and p.description
+        if p.kind == 'double':
+            assert p.low is not None and p.high is not None and p.unit
+    assert spec('rate_hz').default == 100.0
