@@ -963,7 +963,7 @@ def _state(scene: Scene, plan: _Plan, ctx: _Context, theta: Any, omega: Any, alp
 
         for name, joint in joints.items():
             joints[name] = JointMotion(joint.type, finish(joint.position),
-                                      finish(joint.velocity), finish(joint.acceleration))
+                                       finish(joint.velocity), finish(joint.acceleration))
         points = {name: (finish(p), finish(v), finish(a)) for name, (p, v, a) in points.items()}
         measures = {key: finish(m) for key, m in measures.items()}
     return State(scene.name, theta, omega, alpha, joints, points, valid, dict(measures),

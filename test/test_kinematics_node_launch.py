@@ -9,17 +9,14 @@ process is shared by the tests of the running node; the time-source, partial
 cycle, start-up and signal tests start their own.
 """
 
-import contextlib
 from decimal import Decimal, localcontext
 from fractions import Fraction
 import math
 import os
 from pathlib import Path
-import random
 import signal
 import subprocess
 import sys
-import threading
 import time
 
 from builtin_interfaces.msg import Time
@@ -27,120 +24,25 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 import numpy as np
 import pytest
 from rcl_interfaces.msg import Parameter as ParameterMsg
-import rclpy
-from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
-from rclpy.qos import qos_profile_sensor_data, QoSProfile, ReliabilityPolicy
+from rclpy.qos import qos_profile_sensor_data
+from ros_helpers import (NodeProcess, NS, REPO, Ros, SESSION, stamp_ns, STARTUP_S, wait_for,
+                         wrap)
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
 
 import mech_kinematics as mk
 
-REPO = Path(__file__).resolve().parents[1]
 PARAMS_FILE = REPO / 'config' / 'kinematics_node.yaml'
-NS = 1_000_000_000
 #: Relative tolerance between the published values and the solver's.
 RTOL = 1e-12
 #: Tolerance of an angle that the time base fixes exactly, rad.
 ATOL_TIMEBASE = 1e-9  # rad
-STARTUP_S = 20.0       # deadline for a node to come up and be discovered
 RATE_HZ = 200.0
 FRAME_ID = 'test_frame'
 SCENE = mk.load_scene(mk.DEFAULT_SCENE)
-RELIABLE = QoSProfile(depth=200, reliability=ReliabilityPolicy.RELIABLE)
-
-# A domain of this test session's own (set before rclpy.init, inherited by the nodes).
-os.environ['ROS_DOMAIN_ID'] = str(random.SystemRandom().randint(1, 100))
-os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-# Only 100 domains: every node here also runs in a namespace of this session's own, so
-# that another session that drew the same domain cannot mix its messages into ours.
-SESSION = f'/kt_{os.getpid()}_{random.SystemRandom().randrange(16 ** 6):06x}'
-
-
-def stamp_ns(msg) -> int:
-    return msg.header.stamp.sec * NS + msg.header.stamp.nanosec
-
-
-def wrap(angle: float) -> float:
-    """Return ``angle`` wrapped to [-pi, pi]."""
-    return math.remainder(angle, 2 * math.pi)
-
-
-def wait_for(predicate, timeout: float, what: str):
-    """Poll ``predicate`` until it is true or ``timeout`` s pass (then fail naming ``what``)."""
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        value = predicate()
-        if value:
-            return value
-        time.sleep(0.01)
-    pytest.fail(f'timed out after {timeout} s waiting for {what}')
-
-
-class Ros:
-    """This process's side: one rclpy context, node and executor thread for the module."""
-
-    def __init__(self) -> None:
-        self.context = rclpy.Context()
-        rclpy.init(context=self.context)
-        self.node = rclpy.create_node('kinematics_node_test', context=self.context)
-        self.executor = SingleThreadedExecutor(context=self.context)
-        self.executor.add_node(self.node)
-        self._thread = threading.Thread(target=self._spin, daemon=True)
-        self._thread.start()
-
-    def _spin(self) -> None:
-        with contextlib.suppress(Exception):    # the context goes away at teardown
-            self.executor.spin()
-
-    def collect(self, msg_type, topic: str, qos=RELIABLE) -> list:
-        """Subscribe ``topic``; return the list its messages are appended to."""
-        received: list = []
-        self.node.create_subscription(msg_type, topic, received.append, qos)
-        return received
-
-    def call(self, future, timeout: float = 10.0):
-        wait_for(future.done, timeout, 'a service response')
-        return future.result()
-
-    def close(self) -> None:
-        self.executor.shutdown(timeout_sec=1.0)
-        self.node.destroy_node()
-        rclpy.try_shutdown(context=self.context)
-        self._thread.join(timeout=2.0)
-
-
-class NodeProcess:
-    """A kinematics_node subprocess with its output in files."""
-
-    def __init__(self, tmp: Path, *ros_args: str) -> None:
-        env = dict(os.environ)
-        env['PYTHONPATH'] = os.pathsep.join(filter(None, [str(REPO), env.get('PYTHONPATH')]))
-        env['PYTHONUNBUFFERED'] = '1'
-        tmp.mkdir(parents=True, exist_ok=True)
-        self.stdout_path, self.stderr_path = tmp / 'stdout.txt', tmp / 'stderr.txt'
-        with open(self.stdout_path, 'w') as out, open(self.stderr_path, 'w') as err:
-            self.proc = subprocess.Popen(
-                [sys.executable, '-m', 'mech_kinematics.kinematics_node', '--ros-args',
-                 *ros_args], env=env, stdout=out, stderr=err, cwd=tmp)
-
-    def output(self) -> str:
-        return self.stdout_path.read_text() + self.stderr_path.read_text()
-
-    def stop(self, sig=signal.SIGINT, timeout: float = 5.0) -> tuple[int, float]:
-        """Send ``sig``; return (exit status, seconds it took to exit)."""
-        start = time.monotonic()
-        if self.proc.poll() is None:
-            self.proc.send_signal(sig)
-        try:
-            status = self.proc.wait(timeout=timeout)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
-            self.proc.wait()
-            pytest.fail(f'node did not exit within {timeout} s of {sig!r}:\n{self.output()}')
-        return status, time.monotonic() - start
 
 
 @pytest.fixture(scope='module')
@@ -490,8 +392,8 @@ def test_sim_time_drives_the_angle_exactly(ros, tmp_path):
                  'the ticks after the 30-day jump')
         time.sleep(0.3)
         assert len(js_list) == count + 11, 'ticked without the clock moving'
-        assert [stamp_ns(m) for m in js_list[count:]] == list(range(last - 10 * period,
-                                                                   last + 1, period))
+        caught_up = [stamp_ns(m) for m in js_list[count:]]
+        assert caught_up == list(range(last - 10 * period, last + 1, period))
         ci = crank_index()
         first = js_list[0]
         for msg in js_list:

@@ -18,9 +18,8 @@ import warnings
 from builtin_interfaces.msg import Time
 import numpy as np
 import pytest
+from ros_helpers import NodeProcess, Ros, SESSION, stamp_ns, STARTUP_S, wait_for
 from sensor_msgs.msg import JointState
-from test_kinematics_node_launch import (NodeProcess, Ros, SESSION, stamp_ns, STARTUP_S,
-                                         wait_for)
 from trajectory_msgs.msg import MultiDOFJointTrajectory
 from visualization_msgs.msg import Marker, MarkerArray
 

@@ -1,0 +1,124 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""Helpers shared by the tests that run the node over real DDS.
+
+Kept apart from ``helpers.py`` (pure helpers), because importing this module
+imports rclpy and gives the test session a ROS domain of its own (a random
+``ROS_DOMAIN_ID``, discovery on localhost only) before any ``rclpy.init``, and a
+namespace of its own (``SESSION``) for the nodes it starts. Never import one
+test module from another: shared pieces live here.
+"""
+
+import contextlib
+import math
+import os
+from pathlib import Path
+import random
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+import pytest
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+REPO = Path(__file__).resolve().parents[1]
+
+NS = 1_000_000_000
+STARTUP_S = 20.0       # deadline for a node to come up and be discovered
+RELIABLE = QoSProfile(depth=200, reliability=ReliabilityPolicy.RELIABLE)
+
+# A domain of this test session's own (set before rclpy.init, inherited by the nodes).
+os.environ['ROS_DOMAIN_ID'] = str(random.SystemRandom().randint(1, 100))
+os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+# Only 100 domains: every node here also runs in a namespace of this session's own, so
+# that another session that drew the same domain cannot mix its messages into ours.
+SESSION = f'/kt_{os.getpid()}_{random.SystemRandom().randrange(16 ** 6):06x}'
+
+
+def stamp_ns(msg) -> int:
+    """Return a message's header stamp in integer nanoseconds."""
+    return msg.header.stamp.sec * NS + msg.header.stamp.nanosec
+
+
+def wrap(angle: float) -> float:
+    """Return ``angle`` wrapped to [-pi, pi]."""
+    return math.remainder(angle, 2 * math.pi)
+
+
+def wait_for(predicate, timeout: float, what: str):
+    """Poll ``predicate`` until it is true or ``timeout`` s pass (then fail naming ``what``)."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        value = predicate()
+        if value:
+            return value
+        time.sleep(0.01)
+    pytest.fail(f'timed out after {timeout} s waiting for {what}')
+
+
+class Ros:
+    """This process's side: one rclpy context, node and executor thread for the module."""
+
+    def __init__(self) -> None:
+        self.context = rclpy.Context()
+        rclpy.init(context=self.context)
+        self.node = rclpy.create_node('kinematics_node_test', context=self.context)
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.node)
+        self._thread = threading.Thread(target=self._spin, daemon=True)
+        self._thread.start()
+
+    def _spin(self) -> None:
+        with contextlib.suppress(Exception):    # the context goes away at teardown
+            self.executor.spin()
+
+    def collect(self, msg_type, topic: str, qos=RELIABLE) -> list:
+        """Subscribe ``topic``; return the list its messages are appended to."""
+        received: list = []
+        self.node.create_subscription(msg_type, topic, received.append, qos)
+        return received
+
+    def call(self, future, timeout: float = 10.0):
+        wait_for(future.done, timeout, 'a service response')
+        return future.result()
+
+    def close(self) -> None:
+        self.executor.shutdown(timeout_sec=1.0)
+        self.node.destroy_node()
+        rclpy.try_shutdown(context=self.context)
+        self._thread.join(timeout=2.0)
+
+
+class NodeProcess:
+    """A kinematics_node subprocess with its output in files."""
+
+    def __init__(self, tmp: Path, *ros_args: str) -> None:
+        env = dict(os.environ)
+        env['PYTHONPATH'] = os.pathsep.join(filter(None, [str(REPO), env.get('PYTHONPATH')]))
+        env['PYTHONUNBUFFERED'] = '1'
+        tmp.mkdir(parents=True, exist_ok=True)
+        self.stdout_path, self.stderr_path = tmp / 'stdout.txt', tmp / 'stderr.txt'
+        with open(self.stdout_path, 'w') as out, open(self.stderr_path, 'w') as err:
+            self.proc = subprocess.Popen(
+                [sys.executable, '-m', 'mech_kinematics.kinematics_node', '--ros-args',
+                 *ros_args], env=env, stdout=out, stderr=err, cwd=tmp)
+
+    def output(self) -> str:
+        return self.stdout_path.read_text() + self.stderr_path.read_text()
+
+    def stop(self, sig=signal.SIGINT, timeout: float = 5.0) -> tuple[int, float]:
+        """Send ``sig``; return (exit status, seconds it took to exit)."""
+        start = time.monotonic()
+        if self.proc.poll() is None:
+            self.proc.send_signal(sig)
+        try:
+            status = self.proc.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            self.proc.wait()
+            pytest.fail(f'node did not exit within {timeout} s of {sig!r}:\n{self.output()}')
+        return status, time.monotonic() - start
