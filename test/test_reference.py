@@ -18,16 +18,13 @@ import subprocess
 import sys
 import warnings
 
+from helpers import reference_cases, SCENES
 import mpmath
 import numpy as np
 import pytest
-from test_linkage_golden import reference_cases
 
 import mech_kinematics as mk
 from mech_kinematics.tools import reference as ref
-
-HERE = Path(__file__).resolve().parent
-SCENES = HERE.parent / 'config' / 'scenes'
 
 EPS = float(np.finfo(float).eps)
 #: From the decimal inputs as written, the reference rounded to double is the
