@@ -43,6 +43,7 @@ from ..errors import AssemblyError, NearSingularWarning
 from ..linkage import (Branch, CarriedPoint, Crank, JointMotion, Link, NEAR_SINGULAR, RPR, RRP,
                        RRR, Scene, SINGULAR, solve)
 from ..scene import load_scene
+from ..textbook import find_answer, PointNorm
 from ..units import rad_per_s_from_rpm
 
 __all__ = ['Case', 'CaseResult', 'MODES', 'Mode', 'add_parser', 'chain_scene', 'clock_errors',
@@ -80,36 +81,13 @@ WP_RANGES: dict[str, tuple[float, float] | None] = {
     'Geneva': (math.radians(135.0), math.radians(225.0))}
 
 
-@dataclass(frozen=True)
-class PrintedAnswer:
-    """An acceleration printed in the seeds' worked problem of a work-precision scene.
-
-    Copied from ``test/textbook_answers.py`` (the test suite checks they
-    agree), at the scene's own crank angle.
-    """
-
-    quantity: str
-    joint: str | None       # a link's angular acceleration, or
-    point: str | None       # the magnitude of a point's acceleration
-    printed: float          # SI
-    rel_tol: float          # the accuracy the source's method deserves
-    source: str
-
-
-PRINTED_ANSWERS = {
-    'four-bar': PrintedAnswer('alpha_BC, |coupler angular acceleration|', 'coupler', None,
-                              32.02, 0.05, 'Khurmi & Gupta four-bar (seed 001), measured on '
-                              'the acceleration diagram'),
-    'slider-crank': PrintedAnswer('a_D, |acceleration of the rod midpoint|', None, 'D', 117.0,
-                                  0.05, 'slider crank 150/600 (seed 001), measured on the '
-                                  'acceleration diagram'),
-    'slotted lever': PrintedAnswer("alpha_lever = a^t_B'O / B'O = 6.4 / 0.52", 'lever', None,
-                                   12.3, 0.10, 'Khurmi & Gupta Example 8.10 (seed 000), '
-                                   'derived from measured lengths'),
-    'Geneva': PrintedAnswer('alpha_S, wheel angular acceleration', 'wheel', None, -233.0,
-                            0.005, 'Beer & Johnston Geneva sample problem, computed in the '
-                            'text'),
-}
+#: The printed answer drawn on each work-precision diagram: a quantity of the
+#: packaged textbook answers (:mod:`mech_kinematics.textbook`) for the
+#: mechanism's scene, at the scene's own crank angle.
+WP_PRINTED = {'four-bar': 'alpha_BC, |coupler angular acceleration|',
+              'slider-crank': 'a_D (midpoint of the rod), |a_D|',
+              'slotted lever': "alpha_lever = a^t_B'O / B'O = 6.4 / 0.52",
+              'Geneva': 'alpha_S, wheel angular acceleration (signed, clockwise)'}
 #: Where a hand-drawn answer is plotted on the time axis, s: not measured,
 #: an assumption stated on the figure (a velocity and acceleration diagram
 #: takes a practised hand about ten minutes).
@@ -556,18 +534,12 @@ def work_precision(mechanism: str, mode: Mode,
     tick()
 
     # The textbook's printed answer at the scene's own angle.
-    answer = PRINTED_ANSWERS[mechanism]
-    exact = ref_mod.reference(model, scene.input.angle)
-    if answer.joint is not None:
-        value = float(exact.joints[answer.joint][2])
-        miss = abs(answer.printed - value) / abs(value)
-        result.points.append(WorkPoint('printed', answer.quantity, HAND_TIME, math.nan, miss,
-                                       f'stated accuracy {answer.rel_tol:.1%}'))
-    else:
-        value = float(abs(exact.points[answer.point][2]))
-        miss = abs(answer.printed - value) / value
-        result.points.append(WorkPoint('printed', answer.quantity, HAND_TIME, miss, math.nan,
-                                       f'stated accuracy {answer.rel_tol:.1%}'))
+    answer = find_answer(scene.name, WP_PRINTED[mechanism])
+    value = answer.evaluate(ref_mod.as_float_dict(ref_mod.reference(model, scene.input.angle)))
+    miss = abs(answer.printed - value) / abs(value)
+    errors = (miss, math.nan) if isinstance(answer.accessor, PointNorm) else (math.nan, miss)
+    result.points.append(WorkPoint('printed', answer.quantity, HAND_TIME, *errors,
+                                   f'stated accuracy {answer.rel_tol:.1%}'))
     result.printed = {'printed': answer.printed, 'exact': value, 'miss': miss,
                       'stated': answer.rel_tol}
     return result
