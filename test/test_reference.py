@@ -87,7 +87,8 @@ def test_golden_case_from_decimal_inputs(name, case):
 
 
 @pytest.mark.parametrize(('key', 'text'), [
-    ('length', '{length: inch, angle: deg}'), ('angle', '{length: mm, angle: grad}')])
+    ('length', '{length: inch, angle: deg}'), ('angle', '{length: mm, angle: grad}')],
+    ids=['length', 'angle'])
 def test_decimal_values_refuse_an_unknown_unit(tmp_path, key, text):
     """A scene unit the loader does not know is a SceneError naming the key, not a KeyError.
 
