@@ -41,7 +41,7 @@ from typing import Any
 from .baselines import (Configurations, configurations, HAND_TIME, headline, newton_positions,
                         NEWTON_TRACKING_STEP, work_precision, WorkPoint, WorkPrecision,
                         WP_PRINTED, WP_RANGES)
-from .checks import golden_checks, GoldenCheck, reference_checks, ReferenceCheck
+from .checks import golden_checks, golden_folder, GoldenCheck, reference_checks, ReferenceCheck
 from .clock import (clock_errors, CLOCK_TICKS, ClockRow, naive_accumulate, naive_cumsum,
                     naive_wrapped, naive_wrapped_trace, TICK_HZ)
 from .common import DURATIONS, EPS, ERROR_FLOOR, Mode, MODES, slug, WP_SCENES
@@ -59,7 +59,7 @@ __all__ = [
     'TICK_HZ', 'WP_PRINTED', 'WP_RANGES', 'WP_SCENES', 'WorkPoint', 'WorkPrecision',
     'add_parser', 'chain_scene', 'clock_errors', 'configurations', 'cost_growth', 'digits_lost',
     'evaluate_angle', 'evaluate_case', 'extreme_cases', 'formula_audit', 'golden_checks',
-    'headline', 'main', 'naive_accumulate', 'naive_cumsum', 'naive_wrapped',
+    'golden_folder', 'headline', 'main', 'naive_accumulate', 'naive_cumsum', 'naive_wrapped',
     'naive_wrapped_trace', 'newton_positions', 'plot_clock', 'plot_cost', 'plot_extreme',
     'plot_work_precision', 'reference_checks', 'run', 'work_precision', 'write_report',
 ]

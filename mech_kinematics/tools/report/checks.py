@@ -5,7 +5,7 @@
 :func:`reference_checks` runs the reference's own checks on the packaged
 scenes (loop-closure residual, the second route by differences in time, the
 solver's error); :func:`golden_checks` compares it with the published golden
-cases in ``test/data/reference/`` when present.
+cases in ``test/data/reference/`` when the source tree is at hand.
 """
 
 from __future__ import annotations
@@ -18,10 +18,11 @@ from typing import Any
 
 from .common import Mode, quiet_solve
 from ...errors import AssemblyError
-from ...scene import load_scene
+from ...scene import load_scene, scene_dirs
 from ...units import rad_per_s_from_rpm, radians_from_degrees
 
-__all__ = ['GoldenCheck', 'ReferenceCheck', 'golden_checks', 'reference_checks']
+__all__ = ['GoldenCheck', 'ReferenceCheck', 'golden_checks', 'golden_folder',
+           'reference_checks']
 
 
 @dataclass
@@ -75,19 +76,39 @@ class GoldenCheck:
     max_rel_double: float       # double inputs: |diff| / (|expected| + scale)
 
 
+def golden_folder() -> Path:
+    """Return where the published golden cases are in a source tree (``test/data/reference``).
+
+    Found from the package's own location, so it exists for a source tree or an
+    editable install only; an installed copy has no golden files.
+    """
+    import mech_kinematics
+    package = Path(mech_kinematics.__file__).resolve().parent
+    return package.parent / 'test' / 'data' / 'reference'
+
+
+def _scene_path(name: str) -> Path:
+    """Return the file of the packaged scene ``name`` (the scene loader's search order)."""
+    for folder in scene_dirs():
+        path = folder / f'{name}.yaml'
+        if path.is_file():
+            return path
+    msg = f'Expected a packaged scene for the golden file {name}.json, got none'
+    raise FileNotFoundError(msg)
+
+
 def golden_checks(folder: Path | None = None) -> list[GoldenCheck]:
-    """Compare the reference with ``test/data/reference/*.json`` when present."""
+    """Compare the reference with ``folder/*.json`` (default :func:`golden_folder`) if present."""
     import json
 
     import mpmath
 
     from .. import reference as ref_mod
-    root = Path(__file__).resolve().parent.parent
-    folder = folder or root / 'test' / 'data' / 'reference'
+    folder = folder or golden_folder()
     rows = []
     for path in sorted(folder.glob('*.json')) if folder.is_dir() else []:
         data = json.loads(path.read_text(encoding='utf-8'))
-        scene_path = root / 'config' / 'scenes' / f'{path.stem}.yaml'
+        scene_path = _scene_path(path.stem)
         scene = load_scene(scene_path)
         model = ref_mod.Model(scene)
         exact = ref_mod.decimal_values(scene_path, model)

@@ -104,7 +104,7 @@ def _reference(checks: Sequence[ReferenceCheck], golden: Sequence[GoldenCheck]) 
     w = lines.append
     w('## 1. The 50-digit reference')
     w('')
-    w('`mech_kinematics/reference.py` writes each scene as its loop-closure equations '
+    w('`mech_kinematics/tools/reference.py` writes each scene as its loop-closure equations '
       '(two per dyad: RRR, the two link angles; RRP, link angle and slider coordinate; '
       'RPR, lever angle and slider coordinate; carried points as explicit functions of '
       'their frame points) and solves them in mpmath at 64 working digits, without '
@@ -205,7 +205,8 @@ def _clock(mode: Mode, clock: Sequence[ClockRow], clock_check: dict[str, Any]) -
       'angle is theta0 + 2 pi rpm/60 t, in 60-digit arithmetic. Methods:')
     w('')
     w('- **timebase**: `CrankTimebase(t0, angle, speed_rpm, accel, max_speed_rpm).sample(t_ns)` '
-      '(`mech_kinematics/timebase.py`, what the node uses): integer nanoseconds, exact wrap.')
+      '(`mech_kinematics/ros/timebase.py`, what the node uses): integer nanoseconds, exact '
+      'wrap.')
     w('- **naive**: `angle += omega * dt` with `omega = rpm * pi / 30`, `dt = 1e-3`, never '
       'wrapped. Computed exactly for every tick by `naive_accumulate` (inside a binade '
       'each addition adds the same rounded step, so a whole binade is one exact rational '
