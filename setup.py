@@ -31,7 +31,9 @@ setup(
     version='0.1.0',
     packages=find_packages(exclude=['test', 'test.*']) + list(_scenes_package),
     package_dir=_scenes_package,
-    package_data={name: ['*.yaml'] for name in _scenes_package},
+    # The printed textbook answers (mech_kinematics/data/, read by mech_kinematics.textbook).
+    package_data={package_name + '.data': ['*.yaml'],
+                  **{name: ['*.yaml'] for name in _scenes_package}},
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
         ('share/' + package_name, ['package.xml']),

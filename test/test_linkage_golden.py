@@ -13,18 +13,13 @@ import contextlib
 import io
 import json
 import math
-from pathlib import Path
 from typing import Any
 
+from helpers import REFERENCE, reference_cases, REFERENCE_NAMES, SCENES
 import pytest
 
 import mech_kinematics as mk
 from mech_kinematics.__main__ import main
-
-HERE = Path(__file__).resolve().parent
-REFERENCE = HERE / 'data' / 'reference'
-SCENES = HERE.parent / 'config' / 'scenes'
-REFERENCE_NAMES = ('khurmi_four_bar_ad150', 'slider_crank_150_600', 'steam_engine_500_2000')
 
 #: Relative tolerance of a double-precision solver against the 50-digit values,
 #: ``|got - expected| <= RTOL_REFERENCE * (|expected| + scale)`` (reference README).
@@ -33,16 +28,6 @@ RTOL_REFERENCE = 1e-12
 KINDS = {'revolute': ('angle', 'angvel', 'angacc'), 'prismatic': ('length', 'vel', 'acc')}
 POINT_KINDS = {'position': 'length', 'velocity': 'vel', 'acceleration': 'acc'}
 QUANTITIES = ('position', 'velocity', 'acceleration')
-
-
-def reference_cases() -> list[Any]:
-    """Return one pytest param (scene name, case) per published reference instant."""
-    params = []
-    for name in REFERENCE_NAMES:
-        data = json.loads((REFERENCE / f'{name}.json').read_text())
-        for index, case in enumerate(data['cases']):
-            params.append(pytest.param(name, case, id=f'{name}-{index}'))
-    return params
 
 
 def assert_matches_reference(got: dict[str, Any], case: dict[str, Any]) -> None:

@@ -18,16 +18,14 @@ import subprocess
 import sys
 import warnings
 
+from helpers import reference_cases, SCENES
 import mpmath
 import numpy as np
 import pytest
-from test_linkage_golden import reference_cases
 
 import mech_kinematics as mk
 from mech_kinematics.tools import reference as ref
-
-HERE = Path(__file__).resolve().parent
-SCENES = HERE.parent / 'config' / 'scenes'
+from mech_kinematics.units import rad_per_s_from_rpm, radians_from_degrees
 
 EPS = float(np.finfo(float).eps)
 #: From the decimal inputs as written, the reference rounded to double is the
@@ -77,8 +75,8 @@ def test_golden_case_from_decimal_inputs(name, case):
     path = SCENES / f'{name}.yaml'
     model = ref.Model(mk.load_scene(path))
     with mpmath.workdps(ref.DPS):
-        theta = mpmath.radians(mpmath.mpf(case['angle_deg']))
-        omega = mpmath.mpf(case['speed_rpm']) * mpmath.pi / 30
+        theta = radians_from_degrees(mpmath.mpf(case['angle_deg']), mpmath.pi)
+        omega = rad_per_s_from_rpm(mpmath.mpf(case['speed_rpm']), mpmath.pi)
         alpha = mpmath.mpf(case['accel'])
     got = ref.as_float_dict(ref.reference(model, theta, omega, alpha,
                                           values=ref.decimal_values(path, model)))
@@ -88,12 +86,60 @@ def test_golden_case_from_decimal_inputs(name, case):
         assert abs(value - expected) <= MAX_ULPS_GOLDEN * math.ulp(expected), (expected, value)
 
 
+@pytest.mark.parametrize(('key', 'text'), [
+    ('length', '{length: inch, angle: deg}'), ('angle', '{length: mm, angle: grad}')],
+    ids=['length', 'angle'])
+def test_decimal_values_refuse_an_unknown_unit(tmp_path, key, text):
+    """A scene unit the loader does not know is a SceneError naming the key, not a KeyError.
+
+    See issue 9.
+    """
+    source = (SCENES / 'khurmi_four_bar_ad150.yaml').read_text()
+    assert 'units: {length: mm, angle: deg}' in source
+    path = tmp_path / 'bad_units.yaml'
+    path.write_text(source.replace('units: {length: mm, angle: deg}', f'units: {text}'))
+    model = ref.Model(mk.load_scene('khurmi_four_bar_ad150'))
+    with pytest.raises(mk.SceneError, match=rf'bad_units.yaml: units\.{key}: expected one of'):
+        ref.decimal_values(path, model)
+
+
+def test_decimal_values_read_metres_and_radians(tmp_path):
+    """Lengths in m equal those in mm exactly; deg become exact radians, rad stay as written."""
+    body = """
+name: units
+ground:
+  O: [0, 0]
+  E: [{e}, {e}]
+input: {{link: crank, center: O, point: B, length: {crank}, angle: 45, speed_rpm: 600}}
+dyads:
+  - type: RRP
+    point: P
+    link: {{name: rod, from: B, length: {rod}}}
+    guide: {{through: E, angle: {guide}}}
+    slider: piston
+"""
+    mm_deg = tmp_path / 'mm_deg.yaml'
+    mm_deg.write_text('units: {length: mm, angle: deg}'
+                      + body.format(e=50, crank=100, rod=400, guide=30))
+    m_rad = tmp_path / 'm_rad.yaml'
+    m_rad.write_text('units: {length: m, angle: rad}'
+                     + body.format(e='0.05', crank='0.1', rod='0.4', guide='0.5'))
+    model = ref.Model(mk.load_scene(mm_deg))
+    a, b = ref.decimal_values(mm_deg, model), ref.decimal_values(m_rad, model)
+    assert a.keys() == b.keys() and 'guide.P.angle' in a
+    with mpmath.workdps(ref.DPS):
+        assert abs(a.pop('guide.P.angle') - mpmath.pi / 6) <= mpmath.mpf('1e-62')
+        assert b.pop('guide.P.angle') == mpmath.mpf('0.5')
+        assert a['crank.length'] == mpmath.mpf('0.1')
+    assert a == b
+
+
 @pytest.mark.parametrize(('name', 'case'), reference_cases())
 def test_golden_case_from_double_inputs(name, case):
     """From the scene's doubles, the published values agree to 1e-15 of (value + scale)."""
     scene = mk.load_scene(SCENES / f'{name}.yaml')
     got = ref.as_float_dict(ref.reference(scene, math.radians(float(case['angle_deg'])),
-                                          float(case['speed_rpm']) * math.pi / 30.0,
+                                          rad_per_s_from_rpm(float(case['speed_rpm'])),
                                           float(case['accel'])))
     for expected, value, scale in _values(case, got):
         assert abs(value - expected) <= RTOL_GOLDEN * (abs(expected) + scale)

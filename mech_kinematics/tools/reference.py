@@ -46,7 +46,9 @@ import mpmath
 import numpy as np
 import yaml
 
+from ..errors import SceneError
 from ..linkage import RPR, RRP, RRR, Scene
+from ..units import ANGLE_UNITS, LENGTH_UNITS, radians_from_degrees
 
 __all__ = ['DIGITS', 'DPS', 'Jet', 'Model', 'NoAssembly', 'Reference', 'as_float_dict',
            'check_by_differences', 'compare', 'condition', 'decimal_values', 'reference']
@@ -914,19 +916,37 @@ def decimal_values(path: str | os.PathLike[str], model: Model) -> dict[str, Any]
 
     The scene loader rounds ``40 mm`` to the double nearest 0.04 m; published
     50-digit values are computed from the decimal numbers as written, so to
-    reproduce them bit for bit the reference must start from those.
+    reproduce them bit for bit the reference must start from those. The
+    units are :mod:`mech_kinematics.units`' (the scene loader's).
+
+    Raises
+    ------
+    SceneError
+        If the file's ``units.length`` or ``units.angle`` is not one a scene
+        may use.
     """
     data = yaml.safe_load(Path(path).read_text(encoding='utf-8'))
     units = data.get('units') or {}
-    per_metre = {'m': 1, 'mm': 1000}[units.get('length', 'm')]
-    degrees = units.get('angle', 'deg') == 'deg'
+    length_unit = units.get('length', 'm')
+    if length_unit not in LENGTH_UNITS:
+        msg = (f'{path}: units.length: expected one of {", ".join(LENGTH_UNITS)}, '
+               f'got {length_unit!r}')
+        raise SceneError(msg)
+    angle_unit = units.get('angle', 'deg')
+    if angle_unit not in ANGLE_UNITS:
+        msg = (f'{path}: units.angle: expected one of {", ".join(ANGLE_UNITS)}, '
+               f'got {angle_unit!r}')
+        raise SceneError(msg)
     out: dict[str, Any] = {}
     with _precision(DPS):
+        per_metre = mpmath.mpf(LENGTH_UNITS[length_unit])
+
         def length(v: Any) -> Any:
             return mpmath.mpf(str(v)) / per_metre
 
         def angle(v: Any) -> Any:
-            return mpmath.radians(mpmath.mpf(str(v))) if degrees else mpmath.mpf(str(v))
+            value = mpmath.mpf(str(v))
+            return radians_from_degrees(value, mpmath.pi) if angle_unit == 'deg' else value
 
         for name, (x, y) in data['ground'].items():
             out[f'ground.{name}.x'], out[f'ground.{name}.y'] = length(x), length(y)

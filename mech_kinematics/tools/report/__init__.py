@@ -1,0 +1,160 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""Error against cost, and stability on stiff and extreme cases (issue 5).
+
+``python -m mech_kinematics report -o DIR [--quick | --smoke]`` writes
+``DIR/REPORT.md`` and its PNG figures:
+
+1. the 50-digit reference (:mod:`mech_kinematics.tools.reference`) and its
+   checks (:mod:`.checks`);
+2. work-precision diagrams: our solver against Newton-Raphson, finite
+   differences, ``solve_ivp`` and the textbooks' printed answers
+   (:mod:`.baselines`);
+3. the error of the node's crank angle against run time, for the exact time
+   base and for naive ``angle += omega * dt`` accumulation (:mod:`.clock`);
+4. stiff and extreme cases against the reference, with the solver's flags,
+   digits lost and the formula audit (:mod:`.extreme`);
+5. cost growth with the batch size and the number of dyads (:mod:`.cost`).
+
+:mod:`.common` holds the run sizes (:data:`MODES`) and the shared timer,
+:mod:`.figures` draws, :mod:`.markdown` writes ``REPORT.md``; this module
+runs them in order (:func:`run`) and is the command line (:func:`add_parser`,
+:func:`main`).
+
+Every number in the report comes from the functions of these modules, which
+the tests call too. Times are medians of one run on a shared machine: compare
+ratios, not absolute times. matplotlib, SciPy, mpmath and tqdm are imported
+inside the functions that need them, so the solver and the command line stay
+importable without them.
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Sequence
+import os
+from pathlib import Path
+import sys
+import time
+from typing import Any
+
+from .baselines import (Configurations, configurations, HAND_TIME, headline, newton_positions,
+                        NEWTON_TRACKING_STEP, work_precision, WorkPoint, WorkPrecision,
+                        WP_PRINTED, WP_RANGES)
+from .checks import golden_checks, golden_folder, GoldenCheck, reference_checks, ReferenceCheck
+from .clock import (clock_errors, CLOCK_TICKS, ClockRow, naive_accumulate, naive_cumsum,
+                    naive_wrapped, naive_wrapped_trace, TICK_HZ)
+from .common import DURATIONS, EPS, ERROR_FLOOR, Mode, MODES, slug, WP_SCENES
+from .cost import chain_scene, CHUNK, cost_growth, CostGrowth
+from .extreme import (AngleResult, BOUND_FACTOR, Case, CaseResult, digits_lost, evaluate_angle,
+                      evaluate_case, extreme_cases, formula_audit, FormulaAudit)
+from .figures import plot_clock, plot_cost, plot_extreme, plot_work_precision
+from .markdown import write_report
+from ...cli import run_tool
+
+__all__ = [
+    'AngleResult', 'BOUND_FACTOR', 'CHUNK', 'CLOCK_TICKS', 'Case', 'CaseResult', 'ClockRow',
+    'Configurations', 'CostGrowth', 'DURATIONS', 'EPS', 'ERROR_FLOOR', 'FormulaAudit',
+    'GoldenCheck', 'HAND_TIME', 'MODES', 'Mode', 'NEWTON_TRACKING_STEP', 'ReferenceCheck',
+    'TICK_HZ', 'WP_PRINTED', 'WP_RANGES', 'WP_SCENES', 'WorkPoint', 'WorkPrecision',
+    'add_parser', 'chain_scene', 'clock_errors', 'configurations', 'cost_growth', 'digits_lost',
+    'evaluate_angle', 'evaluate_case', 'extreme_cases', 'formula_audit', 'golden_checks',
+    'golden_folder', 'headline', 'main', 'naive_accumulate', 'naive_cumsum', 'naive_wrapped',
+    'naive_wrapped_trace', 'newton_positions', 'plot_clock', 'plot_cost', 'plot_extreme',
+    'plot_work_precision', 'reference_checks', 'run', 'work_precision', 'write_report',
+]
+
+
+def _progress(total: int, enabled: bool) -> Any:
+    from tqdm import tqdm
+    return tqdm(total=total, disable=not enabled, unit='task', file=sys.stderr,
+                dynamic_ncols=True)
+
+
+def run(outdir: str | os.PathLike[str], mode: str | Mode = 'full',
+        progress: bool = True) -> dict[str, Any]:
+    """Compute every section, draw the figures and write ``outdir/REPORT.md``.
+
+    Returns the computed sections (the tests read them).
+    """
+    mode = MODES[mode] if isinstance(mode, str) else mode
+    out = Path(outdir)
+    out.mkdir(parents=True, exist_ok=True)
+    start = time.perf_counter()
+    from ...scene import scene_names
+    n_checks = len(mode.check_scenes or scene_names())
+    total = (n_checks + 1 + 5 * len(mode.wp_mechanisms) + len(mode.clock_rpms) + 1
+             + len(mode.batch_sizes) + len(mode.chain_lengths) + 1)
+    with _progress(total, progress) as bar:
+        def tick() -> None:
+            bar.update(1)
+
+        bar.set_description('reference')
+        checks = reference_checks(mode, tick)
+        golden = golden_checks()
+        tick()
+        wp = []
+        for mechanism in mode.wp_mechanisms:
+            bar.set_description(f'work-precision {mechanism}')
+            wp.append(work_precision(mechanism, mode, tick))
+        bar.set_description('clock')
+        clock, clock_check = clock_errors(mode, tick=tick)
+        bar.set_description('extreme cases')
+        extreme = [evaluate_case(case) for case in extreme_cases(mode)]
+        audit = formula_audit()
+        tick()
+        bar.set_description('cost growth')
+        cost = cost_growth(mode, tick)
+        bar.set_description('figures')
+        for result in wp:
+            plot_work_precision(result, out / f'wp_{slug(result.mechanism)}.png')
+        plot_clock(clock, out / 'clock.png')
+        plot_extreme(extreme, out / 'extreme.png')
+        plot_cost(cost, out / 'cost.png')
+        tick()
+    elapsed = time.perf_counter() - start
+    write_report(out, mode, checks, golden, wp, clock, clock_check, extreme, audit, cost,
+                 elapsed)
+    return {'checks': checks, 'golden': golden, 'work_precision': wp, 'clock': clock,
+            'clock_check': clock_check, 'extreme': extreme, 'audit': audit, 'cost': cost,
+            'elapsed': elapsed}
+
+
+# --- command line ------------------------------------------------------------------
+
+REPORT_HELP = """\
+Measure the solver's error against its cost and its stability on stiff and
+extreme cases, and write DIR/REPORT.md with PNG figures: the 50-digit
+reference and its checks, work-precision diagrams against Newton-Raphson,
+finite differences and solve_ivp, the node's crank-angle error over long runs,
+the extreme-case table, and cost growth. A few minutes; --quick in under one.
+"""
+
+
+def _handle(args: argparse.Namespace) -> int:
+    run(args.output, args.mode, progress=not args.no_progress)
+    print(Path(args.output) / 'REPORT.md')
+    return 0
+
+
+def add_parser(subparsers: Any) -> argparse.ArgumentParser:
+    """Register the ``report`` command on ``python -m mech_kinematics``'s subparsers."""
+    parser = subparsers.add_parser('report', help='error against cost, extreme cases: '
+                                                  'write DIR/REPORT.md and figures',
+                                   description=REPORT_HELP,
+                                   formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument('-o', '--output', required=True, metavar='DIR',
+                        help='folder for REPORT.md and the PNG figures (created)')
+    size = parser.add_mutually_exclusive_group()
+    size.add_argument('--quick', dest='mode', action='store_const', const='quick',
+                      help='a subset, under a minute')
+    size.add_argument('--smoke', dest='mode', action='store_const', const='smoke',
+                      help='the smallest run that fills every section (for tests)')
+    parser.add_argument('--no-progress', action='store_true', help='no progress bar')
+    parser.set_defaults(handler=_handle, mode='full')
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run ``report``; return the exit status."""
+    return run_tool(add_parser, argv)
