@@ -37,6 +37,7 @@ setup(
         ('share/' + package_name, ['package.xml']),
         ('share/' + package_name + '/config', _files('config/*')),
         ('share/' + package_name + '/config/scenes', _files('config/scenes/*')),
+        ('share/' + package_name + '/launch', _files('launch/*.launch.*')),
     ],
     python_requires='>=3.10',
     install_requires=['setuptools'],
