@@ -11,7 +11,7 @@
 # what it needs in three steps, each with a stamp file inside .venv, so that a
 # step is redone only when what it depends on changes:
 # 1. requirements.txt (running: the node and every tool), this package editable;
-# 2. tf2_msgs from its IDL (not on PyPI): scripts/build_tf2_msgs.py, about 2 s;
+# 2. tf2_msgs from its IDL (not on PyPI): scripts/build_tf2_msgs.py, 2-3 s;
 # 3. requirements-dev.txt (test and lint tools): for test, lint and install.
 # `make run` and `make bench` take steps 1-2; `make test` and `make lint` all
 # three.  No ROS installation or sourced environment is needed: the ros-*
