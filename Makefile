@@ -1,16 +1,21 @@
 # mech_kinematics: set-up, run and test with a local virtualenv.
 #
-#   make run     start the node on the default scene (ARGS='...' appends arguments)
-#   make test    the whole test suite (PYTEST_ARGS='-k scene' narrows it)
-#   make bench   solver benchmark
-#   make lint    ruff + flake8 + mypy --strict on the pure modules
-#   make clean   remove .venv and every build/cache artefact
+#   make run       start the node on the default scene (ARGS='...' appends arguments)
+#   make test      the whole test suite (PYTEST_ARGS='-k scene' narrows it)
+#   make bench     solver benchmark
+#   make lint      ruff + flake8 + mypy --strict on the pure modules
+#   make install   set up .venv with everything (what run, test and lint need)
+#   make clean     remove .venv and every build/cache artefact
 #
 # The first target that needs it creates .venv (python3 -m venv) and installs
-# requirements.txt and this package (editable).  A stamp file inside .venv
-# makes later runs skip the install until requirements.txt, setup.py or
-# setup.cfg change.  No ROS installation or sourced environment is needed:
-# the ros-* wheels set their own LD_LIBRARY_PATH (ros-wheels-bootstrapper).
+# what it needs in three steps, each with a stamp file inside .venv, so that a
+# step is redone only when what it depends on changes:
+# 1. requirements.txt (running: the node and every tool), this package editable;
+# 2. tf2_msgs from its IDL (not on PyPI): scripts/build_tf2_msgs.py, 2-3 s;
+# 3. requirements-dev.txt (test and lint tools): for test, lint and install.
+# `make run` and `make bench` take steps 1-2; `make test` and `make lint` all
+# three.  No ROS installation or sourced environment is needed: the ros-*
+# wheels set their own LD_LIBRARY_PATH (ros-wheels-bootstrapper).
 
 SHELL := /bin/bash
 .DEFAULT_GOAL := help
@@ -21,10 +26,12 @@ VPY := $(VENV)/bin/python
 ARGS ?=
 PYTEST_ARGS ?=
 
-# The stamp's name records whether the package directory existed at install
-# time, so the editable install is redone once when mech_kinematics/ appears.
+# The runtime stamp's name records whether the package directory existed at
+# install time, so the editable install is redone once when mech_kinematics/ appears.
 PKG_STATE := $(if $(wildcard mech_kinematics/__init__.py),pkg,nopkg)
 STAMP := $(VENV)/.mech_kinematics-installed-$(PKG_STATE)
+TF2_STAMP := $(VENV)/.tf2_msgs-built
+DEV_STAMP := $(VENV)/.mech_kinematics-dev-installed
 
 # Keep DDS discovery on the loopback interface (no multicast onto the LAN);
 # override with e.g. `make run ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET`.
@@ -49,22 +56,31 @@ $(STAMP): requirements.txt setup.py setup.cfg | $(VPY)
 	$(VPY) -m pip install --quiet --no-build-isolation --no-deps -e .
 	touch $@
 
-install: $(STAMP)
+# Idempotent and quiet on success; loud and failing on error.
+$(TF2_STAMP): $(STAMP) scripts/build_tf2_msgs.py
+	$(VPY) scripts/build_tf2_msgs.py
+	touch $@
 
-run: $(STAMP)
+$(DEV_STAMP): $(STAMP) requirements-dev.txt
+	$(VPY) -m pip install --quiet -r requirements-dev.txt
+	touch $@
+
+install: $(TF2_STAMP) $(DEV_STAMP)
+
+run: $(TF2_STAMP)
 	PYTHONUNBUFFERED=1 $(VPY) -m mech_kinematics run $(ARGS)
 
-test: $(STAMP)
+test: $(TF2_STAMP) $(DEV_STAMP)
 	$(VPY) -m pytest -q --durations=10 $(PYTEST_ARGS)
 
-bench: $(STAMP)
+bench: $(TF2_STAMP)
 	$(VPY) -m mech_kinematics bench $(ARGS)
 
 # Runs all three checkers, then fails if any of them did.
-lint: $(STAMP)
+lint: $(TF2_STAMP) $(DEV_STAMP)
 	@status=0; \
-	echo '== ruff'; $(VPY) -m ruff check mech_kinematics test setup.py || status=1; \
-	echo '== flake8'; $(VPY) -m flake8 mech_kinematics test setup.py || status=1; \
+	echo '== ruff'; $(VPY) -m ruff check mech_kinematics test setup.py scripts launch || status=1; \
+	echo '== flake8'; $(VPY) -m flake8 mech_kinematics test setup.py scripts launch || status=1; \
 	echo '== mypy --strict (linkage.py scene.py errors.py)'; $(VPY) -m mypy || status=1; \
 	exit $$status
 

@@ -39,17 +39,33 @@ setup(
         ('share/' + package_name, ['package.xml']),
         ('share/' + package_name + '/config', _files('config/*')),
         ('share/' + package_name + '/config/scenes', _files('config/scenes/*')),
+        ('share/' + package_name + '/launch', _files('launch/*.launch.*')),
     ],
     python_requires='>=3.10',
     install_requires=['setuptools'],
     zip_safe=False,
     maintainer='mech_kinematics contributors',
     maintainer_email='mech_kinematics@example.com',
-    description='Planar linkage kinematics (four-bar, slider-crank) as a ROS 2 node',
+    description=('Exact kinematics of planar mechanisms: an analytic solver, a ROS 2 node '
+                 'and tools'),
     license='Apache-2.0',
     entry_points={
+        # Installed to lib/mech_kinematics (setup.cfg), so each runs as
+        # `ros2 run mech_kinematics NAME`; in .venv/bin after `make install`.
         'console_scripts': [
             'kinematics_node = mech_kinematics.kinematics_node:main',
+            # Every tool of `python -m mech_kinematics` (mech_kinematics/__main__.py
+            # TOOLS) but `run`, make run's wrapper: NAME = mech_kinematics.tools.NAME:main.
+            # test/test_packaging.py fails when a tool has no line here.
+            'solve = mech_kinematics.tools.solve:main',
+            'record = mech_kinematics.tools.record:main',
+            'plot = mech_kinematics.tools.plot:main',
+            'diagram = mech_kinematics.tools.diagram:main',
+            'report = mech_kinematics.tools.report:main',
+            'bench = mech_kinematics.tools.bench:main',
+            # check and reindex go here when their modules land:
+            # 'check = mech_kinematics.tools.check:main',
+            # 'reindex = mech_kinematics.tools.reindex:main',
         ],
     },
 )

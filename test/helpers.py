@@ -10,12 +10,19 @@ comment naming the modules that use it.
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
+import runpy
 from typing import Any
+from unittest import mock
 
 import pytest
+import setuptools
+
+from mech_kinematics.ros.parameters import PARAMETERS
 
 HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
 #: The shipped scenes, in the source tree.
 SCENES = HERE.parent / 'config' / 'scenes'
 
@@ -38,3 +45,49 @@ def reference_cases() -> list[Any]:
         for index, case in enumerate(data['cases']):
             params.append(pytest.param(name, case, id=f'{name}-{index}'))
     return params
+
+
+# --- what setup.py installs and which parameters the node declares ---------------
+# Used by test_launch.py and test_packaging.py.
+#: Parameters every rclpy node declares itself.
+STANDARD_PARAMETERS = frozenset({'use_sim_time'})
+
+
+def setup_keywords() -> dict:
+    """Return the keyword arguments setup.py passes to ``setuptools.setup``."""
+    captured: dict = {}
+    cwd = os.getcwd()
+    try:
+        os.chdir(ROOT)      # setup.py globs its data files relative to the repository
+        with mock.patch.object(setuptools, 'setup', lambda **kw: captured.update(kw)):
+            runpy.run_path(str(ROOT / 'setup.py'), run_name='__main__')
+    finally:
+        os.chdir(cwd)
+    return captured
+
+
+def console_scripts() -> dict:
+    """Return setup.py's console scripts as {name: 'module:function'}."""
+    scripts = {}
+    for entry in setup_keywords()['entry_points']['console_scripts']:
+        name, target = (part.strip() for part in entry.split('='))
+        scripts[name] = target
+    return scripts
+
+
+def installed_files() -> dict:
+    """Return setup.py's data files as {installed path: repository path}."""
+    files = {}
+    for folder, sources in setup_keywords()['data_files']:
+        for source in sources:
+            files[f'{folder}/{Path(source).name}'] = source
+    return files
+
+
+def node_parameters() -> frozenset:
+    """Return the names of the parameters kinematics_node declares.
+
+    The node declares every entry of ``mech_kinematics.ros.parameters.PARAMETERS``,
+    and rclpy declares the standard ones for every node.
+    """
+    return frozenset({p.name for p in PARAMETERS} | STANDARD_PARAMETERS)

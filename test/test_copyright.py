@@ -22,7 +22,7 @@ HEADER = re.compile(
 
 def _sources():
     files = [ROOT / 'setup.py']
-    for folder in ('mech_kinematics', 'test'):
+    for folder in ('mech_kinematics', 'test', 'scripts', 'launch'):
         if (ROOT / folder).is_dir():
             files += sorted((ROOT / folder).rglob('*.py'))
     return files
@@ -31,7 +31,7 @@ def _sources():
 @pytest.mark.linter
 @pytest.mark.copyright
 def test_copyright():
-    """Each .py in mech_kinematics/, test/ and setup.py carries the header."""
+    """Each .py in mech_kinematics/, test/, scripts/, launch/ and setup.py carries the header."""
     sources = _sources()
     assert Path(__file__).resolve() in sources
     missing = [

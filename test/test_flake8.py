@@ -10,7 +10,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 CONFIG = ROOT / '.flake8'
-TARGETS = ('mech_kinematics', 'test', 'setup.py')
+TARGETS = ('mech_kinematics', 'test', 'setup.py', 'scripts', 'launch')
 PLUGINS = ('flake8-docstrings', 'flake8-quotes', 'flake8_import_order')
 
 
@@ -24,7 +24,7 @@ def _flake8(*args, cwd=ROOT):
 @pytest.mark.linter
 @pytest.mark.flake8
 def test_flake8():
-    """The package, the tests and setup.py have no flake8 errors."""
+    """The package, the tests, setup.py, scripts/ and launch/ have no flake8 errors."""
     targets = [t for t in TARGETS if (ROOT / t).exists()]
     assert 'test' in targets and 'setup.py' in targets
     result = _flake8(*targets)

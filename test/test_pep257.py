@@ -23,8 +23,10 @@ def _pydocstyle(*paths, cwd=ROOT):
 
 
 def _sources():
-    package = ROOT / 'mech_kinematics'
-    files = sorted(package.rglob('*.py')) if package.is_dir() else []
+    files = []
+    for folder in ('mech_kinematics', 'scripts', 'launch'):
+        if (ROOT / folder).is_dir():
+            files += sorted((ROOT / folder).rglob('*.py'))
     return [ROOT / 'setup.py', *files]
 
 
