@@ -29,7 +29,7 @@ REPO = Path(__file__).resolve().parents[1]
 
 NS = 1_000_000_000
 STARTUP_S = 20.0       # deadline for a node to come up and be discovered
-RELIABLE = QoSProfile(depth=200, reliability=ReliabilityPolicy.RELIABLE)
+RELIABLE = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
 
 # A domain of this test session's own (set before rclpy.init, inherited by the nodes).
 os.environ['ROS_DOMAIN_ID'] = str(random.SystemRandom().randint(1, 100))
@@ -80,6 +80,15 @@ class Ros:
         """Subscribe ``topic``; return the list its messages are appended to."""
         received: list = []
         self.node.create_subscription(msg_type, topic, received.append, qos)
+        return received
+
+    def collect_raw(self, msg_type, topic: str, qos=RELIABLE) -> list:
+        """Subscribe ``topic`` without decoding (for high rates); return the list of CDR bytes.
+
+        Decode later with ``rclpy.serialization.deserialize_message(data, msg_type)``.
+        """
+        received: list = []
+        self.node.create_subscription(msg_type, topic, received.append, qos, raw=True)
         return received
 
     def call(self, future, timeout: float = 10.0):

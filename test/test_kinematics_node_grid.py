@@ -13,6 +13,7 @@ import signal
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray
+import pytest
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 from ros_helpers import NodeProcess, NS, Ros, SESSION, stamp_ns, STARTUP_S, wait_for, wrap
@@ -22,19 +23,33 @@ from sensor_msgs.msg import JointState
 ATOL_CONTINUITY = 1e-9
 
 
+@pytest.fixture(scope='module')
+def ros():
+    ros = Ros()
+    yield ros
+    ros.close()
+
+
 def diagnostic_value(msgs, key):
     """Return ``key`` of the timing status of the last diagnostics message, as an int."""
     values = {kv.key: kv.value for status in msgs[-1].status for kv in status.values}
     return int(values[key])
 
 
+def stamps_of(raw) -> list:
+    """Return the header stamps of serialized joint_states messages, ns, in order received."""
+    from rclpy.serialization import deserialize_message
+
+    return [stamp_ns(deserialize_message(data, JointState)) for data in raw]
+
+
 class Stream:
-    """A node of its own and its joint_states and diagnostics, as received here."""
+    """A node of its own and its joint_states (serialized) and diagnostics, as received here."""
 
     def __init__(self, ros: Ros, tmp, name: str, *args: str) -> None:
         self.ros = ros
         self.ns = f'{SESSION}/{name}'
-        self.js = ros.collect(JointState, f'{self.ns}/joint_states')
+        self.js = ros.collect_raw(JointState, f'{self.ns}/joint_states')    # decoded later
         self.diag = ros.collect(DiagnosticArray, f'{self.ns}/diagnostics')
         self.process = NodeProcess(tmp, '-r', f'__ns:={self.ns}', *args)
         self.params = AsyncParameterClient(ros.node, f'{self.ns}/mech_kinematics')
@@ -65,7 +80,7 @@ def test_stamps_are_an_exact_grid_without_holes(ros, tmp_path):
     try:
         start = len(stream.js)
         time.sleep(2.0)
-        stamps = [stamp_ns(m) for m in stream.js[start:]]
+        stamps = stamps_of(stream.js[start:])
         wait_for(lambda: len(stream.diag) >= 2, STARTUP_S, 'diagnostics')
         skipped = diagnostic_value(stream.diag, 'skipped_ticks_total')
     finally:
@@ -77,40 +92,44 @@ def test_stamps_are_an_exact_grid_without_holes(ros, tmp_path):
     assert _holes(stamps, 1_000_000) <= skipped
 
 
-def _assert_continuous(msgs, w_max):
-    """Check consecutive crank samples against the integral of the drive between them.
+def _largest_jump(samples, period, w_max):
+    """Return the largest deviation of consecutive crank samples from the drive's integral, rad.
 
-    Between two instants the drive is the one published at the first (a change
-    applies at an instant not yet published): speed w, acceleration a, held at
-    +-w_max once reached. Return the largest deviation, rad.
+    ``samples`` are (stamp ns, angle, speed, accel) in stamp order; pairs one
+    ``period`` apart are checked (a subscriber on a busy machine may miss a
+    message). Between two instants the drive is the one published at the
+    first (a change applies at an instant not yet published): speed w,
+    acceleration a, held at +-w_max once reached.
     """
     worst = 0.0
-    for first, second in zip(msgs, msgs[1:], strict=False):
-        dt = (stamp_ns(second) - stamp_ns(first)) / NS
-        theta, w, a = first.position[0], first.velocity[0], first.acceleration
+    for (t0, theta, w, a), (t1, theta1, _, _) in zip(samples, samples[1:], strict=False):
+        if t1 - t0 != period:
+            continue
+        dt = period / NS
         if a == 0.0:
             moved = w * dt
         else:
-            t_hold = (math.copysign(w_max, a) - w) / a
+            bound = math.copysign(w_max, a)
+            t_hold = (bound - w) / a
             if t_hold >= dt:
                 moved = w * dt + a * dt * dt / 2
             else:
-                moved = w * t_hold + a * t_hold * t_hold / 2 + math.copysign(w_max, a) * (
-                    dt - t_hold)
-        worst = max(worst, abs(wrap(second.position[0] - theta - moved)))
+                moved = w * t_hold + a * t_hold * t_hold / 2 + bound * (dt - t_hold)
+        worst = max(worst, abs(wrap(theta1 - theta - moved)))
     return worst
 
 
-def _crank_samples(stream, ros, start):
-    """Return (stamp-ordered joint_states with crank accel attached) from index ``start``."""
-    js = sorted(stream.js[start:], key=stamp_ns)
-    accel = {stamp_ns(m): m.points[0].accelerations[0] for m in stream.jt}
-    out = []
-    for msg in js:
-        if stamp_ns(msg) in accel:
-            msg.acceleration = accel[stamp_ns(msg)]
-            out.append(msg)
-    return out
+def _crank_samples(raw):
+    """Return (stamp, angle, speed, accel) of the crank (joint 0), in stamp order."""
+    from rclpy.serialization import deserialize_message
+    from trajectory_msgs.msg import JointTrajectory
+
+    samples = []
+    for data in raw:
+        m = deserialize_message(data, JointTrajectory)
+        p = m.points[0]
+        samples.append((stamp_ns(m), p.positions[0], p.velocities[0], p.accelerations[0]))
+    return sorted(samples)
 
 
 def test_a_burst_of_drive_changes_keeps_the_angle_continuous(ros, tmp_path):
@@ -127,10 +146,10 @@ def test_a_burst_of_drive_changes_keeps_the_angle_continuous(ros, tmp_path):
     for rate in (1000, 5000):
         stream = Stream(ros, tmp_path / str(rate), f'burst_{rate}', '-p', f'rate_hz:={rate}',
                         '-p', 'max_crank_speed_rpm:=3000.0', '-p', 'crank_speed_rpm:=300.0')
-        stream.jt = ros.collect(JointTrajectory, f'{stream.ns}/joint_accelerations')
+        trajectories = ros.collect_raw(JointTrajectory, f'{stream.ns}/joint_accelerations')
         try:
             time.sleep(0.5)
-            start = len(stream.js)
+            start = len(trajectories)
             for k in range(60):
                 if k % 2:
                     stream.params.set_parameters([Parameter(
@@ -140,13 +159,15 @@ def test_a_burst_of_drive_changes_keeps_the_angle_continuous(ros, tmp_path):
                         'crank_accel', value=rng.choice((-1.0, 1.0)) * rng.uniform(1e2, 1e4))])
                 time.sleep(rng.uniform(0.0, 0.02))
             time.sleep(0.5)
-            msgs = _crank_samples(stream, ros, start)
+            samples = _crank_samples(trajectories[start:])
         finally:
             stream.stop()
-        assert len(msgs) > 0.5 * rate
-        speeds = {m.velocity[0] for m in msgs}
-        assert len(speeds) > 30, 'the burst did not change the drive'
-        worst[rate] = _assert_continuous(msgs, w_max)
+        stamps = [s[0] for s in samples]
+        adjacent = sum(b - a == NS // rate for a, b in zip(stamps, stamps[1:], strict=False))
+        assert adjacent > 0.5 * rate, adjacent
+        assert len({s[2] for s in samples}) > 30, 'the burst did not change the drive'
+        worst[rate] = _largest_jump(samples, NS // rate, w_max)
+    print(f'largest angle jump across the burst, rad: {worst}')
     assert max(worst.values()) <= ATOL_CONTINUITY, worst
 
 
@@ -158,7 +179,7 @@ def _stall(stream, seconds):
 
 
 def test_a_stall_is_caught_up_to_the_bound_and_the_rest_counted(ros, tmp_path):
-    """After a 0.5 s stall: the last 0.1 s of instants are published, the rest skipped and counted.
+    """After a 0.5 s stall the last 0.1 s of instants are published, the rest skipped and counted.
 
     With late_ticks: skip, only the latest instant is published. See issue 14.
     """
@@ -168,27 +189,27 @@ def test_a_stall_is_caught_up_to_the_bound_and_the_rest_counted(ros, tmp_path):
         results = {}
         for mode in ('catch_up', 'skip'):
             stream.set(late_ticks=mode)
-            time.sleep(1.5)
-            wait_for(lambda: len(stream.diag) >= 1, STARTUP_S, 'diagnostics')
-            before_diag = len(stream.diag)
-            wait_for(lambda: len(stream.diag) > before_diag, 3.0, 'fresh diagnostics')
+            time.sleep(1.0)
+            count = len(stream.diag)
+            wait_for(lambda: len(stream.diag) > count, 3.0, 'fresh diagnostics')
             skipped_before = diagnostic_value(stream.diag, 'skipped_ticks_total')
-            start = len(stream.js)
+            start = max(0, len(stream.js) - 20)     # from before the stall
             _stall(stream, 0.5)
             time.sleep(1.0)
             count = len(stream.diag)
             wait_for(lambda: len(stream.diag) > count + 1, 5.0, 'diagnostics after the stall')
             skipped = diagnostic_value(stream.diag, 'skipped_ticks_total') - skipped_before
-            stamps = sorted(stamp_ns(m) for m in stream.js[start:])
-            gaps = [b - a for a, b in zip(stamps, stamps[1:], strict=False) if b - a > period]
-            results[mode] = (skipped, _holes(stamps, period), gaps)
+            stamps = sorted(stamps_of(stream.js[start:]))
+            gaps = sorted(b - a for a, b in zip(stamps, stamps[1:], strict=False) if b > a)
+            results[mode] = (skipped, _holes(stamps, period), gaps[-1], gaps[-2])
     finally:
         stream.stop()
-    for mode, (skipped, holes, gaps) in results.items():
-        assert holes == skipped, (mode, results)        # every missing instant is counted
-        assert len(gaps) == 1, (mode, gaps)             # one hole, at the stall
-    catch_up_gap, skip_gap = results['catch_up'][2][0], results['skip'][2][0]
-    # catch_up published the 100 instants before the wake-up; skip only the last one.
-    assert 0.3e9 <= catch_up_gap <= 0.45e9, catch_up_gap
-    assert 0.45e9 <= skip_gap <= 0.6e9, skip_gap
-    assert skip_gap - catch_up_gap >= 0.09e9
+    skipped, holes, stall_gap, next_gap = results['catch_up']
+    # Every instant but those of the stall older than 0.1 s arrived, and those are counted.
+    assert 0.38e9 <= stall_gap <= 0.45e9, results
+    assert next_gap == period, results
+    assert holes == stall_gap // period - 1 <= skipped, results
+    # Skip mode: the stall leaves a hole of its whole length, counted too.
+    skipped, holes, stall_gap, _ = results['skip']
+    assert 0.49e9 <= stall_gap <= 0.6e9, results
+    assert skipped >= stall_gap // period - 1, results

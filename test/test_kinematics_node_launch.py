@@ -268,6 +268,14 @@ def test_bad_values_are_refused_and_publishing_goes_on(node):
         assert not result.successful, f'{param.name}={param.value!r} was accepted'
         assert param.name in result.reason, result.reason
     assert [p.value for p in node.get(*names)] == before
+    # Every refusal is logged once with its reason (issue 13).
+    refused = [line for line in node.process.output().splitlines()
+               if 'parameter refused: ' in line]
+    for param, result in zip(BAD_VALUES, results, strict=True):
+        if param.name in ('scene', 'frame_id'):
+            assert any(f'{param.name}: read-only' in line for line in refused), refused
+        else:
+            assert sum(result.reason in line for line in refused) >= 1, (result.reason, refused)
     start = len(node.joint_states)
     wait_for(lambda: len(node.joint_states) >= start + 20, 5.0, 'joint_states after refusals')
 

@@ -40,7 +40,7 @@ import warnings
 
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
-from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor, SetParametersResult
+from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
 import rclpy
 from rclpy.clock import Clock, ClockType, JumpThreshold
 from rclpy.duration import Duration
@@ -58,7 +58,7 @@ import mech_kinematics as mk
 from .diagnostics import solver_status, Status, TickStats, timing_status
 from .markers import marker_array_from_state, marker_size_from_space, MarkerThrottle
 from .messages import TickMessages
-from .parameters import CATCH_UP, joint_refusal, PARAMETERS, refusal, spec
+from .parameters import CATCH_UP, joint_refusal, PARAMETERS, ParameterSpec, refusal, spec
 from .schedule import period_ns_from_rate, TickGrid
 from .timebase import CrankTimebase
 from ..geometry.diagrams import space_from_state, strokes_from_scene
@@ -84,11 +84,11 @@ SWITCH_INTERVAL_S = 0.0005
 DUPLICATE_CHECK_S = 2.5
 #: The drive parameters, applied by the tick thread at an instant it has not published.
 DRIVE = ('crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm')
+DOUBLES = frozenset(p.name for p in PARAMETERS if p.kind == 'double')
+READ_ONLY = frozenset(p.name for p in PARAMETERS if p.read_only)
 
-#: Publishers of the state: reliable, and deep enough for a catch-up burst.
-STATE_QOS = QoSProfile(history=QoSHistoryPolicy.KEEP_LAST, depth=1000,
-                       reliability=QoSReliabilityPolicy.RELIABLE,
-                       durability=QoSDurabilityPolicy.VOLATILE)
+#: Depth of the state publishers' history: deep enough for a catch-up burst.
+STATE_DEPTH = 1000
 #: Every publisher accepts ``qos_overrides./TOPIC.publisher.POLICY`` for these policies.
 QOS_OVERRIDES = QoSPolicyKind.HISTORY, QoSPolicyKind.DEPTH, QoSPolicyKind.RELIABILITY, \
     QoSPolicyKind.DURABILITY
@@ -111,8 +111,24 @@ def _set_timer_slack(ns: int) -> None:
         pass  # no prctl here: keep the default timer slack
 
 
+def _description(p: ParameterSpec) -> str:
+    """Return the parameter's description with its unit and range, for ``ros2 param describe``."""
+    if p.low is not None and p.high is not None:
+        return f'{p.description} [{p.unit}, {p.low:g} to {p.high:g}]'
+    if p.choices:
+        return f'{p.description} [{" | ".join(p.choices)}]'
+    return p.description
+
+
 def _qos_options() -> QoSOverridingOptions:
     return QoSOverridingOptions(policy_kinds=QOS_OVERRIDES)
+
+
+def _state_qos() -> QoSProfile:
+    """Return a new profile of the state publishers (overrides change the profile they get)."""
+    return QoSProfile(history=QoSHistoryPolicy.KEEP_LAST, depth=STATE_DEPTH,
+                      reliability=QoSReliabilityPolicy.RELIABLE,
+                      durability=QoSDurabilityPolicy.VOLATILE)
 
 
 def diagnostic_status_from(status: Status) -> DiagnosticStatus:
@@ -163,15 +179,13 @@ class KinematicsNode(LifecycleNode):
         self._publishers: list[Any] = []
         self._pub_markers: Any = None
         self._failure_guard = self.create_guard_condition(self._on_failure)
-        self.add_pre_set_parameters_callback(self._coerce_numbers)
+        self.add_pre_set_parameters_callback(self._pre_set)
         self.add_on_set_parameters_callback(self._validate)
         for p in PARAMETERS:
-            descriptor = ParameterDescriptor(
-                description=f'{p.description} [{p.unit}]' if p.unit else p.description,
-                read_only=p.read_only, dynamic_typing=True)
-            if p.low is not None and p.high is not None:
-                descriptor.floating_point_range = [
-                    FloatingPointRange(from_value=p.low, to_value=p.high)]
+            # The range is in the description, not in floating_point_range: rclpy would
+            # check that before _validate and answer with a reason of its own.
+            descriptor = ParameterDescriptor(description=_description(p),
+                                             read_only=p.read_only, dynamic_typing=True)
             # A default of None leaves the parameter unset until the scene gives it.
             value = self.declare_parameter(p.name, p.default, descriptor).value
             if p.kind == 'double' and type(value) is int:
@@ -195,12 +209,18 @@ class KinematicsNode(LifecycleNode):
     def _value(self, name: str) -> Any:
         return self.get_parameter(name).value
 
-    @staticmethod
-    def _coerce_numbers(parameters: list[Parameter]) -> list[Parameter]:
-        """Turn an integer given for a double parameter into a double (rclcpp#979)."""
-        doubles = {p.name for p in PARAMETERS if p.kind == 'double'}
+    def _pre_set(self, parameters: list[Parameter]) -> list[Parameter]:
+        """Turn an integer given for a double into a double (rclcpp#979); log read-only sets.
+
+        rclpy refuses a read-only parameter before the validation callback
+        sees it; it is logged here, so that every refusal is.
+        """
+        for p in parameters:
+            if p.name in READ_ONLY:
+                self.get_logger().warning(
+                    f'parameter refused: {p.name}: read-only (set it at start), got {p.value!r}')
         return [Parameter(p.name, Parameter.Type.DOUBLE, float(p.value))
-                if p.name in doubles and p.type_ == Parameter.Type.INTEGER else p
+                if p.name in DOUBLES and p.type_ == Parameter.Type.INTEGER else p
                 for p in parameters]
 
     def _validate(self, parameters: list[Parameter]) -> SetParametersResult:
@@ -263,9 +283,10 @@ class KinematicsNode(LifecycleNode):
         """Load the scene, fill the scene's defaults, create the publishers."""
         try:
             self._configure()
-        except mk.MechKinematicsError as error:
-            self.configure_error = str(error)
-            self.get_logger().error(f'cannot configure: {error}')
+        except Exception as error:     # noqa: BLE001 - a scene or a QoS override: one line
+            self._teardown()
+            self.configure_error = str(error) or type(error).__name__
+            self.get_logger().error(f'cannot configure: {self.configure_error}')
             return TransitionCallbackReturn.FAILURE
         return TransitionCallbackReturn.SUCCESS
 
@@ -285,12 +306,12 @@ class KinematicsNode(LifecycleNode):
                 raise mk.SceneError(f'{scene.name}: {result.reason}')
         self._messages = TickMessages(scene.output_joints, scene.output_points, self.frame_id)
         self._pub_joint_states = self.create_publisher(
-            JointState, 'joint_states', STATE_QOS, qos_overriding_options=_qos_options())
+            JointState, 'joint_states', _state_qos(), qos_overriding_options=_qos_options())
         self._pub_joint_accel = self.create_publisher(
-            JointTrajectory, 'joint_accelerations', STATE_QOS,
+            JointTrajectory, 'joint_accelerations', _state_qos(),
             qos_overriding_options=_qos_options())
         self._pub_point_accel = self.create_publisher(
-            MultiDOFJointTrajectory, 'point_accelerations', STATE_QOS,
+            MultiDOFJointTrajectory, 'point_accelerations', _state_qos(),
             qos_overriding_options=_qos_options())
         self._publishers = [self._pub_joint_states, self._pub_joint_accel,
                             self._pub_point_accel]

@@ -1,0 +1,191 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The node as a ROS user meets it: lifecycle, QoS overrides, names, start-up errors (issues 12, 13).
+
+Each test starts its own node in a namespace of this session and drives it
+from this process with rclpy (services, subscriptions, the graph).
+"""
+
+import math
+import signal
+import time
+
+from lifecycle_msgs.msg import State, Transition
+from lifecycle_msgs.srv import ChangeState, GetState
+import pytest
+from rclpy.parameter import Parameter
+from rclpy.parameter_client import AsyncParameterClient
+from rclpy.qos import QoSProfile, ReliabilityPolicy
+from ros_helpers import NodeProcess, NS, Ros, SESSION, stamp_ns, STARTUP_S, wait_for, wrap
+from sensor_msgs.msg import JointState
+
+#: Tolerance of an angle that the time base fixes exactly, rad.
+ATOL_TIMEBASE = 1e-9
+
+
+@pytest.fixture(scope='module')
+def ros():
+    ros = Ros()
+    yield ros
+    ros.close()
+
+
+def _exited(proc: NodeProcess) -> tuple[int, str]:
+    try:
+        status = proc.proc.wait(timeout=STARTUP_S)
+    finally:
+        if proc.proc.poll() is None:
+            proc.proc.kill()
+    return status, proc.output()
+
+
+@pytest.mark.parametrize('args, words', [
+    (['-p', 'scene:=123'], ['scene: expected a string, got number 123']),
+    (['-p', 'frame_id:=5'], ['frame_id: expected a string, got number 5']),
+    (['-p', 'scene:='], ["Couldn't parse parameter override rule: '-p scene:='"]),
+    (['-p', 'rate_hz:=fast'], ["rate_hz: expected a number (Hz), got string 'fast'"]),
+    (['-p', 'late_ticks:=later'], ["late_ticks: expected one of catch_up, skip, got 'later'"]),
+    (['-p', 'use_sim_time:=abc'], ['use_sim_time']),
+    (['-p', 'managed:=3'], ['managed: expected true or false']),
+    (['-p', 'qos_overrides./x/joint_states.publisher.reliability:=sometimes'],
+     ['reliability', 'sometimes']),
+])
+def test_bad_start_parameters_are_one_line_and_exit_1(tmp_path, args, words):
+    """Any bad -p at start stops the node with status 1 and one line naming it. See issue 12."""
+    ns = f'{SESSION}/bad_start'
+    args = [a.replace('/x/', f'{ns}/') for a in args]
+    status, output = _exited(NodeProcess(tmp_path, '-r', f'__ns:={ns}', *args))
+    assert status == 1, output
+    assert 'Traceback' not in output
+    fatal = [line for line in output.splitlines() if 'cannot start' in line]
+    assert len(fatal) == 1, output
+    for word in words:
+        assert word in fatal[0], output
+
+
+def test_a_second_node_of_the_same_name_exits_1(ros, tmp_path):
+    """A node whose fully qualified name is taken says so and exits 1; the first goes on."""
+    ns = f'{SESSION}/twice'
+    js = ros.collect(JointState, f'{ns}/joint_states')
+    first = NodeProcess(tmp_path / 'first', '-r', f'__ns:={ns}')
+    try:
+        wait_for(lambda: js, STARTUP_S, 'the first node publishing')
+        status, output = _exited(NodeProcess(tmp_path / 'second', '-r', f'__ns:={ns}'))
+        assert status == 1, output
+        assert f'another node named {ns}/mech_kinematics is running' in output
+        count = len(js)
+        wait_for(lambda: len(js) > count + 50, 5.0, 'the first node still publishing')
+    finally:
+        status, _ = first.stop(signal.SIGINT)
+    assert status == 0, first.output()
+
+
+def test_qos_override_makes_joint_states_best_effort(ros, tmp_path):
+    """qos_overrides./NS/joint_states.publisher.reliability:=best_effort is what a subscriber sees.
+
+    See issue 13.
+    """
+    ns = f'{SESSION}/qos'
+    topic = f'{ns}/joint_states'
+    js = ros.collect(JointState, topic,
+                     QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT))
+    proc = NodeProcess(tmp_path, '-r', f'__ns:={ns}',
+                       '-p', f'qos_overrides.{topic}.publisher.reliability:=best_effort',
+                       '-p', f'qos_overrides.{topic}.publisher.depth:=3')
+    try:
+        wait_for(lambda: js, STARTUP_S, 'joint_states on a best-effort subscription')
+        offers = ros.node.get_publishers_info_by_topic(topic)
+        assert [o.qos_profile.reliability for o in offers] == [ReliabilityPolicy.BEST_EFFORT]
+        params = AsyncParameterClient(ros.node, f'{ns}/mech_kinematics')
+        response = ros.call(params.get_parameters([f'qos_overrides.{topic}.publisher.depth']))
+        assert response.values[0].integer_value == 3
+        others = ros.node.get_publishers_info_by_topic(f'{ns}/joint_accelerations')
+        assert [o.qos_profile.reliability for o in others] == [ReliabilityPolicy.RELIABLE]
+    finally:
+        status, _ = proc.stop(signal.SIGINT)
+    assert status == 0, proc.output()
+
+
+class Lifecycle:
+    """Clients of a managed node's lifecycle services."""
+
+    def __init__(self, ros: Ros, node: str) -> None:
+        self.ros = ros
+        self.change = ros.node.create_client(ChangeState, f'{node}/change_state')
+        self.get = ros.node.create_client(GetState, f'{node}/get_state')
+        assert self.change.wait_for_service(timeout_sec=STARTUP_S)
+
+    def state(self) -> str:
+        return self.ros.call(self.get.call_async(GetState.Request())).current_state.label
+
+    def transition(self, transition_id: int) -> bool:
+        request = ChangeState.Request(transition=Transition(id=transition_id))
+        return self.ros.call(self.change.call_async(request)).success
+
+
+def test_managed_node_follows_the_lifecycle(ros, tmp_path):
+    """managed:=true publishes only when active; deactivating keeps the angle a function of time.
+
+    Driven through lifecycle_msgs services. See issue 13.
+    """
+    ns = f'{SESSION}/managed'
+    js = ros.collect(JointState, f'{ns}/joint_states')
+    proc = NodeProcess(tmp_path, '-r', f'__ns:={ns}', '-p', 'managed:=true',
+                       '-p', 'rate_hz:=200', '-p', 'crank_speed_rpm:=60')
+    try:
+        life = Lifecycle(ros, f'{ns}/mech_kinematics')
+        assert life.state() == 'unconfigured'
+        time.sleep(1.0)
+        assert not js, 'published before activation'
+        assert life.transition(Transition.TRANSITION_CONFIGURE) and life.state() == 'inactive'
+        time.sleep(0.5)
+        assert not js, 'published while inactive'
+        assert life.transition(Transition.TRANSITION_ACTIVATE) and life.state() == 'active'
+        wait_for(lambda: len(js) > 50, STARTUP_S, 'joint_states once active')
+        assert life.transition(Transition.TRANSITION_DEACTIVATE) and life.state() == 'inactive'
+        time.sleep(0.3)
+        before = list(js)
+        time.sleep(1.0)
+        assert len(js) == len(before), 'published while inactive'
+        # While inactive the speed changes: it applies from that instant, as time goes on.
+        params = AsyncParameterClient(ros.node, f'{ns}/mech_kinematics')
+        response = ros.call(params.set_parameters([Parameter('crank_speed_rpm', value=120.0)]))
+        assert response.results[0].successful
+        assert life.transition(Transition.TRANSITION_ACTIVATE)
+        wait_for(lambda: len(js) > len(before) + 20, STARTUP_S, 'joint_states again')
+        last, again = before[-1], js[len(before)]
+        gap = (stamp_ns(again) - stamp_ns(last)) / NS
+        assert gap > 1.0
+        ci = list(last.name).index('crank')
+        assert again.velocity[ci] == pytest.approx(4 * math.pi, rel=1e-15)
+        # The angle went on at 60 rpm, then at 120 rpm from the change: between the two.
+        moved = wrap(again.position[ci] - last.position[ci])
+        low, high = sorted((wrap(2 * math.pi * gap), wrap(4 * math.pi * gap)))
+        assert low - ATOL_TIMEBASE <= moved <= high + ATOL_TIMEBASE or high - low > math.pi
+        for a, b in zip(js[len(before):], js[len(before) + 1:], strict=False):
+            dt = (stamp_ns(b) - stamp_ns(a)) / NS
+            assert abs(wrap(b.position[ci] - a.position[ci] - 4 * math.pi * dt)) < ATOL_TIMEBASE
+        assert life.transition(Transition.TRANSITION_DEACTIVATE)
+        assert life.transition(Transition.TRANSITION_CLEANUP) and life.state() == 'unconfigured'
+        assert life.transition(Transition.TRANSITION_UNCONFIGURED_SHUTDOWN)
+        assert life.state() == 'finalized'
+        assert State.PRIMARY_STATE_FINALIZED == 4
+    finally:
+        status, _ = proc.stop(signal.SIGINT)
+    assert status == 0, proc.output()
+
+
+def test_managed_node_with_a_bad_scene_fails_to_configure(ros, tmp_path):
+    """Configuring a managed node on a missing scene fails with the reason; the node lives on."""
+    ns = f'{SESSION}/managed_bad'
+    proc = NodeProcess(tmp_path, '-r', f'__ns:={ns}', '-p', 'managed:=true',
+                       '-p', 'scene:=no_such_scene')
+    try:
+        life = Lifecycle(ros, f'{ns}/mech_kinematics')
+        assert not life.transition(Transition.TRANSITION_CONFIGURE)
+        assert life.state() == 'unconfigured'
+        wait_for(lambda: 'cannot configure' in proc.output(), 5.0, 'the reason in the log')
+        assert 'no_such_scene' in proc.output()
+    finally:
+        status, _ = proc.stop(signal.SIGINT)
+    assert status == 0, proc.output()
