@@ -8,7 +8,7 @@ import argparse
 from collections.abc import Sequence
 import sys
 
-from .cli import PROG
+from .cli import ArgumentParser, PROG, run_handler
 from .tools import bench, diagram, plot, record, report, run, solve
 
 __all__ = ['TOOLS', 'build_parser', 'main']
@@ -19,7 +19,7 @@ TOOLS = (solve, run, bench, diagram, plot, record, report)
 
 def build_parser() -> argparse.ArgumentParser:
     """Return the parser of ``python -m mech_kinematics``."""
-    parser = argparse.ArgumentParser(
+    parser = ArgumentParser(
         prog=PROG, description='Analytic kinematics of planar linkages (mech_kinematics).')
     commands = parser.add_subparsers(dest='command', required=True, metavar='COMMAND')
     for tool in TOOLS:
@@ -32,8 +32,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv[:1] == ['run']:
         return run.main(argv[1:])   # everything after `run` goes to the node untouched
-    args = build_parser().parse_args(argv)
-    return int(args.handler(args) or 0)
+    return run_handler(build_parser().parse_args(argv))
 
 
 if __name__ == '__main__':

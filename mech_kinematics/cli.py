@@ -10,6 +10,12 @@ default (a function of the parsed arguments returning the exit status), and
 of them statically. Tool modules import heavy dependencies (matplotlib,
 rclpy, mpmath, scipy) inside their functions, so building the parser is
 cheap.
+
+:func:`run_handler` is the one place that turns a failure into what a
+person reads: an error of this package is one line (``error: ...``, exit 2),
+a broken pipe (``solve ... | head``) exits quietly, Ctrl-C exits 130, and an
+unexpected exception is one line too, with its traceback only when
+``MECH_KINEMATICS_TRACEBACK=1`` is set.
 """
 
 from __future__ import annotations
@@ -17,13 +23,37 @@ from __future__ import annotations
 import argparse
 from collections.abc import Callable, Sequence
 import math
+import os
+import re
 import sys
+import traceback
 from typing import Any
 
-__all__ = ['PROG', 'finite_float', 'positive_int', 'run_tool']
+from .errors import MechKinematicsError
+
+__all__ = ['ArgumentParser', 'PROG', 'finite_float', 'positive_int', 'run_handler', 'run_tool']
 
 #: The program name shown in usage lines.
 PROG = 'python -m mech_kinematics'
+#: Exit status of a command whose output pipe was closed (128 + SIGPIPE), as `yes | head`.
+BROKEN_PIPE_STATUS = 141
+#: Set this environment variable to 1 to see the traceback of an unexpected error.
+TRACEBACK_VARIABLE = 'MECH_KINEMATICS_TRACEBACK'
+
+
+class ArgumentParser(argparse.ArgumentParser):
+    """An ``argparse.ArgumentParser`` that reads ``-1e3`` as a number, not as an option.
+
+    argparse takes an argument that starts with ``-`` for an option unless it
+    looks like ``-1`` or ``-1.5``: ``--speed-rpm -1e3`` failed with "expected
+    one argument" (issue 12). No option of ours looks like a number, so every
+    float literal is a value. Subcommand parsers inherit the class.
+    """
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(
+            r'^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$', re.IGNORECASE)
 
 
 def finite_float(text: str) -> float:
@@ -52,6 +82,30 @@ def positive_int(text: str) -> int:
     return value
 
 
+def run_handler(args: argparse.Namespace) -> int:
+    """Run ``args.handler(args)``; return its exit status, turning failures into one line."""
+    try:
+        status = int(args.handler(args) or 0)
+        sys.stdout.flush()
+    except BrokenPipeError:
+        # The reader went away (`solve ... | head`): nothing more to say, to anyone.
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return BROKEN_PIPE_STATUS
+    except KeyboardInterrupt:
+        return 130
+    except MechKinematicsError as error:
+        print(f'error: {error}', file=sys.stderr)
+        return 2
+    except Exception as error:  # noqa: BLE001 - the last resort: one line, not a traceback
+        if os.environ.get(TRACEBACK_VARIABLE) == '1':
+            traceback.print_exc()
+        print(f'error: unexpected {type(error).__name__}: {error} (set '
+              f'{TRACEBACK_VARIABLE}=1 for the traceback)', file=sys.stderr)
+        return 1
+    return status
+
+
 def run_tool(add_parser: Callable[[Any], argparse.ArgumentParser],
              argv: Sequence[str] | None = None) -> int:
     """Parse ``argv`` (default ``sys.argv[1:]``) with one tool's parser and run its handler.
@@ -60,7 +114,6 @@ def run_tool(add_parser: Callable[[Any], argparse.ArgumentParser],
     called as ``python -m mech_kinematics NAME``, as the console script
     ``NAME`` (``ros2 run mech_kinematics NAME``) or from Python.
     """
-    root = argparse.ArgumentParser(prog=PROG)
+    root = ArgumentParser(prog=PROG)
     parser = add_parser(root.add_subparsers(dest='command', required=True))
-    args = parser.parse_args(sys.argv[1:] if argv is None else list(argv))
-    return int(args.handler(args) or 0)
+    return run_handler(parser.parse_args(sys.argv[1:] if argv is None else list(argv)))

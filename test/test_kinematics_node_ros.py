@@ -1,6 +1,8 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""The node as a ROS user meets it: lifecycle, QoS overrides, names, start-up errors (issues 12, 13).
+"""The node as a ROS user meets it: lifecycle, QoS overrides, names, start-up errors.
+
+See issues 12 and 13.
 
 Each test starts its own node in a namespace of this session and drives it
 from this process with rclpy (services, subscriptions, the graph).

@@ -1,0 +1,107 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The layers and their arrows: core <- geometry <- ROS layer and tools. See issue 9.
+
+- the solver core (errors, units, linkage, scene, textbook) imports only NumPy,
+  PyYAML and the standard library;
+- geometry imports the core only, and never matplotlib;
+- the ROS layer never imports a tool (drawing, report, recorder) nor matplotlib;
+- building the command line for ``solve`` imports no heavy dependency.
+"""
+
+import ast
+from pathlib import Path
+import subprocess
+import sys
+
+import pytest
+
+PACKAGE = Path(__file__).resolve().parents[1] / 'mech_kinematics'
+CORE = ('errors', 'units', 'linkage', 'scene', 'textbook')
+HEAVY = ('rclpy', 'matplotlib', 'mpmath', 'scipy', 'rosbags', 'tqdm')
+
+#: Layer of each subpackage (modules at the top are the core), and what each may import.
+LAYERS = {'core': set(), 'data': set(), 'geometry': {'core'}, 'ros': {'core', 'geometry'},
+          'tools': {'core', 'geometry', 'ros', 'data'}}
+
+
+def _modules_after(code: str) -> set:
+    """Return the top-level names in sys.modules after running ``code`` in a fresh Python."""
+    result = subprocess.run(
+        [sys.executable, '-c', f'{code}\nimport sys\nprint(" ".join(sorted(sys.modules)))'],
+        capture_output=True, text=True, check=True, timeout=120)
+    return {name.split('.')[0] for name in result.stdout.split()}
+
+
+def test_core_imports_only_numpy_yaml_and_the_standard_library():
+    """Importing the package and the solver core loads nothing but NumPy, PyYAML and stdlib."""
+    imports = ', '.join(f'mech_kinematics.{m}' for m in CORE)
+    # What the interpreter loads before any import of ours (site hooks of the venv).
+    baseline = _modules_after('pass')
+    loaded = _modules_after(f'import mech_kinematics, {imports}') - baseline
+    # cython_runtime comes with NumPy's compiled extensions.
+    allowed = set(sys.stdlib_module_names) | {'numpy', 'cython_runtime', 'yaml', 'mech_kinematics'}
+    extra = {n for n in loaded - allowed if not n.startswith('_')}
+    assert not extra, extra
+
+
+def test_the_node_imports_no_drawing_or_report_code():
+    """Importing the node module loads neither matplotlib nor any tool module."""
+    result = subprocess.run(
+        [sys.executable, '-c', 'import mech_kinematics.ros.node, sys; '
+         'print(" ".join(sorted(sys.modules)))'],
+        capture_output=True, text=True, check=True, timeout=120)
+    loaded = result.stdout.split()
+    assert 'matplotlib' not in loaded
+    assert not [m for m in loaded if m.startswith('mech_kinematics.tools')]
+
+
+def test_solve_builds_its_command_line_without_heavy_imports():
+    """Parsing `solve` arguments (every tool registered) imports none of the heavy packages."""
+    loaded = _modules_after('from mech_kinematics.__main__ import build_parser\n'
+                            "build_parser().parse_args(['solve', 'x'])")
+    assert not loaded & set(HEAVY), loaded & set(HEAVY)
+
+
+def _layer(path: Path) -> str:
+    relative = path.relative_to(PACKAGE)
+    return 'core' if len(relative.parts) == 1 else relative.parts[0]
+
+
+def _imported_layers(path: Path):
+    """Yield (line, layer) of every import of a mech_kinematics module in ``path``."""
+    tree = ast.parse(path.read_text(encoding='utf-8'))
+    here = path.relative_to(PACKAGE).parent.parts
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = list(here[:len(here) - node.level + 1])
+                parts = base + (node.module.split('.') if node.module else [])
+            elif node.module and node.module.split('.')[0] == 'mech_kinematics':
+                parts = node.module.split('.')[1:]
+            else:
+                continue
+            names = [parts] if parts else [[alias.name] for alias in node.names]
+        elif isinstance(node, ast.Import):
+            names = [n.name.split('.')[1:] for n in node.names
+                     if n.name.split('.')[0] == 'mech_kinematics']
+        else:
+            continue
+        for parts in names:
+            if parts:
+                yield node.lineno, parts[0] if parts[0] in LAYERS else 'core'
+
+
+#: The entry points sit above every layer: they may import anything.
+ENTRY_POINTS = (PACKAGE / '__main__.py', PACKAGE / 'kinematics_node.py')
+
+
+@pytest.mark.parametrize('path', [p for p in sorted(PACKAGE.rglob('*.py'))
+                                  if p not in ENTRY_POINTS],
+                         ids=lambda p: str(p.relative_to(PACKAGE)))
+def test_arrows_run_one_way(path):
+    """A module imports only from its own layer and the layers below it."""
+    layer = _layer(path)
+    for line, target in _imported_layers(path):
+        assert target == layer or target in LAYERS[layer], \
+            f'{path.relative_to(PACKAGE)}:{line} ({layer}) imports from {target}'
