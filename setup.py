@@ -50,6 +50,7 @@ setup(
     entry_points={
         'console_scripts': [
             'kinematics_node = mech_kinematics.kinematics_node:main',
+            'reindex = mech_kinematics.tools.reindex:main',
         ],
     },
 )
