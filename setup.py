@@ -63,9 +63,9 @@ setup(
             'diagram = mech_kinematics.tools.diagram:main',
             'report = mech_kinematics.tools.report:main',
             'bench = mech_kinematics.tools.bench:main',
-            # check and reindex go here when their modules land:
+            'reindex = mech_kinematics.tools.reindex:main',
+            # check goes here when its module lands:
             # 'check = mech_kinematics.tools.check:main',
-            # 'reindex = mech_kinematics.tools.reindex:main',
         ],
     },
 )

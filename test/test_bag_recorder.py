@@ -12,7 +12,16 @@ version 9, by SIGTERM. Every process gets a ROS domain of this module's own
 joins DDS itself.
 
 What the node published comes from its own diagnostics, recorded in the same
-bag: ``published_total`` counts the state messages of each topic.
+bag: ``published_total`` counts the state messages of each topic. The SIGINT
+recorder logs a progress line a second (``--progress 1``).
+
+A second set of recorders meets a node at 1 kHz for the crash-safety tests
+(issue 12): two are killed with SIGKILL a few seconds into the recording
+(mcap and sqlite3) and their bags reindexed, while a third, a witness that
+is stopped normally, tells which messages they had received; two run with a
+file size limit (``RLIMIT_FSIZE``, so that writes fail with ``EFBIG``) and
+must end with one ``error:`` line and a bag whose metadata tells the truth;
+one, in a namespace where nothing publishes, must say what it waits for.
 """
 
 from dataclasses import dataclass
@@ -20,6 +29,8 @@ import os
 from pathlib import Path
 import random
 import re
+import resource
+import shutil
 import signal
 import subprocess
 import sys
@@ -53,7 +64,7 @@ RECORDERS = {
     'duration_mcap': (['--storage', 'mcap', '--duration', str(DURATION_S)], None, 8),
     'duration_sqlite3': (['--storage', 'sqlite3', '--duration', str(DURATION_S),
                           '--executor', 'single'], None, 8),
-    'sigint_mcap': (['--storage', 'mcap'], signal.SIGINT, 8),
+    'sigint_mcap': (['--storage', 'mcap', '--progress', '1'], signal.SIGINT, 8),
     'sigterm_sqlite3_v9': (['--storage', 'sqlite3', '--bag-version', '9'], signal.SIGTERM, 9),
 }
 SUMMARY_LINE = re.compile(r'^(/\S+)\s+(\S+)\s+(\d+)\s+(\d+)$', re.MULTILINE)
@@ -72,12 +83,12 @@ def ros_env() -> dict:
 class Process:
     """A subprocess with its output in files."""
 
-    def __init__(self, name: str, tmp: Path, *argv: str) -> None:
+    def __init__(self, name: str, tmp: Path, *argv: str, **popen) -> None:
         self.name = name
         self.out, self.err = tmp / f'{name}.out', tmp / f'{name}.err'
         with open(self.out, 'w') as out, open(self.err, 'w') as err:
             self.proc = subprocess.Popen([sys.executable, *argv], env=ros_env(), stdout=out,
-                                         stderr=err, cwd=tmp)
+                                         stderr=err, cwd=tmp, **popen)
 
     def output(self) -> str:
         return self.out.read_text() + self.err.read_text()
@@ -124,6 +135,8 @@ def recordings(tmp_path_factory):
                                       '-o', str(tmp / name), *extra)
         for recorder in recorders.values():
             recorder.wait_for_output('recording to', STARTUP_S)
+        # Said one second after start when no topic has a publisher (issue 13).
+        recorders['sigint_mcap'].wait_for_output('waiting for publishers', STARTUP_S)
         node = Process('node', tmp, '-m', 'mech_kinematics.kinematics_node', '--ros-args',
                        '-p', f'rate_hz:={RATE_HZ}')
         try:
@@ -415,3 +428,243 @@ def test_plot_of_a_real_recording(recordings, tmp_path):
     for ax in fig.axes:
         assert ax.get_xlabel() in ('crank angle θ [rad]', 'x [m]')
         assert re.search(r'\[.+\]$', ax.get_ylabel())
+
+
+# -- what the recorder says (issue 13) ---------------------------------------------
+
+LOG_LINE = re.compile(r'^\[INFO\] \[(\d+\.\d+)\] \[(?:\S+\.)?mech_kinematics_recorder\]: (.*)$',
+                      re.MULTILINE)
+PROGRESS = re.compile(r'^recorded (\d+) s: (\d+) messages \((\d+)/s\): (.*)$')
+PROGRESS_TOPIC = re.compile(r'^(/\S+) (\d+) \((\d+)/s\)$')
+
+
+def log_lines(output: str) -> list:
+    """(time s, text) of the recorder's log lines, in order."""
+    return [(float(m[1]), m[2]) for m in LOG_LINE.finditer(output)]
+
+
+def test_recorder_says_what_it_waits_for_then_reports_progress(recordings):
+    """One line naming the four topics before the node runs; then a progress line a second."""
+    recording = recordings['sigint_mcap']
+    lines = log_lines(recording.output)
+    texts = [text for _, text in lines]
+    first_subscribed = next(i for i, t in enumerate(texts) if t.startswith('subscribed to'))
+    waiting = [t for t in texts[:first_subscribed] if t.startswith('waiting for publishers on')]
+    assert waiting, recording.output
+    assert waiting[0].startswith(f'waiting for publishers on {", ".join(TOPICS)} ')
+    progress = []
+    for time_s, text in lines:
+        match = PROGRESS.match(text)
+        if match:
+            topics = {m[1]: (int(m[2]), int(m[3])) for m in map(
+                PROGRESS_TOPIC.match, match[4].split(', '))}
+            progress.append((time_s, int(match[2]), int(match[3]), topics))
+    assert len(progress) >= 2, recording.output
+    for (t0, total0, _, topics0), (t1, total1, rate1, topics1) in zip(progress, progress[1:]):
+        assert 0.9 <= t1 - t0, 'not more often than --progress 1'
+        assert total1 == sum(n for n, _ in topics1.values()) >= total0
+        for topic, (n, rate) in topics1.items():
+            # The rate is the topic's new messages over the interval (rounded to 1/s).
+            before = topics0.get(topic, (0, 0))[0]
+            assert rate == pytest.approx((n - before) / (t1 - t0), rel=0.02, abs=2), topic
+        assert rate1 == pytest.approx(sum(r for _, r in topics1.values()), abs=len(topics1))
+    received = {topic: counts[1] for topic, counts in recording.summary().items()}
+    for topic, (n, _) in progress[-1][3].items():
+        assert n <= received[topic]
+
+
+# -- crash safety (issue 12) -------------------------------------------------------
+
+CRASH_RATE_HZ = 1000.0
+#: How long the killed recorders record (from their /diagnostics subscription) before kill -9.
+CRASH_RECORD_S = 4.0
+#: Messages received this long before kill -9 must be in the reindexed bag (flushes: 0.5 s).
+RECOVERY_S = 1.0
+#: Storage file size limit of the recorders that meet a write error, bytes.
+FILE_LIMIT = 1_500_000
+#: A namespace of its own for the recorder that waits: nothing publishes there.
+IDLE_NS = f'/idle_{os.getpid()}_{random.SystemRandom().randrange(16 ** 6):06x}'
+CRASH_RECORDERS = {
+    'witness': ['--storage', 'mcap'],
+    'kill_mcap': ['--storage', 'mcap'],
+    'kill_sqlite3': ['--storage', 'sqlite3'],
+    'full_mcap': ['--storage', 'mcap'],
+    'full_sqlite3': ['--storage', 'sqlite3'],
+    'idle': ['--ros-args', '-r', f'__ns:={IDLE_NS}'],
+}
+
+
+def readable_counts(path: Path) -> dict:
+    """Topic -> messages rosbags reads (strictly decoded), topics without a message included."""
+    counts = {topic: len(msgs) for topic, msgs in decoded(path).items()}
+    from rosbags.highlevel import AnyReader
+    with AnyReader([path]) as reader:
+        return {c.topic: counts.get(c.topic, 0) for c in reader.connections}
+
+
+def _limit_file_size() -> None:
+    # Python ignores SIGXFSZ: a write past the limit fails with EFBIG ("File too large").
+    resource.setrlimit(resource.RLIMIT_FSIZE, (FILE_LIMIT, FILE_LIMIT))
+
+
+@dataclass
+class Crashes:
+    tmp: Path
+    outputs: dict
+    statuses: dict
+    kill_ns: int
+    reindexed: dict
+
+    def path(self, name: str) -> Path:
+        return self.tmp / name
+
+
+@pytest.fixture(scope='module')
+def crashes(tmp_path_factory):
+    """Run the crash-test recorders against a 1 kHz node; kill, stop and reindex them."""
+    tmp = tmp_path_factory.mktemp('crashes')
+    recorders = {}
+    statuses = {}
+    try:
+        for name, extra in CRASH_RECORDERS.items():
+            popen = {'preexec_fn': _limit_file_size} if name.startswith('full') else {}
+            recorders[name] = Process(name, tmp, '-m', 'mech_kinematics', 'record', '-o',
+                                      str(tmp / name), *extra, **popen)
+        for recorder in recorders.values():
+            recorder.wait_for_output('recording to', STARTUP_S)
+        node = Process('node', tmp, '-m', 'mech_kinematics.kinematics_node', '--ros-args',
+                       '-p', f'rate_hz:={CRASH_RATE_HZ}')
+        try:
+            for name in ('full_mcap', 'full_sqlite3'):
+                statuses[name] = recorders[name].stop(timeout=STARTUP_S + 10)
+            for name in ('kill_mcap', 'kill_sqlite3'):
+                recorders[name].wait_for_output('subscribed to /diagnostics', STARTUP_S)
+            time.sleep(CRASH_RECORD_S)
+            kill_ns = time.time_ns()
+            for name in ('kill_mcap', 'kill_sqlite3'):
+                recorders[name].proc.kill()
+            for name in ('kill_mcap', 'kill_sqlite3'):
+                statuses[name] = recorders[name].proc.wait(timeout=10)
+            time.sleep(0.2)     # the witness gets what was on the way at the kill
+            statuses['witness'] = recorders['witness'].stop(signal.SIGINT)
+            deadline = time.monotonic() + 10
+            while recorders['idle'].output().count('waiting for publishers') < 2:
+                assert time.monotonic() < deadline, recorders['idle'].output()
+                time.sleep(0.1)
+            statuses['idle'] = recorders['idle'].stop(signal.SIGINT)
+        finally:
+            node_status = node.stop(signal.SIGINT)
+        assert node_status == 0, node.output()
+    finally:
+        for recorder in recorders.values():
+            if recorder.proc.poll() is None:
+                recorder.proc.kill()
+                recorder.proc.wait()
+    reindexed = {}
+    for name in ('kill_mcap', 'kill_sqlite3'):
+        copy = tmp / f'{name}_reindexed'
+        shutil.copytree(tmp / name, copy)
+        result = subprocess.run([sys.executable, '-m', 'mech_kinematics', 'reindex', str(copy)],
+                                env=ros_env(), capture_output=True, text=True, cwd=tmp)
+        reindexed[name] = (copy, result.returncode, result.stdout + result.stderr)
+    return Crashes(tmp, {n: r.output() for n, r in recorders.items()}, statuses, kill_ns,
+                   reindexed)
+
+
+@pytest.mark.parametrize('storage', ['mcap', 'sqlite3'])
+def test_killed_recording_is_unreadable_until_reindexed(crashes, storage):
+    """After kill -9 there is no metadata.yaml and rosbags refuses the bag."""
+    from rosbags.highlevel import AnyReader
+
+    path = crashes.path(f'kill_{storage}')
+    assert crashes.statuses[f'kill_{storage}'] == -signal.SIGKILL
+    assert not (path / 'metadata.yaml').exists()
+    with pytest.raises(FileNotFoundError, match='Expected metadata file'):
+        AnyReader([path])
+
+
+@pytest.mark.parametrize('storage', ['mcap', 'sqlite3'])
+def test_reindex_recovers_every_message_older_than_a_second(crashes, storage):
+    """Reindexed after kill -9: every message the witness got by kill - 1 s, and no other."""
+    path, status, output = crashes.reindexed[f'kill_{storage}']
+    assert status == 0, output
+    assert output.startswith(f'reindexed {path} ({storage}, bag version 8): ')
+    killed = decoded(path)
+    witness = decoded(crashes.path('witness'))
+    recovered = expected = 0
+    for topic in STATE_TOPICS:
+        got = [stamp_ns(m) for _, m in killed[topic]]
+        assert len(got) == len(set(got))
+        seen = {stamp_ns(m): t for t, m in witness[topic]}
+        start = max(min(got), min(seen))     # both recording
+        assert {s for s in got if s >= start} <= set(seen), 'only messages the node published'
+        old = {s for s, t in seen.items() if s >= start and t <= crashes.kill_ns - RECOVERY_S * NS}
+        assert old <= set(got), (topic, len(old - set(got)))
+        window = [s for s, t in seen.items() if s >= start and t <= crashes.kill_ns]
+        recovered += len(set(got) & set(window))
+        expected += len(window)
+    newest = max(t for msgs in killed.values() for t, _ in msgs)
+    print(f'\n{storage}: recovered {recovered} of the {expected} state messages received '
+          f'before kill -9 ({recovered / expected:.4f}); the newest was received '
+          f'{(crashes.kill_ns - newest) / 1e6:.0f} ms before the kill')
+    assert recovered >= 0.5 * expected > 0
+
+
+@pytest.mark.parametrize('storage', ['mcap', 'sqlite3'])
+def test_reindexed_bag_metadata_tells_the_truth(crashes, storage):
+    """Reindexed: metadata counts equal rosbags' (strict) counts; Foxglove reads the mcap."""
+    path = crashes.reindexed[f'kill_{storage}'][0]
+    info = yaml.safe_load((path / 'metadata.yaml').read_text())['rosbag2_bagfile_information']
+    counts = {t['topic_metadata']['name']: t['message_count']
+              for t in info['topics_with_message_count']}
+    assert counts == readable_counts(path)
+    assert set(counts) == set(TOPICS)
+    assert info['storage_identifier'] == storage and info['version'] == 8
+    if storage == 'mcap':
+        import mcap.reader as mcap_reader
+        with open(path / 'kill_mcap.mcap', 'rb') as stream:
+            reader = mcap_reader.make_reader(stream, validate_crcs=True)
+            assert sum(1 for _ in reader.iter_messages()) == info['message_count']
+
+
+@pytest.mark.parametrize('storage', ['mcap', 'sqlite3'])
+def test_write_error_ends_with_one_line_and_a_truthful_bag(crashes, storage):
+    """Writes refused (file size limit): exit 1, one error: line, metadata = what is readable."""
+    name = f'full_{storage}'
+    output = crashes.outputs[name]
+    assert crashes.statuses[name] == 1, output
+    assert 'Traceback' not in output
+    errors = [line for line in output.splitlines() if 'error' in line.lower()]
+    path = crashes.path(name)
+    storage_file = path / f'{name}{".mcap" if storage == "mcap" else ".db3"}'
+    assert len(errors) == 1 and errors[0].startswith(f'error: Could not write "{storage_file}": ')
+    assert 'the recording stopped and the bag was closed with the ' in errors[0]
+    meta = yaml.safe_load((path / 'metadata.yaml').read_text())['rosbag2_bagfile_information']
+    counts = {t['topic_metadata']['name']: t['message_count']
+              for t in meta['topics_with_message_count']}
+    readable = readable_counts(path)
+    assert counts == readable
+    summary = Recording(name, path, 1, output, 8).summary()
+    assert {topic: written for topic, (_, _, written) in summary.items()} == readable
+    assert all(received >= written for _, received, written in summary.values())
+    assert sum(received - written for _, received, written in summary.values()) > 0
+    assert sum(readable.values()) > 0
+    assert storage_file.stat().st_size <= FILE_LIMIT
+    assert sorted(p.name for p in path.iterdir()) == sorted([storage_file.name,
+                                                             'metadata.yaml'])
+
+
+def test_recorder_without_publishers_names_them_every_five_seconds(crashes):
+    """Nothing published: the topics it waits for, again every ~5 s; exit 0 and an empty bag."""
+    output = crashes.outputs['idle']
+    assert crashes.statuses['idle'] == 0, output
+    topics = ', '.join(f'{IDLE_NS}/{t.lstrip("/")}' for t in TOPICS)
+    waiting = [t for t, text in log_lines(output)
+               if text.startswith(f'waiting for publishers on {topics} ')]
+    assert len(waiting) >= 2
+    assert all(b - a >= bag_recorder.WAIT_REPORT_INTERVAL_S - 0.1
+               for a, b in zip(waiting, waiting[1:]))
+    assert output.count('(never appeared)') == len(TOPICS)
+    info = yaml.safe_load((crashes.path('idle') / 'metadata.yaml').read_text())[
+        'rosbag2_bagfile_information']
+    assert info['message_count'] == 0 and info['topics_with_message_count'] == []

@@ -1,0 +1,21 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""rosbag2 bags that survive their writer: writing, recovery and ``metadata.yaml``.
+
+- :mod:`.metadata`: a bag's topics (:class:`Topic`), what a closed bag holds
+  (:class:`BagInfo`) and its ``metadata.yaml``;
+- :mod:`.storage_mcap`, :mod:`.storage_sqlite3`: the two storage files, each
+  flushed a chunk or a transaction at a time, and recovered after a crash;
+- :mod:`.writer`: :class:`BagWriter` and :func:`reindex`.
+
+The files are those rosbag2 and rosbags write (MCAP ``ros2`` profile, sqlite3
+schema version 4): rosbags, ``ros2 bag`` and Foxglove read them. Only the
+standard library and PyYAML are imported here; rosbags, for its QoS and
+type-hash helpers, inside the functions that use it.
+"""
+
+from .metadata import BagError, BagInfo, Topic
+from .writer import BagWriter, DEFAULT_VERSION, FLUSH_INTERVAL_S, reindex, STORAGES
+
+__all__ = ['BagError', 'BagInfo', 'BagWriter', 'DEFAULT_VERSION', 'FLUSH_INTERVAL_S', 'STORAGES',
+           'Topic', 'reindex']

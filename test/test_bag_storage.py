@@ -1,0 +1,485 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The crash-safe bag writer and its recovery (``mech_kinematics.tools.bag``), without DDS.
+
+Bags are written here in-process with :class:`BagWriter` from serialized
+``sensor_msgs/msg/JointState`` messages whose stamp is their index, so that a
+bag read back says exactly which messages it holds. A crash is simulated by
+copying the storage file while the writer still has it open (what ``kill -9``
+leaves on disk), a full disk by a file that refuses writes past a limit
+(``ENOSPC``) and by sqlite's ``max_page_count``; everything is read back with
+rosbags (strictly: type hashes checked, every message deserialized) and MCAP
+with Foxglove's reader too. See issue 12.
+"""
+
+import errno
+import functools
+import os
+from pathlib import Path
+import shutil
+import signal
+import subprocess
+import sys
+
+from hypothesis import given, settings, strategies as st
+import numpy as np
+import pytest
+import yaml
+
+from mech_kinematics.tools import record
+from mech_kinematics.tools.bag import BagError, BagWriter, reindex, storage_mcap, storage_sqlite3
+from mech_kinematics.tools.bag.metadata import type_hash_from_definition
+from mech_kinematics.tools.bag.writer import RESERVE_FILE
+
+REPO = Path(__file__).resolve().parents[1]
+TYPE = 'sensor_msgs/msg/JointState'
+T0 = 1_700_000_000_000_000_000     # ns, the receive time of message 0
+DT = 1_000_000                     # ns between messages (1 kHz)
+STORAGES = ('mcap', 'sqlite3')
+
+
+@functools.cache
+def definition() -> tuple[str, str, str]:
+    """Return (encoding, text, RIHS01 hash) of JointState, as the recorder stores them."""
+    encoding, text = record.message_definition(TYPE)
+    return encoding, text, type_hash_from_definition(TYPE, text, encoding)
+
+
+@functools.cache
+def typestore():
+    from rosbags.typesys import get_types_from_msg, get_typestore, Stores
+
+    store = get_typestore(Stores.EMPTY)
+    store.register(get_types_from_msg(definition()[1], TYPE))
+    return store
+
+
+def payload(i: int) -> bytes:
+    """Message ``i``: header stamp i ns, one joint at position i mrad."""
+    store = typestore()
+    header = store.types['std_msgs/msg/Header'](
+        store.types['builtin_interfaces/msg/Time'](0, i), 'mechanism')
+    msg = store.types[TYPE](header, ['crank'], np.array([i * 1e-3]), np.array([0.0]),
+                            np.array([0.0]))
+    return bytes(store.serialize_cdr(msg, TYPE))
+
+
+def qos_profiles(reliable: bool = True) -> list:
+    from rosbags.interfaces import (Qos, QosDurability, QosHistory, QosLiveliness,
+                                    QosReliability, QosTime)
+
+    forever = QosTime(9223372036, 854775807)
+    return [Qos(QosHistory.KEEP_LAST, 10,
+                QosReliability.RELIABLE if reliable else QosReliability.BEST_EFFORT,
+                QosDurability.VOLATILE, forever, forever, QosLiveliness.AUTOMATIC, forever,
+                False)]
+
+
+def open_writer(path: Path, storage: str, version: int = 8, **options):
+    """Return an open BagWriter with topics /js and /quiet (which never gets a message)."""
+    writer = BagWriter(path, storage=storage, version=version, **options)
+    writer.open()
+    encoding, text, type_hash = definition()
+    topic = writer.add_topic('/js', TYPE, definition=text, encoding=encoding,
+                             type_hash=type_hash, qos=qos_profiles())
+    writer.add_topic('/quiet', TYPE, definition=text, encoding=encoding, type_hash=type_hash,
+                     qos=qos_profiles(reliable=False))
+    return writer, topic
+
+
+def write(writer, topic, indexes) -> None:
+    for i in indexes:
+        writer.write(topic, T0 + i * DT, payload(i))
+
+
+def read_back(path: Path) -> dict:
+    """Topic -> list of (receive time, stamp ns) of every message, decoded strictly."""
+    from rosbags.highlevel import AnyReader
+
+    out: dict = {}
+    with AnyReader([path]) as reader:
+        for connection in reader.connections:
+            out.setdefault(connection.topic, [])
+        for connection, timestamp, raw in reader.messages():
+            msg = reader.typestore.deserialize_cdr(raw, connection.msgtype)
+            out[connection.topic].append((timestamp, msg.header.stamp.nanosec))
+    return out
+
+
+def metadata(path: Path) -> dict:
+    return yaml.safe_load((path / 'metadata.yaml').read_text())['rosbag2_bagfile_information']
+
+
+def metadata_counts(path: Path) -> dict:
+    return {t['topic_metadata']['name']: t['message_count']
+            for t in metadata(path)['topics_with_message_count']}
+
+
+def snapshot(writer, destination: Path) -> Path:
+    """Copy the bag directory as it is on disk now (what kill -9 would leave)."""
+    shutil.copytree(writer.path, destination)
+    return destination
+
+
+def assert_truthful(path: Path) -> dict:
+    """metadata.yaml counts exactly what rosbags reads, per topic and in all; return the read."""
+    got = read_back(path)
+    assert metadata_counts(path) == {topic: len(msgs) for topic, msgs in got.items()}
+    assert metadata(path)['message_count'] == sum(len(msgs) for msgs in got.values())
+    return got
+
+
+def assert_prefix(path: Path, n: int) -> None:
+    """Check that the bag holds exactly messages 0..n-1 of /js, and that metadata says so."""
+    got = assert_truthful(path)
+    assert [stamp for _, stamp in got['/js']] == list(range(n))
+    assert [t for t, _ in got['/js']] == [T0 + i * DT for i in range(n)]
+    assert got['/quiet'] == []
+
+
+def foxglove_count(path: Path) -> int:
+    """Messages read by Foxglove's MCAP reader, CRCs checked; the statistics must agree."""
+    import mcap.reader as mcap_reader
+    import mcap_ros2.decoder as mcap_ros2
+
+    with open(path / f'{path.name}.mcap', 'rb') as stream:
+        reader = mcap_reader.make_reader(stream, validate_crcs=True,
+                                         decoder_factories=[mcap_ros2.DecoderFactory()])
+        count = sum(1 for _ in reader.iter_decoded_messages())
+        assert reader.get_summary().statistics.message_count == count
+    return count
+
+
+# -- a normal recording ------------------------------------------------------------
+
+
+@pytest.mark.parametrize('version', [8, 9])
+@pytest.mark.parametrize('storage', STORAGES)
+def test_closed_bag_holds_everything_and_reads_back(tmp_path, storage, version):
+    """Closed normally: every message, counts, time range and QoS format of the version."""
+    writer, topic = open_writer(tmp_path / 'bag', storage, version, flush_bytes=20_000)
+    write(writer, topic, range(3000))
+    info = writer.close()
+    path = tmp_path / 'bag'
+    assert sorted(p.name for p in path.iterdir()) == sorted(
+        ['metadata.yaml', f'bag{".mcap" if storage == "mcap" else ".db3"}'])
+    assert info.count('/js') == 3000 and info.notes == ()
+    assert_prefix(path, 3000)
+    meta = metadata(path)
+    assert meta['version'] == version and meta['storage_identifier'] == storage
+    assert meta['starting_time']['nanoseconds_since_epoch'] == T0
+    assert meta['duration']['nanoseconds'] == 2999 * DT
+    profiles = meta['topics_with_message_count'][0]['topic_metadata']['offered_qos_profiles']
+    if version == 8:
+        assert yaml.safe_load(profiles)[0]['reliability'] == 1
+    else:
+        assert profiles[0]['reliability'] == 'reliable'
+    if storage == 'mcap':
+        assert foxglove_count(path) == 3000
+
+
+@pytest.mark.parametrize('storage', STORAGES)
+def test_reindex_of_a_closed_bag_rewrites_the_same_metadata(tmp_path, storage):
+    """Reindex on a bag closed normally: same metadata.yaml, every message still there."""
+    writer, topic = open_writer(tmp_path / 'bag', storage, 9)
+    write(writer, topic, range(500))
+    writer.close()
+    before = (tmp_path / 'bag' / 'metadata.yaml').read_text()
+    info = reindex(tmp_path / 'bag')
+    assert info.version == 9 and info.notes == ()
+    assert (tmp_path / 'bag' / 'metadata.yaml').read_text() == before
+    assert_prefix(tmp_path / 'bag', 500)
+
+
+def test_existing_directory_is_refused(tmp_path):
+    """A bag directory that exists is never written into."""
+    (tmp_path / 'bag').mkdir()
+    with pytest.raises(BagError, match='Expected a new bag directory'):
+        BagWriter(tmp_path / 'bag').open()
+    assert list((tmp_path / 'bag').iterdir()) == []
+
+
+# -- a crash -------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize('storage', STORAGES)
+def test_every_flush_reaches_the_file(tmp_path, storage):
+    """What kill -9 leaves: every flushed message, none of the pending ones; reindex reads it."""
+    writer, topic = open_writer(tmp_path / 'bag', storage, flush_interval=3600.0)
+    assert (tmp_path / 'bag' / RESERVE_FILE).stat().st_size > 0
+    write(writer, topic, range(700))
+    writer.flush()
+    write(writer, topic, range(700, 900))       # pending: in memory only
+    killed = snapshot(writer, tmp_path / 'killed')
+    assert not (killed / 'metadata.yaml').exists()
+    info = reindex(killed)
+    assert not (killed / RESERVE_FILE).exists()
+    assert info.count('/js') == 700
+    assert_prefix(killed, 700)
+    writer.close()
+    assert_prefix(tmp_path / 'bag', 900)
+
+
+@pytest.mark.parametrize('storage', STORAGES)
+def test_flushes_happen_by_time_and_by_size(tmp_path, storage):
+    """A write older than flush_interval, or flush_bytes pending, is flushed at the next write."""
+    writer, topic = open_writer(tmp_path / 'bag', storage, flush_interval=0.0)
+    write(writer, topic, range(3))
+    assert_prefix(reindex(snapshot(writer, tmp_path / 'a')).path, 3)
+    writer.close()
+    writer, topic = open_writer(tmp_path / 'bag2', storage, flush_interval=3600.0,
+                                flush_bytes=10 * len(payload(0)))
+    write(writer, topic, range(25))
+    flushed = reindex(snapshot(writer, tmp_path / 'b')).count('/js')
+    assert 25 - 10 < flushed < 25      # never 10 messages' bytes pending, never none
+    assert_prefix(tmp_path / 'b', flushed)
+    writer.close()
+
+
+@functools.cache
+def unclosed_mcap(tmp: Path) -> tuple[bytes, list]:
+    """Return an MCAP file of 2000 messages in 10 chunks, as before close, and its chunks."""
+    writer, topic = open_writer(tmp / 'source', 'mcap', flush_interval=3600.0)
+    for start in range(0, 2000, 200):
+        write(writer, topic, range(start, start + 200))
+        writer.flush()
+    data = (tmp / 'source' / 'source.mcap').read_bytes()
+    writer.close()
+    chunks = storage_mcap.RecoveredMcap(tmp / 'source' / 'source.mcap').chunks
+    return data, chunks
+
+
+def cut_bag(tmp: Path, name: str, data: bytes) -> Path:
+    bag = tmp / name
+    bag.mkdir()
+    (bag / f'{name}.mcap').write_bytes(data)
+    return bag
+
+
+@settings(max_examples=40, deadline=None)
+@given(fraction=st.floats(0.0, 1.0))
+def test_mcap_cut_anywhere_keeps_every_chunk_before_the_cut(tmp_path_factory, fraction):
+    """An MCAP file cut at any byte: reindex keeps each chunk whose record is whole."""
+    tmp = tmp_path_factory.getbasetemp()
+    data, chunks = unclosed_mcap(tmp)
+    header = 8 + 9 + int.from_bytes(data[9:17], 'little')
+    cut = header + round(fraction * (len(data) - header))
+    bag = cut_bag(tmp_path_factory.mktemp('cut'), 'bag', data[:cut])
+    info = reindex(bag)
+    kept = sum(sum(c.counts.values()) for c in chunks if c.offset + c.length <= cut)
+    assert info.count('/js') == kept
+    got = assert_truthful(bag)
+    assert [stamp for _, stamp in got.get('/js', [])] == list(range(kept))
+    assert foxglove_count(bag) == kept
+
+
+def test_mcap_damaged_last_chunk_is_dropped(tmp_path):
+    """A chunk whose bytes changed (CRC-32 mismatch) is dropped with the rest of the tail."""
+    data, chunks = unclosed_mcap(tmp_path)
+    last = chunks[-1]
+    damaged = bytearray(data)
+    damaged[last.offset + last.length - 10] ^= 0xFF
+    info = reindex(cut_bag(tmp_path, 'bag', bytes(damaged)))
+    assert info.count('/js') == 1800
+    assert 'a damaged chunk (CRC-32 mismatch)' in info.notes[0]
+    assert_prefix(tmp_path / 'bag', 1800)
+
+
+def test_mcap_cut_message_indexes_are_written_again(tmp_path):
+    """A chunk whose message indexes were cut keeps its messages; its indexes are rewritten."""
+    data, chunks = unclosed_mcap(tmp_path)
+    last = chunks[-1]
+    info = reindex(cut_bag(tmp_path, 'bag', data[:last.offset + last.length + 5]))
+    assert info.count('/js') == 2000
+    assert any('rewrote the message indexes' in note for note in info.notes)
+    assert_prefix(tmp_path / 'bag', 2000)
+    assert foxglove_count(tmp_path / 'bag') == 2000
+
+
+SQLITE_KILLED_MID_TRANSACTION = """
+import os, pickle, signal, sys
+from pathlib import Path
+from mech_kinematics.tools.bag.metadata import Topic
+from mech_kinematics.tools.bag.storage_sqlite3 import Sqlite3Storage
+bag = Path(sys.argv[1])
+topics, payloads = pickle.loads(Path(sys.argv[2]).read_bytes())
+bag.mkdir()
+storage = Sqlite3Storage(bag / 'bag.db3', distro='')
+for topic in topics:
+    storage.add_topic(topic, '')
+for i, data in enumerate(payloads):
+    storage.write(1, {t0} + i * {dt}, data)
+storage.flush()
+storage.conn.execute('BEGIN')   # far larger than the page cache: pages spill to the file
+storage.conn.executemany('INSERT INTO messages (topic_id, timestamp, data) VALUES (?, ?, ?)',
+                         [(1, i, bytes(4000)) for i in range(3000)])
+os.kill(os.getpid(), signal.SIGKILL)
+"""
+
+
+def test_sqlite3_transaction_cut_by_kill_is_rolled_back(tmp_path):
+    """A kill -9 inside a transaction: reindex rolls it back; committed messages stay."""
+    import pickle
+    from mech_kinematics.tools.bag import Topic
+
+    encoding, text, type_hash = definition()
+    topics = [Topic(1, '/js', TYPE, text, encoding, type_hash),
+              Topic(2, '/quiet', TYPE, text, encoding, type_hash)]
+    inputs = tmp_path / 'inputs.pickle'
+    inputs.write_bytes(pickle.dumps((topics, [payload(i) for i in range(300)])))
+    bag = tmp_path / 'bag'
+    code = SQLITE_KILLED_MID_TRANSACTION.format(t0=T0, dt=DT)
+    result = subprocess.run([sys.executable, '-c', code, str(bag), str(inputs)], cwd=REPO,
+                            capture_output=True)
+    assert result.returncode == -signal.SIGKILL, result.stderr.decode()
+    assert (bag / 'bag.db3-journal').stat().st_size > 0      # a hot journal was left
+    info = reindex(bag)
+    assert any('rolled back' in note for note in info.notes)
+    assert not (bag / 'bag.db3-journal').exists()
+    assert_prefix(bag, 300)
+
+
+@pytest.mark.parametrize('storage', STORAGES)
+def test_killed_version_9_bag_is_reindexed_as_version_9(tmp_path, storage):
+    """With no stored metadata, the QoS format tells the version; --bag-version overrides."""
+    writer, topic = open_writer(tmp_path / 'bag', storage, 9)
+    write(writer, topic, range(50))
+    writer.flush()
+    killed = snapshot(writer, tmp_path / 'killed')
+    assert reindex(killed).version == 9
+    assert metadata(killed)['version'] == 9
+    assert reindex(killed, version=8).version == 8
+    assert_prefix(killed, 50)
+    writer.close()
+
+
+# -- a full disk -------------------------------------------------------------------
+
+
+class FullDisk:
+    """A file that takes ``limit`` bytes in all, then refuses writes with ENOSPC."""
+
+    def __init__(self, stream, limit: int) -> None:
+        self.stream = stream
+        self.room = limit
+
+    def write(self, data) -> int:
+        if len(data) > self.room:
+            self.stream.write(bytes(data)[:self.room])   # what fits, as a full disk does
+            self.room = 0
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        self.room -= len(data)
+        return self.stream.write(data)
+
+    def __getattr__(self, name):
+        return getattr(self.stream, name)
+
+
+def test_mcap_full_disk_closes_with_what_fit(tmp_path, monkeypatch):
+    """ENOSPC mid-chunk: BagError with the reason; close keeps the whole chunks, truthfully."""
+    limit = 150_000
+    monkeypatch.setattr(storage_mcap, 'open', raising=False,
+                        value=lambda path, mode: FullDisk(open(path, mode), limit)
+                        if 'x' in mode else open(path, mode))
+    writer, topic = open_writer(tmp_path / 'bag', 'mcap', flush_interval=3600.0,
+                                flush_bytes=20_000)
+    with pytest.raises(BagError, match='No space left on device') as raised:
+        write(writer, topic, range(5000))
+    assert writer.failure == str(raised.value)
+    with pytest.raises(BagError, match='No space left on device'):
+        write(writer, topic, [5000])     # refused from now on
+    info = writer.close()
+    assert any('dropped' in note for note in info.notes)
+    n = info.count('/js')
+    batch = -(-20_000 // (31 + len(payload(0))))      # messages per chunk
+    assert 0 < n < 5000 and n % batch == 0
+    assert_prefix(tmp_path / 'bag', n)
+    assert foxglove_count(tmp_path / 'bag') == n
+    assert (tmp_path / 'bag' / 'bag.mcap').stat().st_size <= limit + 10_000   # + the summary
+
+
+def test_mcap_summary_that_does_not_fit_drops_chunks(tmp_path, monkeypatch):
+    """No room for the summary: the last chunks are dropped until it fits; counts agree."""
+    data, chunks = unclosed_mcap(tmp_path)
+    bag = cut_bag(tmp_path, 'bag', data)
+    limit = len(data) + 200             # the summary needs more than 200 bytes
+    real = storage_mcap._pwrite_all
+
+    def pwrite_all(fd, data, offset):
+        if offset + len(data) > limit:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        real(fd, data, offset)
+
+    monkeypatch.setattr(storage_mcap, '_pwrite_all', pwrite_all)
+    info = reindex(bag)
+    assert info.notes[0].startswith('dropped the last chunk (200 messages)')
+    assert info.count('/js') == 1800
+    assert_prefix(bag, 1800)
+
+
+def test_sqlite3_full_disk_closes_with_what_was_committed(tmp_path, monkeypatch):
+    """SQLITE_FULL (max_page_count): BagError; the bag holds whole flushes, truthfully."""
+    connect = storage_sqlite3._connect
+
+    def limited(path):
+        conn = connect(path)
+        conn.execute('PRAGMA max_page_count = 120')      # 480 KiB with 4 KiB pages
+        return conn
+
+    monkeypatch.setattr(storage_sqlite3, '_connect', limited)
+    writer, topic = open_writer(tmp_path / 'bag', 'sqlite3', flush_interval=3600.0,
+                                flush_bytes=20_000)
+    with pytest.raises(BagError, match='database or disk is full'):
+        write(writer, topic, range(5000))
+    info = writer.close()
+    n = info.count('/js')
+    batch = -(-20_000 // len(payload(0)))       # messages per flush
+    assert 0 < n < 5000 and n % batch == 0
+    assert_prefix(tmp_path / 'bag', n)
+
+
+def test_bag_that_cannot_be_closed_says_to_reindex(tmp_path, monkeypatch):
+    """No room even for metadata.yaml: the error names it and the reindex command."""
+    import mech_kinematics.tools.bag.writer as bag_writer
+
+    writer, topic = open_writer(tmp_path / 'bag', 'sqlite3', flush_interval=3600.0)
+    write(writer, topic, range(100))
+
+    def no_room(info):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(bag_writer, 'write_metadata_yaml', no_room)
+    with pytest.raises(BagError) as raised:
+        writer.close()
+    bag = tmp_path / 'bag'
+    assert str(raised.value) == (f'Could not write "{bag / "metadata.yaml"}": No space left on '
+                                 f'device; remove the cause and run `python -m mech_kinematics '
+                                 f'reindex {bag}`')
+    monkeypatch.undo()
+    reindex(bag)
+    assert_prefix(bag, 100)
+
+
+# -- bags of other writers -------------------------------------------------------
+
+
+@pytest.mark.parametrize('storage', STORAGES)
+def test_reindex_rebuilds_the_metadata_of_a_rosbags_bag(tmp_path, storage):
+    """A bag written by rosbags, its metadata.yaml deleted: reindex writes the same content."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+
+    encoding, text, type_hash = definition()
+    bag = tmp_path / 'bag'
+    with Writer(bag, version=9, storage_plugin=StoragePlugin[storage.upper()]) as writer:
+        connection = writer.add_connection('/js', TYPE, msgdef=text, rihs01=type_hash,
+                                           offered_qos_profiles=qos_profiles())
+        for i in range(400):
+            writer.write(connection, T0 + i * DT, payload(i))
+    original = metadata(bag)
+    (bag / 'metadata.yaml').unlink()
+    reindex(bag)
+    rebuilt = metadata(bag)
+    for key in ('version', 'storage_identifier', 'message_count', 'duration', 'starting_time',
+                'relative_file_paths', 'topics_with_message_count'):
+        assert rebuilt[key] == original[key], key
+    assert [stamp for _, stamp in read_back(bag)['/js']] == list(range(400))
