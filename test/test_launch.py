@@ -20,6 +20,7 @@ import pytest
 import yaml
 
 import mech_kinematics as mk
+from mech_kinematics.ros.parameters import spec
 
 ROOT = Path(__file__).resolve().parent.parent
 LAUNCH_PY = ROOT / 'launch' / 'kinematics.launch.py'
@@ -30,15 +31,6 @@ PACKAGE = 'mech_kinematics'
 #: Launch arguments -> the node parameter each sets ('namespace' sets the namespace).
 ARGUMENTS = {'scene': 'scene', 'rate_hz': 'rate_hz', 'crank_speed_rpm': 'crank_speed_rpm',
              'markers': 'markers', 'namespace': None}
-
-
-def _node_constant(name: str):
-    """Return the value of a module-level constant of mech_kinematics/ros/node.py."""
-    for node in ast.parse(NODE_SOURCE.read_text(encoding='utf-8')).body:
-        if (isinstance(node, ast.Assign) and len(node.targets) == 1
-                and getattr(node.targets[0], 'id', None) == name):
-            return ast.literal_eval(node.value)
-    raise AssertionError(f'{NODE_SOURCE.name} defines no constant {name}')
 
 
 def _py_tree() -> ast.Module:
@@ -95,7 +87,7 @@ def test_defaults_are_the_nodes():
     defaults = _py_arguments()
     assert defaults['scene'] == mk.DEFAULT_SCENE
     assert (ROOT / 'config' / 'scenes' / f'{defaults["scene"]}.yaml').is_file()
-    assert float(defaults['rate_hz']) == _node_constant('DEFAULT_RATE_HZ')
+    assert float(defaults['rate_hz']) == spec('rate_hz').default
     assert defaults['crank_speed_rpm'] == ''      # empty: the scene's own speed
     assert defaults['markers'] == 'false'
     assert defaults['namespace'] == ''
@@ -174,7 +166,7 @@ def test_rviz_config_shows_the_nodes_frame_tf_and_markers():
     """The RViz config's fixed frame is the node's frame_id; it shows TF and the markers."""
     config = yaml.safe_load(RVIZ.read_text(encoding='utf-8'))
     manager = config['Visualization Manager']
-    assert manager['Global Options']['Fixed Frame'] == _node_constant('DEFAULT_FRAME_ID')
+    assert manager['Global Options']['Fixed Frame'] == spec('frame_id').default
     displays = {display['Class']: display for display in manager['Displays']}
     assert displays['rviz_default_plugins/TF']['Enabled'] is True
     markers = displays['rviz_default_plugins/MarkerArray']
