@@ -26,7 +26,7 @@ from sensor_msgs.msg import JointState
 
 import mech_kinematics as mk
 from mech_kinematics.ros.cdr import (cdr_from_message, marker, MessageTemplate,
-                                     padding_from_message, STAMP_MARKER)
+                                     padding_from_message, stamp_from_cdr, STAMP_MARKER)
 from mech_kinematics.ros.messages import (joint_state_from_state, joint_trajectory_from_state,
                                           multi_dof_trajectory_from_state, TickMessages)
 
@@ -343,3 +343,15 @@ def test_template_refuses_a_missing_marker():
     msg.header.stamp.sec = 0
     with pytest.raises(ValueError, match='stamp'):
         MessageTemplate(msg, 1)
+
+
+def test_stamp_is_read_from_the_bytes_in_either_byte_order():
+    """stamp_from_cdr reads header.stamp of little- and big-endian CDR without decoding."""
+    scene = mk.load_scene(SCENES[0])
+    state = mk.solve(scene, scene.input.angle)
+    rendered = TickMessages(scene.output_joints, scene.output_points, 'f').render(
+        state, 1_795_000_000, 123_456_789)
+    for data in rendered:
+        assert stamp_from_cdr(data) == 1_795_000_000_123_456_789
+    big_endian = b'\x00\x00\x00\x00' + struct.pack('>iI', 12, 34) + b'\x00\x00\x00\x00'
+    assert stamp_from_cdr(big_endian) == 12 * 1_000_000_000 + 34

@@ -25,7 +25,6 @@ from dataclasses import dataclass
 import math
 import os
 from pathlib import Path
-import struct
 import sys
 from typing import Any
 import warnings
@@ -35,6 +34,7 @@ import numpy.typing as npt
 
 from ..cli import finite_float, run_tool
 from ..errors import MechKinematicsError
+from ..ros.cdr import stamp_from_cdr
 from ..units import rad_per_s_from_rpm, rpm_from_rad_per_s
 
 __all__ = [
@@ -258,14 +258,14 @@ def motion_from_bag(path: str | os.PathLike[str], *, scene: Any = None,
             # thinned to at most max_samples. Pass 2: decode just those.
             stamps: dict[int, set[int]] = {c.id: set() for c in wanted}
             for connection, _, raw in reader.messages(connections=wanted):
-                stamps[connection.id].add(_header_stamp(raw))
+                stamps[connection.id].add(stamp_from_cdr(raw))
             common = sorted(set.intersection(*stamps.values()))
             step = max(1, math.ceil(len(common) / max_samples)) if max_samples else 1
             chosen = set(common[::step])
             decoders = {c.id: _decoder(reader.typestore, c.msgtype) for c in wanted}
             rows: dict[int, dict[int, Any]] = {c.id: {} for c in wanted}
             for connection, _, raw in reader.messages(connections=wanted):
-                stamp = _header_stamp(raw)
+                stamp = stamp_from_cdr(raw)
                 if stamp in chosen and stamp not in rows[connection.id]:
                     rows[connection.id][stamp] = decoders[connection.id](raw)
             scene_name = ''
@@ -312,16 +312,6 @@ def motion_from_bag(path: str | os.PathLike[str], *, scene: Any = None,
     label = scene.name if scene is not None else (scene_name or 'unknown scene')
     title = f'{label}: recording {path.name}, {time[-1] if len(time) else 0:.3g} s'
     return Motion(title, crank_angle, time, types, joints, points)
-
-
-_STAMP_LE = struct.Struct('<iI')
-_STAMP_BE = struct.Struct('>iI')
-
-
-def _header_stamp(raw: bytes | memoryview) -> int:
-    """Return ``header.stamp`` in ns of CDR bytes of a message whose first field is a Header."""
-    sec, nanosec = (_STAMP_LE if raw[1] & 1 else _STAMP_BE).unpack_from(raw, 4)
-    return int(sec) * NS_PER_S + int(nanosec)
 
 
 def _joint_arrays(msgs: list[Any], connection: Any) -> tuple[list[str], list[Any]]:
