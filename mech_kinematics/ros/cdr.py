@@ -198,13 +198,25 @@ def _find_once(data: bytes, pattern: bytes, what: str) -> int:
     return offset
 
 
+def _find_all(data: bytes, pattern: bytes, what: str) -> tuple[int, ...]:
+    offsets = []
+    offset = data.find(pattern)
+    while offset >= 0:
+        offsets.append(offset)
+        offset = data.find(pattern, offset + len(pattern))
+    if not offsets:
+        msg = f'Expected {what} in the serialized message, got none'
+        raise ValueError(msg)
+    return tuple(offsets)
+
+
 class MessageTemplate:
     """A serialized message with its header stamp and ``n_slots`` float64 fields patchable.
 
     Parameters
     ----------
     msg : ROS message
-        A message with ``header.stamp`` set to :data:`STAMP_MARKER` and the
+        A message with every header stamp set to :data:`STAMP_MARKER` and the
         fields to patch set to ``marker(0)``, ``marker(1)``, ...,
         ``marker(n_slots - 1)``; every other field holds its final value.
     n_slots : int
@@ -219,8 +231,9 @@ class MessageTemplate:
     def __init__(self, msg: Any, n_slots: int) -> None:
         data = cdr_from_message(msg)
         self._stamp = struct.Struct('<iI')
-        self._stamp_offset = _find_once(data, self._stamp.pack(*STAMP_MARKER),
-                                        'the header stamp marker')
+        # One stamp, or several (a TFMessage has one per transform), all patched alike.
+        stamp = self._stamp.pack(*STAMP_MARKER)
+        self._stamp_offsets = _find_all(data, stamp, 'the header stamp marker')
         offsets = [_find_once(data, struct.pack('<d', marker(i)), f'slot {i}')
                    for i in range(n_slots)]
         buffer = bytearray(data)
@@ -249,7 +262,9 @@ class MessageTemplate:
     def render(self, sec: int, nanosec: int, values: Sequence[float]) -> bytes:
         """Return the serialized message with this stamp and slot values (in slot order)."""
         buffer = self._buffer
-        self._stamp.pack_into(buffer, self._stamp_offset, sec, nanosec)
+        pack_stamp = self._stamp.pack_into
+        for offset in self._stamp_offsets:
+            pack_stamp(buffer, offset, sec, nanosec)
         for pack_into, offset, start, stop in self._runs:
             pack_into(buffer, offset, *values[start:stop])
         return bytes(buffer)

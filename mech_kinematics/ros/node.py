@@ -29,6 +29,7 @@ Run it with ``ros2 run mech_kinematics kinematics_node`` or
 from __future__ import annotations
 
 import ctypes
+from dataclasses import replace
 import gc
 import math
 import sys
@@ -60,8 +61,10 @@ from .markers import marker_array_from_state, marker_size_from_space, MarkerThro
 from .messages import TickMessages
 from .parameters import CATCH_UP, joint_refusal, PARAMETERS, ParameterSpec, refusal, spec
 from .schedule import period_ns_from_rate, TickGrid
+from .tf import static_tf_message, TF_STATIC_TOPIC, TF_TOPIC, TfMessages
 from .timebase import CrankTimebase
 from ..geometry.diagrams import space_from_state, strokes_from_scene
+from ..geometry.frames import angle_joints, frames_from_scene, origin_points, poses_from_state
 from ..geometry.instant_centres import full_scene
 from ..units import NS_PER_S, rpm_from_rad_per_s
 
@@ -89,6 +92,8 @@ READ_ONLY = frozenset(p.name for p in PARAMETERS if p.read_only)
 
 #: Depth of the state publishers' history: deep enough for a catch-up burst.
 STATE_DEPTH = 1000
+#: /tf and /tf_static as tf2's broadcasters offer them.
+TF_DEPTH = 100
 #: Every publisher accepts ``qos_overrides./TOPIC.publisher.POLICY`` for these policies.
 QOS_OVERRIDES = QoSPolicyKind.HISTORY, QoSPolicyKind.DEPTH, QoSPolicyKind.RELIABILITY, \
     QoSPolicyKind.DURABILITY
@@ -122,6 +127,14 @@ def _description(p: ParameterSpec) -> str:
 
 def _qos_options() -> QoSOverridingOptions:
     return QoSOverridingOptions(policy_kinds=QOS_OVERRIDES)
+
+
+def _tf_qos(static: bool) -> QoSProfile:
+    """Return the profile of ``/tf`` (volatile) or ``/tf_static`` (transient local, depth 1)."""
+    return QoSProfile(history=QoSHistoryPolicy.KEEP_LAST, depth=1 if static else TF_DEPTH,
+                      reliability=QoSReliabilityPolicy.RELIABLE,
+                      durability=QoSDurabilityPolicy.TRANSIENT_LOCAL if static
+                      else QoSDurabilityPolicy.VOLATILE)
 
 
 def _state_qos() -> QoSProfile:
@@ -176,7 +189,7 @@ class KinematicsNode(LifecycleNode):
         self._pending_lock = threading.Lock()
         self._waiting_for_clock = False
         self._rebase_from: int | None = None
-        self._publishers: list[Any] = []
+        self._state_publishers: list[Any] = []
         self._pub_markers: Any = None
         self._failure_guard = self.create_guard_condition(self._on_failure)
         self.add_pre_set_parameters_callback(self._pre_set)
@@ -197,6 +210,9 @@ class KinematicsNode(LifecycleNode):
         self._period_ns = period_ns_from_rate(self.get_parameter('rate_hz').value)
         self._catch_up = self.get_parameter('late_ticks').value == CATCH_UP
         self._max_behind_ns = round(self.get_parameter('max_catch_up_s').value * NS_PER_S)
+        self._tf_period_ns = self._tf_period(self.get_parameter('tf_rate_hz').value)
+        self._tf: TfMessages | None = None
+        self._next_tf = 0
         self._pub_diagnostics = self.create_publisher(
             DiagnosticArray, 'diagnostics', 10, qos_overriding_options=_qos_options())
         self._diagnostics_timer = self.create_timer(
@@ -205,6 +221,10 @@ class KinematicsNode(LifecycleNode):
             JumpThreshold(min_forward=Duration(nanoseconds=1), min_backward=None,
                           on_clock_change=True),
             post_callback=lambda _jump: self._clock_event.set())
+
+    @staticmethod
+    def _tf_period(rate_hz: float) -> int | None:
+        return None if rate_hz <= 0.0 else period_ns_from_rate(rate_hz)
 
     def _value(self, name: str) -> Any:
         return self.get_parameter(name).value
@@ -253,6 +273,8 @@ class KinematicsNode(LifecycleNode):
             self._catch_up = changes['late_ticks'] == CATCH_UP
         if 'max_catch_up_s' in changes:
             self._max_behind_ns = round(changes['max_catch_up_s'] * NS_PER_S)
+        if 'tf_rate_hz' in changes:
+            self._tf_period_ns = self._tf_period(changes['tf_rate_hz'])
         drive = {name: float(changes[name]) for name in DRIVE if name in changes}
         if drive:
             with self._pending_lock:
@@ -313,19 +335,52 @@ class KinematicsNode(LifecycleNode):
         self._pub_point_accel = self.create_publisher(
             MultiDOFJointTrajectory, 'point_accelerations', _state_qos(),
             qos_overriding_options=_qos_options())
-        self._publishers = [self._pub_joint_states, self._pub_joint_accel,
+        self._state_publishers = [self._pub_joint_states, self._pub_joint_accel,
                             self._pub_point_accel]
+        self._tick_scene = self._setup_tf(scene)
         if self._value('markers'):
             self._setup_markers(scene)
         self.scene = scene
         self._log_start()
 
+    def _setup_tf(self, scene: mk.Scene) -> mk.Scene:
+        """Create the /tf and /tf_static publishers; return the scene the ticks solve.
+
+        The frames' origins and angles may be points and joints the scene does
+        not output: the ticks solve a copy that outputs them too (only the
+        scene's own outputs are published on the state topics).
+        """
+        self._tf = None
+        try:
+            from tf2_msgs.msg import TFMessage
+        except ImportError:
+            self.get_logger().warning(
+                'tf2_msgs is not installed (make install builds it): no frames on /tf')
+            return scene
+        frames = frames_from_scene(scene)
+        prefix = self._value('tf_prefix') or self.frame_id
+        self._tf = TfMessages(frames, self.frame_id, prefix)
+        self._tf_frames = frames
+        self._pub_tf = self.create_publisher(TFMessage, TF_TOPIC, _tf_qos(False),
+                                             qos_overriding_options=_qos_options())
+        self._pub_tf_static = self.create_publisher(TFMessage, TF_STATIC_TOPIC, _tf_qos(True),
+                                                    qos_overriding_options=_qos_options())
+        self._state_publishers += [self._pub_tf, self._pub_tf_static]
+        self._pub_tf_static.publish(static_tf_message(
+            scene.ground, self.frame_id, prefix, self.get_clock().now().to_msg()))
+        points = [p for p in origin_points(frames) if p not in scene.output_points]
+        joints = [j for j in angle_joints(frames) if j not in scene.output_joints]
+        if not points and not joints:
+            return scene
+        return replace(scene, outputs_points=(*scene.output_points, *points),
+                       outputs_joints=(*scene.output_joints, *joints))
+
     def _log_start(self) -> None:
         scene = self.scene
         assert scene is not None
         names = ('scene', 'crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm', 'rate_hz',
-                 'late_ticks', 'max_catch_up_s', 'frame_id', 'use_sim_time', 'markers',
-                 'managed')
+                 'late_ticks', 'max_catch_up_s', 'frame_id', 'tf_rate_hz', 'tf_prefix',
+                 'use_sim_time', 'markers', 'managed')
         settings = ', '.join(f'{name}={self._value(name)!r}' for name in names[1:])
         self.get_logger().info(
             f'scene {scene.name!r} ({self._value("scene")}): joints {list(scene.output_joints)}, '
@@ -353,10 +408,10 @@ class KinematicsNode(LifecycleNode):
         return TransitionCallbackReturn.SUCCESS
 
     def _teardown(self) -> None:
-        for publisher in [*self._publishers, self._pub_markers]:
+        for publisher in [*self._state_publishers, self._pub_markers]:
             if publisher is not None:
                 self.destroy_publisher(publisher)
-        self._publishers = []
+        self._state_publishers = []
         self._pub_markers = None
         self.scene = None
 
@@ -503,7 +558,7 @@ class KinematicsNode(LifecycleNode):
                              self._value('crank_accel'), self._value('max_crank_speed_rpm'))
 
     def _tick(self, stamp: int, lateness: int, late: bool) -> None:
-        scene = self.scene
+        scene = self._tick_scene
         assert scene is not None and self._timebase is not None
         angle, speed, accel = sample = self._timebase.sample(stamp)
         try:
@@ -517,6 +572,11 @@ class KinematicsNode(LifecycleNode):
         self._pub_joint_states.publish(joint_states)
         self._pub_joint_accel.publish(joint_accel)
         self._pub_point_accel.publish(point_accel)
+        tf_period = self._tf_period_ns
+        if self._tf is not None and tf_period is not None and stamp >= self._next_tf:
+            self._pub_tf.publish(self._tf.render(poses_from_state(self._tf_frames, state),
+                                                 sec, nanosec))
+            self._next_tf = stamp + tf_period
         if self._pub_markers is not None and self._marker_throttle.due(
                 self._period_ns, time.monotonic_ns()):
             # Built in the executor's thread, so that this thread keeps its deadlines.

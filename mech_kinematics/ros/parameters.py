@@ -50,6 +50,8 @@ class ParameterSpec:
         Allowed values of a string ('' for any non-empty string).
     read_only : bool
         Set at start only.
+    may_be_empty : bool
+        A string that may be empty.
     """
 
     name: str
@@ -96,6 +98,12 @@ PARAMETERS = (
     ParameterSpec('max_catch_up_s', 'double', 0.1,
                   'How far behind a late wake-up still publishes missed instants; older '
                   'ones are skipped and counted', 's', 0.0, 10.0),
+    ParameterSpec('tf_rate_hz', 'double', 100.0,
+                  'Rate of the link and slider frames on /tf, stamped like the state of the '
+                  'tick they show (at most rate_hz: every tick; 0: off)', 'Hz', 0.0, 10_000.0),
+    ParameterSpec('tf_prefix', 'string', '',
+                  "Prefix of the child frames on /tf and /tf_static, '<prefix>/<link>' "
+                  "(default '': frame_id)", read_only=True, may_be_empty=True),
     ParameterSpec('markers', 'bool', False,
                   'Also publish visualization_msgs/MarkerArray on markers, at most 30 Hz',
                   read_only=True),

@@ -1,0 +1,102 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""A coordinate frame on every moving link and slider block of a scene (for ``/tf``).
+
+A link's frame has its origin at the point the link starts from in the scene
+(the crank's ``center``, a dyad link's ``from``, an RPR lever's ``center``)
+and its x axis along the link, at the link's angle (its joint position); a
+point carried by the link at ``local`` coordinates in the scene sits at the
+same coordinates in this frame when the link starts at its ``origin``. A
+slider's frame sits at the block (an RRP's new point, an RPR's pin) with its
+x axis along the guide (an RRP's fixed guide direction, an RPR's lever).
+
+:func:`frames_from_scene` names the frames once; :func:`poses_from_state`
+reads their poses off a solved state. Pure geometry: NumPy only.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from ..linkage import RPR, RRP, RRR, Scene, State
+
+__all__ = ['FrameSpec', 'Pose', 'angle_joints', 'frames_from_scene', 'origin_points',
+           'poses_from_state']
+
+
+@dataclass(frozen=True)
+class FrameSpec:
+    """Where a joint's frame sits.
+
+    Attributes
+    ----------
+    joint : str
+        The link or slider the frame belongs to (the child frame's last part).
+    origin : str
+        The point at the frame's origin.
+    angle_of : str or None
+        The joint whose position is the frame's angle, or ``None`` for a fixed
+        ``angle`` (an RRP guide).
+    angle : float
+        The fixed angle, rad (when ``angle_of`` is ``None``).
+    """
+
+    joint: str
+    origin: str
+    angle_of: str | None
+    angle: float = 0.0
+
+
+@dataclass(frozen=True)
+class Pose:
+    """A frame's pose in the ground frame: origin (m) and angle (rad, CCW from +x)."""
+
+    joint: str
+    x: float
+    y: float
+    angle: float
+
+
+def frames_from_scene(scene: Scene, joints: Sequence[str] | None = None) -> tuple[FrameSpec, ...]:
+    """Return the frames of ``joints`` (default: the scene's output joints), in that order."""
+    specs: dict[str, FrameSpec] = {}
+    crank = scene.input
+    specs[crank.link] = FrameSpec(crank.link, crank.center, crank.link)
+    for dyad in scene.dyads:
+        if isinstance(dyad, RRR):
+            for link in dyad.links:
+                specs[link.name] = FrameSpec(link.name, link.start, link.name)
+        elif isinstance(dyad, RRP):
+            specs[dyad.link.name] = FrameSpec(dyad.link.name, dyad.link.start, dyad.link.name)
+            specs[dyad.slider] = FrameSpec(dyad.slider, dyad.point, None, dyad.guide_angle)
+        elif isinstance(dyad, RPR):
+            specs[dyad.link] = FrameSpec(dyad.link, dyad.center, dyad.link)
+            specs[dyad.slider] = FrameSpec(dyad.slider, dyad.through, dyad.link)
+    names = scene.output_joints if joints is None else joints
+    return tuple(specs[name] for name in names)
+
+
+def origin_points(frames: Sequence[FrameSpec]) -> tuple[str, ...]:
+    """Return the points whose positions the frames need, each once, in order."""
+    return tuple(dict.fromkeys(f.origin for f in frames))
+
+
+def angle_joints(frames: Sequence[FrameSpec]) -> tuple[str, ...]:
+    """Return the joints whose positions the frames take their angles from, each once."""
+    return tuple(dict.fromkeys(f.angle_of for f in frames if f.angle_of is not None))
+
+
+def poses_from_state(frames: Sequence[FrameSpec], state: State) -> list[Pose]:
+    """Return the pose of every frame in a state solved for one crank angle.
+
+    ``state`` must hold every point of :func:`origin_points` and every joint
+    the frames take their angle from.
+    """
+    points, joints = state.complex_points, state.joints
+    poses = []
+    for f in frames:
+        p = points[f.origin][0]
+        angle = f.angle if f.angle_of is None else float(joints[f.angle_of].position)
+        poses.append(Pose(f.joint, float(p.real), float(p.imag), angle))
+    return poses

@@ -1,0 +1,132 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""Link frames on /tf and ground points on /tf_static, seen from another process (issue 13).
+
+The frames are checked against the published points of the same tick, built
+from the scene's own definitions (not from the module that makes the
+frames): a link's frame carries the link's far end at (length, 0), a slider's
+frame sits at its block, a slotted lever's frame carries the pin at (s, 0).
+"""
+
+import math
+import signal
+import time
+
+import numpy as np
+import pytest
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from ros_helpers import NodeProcess, Ros, SESSION, stamp_ns, STARTUP_S, wait_for
+from sensor_msgs.msg import JointState
+from tf2_msgs.msg import TFMessage    # built by make install (scripts/build_tf2_msgs.py)
+from trajectory_msgs.msg import MultiDOFJointTrajectory
+
+import mech_kinematics as mk
+
+#: Transforms composed against the published points, m (relative to the mechanism's size).
+RTOL_FRAMES = 1e-12
+FRAME_ID = 'base'
+
+
+@pytest.fixture(scope='module')
+def ros():
+    ros = Ros()
+    yield ros
+    ros.close()
+
+
+def _apply(transform, local):
+    """Return the ground position of ``local`` (x, y) in a TransformStamped's child frame."""
+    t, q = transform.translation, transform.rotation
+    assert q.x == 0.0 and q.y == 0.0 and t.z == 0.0
+    angle = 2.0 * math.atan2(q.z, q.w)
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([t.x + c * local[0] - s * local[1], t.y + s * local[0] + c * local[1]])
+
+
+def _expected(scene, points, sliders):
+    """Child frame -> (local point, ground point it must land on), from the scene's data."""
+    crank = scene.input
+    out = {crank.link: ((crank.length, 0.0), points[crank.point])}
+    for dyad in scene.dyads:
+        if isinstance(dyad, mk.RRR):
+            for link in dyad.links:
+                out[link.name] = ((link.length, 0.0), points[dyad.point])
+        elif isinstance(dyad, mk.RRP):
+            out[dyad.link.name] = ((dyad.link.length, 0.0), points[dyad.point])
+            out[dyad.slider] = ((0.0, 0.0), points[dyad.point])
+        else:
+            out[dyad.link] = ((sliders[dyad.slider], 0.0), points[dyad.through])
+            out[dyad.slider] = ((0.0, 0.0), points[dyad.through])
+    origins = {crank.link: crank.center}
+    for dyad in scene.dyads:
+        if isinstance(dyad, mk.RRR):
+            origins.update((link.name, link.start) for link in dyad.links)
+        elif isinstance(dyad, mk.RRP):
+            origins[dyad.link.name] = dyad.link.start
+        else:
+            origins[dyad.link] = dyad.center
+    return out, {name: points[p] for name, p in origins.items()}
+
+
+@pytest.mark.parametrize('scene_name', ['khurmi_four_bar_ad150', 'quick_return'])
+def test_link_frames_compose_to_the_published_points(ros, tmp_path, scene_name):
+    """Every link and slider frame on /tf puts the scene's points where the node publishes them."""
+    scene = mk.load_scene(scene_name)
+    ns = f'{SESSION}/tf_{scene_name}'
+    qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+    static_qos = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                            durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    tf = ros.collect(TFMessage, f'{ns}/tf', qos)
+    points_msgs = ros.collect(MultiDOFJointTrajectory, f'{ns}/point_accelerations', qos)
+    joint_msgs = ros.collect(JointState, f'{ns}/joint_states', qos)
+    proc = NodeProcess(tmp_path, '-r', f'__ns:={ns}', '-r', f'/tf:={ns}/tf',
+                       '-r', f'/tf_static:={ns}/tf_static', '-p', f'scene:={scene_name}',
+                       '-p', 'rate_hz:=200', '-p', 'tf_rate_hz:=50',
+                       '-p', f'frame_id:={FRAME_ID}')
+    try:
+        wait_for(lambda: len(tf) >= 40, STARTUP_S, '40 /tf messages')
+        static = []
+        # A late subscriber still gets the static frames (transient local).
+        ros.node.create_subscription(TFMessage, f'{ns}/tf_static', static.append,
+                                     static_qos)
+        wait_for(lambda: static, 5.0, '/tf_static')
+        time.sleep(0.2)
+    finally:
+        status, _ = proc.stop(signal.SIGINT)
+    assert status == 0, proc.output()
+    size = max(abs(v) for xy in scene.ground.values() for v in xy) + scene.input.length
+    by_stamp = {stamp_ns(m): m for m in points_msgs}
+    joints_by_stamp = {stamp_ns(m): m for m in joint_msgs}
+    checked = 0
+    for msg in tf:
+        stamps = {stamp_ns(t) for t in msg.transforms}
+        assert len(stamps) == 1, 'the transforms of one message share one stamp'
+        stamp = stamps.pop()
+        if stamp not in by_stamp or stamp not in joints_by_stamp:
+            continue
+        pm, jm = by_stamp[stamp], joints_by_stamp[stamp]
+        points = {name: np.array([t.translation.x, t.translation.y])
+                  for name, t in zip(pm.joint_names, pm.points[0].transforms, strict=True)}
+        sliders = dict(zip(jm.name, jm.position, strict=True))
+        expected, origins = _expected(scene, points, sliders)
+        frames = {t.child_frame_id: t for t in msg.transforms}
+        assert set(frames) == {f'{FRAME_ID}/{j}' for j in scene.output_joints}
+        for transform in msg.transforms:
+            assert transform.header.frame_id == FRAME_ID
+            joint = transform.child_frame_id.split('/', 1)[1]
+            local, target = expected[joint]
+            np.testing.assert_allclose(_apply(transform.transform, local), target,
+                                       rtol=0, atol=RTOL_FRAMES * size)
+            if joint in origins:
+                np.testing.assert_allclose(_apply(transform.transform, (0.0, 0.0)),
+                                           origins[joint], rtol=0, atol=RTOL_FRAMES * size)
+        checked += 1
+    assert checked >= 30
+    # 50 Hz of a 200 Hz grid: every fourth instant.
+    tf_stamps = sorted(stamp_ns(m.transforms[0]) for m in tf)
+    assert {b - a for a, b in zip(tf_stamps, tf_stamps[1:], strict=False)} == {20_000_000}
+    ground = {t.child_frame_id: t.transform for t in static[-1].transforms}
+    assert set(ground) == {f'{FRAME_ID}/{name}' for name in scene.ground}
+    for name, (x, y) in scene.ground.items():
+        t = ground[f'{FRAME_ID}/{name}']
+        assert (t.translation.x, t.translation.y, t.rotation.w) == (x, y, 1.0)
