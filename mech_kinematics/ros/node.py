@@ -336,7 +336,7 @@ class KinematicsNode(LifecycleNode):
             MultiDOFJointTrajectory, 'point_accelerations', _state_qos(),
             qos_overriding_options=_qos_options())
         self._state_publishers = [self._pub_joint_states, self._pub_joint_accel,
-                            self._pub_point_accel]
+                                  self._pub_point_accel]
         self._tick_scene = self._setup_tf(scene)
         if self._value('markers'):
             self._setup_markers(scene)
