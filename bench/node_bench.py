@@ -1,49 +1,55 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""Benchmark of the running kinematics_node (a script, not a test).
+"""Benchmark of the running kinematics_node against the rclpy floor (a script, not a test).
 
-For each rate it starts the node on the four-bar scene and one subscriber in
-another process, lets them settle, then measures for ``--seconds``:
+The *floor* is a bare rclpy process that only publishes three pre-serialized
+messages of the node's sizes from a deadline thread on the same exact grid
+(no solving, no rendering: it patches the stamp and publishes). Each run
+starts one publisher (the node or the floor) and one subscriber in another
+process, lets them settle, then measures for ``--seconds``:
 
-- achieved rate: ticks published per second (the node's own counter, from
-  ``diagnostics``);
-- received / sent: state messages the subscriber got over those the node
-  published in the same stretch of stamps, per topic;
-- node CPU: user + system time of the whole node process over wall time, in %
-  of one core (from /proc);
-- tick lateness: how late the tick thread woke for its deadline, median and
-  p99 (the node's own numbers on ``diagnostics``, per 1 s window: the median
-  of the medians and the largest p99);
-- latency: receive time minus ``header.stamp`` at the subscriber, median and
-  p99.
+- CPU: user + system time of the whole publishing process (all threads, DDS
+  included) over wall time, % of one core, from /proc;
+- delivered: grid instants the subscriber received on every state topic over
+  the grid instants in the same stretch of stamps (the subscriber uses
+  ``raw=True`` subscriptions and reads ``header.stamp`` from the bytes with
+  :func:`mech_kinematics.ros.cdr.stamp_from_cdr`);
+- skipped: instants the node counted as skipped (beyond ``max_catch_up_s``),
+  from its ``diagnostics``.
 
-The subscriber uses ``raw=True`` subscriptions and reads the stamp straight
-from the CDR bytes (a decoding Python subscriber tops out at 2-3 k msg/s).
+The node and the floor alternate, ``--repeat`` times each, in one run, so
+that both meet the same machine: read the ratio, not the times.
 
-Usage: ``python bench/node_bench.py [--rates 100 1000 5000] [--seconds 10]``
-(with the package importable, e.g. from ``make`` 's .venv). Prints a Markdown
-table.
+``--chains`` measures a scene that grows: one crank driving 1, 4, 16 and 64
+four-bar dyads (a machine's main shaft), node and floor (messages of the same
+sizes) at 1 kHz.
+
+Usage (with the package importable, e.g. ``make``'s .venv)::
+
+    python bench/node_bench.py [--rates 1000 5000] [--seconds 60] [--repeat 3]
+    python bench/node_bench.py --chains [--seconds 20]
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 from pathlib import Path
 import random
 import signal
 import statistics
-import struct
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 
 NS = 1_000_000_000
 STATE_TOPICS = ('joint_states', 'joint_accelerations', 'point_accelerations')
 SCENE = 'khurmi_four_bar_ad150'
-_STAMP = struct.Struct('<iI')   # header.stamp right after the 4-byte CDR encapsulation
+CHAIN_SIZES = (1, 4, 16, 64)
 
 
 def _cpu_seconds(pid: int) -> float:
@@ -51,112 +57,205 @@ def _cpu_seconds(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
 
 
-def _quantile(values: list[float], q: float) -> float:
-    ordered = sorted(values)
-    return ordered[min(len(ordered) - 1, int(q * len(ordered)))]
+def chain_scene(dyads: int) -> str:
+    """Return the YAML of one crank driving ``dyads`` four-bar dyads about one shaft.
+
+    Each dyad is the packaged four-bar (AB 40, BC 150, CD 80, AD 150 mm, a
+    Grashof crank-rocker that assembles at every angle) turned about A.
+    """
+    lines = [f'name: chain_{dyads}', 'units: {length: mm, angle: deg}', 'ground:',
+             '  A: [0, 0]']
+    for i in range(dyads):
+        turn = 2 * math.pi * i / dyads
+        lines.append(f'  D{i}: [{150 * math.cos(turn):.6f}, {150 * math.sin(turn):.6f}]')
+    lines += ['input: {link: crank, center: A, point: B, length: 40, angle: 60, '
+              'speed_rpm: -120}', 'dyads:']
+    for i in range(dyads):
+        lines.append(f'  - {{type: RRR, point: C{i}, links: [{{name: coupler{i}, from: B, '
+                     f'length: 150}}, {{name: rocker{i}, from: D{i}, length: 80}}], '
+                     'branch: 1}')
+    return '\n'.join(lines) + '\n'
 
 
-# -- the subscriber process ----------------------------------------------------------
+# -- the floor: a bare publisher on the same grid ------------------------------------
 
 
-def subscribe(namespace: str, warmup: float, seconds: float, out: str) -> None:
-    """Record (receive ns, stamp ns) of every state message, and the diagnostics."""
+def floor(namespace: str, rate: float, scene_name: str) -> None:
+    """Publish the three state messages of ``scene_name``, pre-serialized, on an exact grid."""
+    import struct
+
     import rclpy
     from rclpy.qos import QoSProfile, ReliabilityPolicy
-    from diagnostic_msgs.msg import DiagnosticArray
     from sensor_msgs.msg import JointState
     from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
+
+    import mech_kinematics as mk
+    from mech_kinematics.ros.messages import TickMessages
+    from mech_kinematics.ros.schedule import period_ns_from_rate, TickGrid
+
+    scene = mk.load_scene(scene_name)
+    state = mk.solve(scene, scene.input.angle)
+    payloads = [bytearray(b) for b in TickMessages(
+        scene.output_joints, scene.output_points, 'mechanism').render(state, 0, 0)]
+    rclpy.init()
+    node = rclpy.create_node('floor_publisher', namespace=namespace)
+    qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+    publishers = [node.create_publisher(t, topic, qos) for t, topic in zip(
+        (JointState, JointTrajectory, MultiDOFJointTrajectory), STATE_TOPICS, strict=True)]
+    stamp = struct.Struct('<iI')
+    period = period_ns_from_rate(rate)
+    stop = threading.Event()
+
+    def loop() -> None:
+        grid = TickGrid.aligned(time.time_ns(), period)
+        while not stop.is_set():
+            now = time.time_ns()
+            if now < grid.next_ns:
+                time.sleep(min(grid.next_ns - now, 50_000_000) / NS)
+                continue
+            for t in grid.take(now, NS // 10).instants:
+                sec, nanosec = divmod(t, NS)
+                for publisher, payload in zip(publishers, payloads, strict=True):
+                    stamp.pack_into(payload, 4, sec, nanosec)
+                    publisher.publish(bytes(payload))
+
+    sys.setswitchinterval(0.0005)
+    thread = threading.Thread(target=loop, daemon=True)
+    thread.start()
+    signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    try:
+        while not stop.is_set():
+            rclpy.spin_once(node, timeout_sec=0.1)
+    except KeyboardInterrupt:
+        pass
+    stop.set()
+    thread.join(timeout=1.0)
+    node.destroy_node()
+    rclpy.try_shutdown()
+
+
+# -- the subscriber -------------------------------------------------------------------
+
+
+def subscribe(namespace: str, seconds: float, out: str) -> None:
+    """Record the stamps of every state message and the diagnostics, then write them out."""
+    import rclpy
+    from diagnostic_msgs.msg import DiagnosticArray
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+    from sensor_msgs.msg import JointState
+    from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
+
+    from mech_kinematics.ros.cdr import stamp_from_cdr
 
     rclpy.init()
     node = rclpy.create_node('node_bench_subscriber', namespace=namespace)
     qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
-    received: dict[str, list[tuple[int, bytes]]] = {t: [] for t in STATE_TOPICS}
-    now = time.time_ns
+    received: dict[str, list[bytes]] = {t: [] for t in STATE_TOPICS}
     for topic, msg_type in zip(STATE_TOPICS,
                                (JointState, JointTrajectory, MultiDOFJointTrajectory),
                                strict=True):
         sink = received[topic]
-        node.create_subscription(msg_type, topic,
-                                 lambda data, sink=sink: sink.append((now(), data[4:12])),
+        node.create_subscription(msg_type, topic, lambda data, sink=sink: sink.append(data[:12]),
                                  qos, raw=True)
-    diagnostics: list[dict[str, object]] = []
+    diagnostics: list[dict[str, str]] = []
 
     def on_diagnostics(msg: DiagnosticArray) -> None:
-        values = {kv.key: kv.value for s in msg.status for kv in s.values}
-        values['stamp'] = msg.header.stamp.sec * NS + msg.header.stamp.nanosec
-        diagnostics.append(values)
+        diagnostics.append({kv.key: kv.value for s in msg.status for kv in s.values})
 
     node.create_subscription(DiagnosticArray, 'diagnostics', on_diagnostics, 10)
-    end = time.monotonic() + warmup + seconds + 1.5
+    end = time.monotonic() + seconds
     while time.monotonic() < end:
         rclpy.spin_once(node, timeout_sec=0.1)
     node.destroy_node()
     rclpy.try_shutdown()
-    result = {'diagnostics': diagnostics, 'warmup_end_ns': 0,
-              'received': {t: [(r, _STAMP.unpack(s)) for r, s in v]
-                           for t, v in received.items()}}
-    Path(out).write_text(json.dumps(result))
+    Path(out).write_text(json.dumps({
+        'diagnostics': diagnostics,
+        'stamps': {t: [stamp_from_cdr(d) for d in v] for t, v in received.items()}}))
 
 
 # -- the driver ----------------------------------------------------------------------
 
 
-def measure(rate: float, warmup: float, seconds: float, env: dict[str, str],
-            tmp: Path) -> dict[str, float]:
-    """Run node + subscriber at ``rate``; return the row of the table."""
-    namespace = f'/bench_{os.getpid()}_{int(rate)}'
-    out = tmp / f'sub_{int(rate)}.json'
-    sub = subprocess.Popen([sys.executable, __file__, '--subscribe', namespace,
-                            str(warmup), str(seconds), str(out)], env=env)
+def _delivered(stamps: dict[str, list[int]], period: int, lo: int, hi: int) -> float:
+    """Return the least, over the topics, of grid instants in [lo, hi] received over owed."""
+    owed = (hi - lo) // period + 1
+    return min(len({s for s in v if lo <= s <= hi}) / owed for v in stamps.values())
+
+
+def measure(kind: str, rate: float, scene: str, args: argparse.Namespace,
+            env: dict[str, str], tmp: Path) -> dict[str, float]:
+    """Run the node or the floor at ``rate`` with a subscriber; return the row of the table."""
+    namespace = f'/bench_{os.getpid()}_{kind}_{int(rate)}_{random.randrange(10 ** 6)}'
+    out = tmp / f'{namespace[1:]}.json'
+    listen = args.warmup + args.seconds + 2.0
+    sub = subprocess.Popen([sys.executable, __file__, '--subscribe', namespace, str(listen),
+                            str(out)], env=env)
     time.sleep(1.0)     # the subscriber is there before the first message
-    node = subprocess.Popen(
-        [sys.executable, '-m', 'mech_kinematics.kinematics_node', '--ros-args',
-         '-r', f'__ns:={namespace}', '-p', f'scene:={SCENE}', '-p', f'rate_hz:={rate}',
-         '--log-level', 'warn'], env=env)
+    if kind == 'node':
+        command = [sys.executable, '-m', 'mech_kinematics.kinematics_node', '--ros-args',
+                   '-r', f'__ns:={namespace}', '-p', f'scene:={scene}',
+                   '-p', f'rate_hz:={rate}', '--log-level', 'warn']
+    else:
+        command = [sys.executable, __file__, '--floor', namespace, str(rate), scene]
+    publisher = subprocess.Popen(command, env=env)
     try:
-        time.sleep(warmup)
-        cpu0, wall0, stamp0 = _cpu_seconds(node.pid), time.monotonic(), time.time_ns()
-        time.sleep(seconds)
-        cpu1, wall1, stamp1 = _cpu_seconds(node.pid), time.monotonic(), time.time_ns()
+        time.sleep(args.warmup)
+        cpu0, wall0, stamp0 = _cpu_seconds(publisher.pid), time.monotonic(), time.time_ns()
+        time.sleep(args.seconds)
+        cpu1, wall1, stamp1 = _cpu_seconds(publisher.pid), time.monotonic(), time.time_ns()
     finally:
-        node.send_signal(signal.SIGINT)
-        node.wait(timeout=10)
-        sub.wait(timeout=30)
+        publisher.send_signal(signal.SIGINT)
+        publisher.wait(timeout=10)
+        sub.wait(timeout=60)
     data = json.loads(out.read_text())
-    # The node's diagnostics in the window: published totals and lateness per 1 s window.
-    diags = [d for d in data['diagnostics'] if stamp0 <= d['stamp'] <= stamp1]
-    first, last = diags[0], diags[-1]
-    sent = int(last['published_total']) - int(first['published_total'])
-    span_s = (last['stamp'] - first['stamp']) / NS
-    row = {'rate': rate, 'achieved': sent / span_s, 'cpu': 100 * (cpu1 - cpu0) / (wall1 - wall0),
-           'late_median_us': statistics.median(float(d['lateness_median_us']) for d in diags[1:]),
-           'late_p99_us': max(float(d['lateness_p99_us']) for d in diags[1:]),
-           'late_ticks': sum(int(d['late_ticks']) for d in diags[1:]),
-           'skipped_ticks': sum(int(d['skipped_ticks']) for d in diags[1:])}
-    latencies: list[float] = []
-    for topic in STATE_TOPICS:
-        got = [(r, s * NS + n) for r, (s, n) in data['received'][topic]]
-        lo, hi = int(first['last_published_stamp_ns']), int(last['last_published_stamp_ns'])
-        in_window = [(r, t) for r, t in got if lo < t <= hi]
-        row[f'received_{topic}'] = len(in_window) / sent
-        latencies += [(r - t) / 1e3 for r, t in in_window]
-    row['latency_median_us'] = statistics.median(latencies)
-    row['latency_p99_us'] = _quantile(latencies, 0.99)
+    period = round(NS / rate)
+    lo = -(-stamp0 // period) * period
+    hi = stamp1 // period * period
+    row = {'kind': kind, 'rate': rate, 'cpu': 100 * (cpu1 - cpu0) / (wall1 - wall0),
+           'delivered': _delivered(data['stamps'], period, lo, hi)}
+    if data['diagnostics']:
+        last = data['diagnostics'][-1]
+        row['skipped'] = int(last.get('skipped_ticks_total', 0))
     return row
 
 
+def _table(rows: list[dict[str, float]], key: str) -> list[str]:
+    lines = [f'| {key} | floor CPU % (runs) | node CPU % (runs) | node / floor (medians) | '
+             'delivered floor / node (worst run) |', '|---:|---:|---:|---:|---:|']
+    for value in dict.fromkeys(r[key] for r in rows):
+        floor = [r for r in rows if r[key] == value and r['kind'] == 'floor']
+        node = [r for r in rows if r[key] == value and r['kind'] == 'node']
+        f_cpu = [r['cpu'] for r in floor]
+        n_cpu = [r['cpu'] for r in node]
+        ratio = statistics.median(n_cpu) / statistics.median(f_cpu)
+        lines.append(
+            f'| {value:g} | {" / ".join(f"{c:.1f}" for c in f_cpu)} | '
+            f'{" / ".join(f"{c:.1f}" for c in n_cpu)} | {ratio:.2f} | '
+            f'{100 * min(r["delivered"] for r in floor):.3f} % / '
+            f'{100 * min(r["delivered"] for r in node):.3f} % |')
+    return lines
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Run the benchmark and print the table."""
+    """Run the benchmark and print Markdown tables."""
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
-    parser.add_argument('--rates', type=float, nargs='+', default=[100.0, 1000.0, 5000.0])
-    parser.add_argument('--seconds', type=float, default=10.0, help='measured time per rate')
-    parser.add_argument('--warmup', type=float, default=3.0, help='settling time per rate')
+    parser.add_argument('--rates', type=float, nargs='+', default=[1000.0, 5000.0])
+    parser.add_argument('--seconds', type=float, default=60.0, help='measured time per run')
+    parser.add_argument('--warmup', type=float, default=5.0, help='settling time per run')
+    parser.add_argument('--repeat', type=int, default=3, help='runs of each, alternating')
+    parser.add_argument('--chains', action='store_true',
+                        help=f'scenes of {", ".join(map(str, CHAIN_SIZES))} dyads at 1 kHz')
     parser.add_argument('--json', action='store_true', help='also print the rows as JSON')
-    parser.add_argument('--subscribe', nargs=4, help=argparse.SUPPRESS)
+    parser.add_argument('--subscribe', nargs=3, help=argparse.SUPPRESS)
+    parser.add_argument('--floor', nargs=3, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.subscribe:
-        namespace, warmup, seconds, out = args.subscribe
-        subscribe(namespace, float(warmup), float(seconds), out)
+        namespace, seconds, out = args.subscribe
+        subscribe(namespace, float(seconds), out)
+        return 0
+    if args.floor:
+        namespace, rate, scene = args.floor
+        floor(namespace, float(rate), scene)
         return 0
     env = dict(os.environ)
     env.setdefault('ROS_DOMAIN_ID', str(random.SystemRandom().randint(101, 200)))
@@ -165,22 +264,31 @@ def main(argv: list[str] | None = None) -> int:
     env['PYTHONPATH'] = os.pathsep.join(filter(None, [repo, env.get('PYTHONPATH')]))
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
-        for rate in args.rates:
-            rows.append(measure(rate, args.warmup, args.seconds, env, Path(tmp)))
-            print(f'measured {rate:g} Hz', file=sys.stderr, flush=True)
-    print(f'kinematics_node, scene {SCENE}, {args.seconds:g} s per rate, '
-          f'{os.cpu_count()} cores\n')
-    print('| rate Hz | achieved Hz | received/sent js / jt / pt | node CPU % of a core | '
-          'lateness median / p99 us | late / skipped ticks | latency median / p99 us |')
-    print('|---:|---:|---:|---:|---:|---:|---:|')
-    for r in rows:
-        print(f'| {r["rate"]:g} | {r["achieved"]:.1f} | '
-              f'{100 * r["received_joint_states"]:.2f} % / '
-              f'{100 * r["received_joint_accelerations"]:.2f} % / '
-              f'{100 * r["received_point_accelerations"]:.2f} % | {r["cpu"]:.1f} | '
-              f'{r["late_median_us"]:.0f} / {r["late_p99_us"]:.0f} | '
-              f'{r["late_ticks"]} / {r["skipped_ticks"]} | '
-              f'{r["latency_median_us"]:.0f} / {r["latency_p99_us"]:.0f} |')
+        if args.chains:
+            for dyads in CHAIN_SIZES:
+                path = Path(tmp) / f'chain_{dyads}.yaml'
+                path.write_text(chain_scene(dyads))
+                for _ in range(args.repeat):
+                    for kind in ('floor', 'node'):
+                        row = measure(kind, 1000.0, str(path), args, env, Path(tmp))
+                        row['dyads'] = dyads
+                        rows.append(row)
+                        print(f'{kind} {dyads} dyads: {row["cpu"]:.1f} %', file=sys.stderr,
+                              flush=True)
+            key = 'dyads'
+        else:
+            for rate in args.rates:
+                for _ in range(args.repeat):
+                    for kind in ('floor', 'node'):
+                        row = measure(kind, rate, SCENE, args, env, Path(tmp))
+                        rows.append(row)
+                        print(f'{kind} {rate:g} Hz: {row["cpu"]:.1f} %, delivered '
+                              f'{100 * row["delivered"]:.3f} %', file=sys.stderr, flush=True)
+            key = 'rate'
+    print(f'kinematics_node vs the rclpy floor, {args.seconds:g} s per run, '
+          f'{args.repeat} runs each, alternating; {os.cpu_count()} cores, load average '
+          f'{os.getloadavg()[0]:.1f}\n')
+    print('\n'.join(_table(rows, key)))
     if args.json:
         print(json.dumps(rows, indent=1))
     return 0
