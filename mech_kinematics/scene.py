@@ -1,6 +1,6 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""Read scene YAML files (SCENE_FORMAT.md, version 1) into :class:`Scene` objects."""
+"""Read scene YAML files (SCENE_FORMAT.md, version 2) into :class:`Scene` objects."""
 
 from __future__ import annotations
 
@@ -21,6 +21,9 @@ __all__ = ['load_scene', 'parse_scene', 'scene_dirs', 'scene_names', 'DEFAULT_SC
 
 #: The packaged scene that the node and ``make run`` use by default.
 DEFAULT_SCENE = 'khurmi_four_bar_ad150'
+
+#: The two spellings of ``units`` every refusal of a missing or bad one shows.
+UNITS_EXAMPLES = 'units: {length: mm, angle: deg} or units: {length: m, angle: rad}'
 
 T = TypeVar('T')
 
@@ -62,18 +65,23 @@ class _Reader:
 
     def __init__(self, data: dict[str, Any]) -> None:
         self.data = data
-        units = data.get('units', {}) or {}
+        if 'units' not in data:
+            raise SceneError(f'units: missing required key: write {UNITS_EXAMPLES}')
+        units = data['units']
         if not isinstance(units, dict):
-            raise SceneError(f'units: expected a mapping, got {type(units).__name__}')
+            msg = f'units: expected a mapping such as {UNITS_EXAMPLES}, got {_kind(units)}'
+            raise SceneError(msg)
         unknown = set(units) - {'length', 'angle'}
         if unknown:
             raise SceneError(f'units: expected keys length and angle, got {sorted(unknown)}')
-        length = units.get('length', 'm')
-        if length not in LENGTH_UNITS:
-            raise SceneError(f'units.length: expected one of m, mm, got {length!r}')
-        angle = units.get('angle', 'deg')
-        if angle not in ANGLE_UNITS:
-            raise SceneError(f'units.angle: expected one of deg, rad, got {angle!r}')
+        for key, table in (('length', LENGTH_UNITS), ('angle', ANGLE_UNITS)):
+            if key not in units:
+                raise SceneError(f'units.{key}: missing required key ({", ".join(table)}): '
+                                 f'write {UNITS_EXAMPLES}')
+            if not isinstance(units[key], str) or units[key] not in table:
+                raise SceneError(f'units.{key}: expected one of {", ".join(table)}, got '
+                                 f'{units[key]!r}')
+        length, angle = units['length'], units['angle']
         self.per_metre = LENGTH_UNITS[length]
         self.degrees = angle == 'deg'
 
