@@ -15,10 +15,11 @@ from +x; angular velocities and accelerations are positive counter-clockwise.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from enum import IntEnum
 from functools import cached_property
+import heapq
 import math
 import re
 from typing import Any
@@ -506,8 +507,7 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
     for carried in scene.points:
         define(carried.name, 'point', (carried, 'name'))
 
-    size = max([crank.length]
-               + [abs(a - b) for a in ground.values() for b in ground.values()]
+    size = max([crank.length, _diameter(ground.values())]
                + [link.length for d in scene.dyads if isinstance(d, RRR) for link in d.links]
                + [d.link.length for d in scene.dyads if isinstance(d, RRP)])
 
@@ -516,19 +516,17 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
     local: dict[str, dict[str, complex]] = {
         crank.link: {crank.center: 0j, crank.point: complex(crank.length)}}
     slot: dict[str, tuple[str, str]] = {}
-    known = set(ground) | {crank.point}
-    pending: list[Dyad | CarriedPoint] = [*scene.dyads, *scene.points]
     steps: list[Step] = []
-    produces: dict[str, int] = {}  # point or link -> index of its step
+    produces: dict[str, int] = {}  # point, link or slider -> index of its step
 
-    def need_point(name: str, what: str, where: tuple[object, str]) -> bool:
+    def need_point(name: str, what: str, where: tuple[object, str]) -> str:
         if name not in kinds:
             msg = f'Expected {what} to be a known point, got unknown "{name}"'
             raise SceneError(msg, where)
         if kinds[name] != 'point':
             msg = f'Expected {what} to be a point, got {kinds[name]} "{name}"'
             raise SceneError(msg, where)
-        return name in known
+        return name
 
     def need_ground(name: str, what: str, where: tuple[object, str]) -> None:
         need_point(name, what, where)
@@ -536,53 +534,53 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
             msg = f'Expected {what} to be a ground point, got moving point "{name}"'
             raise SceneError(msg, where)
 
-    def place(item: Dyad | CarriedPoint) -> bool:
+    def prerequisites(item: Dyad | CarriedPoint) -> set[str]:
+        """Check the names ``item`` refers to; return those it must wait for."""
         if isinstance(item, RRR):
-            ready = [need_point(link.start, f'the start of link "{link.name}"', (link, 'start'))
-                     for link in item.links]
-            if not all(ready):
-                return False
+            return {need_point(link.start, f'the start of link "{link.name}"', (link, 'start'))
+                    for link in item.links}
+        if isinstance(item, RRP):
+            need_ground(item.through, f'the guide point of RRP "{item.point}"',
+                        (item, 'through'))
+            return {need_point(item.link.start, f'the start of link "{item.link.name}"',
+                               (item.link, 'start'))}
+        if isinstance(item, RPR):
+            need_ground(item.center, f'the center of RPR "{item.link}"', (item, 'center'))
+            return {need_point(item.through, f'the pin of RPR "{item.link}"',
+                               (item, 'through'))}
+        what = f'the link of point "{item.name}"'
+        if item.link not in kinds or kinds[item.link] != 'link':
+            got = f'unknown "{item.link}"' if item.link not in kinds else \
+                f'{kinds[item.link]} "{item.link}"'
+            msg = f'Expected {what} to be a link, got {got}'
+            raise SceneError(msg, (item, 'link'))
+        return {item.link,
+                need_point(item.origin, f'the origin of point "{item.name}"', (item, 'origin')),
+                need_point(item.xaxis, f'the x-axis point of point "{item.name}"',
+                           (item, 'xaxis'))}
+
+    def place(item: Dyad | CarriedPoint) -> tuple[str, ...]:
+        """Append the step of ``item``, whose prerequisites are known; return what it adds."""
+        index = len(steps)
+        if isinstance(item, RRR):
             steps.append(_RRRStep(item))
             for link in item.links:
                 local[link.name] = {link.start: 0j, item.point: complex(link.length)}
-                produces[link.name] = len(steps) - 1
-            produces[item.point] = len(steps) - 1
-            known.add(item.point)
+            added: tuple[str, ...] = (item.point, *(link.name for link in item.links))
         elif isinstance(item, RRP):
-            need_ground(item.through, f'the guide point of RRP "{item.point}"',
-                        (item, 'through'))
-            if not need_point(item.link.start, f'the start of link "{item.link.name}"',
-                              (item.link, 'start')):
-                return False
             steps.append(_RRPStep(item, ground[item.through]))
             local[item.link.name] = {item.link.start: 0j, item.point: complex(item.link.length)}
-            produces[item.link.name] = produces[item.point] = len(steps) - 1
-            known.add(item.point)
+            added = (item.point, item.link.name, item.slider)
         elif isinstance(item, RPR):
-            need_ground(item.center, f'the center of RPR "{item.link}"', (item, 'center'))
-            if not need_point(item.through, f'the pin of RPR "{item.link}"', (item, 'through')):
-                return False
             steps.append(_RPRStep(item, ground[item.center], size))
             local[item.link] = {item.center: 0j}
             slot[item.link] = (item.center, item.through)
-            produces[item.link] = len(steps) - 1
+            added = (item.link, item.slider)
         else:
-            what = f'the link of point "{item.name}"'
-            if item.link not in kinds or kinds[item.link] != 'link':
-                got = f'unknown "{item.link}"' if item.link not in kinds else \
-                    f'{kinds[item.link]} "{item.link}"'
-                msg = f'Expected {what} to be a link, got {got}'
-                raise SceneError(msg, (item, 'link'))
-            ready = [need_point(item.origin, f'the origin of point "{item.name}"',
-                                (item, 'origin')),
-                     need_point(item.xaxis, f'the x-axis point of point "{item.name}"',
-                                (item, 'xaxis'))]
-            if item.link not in local or not all(ready):
-                return False
             fixed = local[item.link]
             if item.origin not in fixed:
                 msg = (f'Expected the origin of point "{item.name}" to be a point fixed on link '
-                       f'"{item.link}" (one of {", ".join(fixed)}), got "{item.origin}"')
+                       f'"{item.link}" (one of {_names(fixed)}), got "{item.origin}"')
                 raise SceneError(msg, (item, 'origin'))
             if item.xaxis in fixed:
                 axis = fixed[item.xaxis] - fixed[item.origin]
@@ -598,23 +596,41 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
                        f'"{item.link}", got "{item.xaxis}"')
                 raise SceneError(msg, (item, 'xaxis'))
             offset = fixed[item.origin] + complex(*item.local) * axis
+            base = next(iter(fixed))  # the link's start, at 0, comes first
             fixed[item.name] = offset
-            base = next(name for name, at in fixed.items() if at == 0)
             steps.append(_CarryStep(item, base, offset))
-            produces[item.name] = len(steps) - 1
-            known.add(item.name)
-        return True
+            added = (item.name,)
+        for name in added:
+            produces[name] = index
+        return added
 
-    while pending:
-        for index, item in enumerate(pending):
-            if place(item):
-                del pending[index]
-                break
-        else:
-            names = [item.point if isinstance(item, (RRR, RRP)) else
-                     item.link if isinstance(item, RPR) else item.name for item in pending]
-            msg = f'Expected dyads and points solvable in order, got a cycle among {names}'
-            raise SceneError(msg, (pending[0], ''))
+    # Place each item as soon as what it starts from is known, the earliest in
+    # the file first (file order wherever it is free): a heap of the ready
+    # items and, per name, the items waiting for it. O(n log n) in all.
+    pending: list[Dyad | CarriedPoint] = [*scene.dyads, *scene.points]
+    known = {*ground, crank.point, crank.link}
+    waiting: dict[str, list[int]] = {}
+    missing = [0] * len(pending)
+    for index, item in enumerate(pending):
+        for name in prerequisites(item) - known:
+            waiting.setdefault(name, []).append(index)
+            missing[index] += 1
+    ready = [index for index, count in enumerate(missing) if count == 0]  # sorted: a heap
+    placed = 0
+    while ready:
+        for name in place(pending[heapq.heappop(ready)]):
+            known.add(name)
+            for index in waiting.pop(name, ()):
+                missing[index] -= 1
+                if missing[index] == 0:
+                    heapq.heappush(ready, index)
+        placed += 1
+    if placed < len(pending):
+        left = [item for index, item in enumerate(pending) if missing[index]]
+        names = [item.point if isinstance(item, (RRR, RRP)) else
+                 item.link if isinstance(item, RPR) else item.name for item in left]
+        msg = f'Expected dyads and points solvable in order, got a cycle among [{_names(names)}]'
+        raise SceneError(msg, (left[0], ''))
 
     order = [*ground, crank.point, *(name for step in steps
                                      for name in _step_points(step))]
@@ -635,10 +651,6 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
     # Keep only the steps that the outputs depend on.
     needed: set[int] = set()
     todo = [produces[name] for name in (*out_joints, *out_points) if name in produces]
-    for name in out_joints:
-        if kinds[name] == 'slider':
-            todo.extend(i for i, s in enumerate(steps)
-                        if getattr(s, 'slider', None) == name)
     while todo:
         index = todo.pop()
         if index in needed:
@@ -651,6 +663,59 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
     kept = tuple(step for index, step in enumerate(steps) if index in needed)
     return _Plan(_CrankStep(crank, ground[crank.center]), kept, ground,
                  {name: joint_types[name] for name in out_joints}, out_joints, out_points)
+
+
+def _diameter(points: Iterable[complex]) -> float:
+    """Return the largest distance between two of ``points``, m (0 for fewer than two).
+
+    The farthest pair is a pair of vertices of the convex hull (Andrew's
+    monotone chain), found among its antipodal pairs (rotating calipers, as in
+    KACTL's ``hullDiameter``): O(n log n) instead of all n^2 pairs, and the
+    same value, each candidate being the same ``abs(a - b)``. The orientation
+    tests run on the points scaled by a power of two (exact) to at most 2**500,
+    so that their products cannot overflow.
+    """
+    unique = sorted({(z.real, z.imag) for z in points})
+    if len(unique) < 2:
+        return 0.0
+    largest = max(max(abs(x), abs(y)) for x, y in unique)
+    scale = 2.0 ** (500 - math.frexp(largest)[1]) if largest > 2.0**500 else 1.0
+    scaled = [(x * scale, y * scale) for x, y in unique]
+
+    def turn(o: int, a: int, b: int) -> float:
+        (ox, oy), (ax, ay), (bx, by) = scaled[o], scaled[a], scaled[b]
+        return (ax - ox) * (by - oy) - (ay - oy) * (bx - ox)
+
+    hull: list[int] = []  # indices into unique, counter-clockwise
+    for run in (range(len(unique)), range(len(unique) - 1, -1, -1)):
+        chain: list[int] = []
+        for k in run:
+            while len(chain) >= 2 and turn(chain[-2], chain[-1], k) <= 0:
+                chain.pop()
+            chain.append(k)
+        hull += chain[:-1]
+    at = [complex(*unique[k]) for k in hull]
+    edge = [complex(*scaled[k]) for k in hull]
+    n = len(hull)
+    if n < 3:  # all on one line: its two ends
+        return abs(at[0] - at[-1])
+    best, i, j = 0.0, 0, 1
+    while i < j:
+        for _ in range(n):  # advance j while the edge from it turns away from edge i
+            best = max(best, abs(at[i] - at[j]))
+            u, v = edge[i + 1] - edge[i], edge[(j + 1) % n] - edge[j]
+            if v.real * u.imag - v.imag * u.real >= 0:
+                break
+            j = (j + 1) % n
+        i += 1
+    return best
+
+
+def _names(names: Iterable[str], most: int = 10) -> str:
+    """Return ``A, B, C`` for a message: the first ``most`` names and how many more."""
+    names = list(names)
+    shown = ', '.join(names[:most])
+    return shown if len(names) <= most else f'{shown} and {len(names) - most} more'
 
 
 def _step_points(step: Step) -> tuple[str, ...]:

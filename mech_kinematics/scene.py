@@ -1,6 +1,36 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""Read scene YAML files (SCENE_FORMAT.md, version 1) into :class:`Scene` objects."""
+"""Read scene YAML files (SCENE_FORMAT.md, version 2) into :class:`Scene` objects.
+
+The file is read by a hardened YAML reader (:class:`SceneLoader`), not by
+``yaml.safe_load``: YAML 1.2 scalars, no duplicate or non-text keys, and every
+resource bounded, so that any file, however hostile, gives a :class:`Scene`
+or one :class:`SceneError` line, quickly and in bounded memory.
+
+YAML dialect
+------------
+Plain scalars resolve by the YAML 1.2 core schema: ``1.5e2``, ``1e-3`` and
+``-1E+3`` are floats, ``0o17`` and ``0x1F`` integers, ``true``/``false``
+booleans, ``~``/``null``/empty null. A plain scalar that YAML 1.1 (the
+dialect of ``yaml.safe_load`` and ROS tools) reads as a boolean or number
+and YAML 1.2 reads otherwise is refused rather than guessed at, so a file
+this loader accepts means the same to both: ``on``/``off``/``yes``/``no``
+(quote them), ``1_000``, ``1:30`` (base 60), ``0b101`` and numbers with a
+leading zero such as ``017`` (octal in 1.1, decimal in 1.2). Merge keys
+(``<<``) are refused; anchors and aliases are fine. Only the standard tags
+``!!str``, ``!!int``, ``!!float``, ``!!bool``, ``!!null``, ``!!seq`` and
+``!!map`` are accepted.
+
+Limits
+------
+Each limit is a module constant named in the refusal: :data:`MAX_FILE_BYTES`,
+:data:`MAX_YAML_NODES` (counted with aliases expanded, so a "billion laughs"
+file is refused), :data:`MAX_DEPTH`, :data:`MAX_INTEGER_DIGITS`,
+:data:`MAX_GROUND_POINTS`, :data:`MAX_DYADS` and :data:`MAX_CARRIED_POINTS`.
+Only regular files are read: a FIFO, a device or a directory is refused
+before anything is read from it, and the read stops one byte past
+:data:`MAX_FILE_BYTES`.
+"""
 
 from __future__ import annotations
 
@@ -8,19 +38,50 @@ from collections.abc import Callable
 import math
 import os
 from pathlib import Path
+import re
+import reprlib
+import stat
 import sys
-from typing import Any, TypedDict, TypeVar
+from typing import Any, NoReturn, TypedDict, TypeVar
 
 import yaml
+from yaml.events import (AliasEvent, DocumentEndEvent, DocumentStartEvent, MappingEndEvent,
+                         MappingStartEvent, ScalarEvent, SequenceEndEvent, SequenceStartEvent,
+                         StreamEndEvent, StreamStartEvent)
 
 from .errors import SceneError
 from .linkage import Branch, CarriedPoint, Crank, Link, RPR, RRP, RRR, Scene
 from .units import ANGLE_UNITS, LENGTH_UNITS, rad_per_s_from_rpm
 
-__all__ = ['load_scene', 'parse_scene', 'scene_dirs', 'scene_names', 'DEFAULT_SCENE']
+__all__ = [
+    'DEFAULT_SCENE', 'MAX_CARRIED_POINTS', 'MAX_DEPTH', 'MAX_DYADS', 'MAX_FILE_BYTES',
+    'MAX_GROUND_POINTS', 'MAX_INTEGER_DIGITS', 'MAX_MESSAGE', 'MAX_YAML_NODES', 'SceneLoader',
+    'load_scene', 'parse_scene', 'read_scene_yaml', 'scene_dirs', 'scene_names',
+]
 
 #: The packaged scene that the node and ``make run`` use by default.
 DEFAULT_SCENE = 'khurmi_four_bar_ad150'
+
+#: Largest scene file read, bytes (8 MiB: room for comments; a scene at all
+#: the count limits below, one dyad key per line, is about 2.5 MB).
+MAX_FILE_BYTES = 8 * 1024 * 1024
+#: Most YAML nodes (scalars, lists, mappings) a scene file may hold, counted
+#: with every alias expanded; a scene at all the count limits has about 370,000.
+MAX_YAML_NODES = 500_000
+#: Deepest nesting of lists and mappings (a scene needs 5).
+MAX_DEPTH = 32
+#: Most digits in an integer: every accepted integer converts to a finite
+#: float (a double reaches 1.8e308).
+MAX_INTEGER_DIGITS = 300
+#: Most ground points in a scene.
+MAX_GROUND_POINTS = 10_000
+#: Most dyads in a scene.
+MAX_DYADS = 10_000
+#: Most carried points (``points:``) in a scene.
+MAX_CARRIED_POINTS = 10_000
+
+#: The two spellings of ``units`` every refusal of a missing or bad one shows.
+UNITS_EXAMPLES = 'units: {length: mm, angle: deg} or units: {length: m, angle: rad}'
 
 T = TypeVar('T')
 
@@ -57,23 +118,346 @@ class SceneDict(TypedDict, total=False):
     outputs: dict[str, list[str]]
 
 
+# --- the YAML reader -------------------------------------------------------------------
+
+_TAG = 'tag:yaml.org,2002:'
+_NULLS = frozenset(('', '~', 'null', 'Null', 'NULL'))
+_BOOLS = {'true': True, 'True': True, 'TRUE': True,
+          'false': False, 'False': False, 'FALSE': False}
+# The YAML 1.2 core schema's numbers (https://yaml.org/spec/1.2.2/#1032-tag-resolution).
+_INT = re.compile(r'[-+]?[0-9]+\Z')
+_INT_BASE = re.compile(r'0(?:o[0-7]+|x[0-9a-fA-F]+)\Z')
+_FLOAT = re.compile(r'[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?\Z')
+_INF = re.compile(r'[-+]?\.(?:inf|Inf|INF)\Z')
+_NAN = re.compile(r'\.(?:nan|NaN|NAN)\Z')
+_LEADING_ZERO = re.compile(r'[-+]?0[0-9]')
+_NUMBER_START = frozenset('0123456789+-.')
+# How YAML 1.1 (PyYAML's resolver) reads a plain scalar, to refuse the ones it
+# reads as a boolean, a number or a merge key while YAML 1.2 reads them otherwise.
+_YAML11 = yaml.resolver.Resolver.yaml_implicit_resolvers
+_YAML11_ONLY = {
+    f'{_TAG}bool': 'a boolean in YAML 1.1, text in 1.2: write true or false, or quote it',
+    f'{_TAG}int': 'a number in YAML 1.1 only (digit separators, base 60 or 0b): write it '
+                  'in decimal, or quote it',
+    f'{_TAG}float': 'a number in YAML 1.1 only (digit separators or base 60): write it in '
+                    'decimal, or quote it',
+    f'{_TAG}merge': 'a YAML 1.1 merge key: write the keys out',
+}
+_INTEGER_BOUND = 10 ** MAX_INTEGER_DIGITS
+_NO_KEY = object()
+_BRIEF = reprlib.Repr()
+_BRIEF.maxstring = _BRIEF.maxother = 60
+_BRIEF.maxlist = _BRIEF.maxdict = 4
+_BRIEF.maxlevel = 2
+
+
+def _brief(value: Any) -> str:
+    """Return ``repr(value)``, shortened for a one-line message."""
+    return _BRIEF.repr(value)
+
+
+def _at(mark: Any) -> str:
+    return f'line {mark.line + 1}, column {mark.column + 1}'
+
+
+def _tag_name(tag: str) -> str:
+    return f'!!{tag[len(_TAG):]}' if tag.startswith(_TAG) else tag
+
+
+class _Frame:
+    """An open list or mapping while a document is built."""
+
+    __slots__ = ('value', 'anchor', 'start', 'key', 'key_mark', 'marks', 'depth')
+
+    def __init__(self, value: Any, anchor: str | None, start: int) -> None:
+        self.value = value
+        self.anchor = anchor
+        self.start = start  # node count when it opened
+        self.key: Any = _NO_KEY  # a mapping's pending key
+        self.key_mark: Any = None
+        self.marks: dict[str, Any] = {}  # a mapping's keys -> where each was given
+        self.depth = 1  # of the subtree so far, with aliases expanded
+
+
+class _SceneBuilder:
+    """Build one YAML document from parser events: YAML 1.2 scalars, bounded, iterative.
+
+    Mixed into a PyYAML loader in place of its composer, constructor and
+    resolver (which build a node graph first, resolve YAML 1.1 and recurse per
+    nesting level). Aliases share the anchored object, as PyYAML's do; the
+    node count and depth are those of the document with every alias expanded.
+    """
+
+    get_event: Callable[[], Any]
+
+    def get_single_data(self) -> Any:
+        """Return the one document of the stream (``None`` if there is none)."""
+        self._nodes = 0
+        self._anchors: dict[str, tuple[Any, int, int]] = {}  # -> (value, nodes, depth)
+        self._open: set[str] = set()
+        self._stack: list[_Frame] = []
+        self._root: Any = None
+        self._plains: dict[str, Any] = {}  # plain scalars resolved so far, by text
+        documents = 0
+        get_event = self.get_event
+        while True:
+            event = get_event()
+            kind = type(event)
+            if kind is ScalarEvent:
+                self._scalar(event)
+            elif kind is MappingStartEvent or kind is SequenceStartEvent:
+                self._start(event, {} if kind is MappingStartEvent else [])
+            elif kind is MappingEndEvent or kind is SequenceEndEvent:
+                self._end(event)
+            elif kind is AliasEvent:
+                self._alias(event)
+            elif kind is DocumentStartEvent:
+                documents += 1
+                if documents > 1:
+                    self._fail(event, 'expected a single document in the stream, got more')
+            elif kind is StreamEndEvent:
+                return self._root
+            elif kind is not DocumentEndEvent and kind is not StreamStartEvent:
+                self._fail(event, f'unexpected YAML event {kind.__name__}')
+
+    # -- events --
+
+    def _scalar(self, event: Any) -> None:
+        self._count(1, event)
+        if event.tag is None and event.implicit[0]:
+            value = self._plains.get(event.value, _NO_KEY)
+            if value is _NO_KEY:
+                value = self._plains[event.value] = self._plain(event, event.value)
+        else:
+            value = self._resolve(event)
+        if event.anchor is not None:
+            self._check_anchor(event)
+            self._anchors[event.anchor] = (value, 1, 0)
+        self._add(value, event, 0)
+
+    def _start(self, event: Any, value: Any) -> None:
+        frame = self._stack[-1] if self._stack else None
+        if frame is not None and isinstance(frame.value, dict) and frame.key is _NO_KEY:
+            kind = 'mapping' if isinstance(value, dict) else 'list'
+            self._fail(event, f'expected a text key, got a {kind}')
+        tag = event.tag
+        expected = f'{_TAG}map' if isinstance(value, dict) else f'{_TAG}seq'
+        if tag is not None and tag != '!' and tag != expected:
+            self._fail(event, f'expected a standard tag, got {_tag_name(tag)}')
+        if len(self._stack) >= MAX_DEPTH:
+            self._fail(event, f'expected lists and mappings nested at most {MAX_DEPTH} deep '
+                              f'(MAX_DEPTH), got deeper')
+        self._count(1, event)
+        if event.anchor is not None:
+            self._check_anchor(event)
+            self._open.add(event.anchor)
+        self._stack.append(_Frame(value, event.anchor, self._nodes - 1))
+
+    def _end(self, event: Any) -> None:
+        frame = self._stack.pop()
+        nodes = self._nodes - frame.start
+        if frame.anchor is not None:
+            self._open.discard(frame.anchor)
+            self._anchors[frame.anchor] = (frame.value, nodes, frame.depth)
+        self._add(frame.value, event, frame.depth)
+
+    def _alias(self, event: Any) -> None:
+        name = event.anchor
+        if name in self._open:
+            self._fail(event, f'expected an alias to a complete node, got *{name} inside '
+                              f'&{name} (a recursive alias)')
+        if name not in self._anchors:
+            self._fail(event, f'expected an alias to an anchor defined before it, got '
+                              f'undefined *{name}')
+        value, nodes, depth = self._anchors[name]
+        if len(self._stack) + depth > MAX_DEPTH:
+            self._fail(event, f'expected lists and mappings nested at most {MAX_DEPTH} deep '
+                              f'(MAX_DEPTH), got deeper through alias *{name}')
+        self._count(nodes, event)
+        self._add(value, event, depth)
+
+    # -- helpers --
+
+    def _add(self, value: Any, event: Any, depth: int) -> None:
+        if not self._stack:
+            self._root = value
+            return
+        frame = self._stack[-1]
+        if depth >= frame.depth:
+            frame.depth = depth + 1
+        container = frame.value
+        if type(container) is list:
+            container.append(value)
+            return
+        if frame.key is _NO_KEY:
+            if type(value) is not str:
+                written = event.value if type(event) is ScalarEvent else value
+                self._fail(event, f'expected a text key, got {_kind_of(value)} '
+                                  f'{_brief(written)}', ' (quote it if it is a name)')
+            previous = frame.marks.get(value)
+            if previous is not None:
+                self._fail(event, f'expected each key once, got {_brief(value)} again',
+                           f' (first at {_at(previous)})')
+            frame.key, frame.key_mark = value, event.start_mark
+            return
+        frame.marks[frame.key] = frame.key_mark
+        container[frame.key] = value
+        frame.key = _NO_KEY
+
+    def _count(self, nodes: int, event: Any) -> None:
+        self._nodes += nodes
+        if self._nodes > MAX_YAML_NODES:  # a bound on the document with aliases expanded
+            self._fail(event, f'expected at most {MAX_YAML_NODES} YAML nodes with aliases '
+                              f'expanded (MAX_YAML_NODES), got more')
+
+    def _check_anchor(self, event: Any) -> None:
+        if event.anchor in self._anchors or event.anchor in self._open:
+            self._fail(event, f'expected each anchor once, got &{event.anchor} again')
+
+    def _resolve(self, event: Any) -> Any:
+        text = event.value
+        tag = event.tag
+        if tag is None:
+            return self._plain(event, text) if event.implicit[0] else text
+        if tag == '!' or tag == f'{_TAG}str':
+            return text
+        value = self._plain(event, text)
+        if tag == f'{_TAG}null' and value is None or tag == f'{_TAG}bool' and \
+                isinstance(value, bool):
+            return value
+        if tag == f'{_TAG}int' and type(value) is int:
+            return value
+        if tag == f'{_TAG}float' and type(value) in (int, float):
+            return float(value)
+        if tag in (f'{_TAG}null', f'{_TAG}bool', f'{_TAG}int', f'{_TAG}float'):
+            self._fail(event, f'expected a {_tag_name(tag)[2:]} after {_tag_name(tag)}, '
+                              f'got {_brief(text)}')
+        self._fail(event, f'expected a standard tag, got {_tag_name(tag)}')
+
+    def _plain(self, event: Any, text: str) -> Any:
+        """Resolve a plain scalar by the YAML 1.2 core schema."""
+        if text in _NULLS:
+            return None
+        if text in _BOOLS:
+            return _BOOLS[text]
+        if text[0] in _NUMBER_START:
+            if _INT.match(text):
+                if _LEADING_ZERO.match(text):
+                    self._fail(event, f'expected a number without a leading zero, got '
+                                      f'{_brief(text)}', ' (octal in YAML 1.1, decimal in 1.2)')
+                return self._integer(event, text, text.lstrip('+-'), 10)
+            if _INT_BASE.match(text):
+                return self._integer(event, text[2:], text[2:], 8 if text[1] == 'o' else 16)
+            if _FLOAT.match(text):
+                return float(text)
+            if _INF.match(text):
+                return -math.inf if text[0] == '-' else math.inf
+            if _NAN.match(text):
+                return math.nan
+        for tag, regexp in _YAML11.get(text[0], ()):
+            if regexp.match(text):
+                if tag in _YAML11_ONLY:
+                    self._fail(event, f'expected a value that YAML 1.1 and 1.2 read alike, '
+                                      f'got {_brief(text)}', f' ({_YAML11_ONLY[tag]})')
+                break
+        return text
+
+    def _integer(self, event: Any, text: str, digits: str, base: int) -> int:
+        value = int(text, base) if len(digits) <= MAX_INTEGER_DIGITS else None
+        if value is None or abs(value) >= _INTEGER_BOUND:
+            self._fail(event, f'expected an integer of at most {MAX_INTEGER_DIGITS} decimal '
+                              f'digits (MAX_INTEGER_DIGITS), got {_brief(text)}')
+        return value
+
+    def _fail(self, event: Any, problem: str, note: str = '') -> NoReturn:
+        raise SceneError(f'{self._where()}: {problem} at {_at(event.start_mark)}{note}')
+
+    def _where(self) -> str:
+        """Return the key path of the node being read, e.g. ``dyads[2].links``."""
+        path = ''
+        for frame in self._stack:
+            if type(frame.value) is list:
+                path += f'[{len(frame.value)}]'
+            elif frame.key is not _NO_KEY:
+                path = _join(path, _BRIEF.repr_str(frame.key, 0)[1:-1])
+        if len(path) > 80:
+            path = f'{path[:60]}...{path[-16:]}'
+        return path or 'scene'
+
+
+def _kind_of(value: Any) -> str:
+    return {type(None): 'null', bool: 'a boolean', int: 'a number',
+            float: 'a number'}.get(type(value), type(value).__name__)
+
+
+class SceneLoader(_SceneBuilder, yaml.SafeLoader):
+    """A PyYAML safe loader that reads scene files: YAML 1.2 scalars, bounded, strict.
+
+    ``yaml.load(text, Loader=SceneLoader)`` returns plain dicts, lists,
+    strings, numbers, booleans and ``None`` and raises :class:`SceneError`
+    (naming the key path, the line and the column) for a duplicate key, a key
+    that is not text, a YAML 1.1-only scalar, an unsupported tag or a node
+    beyond the limits; malformed YAML raises ``yaml.YAMLError`` as usual.
+    """
+
+
+if getattr(yaml, '__with_libyaml__', False):
+    class CSceneLoader(_SceneBuilder, yaml.CSafeLoader):
+        """:class:`SceneLoader` on libyaml's parser (the same results, faster)."""
+
+    _FAST_LOADER: type = CSceneLoader
+else:  # pragma: no cover - PyYAML built without libyaml
+    _FAST_LOADER = SceneLoader
+
+
+def read_scene_yaml(text: str) -> Any:
+    """Parse the text of a scene file with the scene loader's YAML dialect and limits.
+
+    Raises
+    ------
+    SceneError
+        For YAML that is malformed, ambiguous between YAML 1.1 and 1.2, or
+        beyond a limit, naming the line and column.
+    """
+    try:
+        return yaml.load(text, Loader=_FAST_LOADER)  # noqa: S506 - a safe loader
+    except yaml.MarkedYAMLError as error:
+        mark = error.problem_mark
+        at = f' at line {mark.line + 1}, column {mark.column + 1}' if mark else ''
+        problem = ' '.join((error.problem or str(error)).split())
+        raise SceneError(f'invalid YAML{at}: {problem}') from None
+    except yaml.reader.ReaderError as error:
+        character = error.character
+        what = f'#x{character:04x}' if isinstance(character, int) else repr(character)
+        msg = f'invalid YAML: {error.reason} {what} at offset {error.position}'
+        raise SceneError(msg) from None
+    except yaml.YAMLError as error:
+        raise SceneError(f'invalid YAML: {" ".join(str(error).split())}') from None
+
+
 class _Reader:
     """Typed access to a scene mapping, naming the key in every error."""
 
     def __init__(self, data: dict[str, Any]) -> None:
         self.data = data
-        units = data.get('units', {}) or {}
+        if 'units' not in data:
+            raise SceneError(f'units: missing required key: write {UNITS_EXAMPLES}')
+        units = data['units']
         if not isinstance(units, dict):
-            raise SceneError(f'units: expected a mapping, got {type(units).__name__}')
+            msg = f'units: expected a mapping such as {UNITS_EXAMPLES}, got {_kind(units)}'
+            raise SceneError(msg)
         unknown = set(units) - {'length', 'angle'}
         if unknown:
-            raise SceneError(f'units: expected keys length and angle, got {sorted(unknown)}')
-        length = units.get('length', 'm')
-        if length not in LENGTH_UNITS:
-            raise SceneError(f'units.length: expected one of m, mm, got {length!r}')
-        angle = units.get('angle', 'deg')
-        if angle not in ANGLE_UNITS:
-            raise SceneError(f'units.angle: expected one of deg, rad, got {angle!r}')
+            raise SceneError(f'units: expected keys length and angle, got '
+                             f'{_brief(sorted(unknown))}')
+        for key, table in (('length', LENGTH_UNITS), ('angle', ANGLE_UNITS)):
+            if key not in units:
+                raise SceneError(f'units.{key}: missing required key ({", ".join(table)}): '
+                                 f'write {UNITS_EXAMPLES}')
+            if not isinstance(units[key], str) or units[key] not in table:
+                raise SceneError(f'units.{key}: expected one of {", ".join(table)}, got '
+                                 f'{_brief(units[key])}')
+        length, angle = units['length'], units['angle']
         self.per_metre = LENGTH_UNITS[length]
         self.degrees = angle == 'deg'
 
@@ -91,7 +475,7 @@ class _Reader:
         value = self.get(mapping, key, where, default)
         path = _join(where, key)
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise SceneError(f'{path}: expected a number, got {_kind(value)} {value!r}')
+            raise SceneError(f'{path}: expected a number, got {_kind(value)} {_brief(value)}')
         value = float(value)
         if not math.isfinite(value):
             raise SceneError(f'{path}: expected a finite number, got {value!r}')
@@ -111,18 +495,18 @@ class _Reader:
         value = self.get(mapping, key, where)
         if not isinstance(value, str):
             raise SceneError(f'{_join(where, key)}: expected a name, got {_kind(value)} '
-                             f'{value!r}')
+                             f'{_brief(value)}')
         return value
 
     def branch(self, mapping: Any, where: str) -> Branch:
         value = self.get(mapping, 'branch', where, 1)
         if isinstance(value, bool) or value not in (1, -1):
-            raise SceneError(f'{_join(where, "branch")}: expected +1 or -1, got {value!r}')
+            raise SceneError(f'{_join(where, "branch")}: expected +1 or -1, got {_brief(value)}')
         return Branch(int(value))
 
     def point_xy(self, value: Any, where: str) -> tuple[float, float]:
         if not isinstance(value, list) or len(value) != 2:
-            raise SceneError(f'{where}: expected [x, y], got {value!r}')
+            raise SceneError(f'{where}: expected [x, y], got {_brief(value)}')
         x, y = (self.number({f'[{i}]': v}, f'[{i}]', where) for i, v in enumerate(value))
         return x / self.per_metre, y / self.per_metre
 
@@ -140,8 +524,14 @@ def _join(where: str, key: str) -> str:
 def _check_keys(mapping: dict[str, Any], allowed: set[str], where: str) -> None:
     unknown = set(mapping) - allowed
     if unknown:
-        raise SceneError(f'{where}: unknown key(s) {sorted(unknown)}, expected some of '
+        raise SceneError(f'{where}: unknown key(s) {_brief(sorted(unknown))}, expected some of '
                          f'{sorted(allowed)}')
+
+
+def _check_count(where: str, items: Any, limit: int, name: str, what: str) -> None:
+    if len(items) > limit:
+        msg = f'{where}: expected at most {limit} {what} ({name}), got {len(items)}'
+        raise SceneError(msg)
 
 
 class _Keys:
@@ -176,6 +566,10 @@ class _Keys:
 def parse_scene(data: Any) -> Scene:
     """Build a :class:`Scene` from the mapping of a scene file.
 
+    The mapping is what :func:`read_scene_yaml` returns; ``units`` is required
+    and the counts are bounded (:data:`MAX_GROUND_POINTS`, :data:`MAX_DYADS`,
+    :data:`MAX_CARRIED_POINTS`).
+
     Raises
     ------
     SceneError
@@ -193,7 +587,8 @@ def parse_scene(data: Any) -> Scene:
     ground_data = reader.get(data, 'ground', '')
     if not isinstance(ground_data, dict) or not ground_data:
         raise SceneError(f'ground: expected a mapping of at least one point, got '
-                         f'{ground_data!r}')
+                         f'{_brief(ground_data)}')
+    _check_count('ground', ground_data, MAX_GROUND_POINTS, 'MAX_GROUND_POINTS', 'points')
     ground = {str(key): reader.point_xy(value, f'ground.{key}')
               for key, value in ground_data.items()}
 
@@ -211,12 +606,14 @@ def parse_scene(data: Any) -> Scene:
     dyads_data = data.get('dyads', []) or []
     if not isinstance(dyads_data, list):
         raise SceneError(f'dyads: expected a list, got {_kind(dyads_data)}')
+    _check_count('dyads', dyads_data, MAX_DYADS, 'MAX_DYADS', 'dyads')
     dyads = [_dyad(reader, keys, item, f'dyads[{index}]')
              for index, item in enumerate(dyads_data)]
 
     points_data = data.get('points', {}) or {}
     if not isinstance(points_data, dict):
         raise SceneError(f'points: expected a mapping, got {_kind(points_data)}')
+    _check_count('points', points_data, MAX_CARRIED_POINTS, 'MAX_CARRIED_POINTS', 'points')
     points = [_carried(reader, keys, str(key), value, f'points.{key}')
               for key, value in points_data.items()]
 
@@ -229,7 +626,7 @@ def parse_scene(data: Any) -> Scene:
         value = outputs.get(key)
         if value is not None and (not isinstance(value, list)
                                   or not all(isinstance(v, str) for v in value)):
-            raise SceneError(f'outputs.{key}: expected a list of names, got {value!r}')
+            raise SceneError(f'outputs.{key}: expected a list of names, got {_brief(value)}')
         selected[key] = None if value is None else tuple(value)
 
     try:
@@ -254,7 +651,7 @@ def _dyad(reader: _Reader, keys: _Keys, raw: Any, where: str) -> RRR | RRP | RPR
         _check_keys(raw, {'type', 'point', 'links', 'branch'}, where)
         links = reader.get(raw, 'links', where)
         if not isinstance(links, list) or len(links) != 2:
-            raise SceneError(f'{where}.links: expected a list of 2 links, got {links!r}')
+            raise SceneError(f'{where}.links: expected a list of 2 links, got {_brief(links)}')
         first, second = (_link(reader, keys, link, f'{where}.links[{i}]')
                          for i, link in enumerate(links))
         return keys.build(where, {}, RRR, point=reader.name(raw, 'point', where),
@@ -277,7 +674,7 @@ def _dyad(reader: _Reader, keys: _Keys, raw: Any, where: str) -> RRR | RRP | RPR
             where, {}, RPR, link=reader.name(raw, 'link', where),
             center=reader.name(raw, 'center', where), through=reader.name(raw, 'through', where),
             slider=reader.name(raw, 'slider', where))
-    raise SceneError(f'{where}.type: expected RRR, RRP or RPR, got {kind!r}')
+    raise SceneError(f'{where}.type: expected RRR, RRP or RPR, got {_brief(kind)}')
 
 
 def _carried(reader: _Reader, keys: _Keys, name: str, raw: Any, where: str) -> CarriedPoint:
@@ -298,7 +695,7 @@ def _carried(reader: _Reader, keys: _Keys, name: str, raw: Any, where: str) -> C
         local = reader.point_xy(reader.get(raw, 'local', where), f'{where}.local')
     else:
         raise SceneError(f'{where}: expected either from/toward/distance or '
-                         f'origin/xaxis/local, got keys {sorted(raw)}')
+                         f'origin/xaxis/local, got keys {_brief(sorted(raw))}')
     return keys.build(where, fields, CarriedPoint, name=name, link=link, origin=origin,
                       xaxis=xaxis, local=local)
 
@@ -336,8 +733,97 @@ def _resolve(source: str | os.PathLike[str]) -> Path:
     raise SceneError(msg)
 
 
+_FILE_KINDS = ((stat.S_ISDIR, 'a directory'), (stat.S_ISFIFO, 'a FIFO (named pipe)'),
+               (stat.S_ISCHR, 'a character device'), (stat.S_ISBLK, 'a block device'),
+               (stat.S_ISSOCK, 'a socket'))
+
+
+def _file_kind(mode: int) -> str | None:
+    """Return what a non-regular file is, or ``None`` for a regular file."""
+    if stat.S_ISREG(mode):
+        return None
+    return next((name for test, name in _FILE_KINDS if test(mode)), 'not a regular file')
+
+
+def _read_bytes(path: Path) -> bytes:
+    """Read a regular file of at most :data:`MAX_FILE_BYTES` without ever blocking.
+
+    ``stat`` refuses a FIFO or a device before it is opened; ``O_NONBLOCK``
+    keeps the open from waiting for a writer should the path become a FIFO in
+    between, and ``fstat`` on the opened descriptor checks again.
+    """
+    too_big = f'expected a scene file of at most {MAX_FILE_BYTES} bytes (MAX_FILE_BYTES)'
+    try:
+        kind = _file_kind(os.stat(path).st_mode)
+        if kind is not None:
+            raise SceneError(f'{path}: expected a regular file, got {kind}')
+        flags = (os.O_RDONLY | getattr(os, 'O_NONBLOCK', 0) | getattr(os, 'O_NOCTTY', 0)
+                 | getattr(os, 'O_CLOEXEC', 0))
+        fd = os.open(path, flags)
+        try:
+            info = os.fstat(fd)
+            kind = _file_kind(info.st_mode)
+            if kind is not None:
+                raise SceneError(f'{path}: expected a regular file, got {kind}')
+            if info.st_size > MAX_FILE_BYTES:
+                raise SceneError(f'{path}: {too_big}, got {info.st_size}')
+            chunks = []
+            left = MAX_FILE_BYTES + 1  # a file that grows is caught too
+            while left > 0:
+                chunk = os.read(fd, min(left, 1 << 20))
+                if not chunk:
+                    break
+                chunks.append(chunk)
+                left -= len(chunk)
+        finally:
+            os.close(fd)
+    except SceneError:
+        raise
+    except OSError as error:
+        raise SceneError(f'{path}: cannot read: {error.strerror or error}') from None
+    except ValueError as error:  # e.g. an embedded null byte in the path
+        raise SceneError(f'{str(path)!r}: cannot read: {error}') from None
+    data = b''.join(chunks)
+    if len(data) > MAX_FILE_BYTES:
+        raise SceneError(f'{path}: {too_big}, got more')
+    return data
+
+
+def _decode(path: Path, data: bytes) -> str:
+    """Return the file's text, refusing anything but UTF-8 in one line."""
+    try:
+        text = data.decode('utf-8')
+    except UnicodeDecodeError as error:
+        line = data.count(b'\n', 0, error.start) + 1
+        column = error.start - (data.rfind(b'\n', 0, error.start) + 1) + 1
+        msg = (f'{path}: expected UTF-8 text, got byte 0x{data[error.start]:02x} at line '
+               f'{line}, column {column} (byte {error.start})')
+        raise SceneError(msg) from None
+    return text[1:] if text.startswith('\ufeff') else text
+
+
+#: Longest message :func:`load_scene` gives, characters; a longer one (a
+#: long name quoted in it) is shortened in the middle.
+MAX_MESSAGE = 400
+_LONG_QUOTED = re.compile(r'([\'"])([^\'"]{64,})\1')
+
+
+def _one_line(message: str) -> str:
+    """Return ``message`` on one line of at most :data:`MAX_MESSAGE` characters."""
+    message = message.replace('\r', '\\r').replace('\n', '\\n')
+    if len(message) > MAX_MESSAGE:  # first shorten long quoted names and values
+        message = _LONG_QUOTED.sub(lambda m: f'{m[1]}{m[2][:40]}...{m[2][-16:]}{m[1]}',
+                                   message)
+    if len(message) > MAX_MESSAGE:
+        message = f'{message[:MAX_MESSAGE - 125]} ... {message[-120:]}'
+    return message
+
+
 def load_scene(source: str | os.PathLike[str]) -> Scene:
     """Load a scene from a YAML file or by the name of a packaged scene.
+
+    The file must be a regular file of UTF-8 text within the limits of this
+    module (``MAX_*``), in the YAML dialect of :class:`SceneLoader`.
 
     Parameters
     ----------
@@ -352,21 +838,24 @@ def load_scene(source: str | os.PathLike[str]) -> Scene:
     Raises
     ------
     SceneError
-        With one message naming the file, the key and the reason.
+        With one message naming the file, the key and the reason. No other
+        exception escapes, whatever the file holds.
     """
-    path = _resolve(source)
     try:
-        text = path.read_text(encoding='utf-8')
-    except OSError as error:
-        raise SceneError(f'{path}: cannot read: {error.strerror or error}') from None
+        path = _resolve(os.fspath(source))
+    except SceneError:
+        raise
+    except (TypeError, ValueError, OSError) as error:
+        msg = (f'{_brief(source)}: expected a scene file path or a packaged scene name, got '
+               f'neither ({error})')
+        raise SceneError(msg) from None
+    text = _decode(path, _read_bytes(path))
     try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as error:
-        mark = getattr(error, 'problem_mark', None)
-        at = f' at line {mark.line + 1}, column {mark.column + 1}' if mark else ''
-        problem = getattr(error, 'problem', None) or str(error)
-        raise SceneError(f'{path}: invalid YAML{at}: {problem}') from None
-    try:
-        return parse_scene(data)
+        return parse_scene(read_scene_yaml(text))
     except SceneError as error:
-        raise SceneError(f'{path}: {error}') from None
+        raise SceneError(_one_line(f'{path}: {error}')) from None
+    except (ArithmeticError, ValueError) as error:
+        # Not expected (the fuzz test checks it never happens), but a solver
+        # step failing on extreme values must still give one line.
+        msg = f'{path}: scene could not be built: {type(error).__name__}: {error}'
+        raise SceneError(_one_line(msg)) from None

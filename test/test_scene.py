@@ -199,6 +199,19 @@ BAD_SCENES = [
      r'assemble at the initial crank angle 60 deg.*RRR C'),
     ('guide_out_of_reach_at_initial_angle', edit(setitem(['dyads', 1, 'link', 'length'], 20)),
      'input.angle', r'assemble.*RRP P'),
+    # See issue 11: units are explicit; a scene without them is refused, never read as metres.
+    ('missing_units', edit(delitem(['units'])), 'units',
+     r'missing required key: write units: \{length: mm, angle: deg\} or '
+     r'units: \{length: m, angle: rad\}'),
+    ('missing_length_unit', edit(delitem(['units', 'length'])), 'units.length',
+     r'missing required key \(m, mm\).*units: \{length: m, angle: rad\}'),
+    ('missing_angle_unit', edit(delitem(['units', 'angle'])), 'units.angle',
+     r'missing required key \(deg, rad\).*units: \{length: mm, angle: deg\}'),
+    ('empty_units', edit(setitem(['units'], None)), 'units',
+     r'expected a mapping such as units: \{length: mm.*got nothing'),
+    ('units_as_text', edit(setitem(['units'], 'mm')), 'units', r'expected a mapping.*got str'),
+    ('length_unit_not_text', edit(setitem(['units', 'length'], [1])), 'units.length',
+     r'expected one of m, mm, got \[1\]'),
     ('wrong_length_unit', edit(setitem(['units', 'length'], 'inch')), 'units.length',
      r"expected one of m, mm, got 'inch'"),
     ('wrong_angle_unit', edit(setitem(['units', 'angle'], 'grad')), 'units.angle',
@@ -241,6 +254,17 @@ def test_bad_scene_is_rejected_naming_file_key_and_reason(tmp_path, content, key
         assert key in message
     else:
         assert key_of(message, path) in ((key,) if isinstance(key, str) else key), message
+
+
+def test_a_scene_in_mm_without_units_is_refused_not_read_as_metres(tmp_path):
+    """Without `units:` the scene is refused in one line showing both forms. See issue 11."""
+    path = write(tmp_path, BASE.replace('units: {length: mm, angle: deg}\n', ''))
+    with pytest.raises(mk.SceneError) as info:
+        mk.load_scene(path)
+    assert str(info.value) == (f'{path}: units: missing required key: write units: '
+                               '{length: mm, angle: deg} or units: {length: m, angle: rad}')
+    result = run_command('solve', path)
+    assert result.returncode == 2 and result.stderr == f'error: {info.value}\n'
 
 
 def test_there_are_at_least_twenty_bad_scenes():
@@ -295,6 +319,24 @@ def test_packaged_scene_loads_and_solves(path):
     for joint in state.joints.values():
         assert math.isfinite(joint.position + joint.velocity + joint.acceleration)
     json.dumps(state.as_dict())
+
+
+@pytest.mark.parametrize('path', PACKAGED, ids=[path.stem for path in PACKAGED])
+def test_packaged_scene_states_both_units(path):
+    """Every packaged scene names its length and angle units (required). See issue 11."""
+    units = yaml.safe_load(path.read_text(encoding='utf-8'))['units']
+    assert units in ({'length': 'mm', 'angle': 'deg'}, {'length': 'm', 'angle': 'deg'})
+
+
+@pytest.mark.parametrize(('name', 'crank', 'angle_deg'), [
+    ('steam_engine_500_2000', 0.5, 135.0), ('slider_crank_150_600', 0.15, 135.0),
+    ('khurmi_four_bar_ad150', 0.04, 60.0),
+])
+def test_packaged_scene_units_keep_their_meaning(name, crank, angle_deg):
+    """The packaged scenes read as before units became required: the crank in metres, the angle."""
+    scene = mk.load_scene(name)
+    assert scene.input.length == pytest.approx(crank, rel=1e-15)
+    assert scene.input.angle == pytest.approx(math.radians(angle_deg), rel=1e-15)
 
 
 @pytest.mark.parametrize('path', PACKAGED, ids=[path.stem for path in PACKAGED])
@@ -490,7 +532,7 @@ def test_solve_help_mentions_every_option():
 def test_solve_command_exits_2_on_an_unsolvable_angle(tmp_path):
     """At an angle where the mechanism cannot assemble, `solve` prints one line and exits 2."""
     d, a, b, c = 1.0, 0.6, 0.5, 0.7  # non-Grashof: s + l = 1.5 > p + q = 1.3
-    data = {'name': 'non_grashof', 'units': {'length': 'm'},
+    data = {'name': 'non_grashof', 'units': {'length': 'm', 'angle': 'deg'},
             'ground': {'A': [0, 0], 'D': [d, 0]},
             'input': {'link': 'crank', 'center': 'A', 'point': 'B', 'length': a, 'angle': 0},
             'dyads': [{'type': 'RRR', 'point': 'C',
