@@ -355,3 +355,25 @@ def test_stamp_is_read_from_the_bytes_in_either_byte_order():
         assert stamp_from_cdr(data) == 1_795_000_000_123_456_789
     big_endian = b'\x00\x00\x00\x00' + struct.pack('>iI', 12, 34) + b'\x00\x00\x00\x00'
     assert stamp_from_cdr(big_endian) == 12 * 1_000_000_000 + 34
+
+
+def test_templates_of_a_large_scene_keep_every_value():
+    """12,000 points (72,000 float slots, beyond 16 bits of slot index) render exactly.
+
+    See issue 12: a node on a scene of thousands of dyads failed with a ValueError.
+    """
+    from rclpy.serialization import deserialize_message
+    from trajectory_msgs.msg import MultiDOFJointTrajectory
+
+    names = [f'P{i}' for i in range(12_000)]
+    template = TickMessages(['crank'], names, 'f')
+    zs = [complex(i, -i) for i in range(len(names))]
+    state = type('State', (), {
+        'joints': {'crank': mk.JointMotion('revolute', 0.5, 1.5, 2.5)},
+        'complex_points': {n: (z, 2 * z, 3 * z) for n, z in zip(names, zs, strict=True)}})()
+    _, _, points = template.render(state, 7, 8)
+    msg = deserialize_message(points, MultiDOFJointTrajectory)
+    last = msg.points[0]
+    assert msg.joint_names[-1] == 'P11999'
+    assert last.transforms[-1].translation.x == 11999.0
+    assert last.accelerations[-1].linear.y == -3 * 11999.0

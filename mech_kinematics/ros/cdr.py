@@ -34,7 +34,7 @@ from collections.abc import Iterable, Sequence
 import struct
 from typing import Any
 
-__all__ = ['MessageTemplate', 'STAMP_MARKER', 'cdr_from_message', 'marker',
+__all__ = ['MAX_SLOTS', 'MessageTemplate', 'STAMP_MARKER', 'cdr_from_message', 'marker',
            'padding_from_message', 'stamp_from_cdr']
 
 #: Encapsulation header of plain CDR, little-endian (CDR_LE).
@@ -43,7 +43,10 @@ ENCAPSULATION = b'\x00\x01\x00\x00'
 #: Header stamp (sec, nanosec) that marks where the stamp is serialized.
 STAMP_MARKER = (0x5EC04D17, 0x2C5A7E31)
 
-_MARKER_BASE = 0x7FE5A5C35A3C0000   # a large finite float64; slot index in the low bits
+_MARKER_BASE = 0x7FE5A5C35A000000   # a large finite float64; slot index in the low 24 bits
+_MARKER_BITS = 24
+#: How many float64 slots a template can have.
+MAX_SLOTS = 1 << _MARKER_BITS
 
 #: rosidl ``BasicType.typename`` -> struct format character (its size is its alignment).
 _PRIMITIVES = {
@@ -71,9 +74,9 @@ def stamp_from_cdr(data: bytes | bytearray | memoryview) -> int:
 
 
 def marker(index: int) -> float:
-    """Return the float64 that marks slot ``index`` (0 <= index < 65536)."""
-    if not 0 <= index < 0x10000:
-        msg = f'Expected a slot index in [0, 65536), got {index}'
+    """Return the float64 that marks slot ``index`` (0 <= index < MAX_SLOTS)."""
+    if not 0 <= index < MAX_SLOTS:
+        msg = f'Expected a slot index in [0, {MAX_SLOTS}), got {index}'
         raise ValueError(msg)
     value: float = struct.unpack('<d', struct.pack('<Q', _MARKER_BASE + index))[0]
     return value
@@ -190,12 +193,31 @@ def padding_from_message(msg: Any) -> tuple[range, ...]:
     return tuple(writer.padding)
 
 
-def _find_once(data: bytes, pattern: bytes, what: str) -> int:
-    offset = data.find(pattern)
-    if offset < 0 or data.find(pattern, offset + 1) >= 0:
-        msg = f'Expected {what} exactly once in the serialized message'
+def _slot_offsets(data: bytes, n_slots: int) -> list[int]:
+    """Return the offset of every slot marker ``marker(0..n_slots-1)``, in one pass.
+
+    The markers share their five high bytes (little-endian: the last five,
+    which no UTF-8 text holds), so one scan finds every slot whatever their
+    number: a scene of 10,000 dyads builds its templates in milliseconds.
+    """
+    low = _MARKER_BITS // 8
+    suffix = struct.pack('<Q', _MARKER_BASE)[low:]
+    found: dict[int, int] = {}
+    at = data.find(suffix, low)
+    while at >= 0:
+        index = int.from_bytes(data[at - low:at], 'little')
+        if index in found:
+            msg = f'Expected slot {index} exactly once in the serialized message'
+            raise ValueError(msg)
+        found[index] = at - low
+        at = data.find(suffix, at + len(suffix))
+    missing = [i for i in range(n_slots) if i not in found]
+    if missing or len(found) != n_slots:
+        listed = ', '.join(f'slot {i}' for i in missing[:5])
+        msg = (f'Expected {n_slots} slot markers exactly once in the serialized message, got '
+               f'{len(found)}; missing {listed}')
         raise ValueError(msg)
-    return offset
+    return [found[i] for i in range(n_slots)]
 
 
 def _find_all(data: bytes, pattern: bytes, what: str) -> tuple[int, ...]:
@@ -234,8 +256,7 @@ class MessageTemplate:
         # One stamp, or several (a TFMessage has one per transform), all patched alike.
         stamp = self._stamp.pack(*STAMP_MARKER)
         self._stamp_offsets = _find_all(data, stamp, 'the header stamp marker')
-        offsets = [_find_once(data, struct.pack('<d', marker(i)), f'slot {i}')
-                   for i in range(n_slots)]
+        offsets = _slot_offsets(data, n_slots)
         buffer = bytearray(data)
         for offset in offsets:
             buffer[offset:offset + 8] = bytes(8)
