@@ -439,7 +439,7 @@ class _At:
         self.points = {name: mk.PointState(*(getattr(p, q)[index] for q in QUANTITIES))
                        for name, p in state.points.items()}
         self.joints = {name: mk.JointMotion(j.type, *(float(getattr(j, q)[index])
-                                                     for q in QUANTITIES))
+                                                      for q in QUANTITIES))
                        for name, j in state.joints.items()}
 
 
