@@ -382,23 +382,24 @@ class _RRRStep:
         ldiff = l1 - l2
         # 4 * dist^2 * h^2 as a product of factors: no cancellation near toggle.
         k = (lsum + dist) * (lsum - dist) * (dist + ldiff) * (dist - ldiff)
-        m = self.unit
-        if not ctx.vector and not k > 0.0:  # a vector solve catches it in the margin's check
-            ctx.check(False, self.label, lambda: (
-                f'the circles about {self.start1} (radius {l1 * m:.17g} m) and {self.start2} '
-                f'(radius {l2 * m:.17g} m) do not meet: expected |{ldiff * m:.17g}| < '
-                f'|{self.start1}{self.start2}| < {lsum * m:.17g} m, got '
-                f'|{self.start1}{self.start2}| = {dist * m:.17g} m'))
-        # The error of dist, l1 and l2: the inputs', and this step's rounding of
-        # d and dist (2 U dist) and of lsum and ldiff. k's factors are linear in
-        # them, so k stays positive for every input within that error while the
-        # margin to the limit exceeds it.
+        # The circles meet (k > 0) where the margin min(lsum - dist, dist - |ldiff|)
+        # is positive. The error of dist, l1 and l2 (spread) is the inputs' and this
+        # step's rounding of d and dist (2 U dist) and of lsum and ldiff. The margin
+        # is linear in them: beyond ROUNDING_MARGIN spreads of the limit no input
+        # within its error can cross it; nearer, either way, it is not trusted.
         spread = ep1 + ep2 + self.e_lengths + _U2 * dist
         outer = lsum - dist
         inner = dist - abs(ldiff)
         margin = np.minimum(outer, inner) if ctx.vector else (
             outer if outer < inner else inner)
         ok = margin > ROUNDING_MARGIN * spread
+        m = self.unit
+        if not (ctx.vector or ok or margin > -ROUNDING_MARGIN * spread):
+            ctx.check(False, self.label, lambda: (
+                f'the circles about {self.start1} (radius {l1 * m:.17g} m) and {self.start2} '
+                f'(radius {l2 * m:.17g} m) do not meet: expected |{ldiff * m:.17g}| < '
+                f'|{self.start1}{self.start2}| < {lsum * m:.17g} m, got '
+                f'|{self.start1}{self.start2}| = {dist * m:.17g} m'))
         if ctx.vector or not ok:
             ctx.check_margin(ok, self.label, margin * m, spread * m, lambda: (
                 f'the circles about {self.start1} and {self.start2} are within rounding of '
@@ -495,18 +496,21 @@ class _RRPStep:
         along = _dot(w, u)
         offset = _cross(u, w)  # signed distance of the start point from the guide
         k = (length - offset) * (length + offset)
-        m = self.unit
-        if not ctx.vector and not k > 0.0:  # a vector solve catches it in the margin's check
-            ctx.check(False, self.label, lambda: (
-                f'the guide is out of reach of link {self.link}: expected the distance of '
-                f'{self.start} from the guide < {length * m:.17g} m, got '
-                f'{abs(offset) * m:.17g} m'))
-        # The error of the start point relative to the guide (the inputs' and this
-        # step's rounding), which also bounds that of the slider coordinate's data.
+        # The guide is in reach (k > 0) where the margin length - |offset| is
+        # positive. The error of the start point relative to the guide (the
+        # inputs' and this step's rounding; spread) also bounds that of the
+        # slider coordinate's data. Within ROUNDING_MARGIN spreads of the limit,
+        # either way, the answer is not trusted.
         ek = self.e_turn
         spread = eq + (abs(along) + length) * ek + self.e_fixed
         margin = length - abs(offset)
         ok = margin > ROUNDING_MARGIN * spread
+        m = self.unit
+        if not (ctx.vector or ok or margin > -ROUNDING_MARGIN * spread):
+            ctx.check(False, self.label, lambda: (
+                f'the guide is out of reach of link {self.link}: expected the distance of '
+                f'{self.start} from the guide < {length * m:.17g} m, got '
+                f'{abs(offset) * m:.17g} m'))
         if ctx.vector or not ok:
             ctx.check_margin(ok, self.label, margin * m, spread * m, lambda: (
                 f'the guide is within rounding of the reach of link {self.link}: expected '
