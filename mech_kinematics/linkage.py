@@ -1409,6 +1409,18 @@ def _refuse(solver: _Solver, ctx: _Context, omega: float, alpha: float, tol: flo
 def _judge(solver: _Solver, ctx: _Context, omega: Any, alpha: Any, tol: float,
            shape: tuple[int, ...]) -> None:
     """Mask the angles of a vector solve where a reported bound exceeds ``tol``."""
+    w = abs(omega)
+    rate = w * w + abs(alpha)
+    a = solver.crank_length
+    floors = {'position': solver.size, 'angle': 1.0, 'velocity': a * w, 'angular velocity': w,
+              'acceleration': a * rate, 'angular acceleration': rate}
+    lims = {kind: tol * floor for kind, floor in floors.items()}
+    failed = np.logical_not(ctx.valid)  # already refused: not judged again
+    if all(bool(((entry[3] <= lims[kinds[0]]) & (entry[4] <= lims[kinds[1]])
+                 & (entry[5] <= lims[kinds[2]]) | failed).all())
+           for table, name, _, _, kinds in solver.outputs
+           for entry in (getattr(ctx, table)[name],)):
+        return  # within the floors of the scales (as _trusted): no norms needed
     scales = _context_scales(solver, ctx, omega, alpha)
     lims = {kind: limit(tol, scale) for kind, scale in scales.items()}
     for table, name, _, label, kinds in solver.outputs:
