@@ -298,10 +298,12 @@ _U2, _U3, _U4, _U5, _U7, _U16 = (n * U for n in (2, 3, 4, 5, 7, 16))
 # error by the dyad's sensitivity: ``1 / measure`` for an RRR's or RRP's
 # positions and for the rows of its two-by-two velocity and acceleration
 # systems, ``1 / s`` for an RPR. The rounding of the final sums and products
-# adds a few ``U`` of their terms' magnitudes; a point's bound is kept at least
-# ``U |p|`` (and likewise for its velocity and acceleration), so a later sum's
-# rounding is covered by its operand's bound without computing a norm. Every
-# bound is a sum of products of magnitudes: the same bits on both paths.
+# adds a few ``U`` of their terms' magnitudes; a point's position bound is kept
+# at least ``U |p|``, so a later sum's rounding is covered by its operand's
+# bound without computing a norm; where a velocity's or acceleration's size is
+# needed, ``|x| + |y| >= |z|`` stands for it. Every bound is a sum of products
+# of real magnitudes, never a complex norm (NumPy's may differ from Python's by
+# an ulp): the same bits on both paths.
 
 
 class _CrankStep:
@@ -454,8 +456,9 @@ class _RRRStep:
         # U |v1| + U |w1| l1 and 2 U |a1| + a few U (|al1| + w1^2) l1 (in erp).
         ctx.points[self.point] = (
             p1 + r1, v1 + 1j * w1 * r1, a1 + 1j * al1 * r1 - w1 * w1 * r1, er + ep1,
-            ev1 + U * abs(v1) + t + aw1 * erp,
-            ea1 + _U2 * abs(a1) + ta + (2.0 * aw1 + ew1) * t + (aa1 + w1sq) * erp)
+            ev1 + U * (abs(v1.real) + abs(v1.imag)) + t + aw1 * erp,
+            ea1 + _U2 * (abs(a1.real) + abs(a1.imag)) + ta + (2.0 * aw1 + ew1) * t
+            + (aa1 + w1sq) * erp)
         ctx.links[self.link1] = (r1 * (1.0 / l1), w1, al1, er * inv_l1 + _U7, ew1, ta * inv_l1)
         ctx.links[self.link2] = (r2 * (1.0 / l2), w2, al2, er * inv_l2 + _U7, t * inv_l2,
                                  ta * inv_l2)
@@ -645,8 +648,8 @@ class _CarryStep:
         # The sums round by U |p| (in ep) and U |v|, 2 U |a| (and U |r| terms, in er).
         ctx.points[self.point] = (
             p + r, v + 1j * omega * r, a + 1j * alpha * r - omega * omega * r,
-            2.0 * ep + er, ev + U * abs(v) + ew * radius + aw * er,
-            ea + _U2 * abs(a) + (eal + (2.0 * aw + ew) * ew) * radius
+            2.0 * ep + er, ev + U * (abs(v.real) + abs(v.imag)) + ew * radius + aw * er,
+            ea + _U2 * (abs(a.real) + abs(a.imag)) + (eal + (2.0 * aw + ew) * ew) * radius
             + (abs(alpha) + aw * aw) * er)
 
 
