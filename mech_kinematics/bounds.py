@@ -27,7 +27,7 @@ A point's bound is one number, the bound on the Euclidean norm of its error
 vector (m, m/s, m/s^2). An angle's bound is in rad, modulo 2 pi.
 
 The tolerance ``max_error`` is relative to the *scale* of each kind of value
-in the state (:data:`KINDS`; :func:`scales`): a solve is refused when the
+in the state (:data:`KINDS`, ``State.scales``): a solve is refused when the
 bound of any requested value exceeds ``max_error`` times its kind's scale.
 Whatever the tolerance, a dyad within :data:`ROUNDING_MARGIN` times the
 rounding of its inputs of an assembly limit (where changing an input by an

@@ -9,6 +9,13 @@ rigid rotation is a product and every formula is the same for one crank angle
 (Python ``complex`` and :mod:`math`, cheap enough for a node's tick) and for
 an array of crank angles (NumPy, for cycles and plots).
 
+Every step also bounds the error of what it computes (plain sums and products
+of magnitudes beside the values, see :mod:`mech_kinematics.bounds`), and
+:func:`solve` refuses a state whose bounds exceed a tolerance relative to each
+kind's scale, or that lies within rounding of an assembly limit. A scene far
+from 1 m in size, or a crank far from 1 rad/s, is solved scaled by a power of
+two and scaled back (exactly), so no product overflows or underflows.
+
 Everything here is SI: metres, radians, seconds. Angles are counter-clockwise
 from +x; angular velocities and accelerations are positive counter-clockwise.
 """
