@@ -12,14 +12,16 @@ NumPy and PyYAML only; nothing here imports rclpy.
 -4.7846
 """
 
-from .errors import AssemblyError, MechKinematicsError, NearSingularWarning, SceneError
+from .bounds import Bounds, ErrorBound, MAX_ERROR
+from .errors import (AssemblyError, MechKinematicsError, NearSingularWarning, SceneError,
+                     UntrustedError)
 from .linkage import (Branch, CarriedPoint, Crank, JointMotion, Link, NEAR_SINGULAR,
                       PointState, RPR, RRP, RRR, Scene, SINGULAR, solve, State)
 from .scene import DEFAULT_SCENE, load_scene, parse_scene, scene_names
 
 __all__ = [
-    'AssemblyError', 'Branch', 'CarriedPoint', 'Crank', 'DEFAULT_SCENE', 'JointMotion', 'Link',
-    'MechKinematicsError', 'NEAR_SINGULAR', 'NearSingularWarning', 'PointState', 'RPR', 'RRP',
-    'RRR', 'SINGULAR', 'Scene', 'SceneError', 'State', 'load_scene', 'parse_scene',
-    'scene_names', 'solve',
+    'AssemblyError', 'Bounds', 'Branch', 'CarriedPoint', 'Crank', 'DEFAULT_SCENE', 'ErrorBound',
+    'JointMotion', 'Link', 'MAX_ERROR', 'MechKinematicsError', 'NEAR_SINGULAR',
+    'NearSingularWarning', 'PointState', 'RPR', 'RRP', 'RRR', 'SINGULAR', 'Scene', 'SceneError',
+    'State', 'UntrustedError', 'load_scene', 'parse_scene', 'scene_names', 'solve',
 ]

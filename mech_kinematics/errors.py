@@ -52,5 +52,39 @@ class AssemblyError(MechKinematicsError):
         super().__init__(msg)
 
 
+class UntrustedError(AssemblyError):
+    """The mechanism's state at a given crank angle cannot be trusted, so it is refused.
+
+    Raised when the error bound of a requested value exceeds the tolerance
+    (``max_error`` times its kind's scale), when a dyad is within rounding of
+    an assembly limit (an ulp's change of an input could make it unassemblable
+    or flip its branch), or when the state overflows the range of doubles.
+
+    Attributes
+    ----------
+    dyad : str
+        Label of the dyad that produced the value, e.g. ``RRR C``.
+    angle : float
+        The crank angle, rad.
+    reason : str
+        What cannot be trusted, with the numbers.
+    value : str
+        The value refused, as its path in ``State.as_dict()`` (e.g.
+        ``joints.rocker.acceleration``), or ``margin`` for a dyad within
+        rounding of its assembly limit.
+    bound : float
+        Its error bound, SI units.
+    tolerance : float
+        The largest bound accepted, SI units (``max_error`` times the scale).
+    """
+
+    def __init__(self, dyad: str, angle: float, reason: str, value: str, bound: float,
+                 tolerance: float) -> None:
+        super().__init__(dyad, angle, reason)
+        self.value = value
+        self.bound = bound
+        self.tolerance = tolerance
+
+
 class NearSingularWarning(UserWarning):
     """The mechanism is close to a singular position; results lose accuracy."""

@@ -9,26 +9,37 @@ rigid rotation is a product and every formula is the same for one crank angle
 (Python ``complex`` and :mod:`math`, cheap enough for a node's tick) and for
 an array of crank angles (NumPy, for cycles and plots).
 
+Every step also bounds the error of what it computes (plain sums and products
+of magnitudes beside the values, see :mod:`mech_kinematics.bounds`), and
+:func:`solve` refuses a state whose bounds exceed a tolerance relative to each
+kind's scale, or that lies within rounding of an assembly limit. A scene far
+from 1 m in size, or a crank far from 1 rad/s, is solved scaled by a power of
+two and scaled back (exactly), so no product overflows or underflows.
+
 Everything here is SI: metres, radians, seconds. Angles are counter-clockwise
 from +x; angular velocities and accelerations are positive counter-clockwise.
 """
 
 from __future__ import annotations
 
+import cmath
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from enum import IntEnum
 from functools import cached_property
 import heapq
 import math
 import re
-from typing import Any
+from types import SimpleNamespace
+from typing import Any, cast
 import warnings
 
 import numpy as np
 import numpy.typing as npt
 
-from .errors import AssemblyError, NearSingularWarning, SceneError
+from .bounds import (ErrorBound, LARGEST, limit, MAX_ERROR, ROUNDING_MARGIN, SCALE_MEANINGS,
+                     Table, U, UNITS)
+from .errors import AssemblyError, NearSingularWarning, SceneError, UntrustedError
 
 __all__ = [
     'Branch', 'CarriedPoint', 'Crank', 'JointMotion', 'Link', 'NEAR_SINGULAR', 'PointState',
@@ -228,7 +239,13 @@ Dyad = RRR | RRP | RPR
 
 
 class _Context:
-    """Values known so far in one solve; complex numbers or complex arrays."""
+    """Values known so far in one solve; complex numbers or complex arrays.
+
+    Every entry carries the error bounds of its values (see :mod:`.bounds`):
+    ``points[name] = (p, v, a, bound p, bound v, bound a)``, likewise
+    ``links[name] = (e, omega, alpha, ...)`` with ``e`` the unit vector along the
+    link, and ``sliders[name] = (s, sd, sdd, ...)``.
+    """
 
     __slots__ = ('angle', 'vector', 'points', 'links', 'sliders', 'measures', 'valid',
                  'failures')
@@ -236,9 +253,9 @@ class _Context:
     def __init__(self, angle: Any, vector: bool) -> None:
         self.angle = angle
         self.vector = vector
-        self.points: dict[str, tuple[Any, Any, Any]] = {}
-        self.links: dict[str, tuple[Any, Any, Any]] = {}
-        self.sliders: dict[str, tuple[Any, Any, Any]] = {}
+        self.points: dict[str, tuple[Any, Any, Any, Any, Any, Any]] = {}
+        self.links: dict[str, tuple[Any, Any, Any, Any, Any, Any]] = {}
+        self.sliders: dict[str, tuple[Any, Any, Any, Any, Any, Any]] = {}
         self.measures: dict[str, Any] = {}
         self.valid: Any = True
         self.failures: dict[str, Any] = {}
@@ -249,12 +266,25 @@ class _Context:
             if not ok:
                 raise AssemblyError(label, self.angle, reason())
             return
+        self.mask(ok, label)
+
+    def mask(self, ok: Any, label: str) -> None:
+        """Mark the entries of a vector solve where ``ok`` fails as failed under ``label``."""
         if not ok.all():
             failed = ~ok & self.valid
             self.valid = self.valid & ok
             if failed.any():
                 previous = self.failures.get(label)
                 self.failures[label] = failed if previous is None else previous | failed
+
+    def check_margin(self, ok: Any, label: str, margin: Any, bound: Any, reason: Any) -> None:
+        """Like :meth:`check` for a dyad within rounding of an assembly limit (untrusted)."""
+        if not self.vector:
+            if not ok:
+                raise UntrustedError(label, self.angle, reason(), 'margin', float(bound),
+                                     float(margin) / ROUNDING_MARGIN)
+            return
+        self.mask(ok, label)
 
 
 def _dot(a: Any, b: Any) -> Any:
@@ -265,6 +295,25 @@ def _cross(a: Any, b: Any) -> Any:
     return a.real * b.imag - a.imag * b.real
 
 
+# Multiples of the unit roundoff used by the bounds.
+_U2, _U3, _U4, _U5, _U7, _U16 = (n * U for n in (2, 3, 4, 5, 7, 16))
+
+# How the bounds below are built (bounds.py says what they mean). Each step
+# bounds the error of its outputs, first order, from the bounds of its inputs
+# (the points it starts from, the scene's constants rounded to doubles) and
+# its own rounding. A dyad's rounding is counted as a perturbation of its
+# inputs (its closed forms are backward stable), amplified like an input's
+# error by the dyad's sensitivity: ``1 / measure`` for an RRR's or RRP's
+# positions and for the rows of its two-by-two velocity and acceleration
+# systems, ``1 / s`` for an RPR. The rounding of the final sums and products
+# adds a few ``U`` of their terms' magnitudes; a point's position bound is kept
+# at least ``U |p|``, so a later sum's rounding is covered by its operand's
+# bound without computing a norm; where a velocity's or acceleration's size is
+# needed, ``|x| + |y| >= |z|`` stands for it. Every bound is a sum of products
+# of real magnitudes, never a complex norm (NumPy's may differ from Python's by
+# an ulp): the same bits on both paths.
+
+
 class _CrankStep:
     def __init__(self, crank: Crank, center: complex) -> None:
         self.link = crank.link
@@ -272,6 +321,11 @@ class _CrankStep:
         self.center = center
         self.length = crank.length
         self.uses: tuple[str, ...] = (crank.center,)
+        # The tip's sum ``center + r``: the centre's rounding and the sum's.
+        self.e_center = U * (2.0 * abs(center) + crank.length)
+        # r = length * e: the length's rounding and the product's; then those of
+        # v = i omega r and of a = i alpha r - omega^2 r.
+        self.e_r, self.e_v, self.e_a = (n * U * crank.length for n in (2, 4, 7))
 
     def run(self, ctx: _Context, theta: Any, omega: Any, alpha: Any) -> None:
         e: Any
@@ -286,8 +340,14 @@ class _CrankStep:
             acceleration = -(omega * omega) * r
         else:
             acceleration = 1j * alpha * r - omega * omega * r
-        ctx.points[self.point] = (self.center + r, 1j * omega * r, acceleration)
-        ctx.links[self.link] = (e, omega, alpha)
+        # Bounds: theta known to U |theta|, cos and sin to an ulp; r = length * e.
+        ee = U * abs(theta) + _U2
+        re = self.length * ee
+        w = abs(omega)
+        ctx.points[self.point] = (self.center + r, 1j * omega * r, acceleration,
+                                  re + self.e_r + self.e_center, w * (re + self.e_v),
+                                  (abs(alpha) + w * w) * (re + self.e_a))
+        ctx.links[self.link] = (e, omega, alpha, ee + _U4, U * w, U * abs(alpha))
 
 
 # Every complex product below has one real factor or a purely imaginary one
@@ -298,6 +358,8 @@ class _CrankStep:
 
 
 class _RRRStep:
+    unit = 1.0  # metres per length unit of the plan, for messages (see _Solver)
+
     def __init__(self, dyad: RRR) -> None:
         first, second = dyad.links
         self.label = f'RRR {dyad.point}'
@@ -306,31 +368,63 @@ class _RRRStep:
         self.start1, self.start2 = first.start, second.start
         self.link1, self.link2 = first.name, second.name
         self.l1, self.l2 = first.length, second.length
+        self.inv_l1, self.inv_l2 = 1.0 / first.length, 1.0 / second.length
+        self.inv_sum = self.inv_l1 + self.inv_l2
+        lsum = first.length + second.length
+        # The input lengths' rounding (U each), and this step's as more of it:
+        # lsum and ldiff are those of lengths within U lsum of the true ones.
+        self.e_lengths = _U3 * lsum
+        # The rounding of r1 and r2 from the rounded data (not amplified: the
+        # height's root, the unit vector, the final sums), and of the products
+        # of the velocity and acceleration systems.
+        self.e_forward = _U16 * lsum
+        self.e_round = 8.0 * U * max(first.length, second.length)
         self.branch = int(dyad.branch)
         self.uses = (first.start, second.start)
 
     def run(self, ctx: _Context) -> None:
         l1, l2 = self.l1, self.l2
-        p1, v1, a1 = ctx.points[self.start1]
-        p2, v2, a2 = ctx.points[self.start2]
+        p1, v1, a1, ep1, ev1, ea1 = ctx.points[self.start1]
+        p2, v2, a2, ep2, ev2, ea2 = ctx.points[self.start2]
         d = p2 - p1
         dist = np.hypot(d.real, d.imag) if ctx.vector else abs(d)
         lsum = l1 + l2
         ldiff = l1 - l2
         # 4 * dist^2 * h^2 as a product of factors: no cancellation near toggle.
         k = (lsum + dist) * (lsum - dist) * (dist + ldiff) * (dist - ldiff)
-        if not ctx.vector:  # a vector solve catches k <= 0 in the measure's check below
-            ctx.check(k > 0.0, self.label, lambda: (
-                f'the circles about {self.start1} (radius {l1:.17g} m) and {self.start2} '
-                f'(radius {l2:.17g} m) do not meet: expected |{ldiff:.17g}| < |{self.start1}'
-                f'{self.start2}| < {lsum:.17g} m, got |{self.start1}{self.start2}| = '
-                f'{dist:.17g} m'))
+        # The circles meet (k > 0) where the margin min(lsum - dist, dist - |ldiff|)
+        # is positive. The error of dist, l1 and l2 (spread) is the inputs' and this
+        # step's rounding of d and dist (2 U dist) and of lsum and ldiff. The margin
+        # is linear in them: beyond ROUNDING_MARGIN spreads of the limit no input
+        # within its error can cross it; nearer, either way, it is not trusted.
+        spread = ep1 + ep2 + self.e_lengths + _U2 * dist
+        outer = lsum - dist
+        inner = dist - abs(ldiff)
+        margin = np.minimum(outer, inner) if ctx.vector else (
+            outer if outer < inner else inner)
+        ok = margin > ROUNDING_MARGIN * spread
+        m = self.unit
+        if not (ctx.vector or ok or margin > -ROUNDING_MARGIN * spread):
+            ctx.check(False, self.label, lambda: (
+                f'the circles about {self.start1} (radius {l1 * m:.17g} m) and {self.start2} '
+                f'(radius {l2 * m:.17g} m) do not meet: expected |{ldiff * m:.17g}| < '
+                f'|{self.start1}{self.start2}| < {lsum * m:.17g} m, got '
+                f'|{self.start1}{self.start2}| = {dist * m:.17g} m'))
+        if ctx.vector or not ok:
+            ctx.check_margin(ok, self.label, margin * m, spread * m, lambda: (
+                f'the circles about {self.start1} and {self.start2} are within rounding of '
+                f'meeting at one point: expected the margin min({lsum * m:.17g} m - '
+                f'|{self.start1}{self.start2}|, |{self.start1}{self.start2}| - '
+                f'{abs(ldiff) * m:.17g} m) = {margin * m:.3g} m to exceed '
+                f'{ROUNDING_MARGIN:g} times its error bound {spread * m:.3g} m'))
         root = np.sqrt(k) if ctx.vector else math.sqrt(k)
         # sin of the angle between the two links (the transmission angle).
         measure = root / (2.0 * l1 * l2)
-        ctx.check(measure > SINGULAR, self.label, lambda: (
-            f'links {self.link1} and {self.link2} are in line (singular): expected the sine '
-            f'of the angle between them > {SINGULAR:g}, got {measure:.3g}'))
+        ok = measure > SINGULAR
+        if ctx.vector or not ok:
+            ctx.check(ok, self.label, lambda: (
+                f'links {self.link1} and {self.link2} are in line (singular): expected the '
+                f'sine of the angle between them > {SINGULAR:g}, got {measure:.3g}'))
         ctx.measures[self.key] = measure
         half = 0.5 / dist
         shared = ldiff * lsum
@@ -343,15 +437,44 @@ class _RRRStep:
         dv = v2 - v1
         w1 = _dot(dv, r2) * inv
         w2 = _dot(dv, r1) * inv
-        da = a2 - a1 + w1 * w1 * r1 - w2 * w2 * r2
+        w1sq, w2sq = w1 * w1, w2 * w2
+        da = a2 - a1 + w1sq * r1 - w2sq * r2
         al1 = _dot(da, r2) * inv
         al2 = _dot(da, r1) * inv
-        ctx.points[self.point] = (p1 + r1, v1 + 1j * w1 * r1, a1 + 1j * al1 * r1 - w1 * w1 * r1)
-        ctx.links[self.link1] = (r1 * (1.0 / l1), w1, al1)
-        ctx.links[self.link2] = (r2 * (1.0 / l2), w2, al2)
+        # Bounds. r1 and r2 (and the pin) move by at most er: spread / measure
+        # and their own rounding.
+        # The velocity system i w1 r1 - i w2 r2 = dv has rows of norm
+        # 1 / (l1 measure) and 1 / (l2 measure), its matrix moves by er and its
+        # right side by the inputs' bounds: w1 and w2 move by t / l1 and t / l2
+        # (t also holds the rounding of the dot products and of w = dot * inv).
+        # Likewise the acceleration system, whose right side
+        # da = a2 - a1 + w1^2 r1 - w2^2 r2 moves with the w's.
+        inv_m = 1.0 / measure
+        er = spread * inv_m + self.e_forward
+        erp = er + self.e_round
+        inv_l1, inv_l2 = self.inv_l1, self.inv_l2
+        aw1 = abs(w1)
+        aws = aw1 + abs(w2)
+        t = (ev1 + ev2 + aws * erp) * inv_m
+        aa1 = abs(al1)
+        ta = (ea1 + ea2 + (2.0 * aws + t * self.inv_sum) * t
+              + (w1sq + w2sq + aa1 + abs(al2)) * erp) * inv_m
+        ew1 = t * inv_l1
+        # The pin's sums p1 + r1 etc. round by U |p1| + U l1 (in ep1 and er),
+        # U |v1| + U |w1| l1 and 2 U |a1| + a few U (|al1| + w1^2) l1 (in erp).
+        ctx.points[self.point] = (
+            p1 + r1, v1 + 1j * w1 * r1, a1 + 1j * al1 * r1 - w1 * w1 * r1, er + ep1,
+            ev1 + U * (abs(v1.real) + abs(v1.imag)) + t + aw1 * erp,
+            ea1 + _U2 * (abs(a1.real) + abs(a1.imag)) + ta + (2.0 * aw1 + ew1) * t
+            + (aa1 + w1sq) * erp)
+        ctx.links[self.link1] = (r1 * (1.0 / l1), w1, al1, er * inv_l1 + _U7, ew1, ta * inv_l1)
+        ctx.links[self.link2] = (r2 * (1.0 / l2), w2, al2, er * inv_l2 + _U7, t * inv_l2,
+                                 ta * inv_l2)
 
 
 class _RRPStep:
+    unit = 1.0  # metres per length unit of the plan, for messages (see _Solver)
+
     def __init__(self, dyad: RRP, through: complex) -> None:
         self.label = f'RRP {dyad.point}'
         self.key = dyad.point
@@ -359,30 +482,60 @@ class _RRPStep:
         self.start = dyad.link.start
         self.link = dyad.link.name
         self.length = dyad.link.length
+        self.inv_length = 1.0 / dyad.link.length
         self.slider = dyad.slider
         self.through = through
         self.u = complex(math.cos(dyad.guide_angle), math.sin(dyad.guide_angle))
         self.normal = 1j * self.u
         self.branch = int(dyad.branch)
         self.uses = (dyad.link.start,)
+        # The guide: its point known to U |through|, its direction to the angle's
+        # rounding and an ulp of cos and sin.
+        self.e_through = U * abs(through)
+        self.e_guide = U * abs(dyad.guide_angle) + _U2
+        # The rounding of w = q - through, of its components along and across
+        # the guide and of k's factors, as errors of the start point.
+        self.e_turn = self.e_guide + _U5
+        self.e_fixed = self.e_through + _U2 * dyad.link.length
+        self.e_round = _U3 * dyad.link.length  # of the final forms
+        self.e_round2 = 2.0 * self.e_round
 
     def run(self, ctx: _Context) -> None:
         length, u = self.length, self.u
-        q, vq, aq = ctx.points[self.start]
+        q, vq, aq, eq, evq, eaq = ctx.points[self.start]
         w = q - self.through
         along = _dot(w, u)
         offset = _cross(u, w)  # signed distance of the start point from the guide
         k = (length - offset) * (length + offset)
-        if not ctx.vector:  # a vector solve catches k <= 0 in the measure's check below
-            ctx.check(k > 0.0, self.label, lambda: (
+        # The guide is in reach (k > 0) where the margin length - |offset| is
+        # positive. The error of the start point relative to the guide (the
+        # inputs' and this step's rounding; spread) also bounds that of the
+        # slider coordinate's data. Within ROUNDING_MARGIN spreads of the limit,
+        # either way, the answer is not trusted.
+        ek = self.e_turn
+        spread = eq + (abs(along) + length) * ek + self.e_fixed
+        margin = length - abs(offset)
+        ok = margin > ROUNDING_MARGIN * spread
+        m = self.unit
+        if not (ctx.vector or ok or margin > -ROUNDING_MARGIN * spread):
+            ctx.check(False, self.label, lambda: (
                 f'the guide is out of reach of link {self.link}: expected the distance of '
-                f'{self.start} from the guide < {length:.17g} m, got {abs(offset):.17g} m'))
+                f'{self.start} from the guide < {length * m:.17g} m, got '
+                f'{abs(offset) * m:.17g} m'))
+        if ctx.vector or not ok:
+            ctx.check_margin(ok, self.label, margin * m, spread * m, lambda: (
+                f'the guide is within rounding of the reach of link {self.link}: expected '
+                f'the margin {length * m:.17g} m - (distance of {self.start} from the guide) '
+                f'= {margin * m:.3g} m to exceed {ROUNDING_MARGIN:g} times its error bound '
+                f'{spread * m:.3g} m'))
         root = np.sqrt(k) if ctx.vector else math.sqrt(k)
         # sin of the angle between the rod and the guide's normal.
         measure = root / length
-        ctx.check(measure > SINGULAR, self.label, lambda: (
-            f'link {self.link} is perpendicular to the guide (singular): expected the sine of '
-            f'its angle to the guide normal > {SINGULAR:g}, got {measure:.3g}'))
+        ok = measure > SINGULAR
+        if ctx.vector or not ok:
+            ctx.check(ok, self.label, lambda: (
+                f'link {self.link} is perpendicular to the guide (singular): expected the '
+                f'sine of its angle to the guide normal > {SINGULAR:g}, got {measure:.3g}'))
         ctx.measures[self.key] = measure
         den = self.branch * root  # dot(u, r)
         inv = 1.0 / den
@@ -393,12 +546,34 @@ class _RRPStep:
         rest = aq - omega * omega * r
         sdd = _dot(rest, r) * inv
         alpha = _cross(rest, u) * inv
-        ctx.points[self.point] = (self.through + s * u, sd * u, sdd * u)
-        ctx.links[self.link] = (r * (1.0 / length), omega, alpha)
-        ctx.sliders[self.slider] = (s, sd, sdd)
+        # Bounds. The slider coordinate moves by at most spread / measure and the
+        # rod r by that and spread. The velocity system sd u - i omega r = vq has
+        # rows of norm 1 / measure (for sd) and 1 / (length measure) (for omega),
+        # its matrix moves by the guide's and the rod's bounds and its right side
+        # by the start point's: sd moves by t and omega by t / length (t also
+        # holds the rounding of the products, 2 U |vq| <= 2 U (|sd| + |omega| length)).
+        # Likewise for accelerations, whose right side aq - omega^2 r moves with omega.
+        inv_m = 1.0 / measure
+        a_s = abs(s)
+        es = spread * inv_m + U * a_s + self.e_round
+        er = es + spread + self.e_round
+        erp = er + self.e_round2
+        asd, aw = abs(sd), abs(omega)
+        t = (evq + asd * ek + aw * erp) * inv_m
+        ew = t * self.inv_length
+        asdd, aal = abs(sdd), abs(alpha)
+        ta = (eaq + (2.0 * aw + ew) * t + aw * aw * erp + asdd * ek + aal * erp) * inv_m
+        ctx.points[self.point] = (self.through + s * u, sd * u, sdd * u,
+                                  es + a_s * ek + 3.0 * self.e_through, t + asd * ek,
+                                  ta + asdd * ek)
+        ctx.links[self.link] = (r * (1.0 / length), omega, alpha, er * self.inv_length + _U7,
+                                ew, ta * self.inv_length)
+        ctx.sliders[self.slider] = (s, sd, sdd, es, t, ta)
 
 
 class _RPRStep:
+    unit = 1.0  # metres per length unit of the plan, for messages (see _Solver)
+
     def __init__(self, dyad: RPR, center: complex, size: float) -> None:
         self.label = f'RPR {dyad.link}'
         self.key = dyad.link
@@ -408,25 +583,52 @@ class _RPRStep:
         self.center = center
         self.size = size
         self.uses = (dyad.through,)
+        self.e_center = U * abs(center)
 
     def run(self, ctx: _Context) -> None:
-        b, vb, ab = ctx.points[self.through]
+        b, vb, ab, eb, evb, eab = ctx.points[self.through]
         d = b - self.center
         s = np.hypot(d.real, d.imag) if ctx.vector else abs(d)
+        m = self.unit
         # the slider coordinate relative to the mechanism's size.
         measure = s / self.size
-        ctx.check(measure > SINGULAR, self.label, lambda: (
-            f'the pin {self.through} is on the pivot (singular): expected its distance '
-            f'from the pivot > {SINGULAR * self.size:.3g} m, got {s:.3g} m'))
+        ok = measure > SINGULAR
+        if ctx.vector or not ok:
+            ctx.check(ok, self.label, lambda: (
+                f'the pin {self.through} is on the pivot (singular): expected its distance '
+                f'from the pivot > {SINGULAR * self.size * m:.3g} m, got {s * m:.3g} m'))
+        # The error of the pin relative to the pivot (and of s = |d|): within it of
+        # the pivot the lever's direction is not known at all.
+        ed = eb + self.e_center + _U2 * s
+        ok = s > ROUNDING_MARGIN * ed
+        if ctx.vector or not ok:
+            ctx.check_margin(ok, self.label, s * m, ed * m, lambda: (
+                f'the pin {self.through} is within rounding of the pivot: expected its '
+                f'distance from the pivot {s * m:.3g} m to exceed {ROUNDING_MARGIN:g} times '
+                f'its error bound {ed * m:.3g} m'))
         ctx.measures[self.key] = measure
-        e = d * (1.0 / s)
+        inv_s = 1.0 / s
+        e = d * inv_s
         sd = _dot(vb, e)
         omega = _cross(e, vb) / s
         sdd = _dot(ab, e) + s * omega * omega
         # the Coriolis component 2 * omega * sd sits in the transverse balance.
         alpha = (_cross(e, ab) - 2.0 * sd * omega) / s
-        ctx.links[self.link] = (e, omega, alpha)
-        ctx.sliders[self.slider] = (s, sd, sdd)
+        # Bounds: the lever's direction is known to ed / s, and the pin's velocity
+        # and acceleration, whose components along and across it these are, to
+        # their bounds; |vb| <= |sd| + s |omega| and |ab| likewise. Since
+        # ed >= 2 U s, the terms in ed also hold the rounding of the last products.
+        ee = ed * inv_s + _U7
+        ee4 = ee + _U4
+        asd, aw = abs(sd), abs(omega)
+        esd = evb + (asd + s * aw) * ee4
+        ew = (esd + 2.0 * aw * ed) * inv_s
+        asdd, aal = abs(sdd), abs(alpha)
+        tab = eab + (asdd + s * (aw * aw + aal) + 2.0 * asd * aw) * ee4
+        ctx.links[self.link] = (e, omega, alpha, ee, ew,
+                                (tab + 2.0 * (asd * ew + aw * esd + aal * ed)) * inv_s)
+        ctx.sliders[self.slider] = (s, sd, sdd, ed, esd,
+                                    tab + 2.0 * aw * aw * ed + s * (2.0 * aw + ew) * ew)
 
 
 class _CarryStep:
@@ -436,15 +638,27 @@ class _CarryStep:
         self.base = base  # the origin of the link's frame
         self.along, self.across = local.real, local.imag
         self.uses = (base,)
+        # |local| and the error of the offset: the scene's numbers and the
+        # frame's construction, each to a few ulps.
+        # The extra 4 U |local| holds the rounding of the final sums and products.
+        self.radius = abs(local)
+        self.e_local = _U16 * (self.radius + math.hypot(*point.local)) + _U4 * self.radius
 
     def run(self, ctx: _Context) -> None:
-        e, omega, alpha = ctx.links[self.link]
-        p, v, a = ctx.points[self.base]
+        e, omega, alpha, ee, ew, eal = ctx.links[self.link]
+        p, v, a, ep, ev, ea = ctx.points[self.base]
         r = e * self.along
         if self.across:
             r = r + 1j * e * self.across
-        ctx.points[self.point] = (p + r, v + 1j * omega * r,
-                                  a + 1j * alpha * r - omega * omega * r)
+        radius = self.radius
+        er = radius * ee + self.e_local
+        aw = abs(omega)
+        # The sums round by U |p| (in ep) and U |v|, 2 U |a| (and U |r| terms, in er).
+        ctx.points[self.point] = (
+            p + r, v + 1j * omega * r, a + 1j * alpha * r - omega * omega * r,
+            2.0 * ep + er, ev + U * (abs(v.real) + abs(v.imag)) + ew * radius + aw * er,
+            ea + _U2 * (abs(a.real) + abs(a.imag)) + (eal + (2.0 * aw + ew) * ew) * radius
+            + (abs(alpha) + aw * aw) * er)
 
 
 Step = _RRRStep | _RRPStep | _RPRStep | _CarryStep
@@ -722,6 +936,140 @@ def _step_points(step: Step) -> tuple[str, ...]:
     return () if isinstance(step, _RPRStep) else (step.point,)
 
 
+# --- solving with error bounds ----------------------------------------------
+
+#: Mechanism sizes (m) solved as they are; a scene outside is solved with every
+#: length scaled by a power of two (exactly), so that no product of lengths
+#: overflows or underflows, and its answers scaled back.
+_SIZE_RANGE = (2.0 ** -60, 2.0 ** 60)
+#: Crank rates ``max(|omega|, sqrt|alpha|)`` (1/s) solved as they are; outside,
+#: time is scaled by a power of two the same way.
+_RATE_LOW, _RATE_HIGH = 2.0 ** -40, 2.0 ** 40
+_ACCEL_HIGH = _RATE_HIGH * _RATE_HIGH
+#: What scaling a result back by a power of two can lose (a subnormal result
+#: rounds by half the smallest subnormal, its bound by as much again).
+_TINY = 2.0 ** -1073
+#: The kinds of a point's (or slider's) values and of a revolute joint's.
+_LINEAR = ('position', 'velocity', 'acceleration')
+_ANGULAR = ('angle', 'angular velocity', 'angular acceleration')
+_QUANTITIES = ('position', 'velocity', 'acceleration')
+
+
+def _size(scene: Scene) -> float:
+    """Return the mechanism's size, m: the scale its positions are judged on.
+
+    The largest of the crank length, the RRR and RRP link lengths, the
+    distances of the ground points from the crank's centre and the lengths of
+    the carried points' local offsets.
+    """
+    crank = scene.input
+    centre = complex(*scene.ground[crank.center])
+    size = crank.length
+    for x, y in scene.ground.values():
+        size = max(size, abs(complex(x, y) - centre))
+    for dyad in scene.dyads:
+        if isinstance(dyad, RRR):
+            size = max(size, *(link.length for link in dyad.links))
+        elif isinstance(dyad, RRP):
+            size = max(size, dyad.link.length)
+    for point in scene.points:
+        size = max(size, math.hypot(*point.local))
+    return size
+
+
+def _exponent(x: float, low: float, high: float) -> int:
+    """Return 0 if ``x`` is 0 or in [low, high], else ``e`` with ``x * 2**-e`` in [0.5, 1)."""
+    if x == 0.0 or low <= x <= high:
+        return 0
+    return math.frexp(x)[1]
+
+
+def _scaled(scene: Scene, shift: int) -> Scene:
+    """Return ``scene``'s geometry with every length times ``2**-shift`` (exact), to compile."""
+    def scale(x: float) -> float:
+        return math.ldexp(x, -shift)
+
+    dyads: list[Dyad] = []
+    for dyad in scene.dyads:
+        if isinstance(dyad, RRR):
+            first, second = (replace(link, length=scale(link.length)) for link in dyad.links)
+            dyads.append(replace(dyad, links=(first, second)))
+        elif isinstance(dyad, RRP):
+            dyads.append(replace(dyad, link=replace(dyad.link, length=scale(dyad.link.length))))
+        else:
+            dyads.append(dyad)
+    return cast(Scene, SimpleNamespace(
+        name=scene.name,
+        ground={name: (scale(x), scale(y)) for name, (x, y) in scene.ground.items()},
+        input=replace(scene.input, length=scale(scene.input.length)), dyads=tuple(dyads),
+        points=tuple(replace(p, local=(scale(p.local[0]), scale(p.local[1])))
+                     for p in scene.points)))
+
+
+class _Solver:
+    """A compiled plan with what solving it with error bounds needs.
+
+    ``run_plan`` is the plan the steps run: ``plan`` itself, or for a scene
+    whose size is outside :data:`_SIZE_RANGE` the same scene compiled with
+    every length times ``2**-shift``. ``outputs`` lists the reported values in
+    solve order: (table of the context, name, path in ``as_dict()``, label of
+    the dyad that produced it, the kinds of its three values).
+    """
+
+    def __init__(self, scene: Scene, plan: _Plan) -> None:
+        self.plan = plan
+        self.size = _size(scene)
+        self.crank_length = scene.input.length
+        self.shift = _exponent(self.size, *_SIZE_RANGE)
+        run = plan
+        if self.shift:
+            try:
+                run = _compile(_scaled(scene, self.shift), plan.output_joints,
+                               plan.output_points)
+            except SceneError:
+                msg = (f"Expected every length within 2**1000 of the mechanism's size "
+                       f'{self.size:.3g} m, got one that does not survive scaling to 1 m')
+                raise SceneError(msg, (scene, 'ground')) from None
+            unit = math.ldexp(1.0, self.shift)
+            for step in run.steps:
+                if not isinstance(step, _CarryStep):
+                    step.unit = unit
+        self.run_plan = run
+        # Ground points are inputs: known to U |g|.
+        self.ground = {name: (z, 0j, 0j, U * abs(z), 0.0, 0.0) for name, z in run.ground.items()}
+        crank = scene.input
+        labels = dict.fromkeys((crank.link, crank.point), f'input {crank.link}')
+        labels.update((name, f'ground {name}') for name in plan.ground)
+        rank = dict.fromkeys(labels, 0)
+        self.measure_keys: dict[str, str] = {}
+        for index, step in enumerate(plan.steps, 1):
+            if isinstance(step, _CarryStep):
+                names: tuple[str, ...] = (step.point,)
+                label = labels[step.link]  # the dyad that moves its link
+            else:
+                label = step.label
+                self.measure_keys[label] = step.key
+                if isinstance(step, _RRRStep):
+                    names = (step.point, step.link1, step.link2)
+                elif isinstance(step, _RRPStep):
+                    names = (step.point, step.link, step.slider)
+                else:
+                    names = (step.link, step.slider)
+            for name in names:
+                labels[name], rank[name] = label, index
+        outputs = [(rank[name], 'points', name, f'points.{name}', labels[name], _LINEAR)
+                   for name in plan.output_points]
+        for name, kind in plan.joint_types.items():
+            revolute = kind == 'revolute'
+            outputs.append((rank[name], 'links' if revolute else 'sliders', name,
+                            f'joints.{name}', labels[name], _ANGULAR if revolute else _LINEAR))
+        outputs.sort(key=lambda item: item[0])
+        self.outputs = tuple(item[1:] for item in outputs)
+        self.out_points = plan.output_points
+        self.out_links = tuple(n for n, k in plan.joint_types.items() if k == 'revolute')
+        self.out_sliders = tuple(n for n, k in plan.joint_types.items() if k == 'prismatic')
+
+
 @dataclass(frozen=True)
 class Scene:
     """A planar mechanism: ground points, the driving crank, dyads, carried points.
@@ -757,6 +1105,7 @@ class Scene:
     outputs_points: tuple[str, ...] | None = None
     description: str = ''
     _plan: _Plan = field(init=False, repr=False, compare=False)
+    _solver: _Solver = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         """Validate the fields."""
@@ -764,10 +1113,11 @@ class Scene:
         object.__setattr__(self, 'dyads', tuple(self.dyads))
         object.__setattr__(self, 'points', tuple(self.points))
         full = _compile(self, None, None)
+        solver = _Solver(self, full)
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter('ignore', NearSingularWarning)
-                _run(full, self.input.angle, self.input.speed, self.input.accel)
+                _execute(solver, self.input.angle, 0.0, 0.0)  # positions only
         except AssemblyError as error:
             msg = (f'Expected the mechanism to assemble at the initial crank angle '
                    f'{math.degrees(self.input.angle):.6g} deg, got {error.dyad}: {error.reason}')
@@ -776,7 +1126,9 @@ class Scene:
             plan = full
         else:
             plan = _compile(self, self.outputs_joints, self.outputs_points)
+            solver = _Solver(self, plan)
         object.__setattr__(self, '_plan', plan)
+        object.__setattr__(self, '_solver', solver)
 
     @property
     def output_joints(self) -> tuple[str, ...]:
@@ -855,7 +1207,14 @@ class State:
         links, for RRP the sine of the rod's angle to the guide normal, for RPR
         the slider coordinate over the mechanism's size. 0 is singular.
     failures : dict of str to ndarray of bool
-        For arrays: per dyad label, the angles at which it could not be solved.
+        For arrays: per reason, the angles that were refused. The reason is a
+        dyad's label (``RRR C``: it cannot close, is singular or is within
+        rounding of an assembly limit), that label followed by
+        `` (untrusted)`` (a value's error bound exceeds the tolerance) or by
+        `` (overflow)`` (a value is beyond the range of doubles).
+    error_bound : ErrorBound
+        Absolute error bound of every reported value, shaped like ``joints``
+        and ``points`` (see :mod:`mech_kinematics.bounds`).
     """
 
     scene: str
@@ -867,12 +1226,57 @@ class State:
     valid: bool | npt.NDArray[np.bool_]
     singularity: dict[str, Number]
     failures: dict[str, npt.NDArray[np.bool_]]
+    error_bound: ErrorBound
 
     @cached_property
     def points(self) -> dict[str, PointState]:
         """Every reported point as 2-D vectors in the ground frame."""
         return {name: PointState(_xy(p), _xy(v), _xy(a))
                 for name, (p, v, a) in self.complex_points.items()}
+
+    @cached_property
+    def scales(self) -> dict[str, Number]:
+        """Per kind of value (:data:`mech_kinematics.bounds.KINDS`), its scale.
+
+        ``position``: the mechanism's size; ``angle``: 1 rad; ``velocity``: the
+        largest speed of a reported point or slider, at least the crank tip's
+        ``a |omega|``; ``angular velocity``: the largest angular speed of a
+        reported link, at least ``|omega|``; ``acceleration`` and ``angular
+        acceleration`` likewise, at least ``a (omega^2 + |alpha|)`` and
+        ``omega^2 + |alpha|``. A solve is refused where a value's error bound
+        exceeds ``max_error`` times its kind's scale.
+        """
+        bound = self.error_bound
+        vector = not isinstance(self.valid, bool)
+        return _scales(bound.size, bound.crank_length, self.speed, self.accel,
+                       [(v, a) for _, v, a in self.complex_points.values()],
+                       [(j.velocity, j.acceleration) for j in self.joints.values()
+                        if j.type == 'prismatic'],
+                       [(j.velocity, j.acceleration) for j in self.joints.values()
+                        if j.type == 'revolute'], vector)
+
+    @cached_property
+    def relative_error_bound(self) -> Number:
+        """The largest error bound over its kind's scale, over every reported value.
+
+        The smallest ``max_error`` at which this state would be answered (NaN
+        where an array state is not valid).
+        """
+        scales = self.scales
+        worst: Any = 0.0
+        joints, points = self.error_bound.raw()
+        records = [(b, _LINEAR) for b in points.values()]
+        records += [(joints[name], _ANGULAR if j.type == 'revolute' else _LINEAR)
+                    for name, j in self.joints.items()]
+        with np.errstate(divide='ignore', invalid='ignore'):
+            for values, kinds in records:
+                for value, kind in zip(values, kinds, strict=True):
+                    scale = scales[kind]
+                    ratio = np.where(value == 0.0, 0.0, np.asarray(value) / scale)
+                    worst = np.fmax(worst, ratio)
+        if isinstance(self.valid, bool):
+            return float(worst)
+        return np.where(self.valid, np.broadcast_to(worst, np.shape(self.valid)), np.nan)
 
     def as_dict(self) -> dict[str, Any]:
         """Return the structure the ``solve`` command prints (floats or arrays)."""
@@ -895,19 +1299,210 @@ class State:
             'points': {name: {'position': pair(p.position), 'velocity': pair(p.velocity),
                               'acceleration': pair(p.acceleration)}
                        for name, p in self.points.items()},
+            'error_bound': self.error_bound.as_dict(vector),
         }
 
 
-def _run(plan: _Plan, angle: Any, speed: Any, accel: Any) -> _Context:
-    """Run every step of ``plan``; the caller chose scalar or vector inputs."""
+def _run(solver: _Solver, angle: Any, speed: Any, accel: Any) -> _Context:
+    """Run every step of the solver's plan; the caller chose scalar or vector inputs."""
     ctx = _Context(angle, not isinstance(angle, float))
     # Ground points stay complex scalars in both paths: NumPy broadcasts them.
-    for name, position in plan.ground.items():
-        ctx.points[name] = (position, 0j, 0j)
+    ctx.points.update(solver.ground)
+    plan = solver.run_plan
     plan.crank.run(ctx, angle, speed, accel)
     for step in plan.steps:
         step.run(ctx)
     return ctx
+
+
+def _execute(solver: _Solver, theta: Any, omega: Any, alpha: Any) -> _Context:
+    """Run the solver in units that keep every product in range; reported values in SI.
+
+    A crank rate outside [_RATE_LOW, _RATE_HIGH] is solved with time scaled by a
+    power of two, as a scene's size outside :data:`_SIZE_RANGE` is with its
+    lengths (:class:`_Solver`); both are exact, so the answers are the same
+    bits as if every product had stayed in range.
+    """
+    w = abs(omega)
+    if isinstance(w, float) and _RATE_LOW <= w <= _RATE_HIGH and abs(alpha) <= _ACCEL_HIGH:
+        shift = 0  # the single-angle path's usual case, decided without a call
+    else:
+        shift = _rate_exponent(omega, alpha)
+    if shift:
+        omega, alpha = _ldexp(omega, -shift), _ldexp(alpha, -2 * shift)
+    ctx = _run(solver, theta, omega, alpha)
+    if solver.shift or shift:
+        _rescale(solver, ctx, shift)
+    return ctx
+
+
+def _rate_exponent(omega: Any, alpha: Any) -> int:
+    w, a = abs(omega), abs(alpha)
+    if isinstance(w, np.ndarray):
+        w, a = float(np.max(w, initial=0.0)), float(np.max(a, initial=0.0))
+    if _RATE_LOW <= w <= _RATE_HIGH and a <= _ACCEL_HIGH:
+        return 0
+    return _exponent(max(w, math.sqrt(a)), _RATE_LOW, _RATE_HIGH)
+
+
+def _ldexp(x: Any, exponent: int) -> Any:
+    """Return ``x * 2**exponent`` (inf on overflow) for floats, complex numbers and arrays."""
+    if isinstance(x, complex):
+        return complex(_ldexp(x.real, exponent), _ldexp(x.imag, exponent))
+    if isinstance(x, float):
+        try:
+            return math.ldexp(x, exponent)
+        except OverflowError:
+            return math.copysign(math.inf, x)
+    if np.iscomplexobj(x):
+        out = np.empty(np.shape(x), dtype=np.complex128)
+        out.real = np.ldexp(x.real, exponent)
+        out.imag = np.ldexp(x.imag, exponent)
+        return out
+    return np.ldexp(x, exponent)
+
+
+def _finite(x: Any) -> Any:
+    if isinstance(x, (float, complex)):
+        return cmath.isfinite(x)
+    return np.isfinite(x)
+
+
+def _rescale(solver: _Solver, ctx: _Context, shift: int) -> None:
+    """Scale the reported values of a solve in scaled units back to SI; refuse what overflows."""
+    s = solver.shift
+    linear = (s, s + shift, s + 2 * shift)
+    angular = (0, shift, 2 * shift)
+    for table, name, path, label, _ in solver.outputs:
+        store = getattr(ctx, table)
+        x, dx, ddx, ex, edx, eddx = store[name]
+        k0, k1, k2 = angular if table == 'links' else linear
+        entry = (x if table == 'links' else _ldexp(x, k0), _ldexp(dx, k1), _ldexp(ddx, k2),
+                 ex if table == 'links' else _ldexp(ex, k0) + _TINY,
+                 _ldexp(edx, k1) + _TINY, _ldexp(eddx, k2) + _TINY)
+        store[name] = entry
+        if ctx.vector:
+            ok = _finite(entry[0])
+            for x in entry[1:]:
+                ok = ok & _finite(x)
+            ctx.mask(ok, f'{label} (overflow)')
+            continue
+        for index, quantity in enumerate(_QUANTITIES):
+            if not (_finite(entry[index]) and _finite(entry[index + 3])):
+                what = 'its error bound' if _finite(entry[index]) else 'it'
+                reason = (f'the state overflows: the {quantity} of {path} is beyond the range '
+                          f'of doubles (scaled back to SI, {what} exceeds {LARGEST:.3g})')
+                raise UntrustedError(label, ctx.angle, reason, f'{path}.{quantity}', math.inf,
+                                     LARGEST)
+
+
+def _scales(size: float, crank_length: float, omega: Any, alpha: Any,
+            points: Iterable[tuple[Any, Any]], sliders: Iterable[tuple[Any, Any]],
+            links: Iterable[tuple[Any, Any]], vector: bool) -> dict[str, Any]:
+    """Return each kind's scale (see :attr:`State.scales`) from the reported values."""
+    biggest: Any = np.fmax if vector else max
+    w = abs(omega)
+    rate = w * w + abs(alpha)
+    speed, accel = crank_length * w, crank_length * rate
+    turn, turn_accel = w, rate
+    for v, a in points:
+        if vector:
+            speed = biggest(speed, np.hypot(v.real, v.imag))
+            accel = biggest(accel, np.hypot(a.real, a.imag))
+        else:
+            speed = biggest(speed, abs(v))
+            accel = biggest(accel, abs(a))
+    for v, a in sliders:
+        speed = biggest(speed, abs(v))
+        accel = biggest(accel, abs(a))
+    for v, a in links:
+        turn = biggest(turn, abs(v))
+        turn_accel = biggest(turn_accel, abs(a))
+    return {'position': size, 'angle': 1.0, 'velocity': speed, 'angular velocity': turn,
+            'acceleration': accel, 'angular acceleration': turn_accel}
+
+
+def _context_scales(solver: _Solver, ctx: _Context, omega: Any, alpha: Any) -> dict[str, Any]:
+    return _scales(solver.size, solver.crank_length, omega, alpha,
+                   [ctx.points[name][1:3] for name in solver.out_points],
+                   [ctx.sliders[name][1:3] for name in solver.out_sliders],
+                   [ctx.links[name][1:3] for name in solver.out_links], ctx.vector)
+
+
+def _trusted(solver: _Solver, ctx: _Context, omega: float, alpha: float, tol: float) -> bool:
+    """Return True if every reported bound is within ``tol`` of its kind's smallest scale.
+
+    A quick sufficient test for the single-angle path: the scales' floors (the
+    mechanism's size, the crank's own rates) are at most the scales, so a pass
+    here is a pass of :func:`_refuse`'s exact test; NaN fails.
+    """
+    w = abs(omega)
+    rate = w * w + abs(alpha)
+    a = solver.crank_length
+    lp, lv, la = tol * solver.size, tol * (a * w), tol * (a * rate)
+    points = ctx.points
+    for name in solver.out_points:
+        e = points[name]
+        if not (e[3] <= lp and e[4] <= lv and e[5] <= la):
+            return False
+    links = ctx.links
+    lw, lal = tol * w, tol * rate
+    for name in solver.out_links:
+        e = links[name]
+        if not (e[3] <= tol and e[4] <= lw and e[5] <= lal):
+            return False
+    sliders = ctx.sliders
+    for name in solver.out_sliders:
+        e = sliders[name]
+        if not (e[3] <= lp and e[4] <= lv and e[5] <= la):
+            return False
+    return True
+
+
+def _refuse(solver: _Solver, ctx: _Context, omega: float, alpha: float, tol: float) -> None:
+    """Raise :class:`UntrustedError` for the first reported value whose bound exceeds ``tol``."""
+    scales = _context_scales(solver, ctx, omega, alpha)
+    for table, name, path, label, kinds in solver.outputs:
+        entry = getattr(ctx, table)[name]
+        for index, kind in enumerate(kinds):
+            bound, scale = entry[3 + index], scales[kind]
+            lim = limit(tol, scale)
+            if bound <= lim:
+                continue
+            quantity = _QUANTITIES[index]
+            unit = UNITS[kind]
+            reason = (f'the {quantity} of {path} cannot be trusted: expected its error bound '
+                      f'to be at most {tol:g} x {scale:.3g} {unit} ({SCALE_MEANINGS[kind]}), '
+                      f'got {bound:.3g} {unit}')
+            key = solver.measure_keys.get(label)
+            if key is not None:
+                reason += f'; near-singularity measure of {label}: {ctx.measures[key]:.3g}'
+            raise UntrustedError(label, ctx.angle, reason, f'{path}.{quantity}', float(bound),
+                                 float(lim))
+
+
+def _judge(solver: _Solver, ctx: _Context, omega: Any, alpha: Any, tol: float,
+           shape: tuple[int, ...]) -> None:
+    """Mask the angles of a vector solve where a reported bound exceeds ``tol``."""
+    w = abs(omega)
+    rate = w * w + abs(alpha)
+    a = solver.crank_length
+    floors = {'position': solver.size, 'angle': 1.0, 'velocity': a * w, 'angular velocity': w,
+              'acceleration': a * rate, 'angular acceleration': rate}
+    lims = {kind: tol * floor for kind, floor in floors.items()}
+    failed = np.logical_not(ctx.valid)  # already refused: not judged again
+    if all(bool(((entry[3] <= lims[kinds[0]]) & (entry[4] <= lims[kinds[1]])
+                 & (entry[5] <= lims[kinds[2]]) | failed).all())
+           for table, name, _, _, kinds in solver.outputs
+           for entry in (getattr(ctx, table)[name],)):
+        return  # within the floors of the scales (as _trusted): no norms needed
+    scales = _context_scales(solver, ctx, omega, alpha)
+    lims = {kind: limit(tol, scale) for kind, scale in scales.items()}
+    for table, name, _, label, kinds in solver.outputs:
+        entry = getattr(ctx, table)[name]
+        ok = ((entry[3] <= lims[kinds[0]]) & (entry[4] <= lims[kinds[1]])
+              & (entry[5] <= lims[kinds[2]]))
+        ctx.mask(np.broadcast_to(ok, shape), f'{label} (untrusted)')
 
 
 def _angle(e: Any, vector: bool) -> Any:
@@ -921,8 +1516,12 @@ def _angle(e: Any, vector: bool) -> Any:
 
 
 def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None,
-          accel: npt.ArrayLike | None = None) -> State:
+          accel: npt.ArrayLike | None = None, *, max_error: float = MAX_ERROR) -> State:
     """Solve ``scene`` for position, velocity and acceleration at crank ``angle``.
+
+    Every value comes with an absolute error bound (``State.error_bound``,
+    :mod:`mech_kinematics.bounds`); a state in which a reported value's bound
+    exceeds ``max_error`` times its kind's scale (``State.scales``) is refused.
 
     Parameters
     ----------
@@ -934,6 +1533,10 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
         Crank angular velocity, rad/s, + CCW. Defaults to the scene's.
     accel : float or array_like, optional
         Crank angular acceleration, rad/s^2, + CCW. Defaults to the scene's.
+    max_error : float, optional
+        Tolerance: the largest error bound accepted, relative to its kind's
+        scale. Default 1e-6; ``math.inf`` accepts every finite answer. Whatever
+        it is, a dyad within rounding of an assembly limit is refused.
 
     Returns
     -------
@@ -944,21 +1547,30 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
     Raises
     ------
     AssemblyError
-        For a scalar ``angle`` at which a dyad cannot close or is singular.
+        For a scalar ``angle`` at which a dyad cannot close or is singular;
+        its subclass :class:`UntrustedError` where the answer cannot be
+        trusted (a bound above the tolerance, a dyad within rounding of an
+        assembly limit, a value beyond the range of doubles).
     """
     theta: Any
     omega: Any
     alpha: Any
-    plan = scene._plan
+    solver = scene._solver
     speed = scene.input.speed if speed is None else speed
     accel = scene.input.accel if accel is None else accel
+    if not (isinstance(max_error, (float, int)) and max_error > 0.0):
+        msg = f'Expected `max_error` to be a positive number, got {max_error!r}'
+        raise ValueError(msg)
+    tol = float(max_error)
     if _is_scalar(angle) and _is_scalar(speed) and _is_scalar(accel):
         theta, omega, alpha = float(angle), float(speed), float(accel)  # type: ignore[arg-type]
         if not (math.isfinite(theta) and math.isfinite(omega) and math.isfinite(alpha)):
             msg = (f'Expected `angle`, `speed` and `accel` to be finite, got {theta!r}, '
                    f'{omega!r}, {alpha!r}')
             raise ValueError(msg)
-        ctx = _run(plan, theta, omega, alpha)
+        ctx = _execute(solver, theta, omega, alpha)
+        if not _trusted(solver, ctx, omega, alpha, tol):
+            _refuse(solver, ctx, omega, alpha, tol)
         valid: Any = True
     else:
         theta, omega, alpha = (np.asarray(x, dtype=np.float64) for x in (angle, speed, accel))
@@ -973,11 +1585,12 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
         theta = np.broadcast_to(theta, shape)
         with np.errstate(all='ignore'):
             # A constant speed or acceleration stays a scalar through the steps.
-            ctx = _run(plan, theta, omega, alpha)
+            ctx = _execute(solver, theta, omega, alpha)
+            _judge(solver, ctx, omega, alpha, tol, shape)
         omega, alpha = np.broadcast_to(omega, shape), np.broadcast_to(alpha, shape)
         valid = np.broadcast_to(np.asarray(ctx.valid, dtype=bool), shape).copy()
     _warn_near_singular(ctx)
-    return _state(scene, plan, ctx, theta, omega, alpha, valid)
+    return _state(scene, solver, ctx, theta, omega, alpha, valid)
 
 
 def _is_scalar(x: Any) -> bool:
@@ -994,18 +1607,21 @@ def _warn_near_singular(ctx: _Context) -> None:
             warnings.warn(msg, NearSingularWarning, stacklevel=3)
 
 
-def _state(scene: Scene, plan: _Plan, ctx: _Context, theta: Any, omega: Any, alpha: Any,
+def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any, alpha: Any,
            valid: Any) -> State:
     vector = ctx.vector
+    plan = solver.plan
     joints = {}
     for name, kind in plan.joint_types.items():
         if kind == 'revolute':
-            e, w, al = ctx.links[name]
+            e, w, al = ctx.links[name][:3]
             joints[name] = JointMotion(kind, _angle(e, vector), w, al)
         else:
-            joints[name] = JointMotion(kind, *ctx.sliders[name])
-    points = {name: ctx.points[name] for name in plan.output_points}
+            joints[name] = JointMotion(kind, *ctx.sliders[name][:3])
+    table = ctx.points
+    points = {name: table[name][:3] for name in plan.output_points}
     measures = ctx.measures
+    bound = ErrorBound(_table_bounds, (plan, ctx), solver.size, solver.crank_length)
     if vector:
         shape = theta.shape
         bad = None if valid.all() else ~valid
@@ -1031,5 +1647,43 @@ def _state(scene: Scene, plan: _Plan, ctx: _Context, theta: Any, omega: Any, alp
                                        finish(joint.velocity), finish(joint.acceleration))
         points = {name: (finish(p), finish(v), finish(a)) for name, (p, v, a) in points.items()}
         measures = {key: finish(m) for key, m in measures.items()}
-    return State(scene.name, theta, omega, alpha, joints, points, valid, dict(measures),
-                 dict(ctx.failures))
+        joint_bounds, point_bounds = _table_bounds(plan, ctx)
+        bound = ErrorBound(_given, ({name: (finish(a), finish(b), finish(c))
+                                     for name, (a, b, c) in joint_bounds.items()},
+                                    {name: (finish(a), finish(b), finish(c))
+                                     for name, (a, b, c) in point_bounds.items()}),
+                           solver.size, solver.crank_length)
+    return _new_state(scene.name, theta, omega, alpha, joints, points, valid, dict(measures),
+                      dict(ctx.failures), bound)
+
+
+def _new_state(scene: str, angle: Any, speed: Any, accel: Any, joints: dict[str, JointMotion],
+               points: dict[str, Any], valid: Any, singularity: dict[str, Any],
+               failures: dict[str, Any], error_bound: ErrorBound) -> State:
+    """Return ``State(...)`` of these fields, built without the dataclass's ``__init__``.
+
+    A frozen dataclass's ``__init__`` sets each field through
+    ``object.__setattr__``: about 1 us of a 7 us single-angle solve. The fields
+    go straight into the new instance's ``__dict__`` instead (there is no
+    ``__post_init__`` to run); ``test_linkage_bounds`` checks the result equals
+    the dataclass's own construction.
+    """
+    state = object.__new__(State)
+    fields = state.__dict__
+    fields['scene'], fields['angle'], fields['speed'], fields['accel'] = scene, angle, speed, accel
+    fields['joints'], fields['complex_points'], fields['valid'] = joints, points, valid
+    fields['singularity'], fields['failures'] = singularity, failures
+    fields['error_bound'] = error_bound
+    return state
+
+
+def _table_bounds(plan: _Plan, ctx: _Context) -> tuple[Table, Table]:
+    """Return the reported joints' and points' bounds from a solve's context."""
+    joints = {name: (ctx.links if kind == 'revolute' else ctx.sliders)[name][3:]
+              for name, kind in plan.joint_types.items()}
+    table = ctx.points
+    return joints, {name: table[name][3:] for name in plan.output_points}
+
+
+def _given(joints: Table, points: Table) -> tuple[Table, Table]:
+    return joints, points

@@ -421,7 +421,10 @@ def test_loop_closure_over_a_cycle(scene):
     """Over a cycle of 97 angles (array path), valid entries are finite and close every loop."""
     theta = scene.input.angle + np.linspace(0, 2 * np.pi, 97)
     state = mk.solve(scene, theta)
-    assert state.valid[0], 'the scene assembles at its own initial angle'
+    if not state.valid[0]:  # it assembles there, but may be too near singular to trust
+        assert all(key.endswith(' (untrusted)') for key, mask in state.failures.items()
+                   if mask[0]), state.failures
+        assume(False)
     for index in np.flatnonzero(state.valid):
         single = _At(state, index)
         size = mechanism_size(scene, single)
@@ -540,7 +543,11 @@ def test_single_angle_and_array_paths_agree(scene, motion):
     omega0, alpha = motion
     vector = mk.solve(scene, theta, omega0, alpha)
     assert vector.valid.dtype == bool and vector.valid.shape == theta.shape
-    assert vector.valid[12]  # the scene's own initial angle
+    if not vector.valid[12]:  # the scene's own initial angle assembles, but may be untrusted
+        assert vector.failures and all(key.endswith(' (untrusted)') and mask[12]
+                                       for key, mask in vector.failures.items()
+                                       if mask[12]), vector.failures
+        assume(False)
     conditioned = vector.valid & np.all(
         [np.nan_to_num(m) > MIN_MEASURE for m in vector.singularity.values()], axis=0)
     # The typical magnitude of each kind: its largest over the conditioned poses.

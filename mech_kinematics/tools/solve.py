@@ -10,6 +10,7 @@ import json
 import sys
 from typing import Any
 
+from ..bounds import MAX_ERROR
 from ..cli import finite_float, run_tool
 from ..errors import AssemblyError, SceneError
 from ..linkage import solve
@@ -21,11 +22,29 @@ __all__ = ['add_parser', 'main']
 SOLVE_HELP = """\
 Solve a scene at one crank instant and print one JSON object: the input
 (angle rad, speed rad/s, accel rad/s^2), every output joint (type, position,
-velocity, acceleration: rad for revolute joints, m for sliders) and every
-output point (position, velocity, acceleration as [x, y]), all in SI units.
+velocity, acceleration: rad for revolute joints, m for sliders), every
+output point (position, velocity, acceleration as [x, y]) and "error_bound",
+the absolute error bound of each of those values (one number per value; for
+a point, the bound on the length of its error vector), all in SI units.
 Options left out take the scene's own values. On a position that cannot be
-solved it prints a one-line error and exits with status 2.
+solved, or whose answer cannot be trusted (a value's error bound above
+--max-error times its kind's scale, a dyad within rounding of an assembly
+limit, a value beyond the range of doubles), it prints a one-line error and
+exits with status 2.
 """
+
+
+def _max_error(text: str) -> float:
+    """Parse a positive tolerance (``inf`` allowed), or tell argparse why not."""
+    try:
+        value = float(text)
+    except ValueError:
+        msg = f'expected a positive number, got {text!r}'
+        raise argparse.ArgumentTypeError(msg) from None
+    if not value > 0.0:
+        msg = f'expected a positive number, got {text!r}'
+        raise argparse.ArgumentTypeError(msg)
+    return value
 
 
 def _handle(args: argparse.Namespace) -> int:
@@ -37,14 +56,15 @@ def _handle(args: argparse.Namespace) -> int:
     angle = scene.input.angle if args.angle_deg is None else radians_from_degrees(args.angle_deg)
     speed = None if args.speed_rpm is None else rad_per_s_from_rpm(args.speed_rpm)
     try:
-        state = solve(scene, angle, speed, args.accel)
+        state = solve(scene, angle, speed, args.accel, max_error=args.max_error)
     except (AssemblyError, ValueError) as error:
         print(f'error: {error}', file=sys.stderr)
         return 2
     result: dict[str, Any] = state.as_dict()
     if args.diagnostics:
         result['singularity'] = {key: float(m) for key, m in state.singularity.items()}
-    print(json.dumps(result, indent=args.indent))
+        result['relative_error_bound'] = float(state.relative_error_bound)
+    print(json.dumps(result, indent=args.indent, allow_nan=False))
     return 0
 
 
@@ -63,9 +83,15 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     parser.add_argument('--accel', type=finite_float, metavar='A',
                         help='crank angular acceleration in rad/s^2, + CCW (default: the '
                              "scene's)")
+    parser.add_argument('--max-error', type=_max_error, default=MAX_ERROR, metavar='REL',
+                        help="refuse (exit 2) where a value's error bound exceeds REL times "
+                             "its kind's scale (the mechanism's size, its largest speed, its "
+                             f'largest acceleration, ...; default {MAX_ERROR:g}; inf accepts '
+                             'every finite answer)')
     parser.add_argument('--diagnostics', action='store_true',
                         help="also print each dyad's near-singularity measure "
-                             '("singularity": 0 singular, 1 best)')
+                             '("singularity": 0 singular, 1 best) and the largest error '
+                             'bound over its scale ("relative_error_bound")')
     parser.add_argument('--indent', type=int, default=1, metavar='N',
                         help='JSON indentation (default 1)')
     parser.set_defaults(handler=_handle)

@@ -230,7 +230,7 @@ def _solve_flagged(scene: Scene, angle: float, speed: float | None,
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter('always')
         try:
-            state = solve(scene, angle, speed, accel)
+            state = solve(scene, angle, speed, accel, max_error=math.inf)
         except AssemblyError:
             return None, 'refused'
     warned = any(issubclass(w.category, NearSingularWarning) for w in caught)

@@ -1,0 +1,186 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""Error bounds of a solve: what they mean, the scales they are judged on, the tolerance.
+
+Every value the solver returns comes with an absolute error bound in SI
+units: a first-order forward bound on the difference between the returned
+double and the exact value, counting
+
+- the rounding of the inputs: every scene length and coordinate, the guide
+  angles and the crank's angle, speed and acceleration are taken as known only
+  to half an ulp (``U |x|``), so the bound also covers the decimal numbers the
+  doubles were rounded from;
+- the rounding of every step of the closed forms, each dyad's own arithmetic
+  counted as a perturbation of its inputs (the formulas are backward stable:
+  the factored square roots of the dyads see to that) plus the rounding of the
+  final sums and products;
+
+propagated through the chain of dyads with each dyad's sensitivity to its
+inputs: ``1 / measure`` for positions and the two-by-two velocity and
+acceleration systems (the loss near a toggle, a change point, a guide at
+grazing reach), ``1 / s`` for a slotted lever whose pin is ``s`` from its
+pivot. The formulas live beside the values they bound, in the steps of
+:mod:`mech_kinematics.linkage`; they are plain products and sums of
+magnitudes, cheap enough for every tick.
+
+A point's bound is one number, the bound on the Euclidean norm of its error
+vector (m, m/s, m/s^2). An angle's bound is in rad, modulo 2 pi.
+
+The tolerance ``max_error`` is relative to the *scale* of each kind of value
+in the state (:data:`KINDS`, ``State.scales``): a solve is refused when the
+bound of any requested value exceeds ``max_error`` times its kind's scale.
+Whatever the tolerance, a dyad within :data:`ROUNDING_MARGIN` times the
+rounding of its inputs of an assembly limit (where changing an input by an
+ulp could make it unassemblable or flip its branch) is refused too.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = ['Bounds', 'ErrorBound', 'KINDS', 'LARGEST', 'MAX_ERROR', 'ROUNDING_MARGIN', 'U',
+           'limit']
+
+#: Unit roundoff of IEEE doubles, 2**-53: the largest relative rounding error of one
+#: correctly rounded operation.
+U = 2.0 ** -53
+#: Default tolerance of :func:`mech_kinematics.solve` and ``solve --max-error``: the
+#: largest error bound accepted, relative to the kind's scale.
+MAX_ERROR = 1e-6
+#: A dyad is refused, whatever the tolerance, when its distance to an assembly limit
+#: (the circles' margin of an RRR, the guide's of an RRP, the pin's distance from the
+#: pivot of an RPR) is at most this many times that distance's own error bound. Beyond
+#: it the first-order bounds hold to within a few per cent of their slack.
+ROUNDING_MARGIN = 16.0
+#: The largest finite double.
+LARGEST = float(np.finfo(np.float64).max)
+
+#: The kinds of values a state holds, each judged on its own scale. Points and
+#: sliders share the linear kinds; revolute joints have the angular ones.
+KINDS = ('position', 'angle', 'velocity', 'angular velocity', 'acceleration',
+         'angular acceleration')
+#: Units of each kind.
+UNITS = {'position': 'm', 'angle': 'rad', 'velocity': 'm/s', 'angular velocity': 'rad/s',
+         'acceleration': 'm/s^2', 'angular acceleration': 'rad/s^2'}
+#: What each kind's scale is, for messages and the README.
+SCALE_MEANINGS = {
+    'position': "the mechanism's size",
+    'angle': '1 rad',
+    'velocity': 'the largest speed of a point or slider, at least the crank tip speed',
+    'angular velocity': "the largest angular speed of a link, at least the crank's",
+    'acceleration': 'the largest acceleration of a point or slider, at least '
+                    "a (omega^2 + |alpha|) for the crank's length a",
+    'angular acceleration': 'the largest angular acceleration of a link, at least '
+                            'omega^2 + |alpha|',
+}
+
+Number = float | npt.NDArray[np.float64]
+Table = dict[str, tuple[Any, Any, Any]]
+
+
+def limit(max_error: float, scale: Any) -> Any:
+    """Return the largest bound accepted: ``max_error * scale``, capped at :data:`LARGEST`.
+
+    The cap makes an infinite tolerance still refuse a bound that overflowed
+    (and ``inf * 0`` accept a zero bound at rest).
+    """
+    lim = max_error * scale
+    if isinstance(lim, np.ndarray):
+        return np.fmin(lim, LARGEST)
+    return lim if lim <= LARGEST else LARGEST
+
+
+class Bounds:
+    """Absolute error bounds of one joint or point, SI units.
+
+    ``position`` (m, or rad for a revolute joint), ``velocity`` and
+    ``acceleration``: floats for one crank angle, arrays of shape (n,) for n
+    angles (NaN where the state is not valid). A point's bounds bound the
+    Euclidean norm of its error vector.
+    """
+
+    __slots__ = ('position', 'velocity', 'acceleration')
+
+    def __init__(self, position: Number, velocity: Number, acceleration: Number) -> None:
+        self.position = position
+        self.velocity = velocity
+        self.acceleration = acceleration
+
+    def __repr__(self) -> str:
+        """Show every field."""
+        return (f'Bounds(position={self.position!r}, velocity={self.velocity!r}, '
+                f'acceleration={self.acceleration!r})')
+
+
+class ErrorBound:
+    """The error bounds of a state, shaped like its ``joints`` and ``points``.
+
+    Built on first use from ``build(*args)``, which returns the joints' and the
+    points' bounds as ``{name: (position, velocity, acceleration)}``: the
+    single-angle path hands over its solve and pays nothing until they are read.
+
+    Attributes
+    ----------
+    joints : dict of str to Bounds
+        Per reported joint: angle (rad) or slider coordinate (m) and their
+        first and second time derivatives.
+    points : dict of str to Bounds
+        Per reported point: norms of the position (m), velocity (m/s) and
+        acceleration (m/s^2) errors.
+    size : float
+        The mechanism's size, m: the scale of positions.
+    crank_length : float
+        The crank's length, m: with the crank's rates, the least scale of the
+        linear velocities and accelerations.
+    """
+
+    __slots__ = ('_build', '_args', '_raw', '_records', 'size', 'crank_length')
+
+    def __init__(self, build: Callable[..., tuple[Table, Table]], args: tuple[Any, ...],
+                 size: float, crank_length: float) -> None:
+        self._build = build
+        self._args = args
+        self._raw: tuple[Table, Table] | None = None
+        self._records: tuple[dict[str, Bounds], dict[str, Bounds]] | None = None
+        self.size = size
+        self.crank_length = crank_length
+
+    def raw(self) -> tuple[Table, Table]:
+        """Return the joints' and the points' bounds: (position, velocity, acceleration)."""
+        if self._raw is None:
+            self._raw = self._build(*self._args)
+        return self._raw
+
+    def _records_(self) -> tuple[dict[str, Bounds], dict[str, Bounds]]:
+        if self._records is None:
+            joints, points = self.raw()
+            self._records = ({name: Bounds(*b) for name, b in joints.items()},
+                             {name: Bounds(*b) for name, b in points.items()})
+        return self._records
+
+    @property
+    def joints(self) -> dict[str, Bounds]:
+        """Bounds of every reported joint."""
+        return self._records_()[0]
+
+    @property
+    def points(self) -> dict[str, Bounds]:
+        """Bounds of every reported point."""
+        return self._records_()[1]
+
+    def as_dict(self, vector: bool) -> dict[str, Any]:
+        """Return ``{"joints": ..., "points": ...}`` as in ``State.as_dict()``."""
+        def value(x: Any) -> Any:
+            return x if vector else float(x)
+
+        def record(b: tuple[Any, Any, Any]) -> dict[str, Any]:
+            return {'position': value(b[0]), 'velocity': value(b[1]),
+                    'acceleration': value(b[2])}
+
+        joints, points = self.raw()
+        return {'joints': {name: record(b) for name, b in joints.items()},
+                'points': {name: record(b) for name, b in points.items()}}
