@@ -12,10 +12,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+import math
 import statistics
 import time
 from typing import Any
-import math
 import warnings
 
 import numpy as np
