@@ -191,3 +191,40 @@ def test_managed_node_with_a_bad_scene_fails_to_configure(ros, tmp_path):
     finally:
         status, _ = proc.stop(signal.SIGINT)
     assert status == 0, proc.output()
+
+
+def test_untrusted_ticks_publish_nothing_and_say_why(ros, tmp_path):
+    """max_relative_error too tight for the bounds: nothing published, diagnostics say why.
+
+    Changed while running, both ways. See issue 10.
+    """
+    from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+
+    ns = f'{SESSION}/untrusted'
+    js = ros.collect(JointState, f'{ns}/joint_states')
+    diag = ros.collect(DiagnosticArray, f'{ns}/diagnostics')
+    proc = NodeProcess(tmp_path, '-r', f'__ns:={ns}', '-p', 'rate_hz:=200')
+    try:
+        wait_for(lambda: js, STARTUP_S, 'joint_states')
+        params = AsyncParameterClient(ros.node, f'{ns}/mech_kinematics')
+        assert params.wait_for_services(timeout_sec=STARTUP_S)
+        response = ros.call(params.set_parameters(
+            [Parameter('max_relative_error', value=1e-15)]))
+        assert response.results[0].successful, response.results[0].reason
+        time.sleep(0.3)
+        count = len(js)
+        start = len(diag)
+        wait_for(lambda: len(diag) > start + 1, 5.0, 'diagnostics after the change')
+        assert len(js) <= count + 2, 'published while every tick is untrusted'
+        solver = diag[-1].status[0]
+        assert solver.level == DiagnosticStatus.ERROR
+        assert solver.message.startswith('not trusted at ')
+        assert 'cannot be trusted: expected its error bound to be at most 1e-15' in \
+            solver.message
+        response = ros.call(params.set_parameters(
+            [Parameter('max_relative_error', value=1e-6)]))
+        assert response.results[0].successful
+        wait_for(lambda: len(js) > count + 50, 5.0, 'joint_states again')
+    finally:
+        status, _ = proc.stop(signal.SIGINT)
+    assert status == 0, proc.output()

@@ -211,6 +211,7 @@ class KinematicsNode(LifecycleNode):
         self._catch_up = self.get_parameter('late_ticks').value == CATCH_UP
         self._max_behind_ns = round(self.get_parameter('max_catch_up_s').value * NS_PER_S)
         self._tf_period_ns = self._tf_period(self.get_parameter('tf_rate_hz').value)
+        self._max_error = float(self.get_parameter('max_relative_error').value)
         self._tf: TfMessages | None = None
         self._next_tf = 0
         self._pub_diagnostics = self.create_publisher(
@@ -275,6 +276,8 @@ class KinematicsNode(LifecycleNode):
             self._max_behind_ns = round(changes['max_catch_up_s'] * NS_PER_S)
         if 'tf_rate_hz' in changes:
             self._tf_period_ns = self._tf_period(changes['tf_rate_hz'])
+        if 'max_relative_error' in changes:
+            self._max_error = float(changes['max_relative_error'])
         drive = {name: float(changes[name]) for name in DRIVE if name in changes}
         if drive:
             with self._pending_lock:
@@ -379,7 +382,8 @@ class KinematicsNode(LifecycleNode):
         scene = self.scene
         assert scene is not None
         names = ('scene', 'crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm', 'rate_hz',
-                 'late_ticks', 'max_catch_up_s', 'frame_id', 'tf_rate_hz', 'tf_prefix',
+                 'late_ticks', 'max_catch_up_s', 'max_relative_error', 'frame_id',
+                 'tf_rate_hz', 'tf_prefix',
                  'use_sim_time', 'markers', 'managed')
         settings = ', '.join(f'{name}={self._value(name)!r}' for name in names[1:])
         self.get_logger().info(
@@ -562,9 +566,12 @@ class KinematicsNode(LifecycleNode):
         assert scene is not None and self._timebase is not None
         angle, speed, accel = sample = self._timebase.sample(stamp)
         try:
-            state = mk.solve(scene, angle, speed, accel)
+            state = mk.solve(scene, angle, speed, accel, max_error=self._max_error)
         except mk.AssemblyError as exc:
-            self._stats.record(stamp, lateness, late, error=str(exc), sample=sample)
+            refusal = 'not trusted' if isinstance(exc, mk.UntrustedError) else \
+                'cannot assemble'
+            self._stats.record(stamp, lateness, late, error=str(exc), refusal=refusal,
+                               sample=sample)
             self.get_logger().warning(f'no state published: {exc}', throttle_duration_sec=1.0)
             return
         sec, nanosec = divmod(stamp, NS_PER_S)

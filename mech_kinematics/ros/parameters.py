@@ -17,6 +17,7 @@ import math
 from typing import Any
 
 from .markers import DEFAULT_ACCELERATION_SCALE, DEFAULT_VELOCITY_SCALE
+from ..bounds import MAX_ERROR
 from ..scene import DEFAULT_SCENE
 
 __all__ = ['CATCH_UP', 'LATE_TICKS', 'PARAMETERS', 'ParameterSpec', 'SKIP', 'joint_refusal',
@@ -98,6 +99,10 @@ PARAMETERS = (
     ParameterSpec('max_catch_up_s', 'double', 0.1,
                   'How far behind a late wake-up still publishes missed instants; older '
                   'ones are skipped and counted', 's', 0.0, 10.0),
+    ParameterSpec('max_relative_error', 'double', MAX_ERROR,
+                  'A tick whose error bound on any published value exceeds this fraction of '
+                  "its kind's scale publishes nothing (diagnostics say why)", 'of the scale',
+                  1e-15, 1.0),
     ParameterSpec('tf_rate_hz', 'double', 100.0,
                   'Rate of the link and slider frames on /tf, stamped like the state of the '
                   'tick they show (at most rate_hz: every tick; 0: off)', 'Hz', 0.0, 10_000.0),
