@@ -485,7 +485,14 @@ class KinematicsNode(LifecycleNode):
         grid: TickGrid | None = None
         offset = 0          # system clock minus monotonic clock, ns
         while not stop.is_set():
-            sim = clock.ros_time_is_active
+            # The time source can only change with a clock jump (on_clock_change): ask
+            # the clock then, not every loop (the property takes the clock's lock).
+            if self._last_sim is None or self._clock_event.is_set():
+                sim = clock.ros_time_is_active
+                if not sim:
+                    self._clock_event.clear()
+            else:
+                sim = self._last_sim
             if sim != self._last_sim:
                 if self._last_sim is not None and self._timebase is not None \
                         and self._last_stamp is not None:
