@@ -280,12 +280,15 @@ class MessageTemplate:
             start, fmt = i + 1, ''
         self._runs = tuple(runs)
 
-    def render(self, sec: int, nanosec: int, values: Sequence[float]) -> bytes:
-        """Return the serialized message with this stamp and slot values (in slot order)."""
+    def render(self, sec: int, nanosec: int, values: Sequence[float], first: int = 0) -> bytes:
+        """Return the serialized message with this stamp and slot values.
+
+        Slot ``i`` takes ``values[first + i]``.
+        """
         buffer = self._buffer
         pack_stamp = self._stamp.pack_into
         for offset in self._stamp_offsets:
             pack_stamp(buffer, offset, sec, nanosec)
         for pack_into, offset, start, stop in self._runs:
-            pack_into(buffer, offset, *values[start:stop])
+            pack_into(buffer, offset, *values[first + start:first + stop])
         return bytes(buffer)

@@ -19,6 +19,7 @@ from trajectory_msgs.msg import (JointTrajectory, JointTrajectoryPoint,
                                  MultiDOFJointTrajectory, MultiDOFJointTrajectoryPoint)
 
 from .cdr import marker, MessageTemplate, STAMP_MARKER
+from ..ticker import values_from_state
 
 __all__ = [
     'TickMessages', 'joint_state_from_state', 'joint_trajectory_from_state',
@@ -138,27 +139,17 @@ class TickMessages:
 
     def render(self, state: Any, sec: int, nanosec: int) -> tuple[bytes, bytes, bytes]:
         """Return (joint_states, joint_accelerations, point_accelerations) as CDR bytes."""
-        joints = state.joints
-        values: list[float] = []
-        velocities: list[float] = []
-        accelerations: list[float] = []
-        for name in self.joints:
-            joint = joints[name]
-            values.append(joint.position)
-            velocities.append(joint.velocity)
-            accelerations.append(joint.acceleration)
-        values += velocities
-        joint_state = self._joint_state.render(sec, nanosec, values)
-        values += accelerations
-        joint_trajectory = self._joint_trajectory.render(sec, nanosec, values)
-        complex_points = state.complex_points
-        p: list[float] = []
-        v: list[float] = []
-        a: list[float] = []
-        for name in self.points:
-            zp, zv, za = complex_points[name]
-            p += (zp.real, zp.imag)
-            v += (zv.real, zv.imag)
-            a += (za.real, za.imag)
-        points = self._points.render(sec, nanosec, p + v + a)
-        return joint_state, joint_trajectory, points
+        return self.render_values(values_from_state(state, self.joints, self.points), sec,
+                                  nanosec)
+
+    def render_values(self, values: Sequence[float], sec: int,
+                      nanosec: int) -> tuple[bytes, bytes, bytes]:
+        """Return the three messages from the flat values of a tick function.
+
+        ``values`` is in the order of :func:`mech_kinematics.ticker.values_from_state`
+        (joints' positions, velocities, accelerations, then the points' positions,
+        velocities, accelerations as x, y), which is the order of the slots.
+        """
+        return (self._joint_state.render(sec, nanosec, values),
+                self._joint_trajectory.render(sec, nanosec, values),
+                self._points.render(sec, nanosec, values, 3 * len(self.joints)))

@@ -31,7 +31,6 @@ from __future__ import annotations
 import ctypes
 from dataclasses import replace
 import gc
-import math
 import sys
 import threading
 import time
@@ -64,8 +63,9 @@ from .schedule import period_ns_from_rate, TickGrid
 from .tf import static_tf_message, TF_STATIC_TOPIC, TF_TOPIC, TfMessages
 from .timebase import CrankTimebase
 from ..geometry.diagrams import space_from_state, strokes_from_scene
-from ..geometry.frames import angle_joints, frames_from_scene, origin_points, poses_from_state
+from ..geometry.frames import angle_joints, frames_from_scene, origin_points
 from ..geometry.instant_centres import full_scene
+from ..ticker import tick_function
 from ..units import NS_PER_S, rpm_from_rad_per_s
 
 __all__ = ['KinematicsNode', 'NODE_NAME', 'TickThreadError', 'main']
@@ -340,7 +340,14 @@ class KinematicsNode(LifecycleNode):
             qos_overriding_options=_qos_options())
         self._state_publishers = [self._pub_joint_states, self._pub_joint_accel,
                                   self._pub_point_accel]
-        self._tick_scene = self._setup_tf(scene)
+        tick_scene = self._setup_tf(scene)
+        # The scene's solve, compiled into one straight-line function (mech_kinematics.ticker).
+        frames = [(f.origin, f.angle_of, f.angle) for f in self._tf_frames]
+        self._solve, compiled = tick_function(tick_scene, scene.output_joints,
+                                              scene.output_points, frames)
+        self._tf_first = 3 * len(scene.output_joints) + 6 * len(scene.output_points)
+        if not compiled:
+            self.get_logger().info('the scene is solved by the general solver (not compiled)')
         if self._value('markers'):
             self._setup_markers(scene)
         self.scene = scene
@@ -354,6 +361,7 @@ class KinematicsNode(LifecycleNode):
         scene's own outputs are published on the state topics).
         """
         self._tf = None
+        self._tf_frames: tuple[Any, ...] = ()
         try:
             from tf2_msgs.msg import TFMessage
         except ImportError:
@@ -569,11 +577,9 @@ class KinematicsNode(LifecycleNode):
                              self._value('crank_accel'), self._value('max_crank_speed_rpm'))
 
     def _tick(self, stamp: int, lateness: int, late: bool) -> None:
-        scene = self._tick_scene
-        assert scene is not None and self._timebase is not None
-        angle, speed, accel = sample = self._timebase.sample(stamp)
+        angle, speed, accel = sample = self._timebase.sample(stamp)  # type: ignore[union-attr]
         try:
-            state = mk.solve(scene, angle, speed, accel, max_error=self._max_error)
+            values, measure = self._solve(angle, speed, accel, self._max_error)
         except mk.AssemblyError as exc:
             refusal = 'not trusted' if isinstance(exc, mk.UntrustedError) else \
                 'cannot assemble'
@@ -582,14 +588,14 @@ class KinematicsNode(LifecycleNode):
             self.get_logger().warning(f'no state published: {exc}', throttle_duration_sec=1.0)
             return
         sec, nanosec = divmod(stamp, NS_PER_S)
-        joint_states, joint_accel, point_accel = self._messages.render(state, sec, nanosec)
+        joint_states, joint_accel, point_accel = self._messages.render_values(
+            values, sec, nanosec)
         self._pub_joint_states.publish(joint_states)
         self._pub_joint_accel.publish(joint_accel)
         self._pub_point_accel.publish(point_accel)
         tf_period = self._tf_period_ns
         if self._tf is not None and tf_period is not None and stamp >= self._next_tf:
-            self._pub_tf.publish(self._tf.render(poses_from_state(self._tf_frames, state),
-                                                 sec, nanosec))
+            self._pub_tf.publish(self._tf.render_values(values, self._tf_first, sec, nanosec))
             self._next_tf = stamp + tf_period
         if self._pub_markers is not None and self._marker_throttle.due(
                 self._period_ns, time.monotonic_ns()):
@@ -597,7 +603,6 @@ class KinematicsNode(LifecycleNode):
             with self._marker_lock:
                 self._marker_request = (sec, nanosec, angle, speed, accel)
             self._marker_guard.trigger()
-        measure = min(state.singularity.values()) if state.singularity else math.inf
         near = measure < mk.NEAR_SINGULAR
         self._stats.record(stamp, lateness, late, measure=measure, near_singular=near,
                            sample=sample)

@@ -86,12 +86,20 @@ class TfMessages:
 
     def render(self, poses: Sequence[Pose], sec: int, nanosec: int) -> bytes:
         """Return the serialized ``TFMessage`` of ``poses`` (in frame order), stamped alike."""
-        values: list[float] = []
-        sin, cos = math.sin, math.cos
+        flat: list[float] = []
         for pose in poses:
-            half = 0.5 * pose.angle
-            values += (pose.x, pose.y, sin(half), cos(half))
-        return self._template.render(sec, nanosec, values)
+            flat += (pose.x, pose.y, pose.angle)
+        return self.render_values(flat, 0, sec, nanosec)
+
+    def render_values(self, values: Sequence[float], first: int, sec: int,
+                      nanosec: int) -> bytes:
+        """Return the ``TFMessage`` of the poses ``values[first:]`` as (x, y, angle) triples."""
+        out: list[float] = []
+        sin, cos = math.sin, math.cos
+        for i in range(first, first + 3 * len(self.frames), 3):
+            half = 0.5 * values[i + 2]
+            out += (values[i], values[i + 1], sin(half), cos(half))
+        return self._template.render(sec, nanosec, out)
 
 
 def static_tf_message(ground: Mapping[str, tuple[float, float]], parent: str, prefix: str,

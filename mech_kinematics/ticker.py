@@ -1,0 +1,414 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""A scene's single-angle solve compiled into one straight-line Python function.
+
+A node solving one crank angle per tick at kilohertz rates pays for every
+dictionary lookup, attribute read and object the general solver makes, and,
+waking from a sleep each tick with cold caches, for the size of the code it
+runs. :func:`compile_tick` removes that overhead without writing the
+kinematics a second time: it specializes the solver's own step code (the
+``run`` methods of :mod:`mech_kinematics.linkage`) to the scalar path of one
+scene by partial evaluation of their syntax trees.
+
+- ``ctx.vector`` becomes ``False`` and every branch it decides is folded
+  away, so only the single-angle arithmetic is left;
+- ``self.<attribute>`` of each step becomes the step's value (a constant);
+- ``ctx.points[name]``, ``ctx.links[name]``, ``ctx.sliders[name]`` and
+  ``ctx.measures[name]`` become local variables;
+- each step's local names get the step's number as a suffix, and the steps
+  are laid out one after another in plan order in a single function, which
+  ends by packing the values the caller asked for into one flat list.
+
+The same operations run in the same order on the same doubles, so the
+function returns the same bits as :func:`mech_kinematics.solve` (a test
+checks every packaged scene and the extreme suite over a cycle), and raises
+the same errors: a failed assembly check runs the step's own failure code,
+and a bound beyond the quick trust test sends the instant to the general
+solver, which refuses it with the full reason or answers it. Scenes or rates
+the general solver rescales (sizes beyond 2**60, rates beyond 2**40), and any
+step whose code uses something this compiler does not know, are not compiled:
+:func:`compile_tick` returns ``None`` and the caller uses the general solver.
+"""
+
+from __future__ import annotations
+
+import ast
+from collections.abc import Callable, Sequence
+import inspect
+import itertools
+import math
+import textwrap
+from typing import Any, cast
+
+from . import linkage as lk
+
+__all__ = ['TickFunction', 'compile_tick', 'tick_function', 'values_from_state']
+
+#: ``tick(theta, omega, alpha, max_error) -> (values, smallest near-singularity measure)``.
+TickFunction = Callable[[float, float, float, float], tuple[list[float], float]]
+
+_TABLES = {'points': 'P', 'links': 'L', 'sliders': 'S', 'measures': 'M'}
+
+
+class _Unsupported(Exception):
+    """A step's code holds something the specializer does not handle."""
+
+
+def _fold(node: ast.AST) -> ast.AST:
+    """Fold the constants a substitution left: ``x if False else y``, ``False or x``..."""
+
+    class Folder(ast.NodeTransformer):
+        def visit_IfExp(self, node: ast.IfExp) -> ast.AST:
+            self.generic_visit(node)
+            if isinstance(node.test, ast.Constant):
+                return node.body if node.test.value else node.orelse
+            return node
+
+        def visit_BoolOp(self, node: ast.BoolOp) -> ast.AST:
+            self.generic_visit(node)
+            absorbing = isinstance(node.op, ast.Or)     # True absorbs an or, False an and
+            values = []
+            for value in node.values:
+                if isinstance(value, ast.Constant):
+                    if bool(value.value) == absorbing:
+                        return ast.Constant(absorbing)
+                    continue                              # the neutral constant drops out
+                values.append(value)
+            if not values:
+                return ast.Constant(not absorbing)
+            if len(values) == 1:
+                return values[0]
+            node.values = values
+            return node
+
+        def visit_UnaryOp(self, node: ast.UnaryOp) -> ast.AST:
+            self.generic_visit(node)
+            if isinstance(node.op, ast.Not) and isinstance(node.operand, ast.Constant):
+                return ast.Constant(not node.operand.value)
+            return node
+
+        def visit_If(self, node: ast.If) -> Any:
+            self.generic_visit(node)
+            if isinstance(node.test, ast.Constant):
+                return (node.body if node.test.value else node.orelse) or ast.Pass()
+            return node
+
+    folded: ast.AST = Folder().visit(node)
+    return folded
+
+
+class _Specializer(ast.NodeTransformer):
+    """Rewrite one step's ``run`` body for the scalar path of one scene (see the module)."""
+
+    def __init__(self, step: Any, suffix: str, names: dict[str, str],
+                 namespace: dict[str, Any], arguments: dict[str, str]) -> None:
+        self.step = step
+        self.suffix = suffix
+        self.names = names              # table entry -> local variable
+        self.namespace = namespace
+        self.arguments = arguments      # run() argument -> tick argument
+        self.locals: set[str] = set()
+
+    def constant(self, value: Any) -> ast.expr:
+        if value is None or isinstance(value, (bool, int, float, complex, str)):
+            return ast.Constant(value)
+        name = f'_k{len(self.namespace)}'
+        self.namespace[name] = value
+        return ast.Name(name, ast.Load())
+
+    def table_entry(self, node: ast.Subscript) -> str | None:
+        """Return the local variable of ``ctx.<table>[self.<attr>]``, or None."""
+        value = node.value
+        if not (isinstance(value, ast.Attribute) and isinstance(value.value, ast.Name)
+                and value.value.id == 'ctx' and value.attr in _TABLES):
+            return None
+        key = node.slice
+        if not (isinstance(key, ast.Attribute) and isinstance(key.value, ast.Name)
+                and key.value.id == 'self'):
+            raise _Unsupported('a table read with a key that is not a step attribute')
+        name = getattr(self.step, key.attr)
+        entry = f'{_TABLES[value.attr]}_{name}'
+        return self.names.setdefault(entry, f'{entry}_{len(self.names)}')
+
+    def visit_Subscript(self, node: ast.Subscript) -> ast.AST:
+        local = self.table_entry(node)
+        if local is not None:
+            return ast.copy_location(ast.Name(local, node.ctx), node)
+        return self.generic_visit(node)
+
+    def visit_Attribute(self, node: ast.Attribute) -> ast.AST:
+        if isinstance(node.value, ast.Name):
+            if node.value.id == 'self':
+                return ast.copy_location(self.constant(getattr(self.step, node.attr)), node)
+            if node.value.id == 'ctx':
+                if node.attr == 'vector':
+                    return ast.Constant(False)
+                if node.attr == 'angle':
+                    return ast.Name('theta', ast.Load())
+                raise _Unsupported(f'ctx.{node.attr}')
+        return self.generic_visit(node)
+
+    def visit_Call(self, node: ast.Call) -> ast.AST:
+        func = node.func
+        inlined = _inline(func, node.args) if not node.keywords else None
+        if inlined is not None:
+            result: ast.AST = self.visit(ast.copy_location(inlined, node))
+            return result
+        if (isinstance(func, ast.Attribute) and isinstance(func.value, ast.Name)
+                and func.value.id == 'ctx' and func.attr in ('check', 'check_margin')):
+            # The failure path: the general context's own check, at this angle.
+            call = ast.Call(ast.Name(f'_ctx_{func.attr}', ast.Load()),
+                            [ast.Name('theta', ast.Load()), *node.args], node.keywords)
+            return self.generic_visit(ast.copy_location(call, node))
+        return self.generic_visit(node)
+
+    def visit_Name(self, node: ast.Name) -> ast.AST:
+        if node.id in self.arguments:
+            return ast.copy_location(ast.Name(self.arguments[node.id], node.ctx), node)
+        if node.id in self.locals:
+            return ast.copy_location(ast.Name(f'{node.id}{self.suffix}', node.ctx), node)
+        if node.id in ('ctx', 'self'):
+            raise _Unsupported(f'{node.id} used as a value')
+        return node
+
+
+def _inline(func: ast.expr, args: list[ast.expr]) -> ast.expr | None:
+    """Return the call of a one-line helper of the linkage module written out, or None.
+
+    A module function whose body is ``return <expression>`` (``_dot``,
+    ``_cross``), called with plain names or constants, becomes its expression
+    with the arguments put in: the same operations, without the call.
+    """
+    simple = all(isinstance(a, (ast.Name, ast.Constant)) for a in args)
+    if not (isinstance(func, ast.Name) and simple):
+        return None
+    helper = vars(lk).get(func.id)
+    if not inspect.isfunction(helper) or helper.__module__ != lk.__name__:
+        return None
+    definition = ast.parse(textwrap.dedent(inspect.getsource(helper))).body[0]
+    if not (isinstance(definition, ast.FunctionDef) and len(definition.body) == 1
+            and isinstance(definition.body[0], ast.Return) and definition.body[0].value
+            and len(definition.args.args) == len(args) and not definition.args.defaults):
+        return None
+    bound = {p.arg: a for p, a in zip(definition.args.args, args, strict=True)}
+
+    class Substitute(ast.NodeTransformer):
+        def visit_Name(self, node: ast.Name) -> ast.AST:
+            return bound.get(node.id, node)
+
+    expression: ast.expr = Substitute().visit(definition.body[0].value)
+    return expression
+
+
+def _body(step: Any, method: Callable[..., Any], suffix: str, names: dict[str, str],
+          namespace: dict[str, Any], arguments: dict[str, str]) -> list[ast.stmt]:
+    """Return the statements of ``method`` (a step's ``run``) specialized to ``step``."""
+    tree = ast.parse(textwrap.dedent(inspect.getsource(method)))
+    function = tree.body[0]
+    if not isinstance(function, ast.FunctionDef):
+        raise _Unsupported('run is not a plain function')
+    specializer = _Specializer(step, suffix, names, namespace, arguments)
+    parameters = {a.arg for a in function.args.args}
+    specializer.locals = {n.id for n in ast.walk(function)
+                          if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Store)
+                          } - parameters - set(arguments)
+    for n in itertools.chain.from_iterable(ast.walk(stmt) for stmt in function.body):
+        if isinstance(n, ast.Lambda) and (n.args.args or n.args.vararg or n.args.kwarg):
+            raise _Unsupported('a lambda with arguments')
+        if isinstance(n, (ast.Global, ast.Nonlocal, ast.Return, ast.Yield, ast.For,
+                          ast.While, ast.Try, ast.With, ast.FunctionDef)):
+            raise _Unsupported(type(n).__name__)
+    module = ast.Module(body=[stmt for stmt in function.body if not (
+        isinstance(stmt, ast.Expr) and isinstance(stmt.value, ast.Constant))], type_ignores=[])
+    module = cast(ast.Module, _fold(specializer.visit(module)))
+    return [stmt for stmt in module.body if not isinstance(stmt, ast.Pass)]
+
+
+def _ctx_check(theta: float, ok: Any, label: str, reason: Any) -> None:
+    context = lk._Context(theta, False)
+    context.check(ok, label, reason)
+
+
+def _ctx_check_margin(theta: float, ok: Any, label: str, margin: Any, bound: Any,
+                      reason: Any) -> None:
+    context = lk._Context(theta, False)
+    context.check_margin(ok, label, margin, bound, reason)
+
+
+def _wrapped_angle(e: complex) -> float:
+    theta = math.atan2(e.imag, e.real)
+    return math.pi if theta == -math.pi else theta
+
+
+def values_from_state(state: lk.State, joints: Sequence[str], points: Sequence[str],
+                      frames: Sequence[tuple[str, str | None, float]] = ()) -> list[float]:
+    """Return the values of a single-angle state in the order of a tick function.
+
+    That order, ``[positions of joints..., their velocities..., their
+    accelerations..., x, y of every point's position..., of every velocity...,
+    of every acceleration..., x, y, angle of every frame...]``, is the order of
+    the float slots of the node's message templates.
+    """
+    motions = [state.joints[name] for name in joints]
+    values = [float(m.position) for m in motions]
+    values += [float(m.velocity) for m in motions]
+    values += [float(m.acceleration) for m in motions]
+    for index in range(3):
+        for name in points:
+            z = state.complex_points[name][index]
+            values += (float(z.real), float(z.imag))
+    for origin, angle_of, angle in frames:
+        p = state.complex_points[origin][0]
+        values += (float(p.real), float(p.imag), angle if angle_of is None
+                   else float(state.joints[angle_of].position))
+    return values
+
+
+def tick_function(scene: lk.Scene, joints: Sequence[str] | None = None,
+                  points: Sequence[str] | None = None,
+                  frames: Sequence[tuple[str, str | None, float]] = ()
+                  ) -> tuple[TickFunction, bool]:
+    """Return (the tick function of ``scene``, whether it is compiled).
+
+    The compiled function of :func:`compile_tick` where the scene compiles,
+    else one with the same signature around :func:`mech_kinematics.solve`.
+    """
+    tick = compile_tick(scene, joints, points, frames)
+    if tick is not None:
+        return tick, True
+    return _general(scene, joints, points, frames), False
+
+
+def _general(scene: lk.Scene, joints: Sequence[str] | None, points: Sequence[str] | None,
+             frames: Sequence[tuple[str, str | None, float]]) -> TickFunction:
+    """Return a tick function around the general solver (same signature, same answers)."""
+    joints = tuple(scene.output_joints if joints is None else joints)
+    points = tuple(scene.output_points if points is None else points)
+    frames = tuple(frames)
+
+    def general(theta: float, omega: float, alpha: float,
+                tol: float) -> tuple[list[float], float]:
+        state = lk.solve(scene, theta, omega, alpha, max_error=tol)
+        measures = state.singularity.values()
+        return (values_from_state(state, joints, points, frames),
+                float(min(measures)) if measures else math.inf)
+
+    return general
+
+
+def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
+                 points: Sequence[str] | None = None,
+                 frames: Sequence[tuple[str, str | None, float]] = ()) -> TickFunction | None:
+    """Return ``scene``'s single-angle solve as one straight-line function, or ``None``.
+
+    Parameters
+    ----------
+    scene : Scene
+        The mechanism. Its outputs must include ``joints``, ``points``, and the
+        origins and angle joints of ``frames``.
+    joints, points : sequence of str, optional
+        The joints and points whose values the function returns, in order
+        (default: the scene's outputs).
+    frames : sequence of (origin point, angle joint or None, fixed angle)
+        Frames whose pose (x, y of the origin, angle) follows the values.
+
+    Returns
+    -------
+    callable or None
+        ``tick(theta, omega, alpha, max_error) -> (values, measure)``:
+        ``values`` is the flat list ``[positions of joints..., their velocities...,
+        their accelerations..., x, y of every point's position..., of every
+        velocity..., of every acceleration..., x, y, angle of every frame...]`` and
+        ``measure`` the smallest near-singularity measure (inf if none). It
+        raises exactly as :func:`mech_kinematics.solve` does, which it calls for
+        an instant it cannot settle itself. ``None`` where the scene cannot be
+        compiled (see the module's notes).
+    """
+    solver = scene._solver
+    plan = solver.run_plan
+    joints = tuple(scene.output_joints if joints is None else joints)
+    points = tuple(scene.output_points if points is None else points)
+    frames = tuple(frames)
+
+    if solver.shift:
+        return None
+    namespace: dict[str, Any] = {
+        '_ctx_check': _ctx_check, '_ctx_check_margin': _ctx_check_margin,
+        '_wrapped_angle': _wrapped_angle, '_slow': _general(scene, joints, points, frames),
+        'inf': math.inf,
+    }
+    namespace.update((k, v) for k, v in vars(lk).items() if not k.startswith('__'))
+    names: dict[str, str] = {}
+    body: list[ast.stmt] = []
+    try:
+        for name, entry in solver.ground.items():
+            local = names.setdefault(f'P_{name}', f'P_{name}_{len(names)}')
+            namespace[f'_ground_{local}'] = entry
+            body.append(ast.parse(f'{local} = _ground_{local}').body[0])
+        arguments = {'theta': 'theta', 'omega': 'omega', 'alpha': 'alpha'}
+        body += _body(plan.crank, type(plan.crank).run, '_0', names, namespace, arguments)
+        for index, step in enumerate(plan.steps, 1):
+            body += _body(step, type(step).run, f'_{index}', names, namespace, {})
+    except (_Unsupported, OSError, TypeError) as error:
+        del error   # the general solver serves this scene
+        return None
+
+    def var(table: str, name: str) -> str:
+        return names[f'{table}_{name}']
+
+    kinds = dict(plan.joint_types)
+    lines = []
+    # The quick trust test of the general solver (_trusted), on the reported values.
+    lines += ['_w = abs(omega)', '_rate = _w * _w + abs(alpha)',
+              f'_lp = tol * {solver.size!r}', f'_lv = tol * ({solver.crank_length!r} * _w)',
+              f'_la = tol * ({solver.crank_length!r} * _rate)', '_lw = tol * _w',
+              '_lal = tol * _rate']
+    checks = []
+    for name in solver.out_points:
+        e = var('P', name)
+        checks.append(f'{e}[3] <= _lp and {e}[4] <= _lv and {e}[5] <= _la')
+    for name in solver.out_links:
+        e = var('L', name)
+        checks.append(f'{e}[3] <= tol and {e}[4] <= _lw and {e}[5] <= _lal')
+    for name in solver.out_sliders:
+        e = var('S', name)
+        checks.append(f'{e}[3] <= _lp and {e}[4] <= _lv and {e}[5] <= _la')
+    if checks:
+        lines.append(f'if not ({" and ".join(checks)}):')
+        lines.append('    return _slow(theta, omega, alpha, tol)')
+    values = []
+    for index in range(3):
+        for name in joints:
+            if kinds[name] == 'revolute':
+                e = var('L', name)
+                values.append(f'_wrapped_angle({e}[0])' if index == 0 else f'{e}[{index}]')
+            else:
+                values.append(f'{var("S", name)}[{index}]')
+    for index in range(3):
+        for name in points:
+            e = var('P', name)
+            values += [f'{e}[{index}].real', f'{e}[{index}].imag']
+    for origin, angle_of, angle in frames:
+        e = var('P', origin)
+        values += [f'{e}[0].real', f'{e}[0].imag']
+        values.append(repr(angle) if angle_of is None
+                      else f'_wrapped_angle({var("L", angle_of)}[0])')
+    measures = [names[key] for key in names if key.startswith('M_')]
+    measure = f'min({", ".join(measures)})' if len(measures) > 1 else (
+        measures[0] if measures else 'inf')
+    lines.append(f'return [{", ".join(values)}], {measure}')
+    tail = [ast.parse(textwrap.dedent('\n'.join(lines))).body]
+    guard = ast.parse(
+        f'if not ({lk._RATE_LOW!r} <= abs(omega) <= {lk._RATE_HIGH!r} '
+        f'and abs(alpha) <= {lk._ACCEL_HIGH!r}):\n'
+        '    return _slow(theta, omega, alpha, tol)').body
+    function = ast.FunctionDef(
+        name='tick', args=ast.arguments(
+            posonlyargs=[], args=[ast.arg(a) for a in ('theta', 'omega', 'alpha', 'tol')],
+            kwonlyargs=[], kw_defaults=[], defaults=[]),
+        body=guard + body + list(itertools.chain.from_iterable(tail)), decorator_list=[],
+        returns=None)
+    module = ast.fix_missing_locations(ast.Module(body=[function], type_ignores=[]))
+    exec(compile(module, f'<compiled tick of {scene.name}>', 'exec'), namespace)  # noqa: S102
+    tick: TickFunction = namespace['tick']
+    return tick

@@ -1,0 +1,119 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The compiled tick against the general solver: the same bits, the same refusals (issue 14)."""
+
+import math
+from pathlib import Path
+import warnings
+
+import numpy as np
+import pytest
+import yaml
+
+import mech_kinematics as mk
+from mech_kinematics.ticker import compile_tick, tick_function, values_from_state
+from mech_kinematics.tools.report.common import MODES
+from mech_kinematics.tools.report.extreme import extreme_cases
+
+#: Crank angles over two turns and a bit, both signs.
+ANGLES = np.linspace(-7.0, 7.0, 701)
+TOLERANCES = (1e-6, 1e-12, math.inf)
+
+
+def _general(scene, theta, omega, alpha, tol, joints=None, points=None, frames=()):
+    """Return what the general solver answers, in a tick function's terms, or its error."""
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore', mk.NearSingularWarning)
+        try:
+            state = mk.solve(scene, theta, omega, alpha, max_error=tol)
+        except mk.AssemblyError as error:
+            return type(error), str(error)
+    measures = state.singularity.values()
+    joints = scene.output_joints if joints is None else joints
+    points = scene.output_points if points is None else points
+    return (values_from_state(state, joints, points, frames),
+            min(measures) if measures else math.inf)
+
+
+def _compiled(tick, theta, omega, alpha, tol):
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore', mk.NearSingularWarning)
+        try:
+            return tick(theta, omega, alpha, tol)
+        except mk.AssemblyError as error:
+            return type(error), str(error)
+
+
+def _assert_same(scene, tick, angles, speeds=(None,), **kwargs):
+    """Every instant: identical values (bit for bit), measure, or error and message."""
+    refused = 0
+    for theta in angles:
+        for speed in speeds:
+            omega = scene.input.speed if speed is None else speed
+            for tol in TOLERANCES:
+                expected = _general(scene, float(theta), omega, scene.input.accel, tol,
+                                    **kwargs)
+                got = _compiled(tick, float(theta), omega, scene.input.accel, tol)
+                assert repr(got) == repr(expected), (scene.name, theta, tol)
+                refused += isinstance(expected[0], type)
+    return refused
+
+
+@pytest.mark.parametrize('name', mk.scene_names())
+def test_every_packaged_scene_compiles_to_the_same_bits(name):
+    """Over two turns, at three tolerances, the compiled tick answers as mk.solve does."""
+    scene = mk.load_scene(name)
+    tick = compile_tick(scene)
+    assert tick is not None, f'{name} did not compile'
+    refused = _assert_same(scene, tick, ANGLES, speeds=(None, -3.5, 1e4))
+    if name == 'four_bar_coupler_points':
+        assert refused > 0      # the triple rocker's unassemblable angles, refused alike
+
+
+def test_the_extreme_suite_refuses_and_answers_alike():
+    """Toggles, change points, grazing guides, a pin at the pivot: same answers and refusals."""
+    cases = extreme_cases(MODES['smoke'])
+    compiled = 0
+    for case in cases:
+        tick, is_compiled = tick_function(case.scene)
+        compiled += is_compiled
+        speed = case.speed if case.speed is not None else case.scene.input.speed
+        _assert_same(case.scene, tick, case.angles, speeds=(speed,))
+    assert compiled >= len(cases) - 3     # only the rescaled sizes fall back
+
+
+def test_a_chain_of_sixty_four_dyads_and_its_frames(tmp_path):
+    """A large scene with frames of every link: values and frame poses as the solver's."""
+    import sys
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / 'bench'))
+    from node_bench import chain_scene
+
+    path = tmp_path / 'chain.yaml'
+    path.write_text(chain_scene(64))
+    scene = mk.load_scene(path)
+    frames = [(f'D{i}', f'rocker{i}', 0.0) for i in range(64)] + [('B', None, 0.25)]
+    tick = compile_tick(scene, scene.output_joints[:5], scene.output_points[-3:], frames)
+    assert tick is not None
+    _assert_same(scene, tick, ANGLES[::7], joints=scene.output_joints[:5],
+                 points=scene.output_points[-3:], frames=frames)
+
+
+def test_a_scene_the_solver_rescales_is_served_by_the_general_solver(tmp_path):
+    """Lengths of 1e-300 m are not compiled; tick_function falls back with the same answers."""
+    source = Path(__file__).resolve().parents[1] / 'config' / 'scenes' / \
+        'khurmi_four_bar_ad150.yaml'
+    text = source.read_text().replace('units: {length: mm, angle: deg}',
+                                      'units: {length: m, angle: deg}')
+    doc = yaml.safe_load(text)
+    doc['ground'] = {k: [v[0] * 1e-300, v[1] * 1e-300] for k, v in doc['ground'].items()}
+    doc['input']['length'] *= 1e-300
+    for dyad in doc['dyads']:
+        for link in dyad['links']:
+            link['length'] *= 1e-300
+    path = tmp_path / 'tiny.yaml'
+    path.write_text(yaml.safe_dump(doc))
+    scene = mk.load_scene(path)
+    assert compile_tick(scene) is None
+    tick, compiled = tick_function(scene)
+    assert not compiled
+    _assert_same(scene, tick, ANGLES[::10])
