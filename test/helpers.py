@@ -47,6 +47,37 @@ def reference_cases() -> list[Any]:
     return params
 
 
+# --- a scene using every construct -----------------------------------------------
+# Used by test_scene.py and test_scene_loader.py, which edit it.
+
+#: A valid scene using every construct: an RRR four-bar, points carried in both
+#: forms, an RRP from a carried point, a second ground point on the guide.
+BASE_SCENE = """\
+name: base_scene
+units: {length: mm, angle: deg}
+ground:
+  A: [0, 0]
+  D: [150, 0]
+  G: [0, -100]
+input: {link: crank, center: A, point: B, length: 40, angle: 60, speed_rpm: -120, accel: 0}
+dyads:
+  - type: RRR
+    point: C
+    links:
+      - {name: coupler, from: B, length: 150}
+      - {name: rocker, from: D, length: 80}
+    branch: 1
+  - type: RRP
+    point: P
+    link: {name: rod, from: E, length: 150}
+    guide: {through: G, angle: 0}
+    slider: piston
+    branch: 1
+points:
+  E: {link: coupler, from: B, toward: C, distance: 50}
+  F: {link: coupler, origin: B, xaxis: C, local: [40, -30]}
+"""
+
 # --- what setup.py installs and which parameters the node declares ---------------
 # Used by test_launch.py and test_packaging.py.
 #: Parameters every rclpy node declares itself.

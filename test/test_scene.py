@@ -20,6 +20,7 @@ import re
 import subprocess
 import sys
 
+from helpers import BASE_SCENE as BASE
 import numpy as np
 import pytest
 import yaml
@@ -33,34 +34,6 @@ SCENES = ROOT / 'config' / 'scenes'
 TIMEOUT = 60
 #: The same scene in mm and in m: inputs differ by the rounding of x / 1000.
 RTOL_UNITS = 1e-12
-
-#: A valid scene using every construct: an RRR four-bar, points carried in both
-#: forms, an RRP from a carried point, a second ground point on the guide.
-BASE = """\
-name: base_scene
-units: {length: mm, angle: deg}
-ground:
-  A: [0, 0]
-  D: [150, 0]
-  G: [0, -100]
-input: {link: crank, center: A, point: B, length: 40, angle: 60, speed_rpm: -120, accel: 0}
-dyads:
-  - type: RRR
-    point: C
-    links:
-      - {name: coupler, from: B, length: 150}
-      - {name: rocker, from: D, length: 80}
-    branch: 1
-  - type: RRP
-    point: P
-    link: {name: rod, from: E, length: 150}
-    guide: {through: G, angle: 0}
-    slider: piston
-    branch: 1
-points:
-  E: {link: coupler, from: B, toward: C, distance: 50}
-  F: {link: coupler, origin: B, xaxis: C, local: [40, -30]}
-"""
 
 
 def base():

@@ -21,6 +21,7 @@ import stat
 import subprocess
 import sys
 
+from helpers import BASE_SCENE as BASE
 import pytest
 import yaml
 
@@ -39,32 +40,6 @@ TIMEOUT = 120
 #: reached 4 GiB.
 MAX_PEAK_BYTES = 200 * 2**20
 
-#: A scene using every construct (the base scene of test_scene.py), to edit.
-BASE = """\
-name: base_scene
-units: {length: mm, angle: deg}
-ground:
-  A: [0, 0]
-  D: [150, 0]
-  G: [0, -100]
-input: {link: crank, center: A, point: B, length: 40, angle: 60, speed_rpm: -120, accel: 0}
-dyads:
-  - type: RRR
-    point: C
-    links:
-      - {name: coupler, from: B, length: 150}
-      - {name: rocker, from: D, length: 80}
-    branch: 1
-  - type: RRP
-    point: P
-    link: {name: rod, from: E, length: 150}
-    guide: {through: G, angle: 0}
-    slider: piston
-    branch: 1
-points:
-  E: {link: coupler, from: B, toward: C, distance: 50}
-  F: {link: coupler, origin: B, xaxis: C, local: [40, -30]}
-"""
 
 LOADERS = [pytest.param(SceneLoader, id='python')]
 if hasattr(scene_module, 'CSceneLoader'):
