@@ -229,3 +229,24 @@ def test_rounding_at_the_bound_keeps_the_drive_within_its_resolution():
     for t in (int(t_hold * NS) + 1, 3600 * NS, 30 * DAY_NS):
         exact = (x_hold + w_max * (Fraction(t, NS) - t_hold)) % 1
         assert abs(tb.turns(t) - exact) <= Fraction(1, 2 ** POSITION_BITS)
+
+
+@given(angle0=st.floats(-20.0, 20.0), rpm=rpms(), t=instants())
+def test_whole_turns_and_angle_make_the_angle_counted_from_the_start(angle0, rpm, t):
+    """The angle plus 2 pi times the whole turns is the exact position from the start (issue 11)."""
+    tb = CrankTimebase(0, angle0, rpm, 0.0, 100_000.0)
+    turns, sample = tb.sample_turns(t)
+    exact = Fraction(angle0) / TWO_PI + Fraction(rpm) / 60 * Fraction(t, NS)
+    assert exact == tb.total_turns(t)
+    assert abs(exact - turns) <= Fraction(1, 2)
+    assert abs(sample.angle - float((exact - turns) * TWO_PI)) <= ATOL_ANGLE
+    assert sample == tb.sample(t)
+
+
+def test_turns_count_every_turn_across_changes():
+    """Whole turns keep counting through speed changes and reversals (issue 11)."""
+    tb = CrankTimebase(0, 0.0, 60.0, 0.0, 1000.0)      # one turn a second
+    assert tb.sample_turns(10 * NS)[0] == 10
+    tb.update(10 * NS, speed_rpm=-120.0)                # two turns a second, backwards
+    assert tb.sample_turns(15 * NS)[0] == 0
+    assert tb.sample_turns(20 * NS)[0] == -10

@@ -102,13 +102,14 @@ class _Piece:
     def turns(self, tau: int) -> Fraction:
         return Fraction(self.n0 + tau * (self.n1 + tau * self.n2), self.den)
 
-    def sample(self, tau: int) -> CrankSample:
+    def sample(self, tau: int) -> tuple[int, CrankSample]:
         den = self.den
-        r = (self.n0 + tau * (self.n1 + tau * self.n2)) % den
+        whole, r = divmod(self.n0 + tau * (self.n1 + tau * self.n2), den)
         if 2 * r > den:         # wrap the fraction of a turn to (-1/2, 1/2]
             r -= den
-        return CrankSample((r / den) * _TWO_PI_FLOAT,
-                           self.speed + self.speed_slope * tau, self.accel)
+            whole += 1
+        return whole, CrankSample((r / den) * _TWO_PI_FLOAT,
+                                  self.speed + self.speed_slope * tau, self.accel)
 
 
 class _Segment:
@@ -192,7 +193,7 @@ class CrankTimebase:
         if max_speed_rpm < 0:
             msg = f'Expected `max_speed_rpm` >= 0, got {max_speed_rpm!r}'
             raise ValueError(msg)
-        self._segment = _Segment(int(t0), turns_from_radians(angle) % 1,
+        self._segment = _Segment(int(t0), turns_from_radians(angle),
                                  Fraction(speed_rpm) / 60, turns_from_radians(accel),
                                  Fraction(max_speed_rpm) / 60, None)
 
@@ -204,6 +205,16 @@ class CrankTimebase:
 
     def sample(self, t: int) -> CrankSample:
         """Return the crank's angle (wrapped to (-pi, pi]), speed and acceleration at ``t`` ns."""
+        return self.sample_turns(t)[1]
+
+    def sample_turns(self, t: int) -> tuple[int, CrankSample]:
+        """Return (whole turns, the crank's state) at ``t`` ns.
+
+        The crank's angle counted from the start (not wrapped) is
+        ``angle + 2 pi * turns``, with ``angle`` in (-pi, pi] and ``turns`` an
+        exact integer: the pair keeps every digit of an angle that a single
+        float would lose after many turns.
+        """
         seg = self._segment
         if t < seg.t0 and seg.prev is not None:
             seg = seg.prev
@@ -212,6 +223,14 @@ class CrankTimebase:
         if ceil is None or tau < ceil:
             return seg.ramp.sample(tau)
         return seg.hold.sample(tau)
+
+    def total_turns(self, t: int) -> Fraction:
+        """Return the exact crank position at ``t`` ns in turns, counted from the start.
+
+        That is ``angle / (2 pi)`` of the initial angle plus every turn since.
+        """
+        seg, tau = self._at(t)
+        return seg.piece(tau).turns(tau)
 
     def turns(self, t: int) -> Fraction:
         """Return the exact crank position at ``t`` ns, in turns, modulo 1."""
@@ -238,7 +257,7 @@ class CrankTimebase:
         t = int(t)
         old = self._segment
         seg, tau = self._at(t)
-        turns0 = seg.piece(tau).turns(tau) % 1
+        turns0 = seg.piece(tau).turns(tau)
         speed = seg.speed(tau)
         # Keep one level of history, without touching the segment that a
         # concurrent sample() may be reading.
@@ -277,6 +296,6 @@ class CrankTimebase:
         """
         seg, tau = self._at(int(t_from))
         copy = object.__new__(CrankTimebase)
-        copy._segment = _Segment(int(t_to), seg.piece(tau).turns(tau) % 1, seg.speed(tau),
+        copy._segment = _Segment(int(t_to), seg.piece(tau).turns(tau), seg.speed(tau),
                                  self._segment.a, self._segment.w_max, None)
         return copy
