@@ -233,7 +233,7 @@ def test_rounding_at_the_bound_keeps_the_drive_within_its_resolution():
 
 @given(angle0=st.floats(-20.0, 20.0), rpm=rpms(), t=instants())
 def test_whole_turns_and_angle_make_the_angle_counted_from_the_start(angle0, rpm, t):
-    """The angle plus 2 pi times the whole turns is the exact position from the start (issue 11)."""
+    """The angle plus 2 pi times the whole turns is the exact position from the start."""
     tb = CrankTimebase(0, angle0, rpm, 0.0, 100_000.0)
     turns, sample = tb.sample_turns(t)
     exact = Fraction(angle0) / TWO_PI + Fraction(rpm) / 60 * Fraction(t, NS)
