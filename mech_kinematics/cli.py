@@ -13,7 +13,8 @@ cheap.
 
 :func:`run_handler` is the one place that turns a failure into what a
 person reads: an error of this package is one line (``error: ...``, exit 2),
-a broken pipe (``solve ... | head``) exits quietly, Ctrl-C exits 130, and an
+a file that cannot be read or written is one line naming it (exit 2), a
+broken pipe (``solve ... | head``) exits quietly, Ctrl-C exits 130, and an
 unexpected exception is one line too, with its traceback only when
 ``MECH_KINEMATICS_TRACEBACK=1`` is set.
 """
@@ -96,6 +97,10 @@ def run_handler(args: argparse.Namespace) -> int:
         return 130
     except MechKinematicsError as error:
         print(f'error: {error}', file=sys.stderr)
+        return 2
+    except OSError as error:    # a file that cannot be read or written: name it
+        where = f'{error.filename}: ' if error.filename else ''
+        print(f'error: {where}{error.strerror or error}', file=sys.stderr)
         return 2
     except Exception as error:  # noqa: BLE001 - the last resort: one line, not a traceback
         if os.environ.get(TRACEBACK_VARIABLE) == '1':

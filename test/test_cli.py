@@ -1,0 +1,59 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""Every command fails with one line and a non-zero status, never a traceback (issue 12)."""
+
+import subprocess
+import sys
+
+import pytest
+
+from mech_kinematics.cli import BROKEN_PIPE_STATUS
+
+TIMEOUT = 120
+
+
+def run(*args: str, **kwargs) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, '-m', 'mech_kinematics', *args], text=True,
+                          capture_output=True, timeout=TIMEOUT, **kwargs)
+
+
+@pytest.mark.parametrize('args, words', [
+    (['solve', 'no_such_scene'], ['no_such_scene', 'packaged scene name']),
+    (['diagram', 'no_such_scene', '-o', 'x.png'], ['no_such_scene']),
+    (['plot', '--scene', 'no_such_scene', '-o', 'x.png'], ['no_such_scene']),
+    (['reindex', '/no/such/bag'], ['/no/such/bag', 'does not exist']),
+    (['record', '-o', '/proc/no/bag', '--duration', '1'], ['/proc/no/bag']),
+    (['report', '-o', '/proc/no/report', '--smoke', '--no-progress'], ['/proc/no']),
+    (['solve', '/dev/null'], ['/dev/null']),
+])
+def test_a_failing_command_says_one_line(tmp_path, args, words):
+    """A missing scene, bag or output folder: one `error:` line naming it, status 2."""
+    result = run(*args, cwd=tmp_path)
+    assert result.returncode == 2, result.stderr
+    assert 'Traceback' not in result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith('error: '), result.stderr
+    for word in words:
+        assert word in lines[0]
+
+
+def test_a_negative_number_in_exponent_form_is_a_value():
+    """`--speed-rpm -1e3` and `--angle-deg -.5e1` are numbers, not options (issue 12)."""
+    result = run('solve', 'khurmi_four_bar_ad150', '--speed-rpm', '-1e3', '--angle-deg',
+                 '-.5e1', '--indent', '0')
+    assert result.returncode == 0, result.stderr
+    assert '"speed": -104.7197551196597' in result.stdout
+
+
+def test_a_closed_pipe_ends_the_command_quietly():
+    """`solve ... | head -1` exits without a word on stderr (the README's own example)."""
+    proc = subprocess.Popen([sys.executable, '-m', 'mech_kinematics', 'solve', 'whitworth',
+                             '--indent', '4'], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    proc.stdout.readline()
+    proc.stdout.close()          # as `head -1` does after its line
+    status = proc.wait(timeout=TIMEOUT)
+    stderr = proc.stderr.read()
+    proc.stderr.close()
+    assert stderr == '', stderr
+    assert status in (0, BROKEN_PIPE_STATUS)
