@@ -26,7 +26,8 @@ SECTIONS = ('## 1. The 50-digit reference', '## 2. Work-precision',
 #: The modules of the report package, one per concern.
 MODULES = ('baselines', 'checks', 'clock', 'common', 'cost', 'extreme', 'figures', 'markdown')
 #: What common.py shares with the section modules only (not re-exported).
-SHARED_HELPERS = {'median_time', 'quiet_solve', 'slug'}
+SHARED_HELPERS = {'distance_angle', 'four_bar', 'median_time', 'quiet_solve', 'slider_crank',
+                  'slug'}
 
 
 def test_add_parser_registers_report():
