@@ -7,7 +7,7 @@
 mechanisms; :func:`median_time` is the one timer and :func:`quiet_solve`
 the solver with its near-singularity warning silenced. :func:`four_bar`,
 :func:`slider_crank` and :func:`distance_angle` build the mechanisms of the
-extreme cases (:mod:`.extreme`).
+extreme sections (:mod:`.extreme`, :mod:`.bounds`).
 """
 
 from __future__ import annotations
@@ -59,6 +59,8 @@ class Mode:
     chain_lengths: tuple[int, ...]
     chain_angles: int
     repeat: int
+    bound_samples: int                 # angles per error-bound case without a singular position
+    bound_grid: int                    # evenly spaced angles of the refused-fraction grid
 
 
 #: The simulated run times of the node's clock: (label, seconds).
@@ -70,15 +72,15 @@ MODES = {
                  (1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7),
                  (1e-3, 1e-5, 1e-7, 1e-9, 1e-11, 1e-13), tuple(WP_SCENES), 3, None,
                  DURATIONS, (10.0, 1000.0, 100_000.0), 10_000_000, 3_600_000, 8,
-                 tuple(10 ** k for k in range(8)), (1, 2, 4, 8, 16, 32, 64), 1000, 5),
+                 tuple(10 ** k for k in range(8)), (1, 2, 4, 8, 16, 32, 64), 1000, 5, 4, 3600),
     'quick': Mode('quick', 16, 2048, (1e-3, 1e-6, 1e-9, 1e-12), (1e-2, 1e-4, 1e-6),
                   (1e-4, 1e-8, 1e-12), tuple(WP_SCENES), 1,
                   ('khurmi_four_bar_ad150', 'quick_return', 'geneva', 'six_link_slider'),
                   DURATIONS, (10.0, 1000.0, 100_000.0), 1_000_000, 200_000, 2,
-                  tuple(10 ** k for k in range(7)), (1, 4, 16, 64), 1000, 3),
+                  tuple(10 ** k for k in range(7)), (1, 4, 16, 64), 1000, 3, 2, 720),
     'smoke': Mode('smoke', 6, 256, (1e-4, 1e-10), (1e-3,), (1e-6,), ('four-bar', 'Geneva'), 1,
                   ('khurmi_four_bar_ad150', 'geneva'), DURATIONS[:3] + DURATIONS[4:],
-                  (1000.0,), 100_000, 20_000, 0, (1, 100, 10_000), (1, 8), 200, 2),
+                  (1000.0,), 100_000, 20_000, 0, (1, 100, 10_000), (1, 8), 200, 2, 1, 180),
 }
 
 
