@@ -134,6 +134,66 @@ dyads:
     assert a == b
 
 
+def _khurmi_with(tmp_path, name, old, new):
+    """Write khurmi_four_bar_ad150.yaml with ``old`` replaced by ``new``; return its path."""
+    source = (SCENES / 'khurmi_four_bar_ad150.yaml').read_text()
+    assert old in source
+    path = tmp_path / f'{name}.yaml'
+    path.write_text(source.replace(old, new, 1))
+    return path
+
+
+@pytest.mark.parametrize('spelling', ['1.5e2', '1.5E+2', '+150.', '0o226', '0x96'])
+def test_decimal_values_read_numbers_as_the_scene_loader_does(tmp_path, spelling):
+    """A YAML 1.2 number such as `length: 1.5e2` gives the reference of `length: 150.0`.
+
+    The reference reads scene files with the scene loader's YAML reader, so
+    both see the same numbers. See issue 10.
+    """
+    plain = _khurmi_with(tmp_path, 'plain', '[150, 0]', '[150.0, 0]')
+    spelled = _khurmi_with(tmp_path, 'spelled', '[150, 0]', f'[{spelling}, 0]')
+    scene = mk.load_scene(plain)
+    assert mk.load_scene(spelled).ground == scene.ground
+    model = ref.Model(scene)
+    a, b = ref.decimal_values(plain, model), ref.decimal_values(spelled, model)
+    assert a == b
+    with mpmath.workdps(ref.DPS):
+        assert a['ground.D.x'] == mpmath.mpf('0.15')
+    got = [ref.as_float_dict(ref.reference(model, 1.0, values=v)) for v in (a, b)]
+    assert got[0] == got[1]
+
+
+def test_decimal_values_refuse_a_duplicate_key(tmp_path):
+    """A key given twice is refused as the scene loader refuses it, not read as the last one."""
+    path = _khurmi_with(tmp_path, 'twice', '  length: 40\n', '  length: 40\n  length: 45\n')
+    with pytest.raises(mk.SceneError, match=r'twice.yaml: .*length'):
+        mk.load_scene(path)
+    model = ref.Model(mk.load_scene('khurmi_four_bar_ad150'))
+    with pytest.raises(mk.SceneError, match=r'twice.yaml: input: expected each key once'):
+        ref.decimal_values(path, model)
+
+
+def test_decimal_values_keep_every_digit_written(tmp_path):
+    """A length of more digits than a double holds keeps them all; the loader rounds it."""
+    digits = '80.000000000000000000123'
+    path = _khurmi_with(tmp_path, 'long', 'length: 80}', f'length: {digits}}}')
+    model = ref.Model(mk.load_scene(path))
+    assert model.values['link.rocker.length'] == 0.08
+    with mpmath.workdps(ref.DPS):
+        assert ref.decimal_values(path, model)['link.rocker.length'] == (
+            mpmath.mpf(digits) / 1000)
+
+
+@pytest.mark.parametrize('name', ['quick_return', 'whitworth', 'geneva'])
+def test_decimal_values_of_scenes_with_sliding_levers(name):
+    """Scenes with an RPR (no length of its own) are read; each value rounds to its double."""
+    model = ref.Model(mk.load_scene(name))
+    decimals = ref.decimal_values(SCENES / f'{name}.yaml', model)
+    assert decimals.keys() == model.values.keys()
+    for key, value in decimals.items():
+        assert float(value) == pytest.approx(model.values[key], rel=4 * EPS, abs=0), key
+
+
 @pytest.mark.parametrize(('name', 'case'), reference_cases())
 def test_golden_case_from_double_inputs(name, case):
     """From the scene's doubles, the published values agree to 1e-15 of (value + scale)."""

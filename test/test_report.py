@@ -22,11 +22,13 @@ from mech_kinematics.tools import report
 
 SECTIONS = ('## 1. The 50-digit reference', '## 2. Work-precision',
             '## 3. Error against run time of the node', '## 4. Stiff and extreme cases',
-            '## 5. Cost growth')
+            '## 5. Cost growth', '## 6. Error bounds against the truth')
 #: The modules of the report package, one per concern.
-MODULES = ('baselines', 'checks', 'clock', 'common', 'cost', 'extreme', 'figures', 'markdown')
+MODULES = ('baselines', 'bounds', 'checks', 'clock', 'common', 'cost', 'extreme', 'figures',
+           'markdown')
 #: What common.py shares with the section modules only (not re-exported).
-SHARED_HELPERS = {'median_time', 'quiet_solve', 'slug'}
+SHARED_HELPERS = {'distance_angle', 'four_bar', 'median_time', 'quiet_solve', 'slider_crank',
+                  'slug'}
 
 
 def test_add_parser_registers_report():
@@ -78,12 +80,12 @@ def quick_report(tmp_path_factory):
 
 
 def test_quick_report_has_every_section(quick_report):
-    """REPORT.md has the five sections and every figure it links exists."""
+    """REPORT.md has the six sections and every figure it links exists."""
     text = (quick_report / 'REPORT.md').read_text()
     for section in SECTIONS:
         assert section in text
     figures = re.findall(r'!\[[^\]]*\]\(([^)]+)\)', text)
-    assert len(figures) >= 7
+    assert len(figures) >= 9 and {'bounds.png', 'refused.png'} <= set(figures)
     for name in figures:
         assert (quick_report / name).stat().st_size > 10_000, name
 
@@ -100,10 +102,18 @@ def test_quick_report_has_no_failures(quick_report):
 
 
 def test_cli_main_writes_the_smoke_report(tmp_path):
-    """`python -m mech_kinematics.tools.report -o DIR --smoke` exits 0 and prints the path."""
+    """`... report -o DIR --smoke` exits 0, prints the path, writes section 6 and its figures."""
     result = subprocess.run([sys.executable, '-m', 'mech_kinematics.tools.report', '-o',
                              str(tmp_path), '--smoke', '--no-progress'],
                             capture_output=True, text=True, timeout=300, check=False)
     assert result.returncode == 0, result.stderr
     assert Path(result.stdout.strip()) == tmp_path / 'REPORT.md'
-    assert '## 5. Cost growth' in (tmp_path / 'REPORT.md').read_text()
+    text = (tmp_path / 'REPORT.md').read_text()
+    assert '## 5. Cost growth' in text
+    bounds_section = text.split('## 6. Error bounds against the truth')[1]
+    assert re.search(r'\| \| \*\*all cases\*\* \| \d+ / \d+ / \d+ \| \d+ \| \d+ \| \*\*0\*\* \|',
+                     bounds_section)
+    assert 'No bound is below its actual error' in bounds_section
+    for name in ('bounds.png', 'refused.png'):
+        assert f']({name})' in bounds_section
+        assert (tmp_path / name).stat().st_size > 10_000, name

@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 import math
 import os
 from pathlib import Path
+import re
 from typing import Any
 
 import mpmath
@@ -48,10 +49,12 @@ import yaml
 
 from ..errors import SceneError
 from ..linkage import RPR, RRP, RRR, Scene
+from ..scene import read_scene_yaml
 from ..units import ANGLE_UNITS, LENGTH_UNITS, radians_from_degrees
 
 __all__ = ['DIGITS', 'DPS', 'Jet', 'Model', 'NoAssembly', 'Reference', 'as_float_dict',
-           'check_by_differences', 'compare', 'condition', 'decimal_values', 'reference']
+           'check_by_differences', 'compare', 'condition', 'decimal_values', 'reference',
+           'value_errors']
 
 #: Digits the reference values are good to.
 DIGITS = 50
@@ -838,6 +841,40 @@ def compare(state: Any, ref: Reference, index: int | None = None,
     return out
 
 
+def value_errors(state: Any, ref: Reference) -> dict[str, tuple[str, float]]:
+    """Return the absolute error of every value a single-angle ``state`` reports.
+
+    Keyed by the value's path in ``State.as_dict()`` (``joints.rocker.velocity``,
+    ``points.C.acceleration``), as ``(kind, error)``: the kind of
+    :data:`KINDS` and the error in SI units, ``|solver - exact|``: the length
+    of the error vector for a point, modulo 2 pi for a joint angle, exactly
+    what ``state.error_bound`` bounds. Values the reference leaves undefined
+    (the derivatives at a singular pose) are left out.
+    """
+    out: dict[str, tuple[str, float]] = {}
+    quantities = ('position', 'velocity', 'acceleration')
+    with _precision(DPS):
+        for name, values in state.complex_points.items():
+            for index, quantity in enumerate(quantities):
+                exact = ref.points[name][index]
+                if exact is not None:
+                    error = abs(mpmath.mpc(values[index]) - exact)
+                    out[f'points.{name}.{quantity}'] = (quantity, float(error))
+        for name, joint in state.joints.items():
+            revolute = joint.type == 'revolute'
+            kinds = (('angle', 'angular velocity', 'angular acceleration') if revolute
+                     else quantities)
+            for index, quantity in enumerate(quantities):
+                exact = ref.joints[name][index]
+                if exact is None:
+                    continue
+                error = mpmath.mpf(getattr(joint, quantity)) - exact
+                if index == 0 and revolute:
+                    error = _wrap(error)
+                out[f'joints.{name}.{quantity}'] = (kinds[index], float(abs(error)))
+    return out
+
+
 def condition(scene: Scene | Model, ref: Reference,
               step: str = '1e-25') -> dict[str, float]:
     """Return, per kind, the condition number of the state in its inputs.
@@ -911,21 +948,42 @@ def as_float_dict(ref: Reference) -> dict[str, Any]:
     }
 
 
+#: Reads a document with every scalar left as the text written (no numbers resolved).
+_TEXT_LOADER: Any = getattr(yaml, 'CBaseLoader', yaml.BaseLoader)
+#: A decimal number as YAML 1.2 writes one: its digits are taken as written.
+_DECIMAL = re.compile(r'[-+]?(\.[0-9]+|[0-9]+(\.[0-9]*)?)([eE][-+]?[0-9]+)?')
+
+
 def decimal_values(path: str | os.PathLike[str], model: Model) -> dict[str, Any]:
     """Return the geometry of a scene file as exact decimals (mpmath), keyed like ``values``.
 
     The scene loader rounds ``40 mm`` to the double nearest 0.04 m; published
     50-digit values are computed from the decimal numbers as written, so to
-    reproduce them bit for bit the reference must start from those. The
-    units are :mod:`mech_kinematics.units`' (the scene loader's).
+    reproduce them bit for bit the reference must start from those. The file
+    is read by the scene loader's own YAML reader
+    (:func:`mech_kinematics.scene.read_scene_yaml`: YAML 1.2 numbers such as
+    ``1.5e2``, duplicate keys refused), so both read the same numbers; each
+    number written as a decimal is then taken at every digit written (a
+    20-digit length keeps its 20 digits), any other (``0x10``, ``!!float 3``)
+    at its exact value. The units are :mod:`mech_kinematics.units`' (the
+    scene loader's).
 
     Raises
     ------
     SceneError
-        If the file's ``units.length`` or ``units.angle`` is not one a scene
-        may use.
+        If the file cannot be read, is not a scene file the loader reads
+        (naming the line and column), holds a value that is not a number where
+        a number belongs, or has a ``units.length`` or ``units.angle`` that
+        is not one a scene may use.
     """
-    data = yaml.safe_load(Path(path).read_text(encoding='utf-8'))
+    try:
+        text = Path(path).read_text(encoding='utf-8').removeprefix('\ufeff')
+        data = read_scene_yaml(text)
+    except (OSError, UnicodeDecodeError) as error:
+        raise SceneError(f'{path}: cannot read: {error}') from None
+    except SceneError as error:
+        raise SceneError(f'{path}: {error}') from None
+    written = yaml.load(text, Loader=_TEXT_LOADER)  # noqa: S506 - resolves no tags at all
     units = data.get('units') or {}
     length_unit = units.get('length', 'm')
     if length_unit not in LENGTH_UNITS:
@@ -941,25 +999,46 @@ def decimal_values(path: str | os.PathLike[str], model: Model) -> dict[str, Any]
     with _precision(DPS):
         per_metre = mpmath.mpf(LENGTH_UNITS[length_unit])
 
-        def length(v: Any) -> Any:
-            return mpmath.mpf(str(v)) / per_metre
-
-        def angle(v: Any) -> Any:
-            value = mpmath.mpf(str(v))
-            return radians_from_degrees(value, mpmath.pi) if angle_unit == 'deg' else value
+        def put(key: str, value: Any, text: Any, is_angle: bool = False) -> None:
+            """Store ``value`` (the loader's number, written as ``text``) under ``key``, SI."""
+            if type(value) is int:
+                x = mpmath.mpf(value)
+            elif type(value) is float and math.isfinite(value):
+                decimal = isinstance(text, str) and _DECIMAL.fullmatch(text) is not None
+                x = mpmath.mpf(text if decimal and float(text) == value else value)
+            else:
+                msg = f'{path}: {key}: expected a number, got {value!r}'
+                raise SceneError(msg)
+            if not is_angle:
+                out[key] = x / per_metre
+            else:
+                out[key] = radians_from_degrees(x, mpmath.pi) if angle_unit == 'deg' else x
 
         for name, (x, y) in data['ground'].items():
-            out[f'ground.{name}.x'], out[f'ground.{name}.y'] = length(x), length(y)
-        out['crank.length'] = length(data['input']['length'])
-        for dyad in data.get('dyads') or []:
-            for link in dyad.get('links') or ([dyad['link']] if 'link' in dyad else []):
-                out[f'link.{link["name"]}.length'] = length(link['length'])
+            tx, ty = written['ground'][name]
+            put(f'ground.{name}.x', x, tx)
+            put(f'ground.{name}.y', y, ty)
+        put('crank.length', data['input']['length'], written['input']['length'])
+        for dyad, text in zip(data.get('dyads') or [], written.get('dyads') or [], strict=True):
+            if dyad['type'] == 'RRR':
+                pairs = list(zip(dyad['links'], text['links'], strict=True))
+            elif dyad['type'] == 'RRP':
+                pairs = [(dyad['link'], text['link'])]
+            else:  # an RPR has no length of its own
+                pairs = []
+            for link, link_text in pairs:
+                put(f'link.{link["name"]}.length', link['length'], link_text['length'])
             if dyad['type'] == 'RRP':
-                out[f'guide.{dyad["point"]}.angle'] = angle(dyad['guide'].get('angle', 0))
+                put(f'guide.{dyad["point"]}.angle', dyad['guide'].get('angle', 0),
+                    text['guide'].get('angle', '0'), is_angle=True)
+        texts = written.get('points') or {}
         for name, point in (data.get('points') or {}).items():
-            local = point['local'] if 'local' in point else (point['distance'], 0)
-            out[f'point.{name}.local.x'] = length(local[0])
-            out[f'point.{name}.local.y'] = length(local[1])
+            if 'local' in point:
+                local, local_text = point['local'], texts[name]['local']
+            else:
+                local, local_text = (point['distance'], 0), (texts[name]['distance'], '0')
+            put(f'point.{name}.local.x', local[0], local_text[0])
+            put(f'point.{name}.local.y', local[1], local_text[1])
     if set(out) != set(model.values):
         msg = f'Expected the keys {sorted(model.values)}, got {sorted(out)}'
         raise ValueError(msg)

@@ -14,7 +14,9 @@
    base and for naive ``angle += omega * dt`` accumulation (:mod:`.clock`);
 4. stiff and extreme cases against the reference, with the solver's flags,
    digits lost and the formula audit (:mod:`.extreme`);
-5. cost growth with the batch size and the number of dyads (:mod:`.cost`).
+5. cost growth with the batch size and the number of dyads (:mod:`.cost`);
+6. the solver's error bounds against the actual errors over an extreme suite,
+   and the fraction of a turn refused at each tolerance (:mod:`.bounds`).
 
 :mod:`.common` holds the run sizes (:data:`MODES`) and the shared timer,
 :mod:`.figures` draws, :mod:`.markdown` writes ``REPORT.md``; this module
@@ -41,6 +43,9 @@ from typing import Any
 from .baselines import (Configurations, configurations, HAND_TIME, headline, newton_positions,
                         NEWTON_TRACKING_STEP, work_precision, WorkPoint, WorkPrecision,
                         WP_PRINTED, WP_RANGES)
+from .bounds import (bound_cases, bound_statistics, bound_values, BoundCase, BoundStats,
+                     BoundValue, CaseBounds, KAPPA_WELL, OFFSETS, refused_fractions,
+                     RefusedFractions, TOLERANCES)
 from .checks import golden_checks, golden_folder, GoldenCheck, reference_checks, ReferenceCheck
 from .clock import (clock_errors, CLOCK_TICKS, ClockRow, naive_accumulate, naive_cumsum,
                     naive_wrapped, naive_wrapped_trace, TICK_HZ)
@@ -48,20 +53,24 @@ from .common import DURATIONS, EPS, ERROR_FLOOR, Mode, MODES, slug, WP_SCENES
 from .cost import chain_scene, CHUNK, cost_growth, CostGrowth
 from .extreme import (AngleResult, BOUND_FACTOR, Case, CaseResult, digits_lost, evaluate_angle,
                       evaluate_case, extreme_cases, formula_audit, FormulaAudit)
-from .figures import plot_clock, plot_cost, plot_extreme, plot_work_precision
+from .figures import (plot_bounds, plot_clock, plot_cost, plot_extreme, plot_refused,
+                      plot_work_precision)
 from .markdown import write_report
 from ...cli import run_tool
 
 __all__ = [
-    'AngleResult', 'BOUND_FACTOR', 'CHUNK', 'CLOCK_TICKS', 'Case', 'CaseResult', 'ClockRow',
-    'Configurations', 'CostGrowth', 'DURATIONS', 'EPS', 'ERROR_FLOOR', 'FormulaAudit',
-    'GoldenCheck', 'HAND_TIME', 'MODES', 'Mode', 'NEWTON_TRACKING_STEP', 'ReferenceCheck',
-    'TICK_HZ', 'WP_PRINTED', 'WP_RANGES', 'WP_SCENES', 'WorkPoint', 'WorkPrecision',
-    'add_parser', 'chain_scene', 'clock_errors', 'configurations', 'cost_growth', 'digits_lost',
-    'evaluate_angle', 'evaluate_case', 'extreme_cases', 'formula_audit', 'golden_checks',
-    'golden_folder', 'headline', 'main', 'naive_accumulate', 'naive_cumsum', 'naive_wrapped',
-    'naive_wrapped_trace', 'newton_positions', 'plot_clock', 'plot_cost', 'plot_extreme',
-    'plot_work_precision', 'reference_checks', 'run', 'work_precision', 'write_report',
+    'AngleResult', 'BOUND_FACTOR', 'BoundCase', 'BoundStats', 'BoundValue', 'CHUNK', 'CLOCK_TICKS',
+    'Case', 'CaseBounds', 'CaseResult', 'ClockRow', 'Configurations', 'CostGrowth', 'DURATIONS',
+    'EPS', 'ERROR_FLOOR', 'FormulaAudit', 'GoldenCheck', 'HAND_TIME', 'KAPPA_WELL', 'MODES',
+    'Mode', 'NEWTON_TRACKING_STEP', 'OFFSETS', 'ReferenceCheck', 'RefusedFractions', 'TICK_HZ',
+    'TOLERANCES', 'WP_PRINTED', 'WP_RANGES', 'WP_SCENES', 'WorkPoint', 'WorkPrecision',
+    'add_parser', 'bound_cases', 'bound_statistics', 'bound_values', 'chain_scene', 'clock_errors',
+    'configurations', 'cost_growth', 'digits_lost', 'evaluate_angle', 'evaluate_case',
+    'extreme_cases', 'formula_audit', 'golden_checks', 'golden_folder', 'headline', 'main',
+    'naive_accumulate', 'naive_cumsum', 'naive_wrapped', 'naive_wrapped_trace', 'newton_positions',
+    'plot_bounds', 'plot_clock', 'plot_cost', 'plot_extreme', 'plot_refused',
+    'plot_work_precision', 'reference_checks', 'refused_fractions', 'run', 'work_precision',
+    'write_report',
 ]
 
 
@@ -83,8 +92,9 @@ def run(outdir: str | os.PathLike[str], mode: str | Mode = 'full',
     start = time.perf_counter()
     from ...scene import scene_names
     n_checks = len(mode.check_scenes or scene_names())
+    cases = bound_cases(mode)
     total = (n_checks + 1 + 5 * len(mode.wp_mechanisms) + len(mode.clock_rpms) + 1
-             + len(mode.batch_sizes) + len(mode.chain_lengths) + 1)
+             + len(mode.batch_sizes) + len(mode.chain_lengths) + len(cases) + 1)
     with _progress(total, progress) as bar:
         def tick() -> None:
             bar.update(1)
@@ -105,19 +115,27 @@ def run(outdir: str | os.PathLike[str], mode: str | Mode = 'full',
         tick()
         bar.set_description('cost growth')
         cost = cost_growth(mode, tick)
+        bar.set_description('error bounds')
+        bounds, refused = [], []
+        for case in cases:
+            bounds.append(bound_values(case))
+            refused.append(refused_fractions(case, mode))
+            tick()
         bar.set_description('figures')
         for result in wp:
             plot_work_precision(result, out / f'wp_{slug(result.mechanism)}.png')
         plot_clock(clock, out / 'clock.png')
         plot_extreme(extreme, out / 'extreme.png')
         plot_cost(cost, out / 'cost.png')
+        plot_bounds(bounds, out / 'bounds.png')
+        plot_refused(refused, out / 'refused.png')
         tick()
     elapsed = time.perf_counter() - start
     write_report(out, mode, checks, golden, wp, clock, clock_check, extreme, audit, cost,
-                 elapsed)
+                 bounds, refused, elapsed)
     return {'checks': checks, 'golden': golden, 'work_precision': wp, 'clock': clock,
             'clock_check': clock_check, 'extreme': extreme, 'audit': audit, 'cost': cost,
-            'elapsed': elapsed}
+            'bounds': bounds, 'refused': refused, 'elapsed': elapsed}
 
 
 # --- command line ------------------------------------------------------------------
@@ -127,7 +145,8 @@ Measure the solver's error against its cost and its stability on stiff and
 extreme cases, and write DIR/REPORT.md with PNG figures: the 50-digit
 reference and its checks, work-precision diagrams against Newton-Raphson,
 finite differences and solve_ivp, the node's crank-angle error over long runs,
-the extreme-case table, and cost growth. A few minutes; --quick in under one.
+the extreme-case table, cost growth, and the error bounds against the actual
+errors with the fraction of a turn refused. A few minutes; --quick in under one.
 """
 
 

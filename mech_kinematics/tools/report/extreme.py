@@ -19,9 +19,9 @@ import math
 from typing import Any
 import warnings
 
-from .common import EPS, Mode, MODES
+from .common import distance_angle, EPS, four_bar, Mode, MODES, slider_crank
 from ...errors import AssemblyError, NearSingularWarning
-from ...linkage import Branch, CarriedPoint, Crank, Link, RPR, RRP, RRR, Scene, solve
+from ...linkage import CarriedPoint, Crank, RPR, Scene, solve
 from ...scene import load_scene
 from ...units import rad_per_s_from_rpm, radians_from_degrees
 
@@ -48,31 +48,6 @@ class Case:
     note: str = ''
 
 
-def _four_bar(name: str, a: float, b: float, c: float, d: float, angle: float = 0.0,
-              branch: int = 1, speed: float = -4 * math.pi, scale: float = 1.0) -> Scene:
-    links = (Link('coupler', 'B', b * scale), Link('rocker', 'D', c * scale))
-    crank = Crank('crank', 'A', 'B', a * scale, angle, speed, 0.0)
-    return Scene(name, {'A': (0.0, 0.0), 'D': (d * scale, 0.0)}, crank,
-                 (RRR('C', links, Branch(branch)),),
-                 (CarriedPoint('E', 'coupler', 'B', 'C', (0.5 * b * scale, 0.3 * b * scale)),))
-
-
-def _slider_crank(name: str, crank_length: float, rod: float, offset: float = 0.0,
-                  angle: float = 0.0, speed: float = 10 * math.pi) -> Scene:
-    crank = Crank('crank', 'O', 'B', crank_length, angle, speed, 0.0)
-    dyad = RRP('P', Link('rod', 'B', rod), 'E', 0.0, 'piston', Branch.PLUS)
-    return Scene(name, {'O': (0.0, 0.0), 'E': (0.0, offset)}, crank, (dyad,),
-                 (CarriedPoint('M', 'rod', 'B', 'P', (0.5 * rod, 0.0)),))
-
-
-def _distance_angle(a: float, d: float, distance: float) -> Any:
-    """Crank angle (mpmath) at which the crank tip is ``distance`` from ``D = (d, 0)``."""
-    import mpmath
-    with mpmath.workdps(60):
-        a_, d_, r = (mpmath.mpf(x) for x in (a, d, distance))
-        return mpmath.acos((a_ * a_ + d_ * d_ - r * r) / (2 * a_ * d_))
-
-
 def _spread(center: float, width: float, count: int) -> tuple[float, ...]:
     return tuple(center + width * (k / max(count - 1, 1) - 0.5) * 2 for k in range(count)) \
         if count > 1 else (center,)
@@ -85,14 +60,14 @@ def extreme_cases(mode: Mode | None = None) -> list[Case]:
     cases = []
     # A non-Grashof four-bar (seed 002 Problem 3) near its two toggle positions.
     toggle = load_scene('four_bar_coupler_points')
-    t = _distance_angle(0.05, 0.1, 0.066 + 0.056)
+    t = distance_angle(0.05, 0.1, 0.066 + 0.056)
     for delta in ('1e-3', '1e-6', '1e-9', '1e-12'):
         with mpmath.workdps(60):
             angles = (float(t - mpmath.mpf(delta)), float(-(t - mpmath.mpf(delta))))
         cases.append(Case(f'four-bar {delta} rad from toggle', toggle, angles,
                           note='four_bar_coupler_points; both toggles (+-103.79 deg)'))
     # Change-point four-bar a + d = b + c (a parallelogram): flat at crank angle 0.
-    change = _four_bar('change_point', 0.04, 0.1, 0.04, 0.1, angle=0.5)
+    change = four_bar('change_point', 0.04, 0.1, 0.04, 0.1, angle=0.5)
     cases.append(Case('change-point four-bar at flat', change, (0.0,),
                       note='a = c = 0.04, b = d = 0.1; crank angle 0: all pins in line'))
     for offset in (1e-3, 1e-6, 1e-9):
@@ -100,13 +75,13 @@ def extreme_cases(mode: Mode | None = None) -> list[Case]:
                           (offset,), note='parallelogram branch'))
     # Circles that miss each other (or overlap) by 1e-9 of the coupler length.
     for sign, word in ((1, 'miss'), (-1, 'overlap')):
-        beyond = float(_distance_angle(0.05, 0.1, 0.066 + 0.056 + sign * 1e-9 * 0.066))
+        beyond = float(distance_angle(0.05, 0.1, 0.066 + 0.056 + sign * 1e-9 * 0.066))
         cases.append(Case(f'circles {word} by 1e-9 of the coupler', toggle, (beyond, -beyond),
                           note=f'four_bar_coupler_points where |BD| = BC + CD '
                                f'{"+" if sign > 0 else "-"} 1e-9 BC'))
     # Rod-to-crank ratios.
     for ratio, label in ((1.000001, '1.000001'), (1e6, '1e6')):
-        scene = _slider_crank(f'rod_crank_{label.replace(".", "_")}', 0.1, 0.1 * ratio)
+        scene = slider_crank(f'rod_crank_{label.replace(".", "_")}', 0.1, 0.1 * ratio)
         cases.append(Case(f'rod/crank = {label}', scene,
                           (math.pi / 2, -math.pi / 2) + _spread(0.7, 0.6, extra),
                           note='in-line slider-crank, crank 0.1 m; worst at +-90 deg'))
@@ -114,8 +89,8 @@ def extreme_cases(mode: Mode | None = None) -> list[Case]:
     base = load_scene('khurmi_four_bar_ad150')
     for size in (1e-6, 1e3):
         k = size / 0.15
-        scene = _four_bar('khurmi_scaled', 0.04, 0.15, 0.08, 0.15, radians_from_degrees(60),
-                          speed=base.input.speed, scale=k)
+        scene = four_bar('khurmi_scaled', 0.04, 0.15, 0.08, 0.15, radians_from_degrees(60),
+                         speed=base.input.speed, scale=k)
         cases.append(Case(f'four-bar scaled to {size:g} m', scene,
                           (radians_from_degrees(60),) + _spread(0.0, 3.0, extra),
                           note='khurmi_four_bar_ad150 with every length times '
@@ -135,11 +110,11 @@ def extreme_cases(mode: Mode | None = None) -> list[Case]:
                       (-math.pi / 2, -math.pi / 2 + 1e-3) + _spread(0.5, 1.0, extra),
                       note='|OA| = r (1 + 1e-6): closest approach at crank angle -90 deg'))
     # Offset slider-cranks at the edge of assembly (rod = crank + offset).
-    edge = _slider_crank('offset_edge', 0.125, 0.1875, offset=0.0625)
+    edge = slider_crank('offset_edge', 0.125, 0.1875, offset=0.0625)
     cases.append(Case('offset slider-crank exactly at the edge', edge, (-math.pi / 2,),
                       note='crank 0.125, offset 0.0625, rod 0.1875 (exact in binary): '
                            'rod perpendicular to the guide at -90 deg'))
-    near_edge = _slider_crank('offset_near_edge', 0.125, 0.1875 * (1 + 1e-9), offset=0.0625)
+    near_edge = slider_crank('offset_near_edge', 0.125, 0.1875 * (1 + 1e-9), offset=0.0625)
     cases.append(Case('offset slider-crank 1e-9 inside the edge', near_edge,
                       (-math.pi / 2, -math.pi / 2 + 1e-6) + _spread(0.5, 1.0, extra),
                       note='rod = 0.1875 (1 + 1e-9)'))
@@ -318,7 +293,7 @@ def formula_audit() -> list[FormulaAudit]:
     import mpmath
     rows = []
     l1, l2, a, d = 0.066, 0.056, 0.05, 0.1
-    t = _distance_angle(a, d, l1 + l2)
+    t = distance_angle(a, d, l1 + l2)
     for delta in ('1e-3', '1e-6', '1e-9', '1e-12'):
         with mpmath.workdps(60):
             theta = float(t - mpmath.mpf(delta))

@@ -1,6 +1,6 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""The report's figures: one PNG per work-precision mechanism, the clock, extreme cases, cost.
+"""The report's figures: work precision per mechanism, the clock, extreme cases, cost, bounds.
 
 Every function draws one section's computed results; matplotlib (Agg) is
 imported inside :func:`_figure`, so importing this module does not load it.
@@ -16,12 +16,14 @@ from typing import Any
 import numpy as np
 
 from .baselines import WorkPrecision
+from .bounds import CaseBounds, RefusedFractions
 from .clock import ClockRow, TICK_HZ
 from .common import DURATIONS, EPS, ERROR_FLOOR
 from .cost import CHUNK, CostGrowth
 from .extreme import BOUND_FACTOR, CaseResult
 
-__all__ = ['plot_clock', 'plot_cost', 'plot_extreme', 'plot_work_precision']
+__all__ = ['plot_bounds', 'plot_clock', 'plot_cost', 'plot_extreme', 'plot_refused',
+           'plot_work_precision']
 
 
 def _figure(path: Path, draw: Callable[[Any], None], size: tuple[float, float]) -> None:
@@ -218,3 +220,104 @@ def plot_cost(cost: CostGrowth, path: Path) -> None:
         fig.subplots_adjust(wspace=0.3, left=0.08, right=0.98, top=0.9, bottom=0.12)
 
     _figure(path, draw, (11.0, 4.8))
+
+
+_MARKERS = ('o', 's', '^', 'D', 'v', 'P', 'X')
+
+
+def plot_bounds(results: list[CaseBounds], path: Path) -> None:
+    """Draw every value's error bound against its actual error, both over its kind's scale.
+
+    Log-log, one colour and marker per case, the line y = x (every point must
+    lie above it) and the default tolerance; values with no error at all (or
+    one below the range of doubles relative to the scale) are drawn at the
+    left edge, values whose bound is 0 (ground points, exact) are left out.
+    """
+    from ...bounds import MAX_ERROR
+
+    def draw(fig: Any) -> None:
+        import matplotlib
+        ax = fig.subplots()
+        values = [v for r in results for v in r.values if v.bound > 0 and v.scale > 0]
+        ratios = [v.actual / v.scale for v in values] + [v.bound / v.scale for v in values]
+        positive = [x for x in ratios if x > 0]
+        lo = 10.0 ** (math.floor(math.log10(min(positive, default=1e-17))) - 1)
+        hi = 10.0 ** (math.ceil(math.log10(max(positive, default=1.0))) + 1)
+        zero = lo * 3
+        colours = matplotlib.colormaps['tab20'].colors
+        for i, r in enumerate(results):
+            drawn = [v for v in r.values if v.bound > 0 and v.scale > 0]
+            if not drawn:
+                continue
+            colour, marker = colours[i % len(colours)], _MARKERS[i % len(_MARKERS)]
+            for accepted in (True, False):
+                sub = [v for v in drawn if v.accepted is accepted]
+                if not sub:
+                    continue
+                ax.scatter([max(v.actual / v.scale, zero) for v in sub],
+                           [v.bound / v.scale for v in sub], s=14, marker=marker,
+                           color=colour if accepted else 'none', edgecolors=colour,
+                           linewidths=0.8, label=r.case.name if accepted or all(
+                               not v.accepted for v in drawn) else None, zorder=3)
+        line = np.array([lo, hi])
+        ax.plot(line, line, color='k', lw=1.0, label='bound = actual error')
+        ax.axhline(MAX_ERROR, color='C3', lw=0.8, ls=':',
+                   label=f'default tolerance {MAX_ERROR:g} (states above it are refused)')
+        ax.axvspan(lo, lo * 10, color='0.92', zorder=0)
+        ax.text(lo * 1.3, hi / 3, 'actual\nerror 0', fontsize=6.5, va='top')
+        ax.set_xscale('log')
+        ax.set_yscale('log')
+        ax.set_xlim(lo, hi)
+        ax.set_ylim(lo, hi)
+        ax.set_xlabel("actual error against the 50-digit reference / the kind's scale [-]")
+        ax.set_ylabel("error bound / the kind's scale [-]")
+        ax.set_title('Error bound against actual error, every value of every extreme case\n'
+                     '(filled: the instant is answered at the default tolerance; hollow: '
+                     'refused by it)', fontsize=9)
+        ax.grid(True, which='major', alpha=0.3)
+        ax.legend(fontsize=6.5, loc='upper center', bbox_to_anchor=(0.5, -0.09), ncol=3,
+                  frameon=False)
+        fig.subplots_adjust(left=0.1, right=0.97, top=0.93, bottom=0.25)
+
+    _figure(path, draw, (8.0, 8.2))
+
+
+def plot_refused(fractions: list[RefusedFractions], path: Path) -> None:
+    """Draw the fraction of a crank turn refused per tolerance and case (log axis).
+
+    Cases never refused anywhere are left out (the caller names them); a zero
+    fraction is marked 0 at the left edge.
+    """
+    shown = [f for f in fractions if f.no_assembly > 0 or any(v > 0 for v in f.refused.values())]
+
+    def draw(fig: Any) -> None:
+        ax = fig.subplots()
+        tolerances = sorted(next(iter(shown)).refused) if shown else []
+        bars = [(f'refused at max_error = {t:g}' if math.isfinite(t) else
+                 'refused at any tolerance (within rounding of a limit)', t)
+                for t in tolerances] + [('cannot assemble', None)]
+        height = 0.8 / len(bars)
+        lo = 1e-16
+        for j, (label, tol) in enumerate(bars):
+            ys = [i - 0.4 + (j + 0.5) * height for i in range(len(shown))]
+            ws = [f.no_assembly if tol is None else f.refused[tol] for f in shown]
+            colour = '0.55' if tol is None else f'C{j}'
+            ax.barh(ys, [max(w, lo) if w > 0 else 0 for w in ws], height=height, left=lo,
+                    color=colour, label=label)
+            for y, w in zip(ys, ws, strict=True):
+                if w == 0:
+                    ax.text(lo * 1.5, y, '0', va='center', fontsize=6.5, color=colour)
+        ax.set_xscale('log')
+        ax.set_xlim(lo, 1.0)
+        ax.set_yticks(range(len(shown)), [f.case.name for f in shown], fontsize=7.5)
+        ax.invert_yaxis()
+        ax.set_xlabel('fraction of a full crank turn [-]')
+        ax.set_title('Where the solver refuses, per tolerance (single-angle path)', fontsize=10)
+        ax.grid(True, axis='x', which='major', alpha=0.3)
+        ax.legend(fontsize=7, loc='upper center', bbox_to_anchor=(0.4, -0.07), ncol=2,
+                  frameon=False)
+        fig.subplots_adjust(left=0.3, right=0.97, top=1 - 0.5 / height_in,
+                            bottom=1.3 / height_in)
+
+    height_in = 2.0 + 0.6 * max(len(shown), 1)
+    _figure(path, draw, (9.0, height_in))

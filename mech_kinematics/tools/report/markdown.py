@@ -19,11 +19,14 @@ from typing import Any
 import numpy as np
 
 from .baselines import headline, WorkPrecision
+from .bounds import (bound_statistics, BoundStats, CaseBounds, KAPPA_WELL, OFFSETS,
+                     RefusedFractions)
 from .checks import GoldenCheck, ReferenceCheck
 from .clock import ClockRow, TICK_HZ
 from .common import EPS, Mode, slug
 from .cost import CHUNK, CostGrowth
 from .extreme import BOUND_FACTOR, CaseResult, digits_lost, FormulaAudit
+from ...bounds import MAX_ERROR, ROUNDING_MARGIN
 from ...linkage import NEAR_SINGULAR, SINGULAR
 
 __all__ = ['write_report']
@@ -32,12 +35,14 @@ __all__ = ['write_report']
 def write_report(outdir: Path, mode: Mode, checks: list[ReferenceCheck],
                  golden: list[GoldenCheck], wp: list[WorkPrecision], clock: list[ClockRow],
                  clock_check: dict[str, Any], extreme: list[CaseResult],
-                 audit: list[FormulaAudit], cost: CostGrowth, elapsed: float) -> Path:
+                 audit: list[FormulaAudit], cost: CostGrowth, bounds: list[CaseBounds],
+                 refused: list[RefusedFractions], elapsed: float) -> Path:
     """Write ``outdir/REPORT.md`` from the computed sections; return its path."""
-    lines = (_preamble(mode, elapsed) + _headline(wp, extreme, clock, cost)
+    lines = (_preamble(mode, elapsed) + _headline(wp, extreme, clock, cost, bounds, refused)
              + _reference(checks, golden) + _work_precision(mode, wp)
              + _clock(mode, clock, clock_check) + _extreme(extreme) + _digits_lost(extreme)
-             + _formula_audit(extreme, audit) + _cost(mode, cost))
+             + _formula_audit(extreme, audit) + _cost(mode, cost)
+             + _bounds(mode, bounds, refused))
     path = outdir / 'REPORT.md'
     path.write_text('\n'.join(lines), encoding='utf-8')
     return path
@@ -61,7 +66,8 @@ def _preamble(mode: Mode, elapsed: float) -> list[str]:
 
 
 def _headline(wp: Sequence[WorkPrecision], extreme: Sequence[CaseResult],
-              clock: Sequence[ClockRow], cost: CostGrowth) -> list[str]:
+              clock: Sequence[ClockRow], cost: CostGrowth, bounds: Sequence[CaseBounds],
+              refused: Sequence[RefusedFractions]) -> list[str]:
     """Return the headline: ratios against each alternative, one line per other section."""
     lines: list[str] = []
     w = lines.append
@@ -94,6 +100,16 @@ def _headline(wp: Sequence[WorkPrecision], extreme: Sequence[CaseResult],
     w(f'Cost: total time ~ N^{cost.batch_slope:.2f} in the batch size; '
       f'~ dyads^{cost.chain_slope_array:.2f} (arrays) and '
       f'^{cost.chain_slope_single:.2f} (one angle) in the chain length.')
+    stats = bound_statistics([v for r in bounds for v in r.values])
+    worst = max(refused, key=lambda f: f.refused[MAX_ERROR], default=None)
+    if worst is not None:
+        w(f'Error bounds: {stats.values} values of {sum(r.answered for r in bounds)} instants '
+          f'of {len(bounds)} extreme cases, {stats.below} bounds below the actual error; '
+          f'bound / actual error min {stats.min:.3g}, median {stats.median:.3g}; where '
+          f'well-conditioned, bound <= {_r(stats.tightness)} x (actual error + 1 ulp of its '
+          f'scale). At the default tolerance the solver refuses at most '
+          f'{_f(worst.refused[MAX_ERROR])} of a turn where a case assembles '
+          f'({worst.case.name}).')
     w('')
     return lines
 
@@ -399,6 +415,157 @@ def _cost(mode: Mode, cost: CostGrowth) -> list[str]:
     return lines
 
 
+def _bounds(mode: Mode, bounds: Sequence[CaseBounds],
+            refused: Sequence[RefusedFractions]) -> list[str]:
+    """Return section 6: the error bounds against the actual errors, and what they refuse."""
+    lines: list[str] = []
+    w = lines.append
+    w('## 6. Error bounds against the truth')
+    w('')
+    w('**What the bound is.** Every value the solver returns comes with an absolute error '
+      'bound in SI units (`state.error_bound`; one number per point value, bounding the '
+      'length of its error vector). It is a first-order forward bound: the rounding of '
+      "every input (each length, ground coordinate and guide angle, and the crank's angle, "
+      'speed and acceleration, taken as known to half an ulp) and of every step of the '
+      "closed forms, propagated through the chain of dyads with each dyad's sensitivity to "
+      'its inputs: 1/measure for the positions and the velocity and acceleration systems '
+      'of an RRR or RRP (the loss near a toggle, a change point, a guide at grazing reach), '
+      "1/s for a slotted lever whose pin is s from its pivot. Because it counts the inputs' "
+      'rounding, it covers the answer for the decimal numbers the doubles were rounded '
+      'from; the 50-digit reference takes the doubles as exact, so here the bound must lie '
+      'above the actual error, and lies far above it where the rounding of the inputs '
+      'dominates (near singular positions, where no double answer can do better).')
+    w('')
+    w(f'**What is refused.** A state is refused (`UntrustedError` for one angle; an invalid '
+      f'entry of the array path, under `<dyad> (untrusted)` in `failures`; nothing published '
+      f'by the node) '
+      f"when the bound of any value it reports exceeds `max_error` times its kind's scale "
+      f"(`state.scales`: the mechanism's size for positions, 1 rad for angles, the largest "
+      f'speed, angular speed, acceleration and angular acceleration of the state, floored by '
+      f"the crank's own); the default `max_error` is {MAX_ERROR:g} (`solve --max-error`, "
+      f"the node's `max_relative_error`). Whatever the tolerance, a dyad within "
+      f"{ROUNDING_MARGIN:g} times its inputs' error bound of an assembly limit (the margin "
+      f"of an RRR's circles, an RRP's reach, an RPR pin's distance from its pivot) is "
+      f"refused, since an ulp's change of an input could make it unassemblable or flip its "
+      f'branch, and so is a state beyond the range of doubles.')
+    w('')
+    w('### Bound against actual error')
+    w('')
+    w(f'Each case is solved with `max_error=inf` (everything the solver can answer) at '
+      f'{", ".join(OFFSETS)} rad either side of each of its singular positions (or of its '
+      f'nearest approach to one) and at the position itself, or at '
+      f'{mode.bound_samples} angle{"s" if mode.bound_samples != 1 else ""} spread over the '
+      f'turn where it has none; every '
+      f'reported value is compared with the reference '
+      f'(`reference.value_errors`: the length of the error vector for a point, modulo 2 pi '
+      f'for an angle).')
+    w('')
+    w('![bounds against actual errors](bounds.png)')
+    w('')
+    w('How to read it: one point per value and instant, its actual error (x) and its bound '
+      "(y), both over its kind's scale so that 1e-300 m and 1e300 m mechanisms share the "
+      'axes. No point may lie below the line y = x; the height above it is what the bound '
+      'gives away, a factor of tens in ordinary positions, more where the rounding of the '
+      'inputs (which the bound counts and the reference does not) dominates. Filled points '
+      'belong to instants the default tolerance answers, hollow ones to instants it '
+      'refuses; the dotted line is that tolerance, and a state with any value above it is '
+      'refused. Values with no error at all are drawn in the grey strip; values whose bound '
+      'is 0 (ground points) are left out.')
+    w('')
+    w('| # | case | instants: answered / refused at any tolerance / no assembly | refused by '
+      'default | values | bound < actual | bound / actual: min | median | p90 | max | '
+      'well-conditioned values | their max bound / (actual + 1 ulp of scale) |')
+    w('|---|---|---|---|---|---|---|---|---|---|---|---|')
+
+    def row(label: str, st: BoundStats, counts: str, refused_default: str) -> str:
+        return (f'{label} | {counts} | {refused_default} | {st.values} | **{st.below}** | '
+                f'{_r(st.min)} | {_r(st.median)} | {_r(st.p90)} | {_r(st.max)} | {st.well} | '
+                f'{_r(st.tightness)} |')
+
+    for i, r in enumerate(bounds):
+        w(row(f'| {i + 1} | {r.case.name}', bound_statistics(r.values),
+              f'{r.answered} / {r.refused} / {r.no_assembly}', str(r.refused_default)))
+    everything = [v for r in bounds for v in r.values]
+    answered = sum(r.answered for r in bounds)
+    refused_default = sum(r.refused_default for r in bounds)
+    w(row('| | **all cases**', bound_statistics(everything),
+          f'{answered} / {sum(r.refused for r in bounds)} / '
+          f'{sum(r.no_assembly for r in bounds)}', str(refused_default)))
+    w(row('| | **instants answered by default**',
+          bound_statistics([v for v in everything if v.accepted]),
+          str(answered - refused_default), '0'))
+    w('')
+    wrong = [(r.case.name, note) for r in bounds for note in r.wrong]
+    stats = bound_statistics(everything)
+    well = len({(i, v.angle) for i, r in enumerate(bounds) for v in r.values if v.well})
+    if wrong or stats.below:
+        w('**Failures:** ' + '; '.join(f'{name}: {note}' for name, note in wrong)
+          + (f'; {stats.below} bounds below their actual error' if stats.below else '') + '.')
+    else:
+        w(f'No bound is below its actual error, and the solver answers nowhere the reference '
+          f'finds no assembly. Bound / actual error is at least {_r(stats.min)} and '
+          f'{_r(stats.median)} at the median. Its largest values are not a loose bound but a '
+          f'lucky answer: an error far below an ulp of its scale, or a position where the '
+          f'rounding of the inputs, which the bound counts and the reference does not, moves '
+          f'the exact answer by up to kappa ulps. Where that cannot happen, at the {well} '
+          f'well-conditioned instants (the condition number kappa of every kind of value at '
+          f'most {KAPPA_WELL:g}, `reference.condition`), the bound is at most '
+          f'{_r(stats.tightness)} x (the actual error + 1 ulp of its scale): within the 1e3 '
+          f'that issue 10 allows, so good answers are not refused.')
+    w('')
+    for i, r in enumerate(bounds):
+        if r.case.note:
+            w(f'{i + 1}. {r.case.name}: {r.case.note}.')
+    w('')
+    w('### Fraction of a turn refused')
+    w('')
+    tolerances = [t for t in (next(iter(refused)).refused if refused else {}) if math.isfinite(t)]
+    w('For each case, the fraction of a full crank turn (the single-angle path, as the node '
+      'solves its ticks) where the mechanism cannot assemble, and where it assembles but is '
+      'refused at each tolerance; "any tolerance" is the part within rounding of an assembly '
+      f'limit, refused even with `max_error=inf`. The turn is sampled at {mode.bound_grid:,} '
+      'evenly spaced angles and at 20 angles per decade from 1e-1 down to 1e-15 rad either '
+      'side of every singular position and of every edge of the set that cannot assemble; '
+      'every edge between an answered and a refused angle is then located by bisection to '
+      '1e-14 rad, so fractions far below the grid step are measured.')
+    w('')
+    w('![fraction of a turn refused](refused.png)')
+    w('')
+    tight = sorted(tolerances)[:2]
+    w('| # | case | cannot assemble | '
+      + ' | '.join(f'refused at {t:g}{" (default)" if t == MAX_ERROR else ""}'
+                   for t in tolerances)
+      + f' | at any tolerance | shrink, {tight[0]:g} to {tight[-1]:g} | grid angles | '
+        'edges located |')
+    w('|---|---|---|' + '---|' * (len(tolerances) + 4))
+    for i, f in enumerate(refused):
+        shrink = (f'{f.refused[tight[0]] / f.refused[tight[-1]]:.3g}x'
+                  if len(tight) == 2 and f.refused[tight[-1]] > 0 else '-')
+        w(f'| {i + 1} | {f.case.name} | {_f(f.no_assembly)} | '
+          + ' | '.join(_f(f.refused[t]) for t in tolerances)
+          + f' | {_f(f.refused[math.inf])} | {shrink} | {f.angles:,} | {f.edges} |')
+    w('')
+    never = [f.case.name for f in refused
+             if f.no_assembly == 0 and not any(f.refused.values())]
+    if never:
+        w('Never refused anywhere on the turn, at any of these tolerances (not drawn): '
+          + ', '.join(never) + '.')
+        w('')
+    w('How to read it: where the refused set is an interval about a singular position and '
+      'the relative bound grows as distance^-k, each thousandfold loosening of the tolerance '
+      'shrinks the interval by 10^(3/k). The shrink column gives that factor between the '
+      'two tightest tolerances: about 1000 near a toggle (k = 1: the measure goes as '
+      'the square root of the distance, velocities lose 1/measure^2), about 10 at a change '
+      'point or a guide at grazing reach, where the two assembly branches meet (k = 3: the '
+      'measure goes as the distance and accelerations lose 1/measure^3). Mechanisms that '
+      'only come near a singular position (circles or a guide that nearly miss, a rod '
+      'barely longer than its crank, a pin passing near its pivot) are refused only at the '
+      'tighter tolerances, over a fraction of a turn that shrinks the further they stay '
+      'from it.')
+    w('')
+    return lines
+
+
 def _e(x: float) -> str:
     if x is None or (isinstance(x, float) and math.isnan(x)):
         return '-'
@@ -417,3 +584,15 @@ def _t(seconds: float) -> str:
     if seconds >= 1e-6:
         return f'{seconds * 1e6:.3g} us'
     return f'{seconds * 1e9:.3g} ns'
+
+
+def _r(x: float) -> str:
+    """Format a ratio: 3 significant digits, '-' for none."""
+    if x is None or math.isnan(x):
+        return '-'
+    return f'{x:.3g}'
+
+
+def _f(x: float) -> str:
+    """Format a fraction of a turn: '0' for none, 2 significant digits otherwise."""
+    return '0' if x == 0 else f'{x:.2g}'
