@@ -1385,7 +1385,8 @@ def _rescale(solver: _Solver, ctx: _Context, shift: int) -> None:
             ok = _finite(entry[0])
             for x in entry[1:]:
                 ok = ok & _finite(x)
-            ctx.mask(ok, f'{label} (overflow)')
+            # A constant (a ground point) is a plain bool here: mask takes arrays.
+            ctx.mask(np.asarray(ok), f'{label} (overflow)')
             continue
         for index, quantity in enumerate(_QUANTITIES):
             if not (_finite(entry[index]) and _finite(entry[index + 3])):

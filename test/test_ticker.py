@@ -98,13 +98,12 @@ def test_a_chain_of_sixty_four_dyads_and_its_frames(tmp_path):
                  points=scene.output_points[-3:], frames=frames)
 
 
-def test_a_scene_the_solver_rescales_is_served_by_the_general_solver(tmp_path):
-    """Lengths of 1e-300 m are not compiled; tick_function falls back with the same answers."""
+def _tiny_four_bar(tmp_path):
+    """Return the packaged four-bar with every length 1e-300 m (the solver rescales it)."""
     source = Path(__file__).resolve().parents[1] / 'config' / 'scenes' / \
         'khurmi_four_bar_ad150.yaml'
-    text = source.read_text().replace('units: {length: mm, angle: deg}',
-                                      'units: {length: m, angle: deg}')
-    doc = yaml.safe_load(text)
+    doc = yaml.safe_load(source.read_text())
+    doc['units'] = {'length': 'm', 'angle': 'deg'}
     doc['ground'] = {k: [v[0] * 1e-300, v[1] * 1e-300] for k, v in doc['ground'].items()}
     doc['input']['length'] *= 1e-300
     for dyad in doc['dyads']:
@@ -112,8 +111,28 @@ def test_a_scene_the_solver_rescales_is_served_by_the_general_solver(tmp_path):
             link['length'] *= 1e-300
     path = tmp_path / 'tiny.yaml'
     path.write_text(yaml.safe_dump(doc))
-    scene = mk.load_scene(path)
+    return mk.load_scene(path)
+
+
+def test_a_scene_the_solver_rescales_is_served_by_the_general_solver(tmp_path):
+    """Lengths of 1e-300 m are not compiled; tick_function falls back with the same answers."""
+    scene = _tiny_four_bar(tmp_path)
     assert compile_tick(scene) is None
     tick, compiled = tick_function(scene)
     assert not compiled
     _assert_same(scene, tick, ANGLES[::10])
+
+
+def test_the_array_path_solves_a_rescaled_scene(tmp_path):
+    """Lengths of 1e-300 m over an array of angles: answered as one angle at a time.
+
+    The array path failed ('bool' object has no attribute 'all') for a scene
+    the solver rescales, on its ground points' constant values.
+    """
+    scene = _tiny_four_bar(tmp_path)
+    angles = np.linspace(0.0, 2 * np.pi, 9)
+    cycle = mk.solve(scene, angles)
+    assert cycle.valid.all()
+    for i, theta in enumerate(angles):
+        single = mk.solve(scene, float(theta))
+        assert cycle.points['C'].position[i].tolist() == single.points['C'].position.tolist()
