@@ -57,7 +57,7 @@ def _cpu_seconds(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
 
 
-def chain_scene(dyads: int) -> str:
+def shaft_scene(dyads: int) -> str:
     """Return the YAML of one crank driving ``dyads`` four-bar dyads about one shaft.
 
     Each dyad is the packaged four-bar (AB 40, BC 150, CD 80, AD 150 mm, a
@@ -267,7 +267,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.chains:
             for dyads in CHAIN_SIZES:
                 path = Path(tmp) / f'chain_{dyads}.yaml'
-                path.write_text(chain_scene(dyads))
+                path.write_text(shaft_scene(dyads))
                 for _ in range(args.repeat):
                     for kind in ('floor', 'node'):
                         row = measure(kind, 1000.0, str(path), args, env, Path(tmp))

@@ -13,6 +13,7 @@ import yaml
 import mech_kinematics as mk
 from mech_kinematics.ticker import compile_tick, tick_function, values_from_state
 from mech_kinematics.tools.report.common import MODES
+from mech_kinematics.tools.report.cost import chain_scene
 from mech_kinematics.tools.report.extreme import extreme_cases
 
 #: Crank angles over two turns and a bit, both signs.
@@ -82,16 +83,10 @@ def test_the_extreme_suite_refuses_and_answers_alike():
     assert compiled >= len(cases) - 3     # only the rescaled sizes fall back
 
 
-def test_a_chain_of_sixty_four_dyads_and_its_frames(tmp_path):
+def test_a_chain_of_sixty_four_dyads_and_its_frames():
     """A large scene with frames of every link: values and frame poses as the solver's."""
-    import sys
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / 'bench'))
-    from node_bench import chain_scene
-
-    path = tmp_path / 'chain.yaml'
-    path.write_text(chain_scene(64))
-    scene = mk.load_scene(path)
-    frames = [(f'D{i}', f'rocker{i}', 0.0) for i in range(64)] + [('B', None, 0.25)]
+    scene = chain_scene(64)
+    frames = [(f'G{i}', f'rocker{i}', 0.0) for i in range(1, 65)] + [('P0', None, 0.25)]
     tick = compile_tick(scene, scene.output_joints[:5], scene.output_points[-3:], frames)
     assert tick is not None
     _assert_same(scene, tick, ANGLES[::7], joints=scene.output_joints[:5],
