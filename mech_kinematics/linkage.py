@@ -97,7 +97,7 @@ def _check_finite(value: float, what: str, where: Where = None) -> None:
 
 def _check_length(value: float, what: str, where: Where = None) -> None:
     if not (math.isfinite(value) and value > 0.0):
-        msg = f'Expected {what} to be a positive length, got {value!r} m'
+        msg = f'Expected {what} to be a positive length, got {_g(value)} m'
         raise SceneError(msg, where)
 
 

@@ -212,7 +212,7 @@ def test_solve_command_reports_the_jumps_in_json(geneva, capsys):
     assert data['joints']['wheel']['position'] == expected
     assert main(['solve', 'geneva', '--angle-deg', '135']) == 2
     assert capsys.readouterr().err.startswith(
-        'error: RPR wheel cannot be solved at crank angle 135.0 deg: ')
+        'error: RPR wheel cannot be solved at crank angle 135 deg: ')
 
 
 def test_bounds_cover_the_exact_values(geneva):

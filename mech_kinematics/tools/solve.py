@@ -78,7 +78,7 @@ def _handle(args: argparse.Namespace) -> int:
         state = solve(scene, angle, speed, args.accel, turns=turns, max_error=args.max_error)
     except AssemblyError as error:
         shown = scene.units.angle_text(scene.input.angle) if args.angle_deg is None else \
-            f'{args.angle_deg} deg'
+            f'{args.angle_deg:.15g} deg'
         reason = error.reason if isinstance(error, UntrustedError) or error.facts is None \
             else assembly_text(error, scene.units)
         print(f'error: {error.dyad} cannot be solved at crank angle {shown}: {reason}',
