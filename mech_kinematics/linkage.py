@@ -1203,7 +1203,8 @@ def _index_step(scene: Scene, item: RPR, ground: dict[str, complex],
     centre, wheel = ground[crank.center], ground[item.center]
     distance = abs(wheel - centre)
     sine = math.sin(math.pi / n)
-    if not abs(radius - distance * sine) <= TANGENCY_TOLERANCE * sine * distance:
+    if not (radius > 0.0 and abs(radius - distance * sine) <= TANGENCY_TOLERANCE * sine
+            * distance):
         per = LENGTH_UNITS[units.length]
         msg = (f'Expected the pin {item.through} to enter the {n} slots of "{item.link}" '
                f'tangentially: {crank.center} and {item.center} '
