@@ -820,6 +820,8 @@ class _IndexStep(_RPRStep):
         self.e_held_array = np.array(self.e_held)
         self.e_turn_array = np.array(self.e_turn)
         self.e_phase = ec + U * (abs(beta) + math.pi + abs(self.phase0)) + _U2
+        self.e_q = 4.0 * U * math.tau  # per whole turn reduced: 2 pi's rounding and the product's
+        self.e_half = U * self.half
 
     def window(self, angle: Any, turns: Any, vector: bool) -> tuple[Any, Any, Any, Any]:
         """Return (engaged, window, offset in the window, its error bound) at a crank angle."""
@@ -831,62 +833,85 @@ class _IndexStep(_RPRStep):
             q = float(round(d / math.tau))
             window = turns + int(q)
         r = d - q * math.tau
-        er = U * (abs(angle) + abs(d) + abs(r)) + self.e_phase + abs(q) * (4.0 * U * math.tau)
+        er = U * (abs(angle) + abs(d) + abs(r)) + self.e_phase + abs(q) * self.e_q
         return abs(r) <= self.half, window, r, er
 
     def run(self, ctx: _Context) -> None:
         super().run(ctx)
+        if not ctx.vector:
+            self._run_one(ctx)
+            return
         n = self.slots
         engaged, window, r, er = self.window(ctx.angle, ctx.turns, ctx.vector)
-        near = abs(abs(r) - self.half) <= ROUNDING_MARGIN * (er + U * self.half)
+        near = abs(abs(r) - self.half) <= ROUNDING_MARGIN * (er + self.e_half)
         e, w, al, ee, ew, eal = ctx.links[self.link]
         if ctx.engagement is _NOTHING:
             ctx.engagement = {}
         ctx.engagement[self.link] = (engaged, window)
-        if ctx.vector:
-            m = np.mod(window, n)
-            side = np.mod(2 * window + np.where(r > 0.0, 1, -1), 2 * n)
-            t = self.turn_array[m]
-            held = self.held_array[side]
-        else:
-            m = window % n
-            side = (2 * window + (1 if r > 0.0 else -1)) % (2 * n)
-            t = self.turn[m]
-            held = self.held[side]
+        m = np.mod(window, n)
+        side = np.mod(2 * window + np.where(r > 0.0, 1, -1), 2 * n)
+        t = self.turn_array[m]
+        held = self.held_array[side]
         # The engaged direction turned back by 2 pi m / n, in real arithmetic (same bits).
         turned = (e.real * t.real - e.imag * t.imag) + 1j * (e.real * t.imag + e.imag * t.real)
-        if ctx.vector:
-            e_turn, e_held = self.e_turn_array[m], self.e_held_array[side]
-            entry: tuple[Any, ...] = (
-                np.where(engaged, turned, held), np.where(engaged, w, 0.0),
-                np.where(engaged, al, 0.0), np.where(engaged, ee + e_turn, e_held),
-                np.where(engaged, ew, 0.0), np.where(engaged, eal, 0.0))
-            if near.any():
-                # Within rounding of a slot's mouth either side may be the true one:
-                # the bounds cover both (the acceleration jumps there).
-                diff = turned - held
-                gap = abs(diff.real) + abs(diff.imag)
-                entry = (entry[0], entry[1], entry[2],
-                         np.where(near, ee + e_turn + e_held + gap, entry[3]),
-                         np.where(near, ew + abs(w), entry[4]),
-                         np.where(near, eal + abs(al), entry[5]))
+        e_turn, e_held = self.e_turn_array[m], self.e_held_array[side]
+        entry: tuple[Any, ...] = (
+            np.where(engaged, turned, held), np.where(engaged, w, 0.0),
+            np.where(engaged, al, 0.0), np.where(engaged, ee + e_turn, e_held),
+            np.where(engaged, ew, 0.0), np.where(engaged, eal, 0.0))
+        if near.any():
+            # Within rounding of a slot's mouth either side may be the true one: the
+            # bounds cover both (the acceleration jumps there).
+            diff = turned - held
+            gap = abs(diff.real) + abs(diff.imag)
+            entry = (entry[0], entry[1], entry[2],
+                     np.where(near, ee + e_turn + e_held + gap, entry[3]),
+                     np.where(near, ew + abs(w), entry[4]),
+                     np.where(near, eal + abs(al), entry[5]))
+        ctx.links[self.link] = entry
+
+    def _run_one(self, ctx: _Context) -> None:
+        """Do :meth:`run` for one crank angle: the same operations, only those it needs."""
+        angle = ctx.angle
+        d = angle - self.phase0
+        q = round(d / math.tau)  # an int: q * tau and abs(q) * e_q round as the float's would
+        r = d - q * math.tau
+        window = ctx.turns + q
+        ar = abs(r)
+        half = self.half
+        engaged = ar <= half
+        if ctx.engagement is _NOTHING:
+            ctx.engagement = {}
+        ctx.engagement[self.link] = (engaged, window)
+        er = U * (abs(angle) + abs(d) + ar) + self.e_phase + abs(q) * self.e_q
+        near = abs(ar - half) <= ROUNDING_MARGIN * (er + self.e_half)
+        n = self.slots
+        e, w, al, ee, ew, eal = ctx.links[self.link]
+        if engaged or near:
+            m = window % n
+            t = self.turn[m]
+            turned = (e.real * t.real - e.imag * t.imag) + 1j * (e.real * t.imag
+                                                                 + e.imag * t.real)
+        if engaged:
+            entry: tuple[Any, ...] = (turned, w, al, ee + self.e_turn[m], ew, eal)
         else:
-            e_turn, e_held = self.e_turn[m], self.e_held[side]
-            if engaged:
-                entry = (turned, w, al, ee + e_turn, ew, eal)
-            else:
-                entry = (held, 0.0, 0.0, e_held, 0.0, 0.0)
-            if near:
-                diff = turned - held
-                gap = abs(diff.real) + abs(diff.imag)
-                entry = (entry[0], entry[1], entry[2], ee + e_turn + e_held + gap, ew + abs(w),
-                         eal + abs(al))
-                if ctx.notes is _NOTHING:
-                    ctx.notes = {}
-                ctx.notes[self.label] = (
-                    f'the pin {self.through} is within rounding of the mouth of a slot of '
-                    f'{self.link}, where its angular acceleration jumps from or to 0 (an '
-                    f'engagement instant: ask for a crank angle either side of it)')
+            side = (2 * window + (1 if r > 0.0 else -1)) % (2 * n)
+            entry = (self.held[side], 0.0, 0.0, self.e_held[side], 0.0, 0.0)
+        if near:
+            # Within rounding of a slot's mouth either side may be the true one: the
+            # bounds cover both (the acceleration jumps there).
+            side = (2 * window + (1 if r > 0.0 else -1)) % (2 * n)
+            held = self.held[side]
+            diff = turned - held
+            gap = abs(diff.real) + abs(diff.imag)
+            entry = (entry[0], entry[1], entry[2],
+                     ee + self.e_turn[m] + self.e_held[side] + gap, ew + abs(w), eal + abs(al))
+            if ctx.notes is _NOTHING:
+                ctx.notes = {}
+            ctx.notes[self.label] = (
+                f'the pin {self.through} is within rounding of the mouth of a slot of '
+                f'{self.link}, where its angular acceleration jumps from or to 0 (an '
+                f'engagement instant: ask for a crank angle either side of it)')
         ctx.links[self.link] = entry
 
 
@@ -2257,7 +2282,11 @@ def _engagement(step: _IndexStep, ctx: _Context, omega: Any, finish: Any) -> Eng
     if finish is not None:
         entry, exit_, jump, zero = finish(entry), finish(exit_), finish(jump), finish(zero)
         engaged = np.broadcast_to(engaged, np.shape(entry))
-    return Engagement(engaged, window, entry, exit_, (zero, -jump), (jump, zero))
+    # The fields go straight in, as in _new_state: a frozen dataclass's __init__ costs 1 us.
+    record = object.__new__(Engagement)
+    record.__dict__.update(engaged=engaged, window=window, entry=entry, exit=exit_,
+                           entry_acceleration=(zero, -jump), exit_acceleration=(jump, zero))
+    return record
 
 
 def _new_state(scene: str, angle: Any, speed: Any, accel: Any, joints: dict[str, JointMotion],
