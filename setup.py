@@ -64,8 +64,7 @@ setup(
             'report = mech_kinematics.tools.report:main',
             'bench = mech_kinematics.tools.bench:main',
             'reindex = mech_kinematics.tools.reindex:main',
-            # check goes here when its module lands:
-            # 'check = mech_kinematics.tools.check:main',
+            'check = mech_kinematics.tools.check:main',
         ],
     },
 )

@@ -15,13 +15,15 @@ NumPy and PyYAML only; nothing here imports rclpy.
 from .bounds import Bounds, ErrorBound, MAX_ERROR
 from .errors import (AssemblyError, MechKinematicsError, NearSingularWarning, SceneError,
                      UntrustedError)
-from .linkage import (Branch, CarriedPoint, Crank, JointMotion, Link, NEAR_SINGULAR,
-                      PointState, RPR, RRP, RRR, Scene, SINGULAR, solve, State)
+from .linkage import (assembly_text, Branch, CarriedPoint, Crank, Engagement, JointMotion, Link,
+                      MAX_SLOTS, NEAR_SINGULAR, Pin, PointState, RPR, RRP, RRR, Scene, SINGULAR,
+                      solve, State, TANGENCY_TOLERANCE, Units)
 from .scene import DEFAULT_SCENE, load_scene, parse_scene, scene_names
 
 __all__ = [
-    'AssemblyError', 'Bounds', 'Branch', 'CarriedPoint', 'Crank', 'DEFAULT_SCENE', 'ErrorBound',
-    'JointMotion', 'Link', 'MAX_ERROR', 'MechKinematicsError', 'NEAR_SINGULAR',
-    'NearSingularWarning', 'PointState', 'RPR', 'RRP', 'RRR', 'SINGULAR', 'Scene', 'SceneError',
-    'State', 'UntrustedError', 'load_scene', 'parse_scene', 'scene_names', 'solve',
+    'AssemblyError', 'Bounds', 'Branch', 'CarriedPoint', 'Crank', 'DEFAULT_SCENE', 'Engagement',
+    'ErrorBound', 'JointMotion', 'Link', 'MAX_ERROR', 'MAX_SLOTS', 'MechKinematicsError',
+    'NEAR_SINGULAR', 'NearSingularWarning', 'Pin', 'PointState', 'RPR', 'RRP', 'RRR', 'SINGULAR',
+    'Scene', 'SceneError', 'State', 'TANGENCY_TOLERANCE', 'Units', 'UntrustedError',
+    'assembly_text', 'load_scene', 'parse_scene', 'scene_names', 'solve',
 ]

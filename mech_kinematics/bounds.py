@@ -80,6 +80,8 @@ SCALE_MEANINGS = {
 
 Number = float | npt.NDArray[np.float64]
 Table = dict[str, tuple[Any, Any, Any]]
+#: ``ErrorBound.rubbing`` of a scene without pins (replaced, never mutated).
+_NO_PINS: dict[str, Any] = {}
 
 
 def limit(max_error: float, scale: Any) -> Any:
@@ -136,9 +138,12 @@ class ErrorBound:
     crank_length : float
         The crank's length, m: with the crank's rates, the least scale of the
         linear velocities and accelerations.
+    rubbing : dict of str to float or ndarray
+        Per pin of the scene's ``pins``: the bound of its rubbing velocity, m/s
+        (judged on the velocity scale).
     """
 
-    __slots__ = ('_build', '_args', '_raw', '_records', 'size', 'crank_length')
+    __slots__ = ('_build', '_args', '_raw', '_records', 'size', 'crank_length', 'rubbing')
 
     def __init__(self, build: Callable[..., tuple[Table, Table]], args: tuple[Any, ...],
                  size: float, crank_length: float) -> None:
@@ -148,6 +153,7 @@ class ErrorBound:
         self._records: tuple[dict[str, Bounds], dict[str, Bounds]] | None = None
         self.size = size
         self.crank_length = crank_length
+        self.rubbing: dict[str, Any] = _NO_PINS
 
     def raw(self) -> tuple[Table, Table]:
         """Return the joints' and the points' bounds: (position, velocity, acceleration)."""
@@ -173,7 +179,7 @@ class ErrorBound:
         return self._records_()[1]
 
     def as_dict(self, vector: bool) -> dict[str, Any]:
-        """Return ``{"joints": ..., "points": ...}`` as in ``State.as_dict()``."""
+        """Return ``{"joints": ..., "points": ...}`` and ``"rubbing"``, as ``State.as_dict()``."""
         def value(x: Any) -> Any:
             return x if vector else float(x)
 
@@ -182,5 +188,8 @@ class ErrorBound:
                     'acceleration': value(b[2])}
 
         joints, points = self.raw()
-        return {'joints': {name: record(b) for name, b in joints.items()},
+        data = {'joints': {name: record(b) for name, b in joints.items()},
                 'points': {name: record(b) for name, b in points.items()}}
+        if self.rubbing:  # a scene with pins
+            data['rubbing'] = {name: value(b) for name, b in self.rubbing.items()}
+        return data

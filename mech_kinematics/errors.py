@@ -4,6 +4,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 
 class MechKinematicsError(ValueError):
     """Base class of every error this package raises on bad input."""
@@ -41,14 +43,21 @@ class AssemblyError(MechKinematicsError):
     angle : float
         The crank angle, rad.
     reason : str
-        The violated condition.
+        The violated condition (numbers to 6 significant digits, SI units).
+    facts : dict or None
+        The failure as data, for a message in a scene's own units: ``kind``
+        (``'apart'``: an RRR's circles do not meet; ``'in line'``: its links
+        are in line; ``'reach'``: an RRP's guide is out of reach; ``'pivot'``:
+        an RPR pin on its pivot) and the names and SI values involved.
     """
 
-    def __init__(self, dyad: str, angle: float, reason: str) -> None:
+    def __init__(self, dyad: str, angle: float, reason: str, *,
+                 facts: dict[str, Any] | None = None) -> None:
         self.dyad = dyad
         self.angle = angle
         self.reason = reason
-        msg = f'{dyad} cannot be solved at crank angle {angle:.17g} rad: {reason}'
+        self.facts = facts
+        msg = f'{dyad} cannot be solved at crank angle {angle:.6g} rad: {reason}'
         super().__init__(msg)
 
 
@@ -79,8 +88,8 @@ class UntrustedError(AssemblyError):
     """
 
     def __init__(self, dyad: str, angle: float, reason: str, value: str, bound: float,
-                 tolerance: float) -> None:
-        super().__init__(dyad, angle, reason)
+                 tolerance: float, *, facts: dict[str, Any] | None = None) -> None:
+        super().__init__(dyad, angle, reason, facts=facts)
         self.value = value
         self.bound = bound
         self.tolerance = tolerance

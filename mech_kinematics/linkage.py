@@ -40,10 +40,12 @@ import numpy.typing as npt
 from .bounds import (ErrorBound, LARGEST, limit, MAX_ERROR, ROUNDING_MARGIN, SCALE_MEANINGS,
                      Table, U, UNITS)
 from .errors import AssemblyError, NearSingularWarning, SceneError, UntrustedError
+from .units import ANGLE_UNITS, degrees_from_radians, LENGTH_UNITS
 
 __all__ = [
-    'Branch', 'CarriedPoint', 'Crank', 'JointMotion', 'Link', 'NEAR_SINGULAR', 'PointState',
-    'RPR', 'RRP', 'RRR', 'SINGULAR', 'Scene', 'State', 'solve',
+    'Branch', 'CarriedPoint', 'Crank', 'Engagement', 'JointMotion', 'Link', 'MAX_SLOTS',
+    'NEAR_SINGULAR', 'Pin', 'PointState', 'RPR', 'RRP', 'RRR', 'SINGULAR', 'Scene', 'State',
+    'TANGENCY_TOLERANCE', 'Units', 'assembly_text', 'solve',
 ]
 
 #: A dyad whose near-singularity measure falls below this is flagged as
@@ -53,6 +55,12 @@ __all__ = [
 NEAR_SINGULAR = 1e-3
 #: At or below this measure a dyad is treated as singular and not solved.
 SINGULAR = 1e-12
+#: Most slots of an intermittent (Geneva) lever.
+MAX_SLOTS = 1000
+#: An intermittent lever's pin must enter its slots tangentially: the crank
+#: radius R of the pin and the centre distance l must satisfy
+#: ``|R / l - sin(pi / n)| <= TANGENCY_TOLERANCE * sin(pi / n)``.
+TANGENCY_TOLERANCE = 1e-9
 
 IDENTIFIER = re.compile(r'[A-Za-z_][A-Za-z0-9_]*\Z')
 
@@ -89,8 +97,49 @@ def _check_finite(value: float, what: str, where: Where = None) -> None:
 
 def _check_length(value: float, what: str, where: Where = None) -> None:
     if not (math.isfinite(value) and value > 0.0):
-        msg = f'Expected {what} to be a positive length, got {value!r} m'
+        msg = f'Expected {what} to be a positive length, got {_g(value)} m'
         raise SceneError(msg, where)
+
+
+def _g(value: float, *others: float) -> str:
+    """Return ``value`` to 6 significant digits, or more where ``others`` would look equal."""
+    digits = 6
+    while digits < 17 and any(o != value and f'{o:.{digits}g}' == f'{value:.{digits}g}'
+                              for o in others):
+        digits += 1
+    return f'{value:.{digits}g}'
+
+
+@dataclass(frozen=True)
+class Units:
+    """The units a scene was written in, for messages: ``length`` m or mm, ``angle`` rad or deg.
+
+    Everything the solver holds and returns is SI; these only say how to show
+    a scene's own values back to the person who wrote them.
+    """
+
+    length: str = 'm'
+    angle: str = 'rad'
+
+    def __post_init__(self) -> None:
+        """Validate the fields."""
+        if self.length not in LENGTH_UNITS or self.angle not in ANGLE_UNITS:
+            msg = (f'Expected units length in {", ".join(LENGTH_UNITS)} and angle in '
+                   f'{", ".join(ANGLE_UNITS)}, got {self.length!r} and {self.angle!r}')
+            raise SceneError(msg, (self, 'length'))
+
+    def length_text(self, metres: float, *others: float) -> str:
+        """Return a length given in m as text in the scene's unit, 6 significant digits."""
+        per = LENGTH_UNITS[self.length]
+        return f'{_g(metres * per, *(o * per for o in others))} {self.length}'
+
+    def angle_value(self, radians: float) -> float:
+        """Return an angle given in rad in the scene's unit."""
+        return degrees_from_radians(radians) if self.angle == 'deg' else radians
+
+    def angle_text(self, radians: float) -> str:
+        """Return an angle given in rad as text in the scene's unit, 6 significant digits."""
+        return f'{_g(self.angle_value(radians))} {self.angle}'
 
 
 @dataclass(frozen=True)
@@ -190,12 +239,26 @@ class RRP:
 
 @dataclass(frozen=True)
 class RPR:
-    """A slotted ``link`` turning about ground point ``center``, through pin ``through``."""
+    """A slotted ``link`` turning about ground point ``center``, through pin ``through``.
+
+    With ``slots`` (an integer n >= 3) the link is an intermittent (Geneva)
+    wheel: n slots evenly spaced, driven by the pin only while it is in one.
+    The pin must be a point fixed on the crank, entering the slots
+    tangentially (crank radius of the pin ``R = l sin(pi / n)`` for the
+    distance ``l`` between the crank's centre and ``center``, within
+    :data:`TANGENCY_TOLERANCE`); between engagements the wheel is locked, and
+    each engagement indexes it by ``2 pi / n`` against the crank's sense. The
+    link's angle is that of its slot 0: the slot the pin is in during the
+    engagement centred on the crank angle that points the pin at ``center``
+    in the crank's turn 0 (so in that engagement the angle is the plain RPR
+    one, from ``center`` toward the pin).
+    """
 
     link: str
     center: str
     through: str
     slider: str
+    slots: int | None = None
 
     def __post_init__(self) -> None:
         """Validate the fields."""
@@ -203,6 +266,42 @@ class RPR:
         _check_name(self.center, f'the center of RPR "{self.link}"', (self, 'center'))
         _check_name(self.through, f'the pin of RPR "{self.link}"', (self, 'through'))
         _check_name(self.slider, f'the slider of RPR "{self.link}"', (self, 'slider'))
+        n = self.slots
+        if n is not None and (isinstance(n, bool) or not isinstance(n, int)
+                              or not 3 <= n <= MAX_SLOTS):
+            msg = (f'Expected the slots of RPR "{self.link}" to be an integer from 3 to '
+                   f'{MAX_SLOTS}, got {n!r}')
+            raise SceneError(msg, (self, 'slots'))
+
+
+@dataclass(frozen=True)
+class Pin:
+    """A pin of radius ``radius`` (m) at ``point``, whose rubbing velocity is reported.
+
+    The rubbing velocity is ``|omega_a - omega_b| * radius`` for the two bodies
+    the pin joins (the ground counts as a body with omega 0, an RRP slider
+    block too, an RPR block turns with its lever). ``bodies`` names the two
+    where more than two meet at ``point`` (a compound pin); ``None`` takes
+    the only two there are.
+    """
+
+    point: str
+    radius: float
+    bodies: tuple[str, str] | None = None
+
+    def __post_init__(self) -> None:
+        """Validate the fields."""
+        _check_name(self.point, 'a pin point', (self, 'point'))
+        _check_length(self.radius, f'the radius of pin "{self.point}"', (self, 'radius'))
+        if self.bodies is not None:
+            bodies = tuple(self.bodies)
+            if len(bodies) != 2 or bodies[0] == bodies[1]:
+                msg = (f'Expected two different bodies for pin "{self.point}", got '
+                       f'{list(bodies)!r}')
+                raise SceneError(msg, (self, 'bodies'))
+            for body in bodies:
+                _check_name(body, f'a body of pin "{self.point}"', (self, 'bodies'))
+            object.__setattr__(self, 'bodies', bodies)
 
 
 @dataclass(frozen=True)
@@ -238,6 +337,10 @@ Dyad = RRR | RRP | RPR
 # --- the steps of a solve -------------------------------------------------
 
 
+#: The empty table a solve's optional entries start from; replaced, never mutated.
+_NOTHING: dict[str, Any] = {}
+
+
 class _Context:
     """Values known so far in one solve; complex numbers or complex arrays.
 
@@ -247,11 +350,14 @@ class _Context:
     link, and ``sliders[name] = (s, sd, sdd, ...)``.
     """
 
-    __slots__ = ('angle', 'vector', 'points', 'links', 'sliders', 'measures', 'valid',
-                 'failures')
+    __slots__ = ('angle', 'turns', 'shown', 'vector', 'points', 'links', 'sliders', 'measures',
+                 'valid', 'failures', 'engagement', 'rubbing', 'notes')
 
-    def __init__(self, angle: Any, vector: bool) -> None:
+    def __init__(self, angle: Any, vector: bool, turns: Any = 0) -> None:
         self.angle = angle
+        self.turns = turns  # whole crank turns to add to angle (intermittent drives only)
+        # The crank angle counted from the start, for messages (scalar path).
+        self.shown = angle if vector or turns == 0 else angle + math.tau * turns
         self.vector = vector
         self.points: dict[str, tuple[Any, Any, Any, Any, Any, Any]] = {}
         self.links: dict[str, tuple[Any, Any, Any, Any, Any, Any]] = {}
@@ -259,12 +365,21 @@ class _Context:
         self.measures: dict[str, Any] = {}
         self.valid: Any = True
         self.failures: dict[str, Any] = {}
+        # Filled by the steps that have them (shared empty until then: never mutated).
+        self.engagement: dict[str, tuple[Any, Any]] = _NOTHING  # lever -> (engaged, window)
+        self.rubbing: dict[str, tuple[Any, Any]] = _NOTHING  # pin -> (value, bound)
+        self.notes: dict[str, str] = _NOTHING  # label -> why a bound is large (scalar path)
 
-    def check(self, ok: Any, label: str, reason: Any) -> None:
-        """Stop a scalar solve where ``ok`` fails; mask the entries of a vector solve."""
+    def check(self, ok: Any, label: str, reason: Any, facts: Any = None) -> None:
+        """Stop a scalar solve where ``ok`` fails; mask the entries of a vector solve.
+
+        ``reason`` and ``facts`` are callables, called only to raise: the
+        message and the failure's facts for :class:`AssemblyError`.
+        """
         if not self.vector:
             if not ok:
-                raise AssemblyError(label, self.angle, reason())
+                raise AssemblyError(label, self.shown, reason(),
+                                    facts=None if facts is None else facts())
             return
         self.mask(ok, label)
 
@@ -277,12 +392,14 @@ class _Context:
                 previous = self.failures.get(label)
                 self.failures[label] = failed if previous is None else previous | failed
 
-    def check_margin(self, ok: Any, label: str, margin: Any, bound: Any, reason: Any) -> None:
+    def check_margin(self, ok: Any, label: str, margin: Any, bound: Any, reason: Any,
+                     facts: Any = None) -> None:
         """Like :meth:`check` for a dyad within rounding of an assembly limit (untrusted)."""
         if not self.vector:
             if not ok:
-                raise UntrustedError(label, self.angle, reason(), 'margin', float(bound),
-                                     float(margin) / ROUNDING_MARGIN)
+                raise UntrustedError(label, self.shown, reason(), 'margin', float(bound),
+                                     float(margin) / ROUNDING_MARGIN,
+                                     facts=None if facts is None else facts())
             return
         self.mask(ok, label)
 
@@ -362,6 +479,7 @@ class _RRRStep:
 
     def __init__(self, dyad: RRR) -> None:
         first, second = dyad.links
+        self.dyad = dyad
         self.label = f'RRR {dyad.point}'
         self.key = dyad.point
         self.point = dyad.point
@@ -381,6 +499,13 @@ class _RRRStep:
         self.e_round = 8.0 * U * max(first.length, second.length)
         self.branch = int(dyad.branch)
         self.uses = (first.start, second.start)
+
+    def facts(self, dist: float, touching: bool) -> dict[str, Any]:
+        """Return why the circles do not meet, for a message in the scene's units."""
+        m = self.unit
+        return {'kind': 'in line' if touching else 'apart', 'links': (self.link1, self.link2),
+                'lengths': (self.l1 * m, self.l2 * m), 'points': (self.start1, self.start2),
+                'distance': float(dist) * m}
 
     def run(self, ctx: _Context) -> None:
         l1, l2 = self.l1, self.l2
@@ -406,17 +531,19 @@ class _RRRStep:
         m = self.unit
         if not (ctx.vector or ok or margin > -ROUNDING_MARGIN * spread):
             ctx.check(False, self.label, lambda: (
-                f'the circles about {self.start1} (radius {l1 * m:.17g} m) and {self.start2} '
-                f'(radius {l2 * m:.17g} m) do not meet: expected |{ldiff * m:.17g}| < '
-                f'|{self.start1}{self.start2}| < {lsum * m:.17g} m, got '
-                f'|{self.start1}{self.start2}| = {dist * m:.17g} m'))
+                f'the circles about {self.start1} (radius {_g(l1 * m)} m) and {self.start2} '
+                f'(radius {_g(l2 * m)} m) do not meet: expected '
+                f'|{_g(ldiff * m, dist * m)}| < |{self.start1}{self.start2}| < '
+                f'{_g(lsum * m, dist * m)} m, got |{self.start1}{self.start2}| = '
+                f'{_g(dist * m, lsum * m, abs(ldiff) * m)} m'), lambda: self.facts(dist, False))
         if ctx.vector or not ok:
             ctx.check_margin(ok, self.label, margin * m, spread * m, lambda: (
                 f'the circles about {self.start1} and {self.start2} are within rounding of '
-                f'meeting at one point: expected the margin min({lsum * m:.17g} m - '
+                f'meeting at one point: expected the margin min({_g(lsum * m)} m - '
                 f'|{self.start1}{self.start2}|, |{self.start1}{self.start2}| - '
-                f'{abs(ldiff) * m:.17g} m) = {margin * m:.3g} m to exceed '
-                f'{ROUNDING_MARGIN:g} times its error bound {spread * m:.3g} m'))
+                f'{_g(abs(ldiff) * m)} m) = {margin * m:.3g} m to exceed '
+                f'{ROUNDING_MARGIN:g} times its error bound {spread * m:.3g} m'),
+                lambda: self.facts(dist, True))
         root = np.sqrt(k) if ctx.vector else math.sqrt(k)
         # sin of the angle between the two links (the transmission angle).
         measure = root / (2.0 * l1 * l2)
@@ -424,7 +551,8 @@ class _RRRStep:
         if ctx.vector or not ok:
             ctx.check(ok, self.label, lambda: (
                 f'links {self.link1} and {self.link2} are in line (singular): expected the '
-                f'sine of the angle between them > {SINGULAR:g}, got {measure:.3g}'))
+                f'sine of the angle between them > {SINGULAR:g}, got {measure:.3g}'),
+                lambda: self.facts(dist, True))
         ctx.measures[self.key] = measure
         half = 0.5 / dist
         shared = ldiff * lsum
@@ -476,6 +604,7 @@ class _RRPStep:
     unit = 1.0  # metres per length unit of the plan, for messages (see _Solver)
 
     def __init__(self, dyad: RRP, through: complex) -> None:
+        self.dyad = dyad
         self.label = f'RRP {dyad.point}'
         self.key = dyad.point
         self.point = dyad.point
@@ -485,6 +614,8 @@ class _RRPStep:
         self.inv_length = 1.0 / dyad.link.length
         self.slider = dyad.slider
         self.through = through
+        self.through_name = dyad.through
+        self.guide_angle = dyad.guide_angle
         self.u = complex(math.cos(dyad.guide_angle), math.sin(dyad.guide_angle))
         self.normal = 1j * self.u
         self.branch = int(dyad.branch)
@@ -499,6 +630,13 @@ class _RRPStep:
         self.e_fixed = self.e_through + _U2 * dyad.link.length
         self.e_round = _U3 * dyad.link.length  # of the final forms
         self.e_round2 = 2.0 * self.e_round
+
+    def facts(self, offset: float) -> dict[str, Any]:
+        """Return why the guide is out of reach, for a message in the scene's units."""
+        m = self.unit
+        return {'kind': 'reach', 'links': (self.link,), 'lengths': (self.length * m,),
+                'points': (self.start, self.through_name), 'distance': abs(float(offset)) * m,
+                'guide_angle': self.guide_angle}
 
     def run(self, ctx: _Context) -> None:
         length, u = self.length, self.u
@@ -520,14 +658,14 @@ class _RRPStep:
         if not (ctx.vector or ok or margin > -ROUNDING_MARGIN * spread):
             ctx.check(False, self.label, lambda: (
                 f'the guide is out of reach of link {self.link}: expected the distance of '
-                f'{self.start} from the guide < {length * m:.17g} m, got '
-                f'{abs(offset) * m:.17g} m'))
+                f'{self.start} from the guide < {_g(length * m, abs(offset) * m)} m, got '
+                f'{_g(abs(offset) * m, length * m)} m'), lambda: self.facts(offset))
         if ctx.vector or not ok:
             ctx.check_margin(ok, self.label, margin * m, spread * m, lambda: (
                 f'the guide is within rounding of the reach of link {self.link}: expected '
-                f'the margin {length * m:.17g} m - (distance of {self.start} from the guide) '
+                f'the margin {_g(length * m)} m - (distance of {self.start} from the guide) '
                 f'= {margin * m:.3g} m to exceed {ROUNDING_MARGIN:g} times its error bound '
-                f'{spread * m:.3g} m'))
+                f'{spread * m:.3g} m'), lambda: self.facts(offset))
         root = np.sqrt(k) if ctx.vector else math.sqrt(k)
         # sin of the angle between the rod and the guide's normal.
         measure = root / length
@@ -535,7 +673,8 @@ class _RRPStep:
         if ctx.vector or not ok:
             ctx.check(ok, self.label, lambda: (
                 f'link {self.link} is perpendicular to the guide (singular): expected the '
-                f'sine of its angle to the guide normal > {SINGULAR:g}, got {measure:.3g}'))
+                f'sine of its angle to the guide normal > {SINGULAR:g}, got {measure:.3g}'),
+                lambda: self.facts(offset))
         ctx.measures[self.key] = measure
         den = self.branch * root  # dot(u, r)
         inv = 1.0 / den
@@ -575,15 +714,22 @@ class _RPRStep:
     unit = 1.0  # metres per length unit of the plan, for messages (see _Solver)
 
     def __init__(self, dyad: RPR, center: complex, size: float) -> None:
+        self.dyad = dyad
         self.label = f'RPR {dyad.link}'
         self.key = dyad.link
         self.link = dyad.link
         self.through = dyad.through
         self.slider = dyad.slider
         self.center = center
+        self.center_name = dyad.center
         self.size = size
         self.uses = (dyad.through,)
         self.e_center = U * abs(center)
+
+    def facts(self, s: float) -> dict[str, Any]:
+        """Return why the lever is singular, for a message in the scene's units."""
+        return {'kind': 'pivot', 'links': (self.link,), 'lengths': (),
+                'points': (self.through, self.center_name), 'distance': float(s) * self.unit}
 
     def run(self, ctx: _Context) -> None:
         b, vb, ab, eb, evb, eab = ctx.points[self.through]
@@ -596,7 +742,8 @@ class _RPRStep:
         if ctx.vector or not ok:
             ctx.check(ok, self.label, lambda: (
                 f'the pin {self.through} is on the pivot (singular): expected its distance '
-                f'from the pivot > {SINGULAR * self.size * m:.3g} m, got {s * m:.3g} m'))
+                f'from the pivot > {SINGULAR * self.size * m:.3g} m, got {s * m:.3g} m'),
+                lambda: self.facts(s))
         # The error of the pin relative to the pivot (and of s = |d|): within it of
         # the pivot the lever's direction is not known at all.
         ed = eb + self.e_center + _U2 * s
@@ -605,7 +752,7 @@ class _RPRStep:
             ctx.check_margin(ok, self.label, s * m, ed * m, lambda: (
                 f'the pin {self.through} is within rounding of the pivot: expected its '
                 f'distance from the pivot {s * m:.3g} m to exceed {ROUNDING_MARGIN:g} times '
-                f'its error bound {ed * m:.3g} m'))
+                f'its error bound {ed * m:.3g} m'), lambda: self.facts(s))
         ctx.measures[self.key] = measure
         inv_s = 1.0 / s
         e = d * inv_s
@@ -629,6 +776,143 @@ class _RPRStep:
                                 (tab + 2.0 * (asd * ew + aw * esd + aal * ed)) * inv_s)
         ctx.sliders[self.slider] = (s, sd, sdd, ed, esd,
                                     tab + 2.0 * aw * aw * ed + s * (2.0 * aw + ew) * ew)
+
+
+class _IndexStep(_RPRStep):
+    """An RPR whose lever is an intermittent (Geneva) wheel of ``n`` slots (see :class:`RPR`).
+
+    The engaged motion is the plain RPR's, turned back by ``2 pi k / n`` in
+    the crank's engagement window ``k``; between windows the wheel is held at
+    ``c - j pi / n`` (``c`` the direction from the wheel's centre to the
+    crank's, ``j = 2k +- 1``), velocity and acceleration exactly 0. The
+    window comes from the crank angle counted from the start (``angle`` plus
+    ``turns`` whole turns, the turns never added in floating point), so the
+    wheel's index is exact over any number of turns; both tables are
+    computed once, so both paths read the same bits.
+    """
+
+    def __init__(self, dyad: RPR, center: complex, size: float, crank_center: complex,
+                 pin: complex) -> None:
+        super().__init__(dyad, center, size)
+        n = cast(int, dyad.slots)
+        self.slots = n
+        toward = center - crank_center  # from the crank's centre to the wheel's
+        distance = abs(toward)
+        # Window 0 is centred on the crank angle that points the pin at the wheel.
+        beta = math.atan2(pin.imag, pin.real)
+        self.phase0 = math.atan2(toward.imag, toward.real) - beta
+        self.half = math.pi / 2 - math.pi / n  # half the crank's engaged angle
+        self.tan = math.tan(math.pi / n)  # R / (slot mouth): the acceleration's jump / omega^2
+        c = math.atan2(-toward.imag, -toward.real)
+        step = math.pi / n
+        held = [c - j * step for j in range(2 * n)]
+        turn = [-2.0 * step * m for m in range(n)]
+        self.held = [complex(math.cos(x), math.sin(x)) for x in held]
+        self.turn = [complex(math.cos(x), math.sin(x)) for x in turn]
+        self.held_array = np.array(self.held, dtype=np.complex128)
+        self.turn_array = np.array(self.turn, dtype=np.complex128)
+        # Bounds: the line of centres' direction from the rounded ground points
+        # and the atan2; each table angle's own rounding; cos and sin to an ulp;
+        # the final angle's atan2 (as _U7 elsewhere); the rotation's products.
+        ec = U * (abs(center) + abs(crank_center) + distance) / distance + _U2
+        self.e_held = [ec + U * (abs(x) + 2.0 * j * step) + _U7 for j, x in enumerate(held)]
+        self.e_turn = [U * 2.0 * abs(x) + _U4 + _U4 for x in turn]
+        self.e_held_array = np.array(self.e_held)
+        self.e_turn_array = np.array(self.e_turn)
+        self.e_phase = ec + U * (abs(beta) + math.pi + abs(self.phase0)) + _U2
+        self.e_q = 4.0 * U * math.tau  # per whole turn reduced: 2 pi's rounding and the product's
+        self.e_half = U * self.half
+
+    def window(self, angle: Any, turns: Any, vector: bool) -> tuple[Any, Any, Any, Any]:
+        """Return (engaged, window, offset in the window, its error bound) at a crank angle."""
+        d = angle - self.phase0
+        if vector:
+            q = np.rint(d / math.tau)
+            window = np.asarray(turns, dtype=np.int64) + q.astype(np.int64)
+        else:
+            q = float(round(d / math.tau))
+            window = turns + int(q)
+        r = d - q * math.tau
+        er = U * (abs(angle) + abs(d) + abs(r)) + self.e_phase + abs(q) * self.e_q
+        return abs(r) <= self.half, window, r, er
+
+    def run(self, ctx: _Context) -> None:
+        super().run(ctx)
+        if not ctx.vector:
+            self._run_one(ctx)
+            return
+        n = self.slots
+        engaged, window, r, er = self.window(ctx.angle, ctx.turns, ctx.vector)
+        near = abs(abs(r) - self.half) <= ROUNDING_MARGIN * (er + self.e_half)
+        e, w, al, ee, ew, eal = ctx.links[self.link]
+        if ctx.engagement is _NOTHING:
+            ctx.engagement = {}
+        ctx.engagement[self.link] = (engaged, window)
+        m = np.mod(window, n)
+        side = np.mod(2 * window + np.where(r > 0.0, 1, -1), 2 * n)
+        t = self.turn_array[m]
+        held = self.held_array[side]
+        # The engaged direction turned back by 2 pi m / n, in real arithmetic (same bits).
+        turned = (e.real * t.real - e.imag * t.imag) + 1j * (e.real * t.imag + e.imag * t.real)
+        e_turn, e_held = self.e_turn_array[m], self.e_held_array[side]
+        entry: tuple[Any, ...] = (
+            np.where(engaged, turned, held), np.where(engaged, w, 0.0),
+            np.where(engaged, al, 0.0), np.where(engaged, ee + e_turn, e_held),
+            np.where(engaged, ew, 0.0), np.where(engaged, eal, 0.0))
+        if near.any():
+            # Within rounding of a slot's mouth either side may be the true one: the
+            # bounds cover both (the acceleration jumps there).
+            diff = turned - held
+            gap = abs(diff.real) + abs(diff.imag)
+            entry = (entry[0], entry[1], entry[2],
+                     np.where(near, ee + e_turn + e_held + gap, entry[3]),
+                     np.where(near, ew + abs(w), entry[4]),
+                     np.where(near, eal + abs(al), entry[5]))
+        ctx.links[self.link] = entry
+
+    def _run_one(self, ctx: _Context) -> None:
+        """Do :meth:`run` for one crank angle: the same operations, only those it needs."""
+        angle = ctx.angle
+        d = angle - self.phase0
+        q = round(d / math.tau)  # an int: q * tau and abs(q) * e_q round as the float's would
+        r = d - q * math.tau
+        window = ctx.turns + q
+        ar = abs(r)
+        half = self.half
+        engaged = ar <= half
+        if ctx.engagement is _NOTHING:
+            ctx.engagement = {}
+        ctx.engagement[self.link] = (engaged, window)
+        er = U * (abs(angle) + abs(d) + ar) + self.e_phase + abs(q) * self.e_q
+        near = abs(ar - half) <= ROUNDING_MARGIN * (er + self.e_half)
+        n = self.slots
+        e, w, al, ee, ew, eal = ctx.links[self.link]
+        if engaged or near:
+            m = window % n
+            t = self.turn[m]
+            turned = (e.real * t.real - e.imag * t.imag) + 1j * (e.real * t.imag
+                                                                 + e.imag * t.real)
+        if engaged:
+            entry: tuple[Any, ...] = (turned, w, al, ee + self.e_turn[m], ew, eal)
+        else:
+            side = (2 * window + (1 if r > 0.0 else -1)) % (2 * n)
+            entry = (self.held[side], 0.0, 0.0, self.e_held[side], 0.0, 0.0)
+        if near:
+            # Within rounding of a slot's mouth either side may be the true one: the
+            # bounds cover both (the acceleration jumps there).
+            side = (2 * window + (1 if r > 0.0 else -1)) % (2 * n)
+            held = self.held[side]
+            diff = turned - held
+            gap = abs(diff.real) + abs(diff.imag)
+            entry = (entry[0], entry[1], entry[2],
+                     ee + self.e_turn[m] + self.e_held[side] + gap, ew + abs(w), eal + abs(al))
+            if ctx.notes is _NOTHING:
+                ctx.notes = {}
+            ctx.notes[self.label] = (
+                f'the pin {self.through} is within rounding of the mouth of a slot of '
+                f'{self.link}, where its angular acceleration jumps from or to 0 (an '
+                f'engagement instant: ask for a crank angle either side of it)')
+        ctx.links[self.link] = entry
 
 
 class _CarryStep:
@@ -661,6 +945,47 @@ class _CarryStep:
             + (abs(alpha) + aw * aw) * er)
 
 
+class _RubStep:
+    """The rubbing velocity ``|omega_a - omega_b| r`` of a pin of radius ``r`` (seed 001).
+
+    A body is ``('link', name)`` (a link's angular velocity), ``('still', name)``
+    (the ground or an RRP slider block: omega 0) or ``('block', lever)`` (an
+    RPR block, turning with its lever; an intermittent lever's block touches
+    the pin only while engaged, so the rubbing is 0 in a dwell).
+    """
+
+    def __init__(self, pin: Pin, bodies: tuple[tuple[str, str], tuple[str, str]],
+                 names: tuple[str, str]) -> None:
+        self.point = pin.point
+        self.radius = pin.radius
+        self.bodies = bodies
+        self.names = names  # the two bodies' names, as the scene writes them
+        self.uses = tuple(name for kind, name in bodies if kind != 'still')
+
+    def run(self, ctx: _Context) -> None:
+        (wa, ea), (wb, eb) = (self._omega(ctx, body) for body in self.bodies)
+        r = self.radius
+        value = abs(wa - wb) * r
+        # The inputs' bounds, the difference's and the two products' rounding.
+        bound = (ea + eb) * r + _U4 * value
+        for kind, name in self.bodies:
+            if kind == 'block' and name in ctx.engagement:  # an intermittent lever
+                engaged = ctx.engagement[name][0]
+                if ctx.vector:
+                    value, bound = np.where(engaged, value, 0.0), np.where(engaged, bound, 0.0)
+                elif not engaged:
+                    value, bound = 0.0, 0.0
+        ctx.rubbing[self.point] = (value, bound)
+
+    @staticmethod
+    def _omega(ctx: _Context, body: tuple[str, str]) -> tuple[Any, Any]:
+        kind, name = body
+        if kind == 'still':
+            return 0.0, 0.0
+        entry = ctx.links[name]
+        return entry[1], entry[4]
+
+
 Step = _RRRStep | _RRPStep | _RPRStep | _CarryStep
 
 
@@ -674,6 +999,7 @@ class _Plan:
     joint_types: dict[str, str]
     output_joints: tuple[str, ...]
     output_points: tuple[str, ...]
+    rubs: tuple[_RubStep, ...] = ()
 
 
 def _compile(scene: Scene, joints: tuple[str, ...] | None,
@@ -786,7 +1112,10 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
             local[item.link.name] = {item.link.start: 0j, item.point: complex(item.link.length)}
             added = (item.point, item.link.name, item.slider)
         elif isinstance(item, RPR):
-            steps.append(_RPRStep(item, ground[item.center], size))
+            if item.slots is None:
+                steps.append(_RPRStep(item, ground[item.center], size))
+            else:
+                steps.append(_index_step(scene, item, ground, local[crank.link], size))
             local[item.link] = {item.center: 0j}
             slot[item.link] = (item.center, item.through)
             added = (item.link, item.slider)
@@ -862,9 +1191,12 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
             msg = f'Expected outputs.points to list points, got {got}'
             raise SceneError(msg, (scene, 'outputs.points'))
 
-    # Keep only the steps that the outputs depend on.
+    rubs = _rub_steps(scene, kinds, local)
+
+    # Keep only the steps that the outputs (and the pins' rubbing) depend on.
     needed: set[int] = set()
     todo = [produces[name] for name in (*out_joints, *out_points) if name in produces]
+    todo += [produces[name] for rub in rubs for name in rub.uses if name in produces]
     while todo:
         index = todo.pop()
         if index in needed:
@@ -876,7 +1208,96 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
             todo.append(produces[step.link])
     kept = tuple(step for index, step in enumerate(steps) if index in needed)
     return _Plan(_CrankStep(crank, ground[crank.center]), kept, ground,
-                 {name: joint_types[name] for name in out_joints}, out_joints, out_points)
+                 {name: joint_types[name] for name in out_joints}, out_joints, out_points,
+                 rubs)
+
+
+def _index_step(scene: Scene, item: RPR, ground: dict[str, complex],
+                crank_local: dict[str, complex], size: float) -> _IndexStep:
+    """Return the step of an intermittent lever; check its pin and its tangential entry."""
+    crank = scene.input
+    units: Units = getattr(scene, 'units', Units())
+    n = cast(int, item.slots)
+    if item.through not in crank_local or item.through == crank.center:
+        on_crank = _names(p for p in crank_local if p != crank.center)
+        msg = (f'Expected the pin of intermittent RPR "{item.link}" (slots: {n}) to be a point '
+               f'fixed on the crank "{crank.link}" ({on_crank}), got "{item.through}"')
+        raise SceneError(msg, (item, 'through'))
+    pin = crank_local[item.through]
+    radius = abs(pin)
+    centre, wheel = ground[crank.center], ground[item.center]
+    distance = abs(wheel - centre)
+    sine = math.sin(math.pi / n)
+    if not (radius > 0.0 and abs(radius - distance * sine) <= TANGENCY_TOLERANCE * sine
+            * distance):
+        per = LENGTH_UNITS[units.length]
+        msg = (f'Expected the pin {item.through} to enter the {n} slots of "{item.link}" '
+               f'tangentially: {crank.center} and {item.center} '
+               f'{radius / sine * per:.10g} {units.length} apart (pin radius '
+               f'{units.length_text(radius)} / sin(180 deg / {n})) or a pin radius of '
+               f'{distance * sine * per:.10g} {units.length}, to 1e-9, got '
+               f'{units.length_text(distance)} apart')
+        raise SceneError(msg, (item, 'slots'))
+    return _IndexStep(item, wheel, size, centre, pin)
+
+
+def _rub_steps(scene: Scene, kinds: dict[str, str],
+               local: dict[str, dict[str, complex]]) -> tuple[_RubStep, ...]:
+    """Return the rubbing step of every pin of ``scene``, checking the bodies it joins."""
+    pins: tuple[Pin, ...] = tuple(getattr(scene, 'pins', ()))
+    if not pins:
+        return ()
+    ground_body = 'ground' if 'ground' not in kinds else '_ground'
+    at: dict[str, dict[str, tuple[str, str]]] = {}  # point -> body name -> body
+
+    def put(point: str, name: str, body: tuple[str, str]) -> None:
+        at.setdefault(point, {})[name] = body
+
+    for link, fixed in local.items():
+        for point in fixed:
+            put(point, link, ('link', link))
+    for dyad in scene.dyads:
+        if isinstance(dyad, RRP):
+            put(dyad.point, dyad.slider, ('still', dyad.slider))
+        elif isinstance(dyad, RPR):
+            put(dyad.through, dyad.slider, ('block', dyad.link))
+    for point in scene.ground:
+        if point in at:  # a ground point that some link turns about
+            put(point, ground_body, ('still', ground_body))
+    steps = []
+    seen: set[str] = set()
+    for pin in pins:
+        point = pin.point
+        if kinds.get(point) != 'point':
+            got = f'unknown "{point}"' if point not in kinds else f'{kinds[point]} "{point}"'
+            msg = f'Expected pins to name points, got {got}'
+            raise SceneError(msg, (pin, 'point'))
+        if point in seen:
+            msg = f'Expected each pin once, got "{point}" twice'
+            raise SceneError(msg, (pin, 'point'))
+        seen.add(point)
+        bodies = at.get(point, {})
+        names = list(bodies)
+        if len(names) < 2:
+            msg = (f'Expected pin "{point}" where two bodies turn on each other, got '
+                   f'{"only " + _names(names) if names else "no link"} at {point}')
+            raise SceneError(msg, (pin, 'point'))
+        if pin.bodies is None:
+            if len(names) > 2:
+                msg = (f'Expected pin "{point}" to join two bodies, got {len(names)} at {point} '
+                       f'({_names(names)}): name the two it joins, e.g. {point}: '
+                       f'{{radius: R, between: [{names[0]}, {names[1]}]}}')
+                raise SceneError(msg, (pin, 'bodies'))
+            pair = (names[0], names[1])
+        else:
+            pair = pin.bodies
+            for name in pair:
+                if name not in bodies:
+                    msg = (f'Expected the bodies of pin "{point}" to be among those at {point} '
+                           f'({_names(names)}), got "{name}"')
+                    raise SceneError(msg, (pin, 'bodies'))
+        steps.append(_RubStep(pin, (bodies[pair[0]], bodies[pair[1]]), pair))
+    return tuple(steps)
 
 
 def _diameter(points: Iterable[complex]) -> float:
@@ -1003,7 +1424,8 @@ def _scaled(scene: Scene, shift: int) -> Scene:
         ground={name: (scale(x), scale(y)) for name, (x, y) in scene.ground.items()},
         input=replace(scene.input, length=scale(scene.input.length)), dyads=tuple(dyads),
         points=tuple(replace(p, local=(scale(p.local[0]), scale(p.local[1])))
-                     for p in scene.points)))
+                     for p in scene.points),
+        pins=tuple(replace(p, radius=scale(p.radius)) for p in scene.pins), units=scene.units))
 
 
 class _Solver:
@@ -1066,8 +1488,42 @@ class _Solver:
         outputs.sort(key=lambda item: item[0])
         self.outputs = tuple(item[1:] for item in outputs)
         self.out_points = plan.output_points
+        self.levers = {step.link: step for step in plan.steps if isinstance(step, _IndexStep)}
         self.out_links = tuple(n for n, k in plan.joint_types.items() if k == 'revolute')
         self.out_sliders = tuple(n for n, k in plan.joint_types.items() if k == 'prismatic')
+
+
+def assembly_text(error: AssemblyError, units: Units | None = None) -> str:
+    """Return why a mechanism cannot assemble, naming links and lengths in ``units``.
+
+    E.g. ``links coupler (150 mm) and rocker (80 mm) cannot reach from B to D
+    (235 mm apart)``; the error's own reason where it carries no facts.
+    """
+    facts = error.facts
+    if facts is None:
+        return f'{error.dyad}: {error.reason}'
+    units = Units() if units is None else units
+    text = units.length_text
+    kind, links, lengths, points = facts['kind'], facts['links'], facts['lengths'], \
+        facts['points']
+    distance = facts['distance']
+    if kind == 'pivot':
+        return (f'the pin {points[0]} of slotted link {links[0]} on its pivot {points[1]} '
+                f'({text(distance)} from it)')
+    if kind == 'reach':
+        return (f'link {links[0]} ({text(lengths[0], distance)}) cannot reach the guide through '
+                f'{points[1]} at {units.angle_text(facts["guide_angle"])} from {points[0]} '
+                f'({text(distance, lengths[0])} from the guide)')
+    (a, b), (la, lb), (p, q) = links, lengths, points
+    pair = f'links {a} ({text(la)}) and {b} ({text(lb)})'
+    if kind == 'in line':
+        return (f'{pair} in line between {p} and {q} ({text(distance)} apart): a toggle '
+                f'position, where the mechanism locks')
+    if distance >= la + lb:
+        return (f'{pair} cannot reach from {p} to {q} '
+                f'({text(distance, la + lb)} apart, more than {text(la + lb, distance)})')
+    return (f'{pair} cannot meet: {p} and {q} are {text(distance, abs(la - lb))} apart, less '
+            f'than the difference of their lengths ({text(abs(la - lb), distance)})')
 
 
 @dataclass(frozen=True)
@@ -1094,6 +1550,10 @@ class Scene:
         What to compute and report; ``None`` means everything.
     description : str
         Free text.
+    pins : tuple of Pin
+        Pins whose rubbing velocity is reported (``State.rubbing``).
+    units : Units
+        The units the scene was written in, for messages (its values are SI).
     """
 
     name: str
@@ -1104,6 +1564,8 @@ class Scene:
     outputs_joints: tuple[str, ...] | None = None
     outputs_points: tuple[str, ...] | None = None
     description: str = ''
+    pins: tuple[Pin, ...] = ()
+    units: Units = Units()
     _plan: _Plan = field(init=False, repr=False, compare=False)
     _solver: _Solver = field(init=False, repr=False, compare=False)
 
@@ -1112,6 +1574,7 @@ class Scene:
         _check_name(self.name, 'the scene name', (self, 'name'))
         object.__setattr__(self, 'dyads', tuple(self.dyads))
         object.__setattr__(self, 'points', tuple(self.points))
+        object.__setattr__(self, 'pins', tuple(self.pins))
         full = _compile(self, None, None)
         solver = _Solver(self, full)
         try:
@@ -1119,9 +1582,12 @@ class Scene:
                 warnings.simplefilter('ignore', NearSingularWarning)
                 _execute(solver, self.input.angle, 0.0, 0.0)  # positions only
         except AssemblyError as error:
+            dyad = next((step.dyad for step in full.steps
+                         if not isinstance(step, _CarryStep) and step.label == error.dyad), None)
             msg = (f'Expected the mechanism to assemble at the initial crank angle '
-                   f'{math.degrees(self.input.angle):.6g} deg, got {error.dyad}: {error.reason}')
-            raise SceneError(msg, (self.input, 'angle')) from None
+                   f'{self.units.angle_text(self.input.angle)}, got '
+                   f'{assembly_text(error, self.units)}')
+            raise SceneError(msg, (self.input, 'angle') if dyad is None else (dyad, '')) from None
         if self.outputs_joints is None and self.outputs_points is None:
             plan = full
         else:
@@ -1144,6 +1610,11 @@ class Scene:
     def joint_types(self) -> dict[str, str]:
         """Joint name -> ``'revolute'`` or ``'prismatic'``, for the reported joints."""
         return dict(self._plan.joint_types)
+
+    @property
+    def pin_bodies(self) -> dict[str, tuple[str, str]]:
+        """Pin point -> the two bodies it joins (a link, ``ground`` or a slider block)."""
+        return {rub.point: rub.names for rub in self._plan.rubs}
 
 
 class JointMotion:
@@ -1185,6 +1656,56 @@ def _xy(z: Any) -> npt.NDArray[np.float64]:
 
 
 @dataclass(frozen=True)
+class Engagement:
+    """Where an intermittent (Geneva) lever is in its cycle, and its acceleration's jumps.
+
+    The crank's engagement windows are numbered: window ``k`` is centred on the
+    crank angle ``phi + 2 pi k`` (counted from the start) at which the pin
+    points at the lever's centre, and spans ``pi / 2 - pi / n`` either side.
+    Floats for one crank angle, arrays of shape (n,) for n angles.
+
+    Attributes
+    ----------
+    engaged : bool or ndarray of bool
+        Whether the pin is in a slot (the window's ends included).
+    window : int or ndarray of int
+        The number of the nearest window: the one the pin is in, or the
+        nearest one it has left or will enter.
+    entry, exit : float or ndarray
+        Crank angles (rad, counted from the start) where that window begins
+        and ends.
+    entry_acceleration, exit_acceleration : (float, float) or (ndarray, ndarray)
+        The lever's angular acceleration (rad/s^2) just before and just after
+        the crank passes ``entry`` and ``exit`` (turning CCW) at the current
+        crank speed omega: ``(0, -omega^2 tan(pi / n))`` and
+        ``(omega^2 tan(pi / n), 0)``. The angular velocity is 0 at both ends
+        (the pin enters and leaves tangentially); the acceleration jumps.
+    """
+
+    engaged: bool | npt.NDArray[np.bool_]
+    window: int | npt.NDArray[np.int64]
+    entry: Number
+    exit: Number
+    entry_acceleration: tuple[Number, Number]
+    exit_acceleration: tuple[Number, Number]
+
+    def as_dict(self, vector: bool) -> dict[str, Any]:
+        """Return the structure of ``State.as_dict()['intermittent'][LEVER]``."""
+        def value(x: Any) -> Any:
+            return x if vector else float(x)
+
+        def pair(x: tuple[Any, Any]) -> Any:
+            return np.stack(x, axis=-1) if vector else [float(x[0]), float(x[1])]
+
+        return {'engaged': self.engaged if vector else bool(self.engaged),
+                'window': self.window if vector else int(self.window),
+                'entry': {'angle': value(self.entry),
+                          'acceleration': pair(self.entry_acceleration)},
+                'exit': {'angle': value(self.exit),
+                         'acceleration': pair(self.exit_acceleration)}}
+
+
+@dataclass(frozen=True)
 class State:
     """The kinematic state of a scene at one crank angle or an array of them.
 
@@ -1214,7 +1735,15 @@ class State:
         `` (overflow)`` (a value is beyond the range of doubles).
     error_bound : ErrorBound
         Absolute error bound of every reported value, shaped like ``joints``
-        and ``points`` (see :mod:`mech_kinematics.bounds`).
+        and ``points`` (see :mod:`mech_kinematics.bounds`); ``rubbing`` too.
+    turns : int or ndarray of int
+        Whole crank turns added to ``angle`` (``solve(..., turns=)``): the crank
+        angle counted from the start is ``angle + 2 pi turns``.
+    rubbing : dict of str to float or ndarray
+        Rubbing velocity (m/s) at every pin of the scene's ``pins``.
+    intermittent : dict of str to Engagement
+        Every intermittent (Geneva) lever solved: engaged or locked, and where
+        its acceleration jumps.
     """
 
     scene: str
@@ -1227,6 +1756,9 @@ class State:
     singularity: dict[str, Number]
     failures: dict[str, npt.NDArray[np.bool_]]
     error_bound: ErrorBound
+    turns: int | npt.NDArray[np.int64] = 0
+    rubbing: dict[str, Number] = field(default_factory=dict)
+    intermittent: dict[str, Engagement] = field(default_factory=dict)
 
     @cached_property
     def points(self) -> dict[str, PointState]:
@@ -1288,9 +1820,11 @@ class State:
         def pair(x: npt.NDArray[np.float64]) -> Any:
             return x if vector else [float(x[0]), float(x[1])]
 
+        turns = self.turns
+        angle = self.angle if not np.any(turns) else self.angle + math.tau * turns
         return {
             'scene': self.scene,
-            'input': {'angle': value(self.angle), 'speed': value(self.speed),
+            'input': {'angle': value(angle), 'speed': value(self.speed),
                       'accel': value(self.accel)},
             'joints': {name: {'type': j.type, 'position': value(j.position),
                               'velocity': value(j.velocity),
@@ -1299,23 +1833,32 @@ class State:
             'points': {name: {'position': pair(p.position), 'velocity': pair(p.velocity),
                               'acceleration': pair(p.acceleration)}
                        for name, p in self.points.items()},
+            **({'rubbing': {name: value(x) for name, x in self.rubbing.items()}}
+               if self.rubbing else {}),
+            **({'intermittent': {name: e.as_dict(vector)
+                                 for name, e in self.intermittent.items()}}
+               if self.intermittent else {}),
             'error_bound': self.error_bound.as_dict(vector),
         }
 
 
-def _run(solver: _Solver, angle: Any, speed: Any, accel: Any) -> _Context:
+def _run(solver: _Solver, angle: Any, speed: Any, accel: Any, turns: Any) -> _Context:
     """Run every step of the solver's plan; the caller chose scalar or vector inputs."""
-    ctx = _Context(angle, not isinstance(angle, float))
+    ctx = _Context(angle, not isinstance(angle, float), turns)
     # Ground points stay complex scalars in both paths: NumPy broadcasts them.
     ctx.points.update(solver.ground)
     plan = solver.run_plan
     plan.crank.run(ctx, angle, speed, accel)
     for step in plan.steps:
         step.run(ctx)
+    if plan.rubs:
+        ctx.rubbing = {}
+        for rub in plan.rubs:
+            rub.run(ctx)
     return ctx
 
 
-def _execute(solver: _Solver, theta: Any, omega: Any, alpha: Any) -> _Context:
+def _execute(solver: _Solver, theta: Any, omega: Any, alpha: Any, turns: Any = 0) -> _Context:
     """Run the solver in units that keep every product in range; reported values in SI.
 
     A crank rate outside [_RATE_LOW, _RATE_HIGH] is solved with time scaled by a
@@ -1330,7 +1873,7 @@ def _execute(solver: _Solver, theta: Any, omega: Any, alpha: Any) -> _Context:
         shift = _rate_exponent(omega, alpha)
     if shift:
         omega, alpha = _ldexp(omega, -shift), _ldexp(alpha, -2 * shift)
-    ctx = _run(solver, theta, omega, alpha)
+    ctx = _run(solver, theta, omega, alpha, turns)
     if solver.shift or shift:
         _rescale(solver, ctx, shift)
     return ctx
@@ -1393,8 +1936,19 @@ def _rescale(solver: _Solver, ctx: _Context, shift: int) -> None:
                 what = 'its error bound' if _finite(entry[index]) else 'it'
                 reason = (f'the state overflows: the {quantity} of {path} is beyond the range '
                           f'of doubles (scaled back to SI, {what} exceeds {LARGEST:.3g})')
-                raise UntrustedError(label, ctx.angle, reason, f'{path}.{quantity}', math.inf,
+                raise UntrustedError(label, ctx.shown, reason, f'{path}.{quantity}', math.inf,
                                      LARGEST)
+    k = s + shift
+    for name, (value, bound) in ctx.rubbing.items():
+        value, bound = _ldexp(value, k), _ldexp(bound, k) + _TINY
+        ctx.rubbing[name] = (value, bound)
+        if ctx.vector:
+            ctx.mask(_finite(value) & _finite(bound), f'pin {name} (overflow)')
+        elif not (_finite(value) and _finite(bound)):
+            reason = (f'the state overflows: the rubbing velocity at pin {name} is beyond the '
+                      f'range of doubles (scaled back to SI, it exceeds {LARGEST:.3g})')
+            raise UntrustedError(f'pin {name}', ctx.shown, reason, f'rubbing.{name}', math.inf,
+                                 LARGEST)
 
 
 def _scales(size: float, crank_length: float, omega: Any, alpha: Any,
@@ -1457,6 +2011,8 @@ def _trusted(solver: _Solver, ctx: _Context, omega: float, alpha: float, tol: fl
         e = sliders[name]
         if not (e[3] <= lp and e[4] <= lv and e[5] <= la):
             return False
+    if ctx.rubbing:
+        return all(bound <= lv for _, bound in ctx.rubbing.values())
     return True
 
 
@@ -1476,10 +2032,20 @@ def _refuse(solver: _Solver, ctx: _Context, omega: float, alpha: float, tol: flo
                       f'to be at most {tol:g} x {scale:.3g} {unit} ({SCALE_MEANINGS[kind]}), '
                       f'got {bound:.3g} {unit}')
             key = solver.measure_keys.get(label)
-            if key is not None:
+            if label in ctx.notes:
+                reason += f'; {ctx.notes[label]}'
+            elif key is not None:
                 reason += f'; near-singularity measure of {label}: {ctx.measures[key]:.3g}'
-            raise UntrustedError(label, ctx.angle, reason, f'{path}.{quantity}', float(bound),
+            raise UntrustedError(label, ctx.shown, reason, f'{path}.{quantity}', float(bound),
                                  float(lim))
+    lim = limit(tol, scales['velocity'])
+    for name, (_, bound) in ctx.rubbing.items():
+        if not bound <= lim:
+            reason = (f'the rubbing velocity at pin {name} cannot be trusted: expected its '
+                      f'error bound to be at most {tol:g} x {scales["velocity"]:.3g} m/s '
+                      f'({SCALE_MEANINGS["velocity"]}), got {bound:.3g} m/s')
+            raise UntrustedError(f'pin {name}', ctx.shown, reason, f'rubbing.{name}',
+                                 float(bound), float(lim))
 
 
 def _judge(solver: _Solver, ctx: _Context, omega: Any, alpha: Any, tol: float,
@@ -1495,7 +2061,9 @@ def _judge(solver: _Solver, ctx: _Context, omega: Any, alpha: Any, tol: float,
     if all(bool(((entry[3] <= lims[kinds[0]]) & (entry[4] <= lims[kinds[1]])
                  & (entry[5] <= lims[kinds[2]]) | failed).all())
            for table, name, _, _, kinds in solver.outputs
-           for entry in (getattr(ctx, table)[name],)):
+           for entry in (getattr(ctx, table)[name],)) and all(
+               bool(((bound <= lims['velocity']) | failed).all())
+               for _, bound in ctx.rubbing.values()):
         return  # within the floors of the scales (as _trusted): no norms needed
     scales = _context_scales(solver, ctx, omega, alpha)
     lims = {kind: limit(tol, scale) for kind, scale in scales.items()}
@@ -1504,6 +2072,8 @@ def _judge(solver: _Solver, ctx: _Context, omega: Any, alpha: Any, tol: float,
         ok = ((entry[3] <= lims[kinds[0]]) & (entry[4] <= lims[kinds[1]])
               & (entry[5] <= lims[kinds[2]]))
         ctx.mask(np.broadcast_to(ok, shape), f'{label} (untrusted)')
+    for name, (_, bound) in ctx.rubbing.items():
+        ctx.mask(np.broadcast_to(bound <= lims['velocity'], shape), f'pin {name} (untrusted)')
 
 
 def _angle(e: Any, vector: bool) -> Any:
@@ -1517,7 +2087,8 @@ def _angle(e: Any, vector: bool) -> Any:
 
 
 def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None,
-          accel: npt.ArrayLike | None = None, *, max_error: float = MAX_ERROR) -> State:
+          accel: npt.ArrayLike | None = None, *, turns: npt.ArrayLike = 0,
+          max_error: float = MAX_ERROR) -> State:
     """Solve ``scene`` for position, velocity and acceleration at crank ``angle``.
 
     Every value comes with an absolute error bound (``State.error_bound``,
@@ -1529,11 +2100,19 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
     scene : Scene
         The mechanism.
     angle : float or array_like, shape (n,)
-        Crank angle(s), rad, CCW from +x.
+        Crank angle(s), rad, CCW from +x, counted from the start: ``2.5 pi``
+        is a quarter turn into the crank's second turn. Only an intermittent
+        (Geneva) drive tells the turns apart (its wheel indexes once a turn).
     speed : float or array_like, optional
         Crank angular velocity, rad/s, + CCW. Defaults to the scene's.
     accel : float or array_like, optional
         Crank angular acceleration, rad/s^2, + CCW. Defaults to the scene's.
+    turns : int or array_like of int, keyword-only
+        Whole crank turns to add to ``angle``: the crank angle counted from
+        the start is ``angle + 2 pi turns``, the sum never formed in floating
+        point, so a crank kept as whole turns plus an angle within one turn
+        (as the node keeps it) loses nothing however many turns it has made.
+        Default 0.
     max_error : float, optional
         Tolerance: the largest error bound accepted, relative to its kind's
         scale. Default 1e-6; ``math.inf`` accepts every finite answer. Whatever
@@ -1563,19 +2142,24 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
         msg = f'Expected `max_error` to be a positive number, got {max_error!r}'
         raise ValueError(msg)
     tol = float(max_error)
-    if _is_scalar(angle) and _is_scalar(speed) and _is_scalar(accel):
+    whole: Any = turns
+    if whole.__class__ is not int:  # an int is the usual case, decided without a call
+        whole = _turns(whole)
+    if _is_scalar(angle) and _is_scalar(speed) and _is_scalar(accel) and (
+            whole.__class__ is int or _is_scalar(whole)):
         theta, omega, alpha = float(angle), float(speed), float(accel)  # type: ignore[arg-type]
         if not (math.isfinite(theta) and math.isfinite(omega) and math.isfinite(alpha)):
             msg = (f'Expected `angle`, `speed` and `accel` to be finite, got {theta!r}, '
                    f'{omega!r}, {alpha!r}')
             raise ValueError(msg)
-        ctx = _execute(solver, theta, omega, alpha)
+        whole = int(whole)
+        ctx = _execute(solver, theta, omega, alpha, whole)
         if not _trusted(solver, ctx, omega, alpha, tol):
             _refuse(solver, ctx, omega, alpha, tol)
         valid: Any = True
     else:
         theta, omega, alpha = (np.asarray(x, dtype=np.float64) for x in (angle, speed, accel))
-        shape = np.broadcast_shapes(theta.shape, omega.shape, alpha.shape)
+        shape = np.broadcast_shapes(theta.shape, omega.shape, alpha.shape, np.shape(whole))
         if len(shape) != 1:
             msg = f'Expected `angle` to be a float or a 1-D array, got shape {shape}'
             raise ValueError(msg)
@@ -1584,14 +2168,33 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
             msg = 'Expected `angle`, `speed` and `accel` to be finite'
             raise ValueError(msg)
         theta = np.broadcast_to(theta, shape)
+        whole = np.broadcast_to(np.asarray(whole, dtype=np.int64), shape)
         with np.errstate(all='ignore'):
             # A constant speed or acceleration stays a scalar through the steps.
-            ctx = _execute(solver, theta, omega, alpha)
+            ctx = _execute(solver, theta, omega, alpha, whole)
             _judge(solver, ctx, omega, alpha, tol, shape)
         omega, alpha = np.broadcast_to(omega, shape), np.broadcast_to(alpha, shape)
         valid = np.broadcast_to(np.asarray(ctx.valid, dtype=bool), shape).copy()
     _warn_near_singular(ctx)
-    return _state(scene, solver, ctx, theta, omega, alpha, valid)
+    return _state(scene, solver, ctx, theta, omega, alpha, valid, whole)
+
+
+def _turns(turns: Any) -> Any:
+    """Return ``turns`` as an int or an int64 array, or raise a ValueError saying why not."""
+    if isinstance(turns, (int, np.integer)) and not isinstance(turns, (bool, np.bool_)):
+        return int(turns)
+    try:
+        array = np.asarray(turns)
+    except (TypeError, ValueError, OverflowError):
+        array = np.asarray(None)
+    if array.dtype.kind in 'iu':
+        if array.dtype.kind == 'u' and array.size and int(array.max()) >= 2 ** 63:
+            array = np.asarray(None)
+        else:
+            return array.astype(np.int64) if array.ndim else int(array)
+    msg = (f'Expected `turns` to be a whole number of crank turns (an int, or an array of '
+           f'ints within 2**63 for the array path), got {turns!r}')
+    raise ValueError(msg)
 
 
 def _is_scalar(x: Any) -> bool:
@@ -1609,7 +2212,7 @@ def _warn_near_singular(ctx: _Context) -> None:
 
 
 def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any, alpha: Any,
-           valid: Any) -> State:
+           valid: Any, turns: Any) -> State:
     vector = ctx.vector
     plan = solver.plan
     joints = {}
@@ -1654,13 +2257,43 @@ def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any,
                                     {name: (finish(a), finish(b), finish(c))
                                      for name, (a, b, c) in point_bounds.items()}),
                            solver.size, solver.crank_length)
+        rubbing = {name: finish(value) for name, (value, _) in ctx.rubbing.items()}
+        bound.rubbing = {name: finish(b) for name, (_, b) in ctx.rubbing.items()}
+        intermittent = {name: _engagement(step, ctx, omega, finish)
+                        for name, step in solver.levers.items()}
+    else:
+        rubbing = intermittent = {}
+        if ctx.rubbing:
+            rubbing = {name: value for name, (value, _) in ctx.rubbing.items()}
+            bound.rubbing = {name: b for name, (_, b) in ctx.rubbing.items()}
+        if solver.levers:
+            intermittent = {name: _engagement(step, ctx, omega, None)
+                            for name, step in solver.levers.items()}
     return _new_state(scene.name, theta, omega, alpha, joints, points, valid, dict(measures),
-                      dict(ctx.failures), bound)
+                      dict(ctx.failures), bound, turns, rubbing, intermittent)
+
+
+def _engagement(step: _IndexStep, ctx: _Context, omega: Any, finish: Any) -> Engagement:
+    """Return where an intermittent lever is in its cycle (see :class:`Engagement`)."""
+    engaged, window = ctx.engagement[step.link]
+    centre = step.phase0 + (window.astype(np.float64) if ctx.vector else float(window)) * math.tau
+    entry, exit_ = centre - step.half, centre + step.half
+    jump = omega * omega * step.tan
+    zero = 0.0 * jump
+    if finish is not None:
+        entry, exit_, jump, zero = finish(entry), finish(exit_), finish(jump), finish(zero)
+        engaged = np.broadcast_to(engaged, np.shape(entry))
+    # The fields go straight in, as in _new_state: a frozen dataclass's __init__ costs 1 us.
+    record = object.__new__(Engagement)
+    record.__dict__.update(engaged=engaged, window=window, entry=entry, exit=exit_,
+                           entry_acceleration=(zero, -jump), exit_acceleration=(jump, zero))
+    return record
 
 
 def _new_state(scene: str, angle: Any, speed: Any, accel: Any, joints: dict[str, JointMotion],
                points: dict[str, Any], valid: Any, singularity: dict[str, Any],
-               failures: dict[str, Any], error_bound: ErrorBound) -> State:
+               failures: dict[str, Any], error_bound: ErrorBound, turns: Any,
+               rubbing: dict[str, Any], intermittent: dict[str, Engagement]) -> State:
     """Return ``State(...)`` of these fields, built without the dataclass's ``__init__``.
 
     A frozen dataclass's ``__init__`` sets each field through
@@ -1674,7 +2307,8 @@ def _new_state(scene: str, angle: Any, speed: Any, accel: Any, joints: dict[str,
     fields['scene'], fields['angle'], fields['speed'], fields['accel'] = scene, angle, speed, accel
     fields['joints'], fields['complex_points'], fields['valid'] = joints, points, valid
     fields['singularity'], fields['failures'] = singularity, failures
-    fields['error_bound'] = error_bound
+    fields['error_bound'], fields['turns'] = error_bound, turns
+    fields['rubbing'], fields['intermittent'] = rubbing, intermittent
     return state
 
 

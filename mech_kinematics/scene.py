@@ -50,12 +50,13 @@ from yaml.events import (AliasEvent, DocumentEndEvent, DocumentStartEvent, Mappi
                          StreamEndEvent, StreamStartEvent)
 
 from .errors import SceneError
-from .linkage import Branch, CarriedPoint, Crank, Link, RPR, RRP, RRR, Scene
+from .linkage import Branch, CarriedPoint, Crank, Link, MAX_SLOTS, Pin, RPR, RRP, RRR, Scene, Units
 from .units import ANGLE_UNITS, LENGTH_UNITS, rad_per_s_from_rpm
 
 __all__ = [
     'DEFAULT_SCENE', 'MAX_CARRIED_POINTS', 'MAX_DEPTH', 'MAX_DYADS', 'MAX_FILE_BYTES',
-    'MAX_GROUND_POINTS', 'MAX_INTEGER_DIGITS', 'MAX_MESSAGE', 'MAX_YAML_NODES', 'SceneLoader',
+    'MAX_GROUND_POINTS', 'MAX_INTEGER_DIGITS', 'MAX_MESSAGE', 'MAX_PINS', 'MAX_YAML_NODES',
+    'SceneLoader',
     'load_scene', 'parse_scene', 'read_scene_yaml', 'scene_dirs', 'scene_names',
 ]
 
@@ -79,6 +80,8 @@ MAX_GROUND_POINTS = 10_000
 MAX_DYADS = 10_000
 #: Most carried points (``points:``) in a scene.
 MAX_CARRIED_POINTS = 10_000
+#: Most pins (``pins:``) in a scene.
+MAX_PINS = 10_000
 
 #: The two spellings of ``units`` every refusal of a missing or bad one shows.
 UNITS_EXAMPLES = 'units: {length: mm, angle: deg} or units: {length: m, angle: rad}'
@@ -116,6 +119,7 @@ class SceneDict(TypedDict, total=False):
     dyads: list[dict[str, Any]]
     points: dict[str, dict[str, Any]]
     outputs: dict[str, list[str]]
+    pins: dict[str, Any]
 
 
 # --- the YAML reader -------------------------------------------------------------------
@@ -460,6 +464,7 @@ class _Reader:
         length, angle = units['length'], units['angle']
         self.per_metre = LENGTH_UNITS[length]
         self.degrees = angle == 'deg'
+        self.units = Units(length, angle)
 
     @staticmethod
     def get(mapping: Any, key: str, where: str, default: Any = ...) -> Any:
@@ -617,6 +622,14 @@ def parse_scene(data: Any) -> Scene:
     points = [_carried(reader, keys, str(key), value, f'points.{key}')
               for key, value in points_data.items()]
 
+    pins_data = data.get('pins', {}) or {}
+    if not isinstance(pins_data, dict):
+        raise SceneError(f'pins: expected a mapping of point names to radii, got '
+                         f'{_kind(pins_data)}')
+    _check_count('pins', pins_data, MAX_PINS, 'MAX_PINS', 'pins')
+    pins = [_pin(reader, keys, str(key), value, f'pins.{key}')
+            for key, value in pins_data.items()]
+
     outputs = data.get('outputs', {}) or {}
     if not isinstance(outputs, dict):
         raise SceneError(f'outputs: expected a mapping, got {_kind(outputs)}')
@@ -632,7 +645,8 @@ def parse_scene(data: Any) -> Scene:
     try:
         return Scene(name=name, ground=ground, input=crank, dyads=tuple(dyads),
                      points=tuple(points), outputs_joints=selected['joints'],
-                     outputs_points=selected['points'], description=description)
+                     outputs_points=selected['points'], description=description,
+                     pins=tuple(pins), units=reader.units)
     except SceneError as error:
         raise SceneError(f'{keys.key(error)}: {error}') from None
 
@@ -669,11 +683,16 @@ def _dyad(reader: _Reader, keys: _Keys, raw: Any, where: str) -> RRR | RRP | RPR
             guide_angle=reader.angle(guide, 'angle', f'{where}.guide', 0.0),
             slider=reader.name(raw, 'slider', where), branch=reader.branch(raw, where))
     if kind == 'RPR':
-        _check_keys(raw, {'type', 'link', 'center', 'through', 'slider'}, where)
+        _check_keys(raw, {'type', 'link', 'center', 'through', 'slider', 'slots'}, where)
+        slots = raw.get('slots')
+        if slots is not None and (isinstance(slots, bool) or not isinstance(slots, int)
+                                  or not 3 <= slots <= MAX_SLOTS):
+            raise SceneError(f'{where}.slots: expected a whole number of slots from 3 to '
+                             f'{MAX_SLOTS}, got {_brief(slots)}')
         return keys.build(
             where, {}, RPR, link=reader.name(raw, 'link', where),
             center=reader.name(raw, 'center', where), through=reader.name(raw, 'through', where),
-            slider=reader.name(raw, 'slider', where))
+            slider=reader.name(raw, 'slider', where), slots=slots)
     raise SceneError(f'{where}.type: expected RRR, RRP or RPR, got {_brief(kind)}')
 
 
@@ -698,6 +717,24 @@ def _carried(reader: _Reader, keys: _Keys, name: str, raw: Any, where: str) -> C
                          f'origin/xaxis/local, got keys {_brief(sorted(raw))}')
     return keys.build(where, fields, CarriedPoint, name=name, link=link, origin=origin,
                       xaxis=xaxis, local=local)
+
+
+def _pin(reader: _Reader, keys: _Keys, name: str, raw: Any, where: str) -> Pin:
+    bodies = None
+    if isinstance(raw, dict):
+        _check_keys(raw, {'radius', 'between'}, where)
+        radius = reader.length(raw, 'radius', where)
+        between = reader.get(raw, 'between', where, None)
+        if between is not None:
+            if not isinstance(between, list) or len(between) != 2 or not all(
+                    isinstance(b, str) for b in between):
+                raise SceneError(f'{where}.between: expected the names of the two bodies the '
+                                 f'pin joins, e.g. [coupler, rocker], got {_brief(between)}')
+            bodies = (between[0], between[1])
+    else:
+        radius = reader.length({name: raw}, name, 'pins')
+    return keys.build(where, {'radius': 'radius', 'bodies': 'between', 'point': ''}, Pin,
+                      point=name, radius=radius, bodies=bodies)
 
 
 def scene_dirs() -> list[Path]:

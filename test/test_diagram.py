@@ -68,6 +68,12 @@ def _atol(polygon):
     return RTOL_POLYGON * max(float(np.hypot(*xy)) for xy in polygon.letters.values())
 
 
+def _locked(state, dyad):
+    """Return whether ``dyad`` is a Geneva wheel locked between engagements at ``state``."""
+    engagement = state.intermittent.get(dyad.link)
+    return engagement is not None and not engagement.engaged
+
+
 def _links(scene):
     """Each link's relative motions as (link, start, end) from the scene, end not a pin."""
     crank = scene.input
@@ -114,7 +120,12 @@ def test_velocity_polygon_closes(name, angle):
         np.testing.assert_allclose(vector.start, polygon.letters[start.lower()], atol=atol)
         np.testing.assert_allclose(vector.end, polygon.letters[end.lower()], atol=atol)
     for dyad in scene.dyads:
-        if isinstance(dyad, mk.RPR):
+        if isinstance(dyad, mk.RPR) and _locked(state, dyad):
+            # See issue 11: a Geneva wheel's pin is out of the slot, nothing slides.
+            with pytest.raises(KeyError):
+                polygon.find(f"v_{dyad.through}{dyad.through}'")
+            np.testing.assert_allclose(polygon.letters[f"{dyad.through.lower()}'"], 0.0)
+        elif isinstance(dyad, mk.RPR):
             pin = dyad.through.lower()
             slip = polygon.find(f"v_{dyad.through}{dyad.through}'")
             e = p[dyad.through] - p[dyad.center]
@@ -171,7 +182,9 @@ def test_acceleration_components_follow_the_textbook(name, angle):
                                    atol=atol)
         np.testing.assert_allclose(t @ r, 0.0, atol=atol * length)          # perpendicular
     for dyad in scene.dyads:
-        if isinstance(dyad, mk.RPR):
+        if isinstance(dyad, mk.RPR) and _locked(state, dyad):
+            assert not any(v.kind is geo.VectorKind.CORIOLIS for v in polygon.vectors)
+        elif isinstance(dyad, mk.RPR):
             coriolis = polygon.find(f"a_{dyad.through}{dyad.through}'^c")
             omega = state.joints[dyad.link].velocity
             slip = state.joints[dyad.slider].velocity
@@ -200,6 +213,45 @@ def test_space_diagram_is_the_solved_mechanism(name):
             assert 0.0 < s < float(np.hypot(*(guide.end - guide.start)))
     names = {link.name for link in space.links}
     assert scene.input.link in names
+
+
+@pytest.mark.parametrize(('angle_deg', 'engaged'), [(300.0, False), (150.0, True),
+                                                    (510.0, True), (-60.0, False)])
+def test_geneva_wheel_is_drawn_with_its_slots_engaged_or_locked(angle_deg, engaged, tmp_path):
+    """The wheel has 4 slots, slot 0 at its angle, the pin in one only while engaged.
+
+    See issue 11: in a dwell the wheel is drawn locked, its block (the pin in a
+    slot) is not drawn, and its table row says it is locked.
+    """
+    scene = mk.load_scene('geneva')
+    diagram = geo.diagram_from_scene(scene, angle_deg, degrees=True)
+    wheel = next(link for link in diagram.space.links if link.name == 'wheel')
+    values = next(link for link in diagram.links if link.name == 'wheel')
+    assert len(wheel.slots) == 4 and values.engaged is engaged
+    s, p = diagram.space.points['S'], diagram.space.points['P']
+    first = wheel.slots[0][1] - wheel.slots[0][0]
+    assert math.atan2(first[1], first[0]) == pytest.approx(values.angle, abs=1e-12)
+    for inner, mouth in wheel.slots:  # the mouths are 50 mm from S: sqrt(l^2 - R^2)
+        assert float(np.hypot(*(mouth - s))) == pytest.approx(0.05, rel=1e-12)
+        assert float(np.hypot(*(inner - s))) < 70.71067811865476e-3 - 0.05
+
+    def in_a_slot():
+        for inner, mouth in wheel.slots:
+            u = (mouth - inner) / np.hypot(*(mouth - inner))
+            d = p - inner
+            if abs(d[0] * u[1] - d[1] * u[0]) < 1e-9 and 0 <= d @ u <= np.hypot(*(mouth - inner)):
+                return True
+        return False
+
+    assert in_a_slot() is engaged
+    assert any(s.name == 'pin_slot' for s in diagram.space.sliders) is engaged
+    row = next(r for r in geo.tables_from_diagram(diagram)['space'].rows if r[0] == 'wheel')
+    assert row[1] == ('S (engaged)' if engaged else 'S (locked)')
+    if not engaged:
+        assert values.omega == 0.0 and values.alpha == 0.0
+        assert not any(v.kind is geo.VectorKind.SLIP for v in diagram.velocity.vectors)
+    png = dg.write_diagram(diagram, scene, tmp_path / 'geneva.png')
+    assert png.stat().st_size > 10_000
 
 
 def test_four_bar_matches_the_worked_example_layout():

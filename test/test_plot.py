@@ -133,6 +133,37 @@ def test_scene_that_does_not_assemble_everywhere_leaves_gaps(tmp_path):
     assert np.isnan(ydata).sum() == (~state.valid).sum() > 0
 
 
+def test_scene_plot_states_and_shades_where_it_does_not_assemble(tmp_path, capsys):
+    """`plot --scene` prints the unassemblable ranges in one line and shades them (issue 11)."""
+    out = tmp_path / 'fb.png'
+    assert plot.main(['--scene', 'four_bar_coupler_points', '-o', str(out)]) == 0
+    assert capsys.readouterr().out.splitlines()[0] == (
+        'four_bar_coupler_points: does not assemble for crank angles 103.792..256.208 deg')
+    motion = plot.motion_from_scene(mk.load_scene('four_bar_coupler_points'))
+    fig = plot.figure_from_motion(motion, x='angle')
+    assert fig._suptitle.get_text().endswith('does not assemble for crank angles '
+                                             '103.792..256.208 deg')
+    (start, end), = motion.gaps
+    assert math.degrees(start) == pytest.approx(103.792, abs=1e-3)
+    shaded = [patch for patch in panels(fig)['Joint angles'].patches]
+    assert any(abs(p.get_x() - start) < 1e-12 and abs(p.get_width() - (end - start)) < 1e-12
+               for p in shaded)
+
+
+def test_geneva_acceleration_jumps_are_not_smeared(tmp_path):
+    """The wheel's acceleration line breaks where the pin enters and leaves a slot (issue 11)."""
+    motion = plot.motion_from_scene(mk.load_scene('geneva'), samples=700)  # no sample on a mouth
+    assert motion.jumps.sum() == 2  # entry and exit, once each per turn
+    assert np.isfinite(motion.joints['wheel'][2]).all()
+    fig = plot.figure_from_motion(motion, x='angle')
+    y = lines(panels(fig)['Joint angular accelerations'])['wheel'].get_ydata()
+    finite = np.isfinite(y)
+    # no segment joins a locked sample (0) to an engaged one (|alpha| near 100 rad/s^2)
+    for a, b in zip(y[:-1][finite[:-1] & finite[1:]], y[1:][finite[:-1] & finite[1:]],
+                    strict=True):
+        assert (a == 0.0) == (b == 0.0) or abs(a - b) < 1.0
+
+
 @pytest.mark.parametrize('storage', bag_recorder.STORAGES)
 def test_bag_plot_shows_the_recorded_values(tmp_path, storage):
     """From a bag of the node's bytes (mcap and sqlite3): panels, time axis and the values."""

@@ -27,6 +27,7 @@ import yaml
 
 import mech_kinematics as mk
 from mech_kinematics.__main__ import build_parser, main
+from mech_kinematics.tools.solve import turns_from_degrees
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = ROOT / 'config' / 'scenes'
@@ -168,10 +169,17 @@ BAD_SCENES = [
      'outputs.joints', r'unknown "bogus"'),
     ('outputs_point_is_a_link', edit(setitem(['outputs'], {'points': ['rocker']})),
      'outputs.points', r'link "rocker"'),
-    ('cannot_assemble_at_initial_angle', edit(setitem([*LINK1, 'length'], 10)), 'input.angle',
-     r'assemble at the initial crank angle 60 deg.*RRR C'),
+    # See issue 11: the links whose lengths prevent assembly are named, in the scene's units.
+    ('cannot_assemble_at_initial_angle', edit(setitem([*LINK1, 'length'], 10)), 'dyads[0]',
+     r'assemble at the initial crank angle 60 deg, got links coupler \(150 mm\) and rocker '
+     r'\(10 mm\) cannot meet: B and D are 134\.536 mm apart, less than the difference of '
+     r'their lengths \(140 mm\)$'),
+    ('cannot_reach_at_initial_angle', edit(setitem(['dyads', 0, 'links', 0, 'length'], 50)),
+     'dyads[0]', r'assemble at the initial crank angle 60 deg, got links coupler \(50 mm\) and '
+     r'rocker \(80 mm\) cannot reach from B to D \(134\.536 mm apart, more than 130 mm\)$'),
     ('guide_out_of_reach_at_initial_angle', edit(setitem(['dyads', 1, 'link', 'length'], 20)),
-     'input.angle', r'assemble.*RRP P'),
+     'dyads[1]', r'assemble at the initial crank angle 60 deg, got link rod \(20 mm\) cannot '
+     r'reach the guide through G at 0 deg from E \([0-9.]+ mm from the guide\)$'),
     # See issue 11: units are explicit; a scene without them is refused, never read as metres.
     ('missing_units', edit(delitem(['units'])), 'units',
      r'missing required key: write units: \{length: mm, angle: deg\} or '
@@ -460,8 +468,8 @@ def assert_same(got, expected, path='', rel=1e-14):
         assert isinstance(got, list) and len(got) == len(expected), path
         for index, (g, e) in enumerate(zip(got, expected, strict=True)):
             assert_same(g, e, f'{path}[{index}]', rel)
-    elif isinstance(expected, str):
-        assert got == expected, path
+    elif isinstance(expected, (str, bool)):
+        assert got == expected and type(got) is type(expected), path
     else:
         assert isinstance(got, (int, float)) and not isinstance(got, bool), path
         assert math.isclose(got, expected, rel_tol=rel, abs_tol=1e-300), (path, got, expected)
@@ -472,7 +480,10 @@ def test_solve_command_prints_the_api_state(tmp_path):
     path = write(tmp_path, BASE)
     result = run_command('solve', path, '--angle-deg', 200, '--speed-rpm', 30, '--accel', 2.5)
     assert result.returncode == 0, result.stderr
-    expected = mk.solve(mk.load_scene(path), math.radians(200), 30 * math.pi / 30, 2.5)
+    # 200 deg is -160 deg in turn 1 (issue 11: the crank angle is counted from the start).
+    angle, turns = turns_from_degrees(200.0)
+    assert turns == 1 and angle == math.radians(-160.0)
+    expected = mk.solve(mk.load_scene(path), angle, 30 * math.pi / 30, 2.5, turns=turns)
     assert_same(json.loads(result.stdout), expected.as_dict())
 
 

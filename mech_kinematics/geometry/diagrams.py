@@ -43,8 +43,8 @@ from ..errors import NearSingularWarning
 from ..linkage import RPR, RRP, RRR, Scene, solve, State
 
 __all__ = [
-    'COLOURS', 'Diagram', 'GuideLine', 'LinkShape', 'LinkValues', 'Pivot', 'Polygon',
-    'SliderShape', 'SliderValues', 'SpaceDiagram', 'Table', 'Vector', 'VectorKind',
+    'COLOURS', 'Diagram', 'GuideLine', 'LinkShape', 'LinkValues', 'PinValues', 'Pivot',
+    'Polygon', 'SliderShape', 'SliderValues', 'SpaceDiagram', 'Table', 'Vector', 'VectorKind',
     'acceleration_polygon_from_state', 'arrows_from_state', 'colours_from_scene',
     'diagram_from_scene', 'space_from_state', 'strokes_from_scene', 'tables_from_diagram',
     'fmt_sense', 'fmt_value', 'nice_scale', 'scale_text', 'velocity_polygon_from_state',
@@ -167,13 +167,18 @@ class LinkShape:
     outline : ndarray, shape (n, 2)
         A segment (n = 2) through its extreme points, or the convex polygon of
         its points (n > 2, not repeated), m. A lever's outline runs through
-        the pin in its slot.
+        the pin in its slot; an intermittent (Geneva) wheel's is the polygon
+        of its slots' mouths, whether the pin is in a slot or not.
+    slots : tuple of (ndarray, ndarray)
+        An intermittent wheel's slots, each from its inner end to its mouth
+        (m); slot 0 lies along the wheel's angle. Empty for other links.
     """
 
     name: str
     kind: BodyKind
     points: tuple[str, ...]
     outline: Array
+    slots: tuple[tuple[Array, Array], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -255,6 +260,7 @@ class LinkValues:
     angle: float
     omega: float
     alpha: float
+    engaged: bool | None = None  # an intermittent (Geneva) lever: its pin in a slot or not
 
 
 @dataclass(frozen=True)
@@ -265,6 +271,17 @@ class SliderValues:
     s: float
     velocity: float
     acceleration: float
+
+
+@dataclass(frozen=True)
+class PinValues:
+    """A pin's rubbing velocity (m/s): its radius (m) times the bodies' relative angular speed."""
+
+    point: str
+    bodies: tuple[str, str]
+    radius: float
+    relative_omega: float
+    rubbing: float
 
 
 @dataclass(frozen=True)
@@ -288,6 +305,8 @@ class Diagram:
         Every slider.
     instant_centres : InstantCentres or None
         The instant centres, if requested.
+    pins : tuple of PinValues
+        The rubbing velocity at every pin of the scene's ``pins``.
     """
 
     scene: str
@@ -300,6 +319,7 @@ class Diagram:
     links: tuple[LinkValues, ...]
     sliders: tuple[SliderValues, ...]
     instant_centres: InstantCentres | None = None
+    pins: tuple[PinValues, ...] = ()
 
 
 # --- geometry -------------------------------------------------------------
@@ -370,6 +390,33 @@ def _pin_of(scene: Scene) -> dict[str, RPR]:
     return {_coincident(d.through): d for d in scene.dyads if isinstance(d, RPR)}
 
 
+def _locked(state: State) -> set[str]:
+    """Return the intermittent (Geneva) levers locked at this state (the pin out of its slot)."""
+    return {name for name, engagement in state.intermittent.items()
+            if not bool(engagement.engaged)}
+
+
+def _slots(scene: Scene, dyad: RPR, state: State,
+           points: Mapping[str, Array]) -> tuple[tuple[Array, Array], ...]:
+    """Return an intermittent lever's slots, from inside the pin's reach to the mouth, m."""
+    n = dyad.slots
+    if n is None:
+        return ()
+    names = (scene.input.center, dyad.center, dyad.through)
+    centre, wheel, pin = (points[name] for name in names)
+    distance = float(np.hypot(*(wheel - centre)))
+    radius = float(np.hypot(*(pin - centre)))
+    mouth = math.sqrt(max(distance * distance - radius * radius, 0.0))
+    inner = 0.85 * (distance - radius)
+    angle = float(state.joints[dyad.link].position)
+    slots = []
+    for i in range(n):
+        turn = angle + 2 * math.pi * i / n
+        u = np.array([math.cos(turn), math.sin(turn)])
+        slots.append((wheel + inner * u, wheel + mouth * u))
+    return tuple(slots)
+
+
 def _polygon_start(scene: Scene, state: State, index: int,
                    coincident: Callable[[float, float, complex], complex],
                    ) -> tuple[dict[str, str], dict[str, RPR], dict[str, complex],
@@ -420,12 +467,14 @@ def velocity_polygon_from_state(scene: Scene, state: State) -> Polygon:
         The pole ``o`` with every ground point; for every link the relative
         velocity ``omega x r`` of its end with respect to its start, from the
         start's letter; for every slotted lever the coincident point ``b'``
-        and the sliding velocity ``b'b``; the absolute velocity of every
-        moving point not already drawn from a ground point.
+        and the sliding velocity ``b'b`` (not for a Geneva wheel locked
+        between engagements: its pin is out of the slot); the absolute
+        velocity of every moving point not already drawn from a ground point.
     """
     letter, pins, position, velocity, letters = _polygon_start(
         scene, state, 1, lambda omega, alpha, r: 1j * omega * r)
     ground = tuple(letter[name] for name in scene.ground)
+    locked = _locked(state)
     vectors: list[Vector] = []
     drawn: set[str] = set()
     for edge in _edges(scene, state):
@@ -440,7 +489,7 @@ def velocity_polygon_from_state(scene: Scene, state: State) -> Polygon:
                               f'v_{edge.end}' if on_ground else ''))
         if on_ground:
             drawn.add(edge.end)
-        if edge.pin is not None:
+        if edge.pin is not None and edge.body not in locked:
             assert edge.slider is not None
             dyad = pins[edge.end]
             e = position[edge.pin] - position[dyad.center]
@@ -473,7 +522,8 @@ def acceleration_polygon_from_state(scene: Scene, state: State) -> Polygon:
         there, and the total relative acceleration from ``s``; for every
         slotted lever with pin B, after the components of the coincident
         point ``b'``, the Coriolis component ``2 omega x v_slip`` to ``b_b'``
-        and the sliding acceleration from there to ``b``; the absolute
+        and the sliding acceleration from there to ``b`` (not for a locked
+        Geneva wheel); the absolute
         acceleration of every moving point not already drawn from a ground
         point. Components are computed from the links' omega and alpha, and
         the letters of points are the solver's point accelerations, so the
@@ -482,6 +532,7 @@ def acceleration_polygon_from_state(scene: Scene, state: State) -> Polygon:
     letter, _, position, accel, letters = _polygon_start(
         scene, state, 2, lambda omega, alpha, r: (1j * alpha - omega * omega) * r)
     ground = tuple(letter[name] for name in scene.ground)
+    locked = _locked(state)
     vectors: list[Vector] = []
     drawn: set[str] = set()
     for edge in _edges(scene, state):
@@ -504,7 +555,7 @@ def acceleration_polygon_from_state(scene: Scene, state: State) -> Polygon:
                               f'a_{edge.end}' if on_ground else ''))
         if on_ground:
             drawn.add(edge.end)
-        if edge.pin is not None:
+        if edge.pin is not None and edge.body not in locked:
             assert edge.slider is not None
             e = r / abs(r)
             slider = state.joints[edge.slider]
@@ -610,13 +661,20 @@ def space_from_state(scene: Scene, state: State,
                default=1.0) or 1.0
     links = []
     rpr = {d.link: d for d in scene.dyads if isinstance(d, RPR)}
+    locked = _locked(state)
     for body in topology.bodies.values():
         if body.kind in (BodyKind.GROUND, BodyKind.SLIDER):
             continue
         xy = [points[name] for name in body.points]
+        slots: tuple[tuple[Array, Array], ...] = ()
         if body.name in rpr:
-            xy.append(points[rpr[body.name].through])
-        links.append(LinkShape(body.name, body.kind, body.points, _outline(np.array(xy))))
+            slots = _slots(scene, rpr[body.name], state, points)
+            if slots:  # a Geneva wheel: the polygon of its slots' mouths
+                xy += [mouth for _, mouth in slots]
+            else:
+                xy.append(points[rpr[body.name].through])
+        links.append(LinkShape(body.name, body.kind, body.points, _outline(np.array(xy)),
+                               slots))
     pinned = {point for a, b, point in topology.pins
               if topology.ground in (a, b)}
     pivots = tuple(Pivot(name, points[name]) for name in scene.ground if name in pinned)
@@ -633,9 +691,10 @@ def space_from_state(scene: Scene, state: State,
             through = points[dyad.through]
             guides.append(GuideLine(dyad.slider, through + (min(low, s) - pad) * u,
                                     through + (max(high, s) + pad) * u))
-        elif isinstance(dyad, RPR):
+        elif isinstance(dyad, RPR) and dyad.link not in locked:  # a locked wheel's pin is free
+            e = points[dyad.through] - points[dyad.center]
             sliders.append(SliderShape(dyad.slider, dyad.through, points[dyad.through],
-                                       float(state.joints[dyad.link].position), dyad.link))
+                                       math.atan2(e[1], e[0]), dyad.link))
     return SpaceDiagram(points, tuple(scene.ground), tuple(links), pivots, tuple(sliders),
                         tuple(guides))
 
@@ -698,9 +757,18 @@ def _values(scene: Scene, state: State,
             sliders.append(SliderValues(name, float(joint.position), float(joint.velocity),
                                         float(joint.acceleration)))
         else:
+            engagement = state.intermittent.get(name)
             links.append(LinkValues(name, body.points, lengths[name], float(joint.position),
-                                    float(joint.velocity), float(joint.acceleration)))
+                                    float(joint.velocity), float(joint.acceleration),
+                                    None if engagement is None else bool(engagement.engaged)))
     return tuple(links), tuple(sliders)
+
+
+def _pins(scene: Scene, state: State) -> tuple[PinValues, ...]:
+    radii = {pin.point: pin.radius for pin in scene.pins}
+    return tuple(PinValues(point, bodies, radii[point], float(state.rubbing[point]) / radii[point],
+                           float(state.rubbing[point]))
+                 for point, bodies in scene.pin_bodies.items())
 
 
 def diagram_from_scene(scene: Scene, angle: float | None = None, speed: float | None = None,
@@ -745,7 +813,8 @@ def diagram_from_scene(scene: Scene, angle: float | None = None, speed: float | 
     return Diagram(scene.name, theta, float(state.speed), float(state.accel),
                    space_from_state(scene, state, strokes_from_scene(scene)),
                    velocity_polygon_from_state(scene, state),
-                   acceleration_polygon_from_state(scene, state), links, sliders, centres)
+                   acceleration_polygon_from_state(scene, state), links, sliders, centres,
+                   _pins(scene, state))
 
 
 # --- value tables ---------------------------------------------------------
@@ -812,15 +881,20 @@ def tables_from_diagram(diagram: Diagram,
     Returns
     -------
     dict of str to Table
-        ``'space'`` (links: length, angle, omega, alpha; sliders; instant
-        centres if computed), ``'velocity'`` and ``'acceleration'`` (every
-        vector drawn: letters, quantity, magnitude, direction).
+        ``'space'`` (links: length, angle, omega, alpha, a Geneva wheel
+        marked engaged or locked; sliders; pins: radius, relative angular
+        speed, rubbing velocity; instant centres if computed),
+        ``'velocity'`` and ``'acceleration'`` (every vector drawn: letters,
+        quantity, magnitude, direction).
     """
     rows: list[tuple[str, ...]] = []
     for link in diagram.links:
         length = '-' if link.length is None else fmt_value(link.length)
-        rows.append((link.name, ''.join(link.points) if all(len(p) == 1 for p in link.points)
-                     else ','.join(link.points), length,
+        points = ''.join(link.points) if all(len(p) == 1 for p in link.points) \
+            else ','.join(link.points)
+        if link.engaged is not None:
+            points += ' (engaged)' if link.engaged else ' (locked)'
+        rows.append((link.name, points, length,
                      fmt_value(math.degrees(link.angle)),
                      fmt_value(link.omega) + fmt_sense(link.omega),
                      fmt_value(link.alpha) + fmt_sense(link.alpha)))
@@ -828,6 +902,10 @@ def tables_from_diagram(diagram: Diagram,
         rows.append((slider.name, 'slider', f's = {fmt_value(slider.s)}', '-',
                      f'{fmt_value(slider.velocity)} m/s',
                      f'{fmt_value(slider.acceleration)} m/s\u00b2'))
+    for pin in diagram.pins:  # seed 001: rubbing velocity = |omega_a - omega_b| r
+        rows.append((f'pin {pin.point}', '/'.join(pin.bodies), f'r = {fmt_value(pin.radius)}',
+                     '-', f'\u0394\u03c9 {fmt_value(pin.relative_omega)}',
+                     f'rubbing {fmt_value(pin.rubbing)} m/s'))
     tables = {'space': Table('Links and sliders',
                              ('link', 'points', 'length m', 'angle \u00b0', '\u03c9 rad/s',
                               '\u03b1 rad/s\u00b2'), tuple(rows))}

@@ -440,6 +440,17 @@ def _primary(topology: Topology, scene: Scene, state: State, size: float
     for slider, guide in topology.slides:
         if slider in rrp:
             angle = rrp[slider].guide_angle
+        elif rpr[slider].link in state.intermittent:
+            # A Geneva wheel: the slot the pin is in (not slot 0) lies along the pivot-pin
+            # line; while the wheel is locked the pin, out of the slot, moves with the
+            # crank, across the crank's radius (the pin is on the crank).
+            dyad = rpr[slider]
+            pin = complex(state.complex_points[dyad.through][0])
+            engaged = state.intermittent[dyad.link].engaged
+            start = dyad.center if engaged else scene.input.center
+            o = complex(state.complex_points[start][0])
+            angle = math.atan2(pin.imag - o.imag, pin.real - o.real) + (
+                0.0 if engaged else math.pi / 2)
         else:
             angle = float(state.joints[rpr[slider].link].position)
         # normal to the slide: perpendicular to the direction of sliding
@@ -456,7 +467,9 @@ def instant_centres_from_kennedy(scene: Scene, state: State) -> InstantCentres:
     is the intersection of the lines ``I_ik I_jk`` and ``I_im I_jm`` for two
     other bodies k and m whose centres with i and j are known (of the
     candidate pairs of lines, the best conditioned); parallel lines meet at
-    infinity.
+    infinity. A Geneva wheel locked between engagements moves with the ground:
+    its centre with any body is the ground's, and its pin, out of the slot,
+    slides across the crank's radius.
 
     Parameters
     ----------
@@ -476,9 +489,21 @@ def instant_centres_from_kennedy(scene: Scene, state: State) -> InstantCentres:
     check_full_state(topology, scene, state)
     size = _size(state)
     known = _primary(topology, scene, state, size)
+    # A locked Geneva wheel moves with the ground: its centre with any body is the ground's.
+    locked = [d.link for d in scene.dyads if isinstance(d, RPR) and d.link in state.intermittent
+              and not state.intermittent[d.link].engaged]
 
     pairs = _pairs(topology)
     while True:
+        for lever in locked:
+            for body in topology.bodies:
+                if body in (lever, topology.ground):
+                    continue
+                ours, theirs = frozenset((lever, body)), frozenset((topology.ground, body))
+                if theirs in known and ours not in known:
+                    known[ours] = known[theirs]
+                elif ours in known and theirs not in known:
+                    known[theirs] = known[ours]
         best: tuple[float, str, str, npt.NDArray[np.float64]] | None = None
         for a, b in pairs:
             if frozenset((a, b)) in known:

@@ -252,6 +252,11 @@ def _draw_mechanism(ax: Any, scene: Scene, space: SpaceDiagram, colours: Mapping
     for link in space.links:
         colour = colours[link.name]
         xy = link.outline
+        for inner, mouth in link.slots:  # a Geneva wheel: its slots, open at the rim
+            ax.plot([inner[0], mouth[0]], [inner[1], mouth[1]], color=colour, lw=6.0,
+                    zorder=2.2, solid_capstyle='round')
+            ax.plot([inner[0], mouth[0]], [inner[1], mouth[1]], color='white', lw=3.6,
+                    zorder=2.3, solid_capstyle='butt')
         if len(xy) > 2:
             ax.add_patch(Patch(xy, closed=True, facecolor=colour, alpha=0.22, edgecolor=colour,
                                lw=2.0, zorder=2))

@@ -108,6 +108,14 @@ class Motion:
     points : dict of str to (ndarray, ndarray, ndarray or None)
         Position (m), velocity (m/s) and acceleration (m/s², None if not
         available), each of shape (n, 2).
+    jumps : ndarray of bool, shape (n - 1,), or None
+        Where an acceleration jumps between two samples (a Geneva wheel's pin
+        entering or leaving a slot): no line is drawn across, so a jump is
+        not smeared into a steep slope.
+    note : str
+        A line under the title: where the mechanism does not assemble.
+    gaps : tuple of (float, float)
+        Crank-angle ranges (rad) where it does not assemble, shaded.
     """
 
     title: str
@@ -116,6 +124,9 @@ class Motion:
     joint_types: Mapping[str, str]
     joints: Mapping[str, tuple[Array, Array, Array | None]]
     points: Mapping[str, tuple[Array, Array, Array | None]]
+    jumps: Array | None = None
+    note: str = ''
+    gaps: tuple[tuple[float, float], ...] = ()
 
 
 # -- from the solver -------------------------------------------------------------
@@ -159,16 +170,23 @@ def motion_from_scene(scene: Any, *, samples: int = DEFAULT_SAMPLES,
         angle = scene.input.angle + speed * time
     else:
         angle = np.linspace(0.0, 2.0 * math.pi, samples)
+    from ..geometry.assembly import assembly_ranges, summary_from_gaps
+
     with warnings.catch_warnings():
         warnings.simplefilter('ignore', mk.NearSingularWarning)
         state = mk.solve(scene, angle, speed, accel)
     joints = {name: (j.position, j.velocity, j.acceleration) for name, j in state.joints.items()}
     points = {name: (p.position, p.velocity, p.acceleration) for name, p in state.points.items()}
+    jumps = np.zeros(len(angle) - 1, dtype=bool)
+    for engagement in state.intermittent.values():  # a Geneva wheel: engaged or locked
+        engaged = np.asarray(engagement.engaged, dtype=bool)
+        jumps |= engaged[1:] != engaged[:-1]
     rpm = rpm_from_rad_per_s(speed)
     title = (f'{scene.name}: solver, one crank cycle at {rpm:.6g} rpm'
              + (f', {accel:.6g} rad/s²' if accel else ''))
+    _, gaps = assembly_ranges(scene)
     return Motion(title, np.asarray(angle, dtype=np.float64), time, scene.joint_types, joints,
-                  points)
+                  points, jumps, summary_from_gaps(gaps, scene.units), gaps)
 
 
 # -- from a bag ------------------------------------------------------------------
@@ -419,9 +437,11 @@ def figure_from_motion(motion: Motion, *, x: str = 'time') -> Any:
     if prismatic:
         columns.append(('slider_position', 'slider_velocity', 'slider_acceleration'))
     gaps = _gaps(motion.time, len(motion.crank_angle))
+    if motion.jumps is not None:
+        gaps = gaps | motion.jumps  # an acceleration's jump: no line across it
     fig = Figure(figsize=(6.0 * len(columns), 9.0), layout='constrained')
     grid = fig.subplots(3, len(columns), squeeze=False)
-    fig.suptitle(motion.title)
+    fig.suptitle(motion.title + (f'\n{motion.note}' if motion.note else ''))
 
     def series(kind: str) -> list[tuple[str, Array | None, bool]]:
         """(label, values, values wrap at ±π) per line of a panel against ``x``."""
@@ -450,6 +470,10 @@ def figure_from_motion(motion: Motion, *, x: str = 'time') -> Any:
             ax.set_xlabel(XLABELS[x])
             if x == 'angle':
                 _angle_ticks(ax)
+                for start, end in motion.gaps:  # where it does not assemble, shaded
+                    for shift in (-2.0 * math.pi, 0.0, 2.0 * math.pi):
+                        ax.axvspan(start + shift, end + shift, color='0.9', zorder=0)
+                _angle_ticks(ax)  # the spans must not widen the axis
             drawn = 0
             for label, values, wraps in series(kind):
                 if values is None:
@@ -527,7 +551,9 @@ paths and the magnitudes of point velocities and accelerations, in SI units,
 against time or crank angle, to an image file (PNG; no display needed).
 
   plot BAG -o FILE.png             a bag recorded from the node (mcap or sqlite3)
-  plot --scene SCENE -o FILE.png   the solver over one crank cycle
+  plot --scene SCENE -o FILE.png   the solver over one crank cycle; prints (and
+                                   shades) the crank angles where the scene
+                                   does not assemble, in one line
   plot BAG --scene SCENE ...       a bag, with the scene telling sliders from
                                    revolute joints (by default the scene named
                                    in the bag's diagnostics is used)
@@ -552,8 +578,11 @@ def _handle(args: argparse.Namespace) -> int:
             plot_bag(args.bag, output, x=args.x or 'time', scene=scene,
                      namespace=args.namespace, max_samples=args.max_samples or None)
         else:
-            plot_scene(scene, output, x=args.x or 'angle', samples=args.samples, speed=speed,
-                       accel=args.accel)
+            x = args.x or 'angle'
+            motion = motion_from_scene(scene, samples=args.samples, speed=speed,
+                                       accel=args.accel, x=x)
+            save_figure(figure_from_motion(motion, x=x), output)
+            print(f'{scene.name}: {motion.note}')  # where it does not assemble, if anywhere
     except (PlotError, mk.SceneError) as error:
         print(f'error: {error}', file=sys.stderr)
         return 2

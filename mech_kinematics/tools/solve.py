@@ -7,25 +7,29 @@ from __future__ import annotations
 import argparse
 from collections.abc import Sequence
 import json
+import math
 import sys
 from typing import Any
 
 from ..bounds import MAX_ERROR
 from ..cli import finite_float, run_tool
-from ..errors import AssemblyError, SceneError
-from ..linkage import solve
+from ..errors import AssemblyError, SceneError, UntrustedError
+from ..linkage import assembly_text, solve
 from ..scene import load_scene
 from ..units import rad_per_s_from_rpm, radians_from_degrees
 
-__all__ = ['add_parser', 'main']
+__all__ = ['add_parser', 'main', 'turns_from_degrees']
 
 SOLVE_HELP = """\
 Solve a scene at one crank instant and print one JSON object: the input
 (angle rad, speed rad/s, accel rad/s^2), every output joint (type, position,
 velocity, acceleration: rad for revolute joints, m for sliders), every
-output point (position, velocity, acceleration as [x, y]) and "error_bound",
-the absolute error bound of each of those values (one number per value; for
-a point, the bound on the length of its error vector), all in SI units.
+output point (position, velocity, acceleration as [x, y]), "rubbing" (the
+rubbing velocity at each of the scene's pins, m/s), "intermittent" (each
+Geneva wheel: engaged or locked, its engagement window and where its
+acceleration jumps) and "error_bound", the absolute error bound of each of
+those values (one number per value; for a point, the bound on the length of
+its error vector), all in SI units.
 Options left out take the scene's own values. On a position that cannot be
 solved, or whose answer cannot be trusted (a value's error bound above
 --max-error times its kind's scale, a dyad within rounding of an assembly
@@ -47,17 +51,40 @@ def _max_error(text: str) -> float:
     return value
 
 
+def turns_from_degrees(degrees: float) -> tuple[float, int]:
+    """Split a crank angle in degrees, counted from the start, into (rad within a turn, turns).
+
+    ``degrees = 360 * turns + rest`` exactly (IEEE remainder), ``rest`` in
+    [-180, 180]; the angle is ``rest`` in radians. So ``--angle-deg 450`` is
+    90 deg in turn 1, and ``36000090`` is 90 deg in turn 100000, with no
+    rounding of the whole turns.
+    """
+    rest = math.remainder(degrees, 360.0)
+    return radians_from_degrees(rest), round((degrees - rest) / 360.0)
+
+
 def _handle(args: argparse.Namespace) -> int:
     try:
         scene = load_scene(args.scene)
     except SceneError as error:
         print(f'error: {error}', file=sys.stderr)
         return 2
-    angle = scene.input.angle if args.angle_deg is None else radians_from_degrees(args.angle_deg)
+    if args.angle_deg is None:
+        angle, turns = scene.input.angle, 0
+    else:
+        angle, turns = turns_from_degrees(args.angle_deg)
     speed = None if args.speed_rpm is None else rad_per_s_from_rpm(args.speed_rpm)
     try:
-        state = solve(scene, angle, speed, args.accel, max_error=args.max_error)
-    except (AssemblyError, ValueError) as error:
+        state = solve(scene, angle, speed, args.accel, turns=turns, max_error=args.max_error)
+    except AssemblyError as error:
+        shown = scene.units.angle_text(scene.input.angle) if args.angle_deg is None else \
+            f'{args.angle_deg:.15g} deg'
+        reason = error.reason if isinstance(error, UntrustedError) or error.facts is None \
+            else assembly_text(error, scene.units)
+        print(f'error: {error.dyad} cannot be solved at crank angle {shown}: {reason}',
+              file=sys.stderr)
+        return 2
+    except ValueError as error:
         print(f'error: {error}', file=sys.stderr)
         return 2
     result: dict[str, Any] = state.as_dict()
@@ -77,7 +104,9 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
                         help='path to a scene YAML, or the name of a packaged scene '
                              '(e.g. khurmi_four_bar_ad150)')
     parser.add_argument('--angle-deg', type=finite_float, metavar='X',
-                        help="crank angle in degrees CCW from +x (default: the scene's)")
+                        help='crank angle in degrees CCW from +x, counted from the start: 450 '
+                             'is a quarter turn into the second turn (it matters for an '
+                             "intermittent drive; default: the scene's)")
     parser.add_argument('--speed-rpm', type=finite_float, metavar='N',
                         help="signed crank speed in rpm, + CCW (default: the scene's)")
     parser.add_argument('--accel', type=finite_float, metavar='A',

@@ -1,0 +1,550 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""Where a mechanism assembles over one crank turn, and how well it moves there.
+
+:func:`assembly_from_scene` studies one full turn of the crank (angles 0 to
+2 pi, CCW from +x) from the exact solver:
+
+- the crank-angle ranges where the mechanism assembles, their ends refined
+  by bisection to :data:`TOLERANCE` rad;
+- its toggle positions: where a dyad's two links come in line (an RRR's
+  coupler and rocker, an RRP's rod square to its guide), at the ends of
+  those ranges or, at a change point, inside one; the mechanism locks there;
+- its dead centres: where an output (a link turning about a ground pivot
+  other than the crank, or a slider on a fixed guide) reverses, its
+  velocity zero (for a four-bar's rocker, the crank and coupler in line; for
+  a slider-crank, the inner and outer dead centres);
+- the minimum transmission angle of every RRR and RRP dyad and where it
+  occurs (the angle between coupler and rocker folded to [0, 90] deg, 90
+  best; for an RRP the angle between the rod and the guide's normal); the
+  angle is exact, its place known to about 1e-8 rad where the minimum is a
+  smooth one (the function is flat there), exactly where it is an end of a
+  range;
+- the Grashof class of every four-bar loop: an RRR dyad between a ground
+  pivot and a point on a link that turns about another ground pivot.
+
+:func:`assembly_summary` states the ranges where it does not assemble in one
+short line, for ``plot --scene`` and the node's diagnostics. Angles here are
+in rad and lengths in m; :class:`~mech_kinematics.linkage.Units` shows them
+in the scene's own units. NumPy only: the solver does the geometry.
+
+A range narrower than the sampling step (:data:`SAMPLES` per turn) can be
+missed; toggles and transmission minima inside a range are refined from the
+sampled minimum, so a second, equally deep minimum within one step of the
+first is reported once.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+import math
+import warnings
+
+import numpy as np
+import numpy.typing as npt
+
+from .instant_centres import full_scene
+from ..errors import AssemblyError, NearSingularWarning
+from ..linkage import RPR, RRP, RRR, Scene, solve, Units
+
+__all__ = [
+    'Assembly', 'DeadCentre', 'FourBarLoop', 'SAMPLES', 'TOLERANCE', 'Toggle', 'Transmission',
+    'angle_text', 'assembly_from_scene', 'assembly_ranges', 'assembly_summary',
+    'grashof_class', 'summary_from_gaps',
+]
+
+Array = npt.NDArray[np.float64]
+
+#: Crank angles sampled over the turn before refining (every 0.1 deg).
+SAMPLES = 3600
+#: Ends of ranges, toggles and dead centres are refined to this, rad.
+TOLERANCE = 1e-12
+#: A measure (sine of a transmission angle) below this inside a range is a toggle.
+TOGGLE_MEASURE = 1e-6
+#: Relative difference of ``s + l`` and ``p + q`` within which a loop is a change point.
+CHANGE_POINT = 1e-9
+_TURN = 2.0 * math.pi
+
+
+@dataclass(frozen=True)
+class Toggle:
+    """A toggle position: the crank angle (rad) where ``dyad``'s links come in line."""
+
+    angle: float
+    dyad: str
+    links: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class DeadCentre:
+    """A dead centre: the crank angle (rad) where output ``joint`` reverses.
+
+    ``position`` is the joint's value there (rad or m): an extreme of its
+    travel. ``in_line`` names the crank and the link from its tip when the
+    two are in line there (a four-bar's or a slider-crank's dead centre).
+    """
+
+    angle: float
+    joint: str
+    kind: str
+    position: float
+    in_line: tuple[str, str] | None
+
+
+@dataclass(frozen=True)
+class Transmission:
+    """The smallest transmission angle (rad) of ``dyad`` over the turn, at crank ``angle``."""
+
+    dyad: str
+    links: tuple[str, ...]
+    minimum: float
+    angle: float
+
+
+@dataclass(frozen=True)
+class FourBarLoop:
+    """A four-bar loop: ground pivots, the input link and its point, coupler and output.
+
+    ``lengths`` are ground, input, coupler, output (m); ``names`` the same
+    four (the ground named by its pivots, e.g. ``AD``); ``points`` the
+    input's pivot, its moving point, the coupler-output pin and the output's
+    pivot.
+    """
+
+    names: tuple[str, str, str, str]
+    points: tuple[str, str, str, str]
+    lengths: tuple[float, float, float, float]
+
+    @property
+    def grashof(self) -> str:
+        """The Grashof class (:func:`grashof_class`)."""
+        return grashof_class(*self.lengths)
+
+
+@dataclass(frozen=True)
+class Assembly:
+    """What :func:`assembly_from_scene` finds over one crank turn (rad, m).
+
+    Attributes
+    ----------
+    scene : str
+        Scene name.
+    units : Units
+        The scene's units, to show the numbers in.
+    ranges : tuple of (float, float)
+        Crank-angle ranges where it assembles, ``start < end``; a range that
+        runs through 0 starts below 0. ``((0, 2 pi),)`` everywhere.
+    gaps : tuple of (float, float)
+        The ranges in between, where it does not.
+    toggles, dead_centres : tuple
+        As :class:`Toggle` and :class:`DeadCentre`, by crank angle.
+    transmission : tuple of Transmission
+        Per RRR and RRP dyad.
+    loops : tuple of FourBarLoop
+        Every four-bar loop.
+    """
+
+    scene: str
+    units: Units
+    ranges: tuple[tuple[float, float], ...]
+    gaps: tuple[tuple[float, float], ...]
+    toggles: tuple[Toggle, ...]
+    dead_centres: tuple[DeadCentre, ...]
+    transmission: tuple[Transmission, ...]
+    loops: tuple[FourBarLoop, ...]
+
+    @property
+    def everywhere(self) -> bool:
+        """Whether the mechanism assembles at every crank angle."""
+        return not self.gaps
+
+    def summary(self) -> str:
+        """Return the ranges where it does not assemble as one short line (scene's units)."""
+        return summary_from_gaps(self.gaps, self.units)
+
+
+def grashof_class(ground: float, input_: float, coupler: float, output: float) -> str:
+    """Return the Grashof class of a four-bar from its four lengths.
+
+    With s and l the shortest and longest lengths and p, q the others:
+    ``s + l < p + q`` (Grashof) gives a ``crank-rocker`` when the input is
+    shortest, a ``rocker-crank`` when the output is, a ``double-crank`` when
+    the ground is and a ``double-rocker`` when the coupler is; ``s + l = p + q``
+    (to :data:`CHANGE_POINT`) a ``change point``; ``s + l > p + q`` a
+    ``triple-rocker`` (non-Grashof).
+    """
+    lengths = (ground, input_, coupler, output)
+    short, long = min(lengths), max(lengths)
+    pq = sum(lengths) - short - long
+    if abs((short + long) - pq) <= CHANGE_POINT * (short + long):
+        return 'change point'
+    if short + long > pq:
+        return 'triple-rocker'
+    shortest = lengths.index(short)
+    return ('double-crank', 'crank-rocker', 'double-rocker', 'rocker-crank')[shortest]
+
+
+def summary_from_gaps(gaps: Sequence[tuple[float, float]], units: Units) -> str:
+    """Return :func:`assembly_summary`'s line for crank-angle ranges ``gaps`` (rad)."""
+    if not gaps:
+        return 'assembles at every crank angle'
+    return f'does not assemble for crank angles {_ranges_text(gaps, units)}'
+
+
+def assembly_summary(scene: Scene) -> str:
+    """Return, in one short line, where ``scene`` does not assemble over a crank turn.
+
+    E.g. ``does not assemble for crank angles 103.792..256.208 deg``, or
+    ``assembles at every crank angle``; angles in the scene's unit, 6
+    significant digits. Only the ranges are computed (a few ms).
+    """
+    return summary_from_gaps(assembly_ranges(scene)[1], scene.units)
+
+
+def assembly_ranges(scene: Scene) -> tuple[tuple[tuple[float, float], ...],
+                                           tuple[tuple[float, float], ...]]:
+    """Return the crank-angle ranges (rad) where ``scene`` assembles and where it does not.
+
+    As :attr:`Assembly.ranges` and :attr:`Assembly.gaps`; only these are
+    computed.
+    """
+    ranges = _ranges(_Probe(scene))
+    return ranges, _gaps(ranges)
+
+
+def assembly_from_scene(scene: Scene, samples: int = SAMPLES) -> Assembly:
+    """Study one full turn of ``scene``'s crank (see the module's docstring).
+
+    Parameters
+    ----------
+    scene : Scene
+        The mechanism (a scene pruned by ``outputs`` is studied in full).
+    samples : int
+        Crank angles sampled over the turn before refining.
+
+    Returns
+    -------
+    Assembly
+    """
+    probe = _Probe(scene, samples)
+    ranges = _ranges(probe)
+    gaps = _gaps(ranges)
+    toggles = _toggles(probe, ranges)
+    return Assembly(scene.name, scene.units, ranges, gaps, toggles, _dead_centres(probe),
+                    _transmission(probe, ranges, toggles), _loops(probe))
+
+
+# --- sampling and refining ------------------------------------------------------------
+
+
+class _Probe:
+    """The scene solved over the sampled turn, and single angles on request."""
+
+    def __init__(self, scene: Scene, samples: int = SAMPLES) -> None:
+        self.scene = full_scene(scene)
+        self.theta = np.linspace(0.0, _TURN, samples, endpoint=False)
+        self.state = self.solve(self.theta)
+        self.valid = np.asarray(self.state.valid, dtype=bool)
+
+    def solve(self, theta: float | Array) -> object:
+        """Solve at crank speed 1 rad/s, refusing only what does not assemble."""
+        with warnings.catch_warnings():
+            warnings.simplefilter('ignore', NearSingularWarning)
+            return solve(self.scene, theta, 1.0, 0.0, max_error=math.inf)
+
+    def assembles(self, theta: float) -> bool:
+        try:
+            self.solve(theta)
+        except AssemblyError:
+            return False
+        return True
+
+    def failure(self, theta: float) -> AssemblyError | None:
+        try:
+            self.solve(theta)
+        except AssemblyError as error:
+            return error
+        return None
+
+
+def _bisect(test: Callable[[float], bool], low: float, high: float) -> float:
+    """Return the change of ``test`` between ``low`` (its value there kept) and ``high``."""
+    keep = test(low)
+    while high - low > TOLERANCE:
+        middle = 0.5 * (low + high)
+        if middle in (low, high):
+            break
+        if test(middle) == keep:
+            low = middle
+        else:
+            high = middle
+    return 0.5 * (low + high)
+
+
+def _ranges(probe: _Probe) -> tuple[tuple[float, float], ...]:
+    valid, theta = probe.valid, probe.theta
+    n = len(theta)
+    if valid.all():
+        return ((0.0, _TURN),)
+    step = _TURN / n
+    edges = []  # (angle, rising): the refined ends, in order
+    for i in range(n):
+        j = (i + 1) % n
+        if valid[i] != valid[j]:
+            low = float(theta[i])
+            edges.append((_bisect(probe.assembles, low, low + step), bool(valid[j])))
+    starts = [a for a, rising in edges if rising]
+    ends = [a for a, rising in edges if not rising]
+    if ends and starts and ends[0] < starts[0]:
+        starts = [starts[-1] - _TURN] + starts[:-1]
+    return tuple(zip(starts, ends, strict=True))
+
+
+def _gaps(ranges: Sequence[tuple[float, float]]) -> tuple[tuple[float, float], ...]:
+    if len(ranges) == 1 and ranges[0][1] - ranges[0][0] >= _TURN:
+        return ()
+    gaps = []
+    for index, (_, end) in enumerate(ranges):
+        start = ranges[(index + 1) % len(ranges)][0]
+        while start < end:
+            start += _TURN
+        gaps.append((end, start))
+    return tuple(gaps)
+
+
+def _measure_keys(scene: Scene) -> dict[str, tuple[str, tuple[str, ...]]]:
+    """Measure key -> (dyad label, its links) for the RRR and RRP dyads."""
+    keys = {}
+    for dyad in scene.dyads:
+        if isinstance(dyad, RRR):
+            keys[dyad.point] = (f'RRR {dyad.point}', tuple(link.name for link in dyad.links))
+        elif isinstance(dyad, RRP):
+            keys[dyad.point] = (f'RRP {dyad.point}', (dyad.link.name,))
+    return keys
+
+
+def _toggles(probe: _Probe, ranges: Sequence[tuple[float, float]]) -> tuple[Toggle, ...]:
+    keys = _measure_keys(probe.scene)
+    labels = {label: (key, links) for key, (label, links) in keys.items()}
+    toggles = []
+    if len(ranges) != 1 or ranges[0][1] - ranges[0][0] < _TURN:
+        for start, end in ranges:  # the dyad that fails just beyond each end locks there
+            for edge, outside in ((start, start - 1e-9), (end, end + 1e-9)):
+                error = probe.failure(outside)
+                if error is not None and error.dyad in labels:
+                    toggles.append(Toggle(edge % _TURN, error.dyad, labels[error.dyad][1]))
+    state = probe.state
+    for key, (label, links) in keys.items():
+        measure = np.where(probe.valid, np.asarray(state.singularity[key]), np.inf)
+        for index in _local_minima(measure):
+            angle, value = _golden(probe, key, float(probe.theta[index]))
+            if value < TOGGLE_MEASURE:
+                toggles.append(Toggle(angle % _TURN, label, links))
+    toggles.sort(key=lambda t: t.angle)
+    unique: list[Toggle] = []
+    for toggle in toggles:
+        if not any(abs(math.remainder(toggle.angle - t.angle, _TURN)) < 1e-6
+                   and t.dyad == toggle.dyad for t in unique):
+            unique.append(toggle)
+    return tuple(unique)
+
+
+def _local_minima(values: Array) -> list[int]:
+    """Return the indices of the local minima of a cyclic sequence (finite ones only)."""
+    previous, following = np.roll(values, 1), np.roll(values, -1)
+    finite = np.isfinite(values) & np.isfinite(previous) & np.isfinite(following)
+    return [int(i) for i in np.flatnonzero(finite & (values <= previous) & (values < following))]
+
+
+def _golden(probe: _Probe, key: str, centre: float) -> tuple[float, float]:
+    """Refine a sampled minimum of a dyad's measure; return (angle, measure) there."""
+    step = _TURN / len(probe.theta)
+
+    def measure(theta: float) -> float:
+        try:
+            return float(probe.solve(theta).singularity[key])  # type: ignore[attr-defined]
+        except AssemblyError:
+            return math.inf  # beyond an end of a range: the ends are looked at apart
+
+    low, high = centre - step, centre + step
+    ratio = (math.sqrt(5.0) - 1.0) / 2.0
+    a, b = high - ratio * (high - low), low + ratio * (high - low)
+    fa, fb = measure(a), measure(b)
+    while high - low > 1e-10:
+        if fa <= fb:
+            high, b, fb = b, a, fa
+            a = high - ratio * (high - low)
+            fa = measure(a)
+        else:
+            low, a, fa = a, b, fb
+            b = low + ratio * (high - low)
+            fb = measure(b)
+    angle = 0.5 * (low + high)
+    return angle, measure(angle)
+
+
+def _outputs(scene: Scene) -> dict[str, str]:
+    """Output joints that can have dead centres: name -> 'revolute' or 'prismatic'."""
+    outputs = {}
+    for dyad in scene.dyads:
+        if isinstance(dyad, RRR):
+            for link in dyad.links:
+                if link.start in scene.ground:
+                    outputs[link.name] = 'revolute'
+        elif isinstance(dyad, RRP):
+            outputs[dyad.slider] = 'prismatic'
+        elif isinstance(dyad, RPR) and dyad.slots is None:
+            outputs[dyad.link] = 'revolute'
+    return outputs
+
+
+def _dead_centres(probe: _Probe) -> tuple[DeadCentre, ...]:
+    scene, state = probe.scene, probe.state
+    crank = scene.input
+    starting = {}  # link from the crank's tip -> (its dyad's outputs)
+    for dyad in scene.dyads:
+        if isinstance(dyad, RRR):
+            for link in dyad.links:
+                if link.start == crank.point:
+                    starting[link.name] = dyad
+        elif isinstance(dyad, RRP) and dyad.link.start == crank.point:
+            starting[dyad.link.name] = dyad
+    n = len(probe.theta)
+    step = _TURN / n
+    centres = []
+    for joint, kind in _outputs(scene).items():
+        velocity = np.asarray(state.joints[joint].velocity)  # type: ignore[attr-defined]
+        for i in range(n):
+            j = (i + 1) % n
+            if not (probe.valid[i] and probe.valid[j]) or velocity[i] * velocity[j] > 0.0:
+                continue
+            if velocity[j] == 0.0:  # a sample on the reversal: bracket it by its neighbours
+                k = (j + 1) % n
+                if not probe.valid[k] or velocity[i] * velocity[k] >= 0.0:
+                    continue
+            elif velocity[i] == 0.0:
+                continue  # found from the sample before
+
+            def forward(theta: float, name: str = joint) -> bool:
+                try:
+                    return float(probe.solve(theta).joints[name].velocity) > 0.0  # type: ignore
+                except AssemblyError:
+                    return False
+
+            low = float(probe.theta[i])
+            angle = _bisect(forward, low, low + (2 if velocity[j] == 0.0 else 1) * step)
+            solved = probe.solve(angle)
+            position = float(solved.joints[joint].position)  # type: ignore[attr-defined]
+            in_line = None
+            for link, dyad in starting.items():
+                names = {d for d in _dyad_joints(dyad)}
+                if joint in names or joint == link:
+                    e1 = float(solved.joints[crank.link].position)  # type: ignore
+                    e2 = float(solved.joints[link].position)  # type: ignore
+                    if abs(math.sin(e1 - e2)) < 1e-6:
+                        in_line = (crank.link, link)
+            centres.append(DeadCentre(angle % _TURN, joint, kind, position, in_line))
+    centres.sort(key=lambda c: c.angle)
+    return tuple(centres)
+
+
+def _dyad_joints(dyad: RRR | RRP) -> tuple[str, ...]:
+    if isinstance(dyad, RRR):
+        return tuple(link.name for link in dyad.links)
+    return (dyad.link.name, dyad.slider)
+
+
+def _transmission(probe: _Probe, ranges: Sequence[tuple[float, float]],
+                  toggles: Sequence[Toggle]) -> tuple[Transmission, ...]:
+    keys = _measure_keys(probe.scene)
+    result = []
+    everywhere = len(ranges) == 1 and ranges[0][1] - ranges[0][0] >= _TURN
+    for key, (label, links) in keys.items():
+        toggle = next((t for t in toggles if t.dyad == label), None)
+        if toggle is not None:  # its links come in line: a transmission angle of 0
+            result.append(Transmission(label, links, 0.0, toggle.angle))
+            continue
+        measure = np.where(probe.valid, np.asarray(probe.state.singularity[key]), np.inf)
+        index = int(np.argmin(measure))
+        angle, value = _golden(probe, key, float(probe.theta[index]))
+        if not everywhere:  # an end of a range may be lower (a toggle: 0)
+            for start, end in ranges:
+                for edge in (start, end):
+                    if probe.failure(edge - 1e-9 if edge == end else edge + 1e-9) is None:
+                        solved = probe.solve(edge - 1e-9 if edge == end else edge + 1e-9)
+                        m = float(solved.singularity[key])  # type: ignore[attr-defined]
+                        if m < value:
+                            angle, value = edge, m
+        result.append(Transmission(label, links, math.asin(min(1.0, max(0.0, value))),
+                                   angle % _TURN))
+    return tuple(result)
+
+
+def _loops(probe: _Probe) -> tuple[FourBarLoop, ...]:
+    scene = probe.scene
+    crank = scene.input
+    state = probe.solve(scene.input.angle)
+    position = {name: complex(*p.position)  # type: ignore[attr-defined]
+                for name, p in state.points.items()}  # type: ignore[attr-defined]
+    pivot = {crank.link: crank.center}  # link turning about a ground pivot -> that pivot
+    for dyad in scene.dyads:
+        if isinstance(dyad, RRR):
+            for link in dyad.links:
+                if link.start in scene.ground:
+                    pivot[link.name] = link.start
+        elif isinstance(dyad, RPR):
+            pivot[dyad.link] = dyad.center
+    fixed_on: dict[str, str] = {crank.point: crank.link}
+    for dyad in scene.dyads:
+        if isinstance(dyad, RRR):
+            fixed_on.setdefault(dyad.point, dyad.links[0].name)
+            for link in dyad.links:  # the pin is on both links
+                if link.name in pivot:
+                    fixed_on[dyad.point] = link.name
+    for carried in scene.points:
+        fixed_on[carried.name] = carried.link
+    loops = []
+    for dyad in scene.dyads:
+        if not isinstance(dyad, RRR):
+            continue
+        first, second = dyad.links
+        for out, coupler in ((first, second), (second, first)):
+            if out.start not in scene.ground or coupler.start in scene.ground:
+                continue
+            driver = fixed_on.get(coupler.start)
+            if driver is None or driver not in pivot or driver in (out.name, coupler.name):
+                continue
+            o1, q, o2 = pivot[driver], coupler.start, out.start
+            ground = abs(position[o2] - position[o1])
+            input_ = abs(position[q] - position[o1])
+            loops.append(FourBarLoop((f'{o1}{o2}', driver, coupler.name, out.name),
+                                     (o1, q, dyad.point, o2),
+                                     (ground, input_, coupler.length, out.length)))
+            break
+    return tuple(loops)
+
+
+# --- text --------------------------------------------------------------------------
+
+
+def angle_text(units: Units, theta: float) -> str:
+    """Return a crank angle (rad) in the scene's unit to 6 significant digits, without unit.
+
+    A value within 5e-7 of a turn of 0 or of a full turn is shown as 0 (a
+    refined dead centre at 0 deg is 2e-11 deg away, a transmission minimum
+    at 0 is found to about 1e-8 rad: not numbers to print).
+    """
+    value = units.angle_value(theta)
+    turn = units.angle_value(_TURN)
+    if abs(value) < 5e-7 * turn or abs(abs(value) - turn) < 5e-7 * turn:
+        value = 0.0
+    return f'{value:.6g}'
+
+
+_angle = angle_text
+
+
+def _ranges_text(ranges: Sequence[tuple[float, float]], units: Units) -> str:
+    parts = [f'{_angle(units, a)}..{_angle(units, b)}' for a, b in ranges]
+    return f'{", ".join(parts)} {units.angle}'

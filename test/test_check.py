@@ -1,0 +1,96 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The ``check`` command: a scene's assembly ranges, toggles, dead centres, Grashof class.
+
+See issue 11. The numbers are the hand values of ``test_assembly.py``'s cases,
+shown in the scene's units (text) or SI (``--json``).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+import subprocess
+import sys
+
+import pytest
+
+from mech_kinematics.__main__ import build_parser, main, TOOLS
+from mech_kinematics.tools import check
+
+REPO = Path(__file__).resolve().parents[1]
+LIMIT = math.acos((50 ** 2 + 100 ** 2 - 122 ** 2) / (2 * 50 * 100))  # 103.792 deg
+
+
+def test_text_report_of_the_triple_rocker(capsys):
+    """four_bar_coupler_points: every line, in degrees and millimetres."""
+    assert main(['check', 'four_bar_coupler_points']) == 0
+    assert capsys.readouterr().out.splitlines() == [
+        'four_bar_coupler_points: one turn of crank "crank" about A (angles in deg, CCW from '
+        '+x; lengths in mm)',
+        'assembles: for crank angles -103.792..103.792 deg',
+        'does not assemble for crank angles 103.792..256.208 deg',
+        'toggle positions: 103.792 deg (RRR C: coupler and rocker in line), 256.208 deg '
+        '(RRR C: coupler and rocker in line)',
+        'dead centres: 28.8528 deg (rocker reverses at 88.3628 deg; crank and coupler in line)',
+        'minimum transmission angle: 0 deg at crank angle 103.792 deg (RRR C: coupler and '
+        'rocker)',
+        'four-bar loops: A-B-C-D (ground AD 100 mm, crank 50 mm, coupler 66 mm, rocker 56 mm): '
+        'triple-rocker (non-Grashof: s + l = 150 mm > p + q = 122 mm)',
+    ]
+
+
+def test_json_report_is_si(capsys):
+    """--json: ranges, gaps and angles in rad, lengths in m, the summary line as text."""
+    assert main(['check', 'four_bar_coupler_points', '--json']) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data['assembles_everywhere'] is False
+    (start, end), = data['ranges']
+    assert start == pytest.approx(-LIMIT, abs=1e-11) and end == pytest.approx(LIMIT, abs=1e-11)
+    assert data['gaps'][0] == pytest.approx([LIMIT, 2 * math.pi - LIMIT], abs=1e-11)
+    assert data['summary'] == 'does not assemble for crank angles 103.792..256.208 deg'
+    assert [t['dyad'] for t in data['toggles']] == ['RRR C', 'RRR C']
+    (loop,) = data['loops']
+    assert loop['class'] == 'triple-rocker'
+    assert loop['lengths'] == pytest.approx({'ground': 0.1, 'input': 0.05, 'coupler': 0.066,
+                                             'output': 0.056}, rel=1e-15)
+    assert loop['names'] == {'ground': 'AD', 'input': 'crank', 'coupler': 'coupler',
+                             'output': 'rocker'}
+    (centre,) = data['dead_centres']
+    assert centre['joint'] == 'rocker' and centre['in_line'] == ['crank', 'coupler']
+
+
+def test_slider_crank_dead_centres_in_text(capsys):
+    """piston_300: reversals at 0 and 180 deg, at s = 220 and 120 mm."""
+    assert main(['check', 'piston_300']) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[1] == 'assembles: at every crank angle'
+    assert lines[2] == 'toggle positions: none'
+    assert lines[3] == ('dead centres: 0 deg (piston reverses at s = 220 mm; crank and rod in '
+                        'line), 180 deg (piston reverses at s = 120 mm; crank and rod in line)')
+    assert lines[4] == ('minimum transmission angle: 72.8954 deg at crank angle 90 deg '
+                        '(RRP C: rod)')
+    assert lines[5] == 'four-bar loops: none'
+
+
+def test_a_bad_scene_is_one_line_and_exit_2(tmp_path, capsys):
+    """A scene that cannot be read: `error: ...` on one line, status 2."""
+    path = tmp_path / 'bad.yaml'
+    path.write_text('name: bad\n')
+    assert main(['check', str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith('error: ') and err.count('\n') == 1 and 'units' in err
+
+
+def test_registered_as_a_tool_and_a_console_script():
+    """`check` is in TOOLS, parses its options and runs as `check` from setup.py."""
+    assert check in TOOLS
+    args = build_parser().parse_args(['check', 'geneva', '--json'])
+    assert args.handler.__module__ == check.__name__ and args.json
+    result = subprocess.run([sys.executable, '-m', 'mech_kinematics', 'check', '--help'],
+                            capture_output=True, text=True, check=False, cwd=REPO)
+    assert result.returncode == 0
+    for word in ('toggle', 'dead centres', 'transmission', 'Grashof', '--json', 'SI'):
+        assert word in result.stdout, word
+    assert "'check = mech_kinematics.tools.check:main'" in (REPO / 'setup.py').read_text()

@@ -1,0 +1,177 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The scene format reference (docs/scene_format.md) says what the program does. See issue 11.
+
+Its scene examples load, its worked example's printed output is what the
+program prints, every error message it quotes is what the loader says for
+the mistake it names, its links resolve, and nothing shipped points outside
+the repository.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+from pathlib import Path
+import re
+
+import pytest
+
+import mech_kinematics as mk
+from mech_kinematics.__main__ import main
+from mech_kinematics.scene import read_scene_yaml
+
+ROOT = Path(__file__).resolve().parent.parent
+DOC = ROOT / 'docs' / 'scene_format.md'
+README = ROOT / 'README.md'
+
+#: The four-bar the error table of the reference breaks, one thing at a time.
+BASE = """\
+name: four_bar
+units: {length: mm, angle: deg}
+ground:
+  A: [0, 0]
+  D: [150, 0]
+input: {link: crank, center: A, point: B, length: 40, angle: 60, speed_rpm: -120}
+dyads:
+  - type: RRR
+    point: C
+    links:
+      - {name: coupler, from: B, length: 150}
+      - {name: rocker, from: D, length: 80}
+    branch: 1
+"""
+GENEVA = """\
+name: geneva_five
+units: {length: mm, angle: deg}
+ground: {D: [0, 0], S: [0, 100]}
+input: {link: driver, center: D, point: P, length: 50, angle: 80, speed_rpm: 60}
+dyads:
+  - {type: RPR, link: wheel, center: S, through: P, slider: pin_slot, slots: 5}
+"""
+COMPOUND = BASE.replace('D: [150, 0]\n', 'D: [150, 0]\n  F: [300, 100]\n') + """\
+  - type: RRR
+    point: E
+    links:
+      - {name: link_CE, from: C, length: 120}
+      - {name: link_FE, from: F, length: 100}
+pins: {C: 5}
+"""
+#: Each mistake of the reference's error table, as the scene text that makes it.
+MISTAKES = {
+    'no_units': BASE.replace('units: {length: mm, angle: deg}\n', ''),
+    'bad_unit': BASE.replace('length: mm', 'length: inch'),
+    'negative': BASE.replace('length: 80', 'length: -80'),
+    'typo': BASE.replace('length: 80}', 'lenght: 80}'),
+    'string': BASE.replace('length: 80', 'length: 80 mm'),
+    'yes': BASE.replace('branch: 1', 'branch: yes'),
+    'branch0': BASE.replace('branch: 1', 'branch: 0'),
+    'leading0': BASE.replace('length: 40', 'length: 040'),
+    'duplicate_key': BASE.replace('  D: [150, 0]\n', '  D: [150, 0]\n  D: [160, 0]\n'),
+    'twice': BASE.replace('name: rocker', 'name: coupler'),
+    'unknown_point': BASE.replace('  D: [150, 0]\n', '').replace('from: D', 'from: Q'),
+    'cycle': BASE.replace('from: B', 'from: C'),
+    'type': BASE.replace('type: RRR', 'type: RPP'),
+    'reach': BASE.replace('length: 150}', 'length: 50}'),
+    'meet': BASE.replace('length: 80}', 'length: 10}'),
+    'guide': (ROOT / 'docs' / 'toggle_press.yaml').read_text().replace(
+        'G: [300, 20]', 'G: [300, -60]'),
+    'slots': GENEVA,
+    'pin_off_crank': GENEVA.replace('slots: 5', 'slots: 6').replace('through: P', 'through: S'),
+    'compound': COMPOUND,
+}
+
+
+def blocks(text, language):
+    """Return the fenced code blocks of ``text`` in ``language``."""
+    return re.findall(rf'```{language}\n(.*?)```', text, flags=re.DOTALL)
+
+
+def run(*args):
+    """Return what `python -m mech_kinematics ARGS` prints and its status."""
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        status = main([str(a) for a in args])
+    return status, out.getvalue()
+
+
+@pytest.mark.parametrize('path', [DOC, README], ids=['scene_format.md', 'README.md'])
+def test_scene_examples_load(path):
+    """Every YAML block that is a whole scene (it starts with `name:`) loads."""
+    scenes = [b for b in blocks(path.read_text(), 'yaml') if b.startswith('name:')]
+    assert scenes
+    for text in scenes:
+        scene = mk.parse_scene(read_scene_yaml(text))
+        mk.solve(scene, scene.input.angle)
+
+
+def test_worked_example_is_the_file_and_prints_what_it_says(capsys):
+    """docs/toggle_press.yaml is the page's example; `check` and `solve` print the quoted text."""
+    path = ROOT / 'docs' / 'toggle_press.yaml'
+    text = DOC.read_text()
+    assert path.read_text() in [b for b in blocks(text, 'yaml') if b.startswith('name:')]
+    console = next(b for b in blocks(text, 'console') if 'check docs/toggle_press.yaml' in b)
+    status, out = run('check', path)
+    assert status == 0
+    assert out.splitlines() == console.splitlines()[1:]
+    status, out = run('solve', path)
+    data = json.loads(out)
+    excerpt = next(b for b in blocks(text, 'json') if '"rubbing"' in b and '"ram"' in b)
+    for name, value in data['rubbing'].items():
+        assert f'"{name}": {value!r}' in excerpt, name
+    for joint in ('rocker', 'ram'):
+        for quantity in ('position', 'velocity', 'acceleration'):
+            assert f'"{quantity}": {data["joints"][joint][quantity]!r}' in excerpt
+
+
+@pytest.mark.parametrize('mistake', sorted(MISTAKES))
+def test_quoted_error_messages_are_the_real_ones(mistake, tmp_path):
+    """Each message in the table "Errors you will meet" is the loader's, word for word."""
+    path = tmp_path / f'{mistake}.yaml'
+    path.write_text(MISTAKES[mistake])
+    with pytest.raises(mk.SceneError) as caught:
+        mk.load_scene(path)
+    message = str(caught.value)
+    assert message.startswith(f'{path}: ')
+    assert f'`{message[len(str(path)) + 2:]}`' in DOC.read_text(), message
+
+
+def test_quoted_solve_errors_are_the_real_ones():
+    """The errors `solve` prints in the reference and the README are the program's."""
+    quoted = [line for text in (DOC.read_text(), README.read_text())
+              for block in blocks(text, 'console') for line in block.splitlines()
+              if line.startswith('error: ') and 'cannot be solved' in line]
+    assert len(quoted) >= 3
+    commands = {
+        'RRR C cannot be solved at crank angle 150 deg': ('four_bar_coupler_points',
+                                                          '--angle-deg', '150'),
+        'RPR wheel cannot be solved at crank angle 135 deg': ('geneva', '--angle-deg', '135'),
+        'input crank cannot be solved at crank angle 60 deg': ('khurmi_four_bar_ad150',
+                                                               '--speed-rpm', '1e160'),
+    }
+    for line in quoted:
+        args = next(a for key, a in commands.items() if key in line)
+        err = io.StringIO()
+        with contextlib.redirect_stderr(err):
+            assert main(['solve', *args]) == 2
+        assert err.getvalue() == f'{line}\n'
+
+
+def test_links_and_figures_resolve():
+    """The README links the reference; every relative link and image of the reference exists."""
+    assert '(docs/scene_format.md)' in README.read_text()
+    for target in re.findall(r'\]\(([^)#:]+)(?:#[^)]*)?\)', DOC.read_text()):
+        assert (DOC.parent / target).exists(), target
+
+
+def test_nothing_shipped_points_outside_the_repository():
+    """No path to the shared folders or the seed files in the package, docs, scenes, README."""
+    files = [README, *ROOT.joinpath('docs').glob('*.md'), *ROOT.joinpath('config').rglob('*'),
+             *ROOT.joinpath('mech_kinematics').rglob('*.py'),
+             *ROOT.joinpath('mech_kinematics').rglob('*.yaml')]
+    for path in files:
+        if path.is_file():
+            text = path.read_text(errors='replace')
+            for needle in ('../shared', '/shared/', 'seeds/', '/work/'):
+                assert needle not in text, (path, needle)
