@@ -44,8 +44,9 @@ from . import linkage as lk
 
 __all__ = ['TickFunction', 'compile_tick', 'tick_function', 'values_from_state']
 
-#: ``tick(theta, omega, alpha, max_error) -> (values, smallest near-singularity measure)``.
-TickFunction = Callable[[float, float, float, float], tuple[list[float], float]]
+#: ``tick(theta, omega, alpha, max_error, turns) -> (values, smallest near-singularity
+#: measure)``; ``theta + 2 pi turns`` is the crank angle counted from the start.
+TickFunction = Callable[[float, float, float, float, int], tuple[list[float], float]]
 
 _TABLES = {'points': 'P', 'links': 'L', 'sliders': 'S', 'measures': 'M'}
 
@@ -145,6 +146,12 @@ class _Specializer(ast.NodeTransformer):
                     return ast.Constant(False)
                 if node.attr == 'angle':
                     return ast.Name('theta', ast.Load())
+                if node.attr == 'turns':
+                    return ast.Name('turns', ast.Load())
+                if node.attr == 'shown':    # the angle counted from the start, for messages
+                    return ast.Call(ast.Name('_shown', ast.Load()),
+                                    [ast.Name('theta', ast.Load()),
+                                     ast.Name('turns', ast.Load())], [])
                 raise _Unsupported(f'ctx.{node.attr}')
         return self.generic_visit(node)
 
@@ -158,7 +165,8 @@ class _Specializer(ast.NodeTransformer):
                 and func.value.id == 'ctx' and func.attr in ('check', 'check_margin')):
             # The failure path: the general context's own check, at this angle.
             call = ast.Call(ast.Name(f'_ctx_{func.attr}', ast.Load()),
-                            [ast.Name('theta', ast.Load()), *node.args], node.keywords)
+                            [ast.Name('theta', ast.Load()), ast.Name('turns', ast.Load()),
+                             *node.args], node.keywords)
             return self.generic_visit(ast.copy_location(call, node))
         return self.generic_visit(node)
 
@@ -224,15 +232,16 @@ def _body(step: Any, method: Callable[..., Any], suffix: str, names: dict[str, s
     return [stmt for stmt in module.body if not isinstance(stmt, ast.Pass)]
 
 
-def _ctx_check(theta: float, ok: Any, label: str, reason: Any) -> None:
-    context = lk._Context(theta, False)
-    context.check(ok, label, reason)
+def _ctx_check(theta: float, turns: int, *args: Any, **kwargs: Any) -> None:
+    lk._Context(theta, False, turns).check(*args, **kwargs)
 
 
-def _ctx_check_margin(theta: float, ok: Any, label: str, margin: Any, bound: Any,
-                      reason: Any) -> None:
-    context = lk._Context(theta, False)
-    context.check_margin(ok, label, margin, bound, reason)
+def _ctx_check_margin(theta: float, turns: int, *args: Any, **kwargs: Any) -> None:
+    lk._Context(theta, False, turns).check_margin(*args, **kwargs)
+
+
+def _shown(theta: float, turns: int) -> Any:
+    return lk._Context(theta, False, turns).shown
 
 
 def _wrapped_angle(e: complex) -> float:
@@ -286,9 +295,9 @@ def _general(scene: lk.Scene, joints: Sequence[str] | None, points: Sequence[str
     points = tuple(scene.output_points if points is None else points)
     frames = tuple(frames)
 
-    def general(theta: float, omega: float, alpha: float,
-                tol: float) -> tuple[list[float], float]:
-        state = lk.solve(scene, theta, omega, alpha, max_error=tol)
+    def general(theta: float, omega: float, alpha: float, tol: float,
+                turns: int = 0) -> tuple[list[float], float]:
+        state = lk.solve(scene, theta, omega, alpha, turns=turns, max_error=tol)
         measures = state.singularity.values()
         return (values_from_state(state, joints, points, frames),
                 float(min(measures)) if measures else math.inf)
@@ -330,11 +339,12 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
     points = tuple(scene.output_points if points is None else points)
     frames = tuple(frames)
 
-    if solver.shift:
-        return None
+    if solver.shift or plan.rubs:
+        return None     # rescaled units, or rubbing to bound: the general solver's work
     namespace: dict[str, Any] = {
         '_ctx_check': _ctx_check, '_ctx_check_margin': _ctx_check_margin,
-        '_wrapped_angle': _wrapped_angle, '_slow': _general(scene, joints, points, frames),
+        '_shown': _shown, '_wrapped_angle': _wrapped_angle,
+        '_slow': _general(scene, joints, points, frames),
         'inf': math.inf,
     }
     namespace.update((k, v) for k, v in vars(lk).items() if not k.startswith('__'))
@@ -375,7 +385,7 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
         checks.append(f'{e}[3] <= _lp and {e}[4] <= _lv and {e}[5] <= _la')
     if checks:
         lines.append(f'if not ({" and ".join(checks)}):')
-        lines.append('    return _slow(theta, omega, alpha, tol)')
+        lines.append('    return _slow(theta, omega, alpha, tol, turns)')
     values = []
     for index in range(3):
         for name in joints:
@@ -401,11 +411,12 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
     guard = ast.parse(
         f'if not ({lk._RATE_LOW!r} <= abs(omega) <= {lk._RATE_HIGH!r} '
         f'and abs(alpha) <= {lk._ACCEL_HIGH!r}):\n'
-        '    return _slow(theta, omega, alpha, tol)').body
+        '    return _slow(theta, omega, alpha, tol, turns)').body
     function = ast.FunctionDef(
         name='tick', args=ast.arguments(
-            posonlyargs=[], args=[ast.arg(a) for a in ('theta', 'omega', 'alpha', 'tol')],
-            kwonlyargs=[], kw_defaults=[], defaults=[]),
+            posonlyargs=[],
+            args=[ast.arg(a) for a in ('theta', 'omega', 'alpha', 'tol', 'turns')],
+            kwonlyargs=[], kw_defaults=[], defaults=[ast.Constant(0)]),
         body=guard + body + list(itertools.chain.from_iterable(tail)), decorator_list=[],
         returns=None)
     module = ast.fix_missing_locations(ast.Module(body=[function], type_ignores=[]))

@@ -34,6 +34,7 @@ from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
 
 import mech_kinematics as mk
+from mech_kinematics.geometry.assembly import assembly_summary
 
 PARAMS_FILE = REPO / 'config' / 'kinematics_node.yaml'
 #: Relative tolerance between the published values and the solver's.
@@ -335,6 +336,7 @@ def test_diagnostics_report_status_and_timing(node):
     assert solver.level == DiagnosticStatus.OK and solver.message == 'ok'
     solver_values = {kv.key: kv.value for kv in solver.values}
     assert 0 < float(solver_values['worst_singularity_measure']) <= 1
+    assert solver_values['assembly'] == 'assembles at every crank angle'      # issue 11
     values = {kv.key: kv.value for kv in timing.values}
     assert float(values['achieved_rate_hz']) == pytest.approx(RATE_HZ, rel=0.3)
     for key in ('late_ticks', 'skipped_ticks', 'late_ticks_total', 'skipped_ticks_total'):
@@ -457,6 +459,10 @@ def test_unsolvable_ticks_publish_nothing_and_the_node_carries_on(ros, tmp_path)
         time.sleep(0.2)
         solver = [s for m in diag for s in m.status if s.level == DiagnosticStatus.ERROR][0]
         assert 'cannot assemble' in solver.message and 'RRR' in solver.message
+        # Where it cannot, in one line (issue 11): the same as `check` finds.
+        assembly = {kv.key: kv.value for kv in solver.values}['assembly']
+        assert assembly.startswith('does not assemble for crank angles ')
+        assert assembly == assembly_summary(scene)
         assert not not_remapped, 'published on joint_states despite the remap'
         stamps = sorted(stamp_ns(m) for m in remapped)
         assert max(np.diff(stamps)) > 0.1 * NS, 'no gap where the scene cannot assemble'

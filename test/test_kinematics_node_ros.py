@@ -228,3 +228,48 @@ def test_untrusted_ticks_publish_nothing_and_say_why(ros, tmp_path):
     finally:
         status, _ = proc.stop(signal.SIGINT)
     assert status == 0, proc.output()
+
+
+def test_geneva_wheel_dwells_and_indexes_over_ten_turns(ros, tmp_path):
+    """The node's Geneva wheel: exactly still between engagements, 2 pi / 4 per crank turn.
+
+    Over ten crank turns, from a subscriber; the node passes the crank's whole
+    turns to the solver. See issue 11.
+    """
+    from rclpy.serialization import deserialize_message
+    from trajectory_msgs.msg import JointTrajectory
+
+    ns = f'{SESSION}/geneva'
+    raw = ros.collect_raw(JointTrajectory, f'{ns}/joint_accelerations')
+    proc = NodeProcess(tmp_path, '-r', f'__ns:={ns}', '-p', 'scene:=geneva',
+                       '-p', 'rate_hz:=1000', '-p', 'crank_speed_rpm:=600')
+    try:
+        wait_for(lambda: len(raw) > 100, STARTUP_S, 'joint_accelerations')
+        start = len(raw)
+        wait_for(lambda: len(raw) > start + 1200, 10.0, 'ten crank turns')
+    finally:
+        status, _ = proc.stop(signal.SIGINT)
+    assert status == 0, proc.output()
+    msgs = [deserialize_message(data, JointTrajectory) for data in raw[start:]]
+    wheel = msgs[0].joint_names.index('wheel')
+    driver = msgs[0].joint_names.index('driver')
+    samples = sorted((stamp_ns(m), m.points[0].positions[driver],
+                      m.points[0].positions[wheel], m.points[0].velocities[wheel],
+                      m.points[0].accelerations[wheel]) for m in msgs)
+    dwells = []         # (first stamp, wheel angle) of every run of locked samples
+    for t, _, angle, w, alpha in samples:
+        locked = w == 0.0 and alpha == 0.0
+        if locked and dwells and dwells[-1][2] and t - dwells[-1][3] <= 2_000_000:
+            assert angle == dwells[-1][1], 'the wheel moved while locked'
+            dwells[-1][3] = t
+        elif locked:
+            dwells.append([t, angle, True, t])
+        elif dwells:
+            dwells[-1][2] = False
+    assert len(dwells) >= 10
+    steps = [wrap(b[1] - a[1]) for a, b in zip(dwells, dwells[1:], strict=False)]
+    for step in steps:
+        assert abs(abs(step) - math.pi / 2) <= 1e-12, steps
+    assert len({math.copysign(1.0, s) for s in steps}) == 1, 'indexed back and forth'
+    moving = [w for _, _, _, w, _ in samples if w != 0.0]
+    assert moving and len(moving) < 0.5 * len(samples)     # engaged a quarter of each turn

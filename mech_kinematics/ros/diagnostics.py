@@ -144,12 +144,14 @@ def _quantile_us(sorted_ns: Sequence[int], q: float) -> str:
 
 
 def solver_status(window: Window, *, name: str, hardware_id: str, near_singular: float,
-                  waiting_for: str = '') -> Status:
+                  waiting_for: str = '', assembly: str = '') -> Status:
     """Return the solver status of ``window``.
 
     ERROR if any instant could not be solved or was refused (with the last
     reason), WARN if any was near-singular or the node is ``waiting_for``
     something (e.g. ``'/clock'``), STALE if there was nothing to solve, else OK.
+    ``assembly`` says in one line where the scene cannot assemble (key
+    ``assembly``).
     """
     w = window
     if waiting_for:
@@ -171,6 +173,8 @@ def solver_status(window: Window, *, name: str, hardware_id: str, near_singular:
         ('unsolved_ticks_total', str(w.totals.get('unsolved', 0))),
         ('last_error', w.last_error),
     ]
+    if assembly:
+        values.append(('assembly', assembly))
     if w.last_sample is not None:
         values += [('crank_angle', repr(w.last_sample[0])),
                    ('crank_speed', repr(w.last_sample[1])),

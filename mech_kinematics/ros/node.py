@@ -62,6 +62,7 @@ from .parameters import CATCH_UP, joint_refusal, PARAMETERS, ParameterSpec, refu
 from .schedule import period_ns_from_rate, TickGrid
 from .tf import static_tf_message, TF_STATIC_TOPIC, TF_TOPIC, TfMessages
 from .timebase import CrankTimebase
+from ..geometry.assembly import assembly_summary
 from ..geometry.diagrams import space_from_state, strokes_from_scene
 from ..geometry.frames import angle_joints, frames_from_scene, origin_points
 from ..geometry.instant_centres import full_scene
@@ -176,6 +177,7 @@ class KinematicsNode(LifecycleNode):
 
     def _declare(self) -> None:
         self.scene: mk.Scene | None = None
+        self._assembly = ''
         self.configure_error = ''
         self.failed = False
         self._stop = threading.Event()
@@ -346,6 +348,8 @@ class KinematicsNode(LifecycleNode):
         self._solve, compiled = tick_function(tick_scene, scene.output_joints,
                                               scene.output_points, frames)
         self._tf_first = 3 * len(scene.output_joints) + 6 * len(scene.output_points)
+        # Where the scene cannot assemble, in one line, for the diagnostics.
+        self._assembly = assembly_summary(scene)
         if not compiled:
             self.get_logger().info('the scene is solved by the general solver (not compiled)')
         if self._value('markers'):
@@ -577,9 +581,12 @@ class KinematicsNode(LifecycleNode):
                              self._value('crank_accel'), self._value('max_crank_speed_rpm'))
 
     def _tick(self, stamp: int, lateness: int, late: bool) -> None:
-        angle, speed, accel = sample = self._timebase.sample(stamp)  # type: ignore[union-attr]
+        # The crank as whole turns plus an angle in one turn: an intermittent drive
+        # (a Geneva wheel) indexes by the turns, never formed as a float sum.
+        turns, sample = self._timebase.sample_turns(stamp)  # type: ignore[union-attr]
+        angle, speed, accel = sample
         try:
-            values, measure = self._solve(angle, speed, accel, self._max_error)
+            values, measure = self._solve(angle, speed, accel, self._max_error, turns)
         except mk.AssemblyError as exc:
             refusal = 'not trusted' if isinstance(exc, mk.UntrustedError) else \
                 'cannot assemble'
@@ -649,7 +656,8 @@ class KinematicsNode(LifecycleNode):
             waiting = ''
         statuses = [
             solver_status(window, name=name, hardware_id=hardware_id,
-                          near_singular=mk.NEAR_SINGULAR, waiting_for=waiting),
+                          near_singular=mk.NEAR_SINGULAR, waiting_for=waiting,
+                          assembly=self._assembly),
             timing_status(window, name=name, hardware_id=hardware_id,
                           rate_hz=self._value('rate_hz')),
         ]
