@@ -85,6 +85,7 @@ def floor(namespace: str, rate: float, scene_name: str) -> None:
     import struct
 
     import rclpy
+    from rclpy.executors import ExternalShutdownException
     from rclpy.qos import QoSProfile, ReliabilityPolicy
     from sensor_msgs.msg import JointState
     from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
@@ -117,7 +118,12 @@ def floor(namespace: str, rate: float, scene_name: str) -> None:
                 sec, nanosec = divmod(t, NS)
                 for publisher, payload in zip(publishers, payloads, strict=True):
                     stamp.pack_into(payload, 4, sec, nanosec)
-                    publisher.publish(bytes(payload))
+                    try:
+                        publisher.publish(bytes(payload))
+                    except Exception:       # noqa: BLE001 - the context ends under a publish
+                        if stop.is_set() or not rclpy.ok():
+                            return
+                        raise
 
     sys.setswitchinterval(0.0005)
     thread = threading.Thread(target=loop, daemon=True)
@@ -126,7 +132,7 @@ def floor(namespace: str, rate: float, scene_name: str) -> None:
     try:
         while not stop.is_set():
             rclpy.spin_once(node, timeout_sec=0.1)
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, ExternalShutdownException):
         pass
     stop.set()
     thread.join(timeout=1.0)
