@@ -14,9 +14,11 @@ its strict ``deserialize_cdr`` accepts.
 Serializing a message object costs far more than the numbers in it change.
 :class:`MessageTemplate` serializes a message once, with a marker value in
 the header stamp and in every float64 field that changes, finds where each
-marker sits in the CDR bytes, and from then on writes new values at those
-offsets with :mod:`struct`. ``rclpy`` publishes the resulting ``bytes`` as
-they are (``Publisher.publish`` accepts serialized data).
+marker sits in the CDR bytes, and from then on makes the message's bytes with
+one :mod:`struct` pack: the fixed bytes between the markers as constant
+fields, the stamp and the new values in their places (a function written for
+the template makes that one call). ``rclpy`` publishes the resulting
+``bytes`` as they are (``Publisher.publish`` accepts serialized data).
 
 This relies on nothing but the fact that CDR stores a fixed-size field at a
 fixed offset once the lengths of every sequence and string are fixed, which
@@ -30,7 +32,7 @@ message classes it is given.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 import struct
 from typing import Any
 
@@ -220,6 +222,54 @@ def _slot_offsets(data: bytes, n_slots: int) -> list[int]:
     return [found[i] for i in range(n_slots)]
 
 
+#: Templates with at most this many slots render through a function written for them.
+INLINE_SLOTS = 4096
+
+
+def _render_function(pack: Callable[..., bytes],
+                     arguments: Sequence[Any]) -> Callable[[int, int, Sequence[float], int],
+                                                           bytes]:
+    """Return ``render(sec, nanosec, values, first)`` calling ``pack`` with ``arguments``.
+
+    ``arguments`` lists the packed fields in order: a bytes constant, ``'sec'``,
+    ``'nanosec'``, or the index of a slot (``values[first + index]``). Up to
+    :data:`INLINE_SLOTS` slots the function is written out for this template
+    (one call, no loop); beyond, a loop fills a copy of the argument list.
+    """
+    slots = [a for a in arguments if isinstance(a, int)]
+    if len(slots) <= INLINE_SLOTS:
+        namespace: dict[str, Any] = {'_pack': pack}
+        parts = []
+        for k, a in enumerate(arguments):
+            if isinstance(a, bytes):
+                namespace[f'_c{k}'] = a
+                parts.append(f'_c{k}')
+            elif isinstance(a, str):
+                parts.append(a)
+            else:
+                parts.append(f'values[first + {a}]')
+        source = (f'def render(sec, nanosec, values, first=0):\n'
+                  f'    return _pack({", ".join(parts)})\n')
+        exec(compile(source, '<message template>', 'exec'), namespace)  # noqa: S102
+        rendered: Callable[[int, int, Sequence[float], int], bytes] = namespace['render']
+        return rendered
+    positions = [(k, a) for k, a in enumerate(arguments) if isinstance(a, int)]
+    sec_at = [k for k, a in enumerate(arguments) if a == 'sec']
+    nanosec_at = [k for k, a in enumerate(arguments) if a == 'nanosec']
+
+    def render(sec: int, nanosec: int, values: Sequence[float], first: int = 0) -> bytes:
+        args = list(arguments)
+        for k in sec_at:
+            args[k] = sec
+        for k in nanosec_at:
+            args[k] = nanosec
+        for k, index in positions:
+            args[k] = values[first + index]
+        return pack(*args)
+
+    return render
+
+
 def _find_all(data: bytes, pattern: bytes, what: str) -> tuple[int, ...]:
     offsets = []
     offset = data.find(pattern)
@@ -260,35 +310,37 @@ class MessageTemplate:
         buffer = bytearray(data)
         for offset in offsets:
             buffer[offset:offset + 8] = bytes(8)
-        self._buffer = buffer
         self.n_slots = n_slots
-        # Group the slots into runs written by one struct each. Slots next to
-        # each other share a run, and so do slots separated only by zero bytes
-        # (the z and angular parts of a Twist): the run writes those zeros again.
-        runs: list[tuple[Any, int, int, int]] = []
-        start = 0
-        fmt = ''
-        for i in range(n_slots):
-            fmt += 'd'
-            last = i == n_slots - 1
-            gap = 0 if last else offsets[i + 1] - offsets[i] - 8
-            if not last and gap >= 0 and not any(buffer[offsets[i] + 8:offsets[i + 1]]):
-                if gap:
-                    fmt += f'{gap}x'
-                continue
-            runs.append((struct.Struct('<' + fmt).pack_into, offsets[start], start, i + 1))
-            start, fmt = i + 1, ''
-        self._runs = tuple(runs)
+        # The whole message as one struct: its fixed bytes as constant byte-string
+        # fields, the stamps and the slots as the fields that change. One pack
+        # makes the message's bytes; the fields of a render are laid out in
+        # offset order by _render_function.
+        fields: list[tuple[int, str, int]] = sorted(
+            [(offset, 'stamp', 0) for offset in self._stamp_offsets]
+            + [(offset, 'slot', i) for i, offset in enumerate(offsets)])
+        fmt = '<'
+        self._arguments: list[Any] = []       # a constant, 'sec', 'nanosec' or a slot index
+        at = 0
+        for offset, kind, index in fields:
+            if offset > at:
+                fmt += f'{offset - at}s'
+                self._arguments.append(bytes(buffer[at:offset]))
+            if kind == 'stamp':
+                fmt += 'iI'
+                self._arguments += ['sec', 'nanosec']
+            else:
+                fmt += 'd'
+                self._arguments.append(index)
+            at = offset + 8
+        if at < len(buffer):
+            fmt += f'{len(buffer) - at}s'
+            self._arguments.append(bytes(buffer[at:]))
+        self._struct = struct.Struct(fmt)
+        self._render = _render_function(self._struct.pack, self._arguments)
 
     def render(self, sec: int, nanosec: int, values: Sequence[float], first: int = 0) -> bytes:
         """Return the serialized message with this stamp and slot values.
 
         Slot ``i`` takes ``values[first + i]``.
         """
-        buffer = self._buffer
-        pack_stamp = self._stamp.pack_into
-        for offset in self._stamp_offsets:
-            pack_stamp(buffer, offset, sec, nanosec)
-        for pack_into, offset, start, stop in self._runs:
-            pack_into(buffer, offset, *values[first + start:first + stop])
-        return bytes(buffer)
+        return self._render(sec, nanosec, values, first)
