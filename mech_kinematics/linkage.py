@@ -2082,6 +2082,11 @@ def _angle(e: Any, vector: bool) -> Any:
         theta = np.arctan2(e.imag, e.real)
         theta[theta == -np.pi] = np.pi
         return theta
+    return _wrapped_angle(e)
+
+
+def _wrapped_angle(e: complex) -> float:
+    """Angle of unit complex ``e`` (one value), wrapped to (-pi, pi]."""
     theta = math.atan2(e.imag, e.real)
     return math.pi if theta == -math.pi else theta
 

@@ -244,11 +244,6 @@ def _shown(theta: float, turns: int) -> Any:
     return lk._Context(theta, False, turns).shown
 
 
-def _wrapped_angle(e: complex) -> float:
-    theta = math.atan2(e.imag, e.real)
-    return math.pi if theta == -math.pi else theta
-
-
 def values_from_state(state: lk.State, joints: Sequence[str], points: Sequence[str],
                       frames: Sequence[tuple[str, str | None, float]] = ()) -> list[float]:
     """Return the values of a single-angle state in the order of a tick function.
@@ -343,7 +338,7 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
         return None     # rescaled units, or rubbing to bound: the general solver's work
     namespace: dict[str, Any] = {
         '_ctx_check': _ctx_check, '_ctx_check_margin': _ctx_check_margin,
-        '_shown': _shown, '_wrapped_angle': _wrapped_angle,
+        '_shown': _shown,
         '_slow': _general(scene, joints, points, frames),
         'inf': math.inf,
     }

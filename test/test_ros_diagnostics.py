@@ -84,3 +84,17 @@ def test_totals_accumulate_over_windows():
     assert second.totals['published'] == 4 and second.totals['skipped'] == 2
     assert second.last_published_stamp_ns == 3
     assert math.isinf(second.worst_measure)
+
+
+def test_the_ticks_own_count_equals_record():
+    """TickStats.published (the tick thread's call) counts as record without a refusal."""
+    a, b = TickStats(near_singular=1e-3), TickStats(near_singular=1e-3)
+    for k, measure in enumerate((0.5, 1e-4, 0.2)):
+        a.record(k, 10 * k, k == 1, measure=measure, near_singular=measure < 1e-3,
+                 sample=(0.1, 2.0, 0.0))
+        b.published(k, 10 * k, k == 1, measure, (0.1, 2.0, 0.0))
+    wa, wb = a.take_window(a._start + NS), b.take_window(b._start + NS)
+    assert (wa.instants, wa.published, wa.late, wa.near_singular, wa.worst_measure,
+            wa.lateness_ns, wa.last_published_stamp_ns) == \
+        (wb.instants, wb.published, wb.late, wb.near_singular, wb.worst_measure,
+         wb.lateness_ns, wb.last_published_stamp_ns) == (3, 3, 1, 1, 1e-4, [0, 10, 20], 2)

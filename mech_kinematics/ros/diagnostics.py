@@ -74,7 +74,9 @@ _TOTALS = ('instants', 'published', 'unsolved', 'late', 'skipped', 'clock_jumps'
 class TickStats:
     """Counters the tick thread fills and the diagnostics timer empties (thread-safe)."""
 
-    def __init__(self) -> None:
+    def __init__(self, near_singular: float = 0.0) -> None:
+        #: A published instant whose measure is below this counts as near-singular.
+        self.near_singular = near_singular
         self._lock = threading.Lock()
         self._totals = dict.fromkeys(_TOTALS, 0)
         self._last_published_stamp_ns = 0
@@ -110,6 +112,23 @@ class TickStats:
                 w.unsolved += 1
                 w.last_error = error
                 w.last_refusal = refusal
+
+    def published(self, stamp_ns: int, lateness_ns: int, late: bool, measure: float,
+                  sample: tuple[float, float, float]) -> None:
+        """Count one grid instant published: :meth:`record` without a refusal, the tick's way."""
+        with self._lock:
+            w = self._window
+            w.instants += 1
+            w.published += 1
+            w.lateness_ns.append(lateness_ns)
+            w.last_sample = sample
+            self._last_published_stamp_ns = stamp_ns
+            if late:
+                w.late += 1
+            if measure < w.worst_measure:
+                w.worst_measure = measure
+            if measure < self.near_singular:
+                w.near_singular += 1
 
     def skip(self, count: int) -> None:
         """Count ``count`` grid instants dropped."""

@@ -183,7 +183,7 @@ class KinematicsNode(LifecycleNode):
         self._stop = threading.Event()
         self._clock_event = threading.Event()
         self._thread: threading.Thread | None = None
-        self._stats = TickStats()
+        self._stats = TickStats(mk.NEAR_SINGULAR)
         self._timebase: CrankTimebase | None = None
         self._last_stamp: int | None = None
         self._last_sim: bool | None = None
@@ -342,6 +342,7 @@ class KinematicsNode(LifecycleNode):
             qos_overriding_options=_qos_options())
         self._state_publishers = [self._pub_joint_states, self._pub_joint_accel,
                                   self._pub_point_accel]
+        self._publish_state = tuple(p.publish for p in self._state_publishers)
         tick_scene = self._setup_tf(scene)
         # The scene's solve, compiled into one straight-line function (mech_kinematics.ticker).
         frames = [(f.origin, f.angle_of, f.angle) for f in self._tf_frames]
@@ -597,23 +598,26 @@ class KinematicsNode(LifecycleNode):
         sec, nanosec = divmod(stamp, NS_PER_S)
         joint_states, joint_accel, point_accel = self._messages.render_values(
             values, sec, nanosec)
-        self._pub_joint_states.publish(joint_states)
-        self._pub_joint_accel.publish(joint_accel)
-        self._pub_point_accel.publish(point_accel)
-        tf_period = self._tf_period_ns
-        if self._tf is not None and tf_period is not None and stamp >= self._next_tf:
-            self._pub_tf.publish(self._tf.render_values(values, self._tf_first, sec, nanosec))
-            self._next_tf = stamp + tf_period
+        publish_js, publish_jt, publish_pt = self._publish_state
+        publish_js(joint_states)
+        publish_jt(joint_accel)
+        publish_pt(point_accel)
+        if stamp >= self._next_tf:
+            tf_period = self._tf_period_ns
+            if self._tf is not None and tf_period is not None:
+                self._pub_tf.publish(self._tf.render_values(values, self._tf_first, sec,
+                                                            nanosec))
+                self._next_tf = stamp + tf_period
+            else:
+                self._next_tf = stamp + NS_PER_S    # off: look again in a second
         if self._pub_markers is not None and self._marker_throttle.due(
                 self._period_ns, time.monotonic_ns()):
             # Built in the executor's thread, so that this thread keeps its deadlines.
             with self._marker_lock:
                 self._marker_request = (sec, nanosec, angle, speed, accel)
             self._marker_guard.trigger()
-        near = measure < mk.NEAR_SINGULAR
-        self._stats.record(stamp, lateness, late, measure=measure, near_singular=near,
-                           sample=sample)
-        if near:
+        self._stats.published(stamp, lateness, late, measure, sample)
+        if measure < mk.NEAR_SINGULAR:
             self.get_logger().warning(
                 f'near-singular pose at crank angle {angle:.6f} rad: measure {measure:.3g}',
                 throttle_duration_sec=1.0)
