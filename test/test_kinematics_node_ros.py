@@ -273,3 +273,51 @@ def test_geneva_wheel_dwells_and_indexes_over_ten_turns(ros, tmp_path):
     assert len({math.copysign(1.0, s) for s in steps}) == 1, 'indexed back and forth'
     moving = [w for _, _, _, w, _ in samples if w != 0.0]
     assert moving and len(moving) < 0.5 * len(samples)     # engaged a quarter of each turn
+
+
+def test_switching_to_sim_time_and_back_keeps_the_crank_where_it_was(ros, tmp_path):
+    """use_sim_time set while running: the crank goes on from its last published angle.
+
+    The simulated epoch means nothing to the wall clock's: the first instant on
+    the new clock continues the last one on the old, both ways.
+    """
+    from builtin_interfaces.msg import Time
+    from rosgraph_msgs.msg import Clock
+
+    ns = f'{SESSION}/switch'
+    js = ros.collect(JointState, f'{ns}/joint_states')
+    clock_pub = ros.node.create_publisher(Clock, f'{ns}/clock', 10)
+    proc = NodeProcess(tmp_path, '-r', f'__ns:={ns}', '-r', f'/clock:={ns}/clock',
+                       '-p', 'rate_hz:=100', '-p', 'crank_speed_rpm:=60')
+    try:
+        wait_for(lambda: len(js) > 20, STARTUP_S, 'joint_states on the wall clock')
+        params = AsyncParameterClient(ros.node, f'{ns}/mech_kinematics')
+        assert params.wait_for_services(timeout_sec=STARTUP_S)
+        assert ros.call(params.set_parameters(
+            [Parameter('use_sim_time', value=True)])).results[0].successful
+        time.sleep(0.3)
+        wall_last = js[-1]
+        count = len(js)
+        t = 5_000 * NS
+        for _ in range(30):
+            t += 10_000_000
+            clock_pub.publish(Clock(clock=Time(sec=t // NS, nanosec=t % NS)))
+            time.sleep(0.01)
+        wait_for(lambda: len(js) > count + 10, 5.0, 'joint_states on sim time')
+        sim = [m for m in js[count:] if stamp_ns(m) < 100_000 * NS]
+        ci = list(wall_last.name).index('crank')
+        assert abs(wrap(sim[0].position[ci] - wall_last.position[ci])) < ATOL_TIMEBASE
+        for a, b in zip(sim, sim[1:], strict=False):
+            dt = (stamp_ns(b) - stamp_ns(a)) / NS
+            assert abs(wrap(b.position[ci] - a.position[ci] - 2 * math.pi * dt)) < ATOL_TIMEBASE
+        assert ros.call(params.set_parameters(
+            [Parameter('use_sim_time', value=False)])).results[0].successful
+        wait_for(lambda: any(stamp_ns(m) > 100_000 * NS for m in js[count:]), 5.0,
+                 'joint_states on the wall clock again')
+        last_sim = [m for m in js[count:] if stamp_ns(m) < 100_000 * NS][-1]
+        first_wall = next(m for m in js[count:] if stamp_ns(m) > 100_000 * NS)
+        assert abs(wrap(first_wall.position[ci] - last_sim.position[ci])) < ATOL_TIMEBASE
+    finally:
+        status, _ = proc.stop(signal.SIGINT)
+        ros.node.destroy_publisher(clock_pub)
+    assert status == 0, proc.output()

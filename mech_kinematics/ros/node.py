@@ -518,6 +518,9 @@ class KinematicsNode(LifecycleNode):
                 # Instants follow the simulated clock: wake on every /clock update.
                 self._clock_event.wait(MAX_SLEEP_NS / NS_PER_S)
                 self._clock_event.clear()
+                if not clock.ros_time_is_active:
+                    self._clock_event.set()     # switched off: the loop's top sees it
+                    continue
                 now = clock.now().nanoseconds
                 if stop.is_set():
                     break
