@@ -402,7 +402,7 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
     measure = f'min({", ".join(measures)})' if len(measures) > 1 else (
         measures[0] if measures else 'inf')
     lines.append(f'return [{", ".join(values)}], {measure}')
-    tail = [ast.parse(textwrap.dedent('\n'.join(lines))).body]
+    tail = ast.parse('\n'.join(lines)).body
     guard = ast.parse(
         f'if not ({lk._RATE_LOW!r} <= abs(omega) <= {lk._RATE_HIGH!r} '
         f'and abs(alpha) <= {lk._ACCEL_HIGH!r}):\n'
@@ -412,7 +412,7 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
             posonlyargs=[],
             args=[ast.arg(a) for a in ('theta', 'omega', 'alpha', 'tol', 'turns')],
             kwonlyargs=[], kw_defaults=[], defaults=[ast.Constant(0)]),
-        body=guard + body + list(itertools.chain.from_iterable(tail)), decorator_list=[],
+        body=guard + body + tail, decorator_list=[],
         returns=None)
     module = ast.fix_missing_locations(ast.Module(body=[function], type_ignores=[]))
     exec(compile(module, f'<compiled tick of {scene.name}>', 'exec'), namespace)  # noqa: S102
