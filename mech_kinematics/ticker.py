@@ -319,7 +319,8 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
     Returns
     -------
     callable or None
-        ``tick(theta, omega, alpha, max_error) -> (values, measure)``:
+        ``tick(theta, omega, alpha, max_error, turns=0) -> (values, measure)``
+        (``theta + 2 pi turns`` is the crank angle counted from the start):
         ``values`` is the flat list ``[positions of joints..., their velocities...,
         their accelerations..., x, y of every point's position..., of every
         velocity..., of every acceleration..., x, y, angle of every frame...]`` and
