@@ -124,6 +124,14 @@ class Recording:
         return {m[1]: (m[2], int(m[3]), int(m[4])) for m in SUMMARY_LINE.finditer(self.output)}
 
 
+def _kill_left_over(processes) -> None:
+    """Kill whichever of ``processes`` a failed test left running."""
+    for process in processes:
+        if process.proc.poll() is None:
+            process.proc.kill()
+            process.proc.wait()
+
+
 @pytest.fixture(scope='module')
 def recordings(tmp_path_factory):
     """Record the node with four recorders started before it; return them by name."""
@@ -150,10 +158,7 @@ def recordings(tmp_path_factory):
             node_status = node.stop(signal.SIGINT)
         assert node_status == 0, node.output()
     finally:
-        for recorder in recorders.values():
-            if recorder.proc.poll() is None:
-                recorder.proc.kill()
-                recorder.proc.wait()
+        _kill_left_over(recorders.values())
     return {name: Recording(name, tmp / name, statuses[name], recorders[name].output(),
                             RECORDERS[name][2]) for name in RECORDERS}
 
@@ -556,10 +561,7 @@ def crashes(tmp_path_factory):
             node_status = node.stop(signal.SIGINT)
         assert node_status == 0, node.output()
     finally:
-        for recorder in recorders.values():
-            if recorder.proc.poll() is None:
-                recorder.proc.kill()
-                recorder.proc.wait()
+        _kill_left_over(recorders.values())
     reindexed = {}
     for name in ('kill_mcap', 'kill_sqlite3'):
         copy = tmp / f'{name}_reindexed'
