@@ -25,6 +25,8 @@ from mech_kinematics.scene import read_scene_yaml
 ROOT = Path(__file__).resolve().parent.parent
 DOC = ROOT / 'docs' / 'scene_format.md'
 README = ROOT / 'README.md'
+#: README and every page of docs/, the repository's own reference.
+DOCUMENTS = [README, *sorted(ROOT.joinpath('docs').rglob('*.md'))]
 
 #: The four-bar the error table of the reference breaks, one thing at a time.
 BASE = """\
@@ -139,7 +141,7 @@ def test_quoted_error_messages_are_the_real_ones(mistake, tmp_path):
 
 def test_quoted_solve_errors_are_the_real_ones():
     """The errors `solve` prints in the reference and the README are the program's."""
-    quoted = [line for text in (DOC.read_text(), README.read_text())
+    quoted = [line for text in map(Path.read_text, DOCUMENTS)
               for block in blocks(text, 'console') for line in block.splitlines()
               if line.startswith('error: ') and 'cannot be solved' in line]
     assert len(quoted) >= 3
@@ -158,11 +160,37 @@ def test_quoted_solve_errors_are_the_real_ones():
         assert err.getvalue() == f'{line}\n'
 
 
-def test_links_and_figures_resolve():
-    """The README links the reference; every relative link and image of the reference exists."""
-    assert '(docs/scene_format.md)' in README.read_text()
-    for target in re.findall(r'\]\(([^)#:]+)(?:#[^)]*)?\)', DOC.read_text()):
-        assert (DOC.parent / target).exists(), target
+def anchors(text):
+    """Return the GitHub anchors of a Markdown text's headings (outside code blocks)."""
+    found, fenced = set(), False
+    for line in text.splitlines():
+        if line.startswith('```'):
+            fenced = not fenced
+        elif not fenced and line.startswith('#'):
+            title = line.lstrip('#').strip().lower()
+            found.add(re.sub(r'[^\w\- ]', '', title).replace(' ', '-'))
+    return found
+
+
+@pytest.mark.parametrize('path', DOCUMENTS, ids=lambda p: str(p.relative_to(ROOT)))
+def test_links_and_anchors_resolve(path):
+    """Every relative link and image of README and docs/ exists, and so does its anchor."""
+    text = path.read_text()
+    links = re.findall(r'\]\(([^)\s:#]*)(?:#([^)\s]*))?\)', text)
+    for target, anchor in links:
+        file = (path.parent / target).resolve() if target else path
+        assert file.exists(), (path.name, target)
+        if anchor:
+            assert anchor in anchors(file.read_text()), (path.name, target, anchor)
+
+
+def test_readme_is_a_front_door():
+    """README is short, has contents, the two commands, and links every document in docs/."""
+    text = README.read_text()
+    assert len(text.splitlines()) < 400
+    assert '## Contents' in text and 'make run' in text and 'make test' in text
+    for doc in ROOT.joinpath('docs').glob('*.md'):
+        assert f'(docs/{doc.name})' in text, doc.name
 
 
 def test_nothing_shipped_points_outside_the_repository():
@@ -175,3 +203,13 @@ def test_nothing_shipped_points_outside_the_repository():
             text = path.read_text(errors='replace')
             for needle in ('../shared', '/shared/', 'seeds/', '/work/'):
                 assert needle not in text, (path, needle)
+
+
+def test_readme_lists_every_executable():
+    """The README's executables table has a row for every console script of setup.py."""
+    scripts = re.findall(r"^\s+'(\w+) = mech_kinematics", ROOT.joinpath('setup.py').read_text(),
+                         re.MULTILINE)
+    assert 'kinematics_node' in scripts and 'check' in scripts
+    table = README.read_text().split('## Executables', 1)[1].split('\n## ', 1)[0]
+    rows = set(re.findall(r'^\| `(\w+)` \|', table, re.MULTILINE))
+    assert rows == set(scripts)
