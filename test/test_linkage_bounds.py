@@ -30,6 +30,7 @@ doubles) and check that
 from __future__ import annotations
 
 import cmath
+import contextlib
 import dataclasses
 import json
 import math
@@ -519,13 +520,34 @@ def assert_tight(scene, angle, speed=None, accel=None):
     return True
 
 
+#: Packaged scenes whose condition number exceeds KAPPA_WELL at every angle tried.
+NEVER_WELL_CONDITIONED = {
+    'rocking_lever': 'kappa about 21 throughout',
+    'jansen_leg': 'five dyads in a chain: kappa 23 to 187 at the eight angles',
+}
+
+
 @pytest.mark.parametrize('name', mk.scene_names())
 def test_bound_is_tight_on_the_packaged_scenes(name):
     """Where well-conditioned, a packaged scene's bounds are within 1e3 x (error + 1 ulp)."""
     scene = mk.load_scene(name)
     checked = [assert_tight(scene, scene.input.angle + turn)
                for turn in np.linspace(0, 2 * np.pi, 8, endpoint=False)]
-    assert any(checked) or name == 'rocking_lever'  # its kappa is about 21 throughout
+    assert any(checked) or name in NEVER_WELL_CONDITIONED
+
+
+@pytest.mark.parametrize('name', mk.scene_names())
+def test_bound_covers_the_actual_error_on_the_packaged_scenes(name):
+    """At eight angles of a turn, no value of a packaged scene is off by more than its bound."""
+    scene = mk.load_scene(name)
+    answered = []
+    for angle in scene.input.angle + np.linspace(0, 2 * np.pi, 8, endpoint=False):
+        with contextlib.suppress(mk.AssemblyError):
+            state = mk.solve(scene, angle, max_error=math.inf)
+            if not all(e.engaged for e in state.intermittent.values()):
+                continue  # the reference has no dwell: test_intermittent checks locked wheels
+        answered.append(assert_bounded(scene, angle)[0] is not None)
+    assert sum(answered) >= 2, answered
 
 
 @settings(SETTINGS, max_examples=100)
