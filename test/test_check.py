@@ -16,6 +16,7 @@ import sys
 
 import pytest
 
+import mech_kinematics as mk
 from mech_kinematics.__main__ import build_parser, main, TOOLS
 from mech_kinematics.tools import check
 
@@ -94,3 +95,55 @@ def test_registered_as_a_tool_and_a_console_script():
     for word in ('toggle', 'dead centres', 'transmission', 'Grashof', '--json', 'SI'):
         assert word in result.stdout, word
     assert "'check = mech_kinematics.tools.check:main'" in (REPO / 'setup.py').read_text()
+
+
+def test_quick_return_time_ratio_is_the_closed_form(capsys):
+    """Crank and slotted lever: the return stroke takes 2 acos(r/d) of crank (Khurmi 15.3)."""
+    assert main(['check', 'quick_return', '--json']) == 0
+    data = json.loads(capsys.readouterr().out)
+    beta = 2 * math.acos(150 / 400)  # crank AB = 150 mm, centres AO = 400 mm
+    by_joint = {s['joint']: s for s in data['strokes']}
+    assert set(by_joint) == {'lever', 'ram'}
+    for output in by_joint.values():
+        assert output['time_ratio'] == pytest.approx((2 * math.pi - beta) / beta, rel=1e-11)
+        travels = sorted(s['crank_travel'] for s in output['strokes'])
+        assert travels == pytest.approx([beta, 2 * math.pi - beta], abs=1e-11)
+    lever = by_joint['lever']['strokes']
+    assert lever[0]['to_position'] == lever[1]['from_position']
+    assert abs(lever[0]['from_position'] - lever[0]['to_position']) == pytest.approx(
+        2 * math.asin(150 / 400), abs=1e-11)  # the lever's swing
+
+
+def test_offset_slider_crank_time_ratio(capsys):
+    """Offset 50, rod 400, crank 100 mm: time ratio (pi + d) / (pi - d) from the in-line angles."""
+    assert main(['check', 'offset_slider_crank', '--json']) == 0
+    (piston,) = json.loads(capsys.readouterr().out)['strokes']
+    delta = math.asin(50 / 300) - math.asin(50 / 500)
+    assert piston['time_ratio'] == pytest.approx((math.pi + delta) / (math.pi - delta), rel=1e-11)
+    assert abs(piston['strokes'][0]['from_position'] - piston['strokes'][0]['to_position']) \
+        == pytest.approx(math.sqrt(0.5 ** 2 - 0.05 ** 2) - math.sqrt(0.3 ** 2 - 0.05 ** 2),
+                         abs=1e-14)
+
+
+def test_geneva_indexes_a_quarter_turn_in_a_quarter_of_the_crank_turn(capsys):
+    """Four slots: the wheel indexes 90 deg over 90 deg of crank and is locked for 270 deg."""
+    assert main(['check', 'geneva', '--json']) == 0
+    (wheel,) = json.loads(capsys.readouterr().out)['intermittent']
+    assert wheel['engaged_travel'] == pytest.approx(math.pi / 2, abs=1e-15)
+    assert wheel['locked_travel'] == pytest.approx(3 * math.pi / 2, abs=1e-15)
+    start, end = wheel['engaged']
+    scene = mk.load_scene('geneva')
+    before, after = (mk.solve(scene, start - 0.01).joints['wheel'].position,
+                     mk.solve(scene, end + 0.01).joints['wheel'].position)
+    assert math.remainder(after - before - wheel['index'], 2 * math.pi) == pytest.approx(
+        0, abs=1e-14)
+    assert abs(wheel['index']) == pytest.approx(math.pi / 2, abs=1e-15)
+    assert main(['check', 'geneva']) == 0
+    assert ('intermittent: wheel indexes -90 deg while the crank turns CCW from 135 to 225 deg '
+            '(90 deg of each turn); locked for the other 270 deg') in capsys.readouterr().out
+
+
+def test_a_crank_that_cannot_turn_has_no_strokes(capsys):
+    """The triple rocker cannot make a whole turn: no strokes, no time ratio."""
+    assert main(['check', 'four_bar_coupler_points', '--json']) == 0
+    assert json.loads(capsys.readouterr().out)['strokes'] == []

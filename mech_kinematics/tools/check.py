@@ -31,7 +31,12 @@ print:
     is at an end of its stroke);
   - the minimum transmission angle of every RRR and RRP dyad, and where;
   - the Grashof class of every four-bar loop (crank-rocker, rocker-crank,
-    double-crank, double-rocker, change point, triple-rocker).
+    double-crank, double-rocker, change point, triple-rocker);
+  - the strokes of every output that reverses, in the order the crank meets
+    them turning at the scene's own speed, and its time ratio (the slower
+    stroke's crank travel over the quicker's: a quick return's);
+  - the arc of each crank turn in which an intermittent (Geneva) lever
+    indexes, by how much, and the arc in which it is locked.
 Text uses the scene's units; --json prints SI (rad, m). Exit status 2 on a
 scene that cannot be read.
 """
@@ -97,11 +102,41 @@ def report_text(assembly: Any, scene: Any) -> str:
         lines.append('minimum transmission angle: no RRR or RRP dyad')
     loops = [_loop_text(loop, units) for loop in assembly.loops]
     lines.append(f'four-bar loops: {"; ".join(loops) if loops else "none"}')
+    lines.extend(_strokes_text(scene, assembly, angle))
     return '\n'.join(lines)
 
 
-def report_json(assembly: Any) -> dict[str, Any]:
+def _strokes_text(scene: Any, assembly: Any, angle: Any) -> list[str]:
+    from ..geometry.assembly import angle_text
+    from ..geometry.strokes import intermittent_from_scene, strokes_from_assembly
+    units = assembly.units
+    unit = units.angle
+    lines = []
+    outputs = strokes_from_assembly(scene, assembly)
+    if outputs:
+        way = 'CCW' if scene.input.speed >= 0.0 else 'CW'
+        lines.append(f'strokes (the crank turning {way}; time ratio = slower stroke / quicker):')
+    for output in outputs:
+        def where(x: float) -> str:
+            return (f'{angle_text(units, x)} {unit}' if output.kind == 'revolute'  # noqa: B023
+                    else units.length_text(x))
+        parts = [f'{where(s.start_position)} -> {where(s.end_position)} over crank '
+                 f'{angle_text(units, s.start)}..{angle_text(units, s.end)} {unit} '
+                 f'({angle(s.crank_travel)})' for s in output.strokes]
+        ratio = '' if output.time_ratio is None else f'; time ratio {output.time_ratio:.6g}'
+        lines.append(f'  {output.joint}: {", then ".join(parts)}{ratio}')
+    for lever in intermittent_from_scene(scene):
+        start, end = lever.engaged
+        lines.append(f'intermittent: {lever.lever} '
+                     f'indexes {angle(lever.index)} while the crank turns CCW from '
+                     f'{angle_text(units, start)} to {angle(end)} ({angle(lever.engaged_travel)} '
+                     f'of each turn); locked for the other {angle(lever.locked_travel)}')
+    return lines
+
+
+def report_json(assembly: Any, scene: Any) -> dict[str, Any]:
     """Return the report of ``check --json``: SI units (rad, m)."""
+    from ..geometry.strokes import intermittent_from_scene, strokes_from_assembly
     return {
         'scene': assembly.scene,
         'assembles_everywhere': assembly.everywhere,
@@ -122,6 +157,15 @@ def report_json(assembly: Any) -> dict[str, Any]:
                    'lengths': dict(zip(('ground', 'input', 'coupler', 'output'), loop.lengths,
                                        strict=True)),
                    'class': loop.grashof} for loop in assembly.loops],
+        'strokes': [{'joint': s.joint, 'type': s.kind, 'time_ratio': s.time_ratio,
+                     'strokes': [{'from_angle': x.start, 'to_angle': x.end,
+                                  'crank_travel': x.crank_travel,
+                                  'from_position': x.start_position,
+                                  'to_position': x.end_position} for x in s.strokes]}
+                    for s in strokes_from_assembly(scene, assembly)],
+        'intermittent': [{'lever': i.lever, 'index': i.index, 'engaged': list(i.engaged),
+                          'engaged_travel': i.engaged_travel, 'locked_travel': i.locked_travel}
+                         for i in intermittent_from_scene(scene)],
     }
 
 
@@ -132,7 +176,7 @@ def _handle(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene)  # a SceneError is one line, exit 2 (cli.run_handler)
     assembly = assembly_from_scene(scene)
     if args.json:
-        print(json.dumps(report_json(assembly), indent=1, allow_nan=False))
+        print(json.dumps(report_json(assembly, scene), indent=1, allow_nan=False))
     else:
         print(report_text(assembly, scene))
     return 0
