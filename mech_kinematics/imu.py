@@ -1,0 +1,122 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""Exact readings of an inertial sensor rigidly mounted on a moving link.
+
+A sensor ``name: {link: L, point: P, gravity: [gx, gy], angle: beta}`` sits at
+point ``P`` of link ``L`` with its x axis at ``beta`` from the link's (the
+link's ``/tf`` frame turned by ``beta``). What an ideal IMU there reads is a
+function of the solved state alone:
+
+- orientation ``phi = theta_L + beta`` (rad, wrapped to (-pi, pi]): the
+  rotation of the sensor frame about z;
+- angular velocity ``omega_L`` (rad/s about z): a planar body turns at one
+  rate everywhere on it;
+- linear acceleration ``R(-phi) (a_P - g)`` (m/s^2, in the sensor frame):
+  an accelerometer measures specific force, the acceleration less gravity
+  (at rest with ``g = [0, -9.80665]`` it reads ``+9.80665`` along the
+  world's +y).
+
+Each reading carries an absolute error bound built from the state's own
+bounds: the acceleration's ``e_a + |a_P - g| e_phi`` (a rotation by an angle
+off by ``e_phi`` moves a vector by at most ``|v| e_phi``) plus the rounding
+of the rotation itself. Scalars for one crank angle, arrays for many.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+import math
+from typing import Any
+
+import numpy as np
+
+from .bounds import U
+
+__all__ = ['ImuReading', 'ImuSpec', 'imu_reading']
+
+#: Rounding of ``R(-phi) v`` with ``cos``/``sin`` and two products and a sum per
+#: component, relative to ``|v|``: a few units of roundoff, taken generously.
+_ROTATION_ROUNDING = 8.0 * U
+
+
+@dataclass(frozen=True)
+class ImuSpec:
+    """A sensor ``name`` at ``point`` on ``link``; ``gravity`` m/s^2, ``angle`` rad."""
+
+    name: str
+    link: str
+    point: str
+    gravity: tuple[float, float] = (0.0, 0.0)
+    angle: float = 0.0
+
+    def __post_init__(self) -> None:
+        """Refuse a gravity or angle that is not a finite number."""
+        for value, what in ((self.gravity[0], 'gravity[0]'), (self.gravity[1], 'gravity[1]'),
+                            (self.angle, 'angle')):
+            if not math.isfinite(value):
+                msg = f'imus.{self.name}.{what}: expected a finite number, got {value!r}'
+                raise ValueError(msg)
+
+
+@dataclass(frozen=True)
+class ImuReading:
+    """What the sensor reads, and the bound of each reading's error.
+
+    ``linear_acceleration`` has shape (2,) or (n, 2), in the sensor frame;
+    its bound is on the norm of the error vector.
+    """
+
+    orientation: Any
+    angular_velocity: Any
+    linear_acceleration: Any
+    orientation_bound: Any
+    angular_velocity_bound: Any
+    linear_acceleration_bound: Any
+
+    def as_dict(self, vector: bool) -> dict[str, Any]:
+        """Return the ``solve`` JSON's ``imus.NAME`` (floats, or arrays where ``vector``)."""
+        def value(x: Any) -> Any:
+            return x if vector else float(x)
+
+        accel = self.linear_acceleration
+        return {'angular_velocity': value(self.angular_velocity),
+                'linear_acceleration': accel if vector else [float(accel[0]), float(accel[1])],
+                'orientation': value(self.orientation)}
+
+    def bounds_dict(self, vector: bool) -> dict[str, Any]:
+        """Return the bounds shaped like :meth:`as_dict` (one norm for the acceleration)."""
+        def value(x: Any) -> Any:
+            return x if vector else float(x)
+
+        return {'angular_velocity': value(self.angular_velocity_bound),
+                'linear_acceleration': value(self.linear_acceleration_bound),
+                'orientation': value(self.orientation_bound)}
+
+
+def imu_reading(state: Any, spec: ImuSpec) -> ImuReading:
+    """Return what ``spec``'s sensor reads in ``state`` (a :class:`State`), with bounds.
+
+    ``spec.link`` must be a revolute joint of the state and ``spec.point`` a
+    point of it (the scene's outputs must keep both).
+    """
+    joint = state.joints[spec.link]
+    point = state.points[spec.point]
+    joint_bound = state.error_bound.joints[spec.link]
+    point_bound = state.error_bound.points[spec.point]
+    phi = np.asarray(joint.position, dtype=np.float64) + spec.angle
+    phi = np.where(phi > math.pi, phi - 2 * math.pi, np.where(phi <= -math.pi,
+                                                              phi + 2 * math.pi, phi))
+    c, s = np.cos(phi), np.sin(phi)
+    a = np.asarray(point.acceleration, dtype=np.float64) - np.asarray(spec.gravity)
+    ax, ay = a[..., 0], a[..., 1]
+    reading = np.stack((c * ax + s * ay, c * ay - s * ax), axis=-1)
+    size = np.hypot(ax, ay)
+    e_phi = np.asarray(joint_bound.position) + U * (abs(phi) + abs(spec.angle))
+    e_accel = (np.asarray(point_bound.acceleration) + size * e_phi
+               + _ROTATION_ROUNDING * (size + abs(spec.gravity[0]) + abs(spec.gravity[1])))
+    scalar = np.ndim(phi) == 0
+    if scalar:
+        return ImuReading(float(phi), float(joint.velocity), reading,
+                          float(e_phi), float(joint_bound.velocity), float(e_accel))
+    return ImuReading(phi, np.asarray(joint.velocity), reading, e_phi,
+                      np.asarray(joint_bound.velocity), e_accel)

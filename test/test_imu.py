@@ -1,0 +1,118 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""IMU readings from a solved state (issue 18, SCENE_FORMAT version 3 ``imus``).
+
+The readings are checked three ways: against time derivatives of the
+solver's own positions (the definition of what an accelerometer and a gyro
+read), at rest (gravity alone), and against the 50-digit reference, whose
+error must stay within the readings' bounds.
+"""
+
+from __future__ import annotations
+
+import math
+
+import mpmath
+import numpy as np
+import pytest
+
+import mech_kinematics as mk
+from mech_kinematics.imu import imu_reading, ImuSpec
+from mech_kinematics.tools import reference as ref
+
+G = (0.0, -9.80665)  # m/s^2, standard gravity along -y
+SCENE = mk.load_scene('khurmi_four_bar_ad150')
+SPEC = ImuSpec('tip', 'coupler', 'C', G, 0.3)
+#: Central differences in time with step H (s): truncation ~H^2 |f'''| ~ 3e-8 relative,
+#: rounding of the second difference ~eps |p| / H^2 ~ 1e-7 relative.
+H = 1e-5
+RTOL_DIFFERENCE = 1e-6
+
+
+def reading_at(t, accel):
+    """Return the reading and the state at time t from the scene's initial angle."""
+    omega = SCENE.input.speed
+    state = mk.solve(SCENE, SCENE.input.angle + omega * t + accel * t * t / 2,
+                     omega + accel * t, accel)
+    return imu_reading(state, SPEC), state
+
+
+@pytest.mark.parametrize('accel', [0.0, 30.0])
+@pytest.mark.parametrize('t', [0.0, 0.07, 0.19, 0.33])
+def test_readings_are_the_time_derivatives_in_the_sensor_frame(t, accel):
+    """Gyro = d(orientation)/dt; accelerometer = R(-phi) (d2p/dt2 - g); phi = theta + angle."""
+    (now, state), (ahead, s_ahead), (behind, s_behind) = (
+        reading_at(t, accel), reading_at(t + H, accel), reading_at(t - H, accel))
+    coupler = state.joints['coupler'].position
+    assert now.orientation == pytest.approx(math.remainder(coupler + 0.3, 2 * math.pi), abs=1e-15)
+    turn = math.remainder(ahead.orientation - behind.orientation, 2 * math.pi)
+    assert now.angular_velocity == pytest.approx(turn / (2 * H), rel=RTOL_DIFFERENCE)
+    p = [s.points['C'].position for s in (s_behind, state, s_ahead)]
+    a = (p[2] - 2 * p[1] + p[0]) / H ** 2 - np.array(G)
+    c, s = math.cos(now.orientation), math.sin(now.orientation)
+    expected = np.array([c * a[0] + s * a[1], -s * a[0] + c * a[1]])
+    np.testing.assert_allclose(now.linear_acceleration, expected,
+                               atol=RTOL_DIFFERENCE * np.linalg.norm(expected))
+
+
+def test_at_rest_the_accelerometer_reads_gravity_upward():
+    """Speed and acceleration 0: the reading is -g turned into the sensor frame, |9.80665|."""
+    state = mk.solve(SCENE, SCENE.input.angle, 0.0, 0.0)
+    reading = imu_reading(state, SPEC)
+    assert reading.angular_velocity == 0.0
+    assert np.linalg.norm(reading.linear_acceleration) == pytest.approx(9.80665, rel=1e-15)
+    phi = reading.orientation
+    world = (math.cos(phi) * reading.linear_acceleration[0]
+             - math.sin(phi) * reading.linear_acceleration[1],
+             math.sin(phi) * reading.linear_acceleration[0]
+             + math.cos(phi) * reading.linear_acceleration[1])
+    assert world == pytest.approx((0.0, 9.80665), abs=1e-14)
+
+
+@pytest.mark.parametrize('name,link,point', [('khurmi_four_bar_ad150', 'coupler', 'C'),
+                                             ('quick_return', 'lever', 'C'),
+                                             ('steam_engine_500_2000', 'rod', 'E')])
+def test_bounds_cover_the_error_against_the_50_digit_reference(name, link, point):
+    """At eight angles, each reading is within its bound of the exact reading."""
+    scene = mk.load_scene(name)
+    spec = ImuSpec('s', link, point, G, -1.1)
+    for angle in scene.input.angle + np.linspace(0, 2 * np.pi, 8, endpoint=False):
+        state = mk.solve(scene, angle)
+        reading = imu_reading(state, spec)
+        exact = ref.reference(scene, angle)
+        with mpmath.workdps(ref.DPS):
+            theta, omega, _ = exact.joints[link]
+            phi = theta + mpmath.mpf(spec.angle)
+            a = exact.points[point][2] - mpmath.mpc(*G)
+            rotated = a * mpmath.expj(-phi)
+            assert abs(float(ref._wrap(mpmath.mpf(reading.orientation) - phi))) \
+                <= reading.orientation_bound
+            assert abs(float(mpmath.mpf(reading.angular_velocity) - omega)) \
+                <= reading.angular_velocity_bound
+            error = abs(mpmath.mpc(*reading.linear_acceleration) - rotated)
+            assert float(error) <= reading.linear_acceleration_bound
+            assert reading.linear_acceleration_bound < 1e-12 * float(abs(rotated)) + 1e-12
+
+
+def test_the_array_path_gives_the_scalar_readings():
+    """Readings over an array of angles are the single-angle ones, to the ulp of an angle."""
+    angles = SCENE.input.angle + np.linspace(0, 2 * np.pi, 16, endpoint=False)
+    many = imu_reading(mk.solve(SCENE, angles), SPEC)
+    for i, angle in enumerate(angles):
+        one = imu_reading(mk.solve(SCENE, float(angle)), SPEC)
+        assert many.angular_velocity[i] == one.angular_velocity
+        # The link angles of the two paths may differ by an ulp (atan2 of math and
+        # of NumPy), and the readings turned by them likewise.
+        assert many.orientation[i] == pytest.approx(one.orientation, rel=4 * mk.bounds.U)
+        np.testing.assert_allclose(many.linear_acceleration[i], one.linear_acceleration,
+                                   rtol=0, atol=8 * mk.bounds.U * 9.80665 * 10)
+        assert many.linear_acceleration_bound[i] == pytest.approx(
+            one.linear_acceleration_bound, rel=1e-12)
+
+
+def test_gravity_and_angle_must_be_finite():
+    """A NaN or infinite gravity or mounting angle is refused, naming the key."""
+    with pytest.raises(ValueError, match=r'imus\.tip\.gravity\[1\]: expected a finite number'):
+        ImuSpec('tip', 'coupler', 'C', (0.0, math.inf))
+    with pytest.raises(ValueError, match=r'imus\.tip\.angle'):
+        ImuSpec('tip', 'coupler', 'C', G, math.nan)
