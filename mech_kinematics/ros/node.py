@@ -395,8 +395,8 @@ class KinematicsNode(LifecycleNode):
         scene = self.scene
         assert scene is not None
         names = ('scene', 'crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm', 'rate_hz',
-                 'late_ticks', 'max_catch_up_s', 'max_relative_error', 'frame_id',
-                 'tf_rate_hz', 'tf_prefix',
+                 'late_ticks', 'max_catch_up_s', 'max_lateness_ms', 'max_relative_error',
+                 'frame_id', 'tf_rate_hz', 'tf_prefix',
                  'use_sim_time', 'markers', 'managed')
         settings = ', '.join(f'{name}={self._value(name)!r}' for name in names[1:])
         self.get_logger().info(
@@ -666,7 +666,8 @@ class KinematicsNode(LifecycleNode):
                           near_singular=mk.NEAR_SINGULAR, waiting_for=waiting,
                           assembly=self._assembly),
             timing_status(window, name=name, hardware_id=hardware_id,
-                          rate_hz=self._value('rate_hz')),
+                          rate_hz=self._value('rate_hz'),
+                          max_lateness_ms=self._value('max_lateness_ms')),
         ]
         msg = DiagnosticArray(status=[diagnostic_status_from(s) for s in statuses])
         msg.header.stamp = self.get_clock().now().to_msg()
