@@ -65,6 +65,7 @@ setup(
             'bench = mech_kinematics.tools.bench:main',
             'reindex = mech_kinematics.tools.reindex:main',
             'check = mech_kinematics.tools.check:main',
+            'urdf = mech_kinematics.tools.urdf:main',
         ],
     },
 )

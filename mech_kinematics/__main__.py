@@ -9,12 +9,12 @@ from collections.abc import Sequence
 import sys
 
 from .cli import ArgumentParser, PROG, run_handler
-from .tools import bench, check, diagram, plot, record, reindex, report, run, solve
+from .tools import bench, check, diagram, plot, record, reindex, report, run, solve, urdf
 
 __all__ = ['TOOLS', 'build_parser', 'main']
 
 #: The subcommands, in the order ``--help`` lists them.
-TOOLS = (solve, check, run, bench, diagram, plot, record, reindex, report)
+TOOLS = (solve, check, run, bench, diagram, plot, record, reindex, report, urdf)
 
 
 def build_parser() -> argparse.ArgumentParser:

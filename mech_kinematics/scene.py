@@ -57,7 +57,7 @@ __all__ = [
     'DEFAULT_SCENE', 'MAX_CARRIED_POINTS', 'MAX_DEPTH', 'MAX_DYADS', 'MAX_FILE_BYTES',
     'MAX_GROUND_POINTS', 'MAX_INTEGER_DIGITS', 'MAX_MESSAGE', 'MAX_PINS', 'MAX_YAML_NODES',
     'SceneLoader',
-    'load_scene', 'parse_scene', 'read_scene_yaml', 'scene_dirs', 'scene_names',
+    'load_scene', 'parse_scene', 'read_scene_yaml', 'scene_dirs', 'scene_names', 'scene_text',
 ]
 
 #: The packaged scene that the node and ``make run`` use by default.
@@ -854,6 +854,17 @@ def _one_line(message: str) -> str:
     if len(message) > MAX_MESSAGE:
         message = f'{message[:MAX_MESSAGE - 125]} ... {message[-120:]}'
     return message
+
+
+def scene_text(source: str | os.PathLike[str]) -> str:
+    """Return the text of the scene file ``source`` names (a path or a packaged scene name).
+
+    What :func:`load_scene` reads, for a copy (the node publishes it on
+    ``scene`` so that a bag holds the scene it was recorded from). Raises
+    :class:`SceneError` as :func:`load_scene` does.
+    """
+    path = _resolve(os.fspath(source))
+    return _decode(path, _read_bytes(path))
 
 
 def load_scene(source: str | os.PathLike[str]) -> Scene:

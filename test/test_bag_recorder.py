@@ -58,7 +58,11 @@ SCENE = mk.load_scene(mk.DEFAULT_SCENE)
 STATE_TOPICS = {'/joint_states': 'sensor_msgs/msg/JointState',
                 '/joint_accelerations': 'trajectory_msgs/msg/JointTrajectory',
                 '/point_accelerations': 'trajectory_msgs/msg/MultiDOFJointTrajectory'}
-TOPICS = {**STATE_TOPICS, '/diagnostics': 'diagnostic_msgs/msg/DiagnosticArray'}
+#: Everything the node publishes by default, recorded by default (issue 20); /markers is off.
+LATCHED_TOPICS = {'/tf_static': 'tf2_msgs/msg/TFMessage',
+                  '/robot_description': 'std_msgs/msg/String', '/scene': 'std_msgs/msg/String'}
+TOPICS = {**STATE_TOPICS, '/diagnostics': 'diagnostic_msgs/msg/DiagnosticArray',
+          '/tf': 'tf2_msgs/msg/TFMessage', **LATCHED_TOPICS}
 #: name -> (extra arguments, how it is stopped, bag version)
 RECORDERS = {
     'duration_mcap': (['--storage', 'mcap', '--duration', str(DURATION_S)], None, 8),
@@ -338,10 +342,13 @@ def test_metadata_lists_every_topic_as_ros_tools_expect(recordings, name):
             # A YAML string with numeric policies, as Humble reads it (rosbag2#1895).
             assert isinstance(profiles, str)
             profiles = yaml.safe_load(profiles)
-            assert profiles[0]['reliability'] == 1 and profiles[0]['durability'] == 2
+            # durability 1: transient local (the latched topics), 2: volatile.
+            assert profiles[0]['reliability'] == 1
+            assert profiles[0]['durability'] == (1 if topic in LATCHED_TOPICS else 2)
         else:
             assert profiles[0]['reliability'] == 'reliable'
-            assert profiles[0]['durability'] == 'volatile'
+            assert profiles[0]['durability'] == ('transient_local' if topic in LATCHED_TOPICS
+                                                 else 'volatile')
         assert profiles[0]['deadline'] == {'sec': 9223372036, 'nsec': 854775807}
 
 
@@ -375,6 +382,45 @@ def test_mcap_is_readable_by_the_foxglove_mcap_library(recordings):
         assert {c.message_encoding for c in summary.channels.values()} == {'cdr'}
         count = sum(1 for _ in reader.iter_decoded_messages())
     assert count == summary.statistics.message_count > 0
+
+
+@pytest.mark.parametrize('name', RECORDERS)
+def test_a_default_bag_replays_whole(recordings, contents, name):
+    """/tf, /tf_static, robot_description and the scene are in the bag, read by rosbags (issue 20).
+
+    Once each for the latched ones; the scene's text loads to the node's scene
+    and the URDF's links are the frames on /tf and /tf_static.
+    """
+    import xml.etree.ElementTree as ET
+
+    bag = contents[name]
+    for topic in LATCHED_TOPICS:
+        assert len(bag[topic]) == 1, topic
+    assert len(bag['/tf']) > 10
+    (_, scene_msg), = bag['/scene']
+    assert mk.parse_scene(mk.scene.read_scene_yaml(scene_msg.data)) == SCENE
+    (_, urdf_msg), = bag['/robot_description']
+    links = {link.get('name') for link in ET.fromstring(urdf_msg.data).findall('link')}
+    frames = {t.child_frame_id for topic in ('/tf', '/tf_static')
+              for t in bag[topic][-1][1].transforms}
+    assert links == {'mechanism'} | frames
+
+
+def test_the_mcap_reader_reads_the_latched_topics_alike(recordings, contents):
+    """Foxglove's mcap reader decodes the same scene text, URDF and static frames as rosbags."""
+    import mcap.reader as mcap_reader
+    import mcap_ros2.decoder as mcap_ros2
+
+    path = recordings['duration_mcap'].path / 'duration_mcap.mcap'
+    with open(path, 'rb') as stream:
+        reader = mcap_reader.make_reader(stream, decoder_factories=[mcap_ros2.DecoderFactory()])
+        seen = {channel.topic: msg for _, channel, _, msg in
+                reader.iter_decoded_messages(topics=list(LATCHED_TOPICS))}
+    rosbags = contents['duration_mcap']
+    assert seen['/scene'].data == rosbags['/scene'][0][1].data
+    assert seen['/robot_description'].data == rosbags['/robot_description'][0][1].data
+    assert [t.child_frame_id for t in seen['/tf_static'].transforms] == \
+        [t.child_frame_id for t in rosbags['/tf_static'][0][1].transforms]
 
 
 @pytest.mark.parametrize('kind', ['directory', 'file'])
@@ -439,7 +485,8 @@ def test_plot_of_a_real_recording(recordings, tmp_path):
 
 LOG_LINE = re.compile(r'^\[INFO\] \[(\d+\.\d+)\] \[(?:\S+\.)?mech_kinematics_recorder\]: (.*)$',
                       re.MULTILINE)
-PROGRESS = re.compile(r'^recorded (\d+) s: (\d+) messages \((\d+)/s\): (.*)$')
+PROGRESS = re.compile(
+    r'^recorded (\d+) s: (\d+) messages \((\d+)/s\): (.*?)(?:; waiting for .*)?$')
 PROGRESS_TOPIC = re.compile(r'^(/\S+) (\d+) \((\d+)/s\)$')
 
 
@@ -449,14 +496,16 @@ def log_lines(output: str) -> list:
 
 
 def test_recorder_says_what_it_waits_for_then_reports_progress(recordings):
-    """One line naming the four topics before the node runs; then a progress line a second."""
+    """One line naming the default topics before the node runs; then a progress line a second."""
     recording = recordings['sigint_mcap']
     lines = log_lines(recording.output)
     texts = [text for _, text in lines]
     first_subscribed = next(i for i, t in enumerate(texts) if t.startswith('subscribed to'))
     waiting = [t for t in texts[:first_subscribed] if t.startswith('waiting for publishers on')]
     assert waiting, recording.output
-    assert waiting[0].startswith(f'waiting for publishers on {", ".join(TOPICS)} ')
+    requested = [t if t.startswith('/') else f'/{t}' for t in bag_recorder.DEFAULT_TOPICS]
+    assert requested == [*TOPICS, '/markers'] or set(requested) == {*TOPICS, '/markers'}
+    assert waiting[0].startswith(f'waiting for publishers on {", ".join(requested)} ')
     progress = []
     for time_s, text in lines:
         match = PROGRESS.match(text)
@@ -495,7 +544,9 @@ CRASH_RECORDERS = {
     'kill_sqlite3': ['--storage', 'sqlite3'],
     'full_mcap': ['--storage', 'mcap'],
     'full_sqlite3': ['--storage', 'sqlite3'],
-    'idle': ['--ros-args', '-r', f'__ns:={IDLE_NS}'],
+    # /tf and /tf_static are absolute: remapped into the namespace, where nothing publishes.
+    'idle': ['--ros-args', '-r', f'__ns:={IDLE_NS}', '-r', f'/tf:={IDLE_NS}/tf',
+             '-r', f'/tf_static:={IDLE_NS}/tf_static'],
 }
 
 
@@ -660,13 +711,15 @@ def test_recorder_without_publishers_names_them_every_five_seconds(crashes):
     """Nothing published: the topics it waits for, again every ~5 s; exit 0 and an empty bag."""
     output = crashes.outputs['idle']
     assert crashes.statuses['idle'] == 0, output
-    topics = ', '.join(f'{IDLE_NS}/{t.lstrip("/")}' for t in TOPICS)
+    topics = ', '.join(f'{IDLE_NS}/{t.lstrip("/")}' for t in bag_recorder.DEFAULT_TOPICS)
     waiting = [t for t, text in log_lines(output)
                if text.startswith(f'waiting for publishers on {topics} ')]
     assert len(waiting) >= 2
     assert all(b - a >= bag_recorder.WAIT_REPORT_INTERVAL_S - 0.1
                for a, b in zip(waiting, waiting[1:]))
-    assert output.count('(never appeared)') == len(TOPICS)
+    # markers says why it may be absent (the node's markers parameter is off by default).
+    assert output.count('(never appeared)') == len(bag_recorder.DEFAULT_TOPICS) - 1
+    assert output.count('(never appeared: the node publishes it with markers:=true)') == 1
     info = yaml.safe_load((crashes.path('idle') / 'metadata.yaml').read_text())[
         'rosbag2_bagfile_information']
     assert info['message_count'] == 0 and info['topics_with_message_count'] == []

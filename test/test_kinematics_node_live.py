@@ -45,5 +45,8 @@ def test_run_shows_the_node_live_and_ctrl_c_stops_both(tmp_path):
     assert status == 0, output
     assert 'Traceback' not in output
     assert re.search(r'^\s+\d+\.\d+ \|', output, re.MULTILINE), output   # a rate column
+    # Each joint: its value at a drifting instant and its range over the second (issue 20).
+    assert re.search(r'\| crank [+-]\d\.\d{4} \[[+-]\d\.\d{4} \.\. [+-]\d\.\d{4}\]',
+                     output), output
     assert not Path(f'/proc/{node_pid}').exists() or \
         'zombie' in Path(f'/proc/{node_pid}/status').read_text(), 'the node is still running'

@@ -11,12 +11,14 @@ frame sits at its block, a slotted lever's frame carries the pin at (s, 0).
 import math
 import signal
 import time
+import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from ros_helpers import NodeProcess, Ros, SESSION, stamp_ns, STARTUP_S, wait_for
 from sensor_msgs.msg import JointState
+from std_msgs.msg import String
 from tf2_msgs.msg import TFMessage    # built by make install (scripts/build_tf2_msgs.py)
 from trajectory_msgs.msg import MultiDOFJointTrajectory
 
@@ -130,3 +132,40 @@ def test_link_frames_compose_to_the_published_points(ros, tmp_path, scene_name):
     for name, (x, y) in scene.ground.items():
         t = ground[f'{FRAME_ID}/{name}']
         assert (t.translation.x, t.translation.y, t.rotation.w) == (x, y, 1.0)
+
+
+def test_robot_description_and_scene_reach_a_late_subscriber(ros, tmp_path):
+    """robot_description's links are the /tf and /tf_static frames; scene is the file (issue 20).
+
+    Both are transient local: subscribed after the node has published them,
+    they still arrive. Every URDF joint's parent is the parent /tf gives its
+    child, and the scene's text loads to the scene the node runs.
+    """
+    name = 'quick_return'
+    ns = f'{SESSION}/description'
+    latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    tf = ros.collect(TFMessage, f'{ns}/tf', QoSProfile(depth=100))
+    proc = NodeProcess(tmp_path, '-r', f'__ns:={ns}', '-r', f'/tf:={ns}/tf',
+                       '-r', f'/tf_static:={ns}/tf_static', '-p', f'scene:={name}',
+                       '-p', f'frame_id:={FRAME_ID}', '-p', 'tf_prefix:=qr')
+    try:
+        wait_for(lambda: tf, STARTUP_S, '/tf')
+        description = ros.collect(String, f'{ns}/robot_description', latched)
+        scene_text = ros.collect(String, f'{ns}/scene', latched)
+        static = ros.collect(TFMessage, f'{ns}/tf_static', latched)
+        wait_for(lambda: description and scene_text and static, 5.0,
+                 'robot_description, scene and /tf_static')
+    finally:
+        status, _ = proc.stop(signal.SIGINT)
+    assert status == 0, proc.output()
+    robot = ET.fromstring(description[-1].data)
+    links = {link.get('name') for link in robot.findall('link')}
+    parents = {j.find('child').get('link'): j.find('parent').get('link')
+               for j in robot.findall('joint')}
+    on_tf = {t.child_frame_id: t.header.frame_id
+             for msg in [tf[-1], static[-1]] for t in msg.transforms}
+    assert links == {FRAME_ID} | set(on_tf)
+    assert parents == on_tf
+    scene = mk.load_scene(name)
+    assert mk.parse_scene(mk.scene.read_scene_yaml(scene_text[-1].data)) == scene

@@ -54,8 +54,11 @@ def lines(ax) -> dict:
 
 
 def write_bag(path: Path, scene, angles, *, storage='mcap', topics=tuple(TYPES), dt=0.002,
-              namespaces=('',), skip=()):
-    """Write what the node would publish at ``angles`` (one tick per dt s) to a new bag."""
+              namespaces=('',), skip=(), scene_text=None):
+    """Write what the node would publish at ``angles`` (one tick per dt s) to a new bag.
+
+    With ``scene_text``, also the node's latched ``scene`` topic holding it.
+    """
     from rosbags.rosbag2 import StoragePlugin, Writer
     from rosbags.typesys import get_typestore, Stores
     from rosbags.typesys.msg import get_types_from_msg
@@ -75,6 +78,14 @@ def write_bag(path: Path, scene, angles, *, storage='mcap', topics=tuple(TYPES),
                                                       msgdef=definitions[t],
                                                       rihs01=store.hash_rihs01(TYPES[t]))
                        for ns in namespaces for t in topics}
+        if scene_text is not None:
+            string = 'std_msgs/msg/String'
+            text = bag_recorder.message_definition(string)[1]
+            store.register(get_types_from_msg(text, string))
+            connection = writer.add_connection('/scene', string, msgdef=text,
+                                               rihs01=store.hash_rihs01(string))
+            message = store.types[string](data=scene_text)
+            writer.write(connection, start, store.serialize_cdr(message, string))
         for i, angle in enumerate(angles):
             if i in skip:
                 continue
@@ -191,6 +202,29 @@ def test_bag_plot_finds_the_scene_from_diagnostics_or_warns(tmp_path):
     with pytest.warns(UserWarning, match='no scene given'):
         motion = plot.motion_from_bag(bag)
     assert motion.joint_types == dict.fromkeys(scene.output_joints, 'revolute')
+
+
+def test_bag_plot_takes_the_scene_stored_in_the_bag(tmp_path, capsys):
+    """A bag with the node's scene topic and no diagnostics tells a slider from a revolute.
+
+    Without it, the command says so in one `warning:` line, not Python's
+    UserWarning format (issue 20).
+    """
+    scene = mk.load_scene('slider_crank_150_600')
+    angles = np.linspace(0, 1, 20)
+    stored = write_bag(tmp_path / 'stored', scene, angles,
+                       scene_text=mk.scene.scene_text('slider_crank_150_600'))
+    motion = plot.motion_from_bag(stored)
+    assert motion.joint_types == {'crank': 'revolute', 'rod': 'revolute',
+                                  'piston': 'prismatic'}
+    assert motion.title.startswith('slider_crank_150_600: recording stored')
+    assert plot.main([str(stored), '-o', str(tmp_path / 's.png')]) == 0
+    assert 'warning' not in capsys.readouterr().err
+    bare = write_bag(tmp_path / 'bare', scene, angles)
+    assert plot.main([str(bare), '-o', str(tmp_path / 'b.png')]) == 0
+    err = capsys.readouterr().err
+    assert err.startswith('warning: ') and err.count('\n') == 1 and 'UserWarning' not in err
+    assert 'no scene given' in err
 
 
 def test_ticks_missing_from_a_bag_leave_a_gap_not_a_line(tmp_path):

@@ -21,8 +21,8 @@ from dataclasses import dataclass
 
 from ..linkage import RPR, RRP, RRR, Scene, State
 
-__all__ = ['FrameSpec', 'Pose', 'angle_joints', 'frames_from_scene', 'origin_points',
-           'poses_from_state']
+__all__ = ['FrameSpec', 'Pose', 'angle_joints', 'child_frame', 'frames_from_scene',
+           'origin_points', 'poses_from_state']
 
 
 @dataclass(frozen=True)
@@ -56,6 +56,11 @@ class Pose:
     x: float
     y: float
     angle: float
+
+
+def child_frame(prefix: str, name: str) -> str:
+    """Return the frame id of link, slider or ground point ``name``: ``<prefix>/<name>``."""
+    return f'{prefix}/{name}' if prefix else name
 
 
 def frames_from_scene(scene: Scene, joints: Sequence[str] | None = None) -> tuple[FrameSpec, ...]:

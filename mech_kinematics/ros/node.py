@@ -51,6 +51,7 @@ from rclpy.parameter import Parameter
 from rclpy.qos import QoSDurabilityPolicy, QoSHistoryPolicy, QoSProfile, QoSReliabilityPolicy
 from rclpy.qos_overriding_options import QoSOverridingOptions, QoSPolicyKind
 from sensor_msgs.msg import JointState
+from std_msgs.msg import String
 from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
 from visualization_msgs.msg import MarkerArray
 
@@ -66,6 +67,8 @@ from ..geometry.assembly import assembly_summary
 from ..geometry.diagrams import space_from_state, strokes_from_scene
 from ..geometry.frames import angle_joints, frames_from_scene, origin_points
 from ..geometry.instant_centres import full_scene
+from ..geometry.urdf import urdf_from_scene
+from ..scene import scene_text
 from ..ticker import tick_function
 from ..units import NS_PER_S, rpm_from_rad_per_s
 
@@ -344,6 +347,7 @@ class KinematicsNode(LifecycleNode):
                                   self._pub_point_accel]
         self._publish_state = tuple(p.publish for p in self._state_publishers)
         tick_scene = self._setup_tf(scene)
+        self._publish_descriptions(scene)
         # The scene's solve, compiled into one straight-line function (mech_kinematics.ticker).
         frames = [(f.origin, f.angle_of, f.angle) for f in self._tf_frames]
         self._solve, compiled = tick_function(tick_scene, scene.output_joints,
@@ -391,12 +395,29 @@ class KinematicsNode(LifecycleNode):
         return replace(scene, outputs_points=(*scene.output_points, *points),
                        outputs_joints=(*scene.output_joints, *joints))
 
+    def _publish_descriptions(self, scene: mk.Scene) -> None:
+        """Publish the URDF on ``robot_description`` and the scene's text on ``scene``, latched.
+
+        Transient local, depth 1: a late subscriber (RViz, the recorder) gets them.
+        """
+        latched = _tf_qos(True)
+        self._pub_description = self.create_publisher(String, 'robot_description', latched)
+        self._pub_scene = self.create_publisher(String, 'scene', latched)
+        self._state_publishers += [self._pub_description, self._pub_scene]
+        self._pub_scene.publish(String(data=scene_text(self._value('scene'))))
+        try:
+            urdf = urdf_from_scene(scene, self.frame_id, self._value('tf_prefix'))
+        except mk.AssemblyError as error:
+            self.get_logger().warning(f'no robot_description: {error}')
+            return
+        self._pub_description.publish(String(data=urdf))
+
     def _log_start(self) -> None:
         scene = self.scene
         assert scene is not None
         names = ('scene', 'crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm', 'rate_hz',
-                 'late_ticks', 'max_catch_up_s', 'max_relative_error', 'frame_id',
-                 'tf_rate_hz', 'tf_prefix',
+                 'late_ticks', 'max_catch_up_s', 'max_lateness_ms', 'max_relative_error',
+                 'frame_id', 'tf_rate_hz', 'tf_prefix',
                  'use_sim_time', 'markers', 'managed')
         settings = ', '.join(f'{name}={self._value(name)!r}' for name in names[1:])
         self.get_logger().info(
@@ -666,7 +687,8 @@ class KinematicsNode(LifecycleNode):
                           near_singular=mk.NEAR_SINGULAR, waiting_for=waiting,
                           assembly=self._assembly),
             timing_status(window, name=name, hardware_id=hardware_id,
-                          rate_hz=self._value('rate_hz')),
+                          rate_hz=self._value('rate_hz'),
+                          max_lateness_ms=self._value('max_lateness_ms')),
         ]
         msg = DiagnosticArray(status=[diagnostic_status_from(s) for s in statuses])
         msg.header.stamp = self.get_clock().now().to_msg()

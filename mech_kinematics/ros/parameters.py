@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import math
 from typing import Any
 
+from .diagnostics import DEFAULT_MAX_LATENESS_MS
 from .markers import DEFAULT_ACCELERATION_SCALE, DEFAULT_VELOCITY_SCALE
 from ..bounds import MAX_ERROR
 from ..scene import DEFAULT_SCENE
@@ -99,6 +100,10 @@ PARAMETERS = (
     ParameterSpec('max_catch_up_s', 'double', 0.1,
                   'How far behind a late wake-up still publishes missed instants; older '
                   'ones are skipped and counted', 's', 0.0, 10.0),
+    ParameterSpec('max_lateness_ms', 'double', DEFAULT_MAX_LATENESS_MS,
+                  'Timing on diagnostics turns WARN when the p99 lateness of a second of '
+                  'ticks exceeds this (or when an instant is skipped); caught-up late ticks '
+                  'alone are OK', 'ms', 0.0, 10_000.0),
     ParameterSpec('max_relative_error', 'double', MAX_ERROR,
                   'A tick whose error bound on any published value exceeds this fraction of '
                   "its kind's scale publishes nothing (diagnostics say why)", 'of the scale',

@@ -22,18 +22,13 @@ import math
 from typing import Any
 
 from .cdr import marker, MessageTemplate, STAMP_MARKER
-from ..geometry.frames import FrameSpec, Pose
+from ..geometry.frames import child_frame, FrameSpec, Pose
 
 __all__ = ['TF_STATIC_TOPIC', 'TF_TOPIC', 'TfMessages', 'child_frame', 'static_tf_message']
 
 #: The absolute topics every TF broadcaster uses (namespaces do not apply).
 TF_TOPIC = '/tf'
 TF_STATIC_TOPIC = '/tf_static'
-
-
-def child_frame(prefix: str, name: str) -> str:
-    """Return the frame id of link, slider or ground point ``name``: ``<prefix>/<name>``."""
-    return f'{prefix}/{name}' if prefix else name
 
 
 def _transform(parent: str, child: str, stamp: Any, x: float, y: float, angle: float) -> Any:

@@ -79,8 +79,10 @@ _JOINT_STATE = 'sensor_msgs/msg/JointState'
 _JOINT_TRAJECTORY = 'trajectory_msgs/msg/JointTrajectory'
 _POINT_TRAJECTORY = 'trajectory_msgs/msg/MultiDOFJointTrajectory'
 _DIAGNOSTICS = 'diagnostic_msgs/msg/DiagnosticArray'
+_SCENE = 'std_msgs/msg/String'      # the scene file's text, latched on `scene` (issue 20)
 _TOPICS = {_JOINT_STATE: 'joint_states', _JOINT_TRAJECTORY: 'joint_accelerations',
-           _POINT_TRAJECTORY: 'point_accelerations', _DIAGNOSTICS: 'diagnostics'}
+           _POINT_TRAJECTORY: 'point_accelerations', _DIAGNOSTICS: 'diagnostics',
+           _SCENE: 'scene'}
 NS_PER_S = 1_000_000_000
 
 
@@ -221,6 +223,26 @@ def _pick(connections: Sequence[Any], type_name: str, namespace: str | None) -> 
     return found[0] if found else None
 
 
+def _stored_scene(reader: Any, connection: Any, path: Path) -> Any:
+    """Return the scene of the bag's ``scene`` topic (its last message), or None if unreadable."""
+    import mech_kinematics as mk
+
+    from ..scene import read_scene_yaml
+
+    decode = _decoder(reader.typestore, _SCENE)
+    text = None
+    for _, _, raw in reader.messages(connections=[connection]):
+        text = decode(raw).data
+    if text is None:
+        return None
+    try:
+        return mk.parse_scene(read_scene_yaml(text))
+    except mk.SceneError as error:
+        warnings.warn(f'{path}: the scene stored on {connection.topic} cannot be read '
+                      f'({error}); ignoring it', stacklevel=3)
+        return None
+
+
 def motion_from_bag(path: str | os.PathLike[str], *, scene: Any = None,
                     namespace: str | None = None,
                     max_samples: int | None = DEFAULT_MAX_SAMPLES) -> Motion:
@@ -238,8 +260,9 @@ def motion_from_bag(path: str | os.PathLike[str], *, scene: Any = None,
         A rosbag2 directory (mcap or sqlite3).
     scene : Scene, optional
         Tells revolute from prismatic joints and names the crank. By default
-        the scene named in the bag's ``diagnostics`` (``hardware_id``) if it is
-        a packaged scene with the same joints; otherwise every joint is taken
+        the scene stored in the bag (the node's ``scene`` topic), else the
+        scene named in the bag's ``diagnostics`` (``hardware_id``) if it is a
+        packaged scene with the same joints; otherwise every joint is taken
         as revolute and the first joint as the crank, with a warning.
     namespace : str, optional
         Namespace of the node's topics, if the bag holds more than one node's.
@@ -287,6 +310,9 @@ def motion_from_bag(path: str | os.PathLike[str], *, scene: Any = None,
                 if stamp in chosen and stamp not in rows[connection.id]:
                     rows[connection.id][stamp] = decoders[connection.id](raw)
             scene_name = ''
+            stored = picked[_SCENE]
+            if stored is not None and scene is None:
+                scene = _stored_scene(reader, stored, path)
             diagnostics = picked[_DIAGNOSTICS]
             if diagnostics is not None and scene is None:
                 decode = _decoder(reader.typestore, _DIAGNOSTICS)
@@ -575,8 +601,12 @@ def _handle(args: argparse.Namespace) -> int:
     try:
         scene = None if args.scene is None else mk.load_scene(args.scene)
         if args.bag is not None:
-            plot_bag(args.bag, output, x=args.x or 'time', scene=scene,
-                     namespace=args.namespace, max_samples=args.max_samples or None)
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter('always', UserWarning)
+                plot_bag(args.bag, output, x=args.x or 'time', scene=scene,
+                         namespace=args.namespace, max_samples=args.max_samples or None)
+            for warning in caught:      # one line each, not Python's warning format
+                print(f'warning: {warning.message}', file=sys.stderr)
         else:
             x = args.x or 'angle'
             motion = motion_from_scene(scene, samples=args.samples, speed=speed,

@@ -63,8 +63,13 @@ __all__ = [
     'message_definition', 'record', '_handle',
 ]
 
-#: The node's topics (relative names: the recorder's namespace applies).
-DEFAULT_TOPICS = ('joint_states', 'joint_accelerations', 'point_accelerations', 'diagnostics')
+#: Everything the node publishes, so that a bag replays whole (issue 20): its state,
+#: frames, diagnostics, markers (when on), URDF and scene. Relative names take the
+#: recorder's namespace; /tf and /tf_static are absolute, as every TF broadcaster's.
+DEFAULT_TOPICS = ('joint_states', 'joint_accelerations', 'point_accelerations', 'diagnostics',
+                  '/tf', '/tf_static', 'markers', 'robot_description', 'scene')
+#: Default topics the node publishes only with a parameter on: their absence is no fault.
+OPTIONAL_TOPICS = {'markers': 'the node publishes it with markers:=true'}
 STORAGES = ('mcap', 'sqlite3')
 #: As ``ros2 bag record`` since Iron.
 DEFAULT_STORAGE = 'mcap'
@@ -723,7 +728,8 @@ def _print_summary(recorder: BagRecorder) -> None:
             written = s.written if recorder.bag is not None else '?'
             print(f'{s.name:<{width}}  {s.type:<{type_width}}  {s.received:>9}  {written:>9}')
         else:
-            reason = s.error or 'never appeared'
+            optional = OPTIONAL_TOPICS.get(s.name.rsplit('/', 1)[-1])
+            reason = s.error or (f'never appeared: {optional}' if optional else 'never appeared')
             print(f'{s.name:<{width}}  {"-":<{type_width}}  {"-":>9}  {"-":>9}  ({reason})')
 
 
@@ -751,7 +757,9 @@ def _handle(args: argparse.Namespace) -> int:
 
 
 RECORD_HELP = """\
-Record the node's topics (all four by default) to a new rosbag2 directory,
+Record the node's topics (by default everything it publishes: the state,
+/tf, /tf_static, diagnostics, markers when on, robot_description and the
+scene's text on `scene`, so the bag replays whole) to a new rosbag2 directory,
 readable by `ros2 bag info`, `ros2 bag play` and Foxglove: metadata.yaml plus
 one .mcap or .db3 file. Messages are stored as received (serialized CDR),
 stamped with the receive time. Topics not published yet are waited for and

@@ -6,7 +6,7 @@
 as a child process (the arguments go to it unchanged, e.g. ``--ros-args -p
 scene:=slider_crank_150_600``) and subscribes to its ``joint_states`` and
 ``diagnostics`` with the same ROS arguments
-(:class:`mech_kinematics.ros.live_view.LiveView`), so namespaces and remaps
+(:class:`mech_kinematics.tools.live_view.LiveView`), so namespaces and remaps
 apply to both. Ctrl-C (or SIGTERM) stops the view and then the node.
 """
 
@@ -73,7 +73,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     import rclpy
     from rclpy.executors import ExternalShutdownException
 
-    from ..ros.live_view import LiveView
+    from .live_view import LiveView
 
     command = [sys.executable, '-m', 'mech_kinematics.kinematics_node', *argv]
     # A session of its own: Ctrl-C reaches this process only, which then stops

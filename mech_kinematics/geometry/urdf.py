@@ -1,0 +1,226 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""A URDF of a scene's bodies on the frames the node puts on ``/tf`` (``robot_description``).
+
+RViz's RobotModel display and Foxglove's URDF layer draw each URDF link at the
+pose ``/tf`` gives its frame, so the URDF's links are named exactly as the
+node's frames (:mod:`mech_kinematics.geometry.frames`, named
+``<prefix>/<name>`` under ``frame_id``, as :mod:`mech_kinematics.ros.tf`
+publishes them):
+
+- the root link ``frame_id`` (the ground frame), nothing drawn;
+- one link per ground point ``<prefix>/<point>`` (``/tf_static``), a fixed
+  joint at the point, drawn as a pin (a cylinder along z);
+- one link per frame on ``/tf`` ``<prefix>/<joint>``, a floating joint (the
+  pose comes from ``/tf``), drawn in the frame's own coordinates: a bar
+  (box) from the frame's origin to every other point of the body, a pin at
+  each of its points; a slotted lever reaches as far as its pin goes in a
+  turn; a slider is a block along its x axis (the guide).
+
+The body's points are read off the solved scene at the first crank angle
+that assembles, in the frame's coordinates; they are fixed on the body, so
+this holds at every angle. Pure: NumPy and the standard library
+(``xml.etree``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+import math
+import warnings
+import xml.etree.ElementTree as ET
+
+import numpy as np
+
+from .diagrams import space_from_state
+from .frames import child_frame, frames_from_scene, FrameSpec, poses_from_state
+from .instant_centres import bodies_from_scene, BodyKind, full_scene
+from ..errors import AssemblyError, NearSingularWarning
+from ..linkage import RPR, Scene, solve, State
+
+__all__ = ['Visual', 'joint_name', 'urdf_from_scene', 'visuals_from_scene']
+
+#: Crank angles tried for a pose that assembles, and sampled for a lever's reach.
+SAMPLES = 72
+
+#: Bar width, block size and pin radius as fractions of the mechanism's size.
+BAR_WIDTH = 0.02
+PIN_RADIUS = 0.015
+BLOCK_LENGTH = 0.08
+THICKNESS = 0.01
+
+COLOURS = {'crank': (0.84, 0.15, 0.16, 1.0),
+           'link': (0.12, 0.47, 0.71, 1.0), 'lever': (0.17, 0.63, 0.17, 1.0),
+           'slider': (1.0, 0.5, 0.05, 1.0), 'pin': (0.1, 0.1, 0.1, 1.0)}
+
+
+def joint_name(child: str) -> str:
+    """Return the URDF joint that attaches link ``child`` to the root."""
+    return f'{child}_joint'
+
+
+class Visual:
+    """One shape of a link, in the link's frame (m, rad).
+
+    Attributes
+    ----------
+    shape : {'box', 'cylinder'}
+        A box of ``size`` (x, y, z) or a cylinder of ``size`` (radius, length) along z.
+    xyz : (float, float, float)
+        Its centre.
+    yaw : float
+        Its rotation about z.
+    material : str
+        A key of :data:`COLOURS`.
+    """
+
+    def __init__(self, shape: str, size: Sequence[float], xyz: Sequence[float], yaw: float,
+                 material: str) -> None:
+        self.shape, self.size, self.xyz, self.yaw, self.material = \
+            shape, tuple(size), tuple(xyz), yaw, material
+
+
+def _bar(x: float, y: float, width: float, material: str) -> Visual:
+    """Return a bar from the origin to (x, y)."""
+    return Visual('box', (math.hypot(x, y), width, THICKNESS * width / BAR_WIDTH),
+                  (x / 2, y / 2, 0.0), math.atan2(y, x), material)
+
+
+def _pin(x: float, y: float, radius: float) -> Visual:
+    return Visual('cylinder', (radius, 4 * radius), (x, y, 0.0), 0.0, 'pin')
+
+
+def _assembled(scene: Scene) -> State:
+    """Return the full state at the scene's crank angle, or the first angle that assembles."""
+    angles = scene.input.angle + np.linspace(0.0, 2 * math.pi, SAMPLES, endpoint=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore', NearSingularWarning)
+        states = solve(scene, angles)
+        valid = np.flatnonzero(states.valid)
+        if not valid.size:
+            msg = (f'Expected scene {scene.name!r} to assemble at some crank angle to draw its '
+                   f'URDF, got none of {SAMPLES} angles over a turn')
+            raise AssemblyError(msg)
+        return solve(scene, float(angles[valid[0]]))
+
+
+def _local(origin: complex, angle: float, point: complex) -> tuple[float, float]:
+    z = (point - origin) * complex(math.cos(angle), -math.sin(angle))
+    return z.real, z.imag
+
+
+def _lever_reach(scene: Scene, dyad: RPR) -> float:
+    """Return the farthest the pin goes along a slotted lever over a turn, m."""
+    angles = scene.input.angle + np.linspace(0.0, 2 * math.pi, SAMPLES, endpoint=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore', NearSingularWarning)
+        states = solve(scene, angles)
+    points = states.complex_points
+    gap = np.abs(points[dyad.through][0] - points[dyad.center][0])[states.valid]
+    return float(gap.max()) if gap.size else 0.0
+
+
+def visuals_from_scene(scene: Scene, frames: Sequence[FrameSpec] | None = None,
+                       ) -> tuple[list[Visual], dict[str, list[Visual]]]:
+    """Return a ground point's pin and the visuals of each frame's body, in its frame.
+
+    ``frames`` defaults to the frames of the scene's output joints (those the
+    node puts on ``/tf``).
+    """
+    frames = frames_from_scene(scene) if frames is None else tuple(frames)
+    full = full_scene(scene)
+    state = _assembled(full)
+    space = space_from_state(full, state)
+    low, high = space.extent()
+    size = float(np.hypot(*(high - low))) or 1.0
+    width, radius = BAR_WIDTH * size, PIN_RADIUS * size
+    topology = bodies_from_scene(full)
+    levers = {d.link: d for d in full.dyads if isinstance(d, RPR)}
+    points = {name: complex(p) for name, (p, _, _) in state.complex_points.items()}
+    visuals: dict[str, list[Visual]] = {}
+    for frame, pose in zip(frames, poses_from_state(frames, state), strict=True):
+        origin = complex(pose.x, pose.y)
+        body = topology.bodies[frame.joint]
+        shapes: list[Visual] = []
+        if body.kind is BodyKind.SLIDER:
+            shapes.append(Visual('box', (BLOCK_LENGTH * size, 2.5 * width, 1.5 * width),
+                                 (0.0, 0.0, 0.0), 0.0, 'slider'))
+        else:
+            material = body.kind.value
+            on_body = [_local(origin, pose.angle, points[name]) for name in body.points]
+            for x, y in on_body:
+                if math.hypot(x, y) > 1e-9 * size:
+                    shapes.append(_bar(x, y, width, material))
+            if frame.joint in levers:
+                shapes.append(_bar(_lever_reach(full, levers[frame.joint]), 0.0, width,
+                                   material))
+            shapes += [_pin(x, y, radius) for x, y in on_body]
+        visuals[frame.joint] = shapes
+    return [_pin(0.0, 0.0, 1.5 * radius)], visuals
+
+
+def _fmt(*values: float) -> str:
+    # Exact (shortest round trip); round-off below a picometre (or picoradian) is written 0.
+    return ' '.join(repr(float(v if abs(v) >= 1e-12 else 0.0) + 0.0) for v in values)
+
+
+def _add_visuals(link: ET.Element, shapes: Sequence[Visual]) -> None:
+    for shape in shapes:
+        visual = ET.SubElement(link, 'visual')
+        ET.SubElement(visual, 'origin', xyz=_fmt(*shape.xyz), rpy=_fmt(0.0, 0.0, shape.yaw))
+        geometry = ET.SubElement(visual, 'geometry')
+        if shape.shape == 'box':
+            ET.SubElement(geometry, 'box', size=_fmt(*shape.size))
+        else:
+            ET.SubElement(geometry, 'cylinder', radius=_fmt(shape.size[0]),
+                          length=_fmt(shape.size[1]))
+        ET.SubElement(visual, 'material', name=shape.material)
+
+
+def urdf_from_scene(scene: Scene, frame_id: str = 'mechanism', prefix: str = '') -> str:
+    """Return the URDF (XML text) of ``scene`` on the node's frames.
+
+    Parameters
+    ----------
+    scene : Scene
+        The mechanism.
+    frame_id : str
+        The root link: the node's ``frame_id``.
+    prefix : str
+        The node's ``tf_prefix``; ``''`` means ``frame_id``, as for the node.
+
+    Returns
+    -------
+    str
+        The URDF document, one link per frame on ``/tf`` and ``/tf_static``
+        plus the root, each attached to the root by one joint.
+
+    Raises
+    ------
+    AssemblyError
+        If the scene assembles at no crank angle.
+    """
+    prefix = prefix or frame_id
+    pin, visuals = visuals_from_scene(scene)
+    robot = ET.Element('robot', name=scene.name)
+    for name, rgba in COLOURS.items():
+        material = ET.SubElement(robot, 'material', name=name)
+        ET.SubElement(material, 'color', rgba=_fmt(*rgba))
+    ET.SubElement(robot, 'link', name=frame_id)
+    # Ground points: fixed where /tf_static puts them; bodies: floating, posed by /tf.
+    attachments: list[tuple[str, list[Visual], tuple[float, float] | None]] = [
+        (child_frame(prefix, name), pin, (float(x), float(y)))
+        for name, (x, y) in scene.ground.items()]
+    attachments += [(child_frame(prefix, joint), shapes, None)
+                    for joint, shapes in visuals.items()]
+    for child, shapes, at in attachments:
+        link = ET.SubElement(robot, 'link', name=child)
+        _add_visuals(link, shapes)
+        element = ET.SubElement(robot, 'joint', name=joint_name(child),
+                                type='floating' if at is None else 'fixed')
+        ET.SubElement(element, 'parent', link=frame_id)
+        ET.SubElement(element, 'child', link=child)
+        if at is not None:
+            ET.SubElement(element, 'origin', xyz=_fmt(*at, 0.0), rpy='0 0 0')
+    ET.indent(robot)
+    return '<?xml version="1.0"?>\n' + ET.tostring(robot, encoding='unicode') + '\n'

@@ -1,0 +1,70 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""``python -m mech_kinematics urdf SCENE``: the URDF the node publishes on ``robot_description``.
+
+Writes :func:`mech_kinematics.geometry.urdf.urdf_from_scene` to standard
+output or to ``-o FILE``: one link per frame the node puts on ``/tf`` and
+``/tf_static`` (named ``<tf_prefix>/<name>``, under ``frame_id``), for
+RViz's RobotModel display or Foxglove's URDF layer when no node publishes
+``robot_description`` (e.g. a bag from before it did).
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Sequence
+from pathlib import Path
+import sys
+from typing import Any
+
+from ..cli import run_tool
+
+__all__ = ['add_parser', 'main']
+
+URDF_HELP = """\
+Write the URDF of a scene's bodies on the frames kinematics_node puts on /tf:
+the root link FRAME_ID, a fixed link at every ground point and a floating
+link per moving link or slider (posed by /tf), each drawn as bars between
+its points, pins and slider blocks, to scale (m). --frame-id and --tf-prefix
+must match the node's parameters of the same names.
+"""
+
+
+def _handle(args: argparse.Namespace) -> int:
+    from ..geometry.urdf import urdf_from_scene
+    from ..scene import load_scene
+
+    scene = load_scene(args.scene)  # a SceneError is one line, exit 2 (cli.run_handler)
+    text = urdf_from_scene(scene, frame_id=args.frame_id, prefix=args.tf_prefix)
+    if args.output is None:
+        sys.stdout.write(text)
+    else:
+        Path(args.output).write_text(text, encoding='utf-8')
+        print(f'wrote {args.output} ({len(text)} bytes)', file=sys.stderr)
+    return 0
+
+
+def add_parser(subparsers: Any) -> argparse.ArgumentParser:
+    """Register the ``urdf`` command on ``subparsers``; return its parser."""
+    parser: argparse.ArgumentParser = subparsers.add_parser(
+        'urdf', help="write the URDF of a scene (the node's robot_description)",
+        description=URDF_HELP, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument('scene', metavar='SCENE',
+                        help='path to a scene YAML, or the name of a packaged scene')
+    parser.add_argument('-o', '--output', metavar='FILE',
+                        help='write to FILE (default: standard output)')
+    parser.add_argument('--frame-id', default='mechanism',
+                        help="the node's frame_id: the root link (default: %(default)s)")
+    parser.add_argument('--tf-prefix', default='',
+                        help="the node's tf_prefix (default: '', meaning FRAME_ID)")
+    parser.set_defaults(handler=_handle)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run ``urdf``; return the exit status."""
+    return run_tool(add_parser, argv)
+
+
+if __name__ == '__main__':
+    sys.exit(main())

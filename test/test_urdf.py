@@ -1,0 +1,122 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The scene's URDF (robot_description) and the `urdf` tool. See issue 20.
+
+The links must be exactly the frames the node puts on /tf and /tf_static (so
+RViz and Foxglove pose them from /tf), and what each link draws must sit on
+the scene's points at every crank angle, not only the one it was built at.
+"""
+
+import math
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+
+import mech_kinematics as mk
+from mech_kinematics.__main__ import main as cli_main
+from mech_kinematics.geometry.frames import frames_from_scene, poses_from_state
+from mech_kinematics.geometry.instant_centres import bodies_from_scene, full_scene
+from mech_kinematics.geometry.urdf import urdf_from_scene
+
+#: Drawn pins against solved points, m (relative to the mechanism's size).
+RTOL_PLACE = 1e-12
+SCENES = mk.scene_names()
+
+
+def _links_and_joints(text):
+    robot = ET.fromstring(text)
+    assert robot.tag == 'robot'
+    links = {link.get('name'): link for link in robot.findall('link')}
+    joints = {joint.find('child').get('link'): joint for joint in robot.findall('joint')}
+    return robot, links, joints
+
+
+@pytest.mark.parametrize('name', SCENES)
+def test_one_link_per_tf_frame_each_a_child_of_frame_id(name):
+    """Links: frame_id, <prefix>/<output joint> (floating) and <prefix>/<ground point> (fixed)."""
+    scene = mk.load_scene(name)
+    robot, links, joints = _links_and_joints(urdf_from_scene(scene, 'base', 'robot1'))
+    assert robot.get('name') == scene.name
+    moving = {f'robot1/{joint}' for joint in scene.output_joints}
+    ground = {f'robot1/{point}' for point in scene.ground}
+    assert set(links) == {'base'} | moving | ground
+    assert set(joints) == moving | ground                    # the root has no parent
+    assert len(robot.findall('joint')) == len(joints)        # one joint per child
+    for child, joint in joints.items():
+        assert joint.find('parent').get('link') == 'base'    # as /tf: every frame under frame_id
+        assert joint.get('type') == ('floating' if child in moving else 'fixed')
+    for point, (x, y) in scene.ground.items():
+        origin = joints[f'robot1/{point}'].find('origin')
+        assert [float(v) for v in origin.get('xyz').split()] == [x, y, 0.0]
+    names = [j.get('name') for j in robot.findall('joint')] + list(links)
+    assert len(names) == len(set(names))
+
+
+def test_prefix_defaults_to_frame_id_as_on_tf():
+    """An empty tf_prefix names the frames <frame_id>/<name>, as the node's /tf does."""
+    _, links, _ = _links_and_joints(urdf_from_scene(mk.load_scene('slider_crank_150_600')))
+    assert set(links) == {'mechanism', 'mechanism/O', 'mechanism/crank', 'mechanism/rod',
+                          'mechanism/piston'}
+
+
+def _placed_pins(link, pose):
+    """Ground positions of a link's pins when its frame is at ``pose``."""
+    out = []
+    for visual in link.findall('visual'):
+        if visual.find('geometry/cylinder') is None:
+            continue
+        x, y, _ = (float(v) for v in visual.find('origin').get('xyz').split())
+        c, s = math.cos(pose.angle), math.sin(pose.angle)
+        out.append(np.array([pose.x + c * x - s * y, pose.y + s * x + c * y]))
+    return out
+
+
+@pytest.mark.parametrize('name', SCENES)
+def test_pins_land_on_the_bodys_points_at_other_crank_angles(name):
+    """Posed by the frames of another crank angle, each body's pins sit on its solved points."""
+    scene = mk.load_scene(name)
+    full = full_scene(scene)
+    frames = frames_from_scene(scene)
+    topology = bodies_from_scene(full)
+    _, links, _ = _links_and_joints(urdf_from_scene(scene, 'm', 'p'))
+    states = mk.solve(full, scene.input.angle + np.linspace(0.1, 2 * math.pi, 7))
+    size = max(abs(v) for xy in scene.ground.values() for v in xy) + scene.input.length
+    checked = 0
+    for k in np.flatnonzero(states.valid):
+        state = mk.solve(full, float(scene.input.angle + np.linspace(0.1, 2 * math.pi, 7)[k]))
+        points = {n: np.array([p.real, p.imag]) for n, (p, _, _) in state.complex_points.items()}
+        for frame, pose in zip(frames, poses_from_state(frames, state), strict=True):
+            body = topology.bodies[frame.joint]
+            pins = _placed_pins(links[f'p/{frame.joint}'], pose)
+            if not pins:
+                continue        # a slider block: no pins of its own
+            assert len(pins) == len(body.points)
+            for pin, point in zip(pins, body.points, strict=True):
+                np.testing.assert_allclose(pin, points[point], rtol=0, atol=RTOL_PLACE * size)
+            checked += 1
+    assert checked >= len(frames)
+
+
+def test_a_crank_is_a_bar_of_its_length_along_x():
+    """The four-bar's crank (AB = 40 mm) is one box 0.040 m long, centred at (0.020, 0)."""
+    _, links, _ = _links_and_joints(urdf_from_scene(mk.load_scene('khurmi_four_bar_ad150')))
+    boxes = [v for v in links['mechanism/crank'].findall('visual')
+             if v.find('geometry/box') is not None]
+    assert len(boxes) == 1
+    length = float(boxes[0].find('geometry/box').get('size').split()[0])
+    assert length == pytest.approx(0.040, abs=1e-12)
+    assert boxes[0].find('origin').get('xyz') == '0.02 0.0 0.0'
+
+
+def test_urdf_tool_writes_the_same_document(tmp_path, capsys):
+    """`urdf SCENE -o FILE` writes urdf_from_scene's text; a bad scene is one line, status 2."""
+    out = tmp_path / 'four_bar.urdf'
+    assert cli_main(['urdf', 'khurmi_four_bar_ad150', '-o', str(out), '--frame-id', 'base',
+                     '--tf-prefix', 'r']) == 0
+    assert out.read_text() == urdf_from_scene(mk.load_scene('khurmi_four_bar_ad150'), 'base',
+                                              'r')
+    capsys.readouterr()
+    assert cli_main(['urdf', 'no_such_scene']) == 2
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1 and 'no_such_scene' in err
