@@ -7,7 +7,9 @@ as a child process (the arguments go to it unchanged, e.g. ``--ros-args -p
 scene:=slider_crank_150_600``) and subscribes to its ``joint_states`` and
 ``diagnostics`` with the same ROS arguments
 (:class:`mech_kinematics.tools.live_view.LiveView`), so namespaces and remaps
-apply to both. Ctrl-C (or SIGTERM) stops the view and then the node.
+apply to both. The same process serves the browser view
+(:class:`mech_kinematics.tools.view.ViewServer`) and prints its URL. Ctrl-C
+(or SIGTERM) stops the views and then the node.
 """
 
 from __future__ import annotations
@@ -74,6 +76,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     from rclpy.executors import ExternalShutdownException
 
     from .live_view import LiveView
+    from .view import DEFAULT_PORT, ViewServer
 
     command = [sys.executable, '-m', 'mech_kinematics.kinematics_node', *argv]
     # A session of its own: Ctrl-C reaches this process only, which then stops
@@ -82,15 +85,19 @@ def main(argv: Sequence[str] | None = None) -> int:
                              env=dict(os.environ, PYTHONUNBUFFERED='1'))
     ros_args = argv[argv.index('--ros-args'):] if '--ros-args' in argv else []
     rclpy.init(args=['live', *ros_args])
-    view = None
+    view = server = None
     try:
         view = LiveView()
+        server = ViewServer(view, DEFAULT_PORT)
         print(f'mech_kinematics: node started (pid {child.pid}); Ctrl-C stops it.', flush=True)
+        print(f'mech_kinematics: browser view on {server.url}', flush=True)
         while child.poll() is None:
-            rclpy.spin_once(view, timeout_sec=0.2)
+            rclpy.spin_once(view, timeout_sec=0.05)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass  # Ctrl-C: stop the node below
     finally:
+        if server is not None:
+            server.close()
         if view is not None:
             view.destroy_node()
         rclpy.try_shutdown()
