@@ -76,6 +76,14 @@ def test_the_page_fetches_nothing_from_the_internet():
     assert not re.search(r'(src|href)\s*=|https?://|@import|url\(', PAGE)
 
 
+def test_a_bad_port_is_one_line_and_status_2(capsys):
+    """`view --port abc` says what it expected in one line, before ROS starts."""
+    from mech_kinematics.tools import view
+
+    assert view.main(['--port', 'abc', '--ros-args', '-r', '__ns:=/x']) == 2
+    assert capsys.readouterr().err == "error: --port: expected a port number 0..65535, got 'abc'\n"
+
+
 def _chromium():
     path = shutil.which('chromium') or shutil.which('chromium-browser')
     if path is None:

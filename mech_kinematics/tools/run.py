@@ -28,7 +28,8 @@ __all__ = ['add_parser', 'main']
 
 STOP_TIMEOUT_S = 3.0
 
-RUN_HELP = ('Start kinematics_node and a live console view of what it publishes. '
+RUN_HELP = ('Start kinematics_node, a live console view of what it publishes and a browser '
+            'view (its URL is printed). '
             'Arguments after `run` go to the node, e.g. '
             '`run --ros-args -p scene:=quick_return -p rate_hz:=200.0`.')
 
@@ -55,7 +56,8 @@ def _handle(args: argparse.Namespace) -> int:
 def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     """Register the ``run`` command on ``subparsers``; return its parser."""
     parser: argparse.ArgumentParser = subparsers.add_parser(
-        'run', help='start the node with a live console view (make run); Ctrl-C stops both',
+        'run', help='start the node with a live console view and a browser view (make run); '
+                    'Ctrl-C stops both',
         description=RUN_HELP)
     parser.add_argument('node_args', nargs=argparse.REMAINDER, metavar='NODE_ARGS',
                         help='arguments for the node (--ros-args ...)')
