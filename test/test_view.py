@@ -123,6 +123,16 @@ def _browse(chromium, url, *what):
     return result.stdout
 
 
+@pytest.mark.parametrize('ci, outcome', [('true', pytest.fail.Exception),
+                                         ('', pytest.skip.Exception)])
+def test_missing_chromium_fails_under_ci_and_skips_elsewhere(monkeypatch, ci, outcome):
+    """With CI=true a missing chromium fails the browser test; elsewhere it is skipped."""
+    monkeypatch.setattr(shutil, 'which', lambda name: None)
+    monkeypatch.setenv('CI', ci)
+    with pytest.raises(outcome, match='chromium is not installed'):
+        _chromium()
+
+
 @pytest.fixture(scope='module')
 def running(tmp_path_factory):
     """Start a node (quick_return) and a view attached to it; yield (view URL, scene)."""
