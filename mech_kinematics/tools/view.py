@@ -40,8 +40,8 @@ from ..cli import run_tool
 __all__ = ['DEFAULT_PORT', 'PAGE', 'ViewServer', 'add_parser', 'frame_from_state', 'main',
            'scene_bounds']
 
-#: The port tried first; if it is taken, any free port (the URL is printed).
-DEFAULT_PORT = 8765
+#: The port tried first (not foxglove_bridge's 8765); if it is taken, any free port.
+DEFAULT_PORT = 8790
 HOST = '127.0.0.1'
 #: Trace length per point: the published positions over at most this many messages.
 TRACE_LENGTH = 600
