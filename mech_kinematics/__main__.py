@@ -9,12 +9,12 @@ from collections.abc import Sequence
 import sys
 
 from .cli import ArgumentParser, PROG, run_handler
-from .tools import bench, check, diagram, plot, record, reindex, report, run, solve, urdf
+from .tools import bench, check, diagram, plot, record, reindex, report, run, solve, urdf, view
 
 __all__ = ['TOOLS', 'build_parser', 'main']
 
 #: The subcommands, in the order ``--help`` lists them.
-TOOLS = (solve, check, run, bench, diagram, plot, record, reindex, report, urdf)
+TOOLS = (solve, check, run, bench, diagram, plot, record, reindex, report, urdf, view)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -32,6 +32,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv[:1] == ['run']:
         return run.main(argv[1:])   # everything after `run` goes to the node untouched
+    if argv[:1] == ['view']:
+        return view.main(argv[1:])  # --ros-args after `view` go to its node untouched
     return run_handler(build_parser().parse_args(argv))
 
 

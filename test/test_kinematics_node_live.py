@@ -48,5 +48,7 @@ def test_run_shows_the_node_live_and_ctrl_c_stops_both(tmp_path):
     # Each joint: its value at a drifting instant and its range over the second (issue 20).
     assert re.search(r'\| crank [+-]\d\.\d{4} \[[+-]\d\.\d{4} \.\. [+-]\d\.\d{4}\]',
                      output), output
+    # The browser view is served beside it, on localhost (issue 20).
+    assert re.search(r'browser view on http://127\.0\.0\.1:\d+/', output), output
     assert not Path(f'/proc/{node_pid}').exists() or \
         'zombie' in Path(f'/proc/{node_pid}/status').read_text(), 'the node is still running'

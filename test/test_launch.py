@@ -28,9 +28,15 @@ LAUNCH_XML = ROOT / 'launch' / 'kinematics.launch.xml'
 RVIZ = ROOT / 'config' / 'mech_kinematics.rviz'
 NODE_SOURCE = ROOT / 'mech_kinematics' / 'ros' / 'node.py'
 PACKAGE = 'mech_kinematics'
-#: Launch arguments -> the node parameter each sets ('namespace' sets the namespace).
+#: Launch arguments -> the node parameter each sets ('namespace' sets the namespace,
+#: 'params_file' the parameters file, 'rviz' starts RViz).
 ARGUMENTS = {'scene': 'scene', 'rate_hz': 'rate_hz', 'crank_speed_rpm': 'crank_speed_rpm',
-             'markers': 'markers', 'namespace': None}
+             'markers': 'markers', 'namespace': None, 'frame_id': 'frame_id',
+             'tf_prefix': 'tf_prefix', 'use_sim_time': 'use_sim_time', 'params_file': None,
+             'rviz': None}
+#: Parameters set whether or not a params_file is given (issue 20).
+COMMON = {'frame_id', 'tf_prefix', 'use_sim_time'}
+KINEMATICS_NODE_YAML = ROOT / 'config' / 'kinematics_node.yaml'
 
 
 def _py_tree() -> ast.Module:
@@ -51,12 +57,13 @@ def _py_node_calls() -> list:
 
 
 def _py_parameter_names() -> set:
-    """Return the keys of the ``parameters`` dict the .py file builds for the node."""
+    """Return the keys of the ``parameters`` and ``common`` dicts the .py file builds."""
     names = set()
     for node in ast.walk(_py_tree()):
         if isinstance(node, ast.Assign):
             for target in node.targets:
-                if getattr(target, 'id', '') == 'parameters' and isinstance(node.value, ast.Dict):
+                if getattr(target, 'id', '') in ('parameters', 'common') \
+                        and isinstance(node.value, ast.Dict):
                     names |= {key.value for key in node.value.keys}
                 if (isinstance(target, ast.Subscript)
                         and getattr(target.value, 'id', '') == 'parameters'):
@@ -69,7 +76,7 @@ def _xml_root() -> ET.Element:
 
 
 def test_py_launch_declares_the_arguments():
-    """kinematics.launch.py declares scene, rate_hz, crank_speed_rpm, markers and namespace."""
+    """kinematics.launch.py declares the arguments of issues 13 and 20."""
     assert set(_py_arguments()) == set(ARGUMENTS)
     calls = [node for node in ast.walk(_py_tree()) if isinstance(node, ast.Call)
              and getattr(node.func, 'id', '') == 'DeclareLaunchArgument']
@@ -91,13 +98,23 @@ def test_defaults_are_the_nodes():
     assert defaults['crank_speed_rpm'] == ''      # empty: the scene's own speed
     assert defaults['markers'] == 'false'
     assert defaults['namespace'] == ''
+    assert defaults['frame_id'] == spec('frame_id').default
+    assert defaults['tf_prefix'] == spec('tf_prefix').default == ''
+    assert (defaults['use_sim_time'], defaults['params_file'], defaults['rviz']) == \
+        ('false', '', 'false')
 
 
 def test_py_launch_starts_an_installed_executable():
-    """Every Node in the .py is kinematics_node of this package, a console script."""
+    """The .py starts kinematics_node of this package (a console script), and RViz."""
     calls = _py_node_calls()
-    assert len(calls) == 1
-    keywords = {kw.arg: kw.value for kw in calls[0].keywords}
+    assert len(calls) == 2
+    by_executable = {ast.literal_eval({kw.arg: kw.value for kw in c.keywords}['executable']): c
+                     for c in calls}
+    assert set(by_executable) == {'kinematics_node', 'rviz2'}
+    rviz = {kw.arg: kw.value for kw in by_executable['rviz2'].keywords}
+    assert ast.literal_eval(rviz['package']) == 'rviz2'
+    assert ast.unparse(rviz['namespace']) == "value['namespace']"    # the node's namespace
+    keywords = {kw.arg: kw.value for kw in by_executable['kinematics_node'].keywords}
     assert ast.literal_eval(keywords['package']) == PACKAGE
     executable = ast.literal_eval(keywords['executable'])
     assert executable == 'kinematics_node'
@@ -106,8 +123,8 @@ def test_py_launch_starts_an_installed_executable():
 
 
 def test_xml_launch_starts_an_installed_executable():
-    """Every node in the .xml is kinematics_node of this package, a console script."""
-    nodes = list(_xml_root().iter('node'))
+    """Every node in the .xml but RViz is kinematics_node of this package, a console script."""
+    nodes = [node for node in _xml_root().iter('node') if node.get('exec') != 'rviz2']
     assert nodes
     for node in nodes:
         assert node.get('pkg') == PACKAGE
@@ -125,15 +142,24 @@ def test_py_launch_sets_declared_parameters_only():
 
 def test_xml_launch_sets_declared_parameters_only():
     """Each .xml node sets declared parameters from the argument of the same name."""
-    with_speed = 0
+    with_speed = with_file = 0
     for node in _xml_root().iter('node'):
-        params = {p.get('name'): p.get('value') for p in node.iter('param')}
+        if node.get('exec') == 'rviz2':
+            continue
+        params = {p.get('name'): p.get('value') for p in node.iter('param') if p.get('name')}
+        files = [p.get('from') for p in node.iter('param') if p.get('from')]
         assert set(params) <= node_parameters(), set(params) - node_parameters()
-        assert {'scene', 'rate_hz', 'markers'} <= set(params)
+        assert set(params) >= COMMON
+        if files:
+            assert files == ['$(var params_file)'] and set(params) == COMMON
+            with_file += 1
+        else:
+            assert {'scene', 'rate_hz', 'markers'} <= set(params)
         for name, value in params.items():
             assert value == f'$(var {name})'
         with_speed += 'crank_speed_rpm' in params
-    assert with_speed == 1     # exactly one of the two alternatives passes the speed
+    assert with_speed == 1     # exactly one of the alternatives passes the speed
+    assert with_file == 1
 
 
 def test_xml_launch_refers_to_declared_arguments_only():
@@ -142,16 +168,48 @@ def test_xml_launch_refers_to_declared_arguments_only():
     used = set(re.findall(r'\$\(var (\w+)\)', text))
     declared = {arg.get('name') for arg in _xml_root().iter('arg')}
     assert used == declared
-    assert not re.search(r'\$\((find-pkg-share|find-exec|find-pkg-prefix|dirname)', text)
+    # The one file it finds is this package's RViz config, which setup.py installs.
+    assert re.findall(r'\$\((find-pkg-share|find-exec|find-pkg-prefix|dirname)[^)]*\)[^ "]*',
+                      text) == ['find-pkg-share']
+    assert '$(find-pkg-share mech_kinematics)/config/mech_kinematics.rviz' in text
+    assert installed_files()[f'share/{PACKAGE}/config/mech_kinematics.rviz'] == \
+        'config/mech_kinematics.rviz'
 
 
 def test_xml_speed_alternatives_exclude_each_other():
-    """The two node groups are guarded by complementary conditions on crank_speed_rpm."""
-    conditions = sorted(group.get('if') for group in _xml_root().iter('group'))
-    assert conditions == [
-        "$(eval \"'$(var crank_speed_rpm)' != ''\")",
-        "$(eval \"'$(var crank_speed_rpm)' == ''\")",
-    ]
+    """The three node groups are guarded by conditions of which exactly one holds."""
+    conditions = [group.get('if') for group in _xml_root().iter('group')]
+    assert len(conditions) == 3
+    for params_file in ('', 'p.yaml'):
+        for speed in ('', '30'):
+            holding = 0
+            for condition in conditions:
+                expression = re.fullmatch(r'\$\(eval "(.*)"\)', condition)[1]
+                expression = expression.replace('$(var params_file)', params_file).replace(
+                    '$(var crank_speed_rpm)', speed)
+                holding += eval(expression)     # noqa: S307 - the file's own expressions
+            assert holding == 1, (params_file, speed)
+
+
+def test_xml_rviz_follows_the_namespace_and_frame():
+    """rviz:=true starts rviz2 in the node's namespace, with the config and fixed frame."""
+    rviz = [node for node in _xml_root().iter('node') if node.get('exec') == 'rviz2']
+    assert len(rviz) == 1
+    assert rviz[0].get('if') == '$(var rviz)' and rviz[0].get('pkg') == 'rviz2'
+    assert rviz[0].get('namespace') == '$(var namespace)'
+    assert rviz[0].get('args') == ('-d $(find-pkg-share mech_kinematics)/config/'
+                                   'mech_kinematics.rviz -f $(var frame_id)')
+
+
+def test_parameters_file_points_to_files_that_exist():
+    """config/kinematics_node.yaml names docs/scene_format.md, not a missing SCENE_FORMAT.md."""
+    text = KINEMATICS_NODE_YAML.read_text(encoding='utf-8')
+    assert 'SCENE_FORMAT.md' not in text
+    for path in re.findall(r'\b((?:docs|config)/[\w./*-]+\.(?:md|yaml))', text):
+        assert list(ROOT.glob(path)), path
+    assert 'docs/scene_format.md' in text
+    values = yaml.safe_load(text)['/**']['ros__parameters']
+    assert set(values) <= node_parameters()
 
 
 @pytest.mark.parametrize('path', [LAUNCH_PY, LAUNCH_XML, RVIZ], ids=lambda p: p.name)
@@ -171,6 +229,14 @@ def test_rviz_config_shows_the_nodes_frame_tf_and_markers():
     assert displays['rviz_default_plugins/TF']['Enabled'] is True
     markers = displays['rviz_default_plugins/MarkerArray']
     assert markers['Enabled'] is True
-    assert markers['Topic']['Value'] == '/markers'
-    # The node publishes on the relative name 'markers' (so /markers without a namespace).
-    assert "create_publisher(MarkerArray, 'markers'" in NODE_SOURCE.read_text(encoding='utf-8')
+    # Relative names, as the node publishes them: RViz in the node's namespace sees its
+    # topics (issue 20); nothing hard-codes /markers.
+    assert markers['Topic']['Value'] == 'markers'
+    source = NODE_SOURCE.read_text(encoding='utf-8')
+    assert "create_publisher(MarkerArray, 'markers'" in source
+    model = displays['rviz_default_plugins/RobotModel']
+    assert model['Enabled'] is True and model['Description Source'] == 'Topic'
+    assert model['Description Topic']['Value'] == 'robot_description'
+    assert model['Description Topic']['Durability Policy'] == 'Transient Local'
+    assert "create_publisher(String, 'robot_description'" in source
+    assert 'Value: /' not in RVIZ.read_text(encoding='utf-8')     # no absolute topic

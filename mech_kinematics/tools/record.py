@@ -561,7 +561,9 @@ class BagRecorder:
             parts.append(f'{name} {received} ({per_second:.0f}/s)')
         line = (f'recorded {now - self.recording_since:.0f} s: {total:.0f} messages '
                 f'({rate:.0f}/s): {", ".join(parts)}')
-        pending = self._pending()
+        # A default topic the node publishes only when asked (markers) is not waited for aloud.
+        pending = [name for name in self._pending()
+                   if name.rsplit('/', 1)[-1] not in OPTIONAL_TOPICS]
         if pending:
             line += f'; waiting for {", ".join(pending)}'
         self._node.get_logger().info(line)

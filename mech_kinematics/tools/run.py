@@ -7,7 +7,9 @@ as a child process (the arguments go to it unchanged, e.g. ``--ros-args -p
 scene:=slider_crank_150_600``) and subscribes to its ``joint_states`` and
 ``diagnostics`` with the same ROS arguments
 (:class:`mech_kinematics.tools.live_view.LiveView`), so namespaces and remaps
-apply to both. Ctrl-C (or SIGTERM) stops the view and then the node.
+apply to both. The same process serves the browser view
+(:class:`mech_kinematics.tools.view.ViewServer`) and prints its URL. Ctrl-C
+(or SIGTERM) stops the views and then the node.
 """
 
 from __future__ import annotations
@@ -26,7 +28,8 @@ __all__ = ['add_parser', 'main']
 
 STOP_TIMEOUT_S = 3.0
 
-RUN_HELP = ('Start kinematics_node and a live console view of what it publishes. '
+RUN_HELP = ('Start kinematics_node, a live console view of what it publishes and a browser '
+            'view (its URL is printed). '
             'Arguments after `run` go to the node, e.g. '
             '`run --ros-args -p scene:=quick_return -p rate_hz:=200.0`.')
 
@@ -53,7 +56,8 @@ def _handle(args: argparse.Namespace) -> int:
 def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     """Register the ``run`` command on ``subparsers``; return its parser."""
     parser: argparse.ArgumentParser = subparsers.add_parser(
-        'run', help='start the node with a live console view (make run); Ctrl-C stops both',
+        'run', help='start the node with a live console view and a browser view (make run); '
+                    'Ctrl-C stops both',
         description=RUN_HELP)
     parser.add_argument('node_args', nargs=argparse.REMAINDER, metavar='NODE_ARGS',
                         help='arguments for the node (--ros-args ...)')
@@ -74,6 +78,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     from rclpy.executors import ExternalShutdownException
 
     from .live_view import LiveView
+    from .view import DEFAULT_PORT, ViewServer
 
     command = [sys.executable, '-m', 'mech_kinematics.kinematics_node', *argv]
     # A session of its own: Ctrl-C reaches this process only, which then stops
@@ -82,15 +87,19 @@ def main(argv: Sequence[str] | None = None) -> int:
                              env=dict(os.environ, PYTHONUNBUFFERED='1'))
     ros_args = argv[argv.index('--ros-args'):] if '--ros-args' in argv else []
     rclpy.init(args=['live', *ros_args])
-    view = None
+    view = server = None
     try:
         view = LiveView()
+        server = ViewServer(view, DEFAULT_PORT)
         print(f'mech_kinematics: node started (pid {child.pid}); Ctrl-C stops it.', flush=True)
+        print(f'mech_kinematics: browser view on {server.url}', flush=True)
         while child.poll() is None:
-            rclpy.spin_once(view, timeout_sec=0.2)
+            rclpy.spin_once(view, timeout_sec=0.05)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass  # Ctrl-C: stop the node below
     finally:
+        if server is not None:
+            server.close()
         if view is not None:
             view.destroy_node()
         rclpy.try_shutdown()
