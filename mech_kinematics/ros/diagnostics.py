@@ -21,6 +21,8 @@ import statistics
 import threading
 import time
 
+from ..units import NS_PER_S
+
 __all__ = ['ERROR', 'OK', 'STALE', 'Status', 'TIMING_WARN_FRACTION', 'TickStats', 'WARN',
            'Window', 'solver_status', 'timing_status']
 
@@ -28,8 +30,6 @@ OK, WARN, ERROR, STALE = 0, 1, 2, 3
 
 #: Timing turns WARN when late and skipped instants exceed this fraction of a window's.
 TIMING_WARN_FRACTION = 0.01
-
-NS_PER_S = 1_000_000_000
 
 
 @dataclass(frozen=True)

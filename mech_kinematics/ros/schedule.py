@@ -16,9 +16,9 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
-__all__ = ['Due', 'TickGrid', 'period_ns_from_rate']
+from ..units import NS_PER_S
 
-NS_PER_S = 1_000_000_000
+__all__ = ['Due', 'TickGrid', 'period_ns_from_rate']
 
 
 def period_ns_from_rate(rate_hz: float) -> int:
