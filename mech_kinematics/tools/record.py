@@ -53,24 +53,27 @@ import threading
 import time
 from typing import Any
 
-from ..cli import run_tool
+from . import bag
+from ..cli import positive_seconds, run_tool, seconds_or_zero
 from ..errors import MechKinematicsError
+from ..ros import topics
+from ..units import NS_PER_S
 
 __all__ = [
     'BAG_VERSIONS', 'BagRecorder', 'DEFAULT_BAG_VERSION', 'DEFAULT_EXECUTOR',
     'DEFAULT_PROGRESS_S', 'DEFAULT_STORAGE', 'DEFAULT_TOPICS', 'EXECUTORS', 'RecorderError',
-    'STORAGES', 'TopicStats', 'WAIT_REPORT_INTERVAL_S', 'add_parser', 'check_new_output', 'main',
+    'STORAGES', 'TopicStats', 'WAIT_REPORT_INTERVAL_S', 'add_parser', 'main',
     'message_definition', 'record', '_handle',
 ]
 
 #: The node's topics (relative names: the recorder's namespace applies).
-DEFAULT_TOPICS = ('joint_states', 'joint_accelerations', 'point_accelerations', 'diagnostics')
-STORAGES = ('mcap', 'sqlite3')
+DEFAULT_TOPICS = (*topics.STATE_TOPICS, topics.DIAGNOSTICS)
+#: The bag writer's storages and versions (it checks them).
+STORAGES = tuple(bag.STORAGES)
 #: As ``ros2 bag record`` since Iron.
 DEFAULT_STORAGE = 'mcap'
-BAG_VERSIONS = (8, 9)
-#: Version 9 metadata is not readable by Humble (rosbag2#1895).
-DEFAULT_BAG_VERSION = 8
+BAG_VERSIONS = bag.BAG_VERSIONS
+DEFAULT_BAG_VERSION = bag.DEFAULT_VERSION
 NODE_NAME = 'mech_kinematics_recorder'
 #: How often the graph is searched for topics not subscribed yet, and pending messages
 #: are checked for a flush, s (rosbag2 searches every 100 ms).
@@ -224,7 +227,7 @@ def _qos_from_profile(profile: Any) -> Any:
 
     def duration(value: Any) -> QosTime:
         # RMW_DURATION_INFINITE is {9223372036 s, 854775807 ns}, as rosbag2 writes it.
-        return QosTime(*divmod(int(value.nanoseconds), 1_000_000_000))
+        return QosTime(*divmod(int(value.nanoseconds), NS_PER_S))
 
     return Qos(QosHistory(int(profile.history)), int(profile.depth),
                QosReliability(int(profile.reliability)), QosDurability(int(profile.durability)),
@@ -339,13 +342,11 @@ class BagRecorder:
                  args: list[str] | None = None, executor: str = DEFAULT_EXECUTOR,
                  progress: float = DEFAULT_PROGRESS_S) -> None:
         self.output = Path(output)
-        check_new_output(self.output)
-        if storage not in STORAGES:
-            msg = f'Expected storage to be one of {", ".join(STORAGES)}, got {storage!r}'
-            raise RecorderError(msg)
-        if version not in BAG_VERSIONS:
-            msg = f'Expected bag version to be one of {BAG_VERSIONS}, got {version!r}'
-            raise RecorderError(msg)
+        try:
+            bag.check_new_bag(self.output)      # before ROS starts
+            bag.check_options(storage, version)
+        except bag.BagError as error:
+            raise RecorderError(str(error)) from None
         if not topics:
             msg = 'Expected at least one topic to record, got none'
             raise RecorderError(msg)
@@ -636,15 +637,6 @@ class BagRecorder:
         return on_message
 
 
-def check_new_output(path: Path) -> None:
-    """Raise :class:`RecorderError` unless ``path`` does not exist yet (never overwrite)."""
-    if path.exists() or path.is_symlink():
-        kind = 'directory' if path.is_dir() else 'file'
-        msg = (f'Expected a new bag directory, got "{path}", an existing {kind} '
-               f'(refusing to overwrite it; choose another name or remove it)')
-        raise RecorderError(msg)
-
-
 # -- command line ----------------------------------------------------------------
 
 
@@ -686,28 +678,6 @@ def record(output: str | os.PathLike[str], topics: Sequence[str] = DEFAULT_TOPIC
         for sig, handler in previous.items():
             signal.signal(sig, handler)
     return recorder
-
-
-def _positive_seconds(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not (math.isfinite(value) and value > 0):
-        msg = f'expected a positive number of seconds, got {text!r}'
-        raise argparse.ArgumentTypeError(msg)
-    return value
-
-
-def _seconds_or_zero(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not (math.isfinite(value) and value >= 0):
-        msg = f'expected a number of seconds >= 0, got {text!r}'
-        raise argparse.ArgumentTypeError(msg)
-    return value
 
 
 def _print_summary(recorder: BagRecorder) -> None:
@@ -788,7 +758,7 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--topics', nargs='+', default=list(DEFAULT_TOPICS), metavar='T',
                         help="topics to record; relative names take the recorder's namespace "
                              f'(default: {" ".join(DEFAULT_TOPICS)})')
-    parser.add_argument('--duration', type=_positive_seconds, metavar='S',
+    parser.add_argument('--duration', type=positive_seconds, metavar='S',
                         help='stop S seconds after the first topic is subscribed '
                              '(default: at Ctrl-C or SIGTERM)')
     parser.add_argument('--storage', choices=STORAGES, default=DEFAULT_STORAGE,
@@ -797,7 +767,7 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         default=DEFAULT_BAG_VERSION,
                         help='rosbag2 format version; 9 is not readable by Humble '
                              '(default: %(default)s)')
-    parser.add_argument('--progress', type=_seconds_or_zero, default=DEFAULT_PROGRESS_S,
+    parser.add_argument('--progress', type=seconds_or_zero, default=DEFAULT_PROGRESS_S,
                         metavar='S', help='log the messages per topic and per second every S '
                                           'seconds while recording; 0: never '
                                           '(default: %(default)s)')
