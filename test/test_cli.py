@@ -9,8 +9,8 @@ import sys
 
 import pytest
 
-from mech_kinematics.cli import (BROKEN_PIPE_STATUS, positive_float, positive_seconds,
-                                 seconds_or_zero)
+from mech_kinematics.tools.cli import (BROKEN_PIPE_STATUS, positive_float, positive_seconds,
+                                       seconds_or_zero)
 
 TIMEOUT = 120
 

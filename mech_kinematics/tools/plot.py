@@ -32,7 +32,7 @@ import warnings
 import numpy as np
 import numpy.typing as npt
 
-from ..cli import finite_float, run_tool
+from .cli import finite_float, run_tool
 from ..errors import MechKinematicsError
 from ..ros import topics
 from ..ros.cdr import stamp_from_cdr

@@ -54,7 +54,7 @@ import time
 from typing import Any
 
 from . import bag
-from ..cli import positive_seconds, run_tool, seconds_or_zero
+from .cli import positive_seconds, run_tool, seconds_or_zero
 from ..errors import MechKinematicsError
 from ..ros import topics
 from ..units import NS_PER_S

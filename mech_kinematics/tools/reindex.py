@@ -28,7 +28,7 @@ from collections.abc import Sequence
 import sys
 from typing import Any
 
-from ..cli import run_tool
+from .cli import run_tool
 
 __all__ = ['add_parser', 'main', '_handle']
 

@@ -11,8 +11,8 @@ import math
 import sys
 from typing import Any
 
+from .cli import finite_float, positive_float, run_tool
 from ..bounds import MAX_ERROR
-from ..cli import finite_float, positive_float, run_tool
 from ..errors import AssemblyError, SceneError, UntrustedError
 from ..linkage import assembly_text, solve
 from ..scene import load_scene

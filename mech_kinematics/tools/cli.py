@@ -30,7 +30,7 @@ import sys
 import traceback
 from typing import Any
 
-from .errors import MechKinematicsError
+from ..errors import MechKinematicsError
 
 __all__ = ['ArgumentParser', 'PROG', 'finite_float', 'positive_float', 'positive_int',
            'positive_seconds', 'run_handler', 'run_tool', 'seconds_or_zero']
