@@ -6,6 +6,7 @@
   PyYAML and the standard library;
 - geometry imports the core only, and never matplotlib;
 - the ROS layer never imports a tool (drawing, report, recorder) nor matplotlib;
+- the bag writer (``bag/``) imports the core only; the tools use it;
 - building the command line for ``solve`` imports no heavy dependency.
 """
 
@@ -22,7 +23,7 @@ HEAVY = ('rclpy', 'matplotlib', 'mpmath', 'scipy', 'rosbags', 'tqdm')
 
 #: Layer of each subpackage (modules at the top are the core), and what each may import.
 LAYERS = {'core': set(), 'data': set(), 'geometry': {'core'}, 'ros': {'core', 'geometry'},
-          'tools': {'core', 'geometry', 'ros', 'data'}}
+          'bag': {'core'}, 'tools': {'core', 'geometry', 'ros', 'data', 'bag'}}
 
 
 def _modules_after(code: str) -> set:

@@ -3,7 +3,7 @@
 """Record topics to a rosbag2 bag with no ROS install: ``python -m mech_kinematics record``.
 
 The recorder subscribes with *raw* subscriptions (the serialized CDR bytes,
-never decoded) and hands the bytes to :class:`~.bag.BagWriter`, the way
+never decoded) and hands the bytes to :class:`~mech_kinematics.bag.BagWriter`, the way
 ``ros2 bag record`` hands them to rosbag2. What real ROS tools need to open
 the bag comes from the ROS graph and the installed interface files, as
 rosbag2 does it:
@@ -22,7 +22,7 @@ the subscriptions are destroyed and the bag is closed: every message received
 is in it.
 
 Nothing is lost if the recorder itself dies: messages reach the storage file
-at least every :data:`~.bag.FLUSH_INTERVAL_S` (an MCAP chunk closed and synced,
+at least every :data:`~mech_kinematics.bag.FLUSH_INTERVAL_S` (an MCAP chunk closed and synced,
 an sqlite3 transaction committed), and ``python -m mech_kinematics reindex``
 rebuilds ``metadata.yaml`` after ``kill -9``. A write error (a full disk) stops
 the recording: the bag is closed with what it holds, its metadata counting
@@ -53,8 +53,8 @@ import threading
 import time
 from typing import Any
 
-from . import bag
 from .cli import positive_seconds, run_tool, seconds_or_zero
+from .. import bag
 from ..errors import MechKinematicsError
 from ..ros import topics
 from ..units import NS_PER_S
@@ -385,7 +385,7 @@ class BagRecorder:
         import rclpy
         from rclpy.signals import SignalHandlerOptions
 
-        from .bag import BagError, BagWriter
+        from ..bag import BagError, BagWriter
 
         self._context = rclpy.Context()
         # The recorder handles SIGINT and SIGTERM itself (a flag, see run()), so that a
@@ -458,7 +458,7 @@ class BagRecorder:
         list of TopicStats
             Per requested topic: type, messages received and written.
         """
-        from .bag import BagError
+        from ..bag import BagError
 
         if self.recording_since is not None:
             self.recorded_seconds = time.monotonic() - self.recording_since
@@ -509,7 +509,7 @@ class BagRecorder:
 
     def _housekeeping(self) -> None:
         """Poll the graph, flush the bag if due, and log waiting or progress lines."""
-        from .bag import BagError
+        from ..bag import BagError
 
         if self._writer is None:
             return
@@ -568,7 +568,7 @@ class BagRecorder:
 
     def _discover(self) -> None:
         """Subscribe to every requested topic that has publishers now (polled)."""
-        from .bag import BagError
+        from ..bag import BagError
 
         pending = [t for t in self._topics.values() if t.subscription is None and not t.failed]
         if not pending or self._writer is None:
@@ -618,7 +618,7 @@ class BagRecorder:
         self._node.get_logger().info(f'subscribed to {name} ({type_name})')
 
     def _callback(self, topic: _Topic) -> Callable[[bytes], None]:
-        from .bag import BagError
+        from ..bag import BagError
 
         write = self._writer.write
         bag_topic = topic.bag_topic
