@@ -90,7 +90,7 @@ DUPLICATE_CHECK_S = 2.5
 DRIVE = ('crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm')
 #: The crank's name in the driver, and what each drive parameter sets there.
 CRANK = 'crank'
-DRIVE_KEYS = {'crank_speed_rpm': 'speed_rpm', 'crank_accel': 'accel',
+CRANK_KEYS = {'crank_speed_rpm': 'speed_rpm', 'crank_accel': 'accel',
               'max_crank_speed_rpm': 'max_speed_rpm'}
 DOUBLES = frozenset(p.name for p in PARAMETERS if p.kind == 'double')
 READ_ONLY = frozenset(p.name for p in PARAMETERS if p.read_only)
@@ -283,7 +283,7 @@ class KinematicsNode(LifecycleNode):
             self._tf_period_ns = self._tf_period(changes['tf_rate_hz'])
         if 'max_relative_error' in changes:
             self._max_error = float(changes['max_relative_error'])
-        drive = {DRIVE_KEYS[name]: float(changes[name]) for name in DRIVE if name in changes}
+        drive = {CRANK_KEYS[name]: float(changes[name]) for name in DRIVE if name in changes}
         if drive and CRANK in driver.drives:
             driver.request(CRANK, **drive)
             if self._thread is None:
