@@ -292,3 +292,39 @@ def test_resuming_owes_nothing_from_the_pause():
     assert list(wake.instants) == [] and wake.wait_ns == MS // 2 and wake.skipped == 0
     assert list(driver.step(5 * NS_PER_S + MS, monotonic_ns=5 * NS_PER_S + MS).instants) == [
         5 * NS_PER_S + MS]
+
+
+class LinearTimebase:
+    """A stand-in actuator time base (m, m/s): what a driver that does not turn provides."""
+
+    CHANGES = ('speed',)
+
+    def __init__(self, t0, position, speed):
+        self.t0, self.position, self.speed = t0, Fraction(position), Fraction(speed)
+
+    def at(self, t):
+        return self.position + self.speed * Fraction(t - self.t0, NS_PER_S)
+
+    def update(self, t, speed):
+        self.t0, self.position, self.speed = t, self.at(t), Fraction(speed)
+
+    def moved(self, t_from, t_to):
+        return LinearTimebase(t_to, self.at(t_from), self.speed)
+
+    def sample_turns(self, t):
+        return 0, (float(self.at(t)), float(self.speed))
+
+
+def test_a_driver_that_does_not_turn_has_a_time_base_of_its_own():
+    """A linear actuator beside the crank: its own kind, start values and changes (issue 18)."""
+    driver = crank_driver(period_ns=MS)
+    driver.add_drive('ram', LinearTimebase, position=0.25, speed=0.5)
+    publish(driver, driver.step(0, monotonic_ns=0))
+    driver.request('ram', speed=-0.5)
+    (_, crank), (turns, ram) = driver.state_at(2 * MS)
+    assert crank.speed == rad_per_s_from_rpm(60.0)
+    assert turns == 0 and ram == (0.251, -0.5)      # out at 0.5 m/s, back from 2 ms on
+    (_, _), (_, ram) = driver.state_at(4 * MS)
+    assert ram == (0.25, -0.5)
+    with pytest.raises(ValueError, match=r"^Expected drive changes among speed, got \['accel'\]$"):
+        driver.request('ram', accel=1.0)

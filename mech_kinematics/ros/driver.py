@@ -12,8 +12,11 @@ publishes the instants it gets back, taking each driver's state at each of them
 from :meth:`TickDriver.state_at`.
 
 Each driver is named and keeps its own time base and start values, so a scene
-with several drivers gets one entry per driver; today every driver is a crank
-(:class:`~mech_kinematics.ros.timebase.CrankTimebase`).
+with several drivers gets one entry per driver. A driver's time base is a
+class given with it (:class:`~mech_kinematics.ros.timebase.CrankTimebase` for
+a crank, the default): anything built as ``kind(t0, **start)`` with
+``update(t, **changes)``, ``moved(t_from, t_to)`` and ``sample_turns(t)``
+(whole turns, or 0 for a driver that does not turn, and its state) will do.
 
 Thread use: the tick thread calls :meth:`~TickDriver.step` and
 :meth:`~TickDriver.state_at`; any thread may call :meth:`~TickDriver.request`
@@ -24,17 +27,17 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 import threading
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, Protocol
 
 from .schedule import TickGrid
-from .timebase import CrankSample, CrankTimebase
+from .timebase import CrankTimebase
 
-__all__ = ['DRIVE_KEYS', 'Drive', 'TickDriver', 'Wake']
+__all__ = ['Drive', 'TickDriver', 'Timebase', 'Wake']
 
 #: A change of the system clock against the monotonic clock beyond this is a jump, ns.
 CLOCK_JUMP_NS = 10_000_000
-#: What a drive change may set: the keyword arguments of ``CrankTimebase.update``.
-DRIVE_KEYS = ('speed_rpm', 'speed', 'accel', 'max_speed_rpm')
+#: Ways of giving one speed: setting one drops the other.
+_SPEEDS = ('speed_rpm', 'speed')
 
 
 class Wake(NamedTuple):
@@ -52,6 +55,22 @@ class Wake(NamedTuple):
     """Simulated time has not started (no ``/clock`` yet): nothing can be published."""
 
 
+class Timebase(Protocol):
+    """What the driver asks of a driver's time base (``CrankTimebase`` is one)."""
+
+    #: The keyword arguments ``update`` takes.
+    CHANGES: tuple[str, ...]
+
+    def update(self, t: int, **changes: Any) -> None:
+        """From instant ``t`` (ns) on, drive with ``changes``, keeping the position there."""
+
+    def moved(self, t_from: int, t_to: int) -> Timebase:
+        """Return a copy whose drive at ``t_to`` continues this one's at ``t_from``."""
+
+    def sample_turns(self, t: int) -> tuple[int, Any]:
+        """Return (whole turns, the driver's state) at ``t`` ns."""
+
+
 @dataclass
 class Drive:
     """One driver: its start values, then its exact time base from its first published instant.
@@ -63,14 +82,15 @@ class Drive:
 
     name: str
     start: dict[str, Any]
-    timebase: CrankTimebase | None = None
+    kind: Any = CrankTimebase
+    timebase: Timebase | None = None
     pending: dict[str, float] = field(default_factory=dict)
 
     def fold(self) -> None:
         """Take the pending changes into the start values (no instant published yet)."""
         changes, self.pending = self.pending, {}
-        if 'speed_rpm' in changes or 'speed' in changes:
-            self.start.update(speed_rpm=None, speed=None)
+        if any(key in changes for key in _SPEEDS):
+            self.start.update((key, None) for key in _SPEEDS if key in self.start)
         self.start.update(changes)
 
     def apply(self, at_ns: int) -> None:
@@ -107,24 +127,31 @@ class TickDriver:
 
     # -- drivers --------------------------------------------------------------
 
-    def add_drive(self, name: str, **start: Any) -> None:
-        """Add driver ``name`` with its start values (kept if it is there already)."""
+    def add_drive(self, name: str, kind: Any = CrankTimebase, **start: Any) -> None:
+        """Add driver ``name``: its time base ``kind`` and its start values (kept if it is there).
+
+        The time base is built at the driver's first published instant ``t0``
+        as ``kind(t0, **start)``.
+        """
+        if kind is CrankTimebase:
+            start = {'speed_rpm': None, 'speed': None, **start}
         with self._lock:
             if name not in self.drives:
-                self.drives[name] = Drive(name, {'speed_rpm': None, 'speed': None, **start})
+                self.drives[name] = Drive(name, start, kind)
 
     def request(self, name: str, **changes: float) -> None:
         """Drive ``name`` with ``changes`` from the next instant not published (any thread)."""
-        unknown = set(changes) - set(DRIVE_KEYS)
+        drive = self.drives[name]
+        unknown = set(changes) - set(drive.kind.CHANGES)
         if unknown:
-            msg = f'Expected drive changes among {", ".join(DRIVE_KEYS)}, got {sorted(unknown)}'
+            msg = (f'Expected drive changes among {", ".join(drive.kind.CHANGES)}, '
+                   f'got {sorted(unknown)}')
             raise ValueError(msg)
         with self._lock:
-            pending = self.drives[name].pending
-            if 'speed_rpm' in changes or 'speed' in changes:
-                pending.pop('speed_rpm', None)
-                pending.pop('speed', None)
-            pending.update(changes)
+            if any(key in changes for key in _SPEEDS):
+                for key in _SPEEDS:
+                    drive.pending.pop(key, None)
+            drive.pending.update(changes)
 
     def apply_now(self, now_ns: int) -> None:
         """Apply the pending changes at ``now_ns`` (after the last published instant)."""
@@ -201,7 +228,7 @@ class TickDriver:
 
     # -- the drivers at an instant -------------------------------------------
 
-    def state_at(self, stamp: int) -> list[tuple[int, CrankSample]]:
+    def state_at(self, stamp: int) -> list[tuple[int, Any]]:
         """Return each driver's (whole turns, state) at ``stamp`` and mark ``stamp`` published.
 
         Call it for the instants :meth:`step` returned, in order: the pending
@@ -212,7 +239,7 @@ class TickDriver:
             for drive in self.drives.values():
                 if drive.timebase is None:
                     drive.fold()
-                    drive.timebase = CrankTimebase(stamp, **drive.start)
+                    drive.timebase = drive.kind(stamp, **drive.start)
                 if self._rebase_from is not None:
                     drive.timebase = drive.timebase.moved(self._rebase_from, stamp)
                 if drive.pending:

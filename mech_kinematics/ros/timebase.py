@@ -212,6 +212,9 @@ class CrankTimebase:
     still the old drive.
     """
 
+    #: The keyword arguments :meth:`update` takes.
+    CHANGES = ('speed_rpm', 'speed', 'accel', 'max_speed_rpm')
+
     def __init__(self, t0: int, angle: float, speed_rpm: float | None, accel: float,
                  max_speed_rpm: float, *, speed: float | None = None) -> None:
         if (speed_rpm is None) == (speed is None):
