@@ -8,8 +8,8 @@ import argparse
 from collections.abc import Sequence
 import sys
 
-from .cli import ArgumentParser, PROG, run_handler
 from .tools import bench, check, diagram, plot, record, reindex, report, run, solve, urdf, view
+from .tools.cli import ArgumentParser, PROG, run_handler
 
 __all__ = ['TOOLS', 'build_parser', 'main']
 

@@ -6,6 +6,7 @@
   PyYAML and the standard library;
 - geometry imports the core only, and never matplotlib;
 - the ROS layer never imports a tool (drawing, report, recorder) nor matplotlib;
+- the bag writer (``bag/``) imports the core only; the tools use it;
 - building the command line for ``solve`` imports no heavy dependency.
 """
 
@@ -22,7 +23,7 @@ HEAVY = ('rclpy', 'matplotlib', 'mpmath', 'scipy', 'rosbags', 'tqdm')
 
 #: Layer of each subpackage (modules at the top are the core), and what each may import.
 LAYERS = {'core': set(), 'data': set(), 'geometry': {'core'}, 'ros': {'core', 'geometry'},
-          'tools': {'core', 'geometry', 'ros', 'data'}}
+          'bag': {'core'}, 'tools': {'core', 'geometry', 'ros', 'data', 'bag'}}
 
 
 def _modules_after(code: str) -> set:
@@ -105,3 +106,23 @@ def test_arrows_run_one_way(path):
     for line, target in _imported_layers(path):
         assert target == layer or target in LAYERS[layer], \
             f'{path.relative_to(PACKAGE)}:{line} ({layer}) imports from {target}'
+
+
+#: Facts with one home each: the literal, and the module that may spell it.
+ONE_HOME = {
+    '1_000_000_000': 'units.py',
+    "'joint_states'": 'ros/topics.py',
+    "'joint_accelerations'": 'ros/topics.py',
+    "'point_accelerations'": 'ros/topics.py',
+    "'diagnostics'": 'ros/topics.py',
+    "'/tf'": 'ros/topics.py',
+    "'/tf_static'": 'ros/topics.py',
+}
+
+
+@pytest.mark.parametrize('literal, home', ONE_HOME.items(), ids=list(ONE_HOME))
+def test_each_fact_is_spelled_in_its_home_only(literal, home):
+    """NS_PER_S and the node's topic names are written once; every other module imports them."""
+    spelled = sorted(str(p.relative_to(PACKAGE)) for p in PACKAGE.rglob('*.py')
+                     if literal in p.read_text(encoding='utf-8'))
+    assert spelled == [home]

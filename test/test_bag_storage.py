@@ -1,6 +1,6 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""The crash-safe bag writer and its recovery (``mech_kinematics.tools.bag``), without DDS.
+"""The crash-safe bag writer and its recovery (``mech_kinematics.bag``), without DDS.
 
 Bags are written here in-process with :class:`BagWriter` from serialized
 ``sensor_msgs/msg/JointState`` messages whose stamp is their index, so that a
@@ -26,10 +26,10 @@ import numpy as np
 import pytest
 import yaml
 
+from mech_kinematics.bag import BagError, BagWriter, reindex, storage_mcap, storage_sqlite3
+from mech_kinematics.bag.metadata import type_hash_from_definition
+from mech_kinematics.bag.writer import RESERVE_FILE
 from mech_kinematics.tools import record
-from mech_kinematics.tools.bag import BagError, BagWriter, reindex, storage_mcap, storage_sqlite3
-from mech_kinematics.tools.bag.metadata import type_hash_from_definition
-from mech_kinematics.tools.bag.writer import RESERVE_FILE
 
 REPO = Path(__file__).resolve().parents[1]
 TYPE = 'sensor_msgs/msg/JointState'
@@ -299,8 +299,8 @@ def test_mcap_cut_message_indexes_are_written_again(tmp_path):
 SQLITE_KILLED_MID_TRANSACTION = """
 import os, pickle, signal, sys
 from pathlib import Path
-from mech_kinematics.tools.bag.metadata import Topic
-from mech_kinematics.tools.bag.storage_sqlite3 import Sqlite3Storage
+from mech_kinematics.bag.metadata import Topic
+from mech_kinematics.bag.storage_sqlite3 import Sqlite3Storage
 bag = Path(sys.argv[1])
 topics, payloads = pickle.loads(Path(sys.argv[2]).read_bytes())
 bag.mkdir()
@@ -320,7 +320,7 @@ os.kill(os.getpid(), signal.SIGKILL)
 def test_sqlite3_transaction_cut_by_kill_is_rolled_back(tmp_path):
     """A kill -9 inside a transaction: reindex rolls it back; committed messages stay."""
     import pickle
-    from mech_kinematics.tools.bag import Topic
+    from mech_kinematics.bag import Topic
 
     encoding, text, type_hash = definition()
     topics = [Topic(1, '/js', TYPE, text, encoding, type_hash),
@@ -440,7 +440,7 @@ def test_sqlite3_full_disk_closes_with_what_was_committed(tmp_path, monkeypatch)
 
 def test_bag_that_cannot_be_closed_says_to_reindex(tmp_path, monkeypatch):
     """No room even for metadata.yaml: the error names it and the reindex command."""
-    import mech_kinematics.tools.bag.writer as bag_writer
+    import mech_kinematics.bag.writer as bag_writer
 
     writer, topic = open_writer(tmp_path / 'bag', 'sqlite3', flush_interval=3600.0)
     write(writer, topic, range(100))

@@ -2,12 +2,15 @@
 # SPDX-License-Identifier: Apache-2.0
 """Every command fails with one line and a non-zero status, never a traceback (issue 12)."""
 
+import argparse
+import math
 import subprocess
 import sys
 
 import pytest
 
-from mech_kinematics.cli import BROKEN_PIPE_STATUS
+from mech_kinematics.tools.cli import (BROKEN_PIPE_STATUS, positive_float, positive_seconds,
+                                       seconds_or_zero)
 
 TIMEOUT = 120
 
@@ -57,3 +60,44 @@ def test_a_closed_pipe_ends_the_command_quietly():
     proc.stderr.close()
     assert stderr == '', stderr
     assert status in (0, BROKEN_PIPE_STATUS)
+
+
+@pytest.mark.parametrize('parse, text, value', [
+    (positive_float, '1e-9', 1e-9), (positive_float, 'inf', math.inf),
+    (positive_seconds, '0.5', 0.5), (seconds_or_zero, '0', 0.0), (seconds_or_zero, '2', 2.0),
+])
+def test_number_types_accept(parse, text, value):
+    """The shared argparse number types return the number given."""
+    assert parse(text) == value
+
+
+@pytest.mark.parametrize('parse, text, message', [
+    (positive_float, '0', "expected a positive number, got '0'"),
+    (positive_float, 'nan', "expected a positive number, got 'nan'"),
+    (positive_float, 'tight', "expected a positive number, got 'tight'"),
+    (positive_seconds, 'inf', "expected a positive number of seconds, got 'inf'"),
+    (positive_seconds, '-1', "expected a positive number of seconds, got '-1'"),
+    (seconds_or_zero, '-0.1', "expected a number of seconds >= 0, got '-0.1'"),
+    (seconds_or_zero, 'soon', "expected a number of seconds >= 0, got 'soon'"),
+])
+def test_number_types_refuse_with_one_reason(parse, text, message):
+    """A refused number names what was expected and what was given."""
+    with pytest.raises(argparse.ArgumentTypeError) as caught:
+        parse(text)
+    assert str(caught.value) == message
+
+
+@pytest.mark.parametrize('argv, words', [
+    (['solve', 'geneva', '--max-error', '0'],
+     ["--max-error: expected a positive number, got '0'"]),
+    (['record', '-o', 'x', '--duration', '0'],
+     ["--duration: expected a positive number of seconds, got '0'"]),
+    (['record', '-o', 'x', '--progress', '-1'],
+     ["--progress: expected a number of seconds >= 0, got '-1'"]),
+])
+def test_solve_and_record_use_the_shared_number_types(argv, words):
+    """The number options of solve and record refuse with the shared types' reasons."""
+    result = run(*argv)
+    assert result.returncode == 2
+    for word in words:
+        assert word in result.stderr

@@ -15,8 +15,8 @@ import pytest
 import yaml
 
 from mech_kinematics.__main__ import build_parser, TOOLS
+from mech_kinematics.bag import BagWriter
 from mech_kinematics.tools import reindex
-from mech_kinematics.tools.bag import BagWriter
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -37,7 +37,7 @@ def unclosed_bag(path: Path, storage: str, messages: int):
 
 
 def _string_hash(text: str) -> str:
-    from mech_kinematics.tools.bag.metadata import type_hash_from_definition
+    from mech_kinematics.bag.metadata import type_hash_from_definition
 
     return type_hash_from_definition('std_msgs/msg/String', text, 'ros2msg')
 
@@ -118,6 +118,6 @@ def test_reindex_is_a_registered_tool():
 
 def test_importing_reindex_and_the_bag_writer_pulls_in_no_ros():
     """The reindex command and the bag package import rosbags and rclpy only when they run."""
-    code = ('import sys, mech_kinematics.__main__, mech_kinematics.tools.bag; '
+    code = ('import sys, mech_kinematics.__main__, mech_kinematics.bag; '
             'heavy = {"rclpy", "rosbags"} & set(sys.modules); assert not heavy, heavy')
     subprocess.run([sys.executable, '-c', code], check=True, cwd=REPO)

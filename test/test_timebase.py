@@ -190,6 +190,26 @@ def test_bad_values_are_refused(kwargs, match):
             tb.update(1, **kwargs)
 
 
+@pytest.mark.parametrize('speed_rpm, speed', [(None, None), (60.0, 6.0)])
+def test_a_speed_is_given_in_one_unit(speed_rpm, speed):
+    """Exactly one of speed_rpm and speed (rad/s) gives the start speed; update takes one too."""
+    with pytest.raises(ValueError, match=r'^Expected one of `speed_rpm` and `speed`, got '):
+        CrankTimebase(0, 0.0, speed_rpm, 0.0, 100.0, speed=speed)
+    if speed_rpm is not None:
+        tb = CrankTimebase(0, 0.0, 1.0, 0.0, 100.0)
+        with pytest.raises(ValueError, match=r'^Expected one of `speed_rpm` and `speed`, got '):
+            tb.update(1, speed_rpm=speed_rpm, speed=speed)
+
+
+def test_a_speed_in_rad_per_s_is_published_as_given_and_integrated_exactly():
+    """speed=10.0 rad/s: published as 10.0, and the position is 10 t / (2 pi) turns exactly."""
+    tb = CrankTimebase(0, 0.0, None, 0.0, 1000.0, speed=10.0)
+    assert tb.sample(7 * NS).speed == 10.0
+    assert tb.total_turns(7 * NS) == Fraction(70) / TWO_PI
+    tb.update(8 * NS, accel=1.0)            # the speed goes on as the same float
+    assert tb.sample(8 * NS).speed == 10.0
+
+
 def test_two_pi_constant():
     """The rational 2*pi agrees with the float one to the last bit."""
     assert float(TWO_PI) == 2 * math.pi

@@ -36,6 +36,8 @@ from collections.abc import Callable, Iterable, Sequence
 import struct
 from typing import Any
 
+from ..units import NS_PER_S
+
 __all__ = ['MAX_SLOTS', 'MessageTemplate', 'STAMP_MARKER', 'cdr_from_message', 'marker',
            'padding_from_message', 'stamp_from_cdr']
 
@@ -61,7 +63,6 @@ _PRIMITIVES = {
 _UINT32 = struct.Struct('<I')
 #: ``builtin_interfaces/Time`` (int32 sec, uint32 nanosec) in each byte order.
 _STAMP = {True: struct.Struct('<iI'), False: struct.Struct('>iI')}
-NS_PER_S = 1_000_000_000
 
 
 def stamp_from_cdr(data: bytes | bytearray | memoryview) -> int:

@@ -21,6 +21,8 @@ import statistics
 import threading
 import time
 
+from ..units import NS_PER_S
+
 __all__ = ['DEFAULT_MAX_LATENESS_MS', 'ERROR', 'OK', 'STALE', 'Status', 'TickStats', 'WARN',
            'Window', 'lateness_p99_ns', 'solver_status', 'timing_status']
 
@@ -30,8 +32,6 @@ OK, WARN, ERROR, STALE = 0, 1, 2, 3
 #: node's ``max_lateness_ms``: as far back as ``max_catch_up_s`` (0.1 s) still catches up, so
 #: by default only skipped instants (and clock jumps) warn.
 DEFAULT_MAX_LATENESS_MS = 100.0
-
-NS_PER_S = 1_000_000_000
 
 
 @dataclass(frozen=True)

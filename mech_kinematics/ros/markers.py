@@ -33,6 +33,7 @@ from typing import Any
 
 from ..geometry.diagrams import arrows_from_state, COLOURS, space_from_state, SpaceDiagram
 from ..linkage import Scene, State
+from ..units import NS_PER_S
 
 __all__ = [
     'DEFAULT_ACCELERATION_SCALE', 'DEFAULT_VELOCITY_SCALE', 'MAX_RATE_HZ', 'MarkerThrottle',
@@ -207,7 +208,7 @@ class MarkerThrottle:
         if not (math.isfinite(max_rate_hz) and max_rate_hz > 0.0):
             msg = f'Expected `max_rate_hz` > 0, got {max_rate_hz!r}'
             raise ValueError(msg)
-        self.interval_ns = round(1e9 / max_rate_hz)
+        self.interval_ns = round(NS_PER_S / max_rate_hz)
         self.slack_ns = slack_ns
         self._ticks = 0
         self._last_ns: int | None = None

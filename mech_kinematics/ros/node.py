@@ -8,15 +8,15 @@ The node is an adapter around the pure solver. It declares the parameters of
 tick thread, deactivate stops it, cleanup drops the scene); with
 ``managed: false`` (the default) it configures and activates itself at start.
 
-The tick thread wakes on absolute deadlines and publishes every instant of an
-exact grid (:mod:`~mech_kinematics.ros.schedule`): tick k is stamped
-``t0 + k * period`` in integer nanoseconds, and a late wake-up catches up the
-instants it missed (or, with ``late_ticks: skip``, only the latest). For each
-instant it takes the crank from the exact time base
-(:mod:`~mech_kinematics.ros.timebase`), solves, and publishes three messages
-rendered from pre-serialized templates (:mod:`~mech_kinematics.ros.messages`).
-Parameter changes are handed to the tick thread, which applies them at the
-next instant it has not published, so a published stamp is never rewritten.
+The tick thread reads the clock and asks the pure driver
+(:mod:`~mech_kinematics.ros.driver`) what to publish: every instant of an
+exact grid (tick k is stamped ``t0 + k * period`` in integer nanoseconds; a
+late wake-up catches up the instants it missed or, with ``late_ticks: skip``,
+only the latest), and the crank at each of them from its exact time base. For
+each instant it solves and publishes three messages rendered from
+pre-serialized templates (:mod:`~mech_kinematics.ros.messages`). Drive
+parameter changes are handed to the driver, which applies them at the next
+instant not published, so a published stamp is never rewritten.
 The executor serves the parameter and lifecycle services, ``/clock``, the
 1 Hz diagnostics (:mod:`~mech_kinematics.ros.diagnostics`) and, with
 ``markers: true``, the RViz markers (at most 30 a second, built in the
@@ -56,13 +56,15 @@ from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
 from visualization_msgs.msg import MarkerArray
 
 import mech_kinematics as mk
+from . import topics
 from .diagnostics import solver_status, Status, TickStats, timing_status
+from .driver import TickDriver
 from .markers import marker_array_from_state, marker_size_from_space, MarkerThrottle
 from .messages import TickMessages
 from .parameters import CATCH_UP, joint_refusal, PARAMETERS, ParameterSpec, refusal, spec
-from .schedule import period_ns_from_rate, TickGrid
-from .tf import static_tf_message, TF_STATIC_TOPIC, TF_TOPIC, TfMessages
-from .timebase import CrankTimebase
+from .schedule import period_ns_from_rate
+from .tf import static_tf_message, TfMessages
+from .timebase import CrankSample
 from ..geometry.assembly import assembly_summary
 from ..geometry.diagrams import space_from_state, strokes_from_scene
 from ..geometry.frames import angle_joints, frames_from_scene, origin_points
@@ -82,8 +84,6 @@ DEFAULT_MAX_CRANK_SPEED_RPM = 10_000.0
 LATE_NS = 1_000_000
 #: Longest single sleep of the tick thread, so that a stop is seen quickly.
 MAX_SLEEP_NS = 50_000_000
-#: A change of the system clock against the monotonic clock beyond this is a jump.
-CLOCK_JUMP_NS = 10_000_000
 #: Longest time another thread may hold the GIL before the tick thread gets it, s.
 SWITCH_INTERVAL_S = 0.0005
 #: How long the node looks for another node of its name before it starts publishing, s
@@ -91,6 +91,10 @@ SWITCH_INTERVAL_S = 0.0005
 DUPLICATE_CHECK_S = 2.5
 #: The drive parameters, applied by the tick thread at an instant it has not published.
 DRIVE = ('crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm')
+#: The crank's name in the driver, and what each drive parameter sets there.
+CRANK = 'crank'
+CRANK_KEYS = {'crank_speed_rpm': 'speed_rpm', 'crank_accel': 'accel',
+              'max_crank_speed_rpm': 'max_speed_rpm'}
 DOUBLES = frozenset(p.name for p in PARAMETERS if p.kind == 'double')
 READ_ONLY = frozenset(p.name for p in PARAMETERS if p.read_only)
 
@@ -187,13 +191,11 @@ class KinematicsNode(LifecycleNode):
         self._clock_event = threading.Event()
         self._thread: threading.Thread | None = None
         self._stats = TickStats(mk.NEAR_SINGULAR)
-        self._timebase: CrankTimebase | None = None
-        self._last_stamp: int | None = None
-        self._last_sim: bool | None = None
-        self._pending: dict[str, Any] = {}
-        self._pending_lock = threading.Lock()
         self._waiting_for_clock = False
-        self._rebase_from: int | None = None
+        # The clock as a pure driver, at the parameters' defaults until they are declared.
+        self._driver = TickDriver(period_ns_from_rate(spec('rate_hz').default),
+                                  round(spec('max_catch_up_s').default * NS_PER_S),
+                                  spec('late_ticks').default == CATCH_UP)
         self._state_publishers: list[Any] = []
         self._pub_markers: Any = None
         self._failure_guard = self.create_guard_condition(self._on_failure)
@@ -212,15 +214,15 @@ class KinematicsNode(LifecycleNode):
         self.add_post_set_parameters_callback(self._apply)
         self.managed = bool(self.get_parameter('managed').value)
         self.frame_id = self.get_parameter('frame_id').value
-        self._period_ns = period_ns_from_rate(self.get_parameter('rate_hz').value)
-        self._catch_up = self.get_parameter('late_ticks').value == CATCH_UP
-        self._max_behind_ns = round(self.get_parameter('max_catch_up_s').value * NS_PER_S)
+        self._driver.period_ns = period_ns_from_rate(self.get_parameter('rate_hz').value)
+        self._driver.max_behind_ns = round(self.get_parameter('max_catch_up_s').value * NS_PER_S)
+        self._driver.catch_up = self.get_parameter('late_ticks').value == CATCH_UP
         self._tf_period_ns = self._tf_period(self.get_parameter('tf_rate_hz').value)
         self._max_error = float(self.get_parameter('max_relative_error').value)
         self._tf: TfMessages | None = None
         self._next_tf = 0
         self._pub_diagnostics = self.create_publisher(
-            DiagnosticArray, 'diagnostics', 10, qos_overriding_options=_qos_options())
+            DiagnosticArray, topics.DIAGNOSTICS, 10, qos_overriding_options=_qos_options())
         self._diagnostics_timer = self.create_timer(
             1.0, self._publish_diagnostics, clock=Clock(clock_type=ClockType.STEADY_TIME))
         self._jump_handle = self.get_clock().create_jump_callback(
@@ -273,39 +275,29 @@ class KinematicsNode(LifecycleNode):
     def _apply(self, parameters: list[Parameter]) -> None:
         """Hand accepted values to the tick thread; it applies them at its next instant."""
         changes = {p.name: p.value for p in parameters if p.type_ != Parameter.Type.NOT_SET}
+        driver = self._driver
         if 'rate_hz' in changes:
-            self._period_ns = period_ns_from_rate(changes['rate_hz'])
+            driver.period_ns = period_ns_from_rate(changes['rate_hz'])
         if 'late_ticks' in changes:
-            self._catch_up = changes['late_ticks'] == CATCH_UP
+            driver.catch_up = changes['late_ticks'] == CATCH_UP
         if 'max_catch_up_s' in changes:
-            self._max_behind_ns = round(changes['max_catch_up_s'] * NS_PER_S)
+            driver.max_behind_ns = round(changes['max_catch_up_s'] * NS_PER_S)
         if 'tf_rate_hz' in changes:
             self._tf_period_ns = self._tf_period(changes['tf_rate_hz'])
         if 'max_relative_error' in changes:
             self._max_error = float(changes['max_relative_error'])
-        drive = {name: float(changes[name]) for name in DRIVE if name in changes}
-        if drive:
-            with self._pending_lock:
-                self._pending.update(drive)
+        drive = {CRANK_KEYS[name]: float(changes[name]) for name in DRIVE if name in changes}
+        if drive and CRANK in driver.drives:
+            driver.request(CRANK, **drive)
             if self._thread is None:
-                self._apply_pending(None)   # not ticking: from the current instant
+                self._apply_now()   # not ticking: from the current instant
         logged = ', '.join(f'{p.name}={p.value!r}' for p in parameters)
         if self.scene is not None:
             self.get_logger().info(f'parameters set: {logged}')
 
-    def _apply_pending(self, at_ns: int | None) -> None:
-        """Apply the pending drive changes from instant ``at_ns`` (None: the clock now)."""
-        with self._pending_lock:
-            drive, self._pending = self._pending, {}
-        if not drive or self._timebase is None:
-            return
-        if at_ns is None:
-            at_ns = self.get_clock().now().nanoseconds
-            if self._last_stamp is not None:
-                at_ns = max(at_ns, self._last_stamp + 1)
-        self._timebase.update(at_ns, speed_rpm=drive.get('crank_speed_rpm'),
-                              accel=drive.get('crank_accel'),
-                              max_speed_rpm=drive.get('max_crank_speed_rpm'))
+    def _apply_now(self) -> None:
+        """Apply the pending drive changes from the clock now (after the last instant)."""
+        self._driver.apply_now(self.get_clock().now().nanoseconds)
 
     # -- lifecycle ------------------------------------------------------------
 
@@ -330,18 +322,26 @@ class KinematicsNode(LifecycleNode):
         }
         unset = [Parameter(name, Parameter.Type.DOUBLE, float(value))
                  for name, value in defaults.items() if self._value(name) is None]
+        # The scene's own speed is driven in its own unit (rad/s), so that the node
+        # publishes what `solve` prints to the bit; the parameter shows it in rpm.
+        own_speed = self._value('crank_speed_rpm') is None \
+            and abs(scene_rpm) < DEFAULT_MAX_CRANK_SPEED_RPM
         if unset:
             result = self.set_parameters_atomically(unset)
             if not result.successful:
                 raise mk.SceneError(f'{scene.name}: {result.reason}')
+        speed = {'speed': scene.input.speed} if own_speed else \
+            {'speed_rpm': self._value('crank_speed_rpm')}
+        self._driver.add_drive(CRANK, angle=scene.input.angle, accel=self._value('crank_accel'),
+                               max_speed_rpm=self._value('max_crank_speed_rpm'), **speed)
         self._messages = TickMessages(scene.output_joints, scene.output_points, self.frame_id)
         self._pub_joint_states = self.create_publisher(
-            JointState, 'joint_states', _state_qos(), qos_overriding_options=_qos_options())
+            JointState, topics.JOINT_STATES, _state_qos(), qos_overriding_options=_qos_options())
         self._pub_joint_accel = self.create_publisher(
-            JointTrajectory, 'joint_accelerations', _state_qos(),
+            JointTrajectory, topics.JOINT_ACCELERATIONS, _state_qos(),
             qos_overriding_options=_qos_options())
         self._pub_point_accel = self.create_publisher(
-            MultiDOFJointTrajectory, 'point_accelerations', _state_qos(),
+            MultiDOFJointTrajectory, topics.POINT_ACCELERATIONS, _state_qos(),
             qos_overriding_options=_qos_options())
         self._state_publishers = [self._pub_joint_states, self._pub_joint_accel,
                                   self._pub_point_accel]
@@ -381,9 +381,9 @@ class KinematicsNode(LifecycleNode):
         prefix = self._value('tf_prefix') or self.frame_id
         self._tf = TfMessages(frames, self.frame_id, prefix)
         self._tf_frames = frames
-        self._pub_tf = self.create_publisher(TFMessage, TF_TOPIC, _tf_qos(False),
+        self._pub_tf = self.create_publisher(TFMessage, topics.TF, _tf_qos(False),
                                              qos_overriding_options=_qos_options())
-        self._pub_tf_static = self.create_publisher(TFMessage, TF_STATIC_TOPIC, _tf_qos(True),
+        self._pub_tf_static = self.create_publisher(TFMessage, topics.TF_STATIC, _tf_qos(True),
                                                     qos_overriding_options=_qos_options())
         self._state_publishers += [self._pub_tf, self._pub_tf_static]
         self._pub_tf_static.publish(static_tf_message(
@@ -401,8 +401,8 @@ class KinematicsNode(LifecycleNode):
         Transient local, depth 1: a late subscriber (RViz, the recorder) gets them.
         """
         latched = _tf_qos(True)
-        self._pub_description = self.create_publisher(String, 'robot_description', latched)
-        self._pub_scene = self.create_publisher(String, 'scene', latched)
+        self._pub_description = self.create_publisher(String, topics.ROBOT_DESCRIPTION, latched)
+        self._pub_scene = self.create_publisher(String, topics.SCENE, latched)
         self._state_publishers += [self._pub_description, self._pub_scene]
         self._pub_scene.publish(String(data=scene_text(self._value('scene'))))
         try:
@@ -466,7 +466,7 @@ class KinematicsNode(LifecycleNode):
         self._marker_lock = threading.Lock()
         self._marker_request: tuple[int, int, float, float, float] | None = None
         self._marker_guard = self.create_guard_condition(self._publish_markers)
-        self._pub_markers = self.create_publisher(MarkerArray, 'markers', 10,
+        self._pub_markers = self.create_publisher(MarkerArray, topics.MARKERS, 10,
                                                   qos_overriding_options=_qos_options())
 
     # -- the tick thread ------------------------------------------------------
@@ -474,6 +474,7 @@ class KinematicsNode(LifecycleNode):
     def start(self) -> None:
         """Start the tick thread."""
         self._stop.clear()
+        self._driver.resume()
         self._thread = threading.Thread(target=self._run, name='mech_kinematics_tick',
                                         daemon=True)
         self._thread.start()
@@ -485,7 +486,7 @@ class KinematicsNode(LifecycleNode):
         thread, self._thread = self._thread, None
         if thread is not None and thread is not threading.current_thread():
             thread.join(timeout=2.0)
-        self._apply_pending(None)
+        self._apply_now()
 
     def destroy_node(self) -> None:
         """Stop the tick thread, then destroy the node."""
@@ -513,28 +514,18 @@ class KinematicsNode(LifecycleNode):
         raise TickThreadError('the tick thread failed (see the log above)')
 
     def _loop(self) -> None:
-        clock = self.get_clock()
+        clock, driver = self.get_clock(), self._driver
         stop, stats = self._stop, self._stats
         monotonic_ns, time_ns, sleep = time.monotonic_ns, time.time_ns, time.sleep
-        grid: TickGrid | None = None
-        offset = 0          # system clock minus monotonic clock, ns
         while not stop.is_set():
             # The time source can only change with a clock jump (on_clock_change): ask
             # the clock then, not every loop (the property takes the clock's lock).
-            if self._last_sim is None or self._clock_event.is_set():
+            if driver.sim is None or self._clock_event.is_set():
                 sim = clock.ros_time_is_active
                 if not sim:
                     self._clock_event.clear()
             else:
-                sim = self._last_sim
-            if sim != self._last_sim:
-                if self._last_sim is not None and self._timebase is not None \
-                        and self._last_stamp is not None:
-                    # The time source changed and its epoch means nothing to the old
-                    # one: the crank goes on from where it was, at the next instant.
-                    self._rebase_from = self._last_stamp
-                self._last_sim = sim
-                grid = None
+                sim = driver.sim
             if sim:
                 # Instants follow the simulated clock: wake on every /clock update.
                 self._clock_event.wait(MAX_SLEEP_NS / NS_PER_S)
@@ -545,34 +536,26 @@ class KinematicsNode(LifecycleNode):
                 now = clock.now().nanoseconds
                 if stop.is_set():
                     break
-                if now <= 0:
+                wake = driver.step(now, sim=True)
+                if wake.waiting_for_clock:
                     self._wait_for_clock()
                     continue
                 self._waiting_for_clock = False
-                if grid is not None and now < grid.next_ns - grid.period_ns:
+                if wake.jump_ns is not None:
                     stats.clock_jump()      # the simulated clock went back
-                    grid = None
-                if grid is None:
-                    grid = TickGrid.aligned(now, self._period_ns)
-                grid.set_period(self._period_ns)
-                self._publish_due(grid, now, now)
+                self._publish(wake.instants, wake.skipped, now)
                 continue
             now = time_ns()
-            new_offset = now - monotonic_ns()
-            if grid is None or abs(new_offset - offset) > CLOCK_JUMP_NS:
-                if grid is not None:
-                    stats.clock_jump()
-                    self.get_logger().warning(
-                        f'the system clock jumped by {(new_offset - offset) / 1e9:+.3f} s: '
-                        'the tick grid starts again', throttle_duration_sec=1.0)
-                offset = new_offset
-                grid = TickGrid.aligned(now, self._period_ns)
-            grid.set_period(self._period_ns)
-            remaining = grid.next_ns - now
-            if remaining > 0:
-                sleep(min(remaining, MAX_SLEEP_NS) / NS_PER_S)
+            wake = driver.step(now, monotonic_ns=monotonic_ns())
+            if wake.jump_ns is not None:
+                stats.clock_jump()
+                self.get_logger().warning(
+                    f'the system clock jumped by {wake.jump_ns / NS_PER_S:+.3f} s: '
+                    'the tick grid starts again', throttle_duration_sec=1.0)
+            if wake.wait_ns > 0:
+                sleep(min(wake.wait_ns, MAX_SLEEP_NS) / NS_PER_S)
                 continue
-            self._publish_due(grid, now, monotonic_ns() + offset)
+            self._publish(wake.instants, wake.skipped, driver.woke_ns(monotonic_ns()))
 
     def _wait_for_clock(self) -> None:
         if not self._waiting_for_clock:
@@ -581,34 +564,19 @@ class KinematicsNode(LifecycleNode):
                 'use_sim_time is true and no /clock has been received: nothing is published '
                 'until one arrives')
 
-    def _publish_due(self, grid: TickGrid, now: int, woke: int) -> None:
-        """Publish every instant ``grid`` owes at ``now`` (``woke``: when this started)."""
-        due = grid.take(now, self._max_behind_ns, self._catch_up)
-        self._stats.skip(due.skipped)
-        late_ns = min(grid.period_ns // 2, LATE_NS)
-        for stamp in due.instants:
-            if self._timebase is None:
-                self._timebase = self._new_timebase(stamp)
-            if self._rebase_from is not None:
-                self._timebase = self._timebase.moved(self._rebase_from, stamp)
-                self._rebase_from = None
-            if self._pending:
-                self._apply_pending(stamp)
+    def _publish(self, instants: range, skipped: int, woke: int) -> None:
+        """Publish ``instants`` (``skipped`` were dropped; ``woke``: when this wake-up began)."""
+        self._stats.skip(skipped)
+        late_ns = min(self._driver.period_ns // 2, LATE_NS)
+        for stamp in instants:
+            [(turns, sample)] = self._driver.state_at(stamp)
             lateness = woke - stamp
-            self._tick(stamp, lateness, lateness > late_ns)
-            self._last_stamp = stamp
+            self._tick(stamp, lateness, lateness > late_ns, turns, sample)
 
-    def _new_timebase(self, t: int) -> CrankTimebase:
-        assert self.scene is not None
-        with self._pending_lock:
-            self._pending = {}      # the parameters hold them already
-        return CrankTimebase(t, self.scene.input.angle, self._value('crank_speed_rpm'),
-                             self._value('crank_accel'), self._value('max_crank_speed_rpm'))
-
-    def _tick(self, stamp: int, lateness: int, late: bool) -> None:
+    def _tick(self, stamp: int, lateness: int, late: bool, turns: int,
+              sample: CrankSample) -> None:
         # The crank as whole turns plus an angle in one turn: an intermittent drive
         # (a Geneva wheel) indexes by the turns, never formed as a float sum.
-        turns, sample = self._timebase.sample_turns(stamp)  # type: ignore[union-attr]
         angle, speed, accel = sample
         try:
             values, measure = self._solve(angle, speed, accel, self._max_error, turns)
@@ -635,7 +603,7 @@ class KinematicsNode(LifecycleNode):
             else:
                 self._next_tf = stamp + NS_PER_S    # off: look again in a second
         if self._pub_markers is not None and self._marker_throttle.due(
-                self._period_ns, time.monotonic_ns()):
+                self._driver.period_ns, time.monotonic_ns()):
             # Built in the executor's thread, so that this thread keeps its deadlines.
             with self._marker_lock:
                 self._marker_request = (sec, nanosec, angle, speed, accel)

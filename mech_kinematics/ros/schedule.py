@@ -9,16 +9,16 @@ taken yet: in *catch-up* mode all of them that lie within ``max_behind`` of
 ``now`` (older ones are skipped and counted), in *skip* mode only the latest.
 A rate change starts a new grid at the next instant not taken.
 
-Pure Python, no ROS: the node's tick thread owns one :class:`TickGrid`.
+Pure Python, no ROS: the driver (:mod:`~mech_kinematics.ros.driver`) owns one :class:`TickGrid`.
 """
 
 from __future__ import annotations
 
 from typing import NamedTuple
 
-__all__ = ['Due', 'TickGrid', 'period_ns_from_rate']
+from ..units import NS_PER_S
 
-NS_PER_S = 1_000_000_000
+__all__ = ['Due', 'TickGrid', 'period_ns_from_rate']
 
 
 def period_ns_from_rate(rate_hz: float) -> int:

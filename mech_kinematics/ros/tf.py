@@ -24,11 +24,9 @@ from typing import Any
 from .cdr import marker, MessageTemplate, STAMP_MARKER
 from ..geometry.frames import child_frame, FrameSpec, Pose
 
-__all__ = ['TF_STATIC_TOPIC', 'TF_TOPIC', 'TfMessages', 'child_frame', 'static_tf_message']
+__all__ = ['TfMessages', 'child_frame', 'static_tf_message']
 
 #: The absolute topics every TF broadcaster uses (namespaces do not apply).
-TF_TOPIC = '/tf'
-TF_STATIC_TOPIC = '/tf_static'
 
 
 def _transform(parent: str, child: str, stamp: Any, x: float, y: float, angle: float) -> Any:

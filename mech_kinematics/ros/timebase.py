@@ -10,7 +10,11 @@ from the exact position there, so the angle never jumps.
 
 Positions are kept in *turns* as exact rationals. Speeds given in rpm are
 exact rationals in turns/s already (``rpm / 60``); quantities given in
-radians are divided by a rational 2*pi good to 60 digits. Inside a segment the
+radians are divided by a rational 2*pi good to 60 digits. A speed is kept in
+the unit it was given: while it is held, the published float is the one its
+own unit gives (``rpm * pi / 30`` for rpm, as the scene reader computes it;
+the value itself for rad/s), so a scene's 10 rad/s is published as 10.0, not
+as the nearest float to the exact rational. Inside a segment the
 position in turns is ``(n0 + n1*tau + n2*tau**2) / den`` with integers
 ``n0, n1, n2, den`` and ``tau`` the integer nanoseconds since the segment
 start, so the wrap to one turn is an exact integer remainder and the only
@@ -38,10 +42,10 @@ from fractions import Fraction
 import math
 from typing import NamedTuple
 
+from ..units import NS_PER_S, rad_per_s_from_rpm
+
 __all__ = ['CrankSample', 'CrankTimebase', 'MAX_DENOMINATOR_BITS', 'POSITION_BITS', 'TWO_PI',
            'turns_from_radians']
-
-NS_PER_S = 1_000_000_000
 
 #: Rounded positions are multiples of ``2**-POSITION_BITS`` turn.
 POSITION_BITS = 256
@@ -87,15 +91,15 @@ class _Piece:
     __slots__ = ('den', 'n0', 'n1', 'n2', 'speed', 'speed_slope', 'accel')
 
     def __init__(self, c0: Fraction, c1: Fraction, c2: Fraction,
-                 w0: Fraction, a: Fraction) -> None:
+                 w0: Fraction, a: Fraction, w0_float: float | None = None) -> None:
         # turns(tau) = c0 + c1*tau + c2*tau**2 with tau in ns.
         den = math.lcm(c0.denominator, c1.denominator, c2.denominator)
         self.den = den
         self.n0 = c0.numerator * (den // c0.denominator)
         self.n1 = c1.numerator * (den // c1.denominator)
         self.n2 = c2.numerator * (den // c2.denominator)
-        # speed(tau) = w0 + a * tau / 1e9 in rad/s, as floats.
-        self.speed = _radians(w0)
+        # speed(tau) = w0 + a * tau / 1e9 in rad/s, as floats; w0 as given when it was.
+        self.speed = _radians(w0) if w0_float is None else w0_float
         self.speed_slope = _radians(a) / NS_PER_S
         self.accel = _radians(a)
 
@@ -115,11 +119,19 @@ class _Piece:
 class _Segment:
     """The drive from instant ``t0`` on: accelerate at ``a``, then hold at the bound."""
 
-    __slots__ = ('t0', 'turns0', 'w0', 'a', 'w_max', 't_hold', 'ramp', 'hold', 'prev', '_ceil')
+    __slots__ = ('t0', 'turns0', 'w0', 'a', 'w_max', 't_hold', 'ramp', 'hold', 'prev', '_ceil',
+                 'w_max_float')
 
     def __init__(self, t0: int, turns0: Fraction, w0: Fraction, a: Fraction,
-                 w_max: Fraction, prev: _Segment | None) -> None:
-        w0 = min(max(w0, -w_max), w_max)
+                 w_max: Fraction, prev: _Segment | None, w0_float: float | None = None,
+                 w_max_float: float | None = None) -> None:
+        # The floats (rad/s) of w0 and w_max in the units they were given, if known.
+        if w_max_float is None:
+            w_max_float = _radians(w_max)
+        if w0 > w_max or w0 < -w_max:
+            w0 = w_max if w0 > 0 else -w_max
+            w0_float = w_max_float if w0 > 0 else -w_max_float
+        self.w_max_float = w_max_float
         if turns0.denominator.bit_length() > MAX_DENOMINATOR_BITS:
             turns0 = _rounded(turns0)
         self.t0, self.turns0, self.w0, self.a, self.w_max = t0, turns0, w0, a, w_max
@@ -132,7 +144,7 @@ class _Segment:
         if a != 0:
             t_hold = (target - w0) / a * NS_PER_S
         self.t_hold = t_hold
-        self.ramp = _Piece(turns0, w0 * per_ns, a * per_ns * per_ns / 2, w0, a)
+        self.ramp = _Piece(turns0, w0 * per_ns, a * per_ns * per_ns / 2, w0, a, w0_float)
         if t_hold is None:
             self.hold = self.ramp
         else:
@@ -140,7 +152,8 @@ class _Segment:
             th = t_hold
             at_hold = turns0 + w0 * th * per_ns + a * (th * per_ns) ** 2 / 2
             c1 = target * per_ns
-            self.hold = _Piece(_rounded(at_hold - c1 * th), c1, zero, target, zero)
+            self.hold = _Piece(_rounded(at_hold - c1 * th), c1, zero, target, zero,
+                               w_max_float if a > 0 else -w_max_float)
         # First integer instant (ns) on the hold piece.
         self._ceil: int | None = None if t_hold is None else math.ceil(t_hold)
 
@@ -155,6 +168,19 @@ class _Segment:
             return self.w0 + self.a * Fraction(tau, NS_PER_S)
         return self.w_max if self.a > 0 else -self.w_max
 
+    def speed_float(self, tau: int) -> float | None:
+        """Return the float speed (rad/s) held at ``tau``, or None while it changes."""
+        piece = self.piece(tau)
+        return piece.speed if piece.speed_slope == 0.0 and piece.accel == 0.0 else None
+
+
+def _speed_given(speed_rpm: float | None, speed: float | None) -> tuple[Fraction, float]:
+    """Return a speed given in rpm or in rad/s as (exact turns/s, float rad/s)."""
+    if speed is not None:
+        return turns_from_radians(speed), float(speed)
+    assert speed_rpm is not None
+    return Fraction(speed_rpm) / 60, float(rad_per_s_from_rpm(speed_rpm))
+
 
 class CrankTimebase:
     """Crank angle, speed and acceleration as exact functions of clock time.
@@ -165,14 +191,17 @@ class CrankTimebase:
         Clock instant of the start, ns. The crank is at ``angle`` there.
     angle : float
         Crank angle at ``t0``, rad.
-    speed_rpm : float
-        Crank speed at ``t0``, rpm, + CCW.
+    speed_rpm : float or None
+        Crank speed at ``t0``, rpm, + CCW (None: ``speed`` gives it).
     accel : float
         Crank angular acceleration, rad/s^2.
     max_speed_rpm : float
         Bound on the magnitude of the speed, rpm (>= 0). An accelerating drive
         holds its speed once it reaches ``+-max_speed_rpm``; a ``speed_rpm``
         beyond it is clamped.
+    speed : float, optional
+        Crank speed at ``t0`` in rad/s instead of ``speed_rpm`` (a scene's own
+        speed, kept in the unit the scene holds it in).
 
     Notes
     -----
@@ -183,19 +212,26 @@ class CrankTimebase:
     still the old drive.
     """
 
-    def __init__(self, t0: int, angle: float, speed_rpm: float, accel: float,
-                 max_speed_rpm: float) -> None:
-        for value, what in ((angle, 'angle'), (speed_rpm, 'speed_rpm'), (accel, 'accel'),
-                            (max_speed_rpm, 'max_speed_rpm')):
-            if not math.isfinite(value):
+    #: The keyword arguments :meth:`update` takes.
+    CHANGES = ('speed_rpm', 'speed', 'accel', 'max_speed_rpm')
+
+    def __init__(self, t0: int, angle: float, speed_rpm: float | None, accel: float,
+                 max_speed_rpm: float, *, speed: float | None = None) -> None:
+        if (speed_rpm is None) == (speed is None):
+            msg = f'Expected one of `speed_rpm` and `speed`, got {speed_rpm!r} and {speed!r}'
+            raise ValueError(msg)
+        for value, what in ((angle, 'angle'), (speed_rpm, 'speed_rpm'), (speed, 'speed'),
+                            (accel, 'accel'), (max_speed_rpm, 'max_speed_rpm')):
+            if value is not None and not math.isfinite(value):
                 msg = f'Expected `{what}` to be finite, got {value!r}'
                 raise ValueError(msg)
         if max_speed_rpm < 0:
             msg = f'Expected `max_speed_rpm` >= 0, got {max_speed_rpm!r}'
             raise ValueError(msg)
-        self._segment = _Segment(int(t0), turns_from_radians(angle),
-                                 Fraction(speed_rpm) / 60, turns_from_radians(accel),
-                                 Fraction(max_speed_rpm) / 60, None)
+        w0, w0_float = _speed_given(speed_rpm, speed)
+        w_max, w_max_float = _speed_given(max_speed_rpm, None)
+        self._segment = _Segment(int(t0), turns_from_radians(angle), w0,
+                                 turns_from_radians(accel), w_max, None, w0_float, w_max_float)
 
     def _at(self, t: int) -> tuple[_Segment, int]:
         seg = self._segment
@@ -252,31 +288,37 @@ class CrankTimebase:
         """The speed bound, rpm."""
         return float(self._segment.w_max * 60)
 
-    def _restart(self, t: int, w0: Fraction | None, a: Fraction | None,
-                 w_max: Fraction | None) -> None:
+    def _restart(self, t: int, w0: tuple[Fraction, float] | None, a: Fraction | None,
+                 w_max: tuple[Fraction, float] | None) -> None:
         t = int(t)
         old = self._segment
         seg, tau = self._at(t)
         turns0 = seg.piece(tau).turns(tau)
-        speed = seg.speed(tau)
+        if w0 is None:      # go on at the speed there, as the float it was published as
+            w0 = seg.speed(tau), seg.speed_float(tau)
         # Keep one level of history, without touching the segment that a
         # concurrent sample() may be reading.
         before = copy.copy(old)
         before.prev = None
-        self._segment = _Segment(
-            t, turns0, speed if w0 is None else w0, old.a if a is None else a,
-            old.w_max if w_max is None else w_max, before)
+        if w_max is None:
+            w_max = old.w_max, old.w_max_float
+        self._segment = _Segment(t, turns0, w0[0], old.a if a is None else a, w_max[0], before,
+                                 w0[1], w_max[1])
 
     def update(self, t: int, speed_rpm: float | None = None, accel: float | None = None,
-               max_speed_rpm: float | None = None) -> None:
+               max_speed_rpm: float | None = None, *, speed: float | None = None) -> None:
         """From instant ``t`` (ns) on, drive with the given values; ``None`` keeps one.
 
         The position at ``t`` is kept exactly. ``speed_rpm`` is the speed at
         ``t`` (without it the drive goes on from its speed there); ``accel``
         (rad/s^2) applies from ``t``; ``max_speed_rpm`` bounds the speed from
-        ``t`` on, clamping it at once if it is faster.
+        ``t`` on, clamping it at once if it is faster. ``speed`` gives the speed
+        in rad/s instead of ``speed_rpm``.
         """
-        for value, what in ((speed_rpm, 'speed_rpm'), (accel, 'accel'),
+        if speed_rpm is not None and speed is not None:
+            msg = f'Expected one of `speed_rpm` and `speed`, got {speed_rpm!r} and {speed!r}'
+            raise ValueError(msg)
+        for value, what in ((speed_rpm, 'speed_rpm'), (speed, 'speed'), (accel, 'accel'),
                             (max_speed_rpm, 'max_speed_rpm')):
             if value is not None and not math.isfinite(value):
                 msg = f'Expected `{what}` to be finite, got {value!r}'
@@ -284,9 +326,9 @@ class CrankTimebase:
         if max_speed_rpm is not None and max_speed_rpm < 0:
             msg = f'Expected `max_speed_rpm` >= 0, got {max_speed_rpm!r}'
             raise ValueError(msg)
-        self._restart(t, None if speed_rpm is None else Fraction(speed_rpm) / 60,
-                      None if accel is None else turns_from_radians(accel),
-                      None if max_speed_rpm is None else Fraction(max_speed_rpm) / 60)
+        given = None if speed_rpm is None and speed is None else _speed_given(speed_rpm, speed)
+        self._restart(t, given, None if accel is None else turns_from_radians(accel),
+                      None if max_speed_rpm is None else _speed_given(max_speed_rpm, None))
 
     def moved(self, t_from: int, t_to: int) -> CrankTimebase:
         """Return a copy whose drive at ``t_to`` continues this one's at ``t_from``.
@@ -297,5 +339,6 @@ class CrankTimebase:
         seg, tau = self._at(int(t_from))
         copy = object.__new__(CrankTimebase)
         copy._segment = _Segment(int(t_to), seg.piece(tau).turns(tau), seg.speed(tau),
-                                 self._segment.a, self._segment.w_max, None)
+                                 self._segment.a, self._segment.w_max, None,
+                                 seg.speed_float(tau), self._segment.w_max_float)
         return copy

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from ..cli import positive_int, run_tool
+from .cli import positive_int, run_tool
 from ..linkage import solve
 from ..scene import load_scene, scene_names
 

@@ -16,7 +16,7 @@ import json
 import sys
 from typing import Any
 
-from ..cli import run_tool
+from .cli import run_tool
 
 __all__ = ['add_parser', 'main', 'report_text', 'report_json']
 

@@ -22,7 +22,7 @@ import warnings
 import numpy as np
 import numpy.typing as npt
 
-from ..cli import finite_float, positive_int, run_tool
+from .cli import finite_float, positive_int, run_tool
 from ..errors import AssemblyError, NearSingularWarning, SceneError
 from ..geometry.diagrams import (arrows_from_state, colours_from_scene, Diagram,
                                  diagram_from_scene, fmt_sense, fmt_value, nice_scale, POLE,

@@ -25,6 +25,7 @@ from rclpy.node import Node
 from rclpy.qos import qos_profile_sensor_data
 from sensor_msgs.msg import JointState
 
+from ..ros import topics
 from ..units import rpm_from_rad_per_s
 
 __all__ = ['GOLDEN_FRACTION', 'Interval', 'JointSummary', 'LiveView']
@@ -92,9 +93,9 @@ class LiveView(Node):
         super().__init__('mech_kinematics_live')
         self._interval = Interval()
         self._lines = 0
-        self.create_subscription(JointState, 'joint_states', self._on_state,
+        self.create_subscription(JointState, topics.JOINT_STATES, self._on_state,
                                  qos_profile_sensor_data)
-        self.create_subscription(DiagnosticArray, 'diagnostics', self._on_diagnostics, 10)
+        self.create_subscription(DiagnosticArray, topics.DIAGNOSTICS, self._on_diagnostics, 10)
 
     def _on_state(self, msg: JointState) -> None:
         stamp = msg.header.stamp

@@ -32,10 +32,11 @@ import warnings
 import numpy as np
 import numpy.typing as npt
 
-from ..cli import finite_float, run_tool
+from .cli import finite_float, run_tool
 from ..errors import MechKinematicsError
+from ..ros import topics
 from ..ros.cdr import stamp_from_cdr
-from ..units import rad_per_s_from_rpm, rpm_from_rad_per_s
+from ..units import NS_PER_S, rad_per_s_from_rpm, rpm_from_rad_per_s
 
 __all__ = [
     'DEFAULT_MAX_SAMPLES', 'DEFAULT_SAMPLES', 'Motion', 'PlotError', 'add_parser',
@@ -75,15 +76,12 @@ YLABELS = {
 }
 XLABELS = {'time': 'time [s]', 'angle': 'crank angle θ [rad]', 'path': 'x [m]'}
 #: The node's topics, by message type.
-_JOINT_STATE = 'sensor_msgs/msg/JointState'
-_JOINT_TRAJECTORY = 'trajectory_msgs/msg/JointTrajectory'
-_POINT_TRAJECTORY = 'trajectory_msgs/msg/MultiDOFJointTrajectory'
-_DIAGNOSTICS = 'diagnostic_msgs/msg/DiagnosticArray'
-_SCENE = 'std_msgs/msg/String'      # the scene file's text, latched on `scene` (issue 20)
-_TOPICS = {_JOINT_STATE: 'joint_states', _JOINT_TRAJECTORY: 'joint_accelerations',
-           _POINT_TRAJECTORY: 'point_accelerations', _DIAGNOSTICS: 'diagnostics',
-           _SCENE: 'scene'}
-NS_PER_S = 1_000_000_000
+_JOINT_STATE = topics.TYPES[topics.JOINT_STATES]
+_JOINT_TRAJECTORY = topics.TYPES[topics.JOINT_ACCELERATIONS]
+_POINT_TRAJECTORY = topics.TYPES[topics.POINT_ACCELERATIONS]
+_DIAGNOSTICS = topics.TYPES[topics.DIAGNOSTICS]
+_SCENE = topics.TYPES[topics.SCENE]  # the scene file's text, latched on `scene` (issue 20)
+_TOPICS = {topics.TYPES[t]: t for t in (*topics.STATE_TOPICS, topics.DIAGNOSTICS, topics.SCENE)}
 
 
 class PlotError(MechKinematicsError):

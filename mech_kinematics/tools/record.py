@@ -3,7 +3,7 @@
 """Record topics to a rosbag2 bag with no ROS install: ``python -m mech_kinematics record``.
 
 The recorder subscribes with *raw* subscriptions (the serialized CDR bytes,
-never decoded) and hands the bytes to :class:`~.bag.BagWriter`, the way
+never decoded) and hands the bytes to :class:`~mech_kinematics.bag.BagWriter`, the way
 ``ros2 bag record`` hands them to rosbag2. What real ROS tools need to open
 the bag comes from the ROS graph and the installed interface files, as
 rosbag2 does it:
@@ -22,7 +22,7 @@ the subscriptions are destroyed and the bag is closed: every message received
 is in it.
 
 Nothing is lost if the recorder itself dies: messages reach the storage file
-at least every :data:`~.bag.FLUSH_INTERVAL_S` (an MCAP chunk closed and synced,
+at least every :data:`~mech_kinematics.bag.FLUSH_INTERVAL_S` (an MCAP chunk closed and synced,
 an sqlite3 transaction committed), and ``python -m mech_kinematics reindex``
 rebuilds ``metadata.yaml`` after ``kill -9``. A write error (a full disk) stops
 the recording: the bag is closed with what it holds, its metadata counting
@@ -53,29 +53,32 @@ import threading
 import time
 from typing import Any
 
-from ..cli import run_tool
+from .cli import positive_seconds, run_tool, seconds_or_zero
+from .. import bag
 from ..errors import MechKinematicsError
+from ..ros import topics
+from ..units import NS_PER_S
 
 __all__ = [
     'BAG_VERSIONS', 'BagRecorder', 'DEFAULT_BAG_VERSION', 'DEFAULT_EXECUTOR',
     'DEFAULT_PROGRESS_S', 'DEFAULT_STORAGE', 'DEFAULT_TOPICS', 'EXECUTORS', 'RecorderError',
-    'STORAGES', 'TopicStats', 'WAIT_REPORT_INTERVAL_S', 'add_parser', 'check_new_output', 'main',
+    'STORAGES', 'TopicStats', 'WAIT_REPORT_INTERVAL_S', 'add_parser', 'main',
     'message_definition', 'record', '_handle',
 ]
 
 #: Everything the node publishes, so that a bag replays whole (issue 20): its state,
 #: frames, diagnostics, markers (when on), URDF and scene. Relative names take the
 #: recorder's namespace; /tf and /tf_static are absolute, as every TF broadcaster's.
-DEFAULT_TOPICS = ('joint_states', 'joint_accelerations', 'point_accelerations', 'diagnostics',
-                  '/tf', '/tf_static', 'markers', 'robot_description', 'scene')
+DEFAULT_TOPICS = (*topics.STATE_TOPICS, topics.DIAGNOSTICS, topics.TF, topics.TF_STATIC,
+                  topics.MARKERS, topics.ROBOT_DESCRIPTION, topics.SCENE)
 #: Default topics the node publishes only with a parameter on: their absence is no fault.
-OPTIONAL_TOPICS = {'markers': 'the node publishes it with markers:=true'}
-STORAGES = ('mcap', 'sqlite3')
+OPTIONAL_TOPICS = {topics.MARKERS: 'the node publishes it with markers:=true'}
+#: The bag writer's storages and versions (it checks them).
+STORAGES = tuple(bag.STORAGES)
 #: As ``ros2 bag record`` since Iron.
 DEFAULT_STORAGE = 'mcap'
-BAG_VERSIONS = (8, 9)
-#: Version 9 metadata is not readable by Humble (rosbag2#1895).
-DEFAULT_BAG_VERSION = 8
+BAG_VERSIONS = bag.BAG_VERSIONS
+DEFAULT_BAG_VERSION = bag.DEFAULT_VERSION
 NODE_NAME = 'mech_kinematics_recorder'
 #: How often the graph is searched for topics not subscribed yet, and pending messages
 #: are checked for a flush, s (rosbag2 searches every 100 ms).
@@ -229,7 +232,7 @@ def _qos_from_profile(profile: Any) -> Any:
 
     def duration(value: Any) -> QosTime:
         # RMW_DURATION_INFINITE is {9223372036 s, 854775807 ns}, as rosbag2 writes it.
-        return QosTime(*divmod(int(value.nanoseconds), 1_000_000_000))
+        return QosTime(*divmod(int(value.nanoseconds), NS_PER_S))
 
     return Qos(QosHistory(int(profile.history)), int(profile.depth),
                QosReliability(int(profile.reliability)), QosDurability(int(profile.durability)),
@@ -344,13 +347,11 @@ class BagRecorder:
                  args: list[str] | None = None, executor: str = DEFAULT_EXECUTOR,
                  progress: float = DEFAULT_PROGRESS_S) -> None:
         self.output = Path(output)
-        check_new_output(self.output)
-        if storage not in STORAGES:
-            msg = f'Expected storage to be one of {", ".join(STORAGES)}, got {storage!r}'
-            raise RecorderError(msg)
-        if version not in BAG_VERSIONS:
-            msg = f'Expected bag version to be one of {BAG_VERSIONS}, got {version!r}'
-            raise RecorderError(msg)
+        try:
+            bag.check_new_bag(self.output)      # before ROS starts
+            bag.check_options(storage, version)
+        except bag.BagError as error:
+            raise RecorderError(str(error)) from None
         if not topics:
             msg = 'Expected at least one topic to record, got none'
             raise RecorderError(msg)
@@ -389,7 +390,7 @@ class BagRecorder:
         import rclpy
         from rclpy.signals import SignalHandlerOptions
 
-        from .bag import BagError, BagWriter
+        from ..bag import BagError, BagWriter
 
         self._context = rclpy.Context()
         # The recorder handles SIGINT and SIGTERM itself (a flag, see run()), so that a
@@ -462,7 +463,7 @@ class BagRecorder:
         list of TopicStats
             Per requested topic: type, messages received and written.
         """
-        from .bag import BagError
+        from ..bag import BagError
 
         if self.recording_since is not None:
             self.recorded_seconds = time.monotonic() - self.recording_since
@@ -513,7 +514,7 @@ class BagRecorder:
 
     def _housekeeping(self) -> None:
         """Poll the graph, flush the bag if due, and log waiting or progress lines."""
-        from .bag import BagError
+        from ..bag import BagError
 
         if self._writer is None:
             return
@@ -574,7 +575,7 @@ class BagRecorder:
 
     def _discover(self) -> None:
         """Subscribe to every requested topic that has publishers now (polled)."""
-        from .bag import BagError
+        from ..bag import BagError
 
         pending = [t for t in self._topics.values() if t.subscription is None and not t.failed]
         if not pending or self._writer is None:
@@ -624,7 +625,7 @@ class BagRecorder:
         self._node.get_logger().info(f'subscribed to {name} ({type_name})')
 
     def _callback(self, topic: _Topic) -> Callable[[bytes], None]:
-        from .bag import BagError
+        from ..bag import BagError
 
         write = self._writer.write
         bag_topic = topic.bag_topic
@@ -641,15 +642,6 @@ class BagRecorder:
                 stop()      # the writer keeps the reason; close() reports it
 
         return on_message
-
-
-def check_new_output(path: Path) -> None:
-    """Raise :class:`RecorderError` unless ``path`` does not exist yet (never overwrite)."""
-    if path.exists() or path.is_symlink():
-        kind = 'directory' if path.is_dir() else 'file'
-        msg = (f'Expected a new bag directory, got "{path}", an existing {kind} '
-               f'(refusing to overwrite it; choose another name or remove it)')
-        raise RecorderError(msg)
 
 
 # -- command line ----------------------------------------------------------------
@@ -693,28 +685,6 @@ def record(output: str | os.PathLike[str], topics: Sequence[str] = DEFAULT_TOPIC
         for sig, handler in previous.items():
             signal.signal(sig, handler)
     return recorder
-
-
-def _positive_seconds(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not (math.isfinite(value) and value > 0):
-        msg = f'expected a positive number of seconds, got {text!r}'
-        raise argparse.ArgumentTypeError(msg)
-    return value
-
-
-def _seconds_or_zero(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not (math.isfinite(value) and value >= 0):
-        msg = f'expected a number of seconds >= 0, got {text!r}'
-        raise argparse.ArgumentTypeError(msg)
-    return value
 
 
 def _print_summary(recorder: BagRecorder) -> None:
@@ -798,7 +768,7 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--topics', nargs='+', default=list(DEFAULT_TOPICS), metavar='T',
                         help="topics to record; relative names take the recorder's namespace "
                              f'(default: {" ".join(DEFAULT_TOPICS)})')
-    parser.add_argument('--duration', type=_positive_seconds, metavar='S',
+    parser.add_argument('--duration', type=positive_seconds, metavar='S',
                         help='stop S seconds after the first topic is subscribed '
                              '(default: at Ctrl-C or SIGTERM)')
     parser.add_argument('--storage', choices=STORAGES, default=DEFAULT_STORAGE,
@@ -807,7 +777,7 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         default=DEFAULT_BAG_VERSION,
                         help='rosbag2 format version; 9 is not readable by Humble '
                              '(default: %(default)s)')
-    parser.add_argument('--progress', type=_seconds_or_zero, default=DEFAULT_PROGRESS_S,
+    parser.add_argument('--progress', type=seconds_or_zero, default=DEFAULT_PROGRESS_S,
                         metavar='S', help='log the messages per topic and per second every S '
                                           'seconds while recording; 0: never '
                                           '(default: %(default)s)')

@@ -7,7 +7,7 @@ rosbags and rosbag2: one ``.mcap`` or ``.db3`` file). After the recorder was
 killed, its bag has no ``metadata.yaml`` and rosbags and ``ros2 bag`` refuse
 it; this makes it readable, with every message that reached the file (all
 but the last half second of the recording), by
-:func:`mech_kinematics.tools.bag.reindex`:
+:func:`mech_kinematics.bag.reindex`:
 
 - MCAP: the file is scanned; everything after the last intact chunk (a chunk
   cut short, damaged, or an old summary) is truncated, the message indexes of
@@ -28,7 +28,7 @@ from collections.abc import Sequence
 import sys
 from typing import Any
 
-from ..cli import run_tool
+from .cli import run_tool
 
 __all__ = ['add_parser', 'main', '_handle']
 
@@ -59,7 +59,7 @@ def _print_result(info: Any) -> None:
 
 def _handle(args: argparse.Namespace) -> int:
     """Handle ``reindex``: rebuild the metadata, print what the bag holds; return the status."""
-    from .bag import BagError, reindex
+    from ..bag import BagError, reindex
 
     try:
         info = reindex(args.bag, version=args.bag_version)

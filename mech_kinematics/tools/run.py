@@ -22,7 +22,7 @@ import subprocess
 import sys
 from typing import Any
 
-from ..cli import run_tool
+from .cli import run_tool
 
 __all__ = ['add_parser', 'main']
 

@@ -11,8 +11,8 @@ import math
 import sys
 from typing import Any
 
+from .cli import finite_float, positive_float, run_tool
 from ..bounds import MAX_ERROR
-from ..cli import finite_float, run_tool
 from ..errors import AssemblyError, SceneError, UntrustedError
 from ..linkage import assembly_text, solve
 from ..scene import load_scene
@@ -36,19 +36,6 @@ solved, or whose answer cannot be trusted (a value's error bound above
 limit, a value beyond the range of doubles), it prints a one-line error and
 exits with status 2.
 """
-
-
-def _max_error(text: str) -> float:
-    """Parse a positive tolerance (``inf`` allowed), or tell argparse why not."""
-    try:
-        value = float(text)
-    except ValueError:
-        msg = f'expected a positive number, got {text!r}'
-        raise argparse.ArgumentTypeError(msg) from None
-    if not value > 0.0:
-        msg = f'expected a positive number, got {text!r}'
-        raise argparse.ArgumentTypeError(msg)
-    return value
 
 
 def turns_from_degrees(degrees: float) -> tuple[float, int]:
@@ -112,7 +99,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     parser.add_argument('--accel', type=finite_float, metavar='A',
                         help='crank angular acceleration in rad/s^2, + CCW (default: the '
                              "scene's)")
-    parser.add_argument('--max-error', type=_max_error, default=MAX_ERROR, metavar='REL',
+    parser.add_argument('--max-error', type=positive_float, default=MAX_ERROR, metavar='REL',
                         help="refuse (exit 2) where a value's error bound exceeds REL times "
                              "its kind's scale (the mechanism's size, its largest speed, its "
                              f'largest acceleration, ...; default {MAX_ERROR:g}; inf accepts '

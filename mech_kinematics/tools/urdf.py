@@ -17,7 +17,7 @@ from pathlib import Path
 import sys
 from typing import Any
 
-from ..cli import run_tool
+from .cli import run_tool
 
 __all__ = ['add_parser', 'main']
 

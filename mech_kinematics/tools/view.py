@@ -35,7 +35,8 @@ from typing import Any
 from urllib.parse import parse_qs, urlparse
 import warnings
 
-from ..cli import run_tool
+from .cli import run_tool
+from ..ros import topics
 
 __all__ = ['DEFAULT_PORT', 'PAGE', 'ViewServer', 'add_parser', 'frame_from_state', 'main',
            'scene_bounds']
@@ -145,12 +146,12 @@ class ViewServer:
         self.latest = _Latest()
         latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                              durability=DurabilityPolicy.TRANSIENT_LOCAL)
-        node.create_subscription(String, 'scene', self._on_scene, latched)
-        node.create_subscription(JointState, 'joint_states', self._on_joints,
+        node.create_subscription(String, topics.SCENE, self._on_scene, latched)
+        node.create_subscription(JointState, topics.JOINT_STATES, self._on_joints,
                                  qos_profile_sensor_data)
-        node.create_subscription(MultiDOFJointTrajectory, 'point_accelerations',
+        node.create_subscription(MultiDOFJointTrajectory, topics.POINT_ACCELERATIONS,
                                  self._on_points, qos_profile_sensor_data)
-        node.create_subscription(DiagnosticArray, 'diagnostics', self._on_diagnostics, 10)
+        node.create_subscription(DiagnosticArray, topics.DIAGNOSTICS, self._on_diagnostics, 10)
         # The node's name is mech_kinematics in this node's namespace.
         namespace = node.get_namespace().rstrip('/')
         self._set_parameters = node.create_client(

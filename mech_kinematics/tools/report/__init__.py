@@ -56,7 +56,7 @@ from .extreme import (AngleResult, BOUND_FACTOR, Case, CaseResult, digits_lost, 
 from .figures import (plot_bounds, plot_clock, plot_cost, plot_extreme, plot_refused,
                       plot_work_precision)
 from .markdown import write_report
-from ...cli import run_tool
+from ..cli import run_tool
 
 __all__ = [
     'AngleResult', 'BOUND_FACTOR', 'BoundCase', 'BoundStats', 'BoundValue', 'CHUNK', 'CLOCK_TICKS',

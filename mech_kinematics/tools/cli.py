@@ -30,9 +30,10 @@ import sys
 import traceback
 from typing import Any
 
-from .errors import MechKinematicsError
+from ..errors import MechKinematicsError
 
-__all__ = ['ArgumentParser', 'PROG', 'finite_float', 'positive_int', 'run_handler', 'run_tool']
+__all__ = ['ArgumentParser', 'PROG', 'finite_float', 'positive_float', 'positive_int',
+           'positive_seconds', 'run_handler', 'run_tool', 'seconds_or_zero']
 
 #: The program name shown in usage lines.
 PROG = 'python -m mech_kinematics'
@@ -68,6 +69,35 @@ def finite_float(text: str) -> float:
         msg = f'expected a finite number, got {text!r}'
         raise argparse.ArgumentTypeError(msg)
     return value
+
+
+def _number(text: str, ok: Callable[[float], bool], expected: str) -> float:
+    """Parse a number that ``ok`` accepts, or tell argparse ``expected ..., got TEXT``."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not ok(value):
+        msg = f'expected {expected}, got {text!r}'
+        raise argparse.ArgumentTypeError(msg)
+    return value
+
+
+def positive_float(text: str) -> float:
+    """Parse a number above 0 (``inf`` allowed: no bound), or tell argparse why not."""
+    return _number(text, lambda value: value > 0.0, 'a positive number')
+
+
+def positive_seconds(text: str) -> float:
+    """Parse a finite number of seconds above 0, or tell argparse why not."""
+    return _number(text, lambda value: math.isfinite(value) and value > 0.0,
+                   'a positive number of seconds')
+
+
+def seconds_or_zero(text: str) -> float:
+    """Parse a finite number of seconds, 0 or more, or tell argparse why not."""
+    return _number(text, lambda value: math.isfinite(value) and value >= 0.0,
+                   'a number of seconds >= 0')
 
 
 def positive_int(text: str) -> int:

@@ -38,7 +38,7 @@ from .storage_mcap import McapStorage, RecoveredMcap
 from .storage_sqlite3 import RecoveredSqlite3, Sqlite3Storage
 
 __all__ = ['BagWriter', 'DEFAULT_VERSION', 'FLUSH_BYTES', 'FLUSH_INTERVAL_S', 'RESERVE_BYTES',
-           'RESERVE_FILE', 'STORAGES', 'reindex']
+           'RESERVE_FILE', 'STORAGES', 'check_new_bag', 'check_options', 'reindex']
 
 #: rosbag2 storage identifiers, and the suffix of their files.
 STORAGES = {'mcap': '.mcap', 'sqlite3': '.db3'}
@@ -61,6 +61,25 @@ def _reason(error: BaseException) -> str:
     if isinstance(error, OSError) and error.strerror:
         return error.strerror
     return str(error) or type(error).__name__
+
+
+def check_options(storage: str, version: int) -> None:
+    """Raise :class:`BagError` unless ``storage`` and ``version`` are ones a bag can have."""
+    if storage not in STORAGES:
+        msg = f'Expected storage to be one of {", ".join(STORAGES)}, got {storage!r}'
+        raise BagError(msg)
+    if version not in BAG_VERSIONS:
+        msg = f'Expected bag version to be one of {BAG_VERSIONS}, got {version!r}'
+        raise BagError(msg)
+
+
+def check_new_bag(path: Path) -> None:
+    """Raise :class:`BagError` unless ``path`` does not exist yet (a bag never overwrites)."""
+    if path.exists() or path.is_symlink():
+        kind = 'directory' if path.is_dir() else 'file'
+        msg = (f'Expected a new bag directory, got "{path}", an existing {kind} '
+               f'(refusing to overwrite it; choose another name or remove it)')
+        raise BagError(msg)
 
 
 class BagWriter:
@@ -95,12 +114,7 @@ class BagWriter:
     def __init__(self, path: str | Path, *, storage: str = 'mcap',
                  version: int = DEFAULT_VERSION, flush_interval: float = FLUSH_INTERVAL_S,
                  flush_bytes: int = FLUSH_BYTES) -> None:
-        if storage not in STORAGES:
-            msg = f'Expected storage to be one of {", ".join(STORAGES)}, got {storage!r}'
-            raise BagError(msg)
-        if version not in BAG_VERSIONS:
-            msg = f'Expected bag version to be one of {BAG_VERSIONS}, got {version!r}'
-            raise BagError(msg)
+        check_options(storage, version)
         self.path = Path(path)
         self.storage = storage
         self.version = version
@@ -114,6 +128,7 @@ class BagWriter:
 
     def open(self) -> None:
         """Create the directory and the storage file (a valid, empty bag file at once)."""
+        check_new_bag(self.path)
         try:
             self.path.mkdir(mode=0o755, parents=True)
         except FileExistsError:

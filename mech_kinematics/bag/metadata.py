@@ -8,7 +8,7 @@ topic metadata (name, type, serialization format, offered QoS profiles, type
 hash) and the message definitions; ``metadata.yaml`` repeats that with the
 message counts and the time range. rosbags and ``ros2 bag`` refuse a bag
 without ``metadata.yaml``; both storages of this package hold everything needed
-to rebuild it (:func:`mech_kinematics.tools.bag.writer.reindex`).
+to rebuild it (:func:`mech_kinematics.bag.writer.reindex`).
 
 The offered QoS profiles are stored as YAML text in the format of the bag
 version: integers for the policies in version 8 (readable by Humble), names in
@@ -27,7 +27,7 @@ from typing import Any
 
 import yaml
 
-from ...errors import MechKinematicsError
+from ..errors import MechKinematicsError
 
 __all__ = [
     'BAG_VERSIONS', 'BagError', 'BagInfo', 'METADATA_FILE', 'Topic', 'bag_version_of_qos',

@@ -14,8 +14,9 @@ standard library and PyYAML are imported here; rosbags, for its QoS and
 type-hash helpers, inside the functions that use it.
 """
 
-from .metadata import BagError, BagInfo, Topic
-from .writer import BagWriter, DEFAULT_VERSION, FLUSH_INTERVAL_S, reindex, STORAGES
+from .metadata import BAG_VERSIONS, BagError, BagInfo, Topic
+from .writer import (BagWriter, check_new_bag, check_options, DEFAULT_VERSION, FLUSH_INTERVAL_S,
+                     reindex, STORAGES)
 
-__all__ = ['BagError', 'BagInfo', 'BagWriter', 'DEFAULT_VERSION', 'FLUSH_INTERVAL_S', 'STORAGES',
-           'Topic', 'reindex']
+__all__ = ['BAG_VERSIONS', 'BagError', 'BagInfo', 'BagWriter', 'DEFAULT_VERSION',
+           'FLUSH_INTERVAL_S', 'STORAGES', 'Topic', 'check_new_bag', 'check_options', 'reindex']
