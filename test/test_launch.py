@@ -20,6 +20,7 @@ import pytest
 import yaml
 
 import mech_kinematics as mk
+from mech_kinematics.ros import topics
 from mech_kinematics.ros.parameters import spec
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -233,10 +234,12 @@ def test_rviz_config_shows_the_nodes_frame_tf_and_markers():
     # topics (issue 20); nothing hard-codes /markers.
     assert markers['Topic']['Value'] == 'markers'
     source = NODE_SOURCE.read_text(encoding='utf-8')
-    assert "create_publisher(MarkerArray, 'markers'" in source
+    assert topics.MARKERS == 'markers'
+    assert 'create_publisher(MarkerArray, topics.MARKERS' in source
     model = displays['rviz_default_plugins/RobotModel']
     assert model['Enabled'] is True and model['Description Source'] == 'Topic'
     assert model['Description Topic']['Value'] == 'robot_description'
     assert model['Description Topic']['Durability Policy'] == 'Transient Local'
-    assert "create_publisher(String, 'robot_description'" in source
+    assert topics.ROBOT_DESCRIPTION == 'robot_description'
+    assert 'create_publisher(String, topics.ROBOT_DESCRIPTION' in source
     assert 'Value: /' not in RVIZ.read_text(encoding='utf-8')     # no absolute topic
