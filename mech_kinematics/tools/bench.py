@@ -2,10 +2,12 @@
 # SPDX-License-Identifier: Apache-2.0
 """Solver speed: ``python -m mech_kinematics bench`` (``make bench``).
 
-For every packaged scene it times one full single-angle solve (median) and
-the array path per configuration over many angles, beside hand-written closed
-forms of the same four-bar and slider-crank timed in the same run. The machine
-is shared and noisy, so what matters is the ratios of one run.
+For every packaged scene it times one full single-angle solve and the array
+path per configuration over many angles (min / median / max of repeated
+runs), beside hand-written closed forms of the same four-bar and
+slider-crank timed in the same run, and prints the ratios to them against
+issue 19's targets (:data:`SINGLE_TARGET`, :data:`ARRAY_TARGET`). The
+machine is shared and noisy, so what matters is the ratios of one run.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from __future__ import annotations
 import argparse
 from collections.abc import Callable, Sequence
 from functools import partial
+import json
 import math
 import statistics
 import time
@@ -119,12 +122,19 @@ def slider_crank_numpy(theta: Any, w: float, al: float) -> tuple[Any, ...]:
     return x, phi, v, wr, a, ar, bx, by, vbx, vby, abx, aby
 
 
-def _median_times(funcs: list[Callable[[], Any]], number: int,
-                  repeat: int) -> list[float]:
-    """Median time of one call of each function, the functions timed in turn.
+#: Issue 19's targets, bounds included: the array path per configuration over the
+#: hand-written NumPy closed form, the single angle over the hand-written scalar one.
+ARRAY_TARGET = 1.5
+SINGLE_TARGET = 8.0
 
-    Interleaving the repeats makes a load change on the shared machine hit
-    every function alike, so their ratios stay meaningful.
+
+def _spread_times(funcs: list[Callable[[], Any]], number: int,
+                  repeat: int) -> list[tuple[float, float, float]]:
+    """Min, median and max over ``repeat`` runs of the time of one call of each function.
+
+    The functions are timed in turn: interleaving the repeats makes a load
+    change on the shared machine hit every function alike, so their ratios
+    stay meaningful.
     """
     times: list[list[float]] = [[] for _ in funcs]
     for _ in range(repeat):
@@ -133,11 +143,17 @@ def _median_times(funcs: list[Callable[[], Any]], number: int,
             for _ in range(number):
                 func()
             samples.append((time.perf_counter() - start) / number)
-    return [statistics.median(samples) for samples in times]
+    return [(min(s), statistics.median(s), max(s)) for s in times]
 
 
 def measure(names: list[str], angles: int, repeat: int) -> list[dict[str, Any]]:
-    """Time every scene, and the hand-written baselines beside theirs; one row each."""
+    """Time every scene, and the hand-written baselines beside theirs; one row each.
+
+    Each row holds ``single_us`` and ``array_us`` (per configuration) as
+    ``[min, median, max]`` over ``repeat`` runs, microseconds; a row of a
+    scene with a hand-written form also holds the median ratios
+    ``single_ratio`` and ``array_ratio`` to it.
+    """
     sweep = np.linspace(0.0, 2.0 * math.pi, angles, endpoint=False)
     baselines = {
         FOUR_BAR: (four_bar_math, four_bar_numpy),
@@ -153,29 +169,57 @@ def measure(names: list[str], angles: int, repeat: int) -> list[dict[str, Any]]:
             scalar, vector = baselines[name]
             singles.append(partial(scalar, theta, w, al))
             arrays.append(partial(vector, sweep, w, al))
-        one = _median_times(singles, 1000, repeat)
-        many = [t / angles for t in _median_times(arrays, 3, repeat)]
-        rows.append({'scene': name, 'single_us': one[0] * 1e6, 'array_us': many[0] * 1e6})
+        one = [[t * 1e6 for t in spread] for spread in _spread_times(singles, 1000, repeat)]
+        many = [[t * 1e6 / angles for t in spread] for spread in _spread_times(arrays, 3, repeat)]
+        row: dict[str, Any] = {'scene': name, 'single_us': one[0], 'array_us': many[0]}
+        rows.append(row)
         if name in baselines:
-            rows.append({'scene': f'{name} (hand-written)', 'single_us': one[1] * 1e6,
-                         'array_us': many[1] * 1e6, 'baseline_of': name})
+            row['single_ratio'] = one[0][1] / one[1][1]
+            row['array_ratio'] = many[0][1] / many[1][1]
+            rows.append({'scene': f'{name} (hand-written)', 'single_us': one[1],
+                         'array_us': many[1], 'baseline_of': name})
     return rows
+
+
+def _ratio(row: dict[str, Any], key: str, target: float) -> str:
+    if key not in row:
+        return ''
+    verdict = 'ok' if row[key] <= target else 'over'
+    return f'{row[key]:.2f} {verdict}'
+
+
+def table(rows: list[dict[str, Any]], angles: int, repeat: int) -> list[str]:
+    """Return the lines ``make bench`` prints for the rows of :func:`measure`."""
+    lines = [f'min / median / max of {repeat} runs; array path over {angles} angles, per '
+             'configuration; position, velocity and acceleration of every output, bounds '
+             'included',
+             f'ratio: median over the hand-written closed form of the same scene (targets: '
+             f'single <= {SINGLE_TARGET:g}x, array <= {ARRAY_TARGET:g}x); "-": no '
+             'hand-written form of that scene',
+             f'{"scene":40s} {"single µs":>20s} {"ratio":>9s} {"array µs/cfg":>23s} '
+             f'{"ratio":>9s}']
+    for row in rows:
+        single = '/'.join(f'{t:.2f}' for t in row['single_us'])
+        array = '/'.join(f'{t:.3f}' for t in row['array_us'])
+        if 'baseline_of' in row:
+            ratio1 = ratio2 = '1'
+        elif 'single_ratio' in row:
+            ratio1 = _ratio(row, 'single_ratio', SINGLE_TARGET)
+            ratio2 = _ratio(row, 'array_ratio', ARRAY_TARGET)
+        else:
+            ratio1 = ratio2 = '-'
+        lines.append(f'{row["scene"]:40s} {single:>20s} {ratio1:>9s} {array:>23s} {ratio2:>9s}')
+    return lines
 
 
 def _handle(args: argparse.Namespace) -> int:
     """Print the table of ``measure`` with the ratios to the hand-written baselines."""
-    angles, repeat = args.angles, args.repeat
-    rows = measure(scene_names(), angles, repeat)
-    baseline = {row['baseline_of']: row for row in rows if 'baseline_of' in row}
-    print(f'median of {repeat} runs; array path over {angles} angles; position, velocity '
-          f'and acceleration of every output')
-    print(f'{"scene":44s} {"single µs":>10s} {"ratio":>6s} {"array µs/cfg":>13s} {"ratio":>6s}')
-    for row in rows:
-        ref = baseline.get(row['scene'])
-        ratio1 = f'{row["single_us"] / ref["single_us"]:6.2f}' if ref else ''
-        ratio2 = f'{row["array_us"] / ref["array_us"]:6.2f}' if ref else ''
-        print(f'{row["scene"]:44s} {row["single_us"]:10.2f} {ratio1:>6s} '
-              f'{row["array_us"]:13.4f} {ratio2:>6s}')
+    rows = measure(scene_names(), args.angles, args.repeat)
+    if args.json:
+        print(json.dumps({'angles': args.angles, 'repeat': args.repeat, 'rows': rows},
+                         indent=1))
+    else:
+        print('\n'.join(table(rows, args.angles, args.repeat)))
     return 0
 
 
@@ -188,7 +232,10 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
                     'slider-crank.')
     parser.add_argument('--angles', type=positive_int, default=100_000,
                         help='angles in the array path (default 1e5)')
-    parser.add_argument('--repeat', type=positive_int, default=7, help='repeats for medians')
+    parser.add_argument('--repeat', type=positive_int, default=7,
+                        help='runs for the min / median / max (default 7)')
+    parser.add_argument('--json', action='store_true',
+                        help='print the rows as JSON (times as [min, median, max] µs)')
     parser.set_defaults(handler=_handle)
     return parser
 
