@@ -117,7 +117,7 @@ def run(seconds: float, rate: float, scene_name: str, keep_s: float) -> dict[str
             for name, pos, vel in zip(names, msg.position, msg.velocity, strict=True):
                 joint = state.joints[name]
                 worst = max(worst, abs(_wrap(pos - joint.position)),
-                                 abs(vel - joint.velocity))
+                            abs(vel - joint.velocity))
             rows.append({'t_s': (s - s1) / NS, 'angle_error_rad': angle_error,
                          'state_error': worst})
     period = round(NS / rate)
