@@ -4,8 +4,9 @@
 
 :class:`Mode` and :data:`MODES` say how much a run does (``full``,
 ``--quick``, ``--smoke``); :data:`WP_SCENES` names the work-precision
-mechanisms; :func:`median_time` is the one timer and :func:`quiet_solve`
-the solver with its near-singularity warning silenced. :func:`four_bar`,
+mechanisms; :func:`spread_time` (min / median / max) and :func:`median_time`
+are the timers and :func:`quiet_solve` the solver with its near-singularity
+warning silenced. :func:`four_bar`,
 :func:`slider_crank` and :func:`distance_angle` build the mechanisms of the
 extreme sections (:mod:`.extreme`, :mod:`.bounds`).
 """
@@ -26,7 +27,7 @@ from ...errors import NearSingularWarning
 from ...linkage import Branch, CarriedPoint, Crank, Link, RRP, RRR, Scene, solve
 
 __all__ = ['DURATIONS', 'EPS', 'ERROR_FLOOR', 'MODES', 'Mode', 'WP_SCENES', 'distance_angle',
-           'four_bar', 'median_time', 'quiet_solve', 'slider_crank', 'slug']
+           'four_bar', 'median_time', 'quiet_solve', 'slider_crank', 'slug', 'spread_time']
 
 EPS = float(np.finfo(np.float64).eps)
 #: Relative errors below this are drawn at this floor on log axes.
@@ -84,15 +85,24 @@ MODES = {
 }
 
 
-def median_time(fn: Callable[[], Any], repeat: int, number: int = 1) -> float:
-    """Median over ``repeat`` runs of the time of ``number`` calls of ``fn``, s."""
+def spread_time(fn: Callable[[], Any], repeat: int,
+                number: int = 1) -> tuple[float, float, float]:
+    """Min, median and max over ``repeat`` runs of the time of one call of ``fn``, s.
+
+    Each run times ``number`` calls.
+    """
     times = []
     for _ in range(max(repeat, 1)):
         start = time.perf_counter()
         for _ in range(number):
             fn()
-        times.append(time.perf_counter() - start)
-    return statistics.median(times) / number
+        times.append((time.perf_counter() - start) / number)
+    return min(times), statistics.median(times), max(times)
+
+
+def median_time(fn: Callable[[], Any], repeat: int, number: int = 1) -> float:
+    """Median over ``repeat`` runs of the time of ``number`` calls of ``fn``, s."""
+    return spread_time(fn, repeat, number)[1]
 
 
 def quiet_solve(scene: Scene, angle: Any, speed: Any = None, accel: Any = None) -> Any:
