@@ -132,7 +132,7 @@ def run(seconds: float, rate: float, scene_name: str, keep_s: float) -> dict[str
         'max_angle_error_rad': max(r['angle_error_rad'] for r in rows),
         'final_angle_error_rad': rows[-1]['angle_error_rad'],
         'max_state_error': max(r['state_error'] for r in rows),
-        'samples': len(rows), 'rows': rows[:: max(1, len(rows) // 60)],
+        'keep_s': keep_s, 'samples': len(rows), 'rows': rows[:: max(1, len(rows) // 60)],
     }
 
 

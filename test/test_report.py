@@ -24,8 +24,8 @@ SECTIONS = ('## 1. The 50-digit reference', '## 2. Work-precision',
             '## 3. Error against run time of the node', '## 4. Stiff and extreme cases',
             '## 5. Cost growth', '## 6. Error bounds against the truth')
 #: The modules of the report package, one per concern.
-MODULES = ('baselines', 'bounds', 'checks', 'clock', 'common', 'cost', 'extreme', 'figures',
-           'markdown')
+MODULES = ('baselines', 'bounds', 'checks', 'clock', 'common', 'cost', 'data', 'extreme',
+           'figures', 'markdown')
 #: What common.py shares with the section modules only (not re-exported).
 SHARED_HELPERS = {'distance_angle', 'four_bar', 'median_time', 'quiet_solve', 'slider_crank',
                   'slug'}

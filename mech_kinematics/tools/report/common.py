@@ -62,6 +62,8 @@ class Mode:
     repeat: int
     bound_samples: int                 # angles per error-bound case without a singular position
     bound_grid: int                    # evenly spaced angles of the refused-fraction grid
+    bench_angles: int = 100_000        # angles of the array path in ``bench``'s table
+    bench_repeat: int = 7              # runs of ``bench``'s timings (its default)
 
 
 #: The simulated run times of the node's clock: (label, seconds).
@@ -78,10 +80,11 @@ MODES = {
                   (1e-4, 1e-8, 1e-12), tuple(WP_SCENES), 1,
                   ('khurmi_four_bar_ad150', 'quick_return', 'geneva', 'six_link_slider'),
                   DURATIONS, (10.0, 1000.0, 100_000.0), 1_000_000, 200_000, 2,
-                  tuple(10 ** k for k in range(7)), (1, 4, 16, 64), 1000, 3, 2, 720),
+                  tuple(10 ** k for k in range(7)), (1, 4, 16, 64), 1000, 3, 2, 720, 10_000, 3),
     'smoke': Mode('smoke', 6, 256, (1e-4, 1e-10), (1e-3,), (1e-6,), ('four-bar', 'Geneva'), 1,
                   ('khurmi_four_bar_ad150', 'geneva'), DURATIONS[:3] + DURATIONS[4:],
-                  (1000.0,), 100_000, 20_000, 0, (1, 100, 10_000), (1, 8), 200, 2, 1, 180),
+                  (1000.0,), 100_000, 20_000, 0, (1, 100, 10_000), (1, 8), 200, 2, 1, 180,
+                  1000, 2),
 }
 
 
