@@ -94,6 +94,7 @@ def collect(mode: Any, elapsed: float, load: Sequence[float], checks: Any, golde
         'ours_velocity': over('ours_velocity')['max'],
         'ours_acceleration': over('ours_acceleration')['max'],
         'golden_max': max((g.max_rel_double for g in golden), default=math.nan),
+        'golden_ulps_decimal': max((g.max_ulps_decimal for g in golden), default=math.nan),
         'newton_cost_ratio': over('newton', 'cost_ratio'),
         'single_over_newton': over('newton', 'single_over_it'),
         'differences_error_ratio': over('differences', 'error_ratio'),
@@ -218,8 +219,34 @@ def check_text(text: str, data: dict[str, Any], name: str = 'text') -> list[str]
 
 
 def update_text(text: str, data: dict[str, Any]) -> str:
-    """Return ``text`` with every generated block rewritten from ``data``."""
+    """Return ``text`` with every quoted figure and generated block rewritten from ``data``.
+
+    A figure keeps the form it is written in (decimals, exponent, thousands
+    separators); a timing is rewritten to its median. The words around it are
+    the author's to check.
+    """
+    def figure(match: re.Match[str]) -> str:
+        written, key = match.groups()
+        value = lookup(data, key)
+        if isinstance(value, list):
+            value = value[1]
+        return f'{_format_like(written, float(value))}<!--={key}-->'
+
+    text = _FIGURE.sub(figure, text)
     return _BLOCK.sub(lambda m: m.group(1) + render_block(m.group(2), data) + m.group(4), text)
+
+
+def _format_like(written: str, value: float) -> str:
+    """Return ``value`` in the form of ``written`` (its decimals, exponent and separators)."""
+    mantissa, e, _ = written.lower().partition('e')
+    decimals = len(mantissa.partition('.')[2])
+    if e:
+        text = f'{value:.{decimals}e}'
+        digits, exponent = text.split('e')
+        return f'{digits}e{int(exponent)}'
+    if ',' in written:
+        return f'{round(value):,}'
+    return f'{value:.{decimals}f}'
 
 
 # --- generated blocks -------------------------------------------------------------
