@@ -115,3 +115,10 @@ def test_update_text_rewrites_figures_in_their_written_form():
     text = 'a 9.9e-9<!--=a.b--> b 1<!--=a.n--> c 1,000<!--=a.n--> d 0.000<!--=t-->'
     assert data_mod.update_text(text, SAMPLE) == ('a 2.8e-7<!--=a.b--> b 2886<!--=a.n--> c '
                                                   '2,886<!--=a.n--> d 0.320<!--=t-->')
+
+
+def test_examples_in_inline_code_are_not_figures():
+    """The form shown in backticks is an example: neither checked nor rewritten."""
+    text = 'write `2.8e-7<!--=key-->` after 2.8e-7<!--=a.b-->'
+    assert data_mod.check_text(text, SAMPLE) == []
+    assert data_mod.update_text(text, SAMPLE) == text

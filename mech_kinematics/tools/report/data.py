@@ -12,10 +12,10 @@ of the node, ``bench/long_run.py``) are copied in from a file
 The documentation quotes them in two forms that :func:`check_text` checks:
 
 - a figure followed by its key in an HTML comment, ``2.8e-7<!--=clock.naive_1h.min-->``
-  (invisible once rendered). A plain value passes when it rounds to the figure
-  as written (``2.8e-7`` holds 2.75e-7 to 2.85e-7); a timing ``[min, median,
-  max]`` when the figure lies between its min and max (at the figure's
-  precision): :data:`SPREAD_RULE`.
+  (invisible once rendered; not inside inline code, where it is an example).
+  A plain value passes when it rounds to the figure as written (``2.8e-7``
+  holds 2.75e-7 to 2.85e-7); a timing ``[min, median, max]`` when the figure
+  lies between its min and max (at the figure's precision): :data:`SPREAD_RULE`.
 - a generated block between ``<!--data:NAME-->`` and ``<!--data:end-->``: a
   table that :func:`render_block` writes from the data, checked line for line
   (:func:`update_text` rewrites the blocks of a file).
@@ -43,6 +43,13 @@ SPREAD_RULE = ('a timing quoted from [min, median, max] of repeated runs passes 
 
 _FIGURE = re.compile(r'(-?[0-9][0-9,]*(?:\.[0-9]+)?(?:e[-+]?[0-9]+)?)<!--=([A-Za-z0-9_.\-]+)-->')
 _BLOCK = re.compile(r'(<!--data:([a-z_]+)-->\n)(.*?)(<!--data:end-->)', re.S)
+_CODE = re.compile(r'`[^`\n]*`')
+
+
+def _in_code(text: str) -> Any:
+    """Return a test of whether a position of ``text`` lies in an inline code span."""
+    spans = [m.span() for m in _CODE.finditer(text)]
+    return lambda position: any(start < position < end for start, end in spans)
 
 
 # --- collecting -----------------------------------------------------------------
@@ -192,7 +199,10 @@ def _figure_matches(figure: str, value: Any) -> bool:
 def check_text(text: str, data: dict[str, Any], name: str = 'text') -> list[str]:
     """Return one line per figure or block of ``text`` that disagrees with ``data``."""
     problems = []
+    in_code = _in_code(text)
     for match in _FIGURE.finditer(text):
+        if in_code(match.start()):
+            continue        # an example of the form, not a figure
         figure, key = match.groups()
         line = text.count('\n', 0, match.start()) + 1
         try:
@@ -225,7 +235,11 @@ def update_text(text: str, data: dict[str, Any]) -> str:
     separators); a timing is rewritten to its median. The words around it are
     the author's to check.
     """
+    in_code = _in_code(text)
+
     def figure(match: re.Match[str]) -> str:
+        if in_code(match.start()):
+            return match.group(0)
         written, key = match.groups()
         value = lookup(data, key)
         if isinstance(value, list):

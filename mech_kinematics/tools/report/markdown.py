@@ -115,9 +115,9 @@ def _headline(wp: Sequence[WorkPrecision], extreme: Sequence[CaseResult],
     single_over = [1 / h['alternatives']['newton']['cost_ratio_single'] for h in hl.values()
                    if 'newton' in h['alternatives']]
     if single_over:
-        w(f"The node's single-angle path costs {min(single_over):.3g}-{max(single_over):.3g}x "
-          "a batched Newton-Raphson's time per configuration (and our array path less "
-          'than Newton): the node pays for one call per tick, not for the method.')
+        w(f"The node's single-angle path (one call per tick) costs "
+          f"{min(single_over):.3g}-{max(single_over):.3g}x a batched Newton-Raphson's "
+          'time per configuration.')
         w('')
     n_fail = sum(r.verdict == 'FAIL' for r in extreme)
     w(f'Extreme cases: {len(extreme)} cases, {n_fail} failures; every case either meets '
