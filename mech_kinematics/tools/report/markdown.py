@@ -293,7 +293,10 @@ def _clock(mode: Mode, clock: Sequence[ClockRow], clock_check: dict[str, Any],
       + ').')
     w('')
     w('State error: worst relative error of everything published (joint angles, rates, '
-      'accelerations, points) at that instant against the reference at the exact angle.')
+      'accelerations, points) at that instant against the reference at the exact angle. '
+      'It levels off at order 1 once the angle error passes a radian or so, since the '
+      'state is periodic in the angle: the angle error (left) is the one that keeps '
+      'growing.')
     w('')
     w('![clock](clock.png)')
     w('')
