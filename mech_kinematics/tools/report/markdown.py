@@ -496,8 +496,10 @@ def _bench(data: dict[str, Any]) -> list[str]:
             f'configuration), min / median / max of {bench["repeat"]} interleaved runs; '
             'positions, velocities and accelerations of every output, error bounds and the '
             'tolerance check included (the hand-written forms have neither). Ratio: median '
-            'over the hand-written form of the same scene, which exists for the four-bar and '
-            f"the slider-crank only. Issue 19's targets: one angle <= {SINGLE_TARGET:g}x, "
+            'over the hand-written form of the same scene, which exists for every scene of one '
+            'crank and one dyad (four-bars, and slider-cranks on a horizontal guide; it leaves '
+            "out their carried points, which the solver computes). Issue 19's targets: "
+            f'one angle <= {SINGLE_TARGET:g}x, '
             f'arrays <= {ARRAY_TARGET:g}x.', '', render_block('bench', data).rstrip('\n'), '']
 
 
