@@ -24,8 +24,8 @@ SECTIONS = ('## 1. The 50-digit reference', '## 2. Work-precision',
             '## 3. Error against run time of the node', '## 4. Stiff and extreme cases',
             '## 5. Cost growth', '## 6. Error bounds against the truth')
 #: The modules of the report package, one per concern.
-MODULES = ('baselines', 'bounds', 'checks', 'clock', 'common', 'cost', 'extreme', 'figures',
-           'markdown')
+MODULES = ('baselines', 'bounds', 'checks', 'clock', 'common', 'cost', 'data', 'extreme',
+           'figures', 'markdown')
 #: What common.py shares with the section modules only (not re-exported).
 SHARED_HELPERS = {'distance_angle', 'four_bar', 'median_time', 'quiet_solve', 'slider_crank',
                   'slug'}
@@ -117,3 +117,22 @@ def test_cli_main_writes_the_smoke_report(tmp_path):
     for name in ('bounds.png', 'refused.png'):
         assert f']({name})' in bounds_section
         assert (tmp_path / name).stat().st_size > 10_000, name
+
+
+def test_quick_report_writes_its_data_file(quick_report):
+    """data.json beside REPORT.md: every figure the docs quote, timings as [min, median, max]."""
+    from mech_kinematics.scene import scene_names
+    data = report.read_data(quick_report / report.DATA_FILE)
+    assert data['mode'] == 'quick' and data['elapsed_s'] > 0
+    for key in ('summary.ours_position', 'summary.ours_velocity', 'summary.ours_acceleration',
+                'summary.single_over_newton.max', 'clock.naive_year.max', 'bounds.tightness',
+                'cost.batch_slope', 'extreme.cases'):
+        assert report.lookup(data, key) > 0, key
+    low, mid, high = report.lookup(data, 'work_precision.four_bar.ours_single_us')
+    assert 0 < low <= mid <= high
+    assert [r['scene'] for r in data['bench']['rows'] if 'baseline_of' not in r] \
+        == scene_names()
+    text = (quick_report / 'REPORT.md').read_text()
+    assert '## 7. Against hand-written closed forms' in text
+    assert '| mechanism | positions | velocities | accelerations |' in text
+    assert "The node's single-angle path (one call per tick) costs" in text

@@ -72,3 +72,30 @@ def test_headline_ratios(four_bar_wp):
     headline = baselines.headline([four_bar_wp])['four-bar']
     newton = headline['alternatives']['newton']
     assert newton['cost_ratio'] == pytest.approx(newton['seconds'] / headline['ours_seconds'])
+
+
+def test_work_points_hold_every_order_and_their_timing_spread(four_bar_wp):
+    """Positions, velocities and accelerations are measured; timings as min <= median <= max."""
+    for p in four_bar_wp.points:
+        if p.family == 'printed':
+            continue
+        assert set(p.errors) == {'position', 'angle', 'velocity', 'angular velocity',
+                                 'acceleration', 'angular acceleration'}, p
+        low, mid, high = p.spread
+        assert 0 < low <= mid <= high and mid == p.seconds
+        assert p.point_acc == p.errors['acceleration']
+        assert p.angular_acc == p.errors['angular acceleration']
+    ours = baselines.headline([four_bar_wp])['four-bar']['ours_by_order']
+    assert set(ours) == {'position', 'velocity', 'acceleration'}
+    assert 0 < max(ours.values()) <= RTOL_OURS
+    # Differences of positions: exact positions, velocities far off, accelerations worse.
+    diff = next(p for p in four_bar_wp.points if p.label == 'step 1e-03 rad')
+    orders = baselines.by_order(diff.errors)
+    assert orders['position'] <= RTOL_OURS < 100 * RTOL_OURS < orders['velocity']
+
+
+def test_by_order_takes_the_worse_of_points_and_links():
+    errors = {'position': 1.0, 'angle': 2.0, 'velocity': 5.0, 'angular velocity': 3.0,
+              'acceleration': 7.0}
+    assert baselines.by_order(errors) == {'position': 2.0, 'velocity': 5.0,
+                                          'acceleration': 7.0}

@@ -86,3 +86,22 @@ def test_naive_accumulation_drifts(clock_rows):
         < year.angle_error['naive']
     errors = [r.angle_error['naive'] for r in rows]
     assert errors == sorted(errors)
+
+
+def test_the_node_clock_path_from_a_wall_clock_epoch(clock_rows):
+    """The grid owes the last CLOCK_TICKS instants at each run time; whole turns are exact."""
+    _, check = clock_rows
+    assert check['grid_instants'] == [clock.CLOCK_TICKS] * len(MODES['smoke'].clock_durations)
+    assert check['turns_equal']
+    grid, timebase = clock.node_clock(1000.0, 0.5)
+    assert grid.next_ns >= clock.EPOCH_NS and grid.next_ns % grid.period_ns == 0
+    assert timebase.sample(grid.next_ns).angle == 0.5
+    turns, sample = timebase.sample_turns(grid.next_ns + 3600 * 10 ** 9)
+    assert turns == 60_000 and sample.angle == 0.5     # 1000 rpm for an hour: whole turns
+
+
+def test_naive_error_is_not_wrapped(clock_rows):
+    """The naive angle is never wrapped: its error grows past pi instead of saturating."""
+    rows, _ = clock_rows
+    year = next(r for r in rows if r.duration == '1 year')
+    assert year.angle_error['naive'] > math.pi

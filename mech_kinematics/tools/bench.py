@@ -2,10 +2,13 @@
 # SPDX-License-Identifier: Apache-2.0
 """Solver speed: ``python -m mech_kinematics bench`` (``make bench``).
 
-For every packaged scene it times one full single-angle solve (median) and
-the array path per configuration over many angles, beside hand-written closed
-forms of the same four-bar and slider-crank timed in the same run. The machine
-is shared and noisy, so what matters is the ratios of one run.
+For every packaged scene it times one full single-angle solve and the array
+path per configuration over many angles (min / median / max of repeated
+runs), beside hand-written closed forms of the same mechanism timed in the
+same run where the scene is one crank and one dyad (:func:`hand_written`:
+a four-bar, or a slider-crank on a horizontal guide), and prints the ratios
+to them against issue 19's targets (:data:`SINGLE_TARGET`, :data:`ARRAY_TARGET`). The
+machine is shared and noisy, so what matters is the ratios of one run.
 """
 
 from __future__ import annotations
@@ -13,6 +16,7 @@ from __future__ import annotations
 import argparse
 from collections.abc import Callable, Sequence
 from functools import partial
+import json
 import math
 import statistics
 import time
@@ -21,27 +25,35 @@ from typing import Any
 import numpy as np
 
 from .cli import positive_int, run_tool
-from ..linkage import solve
+from ..linkage import RRP, RRR, solve
 from ..scene import load_scene, scene_names
 
-# The hand-written baselines solve the packaged scenes' own geometry.
-FOUR_BAR = 'khurmi_four_bar_ad150'  # AD = 150, AB = 40, BC = 150, CD = 80 mm
-SLIDER_CRANK = 'slider_crank_150_600'  # crank 150, rod 600 mm, piston on the left
+
+#: A four-bar's geometry for the hand-written forms: crank centre (x, y), crank,
+#: coupler and rocker lengths, rocker pivot (x, y), branch sign (+1: C to the left
+#: of B -> D). The default is the packaged four-bar (AD = 150, AB = 40, BC = 150,
+#: CD = 80 mm).
+FOUR_BAR_GEOMETRY = (0.0, 0.0, 0.04, 0.15, 0.08, 0.15, 0.0, 1.0)
+#: A slider-crank's: crank centre (x, y), crank and rod lengths, the height of the
+#: horizontal guide, side of the piston (+1: larger x). The default is the packaged
+#: slider-crank (crank 150, rod 600 mm, piston on the left).
+SLIDER_CRANK_GEOMETRY = (0.0, 0.0, 0.15, 0.6, 0.0, -1.0)
 
 
-def four_bar_math(theta: float, w: float, al: float) -> tuple[float, ...]:
+def four_bar_math(theta: float, w: float, al: float,
+                  geometry: tuple[float, ...] = FOUR_BAR_GEOMETRY) -> tuple[float, ...]:
     """Hand-written four-bar with :mod:`math`: link angles, rates, accelerations; B and C."""
-    a, b, c, d = 0.04, 0.15, 0.08, 0.15
-    bx, by = a * math.cos(theta), a * math.sin(theta)
-    vbx, vby = -w * by, w * bx
-    abx, aby = -al * by - w * w * bx, al * bx - w * w * by
-    ex, ey = d - bx, -by
+    ox, oy, a, b, c, dx, dy, side = geometry
+    bx, by = ox + a * math.cos(theta), oy + a * math.sin(theta)
+    vbx, vby = -w * (by - oy), w * (bx - ox)
+    abx, aby = -al * (by - oy) - w * w * (bx - ox), al * (bx - ox) - w * w * (by - oy)
+    ex, ey = dx - bx, dy - by
     f = math.hypot(ex, ey)
     p = (b * b - c * c + f * f) / (2 * f)
-    h = math.sqrt(b * b - p * p)
+    h = side * math.sqrt(b * b - p * p)
     cx = bx + (p * ex - h * ey) / f
     cy = by + (p * ey + h * ex) / f
-    r1x, r1y, r2x, r2y = cx - bx, cy - by, cx - d, cy
+    r1x, r1y, r2x, r2y = cx - bx, cy - by, cx - dx, cy - dy
     den = r1x * r2y - r1y * r2x
     w1 = (-vbx * r2x - vby * r2y) / den
     w2 = (-vbx * r1x - vby * r1y) / den
@@ -56,20 +68,22 @@ def four_bar_math(theta: float, w: float, al: float) -> tuple[float, ...]:
             bx, by, vbx, vby, abx, aby, cx, cy, vcx, vcy, acx, acy)
 
 
-def four_bar_numpy(theta: Any, w: float, al: float) -> tuple[Any, ...]:
+def four_bar_numpy(theta: Any, w: float, al: float,
+                   geometry: tuple[float, ...] = FOUR_BAR_GEOMETRY) -> tuple[Any, ...]:
     """Solve the same four-bar with NumPy over an array of crank angles."""
-    a, b, c, d = 0.04, 0.15, 0.08, 0.15
+    ox, oy, a, b, c, dx, dy, side = geometry
     cos, sin = np.cos(theta), np.sin(theta)
-    bx, by = a * cos, a * sin
-    vbx, vby = -w * by, w * bx
-    abx, aby = -al * by - w * w * bx, al * bx - w * w * by
-    ex, ey = d - bx, -by
+    rx, ry = a * cos, a * sin
+    bx, by = ox + rx, oy + ry
+    vbx, vby = -w * ry, w * rx
+    abx, aby = -al * ry - w * w * rx, al * rx - w * w * ry
+    ex, ey = dx - bx, dy - by
     f = np.hypot(ex, ey)
     p = (b * b - c * c + f * f) / (2 * f)
-    h = np.sqrt(b * b - p * p)
+    h = side * np.sqrt(b * b - p * p)
     cx = bx + (p * ex - h * ey) / f
     cy = by + (p * ey + h * ex) / f
-    r1x, r1y, r2x, r2y = cx - bx, cy - by, cx - d, cy
+    r1x, r1y, r2x, r2y = cx - bx, cy - by, cx - dx, cy - dy
     den = r1x * r2y - r1y * r2x
     w1 = (-vbx * r2x - vby * r2y) / den
     w2 = (-vbx * r1x - vby * r1y) / den
@@ -84,47 +98,92 @@ def four_bar_numpy(theta: Any, w: float, al: float) -> tuple[Any, ...]:
             bx, by, vbx, vby, abx, aby, cx, cy, vcx, vcy, acx, acy)
 
 
-def slider_crank_math(theta: float, w: float, al: float) -> tuple[float, ...]:
-    """Hand-written in-line slider-crank (piston at negative x) with :mod:`math`."""
-    r, rod = 0.15, 0.6
+def slider_crank_math(theta: float, w: float, al: float,
+                      geometry: tuple[float, ...] = SLIDER_CRANK_GEOMETRY) -> tuple[float, ...]:
+    """Hand-written slider-crank on a horizontal guide with :mod:`math`.
+
+    Returns the piston's x, the rod's angle, their rates and accelerations,
+    and B's position, velocity and acceleration.
+    """
+    ox, oy, r, rod, guide, side = geometry
     s, c = math.sin(theta), math.cos(theta)
-    k = math.sqrt(rod * rod - r * r * s * s)
-    x = r * c - k
-    phi = math.atan2(-r * s, x - r * c)
-    wr = -r * c * w / (rod * math.cos(phi))
-    v = -r * s * w - rod * math.sin(phi) * wr
-    ar = (r * s * w * w - r * c * al + rod * math.sin(phi) * wr * wr) / (rod * math.cos(phi))
-    a = -r * c * w * w - r * s * al - rod * math.cos(phi) * wr * wr - rod * math.sin(phi) * ar
-    bx, by = r * c, r * s
-    vbx, vby = -w * by, w * bx
-    abx, aby = -al * by - w * w * bx, al * bx - w * w * by
+    e = guide - oy - r * s              # the rod's rise from B to the piston
+    k = math.sqrt(rod * rod - e * e)
+    x = ox + r * c + side * k
+    phi = math.atan2(e, side * k)
+    cp, sp = math.cos(phi), math.sin(phi)
+    wr = -r * c * w / (rod * cp)
+    v = -r * s * w - rod * sp * wr
+    ar = (r * s * w * w - r * c * al + rod * sp * wr * wr) / (rod * cp)
+    a = -r * c * w * w - r * s * al - rod * cp * wr * wr - rod * sp * ar
+    bx, by = ox + r * c, oy + r * s
+    vbx, vby = -w * r * s, w * r * c
+    abx, aby = -al * r * s - w * w * r * c, al * r * c - w * w * r * s
     return x, phi, v, wr, a, ar, bx, by, vbx, vby, abx, aby
 
 
-def slider_crank_numpy(theta: Any, w: float, al: float) -> tuple[Any, ...]:
+def slider_crank_numpy(theta: Any, w: float, al: float,
+                       geometry: tuple[float, ...] = SLIDER_CRANK_GEOMETRY) -> tuple[Any, ...]:
     """Solve the same slider-crank with NumPy over an array of crank angles."""
-    r, rod = 0.15, 0.6
+    ox, oy, r, rod, guide, side = geometry
     s, c = np.sin(theta), np.cos(theta)
-    k = np.sqrt(rod * rod - r * r * s * s)
-    x = r * c - k
-    phi = np.arctan2(-r * s, x - r * c)
+    e = guide - oy - r * s
+    k = np.sqrt(rod * rod - e * e)
+    x = ox + r * c + side * k
+    phi = np.arctan2(e, side * k)
     cp, sp = np.cos(phi), np.sin(phi)
     wr = -r * c * w / (rod * cp)
     v = -r * s * w - rod * sp * wr
     ar = (r * s * w * w - r * c * al + rod * sp * wr * wr) / (rod * cp)
     a = -r * c * w * w - r * s * al - rod * cp * wr * wr - rod * sp * ar
-    bx, by = r * c, r * s
-    vbx, vby = -w * by, w * bx
-    abx, aby = -al * by - w * w * bx, al * bx - w * w * by
+    bx, by = ox + r * c, oy + r * s
+    vbx, vby = -w * r * s, w * r * c
+    abx, aby = -al * r * s - w * w * r * c, al * r * c - w * w * r * s
     return x, phi, v, wr, a, ar, bx, by, vbx, vby, abx, aby
 
 
-def _median_times(funcs: list[Callable[[], Any]], number: int,
-                  repeat: int) -> list[float]:
-    """Median time of one call of each function, the functions timed in turn.
+def hand_written(scene: Any) -> tuple[Callable[..., Any], Callable[..., Any]] | None:
+    """Return the hand-written scalar and NumPy forms of ``scene``, or None.
 
-    Interleaving the repeats makes a load change on the shared machine hit
-    every function alike, so their ratios stay meaningful.
+    A scene has them when it is one crank driving one dyad: an RRR (a
+    four-bar) or an RRP on a horizontal guide (a slider-crank). Its carried
+    points are not computed by them (the solver computes them too).
+    """
+    if len(scene.dyads) != 1:
+        return None
+    dyad, crank = scene.dyads[0], scene.input
+    ox, oy = scene.ground[crank.center]
+    if isinstance(dyad, RRR):
+        first, second = dyad.links
+        if first.start != crank.point or second.start not in scene.ground:
+            return None
+        dx, dy = scene.ground[second.start]
+        geometry = (ox, oy, crank.length, first.length, second.length, dx, dy,
+                    float(dyad.branch.value))
+        return partial(four_bar_math, geometry=geometry), partial(four_bar_numpy,
+                                                                  geometry=geometry)
+    if isinstance(dyad, RRP) and dyad.guide_angle == 0.0 and dyad.link.start == crank.point \
+            and dyad.through in scene.ground:
+        guide = scene.ground[dyad.through][1]
+        geometry = (ox, oy, crank.length, dyad.link.length, guide, float(dyad.branch.value))
+        return partial(slider_crank_math, geometry=geometry), partial(slider_crank_numpy,
+                                                                      geometry=geometry)
+    return None
+
+
+#: Issue 19's targets, bounds included: the array path per configuration over the
+#: hand-written NumPy closed form, the single angle over the hand-written scalar one.
+ARRAY_TARGET = 1.5
+SINGLE_TARGET = 8.0
+
+
+def _spread_times(funcs: list[Callable[[], Any]], number: int,
+                  repeat: int) -> list[tuple[float, float, float]]:
+    """Min, median and max over ``repeat`` runs of the time of one call of each function.
+
+    The functions are timed in turn: interleaving the repeats makes a load
+    change on the shared machine hit every function alike, so their ratios
+    stay meaningful.
     """
     times: list[list[float]] = [[] for _ in funcs]
     for _ in range(repeat):
@@ -133,49 +192,87 @@ def _median_times(funcs: list[Callable[[], Any]], number: int,
             for _ in range(number):
                 func()
             samples.append((time.perf_counter() - start) / number)
-    return [statistics.median(samples) for samples in times]
+    return [(min(s), statistics.median(s), max(s)) for s in times]
 
 
 def measure(names: list[str], angles: int, repeat: int) -> list[dict[str, Any]]:
-    """Time every scene, and the hand-written baselines beside theirs; one row each."""
+    """Time every scene, and the hand-written baselines beside theirs; one row each.
+
+    Each row holds ``single_us`` and ``array_us`` (per configuration) as
+    ``[min, median, max]`` over ``repeat`` runs, microseconds; a row of a
+    scene with a hand-written form also holds the median ratios
+    ``single_ratio`` and ``array_ratio`` to it.
+    """
     sweep = np.linspace(0.0, 2.0 * math.pi, angles, endpoint=False)
-    baselines = {
-        FOUR_BAR: (four_bar_math, four_bar_numpy),
-        SLIDER_CRANK: (slider_crank_math, slider_crank_numpy),
-    }
     rows = []
     for name in names:
         scene = load_scene(name)
         theta, w, al = scene.input.angle, scene.input.speed, scene.input.accel
         singles = [partial(solve, scene, theta)]
         arrays = [partial(solve, scene, sweep)]
-        if name in baselines:
-            scalar, vector = baselines[name]
+        forms = hand_written(scene)
+        if forms is not None:
+            # Where a scene does not assemble at every angle, the array path is timed
+            # over the angles where it does (the hand-written forms cannot refuse).
+            with np.errstate(invalid='ignore'):
+                ok = np.isfinite(forms[1](sweep, w, al)[0])
+            if not ok.all():
+                arrays = [partial(solve, scene, sweep[ok])]
+            scalar, vector = forms
             singles.append(partial(scalar, theta, w, al))
-            arrays.append(partial(vector, sweep, w, al))
-        one = _median_times(singles, 1000, repeat)
-        many = [t / angles for t in _median_times(arrays, 3, repeat)]
-        rows.append({'scene': name, 'single_us': one[0] * 1e6, 'array_us': many[0] * 1e6})
-        if name in baselines:
-            rows.append({'scene': f'{name} (hand-written)', 'single_us': one[1] * 1e6,
-                         'array_us': many[1] * 1e6, 'baseline_of': name})
+            arrays.append(partial(vector, sweep[ok], w, al))
+        count = len(sweep) if forms is None else int(ok.sum())
+        one = [[t * 1e6 for t in spread] for spread in _spread_times(singles, 1000, repeat)]
+        many = [[t * 1e6 / count for t in spread] for spread in _spread_times(arrays, 3, repeat)]
+        row: dict[str, Any] = {'scene': name, 'single_us': one[0], 'array_us': many[0]}
+        rows.append(row)
+        if forms is not None:
+            row['single_ratio'] = one[0][1] / one[1][1]
+            row['array_ratio'] = many[0][1] / many[1][1]
+            rows.append({'scene': f'{name} (hand-written)', 'single_us': one[1],
+                         'array_us': many[1], 'baseline_of': name})
     return rows
+
+
+def _ratio(row: dict[str, Any], key: str, target: float) -> str:
+    if key not in row:
+        return ''
+    verdict = 'ok' if row[key] <= target else 'over'
+    return f'{row[key]:.2f} {verdict}'
+
+
+def table(rows: list[dict[str, Any]], angles: int, repeat: int) -> list[str]:
+    """Return the lines ``make bench`` prints for the rows of :func:`measure`."""
+    lines = [f'min / median / max of {repeat} runs; array path over {angles} angles, per '
+             'configuration; position, velocity and acceleration of every output, bounds '
+             'included',
+             f'ratio: median over the hand-written closed form of the same scene (targets: '
+             f'single <= {SINGLE_TARGET:g}x, array <= {ARRAY_TARGET:g}x); "-": no '
+             'hand-written form of that scene',
+             f'{"scene":40s} {"single µs":>20s} {"ratio":>9s} {"array µs/cfg":>23s} '
+             f'{"ratio":>9s}']
+    for row in rows:
+        single = '/'.join(f'{t:.2f}' for t in row['single_us'])
+        array = '/'.join(f'{t:.3f}' for t in row['array_us'])
+        if 'baseline_of' in row:
+            ratio1 = ratio2 = '1'
+        elif 'single_ratio' in row:
+            ratio1 = _ratio(row, 'single_ratio', SINGLE_TARGET)
+            ratio2 = _ratio(row, 'array_ratio', ARRAY_TARGET)
+        else:
+            ratio1 = ratio2 = '-'
+        lines.append(f'{row["scene"]:40s} {single:>20s} {ratio1:>9s} {array:>23s} {ratio2:>9s}')
+    return lines
 
 
 def _handle(args: argparse.Namespace) -> int:
     """Print the table of ``measure`` with the ratios to the hand-written baselines."""
-    angles, repeat = args.angles, args.repeat
-    rows = measure(scene_names(), angles, repeat)
-    baseline = {row['baseline_of']: row for row in rows if 'baseline_of' in row}
-    print(f'median of {repeat} runs; array path over {angles} angles; position, velocity '
-          f'and acceleration of every output')
-    print(f'{"scene":44s} {"single µs":>10s} {"ratio":>6s} {"array µs/cfg":>13s} {"ratio":>6s}')
-    for row in rows:
-        ref = baseline.get(row['scene'])
-        ratio1 = f'{row["single_us"] / ref["single_us"]:6.2f}' if ref else ''
-        ratio2 = f'{row["array_us"] / ref["array_us"]:6.2f}' if ref else ''
-        print(f'{row["scene"]:44s} {row["single_us"]:10.2f} {ratio1:>6s} '
-              f'{row["array_us"]:13.4f} {ratio2:>6s}')
+    rows = measure(scene_names(), args.angles, args.repeat)
+    if args.json:
+        print(json.dumps({'angles': args.angles, 'repeat': args.repeat, 'rows': rows},
+                         indent=1))
+    else:
+        print('\n'.join(table(rows, args.angles, args.repeat)))
     return 0
 
 
@@ -188,7 +285,10 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
                     'slider-crank.')
     parser.add_argument('--angles', type=positive_int, default=100_000,
                         help='angles in the array path (default 1e5)')
-    parser.add_argument('--repeat', type=positive_int, default=7, help='repeats for medians')
+    parser.add_argument('--repeat', type=positive_int, default=7,
+                        help='runs for the min / median / max (default 7)')
+    parser.add_argument('--json', action='store_true',
+                        help='print the rows as JSON (times as [min, median, max] µs)')
     parser.set_defaults(handler=_handle)
     return parser
 

@@ -18,16 +18,21 @@
 6. the solver's error bounds against the actual errors over an extreme suite,
    and the fraction of a turn refused at each tolerance (:mod:`.bounds`).
 
+Beside it, ``DIR/data.json`` holds every figure the documentation quotes
+(:mod:`.data`), with ``bench``'s table (:mod:`mech_kinematics.tools.bench`)
+and the figures of one real run of the node (``--long-run FILE``, from
+``bench/long_run.py``; kept from the folder's previous data file otherwise).
+
 :mod:`.common` holds the run sizes (:data:`MODES`) and the shared timer,
 :mod:`.figures` draws, :mod:`.markdown` writes ``REPORT.md``; this module
 runs them in order (:func:`run`) and is the command line (:func:`add_parser`,
 :func:`main`).
 
 Every number in the report comes from the functions of these modules, which
-the tests call too. Times are medians of one run on a shared machine: compare
-ratios, not absolute times. matplotlib, SciPy, mpmath and tqdm are imported
-inside the functions that need them, so the solver and the command line stay
-importable without them.
+the tests call too. Times are min / median / max of repeated runs on a shared
+machine (the tables give medians): compare ratios, not absolute times.
+matplotlib, SciPy, mpmath and tqdm are imported inside the functions that need
+them, so the solver and the command line stay importable without them.
 """
 
 from __future__ import annotations
@@ -40,17 +45,19 @@ import sys
 import time
 from typing import Any
 
-from .baselines import (Configurations, configurations, HAND_TIME, headline, newton_positions,
-                        NEWTON_TRACKING_STEP, work_precision, WorkPoint, WorkPrecision,
-                        WP_PRINTED, WP_RANGES)
+from .baselines import (by_order, Configurations, configurations, HAND_TIME, headline,
+                        newton_positions, NEWTON_TRACKING_STEP, ORDERS, work_precision,
+                        WorkPoint, WorkPrecision, WP_PRINTED, WP_RANGES)
 from .bounds import (bound_cases, bound_statistics, bound_values, BoundCase, BoundStats,
                      BoundValue, CaseBounds, KAPPA_WELL, OFFSETS, refused_fractions,
                      RefusedFractions, TOLERANCES)
 from .checks import golden_checks, golden_folder, GoldenCheck, reference_checks, ReferenceCheck
-from .clock import (clock_errors, CLOCK_TICKS, ClockRow, naive_accumulate, naive_cumsum,
-                    naive_wrapped, naive_wrapped_trace, TICK_HZ)
-from .common import DURATIONS, EPS, ERROR_FLOOR, Mode, MODES, slug, WP_SCENES
+from .clock import (clock_errors, CLOCK_TICKS, ClockRow, EPOCH_NS, naive_accumulate,
+                    naive_cumsum, naive_wrapped, naive_wrapped_trace, node_clock, TICK_HZ)
+from .common import DURATIONS, EPS, ERROR_FLOOR, Mode, MODES, slug, spread_time, WP_SCENES
 from .cost import chain_scene, CHUNK, cost_growth, CostGrowth
+from .data import (BLOCKS, check_text, collect, DATA_FILE, lookup, read_data, render_block,
+                   SPREAD_RULE, update_text, write_data)
 from .extreme import (AngleResult, BOUND_FACTOR, Case, CaseResult, digits_lost, evaluate_angle,
                       evaluate_case, extreme_cases, formula_audit, FormulaAudit)
 from .figures import (plot_bounds, plot_clock, plot_cost, plot_extreme, plot_refused,
@@ -59,6 +66,9 @@ from .markdown import write_report
 from ..cli import run_tool
 
 __all__ = [
+    'BLOCKS', 'DATA_FILE', 'EPOCH_NS', 'ORDERS', 'SPREAD_RULE', 'by_order', 'check_text',
+    'collect', 'lookup', 'node_clock', 'read_data', 'render_block', 'spread_time', 'update_text',
+    'write_data',
     'AngleResult', 'BOUND_FACTOR', 'BoundCase', 'BoundStats', 'BoundValue', 'CHUNK', 'CLOCK_TICKS',
     'Case', 'CaseBounds', 'CaseResult', 'ClockRow', 'Configurations', 'CostGrowth', 'DURATIONS',
     'EPS', 'ERROR_FLOOR', 'FormulaAudit', 'GoldenCheck', 'HAND_TIME', 'KAPPA_WELL', 'MODES',
@@ -81,20 +91,23 @@ def _progress(total: int, enabled: bool) -> Any:
 
 
 def run(outdir: str | os.PathLike[str], mode: str | Mode = 'full',
-        progress: bool = True) -> dict[str, Any]:
-    """Compute every section, draw the figures and write ``outdir/REPORT.md``.
+        progress: bool = True,
+        long_run: str | os.PathLike[str] | None = None) -> dict[str, Any]:
+    """Compute every section, draw the figures, write ``outdir/REPORT.md`` and its data file.
 
-    Returns the computed sections (the tests read them).
+    ``long_run``: a JSON file of ``bench/long_run.py`` to store in the data
+    file. Returns the computed sections and the data (the tests read them).
     """
     mode = MODES[mode] if isinstance(mode, str) else mode
     out = Path(outdir)
     out.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
+    load = [os.getloadavg()[0]]
     from ...scene import scene_names
     n_checks = len(mode.check_scenes or scene_names())
     cases = bound_cases(mode)
     total = (n_checks + 1 + 5 * len(mode.wp_mechanisms) + len(mode.clock_rpms) + 1
-             + len(mode.batch_sizes) + len(mode.chain_lengths) + len(cases) + 1)
+             + len(mode.batch_sizes) + len(mode.chain_lengths) + len(cases) + 2)
     with _progress(total, progress) as bar:
         def tick() -> None:
             bar.update(1)
@@ -121,6 +134,11 @@ def run(outdir: str | os.PathLike[str], mode: str | Mode = 'full',
             bounds.append(bound_values(case))
             refused.append(refused_fractions(case, mode))
             tick()
+        bar.set_description('bench')
+        from ..bench import measure
+        bench = {'angles': mode.bench_angles, 'repeat': mode.bench_repeat,
+                 'rows': measure(scene_names(), mode.bench_angles, mode.bench_repeat)}
+        tick()
         bar.set_description('figures')
         for result in wp:
             plot_work_precision(result, out / f'wp_{slug(result.mechanism)}.png')
@@ -131,11 +149,15 @@ def run(outdir: str | os.PathLike[str], mode: str | Mode = 'full',
         plot_refused(refused, out / 'refused.png')
         tick()
     elapsed = time.perf_counter() - start
+    load.append(os.getloadavg()[0])
+    data = collect(mode, elapsed, load, checks, golden, wp, clock, clock_check, extreme, cost,
+                   bounds, refused, bench)
+    write_data(out, data, long_run)
     write_report(out, mode, checks, golden, wp, clock, clock_check, extreme, audit, cost,
-                 bounds, refused, elapsed)
+                 bounds, refused, elapsed, data)
     return {'checks': checks, 'golden': golden, 'work_precision': wp, 'clock': clock,
             'clock_check': clock_check, 'extreme': extreme, 'audit': audit, 'cost': cost,
-            'bounds': bounds, 'refused': refused, 'elapsed': elapsed}
+            'bounds': bounds, 'refused': refused, 'elapsed': elapsed, 'data': data}
 
 
 # --- command line ------------------------------------------------------------------
@@ -146,12 +168,17 @@ extreme cases, and write DIR/REPORT.md with PNG figures: the 50-digit
 reference and its checks, work-precision diagrams against Newton-Raphson,
 finite differences and solve_ivp, the node's crank-angle error over long runs,
 the extreme-case table, cost growth, and the error bounds against the actual
-errors with the fraction of a turn refused. A few minutes; --quick in under one.
+errors with the fraction of a turn refused; DIR/data.json holds every figure the
+documentation quotes. A few minutes; --quick in under one.
 """
 
 
 def _handle(args: argparse.Namespace) -> int:
-    run(args.output, args.mode, progress=not args.no_progress)
+    if args.long_run is not None and not Path(args.long_run).is_file():
+        print(f'report: expected --long-run to name the JSON file of bench/long_run.py, got '
+              f'{args.long_run!r} (no such file)', file=sys.stderr)
+        return 2
+    run(args.output, args.mode, progress=not args.no_progress, long_run=args.long_run)
     print(Path(args.output) / 'REPORT.md')
     return 0
 
@@ -170,6 +197,9 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     size.add_argument('--smoke', dest='mode', action='store_const', const='smoke',
                       help='the smallest run that fills every section (for tests)')
     parser.add_argument('--no-progress', action='store_true', help='no progress bar')
+    parser.add_argument('--long-run', metavar='FILE',
+                        help="store FILE (bench/long_run.py's JSON: one real run of the node) "
+                             "in DIR/data.json; without it the folder's previous one is kept")
     parser.set_defaults(handler=_handle, mode='full')
     return parser
 

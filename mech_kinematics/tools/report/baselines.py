@@ -21,14 +21,15 @@ from typing import Any
 
 import numpy as np
 
-from .common import ERROR_FLOOR, median_time, Mode, quiet_solve, WP_SCENES
+from .common import ERROR_FLOOR, Mode, quiet_solve, spread_time, WP_SCENES
 from ...linkage import JointMotion, Scene, solve
 from ...scene import load_scene
 from ...textbook import find_answer, PointNorm
 from ...units import radians_from_degrees
 
 __all__ = ['Configurations', 'HAND_TIME', 'NEWTON_TRACKING_STEP', 'WP_PRINTED', 'WP_RANGES',
-           'WorkPoint', 'WorkPrecision', 'configurations', 'headline', 'newton_positions',
+           'ORDERS', 'WorkPoint', 'WorkPrecision', 'by_order', 'configurations', 'headline',
+           'newton_positions',
            'work_precision']
 
 #: Crank turn between a tracking Newton-Raphson solver's previous solution
@@ -179,6 +180,11 @@ class WorkPoint:
     point_acc: float          # worst relative error of point accelerations
     angular_acc: float        # worst relative error of link angular accelerations
     note: str = ''
+    #: Worst relative error per kind (position, angle, velocity, ... as
+    #: :func:`mech_kinematics.tools.reference.compare`), where measured.
+    errors: dict[str, float] = field(default_factory=dict)
+    #: Min, median and max of the repeated timings, s per configuration.
+    spread: tuple[float, float, float] | None = None
 
 
 @dataclass
@@ -192,14 +198,26 @@ class WorkPrecision:
     printed: dict[str, float] = field(default_factory=dict)
 
 
-def _errors(states: Sequence[tuple[Any, int | None]], refs: Sequence[Any]) -> tuple[float, float]:
+def _errors(states: Sequence[tuple[Any, int | None]], refs: Sequence[Any]) -> dict[str, float]:
+    """Worst relative error per kind over the configurations."""
     from ..reference import compare
-    worst_p = worst_a = 0.0
+    worst: dict[str, float] = {}
     for (state, index), ref in zip(states, refs, strict=True):
-        err = compare(state, ref, index, kinds=('acceleration', 'angular acceleration'))
-        worst_p = max(worst_p, err['acceleration'])
-        worst_a = max(worst_a, err['angular acceleration'])
-    return worst_p, worst_a
+        for kind, value in compare(state, ref, index).items():
+            worst[kind] = max(worst.get(kind, 0.0), value)
+    return worst
+
+
+def _point(family: str, label: str, spread: tuple[float, float, float],
+           errors: dict[str, float], note: str = '') -> WorkPoint:
+    """Return a work point from its timings (s per configuration) and errors per kind."""
+    return WorkPoint(family, label, spread[1], errors['acceleration'],
+                     errors['angular acceleration'], note, errors, spread)
+
+
+def _scaled(spread: tuple[float, float, float], factor: float) -> tuple[float, float, float]:
+    low, mid, high = spread
+    return low * factor, mid * factor, high * factor
 
 
 def work_precision(mechanism: str, mode: Mode,
@@ -227,13 +245,14 @@ def work_precision(mechanism: str, mode: Mode,
                 for th, w in zip(conf.thetas, conf.omegas, strict=True)]
 
     states = singles()
-    seconds = median_time(singles, mode.repeat) / n
-    result.points.append(WorkPoint('ours', 'ours, one angle', seconds,
-                                   *_errors([(s, None) for s in states], refs)))
+    spread = _scaled(spread_time(singles, mode.repeat), 1.0 / n)
+    result.points.append(_point('ours', 'ours, one angle', spread,
+                                _errors([(s, None) for s in states], refs)))
     state = solve(scene, conf.thetas, conf.omegas, alpha)
-    seconds = median_time(lambda: solve(scene, thetas_t, omegas_t, alpha), mode.repeat) * per
-    result.points.append(WorkPoint('ours', 'ours, arrays', seconds,
-                                   *_errors([(state, k) for k in range(n)], refs)))
+    spread = _scaled(spread_time(lambda: solve(scene, thetas_t, omegas_t, alpha), mode.repeat),
+                     per)
+    result.points.append(_point('ours', 'ours, arrays', spread,
+                                _errors([(state, k) for k in range(n)], refs)))
     tick()
 
     # Newton-Raphson from the solution one tracking step earlier.
@@ -249,10 +268,10 @@ def work_precision(mechanism: str, mode: Mode,
             q, _ = newton_positions(model, thetas_t, seed_t, tol)
             return _float_kinematics(model, q, thetas_t, omegas_t, alpha)
 
-        seconds = median_time(newton, mode.repeat) * per
-        result.points.append(WorkPoint('newton', f'tol {tol:.0e}', seconds,
-                                       *_errors([(state, k) for k in range(n)], refs),
-                                       f'{iterations} iterations'))
+        spread = _scaled(spread_time(newton, mode.repeat), per)
+        result.points.append(_point('newton', f'tol {tol:.0e}', spread,
+                                    _errors([(state, k) for k in range(n)], refs),
+                                    f'{iterations} iterations'))
     tick()
 
     # Central differences of our solver's positions in time.
@@ -279,9 +298,10 @@ def work_precision(mechanism: str, mode: Mode,
             return _State(points, joints)
 
         state = differences(conf.thetas, conf.omegas)
-        seconds = median_time(lambda h=h: differences(thetas_t, omegas_t, h), mode.repeat) * per
-        result.points.append(WorkPoint('differences', f'step {step:.0e} rad', seconds,
-                                       *_errors([(state, k) for k in range(n)], refs)))
+        spread = _scaled(spread_time(lambda h=h: differences(thetas_t, omegas_t, h),
+                                     mode.repeat), per)
+        result.points.append(_point('differences', f'step {step:.0e} rad', spread,
+                                    _errors([(state, k) for k in range(n)], refs)))
     tick()
 
     # Integrating the velocity equations in time (positions), then the linear systems.
@@ -304,10 +324,11 @@ def work_precision(mechanism: str, mode: Mode,
         start = time.perf_counter()
         state = integrate()
         seconds = (time.perf_counter() - start) / n
+        spread = (seconds, seconds, seconds)
         if mode.repeat > 2 and seconds < 0.05:
-            seconds = median_time(integrate, 3) / n
-        result.points.append(WorkPoint('solve_ivp', f'rtol {rtol:.0e}', seconds,
-                                       *_errors([(state, k) for k in range(n)], refs)))
+            spread = _scaled(spread_time(integrate, 3), 1.0 / n)
+        result.points.append(_point('solve_ivp', f'rtol {rtol:.0e}', spread,
+                                    _errors([(state, k) for k in range(n)], refs)))
     tick()
 
     # The textbook's printed answer at the scene's own angle.
@@ -322,11 +343,28 @@ def work_precision(mechanism: str, mode: Mode,
     return result
 
 
+#: The kinds of :func:`mech_kinematics.tools.reference.compare` by order of derivative.
+ORDERS = {'position': ('position', 'angle'), 'velocity': ('velocity', 'angular velocity'),
+          'acceleration': ('acceleration', 'angular acceleration')}
+
+
+def by_order(errors: dict[str, float]) -> dict[str, float]:
+    """Return the worst relative error of positions, velocities and accelerations.
+
+    Each is the worse of the points' (and sliders') and the links' errors.
+    """
+    return {order: max(errors.get(kind, 0.0) for kind in kinds)
+            for order, kinds in ORDERS.items()}
+
+
 def headline(results: Sequence[WorkPrecision]) -> dict[str, Any]:
     """Our error and cost against each alternative's best, as ratios measured in one run.
 
     For each mechanism and alternative family: its most accurate point (the
-    worse of the two errors) and its cost, against our array path.
+    worse of the two acceleration errors) and its cost, against our array
+    path (``cost_ratio``) and our single-angle path (``cost_ratio_single``,
+    what the node pays per tick); ours by order of derivative
+    (``ours_by_order``, :func:`by_order`) and the timings' spreads.
     """
     out: dict[str, Any] = {}
     for result in results:
@@ -341,11 +379,14 @@ def headline(results: Sequence[WorkPrecision]) -> dict[str, Any]:
             best = min(pts, key=lambda p: (max(p.point_acc, p.angular_acc), p.seconds))
             err = max(best.point_acc, best.angular_acc)
             rows[family] = {'label': best.label, 'error': err, 'seconds': best.seconds,
+                            'spread': best.spread,
                             'error_ratio': err / max(ours_err, ERROR_FLOOR),
                             'cost_ratio': best.seconds / ours.seconds,
                             'cost_ratio_single': best.seconds / single.seconds}
         out[result.mechanism] = {'ours_error': ours_err, 'ours_seconds': ours.seconds,
+                                 'ours_spread': ours.spread, 'single_spread': single.spread,
                                  'single_seconds': single.seconds,
                                  'single_error': max(single.point_acc, single.angular_acc),
+                                 'ours_by_order': by_order(ours.errors),
                                  'alternatives': rows}
     return out

@@ -2,8 +2,11 @@
 # SPDX-License-Identifier: Apache-2.0
 """Section 3 of the report: the node's crank angle against run time, simulated exactly.
 
-Three ways to get the crank angle at a :data:`TICK_HZ` tick: the node's time
-base (:class:`mech_kinematics.ros.timebase.CrankTimebase`), naive
+Three ways to get the crank angle at a :data:`TICK_HZ` tick: the node's own
+clock path (its tick grid, :class:`mech_kinematics.ros.schedule.TickGrid`,
+aligned at a wall-clock epoch :data:`EPOCH_NS`, each instant sampled by
+:meth:`mech_kinematics.ros.timebase.CrankTimebase.sample_turns` as the node's
+tick does), naive
 ``angle += omega * dt`` (:func:`naive_accumulate`, exact in a few hundred
 rational steps per year, checked bit for bit by :func:`naive_cumsum`) and the
 same wrapped every tick (:func:`naive_wrapped`); :func:`clock_errors`
@@ -25,13 +28,16 @@ from .common import Mode, quiet_solve
 from ...scene import load_scene
 from ...units import NS_PER_S, rad_per_s_from_rpm
 
-__all__ = ['CLOCK_TICKS', 'ClockRow', 'TICK_HZ', 'clock_errors', 'naive_accumulate',
-           'naive_cumsum', 'naive_wrapped', 'naive_wrapped_trace']
+__all__ = ['CLOCK_TICKS', 'ClockRow', 'EPOCH_NS', 'TICK_HZ', 'clock_errors', 'naive_accumulate',
+           'naive_cumsum', 'naive_wrapped', 'naive_wrapped_trace', 'node_clock']
 
 #: Tick rate of the simulated node, Hz.
 TICK_HZ = 1000
 #: Ticks ending at each run time over which the clock errors are the worst.
 CLOCK_TICKS = 3
+#: The simulated node's start, ns since 1970 (2026-11-17, not a round number): the
+#: node's stamps are wall-clock nanoseconds, about 1.8e18, not counted from zero.
+EPOCH_NS = 1_795_398_123_456_789_012
 
 
 def naive_accumulate(angle0: float, step: float, ticks: int) -> float:
@@ -118,6 +124,18 @@ def _drift_rate(trace: Sequence[tuple[int, Any]]) -> Any:
     return sum(k * e for k, e in trace) / sum(k * k for k, _ in trace)
 
 
+def node_clock(rpm: float, theta0: float) -> tuple[Any, Any]:
+    """Return the node's tick grid at :data:`TICK_HZ` and its time base, started at EPOCH_NS.
+
+    As the node's tick thread does: the grid aligned at the first wake-up,
+    the time base started at the grid's first instant with the scene angle.
+    """
+    from ...ros.schedule import period_ns_from_rate, TickGrid
+    from ...ros.timebase import CrankTimebase
+    grid = TickGrid.aligned(EPOCH_NS, period_ns_from_rate(TICK_HZ))
+    return grid, CrankTimebase(grid.next_ns, theta0, rpm, 0.0, abs(rpm))
+
+
 @dataclass
 class ClockRow:
     """The crank angle and the published state after one run time at one speed."""
@@ -125,7 +143,10 @@ class ClockRow:
     duration: str
     seconds: int
     rpm: float
-    angle_error: dict[str, float]   # method -> |angle - exact| wrapped, rad
+    #: method -> angle error, rad: ``timebase`` and ``naive, wrapped`` against the
+    #: exact angle modulo 2 pi (what they publish), ``naive`` against the exact angle
+    #: counted from the start, never wrapped (its own angle is never wrapped).
+    angle_error: dict[str, float]
     state_error: dict[str, float]   # method -> worst relative error of the published state
     wrapped_model: bool             # the wrapped variant extrapolated, not simulated
 
@@ -134,10 +155,11 @@ def clock_errors(mode: Mode, scene_name: str = 'khurmi_four_bar_ad150',
                  tick: Callable[[], None] = lambda: None) -> tuple[list[ClockRow], dict[str, Any]]:
     """Error of the node's crank angle and state after long runs, three ways.
 
-    ``timebase``: :class:`mech_kinematics.ros.timebase.CrankTimebase` sampled at the
-    integer-nanosecond instant; ``naive``: ``angle += omega * dt`` per tick
-    at :data:`TICK_HZ` (:func:`naive_accumulate`, exact); ``naive, wrapped``:
-    the same with the angle wrapped every tick (:func:`naive_wrapped`,
+    ``timebase``: the node's clock path (:func:`node_clock`): its grid's
+    instants after the run time, taken by :meth:`TickGrid.take` as a wake-up
+    then does, each sampled by ``CrankTimebase.sample_turns``; ``naive``:
+    ``angle += omega * dt`` per tick at :data:`TICK_HZ` (:func:`naive_accumulate`,
+    exact); ``naive, wrapped``: the same with the angle wrapped every tick (:func:`naive_wrapped`,
     simulated tick by tick up to ``mode.clock_wrapped_ticks`` ticks, beyond
     that extrapolated linearly from the rate fitted on the simulation: every
     turn rounds the same way binade by binade, so the error grows linearly;
@@ -147,13 +169,12 @@ def clock_errors(mode: Mode, scene_name: str = 'khurmi_four_bar_ad150',
     import mpmath
 
     from .. import reference as ref_mod
-    from ...ros.timebase import CrankTimebase
     scene = load_scene(scene_name)
     model = ref_mod.Model(scene)
     theta0 = scene.input.angle
     dt = 1.0 / TICK_HZ
     rows = []
-    check: dict[str, Any] = {'brute_ticks': 0, 'brute_equal': True}
+    check: dict[str, Any] = {'brute_ticks': 0, 'brute_equal': True, 'turns_equal': True}
     with mpmath.workdps(60):
         two_pi = 2 * mpmath.pi
         for rpm in mode.clock_rpms:
@@ -177,18 +198,29 @@ def clock_errors(mode: Mode, scene_name: str = 'khurmi_four_bar_ad150',
             end = trace[-1][1]
             check.setdefault('wrapped_fit', {})[rpm] = float(abs(early * trace[-1][0] - end)
                                                              / abs(end)) if end else 0.0
-            timebase = CrankTimebase(0, theta0, rpm, 0.0, abs(rpm))
+            grid, timebase = node_clock(rpm, theta0)
+            t0 = grid.next_ns
             for label, seconds in mode.clock_durations:
                 angle_error: dict[str, float] = {}
                 state_error: dict[str, float] = {}
                 model_used = seconds * TICK_HZ > wrapped_ticks
                 # The last CLOCK_TICKS ticks up to the run time: at a whole number of
-                # turns every method may land on the start angle by luck.
-                for ticks in range(seconds * TICK_HZ - CLOCK_TICKS + 1, seconds * TICK_HZ + 1):
-                    exact_turns = Fraction(rpm) * ticks / (60 * TICK_HZ)
+                # turns every method may land on the start angle by luck. The node's grid
+                # owes them at the run time's instant (one wake-up after a long sleep).
+                period = grid.period_ns
+                due = grid.take(t0 + seconds * TICK_HZ * period, (CLOCK_TICKS - 1) * period)
+                stamps = list(due.instants)
+                check.setdefault('grid_instants', []).append(len(stamps))
+                for ticks, stamp in zip(range(seconds * TICK_HZ - CLOCK_TICKS + 1,
+                                              seconds * TICK_HZ + 1), stamps, strict=True):
+                    exact_turns = Fraction(rpm) * (stamp - t0) / (60 * NS_PER_S)
+                    unwrapped = mpmath.mpf(theta0) + two_pi * mpmath.mpf(exact_turns)
                     exact = _wrap_mp(mpmath.mpf(theta0) + two_pi * _frac(exact_turns))
                     angles: dict[str, float] = {}
-                    angles['timebase'] = timebase.sample(ticks * (NS_PER_S // TICK_HZ)).angle
+                    turns, sample = timebase.sample_turns(stamp)
+                    angles['timebase'] = sample.angle
+                    whole = int(mpmath.nint((unwrapped - sample.angle) / two_pi))
+                    check['turns_equal'] = check.get('turns_equal', True) and turns == whole
                     angles['naive'] = naive_accumulate(theta0, step, ticks)
                     if not model_used:
                         angles['naive, wrapped'] = naive_wrapped(theta0, step, ticks)
@@ -196,7 +228,10 @@ def clock_errors(mode: Mode, scene_name: str = 'khurmi_four_bar_ad150',
                         angles['naive, wrapped'] = float(_wrap_mp(exact + rate * ticks))
                     ref = ref_mod.reference(model, exact, omega, 0.0)
                     for method, angle in angles.items():
-                        error = float(abs(_wrap_mp(mpmath.mpf(angle) - exact)))
+                        if method == 'naive':
+                            error = float(abs(mpmath.mpf(angle) - unwrapped))
+                        else:
+                            error = float(abs(_wrap_mp(mpmath.mpf(angle) - exact)))
                         angle_error[method] = max(angle_error.get(method, 0.0), error)
                         state = quiet_solve(scene, angle, omega, 0.0)
                         error = max(ref_mod.compare(state, ref).values())

@@ -4,8 +4,9 @@
 
 :class:`Mode` and :data:`MODES` say how much a run does (``full``,
 ``--quick``, ``--smoke``); :data:`WP_SCENES` names the work-precision
-mechanisms; :func:`median_time` is the one timer and :func:`quiet_solve`
-the solver with its near-singularity warning silenced. :func:`four_bar`,
+mechanisms; :func:`spread_time` (min / median / max) and :func:`median_time`
+are the timers and :func:`quiet_solve` the solver with its near-singularity
+warning silenced. :func:`four_bar`,
 :func:`slider_crank` and :func:`distance_angle` build the mechanisms of the
 extreme sections (:mod:`.extreme`, :mod:`.bounds`).
 """
@@ -26,7 +27,7 @@ from ...errors import NearSingularWarning
 from ...linkage import Branch, CarriedPoint, Crank, Link, RRP, RRR, Scene, solve
 
 __all__ = ['DURATIONS', 'EPS', 'ERROR_FLOOR', 'MODES', 'Mode', 'WP_SCENES', 'distance_angle',
-           'four_bar', 'median_time', 'quiet_solve', 'slider_crank', 'slug']
+           'four_bar', 'median_time', 'quiet_solve', 'slider_crank', 'slug', 'spread_time']
 
 EPS = float(np.finfo(np.float64).eps)
 #: Relative errors below this are drawn at this floor on log axes.
@@ -61,6 +62,8 @@ class Mode:
     repeat: int
     bound_samples: int                 # angles per error-bound case without a singular position
     bound_grid: int                    # evenly spaced angles of the refused-fraction grid
+    bench_angles: int = 100_000        # angles of the array path in ``bench``'s table
+    bench_repeat: int = 7              # runs of ``bench``'s timings (its default)
 
 
 #: The simulated run times of the node's clock: (label, seconds).
@@ -77,22 +80,32 @@ MODES = {
                   (1e-4, 1e-8, 1e-12), tuple(WP_SCENES), 1,
                   ('khurmi_four_bar_ad150', 'quick_return', 'geneva', 'six_link_slider'),
                   DURATIONS, (10.0, 1000.0, 100_000.0), 1_000_000, 200_000, 2,
-                  tuple(10 ** k for k in range(7)), (1, 4, 16, 64), 1000, 3, 2, 720),
+                  tuple(10 ** k for k in range(7)), (1, 4, 16, 64), 1000, 3, 2, 720, 10_000, 3),
     'smoke': Mode('smoke', 6, 256, (1e-4, 1e-10), (1e-3,), (1e-6,), ('four-bar', 'Geneva'), 1,
                   ('khurmi_four_bar_ad150', 'geneva'), DURATIONS[:3] + DURATIONS[4:],
-                  (1000.0,), 100_000, 20_000, 0, (1, 100, 10_000), (1, 8), 200, 2, 1, 180),
+                  (1000.0,), 100_000, 20_000, 0, (1, 100, 10_000), (1, 8), 200, 2, 1, 180,
+                  1000, 2),
 }
 
 
-def median_time(fn: Callable[[], Any], repeat: int, number: int = 1) -> float:
-    """Median over ``repeat`` runs of the time of ``number`` calls of ``fn``, s."""
+def spread_time(fn: Callable[[], Any], repeat: int,
+                number: int = 1) -> tuple[float, float, float]:
+    """Min, median and max over ``repeat`` runs of the time of one call of ``fn``, s.
+
+    Each run times ``number`` calls.
+    """
     times = []
     for _ in range(max(repeat, 1)):
         start = time.perf_counter()
         for _ in range(number):
             fn()
-        times.append(time.perf_counter() - start)
-    return statistics.median(times) / number
+        times.append((time.perf_counter() - start) / number)
+    return min(times), statistics.median(times), max(times)
+
+
+def median_time(fn: Callable[[], Any], repeat: int, number: int = 1) -> float:
+    """Median over ``repeat`` runs of the time of ``number`` calls of ``fn``, s."""
+    return spread_time(fn, repeat, number)[1]
 
 
 def quiet_solve(scene: Scene, angle: Any, speed: Any = None, accel: Any = None) -> Any:

@@ -20,7 +20,7 @@ from typing import Any
 import warnings
 
 from .common import distance_angle, EPS, four_bar, Mode, MODES, slider_crank
-from ...errors import AssemblyError, NearSingularWarning
+from ...errors import AssemblyError, NearSingularWarning, UntrustedError
 from ...linkage import CarriedPoint, Crank, RPR, Scene, solve
 from ...scene import load_scene
 from ...units import rad_per_s_from_rpm, radians_from_degrees
@@ -126,7 +126,7 @@ class AngleResult:
     """The solver against the reference at one crank instant of a case."""
 
     angle: float
-    flag: str                   # 'refused', 'warned' or 'none'
+    flag: str                   # 'refused', 'untrusted', 'warned' or 'none'
     measure_solver: float       # the solver's smallest measure (nan: refused)
     measure_exact: float        # the same measure from the reference (nan: no assembly)
     reference: str              # 'regular', 'singular' or 'no assembly'
@@ -146,7 +146,7 @@ class CaseResult:
     @property
     def flag(self) -> str:
         """The strongest flag over the instants."""
-        rank = {'none': 0, 'warned': 1, 'refused': 2}
+        rank = {'none': 0, 'warned': 1, 'untrusted': 2, 'refused': 3}
         return max((a.flag for a in self.angles), key=rank.__getitem__)
 
     @property
@@ -208,6 +208,16 @@ def _solve_flagged(scene: Scene, angle: float, speed: float | None,
             state = solve(scene, angle, speed, accel, max_error=math.inf)
         except AssemblyError:
             return None, 'refused'
+    # What a user gets at the default tolerance: the solver refuses where its bounds
+    # exceed max_error times the scale (UntrustedError), before any warning.
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter('ignore', NearSingularWarning)
+            solve(scene, angle, speed, accel)
+    except UntrustedError:
+        return state, 'untrusted'
+    except AssemblyError:
+        return state, 'refused'
     warned = any(issubclass(w.category, NearSingularWarning) for w in caught)
     return state, 'warned' if warned else 'none'
 

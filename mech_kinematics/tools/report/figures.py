@@ -146,7 +146,7 @@ def plot_extreme(results: list[CaseResult], path: Path) -> None:
     """Draw each case's error against eps * kappa, with the bound."""
     def draw(fig: Any) -> None:
         ax = fig.subplots()
-        colors = {'none': 'C0', 'warned': 'C1', 'refused': 'C3'}
+        colors = {'none': 'C0', 'warned': 'C1', 'untrusted': 'C2', 'refused': 'C3'}
         seen = set()
         for i, r in enumerate(results):
             if not r.errors:

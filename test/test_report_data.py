@@ -1,0 +1,124 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""One source for every number (issue 19): the data file, and README and docs against it.
+
+Every figure that README.md and docs/*.md quote from the report carries its
+key (``2.8e-7<!--=clock.naive_1h.min-->``) or lies in a generated block;
+:func:`check_text` must find nothing wrong with them against the committed
+docs/report/data.json, and must catch a figure that differs.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from mech_kinematics.tools.report import data as data_mod
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = ROOT / 'docs' / 'report' / 'data.json'
+#: Keys docs/accuracy.md must quote (its "Accuracy and speed" headline and tables).
+REQUIRED_KEYS = ('summary.ours_acceleration', 'summary.golden_max',
+                 'summary.newton_cost_ratio.min', 'summary.single_over_newton.max',
+                 'clock.timebase_year.max', 'clock.naive_1h.min', 'clock.naive_year.max',
+                 'bounds.values', 'bounds.min', 'bounds.median', 'bounds.tightness',
+                 'cost.batch_slope', 'long_run.run_time_s', 'elapsed_s')
+
+SAMPLE = {'a': {'b': 2.83e-7, 'n': 2886}, 't': [0.30, 0.32, 0.36],
+          'bench': {'angles': 10, 'repeat': 3, 'rows': [
+              {'scene': 's', 'single_us': [1.0, 2.0, 3.0], 'array_us': [0.1, 0.2, 0.3],
+               'single_ratio': 2.0, 'array_ratio': 2.0},
+              {'scene': 's (hand-written)', 'single_us': [1.0] * 3, 'array_us': [0.1] * 3,
+               'baseline_of': 's'}]}}
+
+
+@pytest.fixture(scope='module')
+def committed():
+    """Return the committed data file."""
+    return data_mod.read_data(DATA)
+
+
+@pytest.mark.parametrize('path', [ROOT / 'README.md', *sorted((ROOT / 'docs').glob('*.md')),
+                                  ROOT / 'bench' / 'README.md'],
+                         ids=lambda p: str(p.relative_to(ROOT)))
+def test_docs_agree_with_the_data_file(path, committed):
+    """Every quoted figure and generated block of README and docs matches docs/report/data.json."""
+    assert data_mod.check_text(path.read_text(encoding='utf-8'), committed, path.name) == []
+
+
+def test_accuracy_doc_quotes_the_data_file(committed):
+    """docs/accuracy.md quotes its headline figures from the data file, and its tables."""
+    text = (ROOT / 'docs' / 'accuracy.md').read_text(encoding='utf-8')
+    for key in REQUIRED_KEYS:
+        assert f'<!--={key}-->' in text, key
+        data_mod.lookup(committed, key)
+    for block in ('bench', 'refused', 'long_run'):
+        assert f'<!--data:{block}-->' in text, block
+
+
+def test_the_real_run_of_the_node_is_recorded(committed):
+    """The data file holds one real run of the node of at least ten minutes, with its date."""
+    run = committed['long_run']
+    assert run['run_time_s'] >= 600 and run['date'].startswith('20')
+    assert run['received'] <= run['owed'] and run['samples'] >= 600
+
+
+def test_a_figure_that_differs_is_caught():
+    """A plain value must round to the figure as written; the line and the key are named."""
+    good = 'off by 2.8e-7<!--=a.b--> rad; 2,886<!--=a.n--> values'
+    assert data_mod.check_text(good, SAMPLE) == []
+    assert data_mod.check_text('2.83e-7<!--=a.b-->', SAMPLE) == []
+    problems = data_mod.check_text('x\n2.9e-7<!--=a.b-->', SAMPLE, 'doc.md')
+    assert len(problems) == 1 and problems[0].startswith('doc.md:2: 2.9e-7 quotes a.b')
+    assert data_mod.check_text('2885<!--=a.n-->', SAMPLE) != []
+    assert 'lacks' in data_mod.check_text('1<!--=a.c-->', SAMPLE)[0]
+    assert data_mod.check_text('3<!--=a-->', SAMPLE) != []
+
+
+def test_a_timing_passes_within_its_spread():
+    """A timing quoted from [min, median, max] passes between min and max, at its precision."""
+    for figure in ('0.30', '0.3', '0.33', '0.36', '0.4'):
+        assert data_mod.check_text(f'{figure}<!--=t-->', SAMPLE) == [], figure
+    for figure in ('0.28', '0.37', '0.5'):
+        assert data_mod.check_text(f'{figure}<!--=t-->', SAMPLE) != [], figure
+
+
+def test_generated_blocks_are_checked_and_rewritten():
+    """A block that differs from its rendering is caught; update_text rewrites it."""
+    stale = 'before\n<!--data:bench-->\n| old |\n<!--data:end-->\nafter\n'
+    problems = data_mod.check_text(stale, SAMPLE, 'doc.md')
+    assert problems == ['doc.md:2: block bench differs from the data file (rewrite it with '
+                        'data.update_text)']
+    fresh = data_mod.update_text(stale, SAMPLE)
+    assert data_mod.check_text(fresh, SAMPLE) == []
+    assert fresh.startswith('before\n<!--data:bench-->\n| scene |') and fresh.endswith(
+        '<!--data:end-->\nafter\n')
+    assert '| s | 1.00 / 2.00 / 3.00 | 2.00× | 0.100 / 0.200 / 0.300 | 2.00× |' in fresh
+    assert 'block nope needs' in data_mod.check_text('<!--data:nope-->\n<!--data:end-->',
+                                                     SAMPLE)[0]
+
+
+def test_write_data_keeps_the_long_run(tmp_path):
+    """A new report keeps the folder's real run of the node unless given a new one."""
+    run = tmp_path / 'run.json'
+    run.write_text(json.dumps({'date': '2026-11-24', 'run_time_s': 600.0}))
+    data_mod.write_data(tmp_path, {'x': 1}, run)
+    data_mod.write_data(tmp_path, {'x': 2})
+    written = data_mod.read_data(tmp_path / data_mod.DATA_FILE)
+    assert written == {'x': 2, 'long_run': {'date': '2026-11-24', 'run_time_s': 600.0}}
+
+
+def test_update_text_rewrites_figures_in_their_written_form():
+    """Figures keep their decimals, exponent and separators; timings become their median."""
+    text = 'a 9.9e-9<!--=a.b--> b 1<!--=a.n--> c 1,000<!--=a.n--> d 0.000<!--=t-->'
+    assert data_mod.update_text(text, SAMPLE) == ('a 2.8e-7<!--=a.b--> b 2886<!--=a.n--> c '
+                                                  '2,886<!--=a.n--> d 0.320<!--=t-->')
+
+
+def test_examples_in_inline_code_are_not_figures():
+    """The form shown in backticks is an example: neither checked nor rewritten."""
+    text = 'write `2.8e-7<!--=key-->` after 2.8e-7<!--=a.b-->'
+    assert data_mod.check_text(text, SAMPLE) == []
+    assert data_mod.update_text(text, SAMPLE) == text
