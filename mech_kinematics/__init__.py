@@ -15,10 +15,10 @@ NumPy and PyYAML only; nothing here imports rclpy.
 from .bounds import Bounds, ErrorBound, MAX_ERROR
 from .errors import (AssemblyError, MechKinematicsError, NearSingularWarning, SceneError,
                      UntrustedError)
-from .linkage import (assembly_text, Branch, CarriedPoint, Crank, Engagement, JointMotion, Link,
-                      MAX_SLOTS, NEAR_SINGULAR, Pin, PointState, RPR, RRP, RRR, Scene, SINGULAR,
-                      solve, State, TANGENCY_TOLERANCE, Units)
 from .scene import DEFAULT_SCENE, load_scene, parse_scene, scene_names
+from .solver import (assembly_text, Branch, CarriedPoint, Crank, Engagement, JointMotion, Link,
+                     MAX_SLOTS, NEAR_SINGULAR, Pin, PointState, RPR, RRP, RRR, Scene, SINGULAR,
+                     solve, State, TANGENCY_TOLERANCE, Units)
 
 __all__ = [
     'AssemblyError', 'Bounds', 'Branch', 'CarriedPoint', 'Crank', 'DEFAULT_SCENE', 'Engagement',

@@ -50,7 +50,7 @@ from yaml.events import (AliasEvent, DocumentEndEvent, DocumentStartEvent, Mappi
                          StreamEndEvent, StreamStartEvent)
 
 from .errors import SceneError
-from .linkage import Branch, CarriedPoint, Crank, Link, MAX_SLOTS, Pin, RPR, RRP, RRR, Scene, Units
+from .solver import Branch, CarriedPoint, Crank, Link, MAX_SLOTS, Pin, RPR, RRP, RRR, Scene, Units
 from .units import ANGLE_UNITS, LENGTH_UNITS, rad_per_s_from_rpm
 
 __all__ = [

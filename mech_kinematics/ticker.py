@@ -7,7 +7,7 @@ dictionary lookup, attribute read and object the general solver makes, and,
 waking from a sleep each tick with cold caches, for the size of the code it
 runs. :func:`compile_tick` removes that overhead without writing the
 kinematics a second time: it specializes the solver's own step code (the
-``run`` methods of :mod:`mech_kinematics.linkage`) to the scalar path of one
+``run`` methods of the step kinds of :mod:`mech_kinematics.solver`) to the scalar path of one
 scene by partial evaluation of their syntax trees.
 
 - ``ctx.vector`` becomes ``False`` and every branch it decides is folded
@@ -37,10 +37,14 @@ from collections.abc import Callable, Sequence
 import inspect
 import itertools
 import math
+import sys
 import textwrap
 from typing import Any, cast
 
-from . import linkage as lk
+from . import solver as lk
+from .solver.context import _Context
+from .solver.scaling import _ACCEL_HIGH, _RATE_HIGH, _RATE_LOW
+from .solver.solve import _wrapped_angle
 
 __all__ = ['TickFunction', 'compile_tick', 'tick_function', 'values_from_state']
 
@@ -48,6 +52,7 @@ __all__ = ['TickFunction', 'compile_tick', 'tick_function', 'values_from_state']
 #: measure)``; ``theta + 2 pi turns`` is the crank angle counted from the start.
 TickFunction = Callable[[float, float, float, float, int], tuple[list[float], float]]
 
+_SOLVER = lk.__name__ + '.'
 _TABLES = {'points': 'P', 'links': 'L', 'sliders': 'S', 'measures': 'M'}
 
 
@@ -157,7 +162,7 @@ class _Specializer(ast.NodeTransformer):
 
     def visit_Call(self, node: ast.Call) -> ast.AST:
         func = node.func
-        inlined = _inline(func, node.args) if not node.keywords else None
+        inlined = _inline(func, node.args, self.namespace) if not node.keywords else None
         if inlined is not None:
             result: ast.AST = self.visit(ast.copy_location(inlined, node))
             return result
@@ -180,8 +185,9 @@ class _Specializer(ast.NodeTransformer):
         return node
 
 
-def _inline(func: ast.expr, args: list[ast.expr]) -> ast.expr | None:
-    """Return the call of a one-line helper of the linkage module written out, or None.
+def _inline(func: ast.expr, args: list[ast.expr],
+            namespace: dict[str, Any]) -> ast.expr | None:
+    """Return the call of a one-line helper of the solver package written out, or None.
 
     A module function whose body is ``return <expression>`` (``_dot``,
     ``_cross``), called with plain names or constants, becomes its expression
@@ -190,8 +196,8 @@ def _inline(func: ast.expr, args: list[ast.expr]) -> ast.expr | None:
     simple = all(isinstance(a, (ast.Name, ast.Constant)) for a in args)
     if not (isinstance(func, ast.Name) and simple):
         return None
-    helper = vars(lk).get(func.id)
-    if not inspect.isfunction(helper) or helper.__module__ != lk.__name__:
+    helper = namespace.get(func.id)
+    if not inspect.isfunction(helper) or not helper.__module__.startswith(_SOLVER):
         return None
     definition = ast.parse(textwrap.dedent(inspect.getsource(helper))).body[0]
     if not (isinstance(definition, ast.FunctionDef) and len(definition.body) == 1
@@ -233,15 +239,15 @@ def _body(step: Any, method: Callable[..., Any], suffix: str, names: dict[str, s
 
 
 def _ctx_check(theta: float, turns: int, *args: Any, **kwargs: Any) -> None:
-    lk._Context(theta, False, turns).check(*args, **kwargs)
+    _Context(theta, False, turns).check(*args, **kwargs)
 
 
 def _ctx_check_margin(theta: float, turns: int, *args: Any, **kwargs: Any) -> None:
-    lk._Context(theta, False, turns).check_margin(*args, **kwargs)
+    _Context(theta, False, turns).check_margin(*args, **kwargs)
 
 
 def _shown(theta: float, turns: int) -> Any:
-    return lk._Context(theta, False, turns).shown
+    return _Context(theta, False, turns).shown
 
 
 def values_from_state(state: lk.State, joints: Sequence[str], points: Sequence[str],
@@ -343,7 +349,13 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
         '_slow': _general(scene, joints, points, frames),
         'inf': math.inf,
     }
-    namespace.update((k, v) for k, v in vars(lk).items() if not k.startswith('__'))
+    for step in (plan.crank, *plan.steps):
+        for cls in type(step).__mro__:
+            home = sys.modules[cls.__module__]
+            if home.__name__.startswith(_SOLVER):
+                namespace.update((k, v) for k, v in vars(home).items()
+                                 if not k.startswith('__'))
+    namespace['_wrapped_angle'] = _wrapped_angle
     names: dict[str, str] = {}
     body: list[ast.stmt] = []
     try:
@@ -405,8 +417,8 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
     lines.append(f'return [{", ".join(values)}], {measure}')
     tail = ast.parse('\n'.join(lines)).body
     guard = ast.parse(
-        f'if not ({lk._RATE_LOW!r} <= abs(omega) <= {lk._RATE_HIGH!r} '
-        f'and abs(alpha) <= {lk._ACCEL_HIGH!r}):\n'
+        f'if not ({_RATE_LOW!r} <= abs(omega) <= {_RATE_HIGH!r} '
+        f'and abs(alpha) <= {_ACCEL_HIGH!r}):\n'
         '    return _slow(theta, omega, alpha, tol, turns)').body
     function = ast.FunctionDef(
         name='tick', args=ast.arguments(

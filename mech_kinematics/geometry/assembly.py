@@ -46,7 +46,7 @@ import numpy.typing as npt
 
 from .instant_centres import full_scene
 from ..errors import AssemblyError, NearSingularWarning
-from ..linkage import RPR, RRP, RRR, Scene, solve, Units
+from ..solver import RPR, RRP, RRR, Scene, solve, Units
 
 __all__ = [
     'Assembly', 'DeadCentre', 'FourBarLoop', 'SAMPLES', 'TOLERANCE', 'Toggle', 'Transmission',

@@ -40,7 +40,7 @@ import numpy.typing as npt
 from .instant_centres import (bodies_from_scene, BodyKind, check_full_state, full_scene,
                               instant_centres_from_state, InstantCentres, Topology)
 from ..errors import NearSingularWarning
-from ..linkage import RPR, RRP, RRR, Scene, solve, State
+from ..solver import RPR, RRP, RRR, Scene, solve, State
 
 __all__ = [
     'COLOURS', 'Diagram', 'GuideLine', 'LinkShape', 'LinkValues', 'PinValues', 'Pivot',

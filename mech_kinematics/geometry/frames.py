@@ -19,7 +19,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from ..linkage import RPR, RRP, RRR, Scene, State
+from ..solver import RPR, RRP, RRR, Scene, State
 
 __all__ = ['FrameSpec', 'Pose', 'angle_joints', 'frames_from_scene', 'origin_points',
            'poses_from_state']

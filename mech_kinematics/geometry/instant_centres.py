@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ..linkage import RPR, RRP, RRR, Scene, State
+from ..solver import RPR, RRP, RRR, Scene, State
 
 __all__ = [
     'GROUND', 'Body', 'BodyKind', 'Centre', 'InstantCentre', 'InstantCentres', 'Topology',

@@ -21,8 +21,8 @@ from typing import Any
 import numpy as np
 
 from ..cli import positive_int, run_tool
-from ..linkage import solve
 from ..scene import load_scene, scene_names
+from ..solver import solve
 
 # The hand-written baselines solve the packaged scenes' own geometry.
 FOUR_BAR = 'khurmi_four_bar_ad150'  # AD = 150, AB = 40, BC = 150, CD = 80 mm

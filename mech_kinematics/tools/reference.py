@@ -48,8 +48,8 @@ import numpy as np
 import yaml
 
 from ..errors import SceneError
-from ..linkage import RPR, RRP, RRR, Scene
 from ..scene import read_scene_yaml
+from ..solver import RPR, RRP, RRR, Scene
 from ..units import ANGLE_UNITS, LENGTH_UNITS, radians_from_degrees
 
 __all__ = ['DIGITS', 'DPS', 'Jet', 'Model', 'NoAssembly', 'Reference', 'as_float_dict',

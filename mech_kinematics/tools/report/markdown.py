@@ -27,7 +27,7 @@ from .common import EPS, Mode, slug
 from .cost import CHUNK, CostGrowth
 from .extreme import BOUND_FACTOR, CaseResult, digits_lost, FormulaAudit
 from ...bounds import MAX_ERROR, ROUNDING_MARGIN
-from ...linkage import NEAR_SINGULAR, SINGULAR
+from ...solver import NEAR_SINGULAR, SINGULAR
 
 __all__ = ['write_report']
 

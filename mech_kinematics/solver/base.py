@@ -1,0 +1,172 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""What every step kind provides: the protocol between a kind and the rest of the solver.
+
+A mechanism is a driving crank followed by *items* solved one after another
+in closed form: dyads (``RRR``, ``RRP``, ``RPR``, ...) and points carried by
+links. Each kind of item is one module of this package holding two classes:
+
+- the **item**, a frozen dataclass whose fields are the scene's keys for it
+  (:class:`Item`): it validates them, says which names it defines and which
+  it needs, and builds its step (:meth:`Item.place`);
+- the **step** (:class:`Step`), run once per solve: it reads the values known
+  so far from the solve's context and writes what it defines, each value with
+  its error bound (:mod:`mech_kinematics.bounds`).
+
+The plan compiler, the rescaling, the solver and the tools only call these
+methods; none of them tests which kind an item is. ``KINDS`` maps the
+scene's ``type:`` to the item class
+(:mod:`.registry`).
+
+The kernel subset of ``Step.run``
+---------------------------------
+The node's tick (:mod:`mech_kinematics.ticker`) partially evaluates every
+step's ``run`` into one straight-line function, so ``run`` must be written in
+the subset that the ticker understands; anything else makes the scene fall
+back to the general solver, and ``test_ticker`` fails for a packaged scene
+that falls back:
+
+- ``run(self, ctx)`` (the crank's ``run(self, ctx, theta, omega, alpha)``) is
+  a plain method: no ``for``/``while`` loop, ``return``, ``try``, ``with``,
+  ``yield``, nested ``def``, ``global`` or ``nonlocal``; lambdas only without
+  arguments (the deferred messages of ``ctx.check``);
+- the context is used only as ``ctx.vector``, ``ctx.points[...]``,
+  ``ctx.links[...]``, ``ctx.sliders[...]``, ``ctx.measures[...]`` (read or
+  assigned whole), ``ctx.check(...)``, ``ctx.check_margin(...)`` and
+  ``ctx.shown``; table keys are ``self.<attribute>`` (a name fixed when the
+  step is built);
+- ``self.<attribute>`` is read only (it becomes a constant); helpers whose
+  body is one ``return <expression>`` (as ``_dot`` of :mod:`.context`) are written
+  out in place; other names are the step module's globals.
+
+``ctx.vector`` is ``False`` in the tick function and every branch it decides
+is folded away, so a step keeps its scalar and array paths in one ``run``.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Callable, Iterator, Mapping
+from typing import Any, ClassVar, Protocol, TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from .context import _Context
+    from .model import Where
+    from .state import Engagement
+
+#: A body at a pin, for rubbing: ``('link', name)``, ``('still', name)`` or ``('block', lever)``.
+Body = tuple[str, str]
+
+
+class Step(ABC):
+    """The part of a step kind that runs in every solve.
+
+    Attributes
+    ----------
+    label : str
+        The dyad's label in messages and failures, e.g. ``'RRR C'``.
+    key : str
+        The key of its near-singularity measure (``State.singularity``).
+    uses : tuple of str
+        The points (and links) its ``run`` reads.
+    defines : tuple of str
+        The names it computes (points, links, sliders).
+    new_points : tuple of str
+        The points among ``defines``, in the order they are reported.
+    unit : float
+        Metres per length unit of the plan, for messages (the solver sets it
+        for a rescaled scene).
+    owner : str or None
+        For a step that moves no link of its own (a carried point): the link
+        whose dyad's label its values carry; else ``None``.
+    dyad : object
+        The scene item it was built from.
+    intermittent : bool
+        Whether it is an intermittent lever (``State.intermittent``).
+    """
+
+    label: str = ''
+    key: str = ''
+    uses: tuple[str, ...] = ()
+    defines: tuple[str, ...] = ()
+    new_points: tuple[str, ...] = ()
+    unit: float = 1.0
+    owner: str | None = None
+    dyad: Any = None
+    intermittent: ClassVar[bool] = False
+
+    @abstractmethod
+    def run(self, ctx: _Context) -> None:
+        """Compute what the step defines into ``ctx`` (see the module's kernel subset)."""
+
+    @property
+    def requires(self) -> tuple[str, ...]:
+        """Names whose steps must run before this one (its uses and its owner)."""
+        return self.uses if self.owner is None else (*self.uses, self.owner)
+
+
+class Intermittent(Protocol):
+    """A step whose ``intermittent`` is true: it reports where its lever is in its cycle."""
+
+    def engagement(self, ctx: _Context, omega: Any, finish: Any) -> Engagement:
+        """Return its :class:`~.state.Engagement` from a solve's context."""
+
+
+class Names(Protocol):
+    """What the plan compiler lets an item check its references against."""
+
+    kinds: Mapping[str, str]
+
+    def point(self, name: str, what: str, where: Where) -> str:
+        """Return ``name`` if it is a known point, else raise a :class:`SceneError`."""
+
+    def ground(self, name: str, what: str, where: Where) -> str:
+        """Return ``name`` if it is a ground point, else raise a :class:`SceneError`."""
+
+    def link(self, name: str, what: str, where: Where) -> str:
+        """Return ``name`` if it is a known link, else raise a :class:`SceneError`."""
+
+
+class Placing(Protocol):
+    """What the plan compiler lets an item build its step from.
+
+    ``ground`` maps ground points to positions; ``local[link]`` the points
+    fixed on each link to their coordinates in the link's frame (origin at its
+    start, x along it; an item adds its own links); ``slot[lever]`` a slotted
+    lever's (pivot, pin); ``size`` the mechanism's size, m; ``scene`` the scene.
+    """
+
+    ground: Mapping[str, complex]
+    local: dict[str, dict[str, complex]]
+    slot: dict[str, tuple[str, str]]
+    size: float
+    scene: Any
+
+
+class Item(Protocol):
+    """A scene item (a dyad or a carried point): what the solver asks of its kind."""
+
+    @property
+    def key(self) -> str:
+        """Return the name the item is known by in messages (its new point or its lever)."""
+
+    def defined(self) -> Iterator[tuple[str, str, Where]]:
+        """Yield (name, ``'point'``/``'link'``/``'slider'``, where) of every name it defines."""
+
+    def joint_types(self) -> dict[str, str]:
+        """Return joint name -> ``'revolute'`` or ``'prismatic'`` of the joints it moves."""
+
+    def prerequisites(self, names: Names) -> set[str]:
+        """Check the names it refers to; return those its step waits for."""
+
+    def place(self, plan: Placing) -> Step:
+        """Return its step, its prerequisites known; record the points fixed on its links."""
+
+    def lengths(self) -> tuple[float, ...]:
+        """Return its link lengths, m, which count in the mechanism's size."""
+
+    def scaled(self, scale: Callable[[float], float]) -> Item:
+        """Return it with every length ``x`` replaced by ``scale(x)``."""
+
+    def bodies(self) -> Iterator[tuple[str, str, Body]]:
+        """Yield (point, body name, body) of every body besides links it puts at a point."""

@@ -1,0 +1,168 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The RPR dyad: a slotted lever turning about a ground pivot, through a known pin."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .base import Body, Names, Placing, Step
+from .context import _Context, _cross, _dot, _U2, _U4, _U7, SINGULAR
+from .model import _check_name, Where
+from ..bounds import ROUNDING_MARGIN, U
+from ..errors import SceneError
+
+#: Most slots of an intermittent (Geneva) lever.
+MAX_SLOTS = 1000
+
+
+@dataclass(frozen=True)
+class RPR:
+    """A slotted ``link`` turning about ground point ``center``, through pin ``through``.
+
+    With ``slots`` (an integer n >= 3) the link is an intermittent (Geneva)
+    wheel: n slots evenly spaced, driven by the pin only while it is in one.
+    The pin must be a point fixed on the crank, entering the slots
+    tangentially (crank radius of the pin ``R = l sin(pi / n)`` for the
+    distance ``l`` between the crank's centre and ``center``, within
+    :data:`TANGENCY_TOLERANCE`); between engagements the wheel is locked, and
+    each engagement indexes it by ``2 pi / n`` against the crank's sense. The
+    link's angle is that of its slot 0: the slot the pin is in during the
+    engagement centred on the crank angle that points the pin at ``center``
+    in the crank's turn 0 (so in that engagement the angle is the plain RPR
+    one, from ``center`` toward the pin).
+    """
+
+    link: str
+    center: str
+    through: str
+    slider: str
+    slots: int | None = None
+
+    def __post_init__(self) -> None:
+        """Validate the fields."""
+        _check_name(self.link, 'an RPR link', (self, 'link'))
+        _check_name(self.center, f'the center of RPR "{self.link}"', (self, 'center'))
+        _check_name(self.through, f'the pin of RPR "{self.link}"', (self, 'through'))
+        _check_name(self.slider, f'the slider of RPR "{self.link}"', (self, 'slider'))
+        n = self.slots
+        if n is not None and (isinstance(n, bool) or not isinstance(n, int)
+                              or not 3 <= n <= MAX_SLOTS):
+            msg = (f'Expected the slots of RPR "{self.link}" to be an integer from 3 to '
+                   f'{MAX_SLOTS}, got {n!r}')
+            raise SceneError(msg, (self, 'slots'))
+
+    @property
+    def key(self) -> str:
+        """Return the lever."""
+        return self.link
+
+    def defined(self) -> Iterator[tuple[str, str, Where]]:
+        """Yield its lever and its slider."""
+        yield self.link, 'link', (self, 'link')
+        yield self.slider, 'slider', (self, 'slider')
+
+    def joint_types(self) -> dict[str, str]:
+        """Return its lever (revolute) and its slider (prismatic)."""
+        return {self.link: 'revolute', self.slider: 'prismatic'}
+
+    def prerequisites(self, names: Names) -> set[str]:
+        """Check its ground pivot; return its pin."""
+        names.ground(self.center, f'the center of RPR "{self.link}"', (self, 'center'))
+        return {names.point(self.through, f'the pin of RPR "{self.link}"', (self, 'through'))}
+
+    def place(self, plan: Placing) -> Step:
+        """Return its step (an intermittent one with ``slots``); its lever carries its pivot."""
+        step: Step
+        if self.slots is None:
+            step = _RPRStep(self, plan.ground[self.center], plan.size)
+        else:
+            from .geneva import _index_step  # the Geneva kind builds on this one
+            step = _index_step(plan, self)
+        plan.local[self.link] = {self.center: 0j}
+        plan.slot[self.link] = (self.center, self.through)
+        return step
+
+    def lengths(self) -> tuple[float, ...]:
+        """Return nothing: the lever's length varies."""
+        return ()
+
+    def scaled(self, scale: Callable[[float], float]) -> RPR:
+        """Return it unchanged: it holds no length."""
+        return self
+
+    def bodies(self) -> Iterator[tuple[str, str, Body]]:
+        """Yield the slider block at the pin (it turns with the lever)."""
+        yield self.through, self.slider, ('block', self.link)
+
+
+class _RPRStep(Step):
+
+    def __init__(self, dyad: RPR, center: complex, size: float) -> None:
+        self.dyad = dyad
+        self.label = f'RPR {dyad.link}'
+        self.key = dyad.link
+        self.link = dyad.link
+        self.through = dyad.through
+        self.slider = dyad.slider
+        self.center = center
+        self.center_name = dyad.center
+        self.size = size
+        self.uses = (dyad.through,)
+        self.defines = (dyad.link, dyad.slider)
+        self.e_center = U * abs(center)
+
+    def facts(self, s: float) -> dict[str, Any]:
+        """Return why the lever is singular, for a message in the scene's units."""
+        return {'kind': 'pivot', 'links': (self.link,), 'lengths': (),
+                'points': (self.through, self.center_name), 'distance': float(s) * self.unit}
+
+    def run(self, ctx: _Context) -> None:
+        b, vb, ab, eb, evb, eab = ctx.points[self.through]
+        d = b - self.center
+        s = np.hypot(d.real, d.imag) if ctx.vector else abs(d)
+        m = self.unit
+        # the slider coordinate relative to the mechanism's size.
+        measure = s / self.size
+        ok = measure > SINGULAR
+        if ctx.vector or not ok:
+            ctx.check(ok, self.label, lambda: (
+                f'the pin {self.through} is on the pivot (singular): expected its distance '
+                f'from the pivot > {SINGULAR * self.size * m:.3g} m, got {s * m:.3g} m'),
+                lambda: self.facts(s))
+        # The error of the pin relative to the pivot (and of s = |d|): within it of
+        # the pivot the lever's direction is not known at all.
+        ed = eb + self.e_center + _U2 * s
+        ok = s > ROUNDING_MARGIN * ed
+        if ctx.vector or not ok:
+            ctx.check_margin(ok, self.label, s * m, ed * m, lambda: (
+                f'the pin {self.through} is within rounding of the pivot: expected its '
+                f'distance from the pivot {s * m:.3g} m to exceed {ROUNDING_MARGIN:g} times '
+                f'its error bound {ed * m:.3g} m'), lambda: self.facts(s))
+        ctx.measures[self.key] = measure
+        inv_s = 1.0 / s
+        e = d * inv_s
+        sd = _dot(vb, e)
+        omega = _cross(e, vb) / s
+        sdd = _dot(ab, e) + s * omega * omega
+        # the Coriolis component 2 * omega * sd sits in the transverse balance.
+        alpha = (_cross(e, ab) - 2.0 * sd * omega) / s
+        # Bounds: the lever's direction is known to ed / s, and the pin's velocity
+        # and acceleration, whose components along and across it these are, to
+        # their bounds; |vb| <= |sd| + s |omega| and |ab| likewise. Since
+        # ed >= 2 U s, the terms in ed also hold the rounding of the last products.
+        ee = ed * inv_s + _U7
+        ee4 = ee + _U4
+        asd, aw = abs(sd), abs(omega)
+        esd = evb + (asd + s * aw) * ee4
+        ew = (esd + 2.0 * aw * ed) * inv_s
+        asdd, aal = abs(sdd), abs(alpha)
+        tab = eab + (asdd + s * (aw * aw + aal) + 2.0 * asd * aw) * ee4
+        ctx.links[self.link] = (e, omega, alpha, ee, ew,
+                                (tab + 2.0 * (asd * ew + aw * esd + aal * ed)) * inv_s)
+        ctx.sliders[self.slider] = (s, sd, sdd, ed, esd,
+                                    tab + 2.0 * aw * aw * ed + s * (2.0 * aw + ew) * ew)
