@@ -56,6 +56,13 @@ if TYPE_CHECKING:
 
 #: A body at a pin, for rubbing: ``('link', name)``, ``('still', name)`` or ``('block', lever)``.
 Body = tuple[str, str]
+#: Where a joint's frame sits: (joint, origin point, joint whose position is its angle or
+#: ``None``, fixed angle in rad when that is ``None``); see :mod:`mech_kinematics.geometry.frames`.
+Frame = tuple[str, str, str | None, float]
+#: A body an item adds: (name, kind: ``'link'``, ``'lever'`` or ``'slider'``, the points
+#: fixed on it, and for a slider block the body it slides on, ``ground`` standing for
+#: the ground; else ``None``); see :mod:`mech_kinematics.geometry.instant_centres`.
+Member = tuple[str, str, tuple[str, ...], str | None]
 
 
 class Step(ABC):
@@ -170,3 +177,15 @@ class Item(Protocol):
 
     def bodies(self) -> Iterator[tuple[str, str, Body]]:
         """Yield (point, body name, body) of every body besides links it puts at a point."""
+
+    def frames(self) -> Iterator[Frame]:
+        """Yield the frame of every joint it moves (:data:`Frame`, for ``/tf``)."""
+
+    def members(self, ground: str) -> Iterator[Member]:
+        """Yield every body it adds to the mechanism (:data:`Member`, for instant centres)."""
+
+    def slide_angle(self, slider: str, scene: Any, state: Any) -> float:
+        """Return the direction, rad, in which its block ``slider`` slides, in a solved state."""
+
+    def locked(self, state: Any) -> tuple[str, ...]:
+        """Return its bodies that move with the ground in a solved state (a locked wheel)."""

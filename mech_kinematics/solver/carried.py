@@ -7,8 +7,9 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, replace
 import math
+from typing import Any
 
-from .base import Body, Names, Placing, Step
+from .base import Body, Frame, Member, Names, Placing, Step
 from .context import _Context, _U16, _U2, _U4
 from .model import _check_finite, _check_name, _names, Where
 from ..bounds import U
@@ -97,6 +98,23 @@ class CarriedPoint:
     def bodies(self) -> Iterator[tuple[str, str, Body]]:
         """Yield nothing: it is fixed on its link."""
         yield from ()
+
+    def frames(self) -> Iterator[Frame]:
+        """Yield nothing: it moves no joint."""
+        yield from ()
+
+    def members(self, ground: str) -> Iterator[Member]:
+        """Yield nothing: it is a point of its link's body."""
+        yield from ()
+
+    def slide_angle(self, slider: str, scene: Any, state: Any) -> float:
+        """Return nothing useful: a carried point has no slider (never asked)."""
+        msg = f'Expected a slider of point "{self.name}", got "{slider}"'
+        raise KeyError(msg)
+
+    def locked(self, state: Any) -> tuple[str, ...]:
+        """Return no body."""
+        return ()
 
 
 class _CarryStep(Step):

@@ -6,11 +6,12 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+import math
 from typing import Any
 
 import numpy as np
 
-from .base import Body, Names, Placing, Step
+from .base import Body, Frame, Member, Names, Placing, Step
 from .context import _Context, _cross, _dot, _U2, _U4, _U7, SINGULAR
 from .model import _check_name, Where
 from ..bounds import ROUNDING_MARGIN, U
@@ -98,6 +99,35 @@ class RPR:
     def bodies(self) -> Iterator[tuple[str, str, Body]]:
         """Yield the slider block at the pin (it turns with the lever)."""
         yield self.through, self.slider, ('block', self.link)
+
+    def frames(self) -> Iterator[Frame]:
+        """Yield the lever's frame (at its pivot) and the block's (at the pin), along the lever."""
+        yield self.link, self.center, self.link, 0.0
+        yield self.slider, self.through, self.link, 0.0
+
+    def members(self, ground: str) -> Iterator[Member]:
+        """Yield its lever (carrying its pivot) and its block, which slides in the lever."""
+        yield self.link, 'lever', (self.center,), None
+        yield self.slider, 'slider', (self.through,), self.link
+
+    def slide_angle(self, slider: str, scene: Any, state: Any) -> float:
+        """Return the slot's direction: the lever's, or for a Geneva wheel the pin's slot's."""
+        if self.link in state.intermittent:
+            # A Geneva wheel: the slot the pin is in (not slot 0) lies along the pivot-pin
+            # line; while the wheel is locked the pin, out of the slot, moves with the
+            # crank, across the crank's radius (the pin is on the crank).
+            pin = complex(state.complex_points[self.through][0])
+            engaged = state.intermittent[self.link].engaged
+            start = self.center if engaged else scene.input.center
+            o = complex(state.complex_points[start][0])
+            return math.atan2(pin.imag - o.imag, pin.real - o.real) + (
+                0.0 if engaged else math.pi / 2)
+        return float(state.joints[self.link].position)
+
+    def locked(self, state: Any) -> tuple[str, ...]:
+        """Return its lever while a Geneva wheel is locked (it then moves with the ground)."""
+        engagement = state.intermittent.get(self.link)
+        return () if engagement is None or engagement.engaged else (self.link,)
 
 
 class _RPRStep(Step):

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from .base import Body, Names, Placing, Step
+from .base import Body, Frame, Member, Names, Placing, Step
 from .context import _Context, _cross, _dot, _U2, _U3, _U5, _U7, SINGULAR
 from .model import _check_finite, _check_name, _g, Branch, Link, Where
 from ..bounds import ROUNDING_MARGIN, U
@@ -74,6 +74,24 @@ class RRP:
     def bodies(self) -> Iterator[tuple[str, str, Body]]:
         """Yield the slider block at the new point (it does not turn)."""
         yield self.point, self.slider, ('still', self.slider)
+
+    def frames(self) -> Iterator[Frame]:
+        """Yield the link's frame (at its start, along it) and the block's (along the guide)."""
+        yield self.link.name, self.link.start, self.link.name, 0.0
+        yield self.slider, self.point, None, self.guide_angle
+
+    def members(self, ground: str) -> Iterator[Member]:
+        """Yield its link and its block, which slides on the ground."""
+        yield self.link.name, 'link', (self.link.start, self.point), None
+        yield self.slider, 'slider', (self.point,), ground
+
+    def slide_angle(self, slider: str, scene: Any, state: Any) -> float:
+        """Return the guide's angle."""
+        return self.guide_angle
+
+    def locked(self, state: Any) -> tuple[str, ...]:
+        """Return no body: an RRP never locks."""
+        return ()
 
 
 class _RRPStep(Step):

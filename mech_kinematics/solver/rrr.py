@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from .base import Body, Names, Placing, Step
+from .base import Body, Frame, Member, Names, Placing, Step
 from .context import _Context, _dot, _U16, _U2, _U3, _U7, SINGULAR
 from .model import _check_name, _g, Branch, Link, Where
 from ..bounds import ROUNDING_MARGIN, U
@@ -73,6 +73,25 @@ class RRR:
     def bodies(self) -> Iterator[tuple[str, str, Body]]:
         """Yield nothing: an RRR puts only links at its points."""
         yield from ()
+
+    def frames(self) -> Iterator[Frame]:
+        """Yield each link's frame: at its start, along it."""
+        for link in self.links:
+            yield link.name, link.start, link.name, 0.0
+
+    def members(self, ground: str) -> Iterator[Member]:
+        """Yield its two links, each carrying its start and the new pin."""
+        for link in self.links:
+            yield link.name, 'link', (link.start, self.point), None
+
+    def slide_angle(self, slider: str, scene: Any, state: Any) -> float:
+        """Return nothing useful: an RRR has no slider (never asked)."""
+        msg = f'Expected a slider of RRR "{self.point}", got "{slider}"'
+        raise KeyError(msg)
+
+    def locked(self, state: Any) -> tuple[str, ...]:
+        """Return no body: an RRR never locks."""
+        return ()
 
 
 class _RRRStep(Step):
