@@ -63,6 +63,11 @@ Frame = tuple[str, str, str | None, float]
 #: fixed on it, and for a slider block the body it slides on, ``ground`` standing for
 #: the ground; else ``None``); see :mod:`mech_kinematics.geometry.instant_centres`.
 Member = tuple[str, str, tuple[str, ...], str | None]
+#: A relative motion on a body, for the polygons: (body, start point, end point, slider):
+#: the end moves on the body about the start; with a slider, the end is a pin sliding in
+#: the body and the motion is that of the body's point coinciding with it (b'), then the
+#: slider's sliding to the pin; see :mod:`mech_kinematics.geometry.diagrams`.
+Edge = tuple[str, str, str, str | None]
 
 
 class Step(ABC):
@@ -189,3 +194,26 @@ class Item(Protocol):
 
     def locked(self, state: Any) -> tuple[str, ...]:
         """Return its bodies that move with the ground in a solved state (a locked wheel)."""
+
+    def edges(self) -> Iterator[Edge]:
+        """Yield the relative motions it adds to the velocity and acceleration polygons."""
+
+    def link_lengths(self) -> dict[str, float | None]:
+        """Return the length, m, of every link it moves (``None`` where it varies)."""
+
+    def outline(self, body: str, scene: Any, state: Any, points: Mapping[str, Any]
+                ) -> tuple[tuple[str, ...], tuple[tuple[Any, Any], ...]]:
+        """Return the points besides its own that ``body``'s drawing runs through, and its slots.
+
+        ``points`` maps every point to its position (an array of shape (2,),
+        m); a slot is (inner end, mouth), positions likewise.
+        """
+
+    def blocks(self, state: Any, points: Mapping[str, Any], ground: str,
+               locked: set[str]) -> Iterator[tuple[str, str, Any, float, str]]:
+        """Yield (name, point, position, sliding angle in rad, guide body) of its slider blocks."""
+
+    def guides(self, state: Any, points: Mapping[str, Any],
+               strokes: Mapping[str, tuple[float, float]], size: float
+               ) -> Iterator[tuple[str, Any, Any]]:
+        """Yield (slider, start, end) of every fixed guide it draws, over the slider's stroke."""

@@ -4,12 +4,12 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, replace
 import math
 from typing import Any
 
-from .base import Body, Frame, Member, Names, Placing, Step
+from .base import Body, Edge, Frame, Member, Names, Placing, Step
 from .context import _Context, _U16, _U2, _U4
 from .model import _check_finite, _check_name, _names, Where
 from ..bounds import U
@@ -115,6 +115,30 @@ class CarriedPoint:
     def locked(self, state: Any) -> tuple[str, ...]:
         """Return no body."""
         return ()
+
+    def edges(self) -> Iterator[Edge]:
+        """Yield its motion on its link, from its frame's origin."""
+        yield self.link, self.origin, self.name, None
+
+    def link_lengths(self) -> dict[str, float | None]:
+        """Return no link."""
+        return {}
+
+    def outline(self, body: str, scene: Any, state: Any, points: Mapping[str, Any]
+                ) -> tuple[tuple[str, ...], tuple[tuple[Any, Any], ...]]:
+        """Return nothing more: its links are drawn through their own points."""
+        return (), ()
+
+    def blocks(self, state: Any, points: Mapping[str, Any], ground: str,
+               locked: set[str]) -> Iterator[tuple[str, str, Any, float, str]]:
+        """Yield no slider block."""
+        yield from ()
+
+    def guides(self, state: Any, points: Mapping[str, Any],
+               strokes: Mapping[str, tuple[float, float]], size: float
+               ) -> Iterator[tuple[str, Any, Any]]:
+        """Yield no guide."""
+        yield from ()
 
 
 class _CarryStep(Step):

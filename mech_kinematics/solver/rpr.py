@@ -4,14 +4,14 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 import math
 from typing import Any
 
 import numpy as np
 
-from .base import Body, Frame, Member, Names, Placing, Step
+from .base import Body, Edge, Frame, Member, Names, Placing, Step
 from .context import _Context, _cross, _dot, _U2, _U4, _U7, SINGULAR
 from .model import _check_name, Where
 from ..bounds import ROUNDING_MARGIN, U
@@ -128,6 +128,50 @@ class RPR:
         """Return its lever while a Geneva wheel is locked (it then moves with the ground)."""
         engagement = state.intermittent.get(self.link)
         return () if engagement is None or engagement.engaged else (self.link,)
+
+    def edges(self) -> Iterator[Edge]:
+        """Yield the lever's point under the pin, about the pivot, then the pin's sliding."""
+        yield self.link, self.center, self.through, self.slider
+
+    def link_lengths(self) -> dict[str, float | None]:
+        """Return the lever, whose length (pivot to pin) varies."""
+        return {self.link: None}
+
+    def outline(self, body: str, scene: Any, state: Any, points: Mapping[str, Any]
+                ) -> tuple[tuple[str, ...], tuple[tuple[Any, Any], ...]]:
+        """Return the lever through the pin in its slot; a Geneva wheel's slots instead."""
+        if body != self.link:
+            return (), ()
+        n = self.slots
+        if n is None:
+            return (self.through,), ()
+        names = (scene.input.center, self.center, self.through)
+        centre, wheel, pin = (points[name] for name in names)
+        distance = float(np.hypot(*(wheel - centre)))
+        radius = float(np.hypot(*(pin - centre)))
+        mouth = math.sqrt(max(distance * distance - radius * radius, 0.0))
+        inner = 0.85 * (distance - radius)
+        angle = float(state.joints[self.link].position)
+        slots = []
+        for i in range(n):
+            turn = angle + 2 * math.pi * i / n
+            u = np.array([math.cos(turn), math.sin(turn)])
+            slots.append((wheel + inner * u, wheel + mouth * u))
+        return (), tuple(slots)
+
+    def blocks(self, state: Any, points: Mapping[str, Any], ground: str,
+               locked: set[str]) -> Iterator[tuple[str, str, Any, float, str]]:
+        """Yield its block along the lever (none while a Geneva wheel is locked)."""
+        if self.link not in locked:
+            e = points[self.through] - points[self.center]
+            yield (self.slider, self.through, points[self.through], math.atan2(e[1], e[0]),
+                   self.link)
+
+    def guides(self, state: Any, points: Mapping[str, Any],
+               strokes: Mapping[str, tuple[float, float]], size: float
+               ) -> Iterator[tuple[str, Any, Any]]:
+        """Yield no fixed guide: its block slides in the lever."""
+        yield from ()
 
 
 class _RPRStep(Step):

@@ -4,14 +4,14 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, replace
 import math
 from typing import Any
 
 import numpy as np
 
-from .base import Body, Frame, Member, Names, Placing, Step
+from .base import Body, Edge, Frame, Member, Names, Placing, Step
 from .context import _Context, _cross, _dot, _U2, _U3, _U5, _U7, SINGULAR
 from .model import _check_finite, _check_name, _g, Branch, Link, Where
 from ..bounds import ROUNDING_MARGIN, U
@@ -92,6 +92,36 @@ class RRP:
     def locked(self, state: Any) -> tuple[str, ...]:
         """Return no body: an RRP never locks."""
         return ()
+
+    def edges(self) -> Iterator[Edge]:
+        """Yield its link's motion from its start to the new pin."""
+        yield self.link.name, self.link.start, self.point, None
+
+    def link_lengths(self) -> dict[str, float | None]:
+        """Return its link's length."""
+        return {self.link.name: self.link.length}
+
+    def outline(self, body: str, scene: Any, state: Any, points: Mapping[str, Any]
+                ) -> tuple[tuple[str, ...], tuple[tuple[Any, Any], ...]]:
+        """Return nothing more: its links are drawn through their own points."""
+        return (), ()
+
+    def blocks(self, state: Any, points: Mapping[str, Any], ground: str,
+               locked: set[str]) -> Iterator[tuple[str, str, Any, float, str]]:
+        """Yield its block, sliding along the guide on the ground."""
+        yield self.slider, self.point, points[self.point], self.guide_angle, ground
+
+    def guides(self, state: Any, points: Mapping[str, Any],
+               strokes: Mapping[str, tuple[float, float]], size: float
+               ) -> Iterator[tuple[str, Any, Any]]:
+        """Yield its guide over the stroke (or around the block), padded by 8 % of ``size``."""
+        u = np.array([math.cos(self.guide_angle), math.sin(self.guide_angle)])
+        s = float(state.joints[self.slider].position)
+        low, high = strokes.get(self.slider, (s, s))
+        pad = 0.08 * size
+        through = points[self.through]
+        yield (self.slider, through + (min(low, s) - pad) * u,
+               through + (max(high, s) + pad) * u)
 
 
 class _RRPStep(Step):

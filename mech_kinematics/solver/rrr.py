@@ -4,14 +4,14 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, replace
 import math
 from typing import Any
 
 import numpy as np
 
-from .base import Body, Frame, Member, Names, Placing, Step
+from .base import Body, Edge, Frame, Member, Names, Placing, Step
 from .context import _Context, _dot, _U16, _U2, _U3, _U7, SINGULAR
 from .model import _check_name, _g, Branch, Link, Where
 from ..bounds import ROUNDING_MARGIN, U
@@ -92,6 +92,31 @@ class RRR:
     def locked(self, state: Any) -> tuple[str, ...]:
         """Return no body: an RRR never locks."""
         return ()
+
+    def edges(self) -> Iterator[Edge]:
+        """Yield each link's motion from its start to the new pin."""
+        for link in self.links:
+            yield link.name, link.start, self.point, None
+
+    def link_lengths(self) -> dict[str, float | None]:
+        """Return its two links' lengths."""
+        return {link.name: link.length for link in self.links}
+
+    def outline(self, body: str, scene: Any, state: Any, points: Mapping[str, Any]
+                ) -> tuple[tuple[str, ...], tuple[tuple[Any, Any], ...]]:
+        """Return nothing more: its links are drawn through their own points."""
+        return (), ()
+
+    def blocks(self, state: Any, points: Mapping[str, Any], ground: str,
+               locked: set[str]) -> Iterator[tuple[str, str, Any, float, str]]:
+        """Yield no slider block."""
+        yield from ()
+
+    def guides(self, state: Any, points: Mapping[str, Any],
+               strokes: Mapping[str, tuple[float, float]], size: float
+               ) -> Iterator[tuple[str, Any, Any]]:
+        """Yield no guide."""
+        yield from ()
 
 
 class _RRRStep(Step):
