@@ -46,7 +46,7 @@ is folded away, so a step keeps its scalar and array paths in one ``run``.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Collection, Iterator, Mapping
 from typing import Any, ClassVar, Protocol, TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -155,51 +155,72 @@ class Placing(Protocol):
     scene: Any
 
 
-class Item(Protocol):
-    """A scene item (a dyad or a carried point): what the solver asks of its kind."""
+class Item(ABC):
+    """A scene item (a dyad or a carried point): what the solver and the geometry ask of its kind.
+
+    A kind's item is a frozen dataclass deriving from this class. The abstract
+    methods say what it is (the solver's part); the others say what geometry/
+    and the reference need to know of it, and default to "nothing": a kind
+    with no slider, no locked body, no drawing of its own keeps them.
+    """
 
     @property
+    @abstractmethod
     def key(self) -> str:
         """Return the name the item is known by in messages (its new point or its lever)."""
 
+    @abstractmethod
     def defined(self) -> Iterator[tuple[str, str, Where]]:
         """Yield (name, ``'point'``/``'link'``/``'slider'``, where) of every name it defines."""
 
+    @abstractmethod
     def joint_types(self) -> dict[str, str]:
         """Return joint name -> ``'revolute'`` or ``'prismatic'`` of the joints it moves."""
 
+    @abstractmethod
     def prerequisites(self, names: Names) -> set[str]:
         """Check the names it refers to; return those its step waits for."""
 
+    @abstractmethod
     def place(self, plan: Placing) -> Step:
         """Return its step, its prerequisites known; record the points fixed on its links."""
 
-    def lengths(self) -> tuple[float, ...]:
-        """Return its link lengths, m, which count in the mechanism's size."""
-
+    @abstractmethod
     def scaled(self, scale: Callable[[float], float]) -> Item:
         """Return it with every length ``x`` replaced by ``scale(x)``."""
 
+    def lengths(self) -> tuple[float, ...]:
+        """Return its link lengths, m, which count in the mechanism's size."""
+        return ()
+
     def bodies(self) -> Iterator[tuple[str, str, Body]]:
         """Yield (point, body name, body) of every body besides links it puts at a point."""
+        yield from ()
 
     def frames(self) -> Iterator[Frame]:
         """Yield the frame of every joint it moves (:data:`Frame`, for ``/tf``)."""
+        yield from ()
 
     def members(self, ground: str) -> Iterator[Member]:
         """Yield every body it adds to the mechanism (:data:`Member`, for instant centres)."""
+        yield from ()
 
     def slide_angle(self, slider: str, scene: Any, state: Any) -> float:
         """Return the direction, rad, in which its block ``slider`` slides, in a solved state."""
+        msg = f'Expected a slider block of "{self.key}", got "{slider}"'
+        raise KeyError(msg)
 
     def locked(self, state: Any) -> tuple[str, ...]:
         """Return its bodies that move with the ground in a solved state (a locked wheel)."""
+        return ()
 
     def edges(self) -> Iterator[Edge]:
         """Yield the relative motions it adds to the velocity and acceleration polygons."""
+        yield from ()
 
     def link_lengths(self) -> dict[str, float | None]:
         """Return the length, m, of every link it moves (``None`` where it varies)."""
+        return {}
 
     def outline(self, body: str, scene: Any, state: Any, points: Mapping[str, Any]
                 ) -> tuple[tuple[str, ...], tuple[tuple[Any, Any], ...]]:
@@ -208,12 +229,39 @@ class Item(Protocol):
         ``points`` maps every point to its position (an array of shape (2,),
         m); a slot is (inner end, mouth), positions likewise.
         """
+        return (), ()
 
     def blocks(self, state: Any, points: Mapping[str, Any], ground: str,
                locked: set[str]) -> Iterator[tuple[str, str, Any, float, str]]:
         """Yield (name, point, position, sliding angle in rad, guide body) of its slider blocks."""
+        yield from ()
 
     def guides(self, state: Any, points: Mapping[str, Any],
                strokes: Mapping[str, tuple[float, float]], size: float
                ) -> Iterator[tuple[str, Any, Any]]:
         """Yield (slider, start, end) of every fixed guide it draws, over the slider's stroke."""
+        yield from ()
+
+    def toggle(self) -> tuple[str, str, tuple[str, ...]] | None:
+        """Return (measure key, label, links) if its measure is a transmission angle's sine."""
+        return None
+
+    def dead_centre_joints(self, ground: Collection[str]) -> dict[str, str]:
+        """Return its output joints that can reverse (dead centres): name -> joint type."""
+        return {}
+
+    def tip_links(self, point: str) -> Iterator[tuple[str, tuple[str, ...]]]:
+        """Yield (link, the joints it moves) for each of its links starting at ``point``."""
+        yield from ()
+
+    def pivots(self, ground: Collection[str]) -> dict[str, str]:
+        """Return link -> ground pivot of its links that turn about a ground point."""
+        return {}
+
+    def pin_links(self, pivots: Mapping[str, str]) -> Iterator[tuple[str, str, bool]]:
+        """Yield (its new pin, a link it is on, whether that link is preferred)."""
+        yield from ()
+
+    def four_bar(self) -> tuple[str, Any, Any] | None:
+        """Return its new pin and two links (:class:`~.model.Link`) if it can close a four-bar."""
+        return None

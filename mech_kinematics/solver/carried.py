@@ -4,12 +4,11 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, replace
 import math
-from typing import Any
 
-from .base import Body, Edge, Frame, Member, Names, Placing, Step
+from .base import Edge, Item, Names, Placing, Step
 from .context import _Context, _U16, _U2, _U4
 from .model import _check_finite, _check_name, _names, Where
 from ..bounds import U
@@ -17,7 +16,7 @@ from ..errors import SceneError
 
 
 @dataclass(frozen=True)
-class CarriedPoint:
+class CarriedPoint(Item):
     """A point carried rigidly by ``link``.
 
     It lies at ``local`` (m) in the frame with origin at ``origin`` and x-axis
@@ -87,58 +86,13 @@ class CarriedPoint:
         fixed[self.name] = offset
         return _CarryStep(self, base, offset)
 
-    def lengths(self) -> tuple[float, ...]:
-        """Return nothing: it has no link of its own."""
-        return ()
-
     def scaled(self, scale: Callable[[float], float]) -> CarriedPoint:
         """Return it with its local coordinates scaled."""
         return replace(self, local=(scale(self.local[0]), scale(self.local[1])))
 
-    def bodies(self) -> Iterator[tuple[str, str, Body]]:
-        """Yield nothing: it is fixed on its link."""
-        yield from ()
-
-    def frames(self) -> Iterator[Frame]:
-        """Yield nothing: it moves no joint."""
-        yield from ()
-
-    def members(self, ground: str) -> Iterator[Member]:
-        """Yield nothing: it is a point of its link's body."""
-        yield from ()
-
-    def slide_angle(self, slider: str, scene: Any, state: Any) -> float:
-        """Return nothing useful: a carried point has no slider (never asked)."""
-        msg = f'Expected a slider of point "{self.name}", got "{slider}"'
-        raise KeyError(msg)
-
-    def locked(self, state: Any) -> tuple[str, ...]:
-        """Return no body."""
-        return ()
-
     def edges(self) -> Iterator[Edge]:
         """Yield its motion on its link, from its frame's origin."""
         yield self.link, self.origin, self.name, None
-
-    def link_lengths(self) -> dict[str, float | None]:
-        """Return no link."""
-        return {}
-
-    def outline(self, body: str, scene: Any, state: Any, points: Mapping[str, Any]
-                ) -> tuple[tuple[str, ...], tuple[tuple[Any, Any], ...]]:
-        """Return nothing more: its links are drawn through their own points."""
-        return (), ()
-
-    def blocks(self, state: Any, points: Mapping[str, Any], ground: str,
-               locked: set[str]) -> Iterator[tuple[str, str, Any, float, str]]:
-        """Yield no slider block."""
-        yield from ()
-
-    def guides(self, state: Any, points: Mapping[str, Any],
-               strokes: Mapping[str, tuple[float, float]], size: float
-               ) -> Iterator[tuple[str, Any, Any]]:
-        """Yield no guide."""
-        yield from ()
 
 
 class _CarryStep(Step):

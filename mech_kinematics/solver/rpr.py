@@ -4,14 +4,14 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Collection, Iterator, Mapping
 from dataclasses import dataclass
 import math
 from typing import Any
 
 import numpy as np
 
-from .base import Body, Edge, Frame, Member, Names, Placing, Step
+from .base import Body, Edge, Frame, Item, Member, Names, Placing, Step
 from .context import _Context, _cross, _dot, _U2, _U4, _U7, SINGULAR
 from .model import _check_name, Where
 from ..bounds import ROUNDING_MARGIN, U
@@ -22,7 +22,7 @@ MAX_SLOTS = 1000
 
 
 @dataclass(frozen=True)
-class RPR:
+class RPR(Item):
     """A slotted ``link`` turning about ground point ``center``, through pin ``through``.
 
     With ``slots`` (an integer n >= 3) the link is an intermittent (Geneva)
@@ -88,10 +88,6 @@ class RPR:
         plan.slot[self.link] = (self.center, self.through)
         return step
 
-    def lengths(self) -> tuple[float, ...]:
-        """Return nothing: the lever's length varies."""
-        return ()
-
     def scaled(self, scale: Callable[[float], float]) -> RPR:
         """Return it unchanged: it holds no length."""
         return self
@@ -137,6 +133,14 @@ class RPR:
         """Return the lever, whose length (pivot to pin) varies."""
         return {self.link: None}
 
+    def dead_centre_joints(self, ground: Collection[str]) -> dict[str, str]:
+        """Return its lever, which rocks (a Geneva wheel only indexes: none)."""
+        return {self.link: 'revolute'} if self.slots is None else {}
+
+    def pivots(self, ground: Collection[str]) -> dict[str, str]:
+        """Return its lever, which turns about its ground pivot."""
+        return {self.link: self.center}
+
     def outline(self, body: str, scene: Any, state: Any, points: Mapping[str, Any]
                 ) -> tuple[tuple[str, ...], tuple[tuple[Any, Any], ...]]:
         """Return the lever through the pin in its slot; a Geneva wheel's slots instead."""
@@ -166,12 +170,6 @@ class RPR:
             e = points[self.through] - points[self.center]
             yield (self.slider, self.through, points[self.through], math.atan2(e[1], e[0]),
                    self.link)
-
-    def guides(self, state: Any, points: Mapping[str, Any],
-               strokes: Mapping[str, tuple[float, float]], size: float
-               ) -> Iterator[tuple[str, Any, Any]]:
-        """Yield no fixed guide: its block slides in the lever."""
-        yield from ()
 
 
 class _RPRStep(Step):

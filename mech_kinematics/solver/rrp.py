@@ -4,21 +4,21 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Collection, Iterator, Mapping
 from dataclasses import dataclass, replace
 import math
 from typing import Any
 
 import numpy as np
 
-from .base import Body, Edge, Frame, Member, Names, Placing, Step
+from .base import Body, Edge, Frame, Item, Member, Names, Placing, Step
 from .context import _Context, _cross, _dot, _U2, _U3, _U5, _U7, SINGULAR
 from .model import _check_finite, _check_name, _g, Branch, Link, Where
 from ..bounds import ROUNDING_MARGIN, U
 
 
 @dataclass(frozen=True)
-class RRP:
+class RRP(Item):
     """A link ending in a slider ``point`` on a fixed straight guide."""
 
     point: str
@@ -89,10 +89,6 @@ class RRP:
         """Return the guide's angle."""
         return self.guide_angle
 
-    def locked(self, state: Any) -> tuple[str, ...]:
-        """Return no body: an RRP never locks."""
-        return ()
-
     def edges(self) -> Iterator[Edge]:
         """Yield its link's motion from its start to the new pin."""
         yield self.link.name, self.link.start, self.point, None
@@ -101,10 +97,18 @@ class RRP:
         """Return its link's length."""
         return {self.link.name: self.link.length}
 
-    def outline(self, body: str, scene: Any, state: Any, points: Mapping[str, Any]
-                ) -> tuple[tuple[str, ...], tuple[tuple[Any, Any], ...]]:
-        """Return nothing more: its links are drawn through their own points."""
-        return (), ()
+    def toggle(self) -> tuple[str, str, tuple[str, ...]] | None:
+        """Return its measure (the sine of the rod's angle to the guide normal), label, link."""
+        return self.point, f'RRP {self.point}', (self.link.name,)
+
+    def dead_centre_joints(self, ground: Collection[str]) -> dict[str, str]:
+        """Return its slider, which reverses at the ends of its stroke."""
+        return {self.slider: 'prismatic'}
+
+    def tip_links(self, point: str) -> Iterator[tuple[str, tuple[str, ...]]]:
+        """Yield its link if it starts at ``point``, with its link and slider."""
+        if self.link.start == point:
+            yield self.link.name, (self.link.name, self.slider)
 
     def blocks(self, state: Any, points: Mapping[str, Any], ground: str,
                locked: set[str]) -> Iterator[tuple[str, str, Any, float, str]]:

@@ -4,14 +4,14 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Collection, Iterator, Mapping
 from dataclasses import dataclass, replace
 import math
 from typing import Any
 
 import numpy as np
 
-from .base import Body, Edge, Frame, Member, Names, Placing, Step
+from .base import Edge, Frame, Item, Member, Names, Placing, Step
 from .context import _Context, _dot, _U16, _U2, _U3, _U7, SINGULAR
 from .model import _check_name, _g, Branch, Link, Where
 from ..bounds import ROUNDING_MARGIN, U
@@ -19,7 +19,7 @@ from ..errors import SceneError
 
 
 @dataclass(frozen=True)
-class RRR:
+class RRR(Item):
     """Two links meeting at a new pin ``point``."""
 
     point: str
@@ -70,10 +70,6 @@ class RRR:
         first, second = (replace(link, length=scale(link.length)) for link in self.links)
         return replace(self, links=(first, second))
 
-    def bodies(self) -> Iterator[tuple[str, str, Body]]:
-        """Yield nothing: an RRR puts only links at its points."""
-        yield from ()
-
     def frames(self) -> Iterator[Frame]:
         """Yield each link's frame: at its start, along it."""
         for link in self.links:
@@ -84,15 +80,6 @@ class RRR:
         for link in self.links:
             yield link.name, 'link', (link.start, self.point), None
 
-    def slide_angle(self, slider: str, scene: Any, state: Any) -> float:
-        """Return nothing useful: an RRR has no slider (never asked)."""
-        msg = f'Expected a slider of RRR "{self.point}", got "{slider}"'
-        raise KeyError(msg)
-
-    def locked(self, state: Any) -> tuple[str, ...]:
-        """Return no body: an RRR never locks."""
-        return ()
-
     def edges(self) -> Iterator[Edge]:
         """Yield each link's motion from its start to the new pin."""
         for link in self.links:
@@ -102,21 +89,34 @@ class RRR:
         """Return its two links' lengths."""
         return {link.name: link.length for link in self.links}
 
-    def outline(self, body: str, scene: Any, state: Any, points: Mapping[str, Any]
-                ) -> tuple[tuple[str, ...], tuple[tuple[Any, Any], ...]]:
-        """Return nothing more: its links are drawn through their own points."""
-        return (), ()
+    def toggle(self) -> tuple[str, str, tuple[str, ...]] | None:
+        """Return its measure (the sine of the angle between its links), label and links."""
+        return self.point, f'RRR {self.point}', tuple(link.name for link in self.links)
 
-    def blocks(self, state: Any, points: Mapping[str, Any], ground: str,
-               locked: set[str]) -> Iterator[tuple[str, str, Any, float, str]]:
-        """Yield no slider block."""
-        yield from ()
+    def dead_centre_joints(self, ground: Collection[str]) -> dict[str, str]:
+        """Return its links that turn about a ground point (rockers)."""
+        return {link.name: 'revolute' for link in self.links if link.start in ground}
 
-    def guides(self, state: Any, points: Mapping[str, Any],
-               strokes: Mapping[str, tuple[float, float]], size: float
-               ) -> Iterator[tuple[str, Any, Any]]:
-        """Yield no guide."""
-        yield from ()
+    def tip_links(self, point: str) -> Iterator[tuple[str, tuple[str, ...]]]:
+        """Yield its links starting at ``point``, with both its links."""
+        for link in self.links:
+            if link.start == point:
+                yield link.name, tuple(other.name for other in self.links)
+
+    def pivots(self, ground: Collection[str]) -> dict[str, str]:
+        """Return its links that turn about a ground point."""
+        return {link.name: link.start for link in self.links if link.start in ground}
+
+    def pin_links(self, pivots: Mapping[str, str]) -> Iterator[tuple[str, str, bool]]:
+        """Yield the new pin on its first link, and on any link turning about a ground pivot."""
+        yield self.point, self.links[0].name, False
+        for link in self.links:  # the pin is on both links
+            if link.name in pivots:
+                yield self.point, link.name, True
+
+    def four_bar(self) -> tuple[str, Link, Link] | None:
+        """Return its new pin and two links: an RRR can close a four-bar loop."""
+        return self.point, *self.links
 
 
 class _RRRStep(Step):
