@@ -49,9 +49,11 @@ from abc import ABC, abstractmethod
 from collections.abc import Callable, Collection, Iterator, Mapping
 from typing import Any, ClassVar, Protocol, TYPE_CHECKING
 
+from ..errors import SceneError
+
 if TYPE_CHECKING:
     from .context import _Context
-    from .model import Where
+    from .model import Branch, Link, Where
     from .state import Engagement
 
 #: A body at a pin, for rubbing: ``('link', name)``, ``('still', name)`` or ``('block', lever)``.
@@ -155,6 +157,46 @@ class Placing(Protocol):
     scene: Any
 
 
+class Reading(Protocol):
+    """What the scene reader lends a kind to read its keys (:meth:`Item.from_scene`).
+
+    Each method names the file's key in its :class:`SceneError`; lengths come
+    back in m and angles in rad (the scene's ``units`` applied).
+    """
+
+    def get(self, mapping: Any, key: str, where: str, default: Any = ...) -> Any:
+        """Return ``mapping[key]``, or ``default`` where given and the key is absent."""
+
+    def name(self, mapping: Any, key: str, where: str) -> str:
+        """Return the name at ``key``."""
+
+    def length(self, mapping: Any, key: str, where: str, positive: bool = True) -> float:
+        """Return the length at ``key``, m."""
+
+    def angle(self, mapping: Any, key: str, where: str, default: Any = ...) -> float:
+        """Return the angle at ``key``, rad."""
+
+    def branch(self, mapping: Any, where: str) -> Branch:
+        """Return the ``branch`` key (default +1)."""
+
+    def check_keys(self, mapping: Any, allowed: set[str], where: str) -> None:
+        """Refuse any key of ``mapping`` outside ``allowed``."""
+
+    def brief(self, value: Any) -> str:
+        """Return ``value`` shortened for a message."""
+
+    def link(self, raw: Any, where: str) -> Link:
+        """Return the link ``{name, from, length}`` at ``where``."""
+
+    def build(self, where: str, fields: dict[str, str], factory: Callable[..., Any],
+              **kwargs: Any) -> Any:
+        """Return ``factory(**kwargs)``, its errors named by the file key of each field.
+
+        ``fields`` maps a field of ``factory`` to its key under ``where``
+        where the two differ.
+        """
+
+
 class Item(ABC):
     """A scene item (a dyad or a carried point): what the solver and the geometry ask of its kind.
 
@@ -162,7 +204,18 @@ class Item(ABC):
     methods say what it is (the solver's part); the others say what geometry/
     and the reference need to know of it, and default to "nothing": a kind
     with no slider, no locked body, no drawing of its own keeps them.
+
+    ``kind`` is the scene's ``type:`` of the item (``'RRR'``, ...; ``'point'``
+    for a carried point): the reference solver and the registry key on it.
     """
+
+    kind: ClassVar[str]
+
+    @classmethod
+    def from_scene(cls, read: Reading, raw: Any, where: str) -> Item:
+        """Return the item written at ``where`` in a scene file (its keys, checked)."""
+        msg = f'{where}: expected a dyad, got a {cls.kind}'
+        raise SceneError(msg)
 
     @property
     @abstractmethod

@@ -25,6 +25,8 @@ class CarriedPoint(Item):
     local=(d, 0)``.
     """
 
+    kind = 'point'
+
     name: str
     link: str
     origin: str

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from .base import Body, Edge, Frame, Item, Member, Names, Placing, Step
+from .base import Body, Edge, Frame, Item, Member, Names, Placing, Reading, Step
 from .context import _Context, _cross, _dot, _U2, _U4, _U7, SINGULAR
 from .model import _check_name, Where
 from ..bounds import ROUNDING_MARGIN, U
@@ -38,6 +38,8 @@ class RPR(Item):
     one, from ``center`` toward the pin).
     """
 
+    kind = 'RPR'
+
     link: str
     center: str
     through: str
@@ -56,6 +58,21 @@ class RPR(Item):
             msg = (f'Expected the slots of RPR "{self.link}" to be an integer from 3 to '
                    f'{MAX_SLOTS}, got {n!r}')
             raise SceneError(msg, (self, 'slots'))
+
+    @classmethod
+    def from_scene(cls, read: Reading, raw: Any, where: str) -> RPR:
+        """Return the RPR at ``where``: its link, center, through, slider and slots."""
+        read.check_keys(raw, {'type', 'link', 'center', 'through', 'slider', 'slots'}, where)
+        slots = raw.get('slots')
+        if slots is not None and (isinstance(slots, bool) or not isinstance(slots, int)
+                                  or not 3 <= slots <= MAX_SLOTS):
+            raise SceneError(f'{where}.slots: expected a whole number of slots from 3 to '
+                             f'{MAX_SLOTS}, got {read.brief(slots)}')
+        built: RPR = read.build(
+            where, {}, cls, link=read.name(raw, 'link', where),
+            center=read.name(raw, 'center', where), through=read.name(raw, 'through', where),
+            slider=read.name(raw, 'slider', where), slots=slots)
+        return built
 
     @property
     def key(self) -> str:

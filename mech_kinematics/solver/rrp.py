@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from .base import Body, Edge, Frame, Item, Member, Names, Placing, Step
+from .base import Body, Edge, Frame, Item, Member, Names, Placing, Reading, Step
 from .context import _Context, _cross, _dot, _U2, _U3, _U5, _U7, SINGULAR
 from .model import _check_finite, _check_name, _g, Branch, Link, Where
 from ..bounds import ROUNDING_MARGIN, U
@@ -20,6 +20,8 @@ from ..bounds import ROUNDING_MARGIN, U
 @dataclass(frozen=True)
 class RRP(Item):
     """A link ending in a slider ``point`` on a fixed straight guide."""
+
+    kind = 'RRP'
 
     point: str
     link: Link
@@ -36,6 +38,22 @@ class RRP(Item):
         _check_finite(self.guide_angle, f'the guide angle of RRP "{self.point}"',
                       (self, 'guide_angle'))
         object.__setattr__(self, 'branch', Branch(self.branch))
+
+    @classmethod
+    def from_scene(cls, read: Reading, raw: Any, where: str) -> RRP:
+        """Return the RRP at ``where``: ``point``, ``link``, ``guide``, ``slider``, ``branch``."""
+        read.check_keys(raw, {'type', 'point', 'link', 'guide', 'slider', 'branch'}, where)
+        link = read.link(read.get(raw, 'link', where), f'{where}.link')
+        guide = read.get(raw, 'guide', where)
+        if isinstance(guide, dict):
+            read.check_keys(guide, {'through', 'angle'}, f'{where}.guide')
+        built: RRP = read.build(
+            where, {'through': 'guide.through', 'guide_angle': 'guide.angle'}, cls,
+            point=read.name(raw, 'point', where),
+            link=link, through=read.name(guide, 'through', f'{where}.guide'),
+            guide_angle=read.angle(guide, 'angle', f'{where}.guide', 0.0),
+            slider=read.name(raw, 'slider', where), branch=read.branch(raw, where))
+        return built
 
     @property
     def key(self) -> str:

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from .base import Edge, Frame, Item, Member, Names, Placing, Step
+from .base import Edge, Frame, Item, Member, Names, Placing, Reading, Step
 from .context import _Context, _dot, _U16, _U2, _U3, _U7, SINGULAR
 from .model import _check_name, _g, Branch, Link, Where
 from ..bounds import ROUNDING_MARGIN, U
@@ -21,6 +21,8 @@ from ..errors import SceneError
 @dataclass(frozen=True)
 class RRR(Item):
     """Two links meeting at a new pin ``point``."""
+
+    kind = 'RRR'
 
     point: str
     links: tuple[Link, Link]
@@ -34,6 +36,19 @@ class RRR(Item):
             msg = f'Expected RRR "{self.point}" to have 2 links, got {count}'
             raise SceneError(msg, (self, 'links'))
         object.__setattr__(self, 'branch', Branch(self.branch))
+
+    @classmethod
+    def from_scene(cls, read: Reading, raw: Any, where: str) -> RRR:
+        """Return the RRR at ``where``: ``point``, ``links`` (two), ``branch``."""
+        read.check_keys(raw, {'type', 'point', 'links', 'branch'}, where)
+        links = read.get(raw, 'links', where)
+        if not isinstance(links, list) or len(links) != 2:
+            raise SceneError(f'{where}.links: expected a list of 2 links, got '
+                             f'{read.brief(links)}')
+        first, second = (read.link(link, f'{where}.links[{i}]') for i, link in enumerate(links))
+        built: RRR = read.build(where, {}, cls, point=read.name(raw, 'point', where),
+                                links=(first, second), branch=read.branch(raw, where))
+        return built
 
     @property
     def key(self) -> str:

@@ -49,7 +49,7 @@ import yaml
 
 from ..errors import SceneError
 from ..scene import read_scene_yaml
-from ..solver import RPR, RRP, RRR, Scene
+from ..solver import Scene
 from ..units import ANGLE_UNITS, LENGTH_UNITS, radians_from_degrees
 
 __all__ = ['DIGITS', 'DPS', 'Jet', 'Model', 'NoAssembly', 'Reference', 'as_float_dict',
@@ -287,7 +287,8 @@ class Model:
 
     def _place(self, item: Any, known: set[str], values: dict[str, float],
                index: int) -> _Element | None:
-        if isinstance(item, RRR):
+        kind = item.kind
+        if kind == 'RRR':
             first, second = item.links
             if first.start not in known or second.start not in known:
                 return None
@@ -298,7 +299,7 @@ class Model:
             self._unknowns((f'{first.name} angle', False), (f'{second.name} angle', False))
             known.add(item.point)
             return _Element('RRR', item, index)
-        if isinstance(item, RRP):
+        if kind == 'RRP':
             if item.link.start not in known:
                 return None
             values[f'link.{item.link.name}.length'] = item.link.length
@@ -310,7 +311,7 @@ class Model:
             self._unknowns((f'{item.link.name} angle', False), (f'{item.slider}', True))
             known.add(item.point)
             return _Element('RRP', item, index)
-        if isinstance(item, RPR):
+        if kind == 'RPR':
             if item.through not in known:
                 return None
             self.links[item.link] = index
