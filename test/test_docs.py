@@ -72,7 +72,7 @@ MISTAKES = {
     'twice': BASE.replace('name: rocker', 'name: coupler'),
     'unknown_point': BASE.replace('  D: [150, 0]\n', '').replace('from: D', 'from: Q'),
     'cycle': BASE.replace('from: B', 'from: C'),
-    'type': BASE.replace('type: RRR', 'type: RPP'),
+    'type': BASE.replace('type: RRR', 'type: PPP'),
     'reach': BASE.replace('length: 150}', 'length: 50}'),
     'meet': BASE.replace('length: 80}', 'length: 10}'),
     'guide': (ROOT / 'docs' / 'toggle_press.yaml').read_text().replace(

@@ -419,6 +419,21 @@ def _polygon_start(scene: Scene, state: State, index: int,
     return letter, pins, position, values, letters
 
 
+def _slip_vectors(scene: Scene, state: State, letter: Mapping[str, str],
+                  letters: Mapping[str, Array], index: int, symbol: str) -> list[Vector]:
+    """Sliding along a fixed direction (a translating yoke's slot): the slider's rate."""
+    vectors = []
+    for dyad in scene.dyads:
+        for slider, start, end, angle in dyad.slips():
+            joint = state.joints[slider]
+            rate = float(joint.velocity if index == 1 else joint.acceleration)
+            tail = letters[letter[start]]
+            vectors.append(Vector(letter[start], letter[end], tail,
+                                  tail + rate * np.array([math.cos(angle), math.sin(angle)]),
+                                  symbol.format(_sub(end, start)), VectorKind.SLIP, slider))
+    return vectors
+
+
 def _absolute_vectors(scene: Scene, values: Mapping[str, complex], letter: Mapping[str, str],
                       drawn: set[str], symbol: str) -> list[Vector]:
     """Absolute vectors from the pole to every moving point not drawn from a ground point."""
@@ -475,6 +490,7 @@ def velocity_polygon_from_state(scene: Scene, state: State) -> Polygon:
             vectors.append(Vector(letter[edge.end], letter[edge.pin], tail, tail + _xy(slip),
                                   f'v_{_sub(edge.pin, edge.end)}', VectorKind.SLIP,
                                   edge.slider))
+    vectors += _slip_vectors(scene, state, letter, letters, 1, 'v_{}')
     vectors += _absolute_vectors(scene, velocity, letter, drawn, 'v')
     return Polygon('velocity', 'm/s', letters, tuple(vectors), POLE, ground)
 
@@ -546,6 +562,7 @@ def acceleration_polygon_from_state(scene: Scene, state: State) -> Polygon:
                                   VectorKind.CORIOLIS, edge.slider))
             vectors.append(Vector(kink, pin, corner, corner + _xy(sliding), f'a_{sub}^s',
                                   VectorKind.SLIP, edge.slider))
+    vectors += _slip_vectors(scene, state, letter, letters, 2, 'a_{}^s')
     vectors += _absolute_vectors(scene, accel, letter, drawn, 'a')
     return Polygon('acceleration', 'm/s^2', letters, tuple(vectors), POLE, ground)
 

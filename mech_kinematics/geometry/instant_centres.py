@@ -333,12 +333,19 @@ def _body_motion(topology: Topology, state: State,
     if body.kind is BodyKind.GROUND:
         return 0.0, 0j, 0j
     p, v, _ = state.complex_points[body.points[0]]
+    return _omega(topology, state, name), complex(p), complex(v)
+
+
+def _omega(topology: Topology, state: State, name: str) -> float:
+    """Return a body's angular velocity: a slider block turns with what it slides on."""
+    body = topology.bodies[name]
+    if body.kind is BodyKind.GROUND:
+        return 0.0
     if body.kind is BodyKind.SLIDER:
         guide = body.guide
         assert guide is not None
-        omega = 0.0 if guide == topology.ground else float(state.joints[guide].velocity)
-        return omega, complex(p), complex(v)
-    return float(state.joints[name].velocity), complex(p), complex(v)
+        return _omega(topology, state, guide)
+    return float(state.joints[name].velocity)
 
 
 def instant_centres_from_state(scene: Scene, state: State) -> InstantCentres:

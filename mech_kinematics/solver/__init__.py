@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Analytic position, velocity and acceleration of planar linkages.
 
-A mechanism is a driving crank followed by dyads (RRR, RRP, RPR) and points
+A mechanism is a driving crank followed by dyads (RRR, RRP, RPR, RPP) and points
 carried rigidly by links, solved one after another in closed form: no
 iteration anywhere. Points are complex numbers ``x + iy`` internally, so a
 rigid rotation is a product and every formula is the same for one crank angle
@@ -25,7 +25,7 @@ The package holds one module per concern and one per step kind:
 - :mod:`.base`: the protocol every step kind follows (and the kernel subset
   of a step's ``run`` the node's tick compiles); :mod:`.registry` maps the
   scene's ``type:`` to the kind;
-- :mod:`.crank`, :mod:`.rrr`, :mod:`.rrp`, :mod:`.rpr`, :mod:`.geneva`,
+- :mod:`.crank`, :mod:`.rrr`, :mod:`.rrp`, :mod:`.rpr`, :mod:`.geneva`, :mod:`.rpp`,
   :mod:`.carried`, :mod:`.rubbing`: the kinds, each with its item, its
   validation and its step (kernel and error bounds);
 - :mod:`.context`: one solve's values and the roundoff constants;
@@ -40,6 +40,7 @@ from .crank import Crank
 from .geneva import TANGENCY_TOLERANCE
 from .mechanism import assembly_text, Scene
 from .model import Branch, Link, Units
+from .rpp import RPP
 from .rpr import MAX_SLOTS, RPR
 from .rrp import RRP
 from .rrr import RRR
@@ -49,6 +50,6 @@ from .state import Engagement, JointMotion, PointState, State
 
 __all__ = [
     'Branch', 'CarriedPoint', 'Crank', 'Engagement', 'JointMotion', 'Link', 'MAX_SLOTS',
-    'NEAR_SINGULAR', 'Pin', 'PointState', 'RPR', 'RRP', 'RRR', 'SINGULAR', 'Scene', 'State',
+    'NEAR_SINGULAR', 'Pin', 'PointState', 'RPP', 'RPR', 'RRP', 'RRR', 'SINGULAR', 'Scene', 'State',
     'TANGENCY_TOLERANCE', 'Units', 'assembly_text', 'solve',
 ]

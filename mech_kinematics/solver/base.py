@@ -271,6 +271,14 @@ class Item(ABC):
         """Yield the relative motions it adds to the velocity and acceleration polygons."""
         yield from ()
 
+    def slips(self) -> Iterator[tuple[str, str, str, float]]:
+        """Yield (slider, from point, to point, angle): sliding along a fixed direction, rad.
+
+        The motion of ``to`` relative to ``from`` is the slider's rate along
+        that direction (a translating body's slot; no Coriolis component).
+        """
+        yield from ()
+
     def link_lengths(self) -> dict[str, float | None]:
         """Return the length, m, of every link it moves (``None`` where it varies)."""
         return {}

@@ -8,9 +8,10 @@ Adding a kind is one module (its item and step, :mod:`.base`) and one entry here
 from __future__ import annotations
 
 from .base import Item
+from .rpp import RPP
 from .rpr import RPR
 from .rrp import RRP
 from .rrr import RRR
 
 #: The scene's ``type:`` of a dyad -> its item class.
-KINDS: dict[str, type[Item]] = {kind.kind: kind for kind in (RRR, RRP, RPR)}
+KINDS: dict[str, type[Item]] = {kind.kind: kind for kind in (RRR, RRP, RPR, RPP)}

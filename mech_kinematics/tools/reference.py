@@ -222,7 +222,7 @@ def _value(x: Any) -> Any:
 
 @dataclass(frozen=True)
 class _Element:
-    kind: str          # 'RRR', 'RRP', 'RPR' or 'carry'
+    kind: str          # 'RRR', 'RRP', 'RPR', 'RPP' or 'carry'
     item: Any          # the scene's dyad or carried point
     index: int = -1    # first of the element's two unknowns, -1 for a carried point
 
@@ -311,6 +311,17 @@ class Model:
             self._unknowns((f'{item.link.name} angle', False), (f'{item.slider}', True))
             known.add(item.point)
             return _Element('RRP', item, index)
+        if kind == 'RPP':
+            if item.through not in known:
+                return None
+            values[f'guide.{item.point}.angle'] = item.guide_angle
+            values[f'slot.{item.point}.angle'] = item.slot_angle
+            self.sliders[item.slider] = index
+            self.sliders[item.slot_slider] = index + 1
+            self.joint_types[item.slider] = self.joint_types[item.slot_slider] = 'prismatic'
+            self._unknowns((f'{item.slider}', True), (f'{item.slot_slider}', True))
+            known.add(item.point)
+            return _Element('RPP', item, index)
         if kind == 'RPR':
             if item.through not in known:
                 return None
@@ -366,6 +377,12 @@ class Model:
             elif element.kind == 'RPR':
                 residuals.append(points[item.center] + q[i + 1] * expi(q[i])
                                  - points[item.through])
+            elif element.kind == 'RPP':
+                # Y = O + s u on the guide; B = Y + t w in the slot.
+                at = points[item.guide_through] + q[i] * expi(p[f'guide.{item.point}.angle'])
+                residuals.append(at + q[i + 1] * expi(p[f'slot.{item.point}.angle'])
+                                 - points[item.through])
+                points[item.point] = at
             else:
                 origin = points[item.origin]
                 axis = points[item.xaxis] - origin
@@ -425,6 +442,15 @@ class Model:
             elif element.kind == 'RPR':
                 d = pts[item.through] - pts[item.center]
                 q[i], q[i + 1] = mpmath.arg(d), abs(d)
+            elif element.kind == 'RPP':
+                # The two lines' intersection by Cramer's rule.
+                u = mpmath.expj(p[f'guide.{item.point}.angle'])
+                w = mpmath.expj(p[f'slot.{item.point}.angle'])
+                d = pts[item.through] - pts[item.guide_through]
+                c = (mpmath.conj(u) * w).imag
+                q[i] = (mpmath.conj(d) * w).imag / c
+                q[i + 1] = (mpmath.conj(u) * d).imag / c
+                pts[item.point] = pts[item.guide_through] + q[i] * u
             else:
                 origin = pts[item.origin]
                 axis = pts[item.xaxis] - origin
@@ -575,6 +601,10 @@ def _measures(model: Model, p: Mapping[str, Any], points: Mapping[str, Any],
                 f'link.{item.link.name}.length']
         elif element.kind == 'RPR':
             measures[item.link] = abs(q[i + 1]) / model.size
+        elif element.kind == 'RPP':
+            u = mpmath.expj(p[f'guide.{item.point}.angle'])
+            w = mpmath.expj(p[f'slot.{item.point}.angle'])
+            measures[item.point] = abs((mpmath.conj(u) * w).imag)
     return measures
 
 
@@ -595,7 +625,7 @@ def _check_branch(model: Model, p: Mapping[str, Any], points: Mapping[str, Any],
         elif element.kind == 'RPR':
             ok = q[i + 1] >= 0
         else:
-            continue
+            continue    # a yoke, a carried point: one configuration
         if not ok:
             msg = f'{element.kind} {getattr(item, "point", None) or item.link}: wrong branch'
             raise ArithmeticError(msg)
