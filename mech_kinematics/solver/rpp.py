@@ -84,8 +84,8 @@ class RPP(Item):
         sine = abs(math.sin(self.slot_angle - self.guide_angle))
         if not sine > SINGULAR:
             msg = (f'Expected the slot of RPP "{self.point}" to cross its guide (the sine of '
-                   f'the angle between them > {SINGULAR:g}), got {sine:.3g}: a slot parallel '
-                   f'to the guide')
+                   f'the angle between them > {SINGULAR:g}), got a slot parallel to the guide '
+                   f'(sine {sine:.3g}): turn slot_angle away from guide.angle')
             raise SceneError(msg, (self, 'slot_angle'))
 
     @classmethod
