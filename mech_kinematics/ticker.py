@@ -53,6 +53,9 @@ __all__ = ['TickFunction', 'compile_tick', 'tick_function', 'values_from_state']
 TickFunction = Callable[[float, float, float, float, int], tuple[list[float], float]]
 
 _SOLVER = lk.__name__ + '.'
+#: The context's methods that record side facts (an intermittent lever's window, why a
+#: bound is large): the tick reports neither, so their calls are dropped.
+_DROPPED = ('engage', 'note')
 _TABLES = {'points': 'P', 'links': 'L', 'sliders': 'S', 'measures': 'M'}
 
 
@@ -158,6 +161,34 @@ class _Specializer(ast.NodeTransformer):
                                     [ast.Name('theta', ast.Load()),
                                      ast.Name('turns', ast.Load())], [])
                 raise _Unsupported(f'ctx.{node.attr}')
+        return self.generic_visit(node)
+
+    def visit_If(self, node: ast.If) -> Any:
+        # A branch ``ctx.vector`` decides is dropped before it is specialized: the
+        # array path may use what the tick does not (``ctx`` as a value, loops).
+        test = _fold(self.visit(node.test))
+        if isinstance(test, ast.Constant):
+            taken = node.body if test.value else node.orelse
+            return self.statements(taken) or ast.Pass()
+        node.test = cast(ast.expr, test)
+        node.body = self.statements(node.body) or [ast.Pass()]
+        node.orelse = self.statements(node.orelse)
+        return node
+
+    def statements(self, stmts: list[ast.stmt]) -> list[ast.stmt]:
+        """Return ``stmts`` specialized, a statement that became several spliced in."""
+        out: list[ast.stmt] = []
+        for stmt in stmts:
+            result = self.visit(stmt)
+            out.extend(result if isinstance(result, list) else [result])
+        return out
+
+    def visit_Expr(self, node: ast.Expr) -> Any:
+        value = node.value
+        if (isinstance(value, ast.Call) and isinstance(value.func, ast.Attribute)
+                and isinstance(value.func.value, ast.Name) and value.func.value.id == 'ctx'
+                and value.func.attr in _DROPPED):
+            return ast.Pass()       # a side fact the tick does not report
         return self.generic_visit(node)
 
     def visit_Call(self, node: ast.Call) -> ast.AST:
@@ -366,7 +397,8 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
         arguments = {'theta': 'theta', 'omega': 'omega', 'alpha': 'alpha'}
         body += _body(plan.crank, type(plan.crank).run, '_0', names, namespace, arguments)
         for index, step in enumerate(plan.steps, 1):
-            body += _body(step, type(step).run, f'_{index}', names, namespace, {})
+            for part, kernel in enumerate(step.kernels()):
+                body += _body(step, kernel, f'_{index}_{part}', names, namespace, {})
     except (_Unsupported, OSError, TypeError) as error:
         del error   # the general solver serves this scene
         return None

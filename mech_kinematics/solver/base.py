@@ -113,6 +113,16 @@ class Step(ABC):
     def run(self, ctx: _Context) -> None:
         """Compute what the step defines into ``ctx`` (see the module's kernel subset)."""
 
+    @classmethod
+    def kernels(cls) -> tuple[Callable[..., None], ...]:
+        """Return the functions whose bodies, in order, are ``run`` on one crank angle.
+
+        The tick compiles these (the kernel subset above); by default ``run``
+        itself. A step whose ``run`` dispatches to a scalar path of its own
+        names that path here instead.
+        """
+        return (cls.run,)
+
     @property
     def requires(self) -> tuple[str, ...]:
         """Names whose steps must run before this one (its uses and its owner)."""

@@ -58,6 +58,22 @@ class _Context:
         self.rubbing: dict[str, tuple[Any, Any]] = _NOTHING  # pin -> (value, bound)
         self.notes: dict[str, str] = _NOTHING  # label -> why a bound is large (scalar path)
 
+    def engage(self, lever: str, engaged: Any, window: Any) -> None:
+        """Record where an intermittent lever is in its cycle (the tick drops it)."""
+        if self.engagement is _NOTHING:
+            self.engagement = {}
+        self.engagement[lever] = (engaged, window)
+
+    def note(self, label: str, why: Any) -> None:
+        """Record why a dyad's bound is large, for a refusal's message (the tick drops it).
+
+        ``why`` is a callable returning the text, called at once: the scalar
+        path only notes where it is near a limit.
+        """
+        if self.notes is _NOTHING:
+            self.notes = {}
+        self.notes[label] = why()
+
     def check(self, ok: Any, label: str, reason: Any, facts: Any = None) -> None:
         """Stop a scalar solve where ``ok`` fails; mask the entries of a vector solve.
 

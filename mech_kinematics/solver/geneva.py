@@ -8,13 +8,14 @@ the check of its tangential entry, and its :class:`~.state.Engagement`.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 import math
 from typing import Any, cast
 
 import numpy as np
 
 from .base import Placing
-from .context import _Context, _NOTHING, _U2, _U4, _U7
+from .context import _Context, _U2, _U4, _U7
 from .model import _names, Units
 from .rpr import _RPRStep, RPR
 from .state import Engagement
@@ -89,17 +90,25 @@ class _IndexStep(_RPRStep):
         return abs(r) <= self.half, window, r, er
 
     def run(self, ctx: _Context) -> None:
-        super().run(ctx)
-        if not ctx.vector:
-            self._run_one(ctx)
-            return
+        """Run the plain RPR's kernel, then index its motion by the crank's window."""
+        _RPRStep.run(self, ctx)
+        if ctx.vector:
+            self.run_array(ctx)
+        else:
+            self.run_one(ctx)
+
+    @classmethod
+    def kernels(cls) -> tuple[Callable[..., None], ...]:
+        """Return the plain RPR's kernel and :meth:`run_one`: ``run`` on one crank angle."""
+        return (_RPRStep.run, cls.run_one)
+
+    def run_array(self, ctx: _Context) -> None:
+        """Index the lever's engaged motion by the crank's window, for an array of angles."""
         n = self.slots
         engaged, window, r, er = self.window(ctx.angle, ctx.turns, ctx.vector)
         near = abs(abs(r) - self.half) <= ROUNDING_MARGIN * (er + self.e_half)
         e, w, al, ee, ew, eal = ctx.links[self.link]
-        if ctx.engagement is _NOTHING:
-            ctx.engagement = {}
-        ctx.engagement[self.link] = (engaged, window)
+        ctx.engage(self.link, engaged, window)
         m = np.mod(window, n)
         side = np.mod(2 * window + np.where(r > 0.0, 1, -1), 2 * n)
         t = self.turn_array[m]
@@ -122,8 +131,8 @@ class _IndexStep(_RPRStep):
                      np.where(near, eal + abs(al), entry[5]))
         ctx.links[self.link] = entry
 
-    def _run_one(self, ctx: _Context) -> None:
-        """Do :meth:`run` for one crank angle: the same operations, only those it needs."""
+    def run_one(self, ctx: _Context) -> None:
+        """Do :meth:`run_array` for one crank angle: the same operations, only those it needs."""
         angle = ctx.angle
         d = angle - self.phase0
         q = round(d / math.tau)  # an int: q * tau and abs(q) * e_q round as the float's would
@@ -132,9 +141,7 @@ class _IndexStep(_RPRStep):
         ar = abs(r)
         half = self.half
         engaged = ar <= half
-        if ctx.engagement is _NOTHING:
-            ctx.engagement = {}
-        ctx.engagement[self.link] = (engaged, window)
+        ctx.engage(self.link, engaged, window)
         er = U * (abs(angle) + abs(d) + ar) + self.e_phase + abs(q) * self.e_q
         near = abs(ar - half) <= ROUNDING_MARGIN * (er + self.e_half)
         n = self.slots
@@ -158,12 +165,10 @@ class _IndexStep(_RPRStep):
             gap = abs(diff.real) + abs(diff.imag)
             entry = (entry[0], entry[1], entry[2],
                      ee + self.e_turn[m] + self.e_held[side] + gap, ew + abs(w), eal + abs(al))
-            if ctx.notes is _NOTHING:
-                ctx.notes = {}
-            ctx.notes[self.label] = (
+            ctx.note(self.label, lambda: (
                 f'the pin {self.through} is within rounding of the mouth of a slot of '
                 f'{self.link}, where its angular acceleration jumps from or to 0 (an '
-                f'engagement instant: ask for a crank angle either side of it)')
+                f'engagement instant: ask for a crank angle either side of it)'))
         ctx.links[self.link] = entry
 
     def engagement(self, ctx: _Context, omega: Any, finish: Any) -> Engagement:
