@@ -42,9 +42,7 @@ import textwrap
 from typing import Any, cast
 
 from . import solver as lk
-from .solver.context import _Context
-from .solver.scaling import _ACCEL_HIGH, _RATE_HIGH, _RATE_LOW
-from .solver.solve import _wrapped_angle
+from .solver import tick as hooks
 
 __all__ = ['TickFunction', 'compile_tick', 'tick_function', 'values_from_state']
 
@@ -269,18 +267,6 @@ def _body(step: Any, method: Callable[..., Any], suffix: str, names: dict[str, s
     return [stmt for stmt in module.body if not isinstance(stmt, ast.Pass)]
 
 
-def _ctx_check(theta: float, turns: int, *args: Any, **kwargs: Any) -> None:
-    _Context(theta, False, turns).check(*args, **kwargs)
-
-
-def _ctx_check_margin(theta: float, turns: int, *args: Any, **kwargs: Any) -> None:
-    _Context(theta, False, turns).check_margin(*args, **kwargs)
-
-
-def _shown(theta: float, turns: int) -> Any:
-    return _Context(theta, False, turns).shown
-
-
 def values_from_state(state: lk.State, joints: Sequence[str], points: Sequence[str],
                       frames: Sequence[tuple[str, str | None, float]] = ()) -> list[float]:
     """Return the values of a single-angle state in the order of a tick function.
@@ -366,18 +352,18 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
         an instant it cannot settle itself. ``None`` where the scene cannot be
         compiled (see the module's notes).
     """
-    solver = scene._solver
-    plan = solver.run_plan
+    plan = hooks.tick_plan(scene)
     joints = tuple(scene.output_joints if joints is None else joints)
     points = tuple(scene.output_points if points is None else points)
     frames = tuple(frames)
 
-    if solver.shift or plan.rubs:
+    if not plan.compilable:
         return None     # rescaled units, or rubbing to bound: the general solver's work
     namespace: dict[str, Any] = {
-        '_ctx_check': _ctx_check, '_ctx_check_margin': _ctx_check_margin,
-        '_shown': _shown,
+        '_ctx_check': hooks.check, '_ctx_check_margin': hooks.check_margin,
+        '_shown': hooks.shown,
         '_slow': _general(scene, joints, points, frames),
+        '_trust_limits': hooks.trust_limits,
         'inf': math.inf,
     }
     for step in (plan.crank, *plan.steps):
@@ -386,11 +372,11 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
             if home.__name__.startswith(_SOLVER):
                 namespace.update((k, v) for k, v in vars(home).items()
                                  if not k.startswith('__'))
-    namespace['_wrapped_angle'] = _wrapped_angle
+    namespace['_wrapped_angle'] = hooks.wrapped_angle
     names: dict[str, str] = {}
     body: list[ast.stmt] = []
     try:
-        for name, entry in solver.ground.items():
+        for name, entry in plan.ground.items():
             local = names.setdefault(f'P_{name}', f'P_{name}_{len(names)}')
             namespace[f'_ground_{local}'] = entry
             body.append(ast.parse(f'{local} = _ground_{local}').body[0])
@@ -408,21 +394,15 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
 
     kinds = dict(plan.joint_types)
     lines = []
-    # The quick trust test of the general solver (_trusted), on the reported values.
-    lines += ['_w = abs(omega)', '_rate = _w * _w + abs(alpha)',
-              f'_lp = tol * {solver.size!r}', f'_lv = tol * ({solver.crank_length!r} * _w)',
-              f'_la = tol * ({solver.crank_length!r} * _rate)', '_lw = tol * _w',
-              '_lal = tol * _rate']
+    # The general solver's quick trust test (hooks.trust_limits and hooks.TRUST_TEST, the
+    # one source of both), on the reported values.
+    lines.append(f'_l0, _l1, _l2, _l3, _l4, _l5 = _trust_limits(tol, omega, alpha, '
+                 f'{plan.size!r}, {plan.crank_length!r})')
     checks = []
-    for name in solver.out_points:
-        e = var('P', name)
-        checks.append(f'{e}[3] <= _lp and {e}[4] <= _lv and {e}[5] <= _la')
-    for name in solver.out_links:
-        e = var('L', name)
-        checks.append(f'{e}[3] <= tol and {e}[4] <= _lw and {e}[5] <= _lal')
-    for name in solver.out_sliders:
-        e = var('S', name)
-        checks.append(f'{e}[3] <= _lp and {e}[4] <= _lv and {e}[5] <= _la')
+    for table, _, (i, j, k) in hooks.TRUST_TEST:
+        for name in plan.reported[table]:
+            e = var(_TABLES[table], name)
+            checks.append(f'{e}[3] <= _l{i} and {e}[4] <= _l{j} and {e}[5] <= _l{k}')
     if checks:
         lines.append(f'if not ({" and ".join(checks)}):')
         lines.append('    return _slow(theta, omega, alpha, tol, turns)')
@@ -448,9 +428,10 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
         measures[0] if measures else 'inf')
     lines.append(f'return [{", ".join(values)}], {measure}')
     tail = ast.parse('\n'.join(lines)).body
+    low, high, accel_high = hooks.RATES
     guard = ast.parse(
-        f'if not ({_RATE_LOW!r} <= abs(omega) <= {_RATE_HIGH!r} '
-        f'and abs(alpha) <= {_ACCEL_HIGH!r}):\n'
+        f'if not ({low!r} <= abs(omega) <= {high!r} '
+        f'and abs(alpha) <= {accel_high!r}):\n'
         '    return _slow(theta, omega, alpha, tol, turns)').body
     function = ast.FunctionDef(
         name='tick', args=ast.arguments(

@@ -22,7 +22,7 @@ from .model import _check_name, Units
 from .plan import _compile, _Plan
 from .rubbing import Pin
 from .scaling import _ANGULAR, _exponent, _LINEAR, _scaled, _size, _SIZE_RANGE
-from .solve import _execute
+from .solve import _execute, TRUST_TEST
 from ..bounds import U
 from ..errors import AssemblyError, NearSingularWarning, SceneError
 
@@ -83,6 +83,9 @@ class _Solver:
                        if step.intermittent}
         self.out_links = tuple(n for n, k in plan.joint_types.items() if k == 'revolute')
         self.out_sliders = tuple(n for n, k in plan.joint_types.items() if k == 'prismatic')
+        # The quick trust test's groups (TRUST_TEST), with their names, the empty ones left out.
+        self.trust = tuple((table, getattr(self, names), limits)
+                           for table, names, limits in TRUST_TEST if getattr(self, names))
 
 
 def assembly_text(error: AssemblyError, units: Units | None = None) -> str:

@@ -72,34 +72,46 @@ def _context_scales(solver: _Solver, ctx: _Context, omega: Any, alpha: Any) -> d
                    [ctx.links[name][1:3] for name in solver.out_links], ctx.vector)
 
 
-def _trusted(solver: _Solver, ctx: _Context, omega: float, alpha: float, tol: float) -> bool:
-    """Return True if every reported bound is within ``tol`` of its kind's smallest scale.
+def trust_limits(tol: float, omega: float, alpha: float, size: float,
+                 crank_length: float) -> tuple[float, float, float, float, float, float]:
+    """Return the quick trust test's six limits: ``tol`` times each kind's floor.
 
-    A quick sufficient test for the single-angle path: the scales' floors (the
-    mechanism's size, the crank's own rates) are at most the scales, so a pass
-    here is a pass of :func:`_refuse`'s exact test; NaN fails.
+    In order: position, velocity and acceleration (``size``, the crank tip's
+    speed ``a |omega|`` and acceleration ``a (omega^2 + |alpha|)``), angle,
+    angular velocity and angular acceleration (1 rad, ``|omega|``,
+    ``omega^2 + |alpha|``). The floors are at most the scales
+    (:attr:`State.scales`), so a state whose reported bounds are all within
+    them passes :func:`_refuse`'s exact test. With :data:`TRUST_TEST` the one
+    source of the test for :func:`_trusted` and the node's compiled tick.
     """
     w = abs(omega)
     rate = w * w + abs(alpha)
-    a = solver.crank_length
-    lp, lv, la = tol * solver.size, tol * (a * w), tol * (a * rate)
-    points = ctx.points
-    for name in solver.out_points:
-        e = points[name]
-        if not (e[3] <= lp and e[4] <= lv and e[5] <= la):
-            return False
-    links = ctx.links
-    lw, lal = tol * w, tol * rate
-    for name in solver.out_links:
-        e = links[name]
-        if not (e[3] <= tol and e[4] <= lw and e[5] <= lal):
-            return False
-    sliders = ctx.sliders
-    for name in solver.out_sliders:
-        e = sliders[name]
-        if not (e[3] <= lp and e[4] <= lv and e[5] <= la):
-            return False
+    return (tol * size, tol * (crank_length * w), tol * (crank_length * rate), tol, tol * w,
+            tol * rate)
+
+
+#: The quick trust test: per context table, the solver's attribute listing the
+#: reported names in it, and which :func:`trust_limits` bound their values' bounds.
+TRUST_TEST = (('points', 'out_points', (0, 1, 2)), ('links', 'out_links', (3, 4, 5)),
+              ('sliders', 'out_sliders', (0, 1, 2)))
+
+
+def _trusted(solver: _Solver, ctx: _Context, omega: float, alpha: float, tol: float) -> bool:
+    """Return True if every reported bound is within ``tol`` of its kind's smallest scale.
+
+    A quick sufficient test for the single-angle path (:func:`trust_limits`);
+    NaN fails.
+    """
+    lim = trust_limits(tol, omega, alpha, solver.size, solver.crank_length)
+    for table, names, (i, j, k) in solver.trust:
+        entries = getattr(ctx, table)
+        li, lj, lk = lim[i], lim[j], lim[k]
+        for name in names:
+            e = entries[name]
+            if not (e[3] <= li and e[4] <= lj and e[5] <= lk):
+                return False
     if ctx.rubbing:
+        lv = lim[1]
         return all(bound <= lv for _, bound in ctx.rubbing.values())
     return True
 
