@@ -21,8 +21,8 @@ import mech_kinematics as mk
 from mech_kinematics.geometry.diagrams import (acceleration_polygon_from_state, diagram_from_scene,
                                                VectorKind, velocity_polygon_from_state)
 from mech_kinematics.geometry.frames import frames_from_scene, poses_from_state
+from mech_kinematics.ros.ticker import tick_function
 from mech_kinematics.solver import RPP
-from mech_kinematics.ticker import tick_function
 
 pytestmark = pytest.mark.filterwarnings('ignore::mech_kinematics.NearSingularWarning')
 

@@ -20,27 +20,31 @@ scene's ``type:`` to the item class
 
 The kernel subset of ``Step.run``
 ---------------------------------
-The node's tick (:mod:`mech_kinematics.ticker`) partially evaluates every
-step's ``run`` into one straight-line function, so ``run`` must be written in
-the subset that the ticker understands; anything else makes the scene fall
-back to the general solver, and ``test_ticker`` fails for a packaged scene
-that falls back:
+The node's tick (:mod:`mech_kinematics.ros.ticker`) partially evaluates the
+bodies of every step's kernels (:meth:`Step.kernels`: ``run`` itself unless
+the step names its scalar path) into one straight-line function, so they must
+be written in the subset that the ticker understands. Anything else makes the
+scene fall back to the general solver, and ``test_ticker`` fails for a
+packaged scene that falls back:
 
-- ``run(self, ctx)`` (the crank's ``run(self, ctx, theta, omega, alpha)``) is
-  a plain method: no ``for``/``while`` loop, ``return``, ``try``, ``with``,
-  ``yield``, nested ``def``, ``global`` or ``nonlocal``; lambdas only without
-  arguments (the deferred messages of ``ctx.check``);
-- the context is used only as ``ctx.vector``, ``ctx.points[...]``,
-  ``ctx.links[...]``, ``ctx.sliders[...]``, ``ctx.measures[...]`` (read or
-  assigned whole), ``ctx.check(...)``, ``ctx.check_margin(...)`` and
-  ``ctx.shown``; table keys are ``self.<attribute>`` (a name fixed when the
-  step is built);
+- a kernel is a plain function of ``(self, ctx)`` (the crank's of
+  ``(self, ctx, theta, omega, alpha)``): no ``for``/``while`` loop,
+  ``return``, ``try``, ``with``, ``yield``, nested ``def``, ``global`` or
+  ``nonlocal``; lambdas only without arguments (deferred messages);
+- the context is used only as ``ctx.vector``, ``ctx.angle``, ``ctx.turns``,
+  ``ctx.shown``, ``ctx.points[...]``, ``ctx.links[...]``,
+  ``ctx.sliders[...]``, ``ctx.measures[...]`` (read or assigned whole),
+  ``ctx.check(...)``, ``ctx.check_margin(...)``, and ``ctx.engage(...)``
+  and ``ctx.note(...)`` as statements (side facts: the tick drops them);
+  table keys are ``self.<attribute>`` (a name fixed when the step is built);
 - ``self.<attribute>`` is read only (it becomes a constant); helpers whose
-  body is one ``return <expression>`` (as ``_dot`` of :mod:`.context`) are written
-  out in place; other names are the step module's globals.
+  body is one ``return <expression>`` (as ``_dot`` of :mod:`.context`) are
+  written out in place; other names are the kernel module's globals.
 
-``ctx.vector`` is ``False`` in the tick function and every branch it decides
-is folded away, so a step keeps its scalar and array paths in one ``run``.
+``ctx.vector`` is ``False`` in the tick function: a branch it decides is
+dropped before the rest is specialized (the array path may use anything), so
+a step keeps its scalar and array paths in one ``run``. The tick's other
+needs are the public hooks of :mod:`.tick`.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""What the node's compiled tick (:mod:`mech_kinematics.ticker`) uses of the solver: public hooks.
+"""What the node's compiled tick (:mod:`mech_kinematics.ros.ticker`) uses of the solver: hooks.
 
 The ticker partially evaluates the steps' kernels (:meth:`.base.Step.kernels`,
 written in the kernel subset that :mod:`.base` states) into one straight-line

@@ -7,8 +7,11 @@ dictionary lookup, attribute read and object the general solver makes, and,
 waking from a sleep each tick with cold caches, for the size of the code it
 runs. :func:`compile_tick` removes that overhead without writing the
 kinematics a second time: it specializes the solver's own step code (the
-``run`` methods of the step kinds of :mod:`mech_kinematics.solver`) to the scalar path of one
-scene by partial evaluation of their syntax trees.
+kernels of the step kinds of :mod:`mech_kinematics.solver`, written in the
+subset that :mod:`mech_kinematics.solver.base` states) to the scalar path of
+one scene by partial evaluation of their syntax trees, and takes the rest from
+the solver's public hooks (:mod:`mech_kinematics.solver.tick`). It is the
+node's, so it lives in the ROS layer (it imports only the solver).
 
 - ``ctx.vector`` becomes ``False`` and every branch it decides is folded
   away, so only the single-angle arithmetic is left;
@@ -41,8 +44,8 @@ import sys
 import textwrap
 from typing import Any, cast
 
-from . import solver as lk
-from .solver import tick as hooks
+from .. import solver as lk
+from ..solver import tick as hooks
 
 __all__ = ['TickFunction', 'compile_tick', 'tick_function', 'values_from_state']
 
