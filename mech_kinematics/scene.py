@@ -50,7 +50,7 @@ from yaml.events import (AliasEvent, DocumentEndEvent, DocumentStartEvent, Mappi
                          StreamEndEvent, StreamStartEvent)
 
 from .errors import SceneError
-from .solver import Branch, CarriedPoint, Crank, Link, Pin, Scene, Units
+from .solver import Branch, CarriedPoint, Crank, Link, Pin, Scene, SceneUnits
 from .solver.base import Item
 from .solver.registry import KINDS
 from .units import ANGLE_UNITS, LENGTH_UNITS, rad_per_s_from_rpm
@@ -466,7 +466,7 @@ class _Reader:
         length, angle = units['length'], units['angle']
         self.per_metre = LENGTH_UNITS[length]
         self.degrees = angle == 'deg'
-        self.units = Units(length, angle)
+        self.units = SceneUnits(length, angle)
 
     @staticmethod
     def get(mapping: Any, key: str, where: str, default: Any = ...) -> Any:

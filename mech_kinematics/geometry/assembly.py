@@ -25,7 +25,7 @@
 
 :func:`assembly_summary` states the ranges where it does not assemble in one
 short line, for ``plot --scene`` and the node's diagnostics. Angles here are
-in rad and lengths in m; :class:`~mech_kinematics.linkage.Units` shows them
+in rad and lengths in m; :class:`~mech_kinematics.solver.SceneUnits` shows them
 in the scene's own units. NumPy only: the solver does the geometry.
 
 A range narrower than the sampling step (:data:`SAMPLES` per turn) can be
@@ -46,7 +46,7 @@ import numpy.typing as npt
 
 from .instant_centres import full_scene
 from ..errors import AssemblyError, NearSingularWarning
-from ..solver import Scene, solve, Units
+from ..solver import Scene, SceneUnits, solve
 
 __all__ = [
     'Assembly', 'DeadCentre', 'FourBarLoop', 'SAMPLES', 'TOLERANCE', 'Toggle', 'Transmission',
@@ -130,7 +130,7 @@ class Assembly:
     ----------
     scene : str
         Scene name.
-    units : Units
+    units : SceneUnits
         The scene's units, to show the numbers in.
     ranges : tuple of (float, float)
         Crank-angle ranges where it assembles, ``start < end``; a range that
@@ -146,7 +146,7 @@ class Assembly:
     """
 
     scene: str
-    units: Units
+    units: SceneUnits
     ranges: tuple[tuple[float, float], ...]
     gaps: tuple[tuple[float, float], ...]
     toggles: tuple[Toggle, ...]
@@ -185,7 +185,7 @@ def grashof_class(ground: float, input_: float, coupler: float, output: float) -
     return ('double-crank', 'crank-rocker', 'double-rocker', 'rocker-crank')[shortest]
 
 
-def summary_from_gaps(gaps: Sequence[tuple[float, float]], units: Units) -> str:
+def summary_from_gaps(gaps: Sequence[tuple[float, float]], units: SceneUnits) -> str:
     """Return :func:`assembly_summary`'s line for crank-angle ranges ``gaps`` (rad)."""
     if not gaps:
         return 'assembles at every crank angle'
@@ -505,7 +505,7 @@ def _loops(probe: _Probe) -> tuple[FourBarLoop, ...]:
 # --- text --------------------------------------------------------------------------
 
 
-def angle_text(units: Units, theta: float) -> str:
+def angle_text(units: SceneUnits, theta: float) -> str:
     """Return a crank angle (rad) in the scene's unit to 6 significant digits, without unit.
 
     A value within 5e-7 of a turn of 0 or of a full turn is shown as 0 (a
@@ -522,6 +522,6 @@ def angle_text(units: Units, theta: float) -> str:
 _angle = angle_text
 
 
-def _ranges_text(ranges: Sequence[tuple[float, float]], units: Units) -> str:
+def _ranges_text(ranges: Sequence[tuple[float, float]], units: SceneUnits) -> str:
     parts = [f'{_angle(units, a)}..{_angle(units, b)}' for a, b in ranges]
     return f'{", ".join(parts)} {units.angle}'

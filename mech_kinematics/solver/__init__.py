@@ -39,7 +39,7 @@ from .context import NEAR_SINGULAR, SINGULAR
 from .crank import Crank
 from .geneva import TANGENCY_TOLERANCE
 from .mechanism import assembly_text, Scene
-from .model import Branch, Link, Units
+from .model import Branch, Link, SceneUnits
 from .rpp import RPP
 from .rpr import MAX_SLOTS, RPR
 from .rrp import RRP
@@ -51,5 +51,5 @@ from .state import Engagement, JointMotion, PointState, State
 __all__ = [
     'Branch', 'CarriedPoint', 'Crank', 'Engagement', 'JointMotion', 'Link', 'MAX_SLOTS',
     'NEAR_SINGULAR', 'Pin', 'PointState', 'RPP', 'RPR', 'RRP', 'RRR', 'SINGULAR', 'Scene', 'State',
-    'TANGENCY_TOLERANCE', 'Units', 'assembly_text', 'solve',
+    'SceneUnits', 'TANGENCY_TOLERANCE', 'assembly_text', 'solve',
 ]

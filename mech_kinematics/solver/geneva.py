@@ -16,7 +16,7 @@ import numpy as np
 
 from .base import Placing
 from .context import _Context, _U2, _U4, _U7
-from .model import _names, Units
+from .model import _names, SceneUnits
 from .rpr import _RPRStep, RPR
 from .state import Engagement
 from ..bounds import ROUNDING_MARGIN, U
@@ -194,7 +194,7 @@ def _index_step(plan: Placing, item: RPR) -> _IndexStep:
     scene, ground, size = plan.scene, plan.ground, plan.size
     crank = scene.input
     crank_local = plan.local[crank.link]
-    units: Units = getattr(scene, 'units', Units())
+    units: SceneUnits = getattr(scene, 'units', SceneUnits())
     n = cast(int, item.slots)
     if item.through not in crank_local or item.through == crank.center:
         on_crank = _names(p for p in crank_local if p != crank.center)

@@ -18,7 +18,7 @@ import warnings
 from .base import Intermittent, Item
 from .carried import CarriedPoint
 from .crank import Crank
-from .model import _check_name, Units
+from .model import _check_name, SceneUnits
 from .plan import _compile, _Plan
 from .rubbing import Pin
 from .scaling import _ANGULAR, _exponent, _LINEAR, _scaled, _size, _SIZE_RANGE
@@ -88,7 +88,7 @@ class _Solver:
                            for table, names, limits in TRUST_TEST if getattr(self, names))
 
 
-def assembly_text(error: AssemblyError, units: Units | None = None) -> str:
+def assembly_text(error: AssemblyError, units: SceneUnits | None = None) -> str:
     """Return why a mechanism cannot assemble, naming links and lengths in ``units``.
 
     E.g. ``links coupler (150 mm) and rocker (80 mm) cannot reach from B to D
@@ -97,7 +97,7 @@ def assembly_text(error: AssemblyError, units: Units | None = None) -> str:
     facts = error.facts
     if facts is None:
         return f'{error.dyad}: {error.reason}'
-    units = Units() if units is None else units
+    units = SceneUnits() if units is None else units
     text = units.length_text
     kind, links, lengths, points = facts['kind'], facts['links'], facts['lengths'], \
         facts['points']
@@ -147,7 +147,7 @@ class Scene:
         Free text.
     pins : tuple of Pin
         Pins whose rubbing velocity is reported (``State.rubbing``).
-    units : Units
+    units : SceneUnits
         The units the scene was written in, for messages (its values are SI).
     """
 
@@ -160,7 +160,7 @@ class Scene:
     outputs_points: tuple[str, ...] | None = None
     description: str = ''
     pins: tuple[Pin, ...] = ()
-    units: Units = Units()
+    units: SceneUnits = SceneUnits()
     _plan: _Plan = field(init=False, repr=False, compare=False)
     _solver: _Solver = field(init=False, repr=False, compare=False)
 

@@ -69,7 +69,7 @@ def _g(value: float, *others: float) -> str:
 
 
 @dataclass(frozen=True)
-class Units:
+class SceneUnits:
     """The units a scene was written in, for messages: ``length`` m or mm, ``angle`` rad or deg.
 
     Everything the solver holds and returns is SI; these only say how to show
