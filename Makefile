@@ -81,7 +81,7 @@ lint: $(TF2_STAMP) $(DEV_STAMP)
 	@status=0; \
 	echo '== ruff'; $(VPY) -m ruff check mech_kinematics test setup.py scripts launch || status=1; \
 	echo '== flake8'; $(VPY) -m flake8 mech_kinematics test setup.py scripts launch || status=1; \
-	echo '== mypy --strict (linkage.py scene.py errors.py)'; $(VPY) -m mypy || status=1; \
+	echo '== mypy --strict (the solver package, scene.py, errors.py, ...)'; $(VPY) -m mypy || status=1; \
 	exit $$status
 
 clean:

@@ -50,7 +50,9 @@ from yaml.events import (AliasEvent, DocumentEndEvent, DocumentStartEvent, Mappi
                          StreamEndEvent, StreamStartEvent)
 
 from .errors import SceneError
-from .linkage import Branch, CarriedPoint, Crank, Link, MAX_SLOTS, Pin, RPR, RRP, RRR, Scene, Units
+from .solver import Branch, CarriedPoint, Crank, Link, Pin, Scene, SceneUnits
+from .solver.base import Item
+from .solver.registry import KINDS
 from .units import ANGLE_UNITS, LENGTH_UNITS, rad_per_s_from_rpm
 
 __all__ = [
@@ -464,7 +466,7 @@ class _Reader:
         length, angle = units['length'], units['angle']
         self.per_metre = LENGTH_UNITS[length]
         self.degrees = angle == 'deg'
-        self.units = Units(length, angle)
+        self.units = SceneUnits(length, angle)
 
     @staticmethod
     def get(mapping: Any, key: str, where: str, default: Any = ...) -> Any:
@@ -659,41 +661,38 @@ def _link(reader: _Reader, keys: _Keys, raw: Any, where: str) -> Link:
                       length=reader.length(raw, 'length', where))
 
 
-def _dyad(reader: _Reader, keys: _Keys, raw: Any, where: str) -> RRR | RRP | RPR:
+def _dyad(reader: _Reader, keys: _Keys, raw: Any, where: str) -> Item:
     kind = reader.get(raw, 'type', where)
-    if kind == 'RRR':
-        _check_keys(raw, {'type', 'point', 'links', 'branch'}, where)
-        links = reader.get(raw, 'links', where)
-        if not isinstance(links, list) or len(links) != 2:
-            raise SceneError(f'{where}.links: expected a list of 2 links, got {_brief(links)}')
-        first, second = (_link(reader, keys, link, f'{where}.links[{i}]')
-                         for i, link in enumerate(links))
-        return keys.build(where, {}, RRR, point=reader.name(raw, 'point', where),
-                          links=(first, second), branch=reader.branch(raw, where))
-    if kind == 'RRP':
-        _check_keys(raw, {'type', 'point', 'link', 'guide', 'slider', 'branch'}, where)
-        link = _link(reader, keys, reader.get(raw, 'link', where), f'{where}.link')
-        guide = reader.get(raw, 'guide', where)
-        if isinstance(guide, dict):
-            _check_keys(guide, {'through', 'angle'}, f'{where}.guide')
-        return keys.build(
-            where, {'through': 'guide.through', 'guide_angle': 'guide.angle'}, RRP,
-            point=reader.name(raw, 'point', where),
-            link=link, through=reader.name(guide, 'through', f'{where}.guide'),
-            guide_angle=reader.angle(guide, 'angle', f'{where}.guide', 0.0),
-            slider=reader.name(raw, 'slider', where), branch=reader.branch(raw, where))
-    if kind == 'RPR':
-        _check_keys(raw, {'type', 'link', 'center', 'through', 'slider', 'slots'}, where)
-        slots = raw.get('slots')
-        if slots is not None and (isinstance(slots, bool) or not isinstance(slots, int)
-                                  or not 3 <= slots <= MAX_SLOTS):
-            raise SceneError(f'{where}.slots: expected a whole number of slots from 3 to '
-                             f'{MAX_SLOTS}, got {_brief(slots)}')
-        return keys.build(
-            where, {}, RPR, link=reader.name(raw, 'link', where),
-            center=reader.name(raw, 'center', where), through=reader.name(raw, 'through', where),
-            slider=reader.name(raw, 'slider', where), slots=slots)
-    raise SceneError(f'{where}.type: expected RRR, RRP or RPR, got {_brief(kind)}')
+    item = KINDS.get(kind) if isinstance(kind, str) else None
+    if item is None:
+        *first, last = KINDS
+        raise SceneError(f'{where}.type: expected {", ".join(first)} or {last}, got '
+                         f'{_brief(kind)}')
+    return item.from_scene(_Reading(reader, keys), raw, where)
+
+
+class _Reading:
+    """The scene reader as a kind reads its keys with it (:class:`~.solver.base.Reading`)."""
+
+    def __init__(self, reader: _Reader, keys: _Keys) -> None:
+        self.reader, self.keys = reader, keys
+        self.get, self.name, self.length = reader.get, reader.name, reader.length
+        self.angle, self.branch = reader.angle, reader.branch
+        self.build = keys.build
+
+    @staticmethod
+    def check_keys(mapping: Any, allowed: set[str], where: str) -> None:
+        """Refuse any key of ``mapping`` outside ``allowed``."""
+        _check_keys(mapping, allowed, where)
+
+    @staticmethod
+    def brief(value: Any) -> str:
+        """Return ``value`` shortened for a message."""
+        return _brief(value)
+
+    def link(self, raw: Any, where: str) -> Link:
+        """Return the link ``{name, from, length}`` at ``where``."""
+        return _link(self.reader, self.keys, raw, where)
 
 
 def _carried(reader: _Reader, keys: _Keys, name: str, raw: Any, where: str) -> CarriedPoint:

@@ -10,16 +10,20 @@ comment naming the modules that use it.
 from __future__ import annotations
 
 import json
+import math
 import os
 from pathlib import Path
 import runpy
 from typing import Any
 from unittest import mock
 
+import mpmath
 import pytest
 import setuptools
 
+import mech_kinematics as mk
 from mech_kinematics.ros.parameters import PARAMETERS
+from mech_kinematics.tools import reference as ref
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
@@ -122,3 +126,65 @@ def node_parameters() -> frozenset:
     and rclpy declares the standard ones for every node.
     """
     return frozenset({p.name for p in PARAMETERS} | STANDARD_PARAMETERS)
+
+
+# --- error bounds against the 50-digit reference ----------------------------------
+
+
+def actual_errors(state, exact):
+    """Yield (path, kind, actual error, bound, scale) for every value ``state`` reports.
+
+    ``exact`` is the reference at the same instant; errors of points are the
+    lengths of the error vectors, angles compare modulo 2 pi. Values the
+    reference leaves undefined (velocities at a singular pose) are skipped.
+    """
+    joint_bounds, point_bounds = state.error_bound.raw()
+    scales = state.scales
+    with mpmath.workdps(ref.DPS):
+        for name, values in state.complex_points.items():
+            for index, (quantity, kind) in enumerate(zip(
+                    ('position', 'velocity', 'acceleration'),
+                    ('position', 'velocity', 'acceleration'), strict=True)):
+                truth = exact.points[name][index]
+                if truth is None:
+                    continue
+                error = abs(mpmath.mpc(values[index]) - truth)
+                yield (f'points.{name}.{quantity}', kind, float(error),
+                       float(point_bounds[name][index]), float(scales[kind]))
+        for name, joint in state.joints.items():
+            kinds = (('angle', 'angular velocity', 'angular acceleration')
+                     if joint.type == 'revolute' else ('position', 'velocity', 'acceleration'))
+            for index, quantity in enumerate(('position', 'velocity', 'acceleration')):
+                truth = exact.joints[name][index]
+                if truth is None:
+                    continue
+                error = mpmath.mpf(getattr(joint, quantity)) - truth
+                if index == 0 and joint.type == 'revolute':
+                    error = ref._wrap(error)
+                yield (f'joints.{name}.{quantity}', kinds[index], float(abs(error)),
+                       float(joint_bounds[name][index]), float(scales[kinds[index]]))
+
+
+def assert_bounded(scene, angle, speed=None, accel=None):
+    """Assert every value the solver answers is within its bound; return (state, exact).
+
+    The solver is asked with an infinite tolerance, so that every answer it
+    can give is checked; ``state`` is None where it refuses (it must then be
+    refused with the default tolerance too) and ``exact`` is None where the
+    mechanism does not assemble (the solver must refuse).
+    """
+    try:
+        exact = ref.reference(scene, angle, speed, accel)
+    except ref.NoAssembly:
+        with pytest.raises(mk.AssemblyError):
+            mk.solve(scene, angle, speed, accel, max_error=math.inf)
+        return None, None
+    try:
+        state = mk.solve(scene, angle, speed, accel, max_error=math.inf)
+    except mk.AssemblyError:
+        with pytest.raises(mk.AssemblyError):
+            mk.solve(scene, angle, speed, accel)
+        return None, exact
+    for path, _, error, bound, _ in actual_errors(state, exact):
+        assert error <= bound, (scene.name, angle, path, error, bound)
+    return state, exact

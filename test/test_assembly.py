@@ -26,7 +26,7 @@ def four_bar(name, ground, crank, coupler, rocker, angle=0.0, branch=mk.Branch.P
     links = (mk.Link('coupler', 'B', coupler), mk.Link('rocker', 'D', rocker))
     return mk.Scene(name, {'A': (0.0, 0.0), 'D': (ground, 0.0)},
                     mk.Crank('crank', 'A', 'B', crank, angle, 1.0),
-                    (mk.RRR('C', links, branch),), units=mk.Units('mm', 'deg'))
+                    (mk.RRR('C', links, branch),), units=mk.SceneUnits('mm', 'deg'))
 
 
 def test_triple_rocker_assembles_within_its_limits():
@@ -141,7 +141,7 @@ def test_summary_speaks_the_scene_units():
     """The one-line summary is in the scene's angle unit: rad for a scene in rad."""
     scene = mk.load_scene('four_bar_coupler_points')
     in_rad = mk.Scene(scene.name, scene.ground, scene.input, scene.dyads, scene.points,
-                      units=mk.Units('m', 'rad'))
+                      units=mk.SceneUnits('m', 'rad'))
     limit = math.acos((50 ** 2 + 100 ** 2 - 122 ** 2) / (2 * 50 * 100))
     assert asm.assembly_summary(in_rad) == (
         f'does not assemble for crank angles {limit:.6g}..{TURN - limit:.6g} rad')

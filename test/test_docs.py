@@ -60,6 +60,15 @@ COMPOUND = BASE.replace('D: [150, 0]\n', 'D: [150, 0]\n  F: [300, 100]\n') + """
       - {name: link_FE, from: F, length: 100}
 pins: {C: 5}
 """
+YOKE = """\
+name: yoke
+units: {length: mm, angle: deg}
+ground: {A: [0, 0]}
+input: {link: crank, center: A, point: B, length: 50, angle: 30, speed_rpm: 300}
+dyads:
+  - {type: RPP, point: Y, through: B, guide: {through: A, angle: 0}, slot_angle: 90,
+     slider: yoke, slot_slider: pin_in_slot}
+"""
 #: Each mistake of the reference's error table, as the scene text that makes it.
 MISTAKES = {
     'no_units': BASE.replace('units: {length: mm, angle: deg}\n', ''),
@@ -74,7 +83,7 @@ MISTAKES = {
     'twice': BASE.replace('name: rocker', 'name: coupler'),
     'unknown_point': BASE.replace('  D: [150, 0]\n', '').replace('from: D', 'from: Q'),
     'cycle': BASE.replace('from: B', 'from: C'),
-    'type': BASE.replace('type: RRR', 'type: RPP'),
+    'type': BASE.replace('type: RRR', 'type: PPP'),
     'reach': BASE.replace('length: 150}', 'length: 50}'),
     'meet': BASE.replace('length: 80}', 'length: 10}'),
     'guide': (ROOT / 'docs' / 'toggle_press.yaml').read_text().replace(
@@ -82,6 +91,7 @@ MISTAKES = {
     'slots': GENEVA,
     'pin_off_crank': GENEVA.replace('slots: 5', 'slots: 6').replace('through: P', 'through: S'),
     'compound': COMPOUND,
+    'parallel_slot': YOKE.replace('slot_angle: 90', 'slot_angle: 180'),
 }
 
 

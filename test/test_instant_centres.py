@@ -89,6 +89,16 @@ def test_three_centres_of_three_links_are_collinear(name, angle):
         assert abs(np.linalg.det(h)) < ATOL_COLLINEAR, (a, b, c)
 
 
+def _body_omega(topology, state, name):
+    """Return a body's angular velocity: a slider block turns with what it slides on."""
+    body = topology.bodies[name]
+    if body.kind is BodyKind.GROUND:
+        return 0.0
+    if body.kind is BodyKind.SLIDER:
+        return _body_omega(topology, state, body.guide)
+    return state.joints[name].velocity
+
+
 @pytest.mark.parametrize(('name', 'angle'), _states())
 def test_point_velocity_is_omega_times_distance_from_ground_centre(name, angle):
     """Every point P of every link moves as omega x (P - I): |v_P| = |omega| |PI|, normal to PI."""
@@ -101,11 +111,7 @@ def test_point_velocity_is_omega_times_distance_from_ground_centre(name, angle):
         if body.kind is BodyKind.GROUND:
             continue
         centre = centres[(topology.ground, body.name)]
-        if body.kind is BodyKind.SLIDER:
-            guide = body.guide
-            omega = 0.0 if guide == topology.ground else state.joints[guide].velocity
-        else:
-            omega = state.joints[body.name].velocity
+        omega = _body_omega(topology, state, body.name)
         for point in body.points:
             p, v, _ = (complex(x) for x in state.complex_points[point])
             if centre.point is None:

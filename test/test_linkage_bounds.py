@@ -38,6 +38,7 @@ import subprocess
 import sys
 import warnings
 
+from helpers import actual_errors, assert_bounded
 from hypothesis import assume, given, HealthCheck, settings
 from hypothesis import strategies as st
 import mpmath
@@ -68,65 +69,6 @@ SETTINGS = settings(max_examples=300, deadline=None, derandomize=True,
 
 
 # --- measuring the actual error ---------------------------------------------------
-
-
-def actual_errors(state, exact):
-    """Yield (path, kind, actual error, bound, scale) for every value ``state`` reports.
-
-    ``exact`` is the reference at the same instant; errors of points are the
-    lengths of the error vectors, angles compare modulo 2 pi. Values the
-    reference leaves undefined (velocities at a singular pose) are skipped.
-    """
-    joint_bounds, point_bounds = state.error_bound.raw()
-    scales = state.scales
-    with mpmath.workdps(ref.DPS):
-        for name, values in state.complex_points.items():
-            for index, (quantity, kind) in enumerate(zip(
-                    ('position', 'velocity', 'acceleration'),
-                    ('position', 'velocity', 'acceleration'), strict=True)):
-                truth = exact.points[name][index]
-                if truth is None:
-                    continue
-                error = abs(mpmath.mpc(values[index]) - truth)
-                yield (f'points.{name}.{quantity}', kind, float(error),
-                       float(point_bounds[name][index]), float(scales[kind]))
-        for name, joint in state.joints.items():
-            kinds = (('angle', 'angular velocity', 'angular acceleration')
-                     if joint.type == 'revolute' else ('position', 'velocity', 'acceleration'))
-            for index, quantity in enumerate(('position', 'velocity', 'acceleration')):
-                truth = exact.joints[name][index]
-                if truth is None:
-                    continue
-                error = mpmath.mpf(getattr(joint, quantity)) - truth
-                if index == 0 and joint.type == 'revolute':
-                    error = ref._wrap(error)
-                yield (f'joints.{name}.{quantity}', kinds[index], float(abs(error)),
-                       float(joint_bounds[name][index]), float(scales[kinds[index]]))
-
-
-def assert_bounded(scene, angle, speed=None, accel=None):
-    """Assert every value the solver answers is within its bound; return (state, exact).
-
-    The solver is asked with an infinite tolerance, so that every answer it
-    can give is checked; ``state`` is None where it refuses (it must then be
-    refused with the default tolerance too) and ``exact`` is None where the
-    mechanism does not assemble (the solver must refuse).
-    """
-    try:
-        exact = ref.reference(scene, angle, speed, accel)
-    except ref.NoAssembly:
-        with pytest.raises(mk.AssemblyError):
-            mk.solve(scene, angle, speed, accel, max_error=math.inf)
-        return None, None
-    try:
-        state = mk.solve(scene, angle, speed, accel, max_error=math.inf)
-    except mk.AssemblyError:
-        with pytest.raises(mk.AssemblyError):
-            mk.solve(scene, angle, speed, accel)
-        return None, exact
-    for path, _, error, bound, _ in actual_errors(state, exact):
-        assert error <= bound, (scene.name, angle, path, error, bound)
-    return state, exact
 
 
 # --- the extreme suite ------------------------------------------------------------

@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 import mech_kinematics as mk
-from mech_kinematics.linkage import _diameter
+from mech_kinematics.solver.plan import _diameter
 
 SETTINGS = settings(max_examples=300, deadline=None, derandomize=True)
 #: Relative tolerance of the diameter from the hull against all pairs, for

@@ -297,7 +297,7 @@ def test_measures_match_the_solver():
 def test_reference_does_not_use_the_solver():
     """The reference module imports the solver's dataclasses only, never its steps."""
     source = Path(ref.__file__).read_text()
-    assert 'from ..linkage import RPR, RRP, RRR, Scene' in source
+    assert 'from ..solver import Scene' in source
     for name in ('solve', '_RRRStep', '_RRPStep', '_RPRStep', '_run'):
         assert not hasattr(ref, name)
 

@@ -11,7 +11,8 @@ import pytest
 import yaml
 
 import mech_kinematics as mk
-from mech_kinematics.ticker import compile_tick, tick_function, values_from_state
+from mech_kinematics.ros.ticker import compile_tick, tick_function, values_from_state
+from mech_kinematics.solver import tick as hooks
 from mech_kinematics.tools.report.common import MODES
 from mech_kinematics.tools.report.cost import chain_scene
 from mech_kinematics.tools.report.extreme import extreme_cases
@@ -61,24 +62,34 @@ def _assert_same(scene, tick, angles, speeds=(None,), turns=(0,), **kwargs):
     return refused
 
 
-#: Scenes served by the general solver in the node: an intermittent (Geneva) wheel.
-NOT_COMPILED = {'geneva'}
-
-
 @pytest.mark.parametrize('name', mk.scene_names())
 def test_every_packaged_scene_compiles_to_the_same_bits(name):
     """Over two turns, at three tolerances, the compiled tick answers as mk.solve does.
 
-    The one scene that is not compiled (its wheel's step runs code the compiler
-    does not specialize) gets the general solver behind the same signature,
-    with the crank's whole turns passed on.
+    Every packaged scene compiles: a step whose kernels leave the subset the
+    tick understands (``solver/base.py``) would fall back to the general
+    solver and fail here (issue 17). The Geneva wheel's crank turns are passed on.
     """
     scene = mk.load_scene(name)
     tick, compiled = tick_function(scene)
-    assert compiled == (name not in NOT_COMPILED)
+    assert compiled, f'{name}: a step falls back to the general solver'
     refused = _assert_same(scene, tick, ANGLES, speeds=(None, -3.5, 1e4), turns=(0, 3, -40))
     if name == 'four_bar_coupler_points':
         assert refused > 0      # the triple rocker's unassemblable angles, refused alike
+
+
+def test_a_step_outside_the_kernel_subset_falls_back(monkeypatch):
+    """A kernel with a loop is not compiled: the scene falls back (what the test above catches)."""
+    scene = mk.load_scene('khurmi_four_bar_ad150')
+    step = type(hooks.tick_plan(scene).steps[0])
+
+    def looping(self, ctx):
+        for _ in range(1):
+            ctx.measures[self.key] = 1.0
+
+    assert tick_function(scene)[1]
+    monkeypatch.setattr(step, 'kernels', classmethod(lambda cls: (looping,)))
+    assert not tick_function(scene)[1]
 
 
 def test_the_extreme_suite_refuses_and_answers_alike():

@@ -25,7 +25,7 @@
 
 :func:`assembly_summary` states the ranges where it does not assemble in one
 short line, for ``plot --scene`` and the node's diagnostics. Angles here are
-in rad and lengths in m; :class:`~mech_kinematics.linkage.Units` shows them
+in rad and lengths in m; :class:`~mech_kinematics.solver.SceneUnits` shows them
 in the scene's own units. NumPy only: the solver does the geometry.
 
 A range narrower than the sampling step (:data:`SAMPLES` per turn) can be
@@ -46,7 +46,7 @@ import numpy.typing as npt
 
 from .instant_centres import full_scene
 from ..errors import AssemblyError, NearSingularWarning
-from ..linkage import RPR, RRP, RRR, Scene, solve, Units
+from ..solver import Scene, SceneUnits, solve
 
 __all__ = [
     'Assembly', 'DeadCentre', 'FourBarLoop', 'SAMPLES', 'TOLERANCE', 'Toggle', 'Transmission',
@@ -130,7 +130,7 @@ class Assembly:
     ----------
     scene : str
         Scene name.
-    units : Units
+    units : SceneUnits
         The scene's units, to show the numbers in.
     ranges : tuple of (float, float)
         Crank-angle ranges where it assembles, ``start < end``; a range that
@@ -146,7 +146,7 @@ class Assembly:
     """
 
     scene: str
-    units: Units
+    units: SceneUnits
     ranges: tuple[tuple[float, float], ...]
     gaps: tuple[tuple[float, float], ...]
     toggles: tuple[Toggle, ...]
@@ -185,7 +185,7 @@ def grashof_class(ground: float, input_: float, coupler: float, output: float) -
     return ('double-crank', 'crank-rocker', 'double-rocker', 'rocker-crank')[shortest]
 
 
-def summary_from_gaps(gaps: Sequence[tuple[float, float]], units: Units) -> str:
+def summary_from_gaps(gaps: Sequence[tuple[float, float]], units: SceneUnits) -> str:
     """Return :func:`assembly_summary`'s line for crank-angle ranges ``gaps`` (rad)."""
     if not gaps:
         return 'assembles at every crank angle'
@@ -317,10 +317,10 @@ def _measure_keys(scene: Scene) -> dict[str, tuple[str, tuple[str, ...]]]:
     """Measure key -> (dyad label, its links) for the RRR and RRP dyads."""
     keys = {}
     for dyad in scene.dyads:
-        if isinstance(dyad, RRR):
-            keys[dyad.point] = (f'RRR {dyad.point}', tuple(link.name for link in dyad.links))
-        elif isinstance(dyad, RRP):
-            keys[dyad.point] = (f'RRP {dyad.point}', (dyad.link.name,))
+        toggle = dyad.toggle()
+        if toggle is not None:
+            key, label, links = toggle
+            keys[key] = (label, links)
     return keys
 
 
@@ -388,28 +388,16 @@ def _outputs(scene: Scene) -> dict[str, str]:
     """Output joints that can have dead centres: name -> 'revolute' or 'prismatic'."""
     outputs = {}
     for dyad in scene.dyads:
-        if isinstance(dyad, RRR):
-            for link in dyad.links:
-                if link.start in scene.ground:
-                    outputs[link.name] = 'revolute'
-        elif isinstance(dyad, RRP):
-            outputs[dyad.slider] = 'prismatic'
-        elif isinstance(dyad, RPR) and dyad.slots is None:
-            outputs[dyad.link] = 'revolute'
+        outputs.update(dyad.dead_centre_joints(scene.ground))
     return outputs
 
 
 def _dead_centres(probe: _Probe) -> tuple[DeadCentre, ...]:
     scene, state = probe.scene, probe.state
     crank = scene.input
-    starting = {}  # link from the crank's tip -> (its dyad's outputs)
+    starting = {}  # link from the crank's tip -> the joints of its dyad
     for dyad in scene.dyads:
-        if isinstance(dyad, RRR):
-            for link in dyad.links:
-                if link.start == crank.point:
-                    starting[link.name] = dyad
-        elif isinstance(dyad, RRP) and dyad.link.start == crank.point:
-            starting[dyad.link.name] = dyad
+        starting.update(dyad.tip_links(crank.point))
     n = len(probe.theta)
     step = _TURN / n
     centres = []
@@ -437,8 +425,7 @@ def _dead_centres(probe: _Probe) -> tuple[DeadCentre, ...]:
             solved = probe.solve(angle)
             position = float(solved.joints[joint].position)  # type: ignore[attr-defined]
             in_line = None
-            for link, dyad in starting.items():
-                names = {d for d in _dyad_joints(dyad)}
+            for link, names in starting.items():
                 if joint in names or joint == link:
                     e1 = float(solved.joints[crank.link].position)  # type: ignore
                     e2 = float(solved.joints[link].position)  # type: ignore
@@ -447,12 +434,6 @@ def _dead_centres(probe: _Probe) -> tuple[DeadCentre, ...]:
             centres.append(DeadCentre(angle % _TURN, joint, kind, position, in_line))
     centres.sort(key=lambda c: c.angle)
     return tuple(centres)
-
-
-def _dyad_joints(dyad: RRR | RRP) -> tuple[str, ...]:
-    if isinstance(dyad, RRR):
-        return tuple(link.name for link in dyad.links)
-    return (dyad.link.name, dyad.slider)
 
 
 def _transmission(probe: _Probe, ranges: Sequence[tuple[float, float]],
@@ -489,26 +470,22 @@ def _loops(probe: _Probe) -> tuple[FourBarLoop, ...]:
                 for name, p in state.points.items()}  # type: ignore[attr-defined]
     pivot = {crank.link: crank.center}  # link turning about a ground pivot -> that pivot
     for dyad in scene.dyads:
-        if isinstance(dyad, RRR):
-            for link in dyad.links:
-                if link.start in scene.ground:
-                    pivot[link.name] = link.start
-        elif isinstance(dyad, RPR):
-            pivot[dyad.link] = dyad.center
+        pivot.update(dyad.pivots(scene.ground))
     fixed_on: dict[str, str] = {crank.point: crank.link}
     for dyad in scene.dyads:
-        if isinstance(dyad, RRR):
-            fixed_on.setdefault(dyad.point, dyad.links[0].name)
-            for link in dyad.links:  # the pin is on both links
-                if link.name in pivot:
-                    fixed_on[dyad.point] = link.name
+        for point, link_name, preferred in dyad.pin_links(pivot):
+            if preferred:
+                fixed_on[point] = link_name
+            else:
+                fixed_on.setdefault(point, link_name)
     for carried in scene.points:
         fixed_on[carried.name] = carried.link
     loops = []
     for dyad in scene.dyads:
-        if not isinstance(dyad, RRR):
+        pair = dyad.four_bar()
+        if pair is None:
             continue
-        first, second = dyad.links
+        point, first, second = pair
         for out, coupler in ((first, second), (second, first)):
             if out.start not in scene.ground or coupler.start in scene.ground:
                 continue
@@ -519,7 +496,7 @@ def _loops(probe: _Probe) -> tuple[FourBarLoop, ...]:
             ground = abs(position[o2] - position[o1])
             input_ = abs(position[q] - position[o1])
             loops.append(FourBarLoop((f'{o1}{o2}', driver, coupler.name, out.name),
-                                     (o1, q, dyad.point, o2),
+                                     (o1, q, point, o2),
                                      (ground, input_, coupler.length, out.length)))
             break
     return tuple(loops)
@@ -528,7 +505,7 @@ def _loops(probe: _Probe) -> tuple[FourBarLoop, ...]:
 # --- text --------------------------------------------------------------------------
 
 
-def angle_text(units: Units, theta: float) -> str:
+def angle_text(units: SceneUnits, theta: float) -> str:
     """Return a crank angle (rad) in the scene's unit to 6 significant digits, without unit.
 
     A value within 5e-7 of a turn of 0 or of a full turn is shown as 0 (a
@@ -545,6 +522,6 @@ def angle_text(units: Units, theta: float) -> str:
 _angle = angle_text
 
 
-def _ranges_text(ranges: Sequence[tuple[float, float]], units: Units) -> str:
+def _ranges_text(ranges: Sequence[tuple[float, float]], units: SceneUnits) -> str:
     parts = [f'{_angle(units, a)}..{_angle(units, b)}' for a, b in ranges]
     return f'{", ".join(parts)} {units.angle}'

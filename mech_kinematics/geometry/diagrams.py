@@ -37,10 +37,10 @@ import warnings
 import numpy as np
 import numpy.typing as npt
 
-from .instant_centres import (bodies_from_scene, BodyKind, check_full_state, full_scene,
+from .instant_centres import (bodies_from_scene, BodyKind, check_full_state, full_scene, GROUND,
                               instant_centres_from_state, InstantCentres, Topology)
 from ..errors import NearSingularWarning
-from ..linkage import RPR, RRP, RRR, Scene, solve, State
+from ..solver import Scene, solve, State
 
 __all__ = [
     'COLOURS', 'Diagram', 'GuideLine', 'LinkShape', 'LinkValues', 'PinValues', 'Pivot',
@@ -353,15 +353,10 @@ def _edges(scene: Scene, state: State) -> list[_Edge]:
     """Every link's relative motions, in the order the solver places the points."""
     crank = scene.input
     edges = [_Edge(crank.link, crank.center, crank.point)]
-    for dyad in scene.dyads:
-        if isinstance(dyad, RRR):
-            edges.extend(_Edge(link.name, link.start, dyad.point) for link in dyad.links)
-        elif isinstance(dyad, RRP):
-            edges.append(_Edge(dyad.link.name, dyad.link.start, dyad.point))
-        else:
-            edges.append(_Edge(dyad.link, dyad.center, _coincident(dyad.through),
-                               dyad.through, dyad.slider))
-    edges.extend(_Edge(p.link, p.origin, p.name) for p in scene.points)
+    for item in (*scene.dyads, *scene.points):
+        for body, start, end, slider in item.edges():
+            edges.append(_Edge(body, start, end) if slider is None else
+                         _Edge(body, start, _coincident(end), end, slider))
     order = {name: index for index, name in enumerate(state.complex_points)}
 
     def rank(edge: _Edge) -> float:
@@ -386,8 +381,10 @@ def _sub(*names: str) -> str:
     return ('' if all(len(n.rstrip("'")) == 1 for n in names) else ',').join(names)
 
 
-def _pin_of(scene: Scene) -> dict[str, RPR]:
-    return {_coincident(d.through): d for d in scene.dyads if isinstance(d, RPR)}
+def _pin_of(scene: Scene) -> dict[str, tuple[str, str, str]]:
+    """Return the coincident point of every pin sliding in a body: (body, its start, the pin)."""
+    return {_coincident(end): (body, start, end) for d in scene.dyads
+            for body, start, end, slider in d.edges() if slider is not None}
 
 
 def _locked(state: State) -> set[str]:
@@ -396,30 +393,9 @@ def _locked(state: State) -> set[str]:
             if not bool(engagement.engaged)}
 
 
-def _slots(scene: Scene, dyad: RPR, state: State,
-           points: Mapping[str, Array]) -> tuple[tuple[Array, Array], ...]:
-    """Return an intermittent lever's slots, from inside the pin's reach to the mouth, m."""
-    n = dyad.slots
-    if n is None:
-        return ()
-    names = (scene.input.center, dyad.center, dyad.through)
-    centre, wheel, pin = (points[name] for name in names)
-    distance = float(np.hypot(*(wheel - centre)))
-    radius = float(np.hypot(*(pin - centre)))
-    mouth = math.sqrt(max(distance * distance - radius * radius, 0.0))
-    inner = 0.85 * (distance - radius)
-    angle = float(state.joints[dyad.link].position)
-    slots = []
-    for i in range(n):
-        turn = angle + 2 * math.pi * i / n
-        u = np.array([math.cos(turn), math.sin(turn)])
-        slots.append((wheel + inner * u, wheel + mouth * u))
-    return tuple(slots)
-
-
 def _polygon_start(scene: Scene, state: State, index: int,
                    coincident: Callable[[float, float, complex], complex],
-                   ) -> tuple[dict[str, str], dict[str, RPR], dict[str, complex],
+                   ) -> tuple[dict[str, str], dict[str, tuple[str, str, str]], dict[str, complex],
                               dict[str, complex], dict[str, Array]]:
     """Letters, slotted-lever pins, positions and values of one polygon.
 
@@ -432,15 +408,30 @@ def _polygon_start(scene: Scene, state: State, index: int,
     pins = _pin_of(scene)
     position = {name: complex(pva[0]) for name, pva in state.complex_points.items()}
     values = {name: complex(pva[index]) for name, pva in state.complex_points.items()}
-    for name, dyad in pins.items():
-        joint = state.joints[dyad.link]
-        position[name] = position[dyad.through]
+    for name, (body, pivot, pin) in pins.items():
+        joint = state.joints[body]
+        position[name] = position[pin]
         values[name] = coincident(float(joint.velocity), float(joint.acceleration),
-                                  position[dyad.through] - position[dyad.center])
-        letter[name] = _coincident(letter[dyad.through])
+                                  position[pin] - position[pivot])
+        letter[name] = _coincident(letter[pin])
     letters = {POLE: np.zeros(2)}
     letters.update({letter[name]: _xy(value) for name, value in values.items()})
     return letter, pins, position, values, letters
+
+
+def _slip_vectors(scene: Scene, state: State, letter: Mapping[str, str],
+                  letters: Mapping[str, Array], index: int, symbol: str) -> list[Vector]:
+    """Sliding along a fixed direction (a translating yoke's slot): the slider's rate."""
+    vectors = []
+    for dyad in scene.dyads:
+        for slider, start, end, angle in dyad.slips():
+            joint = state.joints[slider]
+            rate = float(joint.velocity if index == 1 else joint.acceleration)
+            tail = letters[letter[start]]
+            vectors.append(Vector(letter[start], letter[end], tail,
+                                  tail + rate * np.array([math.cos(angle), math.sin(angle)]),
+                                  symbol.format(_sub(end, start)), VectorKind.SLIP, slider))
+    return vectors
 
 
 def _absolute_vectors(scene: Scene, values: Mapping[str, complex], letter: Mapping[str, str],
@@ -491,14 +482,15 @@ def velocity_polygon_from_state(scene: Scene, state: State) -> Polygon:
             drawn.add(edge.end)
         if edge.pin is not None and edge.body not in locked:
             assert edge.slider is not None
-            dyad = pins[edge.end]
-            e = position[edge.pin] - position[dyad.center]
+            pivot = pins[edge.end][1]
+            e = position[edge.pin] - position[pivot]
             e /= abs(e)
             slip = float(state.joints[edge.slider].velocity) * e
             tail = letters[letter[edge.end]]
             vectors.append(Vector(letter[edge.end], letter[edge.pin], tail, tail + _xy(slip),
                                   f'v_{_sub(edge.pin, edge.end)}', VectorKind.SLIP,
                                   edge.slider))
+    vectors += _slip_vectors(scene, state, letter, letters, 1, 'v_{}')
     vectors += _absolute_vectors(scene, velocity, letter, drawn, 'v')
     return Polygon('velocity', 'm/s', letters, tuple(vectors), POLE, ground)
 
@@ -570,6 +562,7 @@ def acceleration_polygon_from_state(scene: Scene, state: State) -> Polygon:
                                   VectorKind.CORIOLIS, edge.slider))
             vectors.append(Vector(kink, pin, corner, corner + _xy(sliding), f'a_{sub}^s',
                                   VectorKind.SLIP, edge.slider))
+    vectors += _slip_vectors(scene, state, letter, letters, 2, 'a_{}^s')
     vectors += _absolute_vectors(scene, accel, letter, drawn, 'a')
     return Polygon('acceleration', 'm/s^2', letters, tuple(vectors), POLE, ground)
 
@@ -620,7 +613,8 @@ def strokes_from_scene(scene: Scene,
         ``(s_min, s_max)`` over the angles at which the mechanism assembles.
     """
     scene = full_scene(scene)
-    sliders = [d.slider for d in scene.dyads if isinstance(d, RRP)]
+    sliders = [body for d in scene.dyads for body, _, _, guide in d.members(GROUND)
+               if guide == GROUND]
     if not sliders:
         return {}
     angles = np.linspace(0.0, 2.0 * math.pi, samples, endpoint=False)
@@ -660,19 +654,18 @@ def space_from_state(scene: Scene, state: State,
     size = max((float(np.hypot(*(a - b))) for a in points.values() for b in points.values()),
                default=1.0) or 1.0
     links = []
-    rpr = {d.link: d for d in scene.dyads if isinstance(d, RPR)}
     locked = _locked(state)
     for body in topology.bodies.values():
         if body.kind in (BodyKind.GROUND, BodyKind.SLIDER):
             continue
         xy = [points[name] for name in body.points]
         slots: tuple[tuple[Array, Array], ...] = ()
-        if body.name in rpr:
-            slots = _slots(scene, rpr[body.name], state, points)
-            if slots:  # a Geneva wheel: the polygon of its slots' mouths
+        for dyad in scene.dyads:
+            extra, slots_of = dyad.outline(body.name, scene, state, points)
+            xy += [points[name] for name in extra]
+            if slots_of:  # a Geneva wheel: the polygon of its slots' mouths
+                slots = slots_of
                 xy += [mouth for _, mouth in slots]
-            else:
-                xy.append(points[rpr[body.name].through])
         links.append(LinkShape(body.name, body.kind, body.points, _outline(np.array(xy)),
                                slots))
     pinned = {point for a, b, point in topology.pins
@@ -681,20 +674,10 @@ def space_from_state(scene: Scene, state: State,
     sliders = []
     guides = []
     for dyad in scene.dyads:
-        if isinstance(dyad, RRP):
-            sliders.append(SliderShape(dyad.slider, dyad.point, points[dyad.point],
-                                       dyad.guide_angle, topology.ground))
-            u = np.array([math.cos(dyad.guide_angle), math.sin(dyad.guide_angle)])
-            s = float(state.joints[dyad.slider].position)
-            low, high = (strokes or {}).get(dyad.slider, (s, s))
-            pad = 0.08 * size
-            through = points[dyad.through]
-            guides.append(GuideLine(dyad.slider, through + (min(low, s) - pad) * u,
-                                    through + (max(high, s) + pad) * u))
-        elif isinstance(dyad, RPR) and dyad.link not in locked:  # a locked wheel's pin is free
-            e = points[dyad.through] - points[dyad.center]
-            sliders.append(SliderShape(dyad.slider, dyad.through, points[dyad.through],
-                                       math.atan2(e[1], e[0]), dyad.link))
+        blocks = dyad.blocks(state, points, topology.ground, locked)
+        sliders.extend(SliderShape(*block) for block in blocks)
+        guides.extend(GuideLine(*guide)
+                      for guide in dyad.guides(state, points, strokes or {}, size))
     return SpaceDiagram(points, tuple(scene.ground), tuple(links), pivots, tuple(sliders),
                         tuple(guides))
 
@@ -741,12 +724,7 @@ def _values(scene: Scene, state: State,
             topology: Topology) -> tuple[tuple[LinkValues, ...], tuple[SliderValues, ...]]:
     lengths: dict[str, float | None] = {scene.input.link: scene.input.length}
     for dyad in scene.dyads:
-        if isinstance(dyad, RRR):
-            lengths.update((link.name, link.length) for link in dyad.links)
-        elif isinstance(dyad, RRP):
-            lengths[dyad.link.name] = dyad.link.length
-        else:
-            lengths[dyad.link] = None
+        lengths.update(dyad.link_lengths())
     links = []
     sliders = []
     for name, body in topology.bodies.items():

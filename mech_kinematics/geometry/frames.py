@@ -19,7 +19,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from ..linkage import RPR, RRP, RRR, Scene, State
+from ..solver import Scene, State
 
 __all__ = ['FrameSpec', 'Pose', 'angle_joints', 'child_frame', 'frames_from_scene',
            'origin_points', 'poses_from_state']
@@ -69,15 +69,8 @@ def frames_from_scene(scene: Scene, joints: Sequence[str] | None = None) -> tupl
     crank = scene.input
     specs[crank.link] = FrameSpec(crank.link, crank.center, crank.link)
     for dyad in scene.dyads:
-        if isinstance(dyad, RRR):
-            for link in dyad.links:
-                specs[link.name] = FrameSpec(link.name, link.start, link.name)
-        elif isinstance(dyad, RRP):
-            specs[dyad.link.name] = FrameSpec(dyad.link.name, dyad.link.start, dyad.link.name)
-            specs[dyad.slider] = FrameSpec(dyad.slider, dyad.point, None, dyad.guide_angle)
-        elif isinstance(dyad, RPR):
-            specs[dyad.link] = FrameSpec(dyad.link, dyad.center, dyad.link)
-            specs[dyad.slider] = FrameSpec(dyad.slider, dyad.through, dyad.link)
+        for joint, origin, angle_of, angle in dyad.frames():
+            specs[joint] = FrameSpec(joint, origin, angle_of, angle)
     names = scene.output_joints if joints is None else joints
     return tuple(specs[name] for name in names)
 

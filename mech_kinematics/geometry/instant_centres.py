@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ..linkage import RPR, RRP, RRR, Scene, State
+from ..solver import Scene, State
 
 __all__ = [
     'GROUND', 'Body', 'BodyKind', 'Centre', 'InstantCentre', 'InstantCentres', 'Topology',
@@ -163,19 +163,11 @@ def bodies_from_scene(scene: Scene) -> Topology:
     add(crank.link, BodyKind.CRANK, crank.center, crank.point)
     slides: list[tuple[str, str]] = []
     for dyad in scene.dyads:
-        if isinstance(dyad, RRR):
-            for link in dyad.links:
-                add(link.name, BodyKind.LINK, link.start, dyad.point)
-        elif isinstance(dyad, RRP):
-            add(dyad.link.name, BodyKind.LINK, dyad.link.start, dyad.point)
-            add(dyad.slider, BodyKind.SLIDER, dyad.point)
-            guides[dyad.slider] = ground
-            slides.append((dyad.slider, ground))
-        elif isinstance(dyad, RPR):
-            add(dyad.link, BodyKind.LEVER, dyad.center)
-            add(dyad.slider, BodyKind.SLIDER, dyad.through)
-            guides[dyad.slider] = dyad.link
-            slides.append((dyad.slider, dyad.link))
+        for body, kind, members, guide in dyad.members(ground):
+            add(body, BodyKind(kind), *members)
+            if guide is not None:
+                guides[body] = guide
+                slides.append((body, guide))
     for carried in scene.points:
         points[carried.link].append(carried.name)
     bodies = {name: Body(name, kinds[name], tuple(members), number, guides.get(name))
@@ -192,12 +184,7 @@ def bodies_from_scene(scene: Scene) -> Topology:
 def _names(scene: Scene) -> set[str]:
     names = {scene.input.link}
     for dyad in scene.dyads:
-        if isinstance(dyad, RRR):
-            names.update(link.name for link in dyad.links)
-        elif isinstance(dyad, RRP):
-            names.update((dyad.link.name, dyad.slider))
-        else:
-            names.update((dyad.link, dyad.slider))
+        names.update(dyad.joint_types())
     return names
 
 
@@ -346,12 +333,19 @@ def _body_motion(topology: Topology, state: State,
     if body.kind is BodyKind.GROUND:
         return 0.0, 0j, 0j
     p, v, _ = state.complex_points[body.points[0]]
+    return _omega(topology, state, name), complex(p), complex(v)
+
+
+def _omega(topology: Topology, state: State, name: str) -> float:
+    """Return a body's angular velocity: a slider block turns with what it slides on."""
+    body = topology.bodies[name]
+    if body.kind is BodyKind.GROUND:
+        return 0.0
     if body.kind is BodyKind.SLIDER:
         guide = body.guide
         assert guide is not None
-        omega = 0.0 if guide == topology.ground else float(state.joints[guide].velocity)
-        return omega, complex(p), complex(v)
-    return float(state.joints[name].velocity), complex(p), complex(v)
+        return _omega(topology, state, guide)
+    return float(state.joints[name].velocity)
 
 
 def instant_centres_from_state(scene: Scene, state: State) -> InstantCentres:
@@ -435,24 +429,10 @@ def _primary(topology: Topology, scene: Scene, state: State, size: float
     for a, b, point in topology.pins:
         p = complex(state.complex_points[point][0])
         put(a, b, np.array([p.real / size, p.imag / size, 1.0]), Centre.PIN)
-    rpr = {dyad.slider: dyad for dyad in scene.dyads if isinstance(dyad, RPR)}
-    rrp = {dyad.slider: dyad for dyad in scene.dyads if isinstance(dyad, RRP)}
+    owner = {slider: dyad for dyad in scene.dyads for slider, kind, _, _ in dyad.members('')
+             if kind == 'slider'}
     for slider, guide in topology.slides:
-        if slider in rrp:
-            angle = rrp[slider].guide_angle
-        elif rpr[slider].link in state.intermittent:
-            # A Geneva wheel: the slot the pin is in (not slot 0) lies along the pivot-pin
-            # line; while the wheel is locked the pin, out of the slot, moves with the
-            # crank, across the crank's radius (the pin is on the crank).
-            dyad = rpr[slider]
-            pin = complex(state.complex_points[dyad.through][0])
-            engaged = state.intermittent[dyad.link].engaged
-            start = dyad.center if engaged else scene.input.center
-            o = complex(state.complex_points[start][0])
-            angle = math.atan2(pin.imag - o.imag, pin.real - o.real) + (
-                0.0 if engaged else math.pi / 2)
-        else:
-            angle = float(state.joints[rpr[slider].link].position)
+        angle = owner[slider].slide_angle(slider, scene, state)
         # normal to the slide: perpendicular to the direction of sliding
         put(slider, guide, np.array([-math.sin(angle), math.cos(angle), 0.0]), Centre.SLIDE)
     return known
@@ -490,8 +470,7 @@ def instant_centres_from_kennedy(scene: Scene, state: State) -> InstantCentres:
     size = _size(state)
     known = _primary(topology, scene, state, size)
     # A locked Geneva wheel moves with the ground: its centre with any body is the ground's.
-    locked = [d.link for d in scene.dyads if isinstance(d, RPR) and d.link in state.intermittent
-              and not state.intermittent[d.link].engaged]
+    locked = [lever for d in scene.dyads for lever in d.locked(state)]
 
     pairs = _pairs(topology)
     while True:

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import math
 
 from .assembly import Assembly
-from ..linkage import Scene, solve
+from ..solver import Scene, solve
 
 __all__ = ['Intermittent', 'Stroke', 'Strokes', 'intermittent_from_scene',
            'strokes_from_assembly']

@@ -36,7 +36,7 @@ from .diagrams import space_from_state
 from .frames import child_frame, frames_from_scene, FrameSpec, poses_from_state
 from .instant_centres import bodies_from_scene, BodyKind, full_scene
 from ..errors import AssemblyError, NearSingularWarning
-from ..linkage import RPR, Scene, solve, State
+from ..solver import Scene, solve, State
 
 __all__ = ['Visual', 'joint_name', 'urdf_from_scene', 'visuals_from_scene']
 
@@ -109,14 +109,17 @@ def _local(origin: complex, angle: float, point: complex) -> tuple[float, float]
     return z.real, z.imag
 
 
-def _lever_reach(scene: Scene, dyad: RPR) -> float:
-    """Return the farthest the pin goes along a slotted lever over a turn, m."""
+def _lever_reach(scene: Scene, ends: tuple[str, str]) -> float:
+    """Return the farthest the pin goes along a slotted lever over a turn, m.
+
+    ``ends`` are the lever's pivot and the pin that slides along it.
+    """
     angles = scene.input.angle + np.linspace(0.0, 2 * math.pi, SAMPLES, endpoint=False)
     with warnings.catch_warnings():
         warnings.simplefilter('ignore', NearSingularWarning)
         states = solve(scene, angles)
     points = states.complex_points
-    gap = np.abs(points[dyad.through][0] - points[dyad.center][0])[states.valid]
+    gap = np.abs(points[ends[1]][0] - points[ends[0]][0])[states.valid]
     return float(gap.max()) if gap.size else 0.0
 
 
@@ -135,7 +138,13 @@ def visuals_from_scene(scene: Scene, frames: Sequence[FrameSpec] | None = None,
     size = float(np.hypot(*(high - low))) or 1.0
     width, radius = BAR_WIDTH * size, PIN_RADIUS * size
     topology = bodies_from_scene(full)
-    levers = {d.link: d for d in full.dyads if isinstance(d, RPR)}
+    # A link whose length varies (a slotted lever) is drawn out to the farthest its
+    # pin slides: each kind says which of its links vary and between which points.
+    levers = {}
+    for item in full.dyads:
+        varying = {link for link, length in item.link_lengths().items() if length is None}
+        levers.update({link: (start, end) for link, start, end, _ in item.edges()
+                       if link in varying})
     points = {name: complex(p) for name, (p, _, _) in state.complex_points.items()}
     visuals: dict[str, list[Visual]] = {}
     for frame, pose in zip(frames, poses_from_state(frames, state), strict=True):

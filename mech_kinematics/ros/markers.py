@@ -32,7 +32,7 @@ import math
 from typing import Any
 
 from ..geometry.diagrams import arrows_from_state, COLOURS, space_from_state, SpaceDiagram
-from ..linkage import Scene, State
+from ..solver import Scene, State
 from ..units import NS_PER_S
 
 __all__ = [

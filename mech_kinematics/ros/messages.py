@@ -19,7 +19,7 @@ from trajectory_msgs.msg import (JointTrajectory, JointTrajectoryPoint,
                                  MultiDOFJointTrajectory, MultiDOFJointTrajectoryPoint)
 
 from .cdr import marker, MessageTemplate, STAMP_MARKER
-from ..ticker import values_from_state
+from .ticker import values_from_state
 
 __all__ = [
     'TickMessages', 'joint_state_from_state', 'joint_trajectory_from_state',
@@ -146,7 +146,7 @@ class TickMessages:
                       nanosec: int) -> tuple[bytes, bytes, bytes]:
         """Return the three messages from the flat values of a tick function.
 
-        ``values`` is in the order of :func:`mech_kinematics.ticker.values_from_state`
+        ``values`` is in the order of :func:`mech_kinematics.ros.ticker.values_from_state`
         (joints' positions, velocities, accelerations, then the points' positions,
         velocities, accelerations as x, y), which is the order of the slots.
         """

@@ -64,6 +64,7 @@ from .messages import TickMessages
 from .parameters import CATCH_UP, joint_refusal, PARAMETERS, ParameterSpec, refusal, spec
 from .schedule import period_ns_from_rate
 from .tf import static_tf_message, TfMessages
+from .ticker import tick_function
 from .timebase import CrankSample
 from ..geometry.assembly import assembly_summary
 from ..geometry.diagrams import space_from_state, strokes_from_scene
@@ -71,7 +72,6 @@ from ..geometry.frames import angle_joints, frames_from_scene, origin_points
 from ..geometry.instant_centres import full_scene
 from ..geometry.urdf import urdf_from_scene
 from ..scene import scene_text
-from ..ticker import tick_function
 from ..units import NS_PER_S, rpm_from_rad_per_s
 
 __all__ = ['KinematicsNode', 'NODE_NAME', 'TickThreadError', 'main']
@@ -348,7 +348,7 @@ class KinematicsNode(LifecycleNode):
         self._publish_state = tuple(p.publish for p in self._state_publishers)
         tick_scene = self._setup_tf(scene)
         self._publish_descriptions(scene)
-        # The scene's solve, compiled into one straight-line function (mech_kinematics.ticker).
+        # The scene's solve, compiled into one straight-line function (ros/ticker.py).
         frames = [(f.origin, f.angle_of, f.angle) for f in self._tf_frames]
         self._solve, compiled = tick_function(tick_scene, scene.output_joints,
                                               scene.output_points, frames)

@@ -25,8 +25,8 @@ from typing import Any
 import numpy as np
 
 from .cli import positive_int, run_tool
-from ..linkage import RRP, RRR, solve
 from ..scene import load_scene, scene_names
+from ..solver import solve
 
 
 #: A four-bar's geometry for the hand-written forms: crank centre (x, y), crank,
@@ -151,24 +151,37 @@ def hand_written(scene: Any) -> tuple[Callable[..., Any], Callable[..., Any]] | 
     """
     if len(scene.dyads) != 1:
         return None
-    dyad, crank = scene.dyads[0], scene.input
+    baseline = _BASELINES.get(scene.dyads[0].kind)
+    return None if baseline is None else baseline(scene, scene.dyads[0], scene.input)
+
+
+def _four_bar(scene: Any, dyad: Any, crank: Any) -> Any:
+    """Return the four-bar's forms, for an RRR on the crank's tip and a ground pivot."""
+    first, second = dyad.links
+    if first.start != crank.point or second.start not in scene.ground:
+        return None
     ox, oy = scene.ground[crank.center]
-    if isinstance(dyad, RRR):
-        first, second = dyad.links
-        if first.start != crank.point or second.start not in scene.ground:
-            return None
-        dx, dy = scene.ground[second.start]
-        geometry = (ox, oy, crank.length, first.length, second.length, dx, dy,
-                    float(dyad.branch.value))
-        return partial(four_bar_math, geometry=geometry), partial(four_bar_numpy,
+    dx, dy = scene.ground[second.start]
+    geometry = (ox, oy, crank.length, first.length, second.length, dx, dy,
+                float(dyad.branch.value))
+    return partial(four_bar_math, geometry=geometry), partial(four_bar_numpy, geometry=geometry)
+
+
+def _slider_crank(scene: Any, dyad: Any, crank: Any) -> Any:
+    """Return the slider-crank's forms, for an RRP on the crank's tip and a horizontal guide."""
+    if dyad.guide_angle != 0.0 or dyad.link.start != crank.point \
+            or dyad.through not in scene.ground:
+        return None
+    ox, oy = scene.ground[crank.center]
+    guide = scene.ground[dyad.through][1]
+    geometry = (ox, oy, crank.length, dyad.link.length, guide, float(dyad.branch.value))
+    return partial(slider_crank_math, geometry=geometry), partial(slider_crank_numpy,
                                                                   geometry=geometry)
-    if isinstance(dyad, RRP) and dyad.guide_angle == 0.0 and dyad.link.start == crank.point \
-            and dyad.through in scene.ground:
-        guide = scene.ground[dyad.through][1]
-        geometry = (ox, oy, crank.length, dyad.link.length, guide, float(dyad.branch.value))
-        return partial(slider_crank_math, geometry=geometry), partial(slider_crank_numpy,
-                                                                      geometry=geometry)
-    return None
+
+
+#: The hand-written baselines there are, by the scene's dyad ``type:``.
+_BASELINES: dict[str, Callable[[Any, Any, Any], Any]] = {'RRR': _four_bar,
+                                                         'RRP': _slider_crank}
 
 
 #: Issue 19's targets, bounds included: the array path per configuration over the

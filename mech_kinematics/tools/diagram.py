@@ -30,7 +30,7 @@ from ..geometry.diagrams import (arrows_from_state, colours_from_scene, Diagram,
                                  strokes_from_scene, Table, tables_from_diagram, VectorKind)
 from ..geometry.instant_centres import (bodies_from_scene, BodyKind, full_scene,
                                         instant_centres_from_state)
-from ..linkage import Scene, solve
+from ..solver import Scene, solve
 from ..units import rad_per_s_from_rpm, rpm_from_rad_per_s
 
 __all__ = ['add_parser', 'figure_from_diagram', 'main', 'write_animation', 'write_diagram']

@@ -48,8 +48,8 @@ import numpy as np
 import yaml
 
 from ..errors import SceneError
-from ..linkage import RPR, RRP, RRR, Scene
 from ..scene import read_scene_yaml
+from ..solver import Scene
 from ..units import ANGLE_UNITS, LENGTH_UNITS, radians_from_degrees
 
 __all__ = ['DIGITS', 'DPS', 'Jet', 'Model', 'NoAssembly', 'Reference', 'as_float_dict',
@@ -222,9 +222,14 @@ def _value(x: Any) -> Any:
 
 @dataclass(frozen=True)
 class _Element:
-    kind: str          # 'RRR', 'RRP', 'RPR' or 'carry'
+    kind: str          # the scene's type of the item: 'RRR', 'RRP', 'RPR', 'RPP' or 'point'
     item: Any          # the scene's dyad or carried point
     index: int = -1    # first of the element's two unknowns, -1 for a carried point
+
+    @property
+    def equations(self) -> type[_Kind]:
+        """Return the kind's equations."""
+        return _KINDS[self.kind]
 
 
 class Model:
@@ -287,44 +292,10 @@ class Model:
 
     def _place(self, item: Any, known: set[str], values: dict[str, float],
                index: int) -> _Element | None:
-        if isinstance(item, RRR):
-            first, second = item.links
-            if first.start not in known or second.start not in known:
-                return None
-            values[f'link.{first.name}.length'] = first.length
-            values[f'link.{second.name}.length'] = second.length
-            self.links[first.name], self.links[second.name] = index, index + 1
-            self.joint_types[first.name] = self.joint_types[second.name] = 'revolute'
-            self._unknowns((f'{first.name} angle', False), (f'{second.name} angle', False))
-            known.add(item.point)
-            return _Element('RRR', item, index)
-        if isinstance(item, RRP):
-            if item.link.start not in known:
-                return None
-            values[f'link.{item.link.name}.length'] = item.link.length
-            values[f'guide.{item.point}.angle'] = item.guide_angle
-            self.links[item.link.name] = index
-            self.sliders[item.slider] = index + 1
-            self.joint_types[item.link.name] = 'revolute'
-            self.joint_types[item.slider] = 'prismatic'
-            self._unknowns((f'{item.link.name} angle', False), (f'{item.slider}', True))
-            known.add(item.point)
-            return _Element('RRP', item, index)
-        if isinstance(item, RPR):
-            if item.through not in known:
-                return None
-            self.links[item.link] = index
-            self.sliders[item.slider] = index + 1
-            self.joint_types[item.link] = 'revolute'
-            self.joint_types[item.slider] = 'prismatic'
-            self._unknowns((f'{item.link} angle', False), (f'{item.slider}', True))
-            return _Element('RPR', item, index)
-        if item.origin not in known or item.xaxis not in known or item.link not in self.links:
+        kind = item.kind
+        if not _KINDS[kind].place(self, item, known, values, index):
             return None
-        values[f'point.{item.name}.local.x'] = item.local[0]
-        values[f'point.{item.name}.local.y'] = item.local[1]
-        known.add(item.name)
-        return _Element('carry', item)
+        return _Element(kind, item, index if kind != 'point' else -1)
 
     @property
     def n(self) -> int:
@@ -349,27 +320,7 @@ class Model:
         points[crank.point] = points[crank.center] + p['crank.length'] * expi(theta)
         residuals: list[Any] = []
         for element in self.elements:
-            item, i = element.item, element.index
-            if element.kind == 'RRR':
-                first, second = item.links
-                at = points[first.start] + p[f'link.{first.name}.length'] * expi(q[i])
-                other = points[second.start] + p[f'link.{second.name}.length'] * expi(q[i + 1])
-                residuals.append(at - other)
-                points[item.point] = at
-            elif element.kind == 'RRP':
-                u = expi(p[f'guide.{item.point}.angle'])
-                at = points[item.through] + q[i + 1] * u
-                start = points[item.link.start]
-                residuals.append(start + p[f'link.{item.link.name}.length'] * expi(q[i]) - at)
-                points[item.point] = at
-            elif element.kind == 'RPR':
-                residuals.append(points[item.center] + q[i + 1] * expi(q[i])
-                                 - points[item.through])
-            else:
-                origin = points[item.origin]
-                axis = points[item.xaxis] - origin
-                local = p[f'point.{item.name}.local.x'] + 1j * p[f'point.{item.name}.local.y']
-                points[item.name] = origin + local * axis / norm(axis)
+            element.equations.evaluate(element.item, element.index, p, q, points, residuals)
         return points, residuals
 
     def construct(self, p: Mapping[str, Any], theta: Any) -> list[Any]:
@@ -391,45 +342,7 @@ class Model:
         q: list[Any] = [None] * self.n
         tiny = mpmath.mpf(10) ** (-(mpmath.mp.dps - 8))
         for element in self.elements:
-            item, i = element.item, element.index
-            if element.kind == 'RRR':
-                first, second = item.links
-                l1 = p[f'link.{first.name}.length']
-                l2 = p[f'link.{second.name}.length']
-                d = pts[second.start] - pts[first.start]
-                dist = abs(d)
-                cos_gamma = (l1 * l1 + dist * dist - l2 * l2) / (2 * l1 * dist)
-                if abs(cos_gamma) > 1 + tiny:
-                    msg = f'RRR {item.point}: the circles do not meet'
-                    raise NoAssembly(msg)
-                gamma = mpmath.acos(max(-1, min(1, cos_gamma)))
-                q[i] = mpmath.arg(d) + int(item.branch) * gamma
-                at = pts[first.start] + l1 * mpmath.expj(q[i])
-                q[i + 1] = mpmath.arg(at - pts[second.start])
-                pts[item.point] = at
-            elif element.kind == 'RRP':
-                length = p[f'link.{item.link.name}.length']
-                u = mpmath.expj(p[f'guide.{item.point}.angle'])
-                w = pts[item.link.start] - pts[item.through]
-                along = (w * mpmath.conj(u)).real
-                offset = (w * mpmath.conj(u)).imag
-                square = length * length - offset * offset
-                if square < -tiny * length * length:
-                    msg = f'RRP {item.point}: the guide is out of reach'
-                    raise NoAssembly(msg)
-                s = along + int(item.branch) * mpmath.sqrt(max(square, 0))
-                at = pts[item.through] + s * u
-                q[i], q[i + 1] = mpmath.arg(at - pts[item.link.start]), s
-                pts[item.point] = at
-            elif element.kind == 'RPR':
-                d = pts[item.through] - pts[item.center]
-                q[i], q[i + 1] = mpmath.arg(d), abs(d)
-            else:
-                origin = pts[item.origin]
-                axis = pts[item.xaxis] - origin
-                local = mpmath.mpc(p[f'point.{item.name}.local.x'],
-                                   p[f'point.{item.name}.local.y'])
-                pts[item.name] = origin + local * axis / abs(axis)
+            element.equations.construct(element.item, element.index, p, q, pts, tiny)
         return q
 
     def jacobian_columns(self, p: Mapping[str, Any], q: list[Any], theta: Any) -> list[list[Any]]:
@@ -441,6 +354,309 @@ class Model:
             _, res = self.evaluate(p, seeded, theta)
             columns.append([r.c1 if isinstance(r, Jet) else 0 * _value(r) for r in res])
         return columns
+
+# --- each kind's constraint equations ------------------------------------------------
+
+
+class _Kind:
+    """One scene type's loop-closure equations, written here, apart from the solver's forms.
+
+    ``place`` records the item's parameters and unknowns in the model (or
+    returns None until what it starts from is known); ``evaluate`` appends its
+    complex residual and puts its new point; ``construct`` estimates its
+    unknowns by a textbook construction (mpmath); ``measure`` gives its
+    near-singularity measure as the solver defines it; ``branch_ok`` checks
+    the assembly branch against its definition in the scene format.
+    """
+
+    @staticmethod
+    def place(model: Model, item: Any, known: set[str], values: dict[str, float],
+              index: int) -> bool:
+        """Record ``item`` in ``model`` if what it starts from is ``known``; say if it was."""
+        msg = f'Expected an item of a known kind, got {item!r}'
+        raise TypeError(msg)
+
+    @staticmethod
+    def evaluate(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
+                 points: dict[str, Any], residuals: list[Any]) -> None:
+        """Append the item's residual (numbers, arrays or jets) and put its new point."""
+
+    @staticmethod
+    def construct(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
+                  pts: dict[str, Any], tiny: Any) -> None:
+        """Estimate the item's unknowns into ``q`` and put its new point (mpmath)."""
+
+    @staticmethod
+    def measure(model: Model, item: Any, i: int, p: Mapping[str, Any],
+                points: Mapping[str, Any], q: list[Any], measures: dict[str, Any]) -> None:
+        """Put the item's near-singularity measure, if it has one."""
+
+    @staticmethod
+    def branch_ok(item: Any, i: int, p: Mapping[str, Any], points: Mapping[str, Any],
+                  q: list[Any]) -> bool:
+        """Return whether the item is on its assembly branch (one configuration: True)."""
+        return True
+
+
+class _RRR(_Kind):
+    """Two links from known points meeting at the new pin: unknowns, the two link angles."""
+
+    @staticmethod
+    def place(model: Model, item: Any, known: set[str], values: dict[str, float],
+              index: int) -> bool:
+        """Record both links' lengths and angles."""
+        first, second = item.links
+        if first.start not in known or second.start not in known:
+            return False
+        values[f'link.{first.name}.length'] = first.length
+        values[f'link.{second.name}.length'] = second.length
+        model.links[first.name], model.links[second.name] = index, index + 1
+        model.joint_types[first.name] = model.joint_types[second.name] = 'revolute'
+        model._unknowns((f'{first.name} angle', False), (f'{second.name} angle', False))
+        known.add(item.point)
+        return True
+
+    @staticmethod
+    def evaluate(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
+                 points: dict[str, Any], residuals: list[Any]) -> None:
+        """Each link's end: the two must meet."""
+        first, second = item.links
+        at = points[first.start] + p[f'link.{first.name}.length'] * expi(q[i])
+        other = points[second.start] + p[f'link.{second.name}.length'] * expi(q[i + 1])
+        residuals.append(at - other)
+        points[item.point] = at
+
+    @staticmethod
+    def construct(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
+                  pts: dict[str, Any], tiny: Any) -> None:
+        """Solve by the law of cosines, the branch from its definition."""
+        first, second = item.links
+        l1 = p[f'link.{first.name}.length']
+        l2 = p[f'link.{second.name}.length']
+        d = pts[second.start] - pts[first.start]
+        dist = abs(d)
+        cos_gamma = (l1 * l1 + dist * dist - l2 * l2) / (2 * l1 * dist)
+        if abs(cos_gamma) > 1 + tiny:
+            msg = f'RRR {item.point}: the circles do not meet'
+            raise NoAssembly(msg)
+        gamma = mpmath.acos(max(-1, min(1, cos_gamma)))
+        q[i] = mpmath.arg(d) + int(item.branch) * gamma
+        at = pts[first.start] + l1 * mpmath.expj(q[i])
+        q[i + 1] = mpmath.arg(at - pts[second.start])
+        pts[item.point] = at
+
+    @staticmethod
+    def measure(model: Model, item: Any, i: int, p: Mapping[str, Any],
+                points: Mapping[str, Any], q: list[Any], measures: dict[str, Any]) -> None:
+        """Put the sine of the angle between the links."""
+        first, second = item.links
+        r1 = points[item.point] - points[first.start]
+        r2 = points[item.point] - points[second.start]
+        cross = (mpmath.conj(r1) * r2).imag
+        measures[item.point] = abs(cross) / (p[f'link.{first.name}.length']
+                                             * p[f'link.{second.name}.length'])
+
+    @staticmethod
+    def branch_ok(item: Any, i: int, p: Mapping[str, Any], points: Mapping[str, Any],
+                  q: list[Any]) -> bool:
+        """Check the pin is on the side of the line between the starts the branch names."""
+        first, second = item.links
+        d = points[second.start] - points[first.start]
+        side = (mpmath.conj(d) * (points[item.point] - points[first.start])).imag
+        return bool(side * int(item.branch) >= 0)
+
+
+class _RRP(_Kind):
+    """A link from a known point ending on a fixed guide: unknowns, its angle and the slider."""
+
+    @staticmethod
+    def place(model: Model, item: Any, known: set[str], values: dict[str, float],
+              index: int) -> bool:
+        """Record the link's length and the guide's angle."""
+        if item.link.start not in known:
+            return False
+        values[f'link.{item.link.name}.length'] = item.link.length
+        values[f'guide.{item.point}.angle'] = item.guide_angle
+        model.links[item.link.name] = index
+        model.sliders[item.slider] = index + 1
+        model.joint_types[item.link.name] = 'revolute'
+        model.joint_types[item.slider] = 'prismatic'
+        model._unknowns((f'{item.link.name} angle', False), (f'{item.slider}', True))
+        known.add(item.point)
+        return True
+
+    @staticmethod
+    def evaluate(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
+                 points: dict[str, Any], residuals: list[Any]) -> None:
+        """Require the link's end to be the slider's point on the guide."""
+        u = expi(p[f'guide.{item.point}.angle'])
+        at = points[item.through] + q[i + 1] * u
+        start = points[item.link.start]
+        residuals.append(start + p[f'link.{item.link.name}.length'] * expi(q[i]) - at)
+        points[item.point] = at
+
+    @staticmethod
+    def construct(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
+                  pts: dict[str, Any], tiny: Any) -> None:
+        """Cut the guide with a circle, the branch from its definition."""
+        length = p[f'link.{item.link.name}.length']
+        u = mpmath.expj(p[f'guide.{item.point}.angle'])
+        w = pts[item.link.start] - pts[item.through]
+        along = (w * mpmath.conj(u)).real
+        offset = (w * mpmath.conj(u)).imag
+        square = length * length - offset * offset
+        if square < -tiny * length * length:
+            msg = f'RRP {item.point}: the guide is out of reach'
+            raise NoAssembly(msg)
+        s = along + int(item.branch) * mpmath.sqrt(max(square, 0))
+        at = pts[item.through] + s * u
+        q[i], q[i + 1] = mpmath.arg(at - pts[item.link.start]), s
+        pts[item.point] = at
+
+    @staticmethod
+    def measure(model: Model, item: Any, i: int, p: Mapping[str, Any],
+                points: Mapping[str, Any], q: list[Any], measures: dict[str, Any]) -> None:
+        """Put the sine of the rod's angle to the guide's normal."""
+        u = mpmath.expj(p[f'guide.{item.point}.angle'])
+        r = points[item.point] - points[item.link.start]
+        measures[item.point] = abs((mpmath.conj(u) * r).real) / p[
+            f'link.{item.link.name}.length']
+
+    @staticmethod
+    def branch_ok(item: Any, i: int, p: Mapping[str, Any], points: Mapping[str, Any],
+                  q: list[Any]) -> bool:
+        """Check the slider is beyond (branch +1) or before (-1) the foot of the start."""
+        u = mpmath.expj(p[f'guide.{item.point}.angle'])
+        along = ((points[item.link.start] - points[item.through]) * mpmath.conj(u)).real
+        return bool((q[i + 1] - along) * int(item.branch) >= 0)
+
+
+class _RPR(_Kind):
+    """A slotted lever about a ground pivot through a known pin: its angle and the slider."""
+
+    @staticmethod
+    def place(model: Model, item: Any, known: set[str], values: dict[str, float],
+              index: int) -> bool:
+        """Record the lever's angle and the slider."""
+        if item.through not in known:
+            return False
+        model.links[item.link] = index
+        model.sliders[item.slider] = index + 1
+        model.joint_types[item.link] = 'revolute'
+        model.joint_types[item.slider] = 'prismatic'
+        model._unknowns((f'{item.link} angle', False), (f'{item.slider}', True))
+        return True
+
+    @staticmethod
+    def evaluate(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
+                 points: dict[str, Any], residuals: list[Any]) -> None:
+        """Require the slot's point at the slider coordinate to be the pin."""
+        residuals.append(points[item.center] + q[i + 1] * expi(q[i]) - points[item.through])
+
+    @staticmethod
+    def construct(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
+                  pts: dict[str, Any], tiny: Any) -> None:
+        """Take the pin's polar coordinates about the pivot."""
+        d = pts[item.through] - pts[item.center]
+        q[i], q[i + 1] = mpmath.arg(d), abs(d)
+
+    @staticmethod
+    def measure(model: Model, item: Any, i: int, p: Mapping[str, Any],
+                points: Mapping[str, Any], q: list[Any], measures: dict[str, Any]) -> None:
+        """Put the slider coordinate over the mechanism's size."""
+        measures[item.link] = abs(q[i + 1]) / model.size
+
+    @staticmethod
+    def branch_ok(item: Any, i: int, p: Mapping[str, Any], points: Mapping[str, Any],
+                  q: list[Any]) -> bool:
+        """Check the pin is on the slot's positive side."""
+        return bool(q[i + 1] >= 0)
+
+
+class _RPP(_Kind):
+    """The Scotch yoke: unknowns, the yoke's coordinate on its guide and the pin's in the slot."""
+
+    @staticmethod
+    def place(model: Model, item: Any, known: set[str], values: dict[str, float],
+              index: int) -> bool:
+        """Record the guide's and the slot's angles and both sliders."""
+        if item.through not in known:
+            return False
+        values[f'guide.{item.point}.angle'] = item.guide_angle
+        values[f'slot.{item.point}.angle'] = item.slot_angle
+        model.sliders[item.slider] = index
+        model.sliders[item.slot_slider] = index + 1
+        model.joint_types[item.slider] = model.joint_types[item.slot_slider] = 'prismatic'
+        model._unknowns((f'{item.slider}', True), (f'{item.slot_slider}', True))
+        known.add(item.point)
+        return True
+
+    @staticmethod
+    def evaluate(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
+                 points: dict[str, Any], residuals: list[Any]) -> None:
+        """Y = O + s u on the guide; B = Y + t w in the slot."""
+        at = points[item.guide_through] + q[i] * expi(p[f'guide.{item.point}.angle'])
+        residuals.append(at + q[i + 1] * expi(p[f'slot.{item.point}.angle'])
+                         - points[item.through])
+        points[item.point] = at
+
+    @staticmethod
+    def construct(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
+                  pts: dict[str, Any], tiny: Any) -> None:
+        """Intersect the two lines by Cramer's rule."""
+        u = mpmath.expj(p[f'guide.{item.point}.angle'])
+        w = mpmath.expj(p[f'slot.{item.point}.angle'])
+        d = pts[item.through] - pts[item.guide_through]
+        c = (mpmath.conj(u) * w).imag
+        q[i] = (mpmath.conj(d) * w).imag / c
+        q[i + 1] = (mpmath.conj(u) * d).imag / c
+        pts[item.point] = pts[item.guide_through] + q[i] * u
+
+    @staticmethod
+    def measure(model: Model, item: Any, i: int, p: Mapping[str, Any],
+                points: Mapping[str, Any], q: list[Any], measures: dict[str, Any]) -> None:
+        """Put the sine of the angle between the slot and the guide."""
+        u = mpmath.expj(p[f'guide.{item.point}.angle'])
+        w = mpmath.expj(p[f'slot.{item.point}.angle'])
+        measures[item.point] = abs((mpmath.conj(u) * w).imag)
+
+
+class _Carry(_Kind):
+    """A point carried by a link: an explicit function of its frame's two points."""
+
+    @staticmethod
+    def place(model: Model, item: Any, known: set[str], values: dict[str, float],
+              index: int) -> bool:
+        """Record its local coordinates."""
+        if item.origin not in known or item.xaxis not in known or item.link not in model.links:
+            return False
+        values[f'point.{item.name}.local.x'] = item.local[0]
+        values[f'point.{item.name}.local.y'] = item.local[1]
+        known.add(item.name)
+        return True
+
+    @staticmethod
+    def evaluate(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
+                 points: dict[str, Any], residuals: list[Any]) -> None:
+        """Its position in its frame."""
+        origin = points[item.origin]
+        axis = points[item.xaxis] - origin
+        local = p[f'point.{item.name}.local.x'] + 1j * p[f'point.{item.name}.local.y']
+        points[item.name] = origin + local * axis / norm(axis)
+
+    @staticmethod
+    def construct(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
+                  pts: dict[str, Any], tiny: Any) -> None:
+        """Its position in its frame (mpmath)."""
+        origin = pts[item.origin]
+        axis = pts[item.xaxis] - origin
+        local = mpmath.mpc(p[f'point.{item.name}.local.x'], p[f'point.{item.name}.local.y'])
+        pts[item.name] = origin + local * axis / abs(axis)
+
+
+#: The scene's ``type:`` of an item (``point`` for a carried point) -> its equations.
+_KINDS: dict[str, type[_Kind]] = {'RRR': _RRR, 'RRP': _RRP, 'RPR': _RPR, 'RPP': _RPP,
+                                  'point': _Carry}
 
 
 def _real_vector(residuals: list[Any]) -> list[Any]:
@@ -557,23 +773,9 @@ def _solve_positions(model: Model, p: Mapping[str, Any], theta: Any,
 
 def _measures(model: Model, p: Mapping[str, Any], points: Mapping[str, Any],
               q: list[Any]) -> dict[str, Any]:
-    measures = {}
+    measures: dict[str, Any] = {}
     for element in model.elements:
-        item, i = element.item, element.index
-        if element.kind == 'RRR':
-            first, second = item.links
-            r1 = points[item.point] - points[first.start]
-            r2 = points[item.point] - points[second.start]
-            cross = (mpmath.conj(r1) * r2).imag
-            measures[item.point] = abs(cross) / (p[f'link.{first.name}.length']
-                                                 * p[f'link.{second.name}.length'])
-        elif element.kind == 'RRP':
-            u = mpmath.expj(p[f'guide.{item.point}.angle'])
-            r = points[item.point] - points[item.link.start]
-            measures[item.point] = abs((mpmath.conj(u) * r).real) / p[
-                f'link.{item.link.name}.length']
-        elif element.kind == 'RPR':
-            measures[item.link] = abs(q[i + 1]) / model.size
+        element.equations.measure(model, element.item, element.index, p, points, q, measures)
     return measures
 
 
@@ -581,22 +783,9 @@ def _check_branch(model: Model, p: Mapping[str, Any], points: Mapping[str, Any],
                   q: list[Any]) -> None:
     """Raise if Newton left the branch that SCENE_FORMAT.md defines."""
     for element in model.elements:
-        item, i = element.item, element.index
-        if element.kind == 'RRR':
-            first, second = item.links
-            d = points[second.start] - points[first.start]
-            side = (mpmath.conj(d) * (points[item.point] - points[first.start])).imag
-            ok = side * int(item.branch) >= 0
-        elif element.kind == 'RRP':
-            u = mpmath.expj(p[f'guide.{item.point}.angle'])
-            along = ((points[item.link.start] - points[item.through]) * mpmath.conj(u)).real
-            ok = (q[i + 1] - along) * int(item.branch) >= 0
-        elif element.kind == 'RPR':
-            ok = q[i + 1] >= 0
-        else:
-            continue
-        if not ok:
-            msg = f'{element.kind} {getattr(item, "point", None) or item.link}: wrong branch'
+        item = element.item
+        if not element.equations.branch_ok(item, element.index, p, points, q):
+            msg = f'{element.kind} {item.key}: wrong branch'
             raise ArithmeticError(msg)
 
 

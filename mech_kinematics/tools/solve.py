@@ -14,8 +14,8 @@ from typing import Any
 from .cli import finite_float, positive_float, run_tool
 from ..bounds import MAX_ERROR
 from ..errors import AssemblyError, SceneError, UntrustedError
-from ..linkage import assembly_text, solve
 from ..scene import load_scene
+from ..solver import assembly_text, solve
 from ..units import rad_per_s_from_rpm, radians_from_degrees
 
 __all__ = ['add_parser', 'main', 'turns_from_degrees']

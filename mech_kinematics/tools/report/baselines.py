@@ -22,8 +22,8 @@ from typing import Any
 import numpy as np
 
 from .common import ERROR_FLOOR, Mode, quiet_solve, spread_time, WP_SCENES
-from ...linkage import JointMotion, Scene, solve
 from ...scene import load_scene
+from ...solver import JointMotion, Scene, solve
 from ...textbook import find_answer, PointNorm
 from ...units import radians_from_degrees
 

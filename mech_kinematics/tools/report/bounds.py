@@ -36,8 +36,8 @@ import numpy as np
 from .common import distance_angle, four_bar, Mode, MODES, slider_crank
 from ...bounds import MAX_ERROR
 from ...errors import AssemblyError, NearSingularWarning, UntrustedError
-from ...linkage import CarriedPoint, Crank, Link, RPR, RRP, Scene, solve
 from ...scene import load_scene
+from ...solver import CarriedPoint, Crank, Link, RPR, RRP, Scene, solve
 from ...units import rad_per_s_from_rpm, radians_from_degrees
 
 __all__ = ['BoundCase', 'BoundStats', 'BoundValue', 'CaseBounds', 'KAPPA_WELL', 'OFFSETS',

@@ -24,7 +24,7 @@ import warnings
 import numpy as np
 
 from ...errors import NearSingularWarning
-from ...linkage import Branch, CarriedPoint, Crank, Link, RRP, RRR, Scene, solve
+from ...solver import Branch, CarriedPoint, Crank, Link, RRP, RRR, Scene, solve
 
 __all__ = ['DURATIONS', 'EPS', 'ERROR_FLOOR', 'MODES', 'Mode', 'WP_SCENES', 'distance_angle',
            'four_bar', 'median_time', 'quiet_solve', 'slider_crank', 'slug', 'spread_time']

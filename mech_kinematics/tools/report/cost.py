@@ -17,8 +17,8 @@ from typing import Any
 import numpy as np
 
 from .common import median_time, Mode
-from ...linkage import Branch, CarriedPoint, Crank, Link, RRR, Scene, solve
 from ...scene import load_scene
+from ...solver import Branch, CarriedPoint, Crank, Link, RRR, Scene, solve
 from ...units import radians_from_degrees
 
 __all__ = ['CHUNK', 'CostGrowth', 'chain_scene', 'cost_growth']

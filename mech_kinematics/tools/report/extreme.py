@@ -21,8 +21,8 @@ import warnings
 
 from .common import distance_angle, EPS, four_bar, Mode, MODES, slider_crank
 from ...errors import AssemblyError, NearSingularWarning, UntrustedError
-from ...linkage import CarriedPoint, Crank, RPR, Scene, solve
 from ...scene import load_scene
+from ...solver import CarriedPoint, Crank, RPR, Scene, solve
 from ...units import rad_per_s_from_rpm, radians_from_degrees
 
 __all__ = ['AngleResult', 'BOUND_FACTOR', 'Case', 'CaseResult', 'FormulaAudit', 'digits_lost',

@@ -29,7 +29,7 @@ from .data import render_block
 from .extreme import BOUND_FACTOR, CaseResult, digits_lost, FormulaAudit
 from ..bench import ARRAY_TARGET, SINGLE_TARGET
 from ...bounds import MAX_ERROR, ROUNDING_MARGIN
-from ...linkage import NEAR_SINGULAR, SINGULAR
+from ...solver import NEAR_SINGULAR, SINGULAR
 
 __all__ = ['write_report']
 

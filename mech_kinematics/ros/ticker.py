@@ -7,8 +7,11 @@ dictionary lookup, attribute read and object the general solver makes, and,
 waking from a sleep each tick with cold caches, for the size of the code it
 runs. :func:`compile_tick` removes that overhead without writing the
 kinematics a second time: it specializes the solver's own step code (the
-``run`` methods of :mod:`mech_kinematics.linkage`) to the scalar path of one
-scene by partial evaluation of their syntax trees.
+kernels of the step kinds of :mod:`mech_kinematics.solver`, written in the
+subset that :mod:`mech_kinematics.solver.base` states) to the scalar path of
+one scene by partial evaluation of their syntax trees, and takes the rest from
+the solver's public hooks (:mod:`mech_kinematics.solver.tick`). It is the
+node's, so it lives in the ROS layer (it imports only the solver).
 
 - ``ctx.vector`` becomes ``False`` and every branch it decides is folded
   away, so only the single-angle arithmetic is left;
@@ -37,10 +40,12 @@ from collections.abc import Callable, Sequence
 import inspect
 import itertools
 import math
+import sys
 import textwrap
 from typing import Any, cast
 
-from . import linkage as lk
+from .. import solver as lk
+from ..solver import tick as hooks
 
 __all__ = ['TickFunction', 'compile_tick', 'tick_function', 'values_from_state']
 
@@ -48,6 +53,10 @@ __all__ = ['TickFunction', 'compile_tick', 'tick_function', 'values_from_state']
 #: measure)``; ``theta + 2 pi turns`` is the crank angle counted from the start.
 TickFunction = Callable[[float, float, float, float, int], tuple[list[float], float]]
 
+_SOLVER = lk.__name__ + '.'
+#: The context's methods that record side facts (an intermittent lever's window, why a
+#: bound is large): the tick reports neither, so their calls are dropped.
+_DROPPED = ('engage', 'note')
 _TABLES = {'points': 'P', 'links': 'L', 'sliders': 'S', 'measures': 'M'}
 
 
@@ -155,9 +164,37 @@ class _Specializer(ast.NodeTransformer):
                 raise _Unsupported(f'ctx.{node.attr}')
         return self.generic_visit(node)
 
+    def visit_If(self, node: ast.If) -> Any:
+        # A branch ``ctx.vector`` decides is dropped before it is specialized: the
+        # array path may use what the tick does not (``ctx`` as a value, loops).
+        test = _fold(self.visit(node.test))
+        if isinstance(test, ast.Constant):
+            taken = node.body if test.value else node.orelse
+            return self.statements(taken) or ast.Pass()
+        node.test = cast(ast.expr, test)
+        node.body = self.statements(node.body) or [ast.Pass()]
+        node.orelse = self.statements(node.orelse)
+        return node
+
+    def statements(self, stmts: list[ast.stmt]) -> list[ast.stmt]:
+        """Return ``stmts`` specialized, a statement that became several spliced in."""
+        out: list[ast.stmt] = []
+        for stmt in stmts:
+            result = self.visit(stmt)
+            out.extend(result if isinstance(result, list) else [result])
+        return out
+
+    def visit_Expr(self, node: ast.Expr) -> Any:
+        value = node.value
+        if (isinstance(value, ast.Call) and isinstance(value.func, ast.Attribute)
+                and isinstance(value.func.value, ast.Name) and value.func.value.id == 'ctx'
+                and value.func.attr in _DROPPED):
+            return ast.Pass()       # a side fact the tick does not report
+        return self.generic_visit(node)
+
     def visit_Call(self, node: ast.Call) -> ast.AST:
         func = node.func
-        inlined = _inline(func, node.args) if not node.keywords else None
+        inlined = _inline(func, node.args, self.namespace) if not node.keywords else None
         if inlined is not None:
             result: ast.AST = self.visit(ast.copy_location(inlined, node))
             return result
@@ -180,8 +217,9 @@ class _Specializer(ast.NodeTransformer):
         return node
 
 
-def _inline(func: ast.expr, args: list[ast.expr]) -> ast.expr | None:
-    """Return the call of a one-line helper of the linkage module written out, or None.
+def _inline(func: ast.expr, args: list[ast.expr],
+            namespace: dict[str, Any]) -> ast.expr | None:
+    """Return the call of a one-line helper of the solver package written out, or None.
 
     A module function whose body is ``return <expression>`` (``_dot``,
     ``_cross``), called with plain names or constants, becomes its expression
@@ -190,8 +228,8 @@ def _inline(func: ast.expr, args: list[ast.expr]) -> ast.expr | None:
     simple = all(isinstance(a, (ast.Name, ast.Constant)) for a in args)
     if not (isinstance(func, ast.Name) and simple):
         return None
-    helper = vars(lk).get(func.id)
-    if not inspect.isfunction(helper) or helper.__module__ != lk.__name__:
+    helper = namespace.get(func.id)
+    if not inspect.isfunction(helper) or not helper.__module__.startswith(_SOLVER):
         return None
     definition = ast.parse(textwrap.dedent(inspect.getsource(helper))).body[0]
     if not (isinstance(definition, ast.FunctionDef) and len(definition.body) == 1
@@ -230,18 +268,6 @@ def _body(step: Any, method: Callable[..., Any], suffix: str, names: dict[str, s
         isinstance(stmt, ast.Expr) and isinstance(stmt.value, ast.Constant))], type_ignores=[])
     module = cast(ast.Module, _fold(specializer.visit(module)))
     return [stmt for stmt in module.body if not isinstance(stmt, ast.Pass)]
-
-
-def _ctx_check(theta: float, turns: int, *args: Any, **kwargs: Any) -> None:
-    lk._Context(theta, False, turns).check(*args, **kwargs)
-
-
-def _ctx_check_margin(theta: float, turns: int, *args: Any, **kwargs: Any) -> None:
-    lk._Context(theta, False, turns).check_margin(*args, **kwargs)
-
-
-def _shown(theta: float, turns: int) -> Any:
-    return lk._Context(theta, False, turns).shown
 
 
 def values_from_state(state: lk.State, joints: Sequence[str], points: Sequence[str],
@@ -329,32 +355,39 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
         an instant it cannot settle itself. ``None`` where the scene cannot be
         compiled (see the module's notes).
     """
-    solver = scene._solver
-    plan = solver.run_plan
+    plan = hooks.tick_plan(scene)
     joints = tuple(scene.output_joints if joints is None else joints)
     points = tuple(scene.output_points if points is None else points)
     frames = tuple(frames)
 
-    if solver.shift or plan.rubs:
+    if not plan.compilable:
         return None     # rescaled units, or rubbing to bound: the general solver's work
     namespace: dict[str, Any] = {
-        '_ctx_check': _ctx_check, '_ctx_check_margin': _ctx_check_margin,
-        '_shown': _shown,
+        '_ctx_check': hooks.check, '_ctx_check_margin': hooks.check_margin,
+        '_shown': hooks.shown,
         '_slow': _general(scene, joints, points, frames),
+        '_trust_limits': hooks.trust_limits,
         'inf': math.inf,
     }
-    namespace.update((k, v) for k, v in vars(lk).items() if not k.startswith('__'))
+    for step in (plan.crank, *plan.steps):
+        for cls in type(step).__mro__:
+            home = sys.modules[cls.__module__]
+            if home.__name__.startswith(_SOLVER):
+                namespace.update((k, v) for k, v in vars(home).items()
+                                 if not k.startswith('__'))
+    namespace['_wrapped_angle'] = hooks.wrapped_angle
     names: dict[str, str] = {}
     body: list[ast.stmt] = []
     try:
-        for name, entry in solver.ground.items():
+        for name, entry in plan.ground.items():
             local = names.setdefault(f'P_{name}', f'P_{name}_{len(names)}')
             namespace[f'_ground_{local}'] = entry
             body.append(ast.parse(f'{local} = _ground_{local}').body[0])
         arguments = {'theta': 'theta', 'omega': 'omega', 'alpha': 'alpha'}
         body += _body(plan.crank, type(plan.crank).run, '_0', names, namespace, arguments)
         for index, step in enumerate(plan.steps, 1):
-            body += _body(step, type(step).run, f'_{index}', names, namespace, {})
+            for part, kernel in enumerate(step.kernels()):
+                body += _body(step, kernel, f'_{index}_{part}', names, namespace, {})
     except (_Unsupported, OSError, TypeError) as error:
         del error   # the general solver serves this scene
         return None
@@ -364,21 +397,15 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
 
     kinds = dict(plan.joint_types)
     lines = []
-    # The quick trust test of the general solver (_trusted), on the reported values.
-    lines += ['_w = abs(omega)', '_rate = _w * _w + abs(alpha)',
-              f'_lp = tol * {solver.size!r}', f'_lv = tol * ({solver.crank_length!r} * _w)',
-              f'_la = tol * ({solver.crank_length!r} * _rate)', '_lw = tol * _w',
-              '_lal = tol * _rate']
+    # The general solver's quick trust test (hooks.trust_limits and hooks.TRUST_TEST, the
+    # one source of both), on the reported values.
+    lines.append(f'_l0, _l1, _l2, _l3, _l4, _l5 = _trust_limits(tol, omega, alpha, '
+                 f'{plan.size!r}, {plan.crank_length!r})')
     checks = []
-    for name in solver.out_points:
-        e = var('P', name)
-        checks.append(f'{e}[3] <= _lp and {e}[4] <= _lv and {e}[5] <= _la')
-    for name in solver.out_links:
-        e = var('L', name)
-        checks.append(f'{e}[3] <= tol and {e}[4] <= _lw and {e}[5] <= _lal')
-    for name in solver.out_sliders:
-        e = var('S', name)
-        checks.append(f'{e}[3] <= _lp and {e}[4] <= _lv and {e}[5] <= _la')
+    for table, _, (i, j, k) in hooks.TRUST_TEST:
+        for name in plan.reported[table]:
+            e = var(_TABLES[table], name)
+            checks.append(f'{e}[3] <= _l{i} and {e}[4] <= _l{j} and {e}[5] <= _l{k}')
     if checks:
         lines.append(f'if not ({" and ".join(checks)}):')
         lines.append('    return _slow(theta, omega, alpha, tol, turns)')
@@ -404,9 +431,10 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
         measures[0] if measures else 'inf')
     lines.append(f'return [{", ".join(values)}], {measure}')
     tail = ast.parse('\n'.join(lines)).body
+    low, high, accel_high = hooks.RATES
     guard = ast.parse(
-        f'if not ({lk._RATE_LOW!r} <= abs(omega) <= {lk._RATE_HIGH!r} '
-        f'and abs(alpha) <= {lk._ACCEL_HIGH!r}):\n'
+        f'if not ({low!r} <= abs(omega) <= {high!r} '
+        f'and abs(alpha) <= {accel_high!r}):\n'
         '    return _slow(theta, omega, alpha, tol, turns)').body
     function = ast.FunctionDef(
         name='tick', args=ast.arguments(

@@ -1,0 +1,99 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The driving crank: a link turning about a ground point, at the head of every plan."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+import math
+from typing import Any
+
+import numpy as np
+
+from .context import _Context, _U2, _U4
+from .model import _check_finite, _check_length, _check_name
+from ..bounds import U
+
+
+@dataclass(frozen=True)
+class Crank:
+    """The driving crank: a link turning about a ground point.
+
+    Parameters
+    ----------
+    link : str
+        Name of the crank link (a revolute joint).
+    center : str
+        Ground point it turns about.
+    point : str
+        The point at its tip.
+    length : float
+        Crank length, m.
+    angle : float
+        Crank angle at time zero, rad.
+    speed : float
+        Default angular velocity, rad/s, + CCW.
+    accel : float
+        Default angular acceleration, rad/s^2, + CCW.
+    """
+
+    link: str
+    center: str
+    point: str
+    length: float
+    angle: float = 0.0
+    speed: float = 0.0
+    accel: float = 0.0
+
+    def __post_init__(self) -> None:
+        """Validate the fields."""
+        _check_name(self.link, 'the crank link name', (self, 'link'))
+        _check_name(self.center, 'the crank center', (self, 'center'))
+        _check_name(self.point, 'the crank point', (self, 'point'))
+        _check_length(self.length, f'crank "{self.link}" length', (self, 'length'))
+        _check_finite(self.angle, 'the crank angle', (self, 'angle'))
+        _check_finite(self.speed, 'the crank speed', (self, 'speed'))
+        _check_finite(self.accel, 'the crank acceleration', (self, 'accel'))
+
+
+class _CrankStep:
+    def __init__(self, crank: Crank, center: complex) -> None:
+        self.link = crank.link
+        self.point = crank.point
+        self.center = center
+        self.length = crank.length
+        self.uses: tuple[str, ...] = (crank.center,)
+        # The tip's sum ``center + r``: the centre's rounding and the sum's.
+        self.e_center = U * (2.0 * abs(center) + crank.length)
+        # r = length * e: the length's rounding and the product's; then those of
+        # v = i omega r and of a = i alpha r - omega^2 r.
+        self.e_r, self.e_v, self.e_a = (n * U * crank.length for n in (2, 4, 7))
+
+    def run(self, ctx: _Context, theta: Any, omega: Any, alpha: Any) -> None:
+        e: Any
+        if ctx.vector:
+            e = np.empty(np.shape(theta), dtype=np.complex128)
+            np.cos(theta, out=e.real)
+            np.sin(theta, out=e.imag)
+        else:
+            e = complex(math.cos(theta), math.sin(theta))
+        r = self.length * e
+        if (not ctx.vector or alpha.ndim == 0) and alpha == 0.0:  # a constant crank speed
+            acceleration = -(omega * omega) * r
+        else:
+            acceleration = 1j * alpha * r - omega * omega * r
+        # Bounds: theta known to U |theta|, cos and sin to an ulp; r = length * e.
+        ee = U * abs(theta) + _U2
+        re = self.length * ee
+        w = abs(omega)
+        ctx.points[self.point] = (self.center + r, 1j * omega * r, acceleration,
+                                  re + self.e_r + self.e_center, w * (re + self.e_v),
+                                  (abs(alpha) + w * w) * (re + self.e_a))
+        ctx.links[self.link] = (e, omega, alpha, ee + _U4, U * w, U * abs(alpha))
+
+
+# Every complex product below has one real factor or a purely imaginary one
+# (``1j * x``): such products round the same way in Python's complex type and
+# in NumPy's (whose general complex product may use fused multiply-adds), so
+# the single-angle and array paths give the same bits. Norms use hypot for the
+# same reason.

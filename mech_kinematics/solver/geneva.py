@@ -1,0 +1,219 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The intermittent (Geneva) lever: an RPR whose wheel has ``slots``, driven only while engaged.
+
+Its item is :class:`~.rpr.RPR` with ``slots``; this module holds its step,
+the check of its tangential entry, and its :class:`~.state.Engagement`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+import math
+from typing import Any, cast
+
+import numpy as np
+
+from .base import Placing
+from .context import _Context, _U2, _U4, _U7
+from .model import _names, SceneUnits
+from .rpr import _RPRStep, RPR
+from .state import Engagement
+from ..bounds import ROUNDING_MARGIN, U
+from ..errors import SceneError
+from ..units import LENGTH_UNITS
+
+#: An intermittent lever's pin must enter its slots tangentially: the crank
+#: radius R of the pin and the centre distance l must satisfy
+#: ``|R / l - sin(pi / n)| <= TANGENCY_TOLERANCE * sin(pi / n)``.
+TANGENCY_TOLERANCE = 1e-9
+
+
+class _IndexStep(_RPRStep):
+    """An RPR whose lever is an intermittent (Geneva) wheel of ``n`` slots (see :class:`RPR`).
+
+    The engaged motion is the plain RPR's, turned back by ``2 pi k / n`` in
+    the crank's engagement window ``k``; between windows the wheel is held at
+    ``c - j pi / n`` (``c`` the direction from the wheel's centre to the
+    crank's, ``j = 2k +- 1``), velocity and acceleration exactly 0. The
+    window comes from the crank angle counted from the start (``angle`` plus
+    ``turns`` whole turns, the turns never added in floating point), so the
+    wheel's index is exact over any number of turns; both tables are
+    computed once, so both paths read the same bits.
+    """
+
+    intermittent = True
+
+    def __init__(self, dyad: RPR, center: complex, size: float, crank_center: complex,
+                 pin: complex) -> None:
+        super().__init__(dyad, center, size)
+        n = cast(int, dyad.slots)
+        self.slots = n
+        toward = center - crank_center  # from the crank's centre to the wheel's
+        distance = abs(toward)
+        # Window 0 is centred on the crank angle that points the pin at the wheel.
+        beta = math.atan2(pin.imag, pin.real)
+        self.phase0 = math.atan2(toward.imag, toward.real) - beta
+        self.half = math.pi / 2 - math.pi / n  # half the crank's engaged angle
+        self.tan = math.tan(math.pi / n)  # R / (slot mouth): the acceleration's jump / omega^2
+        c = math.atan2(-toward.imag, -toward.real)
+        step = math.pi / n
+        held = [c - j * step for j in range(2 * n)]
+        turn = [-2.0 * step * m for m in range(n)]
+        self.held = [complex(math.cos(x), math.sin(x)) for x in held]
+        self.turn = [complex(math.cos(x), math.sin(x)) for x in turn]
+        self.held_array = np.array(self.held, dtype=np.complex128)
+        self.turn_array = np.array(self.turn, dtype=np.complex128)
+        # Bounds: the line of centres' direction from the rounded ground points
+        # and the atan2; each table angle's own rounding; cos and sin to an ulp;
+        # the final angle's atan2 (as _U7 elsewhere); the rotation's products.
+        ec = U * (abs(center) + abs(crank_center) + distance) / distance + _U2
+        self.e_held = [ec + U * (abs(x) + 2.0 * j * step) + _U7 for j, x in enumerate(held)]
+        self.e_turn = [U * 2.0 * abs(x) + _U4 + _U4 for x in turn]
+        self.e_held_array = np.array(self.e_held)
+        self.e_turn_array = np.array(self.e_turn)
+        self.e_phase = ec + U * (abs(beta) + math.pi + abs(self.phase0)) + _U2
+        self.e_q = 4.0 * U * math.tau  # per whole turn reduced: 2 pi's rounding and the product's
+        self.e_half = U * self.half
+
+    def window(self, angle: Any, turns: Any, vector: bool) -> tuple[Any, Any, Any, Any]:
+        """Return (engaged, window, offset in the window, its error bound) at a crank angle."""
+        d = angle - self.phase0
+        if vector:
+            q = np.rint(d / math.tau)
+            window = np.asarray(turns, dtype=np.int64) + q.astype(np.int64)
+        else:
+            q = float(round(d / math.tau))
+            window = turns + int(q)
+        r = d - q * math.tau
+        er = U * (abs(angle) + abs(d) + abs(r)) + self.e_phase + abs(q) * self.e_q
+        return abs(r) <= self.half, window, r, er
+
+    def run(self, ctx: _Context) -> None:
+        """Run the plain RPR's kernel, then index its motion by the crank's window."""
+        _RPRStep.run(self, ctx)
+        if ctx.vector:
+            self.run_array(ctx)
+        else:
+            self.run_one(ctx)
+
+    @classmethod
+    def kernels(cls) -> tuple[Callable[..., None], ...]:
+        """Return the plain RPR's kernel and :meth:`run_one`: ``run`` on one crank angle."""
+        return (_RPRStep.run, cls.run_one)
+
+    def run_array(self, ctx: _Context) -> None:
+        """Index the lever's engaged motion by the crank's window, for an array of angles."""
+        n = self.slots
+        engaged, window, r, er = self.window(ctx.angle, ctx.turns, ctx.vector)
+        near = abs(abs(r) - self.half) <= ROUNDING_MARGIN * (er + self.e_half)
+        e, w, al, ee, ew, eal = ctx.links[self.link]
+        ctx.engage(self.link, engaged, window)
+        m = np.mod(window, n)
+        side = np.mod(2 * window + np.where(r > 0.0, 1, -1), 2 * n)
+        t = self.turn_array[m]
+        held = self.held_array[side]
+        # The engaged direction turned back by 2 pi m / n, in real arithmetic (same bits).
+        turned = (e.real * t.real - e.imag * t.imag) + 1j * (e.real * t.imag + e.imag * t.real)
+        e_turn, e_held = self.e_turn_array[m], self.e_held_array[side]
+        entry: tuple[Any, ...] = (
+            np.where(engaged, turned, held), np.where(engaged, w, 0.0),
+            np.where(engaged, al, 0.0), np.where(engaged, ee + e_turn, e_held),
+            np.where(engaged, ew, 0.0), np.where(engaged, eal, 0.0))
+        if near.any():
+            # Within rounding of a slot's mouth either side may be the true one: the
+            # bounds cover both (the acceleration jumps there).
+            diff = turned - held
+            gap = abs(diff.real) + abs(diff.imag)
+            entry = (entry[0], entry[1], entry[2],
+                     np.where(near, ee + e_turn + e_held + gap, entry[3]),
+                     np.where(near, ew + abs(w), entry[4]),
+                     np.where(near, eal + abs(al), entry[5]))
+        ctx.links[self.link] = entry
+
+    def run_one(self, ctx: _Context) -> None:
+        """Do :meth:`run_array` for one crank angle: the same operations, only those it needs."""
+        angle = ctx.angle
+        d = angle - self.phase0
+        q = round(d / math.tau)  # an int: q * tau and abs(q) * e_q round as the float's would
+        r = d - q * math.tau
+        window = ctx.turns + q
+        ar = abs(r)
+        half = self.half
+        engaged = ar <= half
+        ctx.engage(self.link, engaged, window)
+        er = U * (abs(angle) + abs(d) + ar) + self.e_phase + abs(q) * self.e_q
+        near = abs(ar - half) <= ROUNDING_MARGIN * (er + self.e_half)
+        n = self.slots
+        e, w, al, ee, ew, eal = ctx.links[self.link]
+        if engaged or near:
+            m = window % n
+            t = self.turn[m]
+            turned = (e.real * t.real - e.imag * t.imag) + 1j * (e.real * t.imag
+                                                                 + e.imag * t.real)
+        if engaged:
+            entry: tuple[Any, ...] = (turned, w, al, ee + self.e_turn[m], ew, eal)
+        else:
+            side = (2 * window + (1 if r > 0.0 else -1)) % (2 * n)
+            entry = (self.held[side], 0.0, 0.0, self.e_held[side], 0.0, 0.0)
+        if near:
+            # Within rounding of a slot's mouth either side may be the true one: the
+            # bounds cover both (the acceleration jumps there).
+            side = (2 * window + (1 if r > 0.0 else -1)) % (2 * n)
+            held = self.held[side]
+            diff = turned - held
+            gap = abs(diff.real) + abs(diff.imag)
+            entry = (entry[0], entry[1], entry[2],
+                     ee + self.e_turn[m] + self.e_held[side] + gap, ew + abs(w), eal + abs(al))
+            ctx.note(self.label, lambda: (
+                f'the pin {self.through} is within rounding of the mouth of a slot of '
+                f'{self.link}, where its angular acceleration jumps from or to 0 (an '
+                f'engagement instant: ask for a crank angle either side of it)'))
+        ctx.links[self.link] = entry
+
+    def engagement(self, ctx: _Context, omega: Any, finish: Any) -> Engagement:
+        """Return where the lever is in its cycle (see :class:`Engagement`)."""
+        engaged, window = ctx.engagement[self.link]
+        centre = self.phase0 + (window.astype(np.float64) if ctx.vector
+                                else float(window)) * math.tau
+        entry, exit_ = centre - self.half, centre + self.half
+        jump = omega * omega * self.tan
+        zero = 0.0 * jump
+        if finish is not None:
+            entry, exit_, jump, zero = finish(entry), finish(exit_), finish(jump), finish(zero)
+            engaged = np.broadcast_to(engaged, np.shape(entry))
+        # The fields go straight in, as in _new_state: a frozen dataclass's __init__ costs 1 us.
+        record = object.__new__(Engagement)
+        record.__dict__.update(engaged=engaged, window=window, entry=entry, exit=exit_,
+                               entry_acceleration=(zero, -jump), exit_acceleration=(jump, zero))
+        return record
+
+
+def _index_step(plan: Placing, item: RPR) -> _IndexStep:
+    """Return the step of an intermittent lever; check its pin and its tangential entry."""
+    scene, ground, size = plan.scene, plan.ground, plan.size
+    crank = scene.input
+    crank_local = plan.local[crank.link]
+    units: SceneUnits = getattr(scene, 'units', SceneUnits())
+    n = cast(int, item.slots)
+    if item.through not in crank_local or item.through == crank.center:
+        on_crank = _names(p for p in crank_local if p != crank.center)
+        msg = (f'Expected the pin of intermittent RPR "{item.link}" (slots: {n}) to be a point '
+               f'fixed on the crank "{crank.link}" ({on_crank}), got "{item.through}"')
+        raise SceneError(msg, (item, 'through'))
+    pin = crank_local[item.through]
+    radius = abs(pin)
+    centre, wheel = ground[crank.center], ground[item.center]
+    distance = abs(wheel - centre)
+    sine = math.sin(math.pi / n)
+    if not (radius > 0.0 and abs(radius - distance * sine) <= TANGENCY_TOLERANCE * sine
+            * distance):
+        per = LENGTH_UNITS[units.length]
+        msg = (f'Expected the pin {item.through} to enter the {n} slots of "{item.link}" '
+               f'tangentially: {crank.center} and {item.center} '
+               f'{radius / sine * per:.10g} {units.length} apart (pin radius '
+               f'{units.length_text(radius)} / sin(180 deg / {n})) or a pin radius of '
+               f'{distance * sine * per:.10g} {units.length}, to 1e-9, got '
+               f'{units.length_text(distance)} apart')
+        raise SceneError(msg, (item, 'slots'))
+    return _IndexStep(item, wheel, size, centre, pin)

@@ -1,0 +1,212 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The public :class:`Scene`: a mechanism validated, compiled and checked to assemble.
+
+Its solver (:class:`_Solver`) holds the compiled plan, the labels of what it
+reports and the scaling; :func:`assembly_text` says why a mechanism cannot
+assemble in the scene's own units.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+import math
+from typing import cast
+import warnings
+
+from .base import Intermittent, Item
+from .carried import CarriedPoint
+from .crank import Crank
+from .model import _check_name, SceneUnits
+from .plan import _compile, _Plan
+from .rubbing import Pin
+from .scaling import _ANGULAR, _exponent, _LINEAR, _scaled, _size, _SIZE_RANGE
+from .solve import _execute, TRUST_TEST
+from ..bounds import U
+from ..errors import AssemblyError, NearSingularWarning, SceneError
+
+
+class _Solver:
+    """A compiled plan with what solving it with error bounds needs.
+
+    ``run_plan`` is the plan the steps run: ``plan`` itself, or for a scene
+    whose size is outside :data:`_SIZE_RANGE` the same scene compiled with
+    every length times ``2**-shift``. ``outputs`` lists the reported values in
+    solve order: (table of the context, name, path in ``as_dict()``, label of
+    the dyad that produced it, the kinds of its three values).
+    """
+
+    def __init__(self, scene: Scene, plan: _Plan) -> None:
+        self.plan = plan
+        self.size = _size(scene)
+        self.crank_length = scene.input.length
+        self.shift = _exponent(self.size, *_SIZE_RANGE)
+        run = plan
+        if self.shift:
+            try:
+                run = _compile(_scaled(scene, self.shift), plan.output_joints,
+                               plan.output_points)
+            except SceneError:
+                msg = (f"Expected every length within 2**1000 of the mechanism's size "
+                       f'{self.size:.3g} m, got one that does not survive scaling to 1 m')
+                raise SceneError(msg, (scene, 'ground')) from None
+            unit = math.ldexp(1.0, self.shift)
+            for step in run.steps:
+                step.unit = unit
+        self.run_plan = run
+        # Ground points are inputs: known to U |g|.
+        self.ground = {name: (z, 0j, 0j, U * abs(z), 0.0, 0.0) for name, z in run.ground.items()}
+        crank = scene.input
+        labels = dict.fromkeys((crank.link, crank.point), f'input {crank.link}')
+        labels.update((name, f'ground {name}') for name in plan.ground)
+        rank = dict.fromkeys(labels, 0)
+        self.measure_keys: dict[str, str] = {}
+        for index, step in enumerate(plan.steps, 1):
+            if step.owner is not None:
+                label = labels[step.owner]  # the dyad that moves its link
+            else:
+                label = step.label
+                self.measure_keys[label] = step.key
+            for name in step.defines:
+                labels[name], rank[name] = label, index
+        outputs = [(rank[name], 'points', name, f'points.{name}', labels[name], _LINEAR)
+                   for name in plan.output_points]
+        for name, kind in plan.joint_types.items():
+            revolute = kind == 'revolute'
+            outputs.append((rank[name], 'links' if revolute else 'sliders', name,
+                            f'joints.{name}', labels[name], _ANGULAR if revolute else _LINEAR))
+        outputs.sort(key=lambda item: item[0])
+        self.outputs = tuple(item[1:] for item in outputs)
+        self.out_points = plan.output_points
+        self.levers = {step.key: cast(Intermittent, step) for step in plan.steps
+                       if step.intermittent}
+        self.out_links = tuple(n for n, k in plan.joint_types.items() if k == 'revolute')
+        self.out_sliders = tuple(n for n, k in plan.joint_types.items() if k == 'prismatic')
+        # The quick trust test's groups (TRUST_TEST), with their names, the empty ones left out.
+        self.trust = tuple((table, getattr(self, names), limits)
+                           for table, names, limits in TRUST_TEST if getattr(self, names))
+
+
+def assembly_text(error: AssemblyError, units: SceneUnits | None = None) -> str:
+    """Return why a mechanism cannot assemble, naming links and lengths in ``units``.
+
+    E.g. ``links coupler (150 mm) and rocker (80 mm) cannot reach from B to D
+    (235 mm apart)``; the error's own reason where it carries no facts.
+    """
+    facts = error.facts
+    if facts is None:
+        return f'{error.dyad}: {error.reason}'
+    units = SceneUnits() if units is None else units
+    text = units.length_text
+    kind, links, lengths, points = facts['kind'], facts['links'], facts['lengths'], \
+        facts['points']
+    distance = facts['distance']
+    if kind == 'pivot':
+        return (f'the pin {points[0]} of slotted link {links[0]} on its pivot {points[1]} '
+                f'({text(distance)} from it)')
+    if kind == 'reach':
+        return (f'link {links[0]} ({text(lengths[0], distance)}) cannot reach the guide through '
+                f'{points[1]} at {units.angle_text(facts["guide_angle"])} from {points[0]} '
+                f'({text(distance, lengths[0])} from the guide)')
+    (a, b), (la, lb), (p, q) = links, lengths, points
+    pair = f'links {a} ({text(la)}) and {b} ({text(lb)})'
+    if kind == 'in line':
+        return (f'{pair} in line between {p} and {q} ({text(distance)} apart): a toggle '
+                f'position, where the mechanism locks')
+    if distance >= la + lb:
+        return (f'{pair} cannot reach from {p} to {q} '
+                f'({text(distance, la + lb)} apart, more than {text(la + lb, distance)})')
+    return (f'{pair} cannot meet: {p} and {q} are {text(distance, abs(la - lb))} apart, less '
+            f'than the difference of their lengths ({text(abs(la - lb), distance)})')
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A planar mechanism: ground points, the driving crank, dyads, carried points.
+
+    Construction validates names and dependencies and checks that the
+    mechanism assembles at ``input.angle``; a failure raises
+    :class:`SceneError`.
+
+    Parameters
+    ----------
+    name : str
+        Identifier of the scene.
+    ground : mapping of str to (float, float)
+        Fixed points, m.
+    input : Crank
+        The driving crank.
+    dyads : tuple of RRR, RRP or RPR
+        The dyads, solved in dependency order (file order where free).
+    points : tuple of CarriedPoint
+        Points carried rigidly by links.
+    output_joints, output_points : tuple of str or None
+        What to compute and report; ``None`` means everything.
+    description : str
+        Free text.
+    pins : tuple of Pin
+        Pins whose rubbing velocity is reported (``State.rubbing``).
+    units : SceneUnits
+        The units the scene was written in, for messages (its values are SI).
+    """
+
+    name: str
+    ground: Mapping[str, tuple[float, float]]
+    input: Crank
+    dyads: tuple[Item, ...] = ()
+    points: tuple[CarriedPoint, ...] = ()
+    outputs_joints: tuple[str, ...] | None = None
+    outputs_points: tuple[str, ...] | None = None
+    description: str = ''
+    pins: tuple[Pin, ...] = ()
+    units: SceneUnits = SceneUnits()
+    _plan: _Plan = field(init=False, repr=False, compare=False)
+    _solver: _Solver = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        """Validate the fields."""
+        _check_name(self.name, 'the scene name', (self, 'name'))
+        object.__setattr__(self, 'dyads', tuple(self.dyads))
+        object.__setattr__(self, 'points', tuple(self.points))
+        object.__setattr__(self, 'pins', tuple(self.pins))
+        full = _compile(self, None, None)
+        solver = _Solver(self, full)
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter('ignore', NearSingularWarning)
+                _execute(solver, self.input.angle, 0.0, 0.0)  # positions only
+        except AssemblyError as error:
+            dyad = next((step.dyad for step in full.steps
+                         if step.owner is None and step.label == error.dyad), None)
+            msg = (f'Expected the mechanism to assemble at the initial crank angle '
+                   f'{self.units.angle_text(self.input.angle)}, got '
+                   f'{assembly_text(error, self.units)}')
+            raise SceneError(msg, (self.input, 'angle') if dyad is None else (dyad, '')) from None
+        if self.outputs_joints is None and self.outputs_points is None:
+            plan = full
+        else:
+            plan = _compile(self, self.outputs_joints, self.outputs_points)
+            solver = _Solver(self, plan)
+        object.__setattr__(self, '_plan', plan)
+        object.__setattr__(self, '_solver', solver)
+
+    @property
+    def output_joints(self) -> tuple[str, ...]:
+        """Names of the joints reported, in order."""
+        return self._plan.output_joints
+
+    @property
+    def output_points(self) -> tuple[str, ...]:
+        """Names of the points reported, in order."""
+        return self._plan.output_points
+
+    @property
+    def joint_types(self) -> dict[str, str]:
+        """Joint name -> ``'revolute'`` or ``'prismatic'``, for the reported joints."""
+        return dict(self._plan.joint_types)
+
+    @property
+    def pin_bodies(self) -> dict[str, tuple[str, str]]:
+        """Pin point -> the two bodies it joins (a link, ``ground`` or a slider block)."""
+        return {rub.point: rub.names for rub in self._plan.rubs}

@@ -1,0 +1,247 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The plan compiler: a scene's items ordered by dependency, as steps, keeping what is needed.
+
+It asks each item (:class:`~.base.Item`) what it defines, what it needs and
+for its step; it never tests which kind an item is.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+import heapq
+import math
+from typing import Any, TYPE_CHECKING
+
+from .base import Item, Step
+from .crank import _CrankStep
+from .model import _check_finite, _check_name, _names, Where
+from .rubbing import _rub_steps, _RubStep
+from ..errors import SceneError
+
+if TYPE_CHECKING:
+    from .mechanism import Scene
+
+
+@dataclass(frozen=True)
+class _Plan:
+    """A scene compiled to an ordered list of steps."""
+
+    crank: _CrankStep
+    steps: tuple[Step, ...]
+    ground: dict[str, complex]
+    joint_types: dict[str, str]
+    output_joints: tuple[str, ...]
+    output_points: tuple[str, ...]
+    rubs: tuple[_RubStep, ...] = ()
+
+
+class _Names:
+    """The names defined so far, for items to check their references (:class:`~.base.Names`)."""
+
+    def __init__(self, kinds: Mapping[str, str], ground: Mapping[str, complex]) -> None:
+        self.kinds = kinds
+        self._ground = ground
+
+    def point(self, name: str, what: str, where: Where) -> str:
+        """Return ``name`` if it is a known point, else raise a :class:`SceneError`."""
+        kinds = self.kinds
+        if name not in kinds:
+            msg = f'Expected {what} to be a known point, got unknown "{name}"'
+            raise SceneError(msg, where)
+        if kinds[name] != 'point':
+            msg = f'Expected {what} to be a point, got {kinds[name]} "{name}"'
+            raise SceneError(msg, where)
+        return name
+
+    def ground(self, name: str, what: str, where: Where) -> str:
+        """Return ``name`` if it is a ground point, else raise a :class:`SceneError`."""
+        self.point(name, what, where)
+        if name not in self._ground:
+            msg = f'Expected {what} to be a ground point, got moving point "{name}"'
+            raise SceneError(msg, where)
+        return name
+
+    def link(self, name: str, what: str, where: Where) -> str:
+        """Return ``name`` if it is a known link, else raise a :class:`SceneError`."""
+        kinds = self.kinds
+        if name not in kinds or kinds[name] != 'link':
+            got = f'unknown "{name}"' if name not in kinds else f'{kinds[name]} "{name}"'
+            msg = f'Expected {what} to be a link, got {got}'
+            raise SceneError(msg, where)
+        return name
+
+
+@dataclass
+class _Placing:
+    """What items build their steps from (:class:`~.base.Placing`)."""
+
+    ground: Mapping[str, complex]
+    local: dict[str, dict[str, complex]]
+    slot: dict[str, tuple[str, str]]
+    size: float
+    scene: Any
+
+
+def _compile(scene: Scene, joints: tuple[str, ...] | None,
+             points: tuple[str, ...] | None) -> _Plan:
+    """Order the scene's steps by dependency and keep those the outputs need."""
+    kinds: dict[str, str] = {}
+
+    def define(name: str, kind: str, where: Where) -> None:
+        if name in kinds:
+            msg = f'Expected every name to be used once, got "{name}" twice'
+            raise SceneError(msg, where)
+        kinds[name] = kind
+
+    ground = {}
+    for name, (x, y) in scene.ground.items():
+        _check_name(name, 'a ground point name', (scene, f'ground.{name}'))
+        _check_finite(x, f'ground point "{name}" x', (scene, f'ground.{name}'))
+        _check_finite(y, f'ground point "{name}" y', (scene, f'ground.{name}'))
+        define(name, 'point', (scene, f'ground.{name}'))
+        ground[name] = complex(x, y)
+    crank = scene.input
+    if crank.center not in ground:
+        msg = f'Expected the crank center to be a ground point, got "{crank.center}"'
+        raise SceneError(msg, (crank, 'center'))
+    define(crank.link, 'link', (crank, 'link'))
+    define(crank.point, 'point', (crank, 'point'))
+    joint_types = {crank.link: 'revolute'}
+    for dyad in scene.dyads:
+        for name, kind, where in dyad.defined():
+            define(name, kind, where)
+        joint_types.update(dyad.joint_types())
+    for carried in scene.points:
+        for name, kind, where in carried.defined():
+            define(name, kind, where)
+
+    size = max([crank.length, _diameter(ground.values())]
+               + [length for d in scene.dyads for length in d.lengths()])
+
+    # Local coordinates of the points fixed on each link, in the frame at the
+    # link's start with x along the link; and the slot pin of each RPR lever.
+    placing = _Placing(ground, {crank.link: {crank.center: 0j,
+                                             crank.point: complex(crank.length)}},
+                       {}, size, scene)
+    names = _Names(kinds, ground)
+    steps: list[Step] = []
+    produces: dict[str, int] = {}  # point, link or slider -> index of its step
+
+    def place(item: Item) -> tuple[str, ...]:
+        """Append the step of ``item``, whose prerequisites are known; return what it adds."""
+        index = len(steps)
+        step = item.place(placing)
+        steps.append(step)
+        for name in step.defines:
+            produces[name] = index
+        return step.defines
+
+    # Place each item as soon as what it starts from is known, the earliest in
+    # the file first (file order wherever it is free): a heap of the ready
+    # items and, per name, the items waiting for it. O(n log n) in all.
+    pending: list[Item] = [*scene.dyads, *scene.points]
+    known = {*ground, crank.point, crank.link}
+    waiting: dict[str, list[int]] = {}
+    missing = [0] * len(pending)
+    for index, item in enumerate(pending):
+        for name in item.prerequisites(names) - known:
+            waiting.setdefault(name, []).append(index)
+            missing[index] += 1
+    ready = [index for index, count in enumerate(missing) if count == 0]  # sorted: a heap
+    placed = 0
+    while ready:
+        for name in place(pending[heapq.heappop(ready)]):
+            known.add(name)
+            for index in waiting.pop(name, ()):
+                missing[index] -= 1
+                if missing[index] == 0:
+                    heapq.heappush(ready, index)
+        placed += 1
+    if placed < len(pending):
+        left = [item for index, item in enumerate(pending) if missing[index]]
+        keys = [item.key for item in left]
+        msg = f'Expected dyads and points solvable in order, got a cycle among [{_names(keys)}]'
+        raise SceneError(msg, (left[0], ''))
+
+    order = [*ground, crank.point, *(name for step in steps
+                                     for name in step.new_points)]
+    all_joints = tuple(joint_types)
+    out_joints = all_joints if joints is None else tuple(joints)
+    out_points = tuple(order) if points is None else tuple(points)
+    for name in out_joints:
+        if kinds.get(name) not in ('link', 'slider'):
+            got = f'unknown "{name}"' if name not in kinds else f'{kinds[name]} "{name}"'
+            msg = f'Expected outputs.joints to list links and sliders, got {got}'
+            raise SceneError(msg, (scene, 'outputs.joints'))
+    for name in out_points:
+        if kinds.get(name) != 'point':
+            got = f'unknown "{name}"' if name not in kinds else f'{kinds[name]} "{name}"'
+            msg = f'Expected outputs.points to list points, got {got}'
+            raise SceneError(msg, (scene, 'outputs.points'))
+
+    rubs = _rub_steps(scene, kinds, placing.local)
+
+    # Keep only the steps that the outputs (and the pins' rubbing) depend on.
+    needed: set[int] = set()
+    todo = [produces[name] for name in (*out_joints, *out_points) if name in produces]
+    todo += [produces[name] for rub in rubs for name in rub.uses if name in produces]
+    while todo:
+        index = todo.pop()
+        if index in needed:
+            continue
+        needed.add(index)
+        step = steps[index]
+        # (the crank is no step: its link and point are produced by none)
+        todo.extend(produces[name] for name in step.requires if name in produces)
+    kept = tuple(step for index, step in enumerate(steps) if index in needed)
+    return _Plan(_CrankStep(crank, ground[crank.center]), kept, ground,
+                 {name: joint_types[name] for name in out_joints}, out_joints, out_points,
+                 rubs)
+
+
+def _diameter(points: Iterable[complex]) -> float:
+    """Return the largest distance between two of ``points``, m (0 for fewer than two).
+
+    The farthest pair is a pair of vertices of the convex hull (Andrew's
+    monotone chain), found among its antipodal pairs (rotating calipers, as in
+    KACTL's ``hullDiameter``): O(n log n) instead of all n^2 pairs, and the
+    same value, each candidate being the same ``abs(a - b)``. The orientation
+    tests run on the points scaled by a power of two (exact) to at most 2**500,
+    so that their products cannot overflow.
+    """
+    unique = sorted({(z.real, z.imag) for z in points})
+    if len(unique) < 2:
+        return 0.0
+    largest = max(max(abs(x), abs(y)) for x, y in unique)
+    scale = 2.0 ** (500 - math.frexp(largest)[1]) if largest > 2.0**500 else 1.0
+    scaled = [(x * scale, y * scale) for x, y in unique]
+
+    def turn(o: int, a: int, b: int) -> float:
+        (ox, oy), (ax, ay), (bx, by) = scaled[o], scaled[a], scaled[b]
+        return (ax - ox) * (by - oy) - (ay - oy) * (bx - ox)
+
+    hull: list[int] = []  # indices into unique, counter-clockwise
+    for run in (range(len(unique)), range(len(unique) - 1, -1, -1)):
+        chain: list[int] = []
+        for k in run:
+            while len(chain) >= 2 and turn(chain[-2], chain[-1], k) <= 0:
+                chain.pop()
+            chain.append(k)
+        hull += chain[:-1]
+    at = [complex(*unique[k]) for k in hull]
+    edge = [complex(*scaled[k]) for k in hull]
+    n = len(hull)
+    if n < 3:  # all on one line: its two ends
+        return abs(at[0] - at[-1])
+    best, i, j = 0.0, 0, 1
+    while i < j:
+        for _ in range(n):  # advance j while the edge from it turns away from edge i
+            best = max(best, abs(at[i] - at[j]))
+            u, v = edge[i + 1] - edge[i], edge[(j + 1) % n] - edge[j]
+            if v.real * u.imag - v.imag * u.real >= 0:
+                break
+            j = (j + 1) % n
+        i += 1
+    return best

@@ -1,0 +1,17 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The step kinds a scene's dyads may name: ``type:`` -> the kind's item class.
+
+Adding a kind is one module (its item and step, :mod:`.base`) and one entry here.
+"""
+
+from __future__ import annotations
+
+from .base import Item
+from .rpp import RPP
+from .rpr import RPR
+from .rrp import RRP
+from .rrr import RRR
+
+#: The scene's ``type:`` of a dyad -> its item class.
+KINDS: dict[str, type[Item]] = {kind.kind: kind for kind in (RRR, RRP, RPR, RPP)}

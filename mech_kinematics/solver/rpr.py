@@ -1,0 +1,257 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The RPR dyad: a slotted lever turning about a ground pivot, through a known pin."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Collection, Iterator, Mapping
+from dataclasses import dataclass
+import math
+from typing import Any
+
+import numpy as np
+
+from .base import Body, Edge, Frame, Item, Member, Names, Placing, Reading, Step
+from .context import _Context, _cross, _dot, _U2, _U4, _U7, SINGULAR
+from .model import _check_name, Where
+from ..bounds import ROUNDING_MARGIN, U
+from ..errors import SceneError
+
+#: Most slots of an intermittent (Geneva) lever.
+MAX_SLOTS = 1000
+
+
+@dataclass(frozen=True)
+class RPR(Item):
+    """A slotted ``link`` turning about ground point ``center``, through pin ``through``.
+
+    With ``slots`` (an integer n >= 3) the link is an intermittent (Geneva)
+    wheel: n slots evenly spaced, driven by the pin only while it is in one.
+    The pin must be a point fixed on the crank, entering the slots
+    tangentially (crank radius of the pin ``R = l sin(pi / n)`` for the
+    distance ``l`` between the crank's centre and ``center``, within
+    :data:`TANGENCY_TOLERANCE`); between engagements the wheel is locked, and
+    each engagement indexes it by ``2 pi / n`` against the crank's sense. The
+    link's angle is that of its slot 0: the slot the pin is in during the
+    engagement centred on the crank angle that points the pin at ``center``
+    in the crank's turn 0 (so in that engagement the angle is the plain RPR
+    one, from ``center`` toward the pin).
+    """
+
+    kind = 'RPR'
+
+    link: str
+    center: str
+    through: str
+    slider: str
+    slots: int | None = None
+
+    def __post_init__(self) -> None:
+        """Validate the fields."""
+        _check_name(self.link, 'an RPR link', (self, 'link'))
+        _check_name(self.center, f'the center of RPR "{self.link}"', (self, 'center'))
+        _check_name(self.through, f'the pin of RPR "{self.link}"', (self, 'through'))
+        _check_name(self.slider, f'the slider of RPR "{self.link}"', (self, 'slider'))
+        n = self.slots
+        if n is not None and (isinstance(n, bool) or not isinstance(n, int)
+                              or not 3 <= n <= MAX_SLOTS):
+            msg = (f'Expected the slots of RPR "{self.link}" to be an integer from 3 to '
+                   f'{MAX_SLOTS}, got {n!r}')
+            raise SceneError(msg, (self, 'slots'))
+
+    @classmethod
+    def from_scene(cls, read: Reading, raw: Any, where: str) -> RPR:
+        """Return the RPR at ``where``: its link, center, through, slider and slots."""
+        read.check_keys(raw, {'type', 'link', 'center', 'through', 'slider', 'slots'}, where)
+        slots = raw.get('slots')
+        if slots is not None and (isinstance(slots, bool) or not isinstance(slots, int)
+                                  or not 3 <= slots <= MAX_SLOTS):
+            raise SceneError(f'{where}.slots: expected a whole number of slots from 3 to '
+                             f'{MAX_SLOTS}, got {read.brief(slots)}')
+        built: RPR = read.build(
+            where, {}, cls, link=read.name(raw, 'link', where),
+            center=read.name(raw, 'center', where), through=read.name(raw, 'through', where),
+            slider=read.name(raw, 'slider', where), slots=slots)
+        return built
+
+    @property
+    def key(self) -> str:
+        """Return the lever."""
+        return self.link
+
+    def defined(self) -> Iterator[tuple[str, str, Where]]:
+        """Yield its lever and its slider."""
+        yield self.link, 'link', (self, 'link')
+        yield self.slider, 'slider', (self, 'slider')
+
+    def joint_types(self) -> dict[str, str]:
+        """Return its lever (revolute) and its slider (prismatic)."""
+        return {self.link: 'revolute', self.slider: 'prismatic'}
+
+    def prerequisites(self, names: Names) -> set[str]:
+        """Check its ground pivot; return its pin."""
+        names.ground(self.center, f'the center of RPR "{self.link}"', (self, 'center'))
+        return {names.point(self.through, f'the pin of RPR "{self.link}"', (self, 'through'))}
+
+    def place(self, plan: Placing) -> Step:
+        """Return its step (an intermittent one with ``slots``); its lever carries its pivot."""
+        step: Step
+        if self.slots is None:
+            step = _RPRStep(self, plan.ground[self.center], plan.size)
+        else:
+            from .geneva import _index_step  # the Geneva kind builds on this one
+            step = _index_step(plan, self)
+        plan.local[self.link] = {self.center: 0j}
+        plan.slot[self.link] = (self.center, self.through)
+        return step
+
+    def scaled(self, scale: Callable[[float], float]) -> RPR:
+        """Return it unchanged: it holds no length."""
+        return self
+
+    def bodies(self) -> Iterator[tuple[str, str, Body]]:
+        """Yield the slider block at the pin (it turns with the lever)."""
+        yield self.through, self.slider, ('block', self.link)
+
+    def frames(self) -> Iterator[Frame]:
+        """Yield the lever's frame (at its pivot) and the block's (at the pin), along the lever."""
+        yield self.link, self.center, self.link, 0.0
+        yield self.slider, self.through, self.link, 0.0
+
+    def members(self, ground: str) -> Iterator[Member]:
+        """Yield its lever (carrying its pivot) and its block, which slides in the lever."""
+        yield self.link, 'lever', (self.center,), None
+        yield self.slider, 'slider', (self.through,), self.link
+
+    def slide_angle(self, slider: str, scene: Any, state: Any) -> float:
+        """Return the slot's direction: the lever's, or for a Geneva wheel the pin's slot's."""
+        if self.link in state.intermittent:
+            # A Geneva wheel: the slot the pin is in (not slot 0) lies along the pivot-pin
+            # line; while the wheel is locked the pin, out of the slot, moves with the
+            # crank, across the crank's radius (the pin is on the crank).
+            pin = complex(state.complex_points[self.through][0])
+            engaged = state.intermittent[self.link].engaged
+            start = self.center if engaged else scene.input.center
+            o = complex(state.complex_points[start][0])
+            return math.atan2(pin.imag - o.imag, pin.real - o.real) + (
+                0.0 if engaged else math.pi / 2)
+        return float(state.joints[self.link].position)
+
+    def locked(self, state: Any) -> tuple[str, ...]:
+        """Return its lever while a Geneva wheel is locked (it then moves with the ground)."""
+        engagement = state.intermittent.get(self.link)
+        return () if engagement is None or engagement.engaged else (self.link,)
+
+    def edges(self) -> Iterator[Edge]:
+        """Yield the lever's point under the pin, about the pivot, then the pin's sliding."""
+        yield self.link, self.center, self.through, self.slider
+
+    def link_lengths(self) -> dict[str, float | None]:
+        """Return the lever, whose length (pivot to pin) varies."""
+        return {self.link: None}
+
+    def dead_centre_joints(self, ground: Collection[str]) -> dict[str, str]:
+        """Return its lever, which rocks (a Geneva wheel only indexes: none)."""
+        return {self.link: 'revolute'} if self.slots is None else {}
+
+    def pivots(self, ground: Collection[str]) -> dict[str, str]:
+        """Return its lever, which turns about its ground pivot."""
+        return {self.link: self.center}
+
+    def outline(self, body: str, scene: Any, state: Any, points: Mapping[str, Any]
+                ) -> tuple[tuple[str, ...], tuple[tuple[Any, Any], ...]]:
+        """Return the lever through the pin in its slot; a Geneva wheel's slots instead."""
+        if body != self.link:
+            return (), ()
+        n = self.slots
+        if n is None:
+            return (self.through,), ()
+        names = (scene.input.center, self.center, self.through)
+        centre, wheel, pin = (points[name] for name in names)
+        distance = float(np.hypot(*(wheel - centre)))
+        radius = float(np.hypot(*(pin - centre)))
+        mouth = math.sqrt(max(distance * distance - radius * radius, 0.0))
+        inner = 0.85 * (distance - radius)
+        angle = float(state.joints[self.link].position)
+        slots = []
+        for i in range(n):
+            turn = angle + 2 * math.pi * i / n
+            u = np.array([math.cos(turn), math.sin(turn)])
+            slots.append((wheel + inner * u, wheel + mouth * u))
+        return (), tuple(slots)
+
+    def blocks(self, state: Any, points: Mapping[str, Any], ground: str,
+               locked: set[str]) -> Iterator[tuple[str, str, Any, float, str]]:
+        """Yield its block along the lever (none while a Geneva wheel is locked)."""
+        if self.link not in locked:
+            e = points[self.through] - points[self.center]
+            yield (self.slider, self.through, points[self.through], math.atan2(e[1], e[0]),
+                   self.link)
+
+
+class _RPRStep(Step):
+
+    def __init__(self, dyad: RPR, center: complex, size: float) -> None:
+        self.dyad = dyad
+        self.label = f'RPR {dyad.link}'
+        self.key = dyad.link
+        self.link = dyad.link
+        self.through = dyad.through
+        self.slider = dyad.slider
+        self.center = center
+        self.center_name = dyad.center
+        self.size = size
+        self.uses = (dyad.through,)
+        self.defines = (dyad.link, dyad.slider)
+        self.e_center = U * abs(center)
+
+    def facts(self, s: float) -> dict[str, Any]:
+        """Return why the lever is singular, for a message in the scene's units."""
+        return {'kind': 'pivot', 'links': (self.link,), 'lengths': (),
+                'points': (self.through, self.center_name), 'distance': float(s) * self.unit}
+
+    def run(self, ctx: _Context) -> None:
+        b, vb, ab, eb, evb, eab = ctx.points[self.through]
+        d = b - self.center
+        s = np.hypot(d.real, d.imag) if ctx.vector else abs(d)
+        m = self.unit
+        # the slider coordinate relative to the mechanism's size.
+        measure = s / self.size
+        ok = measure > SINGULAR
+        if ctx.vector or not ok:
+            ctx.check(ok, self.label, lambda: (
+                f'the pin {self.through} is on the pivot (singular): expected its distance '
+                f'from the pivot > {SINGULAR * self.size * m:.3g} m, got {s * m:.3g} m'),
+                lambda: self.facts(s))
+        # The error of the pin relative to the pivot (and of s = |d|): within it of
+        # the pivot the lever's direction is not known at all.
+        ed = eb + self.e_center + _U2 * s
+        ok = s > ROUNDING_MARGIN * ed
+        if ctx.vector or not ok:
+            ctx.check_margin(ok, self.label, s * m, ed * m, lambda: (
+                f'the pin {self.through} is within rounding of the pivot: expected its '
+                f'distance from the pivot {s * m:.3g} m to exceed {ROUNDING_MARGIN:g} times '
+                f'its error bound {ed * m:.3g} m'), lambda: self.facts(s))
+        ctx.measures[self.key] = measure
+        inv_s = 1.0 / s
+        e = d * inv_s
+        sd = _dot(vb, e)
+        omega = _cross(e, vb) / s
+        sdd = _dot(ab, e) + s * omega * omega
+        # the Coriolis component 2 * omega * sd sits in the transverse balance.
+        alpha = (_cross(e, ab) - 2.0 * sd * omega) / s
+        # Bounds: the lever's direction is known to ed / s, and the pin's velocity
+        # and acceleration, whose components along and across it these are, to
+        # their bounds; |vb| <= |sd| + s |omega| and |ab| likewise. Since
+        # ed >= 2 U s, the terms in ed also hold the rounding of the last products.
+        ee = ed * inv_s + _U7
+        ee4 = ee + _U4
+        asd, aw = abs(sd), abs(omega)
+        esd = evb + (asd + s * aw) * ee4
+        ew = (esd + 2.0 * aw * ed) * inv_s
+        asdd, aal = abs(sdd), abs(alpha)
+        tab = eab + (asdd + s * (aw * aw + aal) + 2.0 * asd * aw) * ee4
+        ctx.links[self.link] = (e, omega, alpha, ee, ew,
+                                (tab + 2.0 * (asd * ew + aw * esd + aal * ed)) * inv_s)
+        ctx.sliders[self.slider] = (s, sd, sdd, ed, esd,
+                                    tab + 2.0 * aw * aw * ed + s * (2.0 * aw + ew) * ew)

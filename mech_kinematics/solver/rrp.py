@@ -1,0 +1,257 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The RRP dyad: a link from a known point ending in a slider on a fixed guide."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Collection, Iterator, Mapping
+from dataclasses import dataclass, replace
+import math
+from typing import Any
+
+import numpy as np
+
+from .base import Body, Edge, Frame, Item, Member, Names, Placing, Reading, Step
+from .context import _Context, _cross, _dot, _U2, _U3, _U5, _U7, SINGULAR
+from .model import _check_finite, _check_name, _g, Branch, Link, Where
+from ..bounds import ROUNDING_MARGIN, U
+
+
+@dataclass(frozen=True)
+class RRP(Item):
+    """A link ending in a slider ``point`` on a fixed straight guide."""
+
+    kind = 'RRP'
+
+    point: str
+    link: Link
+    through: str
+    guide_angle: float
+    slider: str
+    branch: Branch = Branch.PLUS
+
+    def __post_init__(self) -> None:
+        """Validate the fields."""
+        _check_name(self.point, 'an RRP point', (self, 'point'))
+        _check_name(self.through, f'the guide point of RRP "{self.point}"', (self, 'through'))
+        _check_name(self.slider, f'the slider of RRP "{self.point}"', (self, 'slider'))
+        _check_finite(self.guide_angle, f'the guide angle of RRP "{self.point}"',
+                      (self, 'guide_angle'))
+        object.__setattr__(self, 'branch', Branch(self.branch))
+
+    @classmethod
+    def from_scene(cls, read: Reading, raw: Any, where: str) -> RRP:
+        """Return the RRP at ``where``: ``point``, ``link``, ``guide``, ``slider``, ``branch``."""
+        read.check_keys(raw, {'type', 'point', 'link', 'guide', 'slider', 'branch'}, where)
+        link = read.link(read.get(raw, 'link', where), f'{where}.link')
+        guide = read.get(raw, 'guide', where)
+        if isinstance(guide, dict):
+            read.check_keys(guide, {'through', 'angle'}, f'{where}.guide')
+        built: RRP = read.build(
+            where, {'through': 'guide.through', 'guide_angle': 'guide.angle'}, cls,
+            point=read.name(raw, 'point', where),
+            link=link, through=read.name(guide, 'through', f'{where}.guide'),
+            guide_angle=read.angle(guide, 'angle', f'{where}.guide', 0.0),
+            slider=read.name(raw, 'slider', where), branch=read.branch(raw, where))
+        return built
+
+    @property
+    def key(self) -> str:
+        """Return the dyad's new point (the slider's pin)."""
+        return self.point
+
+    def defined(self) -> Iterator[tuple[str, str, Where]]:
+        """Yield its new point, its link and its slider."""
+        yield self.point, 'point', (self, 'point')
+        yield self.link.name, 'link', (self.link, 'name')
+        yield self.slider, 'slider', (self, 'slider')
+
+    def joint_types(self) -> dict[str, str]:
+        """Return its link (revolute) and its slider (prismatic)."""
+        return {self.link.name: 'revolute', self.slider: 'prismatic'}
+
+    def prerequisites(self, names: Names) -> set[str]:
+        """Check the guide's ground point; return the start of its link."""
+        names.ground(self.through, f'the guide point of RRP "{self.point}"', (self, 'through'))
+        return {names.point(self.link.start, f'the start of link "{self.link.name}"',
+                            (self.link, 'start'))}
+
+    def place(self, plan: Placing) -> Step:
+        """Return its step; its link carries its start and the new point."""
+        plan.local[self.link.name] = {self.link.start: 0j, self.point: complex(self.link.length)}
+        return _RRPStep(self, plan.ground[self.through])
+
+    def lengths(self) -> tuple[float, ...]:
+        """Return its link's length."""
+        return (self.link.length,)
+
+    def scaled(self, scale: Callable[[float], float]) -> RRP:
+        """Return it with its link's length scaled."""
+        return replace(self, link=replace(self.link, length=scale(self.link.length)))
+
+    def bodies(self) -> Iterator[tuple[str, str, Body]]:
+        """Yield the slider block at the new point (it does not turn)."""
+        yield self.point, self.slider, ('still', self.slider)
+
+    def frames(self) -> Iterator[Frame]:
+        """Yield the link's frame (at its start, along it) and the block's (along the guide)."""
+        yield self.link.name, self.link.start, self.link.name, 0.0
+        yield self.slider, self.point, None, self.guide_angle
+
+    def members(self, ground: str) -> Iterator[Member]:
+        """Yield its link and its block, which slides on the ground."""
+        yield self.link.name, 'link', (self.link.start, self.point), None
+        yield self.slider, 'slider', (self.point,), ground
+
+    def slide_angle(self, slider: str, scene: Any, state: Any) -> float:
+        """Return the guide's angle."""
+        return self.guide_angle
+
+    def edges(self) -> Iterator[Edge]:
+        """Yield its link's motion from its start to the new pin."""
+        yield self.link.name, self.link.start, self.point, None
+
+    def link_lengths(self) -> dict[str, float | None]:
+        """Return its link's length."""
+        return {self.link.name: self.link.length}
+
+    def toggle(self) -> tuple[str, str, tuple[str, ...]] | None:
+        """Return its measure (the sine of the rod's angle to the guide normal), label, link."""
+        return self.point, f'RRP {self.point}', (self.link.name,)
+
+    def dead_centre_joints(self, ground: Collection[str]) -> dict[str, str]:
+        """Return its slider, which reverses at the ends of its stroke."""
+        return {self.slider: 'prismatic'}
+
+    def tip_links(self, point: str) -> Iterator[tuple[str, tuple[str, ...]]]:
+        """Yield its link if it starts at ``point``, with its link and slider."""
+        if self.link.start == point:
+            yield self.link.name, (self.link.name, self.slider)
+
+    def blocks(self, state: Any, points: Mapping[str, Any], ground: str,
+               locked: set[str]) -> Iterator[tuple[str, str, Any, float, str]]:
+        """Yield its block, sliding along the guide on the ground."""
+        yield self.slider, self.point, points[self.point], self.guide_angle, ground
+
+    def guides(self, state: Any, points: Mapping[str, Any],
+               strokes: Mapping[str, tuple[float, float]], size: float
+               ) -> Iterator[tuple[str, Any, Any]]:
+        """Yield its guide over the stroke (or around the block), padded by 8 % of ``size``."""
+        u = np.array([math.cos(self.guide_angle), math.sin(self.guide_angle)])
+        s = float(state.joints[self.slider].position)
+        low, high = strokes.get(self.slider, (s, s))
+        pad = 0.08 * size
+        through = points[self.through]
+        yield (self.slider, through + (min(low, s) - pad) * u,
+               through + (max(high, s) + pad) * u)
+
+
+class _RRPStep(Step):
+
+    def __init__(self, dyad: RRP, through: complex) -> None:
+        self.dyad = dyad
+        self.label = f'RRP {dyad.point}'
+        self.key = dyad.point
+        self.point = dyad.point
+        self.start = dyad.link.start
+        self.link = dyad.link.name
+        self.length = dyad.link.length
+        self.inv_length = 1.0 / dyad.link.length
+        self.slider = dyad.slider
+        self.through = through
+        self.through_name = dyad.through
+        self.guide_angle = dyad.guide_angle
+        self.u = complex(math.cos(dyad.guide_angle), math.sin(dyad.guide_angle))
+        self.normal = 1j * self.u
+        self.branch = int(dyad.branch)
+        self.uses = (dyad.link.start,)
+        self.defines = (dyad.point, dyad.link.name, dyad.slider)
+        self.new_points = (dyad.point,)
+        # The guide: its point known to U |through|, its direction to the angle's
+        # rounding and an ulp of cos and sin.
+        self.e_through = U * abs(through)
+        self.e_guide = U * abs(dyad.guide_angle) + _U2
+        # The rounding of w = q - through, of its components along and across
+        # the guide and of k's factors, as errors of the start point.
+        self.e_turn = self.e_guide + _U5
+        self.e_fixed = self.e_through + _U2 * dyad.link.length
+        self.e_round = _U3 * dyad.link.length  # of the final forms
+        self.e_round2 = 2.0 * self.e_round
+
+    def facts(self, offset: float) -> dict[str, Any]:
+        """Return why the guide is out of reach, for a message in the scene's units."""
+        m = self.unit
+        return {'kind': 'reach', 'links': (self.link,), 'lengths': (self.length * m,),
+                'points': (self.start, self.through_name), 'distance': abs(float(offset)) * m,
+                'guide_angle': self.guide_angle}
+
+    def run(self, ctx: _Context) -> None:
+        length, u = self.length, self.u
+        q, vq, aq, eq, evq, eaq = ctx.points[self.start]
+        w = q - self.through
+        along = _dot(w, u)
+        offset = _cross(u, w)  # signed distance of the start point from the guide
+        k = (length - offset) * (length + offset)
+        # The guide is in reach (k > 0) where the margin length - |offset| is
+        # positive. The error of the start point relative to the guide (the
+        # inputs' and this step's rounding; spread) also bounds that of the
+        # slider coordinate's data. Within ROUNDING_MARGIN spreads of the limit,
+        # either way, the answer is not trusted.
+        ek = self.e_turn
+        spread = eq + (abs(along) + length) * ek + self.e_fixed
+        margin = length - abs(offset)
+        ok = margin > ROUNDING_MARGIN * spread
+        m = self.unit
+        if not (ctx.vector or ok or margin > -ROUNDING_MARGIN * spread):
+            ctx.check(False, self.label, lambda: (
+                f'the guide is out of reach of link {self.link}: expected the distance of '
+                f'{self.start} from the guide < {_g(length * m, abs(offset) * m)} m, got '
+                f'{_g(abs(offset) * m, length * m)} m'), lambda: self.facts(offset))
+        if ctx.vector or not ok:
+            ctx.check_margin(ok, self.label, margin * m, spread * m, lambda: (
+                f'the guide is within rounding of the reach of link {self.link}: expected '
+                f'the margin {_g(length * m)} m - (distance of {self.start} from the guide) '
+                f'= {margin * m:.3g} m to exceed {ROUNDING_MARGIN:g} times its error bound '
+                f'{spread * m:.3g} m'), lambda: self.facts(offset))
+        root = np.sqrt(k) if ctx.vector else math.sqrt(k)
+        # sin of the angle between the rod and the guide's normal.
+        measure = root / length
+        ok = measure > SINGULAR
+        if ctx.vector or not ok:
+            ctx.check(ok, self.label, lambda: (
+                f'link {self.link} is perpendicular to the guide (singular): expected the '
+                f'sine of its angle to the guide normal > {SINGULAR:g}, got {measure:.3g}'),
+                lambda: self.facts(offset))
+        ctx.measures[self.key] = measure
+        den = self.branch * root  # dot(u, r)
+        inv = 1.0 / den
+        s = along + den
+        r = den * u - offset * self.normal
+        sd = _dot(vq, r) * inv
+        omega = _cross(vq, u) * inv
+        rest = aq - omega * omega * r
+        sdd = _dot(rest, r) * inv
+        alpha = _cross(rest, u) * inv
+        # Bounds. The slider coordinate moves by at most spread / measure and the
+        # rod r by that and spread. The velocity system sd u - i omega r = vq has
+        # rows of norm 1 / measure (for sd) and 1 / (length measure) (for omega),
+        # its matrix moves by the guide's and the rod's bounds and its right side
+        # by the start point's: sd moves by t and omega by t / length (t also
+        # holds the rounding of the products, 2 U |vq| <= 2 U (|sd| + |omega| length)).
+        # Likewise for accelerations, whose right side aq - omega^2 r moves with omega.
+        inv_m = 1.0 / measure
+        a_s = abs(s)
+        es = spread * inv_m + U * a_s + self.e_round
+        er = es + spread + self.e_round
+        erp = er + self.e_round2
+        asd, aw = abs(sd), abs(omega)
+        t = (evq + asd * ek + aw * erp) * inv_m
+        ew = t * self.inv_length
+        asdd, aal = abs(sdd), abs(alpha)
+        ta = (eaq + (2.0 * aw + ew) * t + aw * aw * erp + asdd * ek + aal * erp) * inv_m
+        ctx.points[self.point] = (self.through + s * u, sd * u, sdd * u,
+                                  es + a_s * ek + 3.0 * self.e_through, t + asd * ek,
+                                  ta + asdd * ek)
+        ctx.links[self.link] = (r * (1.0 / length), omega, alpha, er * self.inv_length + _U7,
+                                ew, ta * self.inv_length)
+        ctx.sliders[self.slider] = (s, sd, sdd, es, t, ta)

@@ -1,0 +1,261 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The RRR dyad: two links from known points meeting at a new pin (one module per kind)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Collection, Iterator, Mapping
+from dataclasses import dataclass, replace
+import math
+from typing import Any
+
+import numpy as np
+
+from .base import Edge, Frame, Item, Member, Names, Placing, Reading, Step
+from .context import _Context, _dot, _U16, _U2, _U3, _U7, SINGULAR
+from .model import _check_name, _g, Branch, Link, Where
+from ..bounds import ROUNDING_MARGIN, U
+from ..errors import SceneError
+
+
+@dataclass(frozen=True)
+class RRR(Item):
+    """Two links meeting at a new pin ``point``."""
+
+    kind = 'RRR'
+
+    point: str
+    links: tuple[Link, Link]
+    branch: Branch = Branch.PLUS
+
+    def __post_init__(self) -> None:
+        """Validate the fields."""
+        _check_name(self.point, 'an RRR point', (self, 'point'))
+        count = len(self.links)  # anything may be passed at run time
+        if count != 2:
+            msg = f'Expected RRR "{self.point}" to have 2 links, got {count}'
+            raise SceneError(msg, (self, 'links'))
+        object.__setattr__(self, 'branch', Branch(self.branch))
+
+    @classmethod
+    def from_scene(cls, read: Reading, raw: Any, where: str) -> RRR:
+        """Return the RRR at ``where``: ``point``, ``links`` (two), ``branch``."""
+        read.check_keys(raw, {'type', 'point', 'links', 'branch'}, where)
+        links = read.get(raw, 'links', where)
+        if not isinstance(links, list) or len(links) != 2:
+            raise SceneError(f'{where}.links: expected a list of 2 links, got '
+                             f'{read.brief(links)}')
+        first, second = (read.link(link, f'{where}.links[{i}]') for i, link in enumerate(links))
+        built: RRR = read.build(where, {}, cls, point=read.name(raw, 'point', where),
+                                links=(first, second), branch=read.branch(raw, where))
+        return built
+
+    @property
+    def key(self) -> str:
+        """Return the dyad's new point."""
+        return self.point
+
+    def defined(self) -> Iterator[tuple[str, str, Where]]:
+        """Yield its new point and its two links."""
+        yield self.point, 'point', (self, 'point')
+        for link in self.links:
+            yield link.name, 'link', (link, 'name')
+
+    def joint_types(self) -> dict[str, str]:
+        """Return its two links, revolute joints."""
+        return {link.name: 'revolute' for link in self.links}
+
+    def prerequisites(self, names: Names) -> set[str]:
+        """Return the start points of its links."""
+        return {names.point(link.start, f'the start of link "{link.name}"', (link, 'start'))
+                for link in self.links}
+
+    def place(self, plan: Placing) -> Step:
+        """Return its step; its links carry their start and the new point."""
+        for link in self.links:
+            plan.local[link.name] = {link.start: 0j, self.point: complex(link.length)}
+        return _RRRStep(self)
+
+    def lengths(self) -> tuple[float, ...]:
+        """Return its two link lengths."""
+        return tuple(link.length for link in self.links)
+
+    def scaled(self, scale: Callable[[float], float]) -> RRR:
+        """Return it with both link lengths scaled."""
+        first, second = (replace(link, length=scale(link.length)) for link in self.links)
+        return replace(self, links=(first, second))
+
+    def frames(self) -> Iterator[Frame]:
+        """Yield each link's frame: at its start, along it."""
+        for link in self.links:
+            yield link.name, link.start, link.name, 0.0
+
+    def members(self, ground: str) -> Iterator[Member]:
+        """Yield its two links, each carrying its start and the new pin."""
+        for link in self.links:
+            yield link.name, 'link', (link.start, self.point), None
+
+    def edges(self) -> Iterator[Edge]:
+        """Yield each link's motion from its start to the new pin."""
+        for link in self.links:
+            yield link.name, link.start, self.point, None
+
+    def link_lengths(self) -> dict[str, float | None]:
+        """Return its two links' lengths."""
+        return {link.name: link.length for link in self.links}
+
+    def toggle(self) -> tuple[str, str, tuple[str, ...]] | None:
+        """Return its measure (the sine of the angle between its links), label and links."""
+        return self.point, f'RRR {self.point}', tuple(link.name for link in self.links)
+
+    def dead_centre_joints(self, ground: Collection[str]) -> dict[str, str]:
+        """Return its links that turn about a ground point (rockers)."""
+        return {link.name: 'revolute' for link in self.links if link.start in ground}
+
+    def tip_links(self, point: str) -> Iterator[tuple[str, tuple[str, ...]]]:
+        """Yield its links starting at ``point``, with both its links."""
+        for link in self.links:
+            if link.start == point:
+                yield link.name, tuple(other.name for other in self.links)
+
+    def pivots(self, ground: Collection[str]) -> dict[str, str]:
+        """Return its links that turn about a ground point."""
+        return {link.name: link.start for link in self.links if link.start in ground}
+
+    def pin_links(self, pivots: Mapping[str, str]) -> Iterator[tuple[str, str, bool]]:
+        """Yield the new pin on its first link, and on any link turning about a ground pivot."""
+        yield self.point, self.links[0].name, False
+        for link in self.links:  # the pin is on both links
+            if link.name in pivots:
+                yield self.point, link.name, True
+
+    def four_bar(self) -> tuple[str, Link, Link] | None:
+        """Return its new pin and two links: an RRR can close a four-bar loop."""
+        return self.point, *self.links
+
+
+class _RRRStep(Step):
+
+    def __init__(self, dyad: RRR) -> None:
+        first, second = dyad.links
+        self.dyad = dyad
+        self.label = f'RRR {dyad.point}'
+        self.key = dyad.point
+        self.point = dyad.point
+        self.start1, self.start2 = first.start, second.start
+        self.link1, self.link2 = first.name, second.name
+        self.l1, self.l2 = first.length, second.length
+        self.inv_l1, self.inv_l2 = 1.0 / first.length, 1.0 / second.length
+        self.inv_sum = self.inv_l1 + self.inv_l2
+        lsum = first.length + second.length
+        # The input lengths' rounding (U each), and this step's as more of it:
+        # lsum and ldiff are those of lengths within U lsum of the true ones.
+        self.e_lengths = _U3 * lsum
+        # The rounding of r1 and r2 from the rounded data (not amplified: the
+        # height's root, the unit vector, the final sums), and of the products
+        # of the velocity and acceleration systems.
+        self.e_forward = _U16 * lsum
+        self.e_round = 8.0 * U * max(first.length, second.length)
+        self.branch = int(dyad.branch)
+        self.uses = (first.start, second.start)
+        self.defines = (dyad.point, first.name, second.name)
+        self.new_points = (dyad.point,)
+
+    def facts(self, dist: float, touching: bool) -> dict[str, Any]:
+        """Return why the circles do not meet, for a message in the scene's units."""
+        m = self.unit
+        return {'kind': 'in line' if touching else 'apart', 'links': (self.link1, self.link2),
+                'lengths': (self.l1 * m, self.l2 * m), 'points': (self.start1, self.start2),
+                'distance': float(dist) * m}
+
+    def run(self, ctx: _Context) -> None:
+        l1, l2 = self.l1, self.l2
+        p1, v1, a1, ep1, ev1, ea1 = ctx.points[self.start1]
+        p2, v2, a2, ep2, ev2, ea2 = ctx.points[self.start2]
+        d = p2 - p1
+        dist = np.hypot(d.real, d.imag) if ctx.vector else abs(d)
+        lsum = l1 + l2
+        ldiff = l1 - l2
+        # 4 * dist^2 * h^2 as a product of factors: no cancellation near toggle.
+        k = (lsum + dist) * (lsum - dist) * (dist + ldiff) * (dist - ldiff)
+        # The circles meet (k > 0) where the margin min(lsum - dist, dist - |ldiff|)
+        # is positive. The error of dist, l1 and l2 (spread) is the inputs' and this
+        # step's rounding of d and dist (2 U dist) and of lsum and ldiff. The margin
+        # is linear in them: beyond ROUNDING_MARGIN spreads of the limit no input
+        # within its error can cross it; nearer, either way, it is not trusted.
+        spread = ep1 + ep2 + self.e_lengths + _U2 * dist
+        outer = lsum - dist
+        inner = dist - abs(ldiff)
+        margin = np.minimum(outer, inner) if ctx.vector else (
+            outer if outer < inner else inner)
+        ok = margin > ROUNDING_MARGIN * spread
+        m = self.unit
+        if not (ctx.vector or ok or margin > -ROUNDING_MARGIN * spread):
+            ctx.check(False, self.label, lambda: (
+                f'the circles about {self.start1} (radius {_g(l1 * m)} m) and {self.start2} '
+                f'(radius {_g(l2 * m)} m) do not meet: expected '
+                f'|{_g(ldiff * m, dist * m)}| < |{self.start1}{self.start2}| < '
+                f'{_g(lsum * m, dist * m)} m, got |{self.start1}{self.start2}| = '
+                f'{_g(dist * m, lsum * m, abs(ldiff) * m)} m'), lambda: self.facts(dist, False))
+        if ctx.vector or not ok:
+            ctx.check_margin(ok, self.label, margin * m, spread * m, lambda: (
+                f'the circles about {self.start1} and {self.start2} are within rounding of '
+                f'meeting at one point: expected the margin min({_g(lsum * m)} m - '
+                f'|{self.start1}{self.start2}|, |{self.start1}{self.start2}| - '
+                f'{_g(abs(ldiff) * m)} m) = {margin * m:.3g} m to exceed '
+                f'{ROUNDING_MARGIN:g} times its error bound {spread * m:.3g} m'),
+                lambda: self.facts(dist, True))
+        root = np.sqrt(k) if ctx.vector else math.sqrt(k)
+        # sin of the angle between the two links (the transmission angle).
+        measure = root / (2.0 * l1 * l2)
+        ok = measure > SINGULAR
+        if ctx.vector or not ok:
+            ctx.check(ok, self.label, lambda: (
+                f'links {self.link1} and {self.link2} are in line (singular): expected the '
+                f'sine of the angle between them > {SINGULAR:g}, got {measure:.3g}'),
+                lambda: self.facts(dist, True))
+        ctx.measures[self.key] = measure
+        half = 0.5 / dist
+        shared = ldiff * lsum
+        height = self.branch * root * half
+        u = d * (1.0 / dist)
+        across = 1j * height * u
+        r1 = (shared + dist * dist) * half * u + across
+        r2 = (shared - dist * dist) * half * u + across
+        inv = 2.0 * self.branch / root  # 1 / cross(r1, r2)
+        dv = v2 - v1
+        w1 = _dot(dv, r2) * inv
+        w2 = _dot(dv, r1) * inv
+        w1sq, w2sq = w1 * w1, w2 * w2
+        da = a2 - a1 + w1sq * r1 - w2sq * r2
+        al1 = _dot(da, r2) * inv
+        al2 = _dot(da, r1) * inv
+        # Bounds. r1 and r2 (and the pin) move by at most er: spread / measure
+        # and their own rounding.
+        # The velocity system i w1 r1 - i w2 r2 = dv has rows of norm
+        # 1 / (l1 measure) and 1 / (l2 measure), its matrix moves by er and its
+        # right side by the inputs' bounds: w1 and w2 move by t / l1 and t / l2
+        # (t also holds the rounding of the dot products and of w = dot * inv).
+        # Likewise the acceleration system, whose right side
+        # da = a2 - a1 + w1^2 r1 - w2^2 r2 moves with the w's.
+        inv_m = 1.0 / measure
+        er = spread * inv_m + self.e_forward
+        erp = er + self.e_round
+        inv_l1, inv_l2 = self.inv_l1, self.inv_l2
+        aw1 = abs(w1)
+        aws = aw1 + abs(w2)
+        t = (ev1 + ev2 + aws * erp) * inv_m
+        aa1 = abs(al1)
+        ta = (ea1 + ea2 + (2.0 * aws + t * self.inv_sum) * t
+              + (w1sq + w2sq + aa1 + abs(al2)) * erp) * inv_m
+        ew1 = t * inv_l1
+        # The pin's sums p1 + r1 etc. round by U |p1| + U l1 (in ep1 and er),
+        # U |v1| + U |w1| l1 and 2 U |a1| + a few U (|al1| + w1^2) l1 (in erp).
+        ctx.points[self.point] = (
+            p1 + r1, v1 + 1j * w1 * r1, a1 + 1j * al1 * r1 - w1 * w1 * r1, er + ep1,
+            ev1 + U * (abs(v1.real) + abs(v1.imag)) + t + aw1 * erp,
+            ea1 + _U2 * (abs(a1.real) + abs(a1.imag)) + ta + (2.0 * aw1 + ew1) * t
+            + (aa1 + w1sq) * erp)
+        ctx.links[self.link1] = (r1 * (1.0 / l1), w1, al1, er * inv_l1 + _U7, ew1, ta * inv_l1)
+        ctx.links[self.link2] = (r2 * (1.0 / l2), w2, al2, er * inv_l2 + _U7, t * inv_l2,
+                                 ta * inv_l2)

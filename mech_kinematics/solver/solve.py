@@ -1,0 +1,412 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""Solving a scene with error bounds: run the plan, judge the bounds, build the :class:`State`.
+
+Every value comes with an absolute error bound; :func:`solve` refuses a state
+whose bounds exceed a tolerance relative to each kind's scale, or that lies
+within rounding of an assembly limit.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, TYPE_CHECKING
+import warnings
+
+import numpy as np
+import numpy.typing as npt
+
+from .context import _Context, NEAR_SINGULAR
+from .scaling import (_ACCEL_HIGH, _ldexp, _QUANTITIES, _rate_exponent, _RATE_HIGH, _RATE_LOW,
+                      _rescale)
+from .state import _scales, Engagement, JointMotion, State
+from ..bounds import ErrorBound, limit, MAX_ERROR, SCALE_MEANINGS, Table, UNITS
+from ..errors import NearSingularWarning, UntrustedError
+
+if TYPE_CHECKING:
+    from .mechanism import _Solver, Scene
+    from .plan import _Plan
+
+
+def _run(solver: _Solver, angle: Any, speed: Any, accel: Any, turns: Any) -> _Context:
+    """Run every step of the solver's plan; the caller chose scalar or vector inputs."""
+    ctx = _Context(angle, not isinstance(angle, float), turns)
+    # Ground points stay complex scalars in both paths: NumPy broadcasts them.
+    ctx.points.update(solver.ground)
+    plan = solver.run_plan
+    plan.crank.run(ctx, angle, speed, accel)
+    for step in plan.steps:
+        step.run(ctx)
+    if plan.rubs:
+        ctx.rubbing = {}
+        for rub in plan.rubs:
+            rub.run(ctx)
+    return ctx
+
+
+def _execute(solver: _Solver, theta: Any, omega: Any, alpha: Any, turns: Any = 0) -> _Context:
+    """Run the solver in units that keep every product in range; reported values in SI.
+
+    A crank rate outside [_RATE_LOW, _RATE_HIGH] is solved with time scaled by a
+    power of two, as a scene's size outside :data:`_SIZE_RANGE` is with its
+    lengths (:class:`_Solver`); both are exact, so the answers are the same
+    bits as if every product had stayed in range.
+    """
+    w = abs(omega)
+    if isinstance(w, float) and _RATE_LOW <= w <= _RATE_HIGH and abs(alpha) <= _ACCEL_HIGH:
+        shift = 0  # the single-angle path's usual case, decided without a call
+    else:
+        shift = _rate_exponent(omega, alpha)
+    if shift:
+        omega, alpha = _ldexp(omega, -shift), _ldexp(alpha, -2 * shift)
+    ctx = _run(solver, theta, omega, alpha, turns)
+    if solver.shift or shift:
+        _rescale(solver, ctx, shift)
+    return ctx
+
+
+def _context_scales(solver: _Solver, ctx: _Context, omega: Any, alpha: Any) -> dict[str, Any]:
+    return _scales(solver.size, solver.crank_length, omega, alpha,
+                   [ctx.points[name][1:3] for name in solver.out_points],
+                   [ctx.sliders[name][1:3] for name in solver.out_sliders],
+                   [ctx.links[name][1:3] for name in solver.out_links], ctx.vector)
+
+
+def trust_limits(tol: float, omega: float, alpha: float, size: float,
+                 crank_length: float) -> tuple[float, float, float, float, float, float]:
+    """Return the quick trust test's six limits: ``tol`` times each kind's floor.
+
+    In order: position, velocity and acceleration (``size``, the crank tip's
+    speed ``a |omega|`` and acceleration ``a (omega^2 + |alpha|)``), angle,
+    angular velocity and angular acceleration (1 rad, ``|omega|``,
+    ``omega^2 + |alpha|``). The floors are at most the scales
+    (:attr:`State.scales`), so a state whose reported bounds are all within
+    them passes :func:`_refuse`'s exact test. With :data:`TRUST_TEST` the one
+    source of the test for :func:`_trusted` and the node's compiled tick.
+    """
+    w = abs(omega)
+    rate = w * w + abs(alpha)
+    return (tol * size, tol * (crank_length * w), tol * (crank_length * rate), tol, tol * w,
+            tol * rate)
+
+
+#: The quick trust test: per context table, the solver's attribute listing the
+#: reported names in it, and which :func:`trust_limits` bound their values' bounds.
+TRUST_TEST = (('points', 'out_points', (0, 1, 2)), ('links', 'out_links', (3, 4, 5)),
+              ('sliders', 'out_sliders', (0, 1, 2)))
+
+
+def _trusted(solver: _Solver, ctx: _Context, omega: float, alpha: float, tol: float) -> bool:
+    """Return True if every reported bound is within ``tol`` of its kind's smallest scale.
+
+    A quick sufficient test for the single-angle path (:func:`trust_limits`);
+    NaN fails.
+    """
+    lim = trust_limits(tol, omega, alpha, solver.size, solver.crank_length)
+    for table, names, (i, j, k) in solver.trust:
+        entries = getattr(ctx, table)
+        li, lj, lk = lim[i], lim[j], lim[k]
+        for name in names:
+            e = entries[name]
+            if not (e[3] <= li and e[4] <= lj and e[5] <= lk):
+                return False
+    if ctx.rubbing:
+        lv = lim[1]
+        return all(bound <= lv for _, bound in ctx.rubbing.values())
+    return True
+
+
+def _refuse(solver: _Solver, ctx: _Context, omega: float, alpha: float, tol: float) -> None:
+    """Raise :class:`UntrustedError` for the first reported value whose bound exceeds ``tol``."""
+    scales = _context_scales(solver, ctx, omega, alpha)
+    for table, name, path, label, kinds in solver.outputs:
+        entry = getattr(ctx, table)[name]
+        for index, kind in enumerate(kinds):
+            bound, scale = entry[3 + index], scales[kind]
+            lim = limit(tol, scale)
+            if bound <= lim:
+                continue
+            quantity = _QUANTITIES[index]
+            unit = UNITS[kind]
+            reason = (f'the {quantity} of {path} cannot be trusted: expected its error bound '
+                      f'to be at most {tol:g} x {scale:.3g} {unit} ({SCALE_MEANINGS[kind]}), '
+                      f'got {bound:.3g} {unit}')
+            key = solver.measure_keys.get(label)
+            if label in ctx.notes:
+                reason += f'; {ctx.notes[label]}'
+            elif key is not None:
+                reason += f'; near-singularity measure of {label}: {ctx.measures[key]:.3g}'
+            raise UntrustedError(label, ctx.shown, reason, f'{path}.{quantity}', float(bound),
+                                 float(lim))
+    lim = limit(tol, scales['velocity'])
+    for name, (_, bound) in ctx.rubbing.items():
+        if not bound <= lim:
+            reason = (f'the rubbing velocity at pin {name} cannot be trusted: expected its '
+                      f'error bound to be at most {tol:g} x {scales["velocity"]:.3g} m/s '
+                      f'({SCALE_MEANINGS["velocity"]}), got {bound:.3g} m/s')
+            raise UntrustedError(f'pin {name}', ctx.shown, reason, f'rubbing.{name}',
+                                 float(bound), float(lim))
+
+
+def _judge(solver: _Solver, ctx: _Context, omega: Any, alpha: Any, tol: float,
+           shape: tuple[int, ...]) -> None:
+    """Mask the angles of a vector solve where a reported bound exceeds ``tol``."""
+    w = abs(omega)
+    rate = w * w + abs(alpha)
+    a = solver.crank_length
+    floors = {'position': solver.size, 'angle': 1.0, 'velocity': a * w, 'angular velocity': w,
+              'acceleration': a * rate, 'angular acceleration': rate}
+    lims = {kind: tol * floor for kind, floor in floors.items()}
+    failed = np.logical_not(ctx.valid)  # already refused: not judged again
+    if all(bool(((entry[3] <= lims[kinds[0]]) & (entry[4] <= lims[kinds[1]])
+                 & (entry[5] <= lims[kinds[2]]) | failed).all())
+           for table, name, _, _, kinds in solver.outputs
+           for entry in (getattr(ctx, table)[name],)) and all(
+               bool(((bound <= lims['velocity']) | failed).all())
+               for _, bound in ctx.rubbing.values()):
+        return  # within the floors of the scales (as _trusted): no norms needed
+    scales = _context_scales(solver, ctx, omega, alpha)
+    lims = {kind: limit(tol, scale) for kind, scale in scales.items()}
+    for table, name, _, label, kinds in solver.outputs:
+        entry = getattr(ctx, table)[name]
+        ok = ((entry[3] <= lims[kinds[0]]) & (entry[4] <= lims[kinds[1]])
+              & (entry[5] <= lims[kinds[2]]))
+        ctx.mask(np.broadcast_to(ok, shape), f'{label} (untrusted)')
+    for name, (_, bound) in ctx.rubbing.items():
+        ctx.mask(np.broadcast_to(bound <= lims['velocity'], shape), f'pin {name} (untrusted)')
+
+
+def _angle(e: Any, vector: bool) -> Any:
+    """Angle of unit complex ``e``, wrapped to (-pi, pi]."""
+    if vector:
+        theta = np.arctan2(e.imag, e.real)
+        theta[theta == -np.pi] = np.pi
+        return theta
+    return _wrapped_angle(e)
+
+
+def _wrapped_angle(e: complex) -> float:
+    """Angle of unit complex ``e`` (one value), wrapped to (-pi, pi]."""
+    theta = math.atan2(e.imag, e.real)
+    return math.pi if theta == -math.pi else theta
+
+
+def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None,
+          accel: npt.ArrayLike | None = None, *, turns: npt.ArrayLike = 0,
+          max_error: float = MAX_ERROR) -> State:
+    """Solve ``scene`` for position, velocity and acceleration at crank ``angle``.
+
+    Every value comes with an absolute error bound (``State.error_bound``,
+    :mod:`mech_kinematics.bounds`); a state in which a reported value's bound
+    exceeds ``max_error`` times its kind's scale (``State.scales``) is refused.
+
+    Parameters
+    ----------
+    scene : Scene
+        The mechanism.
+    angle : float or array_like, shape (n,)
+        Crank angle(s), rad, CCW from +x, counted from the start: ``2.5 pi``
+        is a quarter turn into the crank's second turn. Only an intermittent
+        (Geneva) drive tells the turns apart (its wheel indexes once a turn).
+    speed : float or array_like, optional
+        Crank angular velocity, rad/s, + CCW. Defaults to the scene's.
+    accel : float or array_like, optional
+        Crank angular acceleration, rad/s^2, + CCW. Defaults to the scene's.
+    turns : int or array_like of int, keyword-only
+        Whole crank turns to add to ``angle``: the crank angle counted from
+        the start is ``angle + 2 pi turns``, the sum never formed in floating
+        point, so a crank kept as whole turns plus an angle within one turn
+        (as the node keeps it) loses nothing however many turns it has made.
+        Default 0.
+    max_error : float, optional
+        Tolerance: the largest error bound accepted, relative to its kind's
+        scale. Default 1e-6; ``math.inf`` accepts every finite answer. Whatever
+        it is, a dyad within rounding of an assembly limit is refused.
+
+    Returns
+    -------
+    State
+        Floats for a scalar ``angle``; arrays (with ``valid`` as a mask) for an
+        array.
+
+    Raises
+    ------
+    AssemblyError
+        For a scalar ``angle`` at which a dyad cannot close or is singular;
+        its subclass :class:`UntrustedError` where the answer cannot be
+        trusted (a bound above the tolerance, a dyad within rounding of an
+        assembly limit, a value beyond the range of doubles).
+    """
+    theta: Any
+    omega: Any
+    alpha: Any
+    solver = scene._solver
+    speed = scene.input.speed if speed is None else speed
+    accel = scene.input.accel if accel is None else accel
+    if not (isinstance(max_error, (float, int)) and max_error > 0.0):
+        msg = f'Expected `max_error` to be a positive number, got {max_error!r}'
+        raise ValueError(msg)
+    tol = float(max_error)
+    whole: Any = turns
+    if whole.__class__ is not int:  # an int is the usual case, decided without a call
+        whole = _turns(whole)
+    if _is_scalar(angle) and _is_scalar(speed) and _is_scalar(accel) and (
+            whole.__class__ is int or _is_scalar(whole)):
+        theta, omega, alpha = float(angle), float(speed), float(accel)  # type: ignore[arg-type]
+        if not (math.isfinite(theta) and math.isfinite(omega) and math.isfinite(alpha)):
+            msg = (f'Expected `angle`, `speed` and `accel` to be finite, got {theta!r}, '
+                   f'{omega!r}, {alpha!r}')
+            raise ValueError(msg)
+        whole = int(whole)
+        ctx = _execute(solver, theta, omega, alpha, whole)
+        if not _trusted(solver, ctx, omega, alpha, tol):
+            _refuse(solver, ctx, omega, alpha, tol)
+        valid: Any = True
+    else:
+        theta, omega, alpha = (np.asarray(x, dtype=np.float64) for x in (angle, speed, accel))
+        shape = np.broadcast_shapes(theta.shape, omega.shape, alpha.shape, np.shape(whole))
+        if len(shape) != 1:
+            msg = f'Expected `angle` to be a float or a 1-D array, got shape {shape}'
+            raise ValueError(msg)
+        if not (np.isfinite(theta).all() and np.isfinite(omega).all()
+                and np.isfinite(alpha).all()):
+            msg = 'Expected `angle`, `speed` and `accel` to be finite'
+            raise ValueError(msg)
+        theta = np.broadcast_to(theta, shape)
+        whole = np.broadcast_to(np.asarray(whole, dtype=np.int64), shape)
+        with np.errstate(all='ignore'):
+            # A constant speed or acceleration stays a scalar through the steps.
+            ctx = _execute(solver, theta, omega, alpha, whole)
+            _judge(solver, ctx, omega, alpha, tol, shape)
+        omega, alpha = np.broadcast_to(omega, shape), np.broadcast_to(alpha, shape)
+        valid = np.broadcast_to(np.asarray(ctx.valid, dtype=bool), shape).copy()
+    _warn_near_singular(ctx)
+    return _state(scene, solver, ctx, theta, omega, alpha, valid, whole)
+
+
+def _turns(turns: Any) -> Any:
+    """Return ``turns`` as an int or an int64 array, or raise a ValueError saying why not."""
+    if isinstance(turns, (int, np.integer)) and not isinstance(turns, (bool, np.bool_)):
+        return int(turns)
+    try:
+        array = np.asarray(turns)
+    except (TypeError, ValueError, OverflowError):
+        array = np.asarray(None)
+    if array.dtype.kind in 'iu':
+        if array.dtype.kind == 'u' and array.size and int(array.max()) >= 2 ** 63:
+            array = np.asarray(None)
+        else:
+            return array.astype(np.int64) if array.ndim else int(array)
+    msg = (f'Expected `turns` to be a whole number of crank turns (an int, or an array of '
+           f'ints within 2**63 for the array path), got {turns!r}')
+    raise ValueError(msg)
+
+
+def _is_scalar(x: Any) -> bool:
+    # The cheap test first: the node's tick passes plain floats.
+    return isinstance(x, (float, int)) or np.ndim(x) == 0
+
+
+def _warn_near_singular(ctx: _Context) -> None:
+    for key, measure in ctx.measures.items():
+        low = measure < NEAR_SINGULAR
+        if low if not ctx.vector else (low & ctx.valid).any():
+            msg = (f'dyad at "{key}" is near-singular (measure below {NEAR_SINGULAR:g}): '
+                   f'its velocities and accelerations lose accuracy')
+            warnings.warn(msg, NearSingularWarning, stacklevel=3)
+
+
+def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any, alpha: Any,
+           valid: Any, turns: Any) -> State:
+    vector = ctx.vector
+    plan = solver.plan
+    joints = {}
+    for name, kind in plan.joint_types.items():
+        if kind == 'revolute':
+            e, w, al = ctx.links[name][:3]
+            joints[name] = JointMotion(kind, _angle(e, vector), w, al)
+        else:
+            joints[name] = JointMotion(kind, *ctx.sliders[name][:3])
+    table = ctx.points
+    points = {name: table[name][:3] for name in plan.output_points}
+    measures = ctx.measures
+    bound = ErrorBound(_table_bounds, (plan, ctx), solver.size, solver.crank_length)
+    if vector:
+        shape = theta.shape
+        bad = None if valid.all() else ~valid
+        inputs = (id(theta), id(omega), id(alpha))
+
+        def finish(x: Any) -> Any:
+            # A constant (a ground point, a constant crank speed) becomes a
+            # read-only broadcast view; a copy only where NaN must go in, and
+            # never the caller's own input arrays.
+            if id(x) in inputs:
+                x = np.array(x)
+            elif np.shape(x) != shape:
+                x = np.broadcast_to(x, shape)
+                if bad is None:
+                    return x
+                x = np.array(x)
+            if bad is not None:
+                x[bad] = np.nan
+            return x
+
+        for name, joint in joints.items():
+            joints[name] = JointMotion(joint.type, finish(joint.position),
+                                       finish(joint.velocity), finish(joint.acceleration))
+        points = {name: (finish(p), finish(v), finish(a)) for name, (p, v, a) in points.items()}
+        measures = {key: finish(m) for key, m in measures.items()}
+        joint_bounds, point_bounds = _table_bounds(plan, ctx)
+        bound = ErrorBound(_given, ({name: (finish(a), finish(b), finish(c))
+                                     for name, (a, b, c) in joint_bounds.items()},
+                                    {name: (finish(a), finish(b), finish(c))
+                                     for name, (a, b, c) in point_bounds.items()}),
+                           solver.size, solver.crank_length)
+        rubbing = {name: finish(value) for name, (value, _) in ctx.rubbing.items()}
+        bound.rubbing = {name: finish(b) for name, (_, b) in ctx.rubbing.items()}
+        intermittent = {name: step.engagement(ctx, omega, finish)
+                        for name, step in solver.levers.items()}
+    else:
+        rubbing = intermittent = {}
+        if ctx.rubbing:
+            rubbing = {name: value for name, (value, _) in ctx.rubbing.items()}
+            bound.rubbing = {name: b for name, (_, b) in ctx.rubbing.items()}
+        if solver.levers:
+            intermittent = {name: step.engagement(ctx, omega, None)
+                            for name, step in solver.levers.items()}
+    return _new_state(scene.name, theta, omega, alpha, joints, points, valid, dict(measures),
+                      dict(ctx.failures), bound, turns, rubbing, intermittent)
+
+
+def _new_state(scene: str, angle: Any, speed: Any, accel: Any, joints: dict[str, JointMotion],
+               points: dict[str, Any], valid: Any, singularity: dict[str, Any],
+               failures: dict[str, Any], error_bound: ErrorBound, turns: Any,
+               rubbing: dict[str, Any], intermittent: dict[str, Engagement]) -> State:
+    """Return ``State(...)`` of these fields, built without the dataclass's ``__init__``.
+
+    A frozen dataclass's ``__init__`` sets each field through
+    ``object.__setattr__``: about 1 us of a 7 us single-angle solve. The fields
+    go straight into the new instance's ``__dict__`` instead (there is no
+    ``__post_init__`` to run); ``test_linkage_bounds`` checks the result equals
+    the dataclass's own construction.
+    """
+    state = object.__new__(State)
+    fields = state.__dict__
+    fields['scene'], fields['angle'], fields['speed'], fields['accel'] = scene, angle, speed, accel
+    fields['joints'], fields['complex_points'], fields['valid'] = joints, points, valid
+    fields['singularity'], fields['failures'] = singularity, failures
+    fields['error_bound'], fields['turns'] = error_bound, turns
+    fields['rubbing'], fields['intermittent'] = rubbing, intermittent
+    return state
+
+
+def _table_bounds(plan: _Plan, ctx: _Context) -> tuple[Table, Table]:
+    """Return the reported joints' and points' bounds from a solve's context."""
+    joints = {name: (ctx.links if kind == 'revolute' else ctx.sliders)[name][3:]
+              for name, kind in plan.joint_types.items()}
+    table = ctx.points
+    return joints, {name: table[name][3:] for name in plan.output_points}
+
+
+def _given(joints: Table, points: Table) -> tuple[Table, Table]:
+    return joints, points
