@@ -57,7 +57,7 @@ from ..errors import SceneError
 
 if TYPE_CHECKING:
     from .context import _Context
-    from .model import Branch, Link, Where
+    from .model import Branch, Link, SceneUnits, Where
     from .state import Engagement
 
 #: A body at a pin, for rubbing: ``('link', name)``, ``('still', name)`` or ``('block', lever)``.
@@ -259,6 +259,15 @@ class Item(ABC):
     def lengths(self) -> tuple[float, ...]:
         """Return its link lengths, m, which count in the mechanism's size."""
         return ()
+
+    @staticmethod
+    def fact_texts() -> dict[str, Callable[[dict[str, Any], SceneUnits], str]]:
+        """Return, per ``kind`` of the facts its step's errors carry, their text in scene units.
+
+        See :class:`~mech_kinematics.errors.AssemblyError` and
+        :func:`~.mechanism.assembly_text`.
+        """
+        return {}
 
     def bodies(self) -> Iterator[tuple[str, str, Body]]:
         """Yield (point, body name, body) of every body besides links it puts at a point."""

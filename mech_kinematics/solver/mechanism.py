@@ -20,6 +20,7 @@ from .carried import CarriedPoint
 from .crank import Crank
 from .model import _check_name, SceneUnits
 from .plan import _compile, _Plan
+from .registry import FACT_TEXTS
 from .rubbing import Pin
 from .scaling import _ANGULAR, _exponent, _LINEAR, _scaled, _size, _SIZE_RANGE
 from .solve import _execute, TRUST_TEST
@@ -98,27 +99,7 @@ def assembly_text(error: AssemblyError, units: SceneUnits | None = None) -> str:
     if facts is None:
         return f'{error.dyad}: {error.reason}'
     units = SceneUnits() if units is None else units
-    text = units.length_text
-    kind, links, lengths, points = facts['kind'], facts['links'], facts['lengths'], \
-        facts['points']
-    distance = facts['distance']
-    if kind == 'pivot':
-        return (f'the pin {points[0]} of slotted link {links[0]} on its pivot {points[1]} '
-                f'({text(distance)} from it)')
-    if kind == 'reach':
-        return (f'link {links[0]} ({text(lengths[0], distance)}) cannot reach the guide through '
-                f'{points[1]} at {units.angle_text(facts["guide_angle"])} from {points[0]} '
-                f'({text(distance, lengths[0])} from the guide)')
-    (a, b), (la, lb), (p, q) = links, lengths, points
-    pair = f'links {a} ({text(la)}) and {b} ({text(lb)})'
-    if kind == 'in line':
-        return (f'{pair} in line between {p} and {q} ({text(distance)} apart): a toggle '
-                f'position, where the mechanism locks')
-    if distance >= la + lb:
-        return (f'{pair} cannot reach from {p} to {q} '
-                f'({text(distance, la + lb)} apart, more than {text(la + lb, distance)})')
-    return (f'{pair} cannot meet: {p} and {q} are {text(distance, abs(la - lb))} apart, less '
-            f'than the difference of their lengths ({text(abs(la - lb), distance)})')
+    return FACT_TEXTS[facts['kind']](facts, units)
 
 
 @dataclass(frozen=True)

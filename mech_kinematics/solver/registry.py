@@ -7,7 +7,11 @@ Adding a kind is one module (its item and step, :mod:`.base`) and one entry here
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 from .base import Item
+from .model import SceneUnits
 from .rpp import RPP
 from .rpr import RPR
 from .rrp import RRP
@@ -15,3 +19,7 @@ from .rrr import RRR
 
 #: The scene's ``type:`` of a dyad -> its item class.
 KINDS: dict[str, type[Item]] = {kind.kind: kind for kind in (RRR, RRP, RPR, RPP)}
+
+#: The ``kind`` of an :class:`~mech_kinematics.errors.AssemblyError`'s facts -> their text.
+FACT_TEXTS: dict[str, Callable[[dict[str, Any], SceneUnits], str]] = {
+    fact: text for kind in KINDS.values() for fact, text in kind.fact_texts().items()}

@@ -13,7 +13,7 @@ import numpy as np
 
 from .base import Body, Edge, Frame, Item, Member, Names, Placing, Reading, Step
 from .context import _Context, _cross, _dot, _U2, _U4, _U7, SINGULAR
-from .model import _check_name, Where
+from .model import _check_name, SceneUnits, Where
 from ..bounds import ROUNDING_MARGIN, U
 from ..errors import SceneError
 
@@ -73,6 +73,11 @@ class RPR(Item):
             center=read.name(raw, 'center', where), through=read.name(raw, 'through', where),
             slider=read.name(raw, 'slider', where), slots=slots)
         return built
+
+    @staticmethod
+    def fact_texts() -> dict[str, Callable[[dict[str, Any], SceneUnits], str]]:
+        """Return the text of a pin on the lever's pivot."""
+        return {'pivot': _pivot_text}
 
     @property
     def key(self) -> str:
@@ -187,6 +192,13 @@ class RPR(Item):
             e = points[self.through] - points[self.center]
             yield (self.slider, self.through, points[self.through], math.atan2(e[1], e[0]),
                    self.link)
+
+
+def _pivot_text(facts: dict[str, Any], units: SceneUnits) -> str:
+    """Return why an RPR's lever has no direction, in the scene's units."""
+    links, points = facts['links'], facts['points']
+    return (f'the pin {points[0]} of slotted link {links[0]} on its pivot {points[1]} '
+            f'({units.length_text(facts["distance"])} from it)')
 
 
 class _RPRStep(Step):

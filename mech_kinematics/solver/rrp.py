@@ -13,7 +13,7 @@ import numpy as np
 
 from .base import Body, Edge, Frame, Item, Member, Names, Placing, Reading, Step
 from .context import _Context, _cross, _dot, _U2, _U3, _U5, _U7, SINGULAR
-from .model import _check_finite, _check_name, _g, Branch, Link, Where
+from .model import _check_finite, _check_name, _g, Branch, Link, SceneUnits, Where
 from ..bounds import ROUNDING_MARGIN, U
 
 
@@ -54,6 +54,11 @@ class RRP(Item):
             guide_angle=read.angle(guide, 'angle', f'{where}.guide', 0.0),
             slider=read.name(raw, 'slider', where), branch=read.branch(raw, where))
         return built
+
+    @staticmethod
+    def fact_texts() -> dict[str, Callable[[dict[str, Any], SceneUnits], str]]:
+        """Return the text of a guide out of reach."""
+        return {'reach': _reach_text}
 
     @property
     def key(self) -> str:
@@ -144,6 +149,16 @@ class RRP(Item):
         through = points[self.through]
         yield (self.slider, through + (min(low, s) - pad) * u,
                through + (max(high, s) + pad) * u)
+
+
+def _reach_text(facts: dict[str, Any], units: SceneUnits) -> str:
+    """Return why an RRP's link cannot reach its guide, in the scene's units."""
+    text = units.length_text
+    links, lengths, points = facts['links'], facts['lengths'], facts['points']
+    distance = facts['distance']
+    return (f'link {links[0]} ({text(lengths[0], distance)}) cannot reach the guide through '
+            f'{points[1]} at {units.angle_text(facts["guide_angle"])} from {points[0]} '
+            f'({text(distance, lengths[0])} from the guide)')
 
 
 class _RRPStep(Step):

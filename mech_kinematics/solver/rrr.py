@@ -13,7 +13,7 @@ import numpy as np
 
 from .base import Edge, Frame, Item, Member, Names, Placing, Reading, Step
 from .context import _Context, _dot, _U16, _U2, _U3, _U7, SINGULAR
-from .model import _check_name, _g, Branch, Link, Where
+from .model import _check_name, _g, Branch, Link, SceneUnits, Where
 from ..bounds import ROUNDING_MARGIN, U
 from ..errors import SceneError
 
@@ -49,6 +49,11 @@ class RRR(Item):
         built: RRR = read.build(where, {}, cls, point=read.name(raw, 'point', where),
                                 links=(first, second), branch=read.branch(raw, where))
         return built
+
+    @staticmethod
+    def fact_texts() -> dict[str, Callable[[dict[str, Any], SceneUnits], str]]:
+        """Return the texts of circles apart and of links in line."""
+        return {'apart': _pair_text, 'in line': _pair_text}
 
     @property
     def key(self) -> str:
@@ -132,6 +137,22 @@ class RRR(Item):
     def four_bar(self) -> tuple[str, Link, Link] | None:
         """Return its new pin and two links: an RRR can close a four-bar loop."""
         return self.point, *self.links
+
+
+def _pair_text(facts: dict[str, Any], units: SceneUnits) -> str:
+    """Return why an RRR's two links cannot close, in the scene's units."""
+    text = units.length_text
+    (a, b), (la, lb), (p, q) = facts['links'], facts['lengths'], facts['points']
+    distance = facts['distance']
+    pair = f'links {a} ({text(la)}) and {b} ({text(lb)})'
+    if facts['kind'] == 'in line':
+        return (f'{pair} in line between {p} and {q} ({text(distance)} apart): a toggle '
+                f'position, where the mechanism locks')
+    if distance >= la + lb:
+        return (f'{pair} cannot reach from {p} to {q} '
+                f'({text(distance, la + lb)} apart, more than {text(la + lb, distance)})')
+    return (f'{pair} cannot meet: {p} and {q} are {text(distance, abs(la - lb))} apart, less '
+            f'than the difference of their lengths ({text(abs(la - lb), distance)})')
 
 
 class _RRRStep(Step):
