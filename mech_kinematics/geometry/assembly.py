@@ -38,6 +38,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+import itertools
 import math
 import warnings
 
@@ -46,7 +47,7 @@ import numpy.typing as npt
 
 from .instant_centres import full_scene
 from ..errors import AssemblyError, NearSingularWarning
-from ..solver import Scene, solve, Units
+from ..solver import assembly_margins, Scene, solve, Units
 
 __all__ = [
     'Assembly', 'DeadCentre', 'FourBarLoop', 'SAMPLES', 'TOLERANCE', 'Toggle', 'Transmission',
@@ -246,6 +247,7 @@ class _Probe:
         self.theta = np.linspace(0.0, _TURN, samples, endpoint=False)
         self.state = self.solve(self.theta)
         self.valid = np.asarray(self.state.valid, dtype=bool)
+        self.margins = assembly_margins(self.scene)
 
     def solve(self, theta: float | Array) -> object:
         """Solve at crank speed 1 rad/s, refusing only what does not assemble."""
@@ -283,22 +285,82 @@ def _bisect(test: Callable[[float], bool], low: float, high: float) -> float:
 
 
 def _ranges(probe: _Probe) -> tuple[tuple[float, float], ...]:
-    valid, theta = probe.valid, probe.theta
-    n = len(theta)
-    if valid.all():
+    """Return where every step's margin is positive, its ends the margins' roots.
+
+    Each margin and its rate are sampled over the turn; an extremum of a
+    margin lies where its rate changes sign between two samples and is found
+    by bisection on the rate, so a window where the margin is positive
+    however narrow around an extremum is caught; between extrema a margin is
+    monotonic, and where it changes sign its root is found by bisection on
+    its sign, to an ulp of the angle. Between consecutive roots the
+    mechanism assembles or not throughout: one evaluation tells which.
+    """
+    margins = probe.margins
+    theta = np.linspace(0.0, _TURN, len(probe.theta) + 1)
+    sampled = margins(theta)
+    roots = []
+    for index, (_, margin, rate) in enumerate(sampled):
+        for i in _changes(margin, rate):
+            a, b = float(theta[i]), float(theta[i + 1])
+            ends = [a, b]
+            if rate[i] * rate[i + 1] < 0.0:
+                ends.insert(1, _root(lambda t, k=index: margins(t)[k][2], a, b))
+            values = [float(margins(t)[index][1][0]) for t in ends]
+            for (low, m_low), (high, m_high) in itertools.pairwise(zip(ends, values)):
+                if (m_low > 0.0) != (m_high > 0.0):
+                    roots.append(_root(lambda t, k=index: margins(t)[k][1], low, high))
+    roots = sorted({root % _TURN for root in roots})
+    if not roots:
+        return ((0.0, _TURN),) if _assembles(margins, np.array([0.0]))[0] else ()
+    following = np.array(roots[1:] + [roots[0] + _TURN])
+    inside = _assembles(margins, 0.5 * (np.array(roots) + following))
+    pieces = [(start, float(end)) for start, end, ok in zip(roots, following, inside) if ok]
+    if len(pieces) == len(roots):
         return ((0.0, _TURN),)
-    step = _TURN / n
-    edges = []  # (angle, rising): the refined ends, in order
-    for i in range(n):
-        j = (i + 1) % n
-        if valid[i] != valid[j]:
-            low = float(theta[i])
-            edges.append((_bisect(probe.assembles, low, low + step), bool(valid[j])))
-    starts = [a for a, rising in edges if rising]
-    ends = [a for a, rising in edges if not rising]
-    if ends and starts and ends[0] < starts[0]:
-        starts = [starts[-1] - _TURN] + starts[:-1]
-    return tuple(zip(starts, ends, strict=True))
+    ranges: list[tuple[float, float]] = []
+    for start, end in pieces:  # join pieces meeting at a root where nothing changes
+        if ranges and ranges[-1][1] == start:
+            ranges[-1] = (ranges[-1][0], end)
+        else:
+            ranges.append((start, end))
+    if len(ranges) > 1 and ranges[-1][1] - _TURN == ranges[0][0]:
+        ranges[0] = (ranges[-1][0] - _TURN, ranges[0][1])
+        ranges.pop()
+    elif ranges[-1][1] > _TURN:  # it runs through 0: it starts below 0
+        last = ranges.pop()
+        ranges.insert(0, (last[0] - _TURN, last[1] - _TURN))
+    return tuple(ranges)
+
+
+def _changes(margin: Array, rate: Array) -> list[int]:
+    """Return the sample intervals where a margin or its rate changes sign (both known)."""
+    known = np.isfinite(margin) & np.isfinite(rate)
+    both = known[:-1] & known[1:]
+    positive = margin > 0.0
+    flips = (positive[:-1] != positive[1:]) | (rate[:-1] * rate[1:] < 0.0)
+    return [int(i) for i in np.flatnonzero(both & flips)]
+
+
+def _assembles(margins: Callable[[Array], list[tuple[str, Array, Array]]],
+               theta: Array) -> Array:
+    """Return whether every margin is positive at each crank angle."""
+    ok = np.ones(theta.shape, dtype=bool)
+    for _, margin, _ in margins(theta):
+        ok &= margin > 0.0  # NaN (an earlier step does not close) is not
+    return ok
+
+
+def _root(function: Callable[[Array], Array], low: float, high: float) -> float:
+    """Return where ``function`` (of one crank angle) changes sign in [low, high], to an ulp."""
+    keep = float(function(np.array([low]))[0]) > 0.0
+    while True:
+        middle = 0.5 * (low + high)
+        if middle in (low, high):
+            return middle
+        if (float(function(np.array([middle]))[0]) > 0.0) == keep:
+            low = middle
+        else:
+            high = middle
 
 
 def _gaps(ranges: Sequence[tuple[float, float]]) -> tuple[tuple[float, float], ...]:

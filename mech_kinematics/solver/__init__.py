@@ -44,11 +44,11 @@ from .rpr import MAX_SLOTS, RPR
 from .rrp import RRP
 from .rrr import RRR
 from .rubbing import Pin
-from .solve import solve
+from .solve import assembly_margins, solve
 from .state import Engagement, JointMotion, PointState, State
 
 __all__ = [
     'Branch', 'CarriedPoint', 'Crank', 'Engagement', 'JointMotion', 'Link', 'MAX_SLOTS',
     'NEAR_SINGULAR', 'Pin', 'PointState', 'RPR', 'RRP', 'RRR', 'SINGULAR', 'Scene', 'State',
-    'TANGENCY_TOLERANCE', 'Units', 'assembly_text', 'solve',
+    'TANGENCY_TOLERANCE', 'Units', 'assembly_margins', 'assembly_text', 'solve',
 ]

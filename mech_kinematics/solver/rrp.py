@@ -185,6 +185,16 @@ class _RRPStep(Step):
                 'points': (self.start, self.through_name), 'distance': abs(float(offset)) * m,
                 'guide_angle': self.guide_angle}
 
+    def margins(self, points: Mapping[str, tuple[Any, ...]]) -> tuple[tuple[Any, Any], ...]:
+        """Return the reach margins ``l - o`` and ``l + o`` and their rates.
+
+        ``o`` is the signed distance of the link's start from the guide.
+        """
+        q, vq = points[self.start][:2]
+        offset = _cross(self.u, q - self.through)
+        rate = _cross(self.u, vq)
+        return ((self.length - offset, -rate), (self.length + offset, rate))
+
     def run(self, ctx: _Context) -> None:
         length, u = self.length, self.u
         q, vq, aq, eq, evq, eaq = ctx.points[self.start]

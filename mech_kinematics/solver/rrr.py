@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Collection, Iterator, Mapping
 from dataclasses import dataclass, replace
+from fractions import Fraction
 import math
 from typing import Any
 
@@ -134,6 +135,14 @@ class RRR(Item):
         return self.point, *self.links
 
 
+def _sum_root(x: Fraction, square: Fraction) -> float:
+    """Return ``x + sqrt(square)`` for an exact ``x`` without cancellation (to a few ulp)."""
+    root = math.sqrt(square)
+    if x >= 0:
+        return float(x) + root
+    return float(square - x * x) / (root - float(x))
+
+
 class _RRRStep(Step):
 
     def __init__(self, dyad: RRR) -> None:
@@ -167,6 +176,57 @@ class _RRRStep(Step):
         return {'kind': 'in line' if touching else 'apart', 'links': (self.link1, self.link2),
                 'lengths': (self.l1 * m, self.l2 * m), 'points': (self.start1, self.start2),
                 'distance': float(dist) * m}
+
+    def margins(self, points: Mapping[str, tuple[Any, ...]]) -> tuple[tuple[Any, Any], ...]:
+        """Return the circles' margins ``l1 + l2 - d`` and ``d - |l1 - l2|`` and their rates.
+
+        ``d`` is the distance between the links' starts.
+        """
+        p1, v1 = points[self.start1][:2]
+        p2, v2 = points[self.start2][:2]
+        d = p2 - p1
+        dist = np.hypot(d.real, d.imag)
+        rate = _dot(d, v2 - v1) / dist
+        return ((self.l1 + self.l2 - dist, -rate), (dist - abs(self.l1 - self.l2), rate))
+
+    def crank_margins(self, tip: str, center: complex, radius: float,
+                      ground: Mapping[str, complex]
+                      ) -> Callable[[Any], tuple[tuple[Any, Any], ...]] | None:
+        """Return its margins in closed form when it joins the crank's tip to a ground point.
+
+        With ``r`` the crank, ``g`` and ``phi`` the distance and direction of
+        the ground point from the crank's pivot and ``psi = theta - phi``:
+        ``d^2 = (r - g)^2 + 4 r g sin^2(psi / 2) = (r + g)^2 - 4 r g cos^2(psi / 2)``,
+        so ``(l1 + l2)^2 - d^2`` and ``d^2 - (l1 - l2)^2`` are a constant less a
+        smooth term; the constants are formed exactly from the doubles given
+        (:func:`_sum_root`), so the margins keep their accuracy where the
+        circles barely meet, and their roots come out to an ulp of the angle.
+        """
+        starts = (self.start1, self.start2)
+        if tip not in starts:
+            return None
+        other = starts[1] if starts[0] == tip else starts[0]
+        if other not in ground:
+            return None
+        where = ground[other]
+        dx = Fraction(where.real) - Fraction(center.real)
+        dy = Fraction(where.imag) - Fraction(center.imag)
+        g2 = dx * dx + dy * dy
+        phi = math.atan2(float(dy), float(dx))
+        r = Fraction(radius)
+        lsum = Fraction(self.l1) + Fraction(self.l2)
+        ldiff = abs(Fraction(self.l1) - Fraction(self.l2))
+        outer = _sum_root(lsum - r, g2) * -_sum_root(-(lsum + r), g2)  # lsum^2 - (r - g)^2
+        inner = _sum_root(r - ldiff, g2) * _sum_root(r + ldiff, g2)  # (r + g)^2 - ldiff^2
+        rg4 = 4.0 * radius * math.sqrt(g2)
+
+        def margins(theta: Any) -> tuple[tuple[Any, Any], ...]:
+            half = 0.5 * (theta - phi)
+            s, c = np.sin(half), np.cos(half)
+            rate = rg4 * s * c  # 2 r g sin(psi): the rate of d^2
+            return ((outer - rg4 * s * s, -rate), (inner - rg4 * c * c, rate))
+
+        return margins
 
     def run(self, ctx: _Context) -> None:
         l1, l2 = self.l1, self.l2

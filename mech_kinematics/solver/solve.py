@@ -9,6 +9,7 @@ within rounding of an assembly limit.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 import math
 from typing import Any, TYPE_CHECKING
 import warnings
@@ -270,6 +271,41 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
         valid = np.broadcast_to(np.asarray(ctx.valid, dtype=bool), shape).copy()
     _warn_near_singular(ctx)
     return _state(scene, solver, ctx, theta, omega, alpha, valid, whole)
+
+
+def assembly_margins(scene: Scene) -> Callable[[npt.ArrayLike], list[tuple[str, Any, Any]]]:
+    """Return the function giving every step's assembly margins at crank angles (rad).
+
+    The function takes crank angles (an array) and returns, for each margin of
+    each step in order (:meth:`.base.Step.margins`), ``(label, margin,
+    rate)``: arrays of the margin (positive where the step closes) and of its
+    derivative per radian of crank angle; NaN where the step's inputs are not
+    known (an earlier step does not close). A step fed by the crank's tip and
+    ground points gives its closed forms (:meth:`.base.Step.crank_margins`).
+    The mechanism assembles where every margin is positive; ``solve`` refuses
+    there too within rounding of a zero. Margins are in the plan's units (a
+    scene rescaled for range keeps their signs and roots).
+    """
+    solver = scene._solver
+    plan = solver.run_plan
+    crank = plan.crank
+    ground = {name: entry[0] for name, entry in solver.ground.items()}
+    forms = [step.crank_margins(crank.point, crank.center, crank.length, ground)
+             for step in plan.steps]
+
+    def margins(angle: npt.ArrayLike) -> list[tuple[str, Any, Any]]:
+        theta = np.atleast_1d(np.asarray(angle, dtype=float))
+        result = []
+        with np.errstate(all='ignore'):
+            ctx = _run(solver, theta, np.float64(1.0), np.float64(0.0), 0)
+            for step, form in zip(plan.steps, forms, strict=True):
+                pairs = step.margins(ctx.points) if form is None else form(theta)
+                for margin, rate in pairs:
+                    result.append((step.label, np.broadcast_to(margin, theta.shape),
+                                   np.broadcast_to(rate, theta.shape)))
+        return result
+
+    return margins
 
 
 def _turns(turns: Any) -> Any:
