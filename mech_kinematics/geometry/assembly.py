@@ -65,7 +65,11 @@ TOLERANCE = 1e-12
 TOGGLE_MEASURE = 1e-6
 #: Relative difference of ``s + l`` and ``p + q`` within which a loop is a change point.
 CHANGE_POINT = 1e-9
+#: Crank angles sampled at least in each range where it assembles, for dead centres.
+RANGE_SAMPLES = 64
 _TURN = 2.0 * math.pi
+#: Roots closer than this (a few ulp of 2 pi), found from either side of a sample, are one.
+_SAME = 8 * math.ulp(_TURN)
 
 
 @dataclass(frozen=True)
@@ -232,7 +236,7 @@ def assembly_from_scene(scene: Scene, samples: int = SAMPLES) -> Assembly:
     ranges = _ranges(probe)
     gaps = _gaps(ranges)
     toggles = _toggles(probe, ranges)
-    return Assembly(scene.name, scene.units, ranges, gaps, toggles, _dead_centres(probe),
+    return Assembly(scene.name, scene.units, ranges, gaps, toggles, _dead_centres(probe, ranges),
                     _transmission(probe, ranges, toggles), _loops(probe))
 
 
@@ -293,28 +297,28 @@ def _ranges(probe: _Probe) -> tuple[tuple[float, float], ...]:
     however narrow around an extremum is caught; between extrema a margin is
     monotonic, and where it changes sign its root is found by bisection on
     its sign, to an ulp of the angle. Between consecutive roots the
-    mechanism assembles or not throughout: one evaluation tells which.
+    mechanism assembles or not throughout (but where a margin touches zero,
+    a toggle): two evaluations tell which.
     """
     margins = probe.margins
-    theta = np.linspace(0.0, _TURN, len(probe.theta) + 1)
+    theta = _turn_grid(len(probe.theta))
     sampled = margins(theta)
     roots = []
     for index, (_, margin, rate) in enumerate(sampled):
-        for i in _changes(margin, rate):
-            a, b = float(theta[i]), float(theta[i + 1])
-            ends = [a, b]
-            if rate[i] * rate[i + 1] < 0.0:
-                ends.insert(1, _root(lambda t, k=index: margins(t)[k][2], a, b))
-            values = [float(margins(t)[index][1][0]) for t in ends]
-            for (low, m_low), (high, m_high) in itertools.pairwise(zip(ends, values)):
-                if (m_low > 0.0) != (m_high > 0.0):
-                    roots.append(_root(lambda t, k=index: margins(t)[k][1], low, high))
-    roots = sorted({root % _TURN for root in roots})
+        def function(t: Array, k: int = index) -> tuple[Array, Array]:
+            return margins(t)[k][1:]
+
+        roots.extend(_crossings(function, theta, (margin, rate)))
+    roots = _distinct(roots)
     if not roots:
         return ((0.0, _TURN),) if _assembles(margins, np.array([0.0]))[0] else ()
     following = np.array(roots[1:] + [roots[0] + _TURN])
-    inside = _assembles(margins, 0.5 * (np.array(roots) + following))
-    pieces = [(start, float(end)) for start, end, ok in zip(roots, following, inside) if ok]
+    # Two points of each piece: either tells (a margin may touch 0 at one angle, a toggle).
+    width = following - np.array(roots)
+    inside = (_assembles(margins, roots + 0.382 * width)
+              | _assembles(margins, roots + 0.618 * width))
+    pieces = [(start, float(end)) for start, end, ok in zip(roots, following, inside, strict=True)
+              if ok]
     if len(pieces) == len(roots):
         return ((0.0, _TURN),)
     ranges: list[tuple[float, float]] = []
@@ -332,13 +336,68 @@ def _ranges(probe: _Probe) -> tuple[tuple[float, float], ...]:
     return tuple(ranges)
 
 
-def _changes(margin: Array, rate: Array) -> list[int]:
-    """Return the sample intervals where a margin or its rate changes sign (both known)."""
-    known = np.isfinite(margin) & np.isfinite(rate)
+def _crossings(function: Callable[[Array], tuple[Array, Array]], theta: Array,
+               sampled: tuple[Array, Array] | None = None) -> list[float]:
+    """Return where ``function``'s value changes sign between the first and last of ``theta``.
+
+    ``function`` gives (value, rate) at crank angles, NaN where unknown;
+    ``sampled`` is its answer at ``theta`` if already known. Where the rate
+    changes sign between two samples the extremum is found by bisection on
+    the rate, so a sign change of the value on either side of it is caught
+    however close together the two are (unless the value is further from zero
+    than twice the step times the larger rate: it cannot get there, and the
+    rate's rounding noise about a flat value is not chased); each sign change
+    is then found by bisection on the value's sign, to an ulp of the angle. An interval where
+    the rate changes sign twice (two extrema within one sample step) is seen
+    as monotonic.
+    """
+    value, rate = function(theta) if sampled is None else sampled
+    roots = []
+    for i in _changes(value, rate):
+        a, b = float(theta[i]), float(theta[i + 1])
+        ends, values = [a, b], [float(value[i]), float(value[i + 1])]
+        reach = 2.0 * (b - a) * max(abs(rate[i]), abs(rate[i + 1]))  # of the value, at most
+        if rate[i] * rate[i + 1] < 0.0 and min(abs(values[0]), abs(values[1])) <= reach:
+            # an extremum between that may cross 0: the value is monotonic either side
+            extremum = _root(lambda t: function(t)[1], a, b)
+            ends.insert(1, extremum)
+            values.insert(1, float(function(np.array([extremum]))[0][0]))
+        for (low, v_low), (high, v_high) in itertools.pairwise(zip(ends, values, strict=True)):
+            if v_low * v_high < 0.0:
+                roots.append(_root(lambda t: function(t)[0], low, high))
+            elif v_high == 0.0 and high == b and i + 2 < len(theta) and v_low * value[i + 2] < 0.0:
+                roots.append(b)  # on a sample
+    return roots
+
+
+def _turn_grid(samples: int) -> Array:
+    """Return ``samples`` steps over the turn, and one more each side (a sign change at 0)."""
+    return np.arange(-1, samples + 2) * (_TURN / samples)
+
+
+def _distinct(angles: Sequence[float]) -> list[float]:
+    """Return the angles in [0, 2 pi), sorted, those within a few ulp of another (mod 2 pi) once."""
+    result: list[float] = []
+    for angle in sorted(a % _TURN for a in angles):
+        if not result or angle - result[-1] > _SAME:
+            result.append(angle)
+    if len(result) > 1 and result[0] + _TURN - result[-1] <= _SAME:
+        result.pop()
+    return result
+
+
+def _changes(value: Array, rate: Array) -> list[int]:
+    """Return the sample intervals where a value or its rate changes sign (both known).
+
+    A value exactly zero at a sample between two of opposite signs gives the
+    interval before it (its bisection ends on that sample).
+    """
+    known = np.isfinite(value) & np.isfinite(rate)
     both = known[:-1] & known[1:]
-    positive = margin > 0.0
-    flips = (positive[:-1] != positive[1:]) | (rate[:-1] * rate[1:] < 0.0)
-    return [int(i) for i in np.flatnonzero(both & flips)]
+    flips = (value[:-1] * value[1:] < 0.0) | (rate[:-1] * rate[1:] < 0.0)
+    zero = np.zeros_like(flips)
+    zero[:-1] = (value[1:-1] == 0.0) & (value[:-2] * value[2:] < 0.0) & known[2:]
+    return [int(i) for i in np.flatnonzero(both & (flips | zero))]
 
 
 def _assembles(margins: Callable[[Array], list[tuple[str, Array, Array]]],
@@ -397,8 +456,11 @@ def _toggles(probe: _Probe, ranges: Sequence[tuple[float, float]]) -> tuple[Togg
                 if error is not None and error.dyad in labels:
                     toggles.append(Toggle(edge % _TURN, error.dyad, labels[error.dyad][1]))
     state = probe.state
+    # A sample inside a range that the solver refuses is on a toggle (a margin touching 0).
+    refused = _inside(probe.theta, ranges) & ~probe.valid
     for key, (label, links) in keys.items():
-        measure = np.where(probe.valid, np.asarray(state.singularity[key]), np.inf)
+        measure = np.where(probe.valid, np.asarray(state.singularity[key]),
+                           np.where(refused, 0.0, np.inf))
         for index in _local_minima(measure):
             angle, value = _golden(probe, key, float(probe.theta[index]))
             if value < TOGGLE_MEASURE:
@@ -410,6 +472,15 @@ def _toggles(probe: _Probe, ranges: Sequence[tuple[float, float]]) -> tuple[Togg
                    and t.dyad == toggle.dyad for t in unique):
             unique.append(toggle)
     return tuple(unique)
+
+
+def _inside(theta: Array, ranges: Sequence[tuple[float, float]]) -> Array:
+    """Return whether each crank angle in [0, 2 pi) lies inside one of the ranges."""
+    inside = np.zeros(theta.shape, dtype=bool)
+    for start, end in ranges:
+        for shift in (0.0, _TURN):
+            inside |= (theta + shift > start) & (theta + shift < end)
+    return inside
 
 
 def _local_minima(values: Array) -> list[int]:
@@ -454,36 +525,39 @@ def _outputs(scene: Scene) -> dict[str, str]:
     return outputs
 
 
-def _dead_centres(probe: _Probe) -> tuple[DeadCentre, ...]:
-    scene, state = probe.scene, probe.state
+def _dead_centres(probe: _Probe, ranges: Sequence[tuple[float, float]]
+                  ) -> tuple[DeadCentre, ...]:
+    """Return where an output's velocity changes sign, inside the ranges where it assembles.
+
+    Each range is sampled at the turn's step (at least :data:`RANGE_SAMPLES`
+    angles, so a narrow range is sampled too) and the reversals found as the
+    ranges' ends are (:func:`_crossings`, the acceleration at unit crank speed
+    being the velocity's rate).
+    """
+    scene = probe.scene
     crank = scene.input
     starting = {}  # link from the crank's tip -> the joints of its dyad
     for dyad in scene.dyads:
         starting.update(dyad.tip_links(crank.point))
-    n = len(probe.theta)
-    step = _TURN / n
+    step = _TURN / len(probe.theta)
+    grids = []
+    for start, end in ranges:
+        if end - start >= _TURN:
+            grids.append(_turn_grid(len(probe.theta)))
+            continue
+        count = max(RANGE_SAMPLES, math.ceil((end - start) / step) + 1)
+        inward = 1e-6 * (end - start)  # the ends themselves are refused (toggles)
+        grids.append(np.linspace(start + inward, end - inward, count))
     centres = []
     for joint, kind in _outputs(scene).items():
-        velocity = np.asarray(state.joints[joint].velocity)  # type: ignore[attr-defined]
-        for i in range(n):
-            j = (i + 1) % n
-            if not (probe.valid[i] and probe.valid[j]) or velocity[i] * velocity[j] > 0.0:
-                continue
-            if velocity[j] == 0.0:  # a sample on the reversal: bracket it by its neighbours
-                k = (j + 1) % n
-                if not probe.valid[k] or velocity[i] * velocity[k] >= 0.0:
-                    continue
-            elif velocity[i] == 0.0:
-                continue  # found from the sample before
+        def motion(theta: Array, name: str = joint) -> tuple[Array, Array]:
+            state = probe.solve(theta)
+            valid = np.asarray(state.valid, dtype=bool)  # type: ignore[attr-defined]
+            solved = state.joints[name]  # type: ignore[attr-defined]
+            return (np.where(valid, solved.velocity, np.nan),
+                    np.where(valid, solved.acceleration, np.nan))
 
-            def forward(theta: float, name: str = joint) -> bool:
-                try:
-                    return float(probe.solve(theta).joints[name].velocity) > 0.0  # type: ignore
-                except AssemblyError:
-                    return False
-
-            low = float(probe.theta[i])
-            angle = _bisect(forward, low, low + (2 if velocity[j] == 0.0 else 1) * step)
+        for angle in _distinct([a for grid in grids for a in _crossings(motion, grid)]):
             solved = probe.solve(angle)
             position = float(solved.joints[joint].position)  # type: ignore[attr-defined]
             in_line = None
