@@ -376,7 +376,7 @@ def _turn_grid(samples: int) -> Array:
 
 
 def _distinct(angles: Sequence[float]) -> list[float]:
-    """Return the angles in [0, 2 pi), sorted, those within a few ulp of another (mod 2 pi) once."""
+    """Return the angles in [0, 2 pi), sorted; those within a few ulp (mod 2 pi) once."""
     result: list[float] = []
     for angle in sorted(a % _TURN for a in angles):
         if not result or angle - result[-1] > _SAME:
