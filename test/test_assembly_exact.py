@@ -1,0 +1,206 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""``check`` is exact: region ends, dead centres and toggles by root finding. See issue 19.
+
+A four-bar that assembles only within 0.005 deg of 180.05 deg (between two
+0.1-deg samples, at both of which ``solve`` refuses) is reported with its
+range, its ends within 1e-12 rad of the closed form computed to 50 digits;
+for every packaged scene, ``check``'s ranges and dead centres agree with a
+sweep of +-1e-4 deg at 1e-6 deg around each end and a 0.01-deg sweep of the
+whole turn.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import warnings
+
+import mpmath
+import numpy as np
+import pytest
+
+import mech_kinematics as mk
+from mech_kinematics.__main__ import main
+from mech_kinematics.errors import AssemblyError
+from mech_kinematics.geometry import assembly as asm
+from mech_kinematics.solver import assembly_margins
+
+TURN = 2 * math.pi
+#: The narrow four-bar (mm): crank 50 about A, D at 100 mm and 0.05 deg from +x,
+#: rocker 50, coupler such that it assembles for |crank - 180.05 deg| <= 0.005 deg.
+PHI, HALF_WIDTH = math.radians(0.05), math.radians(0.005)
+CRANK, GROUND, ROCKER = 50.0, 100.0, 50.0
+COUPLER = ROCKER + math.sqrt((CRANK + GROUND) ** 2
+                             - 4 * CRANK * GROUND * math.sin(HALF_WIDTH / 2) ** 2)
+NARROW = f"""\
+name: narrow_window
+units: {{length: mm, angle: deg}}
+ground:
+  A: [0, 0]
+  D: [{GROUND * math.cos(PHI)!r}, {GROUND * math.sin(PHI)!r}]
+input: {{link: crank, center: A, point: B, length: {CRANK!r}, angle: 180.05, speed_rpm: 60}}
+dyads:
+  - type: RRR
+    point: C
+    links:
+      - {{name: coupler, from: B, length: {COUPLER!r}}}
+      - {{name: rocker, from: D, length: {ROCKER!r}}}
+"""
+#: The sweep around each end: +-1e-4 deg at 1e-6 deg.
+NEAR = np.radians(np.arange(-100, 101) * 1e-6)
+
+
+@pytest.fixture(name='narrow')
+def fixture_narrow(tmp_path):
+    """Return the path of the narrow four-bar's scene file."""
+    path = tmp_path / 'narrow_window.yaml'
+    path.write_text(NARROW)
+    return path
+
+
+def window_by_hand(scene):
+    """Return the narrow four-bar's range (rad), from the scene's doubles, to 50 digits.
+
+    |BD|^2 = (r + g)^2 - 4 r g cos^2(psi / 2), psi = theta - phi: it reaches
+    coupler - rocker for psi = pi +- delta, sin(delta / 2)^2 =
+    ((r + g)^2 - (coupler - rocker)^2) / (4 r g).
+    """
+    with mpmath.workdps(50):
+        dx, dy = (mpmath.mpf(v) for v in scene.ground['D'])
+        g, phi = mpmath.sqrt(dx * dx + dy * dy), mpmath.atan2(dy, dx)
+        r = mpmath.mpf(scene.input.length)
+        coupler, rocker = (mpmath.mpf(link.length) for link in scene.dyads[0].links)
+        delta = 2 * mpmath.asin(mpmath.sqrt(((r + g) ** 2 - (coupler - rocker) ** 2)
+                                            / (4 * r * g)))
+        return phi + mpmath.pi - delta, phi + mpmath.pi + delta
+
+
+def solved(scene, theta):
+    """Solve an array of crank angles at 1 rad/s, accepting every finite answer."""
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore')
+        return mk.solve(scene, np.asarray(theta, dtype=float), 1.0, 0.0, max_error=math.inf)
+
+
+def inside(theta, ranges):
+    """Return whether each angle lies strictly inside one of the ranges (mod 2 pi)."""
+    theta = np.asarray(theta) % TURN
+    result = np.zeros(theta.shape, dtype=bool)
+    for start, end in ranges:
+        for shift in (-TURN, 0.0, TURN):
+            result |= (theta + shift > start) & (theta + shift < end)
+    return result
+
+
+def test_the_narrow_window_lies_between_two_samples_that_solve_refuses(narrow):
+    """At 180.0 and 180.1 deg, and every other 0.1-deg sample, solve refuses: sampling sees none."""
+    scene = mk.load_scene(str(narrow))
+    for deg in (180.0, 180.1):
+        with pytest.raises(AssemblyError, match='do not meet'):
+            mk.solve(scene, math.radians(deg))
+    assert not solved(scene, np.radians(np.arange(3600) / 10)).valid.any()
+
+
+def test_check_reports_the_narrow_range_to_1e12_rad(narrow, capsys):
+    """check: the range 180.045..180.055 deg, ends within 1e-12 rad of the closed form."""
+    scene = mk.load_scene(str(narrow))
+    low, high = window_by_hand(scene)
+    result = asm.assembly_from_scene(scene)
+    (start, end), = result.ranges
+    assert abs(start - low) <= 1e-12 and abs(end - high) <= 1e-12
+    assert not result.everywhere
+    # Its links are in line at both ends (toggles): the transmission angle there is 0.
+    assert [t.angle for t in result.toggles] == pytest.approx([start, end], abs=1e-12)
+    assert result.transmission[0].minimum == 0.0
+    assert main(['check', str(narrow), '--json']) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data['assembles_everywhere'] is False
+    (json_start, json_end), = data['ranges']
+    assert (json_start, json_end) == (start, end)
+    assert main(['check', str(narrow)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[1] == 'assembles: for crank angles 180.045..180.055 deg'
+
+
+def test_the_rocker_reverses_inside_the_narrow_range(narrow):
+    """The dead centre inside the 0.01-deg range is found (no 0.1-deg sample lies in it)."""
+    scene = mk.load_scene(str(narrow))
+    result = asm.assembly_from_scene(scene)
+    (start, end), = result.ranges
+    (centre,) = result.dead_centres
+    assert centre.joint == 'rocker' and start < centre.angle < end
+    velocity = solved(scene, centre.angle + np.array([-1e-9, 1e-9])).joints['rocker'].velocity
+    assert velocity[0] * velocity[1] < 0.0
+
+
+def test_closed_form_margins_match_the_solved_positions():
+    """An RRR on the crank: its closed-form margins are the positional ones times a sum.
+
+    (l1 + l2 + d) and (d + |l1 - l2|) times the margins from the solved
+    positions; their rates likewise, 2 d times the distance's rate.
+    """
+    scene = mk.load_scene('khurmi_four_bar_ad150')
+    solver = scene._solver
+    step = solver.run_plan.steps[0]
+    crank = solver.run_plan.crank
+    ground = {name: entry[0] for name, entry in solver.ground.items()}
+    form = step.crank_margins(crank.point, crank.center, crank.length, ground)
+    assert form is not None
+    theta = np.linspace(0.0, TURN, 37)
+    state = solved(scene, theta)
+    b = state.points['B'].position[:, 0] + 1j * state.points['B'].position[:, 1]
+    d = np.abs(b - complex(*scene.ground['D']))
+    lsum, ldiff = 0.15 + 0.08, 0.15 - 0.08
+    (outer, outer_rate), (inner, inner_rate) = form(theta)
+    assert outer == pytest.approx((lsum - d) * (lsum + d), rel=1e-12, abs=1e-17)
+    assert inner == pytest.approx((d - ldiff) * (d + ldiff), rel=1e-12, abs=1e-17)
+    vb = state.points['B'].velocity[:, 0] + 1j * state.points['B'].velocity[:, 1]
+    table = {'B': (b, vb), 'D': (complex(*scene.ground['D']), 0j)}
+    (p_outer, p_outer_rate), (p_inner, p_inner_rate) = step.margins(table)
+    assert p_outer == pytest.approx(lsum - d, rel=1e-12)
+    assert p_inner == pytest.approx(d - ldiff, rel=1e-12)
+    assert outer_rate == pytest.approx(-inner_rate, rel=1e-15)
+    assert inner_rate == pytest.approx(2 * d * p_inner_rate, rel=1e-9, abs=1e-15)
+    assert outer_rate == pytest.approx(2 * d * p_outer_rate, rel=1e-9, abs=1e-15)
+    # assembly_margins gives the closed forms for it.
+    (_, outer2, _), (_, inner2, rate2) = assembly_margins(scene)(theta)
+    assert (outer2 == outer).all() and (inner2 == inner).all() and (rate2 == inner_rate).all()
+
+
+@pytest.mark.parametrize('name', [*mk.scene_names(), 'narrow'])
+def test_check_agrees_with_a_fine_sweep_at_every_end_and_a_coarse_one_elsewhere(name, narrow):
+    """Every range end is where assembly changes (1e-6 deg each side); nothing else changes.
+
+    The dead centres likewise: each output's velocity changes sign across each
+    of its dead centres, and the whole-turn sweep sees no other reversal (and,
+    where no range is too narrow for it, sees every one).
+    """
+    scene = mk.load_scene(str(narrow) if name == 'narrow' else name)
+    result = asm.assembly_from_scene(scene)
+    ends = [a for r in result.ranges for a in r] if not result.everywhere else []
+    for end in ends:
+        theta = end + NEAR
+        valid = solved(scene, theta).valid
+        expected = inside(theta, result.ranges)
+        assert (valid == expected)[NEAR != 0].all(), (name, end)
+        assert expected[NEAR < 0].any() != expected[NEAR > 0].any()
+    coarse = np.arange(36000) * (TURN / 36000) + 1e-7  # 0.01 deg, off the round angles
+    state = solved(scene, coarse)
+    expected = inside(coarse, result.ranges) if not result.everywhere else np.ones(36000, bool)
+    assert (state.valid == expected).all(), name
+    outputs = {j for dyad in scene.dyads for j in dyad.dead_centre_joints(scene.ground)}
+    for joint in outputs | {c.joint for c in result.dead_centres}:
+        centres = [c.angle for c in result.dead_centres if c.joint == joint]
+        for angle in centres:
+            velocity = solved(scene, angle + NEAR[[0, -1]]).joints[joint].velocity
+            assert velocity[0] * velocity[1] < 0.0, (name, joint, angle)
+        velocity = np.where(state.valid, state.joints[joint].velocity, np.nan)
+        signs = np.sign(velocity)
+        following = np.roll(signs, -1)
+        reversals = np.flatnonzero(signs * following < 0)
+        step = TURN / 36000
+        for i in reversals:  # each reversal the sweep sees is a dead centre found
+            assert any((c - coarse[i]) % TURN < step for c in centres), (name, joint, i)
+        if all(end - start > 10 * step for start, end in result.ranges):
+            assert len(reversals) == len(centres), (name, joint)
