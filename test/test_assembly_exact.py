@@ -94,7 +94,7 @@ def inside(theta, ranges):
 
 
 def test_the_narrow_window_lies_between_two_samples_that_solve_refuses(narrow):
-    """At 180.0 and 180.1 deg, and every other 0.1-deg sample, solve refuses: sampling sees none."""
+    """At 180.0 and 180.1 deg and every other 0.1-deg sample solve refuses: sampling sees none."""
     scene = mk.load_scene(str(narrow))
     for deg in (180.0, 180.1):
         with pytest.raises(AssemblyError, match='do not meet'):
