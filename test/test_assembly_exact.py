@@ -204,3 +204,20 @@ def test_check_agrees_with_a_fine_sweep_at_every_end_and_a_coarse_one_elsewhere(
             assert any((c - coarse[i]) % TURN < step for c in centres), (name, joint, i)
         if all(end - start > 10 * step for start, end in result.ranges):
             assert len(reversals) == len(centres), (name, joint)
+
+
+def test_solve_inside_the_narrow_range_is_one_clean_line_or_an_answer(narrow, capsys):
+    """At 180.05 deg, solve prints one `error:` line (exit 2).
+
+    With --max-error inf, the answer and one `warning:` line: never Python's
+    warning with its source line.
+    """
+    assert main(['solve', str(narrow), '--angle-deg', '180.05']) == 2
+    captured = capsys.readouterr()
+    assert captured.out == '' and captured.err.count('\n') == 1
+    assert captured.err.startswith('error: RRR C cannot be solved at crank angle 180.05 deg: ')
+    assert main(['solve', str(narrow), '--angle-deg', '180.05', '--max-error', 'inf']) == 0
+    captured = capsys.readouterr()
+    assert captured.err == ('warning: dyad at "C" is near-singular (measure below 0.001): its '
+                            'velocities and accelerations lose accuracy\n')
+    assert json.loads(captured.out)['scene'] == 'narrow_window'
