@@ -5,8 +5,10 @@
 :func:`assembly_from_scene` studies one full turn of the crank (angles 0 to
 2 pi, CCW from +x) from the exact solver:
 
-- the crank-angle ranges where the mechanism assembles, their ends refined
-  by bisection to :data:`TOLERANCE` rad;
+- the crank-angle ranges where the mechanism assembles, however narrow: the
+  roots of each step's assembly margins (:meth:`.solver.base.Step.margins`;
+  closed forms in the crank angle for a dyad on the crank), found to an ulp
+  of the angle (within :data:`TOLERANCE` rad);
 - its toggle positions: where a dyad's two links come in line (an RRR's
   coupler and rocker, an RRP's rod square to its guide), at the ends of
   those ranges or, at a change point, inside one; the mechanism locks there;
@@ -28,10 +30,18 @@ short line, for ``plot --scene`` and the node's diagnostics. Angles here are
 in rad and lengths in m; :class:`~mech_kinematics.linkage.Units` shows them
 in the scene's own units. NumPy only: the solver does the geometry.
 
-A range narrower than the sampling step (:data:`SAMPLES` per turn) can be
-missed; toggles and transmission minima inside a range are refined from the
-sampled minimum, so a second, equally deep minimum within one step of the
-first is reported once.
+What is guaranteed: each margin and its rate are sampled (:data:`SAMPLES`
+per turn); a margin's extremum lies where its rate changes sign and is found
+by bisection on the rate, and a sign change of the margin on either side of
+it by bisection on the margin, so a range of any width around an extremum is
+found, its ends exact (``solve`` refuses within rounding of them). Only two
+extrema of one margin within one sample step (its rate changing sign twice
+between samples) can hide a range. Dead centres are the velocity's sign
+changes, found the same way (the acceleration at unit crank speed being its
+rate) in each range, sampled at the turn's step and at least
+:data:`RANGE_SAMPLES` times. Toggles and transmission minima inside a range
+are refined from the sampled minimum, so a second, equally deep minimum
+within one step of the first is reported once.
 """
 
 from __future__ import annotations
