@@ -420,16 +420,43 @@ def _assembles(margins: Callable[[Array], list[tuple[str, Array, Array]]],
 
 
 def _root(function: Callable[[Array], Array], low: float, high: float) -> float:
-    """Return where ``function`` (of one crank angle) changes sign in [low, high], to an ulp."""
-    keep = float(function(np.array([low]))[0]) > 0.0
+    """Return where ``function`` (of one crank angle) changes sign in [low, high], to an ulp.
+
+    Regula falsi, Illinois variant (a stale end's value halved), the bracket
+    kept by sign; a bisection step wherever that did not halve the bracket
+    twice running; until no double lies strictly inside the bracket.
+    """
+    def at(theta: float) -> float:
+        return float(function(np.array([theta]))[0])
+
+    f_low, f_high = at(low), at(high)
+    keep = f_low > 0.0
+    side = 0
+    slow = 0
     while True:
+        width = high - low
         middle = 0.5 * (low + high)
         if middle in (low, high):
             return middle
-        if (float(function(np.array([middle]))[0]) > 0.0) == keep:
-            low = middle
+        t = middle
+        if slow < 2 and math.isfinite(f_low) and math.isfinite(f_high) and f_low != f_high:
+            guess = high - f_high * width / (f_high - f_low)
+            if low < guess < high:
+                t = guess
+        f = at(t)
+        if f == 0.0:
+            return t
+        if (f > 0.0) == keep:
+            low, f_low = t, f
+            if side == -1:
+                f_high *= 0.5
+            side = -1
         else:
-            high = middle
+            high, f_high = t, f
+            if side == 1:
+                f_low *= 0.5
+            side = 1
+        slow = slow + 1 if high - low > 0.5 * width else 0
 
 
 def _gaps(ranges: Sequence[tuple[float, float]]) -> tuple[tuple[float, float], ...]:
