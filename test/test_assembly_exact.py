@@ -168,6 +168,21 @@ def test_closed_form_margins_match_the_solved_positions():
     assert (outer2 == outer).all() and (inner2 == inner).all() and (rate2 == inner_rate).all()
 
 
+def test_one_steps_margins_are_those_of_the_whole_plan():
+    """margins(theta, label) gives that step's margins alone, the same bits as the whole list."""
+    scene = mk.load_scene('six_link_slider')
+    margins = assembly_margins(scene)
+    theta = np.linspace(0.0, TURN, 73)
+    whole = margins(theta)
+    assert [label for label, _, _ in whole] == ['RRR B', 'RRR B', 'RRP D', 'RRP D']
+    for label in ('RRR B', 'RRP D'):
+        alone = margins(theta, label)
+        mine = [entry for entry in whole if entry[0] == label]
+        assert len(alone) == 2
+        for (_, m1, r1), (_, m2, r2) in zip(alone, mine, strict=True):
+            assert np.array_equal(m1, m2) and np.array_equal(r1, r2)
+
+
 @pytest.mark.parametrize('name', [*mk.scene_names(), 'narrow'])
 def test_check_agrees_with_a_fine_sweep_at_every_end_and_a_coarse_one_elsewhere(name, narrow):
     """Every range end is where assembly changes (1e-6 deg each side); nothing else changes.

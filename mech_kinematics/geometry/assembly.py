@@ -314,9 +314,12 @@ def _ranges(probe: _Probe) -> tuple[tuple[float, float], ...]:
     theta = _turn_grid(len(probe.theta))
     sampled = margins(theta)
     roots = []
-    for index, (_, margin, rate) in enumerate(sampled):
-        def function(t: Array, k: int = index) -> tuple[Array, Array]:
-            return margins(t)[k][1:]
+    seen: dict[str, int] = {}
+    for label, margin, rate in sampled:
+        order = seen[label] = seen.get(label, -1) + 1  # which of its step's margins
+
+        def function(t: Array, name: str = label, k: int = order) -> tuple[Array, Array]:
+            return margins(t, name)[k][1:]
 
         roots.extend(_crossings(function, theta, (margin, rate)))
     roots = _distinct(roots)
@@ -410,7 +413,7 @@ def _changes(value: Array, rate: Array) -> list[int]:
     return [int(i) for i in np.flatnonzero(both & (flips | zero))]
 
 
-def _assembles(margins: Callable[[Array], list[tuple[str, Array, Array]]],
+def _assembles(margins: Callable[..., list[tuple[str, Array, Array]]],
                theta: Array) -> Array:
     """Return whether every margin is positive at each crank angle."""
     ok = np.ones(theta.shape, dtype=bool)
