@@ -236,3 +236,18 @@ def test_solve_inside_the_narrow_range_is_one_clean_line_or_an_answer(narrow, ca
     assert captured.err == ('warning: dyad at "C" is near-singular (measure below 0.001): its '
                             'velocities and accelerations lose accuracy\n')
     assert json.loads(captured.out)['scene'] == 'narrow_window'
+
+
+def test_a_change_points_toggles_are_exact_and_no_gap():
+    """A parallelogram's margins touch 0 at 0 and 180 deg: toggles there to 1e-12 rad, no gap.
+
+    Its outer margin (l1 + l2)^2 - |BD|^2 is 0 at 180 deg in exact arithmetic and
+    within rounding of it in doubles: a touch, not a range where it does not assemble.
+    """
+    links = (mk.Link('coupler', 'B', 0.1), mk.Link('rocker', 'D', 0.04))
+    scene = mk.Scene('parallelogram', {'A': (0.0, 0.0), 'D': (0.1, 0.0)},
+                     mk.Crank('crank', 'A', 'B', 0.04, 0.5, 1.0), (mk.RRR('C', links),))
+    result = asm.assembly_from_scene(scene)
+    assert result.everywhere and result.gaps == ()
+    assert [t.angle for t in result.toggles] == pytest.approx([0.0, math.pi], abs=1e-12)
+    assert {t.dyad for t in result.toggles} == {'RRR C'}

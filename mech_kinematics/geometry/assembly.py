@@ -73,6 +73,9 @@ SAMPLES = 3600
 TOLERANCE = 1e-12
 #: A measure (sine of a transmission angle) below this inside a range is a toggle.
 TOGGLE_MEASURE = 1e-6
+#: A margin's extremum within this of 0 (relative to its largest sampled size: its
+#: rounding) touches 0: a toggle inside a range (a change point's), not a gap.
+TOUCH = 1e-14
 #: Relative difference of ``s + l`` and ``p + q`` within which a loop is a change point.
 CHANGE_POINT = 1e-9
 #: Crank angles sampled at least in each range where it assembles, for dead centres.
@@ -262,6 +265,10 @@ class _Probe:
         self.state = self.solve(self.theta)
         self.valid = np.asarray(self.state.valid, dtype=bool)
         self.margins = assembly_margins(self.scene)
+        # Filled by _ranges: (angle, step label) of each margin's roots and of each
+        # extremum where a margin touches 0.
+        self.roots: list[tuple[float, str]] = []
+        self.touches: list[tuple[float, str]] = []
 
     def solve(self, theta: float | Array) -> object:
         """Solve at crank speed 1 rad/s, refusing only what does not assemble."""
@@ -321,7 +328,13 @@ def _ranges(probe: _Probe) -> tuple[tuple[float, float], ...]:
         def function(t: Array, name: str = label, k: int = order) -> tuple[Array, Array]:
             return margins(t, name)[k][1:]
 
-        roots.extend(_crossings(function, theta, (margin, rate)))
+        extrema: list[tuple[float, float]] = []
+        touch = TOUCH * float(np.nanmax(np.abs(margin), initial=0.0))
+        found = _crossings(function, theta, (margin, rate), extrema, touch)
+        roots.extend(found)
+        probe.roots.extend((root, label) for root in found)
+        probe.touches.extend((angle, label) for angle, value in extrema  # a toggle inside
+                             if abs(value) <= touch)
     roots = _distinct(roots)
     if not roots:
         return ((0.0, _TURN),) if _assembles(margins, np.array([0.0]))[0] else ()
@@ -350,7 +363,9 @@ def _ranges(probe: _Probe) -> tuple[tuple[float, float], ...]:
 
 
 def _crossings(function: Callable[[Array], tuple[Array, Array]], theta: Array,
-               sampled: tuple[Array, Array] | None = None) -> list[float]:
+               sampled: tuple[Array, Array] | None = None,
+               extrema: list[tuple[float, float]] | None = None,
+               touch: float = -1.0) -> list[float]:
     """Return where ``function``'s value changes sign between the first and last of ``theta``.
 
     ``function`` gives (value, rate) at crank angles, NaN where unknown;
@@ -360,7 +375,10 @@ def _crossings(function: Callable[[Array], tuple[Array, Array]], theta: Array,
     however close together the two are (unless the value is further from zero
     than twice the step times the larger rate: it cannot get there, and the
     rate's rounding noise about a flat value is not chased); each sign change
-    is then found by bisection on the value's sign, to an ulp of the angle. An interval where
+    is then found by bisection on the value's sign, to an ulp of the angle.
+    The extrema found are appended to ``extrema`` as (angle, value); one
+    within ``touch`` of zero touches it (within rounding): no sign change is
+    sought beside it. An interval where
     the rate changes sign twice (two extrema within one sample step) is seen
     as monotonic.
     """
@@ -375,6 +393,10 @@ def _crossings(function: Callable[[Array], tuple[Array, Array]], theta: Array,
             extremum = _root(lambda t: function(t)[1], a, b)
             ends.insert(1, extremum)
             values.insert(1, float(function(np.array([extremum]))[0][0]))
+            if extrema is not None:
+                extrema.append((extremum, values[1]))
+            if abs(values[1]) <= touch:
+                continue
         for (low, v_low), (high, v_high) in itertools.pairwise(zip(ends, values, strict=True)):
             if v_low * v_high < 0.0:
                 roots.append(_root(lambda t: function(t)[0], low, high))
@@ -488,13 +510,17 @@ def _measure_keys(scene: Scene) -> dict[str, tuple[str, tuple[str, ...]]]:
 def _toggles(probe: _Probe, ranges: Sequence[tuple[float, float]]) -> tuple[Toggle, ...]:
     keys = _measure_keys(probe.scene)
     labels = {label: (key, links) for key, (label, links) in keys.items()}
-    toggles = []
+    exact = []  # the roots of margins: the ends of ranges and where a margin touches 0
     if len(ranges) != 1 or ranges[0][1] - ranges[0][0] < _TURN:
-        for start, end in ranges:  # the dyad that fails just beyond each end locks there
-            for edge, outside in ((start, start - 1e-9), (end, end + 1e-9)):
-                error = probe.failure(outside)
-                if error is not None and error.dyad in labels:
-                    toggles.append(Toggle(edge % _TURN, error.dyad, labels[error.dyad][1]))
+        for start, end in ranges:  # the dyad whose margin ends the range locks there
+            for edge in (start, end):
+                label = next((label for angle, label in probe.roots
+                              if abs(math.remainder(angle - edge, _TURN)) <= _SAME), None)
+                if label in labels:
+                    exact.append(Toggle(edge % _TURN, label, labels[label][1]))
+    exact.extend(Toggle(angle % _TURN, label, labels[label][1])
+                 for angle, label in probe.touches if label in labels)
+    toggles = []
     state = probe.state
     # A sample inside a range that the solver refuses is on a toggle (a margin touching 0).
     refused = _inside(probe.theta, ranges) & ~probe.valid
@@ -505,13 +531,12 @@ def _toggles(probe: _Probe, ranges: Sequence[tuple[float, float]]) -> tuple[Togg
             angle, value = _golden(probe, key, float(probe.theta[index]))
             if value < TOGGLE_MEASURE:
                 toggles.append(Toggle(angle % _TURN, label, links))
-    toggles.sort(key=lambda t: t.angle)
     unique: list[Toggle] = []
-    for toggle in toggles:
+    for toggle in sorted(exact, key=lambda t: t.angle) + sorted(toggles, key=lambda t: t.angle):
         if not any(abs(math.remainder(toggle.angle - t.angle, _TURN)) < 1e-6
                    and t.dyad == toggle.dyad for t in unique):
             unique.append(toggle)
-    return tuple(unique)
+    return tuple(sorted(unique, key=lambda t: t.angle))
 
 
 def _inside(theta: Array, ranges: Sequence[tuple[float, float]]) -> Array:
