@@ -251,3 +251,21 @@ def test_a_change_points_toggles_are_exact_and_no_gap():
     assert result.everywhere and result.gaps == ()
     assert [t.angle for t in result.toggles] == pytest.approx([0.0, math.pi], abs=1e-12)
     assert {t.dyad for t in result.toggles} == {'RRR C'}
+
+
+def test_a_sign_change_just_before_an_earlier_dyad_stops_closing_is_found():
+    """A margin known only up to 0.3001 rad (NaN beyond) crossing 0 at 0.30005 rad.
+
+    Both lie inside one sample step (0.300..0.301): the step is cut where
+    the margin stops being known and the root is still found, to an ulp.
+    """
+    root, limit = 0.30005, 0.3001
+
+    def function(theta):
+        theta = np.asarray(theta, dtype=float)
+        known = theta <= limit
+        return np.where(known, theta - root, np.nan), np.where(known, 1.0, np.nan)
+
+    grid = np.arange(1001) * 0.001
+    (found,) = asm._crossings(function, grid)
+    assert abs(found - root) <= math.ulp(root)

@@ -376,19 +376,27 @@ def _crossings(function: Callable[[Array], tuple[Array, Array]], theta: Array,
     than twice the step times the larger rate: it cannot get there, and the
     rate's rounding noise about a flat value is not chased); each sign change
     is then found by bisection on the value's sign, to an ulp of the angle.
-    The extrema found are appended to ``extrema`` as (angle, value); one
-    within ``touch`` of zero touches it (within rounding): no sign change is
-    sought beside it. An interval where
-    the rate changes sign twice (two extrema within one sample step) is seen
-    as monotonic.
+    Where the value is known at one end of a step only (an earlier dyad stops
+    closing between), the step is cut where it stops being known. The
+    extrema found are appended to ``extrema`` as (angle, value); one within
+    ``touch`` of zero touches it (within rounding): no sign change is sought
+    beside it. An interval where the rate changes sign twice (two extrema
+    within one sample step) is seen as monotonic.
     """
     value, rate = function(theta) if sampled is None else sampled
     roots = []
     for i in _changes(value, rate):
         a, b = float(theta[i]), float(theta[i + 1])
-        ends, values = [a, b], [float(value[i]), float(value[i + 1])]
-        reach = 2.0 * (b - a) * max(abs(rate[i]), abs(rate[i + 1]))  # of the value, at most
-        if rate[i] * rate[i + 1] < 0.0 and min(abs(values[0]), abs(values[1])) <= reach:
+        va, vb, ra, rb = float(value[i]), float(value[i + 1]), float(rate[i]), float(rate[i + 1])
+        if not math.isfinite(va + ra):  # known from b on only: cut the step there
+            a = _known_from(function, b, a)
+            va, ra = (float(x[0]) for x in function(np.array([a])))
+        elif not math.isfinite(vb + rb):
+            b = _known_from(function, a, b)
+            vb, rb = (float(x[0]) for x in function(np.array([b])))
+        ends, values = [a, b], [va, vb]
+        reach = 2.0 * (b - a) * max(abs(ra), abs(rb))  # of the value, at most
+        if ra * rb < 0.0 and min(abs(va), abs(vb)) <= reach:
             # an extremum between that may cross 0: the value is monotonic either side
             extremum = _root(lambda t: function(t)[1], a, b)
             ends.insert(1, extremum)
@@ -400,9 +408,24 @@ def _crossings(function: Callable[[Array], tuple[Array, Array]], theta: Array,
         for (low, v_low), (high, v_high) in itertools.pairwise(zip(ends, values, strict=True)):
             if v_low * v_high < 0.0:
                 roots.append(_root(lambda t: function(t)[0], low, high))
-            elif v_high == 0.0 and high == b and i + 2 < len(theta) and v_low * value[i + 2] < 0.0:
-                roots.append(b)  # on a sample
+            elif (v_high == 0.0 and high == float(theta[i + 1]) and i + 2 < len(theta)
+                  and v_low * value[i + 2] < 0.0):
+                roots.append(high)  # on a sample
     return roots
+
+
+def _known_from(function: Callable[[Array], tuple[Array, Array]], known: float,
+                unknown: float) -> float:
+    """Return the angle nearest ``unknown`` from ``known`` at which ``function`` is known."""
+    while True:
+        middle = 0.5 * (known + unknown)
+        if middle in (known, unknown):
+            return known
+        value, rate = (float(x[0]) for x in function(np.array([middle])))
+        if math.isfinite(value + rate):
+            known = middle
+        else:
+            unknown = middle
 
 
 def _turn_grid(samples: int) -> Array:
@@ -422,14 +445,15 @@ def _distinct(angles: Sequence[float]) -> list[float]:
 
 
 def _changes(value: Array, rate: Array) -> list[int]:
-    """Return the sample intervals where a value or its rate changes sign (both known).
+    """Return the sample intervals where a value or its rate changes sign, or stops being known.
 
     A value exactly zero at a sample between two of opposite signs gives the
     interval before it (its bisection ends on that sample).
     """
     known = np.isfinite(value) & np.isfinite(rate)
-    both = known[:-1] & known[1:]
-    flips = (value[:-1] * value[1:] < 0.0) | (rate[:-1] * rate[1:] < 0.0)
+    both = known[:-1] | known[1:]  # known at one end only: cut where it stops being known
+    flips = ((value[:-1] * value[1:] < 0.0) | (rate[:-1] * rate[1:] < 0.0)
+             | (known[:-1] != known[1:]))
     zero = np.zeros_like(flips)
     zero[:-1] = (value[1:-1] == 0.0) & (value[:-2] * value[2:] < 0.0) & known[2:]
     return [int(i) for i in np.flatnonzero(both & (flips | zero))]
