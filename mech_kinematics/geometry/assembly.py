@@ -472,8 +472,9 @@ def _root(function: Callable[[Array], Array], low: float, high: float) -> float:
     """Return where ``function`` (of one crank angle) changes sign in [low, high], to an ulp.
 
     Regula falsi, Illinois variant (a stale end's value halved), the bracket
-    kept by sign; a bisection step wherever that did not halve the bracket
-    twice running; until no double lies strictly inside the bracket.
+    kept by sign; near the root a step of a few ulp past the estimate closes
+    the bracket; a bisection step wherever the bracket did not halve twice
+    running; until no double lies strictly inside the bracket.
     """
     def at(theta: float) -> float:
         return float(function(np.array([theta]))[0])
@@ -495,6 +496,7 @@ def _root(function: Callable[[Array], Array], low: float, high: float) -> float:
         f = at(t)
         if f == 0.0:
             return t
+        close = t != middle and abs(f) < abs(f_low) and abs(f) < abs(f_high)
         if (f > 0.0) == keep:
             low, f_low = t, f
             if side == -1:
@@ -505,6 +507,14 @@ def _root(function: Callable[[Array], Array], low: float, high: float) -> float:
             if side == 1:
                 f_low *= 0.5
             side = 1
+        if close:  # nearly there: a step of a few ulp toward the bracket's other end
+            near = t + math.copysign(4.0 * math.ulp(t), (high if t == low else low) - t)
+            if low < near < high:
+                f_near = at(near)
+                if (f_near > 0.0) == keep:
+                    low, f_low = near, f_near
+                else:
+                    high, f_high = near, f_near
         slow = slow + 1 if high - low > 0.5 * width else 0
 
 
