@@ -269,3 +269,91 @@ def test_a_sign_change_just_before_an_earlier_dyad_stops_closing_is_found():
     grid = np.arange(1001) * 0.001
     (found,) = asm._crossings(function, grid)
     assert abs(found - root) <= math.ulp(root)
+
+
+def slider_window_scene(gamma, half_width, crank=0.05, rod=0.12):
+    """Return an RRP whose guide (through T, at ``gamma``) is in reach only near 90 deg + gamma.
+
+    T = (0, t) with cos(gamma) t = rod + crank (1 - 2 sin^2(half_width / 2)): the
+    tip's distance from the guide is within the rod for |theta - gamma - 90 deg|
+    <= half_width (to the rounding of the doubles; the closed form below uses them).
+    """
+    t = (rod + crank * (1 - 2 * math.sin(half_width / 2) ** 2)) / math.cos(gamma)
+    rrp = mk.RRP('C', mk.Link('rod', 'B', rod), 'T', gamma, 'block')
+    return mk.Scene('slider_window', {'A': (0.0, 0.0), 'T': (0.0, t)},
+                    mk.Crank('crank', 'A', 'B', crank, gamma + math.pi / 2, 1.0), (rrp,),
+                    units=mk.Units('mm', 'deg'))
+
+
+def slider_window_by_hand(scene):
+    """Return the RRP window's range (rad) from the scene's doubles, to 50 digits.
+
+    The guide direction is the rounded u = (cos gamma, sin gamma), of length k
+    and angle g; the tip's signed distance is o = c + r k sin(theta - g),
+    c = cross(u, A - T); l + o >= 0 within acos(-(l + c) / (r k)) of g + 90 deg.
+    """
+    (rrp,) = scene.dyads
+    with mpmath.workdps(50):
+        ux, uy = mpmath.mpf(math.cos(rrp.guide_angle)), mpmath.mpf(math.sin(rrp.guide_angle))
+        tx, ty = (mpmath.mpf(v) for v in scene.ground[rrp.through])
+        c = ux * (0 - ty) - uy * (0 - tx)
+        rk = mpmath.mpf(scene.input.length) * mpmath.sqrt(ux * ux + uy * uy)
+        x = (mpmath.mpf(rrp.link.length) + c + rk) / rk  # 1 - cos(delta)
+        delta = 2 * mpmath.asin(mpmath.sqrt(x / 2))
+        centre = mpmath.atan2(uy, ux) + mpmath.pi / 2
+        return centre - delta, centre + delta
+
+
+def test_a_slider_cranks_narrow_range_is_found_to_1e12_rad():
+    """A guide in the crank tip's reach only within 0.005 deg of 90.05 deg: that range, exactly."""
+    scene = slider_window_scene(math.radians(0.05), math.radians(0.005))
+    assert not solved(scene, np.radians(np.arange(3600) / 10)).valid.any()
+    low, high = slider_window_by_hand(scene)
+    (start, end), = asm.assembly_from_scene(scene).ranges
+    assert abs(start - low) <= 1e-12 and abs(end - high) <= 1e-12
+    assert math.degrees(start) == pytest.approx(90.045, abs=1e-6)
+
+
+@pytest.mark.parametrize('name', ['piston_300', 'offset_slider_crank', 'slider_crank_150_600'])
+def test_an_rrp_on_the_cranks_closed_forms_match_its_solved_positions(name):
+    """An RRP whose rod starts at the crank's tip: closed-form margins = positional ones."""
+    scene = mk.load_scene(name)
+    solver = scene._solver
+    plan = solver.run_plan
+    step = plan.steps[0]
+    ground = {name: entry[0] for name, entry in solver.ground.items()}
+    form = step.crank_margins(plan.crank.point, plan.crank.center, plan.crank.length, ground)
+    assert form is not None
+    theta = np.linspace(0.0, TURN, 37)
+    state = solved(scene, theta)
+    tip = plan.crank.point
+    position = state.points[tip].position[:, 0] + 1j * state.points[tip].position[:, 1]
+    velocity = state.points[tip].velocity[:, 0] + 1j * state.points[tip].velocity[:, 1]
+    for (m1, r1), (m2, r2) in zip(form(theta), step.margins({tip: (position, velocity)}),
+                                  strict=True):
+        assert m1 == pytest.approx(m2, rel=1e-12, abs=1e-16)
+        assert r1 == pytest.approx(r2, rel=1e-12, abs=1e-16)
+
+
+def test_a_narrow_gap_is_found_to_1e12_rad():
+    """A four-bar that does not assemble only within 0.005 deg of 0.05 deg: that gap, exactly.
+
+    |BD| is least, g - r, at theta = phi; with coupler - rocker just above it the
+    links fail to reach there: sin(delta / 2)^2 = ((l1 - l2)^2 - (g - r)^2) / (4 r g).
+    """
+    r, g, rocker = 0.05, 0.1, 0.05
+    coupler = rocker + math.sqrt((g - r) ** 2 + 4 * r * g * math.sin(HALF_WIDTH / 2) ** 2)
+    links = (mk.Link('coupler', 'B', coupler), mk.Link('rocker', 'D', rocker))
+    scene = mk.Scene('narrow_gap', {'A': (0.0, 0.0), 'D': (g * math.cos(PHI), g * math.sin(PHI))},
+                     mk.Crank('crank', 'A', 'B', r, math.pi, 1.0), (mk.RRR('C', links),))
+    assert solved(scene, np.radians(np.arange(3600) / 10)).valid.all()
+    with mpmath.workdps(50):
+        dx, dy = (mpmath.mpf(v) for v in scene.ground['D'])
+        gg, phi = mpmath.sqrt(dx * dx + dy * dy), mpmath.atan2(dy, dx)
+        ldiff = mpmath.mpf(coupler) - mpmath.mpf(rocker)
+        delta = 2 * mpmath.asin(mpmath.sqrt((ldiff ** 2 - (gg - mpmath.mpf(r)) ** 2)
+                                            / (4 * mpmath.mpf(r) * gg)))
+        low, high = phi - delta, phi + delta
+    result = asm.assembly_from_scene(scene)
+    (gap_start, gap_end), = result.gaps
+    assert abs(gap_start - low) <= 1e-12 and abs(gap_end - high) <= 1e-12

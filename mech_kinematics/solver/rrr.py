@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from .base import Edge, Frame, Item, Member, Names, Placing, Reading, Step
-from .context import _Context, _dot, _U16, _U2, _U3, _U7, SINGULAR
+from .context import _Context, _dot, _sum_root, _U16, _U2, _U3, _U7, SINGULAR
 from .model import _check_name, _g, Branch, Link, Where
 from ..bounds import ROUNDING_MARGIN, U
 from ..errors import SceneError
@@ -135,14 +135,6 @@ class RRR(Item):
         return self.point, *self.links
 
 
-def _sum_root(x: Fraction, square: Fraction) -> float:
-    """Return ``x + sqrt(square)`` for an exact ``x`` without cancellation (to a few ulp)."""
-    root = math.sqrt(square)
-    if x >= 0:
-        return float(x) + root
-    return float(square - x * x) / (root - float(x))
-
-
 class _RRRStep(Step):
 
     def __init__(self, dyad: RRR) -> None:
@@ -197,10 +189,12 @@ class _RRRStep(Step):
         With ``r`` the crank, ``g`` and ``phi`` the distance and direction of
         the ground point from the crank's pivot and ``psi = theta - phi``:
         ``d^2 = (r - g)^2 + 4 r g sin^2(psi / 2) = (r + g)^2 - 4 r g cos^2(psi / 2)``,
-        so ``(l1 + l2)^2 - d^2`` and ``d^2 - (l1 - l2)^2`` are a constant less a
-        smooth term; the constants are formed exactly from the doubles given
-        (:func:`_sum_root`), so the margins keep their accuracy where the
-        circles barely meet, and their roots come out to an ulp of the angle.
+        so ``(l1 + l2)^2 - d^2`` and ``d^2 - (l1 - l2)^2`` are each a constant
+        plus a smooth term, taken in the form whose term is the smaller (near
+        ``psi = 0`` or ``pi``); the constants are formed exactly from the
+        doubles given (:func:`._sum_root`), so the margins keep their accuracy
+        where the circles barely meet (or barely fail to), and their roots
+        come out to an ulp of the angle.
         """
         starts = (self.start1, self.start2)
         if tip not in starts:
@@ -216,15 +210,21 @@ class _RRRStep(Step):
         r = Fraction(radius)
         lsum = Fraction(self.l1) + Fraction(self.l2)
         ldiff = abs(Fraction(self.l1) - Fraction(self.l2))
-        outer = _sum_root(lsum - r, g2) * -_sum_root(-(lsum + r), g2)  # lsum^2 - (r - g)^2
-        inner = _sum_root(r - ldiff, g2) * _sum_root(r + ldiff, g2)  # (r + g)^2 - ldiff^2
+        # Near psi = 0 (d = |r - g|) and near psi = pi (d = r + g):
+        outer_0 = _sum_root(lsum - r, g2) * -_sum_root(-(lsum + r), g2)  # lsum^2 - (r - g)^2
+        outer_pi = -_sum_root(r - lsum, g2) * _sum_root(lsum + r, g2)  # lsum^2 - (r + g)^2
+        inner_0 = _sum_root(ldiff - r, g2) * _sum_root(-(r + ldiff), g2)  # (r - g)^2 - ldiff^2
+        inner_pi = _sum_root(r - ldiff, g2) * _sum_root(r + ldiff, g2)  # (r + g)^2 - ldiff^2
         rg4 = 4.0 * radius * math.sqrt(g2)
 
         def margins(theta: Any) -> tuple[tuple[Any, Any], ...]:
             half = 0.5 * (theta - phi)
             s, c = np.sin(half), np.cos(half)
+            s2, c2 = rg4 * s * s, rg4 * c * c
+            near_0 = s * s < 0.5
             rate = rg4 * s * c  # 2 r g sin(psi): the rate of d^2
-            return ((outer - rg4 * s * s, -rate), (inner - rg4 * c * c, rate))
+            return ((np.where(near_0, outer_0 - s2, outer_pi + c2), -rate),
+                    (np.where(near_0, inner_0 + s2, inner_pi - c2), rate))
 
         return margins
 
