@@ -32,16 +32,19 @@ in the scene's own units. NumPy only: the solver does the geometry.
 
 What is guaranteed: each margin and its rate are sampled (:data:`SAMPLES`
 per turn); a margin's extremum lies where its rate changes sign and is found
-by bisection on the rate, and a sign change of the margin on either side of
-it by bisection on the margin, so a range of any width around an extremum is
-found, its ends exact (``solve`` refuses within rounding of them). Only two
+by a bracketing root finder on the rate, and a sign change of the margin on
+either side of it likewise on the margin, so a range of any width around an
+extremum is found, its ends exact (``solve`` refuses within rounding of
+them). Only two
 extrema of one margin within one sample step (its rate changing sign twice
 between samples) can hide a range. Dead centres are the velocity's sign
 changes, found the same way (the acceleration at unit crank speed being its
 rate) in each range, sampled at the turn's step and at least
-:data:`RANGE_SAMPLES` times. Toggles and transmission minima inside a range
-are refined from the sampled minimum, so a second, equally deep minimum
-within one step of the first is reported once.
+:data:`RANGE_SAMPLES` times. A toggle at an end of a range is that end; one
+inside a range where a margin touches zero (a change point's) is that
+margin's extremum, found exactly; others, and transmission minima, are
+refined from the sampled minimum of the dyad's measure, so a second, equally
+deep minimum within one step of the first is reported once.
 """
 
 from __future__ import annotations
@@ -276,13 +279,6 @@ class _Probe:
             warnings.simplefilter('ignore', NearSingularWarning)
             return solve(self.scene, theta, 1.0, 0.0, max_error=math.inf)
 
-    def assembles(self, theta: float) -> bool:
-        try:
-            self.solve(theta)
-        except AssemblyError:
-            return False
-        return True
-
     def failure(self, theta: float) -> AssemblyError | None:
         try:
             self.solve(theta)
@@ -291,29 +287,15 @@ class _Probe:
         return None
 
 
-def _bisect(test: Callable[[float], bool], low: float, high: float) -> float:
-    """Return the change of ``test`` between ``low`` (its value there kept) and ``high``."""
-    keep = test(low)
-    while high - low > TOLERANCE:
-        middle = 0.5 * (low + high)
-        if middle in (low, high):
-            break
-        if test(middle) == keep:
-            low = middle
-        else:
-            high = middle
-    return 0.5 * (low + high)
-
-
 def _ranges(probe: _Probe) -> tuple[tuple[float, float], ...]:
     """Return where every step's margin is positive, its ends the margins' roots.
 
     Each margin and its rate are sampled over the turn; an extremum of a
     margin lies where its rate changes sign between two samples and is found
-    by bisection on the rate, so a window where the margin is positive
+    by root finding on the rate, so a window where the margin is positive
     however narrow around an extremum is caught; between extrema a margin is
-    monotonic, and where it changes sign its root is found by bisection on
-    its sign, to an ulp of the angle. Between consecutive roots the
+    monotonic, and where it changes sign its root is found (bracketed by
+    sign), to an ulp of the angle. Between consecutive roots the
     mechanism assembles or not throughout (but where a margin touches zero,
     a toggle): two evaluations tell which.
     """
@@ -370,12 +352,12 @@ def _crossings(function: Callable[[Array], tuple[Array, Array]], theta: Array,
 
     ``function`` gives (value, rate) at crank angles, NaN where unknown;
     ``sampled`` is its answer at ``theta`` if already known. Where the rate
-    changes sign between two samples the extremum is found by bisection on
-    the rate, so a sign change of the value on either side of it is caught
+    changes sign between two samples the extremum is found by root finding
+    on the rate (:func:`_root`), so a sign change of the value on either side of it is caught
     however close together the two are (unless the value is further from zero
     than twice the step times the larger rate: it cannot get there, and the
     rate's rounding noise about a flat value is not chased); each sign change
-    is then found by bisection on the value's sign, to an ulp of the angle.
+    is then found, bracketed by the value's sign, to an ulp of the angle.
     Where the value is known at one end of a step only (an earlier dyad stops
     closing between), the step is cut where it stops being known. The
     extrema found are appended to ``extrema`` as (angle, value); one within
@@ -448,7 +430,7 @@ def _changes(value: Array, rate: Array) -> list[int]:
     """Return the sample intervals where a value or its rate changes sign, or stops being known.
 
     A value exactly zero at a sample between two of opposite signs gives the
-    interval before it (its bisection ends on that sample).
+    interval before it (its root finding ends on that sample).
     """
     known = np.isfinite(value) & np.isfinite(rate)
     both = known[:-1] | known[1:]  # known at one end only: cut where it stops being known
