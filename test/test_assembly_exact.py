@@ -120,7 +120,9 @@ def test_check_reports_the_narrow_range_to_1e12_rad(narrow, capsys):
     assert (json_start, json_end) == (start, end)
     assert main(['check', str(narrow)]) == 0
     lines = capsys.readouterr().out.splitlines()
-    assert lines[1] == 'assembles: for crank angles 180.045..180.055 deg'
+    assert lines[1:3] == ['assembles: for crank angles 180.045..180.055 deg',
+                          'does not assemble for crank angles -179.945..180.045 deg']
+    assert data['gaps'] == [[end - TURN, start]]
 
 
 def test_the_rocker_reverses_inside_the_narrow_range(narrow):

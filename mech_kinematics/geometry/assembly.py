@@ -157,7 +157,8 @@ class Assembly:
         Crank-angle ranges where it assembles, ``start < end``; a range that
         runs through 0 starts below 0. ``((0, 2 pi),)`` everywhere.
     gaps : tuple of (float, float)
-        The ranges in between, where it does not.
+        The ranges in between, where it does not; likewise one that runs
+        through 0 starts below 0.
     toggles, dead_centres : tuple
         As :class:`Toggle` and :class:`DeadCentre`, by crank angle.
     transmission : tuple of Transmission
@@ -505,11 +506,15 @@ def _gaps(ranges: Sequence[tuple[float, float]]) -> tuple[tuple[float, float], .
         return ()
     gaps = []
     for index, (_, end) in enumerate(ranges):
-        start = ranges[(index + 1) % len(ranges)][0]
-        while start < end:
-            start += _TURN
-        gaps.append((end, start))
-    return tuple(gaps)
+        following = ranges[(index + 1) % len(ranges)][0]
+        turns = 0
+        while following + turns * _TURN < end:
+            turns += 1
+        if turns and following + turns * _TURN > _TURN:  # it runs through 0: it starts
+            gaps.append((end - _TURN, following + (turns - 1) * _TURN))  # below 0, as a range
+        else:
+            gaps.append((end, following + turns * _TURN))
+    return tuple(sorted(gaps))
 
 
 def _measure_keys(scene: Scene) -> dict[str, tuple[str, tuple[str, ...]]]:
