@@ -16,6 +16,8 @@ import json
 import math
 import warnings
 
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 import mpmath
 import numpy as np
 import pytest
@@ -359,3 +361,41 @@ def test_a_narrow_gap_is_found_to_1e12_rad():
     result = asm.assembly_from_scene(scene)
     (gap_start, gap_end), = result.gaps
     assert abs(gap_start - low) <= 1e-12 and abs(gap_end - high) <= 1e-12
+
+
+@settings(max_examples=150, deadline=None, derandomize=True)
+@given(st.floats(0.01, 0.2), st.floats(0.01, 0.3), st.floats(0.01, 0.4), st.floats(0.01, 0.4),
+       st.floats(-math.pi, math.pi))
+def test_every_four_bars_ranges_are_the_closed_forms(r, g, coupler, rocker, phi):
+    """Any four-bar: its ranges' ends within 1e-12 rad of the law of cosines, to 50 digits.
+
+    |BD|^2 = r^2 + g^2 - 2 r g cos(theta - phi) lies within (|l1 - l2|, l1 + l2)
+    for |theta - phi| in (psi_low, psi_high): one range, two, or the whole turn.
+    """
+    d_x, d_y = g * math.cos(phi), g * math.sin(phi)
+    with mpmath.workdps(50):
+        gg = mpmath.sqrt(mpmath.mpf(d_x) ** 2 + mpmath.mpf(d_y) ** 2)
+        centre = mpmath.atan2(d_y, d_x)
+        rr, l1, l2 = mpmath.mpf(r), mpmath.mpf(coupler), mpmath.mpf(rocker)
+
+        def psi(length):
+            return mpmath.acos((rr ** 2 + gg ** 2 - length ** 2) / (2 * rr * gg))
+
+        lsum, ldiff = l1 + l2, abs(l1 - l2)
+        for limit in (ldiff, lsum):  # no tangency within rounding: a touch is no range end
+            assume(min(abs(limit - abs(rr - gg)), abs(limit - (rr + gg))) > 1e-9)
+        assume(ldiff < rr + gg and lsum > abs(rr - gg))  # it assembles somewhere
+        low = mpmath.mpf(0) if ldiff <= abs(rr - gg) else psi(ldiff)
+        high = mpmath.pi if lsum >= rr + gg else psi(lsum)
+        assume(high - low > 1e-6)
+        ends = ([centre - low, centre + low] if low > 0 else []) + (
+            [centre - high, centre + high] if high < mpmath.pi else [])
+    links = (mk.Link('coupler', 'B', coupler), mk.Link('rocker', 'D', rocker))
+    scene = mk.Scene('any', {'A': (0.0, 0.0), 'D': (d_x, d_y)},
+                     mk.Crank('crank', 'A', 'B', r, float(centre + (low + high) / 2), 1.0),
+                     (mk.RRR('C', links),))
+    ranges, _ = asm.assembly_ranges(scene)
+    found = [a for span in ranges for a in span] if ranges != ((0.0, TURN),) else []
+    assert len(found) == len(ends)
+    for end in ends:
+        assert min(abs(math.remainder(float(end - a), TURN)) for a in found) <= 1e-12
