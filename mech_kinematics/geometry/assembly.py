@@ -474,6 +474,10 @@ def _root(function: Callable[[Array], Array], low: float, high: float) -> float:
         t = middle
         if slow < 2 and math.isfinite(f_low) and math.isfinite(f_high) and f_low != f_high:
             guess = high - f_high * width / (f_high - f_low)
+            if guess <= low:  # the root within rounding of an end: a few ulp inside it
+                guess = low + 4.0 * math.ulp(low)
+            elif guess >= high:
+                guess = high - 4.0 * math.ulp(high)
             if low < guess < high:
                 t = guess
         f = at(t)
