@@ -53,6 +53,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 import itertools
 import math
+from typing import Any
 import warnings
 
 import numpy as np
@@ -638,16 +639,23 @@ def _dead_centres(probe: _Probe, ranges: Sequence[tuple[float, float]]
         count = max(RANGE_SAMPLES, math.ceil((end - start) / step) + 1)
         inward = 1e-6 * (end - start)  # the ends themselves are refused (toggles)
         grids.append(np.linspace(start + inward, end - inward, count))
+
+    def motion(theta: Array, name: str, state: Any = None) -> tuple[Array, Array]:
+        state = probe.solve(theta) if state is None else state
+        valid = np.asarray(state.valid, dtype=bool)
+        solved = state.joints[name]
+        return (np.where(valid, solved.velocity, np.nan),
+                np.where(valid, solved.acceleration, np.nan))
+
+    states = [probe.solve(grid) for grid in grids]  # once for every joint
     centres = []
     for joint, kind in _outputs(scene).items():
-        def motion(theta: Array, name: str = joint) -> tuple[Array, Array]:
-            state = probe.solve(theta)
-            valid = np.asarray(state.valid, dtype=bool)  # type: ignore[attr-defined]
-            solved = state.joints[name]  # type: ignore[attr-defined]
-            return (np.where(valid, solved.velocity, np.nan),
-                    np.where(valid, solved.acceleration, np.nan))
+        def function(theta: Array, name: str = joint) -> tuple[Array, Array]:
+            return motion(theta, name)
 
-        for angle in _distinct([a for grid in grids for a in _crossings(motion, grid)]):
+        found = [a for grid, state in zip(grids, states, strict=True)
+                 for a in _crossings(function, grid, motion(grid, joint, state))]
+        for angle in _distinct(found):
             solved = probe.solve(angle)
             position = float(solved.joints[joint].position)  # type: ignore[attr-defined]
             in_line = None
