@@ -5,8 +5,10 @@
 :func:`assembly_from_scene` studies one full turn of the crank (angles 0 to
 2 pi, CCW from +x) from the exact solver:
 
-- the crank-angle ranges where the mechanism assembles, their ends refined
-  by bisection to :data:`TOLERANCE` rad;
+- the crank-angle ranges where the mechanism assembles, however narrow: the
+  roots of each step's assembly margins (:meth:`.solver.base.Step.margins`;
+  closed forms in the crank angle for a dyad on the crank), found to an ulp
+  of the angle (within :data:`TOLERANCE` rad);
 - its toggle positions: where a dyad's two links come in line (an RRR's
   coupler and rocker, an RRP's rod square to its guide), at the ends of
   those ranges or, at a change point, inside one; the mechanism locks there;
@@ -28,17 +30,30 @@ short line, for ``plot --scene`` and the node's diagnostics. Angles here are
 in rad and lengths in m; :class:`~mech_kinematics.solver.SceneUnits` shows them
 in the scene's own units. NumPy only: the solver does the geometry.
 
-A range narrower than the sampling step (:data:`SAMPLES` per turn) can be
-missed; toggles and transmission minima inside a range are refined from the
-sampled minimum, so a second, equally deep minimum within one step of the
-first is reported once.
+What is guaranteed: each margin and its rate are sampled (:data:`SAMPLES`
+per turn); a margin's extremum lies where its rate changes sign and is found
+by a bracketing root finder on the rate, and a sign change of the margin on
+either side of it likewise on the margin, so a range of any width around an
+extremum is found, its ends exact (``solve`` refuses within rounding of
+them). Only two
+extrema of one margin within one sample step (its rate changing sign twice
+between samples) can hide a range. Dead centres are the velocity's sign
+changes, found the same way (the acceleration at unit crank speed being its
+rate) in each range, sampled at the turn's step and at least
+:data:`RANGE_SAMPLES` times. A toggle at an end of a range is that end; one
+inside a range where a margin touches zero (a change point's) is that
+margin's extremum, found exactly; others, and transmission minima, are
+refined from the sampled minimum of the dyad's measure, so a second, equally
+deep minimum within one step of the first is reported once.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+import itertools
 import math
+from typing import Any
 import warnings
 
 import numpy as np
@@ -46,7 +61,7 @@ import numpy.typing as npt
 
 from .instant_centres import full_scene
 from ..errors import AssemblyError, NearSingularWarning
-from ..solver import Scene, SceneUnits, solve
+from ..solver import assembly_margins, Scene, SceneUnits, solve
 
 __all__ = [
     'Assembly', 'DeadCentre', 'FourBarLoop', 'SAMPLES', 'TOLERANCE', 'Toggle', 'Transmission',
@@ -62,9 +77,16 @@ SAMPLES = 3600
 TOLERANCE = 1e-12
 #: A measure (sine of a transmission angle) below this inside a range is a toggle.
 TOGGLE_MEASURE = 1e-6
+#: A margin's extremum within this of 0 (relative to its largest sampled size: its
+#: rounding) touches 0: a toggle inside a range (a change point's), not a gap.
+TOUCH = 1e-14
 #: Relative difference of ``s + l`` and ``p + q`` within which a loop is a change point.
 CHANGE_POINT = 1e-9
+#: Crank angles sampled at least in each range where it assembles, for dead centres.
+RANGE_SAMPLES = 64
 _TURN = 2.0 * math.pi
+#: Roots closer than this (a few ulp of 2 pi), found from either side of a sample, are one.
+_SAME = 8 * math.ulp(_TURN)
 
 
 @dataclass(frozen=True)
@@ -136,7 +158,8 @@ class Assembly:
         Crank-angle ranges where it assembles, ``start < end``; a range that
         runs through 0 starts below 0. ``((0, 2 pi),)`` everywhere.
     gaps : tuple of (float, float)
-        The ranges in between, where it does not.
+        The ranges in between, where it does not; likewise one that runs
+        through 0 starts below 0.
     toggles, dead_centres : tuple
         As :class:`Toggle` and :class:`DeadCentre`, by crank angle.
     transmission : tuple of Transmission
@@ -231,7 +254,7 @@ def assembly_from_scene(scene: Scene, samples: int = SAMPLES) -> Assembly:
     ranges = _ranges(probe)
     gaps = _gaps(ranges)
     toggles = _toggles(probe, ranges)
-    return Assembly(scene.name, scene.units, ranges, gaps, toggles, _dead_centres(probe),
+    return Assembly(scene.name, scene.units, ranges, gaps, toggles, _dead_centres(probe, ranges),
                     _transmission(probe, ranges, toggles), _loops(probe))
 
 
@@ -246,19 +269,17 @@ class _Probe:
         self.theta = np.linspace(0.0, _TURN, samples, endpoint=False)
         self.state = self.solve(self.theta)
         self.valid = np.asarray(self.state.valid, dtype=bool)
+        self.margins = assembly_margins(self.scene)
+        # Filled by _ranges: (angle, step label) of each margin's roots and of each
+        # extremum where a margin touches 0.
+        self.roots: list[tuple[float, str]] = []
+        self.touches: list[tuple[float, str]] = []
 
     def solve(self, theta: float | Array) -> object:
         """Solve at crank speed 1 rad/s, refusing only what does not assemble."""
         with warnings.catch_warnings():
             warnings.simplefilter('ignore', NearSingularWarning)
             return solve(self.scene, theta, 1.0, 0.0, max_error=math.inf)
-
-    def assembles(self, theta: float) -> bool:
-        try:
-            self.solve(theta)
-        except AssemblyError:
-            return False
-        return True
 
     def failure(self, theta: float) -> AssemblyError | None:
         try:
@@ -268,37 +289,221 @@ class _Probe:
         return None
 
 
-def _bisect(test: Callable[[float], bool], low: float, high: float) -> float:
-    """Return the change of ``test`` between ``low`` (its value there kept) and ``high``."""
-    keep = test(low)
-    while high - low > TOLERANCE:
+def _ranges(probe: _Probe) -> tuple[tuple[float, float], ...]:
+    """Return where every step's margin is positive, its ends the margins' roots.
+
+    Each margin and its rate are sampled over the turn; an extremum of a
+    margin lies where its rate changes sign between two samples and is found
+    by root finding on the rate, so a window where the margin is positive
+    however narrow around an extremum is caught; between extrema a margin is
+    monotonic, and where it changes sign its root is found (bracketed by
+    sign), to an ulp of the angle. Between consecutive roots the
+    mechanism assembles or not throughout (but where a margin touches zero,
+    a toggle): two evaluations tell which.
+    """
+    margins = probe.margins
+    theta = _turn_grid(len(probe.theta))
+    sampled = margins(theta)
+    roots = []
+    seen: dict[str, int] = {}
+    for label, margin, rate in sampled:
+        order = seen[label] = seen.get(label, -1) + 1  # which of its step's margins
+
+        def function(t: Array, name: str = label, k: int = order) -> tuple[Array, Array]:
+            return margins(t, name)[k][1:]
+
+        extrema: list[tuple[float, float]] = []
+        touch = TOUCH * float(np.nanmax(np.abs(margin), initial=0.0))
+        found = _crossings(function, theta, (margin, rate), extrema, touch)
+        roots.extend(found)
+        probe.roots.extend((root, label) for root in found)
+        probe.touches.extend((angle, label) for angle, value in extrema  # a toggle inside
+                             if abs(value) <= touch)
+    roots = _distinct(roots)
+    if not roots:
+        return ((0.0, _TURN),) if _assembles(margins, np.array([0.0]))[0] else ()
+    following = np.array(roots[1:] + [roots[0] + _TURN])
+    # Two points of each piece: either tells (a margin may touch 0 at one angle, a toggle).
+    width = following - np.array(roots)
+    inside = (_assembles(margins, roots + 0.382 * width)
+              | _assembles(margins, roots + 0.618 * width))
+    pieces = [(start, float(end)) for start, end, ok in zip(roots, following, inside, strict=True)
+              if ok]
+    if len(pieces) == len(roots):
+        return ((0.0, _TURN),)
+    ranges: list[tuple[float, float]] = []
+    for start, end in pieces:  # join pieces meeting at a root where nothing changes
+        if ranges and ranges[-1][1] == start:
+            ranges[-1] = (ranges[-1][0], end)
+        else:
+            ranges.append((start, end))
+    if len(ranges) > 1 and ranges[-1][1] - _TURN == ranges[0][0]:
+        ranges[0] = (ranges[-1][0] - _TURN, ranges[0][1])
+        ranges.pop()
+    elif ranges[-1][1] > _TURN:  # it runs through 0: it starts below 0
+        last = ranges.pop()
+        ranges.insert(0, (last[0] - _TURN, last[1] - _TURN))
+    return tuple(ranges)
+
+
+def _crossings(function: Callable[[Array], tuple[Array, Array]], theta: Array,
+               sampled: tuple[Array, Array] | None = None,
+               extrema: list[tuple[float, float]] | None = None,
+               touch: float = -1.0) -> list[float]:
+    """Return where ``function``'s value changes sign between the first and last of ``theta``.
+
+    ``function`` gives (value, rate) at crank angles, NaN where unknown;
+    ``sampled`` is its answer at ``theta`` if already known. Where the rate
+    changes sign between two samples the extremum is found by root finding
+    on the rate (:func:`_root`), so a sign change of the value on either side of it is caught
+    however close together the two are (unless the value is further from zero
+    than twice the step times the larger rate: it cannot get there, and the
+    rate's rounding noise about a flat value is not chased); each sign change
+    is then found, bracketed by the value's sign, to an ulp of the angle.
+    Where the value is known at one end of a step only (an earlier dyad stops
+    closing between), the step is cut where it stops being known. The
+    extrema found are appended to ``extrema`` as (angle, value); one within
+    ``touch`` of zero touches it (within rounding): no sign change is sought
+    beside it. An interval where the rate changes sign twice (two extrema
+    within one sample step) is seen as monotonic.
+    """
+    value, rate = function(theta) if sampled is None else sampled
+    roots = []
+    for i in _changes(value, rate):
+        a, b = float(theta[i]), float(theta[i + 1])
+        va, vb, ra, rb = float(value[i]), float(value[i + 1]), float(rate[i]), float(rate[i + 1])
+        if not math.isfinite(va + ra):  # known from b on only: cut the step there
+            a = _known_from(function, b, a)
+            va, ra = (float(x[0]) for x in function(np.array([a])))
+        elif not math.isfinite(vb + rb):
+            b = _known_from(function, a, b)
+            vb, rb = (float(x[0]) for x in function(np.array([b])))
+        ends, values = [a, b], [va, vb]
+        reach = 2.0 * (b - a) * max(abs(ra), abs(rb))  # of the value, at most
+        if ra * rb < 0.0 and min(abs(va), abs(vb)) <= reach:
+            # an extremum between that may cross 0: the value is monotonic either side
+            extremum = _root(lambda t: function(t)[1], a, b)
+            ends.insert(1, extremum)
+            values.insert(1, float(function(np.array([extremum]))[0][0]))
+            if extrema is not None:
+                extrema.append((extremum, values[1]))
+            if abs(values[1]) <= touch:
+                continue
+        for (low, v_low), (high, v_high) in itertools.pairwise(zip(ends, values, strict=True)):
+            if v_low * v_high < 0.0:
+                roots.append(_root(lambda t: function(t)[0], low, high))
+            elif (v_high == 0.0 and high == float(theta[i + 1]) and i + 2 < len(theta)
+                  and v_low * value[i + 2] < 0.0):
+                roots.append(high)  # on a sample
+    return roots
+
+
+def _known_from(function: Callable[[Array], tuple[Array, Array]], known: float,
+                unknown: float) -> float:
+    """Return the angle nearest ``unknown`` from ``known`` at which ``function`` is known."""
+    while True:
+        middle = 0.5 * (known + unknown)
+        if middle in (known, unknown):
+            return known
+        value, rate = (float(x[0]) for x in function(np.array([middle])))
+        if math.isfinite(value + rate):
+            known = middle
+        else:
+            unknown = middle
+
+
+def _turn_grid(samples: int) -> Array:
+    """Return ``samples`` steps over the turn, and one more each side (a sign change at 0)."""
+    return np.arange(-1, samples + 2) * (_TURN / samples)
+
+
+def _distinct(angles: Sequence[float]) -> list[float]:
+    """Return the angles in [0, 2 pi), sorted; those within a few ulp (mod 2 pi) once."""
+    result: list[float] = []
+    for angle in sorted(a % _TURN for a in angles):
+        if not result or angle - result[-1] > _SAME:
+            result.append(angle)
+    if len(result) > 1 and result[0] + _TURN - result[-1] <= _SAME:
+        result.pop()
+    return result
+
+
+def _changes(value: Array, rate: Array) -> list[int]:
+    """Return the sample intervals where a value or its rate changes sign, or stops being known.
+
+    A value exactly zero at a sample between two of opposite signs gives the
+    interval before it (its root finding ends on that sample).
+    """
+    known = np.isfinite(value) & np.isfinite(rate)
+    both = known[:-1] | known[1:]  # known at one end only: cut where it stops being known
+    flips = ((value[:-1] * value[1:] < 0.0) | (rate[:-1] * rate[1:] < 0.0)
+             | (known[:-1] != known[1:]))
+    zero = np.zeros_like(flips)
+    zero[:-1] = (value[1:-1] == 0.0) & (value[:-2] * value[2:] < 0.0) & known[2:]
+    return [int(i) for i in np.flatnonzero(both & (flips | zero))]
+
+
+def _assembles(margins: Callable[..., list[tuple[str, Array, Array]]],
+               theta: Array) -> Array:
+    """Return whether every margin is positive at each crank angle."""
+    ok = np.ones(theta.shape, dtype=bool)
+    for _, margin, _ in margins(theta):
+        ok &= margin > 0.0  # NaN (an earlier step does not close) is not
+    return ok
+
+
+def _root(function: Callable[[Array], Array], low: float, high: float) -> float:
+    """Return where ``function`` (of one crank angle) changes sign in [low, high], to an ulp.
+
+    Regula falsi, Illinois variant (a stale end's value halved), the bracket
+    kept by sign; near the root a step of a few ulp past the estimate closes
+    the bracket; a bisection step wherever the bracket did not halve twice
+    running; until no double lies strictly inside the bracket.
+    """
+    def at(theta: float) -> float:
+        return float(function(np.array([theta]))[0])
+
+    f_low, f_high = at(low), at(high)
+    keep = f_low > 0.0
+    side = 0
+    slow = 0
+    while True:
+        width = high - low
         middle = 0.5 * (low + high)
         if middle in (low, high):
-            break
-        if test(middle) == keep:
-            low = middle
+            return middle
+        t = middle
+        if slow < 2 and math.isfinite(f_low) and math.isfinite(f_high) and f_low != f_high:
+            guess = high - f_high * width / (f_high - f_low)
+            if guess <= low:  # the root within rounding of an end: a few ulp inside it
+                guess = low + 4.0 * math.ulp(low)
+            elif guess >= high:
+                guess = high - 4.0 * math.ulp(high)
+            if low < guess < high:
+                t = guess
+        f = at(t)
+        if f == 0.0:
+            return t
+        close = t != middle and abs(f) < abs(f_low) and abs(f) < abs(f_high)
+        if (f > 0.0) == keep:
+            low, f_low = t, f
+            if side == -1:
+                f_high *= 0.5
+            side = -1
         else:
-            high = middle
-    return 0.5 * (low + high)
-
-
-def _ranges(probe: _Probe) -> tuple[tuple[float, float], ...]:
-    valid, theta = probe.valid, probe.theta
-    n = len(theta)
-    if valid.all():
-        return ((0.0, _TURN),)
-    step = _TURN / n
-    edges = []  # (angle, rising): the refined ends, in order
-    for i in range(n):
-        j = (i + 1) % n
-        if valid[i] != valid[j]:
-            low = float(theta[i])
-            edges.append((_bisect(probe.assembles, low, low + step), bool(valid[j])))
-    starts = [a for a, rising in edges if rising]
-    ends = [a for a, rising in edges if not rising]
-    if ends and starts and ends[0] < starts[0]:
-        starts = [starts[-1] - _TURN] + starts[:-1]
-    return tuple(zip(starts, ends, strict=True))
+            high, f_high = t, f
+            if side == 1:
+                f_low *= 0.5
+            side = 1
+        if close:  # nearly there: a step of a few ulp toward the bracket's other end
+            near = t + math.copysign(4.0 * math.ulp(t), (high if t == low else low) - t)
+            if low < near < high:
+                f_near = at(near)
+                if (f_near > 0.0) == keep:
+                    low, f_low = near, f_near
+                else:
+                    high, f_high = near, f_near
+        slow = slow + 1 if high - low > 0.5 * width else 0
 
 
 def _gaps(ranges: Sequence[tuple[float, float]]) -> tuple[tuple[float, float], ...]:
@@ -306,11 +511,15 @@ def _gaps(ranges: Sequence[tuple[float, float]]) -> tuple[tuple[float, float], .
         return ()
     gaps = []
     for index, (_, end) in enumerate(ranges):
-        start = ranges[(index + 1) % len(ranges)][0]
-        while start < end:
-            start += _TURN
-        gaps.append((end, start))
-    return tuple(gaps)
+        following = ranges[(index + 1) % len(ranges)][0]
+        turns = 0
+        while following + turns * _TURN < end:
+            turns += 1
+        if turns and following + turns * _TURN > _TURN:  # it runs through 0: it starts
+            gaps.append((end - _TURN, following + (turns - 1) * _TURN))  # below 0, as a range
+        else:
+            gaps.append((end, following + turns * _TURN))
+    return tuple(sorted(gaps))
 
 
 def _measure_keys(scene: Scene) -> dict[str, tuple[str, tuple[str, ...]]]:
@@ -327,27 +536,42 @@ def _measure_keys(scene: Scene) -> dict[str, tuple[str, tuple[str, ...]]]:
 def _toggles(probe: _Probe, ranges: Sequence[tuple[float, float]]) -> tuple[Toggle, ...]:
     keys = _measure_keys(probe.scene)
     labels = {label: (key, links) for key, (label, links) in keys.items()}
-    toggles = []
+    exact = []  # the roots of margins: the ends of ranges and where a margin touches 0
     if len(ranges) != 1 or ranges[0][1] - ranges[0][0] < _TURN:
-        for start, end in ranges:  # the dyad that fails just beyond each end locks there
-            for edge, outside in ((start, start - 1e-9), (end, end + 1e-9)):
-                error = probe.failure(outside)
-                if error is not None and error.dyad in labels:
-                    toggles.append(Toggle(edge % _TURN, error.dyad, labels[error.dyad][1]))
+        for start, end in ranges:  # the dyad whose margin ends the range locks there
+            for edge in (start, end):
+                label = next((label for angle, label in probe.roots
+                              if abs(math.remainder(angle - edge, _TURN)) <= _SAME), None)
+                if label in labels:
+                    exact.append(Toggle(edge % _TURN, label, labels[label][1]))
+    exact.extend(Toggle(angle % _TURN, label, labels[label][1])
+                 for angle, label in probe.touches if label in labels)
+    toggles = []
     state = probe.state
+    # A sample inside a range that the solver refuses is on a toggle (a margin touching 0).
+    refused = _inside(probe.theta, ranges) & ~probe.valid
     for key, (label, links) in keys.items():
-        measure = np.where(probe.valid, np.asarray(state.singularity[key]), np.inf)
+        measure = np.where(probe.valid, np.asarray(state.singularity[key]),
+                           np.where(refused, 0.0, np.inf))
         for index in _local_minima(measure):
             angle, value = _golden(probe, key, float(probe.theta[index]))
             if value < TOGGLE_MEASURE:
                 toggles.append(Toggle(angle % _TURN, label, links))
-    toggles.sort(key=lambda t: t.angle)
     unique: list[Toggle] = []
-    for toggle in toggles:
+    for toggle in sorted(exact, key=lambda t: t.angle) + sorted(toggles, key=lambda t: t.angle):
         if not any(abs(math.remainder(toggle.angle - t.angle, _TURN)) < 1e-6
                    and t.dyad == toggle.dyad for t in unique):
             unique.append(toggle)
-    return tuple(unique)
+    return tuple(sorted(unique, key=lambda t: t.angle))
+
+
+def _inside(theta: Array, ranges: Sequence[tuple[float, float]]) -> Array:
+    """Return whether each crank angle in [0, 2 pi) lies inside one of the ranges."""
+    inside = np.zeros(theta.shape, dtype=bool)
+    for start, end in ranges:
+        for shift in (0.0, _TURN):
+            inside |= (theta + shift > start) & (theta + shift < end)
+    return inside
 
 
 def _local_minima(values: Array) -> list[int]:
@@ -392,36 +616,46 @@ def _outputs(scene: Scene) -> dict[str, str]:
     return outputs
 
 
-def _dead_centres(probe: _Probe) -> tuple[DeadCentre, ...]:
-    scene, state = probe.scene, probe.state
+def _dead_centres(probe: _Probe, ranges: Sequence[tuple[float, float]]
+                  ) -> tuple[DeadCentre, ...]:
+    """Return where an output's velocity changes sign, inside the ranges where it assembles.
+
+    Each range is sampled at the turn's step (at least :data:`RANGE_SAMPLES`
+    angles, so a narrow range is sampled too) and the reversals found as the
+    ranges' ends are (:func:`_crossings`, the acceleration at unit crank speed
+    being the velocity's rate).
+    """
+    scene = probe.scene
     crank = scene.input
     starting = {}  # link from the crank's tip -> the joints of its dyad
     for dyad in scene.dyads:
         starting.update(dyad.tip_links(crank.point))
-    n = len(probe.theta)
-    step = _TURN / n
+    step = _TURN / len(probe.theta)
+    grids = []
+    for start, end in ranges:
+        if end - start >= _TURN:
+            grids.append(_turn_grid(len(probe.theta)))
+            continue
+        count = max(RANGE_SAMPLES, math.ceil((end - start) / step) + 1)
+        inward = 1e-6 * (end - start)  # the ends themselves are refused (toggles)
+        grids.append(np.linspace(start + inward, end - inward, count))
+
+    def motion(theta: Array, name: str, state: Any = None) -> tuple[Array, Array]:
+        state = probe.solve(theta) if state is None else state
+        valid = np.asarray(state.valid, dtype=bool)
+        solved = state.joints[name]
+        return (np.where(valid, solved.velocity, np.nan),
+                np.where(valid, solved.acceleration, np.nan))
+
+    states = [probe.solve(grid) for grid in grids]  # once for every joint
     centres = []
     for joint, kind in _outputs(scene).items():
-        velocity = np.asarray(state.joints[joint].velocity)  # type: ignore[attr-defined]
-        for i in range(n):
-            j = (i + 1) % n
-            if not (probe.valid[i] and probe.valid[j]) or velocity[i] * velocity[j] > 0.0:
-                continue
-            if velocity[j] == 0.0:  # a sample on the reversal: bracket it by its neighbours
-                k = (j + 1) % n
-                if not probe.valid[k] or velocity[i] * velocity[k] >= 0.0:
-                    continue
-            elif velocity[i] == 0.0:
-                continue  # found from the sample before
+        def function(theta: Array, name: str = joint) -> tuple[Array, Array]:
+            return motion(theta, name)
 
-            def forward(theta: float, name: str = joint) -> bool:
-                try:
-                    return float(probe.solve(theta).joints[name].velocity) > 0.0  # type: ignore
-                except AssemblyError:
-                    return False
-
-            low = float(probe.theta[i])
-            angle = _bisect(forward, low, low + (2 if velocity[j] == 0.0 else 1) * step)
+        found = [a for grid, state in zip(grids, states, strict=True)
+                 for a in _crossings(function, grid, motion(grid, joint, state))]
+        for angle in _distinct(found):
             solved = probe.solve(angle)
             position = float(solved.joints[joint].position)  # type: ignore[attr-defined]
             in_line = None

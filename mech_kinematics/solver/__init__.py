@@ -45,11 +45,11 @@ from .rpr import MAX_SLOTS, RPR
 from .rrp import RRP
 from .rrr import RRR
 from .rubbing import Pin
-from .solve import solve
+from .solve import assembly_margins, solve
 from .state import Engagement, JointMotion, PointState, State
 
 __all__ = [
     'Branch', 'CarriedPoint', 'Crank', 'Engagement', 'JointMotion', 'Link', 'MAX_SLOTS',
     'NEAR_SINGULAR', 'Pin', 'PointState', 'RPP', 'RPR', 'RRP', 'RRR', 'SINGULAR', 'Scene', 'State',
-    'SceneUnits', 'TANGENCY_TOLERANCE', 'assembly_text', 'solve',
+    'SceneUnits', 'TANGENCY_TOLERANCE', 'assembly_margins', 'assembly_text', 'solve',
 ]

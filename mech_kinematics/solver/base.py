@@ -127,6 +127,33 @@ class Step(ABC):
         """
         return (cls.run,)
 
+    def margins(self, points: Mapping[str, tuple[Any, ...]]) -> tuple[tuple[Any, Any], ...]:
+        """Return (margin, rate) of each condition under which it closes, from its inputs.
+
+        ``points`` is a solve's table of points (:class:`._Context`: position
+        and velocity first, velocities at unit crank speed). A margin is
+        positive where the step closes and crosses zero where it stops closing
+        (``run`` refuses where one is not positive, and within rounding of
+        zero); its rate is its derivative per radian of crank angle. Complex
+        scalars or arrays in, floats or arrays out. Default: none (the step
+        closes wherever its inputs are known, or fails at isolated angles).
+        """
+        return ()
+
+    def crank_margins(self, tip: str, center: complex, radius: float,
+                      ground: Mapping[str, complex]
+                      ) -> Callable[[Any], tuple[tuple[Any, Any], ...]] | None:
+        """Return its margins as closed forms in the crank angle, if it has them.
+
+        For a step fed directly by the crank's ``tip`` (a crank of ``radius``
+        about ``center``) and ground points (``ground``: name -> position):
+        a function of the crank angle (rad, float or array) returning what
+        :meth:`margins` does (a margin may be scaled by a positive factor),
+        computed without the cancellation of positions near a limit. ``None``
+        where it has none (then :meth:`margins` is used).
+        """
+        return None
+
     @property
     def requires(self) -> tuple[str, ...]:
         """Names whose steps must run before this one (its uses and its owner)."""

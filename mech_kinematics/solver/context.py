@@ -9,6 +9,7 @@ inputs and its own rounding (see the comment above ``_U2``).
 
 from __future__ import annotations
 
+from fractions import Fraction
 import math
 from typing import Any
 
@@ -114,6 +115,14 @@ def _dot(a: Any, b: Any) -> Any:
 
 def _cross(a: Any, b: Any) -> Any:
     return a.real * b.imag - a.imag * b.real
+
+
+def _sum_root(x: Fraction, square: Fraction) -> float:
+    """Return ``x + sqrt(square)`` for an exact ``x`` without cancellation (to a few ulp)."""
+    root = math.sqrt(square)
+    if x >= 0:
+        return float(x) + root
+    return float(square - x * x) / (root - float(x))
 
 
 # Multiples of the unit roundoff used by the bounds.

@@ -6,13 +6,14 @@ from __future__ import annotations
 
 from collections.abc import Callable, Collection, Iterator, Mapping
 from dataclasses import dataclass, replace
+from fractions import Fraction
 import math
 from typing import Any
 
 import numpy as np
 
 from .base import Body, Edge, Frame, Item, Member, Names, Placing, Reading, Step
-from .context import _Context, _cross, _dot, _U2, _U3, _U5, _U7, SINGULAR
+from .context import _Context, _cross, _dot, _sum_root, _U2, _U3, _U5, _U7, SINGULAR
 from .model import _check_finite, _check_name, _g, Branch, Link, SceneUnits, Where
 from ..bounds import ROUNDING_MARGIN, U
 
@@ -199,6 +200,56 @@ class _RRPStep(Step):
         return {'kind': 'reach', 'links': (self.link,), 'lengths': (self.length * m,),
                 'points': (self.start, self.through_name), 'distance': abs(float(offset)) * m,
                 'guide_angle': self.guide_angle}
+
+    def margins(self, points: Mapping[str, tuple[Any, ...]]) -> tuple[tuple[Any, Any], ...]:
+        """Return the reach margins ``l - o`` and ``l + o`` and their rates.
+
+        ``o`` is the signed distance of the link's start from the guide.
+        """
+        q, vq = points[self.start][:2]
+        offset = _cross(self.u, q - self.through)
+        rate = _cross(self.u, vq)
+        return ((self.length - offset, -rate), (self.length + offset, rate))
+
+    def crank_margins(self, tip: str, center: complex, radius: float,
+                      ground: Mapping[str, complex]
+                      ) -> Callable[[Any], tuple[tuple[Any, Any], ...]] | None:
+        """Return its reach margins in closed form when its link starts at the crank's tip.
+
+        The tip's signed distance from the guide is ``o = c + r k sin(psi)``,
+        ``psi = theta - gamma``, with ``c`` that of the crank's pivot and
+        ``k``, ``gamma`` the length and angle of the (rounded) guide direction.
+        With ``f = psi / 2 - pi / 4``, ``l - o = (l - c - r k) + 2 r k sin^2 f
+        = (l - c + r k) - 2 r k cos^2 f`` and ``l + o = (l + c + r k) - 2 r k
+        sin^2 f = (l + c - r k) + 2 r k cos^2 f``: each is taken in the form
+        whose varying term is the smaller, its constant formed exactly from the
+        doubles, so no cancellation where the guide is barely in (or out of)
+        reach.
+        """
+        if self.start != tip:
+            return None
+        ux, uy = Fraction(self.u.real), Fraction(self.u.imag)
+        offset = (ux * (Fraction(center.imag) - Fraction(self.through.imag))
+                  - uy * (Fraction(center.real) - Fraction(self.through.real)))
+        r = Fraction(radius)
+        rk2 = r * r * (ux * ux + uy * uy)  # (r k)^2, exact
+        rk = math.sqrt(rk2)
+        length = Fraction(self.length)
+        # l - o and l + o near sin(psi) = 1 (from sin^2) and near -1 (from cos^2).
+        below_up, below_down = -_sum_root(offset - length, rk2), _sum_root(length - offset, rk2)
+        above_up, above_down = _sum_root(length + offset, rk2), -_sum_root(-(length + offset), rk2)
+        gamma = math.atan2(self.u.imag, self.u.real)
+
+        def margins(theta: Any) -> tuple[tuple[Any, Any], ...]:
+            half = 0.5 * (theta - gamma) - 0.25 * math.pi
+            s, c = np.sin(half), np.cos(half)
+            s2, c2 = 2.0 * rk * s * s, 2.0 * rk * c * c
+            up = s * s < 0.5
+            rate = rk * np.cos(theta - gamma)  # the rate of o
+            return ((np.where(up, below_up + s2, below_down - c2), -rate),
+                    (np.where(up, above_up - s2, above_down + c2), rate))
+
+        return margins
 
     def run(self, ctx: _Context) -> None:
         length, u = self.length, self.u

@@ -6,13 +6,14 @@ from __future__ import annotations
 
 from collections.abc import Callable, Collection, Iterator, Mapping
 from dataclasses import dataclass, replace
+from fractions import Fraction
 import math
 from typing import Any
 
 import numpy as np
 
 from .base import Edge, Frame, Item, Member, Names, Placing, Reading, Step
-from .context import _Context, _dot, _U16, _U2, _U3, _U7, SINGULAR
+from .context import _Context, _dot, _sum_root, _U16, _U2, _U3, _U7, SINGULAR
 from .model import _check_name, _g, Branch, Link, SceneUnits, Where
 from ..bounds import ROUNDING_MARGIN, U
 from ..errors import SceneError
@@ -188,6 +189,65 @@ class _RRRStep(Step):
         return {'kind': 'in line' if touching else 'apart', 'links': (self.link1, self.link2),
                 'lengths': (self.l1 * m, self.l2 * m), 'points': (self.start1, self.start2),
                 'distance': float(dist) * m}
+
+    def margins(self, points: Mapping[str, tuple[Any, ...]]) -> tuple[tuple[Any, Any], ...]:
+        """Return the circles' margins ``l1 + l2 - d`` and ``d - |l1 - l2|`` and their rates.
+
+        ``d`` is the distance between the links' starts.
+        """
+        p1, v1 = points[self.start1][:2]
+        p2, v2 = points[self.start2][:2]
+        d = p2 - p1
+        dist = np.hypot(d.real, d.imag)
+        rate = _dot(d, v2 - v1) / dist
+        return ((self.l1 + self.l2 - dist, -rate), (dist - abs(self.l1 - self.l2), rate))
+
+    def crank_margins(self, tip: str, center: complex, radius: float,
+                      ground: Mapping[str, complex]
+                      ) -> Callable[[Any], tuple[tuple[Any, Any], ...]] | None:
+        """Return its margins in closed form when it joins the crank's tip to a ground point.
+
+        With ``r`` the crank, ``g`` and ``phi`` the distance and direction of
+        the ground point from the crank's pivot and ``psi = theta - phi``:
+        ``d^2 = (r - g)^2 + 4 r g sin^2(psi / 2) = (r + g)^2 - 4 r g cos^2(psi / 2)``,
+        so ``(l1 + l2)^2 - d^2`` and ``d^2 - (l1 - l2)^2`` are each a constant
+        plus a smooth term, taken in the form whose term is the smaller (near
+        ``psi = 0`` or ``pi``); the constants are formed exactly from the
+        doubles given (:func:`._sum_root`), so the margins keep their accuracy
+        where the circles barely meet (or barely fail to), and their roots
+        come out to an ulp of the angle.
+        """
+        starts = (self.start1, self.start2)
+        if tip not in starts:
+            return None
+        other = starts[1] if starts[0] == tip else starts[0]
+        if other not in ground:
+            return None
+        where = ground[other]
+        dx = Fraction(where.real) - Fraction(center.real)
+        dy = Fraction(where.imag) - Fraction(center.imag)
+        g2 = dx * dx + dy * dy
+        phi = math.atan2(float(dy), float(dx))
+        r = Fraction(radius)
+        lsum = Fraction(self.l1) + Fraction(self.l2)
+        ldiff = abs(Fraction(self.l1) - Fraction(self.l2))
+        # Near psi = 0 (d = |r - g|) and near psi = pi (d = r + g):
+        outer_0 = _sum_root(lsum - r, g2) * -_sum_root(-(lsum + r), g2)  # lsum^2 - (r - g)^2
+        outer_pi = -_sum_root(r - lsum, g2) * _sum_root(lsum + r, g2)  # lsum^2 - (r + g)^2
+        inner_0 = _sum_root(ldiff - r, g2) * _sum_root(-(r + ldiff), g2)  # (r - g)^2 - ldiff^2
+        inner_pi = _sum_root(r - ldiff, g2) * _sum_root(r + ldiff, g2)  # (r + g)^2 - ldiff^2
+        rg4 = 4.0 * radius * math.sqrt(g2)
+
+        def margins(theta: Any) -> tuple[tuple[Any, Any], ...]:
+            half = 0.5 * (theta - phi)
+            s, c = np.sin(half), np.cos(half)
+            s2, c2 = rg4 * s * s, rg4 * c * c
+            near_0 = s * s < 0.5
+            rate = rg4 * s * c  # 2 r g sin(psi): the rate of d^2
+            return ((np.where(near_0, outer_0 - s2, outer_pi + c2), -rate),
+                    (np.where(near_0, inner_0 + s2, inner_pi - c2), rate))
+
+        return margins
 
     def run(self, ctx: _Context) -> None:
         l1, l2 = self.l1, self.l2

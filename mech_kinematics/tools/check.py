@@ -23,8 +23,9 @@ __all__ = ['add_parser', 'main', 'report_text', 'report_json']
 CHECK_HELP = """\
 Study one full turn of a scene's crank (angles 0 to 360 deg, CCW from +x) and
 print:
-  - the crank-angle ranges where the mechanism assembles (their ends refined
-    to 1e-12 rad) and where it does not;
+  - the crank-angle ranges where the mechanism assembles and where it does
+    not, however narrow (their ends the roots of the dyads' assembly margins,
+    to 1e-12 rad);
   - its toggle positions (a dyad's links in line: the mechanism locks there);
   - its dead centres (an output link or slider reverses: for a four-bar's
     rocker the crank and coupler are in line, for a slider-crank the piston

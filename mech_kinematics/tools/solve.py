@@ -10,10 +10,11 @@ import json
 import math
 import sys
 from typing import Any
+import warnings
 
 from .cli import finite_float, positive_float, run_tool
 from ..bounds import MAX_ERROR
-from ..errors import AssemblyError, SceneError, UntrustedError
+from ..errors import AssemblyError, NearSingularWarning, SceneError, UntrustedError
 from ..scene import load_scene
 from ..solver import assembly_text, solve
 from ..units import rad_per_s_from_rpm, radians_from_degrees
@@ -62,7 +63,9 @@ def _handle(args: argparse.Namespace) -> int:
         angle, turns = turns_from_degrees(args.angle_deg)
     speed = None if args.speed_rpm is None else rad_per_s_from_rpm(args.speed_rpm)
     try:
-        state = solve(scene, angle, speed, args.accel, turns=turns, max_error=args.max_error)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter('always', NearSingularWarning)
+            state = solve(scene, angle, speed, args.accel, turns=turns, max_error=args.max_error)
     except AssemblyError as error:
         shown = scene.units.angle_text(scene.input.angle) if args.angle_deg is None else \
             f'{args.angle_deg:.15g} deg'
@@ -74,6 +77,12 @@ def _handle(args: argparse.Namespace) -> int:
     except ValueError as error:
         print(f'error: {error}', file=sys.stderr)
         return 2
+    for warning in caught:  # one line each, without Python's source line
+        if issubclass(warning.category, NearSingularWarning):
+            print(f'warning: {warning.message}', file=sys.stderr)
+        else:
+            warnings.warn_explicit(warning.message, warning.category, warning.filename,
+                                   warning.lineno)
     result: dict[str, Any] = state.as_dict()
     if args.diagnostics:
         result['singularity'] = {key: float(m) for key, m in state.singularity.items()}
