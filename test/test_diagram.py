@@ -370,6 +370,19 @@ def test_animation_skips_angles_that_cannot_assemble(tmp_path):
         assert image.format == 'GIF' and image.n_frames == count
 
 
+def test_geneva_animation_has_every_frame(tmp_path):
+    """Every 5 deg from 150 deg lands on 225 and 135 deg, the jumps: all 72 frames drawn.
+
+    See issue 19: those two engagement instants are answered one-sided now.
+    """
+    from PIL import Image
+
+    path = tmp_path / 'geneva.gif'
+    assert dg.write_animation(mk.load_scene('geneva'), path, dpi=30.0) == 72
+    with Image.open(path) as image:
+        assert image.n_frames == 72
+
+
 def test_cli_writes_diagram_and_animation(tmp_path, capsys):
     """`diagram SCENE -o FILE` writes a PNG; `--animate` a GIF; both exit 0."""
     png, gif = tmp_path / 'd.png', tmp_path / 'a.gif'

@@ -23,6 +23,7 @@ import pytest
 
 import mech_kinematics as mk
 from mech_kinematics.__main__ import main
+from mech_kinematics.ros.ticker import tick_function, values_from_state
 from mech_kinematics.tools import reference as ref
 
 SLOTS = 4
@@ -185,16 +186,142 @@ def test_acceleration_jumps_are_reported_not_smeared(geneva, offset):
         pytest.approx((JUMP, 0.0), rel=1e-15)
 
 
-def test_the_engagement_instant_is_refused_unless_the_bound_may_cover_both_sides(geneva):
-    """At 135 deg exactly the acceleration is two-valued: refused, or bounded by the jump."""
-    with pytest.raises(mk.UntrustedError, match='mouth of a slot of wheel') as caught:
-        mk.solve(geneva, ENTRY)
-    assert caught.value.value == 'joints.wheel.acceleration'
-    state = mk.solve(geneva, ENTRY, max_error=math.inf)
-    assert state.error_bound.joints['wheel'].acceleration >= JUMP
-    vector = mk.solve(geneva, np.array([ENTRY - 0.01, ENTRY, ENTRY + 0.01]))
-    np.testing.assert_array_equal(vector.valid, [True, False, True])
-    assert vector.failures['RPR wheel (untrusted)'][1]
+#: The engagement instants of the first two turns, deg: entry and exit of windows 0 and 1.
+INSTANTS = (135.0, 225.0, 495.0, 585.0)
+#: Crank speeds, rad/s: CCW, CW and at rest (a crank at rest counts as turning CCW).
+SPEEDS = (OMEGA, -OMEGA, 0.0)
+
+
+def edge_at(degrees):
+    """Return 'entry' or 'exit': which end of a window of the packaged wheel ``degrees`` is."""
+    return 'entry' if math.remainder(degrees - 135.0, 360.0) == 0.0 else 'exit'
+
+
+def one_sided(engagement, edge, speed):
+    """Return (after, before): the wheel's acceleration either side of ``edge`` of a window.
+
+    Taken from the Engagement record, which gives them for a crank turning
+    CCW; a crank turning CW passes the instant the other way.
+    """
+    before, after = getattr(engagement, f'{edge}_acceleration')
+    return (before, after) if speed < 0.0 else (after, before)
+
+
+@pytest.mark.parametrize('speed', SPEEDS)
+@pytest.mark.parametrize('degrees', INSTANTS)
+def test_engagement_instants_are_answered_one_sided(geneva, degrees, speed):
+    """At entry and exit: the side after the jump, the other side in "jumps". See issue 19.
+
+    The wheel's acceleration is the one-sided limit after the instant in the
+    crank's sense of motion, within its own bound of the exact limit
+    -+omega^2 tan(pi / n); position and velocity are those of either side; the
+    point W carried by the wheel jumps with it, the crank and the pin do not.
+    """
+    scene = with_wheel_point(geneva)
+    state = mk.solve(scene, math.radians(degrees), speed)
+    engagement = state.intermittent['wheel']
+    after, before = one_sided(engagement, edge_at(degrees), speed)
+    wheel, bound = state.joints['wheel'], state.error_bound.joints['wheel']
+    assert wheel.acceleration == after
+    assert state.jumps['joints'] == {'wheel': {'acceleration': before}}
+    assert engagement.engaged and engagement.window == int(degrees // 360.0)
+    with mpmath.workdps(60):
+        jump = mpmath.mpf(speed) ** 2 * mpmath.tan(mpmath.pi / SLOTS)
+        exact = mpmath.sign(after) * jump  # the exact one-sided limit (0 if held after)
+        assert abs(mpmath.mpf(wheel.acceleration) - exact) <= bound.acceleration
+    assert bound.acceleration <= 1e-14 * max(JUMP, 1.0)
+    assert abs(wheel.velocity) <= bound.velocity <= 1e-12 * OMEGA  # 0 on both sides
+    edge = exact_held(geneva, 2 * int(degrees // 360.0) + (1 if degrees % 360 == 225 else -1))
+    assert angle_error(wheel.position, edge) <= bound.position <= 1e-13
+    # W is carried by the wheel 30 mm from S: a_W = (i alpha - omega^2) (W - S), omega ~ 0.
+    w = state.complex_points['W']
+    arm = w[0] - complex(*scene.ground['S'])
+    assert abs(arm) == pytest.approx(0.03, rel=1e-12)
+    assert w[2] == pytest.approx(1j * after * arm, abs=1e-12 * OMEGA ** 2)
+    other = state.jumps['points']['W']['acceleration']
+    assert list(state.jumps['points']) == ['W']
+    np.testing.assert_allclose(other, [-before * arm.imag, before * arm.real],
+                               rtol=0, atol=1e-12 * OMEGA ** 2)
+    data = state.as_dict()['jumps']
+    assert data['joints'] == {'wheel': {'acceleration': before}}
+    assert data['points']['W']['acceleration'] == [float(x) for x in other]
+
+
+def test_the_other_side_is_a_solve_a_hair_before(geneva):
+    """The "jumps" side equals a solve a little before the instant, the answer one after."""
+    scene = with_wheel_point(geneva)
+    for degrees in INSTANTS:
+        for speed in (OMEGA, -OMEGA):
+            theta, step = math.radians(degrees), math.copysign(1e-9, speed)
+            state = mk.solve(scene, theta, speed)
+            before, after = mk.solve(scene, theta - step, speed), mk.solve(scene, theta + step,
+                                                                           speed)
+            got = state.jumps['joints']['wheel']['acceleration']
+            assert got == pytest.approx(before.joints['wheel'].acceleration, abs=1e-6)
+            assert state.joints['wheel'].acceleration == pytest.approx(
+                after.joints['wheel'].acceleration, abs=1e-6)
+            np.testing.assert_allclose(state.jumps['points']['W']['acceleration'],
+                                       before.points['W'].acceleration, rtol=0, atol=1e-7)
+            np.testing.assert_allclose(state.points['W'].acceleration,
+                                       after.points['W'].acceleration, rtol=0, atol=1e-7)
+
+
+def test_no_jumps_away_from_the_instants(geneva):
+    """At other angles "jumps" is empty and absent from the JSON; a scene without one never."""
+    for degrees in (134.99, 135.01, 150.0, 224.99, 300.0):
+        state = mk.solve(geneva, math.radians(degrees))
+        assert state.jumps == {} and 'jumps' not in state.as_dict()
+        assert not geneva.jumps_at(math.radians(degrees))
+    four_bar = mk.load_scene('khurmi_four_bar_ad150')
+    assert four_bar.intermittent == () and not four_bar.jumps_at(1.0)
+    assert mk.solve(four_bar, np.linspace(0, 6, 7)).jumps == {}
+    assert geneva.intermittent == ('wheel',)
+    for degrees in INSTANTS:
+        assert geneva.jumps_at(math.radians(degrees))
+    assert geneva.jumps_at(math.radians(135.0), turns=10 ** 12)
+
+
+@pytest.mark.parametrize('speed', SPEEDS)
+def test_both_paths_answer_the_instants_alike(geneva, speed):
+    """In an array the instants are valid, and both paths give the same bits and jumps."""
+    scene = with_wheel_point(geneva)
+    degrees = np.array([*INSTANTS, 150.0, 300.0, 135.0])
+    turns = np.array([0, 0, 0, 0, 0, 0, 7])
+    vector = mk.solve(scene, np.radians(degrees), speed, turns=turns)
+    assert vector.valid.all()
+    jumped = ~np.isnan(vector.jumps['joints']['wheel']['acceleration'])
+    np.testing.assert_array_equal(jumped, [True] * 4 + [False, False, True])
+    assert np.isnan(vector.jumps['points']['W']['acceleration'][~jumped]).all()
+    vector_bounds = vector.error_bound.raw()
+    for index, (deg, k) in enumerate(zip(degrees, turns, strict=True)):
+        single = mk.solve(scene, math.radians(deg), speed, turns=int(k))
+        for name, joint in single.joints.items():
+            position = vector.joints[name].position[index]
+            assert abs(joint.position - position) <= np.spacing(abs(position))
+            for quantity in ('velocity', 'acceleration'):
+                assert getattr(joint, quantity) == getattr(vector.joints[name], quantity)[index]
+        for name, values in single.error_bound.raw()[0].items():
+            assert tuple(values) == tuple(x[index] for x in vector_bounds[0][name]), name
+        assert single.complex_points['W'][2] == vector.complex_points['W'][2][index]
+        if single.jumps:
+            assert single.jumps['joints']['wheel']['acceleration'] == \
+                vector.jumps['joints']['wheel']['acceleration'][index]
+            np.testing.assert_array_equal(single.jumps['points']['W']['acceleration'],
+                                          vector.jumps['points']['W']['acceleration'][index])
+        assert bool(single.jumps) == jumped[index]
+        assert single.intermittent['wheel'].engaged == vector.intermittent['wheel'].engaged[index]
+
+
+def test_the_tick_answers_the_instants_as_solve_does(geneva):
+    """The node's tick, compiled or not, publishes the instants with mk.solve's values."""
+    tick, _ = tick_function(geneva)
+    for degrees in INSTANTS:
+        for speed in SPEEDS:
+            theta, turns = math.radians(degrees % 360.0), int(degrees // 360.0)
+            values, _ = tick(theta, speed, 0.0, mk.MAX_ERROR, turns)
+            state = mk.solve(geneva, theta, speed, 0.0, turns=turns)
+            assert values == values_from_state(state, geneva.output_joints,
+                                               geneva.output_points)
 
 
 def test_solve_command_reports_the_jumps_in_json(geneva, capsys):
@@ -210,9 +337,19 @@ def test_solve_command_reports_the_jumps_in_json(geneva, capsys):
     assert data['input']['angle'] == pytest.approx(math.radians(510.0), rel=1e-15)
     expected = mk.solve(geneva, math.radians(150.0), turns=1).joints['wheel'].position
     assert data['joints']['wheel']['position'] == expected
-    assert main(['solve', 'geneva', '--angle-deg', '135']) == 2
-    assert capsys.readouterr().err.startswith(
-        'error: RPR wheel cannot be solved at crank angle 135 deg: ')
+    assert 'jumps' not in data
+    # An engagement instant is answered: the side after it, the other in "jumps" (issue 19).
+    for degrees, after, before in (('135', -JUMP, 0.0), ('585', 0.0, JUMP)):
+        assert main(['solve', 'geneva', '--angle-deg', degrees]) == 0
+        data = json.loads(capsys.readouterr().out)
+        assert data['joints']['wheel']['acceleration'] == pytest.approx(after, rel=1e-15)
+        assert data['jumps'] == {'joints': {'wheel': {'acceleration': pytest.approx(
+            before, rel=1e-15)}}, 'points': {}}
+    assert main(['solve', 'geneva', '--angle-deg', '135', '--speed-rpm', '-60']) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data['joints']['wheel']['acceleration'] == 0.0
+    assert data['jumps']['joints']['wheel']['acceleration'] == pytest.approx(
+        -(2 * math.pi) ** 2, rel=1e-14)
 
 
 def test_bounds_cover_the_exact_values(geneva):
@@ -314,6 +451,27 @@ def test_a_six_slot_wheel_written_in_general_terms(tmp_path):
         middle = mk.solve(scene, math.radians(90.0))
     # At the line of centres the pin is closest: omega = -w R / (l - R) = -2 pi / 1 rad/s.
     assert middle.joints['wheel'].velocity == pytest.approx(-2 * math.pi, rel=1e-14)
+
+
+@pytest.mark.parametrize(('speed', 'accel'), [(2 * math.pi, 0.0), (-3.0, 1.0), (0.0, 5.0)])
+def test_a_six_slot_wheel_is_answered_one_sided_at_its_instants(tmp_path, speed, accel):
+    """Entry at 30 deg, exit at 150 deg: the one-sided limits -+omega^2 tan(30 deg). Issue 19."""
+    path = tmp_path / 'six.yaml'
+    path.write_text(SCENE)
+    scene = mk.load_scene(path)
+    for degrees, edge, sign in ((30.0, 'entry', -1), (150.0, 'exit', 1)):
+        state = mk.solve(scene, math.radians(degrees), speed, accel)
+        after, before = one_sided(state.intermittent['wheel'], edge, speed)
+        got = state.joints['wheel'].acceleration
+        assert got == after and state.jumps['joints']['wheel']['acceleration'] == before
+        with mpmath.workdps(60):
+            exact = sign * mpmath.mpf(speed) ** 2 * mpmath.tan(mpmath.pi / 6)
+            side = exact if (edge == 'entry') == (speed >= 0.0) else 0
+            assert abs(mpmath.mpf(got) - side) <= state.error_bound.joints['wheel'].acceleration
+        # and a hair after the instant the plain solve agrees, to first order
+        step = math.copysign(1e-8, speed) if speed else 1e-8
+        near = mk.solve(scene, math.radians(degrees) + step, speed, accel)
+        assert near.joints['wheel'].acceleration == pytest.approx(after, abs=1e-6)
 
 
 @pytest.mark.parametrize(('edit', 'message'), [

@@ -126,10 +126,31 @@ def test_the_ticks_own_count_equals_record():
     a, b = TickStats(near_singular=1e-3), TickStats(near_singular=1e-3)
     for k, measure in enumerate((0.5, 1e-4, 0.2)):
         a.record(k, 10 * k, k == 1, measure=measure, near_singular=measure < 1e-3,
-                 sample=(0.1, 2.0, 0.0))
-        b.published(k, 10 * k, k == 1, measure, (0.1, 2.0, 0.0))
+                 sample=(0.1, 2.0, 0.0), jump=k == 2)
+        b.published(k, 10 * k, k == 1, measure, (0.1, 2.0, 0.0), jump=k == 2)
+    a.record(3, 30, False, measure=0.5, sample=(0.1, 2.0, 0.0), jump=True)
+    b.published(3, 30, False, 0.5, (0.1, 2.0, 0.0), True)
     wa, wb = a.take_window(a._start + NS), b.take_window(b._start + NS)
     assert (wa.instants, wa.published, wa.late, wa.near_singular, wa.worst_measure,
-            wa.lateness_ns, wa.last_published_stamp_ns) == \
+            wa.lateness_ns, wa.last_published_stamp_ns, wa.jump_instants) == \
         (wb.instants, wb.published, wb.late, wb.near_singular, wb.worst_measure,
-         wb.lateness_ns, wb.last_published_stamp_ns) == (3, 3, 1, 1, 1e-4, [0, 10, 20], 2)
+         wb.lateness_ns, wb.last_published_stamp_ns, wb.jump_instants) == \
+        (4, 4, 1, 1, 1e-4, [0, 10, 20, 30], 3, 2)
+
+
+def test_jump_instants_are_counted_at_level_ok():
+    """Instants published one-sided at a jump (a Geneva wheel's) are counted, the level OK.
+
+    See issue 19: they are answered, not refused.
+    """
+    stats = TickStats(near_singular=1e-3)
+    for k in range(1000):
+        stats.published(k, 5_000, False, 0.5, (0.1, 2.0, 0.0), k in (250, 750))
+    first = stats.take_window(stats._start + NS)
+    stats.published(1000, 5_000, False, 0.5, (0.1, 2.0, 0.0), True)
+    second = stats.take_window(stats._start + NS)
+    solver = solver_status(first, near_singular=1e-3, **NAME)
+    assert solver.level == OK and solver.message == 'ok'
+    assert solver.value('jump_instants') == '2' == solver.value('jump_instants_total')
+    later = solver_status(second, near_singular=1e-3, **NAME)
+    assert later.value('jump_instants') == '1' and later.value('jump_instants_total') == '3'

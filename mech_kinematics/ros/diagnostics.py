@@ -58,6 +58,7 @@ class Window:
     published: int = 0
     unsolved: int = 0           # refused: cannot assemble, or not trusted
     near_singular: int = 0
+    jump_instants: int = 0      # published one-sided: a value jumps there (a Geneva wheel's)
     late: int = 0
     skipped: int = 0            # grid instants dropped
     clock_jumps: int = 0
@@ -70,7 +71,8 @@ class Window:
     totals: dict[str, int] = field(default_factory=dict)
 
 
-_TOTALS = ('instants', 'published', 'unsolved', 'late', 'skipped', 'clock_jumps')
+_TOTALS = ('instants', 'published', 'unsolved', 'late', 'skipped', 'clock_jumps',
+           'jump_instants')
 
 
 class TickStats:
@@ -91,11 +93,12 @@ class TickStats:
     def record(self, stamp_ns: int, lateness_ns: int, late: bool, *, error: str | None = None,
                refusal: str = 'cannot assemble', measure: float = math.inf,
                near_singular: bool = False,
-               sample: tuple[float, float, float] | None = None) -> None:
+               sample: tuple[float, float, float] | None = None, jump: bool = False) -> None:
         """Count one grid instant: published (``error`` None) or refused with ``error``.
 
         ``refusal`` names the kind of refusal: ``'cannot assemble'`` or
-        ``'not trusted'`` (an error bound above the tolerance).
+        ``'not trusted'`` (an error bound above the tolerance); ``jump``: a
+        value jumps at the published instant (published one-sided).
         """
         with self._lock:
             w = self._window
@@ -110,14 +113,19 @@ class TickStats:
                 w.worst_measure = min(w.worst_measure, measure)
                 if near_singular:
                     w.near_singular += 1
+                if jump:
+                    w.jump_instants += 1
             else:
                 w.unsolved += 1
                 w.last_error = error
                 w.last_refusal = refusal
 
     def published(self, stamp_ns: int, lateness_ns: int, late: bool, measure: float,
-                  sample: tuple[float, float, float]) -> None:
-        """Count one grid instant published: :meth:`record` without a refusal, the tick's way."""
+                  sample: tuple[float, float, float], jump: bool = False) -> None:
+        """Count one grid instant published: :meth:`record` without a refusal, the tick's way.
+
+        ``jump``: a value jumps at the instant (published one-sided).
+        """
         with self._lock:
             w = self._window
             w.instants += 1
@@ -131,6 +139,8 @@ class TickStats:
                 w.worst_measure = measure
             if measure < self.near_singular:
                 w.near_singular += 1
+            if jump:
+                w.jump_instants += 1
 
     def skip(self, count: int) -> None:
         """Count ``count`` grid instants dropped."""
@@ -181,6 +191,9 @@ def solver_status(window: Window, *, name: str, hardware_id: str, near_singular:
     ERROR if any instant could not be solved or was refused (with the last
     reason), WARN if any was near-singular or the node is ``waiting_for``
     something (e.g. ``'/clock'``), STALE if there was nothing to solve, else OK.
+    Instants at which a value jumps, published one-sided (a Geneva wheel's
+    engagement instants), are counted (keys ``jump_instants``,
+    ``jump_instants_total``) and do not change the level.
     ``assembly`` says in one line where the scene cannot assemble (key
     ``assembly``).
     """
@@ -202,6 +215,8 @@ def solver_status(window: Window, *, name: str, hardware_id: str, near_singular:
         ('near_singular_threshold', f'{near_singular:g}'),
         ('unsolved_ticks', str(w.unsolved)),
         ('unsolved_ticks_total', str(w.totals.get('unsolved', 0))),
+        ('jump_instants', str(w.jump_instants)),
+        ('jump_instants_total', str(w.totals.get('jump_instants', 0))),
         ('last_error', w.last_error),
     ]
     if assembly:

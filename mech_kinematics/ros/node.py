@@ -353,6 +353,8 @@ class KinematicsNode(LifecycleNode):
         self._solve, compiled = tick_function(tick_scene, scene.output_joints,
                                               scene.output_points, frames)
         self._tf_first = 3 * len(scene.output_joints) + 6 * len(scene.output_points)
+        # Instants where a value jumps (a Geneva wheel's) are published one-sided and counted.
+        self._jumps_at = tick_scene.jumps_at if tick_scene.intermittent else None
         # Where the scene cannot assemble, in one line, for the diagnostics.
         self._assembly = assembly_summary(scene)
         if not compiled:
@@ -608,7 +610,8 @@ class KinematicsNode(LifecycleNode):
             with self._marker_lock:
                 self._marker_request = (sec, nanosec, angle, speed, accel)
             self._marker_guard.trigger()
-        self._stats.published(stamp, lateness, late, measure, sample)
+        self._stats.published(stamp, lateness, late, measure, sample,
+                              self._jumps_at is not None and self._jumps_at(angle, turns=turns))
         if measure < mk.NEAR_SINGULAR:
             self.get_logger().warning(
                 f'near-singular pose at crank angle {angle:.6f} rad: measure {measure:.3g}',

@@ -55,8 +55,8 @@ TickFunction = Callable[[float, float, float, float, int], tuple[list[float], fl
 
 _SOLVER = lk.__name__ + '.'
 #: The context's methods that record side facts (an intermittent lever's window, why a
-#: bound is large): the tick reports neither, so their calls are dropped.
-_DROPPED = ('engage', 'note')
+#: bound is large, a jump): the tick reports none, so their calls are dropped.
+_DROPPED = ('engage', 'note', 'jump')
 _TABLES = {'points': 'P', 'links': 'L', 'sliders': 'S', 'measures': 'M'}
 
 
@@ -151,7 +151,7 @@ class _Specializer(ast.NodeTransformer):
             if node.value.id == 'self':
                 return ast.copy_location(self.constant(getattr(self.step, node.attr)), node)
             if node.value.id == 'ctx':
-                if node.attr == 'vector':
+                if node.attr in ('vector', 'flip'):   # the tick answers the side after a jump
                     return ast.Constant(False)
                 if node.attr == 'angle':
                     return ast.Name('theta', ast.Load())

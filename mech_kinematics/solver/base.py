@@ -166,6 +166,9 @@ class Intermittent(Protocol):
     def engagement(self, ctx: _Context, omega: Any, finish: Any) -> Engagement:
         """Return its :class:`~.state.Engagement` from a solve's context."""
 
+    def jumps_at(self, angle: float, turns: int) -> bool:
+        """Return whether one crank angle (plus whole turns) is within rounding of a jump."""
+
 
 class Names(Protocol):
     """What the plan compiler lets an item check its references against."""

@@ -40,9 +40,9 @@ class _Context:
     """
 
     __slots__ = ('angle', 'turns', 'shown', 'vector', 'points', 'links', 'sliders', 'measures',
-                 'valid', 'failures', 'engagement', 'rubbing', 'notes')
+                 'valid', 'failures', 'engagement', 'rubbing', 'notes', 'flip', 'jumps')
 
-    def __init__(self, angle: Any, vector: bool, turns: Any = 0) -> None:
+    def __init__(self, angle: Any, vector: bool, turns: Any = 0, flip: bool = False) -> None:
         self.angle = angle
         self.turns = turns  # whole crank turns to add to angle (intermittent drives only)
         # The crank angle counted from the start, for messages (scalar path).
@@ -58,6 +58,19 @@ class _Context:
         self.engagement: dict[str, tuple[Any, Any]] = _NOTHING  # lever -> (engaged, window)
         self.rubbing: dict[str, tuple[Any, Any]] = _NOTHING  # pin -> (value, bound)
         self.notes: dict[str, str] = _NOTHING  # label -> why a bound is large (scalar path)
+        # At a jump (an engagement instant) the steps answer the side after it; with
+        # flip, the side before it. jumps: lever -> where it jumps (True, or a mask).
+        self.flip = flip
+        self.jumps: dict[str, Any] = _NOTHING
+
+    def jump(self, lever: str, where: Any) -> None:
+        """Record that ``lever``'s values jump at the instant (``where``: True, or a mask).
+
+        The step answered the side after the jump (before it where ``flip``).
+        """
+        if self.jumps is _NOTHING:
+            self.jumps = {}
+        self.jumps[lever] = where
 
     def engage(self, lever: str, engaged: Any, window: Any) -> None:
         """Record where an intermittent lever is in its cycle (the tick drops it)."""

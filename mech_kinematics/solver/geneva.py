@@ -40,15 +40,26 @@ class _IndexStep(_RPRStep):
     ``turns`` whole turns, the turns never added in floating point), so the
     wheel's index is exact over any number of turns; both tables are
     computed once, so both paths read the same bits.
+
+    Within rounding of a slot's mouth (an engagement instant, where the
+    wheel's angular acceleration jumps between 0 and ``-+omega^2 tan(pi /
+    n)``) the answer is the side *after* the jump in the direction the crank
+    turns (increasing angle for a crank at rest): engaged or held, its
+    acceleration the one-sided limit with its own bound; position and
+    velocity, continuous there, keep bounds that cover both sides. The
+    instant is recorded (``ctx.jump``); a context with ``flip`` set
+    answers the side before the jump instead (how :func:`~.solve.solve`
+    finds the other side of every value that jumps).
     """
 
     intermittent = True
 
-    def __init__(self, dyad: RPR, center: complex, size: float, crank_center: complex,
-                 pin: complex) -> None:
+    def __init__(self, dyad: RPR, center: complex, size: float, crank: str,
+                 crank_center: complex, pin: complex) -> None:
         super().__init__(dyad, center, size)
         n = cast(int, dyad.slots)
         self.slots = n
+        self.crank = crank  # the driving crank's link: its speed says which side is after
         toward = center - crank_center  # from the crank's centre to the wheel's
         distance = abs(toward)
         # Window 0 is centred on the crank angle that points the pin at the wheel.
@@ -56,6 +67,10 @@ class _IndexStep(_RPRStep):
         self.phase0 = math.atan2(toward.imag, toward.real) - beta
         self.half = math.pi / 2 - math.pi / n  # half the crank's engaged angle
         self.tan = math.tan(math.pi / n)  # R / (slot mouth): the acceleration's jump / omega^2
+        # The jump omega^2 tan(pi / n), relative: pi / n's rounding (2 U) through tan's
+        # slope, tan to an ulp (2 U), omega to U (the crank's bound) squared, two products.
+        x = math.pi / n
+        self.e_jump = U * (2.0 * x * (1.0 + self.tan * self.tan) / self.tan + 2.0) + _U4
         c = math.atan2(-toward.imag, -toward.real)
         step = math.pi / n
         held = [c - j * step for j in range(2 * n)]
@@ -89,6 +104,13 @@ class _IndexStep(_RPRStep):
         er = U * (abs(angle) + abs(d) + abs(r)) + self.e_phase + abs(q) * self.e_q
         return abs(r) <= self.half, window, r, er
 
+    def mouth(self, r: Any, er: Any) -> Any:
+        """Return whether an offset ``r`` in a window (bound ``er``) is within rounding of a mouth.
+
+        There the wheel's angular acceleration jumps: an engagement instant.
+        """
+        return abs(abs(r) - self.half) <= ROUNDING_MARGIN * (er + self.e_half)
+
     def run(self, ctx: _Context) -> None:
         """Run the plain RPR's kernel, then index its motion by the crank's window."""
         _RPRStep.run(self, ctx)
@@ -106,9 +128,9 @@ class _IndexStep(_RPRStep):
         """Index the lever's engaged motion by the crank's window, for an array of angles."""
         n = self.slots
         engaged, window, r, er = self.window(ctx.angle, ctx.turns, ctx.vector)
-        near = abs(abs(r) - self.half) <= ROUNDING_MARGIN * (er + self.e_half)
+        near = self.mouth(r, er)
         e, w, al, ee, ew, eal = ctx.links[self.link]
-        ctx.engage(self.link, engaged, window)
+        ctx.engage(self.link, engaged | near, window)
         m = np.mod(window, n)
         side = np.mod(2 * window + np.where(r > 0.0, 1, -1), 2 * n)
         t = self.turn_array[m]
@@ -116,36 +138,59 @@ class _IndexStep(_RPRStep):
         # The engaged direction turned back by 2 pi m / n, in real arithmetic (same bits).
         turned = (e.real * t.real - e.imag * t.imag) + 1j * (e.real * t.imag + e.imag * t.real)
         e_turn, e_held = self.e_turn_array[m], self.e_held_array[side]
-        entry: tuple[Any, ...] = (
-            np.where(engaged, turned, held), np.where(engaged, w, 0.0),
-            np.where(engaged, al, 0.0), np.where(engaged, ee + e_turn, e_held),
-            np.where(engaged, ew, 0.0), np.where(engaged, eal, 0.0))
         if near.any():
-            # Within rounding of a slot's mouth either side may be the true one: the
-            # bounds cover both (the acceleration jumps there).
+            # An engagement instant: the side after the jump in the crank's sense of
+            # motion (the pin entering at r = -half when it turns forward), or before
+            # it for a flipped context; the acceleration its one-sided limit.
+            crank = ctx.links[self.crank][1]
+            after = (r < 0.0) == (crank >= 0.0)
+            inside = np.where(near, after != ctx.flip, engaged)
+            jump = crank * crank * self.tan
+            limit = np.where(r < 0.0, -jump, jump)
             diff = turned - held
             gap = abs(diff.real) + abs(diff.imag)
-            entry = (entry[0], entry[1], entry[2],
-                     np.where(near, ee + e_turn + e_held + gap, entry[3]),
-                     np.where(near, ew + abs(w), entry[4]),
-                     np.where(near, eal + abs(al), entry[5]))
+            entry: tuple[Any, ...] = (
+                np.where(inside, turned, held), np.where(inside, w, 0.0),
+                np.where(inside, np.where(near, limit, al), 0.0),
+                np.where(near, ee + e_turn + e_held + gap,
+                         np.where(inside, ee + e_turn, e_held)),
+                np.where(near, ew + abs(w), np.where(inside, ew, 0.0)),
+                np.where(inside, np.where(near, self.e_jump * jump, eal), 0.0))
+            ctx.jump(self.link, near)
+        else:
+            entry = (
+                np.where(engaged, turned, held), np.where(engaged, w, 0.0),
+                np.where(engaged, al, 0.0), np.where(engaged, ee + e_turn, e_held),
+                np.where(engaged, ew, 0.0), np.where(engaged, eal, 0.0))
         ctx.links[self.link] = entry
 
-    def run_one(self, ctx: _Context) -> None:
-        """Do :meth:`run_array` for one crank angle: the same operations, only those it needs."""
-        angle = ctx.angle
+    def offset(self, angle: float, turns: int) -> tuple[int, float, float]:
+        """Return (window, offset in the window, its error bound) at one crank angle."""
         d = angle - self.phase0
         q = round(d / math.tau)  # an int: q * tau and abs(q) * e_q round as the float's would
         r = d - q * math.tau
-        window = ctx.turns + q
-        ar = abs(r)
-        half = self.half
-        engaged = ar <= half
-        ctx.engage(self.link, engaged, window)
-        er = U * (abs(angle) + abs(d) + ar) + self.e_phase + abs(q) * self.e_q
-        near = abs(ar - half) <= ROUNDING_MARGIN * (er + self.e_half)
+        er = U * (abs(angle) + abs(d) + abs(r)) + self.e_phase + abs(q) * self.e_q
+        return turns + q, r, er
+
+    def jumps_at(self, angle: float, turns: int) -> bool:
+        """Return whether one crank angle is an engagement instant (see :meth:`mouth`)."""
+        _, r, er = self.offset(angle, turns)
+        return bool(self.mouth(r, er))
+
+    def run_one(self, ctx: _Context) -> None:
+        """Do :meth:`run_array` for one crank angle: the same operations, only those it needs."""
+        window, r, er = self.offset(ctx.angle, ctx.turns)
+        engaged = abs(r) <= self.half
+        near = self.mouth(r, er)
+        ctx.engage(self.link, engaged or near, window)
         n = self.slots
         e, w, al, ee, ew, eal = ctx.links[self.link]
+        if near:
+            # An engagement instant (see run): the side after the jump, or before it.
+            crank = ctx.links[self.crank][1]
+            engaged = ((r < 0.0) == (crank >= 0.0)) != ctx.flip
+            jump = crank * crank * self.tan
+            ctx.jump(self.link, True)
         if engaged or near:
             m = window % n
             t = self.turn[m]
@@ -157,18 +202,14 @@ class _IndexStep(_RPRStep):
             side = (2 * window + (1 if r > 0.0 else -1)) % (2 * n)
             entry = (self.held[side], 0.0, 0.0, self.e_held[side], 0.0, 0.0)
         if near:
-            # Within rounding of a slot's mouth either side may be the true one: the
-            # bounds cover both (the acceleration jumps there).
+            # Position and velocity are continuous: their bounds cover both sides.
             side = (2 * window + (1 if r > 0.0 else -1)) % (2 * n)
-            held = self.held[side]
-            diff = turned - held
+            diff = turned - self.held[side]
             gap = abs(diff.real) + abs(diff.imag)
-            entry = (entry[0], entry[1], entry[2],
-                     ee + self.e_turn[m] + self.e_held[side] + gap, ew + abs(w), eal + abs(al))
-            ctx.note(self.label, lambda: (
-                f'the pin {self.through} is within rounding of the mouth of a slot of '
-                f'{self.link}, where its angular acceleration jumps from or to 0 (an '
-                f'engagement instant: ask for a crank angle either side of it)'))
+            limit = -jump if r < 0.0 else jump
+            entry = (entry[0], entry[1], limit if engaged else 0.0,
+                     ee + self.e_turn[m] + self.e_held[side] + gap, ew + abs(w),
+                     self.e_jump * jump if engaged else 0.0)
         ctx.links[self.link] = entry
 
     def engagement(self, ctx: _Context, omega: Any, finish: Any) -> Engagement:
@@ -216,4 +257,4 @@ def _index_step(plan: Placing, item: RPR) -> _IndexStep:
                f'{distance * sine * per:.10g} {units.length}, to 1e-9, got '
                f'{units.length_text(distance)} apart')
         raise SceneError(msg, (item, 'slots'))
-    return _IndexStep(item, wheel, size, centre, pin)
+    return _IndexStep(item, wheel, size, crank.link, centre, pin)

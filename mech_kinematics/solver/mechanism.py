@@ -82,11 +82,26 @@ class _Solver:
         self.out_points = plan.output_points
         self.levers = {step.key: cast(Intermittent, step) for step in plan.steps
                        if step.intermittent}
+        self.jumping = {lever: _jumping(plan, lever) for lever in self.levers}
         self.out_links = tuple(n for n, k in plan.joint_types.items() if k == 'revolute')
         self.out_sliders = tuple(n for n, k in plan.joint_types.items() if k == 'prismatic')
         # The quick trust test's groups (TRUST_TEST), with their names, the empty ones left out.
         self.trust = tuple((table, getattr(self, names), limits)
                            for table, names, limits in TRUST_TEST if getattr(self, names))
+
+
+def _jumping(plan: _Plan, lever: str) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """Return the reported joints and points whose acceleration jumps with ``lever``'s.
+
+    The lever itself and every name solved from it: what is carried on it and
+    the dyads downstream of those, in plan order.
+    """
+    moved = {lever}
+    for step in plan.steps:
+        if moved.intersection(step.requires):
+            moved.update(step.defines)
+    return (tuple(name for name in plan.joint_types if name in moved),
+            tuple(name for name in plan.output_points if name in moved))
 
 
 def assembly_text(error: AssemblyError, units: SceneUnits | None = None) -> str:
@@ -186,6 +201,21 @@ class Scene:
     def joint_types(self) -> dict[str, str]:
         """Joint name -> ``'revolute'`` or ``'prismatic'``, for the reported joints."""
         return dict(self._plan.joint_types)
+
+    @property
+    def intermittent(self) -> tuple[str, ...]:
+        """Its intermittent (Geneva) levers, whose accelerations jump (``State.jumps``)."""
+        return tuple(self._solver.levers)
+
+    def jumps_at(self, angle: float, *, turns: int = 0) -> bool:
+        """Return whether a value jumps at crank ``angle`` (rad) plus ``turns`` whole turns.
+
+        True within rounding of an intermittent (Geneva) wheel's engagement
+        instant, where :func:`~.solve.solve` answers the side after the jump
+        and gives the other in ``State.jumps``: the solve's own test, for one
+        angle without solving (the node counts these instants).
+        """
+        return any(lever.jumps_at(angle, turns) for lever in self._solver.levers.values())
 
     @property
     def pin_bodies(self) -> dict[str, tuple[str, str]]:

@@ -20,7 +20,7 @@ import numpy.typing as npt
 from .context import _Context, NEAR_SINGULAR
 from .scaling import (_ACCEL_HIGH, _ldexp, _QUANTITIES, _rate_exponent, _RATE_HIGH, _RATE_LOW,
                       _rescale)
-from .state import _scales, Engagement, JointMotion, State
+from .state import _scales, _xy, Engagement, JointMotion, State
 from ..bounds import ErrorBound, limit, MAX_ERROR, SCALE_MEANINGS, Table, UNITS
 from ..errors import NearSingularWarning, UntrustedError
 
@@ -29,9 +29,14 @@ if TYPE_CHECKING:
     from .plan import _Plan
 
 
-def _run(solver: _Solver, angle: Any, speed: Any, accel: Any, turns: Any) -> _Context:
-    """Run every step of the solver's plan; the caller chose scalar or vector inputs."""
-    ctx = _Context(angle, not isinstance(angle, float), turns)
+def _run(solver: _Solver, angle: Any, speed: Any, accel: Any, turns: Any,
+         flip: bool = False) -> _Context:
+    """Run every step of the solver's plan; the caller chose scalar or vector inputs.
+
+    With ``flip``, a value that jumps at the instant takes its side before the
+    jump (see :func:`solve`).
+    """
+    ctx = _Context(angle, not isinstance(angle, float), turns, flip)
     # Ground points stay complex scalars in both paths: NumPy broadcasts them.
     ctx.points.update(solver.ground)
     plan = solver.run_plan
@@ -45,7 +50,8 @@ def _run(solver: _Solver, angle: Any, speed: Any, accel: Any, turns: Any) -> _Co
     return ctx
 
 
-def _execute(solver: _Solver, theta: Any, omega: Any, alpha: Any, turns: Any = 0) -> _Context:
+def _execute(solver: _Solver, theta: Any, omega: Any, alpha: Any, turns: Any = 0,
+             flip: bool = False) -> _Context:
     """Run the solver in units that keep every product in range; reported values in SI.
 
     A crank rate outside [_RATE_LOW, _RATE_HIGH] is solved with time scaled by a
@@ -60,7 +66,7 @@ def _execute(solver: _Solver, theta: Any, omega: Any, alpha: Any, turns: Any = 0
         shift = _rate_exponent(omega, alpha)
     if shift:
         omega, alpha = _ldexp(omega, -shift), _ldexp(alpha, -2 * shift)
-    ctx = _run(solver, theta, omega, alpha, turns)
+    ctx = _run(solver, theta, omega, alpha, turns, flip)
     if solver.shift or shift:
         _rescale(solver, ctx, shift)
     return ctx
@@ -263,6 +269,7 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
         if not _trusted(solver, ctx, omega, alpha, tol):
             _refuse(solver, ctx, omega, alpha, tol)
         valid: Any = True
+        jumps = _jumps(solver, ctx, theta, omega, alpha, whole, None) if ctx.jumps else {}
     else:
         theta, omega, alpha = (np.asarray(x, dtype=np.float64) for x in (angle, speed, accel))
         shape = np.broadcast_shapes(theta.shape, omega.shape, alpha.shape, np.shape(whole))
@@ -281,8 +288,57 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
             _judge(solver, ctx, omega, alpha, tol, shape)
         omega, alpha = np.broadcast_to(omega, shape), np.broadcast_to(alpha, shape)
         valid = np.broadcast_to(np.asarray(ctx.valid, dtype=bool), shape).copy()
+        jumps = _jumps(solver, ctx, theta, omega, alpha, whole, valid) if ctx.jumps else {}
     _warn_near_singular(ctx)
-    return _state(scene, solver, ctx, theta, omega, alpha, valid, whole)
+    return _state(scene, solver, ctx, theta, omega, alpha, valid, whole, jumps)
+
+
+def _jumps(solver: _Solver, ctx: _Context, theta: Any, omega: Any, alpha: Any, turns: Any,
+           valid: Any) -> dict[str, Any]:
+    """Return ``State.jumps``: the other side of every reported value that jumps at the instant.
+
+    ``ctx`` holds the side after each jump (``ctx.jumps``: lever -> where it
+    jumps); the instants where something jumps are solved again with
+    ``flip``, which answers the side before. ``valid`` is None for one
+    instant, else the array solve's mask: there the values are arrays, NaN
+    where nothing jumps.
+    """
+    joints: dict[str, Any] = {}
+    points: dict[str, Any] = {}
+    kinds = solver.plan.joint_types
+    if valid is None:
+        other = _execute(solver, theta, omega, alpha, turns, flip=True)
+        for lever in ctx.jumps:
+            names, carried = solver.jumping[lever]
+            for name in names:
+                table = other.links if kinds[name] == 'revolute' else other.sliders
+                joints[name] = {'acceleration': table[name][2]}
+            for name in carried:
+                points[name] = {'acceleration': _xy(other.points[name][2])}
+        return {'joints': joints, 'points': points}
+    shape = valid.shape
+    where = {lever: np.broadcast_to(near, shape) & valid for lever, near in ctx.jumps.items()}
+    at = np.flatnonzero(np.logical_or.reduce(list(where.values())))
+    if not at.size:
+        return {}
+
+    def subset(x: Any) -> Any:
+        return x if x.ndim == 0 else np.broadcast_to(x, shape)[at]
+
+    with np.errstate(all='ignore'):
+        other = _execute(solver, theta[at], subset(omega), subset(alpha), turns[at], flip=True)
+    for lever, near in where.items():
+        names, carried = solver.jumping[lever]
+        mine = near[at]
+        for name in names:
+            table = other.links if kinds[name] == 'revolute' else other.sliders
+            value = joints.setdefault(name, {'acceleration': np.full(shape, np.nan)})
+            value['acceleration'][at[mine]] = np.broadcast_to(table[name][2], at.shape)[mine]
+        for name in carried:
+            value = points.setdefault(name, {'acceleration': np.full((*shape, 2), np.nan)})
+            a = np.broadcast_to(other.points[name][2], at.shape)[mine]
+            value['acceleration'][at[mine]] = np.stack((a.real, a.imag), axis=-1)
+    return {'joints': joints, 'points': points}
 
 
 def assembly_margins(scene: Scene) -> Callable[..., list[tuple[str, Any, Any]]]:
@@ -370,7 +426,7 @@ def _warn_near_singular(ctx: _Context) -> None:
 
 
 def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any, alpha: Any,
-           valid: Any, turns: Any) -> State:
+           valid: Any, turns: Any, jumps: dict[str, Any]) -> State:
     vector = ctx.vector
     plan = solver.plan
     joints = {}
@@ -428,13 +484,14 @@ def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any,
             intermittent = {name: step.engagement(ctx, omega, None)
                             for name, step in solver.levers.items()}
     return _new_state(scene.name, theta, omega, alpha, joints, points, valid, dict(measures),
-                      dict(ctx.failures), bound, turns, rubbing, intermittent)
+                      dict(ctx.failures), bound, turns, rubbing, intermittent, jumps)
 
 
 def _new_state(scene: str, angle: Any, speed: Any, accel: Any, joints: dict[str, JointMotion],
                points: dict[str, Any], valid: Any, singularity: dict[str, Any],
                failures: dict[str, Any], error_bound: ErrorBound, turns: Any,
-               rubbing: dict[str, Any], intermittent: dict[str, Engagement]) -> State:
+               rubbing: dict[str, Any], intermittent: dict[str, Engagement],
+               jumps: dict[str, Any]) -> State:
     """Return ``State(...)`` of these fields, built without the dataclass's ``__init__``.
 
     A frozen dataclass's ``__init__`` sets each field through
@@ -450,6 +507,7 @@ def _new_state(scene: str, angle: Any, speed: Any, accel: Any, joints: dict[str,
     fields['singularity'], fields['failures'] = singularity, failures
     fields['error_bound'], fields['turns'] = error_bound, turns
     fields['rubbing'], fields['intermittent'] = rubbing, intermittent
+    fields['jumps'] = jumps
     return state
 
 

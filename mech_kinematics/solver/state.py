@@ -145,6 +145,16 @@ class State:
     intermittent : dict of str to Engagement
         Every intermittent (Geneva) lever solved: engaged or locked, and where
         its acceleration jumps.
+    jumps : dict
+        Empty unless some value jumps at the instant (a Geneva wheel's pin
+        entering or leaving a slot, within rounding). There the state holds
+        the value *after* the jump in the direction the crank turns (for a
+        crank at rest, increasing angle), and ``jumps`` the value on the other
+        side of every value that jumps (the wheel's acceleration and that of
+        whatever is carried on it or solved from it):
+        ``{'joints': {name: {'acceleration': x}}, 'points': {name:
+        {'acceleration': ndarray, shape (2,)}}}``. For arrays, shapes (n,) and
+        (n, 2), NaN at the angles where nothing jumps.
     """
 
     scene: str
@@ -160,6 +170,7 @@ class State:
     turns: int | npt.NDArray[np.int64] = 0
     rubbing: dict[str, Number] = field(default_factory=dict)
     intermittent: dict[str, Engagement] = field(default_factory=dict)
+    jumps: dict[str, Any] = field(default_factory=dict)
 
     @cached_property
     def points(self) -> dict[str, PointState]:
@@ -239,6 +250,11 @@ class State:
             **({'intermittent': {name: e.as_dict(vector)
                                  for name, e in self.intermittent.items()}}
                if self.intermittent else {}),
+            **({'jumps': {'joints': {name: {'acceleration': value(x['acceleration'])}
+                                     for name, x in self.jumps['joints'].items()},
+                          'points': {name: {'acceleration': pair(x['acceleration'])}
+                                     for name, x in self.jumps['points'].items()}}}
+               if self.jumps else {}),
             'error_bound': self.error_bound.as_dict(vector),
         }
 
