@@ -296,6 +296,88 @@ def test_mcap_cut_message_indexes_are_written_again(tmp_path):
     assert foxglove_count(tmp_path / 'bag') == 2000
 
 
+@functools.cache
+def closed_mcap(tmp: Path) -> tuple[bytes, list]:
+    """Return a closed MCAP file of 2000 messages in 10 chunks, and its chunks."""
+    data, _ = unclosed_mcap(tmp)
+    bag = cut_bag(tmp, 'closed_source', data)
+    reindex(bag)
+    data = (bag / 'closed_source.mcap').read_bytes()
+    return data, storage_mcap.RecoveredMcap(bag / 'closed_source.mcap').chunks
+
+
+#: Where a byte is flipped in a chunk: its opcode, its length, its CRC, a message's data.
+FLIPS = {'opcode': lambda c: c.offset, 'length': lambda c: c.offset + 2,
+         'length high byte': lambda c: c.offset + 8, 'crc': lambda c: c.offset + 9 + 24,
+         'data': lambda c: c.offset + c.length - 10}
+
+
+def damaged_copy(data: bytes, offset: int) -> bytes:
+    damaged = bytearray(data)
+    damaged[offset] ^= 0xFF
+    return bytes(damaged)
+
+
+@pytest.mark.parametrize('closed', [False, True], ids=['killed', 'closed'])
+@pytest.mark.parametrize('where', sorted(FLIPS))
+@pytest.mark.parametrize('which', [0, 4, 9], ids=['first', 'middle', 'last'])
+def test_mcap_damaged_chunk_loses_nothing_else(tmp_path, which, where, closed):
+    """A flipped byte in one chunk: every message of every other chunk survives (issue 21).
+
+    The damaged chunk alone is dropped, and the notes say which bytes and why;
+    the original file is kept, byte for byte, as ``bag.mcap.damaged``.
+    """
+    data, chunks = (closed_mcap if closed else unclosed_mcap)(tmp_path)
+    damaged = damaged_copy(data, FLIPS[where](chunks[which]))
+    bag = cut_bag(tmp_path, 'bag', damaged)
+    info = reindex(bag)
+    lost = set(range(200 * which, 200 * which + 200))
+    kept = [i for i in range(2000) if i not in lost]
+    assert info.count('/js') == 1800
+    got = assert_truthful(bag)
+    assert [stamp for _, stamp in got['/js']] == kept
+    assert [t for t, _ in got['/js']] == [T0 + i * DT for i in kept]
+    assert foxglove_count(bag) == 1800
+    dropped = [n for n in info.notes if n.startswith('dropped')]
+    assert len(dropped) == 1 and f'from offset {chunks[which].offset}: ' in dropped[0]
+    if where in ('crc', 'data'):
+        assert 'a damaged chunk (CRC-32 mismatch) holding 200 messages (/js: 200)' in dropped[0]
+    assert (bag / 'bag.mcap.damaged').read_bytes() == damaged
+    assert any('the original file is kept as "bag.mcap.damaged"' in n for n in info.notes)
+    again = reindex(bag)      # the repaired file is whole: reindex changes nothing more
+    assert again.count('/js') == 1800 and again.notes == ()
+
+
+def test_mcap_damaged_message_index_keeps_its_chunk(tmp_path):
+    """A flipped byte in a message index (outside the CRC): the chunk is kept, indexes new."""
+    data, chunks = unclosed_mcap(tmp_path)
+    middle = chunks[4]
+    bag = cut_bag(tmp_path, 'bag', damaged_copy(data, middle.offset + middle.length + 12))
+    info = reindex(bag)
+    assert info.count('/js') == 2000
+    assert_prefix(bag, 2000)
+    assert foxglove_count(bag) == 2000
+    assert any('a message index that does not match its chunk' in n for n in info.notes)
+
+
+def test_mcap_repair_that_does_not_fit_leaves_the_original(tmp_path, monkeypatch):
+    """No room for the repaired copy: BagError, the original untouched, no copy left behind."""
+    data, chunks = unclosed_mcap(tmp_path)
+    damaged = damaged_copy(data, chunks[4].offset + 100)
+    bag = cut_bag(tmp_path, 'bag', damaged)
+    real_open = open
+
+    def full_open(path, mode='r', *args, **kwargs):
+        stream = real_open(path, mode, *args, **kwargs)
+        return FullDisk(stream, 1000) if 'x' in mode else stream
+
+    monkeypatch.setattr(storage_mcap, 'open', full_open, raising=False)
+    with pytest.raises(BagError, match='No space left on device'):
+        reindex(bag)
+    assert sorted(p.name for p in bag.iterdir()) == ['bag.mcap']
+    assert (bag / 'bag.mcap').read_bytes() == damaged
+
+
 SQLITE_KILLED_MID_TRANSACTION = """
 import os, pickle, signal, sys
 from pathlib import Path
@@ -373,6 +455,12 @@ class FullDisk:
 
     def __getattr__(self, name):
         return getattr(self.stream, name)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc_info) -> None:
+        self.stream.close()
 
 
 def test_mcap_full_disk_closes_with_what_fit(tmp_path, monkeypatch):
