@@ -378,6 +378,91 @@ def test_mcap_repair_that_does_not_fit_leaves_the_original(tmp_path, monkeypatch
     assert (bag / 'bag.mcap').read_bytes() == damaged
 
 
+def message_leaf_pages(db: bytes, root: int) -> list[int]:
+    """Return the leaf pages of the table b-tree at page ``root`` of database ``db``, in order."""
+    page_size = int.from_bytes(db[16:18], 'big')
+    start = (root - 1) * page_size
+    head = start + (100 if root == 1 else 0)
+    if db[head] == 0x0D:
+        return [root]
+    assert db[head] == 0x05, 'an interior table page'
+    cells = int.from_bytes(db[head + 3:head + 5], 'big')
+    children = []
+    for i in range(cells):
+        cell = start + int.from_bytes(db[head + 12 + 2 * i:head + 14 + 2 * i], 'big')
+        children.append(int.from_bytes(db[cell:cell + 4], 'big'))
+    children.append(int.from_bytes(db[head + 8:head + 12], 'big'))
+    return [leaf for child in children for leaf in message_leaf_pages(db, child)]
+
+
+def rows_of_leaf(db: bytes, page: int) -> list[int]:
+    """Return the rowids of the cells of table leaf page ``page`` (a one-byte-varint payload)."""
+    page_size = int.from_bytes(db[16:18], 'big')
+    start = (page - 1) * page_size
+    cells = int.from_bytes(db[start + 3:start + 5], 'big')
+    rowids = []
+    for i in range(cells):
+        cell = start + int.from_bytes(db[start + 8 + 2 * i:start + 10 + 2 * i], 'big')
+        pos = cell
+        while db[pos] & 0x80:       # the payload size varint
+            pos += 1
+        pos += 1
+        rowid = 0
+        while True:
+            rowid = (rowid << 7) | (db[pos] & 0x7F)
+            if not db[pos] & 0x80:
+                break
+            pos += 1
+        rowids.append(rowid)
+    return rowids
+
+
+@pytest.mark.parametrize('which', ['first', 'middle', 'last'])
+def test_sqlite3_damaged_page_loses_nothing_else(tmp_path, which):
+    """A flipped byte on one page of messages: every row of every other page survives.
+
+    The unreadable rows alone are dropped, the notes name their ids, and the
+    original database is kept, byte for byte, as ``bag.db3.damaged`` (issue 21).
+    """
+    import sqlite3
+
+    writer, topic = open_writer(tmp_path / 'source', 'sqlite3')
+    write(writer, topic, range(2000))
+    writer.close()
+    data = (tmp_path / 'source' / 'source.db3').read_bytes()
+    with sqlite3.connect(tmp_path / 'source' / 'source.db3') as conn:
+        (root,) = conn.execute("SELECT rootpage FROM sqlite_master WHERE name = 'messages'"
+                               ).fetchone()
+    leaves = message_leaf_pages(data, root)
+    assert len(leaves) > 20
+    page = leaves[{'first': 0, 'middle': len(leaves) // 2, 'last': -1}[which]]
+    lost_ids = rows_of_leaf(data, page)
+    page_size = int.from_bytes(data[16:18], 'big')
+    damaged = damaged_copy(data, (page - 1) * page_size)     # the page's type
+    bag = tmp_path / 'bag'
+    bag.mkdir()
+    (bag / 'bag.db3').write_bytes(damaged)
+    info = reindex(bag)
+    lost = {i - 1 for i in lost_ids}       # message i has row id i + 1
+    kept = [i for i in range(2000) if i not in lost]
+    assert info.count('/js') == len(kept) == 2000 - len(lost_ids)
+    got = assert_truthful(bag)
+    assert [stamp for _, stamp in got['/js']] == kept
+    assert [t for t, _ in got['/js']] == [T0 + i * DT for i in kept]
+    dropped = [n for n in info.notes if n.startswith('dropped')]
+    if which == 'last':
+        assert dropped == [f'dropped every row of "messages" after id {min(lost_ids) - 1}: '
+                           f'unreadable (database disk image is malformed)']
+    else:
+        assert dropped[0].startswith(f'dropped the rows of "messages" with ids '
+                                     f'{min(lost_ids)} to {max(lost_ids)} (at most '
+                                     f'{len(lost_ids)} messages): unreadable')
+    assert (bag / 'bag.db3.damaged').read_bytes() == damaged
+    assert any('the original file is kept as "bag.db3.damaged"' in n for n in info.notes)
+    again = reindex(bag)
+    assert again.count('/js') == len(kept) and again.notes == ()
+
+
 SQLITE_KILLED_MID_TRANSACTION = """
 import os, pickle, signal, sys
 from pathlib import Path
