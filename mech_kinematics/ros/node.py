@@ -320,8 +320,10 @@ class KinematicsNode(LifecycleNode):
     def _configure(self) -> None:
         scene = mk.load_scene(self._value('scene'))
         scene_rpm = rpm_parameter(scene.input.speed)
+        given_rpm = self._value('crank_speed_rpm')      # a speed set at start raises the bound
         defaults = {
-            'max_crank_speed_rpm': max(DEFAULT_MAX_CRANK_SPEED_RPM, abs(scene_rpm)),
+            'max_crank_speed_rpm': max(DEFAULT_MAX_CRANK_SPEED_RPM, abs(scene_rpm),
+                                       abs(given_rpm or 0.0)),
             'crank_speed_rpm': scene_rpm,
             'crank_accel': scene.input.accel,
         }
