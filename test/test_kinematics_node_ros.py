@@ -321,3 +321,33 @@ def test_switching_to_sim_time_and_back_keeps_the_crank_where_it_was(ros, tmp_pa
         status, _ = proc.stop(signal.SIGINT)
         ros.node.destroy_publisher(clock_pub)
     assert status == 0, proc.output()
+
+
+@pytest.mark.parametrize('args, reason', [
+    (['-p', 'frame_id:=/'], "frame_id: expected a tf2 frame id (no leading '/', no empty, '.' "
+                            "or '..' part between '/', no space), got '/'"),
+    (['-p', 'tf_prefix:=../..'], 'tf_prefix: expected a tf2 frame id'),
+    (['-p', 'rate_hz:=abc'], "rate_hz: expected a number (Hz), got string 'abc'"),
+    (['-p', 'scene:=no_such_scene'], 'no_such_scene: expected a scene file path'),
+    (['-p', 'qos_overrides./x/joint_states.publisher.depth:=-1'],
+     'qos_overrides./x/joint_states.publisher.depth: expected a whole number of messages from 0 '
+     'to 2147483647, got number -1'),
+])
+def test_a_bad_start_is_one_line_with_the_nodes_own_name(tmp_path, args, reason):
+    """Every refused start is exactly one FATAL line, naming the node as renamed (issue 21).
+
+    It was 2-3 lines (a WARN or ERROR, then FATAL with the same text, or rmw's
+    text with a build path) and named [mech_kinematics] after -r __node:=NAME.
+    """
+    ns = f'{SESSION}/one_line'
+    args = [a.replace('/x/', f'{ns}/') for a in args]
+    reason = reason.replace('/x/', f'{ns}/')
+    status, output = _exited(NodeProcess(tmp_path, '-r', f'__ns:={ns}', '-r', '__node:=renamed',
+                                         *args))
+    assert status == 1, output
+    lines = output.strip().splitlines()
+    assert len(lines) == 1, output
+    assert lines[0].startswith('[FATAL]'), output
+    logger = ns.strip('/').replace('/', '.') + '.renamed'
+    assert f'[{logger}]: cannot start: {reason}' in lines[0], output
+    assert '.cpp' not in lines[0] and '.c:' not in lines[0]

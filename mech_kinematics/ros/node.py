@@ -167,10 +167,18 @@ class KinematicsNode(LifecycleNode):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(NODE_NAME, **kwargs)
+        #: While True (until main() has started the node), refusals are not logged here:
+        #: main() says the one line of a refused start.
+        self.starting = True
+        self.start_refusal = ''
         try:
             self._declare()
-        except BaseException:
+        except BaseException as error:
+            logger_name = self.get_logger().name
+            reason = self.start_refusal or ' '.join(str(error).split()) or type(error).__name__
             self.destroy_node()
+            if isinstance(error, Exception):
+                raise StartError(reason, logger_name) from None
             raise
 
     # -- parameters -----------------------------------------------------------
@@ -239,7 +247,7 @@ class KinematicsNode(LifecycleNode):
         sees it; it is logged here, so that every refusal is.
         """
         for p in parameters:
-            if p.name in READ_ONLY:
+            if p.name in READ_ONLY and not self.starting:
                 self.get_logger().warning(
                     f'parameter refused: {p.name}: read-only (set it at start), got {p.value!r}')
         return [Parameter(p.name, Parameter.Type.DOUBLE, float(p.value))
@@ -263,8 +271,12 @@ class KinematicsNode(LifecycleNode):
                 reason = joint_refusal(current)
         if reason is None:
             return SetParametersResult(successful=True)
-        # Every refusal is logged once, with its reason, besides the service's answer.
-        self.get_logger().warning(f'parameter refused: {reason}')
+        # Every refusal is logged once, with its reason, besides the service's answer
+        # (at start, main() says it in its one line).
+        if self.starting:
+            self.start_refusal = self.start_refusal or reason
+        else:
+            self.get_logger().warning(f'parameter refused: {reason}')
         return SetParametersResult(successful=False, reason=reason)
 
     def _apply(self, parameters: list[Parameter]) -> None:
@@ -312,8 +324,10 @@ class KinematicsNode(LifecycleNode):
             self._configure()
         except Exception as error:     # noqa: BLE001 - a scene or a QoS override: one line
             self._teardown()
-            self.configure_error = str(error) or type(error).__name__
-            self.get_logger().error(f'cannot configure: {self.configure_error}')
+            self.configure_error = ((self.starting and self.start_refusal)
+                                    or ' '.join(str(error).split()) or type(error).__name__)
+            if not self.starting or self.managed:
+                self.get_logger().error(f'cannot configure: {self.configure_error}')
             return TransitionCallbackReturn.FAILURE
         return TransitionCallbackReturn.SUCCESS
 
@@ -684,6 +698,15 @@ def spec_default_is_none(name: str) -> bool:
         return False
 
 
+class StartError(Exception):
+    """The node refused to start: ``reason`` (one line), for the logger named ``logger_name``."""
+
+    def __init__(self, reason: str, logger_name: str) -> None:
+        super().__init__(reason)
+        self.reason = reason
+        self.logger_name = logger_name
+
+
 def _duplicate_names(node: KinematicsNode, wait_s: float) -> int:
     """Return how many other nodes share ``node``'s fully qualified name (looking ``wait_s``).
 
@@ -708,12 +731,13 @@ def main(args: list[str] | None = None) -> int:
     try:
         rclpy.init(args=args)
     except Exception as exc:     # noqa: BLE001 - rclpy's argument errors come in several kinds
-        logger.fatal(f'cannot start: bad arguments: {exc}')
+        logger.fatal(f'cannot start: bad arguments: {_one_line(exc)}')
         return 1
     node = None
     status = 0
     try:
         node = KinematicsNode()
+        logger = node.get_logger()
         if not node.managed:
             node.trigger_configure()
             if node.scene is None:
@@ -725,6 +749,7 @@ def main(args: list[str] | None = None) -> int:
                          'is running (remap the name with -r __node:=NAME or the namespace '
                          'with -r __ns:=/NS)')
             return 1
+        node.starting = False
         if not node.managed:
             node.trigger_activate()
         # Everything built so far lives as long as the node: keep it out of the
@@ -735,14 +760,21 @@ def main(args: list[str] | None = None) -> int:
         pass  # Ctrl-C or shutdown: a clean exit, status 0
     except TickThreadError:
         status = 1
+    except StartError as exc:
+        get_logger(exc.logger_name).fatal(f'cannot start: {exc.reason}')
+        status = 1
     except Exception as exc:     # noqa: BLE001 - a start-up failure: one line, no traceback
-        logger.fatal(f'cannot start: {exc}')
+        logger.fatal(f'cannot start: {_one_line(exc)}')
         status = 1
     finally:
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
     return status
+
+
+def _one_line(error: BaseException) -> str:
+    return ' '.join(str(error).split()) or type(error).__name__
 
 
 if __name__ == '__main__':

@@ -21,7 +21,7 @@ from ..bounds import MAX_ERROR
 from ..scene import DEFAULT_SCENE
 
 __all__ = ['CATCH_UP', 'LATE_TICKS', 'PARAMETERS', 'ParameterSpec', 'SHOWN_CHARS', 'SKIP',
-           'frame_refusal', 'joint_refusal', 'refusal', 'shown', 'spec']
+           'depth_refusal', 'frame_refusal', 'joint_refusal', 'refusal', 'shown', 'spec']
 
 #: ``late_ticks`` values: publish every missed grid instant, or only the latest.
 CATCH_UP = 'catch_up'
@@ -172,6 +172,18 @@ def frame_refusal(name: str, value: str) -> str | None:
             f"between '/', no space), got {shown(value)}; e.g. 'mechanism' or 'robot/base'")
 
 
+#: Largest history depth a DDS implementation takes (its depth is a 32-bit signed integer).
+MAX_DEPTH = 2**31 - 1
+
+
+def depth_refusal(name: str, value: Any) -> str | None:
+    """Return why ``value`` is not a QoS history depth, or ``None`` (rmw's text names files)."""
+    if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= MAX_DEPTH:
+        return (f'{name}: expected a whole number of messages from 0 to {MAX_DEPTH}, got '
+                f'{_kind_of(value)} {shown(value)}')
+    return None
+
+
 def refusal(name: str, value: Any) -> str | None:
     """Return why ``value`` is refused for parameter ``name``, or ``None`` if it is accepted.
 
@@ -180,6 +192,8 @@ def refusal(name: str, value: Any) -> str | None:
     """
     if not name:
         return f'expected a parameter name, got an empty one (with value {shown(value)})'
+    if name.startswith('qos_overrides.') and name.endswith('.depth'):
+        return depth_refusal(name, value)
     p = _BY_NAME.get(name)
     if p is None:
         return None
