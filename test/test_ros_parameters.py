@@ -86,3 +86,23 @@ def test_the_speed_bound_refusal_says_what_to_do():
     assert joint_refusal({'crank_speed_rpm': 20000.0, 'max_crank_speed_rpm': 10000.0}) == (
         'crank_speed_rpm: expected |crank_speed_rpm| <= max_crank_speed_rpm (10000 rpm), got '
         '20000 rpm; set max_crank_speed_rpm (up to 100000) first to go faster')
+
+
+@pytest.mark.parametrize('rate_hz', [1.0, 100.0, 1000.0, 4000.0, 10_000.0])
+@pytest.mark.parametrize('max_catch_up_s', [0.0, 0.1, 1.0, 10.0])
+def test_a_catch_up_burst_fits_the_history(rate_hz, max_catch_up_s):
+    """A late wake-up publishes at most the history depth of missed instants.
+
+    A 10 s SIGSTOP at 1 kHz published 10,001 instants at once and a KEEP_LAST
+    1000 reader lost 1,712 of them (issue 21); older instants are now skipped.
+    """
+    from mech_kinematics.ros.parameters import catch_up_window_ns, STATE_DEPTH
+    from mech_kinematics.ros.schedule import period_ns_from_rate, TickGrid
+
+    period = period_ns_from_rate(rate_hz)
+    grid = TickGrid(0, period)
+    window = catch_up_window_ns(max_catch_up_s, period)
+    due = grid.take(20 * 10**9, window)        # woke 20 s late
+    wanted = min(round(max_catch_up_s * 1e9) // period + 1, STATE_DEPTH)
+    assert len(due.instants) == wanted <= STATE_DEPTH
+    assert window <= round(max_catch_up_s * 1e9)

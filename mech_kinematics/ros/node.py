@@ -58,7 +58,8 @@ import mech_kinematics as mk
 from .diagnostics import solver_status, Status, TickStats, timing_status
 from .markers import marker_array_from_state, marker_size_from_space, MarkerThrottle
 from .messages import TickMessages
-from .parameters import CATCH_UP, joint_refusal, PARAMETERS, ParameterSpec, refusal, spec
+from .parameters import (CATCH_UP, catch_up_window_ns, joint_refusal, PARAMETERS, ParameterSpec,
+                         refusal, spec, STATE_DEPTH)
 from .schedule import period_ns_from_rate, TickGrid
 from .tf import static_tf_message, TF_STATIC_TOPIC, TF_TOPIC, TfMessages
 from .timebase import CrankTimebase
@@ -91,8 +92,6 @@ DRIVE = ('crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm')
 DOUBLES = frozenset(p.name for p in PARAMETERS if p.kind == 'double')
 READ_ONLY = frozenset(p.name for p in PARAMETERS if p.read_only)
 
-#: Depth of the state publishers' history: deep enough for a catch-up burst.
-STATE_DEPTH = 1000
 #: /tf and /tf_static as tf2's broadcasters offer them.
 TF_DEPTH = 100
 #: Every publisher accepts ``qos_overrides./TOPIC.publisher.POLICY`` for these policies.
@@ -219,7 +218,8 @@ class KinematicsNode(LifecycleNode):
         self.frame_id = self.get_parameter('frame_id').value
         self._period_ns = period_ns_from_rate(self.get_parameter('rate_hz').value)
         self._catch_up = self.get_parameter('late_ticks').value == CATCH_UP
-        self._max_behind_ns = round(self.get_parameter('max_catch_up_s').value * NS_PER_S)
+        self._max_behind_ns = catch_up_window_ns(self.get_parameter('max_catch_up_s').value,
+                                                 self._period_ns)
         self._tf_period_ns = self._tf_period(self.get_parameter('tf_rate_hz').value)
         self._max_error = float(self.get_parameter('max_relative_error').value)
         self._tf: TfMessages | None = None
@@ -286,8 +286,9 @@ class KinematicsNode(LifecycleNode):
             self._period_ns = period_ns_from_rate(changes['rate_hz'])
         if 'late_ticks' in changes:
             self._catch_up = changes['late_ticks'] == CATCH_UP
-        if 'max_catch_up_s' in changes:
-            self._max_behind_ns = round(changes['max_catch_up_s'] * NS_PER_S)
+        if 'max_catch_up_s' in changes or 'rate_hz' in changes:
+            self._max_behind_ns = catch_up_window_ns(self._value('max_catch_up_s'),
+                                                     self._period_ns)
         if 'tf_rate_hz' in changes:
             self._tf_period_ns = self._tf_period(changes['tf_rate_hz'])
         if 'max_relative_error' in changes:

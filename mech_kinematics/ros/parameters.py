@@ -21,7 +21,8 @@ from ..bounds import MAX_ERROR
 from ..scene import DEFAULT_SCENE
 
 __all__ = ['CATCH_UP', 'LATE_TICKS', 'PARAMETERS', 'ParameterSpec', 'SHOWN_CHARS', 'SKIP',
-           'depth_refusal', 'frame_refusal', 'joint_refusal', 'refusal', 'shown', 'spec']
+           'STATE_DEPTH', 'catch_up_window_ns', 'depth_refusal', 'frame_refusal',
+           'joint_refusal', 'refusal', 'shown', 'spec']
 
 #: ``late_ticks`` values: publish every missed grid instant, or only the latest.
 CATCH_UP = 'catch_up'
@@ -101,7 +102,8 @@ PARAMETERS = (
                   'max_catch_up_s) or only the latest (skip)', choices=LATE_TICKS),
     ParameterSpec('max_catch_up_s', 'double', 0.1,
                   'How far behind a late wake-up still publishes missed instants; older '
-                  'ones are skipped and counted', 's', 0.0, 10.0),
+                  'ones are skipped and counted. Capped so that a burst is at most 1000 '
+                  'messages (the history depth): (1000 - 1) / rate_hz', 's', 0.0, 10.0),
     ParameterSpec('max_relative_error', 'double', MAX_ERROR,
                   'A tick whose error bound on any published value exceeds this fraction of '
                   "its kind's scale publishes nothing (diagnostics say why)", 'of the scale',
@@ -170,6 +172,21 @@ def frame_refusal(name: str, value: str) -> str | None:
         return None
     return (f"{name}: expected a tf2 frame id (no leading '/', no empty, '.' or '..' part "
             f"between '/', no space), got {shown(value)}; e.g. 'mechanism' or 'robot/base'")
+
+
+#: History depth of the state publishers: a catch-up burst never publishes more instants.
+STATE_DEPTH = 1000
+
+
+def catch_up_window_ns(max_catch_up_s: float, period_ns: int, depth: int = STATE_DEPTH) -> int:
+    """Return how far behind a late wake-up still publishes missed instants, ns.
+
+    ``max_catch_up_s``, capped so that one burst (the instants within the
+    window, the latest included) is at most ``depth`` messages: a KEEP_LAST
+    reader of that depth loses none of them. Older instants are skipped and
+    counted, as beyond ``max_catch_up_s``.
+    """
+    return min(round(max_catch_up_s * 1e9), (depth - 1) * period_ns)
 
 
 #: Largest history depth a DDS implementation takes (its depth is a 32-bit signed integer).
