@@ -702,3 +702,21 @@ def test_untrusted_error_is_one_clear_line():
     assert '\n' not in text
     for part in (error.dyad, error.value.split('.')[1], f'{error.bound:.3g}', '1e-06 x'):
         assert part in text
+
+
+@pytest.mark.parametrize('speed', [1e-160, 1e-300, 1e-320])
+def test_tiny_speeds_are_answered_and_right(speed):
+    """1e-160 and 1e-320 rad/s were refused ("at most 1e-06 x 0 m/s^2"); 0 was answered.
+
+    Velocities are linear in the speed: each equals ``speed`` times the one at
+    1 rad/s, within its error bound plus the float format's resolution (issue 21).
+    """
+    scene = mk.load_scene('khurmi_four_bar_ad150')
+    unit = mk.solve(scene, 1.0, speed=1.0, accel=0.0)
+    tiny = mk.solve(scene, 1.0, speed=speed, accel=0.0)
+    bounds = tiny.error_bound
+    for name, joint in tiny.joints.items():
+        expected = speed * unit.joints[name].velocity
+        assert abs(joint.velocity - expected) <= (bounds.joints[name].velocity
+                                                  + 1e-9 * abs(expected) + 1e-322)
+        assert joint.position == unit.joints[name].position
