@@ -351,3 +351,45 @@ def test_a_bad_start_is_one_line_with_the_nodes_own_name(tmp_path, args, reason)
     logger = ns.strip('/').replace('/', '.') + '.renamed'
     assert f'[{logger}]: cannot start: {reason}' in lines[0], output
     assert '.cpp' not in lines[0] and '.c:' not in lines[0]
+
+
+SUBNORMAL_SCENE = """\
+name: subnormal_four_bar
+units: {length: mm, angle: deg}
+ground: {A: [0, 0], D: [1.5e-319, 0]}
+input: {link: crank, center: A, point: B, length: 4e-320, angle: 60, speed_rpm: -120}
+dyads:
+  - type: RRR
+    point: C
+    links:
+      - {name: coupler, from: B, length: 1.5e-319}
+      - {name: rocker, from: D, length: 8e-320}
+    branch: 1
+"""
+
+
+def test_a_scene_of_subnormal_lengths_is_published_as_solve_answers_it(ros, tmp_path):
+    """Subnormal lengths started a node that published nothing and warned forever (issue 21).
+
+    ``solve`` answers the scene (errors within max_relative_error of the
+    smallest normal float); the node publishes the same angles.
+    """
+    import mech_kinematics as mk
+
+    scene_file = tmp_path / 'subnormal.yaml'
+    scene_file.write_text(SUBNORMAL_SCENE)
+    scene = mk.load_scene(str(scene_file))
+    ns = f'{SESSION}/subnormal'
+    js = ros.collect(JointState, f'{ns}/joint_states')
+    proc = NodeProcess(tmp_path, '-r', f'__ns:={ns}', '-p', f'scene:={scene_file}')
+    try:
+        wait_for(lambda: len(js) >= 5, STARTUP_S, 'joint_states from the subnormal scene')
+        msg = js[-1]
+        crank = msg.position[list(msg.name).index('crank')]
+        state = mk.solve(scene, crank)
+        coupler = msg.position[list(msg.name).index('coupler')]
+        assert coupler == pytest.approx(wrap(state.joints['coupler'].position), abs=1e-9)
+    finally:
+        status, _ = proc.stop(signal.SIGINT)
+    assert status == 0, proc.output()
+    assert 'no state published' not in proc.output()
