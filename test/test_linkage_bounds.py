@@ -720,3 +720,38 @@ def test_tiny_speeds_are_answered_and_right(speed):
         assert abs(joint.velocity - expected) <= (bounds.joints[name].velocity
                                                   + 1e-9 * abs(expected) + 1e-322)
         assert joint.position == unit.joints[name].position
+
+
+def _four_bar_yaml(crank: str, coupler: str, rocker: str, ground: str) -> str:
+    return (f'name: huge\nunits: {{length: m, angle: deg}}\n'
+            f'ground: {{A: [0, 0], D: [{ground}, 0]}}\n'
+            f'input: {{link: crank, center: A, point: B, length: {crank}, angle: 60, '
+            f'speed_rpm: 1}}\n'
+            f'dyads:\n  - type: RRR\n    point: C\n    links:\n'
+            f'      - {{name: coupler, from: B, length: {coupler}}}\n'
+            f'      - {{name: rocker, from: D, length: {rocker}}}\n    branch: 1\n')
+
+
+def test_lengths_near_the_largest_float_load_and_solve(tmp_path):
+    """1e308 m lengths said "OverflowError: math range error" (issue 21): now they solve."""
+    path = tmp_path / 'huge.yaml'
+    path.write_text(_four_bar_yaml('0.4e308', '1.5e308', '0.8e308', '1.5e308'))
+    scene = mk.load_scene(str(path))
+    state = mk.solve(scene, 1.0, speed=1e-3, accel=0.0)
+    b = state.points['B'].position
+    assert b[0] == pytest.approx(0.4e308 * math.cos(1.0), rel=1e-15)
+    assert b[1] == pytest.approx(0.4e308 * math.sin(1.0), rel=1e-15)
+    normal = mk.solve(mk.load_scene('khurmi_four_bar_ad150'), 1.0, speed=1e-3, accel=0.0)
+    for name, joint in state.joints.items():
+        assert joint.position == pytest.approx(normal.joints[name].position, abs=1e-12)
+
+
+def test_the_largest_float_as_a_length_is_named_as_it_is(tmp_path):
+    """A crank of 1.7976931348623157e308 m is refused with a true reason, never an overflow."""
+    path = tmp_path / 'max.yaml'
+    path.write_text(_four_bar_yaml('1.7976931348623157e308', '150', '80', '150'))
+    with pytest.raises(mk.SceneError) as raised:
+        mk.load_scene(str(path))
+    message = str(raised.value)
+    assert 'cannot reach from B to D (1.79769e+308 m apart, more than 230 m)' in message
+    assert 'inf' not in message and 'Overflow' not in message
