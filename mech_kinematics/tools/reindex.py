@@ -47,8 +47,9 @@ and given a summary; an sqlite3 database has its interrupted transaction
 rolled back. Damage with intact data after it (a changed byte in a chunk, an
 unreadable database page) is never repaired in place: every intact chunk or
 readable row is copied to a new file and the original is kept beside it as
-NAME.damaged. Each note says what was dropped and why. The bag version is --bag-version if given, else the one stored
-in the bag, else the one its QoS profiles are written in, else 8.
+NAME.damaged. Each note says what was dropped and why. The bag version is
+--bag-version if given, else the one stored in the bag, else the one its QoS
+profiles are written in, else 8.
 """
 
 
