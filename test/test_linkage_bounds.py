@@ -755,3 +755,21 @@ def test_the_largest_float_as_a_length_is_named_as_it_is(tmp_path):
     message = str(raised.value)
     assert 'cannot reach from B to D (1.79769e+308 m apart, more than 230 m)' in message
     assert 'inf' not in message and 'Overflow' not in message
+
+
+def test_the_largest_float_in_rpm_is_a_finite_speed():
+    """1.7976931348623157e308 rpm became inf rad/s ("got inf"); now 1.88e307 rad/s (issue 21).
+
+    Values whose product with pi fits keep their bits (``rpm * pi / 30``).
+    """
+    from mech_kinematics.units import rad_per_s_from_rpm, rpm_from_rad_per_s
+
+    largest = 1.7976931348623157e308
+    assert rad_per_s_from_rpm(largest) == pytest.approx(largest / 30 * math.pi, rel=1e-15)
+    assert rpm_from_rad_per_s(largest) == pytest.approx(largest / math.pi * 30, rel=1e-15)
+    assert rad_per_s_from_rpm(-1e3) == -1e3 * math.pi / 30
+    assert rpm_from_rad_per_s(2.5) == 2.5 * 30 / math.pi
+    scene = mk.load_scene('khurmi_four_bar_ad150')
+    with pytest.raises(mk.AssemblyError, match='the state overflows') as raised:
+        mk.solve(scene, 1.0, rad_per_s_from_rpm(largest))
+    assert 'inf' not in str(raised.value)
