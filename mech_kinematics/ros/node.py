@@ -68,7 +68,7 @@ from ..geometry.diagrams import space_from_state, strokes_from_scene
 from ..geometry.frames import angle_joints, frames_from_scene, origin_points
 from ..geometry.instant_centres import full_scene
 from ..ticker import tick_function
-from ..units import NS_PER_S, rpm_from_rad_per_s
+from ..units import NS_PER_S, rad_per_s_from_rpm, rpm_from_rad_per_s
 
 __all__ = ['KinematicsNode', 'NODE_NAME', 'TickThreadError', 'main']
 
@@ -348,6 +348,12 @@ class KinematicsNode(LifecycleNode):
             result = self.set_parameters_atomically(unset)
             if not result.successful:
                 raise mk.SceneError(f'{scene.name}: {result.reason}')
+        try:    # what `solve` refuses at the start, the node refuses to start with
+            mk.solve(scene, scene.input.angle, rad_per_s_from_rpm(self._value('crank_speed_rpm')),
+                     self._value('crank_accel'), max_error=self._max_error)
+        except mk.AssemblyError as error:
+            msg = f'{scene.name}: {error}'
+            raise mk.SceneError(msg) from None
         self._messages = TickMessages(scene.output_joints, scene.output_points, self.frame_id)
         self._pub_joint_states = self.create_publisher(
             JointState, 'joint_states', _state_qos(), qos_overriding_options=_qos_options())
