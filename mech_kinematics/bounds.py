@@ -58,6 +58,8 @@ MAX_ERROR = 1e-6
 ROUNDING_MARGIN = 16.0
 #: The largest finite double.
 LARGEST = float(np.finfo(np.float64).max)
+#: The smallest positive normal float64 (2.2e-308): the least scale a bound is judged on.
+SMALLEST_NORMAL = float(np.finfo(np.float64).tiny)
 
 #: The kinds of values a state holds, each judged on its own scale. Points and
 #: sliders share the linear kinds; revolute joints have the angular ones.
@@ -87,12 +89,16 @@ _NO_PINS: dict[str, Any] = {}
 def limit(max_error: float, scale: Any) -> Any:
     """Return the largest bound accepted: ``max_error * scale``, capped at :data:`LARGEST`.
 
-    The cap makes an infinite tolerance still refuse a bound that overflowed
-    (and ``inf * 0`` accept a zero bound at rest).
+    The scale counts as at least :data:`SMALLEST_NORMAL`: below it floats are
+    subnormal and hold no relative precision, so a speed of 1e-160 rpm (whose
+    accelerations underflow to a few 1e-324) is answered with errors within
+    ``max_error * SMALLEST_NORMAL`` instead of refused. The cap makes an
+    infinite tolerance still refuse a bound that overflowed.
     """
-    lim = max_error * scale
-    if isinstance(lim, np.ndarray):
+    if isinstance(scale, np.ndarray) or isinstance(max_error, np.ndarray):
+        lim = max_error * np.fmax(scale, SMALLEST_NORMAL)
         return np.fmin(lim, LARGEST)
+    lim = max_error * max(scale, SMALLEST_NORMAL)
     return lim if lim <= LARGEST else LARGEST
 
 

@@ -28,13 +28,23 @@ NS_PER_S = 1_000_000_000
 
 
 def rad_per_s_from_rpm(rpm: Any, pi: Any = math.pi) -> Any:
-    """Return a speed in rpm (revolutions per minute) as rad/s: ``rpm * pi / 30``."""
-    return rpm * pi / 30
+    """Return a speed in rpm (revolutions per minute) as rad/s: ``rpm * pi / 30``.
+
+    For a float whose product with pi overflows (above 5.7e307 rpm), ``rpm /
+    30 * pi``: the largest float in rpm is 1.88e307 rad/s, not inf.
+    """
+    speed = rpm * pi / 30
+    if isinstance(speed, float) and math.isinf(speed) and math.isfinite(rpm):
+        return rpm / 30 * pi
+    return speed
 
 
 def rpm_from_rad_per_s(speed: Any, pi: Any = math.pi) -> Any:
-    """Return a speed in rad/s as rpm: ``speed * 30 / pi``."""
-    return speed * 30 / pi
+    """Return a speed in rad/s as rpm: ``speed * 30 / pi`` (or ``speed / pi * 30`` on overflow)."""
+    rpm = speed * 30 / pi
+    if isinstance(rpm, float) and math.isinf(rpm) and math.isfinite(speed):
+        return speed / pi * 30
+    return rpm
 
 
 def radians_from_degrees(angle: Any, pi: Any = math.pi) -> Any:

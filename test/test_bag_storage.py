@@ -296,6 +296,173 @@ def test_mcap_cut_message_indexes_are_written_again(tmp_path):
     assert foxglove_count(tmp_path / 'bag') == 2000
 
 
+@functools.cache
+def closed_mcap(tmp: Path) -> tuple[bytes, list]:
+    """Return a closed MCAP file of 2000 messages in 10 chunks, and its chunks."""
+    data, _ = unclosed_mcap(tmp)
+    bag = cut_bag(tmp, 'closed_source', data)
+    reindex(bag)
+    data = (bag / 'closed_source.mcap').read_bytes()
+    return data, storage_mcap.RecoveredMcap(bag / 'closed_source.mcap').chunks
+
+
+#: Where a byte is flipped in a chunk: its opcode, its length, its CRC, a message's data.
+FLIPS = {'opcode': lambda c: c.offset, 'length': lambda c: c.offset + 2,
+         'length high byte': lambda c: c.offset + 8, 'crc': lambda c: c.offset + 9 + 24,
+         'data': lambda c: c.offset + c.length - 10}
+
+
+def damaged_copy(data: bytes, offset: int) -> bytes:
+    damaged = bytearray(data)
+    damaged[offset] ^= 0xFF
+    return bytes(damaged)
+
+
+@pytest.mark.parametrize('closed', [False, True], ids=['killed', 'closed'])
+@pytest.mark.parametrize('where', sorted(FLIPS))
+@pytest.mark.parametrize('which', [0, 4, 9], ids=['first', 'middle', 'last'])
+def test_mcap_damaged_chunk_loses_nothing_else(tmp_path, which, where, closed):
+    """A flipped byte in one chunk: every message of every other chunk survives (issue 21).
+
+    The damaged chunk alone is dropped, and the notes say which bytes and why;
+    the original file is kept, byte for byte, as ``bag.mcap.damaged``.
+    """
+    data, chunks = (closed_mcap if closed else unclosed_mcap)(tmp_path)
+    damaged = damaged_copy(data, FLIPS[where](chunks[which]))
+    bag = cut_bag(tmp_path, 'bag', damaged)
+    info = reindex(bag)
+    lost = set(range(200 * which, 200 * which + 200))
+    kept = [i for i in range(2000) if i not in lost]
+    assert info.count('/js') == 1800
+    got = assert_truthful(bag)
+    assert [stamp for _, stamp in got['/js']] == kept
+    assert [t for t, _ in got['/js']] == [T0 + i * DT for i in kept]
+    assert foxglove_count(bag) == 1800
+    dropped = [n for n in info.notes if n.startswith('dropped')]
+    assert len(dropped) == 1 and f'from offset {chunks[which].offset}: ' in dropped[0]
+    if where in ('crc', 'data'):
+        assert 'a damaged chunk (CRC-32 mismatch) holding 200 messages (/js: 200)' in dropped[0]
+    assert (bag / 'bag.mcap.damaged').read_bytes() == damaged
+    assert any('the original file is kept as "bag.mcap.damaged"' in n for n in info.notes)
+    again = reindex(bag)      # the repaired file is whole: reindex changes nothing more
+    assert again.count('/js') == 1800 and again.notes == ()
+
+
+def test_mcap_damaged_message_index_keeps_its_chunk(tmp_path):
+    """A flipped byte in a message index (outside the CRC): the chunk is kept, indexes new."""
+    data, chunks = unclosed_mcap(tmp_path)
+    middle = chunks[4]
+    bag = cut_bag(tmp_path, 'bag', damaged_copy(data, middle.offset + middle.length + 12))
+    info = reindex(bag)
+    assert info.count('/js') == 2000
+    assert_prefix(bag, 2000)
+    assert foxglove_count(bag) == 2000
+    assert any('a message index that does not match its chunk' in n for n in info.notes)
+
+
+def test_mcap_repair_that_does_not_fit_leaves_the_original(tmp_path, monkeypatch):
+    """No room for the repaired copy: BagError, the original untouched, no copy left behind."""
+    data, chunks = unclosed_mcap(tmp_path)
+    damaged = damaged_copy(data, chunks[4].offset + 100)
+    bag = cut_bag(tmp_path, 'bag', damaged)
+    real_open = open
+
+    def full_open(path, mode='r', *args, **kwargs):
+        stream = real_open(path, mode, *args, **kwargs)
+        return FullDisk(stream, 1000) if 'x' in mode else stream
+
+    monkeypatch.setattr(storage_mcap, 'open', full_open, raising=False)
+    with pytest.raises(BagError, match='No space left on device'):
+        reindex(bag)
+    assert sorted(p.name for p in bag.iterdir()) == ['bag.mcap']
+    assert (bag / 'bag.mcap').read_bytes() == damaged
+
+
+def message_leaf_pages(db: bytes, root: int) -> list[int]:
+    """Return the leaf pages of the table b-tree at page ``root`` of database ``db``, in order."""
+    page_size = int.from_bytes(db[16:18], 'big')
+    start = (root - 1) * page_size
+    head = start + (100 if root == 1 else 0)
+    if db[head] == 0x0D:
+        return [root]
+    assert db[head] == 0x05, 'an interior table page'
+    cells = int.from_bytes(db[head + 3:head + 5], 'big')
+    children = []
+    for i in range(cells):
+        cell = start + int.from_bytes(db[head + 12 + 2 * i:head + 14 + 2 * i], 'big')
+        children.append(int.from_bytes(db[cell:cell + 4], 'big'))
+    children.append(int.from_bytes(db[head + 8:head + 12], 'big'))
+    return [leaf for child in children for leaf in message_leaf_pages(db, child)]
+
+
+def rows_of_leaf(db: bytes, page: int) -> list[int]:
+    """Return the rowids of the cells of table leaf page ``page`` (a one-byte-varint payload)."""
+    page_size = int.from_bytes(db[16:18], 'big')
+    start = (page - 1) * page_size
+    cells = int.from_bytes(db[start + 3:start + 5], 'big')
+    rowids = []
+    for i in range(cells):
+        cell = start + int.from_bytes(db[start + 8 + 2 * i:start + 10 + 2 * i], 'big')
+        pos = cell
+        while db[pos] & 0x80:       # the payload size varint
+            pos += 1
+        pos += 1
+        rowid = 0
+        while True:
+            rowid = (rowid << 7) | (db[pos] & 0x7F)
+            if not db[pos] & 0x80:
+                break
+            pos += 1
+        rowids.append(rowid)
+    return rowids
+
+
+@pytest.mark.parametrize('which', ['first', 'middle', 'last'])
+def test_sqlite3_damaged_page_loses_nothing_else(tmp_path, which):
+    """A flipped byte on one page of messages: every row of every other page survives.
+
+    The unreadable rows alone are dropped, the notes name their ids, and the
+    original database is kept, byte for byte, as ``bag.db3.damaged`` (issue 21).
+    """
+    import sqlite3
+
+    writer, topic = open_writer(tmp_path / 'source', 'sqlite3')
+    write(writer, topic, range(2000))
+    writer.close()
+    data = (tmp_path / 'source' / 'source.db3').read_bytes()
+    with sqlite3.connect(tmp_path / 'source' / 'source.db3') as conn:
+        (root,) = conn.execute("SELECT rootpage FROM sqlite_master WHERE name = 'messages'"
+                               ).fetchone()
+    leaves = message_leaf_pages(data, root)
+    assert len(leaves) > 20
+    page = leaves[{'first': 0, 'middle': len(leaves) // 2, 'last': -1}[which]]
+    lost_ids = rows_of_leaf(data, page)
+    page_size = int.from_bytes(data[16:18], 'big')
+    damaged = damaged_copy(data, (page - 1) * page_size)     # the page's type
+    bag = tmp_path / 'bag'
+    bag.mkdir()
+    (bag / 'bag.db3').write_bytes(damaged)
+    info = reindex(bag)
+    lost = {i - 1 for i in lost_ids}       # message i has row id i + 1
+    kept = [i for i in range(2000) if i not in lost]
+    assert info.count('/js') == len(kept) == 2000 - len(lost_ids)
+    got = assert_truthful(bag)
+    assert [stamp for _, stamp in got['/js']] == kept
+    assert [t for t, _ in got['/js']] == [T0 + i * DT for i in kept]
+    dropped = [n for n in info.notes if n.startswith('dropped')]
+    if which == 'last':
+        assert dropped == [f'dropped every row of "messages" after id {min(lost_ids) - 1}: '
+                           f'unreadable (database disk image is malformed)']
+    else:
+        assert dropped[0].startswith(f'dropped the rows of "messages" with ids '
+                                     f'{min(lost_ids)} to {max(lost_ids)} (at most '
+                                     f'{len(lost_ids)} messages): unreadable')
+    assert (bag / 'bag.db3.damaged').read_bytes() == damaged
+    assert any('the original file is kept as "bag.db3.damaged"' in n for n in info.notes)
+    again = reindex(bag)
+    assert again.count('/js') == len(kept) and again.notes == ()
+
+
 SQLITE_KILLED_MID_TRANSACTION = """
 import os, pickle, signal, sys
 from pathlib import Path
@@ -373,6 +540,12 @@ class FullDisk:
 
     def __getattr__(self, name):
         return getattr(self.stream, name)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc_info) -> None:
+        self.stream.close()
 
 
 def test_mcap_full_disk_closes_with_what_fit(tmp_path, monkeypatch):

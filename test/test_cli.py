@@ -101,3 +101,37 @@ def test_solve_and_record_use_the_shared_number_types(argv, words):
     assert result.returncode == 2
     for word in words:
         assert word in result.stderr
+
+
+def _handler_raising(error: BaseException):
+    import argparse
+
+    def handler(args):
+        raise error
+
+    return argparse.Namespace(handler=handler)
+
+
+def test_running_out_of_memory_is_one_line_saying_what_to_do(capsys):
+    """``--indent 10000000`` said "unexpected MemoryError:" and nothing else (issue 21)."""
+    from mech_kinematics.tools.cli import run_handler
+
+    assert run_handler(_handler_raising(MemoryError())) == 2
+    err = capsys.readouterr().err
+    assert err == ('error: Expected a request that fits in memory, got one that does not; ask '
+                   'for less (fewer samples, a smaller indent or scene)\n')
+
+
+@pytest.mark.parametrize('error, line', [
+    (ValueError(''), 'error: unexpected ValueError (set MECH_KINEMATICS_TRACEBACK=1 for the '
+                     'traceback)\n'),
+    (RuntimeError('first\nsecond\n'), 'error: unexpected RuntimeError: first second (set '
+                                      'MECH_KINEMATICS_TRACEBACK=1 for the traceback)\n'),
+])
+def test_an_unexpected_error_is_one_nonempty_line(capsys, monkeypatch, error, line):
+    """An exception with no text or with several lines still makes exactly one full line."""
+    from mech_kinematics.tools.cli import run_handler
+
+    monkeypatch.delenv('MECH_KINEMATICS_TRACEBACK', raising=False)
+    assert run_handler(_handler_raising(error)) == 1
+    assert capsys.readouterr().err == line

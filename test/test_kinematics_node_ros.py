@@ -321,3 +321,78 @@ def test_switching_to_sim_time_and_back_keeps_the_crank_where_it_was(ros, tmp_pa
         status, _ = proc.stop(signal.SIGINT)
         ros.node.destroy_publisher(clock_pub)
     assert status == 0, proc.output()
+
+
+@pytest.mark.parametrize('args, reason', [
+    (['-p', 'frame_id:=/'], "frame_id: expected a tf2 frame id (no leading '/', no empty, '.' "
+                            "or '..' part between '/', no space), got '/'"),
+    (['-p', 'tf_prefix:=../..'], 'tf_prefix: expected a tf2 frame id'),
+    (['-p', 'rate_hz:=abc'], "rate_hz: expected a number (Hz), got string 'abc'"),
+    (['-p', 'scene:=no_such_scene'], 'no_such_scene: expected a scene file path'),
+    (['-p', 'max_relative_error:=1e-15'],   # what solve refuses, the node does not start with
+     'khurmi_four_bar_ad150: input crank cannot be solved at crank angle 1.0472 rad: the '
+     'acceleration of points.B cannot be trusted: expected its error bound to be at most 1e-15'),
+    (['-p', 'qos_overrides./x/joint_states.publisher.depth:=-1'],
+     'qos_overrides./x/joint_states.publisher.depth: expected a whole number of messages from 0 '
+     'to 2147483647, got number -1'),
+])
+def test_a_bad_start_is_one_line_with_the_nodes_own_name(tmp_path, args, reason):
+    """Every refused start is exactly one FATAL line, naming the node as renamed (issue 21).
+
+    It was 2-3 lines (a WARN or ERROR, then FATAL with the same text, or rmw's
+    text with a build path) and named [mech_kinematics] after -r __node:=NAME.
+    """
+    ns = f'{SESSION}/one_line'
+    args = [a.replace('/x/', f'{ns}/') for a in args]
+    reason = reason.replace('/x/', f'{ns}/')
+    status, output = _exited(NodeProcess(tmp_path, '-r', f'__ns:={ns}', '-r', '__node:=renamed',
+                                         *args))
+    assert status == 1, output
+    lines = output.strip().splitlines()
+    assert len(lines) == 1, output
+    assert lines[0].startswith('[FATAL]'), output
+    logger = ns.strip('/').replace('/', '.') + '.renamed'
+    assert f'[{logger}]: cannot start: {reason}' in lines[0], output
+    assert '.cpp' not in lines[0] and '.c:' not in lines[0]
+
+
+SUBNORMAL_SCENE = """\
+name: subnormal_four_bar
+units: {length: mm, angle: deg}
+ground: {A: [0, 0], D: [1.5e-319, 0]}
+input: {link: crank, center: A, point: B, length: 4e-320, angle: 60, speed_rpm: -120}
+dyads:
+  - type: RRR
+    point: C
+    links:
+      - {name: coupler, from: B, length: 1.5e-319}
+      - {name: rocker, from: D, length: 8e-320}
+    branch: 1
+"""
+
+
+def test_a_scene_of_subnormal_lengths_is_published_as_solve_answers_it(ros, tmp_path):
+    """Subnormal lengths started a node that published nothing and warned forever (issue 21).
+
+    ``solve`` answers the scene (errors within max_relative_error of the
+    smallest normal float); the node publishes the same angles.
+    """
+    import mech_kinematics as mk
+
+    scene_file = tmp_path / 'subnormal.yaml'
+    scene_file.write_text(SUBNORMAL_SCENE)
+    scene = mk.load_scene(str(scene_file))
+    ns = f'{SESSION}/subnormal'
+    js = ros.collect(JointState, f'{ns}/joint_states')
+    proc = NodeProcess(tmp_path, '-r', f'__ns:={ns}', '-p', f'scene:={scene_file}')
+    try:
+        wait_for(lambda: len(js) >= 5, STARTUP_S, 'joint_states from the subnormal scene')
+        msg = js[-1]
+        crank = msg.position[list(msg.name).index('crank')]
+        state = mk.solve(scene, crank)
+        coupler = msg.position[list(msg.name).index('coupler')]
+        assert coupler == pytest.approx(wrap(state.joints['coupler'].position), abs=1e-9)
+    finally:
+        status, _ = proc.stop(signal.SIGINT)
+    assert status == 0, proc.output()
+    assert 'no state published' not in proc.output()

@@ -664,3 +664,74 @@ def test_untrusted_error_is_one_clear_line():
     assert '\n' not in text
     for part in (error.dyad, error.value.split('.')[1], f'{error.bound:.3g}', '1e-06 x'):
         assert part in text
+
+
+@pytest.mark.parametrize('speed', [1e-160, 1e-300, 1e-320])
+def test_tiny_speeds_are_answered_and_right(speed):
+    """1e-160 and 1e-320 rad/s were refused ("at most 1e-06 x 0 m/s^2"); 0 was answered.
+
+    Velocities are linear in the speed: each equals ``speed`` times the one at
+    1 rad/s, within its error bound plus the float format's resolution (issue 21).
+    """
+    scene = mk.load_scene('khurmi_four_bar_ad150')
+    unit = mk.solve(scene, 1.0, speed=1.0, accel=0.0)
+    tiny = mk.solve(scene, 1.0, speed=speed, accel=0.0)
+    bounds = tiny.error_bound
+    for name, joint in tiny.joints.items():
+        expected = speed * unit.joints[name].velocity
+        assert abs(joint.velocity - expected) <= (bounds.joints[name].velocity
+                                                  + 1e-9 * abs(expected) + 1e-322)
+        assert joint.position == unit.joints[name].position
+
+
+def _four_bar_yaml(crank: str, coupler: str, rocker: str, ground: str) -> str:
+    return (f'name: huge\nunits: {{length: m, angle: deg}}\n'
+            f'ground: {{A: [0, 0], D: [{ground}, 0]}}\n'
+            f'input: {{link: crank, center: A, point: B, length: {crank}, angle: 60, '
+            f'speed_rpm: 1}}\n'
+            f'dyads:\n  - type: RRR\n    point: C\n    links:\n'
+            f'      - {{name: coupler, from: B, length: {coupler}}}\n'
+            f'      - {{name: rocker, from: D, length: {rocker}}}\n    branch: 1\n')
+
+
+def test_lengths_near_the_largest_float_load_and_solve(tmp_path):
+    """1e308 m lengths said "OverflowError: math range error" (issue 21): now they solve."""
+    path = tmp_path / 'huge.yaml'
+    path.write_text(_four_bar_yaml('0.4e308', '1.5e308', '0.8e308', '1.5e308'))
+    scene = mk.load_scene(str(path))
+    state = mk.solve(scene, 1.0, speed=1e-3, accel=0.0)
+    b = state.points['B'].position
+    assert b[0] == pytest.approx(0.4e308 * math.cos(1.0), rel=1e-15)
+    assert b[1] == pytest.approx(0.4e308 * math.sin(1.0), rel=1e-15)
+    normal = mk.solve(mk.load_scene('khurmi_four_bar_ad150'), 1.0, speed=1e-3, accel=0.0)
+    for name, joint in state.joints.items():
+        assert joint.position == pytest.approx(normal.joints[name].position, abs=1e-12)
+
+
+def test_the_largest_float_as_a_length_is_named_as_it_is(tmp_path):
+    """A crank of 1.7976931348623157e308 m is refused with a true reason, never an overflow."""
+    path = tmp_path / 'max.yaml'
+    path.write_text(_four_bar_yaml('1.7976931348623157e308', '150', '80', '150'))
+    with pytest.raises(mk.SceneError) as raised:
+        mk.load_scene(str(path))
+    message = str(raised.value)
+    assert 'cannot reach from B to D (1.79769e+308 m apart, more than 230 m)' in message
+    assert 'inf' not in message and 'Overflow' not in message
+
+
+def test_the_largest_float_in_rpm_is_a_finite_speed():
+    """1.7976931348623157e308 rpm became inf rad/s ("got inf"); now 1.88e307 rad/s (issue 21).
+
+    Values whose product with pi fits keep their bits (``rpm * pi / 30``).
+    """
+    from mech_kinematics.units import rad_per_s_from_rpm, rpm_from_rad_per_s
+
+    largest = 1.7976931348623157e308
+    assert rad_per_s_from_rpm(largest) == pytest.approx(largest / 30 * math.pi, rel=1e-15)
+    assert rpm_from_rad_per_s(largest) == pytest.approx(largest / math.pi * 30, rel=1e-15)
+    assert rad_per_s_from_rpm(-1e3) == -1e3 * math.pi / 30
+    assert rpm_from_rad_per_s(2.5) == 2.5 * 30 / math.pi
+    scene = mk.load_scene('khurmi_four_bar_ad150')
+    with pytest.raises(mk.AssemblyError, match='the state overflows') as raised:
+        mk.solve(scene, 1.0, rad_per_s_from_rpm(largest))
+    assert 'inf' not in str(raised.value)

@@ -272,3 +272,90 @@ def test_importing_the_commands_pulls_in_neither_matplotlib_nor_rclpy():
             'heavy = {"matplotlib", "rclpy", "rosbags"} & set(sys.modules); '
             'assert not heavy, heavy')
     subprocess.run([sys.executable, '-c', code], check=True, cwd=REPO)
+
+
+def test_output_without_an_image_suffix_is_refused(tmp_path, capsys):
+    """``-o NAME`` would have written NAME.png and said "wrote NAME": refused, nothing written."""
+    assert plot.main(['--scene', 'khurmi_four_bar_ad150', '-o', str(tmp_path / 'NAME')]) == 2
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1
+    assert f'got "{tmp_path / "NAME"}" without one; e.g. -o {tmp_path / "NAME.png"}' in err
+    assert plot.main(['--scene', 'khurmi_four_bar_ad150', '-o', str(tmp_path / 'a.txt')]) == 2
+    assert 'whose suffix is not one' in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_samples_beyond_the_bound_are_refused_at_once(tmp_path, capsys):
+    """``--samples 1000000000`` allocated until the kernel killed it: now one line, exit 2."""
+    out = tmp_path / 'x.png'
+    assert plot.main(['--scene', 'khurmi_four_bar_ad150', '--samples', '1000000000',
+                      '-o', str(out)]) == 2
+    assert capsys.readouterr().err == (f'error: Expected --samples from 2 to {plot.MAX_SAMPLES}, '
+                                       f'got 1000000000; a figure shows no more\n')
+    assert plot.main(['--scene', 'khurmi_four_bar_ad150', '--samples', str(plot.MAX_SAMPLES),
+                      '-o', str(out)]) == 0
+    assert_png(out)
+
+
+def test_bag_whose_metadata_is_a_fifo_is_refused_not_hung(tmp_path):
+    """A FIFO named metadata.yaml made ``plot`` hang: now one line naming it, at once."""
+    import os
+
+    scene = mk.load_scene('khurmi_four_bar_ad150')
+    bag = write_bag(tmp_path / 'bag', scene, [1.0, 1.1])
+    (bag / 'metadata.yaml').unlink()
+    os.mkfifo(bag / 'metadata.yaml')
+    result = subprocess.run([sys.executable, '-m', 'mech_kinematics', 'plot', str(bag), '-o',
+                             str(tmp_path / 'x.png')], cwd=REPO, capture_output=True, text=True,
+                            timeout=120)
+    assert result.returncode == 2
+    assert result.stderr == (f'error: Expected "{bag / "metadata.yaml"}" to be a regular file, '
+                             f'got a FIFO; replace it with the file itself\n')
+
+
+def test_bag_without_metadata_or_with_a_damaged_chunk_says_to_reindex(tmp_path, capsys):
+    """No metadata.yaml (recorder killed), or a chunk checksum mismatch: the line says reindex."""
+    scene = mk.load_scene('khurmi_four_bar_ad150')
+    bag = write_bag(tmp_path / 'bag', scene, [1.0, 1.1])
+    (bag / 'metadata.yaml').rename(tmp_path / 'metadata.yaml')
+    assert plot.main([str(bag), '-o', str(tmp_path / 'x.png')]) == 2
+    err = capsys.readouterr().err
+    assert err == (f'error: Expected a bag directory with a metadata.yaml, got "{bag}" without '
+                   f'one (was its recorder killed?); run `python -m mech_kinematics reindex '
+                   f'{bag}` to rebuild it\n')
+    (tmp_path / 'metadata.yaml').rename(bag / 'metadata.yaml')
+    ours = copied_by_the_recorders_writer(bag, tmp_path / 'ours')   # chunks with a CRC
+    storage = ours / 'ours.mcap'
+    data = bytearray(storage.read_bytes())
+    data[data.index(b'coupler') + 2] ^= 0xFF      # inside the first message of the chunk
+    storage.write_bytes(bytes(data))
+    bag = ours
+    assert plot.main([str(bag), '-o', str(tmp_path / 'x.png')]) == 2
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1 and 'Chunk checksum mismatch' in err
+    assert err.endswith(f'run `python -m mech_kinematics reindex {bag}` to keep every intact '
+                        f'message\n')
+    assert not (tmp_path / 'x.png').exists()
+
+
+def copied_by_the_recorders_writer(bag: Path, destination: Path) -> Path:
+    """Copy every message of ``bag`` into a new bag written by ``record``'s BagWriter."""
+    from rosbags.highlevel import AnyReader
+
+    from mech_kinematics.tools.bag import BagWriter
+    from mech_kinematics.tools.bag.metadata import type_hash_from_definition
+
+    writer = BagWriter(destination, storage='mcap')
+    writer.open()
+    with AnyReader([bag]) as reader:
+        topics = {}
+        for c in reader.connections:
+            encoding, text = bag_recorder.message_definition(c.msgtype)
+            topics[c.id] = writer.add_topic(c.topic, c.msgtype, definition=text,
+                                            encoding=encoding,
+                                            type_hash=type_hash_from_definition(c.msgtype, text,
+                                                                                encoding))
+        for c, timestamp, raw in reader.messages():
+            writer.write(topics[c.id], timestamp, bytes(raw))
+    writer.close()
+    return destination

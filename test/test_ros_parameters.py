@@ -47,3 +47,62 @@ def test_every_parameter_is_described():
         if p.kind == 'double':
             assert p.low is not None and p.high is not None and p.unit
     assert spec('rate_hz').default == 100.0
+
+
+@pytest.mark.parametrize('name, value', [
+    ('frame_id', '/'), ('frame_id', '/mechanism'), ('frame_id', 'a//b'), ('frame_id', 'a/'),
+    ('frame_id', 'two words'), ('frame_id', 'tab\there'), ('tf_prefix', '../..'),
+    ('tf_prefix', '.'), ('tf_prefix', '/robot'), ('tf_prefix', 'robot/'),
+])
+def test_frame_ids_are_refused_where_tf2_would(name, value):
+    """``frame_id:=/`` and ``tf_prefix:=../..`` put ``//crank`` on /tf: refused (issue 21)."""
+    assert refusal(name, value) == (
+        f"{name}: expected a tf2 frame id (no leading '/', no empty, '.' or '..' part "
+        f"between '/', no space), got {value!r}; e.g. 'mechanism' or 'robot/base'")
+
+
+@pytest.mark.parametrize('name, value', [
+    ('frame_id', 'mechanism'), ('frame_id', 'robot_1/base'), ('tf_prefix', ''),
+    ('tf_prefix', 'left/arm'), ('frame_id', 'a.b'),
+])
+def test_good_frame_ids_pass(name, value):
+    assert refusal(name, value) is None
+
+
+def test_an_empty_parameter_name_is_refused():
+    """The parameter named '' was accepted and listed (issue 21)."""
+    assert refusal('', 5) == 'expected a parameter name, got an empty one (with value 5)'
+
+
+def test_a_huge_refused_value_is_not_echoed_whole():
+    """A 1 MB refused string was echoed whole into the log: the message stays short."""
+    reason = refusal('late_ticks', 'x' * 1_000_000)
+    assert reason == (f"late_ticks: expected one of catch_up, skip, got '{'x' * 59}... "
+                      '(1000000 characters)')
+
+
+def test_the_speed_bound_refusal_says_what_to_do():
+    """Blaming max_crank_speed_rpm, which the user never set, now says how to go faster."""
+    assert joint_refusal({'crank_speed_rpm': 20000.0, 'max_crank_speed_rpm': 10000.0}) == (
+        'crank_speed_rpm: expected |crank_speed_rpm| <= max_crank_speed_rpm (10000 rpm), got '
+        '20000 rpm; set max_crank_speed_rpm (up to 100000) first to go faster')
+
+
+@pytest.mark.parametrize('rate_hz', [1.0, 100.0, 1000.0, 4000.0, 10_000.0])
+@pytest.mark.parametrize('max_catch_up_s', [0.0, 0.1, 1.0, 10.0])
+def test_a_catch_up_burst_fits_the_history(rate_hz, max_catch_up_s):
+    """A late wake-up publishes at most the history depth of missed instants.
+
+    A 10 s SIGSTOP at 1 kHz published 10,001 instants at once and a KEEP_LAST
+    1000 reader lost 1,712 of them (issue 21); older instants are now skipped.
+    """
+    from mech_kinematics.ros.parameters import catch_up_window_ns, STATE_DEPTH
+    from mech_kinematics.ros.schedule import period_ns_from_rate, TickGrid
+
+    period = period_ns_from_rate(rate_hz)
+    grid = TickGrid(0, period)
+    window = catch_up_window_ns(max_catch_up_s, period)
+    due = grid.take(20 * 10**9, window)        # woke 20 s late
+    wanted = min(round(max_catch_up_s * 1e9) // period + 1, STATE_DEPTH)
+    assert len(due.instants) == wanted <= STATE_DEPTH
+    assert window <= round(max_catch_up_s * 1e9)

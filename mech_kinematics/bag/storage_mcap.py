@@ -22,27 +22,44 @@ outside the chunks, so that a topic is in the data section as soon as it is
 added, and a chunk is never empty.
 
 :class:`RecoveredMcap` (``reindex``, and :class:`~.writer.BagWriter` after a
-write error) scans a file record by record, keeps every intact chunk (length,
-CRC and each message checked), truncates what follows the last one (a chunk
-cut short, a partial message index, an old summary), rewrites the message
-indexes of the last chunk if they were cut, and appends the summary that a
-normal close writes, built by the same function. If the file system has no
-room for the summary, the last chunks are dropped until it fits.
+write error) scans a file record by record and keeps every intact chunk
+(length, CRC and each message checked). After a damaged record (a flipped
+byte, a length that runs past the file, an unknown opcode) it searches the
+following bytes for the next intact chunk (its CRC matches) or Schema or
+Channel record and goes on from there, so every intact chunk after a damaged
+one is kept. Then:
+
+- if what is dropped is only the end of an interrupted recording (a record
+  cut short, zeroes, message indexes cut short, an old summary), the file is
+  truncated after the last intact chunk, the message indexes of that chunk
+  rewritten if they were cut, and the summary that a normal close writes
+  appended (built by the same function). If the file system has no room for
+  the summary, the last chunks are dropped until it fits;
+- otherwise (damage with intact data after it, or a damaged last chunk) the
+  original is not changed: the kept records are copied to a new file with new
+  message indexes and a summary, which takes the original's name, and the
+  original is kept as ``NAME.damaged`` (:mod:`.salvage`).
+
+Each dropped range is noted: its offsets, why, and how many messages of which
+topics a dropped chunk held if its records can still be parsed.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
+import contextlib
 from dataclasses import dataclass, field
 import errno
 import os
 from pathlib import Path
+import re
 import struct
 from typing import BinaryIO, NamedTuple
 import zlib
 
 from .metadata import (BagError, parse_qos, stored_version, Topic,
                        type_hash_from_definition)
+from .salvage import new_copy_path, replace_keeping_original
 
 __all__ = ['MAGIC', 'McapStorage', 'RecoveredMcap']
 
@@ -51,6 +68,7 @@ PROFILE = 'ros2'
 
 # Record opcodes (MCAP specification).
 HEADER, FOOTER, SCHEMA, CHANNEL, MESSAGE, CHUNK, MESSAGE_INDEX, CHUNK_INDEX = range(1, 9)
+ATTACHMENT, ATTACHMENT_INDEX = 0x09, 0x0A
 STATISTICS, METADATA, METADATA_INDEX, SUMMARY_OFFSET, DATA_END = range(0x0B, 0x10)
 
 _U16 = struct.Struct('<H')
@@ -312,10 +330,9 @@ class McapStorage:
 
     def abort(self) -> None:
         """Close the file as it is (after an error; :class:`RecoveredMcap` finishes it)."""
-        try:
+        # The buffered rest may not fit; the scan drops a partial record.
+        with contextlib.suppress(OSError):
             self._file.close()
-        except OSError:
-            pass    # the buffered rest may not fit; the scan drops a partial record
 
     def _write(self, data: bytes | bytearray) -> None:
         self._file.write(data)
@@ -401,7 +418,7 @@ class _ParsedChunk:
     entries: dict[int, bytearray]
 
 
-def _parse_chunk(body: memoryview, offset: int) -> _ParsedChunk:
+def _parse_chunk(body: memoryview, offset: int, *, check_crc: bool = True) -> _ParsedChunk:
     """Parse and check the Chunk record at ``offset`` (body ``body``)."""
     fields = _Fields(body)
     start, end, size, crc = fields.unpack(_CHUNK_HEAD)
@@ -414,7 +431,7 @@ def _parse_chunk(body: memoryview, offset: int) -> _ParsedChunk:
     if stored != size or fields.pos != len(body):
         msg = f'sizes disagree ({stored} stored, {size} uncompressed, record {len(body)})'
         raise _Corrupt(msg)
-    if crc and zlib.crc32(records) != crc:
+    if check_crc and crc and zlib.crc32(records) != crc:
         raise _Corrupt('CRC-32 mismatch')
     parsed = _ParsedChunk(Chunk(offset, _RECORD.size + len(body), start, end, size, {}), [], [],
                           {})
@@ -438,6 +455,101 @@ def _parse_chunk(body: memoryview, offset: int) -> _ParsedChunk:
         pos += _RECORD.size + length
     parsed.chunk.counts = {cid: len(e) // _INDEX_ENTRY.size for cid, e in parsed.entries.items()}
     return parsed
+
+
+@dataclass
+class _Drop:
+    """Bytes of the file that recovery drops, and why."""
+
+    start: int
+    end: int
+    reason: str
+    cut: bool = False       # the end of an interrupted recording: nothing intact follows
+    messages: str = ''      # what a dropped chunk held
+
+
+def _describe(body: memoryview, channels: Mapping[int, Channel]) -> str:
+    """Say how many messages of which topics a damaged chunk holds, if its records parse."""
+    try:
+        parsed = _parse_chunk(body, 0, check_crc=False)
+    except (_Corrupt, BagError, struct.error):
+        return ''
+    chunk = parsed.chunk
+    topics = ', '.join(f'{channels[cid].topic if cid in channels else f"channel {cid}"}: {n}'
+                       for cid, n in sorted(chunk.counts.items()))
+    return (f'{sum(chunk.counts.values())} messages ({topics or "none"}) logged from '
+            f'{chunk.start} to {chunk.end} ns, which cannot be told from damaged ones')
+
+
+_WINDOW = 1 << 22
+_RESYNC_OPCODES = re.compile(b'[\x03\x04\x06]')
+
+
+def _next_record(stream: BinaryIO, start: int, size: int) -> int | None:
+    """Return the offset of the first intact Chunk, Schema or Channel record after ``start``.
+
+    A chunk is intact if its sizes agree and its CRC-32 matches; a Schema or
+    Channel record if its fields fill it exactly. None if there is none.
+    """
+    pos = start
+    while pos < size:
+        stream.seek(pos)
+        window = stream.read(_WINDOW + 64)
+        for match in _RESYNC_OPCODES.finditer(window, 0, _WINDOW):
+            at = pos + match.start()
+            if _intact_at(stream, window, match.start(), at, size):
+                return at
+        pos += _WINDOW
+    return None
+
+
+def _whole_chunk_at(stream: BinaryIO, pos: int, size: int) -> bool:
+    """Tell whether the chunk at ``pos`` is whole by its inner sizes and CRC (not its length)."""
+    stream.seek(pos + _RECORD.size)
+    head = stream.read(_CHUNK_HEAD.size + 4)
+    if len(head) < _CHUNK_HEAD.size + 4:
+        return False
+    _, _, uncompressed, _ = _CHUNK_HEAD.unpack_from(head)
+    (compression,) = _U32.unpack_from(head, _CHUNK_HEAD.size)
+    if compression or pos + _RECORD.size + 40 + uncompressed > size:
+        return False
+    stream.seek(pos + _RECORD.size)
+    try:
+        _parse_chunk(memoryview(stream.read(40 + uncompressed)), pos)
+    except (_Corrupt, BagError, struct.error):
+        return False
+    return True
+
+
+def _intact_at(stream: BinaryIO, window: bytes, i: int, at: int, size: int) -> bool:
+    if i + _RECORD.size + _CHUNK_HEAD.size + 4 > len(window):
+        return False
+    op, length = _RECORD.unpack_from(window, i)
+    end = at + _RECORD.size + length
+    if end > size:
+        return False
+    if op == CHUNK:
+        _, _, uncompressed, _ = _CHUNK_HEAD.unpack_from(window, i + _RECORD.size)
+        (compression,) = _U32.unpack_from(window, i + _RECORD.size + _CHUNK_HEAD.size)
+        if compression or length != 40 + uncompressed:
+            return False
+    elif length > _WINDOW:
+        return False
+    stream.seek(at + _RECORD.size)
+    body = memoryview(stream.read(length))
+    try:
+        if op == CHUNK:
+            _parse_chunk(body, at)
+            return True
+        fields = _Fields(body)
+        record = fields.schema(at) if op == SCHEMA else fields.channel(at)
+    except (_Corrupt, BagError, struct.error):
+        return False
+    if fields.pos != len(body):
+        return False
+    if isinstance(record, Channel):
+        return record.topic.startswith('/') and bool(record.message_encoding)
+    return bool(record.name) and bool(record.encoding)
 
 
 class RecoveredMcap:
@@ -471,7 +583,11 @@ class RecoveredMcap:
         self._schemas: dict[int, Schema] = {}
         self._channels: dict[int, Channel] = {}
         self.chunks: list[Chunk] = []
-        self._unindexed: _ParsedChunk | None = None
+        self._unindexed: list[Chunk] = []
+        self._entries: dict[int, dict[int, bytearray]] = {}
+        self._drops: list[_Drop] = []
+        self._records: list[tuple[int, int]] = []
+        self._copy = False
         try:
             with open(path, 'rb') as stream:
                 size = os.fstat(stream.fileno()).st_size
@@ -530,20 +646,31 @@ class RecoveredMcap:
         if profile != PROFILE:
             msg = f'Expected the MCAP profile "{PROFILE}" in "{path}", got "{profile}"'
             raise BagError(msg)
-        self.data_end = pos
+        self.header_end = self.data_end = pos
         pending: _ParsedChunk | None = None
         missing: set[int] = set()
-        tail = ''
         closed = False
         while pos + _RECORD.size <= size:
+            stream.seek(pos)
             op, length = _RECORD.unpack(stream.read(_RECORD.size))
             end = pos + _RECORD.size + length
+            damage = ''
             if end > size:
-                tail = 'a record cut short'
-                break
-            if op == 0:
-                tail = 'zeroes where a record should start'
-                break
+                damage = 'a record cut short'
+            elif op == 0:
+                damage = 'zeroes where a record should start'
+            if damage:
+                if pending is not None:
+                    self._keep_unindexed(pending)
+                    pending = None
+                whole = op == CHUNK and _whole_chunk_at(stream, pos, size)
+                if whole:
+                    damage = 'a chunk whose length field is damaged'
+                resume = self._drop(stream, pos, size, damage, cut=not whole)
+                if resume is None:
+                    break
+                pos = resume
+                continue
             body = memoryview(stream.read(length))
             if pending is not None:
                 if op == MESSAGE_INDEX and self._index_matches(body, pending, missing):
@@ -556,19 +683,25 @@ class RecoveredMcap:
                         pending = None
                     pos = end
                     continue
-                if op != MESSAGE_INDEX:
-                    msg = (f'Expected message indexes after the chunk at offset '
-                           f'{pending.chunk.offset} of "{path}", got a record of opcode '
-                           f'{op:#04x}; files without message indexes are not supported')
-                    raise BagError(msg)
-                tail = 'a message index that does not match its chunk'
-                break
+                self._keep_unindexed(pending)
+                pending = None
+                if op == MESSAGE_INDEX:
+                    resume = self._drop(stream, pos, size,
+                                        'a message index that does not match its chunk')
+                    if resume is None:
+                        break
+                    pos = resume
+                    continue
             if op == CHUNK:
                 try:
                     parsed = _parse_chunk(body, pos)
                 except _Corrupt as error:
-                    tail = f'a damaged chunk ({error})'
-                    break
+                    resume = self._drop(stream, pos, size, f'a damaged chunk ({error})',
+                                        body=body)
+                    if resume is None:
+                        break
+                    pos = resume
+                    continue
                 if parsed.chunk.counts:
                     pending, missing = parsed, set(parsed.chunk.counts)
                 else:
@@ -578,9 +711,15 @@ class RecoveredMcap:
                     fields = _Fields(body)
                     record = fields.schema(pos) if op == SCHEMA else fields.channel(pos)
                 except _Corrupt as error:
-                    tail = f'a damaged record ({error})'
-                    break
-                (self._schemas if op == SCHEMA else self._channels)[record.id] = record
+                    resume = self._drop(stream, pos, size, f'a damaged record ({error})')
+                    if resume is None:
+                        break
+                    pos = resume
+                    continue
+                known = self._schemas if op == SCHEMA else self._channels
+                if record.id not in known:      # the summary repeats them after a resync
+                    known[record.id] = record
+                    self._records.append((pos, end))
                 self.data_end = end
             elif op == MESSAGE:
                 msg = f'Expected the messages of "{path}" in chunks, got one at offset {pos}'
@@ -590,28 +729,77 @@ class RecoveredMcap:
                     fields = _Fields(body)
                     name, values = fields.string(), fields.string_map()
                 except _Corrupt as error:
-                    tail = f'a damaged record ({error})'
-                    break
+                    resume = self._drop(stream, pos, size, f'a damaged record ({error})')
+                    if resume is None:
+                        break
+                    pos = resume
+                    continue
                 if name == _ROSBAG2:
                     self.stored_version = stored_version(values.get('serialized_metadata', ''))
                     closed = True
                     break
+                self._records.append((pos, end))
                 self.data_end = end
             elif op in (DATA_END, FOOTER, CHUNK_INDEX, STATISTICS, METADATA_INDEX,
                         SUMMARY_OFFSET):
                 closed = True
                 break
+            elif op in (ATTACHMENT, ATTACHMENT_INDEX):
+                self._records.append((pos, end))    # attachments stay as they are
+                self.data_end = end
             else:
-                self.data_end = end     # attachments or unknown records stay as they are
+                resume = self._drop(stream, pos, size, f'a record of unknown opcode {op:#04x}',
+                                    body=body, counted=False)
+                if resume is None:
+                    break
+                pos = resume
+                continue
             pos = end
         if pending is not None:     # a chunk whose message indexes were cut: written again
-            self.data_end = pending.chunk.offset + pending.chunk.length
-            self._unindexed = pending
-            tail = tail or 'message indexes cut short'
-        if not closed and size > self.data_end:
+            self._keep_unindexed(pending)
+            if not closed and size > self.data_end:
+                self._drops.append(_Drop(self.data_end, size, 'message indexes cut short',
+                                         cut=True))
+        # Repaired in place only if what is dropped is the end of an interrupted recording.
+        self._copy = (any(not d.cut for d in self._drops)
+                      or any(u is not self.chunks[-1] for u in self._unindexed))
+        self._note_drops(closed, size)
+
+    def _note_drops(self, closed: bool, size: int) -> None:
+        for drop in self._drops:
+            what = f'{drop.end - drop.start} bytes from offset {drop.start}: {drop.reason}'
+            if drop.messages:
+                what += f' holding {drop.messages}'
+            if drop.cut and not self._copy and drop.end == size:
+                what += ' (the recording was interrupted)'
+            self.notes.append(f'dropped {what}')
+        if not self._drops and not closed and size > self.data_end:
             self.notes.append(f'dropped {size - self.data_end} bytes from offset '
-                              f'{self.data_end}: {tail or "a record cut short"} '
+                              f'{self.data_end}: a record cut short '
                               f'(the recording was interrupted)')
+
+    def _drop(self, stream: BinaryIO, pos: int, size: int, reason: str, *, cut: bool = False,
+              body: memoryview | None = None, counted: bool = True) -> int | None:
+        """Record that the bytes from ``pos`` are dropped; return where the next record starts.
+
+        The next record is the next intact chunk (its CRC checked) or Schema or
+        Channel record after ``pos``; None if there is none (the rest is dropped).
+        """
+        resume = _next_record(stream, pos + 1, size)
+        end = size if resume is None else resume
+        messages = _describe(body, self._channels) if body is not None else ''
+        if body is not None and counted and not messages:
+            messages = 'messages that cannot be counted'
+        self._drops.append(_Drop(pos, end, reason, cut=cut and resume is None,
+                                 messages=messages))
+        return resume
+
+    def _keep_unindexed(self, parsed: _ParsedChunk) -> None:
+        """Keep a chunk (its CRC checked) whose message indexes are missing or damaged."""
+        chunk = parsed.chunk
+        self._keep(parsed, chunk.offset + chunk.length)
+        self._unindexed.append(chunk)
+        self._entries[chunk.offset] = parsed.entries
 
     def _index_matches(self, body: memoryview, pending: _ParsedChunk, missing: set[int]) -> bool:
         if len(body) < 6:
@@ -637,20 +825,29 @@ class RecoveredMcap:
                           f'to make room for the summary')
 
     def finish(self, metadata: Callable[[], str]) -> None:
-        """Truncate after the data section and append the summary; sync the file.
+        """Make the file readable with every chunk kept, a summary at its end; sync it.
 
-        ``metadata()`` is the rosbag2 metadata to embed; it is called again
-        whenever a chunk had to be dropped for lack of space.
+        If only the end of an interrupted recording is dropped, the file is
+        truncated after its data section and the summary appended. Otherwise
+        (damage with intact data after it) the kept records are copied to a
+        new file, which replaces the original; the original is kept as
+        ``NAME.damaged`` (see :mod:`.salvage`). ``metadata()`` is the rosbag2
+        metadata to embed; it is called again whenever a chunk had to be
+        dropped for lack of space.
 
         Raises
         ------
         OSError
-            If even a summary of no chunk at all cannot be written.
+            If even a summary of no chunk at all cannot be written, or (when
+            copying) the copy does not fit: then the original is unchanged.
         """
+        if self._copy:
+            self._finish_copy(metadata)
+            return
         fd = os.open(self.path, os.O_RDWR)
         try:
-            if self._unindexed is not None:
-                self._write_indexes(fd, self._unindexed)
+            if self._unindexed:
+                self._write_indexes(fd, self._unindexed[-1])
             while True:
                 closing = closing_records(list(self._schemas.values()),
                                           list(self._channels.values()), self.chunks,
@@ -667,10 +864,9 @@ class RecoveredMcap:
         finally:
             os.close(fd)
 
-    def _write_indexes(self, fd: int, parsed: _ParsedChunk) -> None:
-        chunk = parsed.chunk
+    def _write_indexes(self, fd: int, chunk: Chunk) -> None:
         offset = chunk.offset + chunk.length
-        records = _message_indexes(parsed.entries)
+        records = _message_indexes(self._entries[chunk.offset])
         chunk.index_offsets, chunk.index_length = {}, 0
         for cid, record in records:
             chunk.index_offsets[cid] = offset + chunk.index_length
@@ -681,12 +877,54 @@ class RecoveredMcap:
         except OSError as error:
             if error.errno not in _NO_SPACE:
                 raise
+            self.chunks.pop()
             self.data_end = chunk.offset
             self.notes.append(f'dropped the last chunk ({sum(chunk.counts.values())} messages): '
                               f'no room for its message indexes')
             return
-        self._keep(parsed, offset + chunk.index_length)
+        self.data_end = offset + chunk.index_length
         self.notes.append(f'rewrote the message indexes of the last chunk (offset {chunk.offset})')
+
+    def _finish_copy(self, metadata: Callable[[], str]) -> None:
+        copy = new_copy_path(self.path)
+        try:
+            with open(self.path, 'rb') as source, open(copy, 'xb') as out:
+                source.seek(0)
+                out.write(source.read(self.header_end))
+                offset = self.header_end
+                chunks: list[Chunk] = []
+                kept = sorted([(c.offset, c.length, c) for c in self.chunks]
+                              + [(start, end - start, None) for start, end in self._records],
+                              key=lambda item: item[0])
+                for start, length, chunk in kept:
+                    source.seek(start)
+                    data = source.read(length)
+                    out.write(data)
+                    if chunk is not None:
+                        parsed = _parse_chunk(memoryview(data)[_RECORD.size:], offset)
+                        new = parsed.chunk
+                        position = offset + length
+                        for cid, record in _message_indexes(parsed.entries):
+                            new.index_offsets[cid] = position + new.index_length
+                            new.index_length += len(record)
+                            out.write(record)
+                        chunks.append(new)
+                        length += new.index_length
+                    offset += length
+                self.chunks = chunks
+                out.write(closing_records(list(self._schemas.values()),
+                                          list(self._channels.values()), chunks, offset,
+                                          metadata()))
+                out.flush()
+                os.fsync(out.fileno())
+            kept_as = replace_keeping_original(self.path, copy)
+        except BaseException:
+            with contextlib.suppress(OSError):
+                copy.unlink()
+            raise
+        self.notes.append(f'wrote the {len(chunks)} intact chunks to a new "{self.path.name}" '
+                          f'with new message indexes; the original file is kept as '
+                          f'"{kept_as.name}"')
 
 
 def _pwrite_all(fd: int, data: bytes, offset: int) -> None:

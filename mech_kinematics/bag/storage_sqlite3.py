@@ -18,13 +18,15 @@ writing first, which does, and counts what the committed transactions hold.
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 import contextlib
+import os
 from pathlib import Path
 import sqlite3
 
 from .metadata import (BagError, parse_qos, stored_version, Topic,
                        type_hash_from_definition)
+from .salvage import new_copy_path, replace_keeping_original
 
 __all__ = ['RecoveredSqlite3', 'Sqlite3Storage']
 
@@ -221,6 +223,7 @@ class RecoveredSqlite3:
     def __init__(self, path: Path) -> None:
         self.path = path
         self.notes: list[str] = []
+        self._damaged = ''
         journal = path.with_name(path.name + '-journal')
         hot = journal.is_file() and journal.stat().st_size > 0
         wal = path.with_name(path.name + '-wal')
@@ -280,13 +283,21 @@ class RecoveredSqlite3:
         self.qos_texts = [row[4] for row in rows]
         known = {t.id for t in topics}
         self.counts = {t.id: 0 for t in topics}
-        for tid, n in conn.execute('SELECT topic_id, COUNT(*) FROM messages GROUP BY topic_id'):
-            if tid in known:
-                self.counts[tid] = n
-        start, end = conn.execute(
-            'SELECT MIN(timestamp), MAX(timestamp) FROM messages WHERE topic_id IN '
-            '(SELECT id FROM topics)').fetchone()
-        self.start, self.end = (start or 0), (end or 0)
+        try:
+            problems = [row[0] for row in conn.execute('PRAGMA quick_check')]
+        except sqlite3.DatabaseError as error:
+            problems = [str(error)]
+        if problems != ['ok']:
+            self._count_readable(known, problems[0])
+        else:
+            for tid, n in conn.execute(
+                    'SELECT topic_id, COUNT(*) FROM messages GROUP BY topic_id'):
+                if tid in known:
+                    self.counts[tid] = n
+            start, end = conn.execute(
+                'SELECT MIN(timestamp), MAX(timestamp) FROM messages WHERE topic_id IN '
+                '(SELECT id FROM topics)').fetchone()
+            self.start, self.end = (start or 0), (end or 0)
         self.stored_version = None
         if 'metadata' in tables:
             row = conn.execute('SELECT metadata_version, metadata FROM metadata '
@@ -294,14 +305,165 @@ class RecoveredSqlite3:
             if row is not None:
                 self.stored_version = stored_version(row[1]) or row[0]
 
+    def _count_readable(self, known: set[int], problem: str) -> None:
+        """Count the readable rows of a damaged database, and note those that are not."""
+        self._damaged = problem
+        start, end = 2**63 - 1, 0
+        gaps: list[tuple[int, int | None]] = []
+        for _, tid, timestamp, _ in _readable_rows(self.conn, gaps):
+            if tid in known:
+                self.counts[tid] += 1
+                start, end = min(start, timestamp), max(end, timestamp)
+        self.start, self.end = (start, end) if end else (0, 0)
+        for after, resume in gaps:
+            first = max(after + 1, 1)
+            rows = (f'every row of "messages" after id {after}' if resume is None else
+                    f'the rows of "messages" with ids {first} to {resume - 1} (at most '
+                    f'{resume - first} messages)')
+            self.notes.append(f'dropped {rows}: unreadable ({problem})')
+        if not gaps:
+            self.notes.append(f'found damage that no message row is in ({problem})')
+
     def finish(self, version: int, metadata: Callable[[], str]) -> None:
-        """Store ``metadata()`` in the ``metadata`` table (skipped, with a note, if it fails)."""
+        """Store ``metadata()`` in the ``metadata`` table (skipped, with a note, if it fails).
+
+        A damaged database is not changed: its readable rows are copied to a
+        new database, with the metadata, which takes its name; the original is
+        kept as ``NAME.damaged`` (see :mod:`.salvage`).
+
+        Raises
+        ------
+        OSError, sqlite3.Error
+            If the copy of a damaged database cannot be written (the original
+            is then unchanged).
+        """
+        if self._damaged:
+            self._finish_copy(version, metadata)
+            return
         try:
             _write_metadata(self.conn, version, metadata())
         except sqlite3.Error as error:
             self.notes.append(f'left the metadata table as it was ({error})')
 
+    def _finish_copy(self, version: int, metadata: Callable[[], str]) -> None:
+        copy = new_copy_path(self.path)
+        try:
+            new = _connect(copy)
+            try:
+                self._copy_into(new)
+                _write_metadata(new, version, metadata())
+            finally:
+                new.close()
+            with open(copy, 'rb+') as stream:
+                os.fsync(stream.fileno())
+            kept = replace_keeping_original(self.path, copy)
+        except BaseException:
+            with contextlib.suppress(OSError):
+                copy.unlink()
+            with contextlib.suppress(OSError):
+                copy.with_name(copy.name + '-journal').unlink()
+            raise
+        self.notes.append(f'wrote every readable row to a new "{self.path.name}"; the original '
+                          f'file is kept as "{kept.name}"')
+
+    def _copy_into(self, new: sqlite3.Connection) -> None:
+        old = self.conn
+        schema = old.execute('SELECT type, name, sql FROM sqlite_master WHERE sql IS NOT NULL '
+                             'AND name NOT LIKE ? ORDER BY type = ?, rowid',
+                             ('sqlite_%', 'index')).fetchall()
+        new.execute('BEGIN')
+        for _, _, sql in schema:
+            new.execute(sql)
+        for kind, name, _ in schema:
+            if kind != 'table' or name == 'messages':
+                continue
+            try:
+                rows = old.execute(f'SELECT * FROM "{name}"').fetchall()
+            except sqlite3.DatabaseError as error:
+                msg = (f'Expected a readable table "{name}" in "{self.path}", got {error}; '
+                       f'the file is unchanged')
+                raise BagError(msg) from None
+            if rows:
+                marks = ', '.join('?' * len(rows[0]))
+                new.executemany(f'INSERT INTO "{name}" VALUES ({marks})', rows)
+        new.executemany('INSERT INTO messages (id, topic_id, timestamp, data) VALUES (?, ?, ?, ?)',
+                        _readable_rows(old, None))
+        new.execute('COMMIT')
+
     def close(self) -> None:
         """Close the database."""
         with contextlib.suppress(sqlite3.Error):
             self.conn.close()
+
+
+_BATCH = 512
+_LAST_ID = 2**63 - 1
+
+
+def _rows_after(conn: sqlite3.Connection, after: int, limit: int) -> list | None:
+    """Rows of ``messages`` with id > ``after``, in id order; None if a page is unreadable."""
+    try:
+        # id >= after + 1, not id > after: a seek to ``after`` would enter its (damaged) page
+        return conn.execute('SELECT id, topic_id, timestamp, data FROM messages WHERE id >= ? '
+                            'ORDER BY id LIMIT ?', (after + 1, limit)).fetchall()
+    except sqlite3.DatabaseError:
+        return None
+
+
+def _first_id_from(conn: sqlite3.Connection, low: int) -> list | None:
+    """``[(id,)]`` of the first row with id >= ``low`` ([] if none); None if unreadable."""
+    try:
+        return conn.execute('SELECT id FROM messages WHERE id >= ? ORDER BY id LIMIT 1',
+                            (low,)).fetchall()
+    except sqlite3.DatabaseError:
+        return None
+
+
+def _next_readable(conn: sqlite3.Connection, after: int) -> int | None:
+    """Return the first id after the unreadable rows that follow id ``after``, if any.
+
+    Finds the smallest id from which a seek into the table succeeds (the
+    unreadable page ends before it), probing at doubling distances, then by
+    bisection.
+    """
+    low, step = after + 1, 1
+    while True:
+        high = min(low + step, _LAST_ID)
+        if _first_id_from(conn, high) is not None:
+            break
+        if high == _LAST_ID:
+            return None
+        step *= 2
+    while high - low > 1:
+        middle = (low + high) // 2
+        if _first_id_from(conn, middle) is None:
+            low = middle
+        else:
+            high = middle
+    found = _first_id_from(conn, high)
+    return found[0][0] if found else None
+
+
+def _readable_rows(conn: sqlite3.Connection, gaps: list | None) -> Iterator[tuple]:
+    """Yield every readable row ``(id, topic_id, timestamp, data)`` of ``messages`` in id order.
+
+    Unreadable rows (a damaged page) are skipped; each skipped range is added
+    to ``gaps`` as ``(last id read, next id read or None)``.
+    """
+    after = -_LAST_ID
+    while True:
+        rows = _rows_after(conn, after, _BATCH)
+        if rows is None:
+            rows = _rows_after(conn, after, 1)
+        if rows is None:
+            resume = _next_readable(conn, after)
+            if gaps is not None:
+                gaps.append((after, resume))
+            if resume is None:
+                return
+            after = resume - 1
+            continue
+        if not rows:
+            return
+        yield from rows
+        after = rows[-1][0]

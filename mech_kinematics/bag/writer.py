@@ -24,6 +24,7 @@ and sqlite3's last journal), the writer fills a file of :data:`RESERVE_BYTES`
 from __future__ import annotations
 
 from collections.abc import Sequence
+import contextlib
 import os
 from pathlib import Path
 import sqlite3
@@ -268,10 +269,9 @@ def _reserve(path: Path) -> None:
 
 
 def _release(path: Path) -> None:
-    try:
+    # If it cannot be deleted, its space stays taken; closing may still fit.
+    with contextlib.suppress(OSError):
         path.unlink(missing_ok=True)
-    except OSError:
-        pass    # its space stays taken; closing may still fit
 
 
 def _storage_file(path: Path) -> Path:

@@ -61,7 +61,8 @@ from .diagnostics import solver_status, Status, TickStats, timing_status
 from .driver import TickDriver
 from .markers import marker_array_from_state, marker_size_from_space, MarkerThrottle
 from .messages import TickMessages
-from .parameters import CATCH_UP, joint_refusal, PARAMETERS, ParameterSpec, refusal, spec
+from .parameters import (CATCH_UP, catch_up_window_ns, joint_refusal, PARAMETERS, ParameterSpec,
+                         refusal, spec, STATE_DEPTH)
 from .schedule import period_ns_from_rate
 from .tf import static_tf_message, TfMessages
 from .ticker import tick_function
@@ -72,7 +73,7 @@ from ..geometry.frames import angle_joints, frames_from_scene, origin_points
 from ..geometry.instant_centres import full_scene
 from ..geometry.urdf import urdf_from_scene
 from ..scene import scene_text
-from ..units import NS_PER_S, rpm_from_rad_per_s
+from ..units import NS_PER_S, rad_per_s_from_rpm, rpm_from_rad_per_s
 
 __all__ = ['KinematicsNode', 'NODE_NAME', 'TickThreadError', 'main']
 
@@ -98,8 +99,6 @@ CRANK_KEYS = {'crank_speed_rpm': 'speed_rpm', 'crank_accel': 'accel',
 DOUBLES = frozenset(p.name for p in PARAMETERS if p.kind == 'double')
 READ_ONLY = frozenset(p.name for p in PARAMETERS if p.read_only)
 
-#: Depth of the state publishers' history: deep enough for a catch-up burst.
-STATE_DEPTH = 1000
 #: /tf and /tf_static as tf2's broadcasters offer them.
 TF_DEPTH = 100
 #: Every publisher accepts ``qos_overrides./TOPIC.publisher.POLICY`` for these policies.
@@ -174,10 +173,18 @@ class KinematicsNode(LifecycleNode):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(NODE_NAME, **kwargs)
+        #: While True (until main() has started the node), refusals are not logged here:
+        #: main() says the one line of a refused start.
+        self.starting = True
+        self.start_refusal = ''
         try:
             self._declare()
-        except BaseException:
+        except BaseException as error:
+            logger_name = self.get_logger().name
+            reason = self.start_refusal or ' '.join(str(error).split()) or type(error).__name__
             self.destroy_node()
+            if isinstance(error, Exception):
+                raise StartError(reason, logger_name) from None
             raise
 
     # -- parameters -----------------------------------------------------------
@@ -214,8 +221,10 @@ class KinematicsNode(LifecycleNode):
         self.add_post_set_parameters_callback(self._apply)
         self.managed = bool(self.get_parameter('managed').value)
         self.frame_id = self.get_parameter('frame_id').value
-        self._driver.period_ns = period_ns_from_rate(self.get_parameter('rate_hz').value)
-        self._driver.max_behind_ns = round(self.get_parameter('max_catch_up_s').value * NS_PER_S)
+        rate_period_ns = period_ns_from_rate(self.get_parameter('rate_hz').value)
+        self._driver.period_ns = rate_period_ns
+        self._driver.max_behind_ns = catch_up_window_ns(
+            self.get_parameter('max_catch_up_s').value, rate_period_ns)
         self._driver.catch_up = self.get_parameter('late_ticks').value == CATCH_UP
         self._tf_period_ns = self._tf_period(self.get_parameter('tf_rate_hz').value)
         self._max_error = float(self.get_parameter('max_relative_error').value)
@@ -244,7 +253,7 @@ class KinematicsNode(LifecycleNode):
         sees it; it is logged here, so that every refusal is.
         """
         for p in parameters:
-            if p.name in READ_ONLY:
+            if p.name in READ_ONLY and not self.starting:
                 self.get_logger().warning(
                     f'parameter refused: {p.name}: read-only (set it at start), got {p.value!r}')
         return [Parameter(p.name, Parameter.Type.DOUBLE, float(p.value))
@@ -268,8 +277,12 @@ class KinematicsNode(LifecycleNode):
                 reason = joint_refusal(current)
         if reason is None:
             return SetParametersResult(successful=True)
-        # Every refusal is logged once, with its reason, besides the service's answer.
-        self.get_logger().warning(f'parameter refused: {reason}')
+        # Every refusal is logged once, with its reason, besides the service's answer
+        # (at start, main() says it in its one line).
+        if self.starting:
+            self.start_refusal = self.start_refusal or reason
+        else:
+            self.get_logger().warning(f'parameter refused: {reason}')
         return SetParametersResult(successful=False, reason=reason)
 
     def _apply(self, parameters: list[Parameter]) -> None:
@@ -280,8 +293,11 @@ class KinematicsNode(LifecycleNode):
             driver.period_ns = period_ns_from_rate(changes['rate_hz'])
         if 'late_ticks' in changes:
             driver.catch_up = changes['late_ticks'] == CATCH_UP
-        if 'max_catch_up_s' in changes:
-            driver.max_behind_ns = round(changes['max_catch_up_s'] * NS_PER_S)
+        if 'max_catch_up_s' in changes or 'rate_hz' in changes:
+            # At most one history's depth of instants a burst (issue 21, item 7).
+            driver.max_behind_ns = catch_up_window_ns(
+                changes.get('max_catch_up_s', self._value('max_catch_up_s')),
+                period_ns_from_rate(changes.get('rate_hz', self._value('rate_hz'))))
         if 'tf_rate_hz' in changes:
             self._tf_period_ns = self._tf_period(changes['tf_rate_hz'])
         if 'max_relative_error' in changes:
@@ -307,16 +323,20 @@ class KinematicsNode(LifecycleNode):
             self._configure()
         except Exception as error:     # noqa: BLE001 - a scene or a QoS override: one line
             self._teardown()
-            self.configure_error = str(error) or type(error).__name__
-            self.get_logger().error(f'cannot configure: {self.configure_error}')
+            self.configure_error = ((self.starting and self.start_refusal)
+                                    or ' '.join(str(error).split()) or type(error).__name__)
+            if not self.starting or self.managed:
+                self.get_logger().error(f'cannot configure: {self.configure_error}')
             return TransitionCallbackReturn.FAILURE
         return TransitionCallbackReturn.SUCCESS
 
     def _configure(self) -> None:
         scene = mk.load_scene(self._value('scene'))
         scene_rpm = rpm_parameter(scene.input.speed)
+        given_rpm = self._value('crank_speed_rpm')      # a speed set at start raises the bound
         defaults = {
-            'max_crank_speed_rpm': max(DEFAULT_MAX_CRANK_SPEED_RPM, abs(scene_rpm)),
+            'max_crank_speed_rpm': max(DEFAULT_MAX_CRANK_SPEED_RPM, abs(scene_rpm),
+                                       abs(given_rpm or 0.0)),
             'crank_speed_rpm': scene_rpm,
             'crank_accel': scene.input.accel,
         }
@@ -332,6 +352,13 @@ class KinematicsNode(LifecycleNode):
                 raise mk.SceneError(f'{scene.name}: {result.reason}')
         speed = {'speed': scene.input.speed} if own_speed else \
             {'speed_rpm': self._value('crank_speed_rpm')}
+        try:    # what `solve` refuses at the start, the node refuses to start with
+            mk.solve(scene, scene.input.angle,
+                     speed['speed'] if own_speed else rad_per_s_from_rpm(speed['speed_rpm']),
+                     self._value('crank_accel'), max_error=self._max_error)
+        except mk.AssemblyError as error:
+            msg = f'{scene.name}: {error}'
+            raise mk.SceneError(msg) from None
         self._driver.add_drive(CRANK, angle=scene.input.angle, accel=self._value('crank_accel'),
                                max_speed_rpm=self._value('max_crank_speed_rpm'), **speed)
         self._messages = TickMessages(scene.output_joints, scene.output_points, self.frame_id)
@@ -675,6 +702,15 @@ def spec_default_is_none(name: str) -> bool:
         return False
 
 
+class StartError(Exception):
+    """The node refused to start: ``reason`` (one line), for the logger named ``logger_name``."""
+
+    def __init__(self, reason: str, logger_name: str) -> None:
+        super().__init__(reason)
+        self.reason = reason
+        self.logger_name = logger_name
+
+
 def _duplicate_names(node: KinematicsNode, wait_s: float) -> int:
     """Return how many other nodes share ``node``'s fully qualified name (looking ``wait_s``).
 
@@ -699,12 +735,13 @@ def main(args: list[str] | None = None) -> int:
     try:
         rclpy.init(args=args)
     except Exception as exc:     # noqa: BLE001 - rclpy's argument errors come in several kinds
-        logger.fatal(f'cannot start: bad arguments: {exc}')
+        logger.fatal(f'cannot start: bad arguments: {_one_line(exc)}')
         return 1
     node = None
     status = 0
     try:
         node = KinematicsNode()
+        logger = node.get_logger()
         if not node.managed:
             node.trigger_configure()
             if node.scene is None:
@@ -716,6 +753,7 @@ def main(args: list[str] | None = None) -> int:
                          'is running (remap the name with -r __node:=NAME or the namespace '
                          'with -r __ns:=/NS)')
             return 1
+        node.starting = False
         if not node.managed:
             node.trigger_activate()
         # Everything built so far lives as long as the node: keep it out of the
@@ -726,14 +764,21 @@ def main(args: list[str] | None = None) -> int:
         pass  # Ctrl-C or shutdown: a clean exit, status 0
     except TickThreadError:
         status = 1
+    except StartError as exc:
+        get_logger(exc.logger_name).fatal(f'cannot start: {exc.reason}')
+        status = 1
     except Exception as exc:     # noqa: BLE001 - a start-up failure: one line, no traceback
-        logger.fatal(f'cannot start: {exc}')
+        logger.fatal(f'cannot start: {_one_line(exc)}')
         status = 1
     finally:
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
     return status
+
+
+def _one_line(error: BaseException) -> str:
+    return ' '.join(str(error).split()) or type(error).__name__
 
 
 if __name__ == '__main__':

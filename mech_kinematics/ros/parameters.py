@@ -20,9 +20,11 @@ from .diagnostics import DEFAULT_MAX_LATENESS_MS
 from .markers import DEFAULT_ACCELERATION_SCALE, DEFAULT_VELOCITY_SCALE
 from ..bounds import MAX_ERROR
 from ..scene import DEFAULT_SCENE
+from ..units import NS_PER_S
 
-__all__ = ['CATCH_UP', 'LATE_TICKS', 'PARAMETERS', 'ParameterSpec', 'SKIP', 'joint_refusal',
-           'refusal', 'spec']
+__all__ = ['CATCH_UP', 'LATE_TICKS', 'PARAMETERS', 'ParameterSpec', 'SHOWN_CHARS', 'SKIP',
+           'STATE_DEPTH', 'catch_up_window_ns', 'depth_refusal', 'frame_refusal',
+           'joint_refusal', 'refusal', 'shown', 'spec']
 
 #: ``late_ticks`` values: publish every missed grid instant, or only the latest.
 CATCH_UP = 'catch_up'
@@ -54,6 +56,8 @@ class ParameterSpec:
         Set at start only.
     may_be_empty : bool
         A string that may be empty.
+    frame : bool
+        A tf2 frame id (or a prefix of frame ids): see :func:`frame_refusal`.
     """
 
     name: str
@@ -66,6 +70,7 @@ class ParameterSpec:
     choices: tuple[str, ...] = ()
     read_only: bool = False
     may_be_empty: bool = False
+    frame: bool = False
 
 
 PARAMETERS = (
@@ -74,7 +79,7 @@ PARAMETERS = (
                   read_only=True),
     ParameterSpec('frame_id', 'string', 'mechanism',
                   'header.frame_id of every message: the ground frame of the scene',
-                  read_only=True),
+                  read_only=True, frame=True),
     ParameterSpec('managed', 'bool', False,
                   'Follow the ROS 2 node lifecycle: configure loads the scene, activate '
                   'starts publishing (default: configure and activate at start)',
@@ -99,7 +104,8 @@ PARAMETERS = (
                   'max_catch_up_s) or only the latest (skip)', choices=LATE_TICKS),
     ParameterSpec('max_catch_up_s', 'double', 0.1,
                   'How far behind a late wake-up still publishes missed instants; older '
-                  'ones are skipped and counted', 's', 0.0, 10.0),
+                  'ones are skipped and counted. Capped so that a burst is at most 1000 '
+                  'messages (the history depth): (1000 - 1) / rate_hz', 's', 0.0, 10.0),
     ParameterSpec('max_lateness_ms', 'double', DEFAULT_MAX_LATENESS_MS,
                   'Timing on diagnostics turns WARN when the p99 lateness of a second of '
                   'ticks exceeds this (or when an instant is skipped); caught-up late ticks '
@@ -113,7 +119,7 @@ PARAMETERS = (
                   'tick they show (at most rate_hz: every tick; 0: off)', 'Hz', 0.0, 10_000.0),
     ParameterSpec('tf_prefix', 'string', '',
                   "Prefix of the child frames on /tf and /tf_static, '<prefix>/<link>' "
-                  "(default '': frame_id)", read_only=True, may_be_empty=True),
+                  "(default '': frame_id)", read_only=True, may_be_empty=True, frame=True),
     ParameterSpec('markers', 'bool', False,
                   'Also publish visualization_msgs/MarkerArray on markers, at most 30 Hz',
                   read_only=True),
@@ -143,19 +149,81 @@ def _kind_of(value: Any) -> str:
     return type(value).__name__
 
 
+#: Longest text of a refused value shown in a message (a 1 MB string is not echoed whole).
+SHOWN_CHARS = 60
+
+
+def shown(value: Any) -> str:
+    """Return ``repr(value)``, cut to about :data:`SHOWN_CHARS` characters with its length."""
+    text = repr(value)
+    if len(text) <= SHOWN_CHARS:
+        return text
+    size = f'{len(value)} characters' if isinstance(value, str) else f'{len(text)} characters'
+    return f'{text[:SHOWN_CHARS]}... ({size})'
+
+
+def frame_refusal(name: str, value: str) -> str | None:
+    """Return why ``value`` is not a frame id as tf2 requires, or ``None``.
+
+    tf2 refuses a frame id that starts with '/'; '<prefix>/<link>' must be
+    one too, so no part may be empty, '.' or '..', and none may hold a space
+    or a control character.
+    """
+    if not value:
+        return None
+    parts = value.split('/')
+    bad = (value.startswith('/') or any(p in ('', '.', '..') for p in parts)
+           or any(c.isspace() or not c.isprintable() for c in value))
+    if not bad:
+        return None
+    return (f"{name}: expected a tf2 frame id (no leading '/', no empty, '.' or '..' part "
+            f"between '/', no space), got {shown(value)}; e.g. 'mechanism' or 'robot/base'")
+
+
+#: History depth of the state publishers: a catch-up burst never publishes more instants.
+STATE_DEPTH = 1000
+
+
+def catch_up_window_ns(max_catch_up_s: float, period_ns: int, depth: int = STATE_DEPTH) -> int:
+    """Return how far behind a late wake-up still publishes missed instants, ns.
+
+    ``max_catch_up_s``, capped so that one burst (the instants within the
+    window, the latest included) is at most ``depth`` messages: a KEEP_LAST
+    reader of that depth loses none of them. Older instants are skipped and
+    counted, as beyond ``max_catch_up_s``.
+    """
+    return min(round(max_catch_up_s * NS_PER_S), (depth - 1) * period_ns)
+
+
+#: Largest history depth a DDS implementation takes (its depth is a 32-bit signed integer).
+MAX_DEPTH = 2**31 - 1
+
+
+def depth_refusal(name: str, value: Any) -> str | None:
+    """Return why ``value`` is not a QoS history depth, or ``None`` (rmw's text names files)."""
+    if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= MAX_DEPTH:
+        return (f'{name}: expected a whole number of messages from 0 to {MAX_DEPTH}, got '
+                f'{_kind_of(value)} {shown(value)}')
+    return None
+
+
 def refusal(name: str, value: Any) -> str | None:
     """Return why ``value`` is refused for parameter ``name``, or ``None`` if it is accepted.
 
     Names the node does not own (``use_sim_time``, ``qos_overrides.*``) are
-    accepted here: rclpy checks them.
+    accepted here: rclpy checks them. An empty name is refused.
     """
+    if not name:
+        return f'expected a parameter name, got an empty one (with value {shown(value)})'
+    if name.startswith('qos_overrides.') and name.endswith('.depth'):
+        return depth_refusal(name, value)
     p = _BY_NAME.get(name)
     if p is None:
         return None
     if p.kind == 'double':
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             return (f'{name}: expected a number ({p.unit or "no unit"}), got '
-                    f'{_kind_of(value)} {value!r}')
+                    f'{_kind_of(value)} {shown(value)}')
         number = float(value)
         if not math.isfinite(number):
             return f'{name}: expected a finite number, got {number!r}'
@@ -165,14 +233,16 @@ def refusal(name: str, value: Any) -> str | None:
         return None
     if p.kind == 'bool':
         if not isinstance(value, bool):
-            return f'{name}: expected true or false, got {_kind_of(value)} {value!r}'
+            return f'{name}: expected true or false, got {_kind_of(value)} {shown(value)}'
         return None
     if not isinstance(value, str):
-        return f'{name}: expected a string, got {_kind_of(value)} {value!r}'
+        return f'{name}: expected a string, got {_kind_of(value)} {shown(value)}'
     if p.choices and value not in p.choices:
-        return f'{name}: expected one of {", ".join(p.choices)}, got {value!r}'
+        return f'{name}: expected one of {", ".join(p.choices)}, got {shown(value)}'
     if not value and not p.may_be_empty:
         return f'{name}: expected a non-empty string, got {value!r}'
+    if p.frame:
+        return frame_refusal(name, value)
     return None
 
 
@@ -185,5 +255,6 @@ def joint_refusal(values: Mapping[str, Any]) -> str | None:
     speed, bound = values.get('crank_speed_rpm'), values.get('max_crank_speed_rpm')
     if speed is not None and bound is not None and abs(float(speed)) > float(bound):
         return (f'crank_speed_rpm: expected |crank_speed_rpm| <= max_crank_speed_rpm '
-                f'({float(bound):g} rpm), got {float(speed):g} rpm')
+                f'({float(bound):g} rpm), got {float(speed):g} rpm; set max_crank_speed_rpm '
+                f'(up to {spec("max_crank_speed_rpm").high:g}) first to go faster')
     return None

@@ -63,10 +63,14 @@ def _size(scene: Scene) -> float:
 
 
 def _exponent(x: float, low: float, high: float) -> int:
-    """Return 0 if ``x`` is 0 or in [low, high], else ``e`` with ``x * 2**-e`` in [0.5, 1)."""
+    """Return 0 if ``x`` is 0 or in [low, high], else ``e`` with ``x * 2**-e`` in [0.5, 2).
+
+    At most 1023, so that ``2**e`` is a float: ``x`` of 2**1023 or more (up
+    to the largest float) is scaled into [1, 2).
+    """
     if x == 0.0 or low <= x <= high:
         return 0
-    return math.frexp(x)[1]
+    return min(math.frexp(x)[1], 1023)
 
 
 def _scaled(scene: Scene, shift: int) -> Scene:

@@ -14,8 +14,9 @@ cheap.
 :func:`run_handler` is the one place that turns a failure into what a
 person reads: an error of this package is one line (``error: ...``, exit 2),
 a file that cannot be read or written is one line naming it (exit 2), a
-broken pipe (``solve ... | head``) exits quietly, Ctrl-C exits 130, and an
-unexpected exception is one line too, with its traceback only when
+broken pipe (``solve ... | head``) exits quietly, Ctrl-C exits 130, running
+out of memory is one line saying to ask for less (exit 2), and an
+unexpected exception is one line too (never empty, never several), with its traceback only when
 ``MECH_KINEMATICS_TRACEBACK=1`` is set.
 """
 
@@ -132,11 +133,17 @@ def run_handler(args: argparse.Namespace) -> int:
         where = f'{error.filename}: ' if error.filename else ''
         print(f'error: {where}{error.strerror or error}', file=sys.stderr)
         return 2
+    except MemoryError:
+        print('error: Expected a request that fits in memory, got one that does not; ask for '
+              'less (fewer samples, a smaller indent or scene)', file=sys.stderr)
+        return 2
     except Exception as error:  # noqa: BLE001 - the last resort: one line, not a traceback
         if os.environ.get(TRACEBACK_VARIABLE) == '1':
             traceback.print_exc()
-        print(f'error: unexpected {type(error).__name__}: {error} (set '
-              f'{TRACEBACK_VARIABLE}=1 for the traceback)', file=sys.stderr)
+        text = ' '.join(str(error).split())     # one line, and never an empty one
+        what = f'{type(error).__name__}: {text}' if text else type(error).__name__
+        print(f'error: unexpected {what} (set {TRACEBACK_VARIABLE}=1 for the traceback)',
+              file=sys.stderr)
         return 1
     return status
 

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import math
 import os
 from pathlib import Path
+import stat
 import sys
 from typing import Any
 import warnings
@@ -32,7 +33,7 @@ import warnings
 import numpy as np
 import numpy.typing as npt
 
-from .cli import finite_float, run_tool
+from .cli import finite_float, PROG, run_tool
 from ..errors import MechKinematicsError
 from ..ros import topics
 from ..ros.cdr import stamp_from_cdr
@@ -50,6 +51,8 @@ Array = npt.NDArray[np.float64]
 DEFAULT_SAMPLES = 721
 #: Most ticks decoded from a bag (a 1 kHz minute has 60 000); more draw no differently.
 DEFAULT_MAX_SAMPLES = 20_000
+#: Most crank angles per cycle for ``--samples`` (memory stays bounded; no figure shows more).
+MAX_SAMPLES = 100_000
 AXES = ('time', 'angle')
 #: Panel titles, by column; tests and readers rely on them.
 TITLES = {
@@ -241,6 +244,42 @@ def _stored_scene(reader: Any, connection: Any, path: Path) -> Any:
         return None
 
 
+def _check_bag_directory(path: Path) -> None:
+    """Refuse what is not a bag directory whose files can be read without blocking.
+
+    A FIFO or device named ``metadata.yaml`` or ``*.mcap`` would block or
+    never end; a bag without ``metadata.yaml`` (its recorder was killed)
+    needs ``reindex``.
+    """
+    if not path.exists():
+        msg = f'Expected a bag directory, got "{path}", which does not exist'
+        raise PlotError(msg)
+    if not path.is_dir():
+        msg = f'Expected a bag directory, got "{path}", which is not a directory'
+        raise PlotError(msg)
+    try:
+        entries = [p for p in path.iterdir()
+                   if p.name == 'metadata.yaml' or p.suffix in ('.mcap', '.db3')]
+        for entry in entries:
+            if not stat.S_ISREG(entry.stat().st_mode):
+                msg = (f'Expected "{entry}" to be a regular file, got a '
+                       f'{_file_kind(entry.stat().st_mode)}; replace it with the file itself')
+                raise PlotError(msg)
+    except OSError as error:
+        msg = f'Expected a readable bag directory, got "{path}": {error.strerror or error}'
+        raise PlotError(msg) from None
+    if not any(p.name == 'metadata.yaml' for p in entries):
+        msg = (f'Expected a bag directory with a metadata.yaml, got "{path}" without one (was '
+               f'its recorder killed?); run `{PROG} reindex {path}` to rebuild it')
+        raise PlotError(msg)
+
+
+def _file_kind(mode: int) -> str:
+    kinds = ((stat.S_ISFIFO, 'FIFO'), (stat.S_ISDIR, 'directory'), (stat.S_ISSOCK, 'socket'),
+             (stat.S_ISCHR, 'character device'), (stat.S_ISBLK, 'block device'))
+    return next((name for test, name in kinds if test(mode)), 'special file')
+
+
 def motion_from_bag(path: str | os.PathLike[str], *, scene: Any = None,
                     namespace: str | None = None,
                     max_samples: int | None = DEFAULT_MAX_SAMPLES) -> Motion:
@@ -278,10 +317,10 @@ def motion_from_bag(path: str | os.PathLike[str], *, scene: Any = None,
 
     import mech_kinematics as mk
 
+    from rosbags.rosbag2 import ReaderError
+
     path = Path(path)
-    if not path.exists():
-        msg = f'Expected a bag directory, got "{path}", which does not exist'
-        raise PlotError(msg)
+    _check_bag_directory(path)
     try:
         with AnyReader([path], default_typestore=get_typestore(Stores.LATEST)) as reader:
             picked = {t: _pick(reader.connections, t, namespace) for t in _TOPICS}
@@ -318,10 +357,11 @@ def motion_from_bag(path: str | os.PathLike[str], *, scene: Any = None,
                     statuses = decode(raw).status
                     scene_name = next((s.hardware_id for s in statuses if s.hardware_id), '')
                     break
-    except (AnyReaderError, OSError, KeyError, ValueError) as error:
+    except (AnyReaderError, ReaderError, OSError, KeyError, ValueError) as error:
         if isinstance(error, PlotError):
             raise
-        msg = f'Expected a readable rosbag2 bag at "{path}", got {type(error).__name__}: {error}'
+        msg = (f'Expected a readable rosbag2 bag at "{path}", got {type(error).__name__}: '
+               f'{error}; run `{PROG} reindex {path}` to keep every intact message')
         raise PlotError(msg) from None
 
     ticks = sorted(chosen)
@@ -595,6 +635,14 @@ def _handle(args: argparse.Namespace) -> int:
     if not output.parent.is_dir():
         print(f'error: Expected an existing folder for {output}, got none', file=sys.stderr)
         return 2
+    problem = _output_problem(output)
+    if problem:
+        print(f'error: {problem}', file=sys.stderr)
+        return 2
+    if not 2 <= args.samples <= MAX_SAMPLES:
+        print(f'error: Expected --samples from 2 to {MAX_SAMPLES}, got {args.samples}; a '
+              f'figure shows no more', file=sys.stderr)
+        return 2
     speed = None if args.speed_rpm is None else rad_per_s_from_rpm(args.speed_rpm)
     try:
         scene = None if args.scene is None else mk.load_scene(args.scene)
@@ -616,6 +664,21 @@ def _handle(args: argparse.Namespace) -> int:
         return 2
     print(f'wrote {output}')
     return 0
+
+
+def _output_problem(output: Path) -> str:
+    """Say why ``output`` cannot be the image written as named, or return ''."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    formats = sorted(FigureCanvasAgg.get_supported_filetypes())
+    suffix = output.suffix.lower().lstrip('.')
+    if suffix not in formats:
+        got = f'"{output}", whose suffix is not one' if suffix else f'"{output}" without one'
+        return (f'Expected -o FILE with an image suffix (.png, .svg, .pdf, or one of '
+                f'{", ".join(formats)}), got {got}; e.g. -o {output.with_suffix(".png")}')
+    if output.exists() and not output.is_file():
+        return f'Expected -o to name a regular file, got "{output}", which exists and is not one'
+    return ''
 
 
 def _add_arguments(parser: argparse.ArgumentParser) -> None:

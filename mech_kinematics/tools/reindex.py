@@ -9,12 +9,18 @@ it; this makes it readable, with every message that reached the file (all
 but the last half second of the recording), by
 :func:`mech_kinematics.bag.reindex`:
 
-- MCAP: the file is scanned; everything after the last intact chunk (a chunk
-  cut short, damaged, or an old summary) is truncated, the message indexes of
-  the last chunk are rewritten if they were cut, and the summary and footer
-  are appended;
+- MCAP: the file is scanned and every intact chunk kept, also those after a
+  damaged one. If only the end of an interrupted recording is dropped, the
+  file is truncated after its last intact chunk (whose message indexes are
+  rewritten if they were cut) and the summary and footer appended; if damage
+  is dropped with intact data after it, the kept chunks are copied to a new
+  file and the original is kept as ``NAME.damaged``;
 - sqlite3: opening the database for writing rolls back the transaction that
-  was cut, then the tables are counted.
+  was cut, then the tables are checked and counted; if pages are unreadable,
+  every readable row is copied to a new database and the original is kept as
+  ``NAME.damaged``.
+
+Each note printed says what was dropped (offsets or row ids) and why.
 
 Topics, types, message definitions, type hashes, offered QoS, message counts,
 time range, storage identifier and bag version are taken from the storage
@@ -38,8 +44,12 @@ Rebuild metadata.yaml of the bag directory BAG from its storage file (.mcap or
 bag becomes readable by rosbags, `ros2 bag` and Foxglove with every message
 that reached the file. An MCAP file is truncated after its last intact chunk
 and given a summary; an sqlite3 database has its interrupted transaction
-rolled back. The bag version is --bag-version if given, else the one stored
-in the bag, else the one its QoS profiles are written in, else 8.
+rolled back. Damage with intact data after it (a changed byte in a chunk, an
+unreadable database page) is never repaired in place: every intact chunk or
+readable row is copied to a new file and the original is kept beside it as
+NAME.damaged. Each note says what was dropped and why. The bag version is
+--bag-version if given, else the one stored in the bag, else the one its QoS
+profiles are written in, else 8.
 """
 
 
