@@ -1,6 +1,6 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""Read scene YAML files (SCENE_FORMAT.md, version 2) into :class:`Scene` objects.
+"""Read scene YAML files (docs/scene_format.md) into :class:`Scene` objects.
 
 The file is read by a hardened YAML reader (:class:`SceneLoader`), not by
 ``yaml.safe_load``: YAML 1.2 scalars, no duplicate or non-text keys, and every

@@ -231,6 +231,19 @@ def test_nothing_shipped_points_outside_the_repository():
                 assert needle not in text, (path, needle)
 
 
+def test_nothing_names_a_file_the_repository_lacks():
+    """No code, test or page names the contracts' files, which users who clone do not have."""
+    contracts = [name + '.md' for name in ('SCENE_FORMAT', 'INTERFACE', 'STYLE')]
+    files = [README, *ROOT.joinpath('docs').rglob('*.md'), *ROOT.joinpath('config').rglob('*'),
+             *ROOT.joinpath('mech_kinematics').rglob('*.py'), *ROOT.joinpath('test').glob('*.py'),
+             *ROOT.joinpath('bench').glob('*')]
+    for path in files:
+        if path.is_file():
+            text = path.read_text(errors='replace')
+            for name in contracts:
+                assert name not in text, (path, name)
+
+
 def test_readme_lists_every_executable():
     """The README's executables table has a row for every console script of setup.py."""
     scripts = re.findall(r"^\s+'(\w+) = mech_kinematics", ROOT.joinpath('setup.py').read_text(),

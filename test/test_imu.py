@@ -1,6 +1,6 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""IMU readings from a solved state (issue 18, SCENE_FORMAT version 3 ``imus``).
+"""IMU readings from a solved state (issue 18, the scene format's version 3 ``imus``).
 
 The readings are checked three ways: against time derivatives of the
 solver's own positions (the definition of what an accelerometer and a gyro

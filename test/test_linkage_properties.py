@@ -9,7 +9,7 @@ returns with a ram, four-bars with coupler points, six-links), or is one of a
 few fixed textbook linkages. The checks compare the solver with formulas
 written here independently of it: the constraint equations of each dyad, an
 8th-order central difference in time, the branch definitions of
-SCENE_FORMAT.md, and the symmetries of the plane (scaling, rotation, units).
+docs/scene_format.md, and the symmetries of the plane (scaling, rotation, units).
 """
 
 from __future__ import annotations
@@ -465,7 +465,7 @@ def test_point_carried_by_the_crank(angle, local):
 @example(TEXTBOOK[1], 1e-17).via('slider-crank: rod along -x, just above the axis')
 @example(TEXTBOOK[1], 0.0).via('slider-crank: rod exactly along -x')
 def test_joint_angles_are_wrapped_to_half_open_interval(scene, angle):
-    """Every revolute joint position lies in (-pi, pi] (SCENE_FORMAT.md), scalar and array."""
+    """Every revolute joint position lies in (-pi, pi] (docs/scene_format.md), scalar and array."""
     try:
         state = mk.solve(scene, angle)
     except mk.AssemblyError:

@@ -342,8 +342,8 @@ def copied_by_the_recorders_writer(bag: Path, destination: Path) -> Path:
     """Copy every message of ``bag`` into a new bag written by ``record``'s BagWriter."""
     from rosbags.highlevel import AnyReader
 
-    from mech_kinematics.tools.bag import BagWriter
-    from mech_kinematics.tools.bag.metadata import type_hash_from_definition
+    from mech_kinematics.bag import BagWriter
+    from mech_kinematics.bag.metadata import type_hash_from_definition
 
     writer = BagWriter(destination, storage='mcap')
     writer.open()

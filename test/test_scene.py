@@ -1,10 +1,10 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""Scene loading (SCENE_FORMAT.md): bad scenes, packaged scenes, units, outputs, the CLI.
+"""Scene loading (docs/scene_format.md): bad scenes, packaged scenes, units, outputs, the CLI.
 
 Every bad scene is written to a file and must be rejected with one
 :class:`mech_kinematics.SceneError` whose message reads ``FILE: KEY: reason``
-(SCENE_FORMAT.md, "Errors"; STYLE.md, scene.load_scene).
+(docs/scene_format.md, "Errors you will meet").
 """
 
 from __future__ import annotations
@@ -106,7 +106,7 @@ BAD_SCENES = [
     ('missing_name', edit(delitem(['name'])), 'name', r'missing required key'),
     ('missing_ground', edit(delitem(['ground'])), 'ground', r'missing required key'),
     ('missing_input', edit(delitem(['input'])), 'input', r'missing required key'),
-    # `dyads` is optional in SCENE_FORMAT.md; without it the points lose their links.
+    # `dyads` is optional in docs/scene_format.md; without it the points lose their links.
     ('missing_dyads', edit(delitem(['dyads'])), 'points.E.link', r'unknown "coupler"'),
     ('missing_link_length', edit(delitem([*LINK1, 'length'])), 'dyads[0].links[1].length',
      r'missing required key'),
@@ -267,7 +267,7 @@ def test_unknown_packaged_name_lists_the_packaged_scenes():
 
 
 def test_scene_without_dyads_is_a_bare_crank(tmp_path):
-    """`dyads` is optional (SCENE_FORMAT.md marks only name, ground and input required)."""
+    """`dyads` is optional (docs/scene_format.md marks only name, ground and input required)."""
     data = edit(delitem(['dyads']))
     del data['points']
     scene = mk.load_scene(write(tmp_path, data))

@@ -1,6 +1,6 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""The RPP dyad, the Scotch yoke (SCENE_FORMAT version 3; issue 17): closed forms, bounds, scene.
+"""The RPP dyad, the Scotch yoke (docs/scene_format.md; issue 17): closed forms, bounds, scene.
 
 The packaged ``scotch_yoke`` has a crank of radius r about A on the yoke's
 horizontal guide and a vertical slot, so the yoke's point Y is at

@@ -13,7 +13,7 @@ positions
     a textbook construction (law of cosines, circle and line) gives a start,
     then Newton-Raphson on the whole constraint system at :data:`DPS` digits
     brings the residual below ``10**-(DPS - 6)`` of the mechanism's size; the
-    assembly branch is then checked against its definition in SCENE_FORMAT.md;
+    assembly branch is then checked against its definition in docs/scene_format.md;
 velocities and accelerations
     from the differentiated constraint equations, ``J qdot = -Phi_t`` and
     ``J qddot = -(d/dt)^2 Phi`` at ``qddot = 0``, two linear systems solved in
@@ -781,7 +781,7 @@ def _measures(model: Model, p: Mapping[str, Any], points: Mapping[str, Any],
 
 def _check_branch(model: Model, p: Mapping[str, Any], points: Mapping[str, Any],
                   q: list[Any]) -> None:
-    """Raise if Newton left the branch that SCENE_FORMAT.md defines."""
+    """Raise if Newton left the branch that docs/scene_format.md defines."""
     for element in model.elements:
         item = element.item
         if not element.equations.branch_ok(item, element.index, p, points, q):

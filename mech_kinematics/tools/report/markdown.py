@@ -162,7 +162,7 @@ def _reference(checks: Sequence[ReferenceCheck], golden: Sequence[GoldenCheck]) 
     w('- positions: a textbook construction done at only 20 digits (law of cosines, '
       'circle and line) starts Newton-Raphson on the whole system, which brings the '
       'residual below 1e-58 of the size; the assembly branch is then checked against its '
-      'definition in SCENE_FORMAT.md;')
+      'definition in docs/scene_format.md;')
     w('- velocities and accelerations: the linear systems of the differentiated '
       'constraints, J qdot = -Phi_t and J qddot = -(d/dt)^2 Phi|qddot=0, derivatives by '
       'forward-mode Taylor arithmetic;')
