@@ -86,7 +86,7 @@ Table = dict[str, tuple[Any, Any, Any]]
 _NO_PINS: dict[str, Any] = {}
 
 
-def limit(max_error: float, scale: Any) -> Any:
+def limit(max_error: Any, scale: Any) -> Any:
     """Return the largest bound accepted: ``max_error * scale``, capped at :data:`LARGEST`.
 
     The scale counts as at least :data:`SMALLEST_NORMAL`: below it floats are

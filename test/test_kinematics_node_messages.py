@@ -306,7 +306,7 @@ def test_rendered_bytes_are_the_canonical_cdr_of_the_messages(name, angle, speed
 
 @pytest.mark.parametrize('name', SCENES)
 def test_messages_follow_the_contract(name):
-    """Names, array lengths, frame, z = 0 and identity rotations are as the node's reference (docs/node.md) says."""
+    """Names, array lengths, frame, z = 0 and identity rotations are as docs/node.md says."""
     scene = mk.load_scene(name)
     state = mk.solve(scene, scene.input.angle)
     joints, points = scene.output_joints, scene.output_points
