@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 import mech_kinematics as mk
-from mech_kinematics.tools import reference as ref
 from mech_kinematics.tools.report import cost
+from mech_kinematics.tools.report import reference as ref
 from mech_kinematics.tools.report.extreme import BOUND_FACTOR
 
 EPS = float(np.finfo(float).eps)

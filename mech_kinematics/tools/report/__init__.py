@@ -5,7 +5,7 @@
 ``python -m mech_kinematics report -o DIR [--quick | --smoke]`` writes
 ``DIR/REPORT.md`` and its PNG figures:
 
-1. the 50-digit reference (:mod:`mech_kinematics.tools.reference`) and its
+1. the 50-digit reference (:mod:`mech_kinematics.tools.report.reference`) and its
    checks (:mod:`.checks`);
 2. work-precision diagrams: our solver against Newton-Raphson, finite
    differences, ``solve_ivp`` and the textbooks' printed answers

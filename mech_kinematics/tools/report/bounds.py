@@ -12,7 +12,7 @@ passing through its pivot, extreme ratios, scales and speeds):
 - :func:`bound_values` solves each case with an infinite tolerance at
   :data:`OFFSETS` from every singular position, and puts every value's bound
   beside its actual error against the 50-digit reference
-  (:func:`mech_kinematics.tools.reference.value_errors`);
+  (:func:`mech_kinematics.tools.report.reference.value_errors`);
   :func:`bound_statistics` sums them up: no bound may be below its error;
 - :func:`refused_fractions` measures, for each case, the fraction of a full
   crank turn refused at each of :data:`TOLERANCES` (and the part that cannot
@@ -233,7 +233,7 @@ def bound_values(case: BoundCase) -> CaseBounds:
     an assembly limit) counts as refused. Where the reference finds no
     assembly, the solver must refuse; an answer there is recorded in ``wrong``.
     """
-    from .. import reference as ref_mod
+    from . import reference as ref_mod
     model = ref_mod.Model(case.scene)
     result = CaseBounds(case)
     for angle in case.angles():

@@ -40,7 +40,7 @@ class ReferenceCheck:
 def reference_checks(mode: Mode, tick: Callable[[], None] = lambda: None
                      ) -> list[ReferenceCheck]:
     """Check the reference on the packaged scenes: residual, second route, solver."""
-    from .. import reference as ref_mod
+    from . import reference as ref_mod
     from ...scene import scene_names
     rows = []
     names = mode.check_scenes or tuple(scene_names())
@@ -103,7 +103,7 @@ def golden_checks(folder: Path | None = None) -> list[GoldenCheck]:
 
     import mpmath
 
-    from .. import reference as ref_mod
+    from . import reference as ref_mod
     folder = folder or golden_folder()
     rows = []
     for path in sorted(folder.glob('*.json')) if folder.is_dir() else []:

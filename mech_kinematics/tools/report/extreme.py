@@ -31,7 +31,7 @@ __all__ = ['AngleResult', 'BOUND_FACTOR', 'Case', 'CaseResult', 'FormulaAudit', 
 #: An extreme case meets its bound when, for every kind of value, the error
 #: relative to that kind's largest magnitude is at most
 #: ``BOUND_FACTOR * EPS * max(1, kappa)``, kappa the problem's condition number
-#: (:func:`mech_kinematics.tools.reference.condition`): the error that rounding
+#: (:func:`mech_kinematics.tools.report.reference.condition`): the error that rounding
 #: the inputs alone would cause, with room for the few roundings per dyad.
 BOUND_FACTOR = 4.0
 
@@ -230,7 +230,7 @@ def evaluate_angle(case: Case, angle: float, model: Any = None) -> AngleResult:
     refused, and the solver warned or refused); ``refused (no assembly)``
     (no real configuration, and the solver refused); ``FAIL`` otherwise.
     """
-    from .. import reference as ref_mod
+    from . import reference as ref_mod
     model = model or ref_mod.Model(case.scene)
     state, flag = _solve_flagged(case.scene, angle, case.speed, case.accel)
     measure_solver = min(state.singularity.values()) if state is not None else math.nan
@@ -258,7 +258,7 @@ def evaluate_angle(case: Case, angle: float, model: Any = None) -> AngleResult:
 
 def evaluate_case(case: Case) -> CaseResult:
     """Evaluate every instant of ``case``."""
-    from .. import reference as ref_mod
+    from . import reference as ref_mod
     model = ref_mod.Model(case.scene)
     return CaseResult(case, [evaluate_angle(case, angle, model) for angle in case.angles])
 

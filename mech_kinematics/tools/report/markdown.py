@@ -153,8 +153,8 @@ def _reference(checks: Sequence[ReferenceCheck], golden: Sequence[GoldenCheck]) 
     w = lines.append
     w('## 1. The 50-digit reference')
     w('')
-    w('`mech_kinematics/tools/reference.py` writes each scene as its loop-closure equations '
-      '(two per dyad: RRR, the two link angles; RRP, link angle and slider coordinate; '
+    w('`mech_kinematics/tools/report/reference.py` writes each scene as its loop-closure '
+      'equations (two per dyad: RRR, the two link angles; RRP, link angle and slider coordinate; '
       'RPR, lever angle and slider coordinate; carried points as explicit functions of '
       'their frame points) and solves them in mpmath at 64 working digits, without '
       "any of the solver's formulas:")
