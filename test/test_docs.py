@@ -235,7 +235,7 @@ def test_nothing_names_a_file_the_repository_lacks():
     """No code, test or page names the contracts' files, which users who clone do not have."""
     contracts = [name + '.md' for name in ('SCENE_FORMAT', 'INTERFACE', 'STYLE')]
     files = [README, *ROOT.joinpath('docs').rglob('*.md'), *ROOT.joinpath('config').rglob('*'),
-             *ROOT.joinpath('mech_kinematics').rglob('*.py'), *ROOT.joinpath('test').glob('*.py'),
+             *ROOT.joinpath('mech_kinematics').rglob('*.py'), *ROOT.joinpath('test').rglob('*.py'),
              *ROOT.joinpath('bench').glob('*')]
     for path in files:
         if path.is_file():

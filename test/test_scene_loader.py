@@ -27,6 +27,7 @@ import yaml
 
 import mech_kinematics as mk
 from mech_kinematics import scene as scene_module
+from mech_kinematics import yaml12
 from mech_kinematics.scene import (MAX_CARRIED_POINTS, MAX_DEPTH, MAX_DYADS, MAX_FILE_BYTES,
                                    MAX_GROUND_POINTS, MAX_INTEGER_DIGITS, MAX_MESSAGE,
                                    MAX_YAML_NODES, SceneLoader)
@@ -42,8 +43,10 @@ MAX_PEAK_BYTES = 200 * 2**20
 
 
 LOADERS = [pytest.param(SceneLoader, id='python')]
-if hasattr(scene_module, 'CSceneLoader'):
-    LOADERS.append(pytest.param(scene_module.CSceneLoader, id='libyaml'))
+# The PyPI wheels of PyYAML have libyaml: then the fast loader must exist and is tested too.
+assert hasattr(yaml12, 'CSceneLoader') == bool(getattr(yaml, '__with_libyaml__', False))
+if hasattr(yaml12, 'CSceneLoader'):
+    LOADERS.append(pytest.param(yaml12.CSceneLoader, id='libyaml'))
 
 
 def write(tmp_path, text, name='scene.yaml'):

@@ -18,7 +18,7 @@ import pytest
 import mech_kinematics as mk
 from mech_kinematics.tools import plot, record as bag_recorder
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 #: Values drawn are the solver's, untouched: exact up to float64 rounding of |v|.
 RTOL = 1e-12
 PNG_MAGIC = b'\x89PNG\r\n\x1a\n'

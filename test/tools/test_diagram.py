@@ -30,7 +30,7 @@ ATOL_POSITION = 1e-12
 MIN_PNG_SIZE = (1200, 600)
 
 SCENES = tuple(mk.scene_names())
-SCENE_FILES = sorted((Path(__file__).resolve().parent.parent / 'config' / 'scenes')
+SCENE_FILES = sorted((Path(__file__).resolve().parents[2] / 'config' / 'scenes')
                      .glob('*.yaml'))
 #: Crank angles tried besides each scene's own, degrees.
 ANGLES_DEG = (20.0, 100.0, 200.0, 300.0)

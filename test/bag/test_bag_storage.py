@@ -31,7 +31,7 @@ from mech_kinematics.bag.metadata import type_hash_from_definition
 from mech_kinematics.bag.writer import RESERVE_FILE
 from mech_kinematics.tools import record
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 TYPE = 'sensor_msgs/msg/JointState'
 T0 = 1_700_000_000_000_000_000     # ns, the receive time of message 0
 DT = 1_000_000                     # ns between messages (1 kHz)

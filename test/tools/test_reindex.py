@@ -18,7 +18,7 @@ from mech_kinematics.__main__ import build_parser, TOOLS
 from mech_kinematics.bag import BagWriter
 from mech_kinematics.tools import reindex
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 
 
 def unclosed_bag(path: Path, storage: str, messages: int):

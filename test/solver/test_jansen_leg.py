@@ -40,7 +40,7 @@ ATOL_LENGTH = 1e-15  # m
 H = 1e-5  # s
 RTOL_DIFFERENCE = 1e-7
 
-SCENE_FILE = Path(__file__).resolve().parent.parent / 'config' / 'scenes' / 'jansen_leg.yaml'
+SCENE_FILE = Path(__file__).resolve().parents[2] / 'config' / 'scenes' / 'jansen_leg.yaml'
 SCENE = mk.load_scene(SCENE_FILE)
 ANGLES = np.linspace(0.0, 2 * np.pi, 3600, endpoint=False)
 

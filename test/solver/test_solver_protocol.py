@@ -13,7 +13,7 @@ import mech_kinematics as mk
 from mech_kinematics.solver.base import Item
 from mech_kinematics.solver.registry import FACT_TEXTS, KINDS
 
-PACKAGE = Path(__file__).resolve().parents[1] / 'mech_kinematics'
+PACKAGE = Path(__file__).resolve().parents[2] / 'mech_kinematics'
 #: A test of which kind an object is: what the protocol replaces.
 KIND_TEST = re.compile(r'(isinstance\(|type\(.*\) +is |^\s*case ).*\b(RRR|RRP|RPR|RPP|_\w+Step|'
                        r'Crank|CarriedPoint)\b')

@@ -11,7 +11,7 @@ import subprocess
 import sys
 import time
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 STARTUP_S = 20.0
 
 

@@ -43,7 +43,7 @@ import yaml
 import mech_kinematics as mk
 from mech_kinematics.tools import plot, record as bag_recorder
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 NS = 1_000_000_000
 #: Values in the bag against the solver at the message's crank angle (relative; absolute
 #: tolerances are RTOL times the largest magnitude of the quantity over a cycle).

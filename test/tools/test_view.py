@@ -33,7 +33,7 @@ from mech_kinematics.geometry.diagrams import strokes_from_scene
 from mech_kinematics.geometry.instant_centres import full_scene
 from mech_kinematics.tools.view import frame_from_state, PAGE, scene_bounds
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 STARTUP_S = 30.0
 #: Frames against the solver: the same computation, exact up to rounding, m.
 ATOL_FRAME = 1e-12

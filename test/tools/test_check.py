@@ -20,7 +20,7 @@ import mech_kinematics as mk
 from mech_kinematics.__main__ import build_parser, main, TOOLS
 from mech_kinematics.tools import check
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 LIMIT = math.acos((50 ** 2 + 100 ** 2 - 122 ** 2) / (2 * 50 * 100))  # 103.792 deg
 
 

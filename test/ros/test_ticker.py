@@ -116,7 +116,7 @@ def test_a_chain_of_sixty_four_dyads_and_its_frames():
 
 def _tiny_four_bar(tmp_path):
     """Return the packaged four-bar with every length 1e-300 m (the solver rescales it)."""
-    source = Path(__file__).resolve().parents[1] / 'config' / 'scenes' / \
+    source = Path(__file__).resolve().parents[2] / 'config' / 'scenes' / \
         'khurmi_four_bar_ad150.yaml'
     doc = yaml.safe_load(source.read_text())
     doc['units'] = {'length': 'm', 'angle': 'deg'}

@@ -18,7 +18,7 @@ import sys
 
 import pytest
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 BUILD_SCRIPT = ROOT / 'scripts' / 'build_tf2_msgs.py'
 #: RIHS01 hash of tf2_msgs/msg/TFMessage as ROS 2 Kilted (and Jazzy) announce it
 #: (`ros2 topic info -v /tf`); rosbags' Kilted type store computes the same.

@@ -17,7 +17,7 @@ import pytest
 
 from mech_kinematics.tools.report import data as data_mod
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[3]
 DATA = ROOT / 'docs' / 'report' / 'data.json'
 #: Keys docs/accuracy.md must quote (its "Accuracy and speed" headline and tables).
 REQUIRED_KEYS = ('summary.ours_acceleration', 'summary.golden_max',
