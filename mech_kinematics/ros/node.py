@@ -675,8 +675,7 @@ class KinematicsNode(LifecycleNode):
         if self.scene is None:
             waiting = 'configure (lifecycle)'
         elif self._thread is None:
-            waiting = 'activate (lifecycle)' if self.managed else \
-                'the start-up check for another node of this name'
+            waiting = 'activate (lifecycle)' if self.managed else 'the start'
         elif self._waiting_for_clock:
             waiting = '/clock'
         else:
