@@ -60,6 +60,25 @@ def wait_for(predicate, timeout: float, what: str):
     pytest.fail(f'timed out after {timeout} s waiting for {what}')
 
 
+def wait_for_parameters(params, timeout: float = STARTUP_S) -> None:
+    """Wait until a node answers ``params`` (an AsyncParameterClient) on its services.
+
+    ``wait_for_services`` says only that this side sees the node's services; a
+    request sent before the node has matched this client is lost. A node
+    publishes from its start, before it may have discovered this process.
+    """
+    assert params.wait_for_services(timeout_sec=timeout)
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        future = params.get_parameters(['rate_hz'])
+        retry = min(deadline, time.monotonic() + 0.5)
+        while not future.done() and time.monotonic() < retry:
+            time.sleep(0.01)
+        if future.done():
+            return
+    pytest.fail(f'timed out after {timeout} s waiting for the parameter services to answer')
+
+
 class Ros:
     """This process's side: one rclpy context, node and executor thread for the module."""
 

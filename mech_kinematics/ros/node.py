@@ -31,6 +31,7 @@ from __future__ import annotations
 import ctypes
 from dataclasses import replace
 import gc
+import random
 import sys
 import threading
 import time
@@ -87,9 +88,9 @@ LATE_NS = 1_000_000
 MAX_SLEEP_NS = 50_000_000
 #: Longest time another thread may hold the GIL before the tick thread gets it, s.
 SWITCH_INTERVAL_S = 0.0005
-#: How long the node looks for another node of its name before it starts publishing, s
-#: (the graph of a node that is already running takes about 2 s to arrive here).
-DUPLICATE_CHECK_S = 2.5
+#: The node-private, hidden topic on which each node says when it started (transient local,
+#: so that a newcomer of the same name hears an older node as soon as they are matched).
+INSTANCE_TOPIC = '~/_instance'
 #: The drive parameters, applied by the tick thread at an instant it has not published.
 DRIVE = ('crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm')
 #: The crank's name in the driver, and what each drive parameter sets there.
@@ -674,8 +675,7 @@ class KinematicsNode(LifecycleNode):
         if self.scene is None:
             waiting = 'configure (lifecycle)'
         elif self._thread is None:
-            waiting = 'activate (lifecycle)' if self.managed else \
-                'the start-up check for another node of this name'
+            waiting = 'activate (lifecycle)' if self.managed else 'the start'
         elif self._waiting_for_clock:
             waiting = '/clock'
         else:
@@ -711,18 +711,37 @@ class StartError(Exception):
         self.logger_name = logger_name
 
 
-def _duplicate_names(node: KinematicsNode, wait_s: float) -> int:
-    """Return how many other nodes share ``node``'s fully qualified name (looking ``wait_s``).
+class DuplicateNodeError(Exception):
+    """An older node of the same fully qualified name is running: this one is the newcomer."""
 
-    The node is spun meanwhile, so its services and diagnostics answer.
+
+class Instance:
+    """A node's start instant and random id, said on and heard from ``~/_instance``.
+
+    Of the nodes that share a fully qualified name, the oldest (earliest start, then smallest
+    id) goes on; a node that hears an older one raises DuplicateNodeError from its spin after
+    stopping its tick thread. An older node ignores younger ones.
     """
-    me = node.get_fully_qualified_name()
-    deadline = time.monotonic() + wait_s
-    while True:
-        others = node.get_fully_qualified_node_names().count(me) - 1
-        if others > 0 or time.monotonic() >= deadline:
-            return others
-        rclpy.spin_once(node, timeout_sec=0.05)
+
+    def __init__(self, node: KinematicsNode, start_ns: int) -> None:
+        self.node = node
+        self.key = start_ns, random.SystemRandom().getrandbits(64)
+        qos = QoSProfile(depth=1, reliability=QoSReliabilityPolicy.RELIABLE,
+                         durability=QoSDurabilityPolicy.TRANSIENT_LOCAL)
+        node.create_subscription(String, INSTANCE_TOPIC, self._heard, qos)
+        node.create_publisher(String, INSTANCE_TOPIC, qos).publish(
+            String(data=f'{self.key[0]} {self.key[1]}'))
+
+    def _heard(self, msg: String) -> None:
+        try:
+            start_ns, ident = (int(word) for word in msg.data.split())
+        except ValueError:
+            return      # not a node of ours: nothing to compare
+        if (start_ns, ident) < self.key:
+            self.node.stop()
+            raise DuplicateNodeError(
+                f'another node named {self.node.get_fully_qualified_name()} is running '
+                '(remap the name with -r __node:=NAME or the namespace with -r __ns:=/NS)')
 
 
 def main(args: list[str] | None = None) -> int:
@@ -732,6 +751,7 @@ def main(args: list[str] | None = None) -> int:
     # The tick thread must not wait long for the GIL when it wakes (default 5 ms).
     sys.setswitchinterval(SWITCH_INTERVAL_S)
     logger = get_logger(NODE_NAME)
+    start_ns = time.time_ns()
     try:
         rclpy.init(args=args)
     except Exception as exc:     # noqa: BLE001 - rclpy's argument errors come in several kinds
@@ -742,17 +762,12 @@ def main(args: list[str] | None = None) -> int:
     try:
         node = KinematicsNode()
         logger = node.get_logger()
+        Instance(node, start_ns)
         if not node.managed:
             node.trigger_configure()
             if node.scene is None:
                 logger.fatal(f'cannot start: {node.configure_error}')
                 return 1
-        # Publishers are matched meanwhile, so the wait costs subscribers little.
-        if _duplicate_names(node, DUPLICATE_CHECK_S):
-            logger.fatal(f'cannot start: another node named {node.get_fully_qualified_name()} '
-                         'is running (remap the name with -r __node:=NAME or the namespace '
-                         'with -r __ns:=/NS)')
-            return 1
         node.starting = False
         if not node.managed:
             node.trigger_activate()
@@ -763,6 +778,9 @@ def main(args: list[str] | None = None) -> int:
     except (KeyboardInterrupt, ExternalShutdownException):
         pass  # Ctrl-C or shutdown: a clean exit, status 0
     except TickThreadError:
+        status = 1
+    except DuplicateNodeError as exc:
+        logger.fatal(f'cannot start: {exc}')
         status = 1
     except StartError as exc:
         get_logger(exc.logger_name).fatal(f'cannot start: {exc.reason}')

@@ -16,7 +16,8 @@ from diagnostic_msgs.msg import DiagnosticArray
 import pytest
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
-from ros_helpers import NodeProcess, NS, Ros, SESSION, stamp_ns, STARTUP_S, wait_for, wrap
+from ros_helpers import (NodeProcess, NS, Ros, SESSION, stamp_ns, STARTUP_S, wait_for,
+                         wait_for_parameters, wrap)
 from sensor_msgs.msg import JointState
 
 #: Largest jump of the published crank angle allowed across a drive change, rad.
@@ -56,7 +57,7 @@ class Stream:
         wait_for(lambda: len(self.js) > 50 or self.process.proc.poll() is not None, STARTUP_S,
                  'the node publishing')
         assert self.process.proc.poll() is None, self.process.output()
-        assert self.params.wait_for_services(timeout_sec=STARTUP_S)
+        wait_for_parameters(self.params)
 
     def set(self, **values) -> None:
         """Set parameters (one call), asserting they were accepted."""

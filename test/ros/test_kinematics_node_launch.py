@@ -28,7 +28,7 @@ from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 from rclpy.qos import qos_profile_sensor_data
 from ros_helpers import (NodeProcess, NS, REPO, Ros, SESSION, stamp_ns, STARTUP_S, wait_for,
-                         wrap)
+                         wait_for_parameters, wrap)
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
@@ -75,7 +75,7 @@ class Running:
         wait_for(lambda: all(topics) or self.process.proc.poll() is not None, STARTUP_S,
                  'the first message on every topic')
         assert self.process.proc.poll() is None, self.process.output()
-        assert self.params.wait_for_services(timeout_sec=STARTUP_S)
+        wait_for_parameters(self.params)
 
     def set(self, *parameters: Parameter):
         """Set parameters one by one; return the results."""

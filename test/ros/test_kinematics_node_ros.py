@@ -18,7 +18,8 @@ import pytest
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 from rclpy.qos import QoSProfile, ReliabilityPolicy
-from ros_helpers import NodeProcess, NS, Ros, SESSION, stamp_ns, STARTUP_S, wait_for, wrap
+from ros_helpers import (NodeProcess, NS, Ros, SESSION, stamp_ns, STARTUP_S, wait_for,
+                         wait_for_parameters, wrap)
 from sensor_msgs.msg import JointState
 
 #: Tolerance of an angle that the time base fixes exactly, rad.
@@ -207,7 +208,7 @@ def test_untrusted_ticks_publish_nothing_and_say_why(ros, tmp_path):
     try:
         wait_for(lambda: js, STARTUP_S, 'joint_states')
         params = AsyncParameterClient(ros.node, f'{ns}/mech_kinematics')
-        assert params.wait_for_services(timeout_sec=STARTUP_S)
+        wait_for_parameters(params)
         response = ros.call(params.set_parameters(
             [Parameter('max_relative_error', value=1e-15)]))
         assert response.results[0].successful, response.results[0].reason
@@ -292,7 +293,7 @@ def test_switching_to_sim_time_and_back_keeps_the_crank_where_it_was(ros, tmp_pa
     try:
         wait_for(lambda: len(js) > 20, STARTUP_S, 'joint_states on the wall clock')
         params = AsyncParameterClient(ros.node, f'{ns}/mech_kinematics')
-        assert params.wait_for_services(timeout_sec=STARTUP_S)
+        wait_for_parameters(params)
         assert ros.call(params.set_parameters(
             [Parameter('use_sim_time', value=True)])).results[0].successful
         time.sleep(0.3)
