@@ -552,8 +552,8 @@ def test_mcap_full_disk_closes_with_what_fit(tmp_path, monkeypatch):
     """ENOSPC mid-chunk: BagError with the reason; close keeps the whole chunks, truthfully."""
     limit = 150_000
     monkeypatch.setattr(storage_mcap, 'open', raising=False,
-                        value=lambda path, mode: FullDisk(open(path, mode), limit)
-                        if 'x' in mode else open(path, mode))
+                        value=lambda path, mode: FullDisk(open(path, mode), limit)  # noqa: SIM115
+                        if 'x' in mode else open(path, mode))  # noqa: SIM115 (the writer closes)
     writer, topic = open_writer(tmp_path / 'bag', 'mcap', flush_interval=3600.0,
                                 flush_bytes=20_000)
     with pytest.raises(BagError, match='No space left on device') as raised:

@@ -192,13 +192,13 @@ def test_a_stall_is_caught_up_to_the_bound_and_the_rest_counted(ros, tmp_path):
             stream.set(late_ticks=mode)
             time.sleep(1.0)
             count = len(stream.diag)
-            wait_for(lambda: len(stream.diag) > count, 3.0, 'fresh diagnostics')
+            wait_for(lambda n=count: len(stream.diag) > n, 3.0, 'fresh diagnostics')
             skipped_before = diagnostic_value(stream.diag, 'skipped_ticks_total')
             start = max(0, len(stream.js) - 20)     # from before the stall
             _stall(stream, 0.5)
             time.sleep(1.0)
             count = len(stream.diag)
-            wait_for(lambda: len(stream.diag) > count + 1, 5.0, 'diagnostics after the stall')
+            wait_for(lambda n=count: len(stream.diag) > n + 1, 5.0, 'diagnostics after the stall')
             skipped = diagnostic_value(stream.diag, 'skipped_ticks_total') - skipped_before
             stamps = sorted(stamps_of(stream.js[start:]))
             gaps = sorted(b - a for a, b in zip(stamps, stamps[1:], strict=False) if b > a)

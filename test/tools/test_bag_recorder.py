@@ -514,8 +514,9 @@ def test_recorder_says_what_it_waits_for_then_reports_progress(recordings):
                 PROGRESS_TOPIC.match, match[4].split(', '))}
             progress.append((time_s, int(match[2]), int(match[3]), topics))
     assert len(progress) >= 2, recording.output
-    for (t0, total0, _, topics0), (t1, total1, rate1, topics1) in zip(progress, progress[1:]):
-        assert 0.9 <= t1 - t0, 'not more often than --progress 1'
+    pairs = zip(progress, progress[1:], strict=False)
+    for (t0, total0, _, topics0), (t1, total1, rate1, topics1) in pairs:
+        assert t1 - t0 >= 0.9, 'not more often than --progress 1'
         assert total1 == sum(n for n, _ in topics1.values()) >= total0
         for topic, (n, rate) in topics1.items():
             # The rate is the topic's new messages over the interval (rounded to 1/s).
@@ -718,7 +719,7 @@ def test_recorder_without_publishers_names_them_every_five_seconds(crashes):
                if text.startswith(f'waiting for publishers on {topics} ')]
     assert len(waiting) >= 2
     assert all(b - a >= bag_recorder.WAIT_REPORT_INTERVAL_S - 0.1
-               for a, b in zip(waiting, waiting[1:]))
+               for a, b in zip(waiting, waiting[1:], strict=False))
     # markers says why it may be absent (the node's markers parameter is off by default).
     assert output.count('(never appeared)') == len(bag_recorder.DEFAULT_TOPICS) - 1
     assert output.count('(never appeared: the node publishes it with markers:=true)') == 1

@@ -106,8 +106,9 @@ def test_refused_fractions_are_monotone_in_the_tolerance(results):
     for fractions in results[1]:
         values = [fractions.refused[t] for t in sorted(bounds.TOLERANCES)]
         values.append(fractions.refused[math.inf])
-        assert all(a >= b for a, b in zip(values, values[1:])), (fractions.case.name, values)
-        assert values[-1] >= 0 and 0 <= fractions.no_assembly
+        assert all(a >= b for a, b in zip(values, values[1:], strict=False)), (
+            fractions.case.name, values)
+        assert values[-1] >= 0 and fractions.no_assembly >= 0
         assert fractions.no_assembly + values[0] <= 1 + 1e-12
 
 
