@@ -51,7 +51,10 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Collection, Iterator, Mapping
+import math
 from typing import Any, ClassVar, Protocol, TYPE_CHECKING
+
+import numpy as np
 
 from ..errors import SceneError
 
@@ -379,3 +382,19 @@ class Item(ABC):
     def four_bar(self) -> tuple[str, Any, Any] | None:
         """Return its new pin and two links (:class:`~.model.Link`) if it can close a four-bar."""
         return None
+
+
+def fixed_guide(slider: str, through: Any, angle: float, state: Any,
+                strokes: Mapping[str, tuple[float, float]], size: float
+                ) -> tuple[str, Any, Any]:
+    """Return (slider, start, end) of a fixed guide through ``through`` at ``angle`` (rad).
+
+    The guide is drawn over the slider's stroke (or around its place, where no
+    stroke is known), padded by 8 % of the drawing's ``size``: what
+    :meth:`Item.guides` yields for a slider on a fixed straight guide.
+    """
+    u = np.array([math.cos(angle), math.sin(angle)])
+    s = float(state.joints[slider].position)
+    low, high = strokes.get(slider, (s, s))
+    pad = 0.08 * size
+    return slider, through + (min(low, s) - pad) * u, through + (max(high, s) + pad) * u

@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from .base import Body, Edge, Frame, Item, Member, Names, Placing, Reading, Step
+from .base import Body, Edge, fixed_guide, Frame, Item, Member, Names, Placing, Reading, Step
 from .context import _Context, _cross, _U2, SINGULAR
 from .model import _check_finite, _check_name, Where
 from ..bounds import U
@@ -172,13 +172,8 @@ class RPP(Item):
                strokes: Mapping[str, tuple[float, float]], size: float
                ) -> Iterator[tuple[str, Any, Any]]:
         """Yield the yoke's guide over its stroke (or around Y), padded by 8 % of ``size``."""
-        u = np.array([math.cos(self.guide_angle), math.sin(self.guide_angle)])
-        s = float(state.joints[self.slider].position)
-        low, high = strokes.get(self.slider, (s, s))
-        pad = 0.08 * size
-        through = points[self.guide_through]
-        yield (self.slider, through + (min(low, s) - pad) * u,
-               through + (max(high, s) + pad) * u)
+        yield fixed_guide(self.slider, points[self.guide_through], self.guide_angle, state,
+                          strokes, size)
 
     def dead_centre_joints(self, ground: Collection[str]) -> dict[str, str]:
         """Return the yoke, which reverses at the ends of its stroke."""

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from .base import Body, Edge, Frame, Item, Member, Names, Placing, Reading, Step
+from .base import Body, Edge, fixed_guide, Frame, Item, Member, Names, Placing, Reading, Step
 from .context import _Context, _cross, _dot, _sum_root, _U2, _U3, _U5, _U7, SINGULAR
 from .model import _check_finite, _check_name, _g, Branch, Link, SceneUnits, Where
 from ..bounds import ROUNDING_MARGIN, U
@@ -143,13 +143,8 @@ class RRP(Item):
                strokes: Mapping[str, tuple[float, float]], size: float
                ) -> Iterator[tuple[str, Any, Any]]:
         """Yield its guide over the stroke (or around the block), padded by 8 % of ``size``."""
-        u = np.array([math.cos(self.guide_angle), math.sin(self.guide_angle)])
-        s = float(state.joints[self.slider].position)
-        low, high = strokes.get(self.slider, (s, s))
-        pad = 0.08 * size
-        through = points[self.through]
-        yield (self.slider, through + (min(low, s) - pad) * u,
-               through + (max(high, s) + pad) * u)
+        yield fixed_guide(self.slider, points[self.through], self.guide_angle, state, strokes,
+                          size)
 
 
 def _reach_text(facts: dict[str, Any], units: SceneUnits) -> str:
