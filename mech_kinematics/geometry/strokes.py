@@ -24,8 +24,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 import math
+import warnings
 
 from .assembly import Assembly
+from ..errors import NearSingularWarning
 from ..solver import Scene, solve
 
 __all__ = ['Intermittent', 'Stroke', 'Strokes', 'intermittent_from_scene',
@@ -122,14 +124,19 @@ def strokes_from_assembly(scene: Scene, assembly: Assembly) -> tuple[Strokes, ..
 
 def intermittent_from_scene(scene: Scene) -> tuple[Intermittent, ...]:
     """Return the index and locked arcs of every intermittent lever of ``scene``."""
-    state = solve(scene, scene.input.angle, max_error=math.inf)
+    if not scene.intermittent:
+        return ()
     result = []
-    for lever, engagement in state.intermittent.items():
-        entry, exit_ = float(engagement.entry), float(engagement.exit)
-        # The direction of indexing: the lever's angular velocity mid-window
-        # with the crank turning counter-clockwise.
-        middle = solve(scene, (entry + exit_) / 2.0, 1.0, 0.0, max_error=math.inf)
-        sign = math.copysign(1.0, middle.joints[lever].velocity)
-        result.append(Intermittent(lever, (entry % _TURN, exit_ % _TURN),
-                                   sign * (math.pi - (exit_ - entry))))
+    with warnings.catch_warnings():
+        # The windows do not depend on how well conditioned the rest of the scene is.
+        warnings.simplefilter('ignore', NearSingularWarning)
+        state = solve(scene, scene.input.angle, max_error=math.inf)
+        for lever, engagement in state.intermittent.items():
+            entry, exit_ = float(engagement.entry), float(engagement.exit)
+            # The direction of indexing: the lever's angular velocity mid-window
+            # with the crank turning counter-clockwise.
+            middle = solve(scene, (entry + exit_) / 2.0, 1.0, 0.0, max_error=math.inf)
+            sign = math.copysign(1.0, middle.joints[lever].velocity)
+            result.append(Intermittent(lever, (entry % _TURN, exit_ % _TURN),
+                                       sign * (math.pi - (exit_ - entry))))
     return tuple(result)
