@@ -16,7 +16,7 @@ import json
 import sys
 from typing import Any
 
-from .cli import run_tool
+from .cli import add_scene_argument, run_tool
 
 __all__ = ['add_parser', 'main', 'report_text', 'report_json']
 
@@ -189,8 +189,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         'check', help='where a scene assembles over a crank turn, toggles, dead centres, '
                       'transmission angle, Grashof class', description=CHECK_HELP,
         formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument('scene', metavar='SCENE',
-                        help='path to a scene YAML, or the name of a packaged scene')
+    add_scene_argument(parser)
     parser.add_argument('--json', action='store_true',
                         help='print one JSON object, in SI units (rad, m)')
     parser.set_defaults(handler=_handle)

@@ -33,8 +33,8 @@ from typing import Any
 
 from ..errors import MechKinematicsError
 
-__all__ = ['ArgumentParser', 'PROG', 'finite_float', 'positive_float', 'positive_int',
-           'positive_seconds', 'run_handler', 'run_tool', 'seconds_or_zero']
+__all__ = ['ArgumentParser', 'PROG', 'add_scene_argument', 'finite_float', 'positive_float',
+           'positive_int', 'positive_seconds', 'run_handler', 'run_tool', 'seconds_or_zero']
 
 #: The program name shown in usage lines.
 PROG = 'python -m mech_kinematics'
@@ -57,6 +57,13 @@ class ArgumentParser(argparse.ArgumentParser):
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = re.compile(
             r'^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$', re.IGNORECASE)
+
+
+def add_scene_argument(parser: argparse.ArgumentParser) -> None:
+    """Add the positional ``SCENE`` every scene command takes: a path or a packaged name."""
+    parser.add_argument('scene', metavar='SCENE',
+                        help='path to a scene YAML, or the name of a packaged scene '
+                             '(e.g. khurmi_four_bar_ad150)')
 
 
 def finite_float(text: str) -> float:

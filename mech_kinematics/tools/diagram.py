@@ -22,7 +22,7 @@ import warnings
 import numpy as np
 import numpy.typing as npt
 
-from .cli import finite_float, positive_int, run_tool
+from .cli import add_scene_argument, finite_float, positive_int, run_tool
 from ..errors import AssemblyError, NearSingularWarning, SceneError
 from ..geometry.diagrams import (arrows_from_state, colours_from_scene, Diagram,
                                  diagram_from_scene, fmt_sense, fmt_value, nice_scale, POLE,
@@ -707,9 +707,7 @@ solved.
 
 
 def _add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument('scene', metavar='SCENE',
-                        help='path to a scene YAML, or the name of a packaged scene '
-                             '(e.g. khurmi_four_bar_ad150)')
+    add_scene_argument(parser)
     parser.add_argument('-o', '--output', required=True, metavar='FILE',
                         help='output file: .png, .svg or .pdf (.gif with --animate)')
     parser.add_argument('--angle-deg', type=finite_float, metavar='X',

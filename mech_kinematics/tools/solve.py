@@ -12,7 +12,7 @@ import sys
 from typing import Any
 import warnings
 
-from .cli import finite_float, positive_float, run_tool
+from .cli import add_scene_argument, finite_float, positive_float, run_tool
 from ..bounds import MAX_ERROR
 from ..errors import AssemblyError, NearSingularWarning, SceneError, UntrustedError
 from ..scene import load_scene
@@ -96,9 +96,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     parser: argparse.ArgumentParser = subparsers.add_parser(
         'solve', help='solve a scene at one instant, print JSON', description=SOLVE_HELP,
         formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument('scene', metavar='SCENE',
-                        help='path to a scene YAML, or the name of a packaged scene '
-                             '(e.g. khurmi_four_bar_ad150)')
+    add_scene_argument(parser)
     parser.add_argument('--angle-deg', type=finite_float, metavar='X',
                         help='crank angle in degrees CCW from +x, counted from the start: 450 '
                              'is a quarter turn into the second turn (it matters for an '

@@ -17,7 +17,7 @@ from pathlib import Path
 import sys
 from typing import Any
 
-from .cli import run_tool
+from .cli import add_scene_argument, run_tool
 
 __all__ = ['add_parser', 'main']
 
@@ -49,8 +49,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     parser: argparse.ArgumentParser = subparsers.add_parser(
         'urdf', help="write the URDF of a scene (the node's robot_description)",
         description=URDF_HELP, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument('scene', metavar='SCENE',
-                        help='path to a scene YAML, or the name of a packaged scene')
+    add_scene_argument(parser)
     parser.add_argument('-o', '--output', metavar='FILE',
                         help='write to FILE (default: standard output)')
     parser.add_argument('--frame-id', default='mechanism',
