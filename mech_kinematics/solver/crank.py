@@ -55,6 +55,26 @@ class Crank:
         _check_finite(self.speed, 'the crank speed', (self, 'speed'))
         _check_finite(self.accel, 'the crank acceleration', (self, 'accel'))
 
+    @property
+    def name(self) -> str:
+        """The driver's name: the crank link (its revolute joint)."""
+        return self.link
+
+    @property
+    def joint_type(self) -> str:
+        """The driver's joint type: ``'revolute'``."""
+        return 'revolute'
+
+    @property
+    def start(self) -> float:
+        """The driver's position at time zero: the crank angle, rad."""
+        return self.angle
+
+    @property
+    def stroke(self) -> tuple[float, float] | None:
+        """A crank has no stroke limits."""
+        return None
+
 
 class _CrankStep:
     def __init__(self, crank: Crank, center: complex) -> None:

@@ -188,6 +188,11 @@ class Scene:
         object.__setattr__(self, '_solver', solver)
 
     @property
+    def drivers(self) -> tuple[Crank, ...]:
+        """The drivers in scene order (each has ``name``, ``joint_type``, ``start``, ...)."""
+        return (self.input,)
+
+    @property
     def output_joints(self) -> tuple[str, ...]:
         """Names of the joints reported, in order."""
         return self._plan.output_joints
