@@ -33,7 +33,7 @@ import warnings
 import numpy as np
 import numpy.typing as npt
 
-from .cli import finite_float, PROG, run_tool
+from .cli import finite_float, positive_float, PROG, run_tool
 from ..errors import MechKinematicsError
 from ..ros import topics
 from ..ros.cdr import stamp_from_cdr
@@ -41,8 +41,8 @@ from ..units import NS_PER_S, rad_per_s_from_rpm, rpm_from_rad_per_s
 
 __all__ = [
     'DEFAULT_MAX_SAMPLES', 'DEFAULT_SAMPLES', 'Motion', 'PlotError', 'add_parser',
-    'figure_from_motion', 'main', 'motion_from_bag', 'motion_from_scene', 'plot_bag',
-    'plot_scene', '_handle', 'save_figure',
+    'drivers_period', 'figure_from_motion', 'main', 'motion_from_bag', 'motion_from_scene',
+    'plot_bag', 'plot_scene', '_handle', 'save_figure',
 ]
 
 Array = npt.NDArray[np.float64]
@@ -137,8 +137,16 @@ class Motion:
 
 def motion_from_scene(scene: Any, *, samples: int = DEFAULT_SAMPLES,
                       speed: float | None = None, accel: float | None = None,
-                      x: str = 'angle') -> Motion:
-    """Solve ``scene`` over one crank cycle.
+                      x: str = 'angle', duration: float | None = None) -> Motion:
+    """Solve ``scene`` over one crank cycle (several drivers: along a path in time).
+
+    A scene with several drivers (or an actuator) is solved along the path
+    each driver takes from its start at its default speed and acceleration,
+    for the shortest of the drivers' periods (a crank's turn, an actuator's
+    travel to the end of its stroke it moves toward; :func:`drivers_period`)
+    or ``duration`` (s); against time only. A path that leaves the region where
+    the mechanism assembles (or its answers cannot be trusted) is refused with
+    where and why.
 
     Parameters
     ----------
@@ -152,6 +160,9 @@ def motion_from_scene(scene: Any, *, samples: int = DEFAULT_SAMPLES,
         ``'angle'``: crank angles 0 to 2π. ``'time'``: one period 2π/|speed|
         from the scene's initial angle, turning at the constant ``speed``.
 
+    duration : float, optional
+        Several drivers: the time plotted, s (default: :func:`drivers_period`).
+
     Returns
     -------
     Motion
@@ -162,6 +173,8 @@ def motion_from_scene(scene: Any, *, samples: int = DEFAULT_SAMPLES,
     if samples < 2:
         msg = f'Expected at least 2 samples, got {samples}'
         raise PlotError(msg)
+    if len(scene.drivers) > 1 or scene.drivers[0].joint_type != 'revolute':
+        return _motion_of_drivers(scene, samples, speed, accel, x, duration)
     speed = scene.input.speed if speed is None else float(speed)
     accel = scene.input.accel if accel is None else float(accel)
     time = None
@@ -190,6 +203,115 @@ def motion_from_scene(scene: Any, *, samples: int = DEFAULT_SAMPLES,
     _, gaps = assembly_ranges(scene)
     return Motion(title, np.asarray(angle, dtype=np.float64), time, scene.joint_types, joints,
                   points, jumps, summary_from_gaps(gaps, scene.units), gaps)
+
+
+def _first_time(v: float, a: float, distance: float) -> float:
+    """Return the first t > 0 with v t + a t^2 / 2 = distance (s), or inf if never."""
+    if a == 0.0:
+        t = distance / v if v != 0.0 else math.inf
+        return t if t > 0.0 else math.inf
+    disc = v * v + 2.0 * a * distance
+    if disc < 0.0:
+        return math.inf
+    root = math.sqrt(disc)
+    times = [t for t in ((-v - root) / a, (-v + root) / a) if t > 0.0]
+    return min(times, default=math.inf)
+
+
+def drivers_period(scene: Any) -> tuple[float, str]:
+    """Return the time (s) of the quickest driver's period, and which driver and what it does.
+
+    A crank's period is the time it takes to turn once either way from its
+    start at its default speed and acceleration; an actuator's, the time it
+    takes to reach the end of its stroke it moves toward (one without stroke
+    limits has none). The shortest of these keeps every actuator within its
+    stroke.
+    """
+    best, what = math.inf, ''
+    for driver in scene.drivers:
+        v, a = driver.speed, driver.accel
+        if driver.joint_type == 'revolute':
+            t = min(_first_time(v, a, 2.0 * math.pi), _first_time(v, a, -2.0 * math.pi))
+            doing = f'{driver.name} turning once'
+        elif driver.stroke is not None:
+            low, high = driver.stroke
+            t = min(_first_time(v, a, high - driver.start), _first_time(v, a, low - driver.start))
+            doing = f'{driver.name} reaching the end of its stroke'
+        else:
+            t = math.inf
+        if t < best:
+            best, what = t, doing
+    if not math.isfinite(best):
+        msg = (f'Expected a driver of {scene.name} that turns or reaches the end of its stroke '
+               f'at its default speed and acceleration, got none: give --duration SECONDS')
+        raise PlotError(msg)
+    return best, what
+
+
+def _motion_of_drivers(scene: Any, samples: int, speed: float | None, accel: float | None,
+                       x: str, duration: float | None) -> Motion:
+    """Solve a scene with several drivers (or an actuator) along its drivers' default path."""
+    import mech_kinematics as mk
+
+    if x != 'time':
+        msg = (f'Expected --x time for {scene.name}, which has several drivers or an actuator '
+               f'(no one crank angle to plot against), got --x {x}')
+        raise PlotError(msg)
+    if speed is not None or accel is not None:
+        msg = (f'Expected no --speed-rpm or --accel for {scene.name}: each of its drivers '
+               f'moves at its own default speed and acceleration')
+        raise PlotError(msg)
+    if duration is None:
+        duration, what = drivers_period(scene)
+        span = f'{duration:.6g} s ({what})'
+    else:
+        span = f'{duration:.6g} s'
+    time = np.linspace(0.0, duration, samples)
+    drivers = scene.drivers
+    positions = [d.start + d.speed * time + 0.5 * d.accel * time * time for d in drivers]
+    speeds = [d.speed + d.accel * time for d in drivers]
+    accels = [np.full_like(time, d.accel) for d in drivers]
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore', mk.NearSingularWarning)
+        if len(drivers) == 1:
+            state = mk.solve(scene, positions[0], speeds[0], accels[0])
+        else:
+            state = mk.solve(scene, positions, speeds, accels)
+    valid = np.asarray(state.valid, dtype=bool)
+    if not valid.all():
+        index = int(np.flatnonzero(~valid)[0])
+        where = ', '.join(f'{d.name} = {d.position_text(float(p[index]), scene.units)}'
+                          for d, p in zip(drivers, positions, strict=True))
+        reason = 'its answer cannot be trusted'
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter('ignore', mk.NearSingularWarning)
+                at = [float(p[index]) for p in positions]
+                rates = [float(v[index]) for v in speeds]
+                rate2 = [float(a[index]) for a in accels]
+                if len(drivers) == 1:
+                    mk.solve(scene, at[0], rates[0], rate2[0])
+                else:
+                    mk.solve(scene, at, rates, rate2)
+        except mk.AssemblyError as error:
+            reason = error.reason
+        msg = (f"Expected the drivers' path of {scene.name} to stay where it assembles, got it "
+               f'leaving at t = {time[index]:.6g} s ({where}): {reason}; plot less with '
+               f'--duration SECONDS (at most {time[max(index - 1, 0)]:.6g} s)')
+        raise PlotError(msg)
+    joints = {name: (j.position, j.velocity, j.acceleration) for name, j in state.joints.items()}
+    points = {name: (p.position, p.velocity, p.acceleration) for name, p in state.points.items()}
+    rates = ', '.join(
+        f'{d.name} {rpm_from_rad_per_s(d.speed):.6g} rpm' if d.joint_type == 'revolute'
+        else f'{d.name} {d.speed:.6g} m/s' for d in drivers)
+    title = (f'{scene.name}: solver, every driver from its start at its default speed '
+             f'({rates}) for {span}')
+    jumps = np.zeros(samples - 1, dtype=bool)
+    for engagement in state.intermittent.values():
+        engaged = np.asarray(engagement.engaged, dtype=bool)
+        jumps |= engaged[1:] != engaged[:-1]
+    return Motion(title, np.asarray(positions[0], dtype=np.float64), time, scene.joint_types,
+                  joints, points, jumps, 'the path stays where it assembles')
 
 
 # -- from a bag ------------------------------------------------------------------
@@ -596,11 +718,20 @@ def plot_bag(path: str | os.PathLike[str], output: str | os.PathLike[str], *,
     return fig
 
 
-def plot_scene(scene: Any, output: str | os.PathLike[str], *, x: str = 'angle',
+def plot_scene(scene: Any, output: str | os.PathLike[str], *, x: str | None = None,
                samples: int = DEFAULT_SAMPLES, speed: float | None = None,
-               accel: float | None = None) -> Any:
-    """Plot one crank cycle of ``scene`` to ``output``; return the Figure."""
-    motion = motion_from_scene(scene, samples=samples, speed=speed, accel=accel, x=x)
+               accel: float | None = None, duration: float | None = None) -> Any:
+    """Plot one crank cycle of ``scene`` to ``output``; return the Figure.
+
+    ``x`` defaults to ``'angle'``, or ``'time'`` for a scene with several
+    drivers (or an actuator), which :func:`motion_from_scene` plots along its
+    drivers' path.
+    """
+    if x is None:
+        several = len(scene.drivers) > 1 or scene.drivers[0].joint_type != 'revolute'
+        x = 'time' if several else 'angle'
+    motion = motion_from_scene(scene, samples=samples, speed=speed, accel=accel, x=x,
+                               duration=duration)
     fig = figure_from_motion(motion, x=x)
     save_figure(fig, output)
     return fig
@@ -621,6 +752,13 @@ against time or crank angle, to an image file (PNG; no display needed).
   plot BAG --scene SCENE ...       a bag, with the scene telling sliders from
                                    revolute joints (by default the scene named
                                    in the bag's diagnostics is used)
+
+A scene with several drivers (or an actuator) is plotted against time along
+the path its drivers take from their start positions at their default speeds,
+for the quickest driver's period (a crank's turn, an actuator's travel to the
+end of its stroke it moves toward; the title says which) or --duration
+SECONDS; a path leaving the region where it assembles is refused, saying
+where and why.
 """
 
 
@@ -654,9 +792,14 @@ def _handle(args: argparse.Namespace) -> int:
             for warning in caught:      # one line each, not Python's warning format
                 print(f'warning: {warning.message}', file=sys.stderr)
         else:
-            x = args.x or 'angle'
+            several = len(scene.drivers) > 1 or scene.drivers[0].joint_type != 'revolute'
+            x = args.x or ('time' if several else 'angle')
+            if args.duration is not None and not several:
+                msg = (f'Expected --duration only for a scene with several drivers or an '
+                       f'actuator, got {scene.name}, driven by one crank: drop --duration')
+                raise PlotError(msg)
             motion = motion_from_scene(scene, samples=args.samples, speed=speed,
-                                       accel=args.accel, x=x)
+                                       accel=args.accel, x=x, duration=args.duration)
             save_figure(figure_from_motion(motion, x=x), output)
             print(f'{scene.name}: {motion.note}')  # where it does not assemble, if anywhere
     except (PlotError, mk.SceneError) as error:
@@ -701,6 +844,9 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="crank speed for --scene, rpm (default: the scene's)")
     parser.add_argument('--accel', type=finite_float, metavar='A',
                         help="crank acceleration for --scene, rad/s^2 (default: the scene's)")
+    parser.add_argument('--duration', type=positive_float, metavar='SECONDS',
+                        help='--scene with several drivers: the time plotted (default: the '
+                             "quickest driver's turn or stroke)")
 
 
 def add_parser(subparsers: Any) -> argparse.ArgumentParser:

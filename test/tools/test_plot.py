@@ -12,8 +12,10 @@ from pathlib import Path
 import subprocess
 import sys
 
+from helpers import BOOM_CYLINDER, FIVE_BAR_TWO_CRANKS
 import numpy as np
 import pytest
+import yaml
 
 import mech_kinematics as mk
 from mech_kinematics.tools import plot, record as bag_recorder
@@ -359,3 +361,78 @@ def copied_by_the_recorders_writer(bag: Path, destination: Path) -> Path:
             writer.write(topics[c.id], timestamp, bytes(raw))
     writer.close()
     return destination
+
+
+# --- several drivers (issue 18): along the drivers' path ------------------------------
+
+#: The five-bar's cranks turning together (60 deg apart: |BD| stays below 0.22 m).
+TOGETHER = FIVE_BAR_TWO_CRANKS.replace('speed_rpm: -10', 'speed_rpm: 10')
+#: The boom's cylinder retracting toward its shortest stroke (2000 mm, reached at 12 s).
+RETRACTING = BOOM_CYLINDER.replace('speed: 0.05', 'speed: -0.05')
+
+
+def test_several_drivers_are_plotted_along_their_path_in_time(tmp_path):
+    """Each driver from its start at its speed for the quickest's period; the solver's values."""
+    scene = mk.parse_scene(yaml.safe_load(TOGETHER))
+    fig = plot.plot_scene(scene, tmp_path / 'five.png', samples=61)
+    assert_png(tmp_path / 'five.png')
+    assert fig._suptitle.get_text().startswith(
+        'five: solver, every driver from its start at its default speed (left 10 rpm, right '
+        '10 rpm) for 6 s (left turning once)')
+    time = np.linspace(0.0, 6.0, 61)
+    omega = 2 * math.pi / 6
+    state = mk.solve(scene, [math.radians(120) + omega * time, math.radians(60) + omega * time],
+                     [omega, omega], [0.0, 0.0])
+    ldist = lines(panels(fig)['Joint angular velocities'])['ldist']
+    np.testing.assert_allclose(ldist.get_xdata(), time, rtol=RTOL, atol=0)
+    np.testing.assert_allclose(ldist.get_ydata(), state.joints['ldist'].velocity, rtol=RTOL,
+                               atol=0)
+    assert set(lines(panels(fig)['Joint angles'])) == {'left', 'right', 'ldist', 'rdist'}
+
+
+def test_an_actuator_runs_to_the_end_of_its_stroke(tmp_path):
+    """The retracting cylinder is plotted for 12 s, to its shortest length, in the slider panel."""
+    scene = mk.parse_scene(yaml.safe_load(RETRACTING))
+    motion = plot.motion_from_scene(scene, samples=25, x='time')
+    assert motion.time[-1] == pytest.approx(12.0, rel=1e-14)
+    assert 'for 12 s (cyl reaching the end of its stroke)' in motion.title
+    position, velocity, _ = motion.joints['cyl']
+    np.testing.assert_allclose(position, 2.6 - 0.05 * motion.time, rtol=1e-15, atol=1e-15)
+    assert np.all(velocity == -0.05)
+
+
+def test_a_path_leaving_the_region_is_refused_saying_where(tmp_path, capsys):
+    """The cranks turning apart straighten the distal links at 0.31 s: one line, exit 2."""
+    path = tmp_path / 'five.yaml'
+    path.write_text(FIVE_BAR_TWO_CRANKS)
+    out = tmp_path / 'five.png'
+    assert plot.main(['--scene', str(path), '-o', str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: Expected the drivers' path of five to stay where it "
+                          'assembles, got it leaving at t = 0.316667 s (left = 139 deg, right '
+                          '= 41 deg): the circles about B (radius 0.14 m) and D (radius 0.14 '
+                          'm) do not meet')
+    assert err.rstrip().endswith('plot less with --duration SECONDS (at most 0.308333 s)')
+    assert len(err.strip().splitlines()) == 1 and not out.exists()
+    assert plot.main(['--scene', str(path), '-o', str(out), '--duration', '0.3']) == 0
+    assert_png(out)
+
+
+@pytest.mark.parametrize(('args', 'match'), [
+    (['--x', 'angle'], 'Expected --x time for five, which has several drivers'),
+    (['--speed-rpm', '5'], 'Expected no --speed-rpm or --accel for five'),
+])
+def test_options_that_mean_one_crank_are_refused(tmp_path, capsys, args, match):
+    """--x angle and --speed-rpm have no meaning with several drivers: one line, exit 2."""
+    path = tmp_path / 'five.yaml'
+    path.write_text(TOGETHER)
+    assert plot.main(['--scene', str(path), '-o', str(tmp_path / 'p.png'), *args]) == 2
+    assert match in capsys.readouterr().err
+
+
+def test_duration_with_one_crank_is_refused(tmp_path, capsys):
+    """--duration is for several drivers: one line, exit 2."""
+    assert plot.main(['--scene', 'khurmi_four_bar_ad150', '-o', str(tmp_path / 'p.png'),
+                      '--duration', '1']) == 2
+    assert 'Expected --duration only for a scene with several drivers' in (
+        capsys.readouterr().err)
