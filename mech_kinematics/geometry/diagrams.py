@@ -43,11 +43,12 @@ from ..errors import NearSingularWarning
 from ..solver import Scene, solve, State
 
 __all__ = [
-    'COLOURS', 'Diagram', 'GuideLine', 'LinkShape', 'LinkValues', 'PinValues', 'Pivot',
-    'Polygon', 'SliderShape', 'SliderValues', 'SpaceDiagram', 'Table', 'Vector', 'VectorKind',
-    'acceleration_polygon_from_state', 'arrows_from_state', 'colours_from_scene',
+    'COLOURS', 'Diagram', 'DriverValues', 'GuideLine', 'LinkShape', 'LinkValues', 'PinValues',
+    'Pivot', 'Polygon', 'SliderShape', 'SliderValues', 'SpaceDiagram', 'Table', 'Vector',
+    'VectorKind', 'acceleration_polygon_from_state', 'arrows_from_state', 'colours_from_scene',
     'diagram_from_scene', 'space_from_state', 'strokes_from_scene', 'tables_from_diagram',
-    'fmt_sense', 'fmt_value', 'nice_scale', 'scale_text', 'velocity_polygon_from_state',
+    'fmt_sense', 'fmt_value', 'nice_scale', 'scale_text', 'varying_links',
+    'velocity_polygon_from_state',
 ]
 
 Array = npt.NDArray[np.float64]
@@ -285,6 +286,17 @@ class PinValues:
 
 
 @dataclass(frozen=True)
+class DriverValues:
+    """A driver's position (rad or m), speed and acceleration (per s, per s^2), its joint type."""
+
+    name: str
+    joint_type: str
+    position: float
+    speed: float
+    accel: float
+
+
+@dataclass(frozen=True)
 class Diagram:
     """The three diagrams of a scene at one crank angle.
 
@@ -307,6 +319,12 @@ class Diagram:
         The instant centres, if requested.
     pins : tuple of PinValues
         The rubbing velocity at every pin of the scene's ``pins``.
+    drivers : tuple of DriverValues
+        Every driver's position and rates, in scene order (``angle``,
+        ``speed`` and ``accel`` are the first one's).
+    refused : str
+        Why the velocity and acceleration polygons are not drawn (then both
+        are ``None``), or ''.
     """
 
     scene: str
@@ -314,12 +332,14 @@ class Diagram:
     speed: float
     accel: float
     space: SpaceDiagram
-    velocity: Polygon
-    acceleration: Polygon
+    velocity: Polygon | None
+    acceleration: Polygon | None
     links: tuple[LinkValues, ...]
     sliders: tuple[SliderValues, ...]
     instant_centres: InstantCentres | None = None
     pins: tuple[PinValues, ...] = ()
+    drivers: tuple[DriverValues, ...] = ()
+    refused: str = ''
 
 
 # --- geometry -------------------------------------------------------------
@@ -349,10 +369,18 @@ def _coincident(pin: str) -> str:
     return f"{pin}'"
 
 
+def _driven_links(scene: Scene) -> dict[str, dict[str, complex]]:
+    """Return each crank driver's link: its centre and tip in its frame (an actuator none)."""
+    ground = {name: complex(*xy) for name, xy in scene.ground.items()}
+    links: dict[str, dict[str, complex]] = {}
+    for driver in scene.drivers:
+        links.update(driver.local(ground))
+    return links
+
+
 def _edges(scene: Scene, state: State) -> list[_Edge]:
     """Every link's relative motions, in the order the solver places the points."""
-    crank = scene.input
-    edges = [_Edge(crank.link, crank.center, crank.point)]
+    edges = [_Edge(link, *members) for link, members in _driven_links(scene).items()]
     for item in (*scene.dyads, *scene.points):
         for body, start, end, slider in item.edges():
             edges.append(_Edge(body, start, end) if slider is None else
@@ -722,7 +750,8 @@ def arrows_from_state(scene: Scene, state: State, velocity_scale: float,
 
 def _values(scene: Scene, state: State,
             topology: Topology) -> tuple[tuple[LinkValues, ...], tuple[SliderValues, ...]]:
-    lengths: dict[str, float | None] = {scene.input.link: scene.input.length}
+    lengths: dict[str, float | None] = {link: max(abs(z) for z in members.values())
+                                        for link, members in _driven_links(scene).items()}
     for dyad in scene.dyads:
         lengths.update(dyad.link_lengths())
     links = []
@@ -749,10 +778,27 @@ def _pins(scene: Scene, state: State) -> tuple[PinValues, ...]:
                  for point, bodies in scene.pin_bodies.items())
 
 
+def varying_links(scene: Scene) -> tuple[str, ...]:
+    """Return the links whose length varies (an actuator's): no polygon is built through them.
+
+    The relative velocity of a link's end about its start is ``omega x r`` only
+    for a rigid link; a cylinder's adds its extension rate along it. (A slotted
+    lever's length varies too, but its pin's sliding is drawn: it has a slider.)
+    """
+    rigid = {body for dyad in scene.dyads for body, _, _, slider in dyad.edges()
+             if slider is None}
+    return tuple(name for dyad in scene.dyads
+                 for name, length in dyad.link_lengths().items()
+                 if length is None and name in rigid)
+
+
 def diagram_from_scene(scene: Scene, angle: float | None = None, speed: float | None = None,
                        accel: float | None = None, *, degrees: bool = False,
-                       instant_centres: bool = False) -> Diagram:
-    """Solve ``scene`` at one crank angle and build its three diagrams.
+                       instant_centres: bool = False,
+                       inputs: Mapping[str, float] | None = None,
+                       speeds: Mapping[str, float] | None = None,
+                       accels: Mapping[str, float] | None = None) -> Diagram:
+    """Solve ``scene`` at one crank angle (or drivers' positions) and build its three diagrams.
 
     Parameters
     ----------
@@ -768,31 +814,67 @@ def diagram_from_scene(scene: Scene, angle: float | None = None, speed: float | 
         Whether ``angle`` is in degrees.
     instant_centres : bool, keyword-only
         Whether to compute the instant centres too.
+    inputs, speeds, accels : mapping of str to float, keyword-only
+        For a scene with several drivers (or an actuator): positions (rad, or
+        m), speeds (rad/s or m/s) and accelerations by driver name, SI; a
+        driver left out takes the scene's default. ``angle``, ``speed`` and
+        ``accel`` are then not used.
 
     Returns
     -------
     Diagram
-        Space, velocity and acceleration diagrams and the links' values.
+        Space, velocity and acceleration diagrams and the links' values; the
+        polygons are ``None``, and ``refused`` says why, where a link's
+        length varies (:func:`varying_links`).
 
     Raises
     ------
     AssemblyError
-        If the mechanism cannot be assembled at ``angle``.
+        If the mechanism cannot be assembled at ``angle`` (or ``inputs``).
     """
     scene = full_scene(scene)
-    if angle is None:
-        theta = scene.input.angle
+    drivers = scene.drivers
+    several = len(drivers) > 1 or drivers[0].joint_type != 'revolute'
+    if several or inputs is not None:
+        names = [d.name for d in drivers]
+        for given in (inputs, speeds, accels):
+            unknown = sorted(set(given or {}) - set(names))
+            if unknown:
+                msg = (f'Expected drivers of {scene.name} ({", ".join(names)}), got '
+                       f'{", ".join(unknown)}')
+                raise ValueError(msg)
+        xs = [float((inputs or {}).get(d.name, d.start)) for d in drivers]
+        vs = [float((speeds or {}).get(d.name, d.speed)) for d in drivers]
+        accs = [float((accels or {}).get(d.name, d.accel)) for d in drivers]
+        state = (solve(scene, xs[0], vs[0], accs[0]) if len(drivers) == 1
+                 else solve(scene, xs, vs, accs))
+        theta = xs[0]
     else:
-        theta = math.radians(angle) if degrees else float(angle)
-    state = solve(scene, theta, speed, accel)
+        theta = scene.input.angle if angle is None else (
+            math.radians(angle) if degrees else float(angle))
+        state = solve(scene, theta, speed, accel)
+    motions = state.drivers
+    values = tuple(DriverValues(d.name, d.joint_type, float(motions[d.name].position),
+                                float(motions[d.name].velocity),
+                                float(motions[d.name].acceleration)) for d in drivers)
     topology = bodies_from_scene(scene)
     links, sliders = _values(scene, state, topology)
     centres = instant_centres_from_state(scene, state) if instant_centres else None
-    return Diagram(scene.name, theta, float(state.speed), float(state.accel),
+    varying = varying_links(scene)
+    refused = ''
+    velocity: Polygon | None = None
+    acceleration: Polygon | None = None
+    if varying:
+        refused = (f'no velocity or acceleration polygon: link{"s" if len(varying) > 1 else ""} '
+                   f'{", ".join(varying)} change{"" if len(varying) > 1 else "s"} length (an '
+                   f"actuator's), which these polygons do not draw")
+    else:
+        velocity = velocity_polygon_from_state(scene, state)
+        acceleration = acceleration_polygon_from_state(scene, state)
+    return Diagram(scene.name, theta, values[0].speed, values[0].accel,
                    space_from_state(scene, state, strokes_from_scene(scene)),
-                   velocity_polygon_from_state(scene, state),
-                   acceleration_polygon_from_state(scene, state), links, sliders, centres,
-                   _pins(scene, state))
+                   velocity, acceleration, links, sliders, centres, _pins(scene, state), values,
+                   refused)
 
 
 # --- value tables ---------------------------------------------------------
@@ -860,7 +942,7 @@ def tables_from_diagram(diagram: Diagram,
     -------
     dict of str to Table
         ``'space'`` (links: length, angle, omega, alpha, a Geneva wheel
-        marked engaged or locked; sliders; pins: radius, relative angular
+        marked engaged or locked; sliders; actuators: length, rates; pins: radius, relative angular
         speed, rubbing velocity; instant centres if computed),
         ``'velocity'`` and ``'acceleration'`` (every vector drawn: letters,
         quantity, magnitude, direction).
@@ -880,6 +962,10 @@ def tables_from_diagram(diagram: Diagram,
         rows.append((slider.name, 'slider', f's = {fmt_value(slider.s)}', '-',
                      f'{fmt_value(slider.velocity)} m/s',
                      f'{fmt_value(slider.acceleration)} m/s\u00b2'))
+    for driver in diagram.drivers:  # an actuator: its length and extension rate
+        if driver.joint_type == 'prismatic':
+            rows.append((driver.name, 'actuator', f'L = {fmt_value(driver.position)}', '-',
+                         f'{fmt_value(driver.speed)} m/s', f'{fmt_value(driver.accel)} m/s\u00b2'))
     for pin in diagram.pins:  # seed 001: rubbing velocity = |omega_a - omega_b| r
         rows.append((f'pin {pin.point}', '/'.join(pin.bodies), f'r = {fmt_value(pin.radius)}',
                      '-', f'\u0394\u03c9 {fmt_value(pin.relative_omega)}',
@@ -901,6 +987,8 @@ def tables_from_diagram(diagram: Diagram,
         tables['centres'] = Table('Instant centres', ('centre', 'links', 'x m', 'y m'),
                                   tuple(rows))
     for polygon in (diagram.velocity, diagram.acceleration):
+        if polygon is None:  # refused (diagram.refused says why)
+            continue
         scale = None if scales is None else scales.get(polygon.quantity)
         unit = polygon.unit.replace('^2', '\u00b2')
         columns: tuple[str, ...] = ('vector', 'quantity', unit, 'dir \u00b0')

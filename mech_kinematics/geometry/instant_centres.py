@@ -159,8 +159,10 @@ def bodies_from_scene(scene: Scene) -> Topology:
         fixed = points.setdefault(body, [])
         fixed.extend(member for member in members if member not in fixed)
 
-    crank = scene.input
-    add(crank.link, BodyKind.CRANK, crank.center, crank.point)
+    positions = {name: complex(*xy) for name, xy in scene.ground.items()}
+    for driver in scene.drivers:  # a crank's link carries its centre and tip; an actuator none
+        for link, members in driver.local(positions).items():
+            add(link, BodyKind.CRANK, *members)
     slides: list[tuple[str, str]] = []
     for dyad in scene.dyads:
         for body, kind, members, guide in dyad.members(ground):
@@ -182,7 +184,7 @@ def bodies_from_scene(scene: Scene) -> Topology:
 
 
 def _names(scene: Scene) -> set[str]:
-    names = {scene.input.link}
+    names = {driver.name for driver in scene.drivers}
     for dyad in scene.dyads:
         names.update(dyad.joint_types())
     return names

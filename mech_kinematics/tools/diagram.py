@@ -16,6 +16,7 @@ from collections.abc import Mapping, Sequence
 import math
 from pathlib import Path
 import sys
+import textwrap
 from typing import Any
 import warnings
 
@@ -33,7 +34,8 @@ from ..geometry.instant_centres import (bodies_from_scene, BodyKind, full_scene,
 from ..solver import Scene, solve
 from ..units import rad_per_s_from_rpm, rpm_from_rad_per_s
 
-__all__ = ['add_parser', 'figure_from_diagram', 'main', 'write_animation', 'write_diagram']
+__all__ = ['add_parser', 'figure_from_diagram', 'main', 'title_from_diagram', 'write_animation',
+           'write_diagram']
 
 Array = npt.NDArray[np.float64]
 
@@ -282,15 +284,29 @@ def _draw_mechanism(ax: Any, scene: Scene, space: SpaceDiagram, colours: Mapping
             ax.plot(*xy, marker='+', ms=6, color='#555555', zorder=5)
 
 
-def _crank_sense(ax: Any, scene: Scene, space: SpaceDiagram, speed: float,
+def _crank_senses(ax: Any, scene: Scene, diagram: Diagram,
+                  unit: float) -> list[tuple[Array, Array]]:
+    """Draw an arc arrow at each crank's pivot in its sense of rotation; return the chords."""
+    ground = {name: complex(*xy) for name, xy in scene.ground.items()}
+    speeds = {d.name: d.speed for d in diagram.drivers}
+    chords = []
+    for driver in scene.drivers:
+        for members in driver.local(ground).values():  # a crank's centre and tip
+            centre, tip = list(members)
+            chords += _crank_sense(ax, diagram.space, centre, tip,
+                                   speeds.get(driver.name, diagram.speed), unit)
+    return chords
+
+
+def _crank_sense(ax: Any, space: SpaceDiagram, centre: str, tip: str, speed: float,
                  unit: float) -> list[tuple[Array, Array]]:
-    """Draw an arc arrow at the crank's pivot in its sense of rotation; return its chords."""
+    """Draw an arc arrow at a crank's pivot in its sense of rotation; return its chords."""
     from matplotlib.patches import FancyArrowPatch
 
     if speed == 0.0:
         return []
-    c = space.points[scene.input.center]
-    p = space.points[scene.input.point]
+    c = space.points[centre]
+    p = space.points[tip]
     theta = math.atan2(p[1] - c[1], p[0] - c[0])
     sign = 1.0 if speed > 0 else -1.0
     r = 0.75 * unit
@@ -328,7 +344,7 @@ def _space_panel(ax: Any, scene: Scene, diagram: Diagram, colours: Mapping[str, 
     scale = _fit_scale(lo - [0, 0.7 * scale], hi)
     origin = _frame(ax, lo - [0, 0.7 * scale], hi, scale)
     _draw_mechanism(ax, scene, space, colours, scale)
-    sense = _crank_sense(ax, scene, space, diagram.speed, scale)
+    sense = _crank_senses(ax, scene, diagram, scale)
     segments = sense + [(link.outline[i], link.outline[(i + 1) % len(link.outline)])
                         for link in space.links
                         for i in range(len(link.outline) - (len(link.outline) == 2))]
@@ -507,7 +523,8 @@ def figure_from_diagram(diagram: Diagram, scene: Scene) -> Any:
     tables = tables_from_diagram(diagram)  # row counts; drawn again below with scales
     space_rows = len(tables['space'].rows) + (len(tables['centres'].rows) + 2
                                               if 'centres' in tables else 0)
-    rows = max(space_rows, len(tables['velocity'].rows), len(tables['acceleration'].rows)) + 1
+    rows = max([space_rows] + [len(tables[key].rows) for key in ('velocity', 'acceleration')
+                               if key in tables]) + 1
     table_h = rows * ROW_H + 0.6
     width = 2 * MARGIN + 3 * PANEL_W + 2 * PANEL_GAP
     height = TITLE_H + PANEL_H + 0.5 + table_h + 0.3
@@ -520,11 +537,17 @@ def figure_from_diagram(diagram: Diagram, scene: Scene) -> Any:
     panel_y = height - TITLE_H - PANEL_H
     xs = [MARGIN + i * (PANEL_W + PANEL_GAP) for i in range(3)]
     scales = {'space': _space_panel(axes(xs[0], panel_y, PANEL_W, PANEL_H), scene, diagram,
-                                    colours),
-              'velocity': _polygon_panel(axes(xs[1], panel_y, PANEL_W, PANEL_H),
-                                         diagram.velocity, colours),
-              'acceleration': _polygon_panel(axes(xs[2], panel_y, PANEL_W, PANEL_H),
-                                             diagram.acceleration, colours)}
+                                    colours)}
+    for x, key, polygon in ((xs[1], 'velocity', diagram.velocity),
+                            (xs[2], 'acceleration', diagram.acceleration)):
+        ax = axes(x, panel_y, PANEL_W, PANEL_H)
+        if polygon is None:  # refused: say why where it would be
+            ax.set_axis_off()
+            ax.set_title(f'{key.capitalize()} polygon', fontsize=FONT + 2)
+            ax.text(0.5, 0.5, '\n'.join(textwrap.wrap(diagram.refused, 48)),
+                    transform=ax.transAxes, ha='center', va='center', fontsize=FONT + 1)
+        else:
+            scales[key] = _polygon_panel(ax, polygon, colours)
     tables = tables_from_diagram(diagram, scales)
     top = panel_y - 0.55
     n = len(tables['space'].rows) + 1
@@ -534,16 +557,38 @@ def figure_from_diagram(diagram: Diagram, scene: Scene) -> Any:
         _table(axes(xs[0] + 1.5, top - (n + m) * ROW_H - 0.9, PANEL_W - 3.0, m * ROW_H),
                tables['centres'])
     for x, key in ((xs[1], 'velocity'), (xs[2], 'acceleration')):
+        if key not in tables:
+            continue
         n = len(tables[key].rows) + 1
         _table(axes(x, top - n * ROW_H, PANEL_W, n * ROW_H), tables[key], mathcols=(0, 1))
-    rpm = rpm_from_rad_per_s(diagram.speed)
-    fig.text(MARGIN / width, 1.0 - 0.5 / height,
-             f'{diagram.scene}: crank angle {fmt_value(math.degrees(diagram.angle))}\u00b0, '
-             f'\u03c9 = {fmt_value(diagram.speed)} rad/s{fmt_sense(diagram.speed)} '
-             f'({fmt_value(rpm)} rpm), '
-             f'\u03b1 = {fmt_value(diagram.accel)} rad/s\u00b2   (SI units; angles CCW from +x)',
+    fig.text(MARGIN / width, 1.0 - 0.5 / height, title_from_diagram(diagram),
              fontsize=FONT + 3, va='center', ha='left')
     return fig
+
+
+def title_from_diagram(diagram: Diagram) -> str:
+    """Return the figure's title: the scene and where its drivers stand, SI units.
+
+    One crank: its angle (deg), speed (rad/s and rpm) and acceleration;
+    several drivers (or an actuator): each one's position, speed and
+    acceleration.
+    """
+    drivers = diagram.drivers
+    if len(drivers) <= 1 and all(d.joint_type == 'revolute' for d in drivers):
+        rpm = rpm_from_rad_per_s(diagram.speed)
+        return (f'{diagram.scene}: crank angle {fmt_value(math.degrees(diagram.angle))}\u00b0, '
+                f'\u03c9 = {fmt_value(diagram.speed)} rad/s{fmt_sense(diagram.speed)} '
+                f'({fmt_value(rpm)} rpm), \u03b1 = {fmt_value(diagram.accel)} rad/s\u00b2   '
+                f'(SI units; angles CCW from +x)')
+    parts = []
+    for d in drivers:
+        if d.joint_type == 'revolute':
+            parts.append(f'{d.name} {fmt_value(math.degrees(d.position))}\u00b0, '
+                         f'{fmt_value(d.speed)} rad/s, {fmt_value(d.accel)} rad/s\u00b2')
+        else:
+            parts.append(f'{d.name} {fmt_value(d.position)} m, {fmt_value(d.speed)} m/s, '
+                         f'{fmt_value(d.accel)} m/s\u00b2')
+    return f'{diagram.scene}: {"; ".join(parts)}   (SI units; angles CCW from +x)'
 
 
 def write_diagram(diagram: Diagram, scene: Scene, path: str | Path) -> Path:

@@ -13,8 +13,10 @@ import subprocess
 import sys
 import warnings
 
+from helpers import BOOM_CYLINDER, FIVE_BAR_TWO_CRANKS
 import numpy as np
 import pytest
+import yaml
 
 import mech_kinematics as mk
 from mech_kinematics.geometry import diagrams as geo
@@ -423,3 +425,81 @@ def test_import_needs_no_matplotlib():
             'mech_kinematics.geometry.instant_centres; '
             "assert 'matplotlib' not in sys.modules and 'rclpy' not in sys.modules")
     subprocess.run([sys.executable, '-c', code], check=True, timeout=60)
+
+
+# --- several drivers (issue 18) ---------------------------------------------------------
+
+
+def _scene(text):
+    return mk.parse_scene(yaml.safe_load(text))
+
+
+def test_five_bar_polygons_at_given_driver_positions_and_rates():
+    """Both cranks given: each letter is the solved velocity and acceleration; links close."""
+    scene = _scene(FIVE_BAR_TWO_CRANKS)
+    diagram = geo.diagram_from_scene(scene, inputs={'left': 2.0}, speeds={'right': -2.0},
+                                     accels={'left': 3.0})
+    state = mk.solve(scene, [2.0, math.radians(60)], [2 * math.pi / 6, -2.0], [3.0, 0.0])
+    assert [(d.name, d.joint_type) for d in diagram.drivers] == [
+        ('left', 'revolute'), ('right', 'revolute')]
+    assert (diagram.drivers[1].position, diagram.drivers[1].speed) == (math.radians(60), -2.0)
+    assert diagram.refused == ''
+    for polygon, index in ((diagram.velocity, 1), (diagram.acceleration, 2)):
+        atol = _atol(polygon)
+        for point, values in state.complex_points.items():
+            np.testing.assert_allclose(polygon.letters[point.lower()], _xy(complex(values[index])),
+                                       atol=atol)
+    p = {n: complex(x[0]) for n, x in state.complex_points.items()}
+    for link, start, end in (('left', 'A', 'B'), ('right', 'E', 'D'), ('ldist', 'B', 'P'),
+                             ('rdist', 'D', 'P')):
+        vector = diagram.velocity.find(f'v_{end}{start}')
+        expected = _xy(1j * state.joints[link].velocity * (p[end] - p[start]))
+        np.testing.assert_allclose(vector.end - vector.start, expected,
+                                   atol=_atol(diagram.velocity))
+    assert [link.name for link in diagram.links] == ['left', 'right', 'ldist', 'rdist']
+    assert diagram.links[1].length == 0.12
+
+
+def test_instant_centre_of_two_cranks_is_on_the_line_of_their_pivots():
+    """Cranks at 1 and -0.5 rad/s about A and E: I(left, right) divides AE as -0.5 / -1.5."""
+    scene = _scene(FIVE_BAR_TWO_CRANKS)
+    diagram = geo.diagram_from_scene(scene, speeds={'left': 1.0, 'right': -0.5},
+                                     instant_centres=True)
+    centre = next(c for c in diagram.instant_centres if c.bodies == ('left', 'right'))
+    np.testing.assert_allclose(centre.point, [0.1 / 3, 0.0], atol=1e-15)
+
+
+def test_polygons_are_refused_in_one_line_through_an_actuator(tmp_path):
+    """The cylinder's link changes length: the mechanism is drawn, the polygons refused."""
+    scene = _scene(BOOM_CYLINDER)
+    diagram = geo.diagram_from_scene(scene, inputs={'cyl': 3.0}, speeds={'cyl': -0.1})
+    assert diagram.velocity is None and diagram.acceleration is None
+    assert diagram.refused == ('no velocity or acceleration polygon: link body changes length '
+                               "(an actuator's), which these polygons do not draw")
+    assert geo.varying_links(scene) == ('body',)
+    tables = geo.tables_from_diagram(diagram)
+    assert set(tables) == {'space'}
+    assert ('cyl', 'actuator', 'L = 3', '-', '-0.1 m/s', '0 m/s\u00b2') in tables['space'].rows
+    np.testing.assert_allclose(abs(complex(*(diagram.space.points['Q']
+                                             - diagram.space.points['F']))), 3.0, rtol=1e-15)
+    out = dg.write_diagram(diagram, scene, tmp_path / 'boom.png')
+    assert _png_size(out)[0] >= MIN_PNG_SIZE[0]
+    assert dg.title_from_diagram(diagram) == (
+        'boom: cyl 3 m, -0.1 m/s, 0 m/s\u00b2   (SI units; angles CCW from +x)')
+
+
+def test_five_bar_figure_title_lists_every_driver(tmp_path):
+    """The title gives each driver's angle, speed and acceleration."""
+    scene = _scene(FIVE_BAR_TWO_CRANKS)
+    diagram = geo.diagram_from_scene(scene, instant_centres=True)
+    assert dg.title_from_diagram(diagram) == (
+        'five: left 120\u00b0, 1.047 rad/s, 0 rad/s\u00b2; right 60\u00b0, -1.047 rad/s, '
+        '0 rad/s\u00b2   (SI units; angles CCW from +x)')
+    out = dg.write_diagram(diagram, scene, tmp_path / 'five.png')
+    assert out.stat().st_size > 30_000
+
+
+def test_unknown_driver_names_are_refused():
+    """A position for a driver the scene has not: one ValueError naming the drivers."""
+    with pytest.raises(ValueError, match=r'Expected drivers of five \(left, right\), got x'):
+        geo.diagram_from_scene(_scene(FIVE_BAR_TWO_CRANKS), inputs={'x': 1.0})
