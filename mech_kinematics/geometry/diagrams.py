@@ -43,11 +43,11 @@ from ..errors import NearSingularWarning
 from ..solver import Scene, solve, State
 
 __all__ = [
-    'COLOURS', 'Diagram', 'DriverValues', 'GuideLine', 'LinkShape', 'LinkValues', 'PinValues',
-    'Pivot', 'Polygon', 'SliderShape', 'SliderValues', 'SpaceDiagram', 'Table', 'Vector',
-    'VectorKind', 'acceleration_polygon_from_state', 'arrows_from_state', 'colours_from_scene',
-    'diagram_from_scene', 'space_from_state', 'strokes_from_scene', 'tables_from_diagram',
-    'fmt_sense', 'fmt_value', 'nice_scale', 'scale_text', 'varying_links',
+    'ActuatorShape', 'COLOURS', 'Diagram', 'DriverValues', 'GuideLine', 'LinkShape',
+    'LinkValues', 'PinValues', 'Pivot', 'Polygon', 'SliderShape', 'SliderValues', 'SpaceDiagram',
+    'Table', 'Vector', 'VectorKind', 'acceleration_polygon_from_state', 'arrows_from_state',
+    'colours_from_scene', 'diagram_from_scene', 'space_from_state', 'strokes_from_scene',
+    'tables_from_diagram', 'fmt_sense', 'fmt_value', 'nice_scale', 'scale_text', 'varying_links',
     'velocity_polygon_from_state',
 ]
 
@@ -211,6 +211,15 @@ class GuideLine:
 
 
 @dataclass(frozen=True)
+class ActuatorShape:
+    """A link whose length is an actuator's (a cylinder), from ``start`` to ``end``, m."""
+
+    link: str
+    start: Array
+    end: Array
+
+
+@dataclass(frozen=True)
 class SpaceDiagram:
     """The mechanism at one instant (positions in m).
 
@@ -228,6 +237,8 @@ class SpaceDiagram:
         Every slider block.
     guides : tuple of GuideLine
         Fixed guides.
+    actuators : tuple of ActuatorShape
+        The links whose length is an actuator's (:func:`varying_links`), also in ``links``.
     """
 
     points: dict[str, Array]
@@ -236,6 +247,7 @@ class SpaceDiagram:
     pivots: tuple[Pivot, ...]
     sliders: tuple[SliderShape, ...]
     guides: tuple[GuideLine, ...]
+    actuators: tuple[ActuatorShape, ...] = ()
 
     def extent(self) -> tuple[Array, Array]:
         """Return the lower-left and upper-right corners of everything drawn, m."""
@@ -706,8 +718,11 @@ def space_from_state(scene: Scene, state: State,
         sliders.extend(SliderShape(*block) for block in blocks)
         guides.extend(GuideLine(*guide)
                       for guide in dyad.guides(state, points, strokes or {}, size))
+    actuators = tuple(ActuatorShape(name, points[topology.bodies[name].points[0]],
+                                    points[topology.bodies[name].points[1]])
+                      for name in varying_links(scene))
     return SpaceDiagram(points, tuple(scene.ground), tuple(links), pivots, tuple(sliders),
-                        tuple(guides))
+                        tuple(guides), actuators)
 
 
 def arrows_from_state(scene: Scene, state: State, velocity_scale: float,

@@ -477,6 +477,11 @@ def test_polygons_are_refused_in_one_line_through_an_actuator(tmp_path):
     assert diagram.refused == ('no velocity or acceleration polygon: link body changes length '
                                "(an actuator's), which these polygons do not draw")
     assert geo.varying_links(scene) == ('body',)
+    (cylinder,) = diagram.space.actuators
+    assert cylinder.link == 'body'
+    np.testing.assert_array_equal(cylinder.start, diagram.space.points['F'])
+    np.testing.assert_array_equal(cylinder.end, diagram.space.points['Q'])
+    assert geo.diagram_from_scene(_scene(FIVE_BAR_TWO_CRANKS)).space.actuators == ()
     tables = geo.tables_from_diagram(diagram)
     assert set(tables) == {'space'}
     assert ('cyl', 'actuator', 'L = 3', '-', '-0.1 m/s', '0 m/s\u00b2') in tables['space'].rows
