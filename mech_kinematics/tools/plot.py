@@ -500,7 +500,10 @@ def motion_from_bag(path: str | os.PathLike[str], *, scene: Any = None,
             scene = candidate
     if scene is not None:
         types = {n: scene.joint_types.get(n, 'revolute') for n in names}
-        crank = scene.input.link
+        drivers = scene.drivers
+        # Several drivers (or an actuator): no one crank angle (NaN; --x angle is refused).
+        crank = drivers[0].name if len(drivers) == 1 and drivers[0].joint_type == 'revolute' \
+            else ''
     else:
         if any(names):
             warnings.warn(f'{path}: no scene given or named in the bag; plotting every joint '
@@ -711,8 +714,17 @@ def save_figure(fig: Any, output: str | os.PathLike[str]) -> Path:
 def plot_bag(path: str | os.PathLike[str], output: str | os.PathLike[str], *,
              x: str = 'time', scene: Any = None, namespace: str | None = None,
              max_samples: int | None = DEFAULT_MAX_SAMPLES) -> Any:
-    """Plot the recording at ``path`` to ``output``; return the Figure."""
+    """Plot the recording at ``path`` to ``output``; return the Figure.
+
+    A recording of a scene with several drivers (or an actuator) has no one
+    crank angle: ``x='angle'`` is refused.
+    """
     motion = motion_from_bag(path, scene=scene, namespace=namespace, max_samples=max_samples)
+    if x == 'angle' and motion.joints and not np.isfinite(motion.crank_angle).any():
+        msg = (f'Expected a recording of a scene driven by one crank to plot against crank '
+               f'angle, got {motion.title.split(":")[0]}, with several drivers or an '
+               f'actuator: use --x time')
+        raise PlotError(msg)
     fig = figure_from_motion(motion, x=x)
     save_figure(fig, output)
     return fig

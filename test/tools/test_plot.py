@@ -436,3 +436,17 @@ def test_duration_with_one_crank_is_refused(tmp_path, capsys):
                       '--duration', '1']) == 2
     assert 'Expected --duration only for a scene with several drivers' in (
         capsys.readouterr().err)
+
+
+def test_bag_of_a_scene_with_several_drivers_plots_against_time_only(tmp_path, capsys):
+    """A five-bar recording: each driver's joint against time; --x angle is refused (exit 2)."""
+    scene = mk.parse_scene(yaml.safe_load(TOGETHER))
+    positions = [[math.radians(120) + 0.01 * i, math.radians(60) + 0.01 * i] for i in range(50)]
+    bag = write_bag(tmp_path / 'five', scene, positions, scene_text=TOGETHER)
+    fig = plot.plot_bag(bag, tmp_path / 'five.png')
+    left = lines(panels(fig)['Joint angles'])['left']
+    np.testing.assert_allclose(left.get_ydata(), [p[0] for p in positions], rtol=1e-15)
+    assert plot.main([str(bag), '-o', str(tmp_path / 'a.png'), '--x', 'angle']) == 2
+    assert ('Expected a recording of a scene driven by one crank to plot against crank angle, '
+            'got five, with several drivers or an actuator: use --x time') in (
+        capsys.readouterr().err)
