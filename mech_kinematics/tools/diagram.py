@@ -55,6 +55,7 @@ ROW_H = 0.44             # cm per table row
 DPI = 110
 FONT = 8.5               # pt, labels
 TABLE_FONT = 7.5         # pt
+BARREL = 0.55            # of an actuator's length drawn as its barrel
 
 STYLE = {
     VectorKind.RELATIVE: ('-', 1.7), VectorKind.NORMAL: ('-', 1.5),
@@ -267,6 +268,11 @@ def _draw_mechanism(ax: Any, scene: Scene, space: SpaceDiagram, colours: Mapping
             ax.plot(xy[:, 0], xy[:, 1], color='white', lw=1.4, zorder=2.1)
         else:
             ax.plot(xy[:, 0], xy[:, 1], color=colour, lw=3.0, zorder=2, solid_capstyle='round')
+    for actuator in space.actuators:  # a cylinder: its barrel over the rod, from its base pin
+        start, end = actuator.start, actuator.end
+        barrel = start + BARREL * (end - start)
+        ax.plot([start[0], barrel[0]], [start[1], barrel[1]], color=colours[actuator.link],
+                lw=8.0, alpha=0.55, zorder=2.2, solid_capstyle='butt')
     for slider in space.sliders:
         corners = _block(slider.xy, slider.angle, block_l, block_h)
         ax.add_patch(Patch(corners, closed=True, facecolor=colours.get(slider.name, 'white'),
@@ -808,6 +814,9 @@ def _handle(args: argparse.Namespace) -> int:
     speed = None if args.speed_rpm is None else rad_per_s_from_rpm(args.speed_rpm)
     try:
         scene = load_scene(args.scene)
+        drivers = scene.drivers
+        if len(drivers) > 1 or drivers[0].joint_type != 'revolute':
+            return _handle_drivers(args, scene, output)
         if args.animate:
             if args.angle_deg is not None:
                 scene = _with_angle(scene, math.radians(args.angle_deg))
@@ -822,6 +831,24 @@ def _handle(args: argparse.Namespace) -> int:
     except (SceneError, AssemblyError, ValueError, OSError) as error:
         print(f'error: {error}', file=sys.stderr)
         return 2
+    return 0
+
+
+def _handle_drivers(args: argparse.Namespace, scene: Scene, output: Path) -> int:
+    """Draw a scene with several drivers (or an actuator) at its drivers' start positions."""
+    names = ', '.join(d.name for d in scene.drivers)
+    for flag, used in (('--animate', args.animate), ('--angle-deg', args.angle_deg is not None),
+                       ('--speed-rpm', args.speed_rpm is not None),
+                       ('--accel', args.accel is not None)):
+        if used:
+            msg = (f'Expected no {flag} for {scene.name}, which has several drivers or an '
+                   f"actuator ({names}): it is drawn at its drivers' start positions")
+            raise ValueError(msg)
+    diagram = diagram_from_scene(scene, inputs={}, instant_centres=args.instant_centres)
+    write_diagram(diagram, scene, output)
+    if diagram.refused:
+        print(f'{scene.name}: {diagram.refused}')
+    print(f'wrote {output}')
     return 0
 
 

@@ -508,3 +508,26 @@ def test_unknown_driver_names_are_refused():
     """A position for a driver the scene has not: one ValueError naming the drivers."""
     with pytest.raises(ValueError, match=r'Expected drivers of five \(left, right\), got x'):
         geo.diagram_from_scene(_scene(FIVE_BAR_TWO_CRANKS), inputs={'x': 1.0})
+
+
+def test_cli_draws_several_drivers_and_says_why_polygons_are_left_out(tmp_path, capsys):
+    """Diagram SCENE: the boom at its start, the polygons refused in one printed line."""
+    path = tmp_path / 'boom.yaml'
+    path.write_text(BOOM_CYLINDER)
+    assert dg.main([str(path), '-o', str(tmp_path / 'boom.png')]) == 0
+    assert capsys.readouterr().out.splitlines() == [
+        "boom: no velocity or acceleration polygon: link body changes length (an actuator's), "
+        'which these polygons do not draw', f'wrote {tmp_path / "boom.png"}']
+    assert _png_size(tmp_path / 'boom.png')[0] >= MIN_PNG_SIZE[0]
+
+
+@pytest.mark.parametrize('flag', [['--animate'], ['--angle-deg', '30'], ['--speed-rpm', '5']])
+def test_cli_refuses_one_crank_options_for_several_drivers(flag, tmp_path, capsys):
+    """--animate, --angle-deg, --speed-rpm have one crank's meaning: one error line, exit 2."""
+    path = tmp_path / 'five.yaml'
+    path.write_text(FIVE_BAR_TWO_CRANKS)
+    out = tmp_path / ('five.gif' if flag == ['--animate'] else 'five.png')
+    assert dg.main([str(path), '-o', str(out), *flag]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f'error: Expected no {flag[0]} for five, which has several drivers')
+    assert not out.exists()
