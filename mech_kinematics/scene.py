@@ -34,7 +34,8 @@ from .errors import SceneError
 from .solver import Branch, CarriedPoint, Crank, Link, Pin, Scene, SceneUnits
 from .solver.base import Item
 from .solver.registry import KINDS
-from .units import ANGLE_UNITS, LENGTH_UNITS, rad_per_s_from_rpm
+from .units import (ANGLE_UNITS, LENGTH_UNITS, rad_per_s_from_rpm, reduce_radians,
+                    turns_from_degrees)
 from .yaml12 import (_brief, _join, MAX_DEPTH, MAX_INTEGER_DIGITS, MAX_YAML_NODES,
                      read_scene_yaml, SceneLoader)
 
@@ -156,6 +157,19 @@ class _Reader:
         value = self.number(mapping, key, where, default)
         return math.radians(value) if self.degrees else value
 
+    def start_angle(self, mapping: Any, key: str, where: str) -> tuple[float, int]:
+        """Return the crank angle at ``key`` as (rad within a turn, whole turns).
+
+        An angle beyond a turn is reduced exactly (in degrees as written, or
+        in rad with 2 pi to 400 digits), so that 1e308 deg is the same crank
+        position as ``solve --angle-deg 1e308``; within a turn it is read as
+        :meth:`angle` reads it, with no turns.
+        """
+        value = self.number(mapping, key, where, 0.0)
+        if self.degrees:
+            return turns_from_degrees(value) if abs(value) > 360.0 else (math.radians(value), 0)
+        return reduce_radians(value) if abs(value) > math.tau else (value, 0)
+
     def name(self, mapping: Any, key: str, where: str) -> str:
         value = self.get(mapping, key, where)
         if not isinstance(value, str):
@@ -255,11 +269,12 @@ def parse_scene(data: Any) -> Scene:
     raw = reader.get(data, 'input', '')
     _check_keys(raw if isinstance(raw, dict) else {}, set(InputDict.__annotations__), 'input')
     rpm = reader.number(raw, 'speed_rpm', 'input', 0.0)
+    angle, turns = reader.start_angle(raw, 'angle', 'input')
     crank = keys.build(
         'input', {'speed': 'speed_rpm'}, Crank,
         link=reader.name(raw, 'link', 'input'), center=reader.name(raw, 'center', 'input'),
         point=reader.name(raw, 'point', 'input'), length=reader.length(raw, 'length', 'input'),
-        angle=reader.angle(raw, 'angle', 'input', 0.0), speed=rad_per_s_from_rpm(rpm),
+        angle=angle, turns=turns, speed=rad_per_s_from_rpm(rpm),
         accel=reader.number(raw, 'accel', 'input', 0.0))
 
     dyads_data = data.get('dyads', []) or []

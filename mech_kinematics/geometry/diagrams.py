@@ -781,10 +781,10 @@ def diagram_from_scene(scene: Scene, angle: float | None = None, speed: float | 
     """
     scene = full_scene(scene)
     if angle is None:
-        theta = scene.input.angle
+        theta, turns = scene.input.angle, scene.input.turns
     else:
-        theta = math.radians(angle) if degrees else float(angle)
-    state = solve(scene, theta, speed, accel)
+        theta, turns = (math.radians(angle) if degrees else float(angle)), 0
+    state = solve(scene, theta, speed, accel, turns=turns)
     topology = bodies_from_scene(scene)
     links, sliders = _values(scene, state, topology)
     centres = instant_centres_from_state(scene, state) if instant_centres else None

@@ -356,11 +356,13 @@ class KinematicsNode(LifecycleNode):
         try:    # what `solve` refuses at the start, the node refuses to start with
             mk.solve(scene, scene.input.angle,
                      speed['speed'] if own_speed else rad_per_s_from_rpm(speed['speed_rpm']),
-                     self._value('crank_accel'), max_error=self._max_error)
+                     self._value('crank_accel'), turns=scene.input.turns,
+                     max_error=self._max_error)
         except mk.AssemblyError as error:
             msg = f'{scene.name}: {error}'
             raise mk.SceneError(msg) from None
-        self._driver.add_drive(CRANK, angle=scene.input.angle, accel=self._value('crank_accel'),
+        self._driver.add_drive(CRANK, angle=scene.input.angle, turns=scene.input.turns,
+                               accel=self._value('crank_accel'),
                                max_speed_rpm=self._value('max_crank_speed_rpm'), **speed)
         self._messages = TickMessages(scene.output_joints, scene.output_points, self.frame_id)
         self._pub_joint_states = self.create_publisher(
@@ -489,7 +491,8 @@ class KinematicsNode(LifecycleNode):
         self._marker_strokes = strokes_from_scene(self._marker_scene)
         try:
             self._marker_size: float | None = marker_size_from_space(space_from_state(
-                self._marker_scene, mk.solve(self._marker_scene, scene.input.angle)))
+                self._marker_scene, mk.solve(self._marker_scene, scene.input.angle,
+                                             turns=scene.input.turns)))
         except mk.AssemblyError:
             self._marker_size = None    # the part beyond the outputs cannot assemble here
         self._marker_throttle = MarkerThrottle()

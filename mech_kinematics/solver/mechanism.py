@@ -122,7 +122,7 @@ class Scene:
     """A planar mechanism: ground points, the driving crank, dyads, carried points.
 
     Construction validates names and dependencies and checks that the
-    mechanism assembles at ``input.angle``; a failure raises
+    mechanism assembles at ``input.angle`` (plus ``input.turns``); a failure raises
     :class:`SceneError`.
 
     Parameters
@@ -171,12 +171,12 @@ class Scene:
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter('ignore', NearSingularWarning)
-                _execute(solver, self.input.angle, 0.0, 0.0)  # positions only
+                _execute(solver, self.input.angle, 0.0, 0.0, self.input.turns)  # positions only
         except AssemblyError as error:
             dyad = next((step.dyad for step in full.steps
                          if step.owner is None and step.label == error.dyad), None)
             msg = (f'Expected the mechanism to assemble at the initial crank angle '
-                   f'{self.units.angle_text(self.input.angle)}, got '
+                   f'{self.units.angle_text(self.input.shown)}, got '
                    f'{assembly_text(error, self.units)}')
             raise SceneError(msg, (self.input, 'angle') if dyad is None else (dyad, '')) from None
         if self.outputs_joints is None and self.outputs_points is None:

@@ -7,7 +7,6 @@ from __future__ import annotations
 import argparse
 from collections.abc import Sequence
 import json
-import math
 import sys
 from typing import Any
 import warnings
@@ -17,7 +16,7 @@ from ..bounds import MAX_ERROR
 from ..errors import AssemblyError, NearSingularWarning, SceneError, UntrustedError
 from ..scene import load_scene
 from ..solver import assembly_text, solve
-from ..units import rad_per_s_from_rpm, radians_from_degrees
+from ..units import rad_per_s_from_rpm, turns_from_degrees
 
 __all__ = ['add_parser', 'main', 'turns_from_degrees']
 
@@ -39,18 +38,6 @@ exits with status 2.
 """
 
 
-def turns_from_degrees(degrees: float) -> tuple[float, int]:
-    """Split a crank angle in degrees, counted from the start, into (rad within a turn, turns).
-
-    ``degrees = 360 * turns + rest`` exactly (IEEE remainder), ``rest`` in
-    [-180, 180]; the angle is ``rest`` in radians. So ``--angle-deg 450`` is
-    90 deg in turn 1, and ``36000090`` is 90 deg in turn 100000, with no
-    rounding of the whole turns.
-    """
-    rest = math.remainder(degrees, 360.0)
-    return radians_from_degrees(rest), round((degrees - rest) / 360.0)
-
-
 def _handle(args: argparse.Namespace) -> int:
     try:
         scene = load_scene(args.scene)
@@ -58,7 +45,7 @@ def _handle(args: argparse.Namespace) -> int:
         print(f'error: {error}', file=sys.stderr)
         return 2
     if args.angle_deg is None:
-        angle, turns = scene.input.angle, 0
+        angle, turns = scene.input.angle, scene.input.turns
     else:
         angle, turns = turns_from_degrees(args.angle_deg)
     speed = None if args.speed_rpm is None else rad_per_s_from_rpm(args.speed_rpm)
@@ -67,7 +54,7 @@ def _handle(args: argparse.Namespace) -> int:
             warnings.simplefilter('always', NearSingularWarning)
             state = solve(scene, angle, speed, args.accel, turns=turns, max_error=args.max_error)
     except AssemblyError as error:
-        shown = scene.units.angle_text(scene.input.angle) if args.angle_deg is None else \
+        shown = scene.units.angle_text(scene.input.shown) if args.angle_deg is None else \
             f'{args.angle_deg:.15g} deg'
         reason = error.reason if isinstance(error, UntrustedError) or error.facts is None \
             else assembly_text(error, scene.units)
