@@ -41,6 +41,7 @@ from .instant_centres import (bodies_from_scene, BodyKind, check_full_state, ful
                               instant_centres_from_state, InstantCentres, Topology)
 from ..errors import NearSingularWarning
 from ..solver import Scene, solve, State
+from ..units import turns_from_degrees
 
 __all__ = [
     'COLOURS', 'Diagram', 'GuideLine', 'LinkShape', 'LinkValues', 'PinValues', 'Pivot',
@@ -793,6 +794,8 @@ def diagram_from_scene(scene: Scene, angle: float | None = None, speed: float | 
     scene = full_scene(scene)
     if angle is None:
         theta, turns = scene.input.angle, scene.input.turns
+    elif degrees and abs(angle) > 360.0:  # counted from the start: whole turns read exactly
+        theta, turns = turns_from_degrees(angle)
     else:
         theta, turns = (math.radians(angle) if degrees else float(angle)), 0
     state = solve(scene, theta, speed, accel, turns=turns)

@@ -452,3 +452,20 @@ def test_a_geneva_wheel_of_radius_1e300_is_drawn(tmp_path, capsys):
     assert dg.main([str(path), '-o', str(png)]) == 0
     assert _png_size(png)[0] >= MIN_PNG_SIZE[0]
     assert capsys.readouterr().err == ''
+
+
+def test_a_diagram_far_out_is_drawn_where_solve_puts_it(tmp_path):
+    """`diagram --angle-deg 1e17` answers as `solve --angle-deg 1e17` (it said "pin on pivot").
+
+    1e17 deg is -80 deg after 277777777777778 whole turns, read exactly: the Geneva
+    wheel is held at the index it has there, as for the scene started at that angle.
+    """
+    scene = mk.load_scene('geneva')
+    diagram = geo.diagram_from_scene(scene, 1e17, degrees=True)
+    solved = mk.solve(scene, math.radians(-80.0), turns=277777777777778)
+    wheel = next(link for link in diagram.links if link.name == 'wheel')
+    assert wheel.angle == solved.joints['wheel'].position and wheel.engaged is False
+    assert dg.main(['geneva', '--angle-deg', '1e17', '-o', str(tmp_path / 'far.png')]) == 0
+    gif = tmp_path / 'far.gif'
+    assert dg.main(['geneva', '--angle-deg', '1e17', '--animate', '--frames', '4', '-o',
+                    str(gif)]) == 0
