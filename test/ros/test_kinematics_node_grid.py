@@ -246,8 +246,9 @@ def test_a_10_s_stop_at_1_khz_is_one_burst_a_keep_last_1000_reader_gets_whole(ro
         stream.stop()
     gaps = [(b - a, i) for i, (a, b) in enumerate(zip(stamps, stamps[1:], strict=False))]
     stop_gap, at = max(gaps)
-    # The stop: older instants skipped (counted), then 1000 instants in one burst at most.
-    assert 8.5e9 <= stop_gap <= 9.6e9, stop_gap
+    # The stop: older instants skipped (counted), then 1000 instants in one burst at most
+    # (uncapped, the burst would have left no gap at all; a late wake-up widens it).
+    assert 8.5e9 <= stop_gap <= 12e9, stop_gap
     assert stop_gap // period - 1 <= skipped
     after = stamps[at + 1:]
     assert len(after) >= 1000 + 500
