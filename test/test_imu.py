@@ -116,3 +116,85 @@ def test_gravity_and_angle_must_be_finite():
         ImuSpec('tip', 'coupler', 'C', (0.0, math.inf))
     with pytest.raises(ValueError, match=r'imus\.tip\.angle'):
         ImuSpec('tip', 'coupler', 'C', G, math.nan)
+
+
+# -- the scene's ``imus:`` (read and checked by scene.py) ------------------------------------
+
+IMU_SCENE = {
+    'name': 'imu_test', 'units': {'length': 'mm', 'angle': 'deg'},
+    'ground': {'A': [0, 0], 'D': [150, 0]},
+    'input': {'link': 'crank', 'center': 'A', 'point': 'B', 'length': 40, 'angle': 60,
+              'speed_rpm': -120},
+    'dyads': [{'type': 'RRR', 'point': 'C',
+               'links': [{'name': 'coupler', 'from': 'B', 'length': 150},
+                         {'name': 'rocker', 'from': 'D', 'length': 80}]}],
+    'points': {'E': {'link': 'coupler', 'origin': 'B', 'xaxis': 'C', 'local': [30, 20]}},
+    'outputs': {'joints': ['rocker'], 'points': ['C']},
+}
+
+
+def imu_scene(imus):
+    """Return the test scene (mm, deg) with ``imus``."""
+    return mk.parse_scene({**IMU_SCENE, 'imus': imus})
+
+
+def test_the_scene_reads_imus_in_its_angle_unit_and_gravity_in_si():
+    """``angle`` in the scene's unit (deg here), gravity in m/s^2; defaults 0 and [0, 0]."""
+    scene = imu_scene({'tip': {'link': 'coupler', 'point': 'E', 'gravity': [0, -9.80665],
+                               'angle': 30},
+                       'bare': {'link': 'rocker', 'point': 'C'}})
+    assert scene.imus == (ImuSpec('tip', 'coupler', 'E', (0.0, -9.80665), math.radians(30)),
+                          ImuSpec('bare', 'rocker', 'C', (0.0, 0.0), 0.0))
+
+
+def test_outputs_keep_what_each_imu_needs_after_what_they_list():
+    """outputs: lists rocker and C only; the sensor's link and point are added after them."""
+    scene = imu_scene({'tip': {'link': 'coupler', 'point': 'E'}})
+    assert scene.output_joints == ('rocker', 'coupler')
+    assert scene.output_points == ('C', 'E')
+    state = mk.solve(scene, scene.input.angle)
+    reading = imu_reading(state, scene.imus[0])
+    assert reading.orientation == state.joints['coupler'].position
+    # Without the sensor the outputs stay as listed (nothing more is solved).
+    plain = mk.parse_scene(IMU_SCENE)
+    assert (plain.output_joints, plain.output_points) == (('rocker',), ('C',))
+
+
+@pytest.mark.parametrize('imus, message', [
+    ({'tip': {'link': 'nope', 'point': 'E'}},
+     r'imus\.tip\.link: Expected a moving link \(crank, coupler, rocker\), got unknown "nope"'),
+    ({'tip': {'link': 'A', 'point': 'E'}},
+     r'imus\.tip\.link: .* got ground point "A", which does not move'),
+    ({'tip': {'link': 'rocker', 'point': 'E'}},
+     r'imus\.tip\.point: Expected a point carried by or lying on link "rocker" \(D, C\), '
+     r'got "E"'),
+    ({'tip': {'link': 'coupler', 'point': 'E', 'gravity': [0, math.nan]}},
+     r'imus\.tip\.gravity\[1\]: expected a finite number, got nan'),
+    ({'tip': {'link': 'coupler', 'point': 'E', 'gravity': [0]}},
+     r'imus\.tip\.gravity: expected \[gx, gy\] in m/s\^2'),
+    ({'tip': {'link': 'coupler', 'point': 'E', 'angle': math.inf}},
+     r'imus\.tip\.angle: expected a finite number, got inf'),
+    ({'tip': {'link': 'coupler', 'point': 'E', 'mass': 1}},
+     r"imus\.tip: unknown key\(s\) \['mass'\]"),
+    ({'tip': {'point': 'E'}}, r'imus\.tip\.link: missing required key'),
+    ({'C': {'link': 'coupler', 'point': 'E'}},
+     r'imus\.C: Expected a sensor name not used for a point, link or slider, got "C"'),
+    ({'tip': 3}, r'imus\.tip: expected a mapping'),
+    ([1], r'imus: expected a mapping'),
+])
+def test_a_bad_imu_is_refused_in_one_line_naming_its_key(imus, message):
+    """Unknown or still link, a point not on it, non-finite numbers, unknown keys."""
+    with pytest.raises(mk.SceneError, match=message) as caught:
+        imu_scene(imus)
+    assert '\n' not in str(caught.value)
+
+
+def test_an_imu_on_a_slider_is_refused():
+    """A slider (a prismatic joint) does not turn: no sensor frame on it."""
+    scene = mk.load_scene('slider_crank_150_600')
+    slider = next(n for n, t in scene.joint_types.items() if t == 'prismatic')
+    data = mk.scene.read_scene_yaml(mk.scene.scene_text('slider_crank_150_600'))
+    data['imus'] = {'s': {'link': slider, 'point': scene.input.point}}
+    with pytest.raises(mk.SceneError, match=f'imus.s.link: .*got slider "{slider}", which '
+                                            f'does not turn'):
+        mk.parse_scene(data)
