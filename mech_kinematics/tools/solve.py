@@ -15,11 +15,12 @@ import warnings
 from .cli import add_scene_argument, finite_float, positive_float, run_tool
 from ..bounds import MAX_ERROR
 from ..errors import AssemblyError, NearSingularWarning, SceneError, UntrustedError
+from ..imu import imu_reading
 from ..scene import load_scene
-from ..solver import assembly_text, solve
+from ..solver import assembly_text, Scene, solve, State
 from ..units import rad_per_s_from_rpm, radians_from_degrees
 
-__all__ = ['add_parser', 'main', 'turns_from_degrees']
+__all__ = ['add_parser', 'main', 'turns_from_degrees', 'with_imus']
 
 SOLVE_HELP = """\
 Solve a scene at one crank instant and print one JSON object: the input
@@ -28,9 +29,11 @@ velocity, acceleration: rad for revolute joints, m for sliders), every
 output point (position, velocity, acceleration as [x, y]), "rubbing" (the
 rubbing velocity at each of the scene's pins, m/s), "intermittent" (each
 Geneva wheel: engaged or locked, its engagement window and where its
-acceleration jumps) and "error_bound", the absolute error bound of each of
-those values (one number per value; for a point, the bound on the length of
-its error vector), all in SI units.
+acceleration jumps), "imus" (each of the scene's inertial sensors: angular
+velocity rad/s, linear acceleration [x, y] m/s^2 in the sensor's frame,
+orientation rad) and "error_bound", the absolute error bound of each of
+those values (one number per value; for a point or an acceleration, the
+bound on the length of its error vector), all in SI units.
 Options left out take the scene's own values. On a position that cannot be
 solved, or whose answer cannot be trusted (a value's error bound above
 --max-error times its kind's scale, a dyad within rounding of an assembly
@@ -83,12 +86,32 @@ def _handle(args: argparse.Namespace) -> int:
         else:
             warnings.warn_explicit(warning.message, warning.category, warning.filename,
                                    warning.lineno)
-    result: dict[str, Any] = state.as_dict()
+    result: dict[str, Any] = with_imus(state.as_dict(), scene, state)
     if args.diagnostics:
         result['singularity'] = {key: float(m) for key, m in state.singularity.items()}
         result['relative_error_bound'] = float(state.relative_error_bound)
     print(json.dumps(result, indent=args.indent, allow_nan=False))
     return 0
+
+
+def with_imus(result: dict[str, Any], scene: Scene, state: State) -> dict[str, Any]:
+    """Return ``state.as_dict()`` (``result``) with the scene's IMUs and their bounds.
+
+    ``"imus": {NAME: {"angular_velocity", "linear_acceleration": [x, y],
+    "orientation"}}`` before ``"error_bound"``, and ``"error_bound": {"imus":
+    {NAME: ...}}`` shaped alike (the acceleration's bound on its error's
+    length); a scene without sensors keeps the JSON it had. Arrays where the
+    state was solved for many instants.
+    """
+    if not scene.imus:
+        return result
+    vector = not isinstance(state.valid, bool)
+    readings = {spec.name: imu_reading(state, spec) for spec in scene.imus}
+    bound = result.pop('error_bound')
+    result['imus'] = {name: r.as_dict(vector) for name, r in readings.items()}
+    result['error_bound'] = {**bound, 'imus': {name: r.bounds_dict(vector)
+                                               for name, r in readings.items()}}
+    return result
 
 
 def add_parser(subparsers: Any) -> argparse.ArgumentParser:
