@@ -23,7 +23,6 @@ import mech_kinematics as mk
 from mech_kinematics.__main__ import main
 from mech_kinematics.imu import imu_reading, ImuSpec
 from mech_kinematics.tools.report import reference as ref
-from mech_kinematics.tools.solve import with_imus
 
 G = (0.0, -9.80665)  # m/s^2, standard gravity along -y
 SCENE = mk.load_scene('khurmi_four_bar_ad150')
@@ -215,9 +214,9 @@ IMU_TIP = {'tip': {'link': 'coupler', 'point': 'E', 'gravity': [0.0, -9.80665], 
 
 
 def solve_json(scene, angle, speed, accel):
-    """Return the ``solve`` JSON (as a dict) of ``scene`` at one instant."""
+    """Return ``State.as_dict()`` (the ``solve`` JSON) of ``scene`` at one instant."""
     state = mk.solve(scene, angle, speed, accel)
-    return with_imus(state.as_dict(), scene, state)
+    return state.as_dict()
 
 
 def five_point(f, h):
@@ -308,14 +307,26 @@ def test_solve_prints_imus_before_error_bound_and_only_for_a_scene_with_imus(tmp
     assert main(['solve', 'khurmi_four_bar_ad150']) == 0
     data = json.loads(capsys.readouterr().out)
     assert 'imus' not in data and set(data['error_bound']) == {'joints', 'points'}
+    assert mk.solve(mk.load_scene('khurmi_four_bar_ad150'), 1.0).imus == {}
 
 
-def test_with_imus_on_the_array_path_gives_the_single_instant_values():
+def test_state_imus_are_the_readings_of_the_scenes_sensors():
+    """``State.imus`` holds each sensor's :func:`imu_reading` of that state, in scene order."""
+    scene = imu_scene({**IMU_TIP, 'rock': {'link': 'rocker', 'point': 'C'}})
+    state = mk.solve(scene, 0.4, 2.0, -3.0)
+    assert list(state.imus) == ['tip', 'rock']
+    for spec in scene.imus:
+        got, expected = state.imus[spec.name], imu_reading(state, spec)
+        assert got.as_dict(False) == expected.as_dict(False)
+        assert got.bounds_dict(False) == expected.bounds_dict(False)
+
+
+def test_as_dict_on_the_array_path_gives_the_single_instant_readings():
     """Over an array of angles the readings and bounds are arrays of the single-angle ones."""
     scene = imu_scene(IMU_TIP)
     angles = np.linspace(-3, 3, 9)
     state = mk.solve(scene, angles)
-    many = with_imus(state.as_dict(), scene, state)
+    many = state.as_dict()
     for i, angle in enumerate(angles):
         one = solve_json(scene, float(angle), None, None)
         assert many['imus']['tip']['angular_velocity'][i] == \

@@ -15,12 +15,11 @@ import warnings
 from .cli import add_scene_argument, finite_float, positive_float, run_tool
 from ..bounds import MAX_ERROR
 from ..errors import AssemblyError, NearSingularWarning, SceneError, UntrustedError
-from ..imu import imu_reading
 from ..scene import load_scene
-from ..solver import assembly_text, Scene, solve, State
+from ..solver import assembly_text, solve
 from ..units import rad_per_s_from_rpm, radians_from_degrees
 
-__all__ = ['add_parser', 'main', 'turns_from_degrees', 'with_imus']
+__all__ = ['add_parser', 'main', 'turns_from_degrees']
 
 SOLVE_HELP = """\
 Solve a scene at one crank instant and print one JSON object: the input
@@ -86,32 +85,12 @@ def _handle(args: argparse.Namespace) -> int:
         else:
             warnings.warn_explicit(warning.message, warning.category, warning.filename,
                                    warning.lineno)
-    result: dict[str, Any] = with_imus(state.as_dict(), scene, state)
+    result: dict[str, Any] = state.as_dict()
     if args.diagnostics:
         result['singularity'] = {key: float(m) for key, m in state.singularity.items()}
         result['relative_error_bound'] = float(state.relative_error_bound)
     print(json.dumps(result, indent=args.indent, allow_nan=False))
     return 0
-
-
-def with_imus(result: dict[str, Any], scene: Scene, state: State) -> dict[str, Any]:
-    """Return ``state.as_dict()`` (``result``) with the scene's IMUs and their bounds.
-
-    ``"imus": {NAME: {"angular_velocity", "linear_acceleration": [x, y],
-    "orientation"}}`` before ``"error_bound"``, and ``"error_bound": {"imus":
-    {NAME: ...}}`` shaped alike (the acceleration's bound on its error's
-    length); a scene without sensors keeps the JSON it had. Arrays where the
-    state was solved for many instants.
-    """
-    if not scene.imus:
-        return result
-    vector = not isinstance(state.valid, bool)
-    readings = {spec.name: imu_reading(state, spec) for spec in scene.imus}
-    bound = result.pop('error_bound')
-    result['imus'] = {name: r.as_dict(vector) for name, r in readings.items()}
-    result['error_bound'] = {**bound, 'imus': {name: r.bounds_dict(vector)
-                                               for name, r in readings.items()}}
-    return result
 
 
 def add_parser(subparsers: Any) -> argparse.ArgumentParser:

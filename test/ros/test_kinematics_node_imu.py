@@ -22,7 +22,6 @@ import yaml
 
 import mech_kinematics as mk
 from mech_kinematics.ros import topics
-from mech_kinematics.tools.solve import with_imus
 
 FRAME_ID = 'base'
 #: The node's readings against `solve`'s at the same crank angle: the same formulas on the
@@ -80,7 +79,7 @@ def test_imu_topics_carry_the_readings_solve_prints(ros, tmp_path):
             if stamp not in crank:
                 continue
             state = mk.solve(scene, crank[stamp])
-            data = with_imus(state.as_dict(), scene, state)['imus'][name]
+            data = state.as_dict()['imus'][name]
             assert msg.header.frame_id == frame
             q = msg.orientation
             assert (q.x, q.y) == (0.0, 0.0)
@@ -139,7 +138,7 @@ def test_rendered_imu_bytes_are_the_canonical_cdr_of_the_message():
         state = mk.solve(scene, float(angle), 3.0, -20.0)
         values = values_from_state(state, scene.output_joints, scene.output_points)
         rendered = messages.render_values(values, 7, 123)
-        data = with_imus(state.as_dict(), scene, state)['imus']
+        data = state.as_dict()['imus']
         for spec, raw in zip(scene.imus, rendered, strict=True):
             p = state.points[spec.point].acceleration
             msg = imu_from_values(spec, 'p', 7, 123, state.joints[spec.link].position,
