@@ -150,3 +150,46 @@ def test_rendered_imu_bytes_are_the_canonical_cdr_of_the_message():
             assert [back.linear_acceleration.x, back.linear_acceleration.y] == pytest.approx(
                 data[spec.name]['linear_acceleration'], rel=1e-14)
             assert back.angular_velocity.z == data[spec.name]['angular_velocity']
+
+
+def test_the_gripper_runs_a_whole_turn_with_its_fingertip_imu(ros, tmp_path):
+    """The packaged gripper at its own 30 rpm: one Imu per state over a turn, none refused.
+
+    Every state the node publishes over a crank turn (2 s) has its fingertip
+    reading, in the jaw's frame, equal to solve's at that stamp's crank angle;
+    the jaw translates, so the gyro reads 0 to rounding and the orientation is
+    the jaw's constant angle atan2(18, 24).
+    """
+    scene = mk.load_scene('gripper')
+    ns = f'{SESSION}/gripper'
+    qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+    imu = ros.collect(Imu, f'{ns}/imu/fingertip', qos)
+    joints = ros.collect(JointState, f'{ns}/joint_states', qos)
+    proc = NodeProcess(tmp_path, '-r', f'__ns:={ns}', '-r', f'/tf:={ns}/tf',
+                       '-r', f'/tf_static:={ns}/tf_static', '-p', 'scene:=gripper',
+                       '-p', 'rate_hz:=100')
+    try:
+        wait_for(lambda: len(imu) >= 230 and len(joints) >= 230, STARTUP_S + 5,
+                 'a crank turn of Imu and joint_states messages')
+    finally:
+        status, _ = proc.stop(signal.SIGINT)
+    assert status == 0, proc.output()
+    assert 'no state published' not in proc.output()
+    crank = {stamp_ns(m): m.position[m.name.index('crank')] for m in joints}
+    stamps = [stamp_ns(m) for m in imu]
+    assert stamps == sorted(stamps) and len(set(stamps)) == len(stamps)
+    # Every state has its reading (the first few may precede this side's subscription).
+    assert len(set(crank) - set(stamps)) <= 5 and len(set(stamps) - set(crank)) <= 5
+    turned = np.unwrap(np.array([crank[s] for s in sorted(set(crank) & set(stamps))]))
+    assert turned[-1] - turned[0] >= 2 * math.pi * 0.95
+    for msg in imu:
+        stamp = stamp_ns(msg)
+        if stamp not in crank:
+            continue
+        data = mk.solve(scene, crank[stamp]).as_dict()['imus']['fingertip']
+        assert msg.header.frame_id == 'mechanism/jaw'
+        assert 2 * math.atan2(msg.orientation.z, msg.orientation.w) == pytest.approx(
+            math.atan2(18, 24), abs=1e-14)
+        assert abs(msg.angular_velocity.z) < 1e-14
+        np.testing.assert_allclose([msg.linear_acceleration.x, msg.linear_acceleration.y],
+                                   data['linear_acceleration'], rtol=0, atol=1e-12)
