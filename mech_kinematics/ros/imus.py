@@ -32,7 +32,7 @@ messages are; :func:`imu_from_values` builds the same message as an object
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 import math
 from typing import Any
 
@@ -40,10 +40,10 @@ from builtin_interfaces.msg import Time
 from sensor_msgs.msg import Imu
 
 from .cdr import marker, MessageTemplate, STAMP_MARKER
-from ..geometry.frames import child_frame, FrameSpec
+from ..geometry.frames import child_frame
 from ..imu import imu_values, ImuSpec
 
-__all__ = ['ImuFrames', 'ImuMessages', 'imu_frame', 'imu_from_values', 'local_points']
+__all__ = ['ImuFrames', 'ImuMessages', 'imu_frame', 'imu_from_values']
 
 
 def imu_frame(spec: ImuSpec, prefix: str) -> str:
@@ -117,7 +117,7 @@ class ImuMessages:
         """Return the ``TransformStamped`` of every sensor with a frame of its own (stamp unset).
 
         ``local`` maps each such sensor's name to its point's coordinates in
-        its link's frame, m.
+        its link's frame, m (:func:`~mech_kinematics.geometry.frames.sensor_offsets`).
         """
         from geometry_msgs.msg import TransformStamped
 
@@ -133,24 +133,6 @@ class ImuMessages:
             t.transform.rotation.w = math.cos(spec.angle / 2)
             transforms.append(t)
         return transforms
-
-
-def local_points(specs: Sequence[ImuSpec], frames: Mapping[str, FrameSpec],
-                 state: Any) -> dict[str, tuple[float, float]]:
-    """Return each sensor's point in its link's frame (``frames[link]``), m, from a state.
-
-    The point is fixed on the link, so any solved instant gives the same
-    coordinates (to rounding); ``state`` must hold the frames' origins.
-    """
-    local = {}
-    for spec in specs:
-        frame = frames[spec.link]
-        theta = float(state.joints[spec.link].position)
-        d = complex(state.complex_points[spec.point][0]) - complex(
-            state.complex_points[frame.origin][0])
-        z = d * complex(math.cos(theta), -math.sin(theta))
-        local[spec.name] = (z.real, z.imag)
-    return local
 
 
 class ImuFrames:

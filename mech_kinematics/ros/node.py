@@ -61,7 +61,7 @@ import mech_kinematics as mk
 from . import topics
 from .diagnostics import solver_status, Status, TickStats, timing_status
 from .driver import TickDriver
-from .imus import ImuFrames, ImuMessages, local_points
+from .imus import ImuFrames, ImuMessages
 from .markers import marker_array_from_state, marker_size_from_space, MarkerThrottle
 from .messages import TickMessages
 from .parameters import (CATCH_UP, catch_up_window_ns, joint_refusal, PARAMETERS, ParameterSpec,
@@ -72,7 +72,7 @@ from .ticker import tick_function
 from .timebase import CrankSample
 from ..geometry.assembly import assembly_summary
 from ..geometry.diagrams import space_from_state, strokes_from_scene
-from ..geometry.frames import angle_joints, frames_from_scene, origin_points
+from ..geometry.frames import angle_joints, frames_from_scene, origin_points, sensor_offsets
 from ..geometry.instant_centres import full_scene
 from ..geometry.urdf import urdf_from_scene
 from ..scene import scene_text
@@ -449,7 +449,7 @@ class KinematicsNode(LifecycleNode):
         if self._tf is not None:
             state = mk.solve(tick_scene, scene.input.angle, 0.0, 0.0, max_error=math.inf)
             frames = {f.joint: f for f in self._tf_frames}
-            transforms = self._imus.frame_transforms(local_points(scene.imus, frames, state))
+            transforms = self._imus.frame_transforms(sensor_offsets(scene.imus, frames, state))
             if transforms:
                 self._imu_frames = ImuFrames(transforms)
 

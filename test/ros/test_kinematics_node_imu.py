@@ -10,12 +10,14 @@ state, in the link's frame (``angle: 0``) or a frame of its own on ``/tf``
 
 import math
 import signal
+import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
-from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from ros_helpers import NodeProcess, Ros, SESSION, stamp_ns, STARTUP_S, wait_for
 from sensor_msgs.msg import Imu, JointState
+from std_msgs.msg import String
 from tf2_msgs.msg import TFMessage    # built by make install (scripts/build_tf2_msgs.py)
 from trajectory_msgs.msg import MultiDOFJointTrajectory
 import yaml
@@ -60,13 +62,16 @@ def test_imu_topics_carry_the_readings_solve_prints(ros, tmp_path):
     joints = ros.collect(JointState, f'{ns}/joint_states', qos)
     points = ros.collect(MultiDOFJointTrajectory, f'{ns}/point_accelerations', qos)
     tf = ros.collect(TFMessage, f'{ns}/tf', qos)
+    description = ros.collect(String, f'{ns}/robot_description', QoSProfile(
+        depth=1, reliability=ReliabilityPolicy.RELIABLE,
+        durability=DurabilityPolicy.TRANSIENT_LOCAL))
     proc = NodeProcess(tmp_path, '-r', f'__ns:={ns}', '-r', f'/tf:={ns}/tf',
                        '-r', f'/tf_static:={ns}/tf_static', '-p', f'scene:={path}',
                        '-p', 'rate_hz:=100', '-p', 'tf_rate_hz:=100',
                        '-p', f'frame_id:={FRAME_ID}')
     try:
-        wait_for(lambda: min(len(m) for m in imus.values()) >= 40 and len(tf) >= 40,
-                 STARTUP_S, '40 Imu messages on each topic')
+        wait_for(lambda: min(len(m) for m in imus.values()) >= 40 and len(tf) >= 40
+                 and description, STARTUP_S, '40 Imu messages on each topic')
     finally:
         status, _ = proc.stop(signal.SIGINT)
     assert status == 0, proc.output()
@@ -122,6 +127,13 @@ def test_imu_topics_carry_the_readings_solve_prints(ros, tmp_path):
         assert (x, y) == pytest.approx((e_at[stamp].x, e_at[stamp].y), abs=1e-15)
         composed += 1
     assert composed >= 30
+    # robot_description has the sensor's frame as /tf has it: fixed to the coupler's.
+    joints = {j.find('child').get('link'): j
+              for j in ET.fromstring(description[-1].data).findall('joint')}
+    joint = joints[f'{FRAME_ID}/tip']
+    assert joint.find('parent').get('link') == f'{FRAME_ID}/coupler'
+    xyz = [float(v) for v in joint.find('origin').get('xyz').split()]
+    assert xyz == pytest.approx([t.translation.x, t.translation.y, 0.0], abs=1e-15)
 
 
 def test_rendered_imu_bytes_are_the_canonical_cdr_of_the_message():
