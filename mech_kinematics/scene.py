@@ -12,7 +12,8 @@ Limits
 Each limit is a module constant named in the refusal: :data:`MAX_FILE_BYTES`,
 :data:`MAX_YAML_NODES` (counted with aliases expanded, so a "billion laughs"
 file is refused), :data:`MAX_DEPTH`, :data:`MAX_INTEGER_DIGITS`,
-:data:`MAX_GROUND_POINTS`, :data:`MAX_DYADS` and :data:`MAX_CARRIED_POINTS`.
+:data:`MAX_GROUND_POINTS`, :data:`MAX_DYADS`, :data:`MAX_CARRIED_POINTS`,
+:data:`MAX_PINS` and :data:`MAX_IMUS`.
 Only regular files are read: a FIFO, a device or a directory is refused
 before anything is read from it, and the read stops one byte past
 :data:`MAX_FILE_BYTES`.
@@ -42,7 +43,8 @@ from .yaml12 import (_brief, _join, MAX_DEPTH, MAX_INTEGER_DIGITS, MAX_YAML_NODE
 
 __all__ = [
     'DEFAULT_SCENE', 'MAX_CARRIED_POINTS', 'MAX_DEPTH', 'MAX_DYADS', 'MAX_FILE_BYTES',
-    'MAX_GROUND_POINTS', 'MAX_INTEGER_DIGITS', 'MAX_MESSAGE', 'MAX_PINS', 'MAX_YAML_NODES',
+    'MAX_GROUND_POINTS', 'MAX_IMUS', 'MAX_INTEGER_DIGITS', 'MAX_MESSAGE', 'MAX_PINS',
+    'MAX_YAML_NODES',
     'SceneLoader',
     'load_scene', 'parse_scene', 'read_scene_yaml', 'scene_dirs', 'scene_names', 'scene_text',
 ]
@@ -61,6 +63,8 @@ MAX_DYADS = 10_000
 MAX_CARRIED_POINTS = 10_000
 #: Most pins (``pins:``) in a scene.
 MAX_PINS = 10_000
+#: Most inertial sensors (``imus:``) in a scene.
+MAX_IMUS = 10_000
 
 #: The two spellings of ``units`` every refusal of a missing or bad one shows.
 UNITS_EXAMPLES = 'units: {length: mm, angle: deg} or units: {length: m, angle: rad}'
@@ -407,7 +411,7 @@ def _imus(reader: _Reader, keys: _Keys, raw: Any) -> tuple[ImuSpec, ...]:
     if not isinstance(raw, dict):
         raise SceneError(f'imus: expected a mapping of sensor names to {{link, point}}, got '
                          f'{_kind(raw)}')
-    _check_count('imus', raw, MAX_PINS, 'MAX_PINS', 'sensors')
+    _check_count('imus', raw, MAX_IMUS, 'MAX_IMUS', 'sensors')
     specs = []
     for key, value in raw.items():
         where = f'imus.{key}'

@@ -335,3 +335,12 @@ def test_as_dict_on_the_array_path_gives_the_single_instant_readings():
                                    one['imus']['tip']['linear_acceleration'], rtol=1e-13)
         assert many['error_bound']['imus']['tip']['linear_acceleration'][i] == pytest.approx(
             one['error_bound']['imus']['tip']['linear_acceleration'], rel=1e-12)
+
+
+def test_the_number_of_imus_is_bounded(monkeypatch):
+    """More sensors than MAX_IMUS are refused in one line naming the limit."""
+    monkeypatch.setattr(mk.scene, 'MAX_IMUS', 1)
+    with pytest.raises(mk.SceneError, match=r'imus: expected at most 1 sensors \(MAX_IMUS\), '
+                                            r'got 2'):
+        imu_scene({'a': {'link': 'coupler', 'point': 'E'}, 'b': {'link': 'rocker',
+                                                                 'point': 'C'}})
