@@ -11,7 +11,7 @@ stamped like the state:
   is 0 (the sensor's axes are the link's), else a frame of the sensor's own,
   ``<prefix>/NAME``, a child of the link's frame turned by ``angle`` with
   its origin at the sensor's point, published on ``/tf`` with the link
-  frames (:meth:`ImuMessages.render_frames`);
+  frames (:class:`ImuFrames`);
 - ``orientation``: the sensor frame's rotation about z in the node's
   ``frame_id``, ``(0, 0, sin(phi/2), cos(phi/2))``;
 - ``angular_velocity``: ``(0, 0, omega)``, rad/s;
