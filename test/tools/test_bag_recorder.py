@@ -784,3 +784,10 @@ def test_default_recording_holds_the_scenes_imu_topics(tmp_path):
     assert len(set(stamps) & states) >= min(len(stamps), len(states)) - 100
     assert all(m.header.frame_id == 'mechanism/coupler' for _, m in imu)
     assert set(decoded(tmp_path / 'chosen')) == {f'{ns}/joint_states'}
+    # plot reads the recorded readings back, at the ticks it draws.
+    motion = plot.motion_from_bag(tmp_path / 'default', namespace=ns)
+    recorded = {(m.linear_acceleration.x, m.linear_acceleration.y) for _, m in imu}
+    accel = motion.imus['tip'][2]
+    drawn = accel[np.isfinite(accel).all(axis=1)]
+    assert len(drawn) >= len(accel) - 100
+    assert {(float(x), float(y)) for x, y in drawn} <= recorded
