@@ -27,9 +27,11 @@ velocity, acceleration: rad for revolute joints, m for sliders), every
 output point (position, velocity, acceleration as [x, y]), "rubbing" (the
 rubbing velocity at each of the scene's pins, m/s), "intermittent" (each
 Geneva wheel: engaged or locked, its engagement window and where its
-acceleration jumps) and "error_bound", the absolute error bound of each of
-those values (one number per value; for a point, the bound on the length of
-its error vector), all in SI units.
+acceleration jumps), "imus" (each of the scene's inertial sensors: angular
+velocity rad/s, linear acceleration [x, y] m/s^2 in the sensor's frame,
+orientation rad) and "error_bound", the absolute error bound of each of
+those values (one number per value; for a point or an acceleration, the
+bound on the length of its error vector), all in SI units.
 Options left out take the scene's own values. On a position that cannot be
 solved, or whose answer cannot be trusted (a value's error bound above
 --max-error times its kind's scale, a dyad within rounding of an assembly
