@@ -90,6 +90,10 @@ class Crank:
         """Return it with its length scaled."""
         return replace(self, length=scale(self.length))
 
+    def frames(self) -> tuple[tuple[str, str, str | None, float], ...]:
+        """Return its joint's frame (:data:`~.base.Frame`): at its centre, along it."""
+        return ((self.link, self.center, self.link, 0.0),)
+
     def defined(self) -> tuple[tuple[str, str], ...]:
         """Return (name, kind) of the names it defines: its link and its tip."""
         return (self.link, 'link'), (self.point, 'point')

@@ -149,9 +149,17 @@ class RRR(Item):
         return replace(self, links=(first, second))
 
     def frames(self) -> Iterator[Frame]:
-        """Yield each link's frame: at its start, along it."""
+        """Yield each link's frame: at its start, along it; an actuator's at its rod's pin.
+
+        An actuated link is a cylinder's body (at its start pin) and the
+        actuator a prismatic joint whose frame, the rod's, sits at the dyad's
+        new pin, along the link.
+        """
         for link in self.links:
             yield link.name, link.start, link.name, 0.0
+        for link, actuator in zip(self.links, self.actuators, strict=True):
+            if actuator is not None:
+                yield actuator, self.point, link.name, 0.0
 
     def members(self, ground: str) -> Iterator[Member]:
         """Yield its two links, each carrying its start and the new pin."""
