@@ -43,6 +43,12 @@ def crank_scene_names() -> list[str]:
             and mk.load_scene(name).input is not None]
 
 
+def start_positions(scene: Any) -> Any:
+    """Return where ``scene``'s drivers start: the crank angle, or one position per driver."""
+    drivers = scene.drivers
+    return drivers[0].start if len(drivers) == 1 else [d.start for d in drivers]
+
+
 def driver_scene_names() -> list[str]:
     """Return the packaged scenes with several drivers or an actuator (``inputs:``), sorted."""
     return sorted(set(mk.scene_names()) - set(crank_scene_names()))

@@ -20,7 +20,7 @@ import re
 import subprocess
 import sys
 
-from helpers import BASE_SCENE as BASE
+from helpers import BASE_SCENE as BASE, start_positions
 import numpy as np
 import pytest
 import yaml
@@ -293,7 +293,7 @@ def test_packaged_scene_loads_and_solves(path):
     """Every packaged scene loads by path and by name and solves at its initial angle."""
     scene = mk.load_scene(path)
     assert mk.load_scene(path.stem) == scene
-    state = mk.solve(scene, starts(scene))
+    state = mk.solve(scene, start_positions(scene))
     for point in state.points.values():
         for value in (point.position, point.velocity, point.acceleration):
             assert np.all(np.isfinite(value))
@@ -328,13 +328,7 @@ def test_solve_command_answers_every_packaged_scene(path):
         status = main(['solve', path.stem])
     assert status == 0
     scene = mk.load_scene(path)
-    assert_same(json.loads(out.getvalue()), mk.solve(scene, starts(scene)).as_dict())
-
-
-def starts(scene):
-    """Return where ``scene``'s drivers start: the crank angle, or one position per driver."""
-    drivers = scene.drivers
-    return drivers[0].start if len(drivers) == 1 else [d.start for d in drivers]
+    assert_same(json.loads(out.getvalue()), mk.solve(scene, start_positions(scene)).as_dict())
 
 
 # --- units and outputs ----------------------------------------------------------------
