@@ -90,6 +90,10 @@ class Crank:
         """Return it with its length scaled."""
         return replace(self, length=scale(self.length))
 
+    def members(self, ground: str) -> tuple[tuple[str, str, tuple[str, ...], str | None], ...]:
+        """Return its body (:data:`~.base.Member`): the crank, carrying its centre and tip."""
+        return ((self.link, 'crank', (self.center, self.point), None),)
+
     def frames(self) -> tuple[tuple[str, str, str | None, float], ...]:
         """Return its joint's frame (:data:`~.base.Frame`): at its centre, along it."""
         return ((self.link, self.center, self.link, 0.0),)

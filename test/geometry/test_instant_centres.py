@@ -7,6 +7,7 @@ from __future__ import annotations
 from dataclasses import replace
 import itertools
 import math
+import re
 import warnings
 
 from helpers import crank_scene_names
@@ -195,3 +196,18 @@ def test_pruned_state_is_refused():
         instant_centres_from_kennedy(scene, state)
     full = full_scene(scene)
     assert len(instant_centres_from_state(full, mk.solve(full, scene.input.angle))) == 15
+
+
+@pytest.mark.parametrize('name', ['five_bar', 'excavator'])
+def test_several_drivers_are_refused_in_one_line(name):
+    """Instant centres are one driver's (issue 18): a clear SceneError, not a crash."""
+    scene = full_scene(mk.load_scene(name))
+    state = mk.solve(scene, [d.start for d in scene.drivers])
+    names = ', '.join(d.name for d in scene.drivers)
+    for method in (instant_centres_from_state, instant_centres_from_kennedy):
+        with pytest.raises(mk.SceneError, match=re.escape(
+                f"Expected a scene driven by one crank for instant centres (one driver's), got "
+                f'scene "{name}" with 2 drivers ({names})')):
+            method(scene, state)
+    assert {body.name for body in bodies_from_scene(scene).bodies.values()} >= {
+        d.name for d in scene.drivers if d.joint_type == 'revolute'}

@@ -424,3 +424,16 @@ def test_import_needs_no_matplotlib():
             'mech_kinematics.geometry.instant_centres; '
             "assert 'matplotlib' not in sys.modules and 'rclpy' not in sys.modules")
     subprocess.run([sys.executable, '-c', code], check=True, timeout=60)
+
+
+@pytest.mark.parametrize('name', ['five_bar', 'excavator'])
+def test_several_drivers_are_refused_in_one_line(name, tmp_path):
+    """Velocity polygons are one driver's (issue 18): the diagram refuses, in one line."""
+    scene = mk.load_scene(name)
+    with pytest.raises(mk.SceneError, match='Expected a scene driven by one crank for velocity '
+                       'and acceleration polygons'):
+        geo.diagram_from_scene(scene)
+    status = subprocess.run([sys.executable, '-m', 'mech_kinematics', 'diagram', name, '-o',
+                             str(tmp_path / 'd.png')], capture_output=True, text=True, check=False)
+    assert status.returncode == 2
+    assert status.stderr.count('\n') == 1 and 'driven by one crank' in status.stderr

@@ -359,3 +359,13 @@ def copied_by_the_recorders_writer(bag: Path, destination: Path) -> Path:
             writer.write(topics[c.id], timestamp, bytes(raw))
     writer.close()
     return destination
+
+
+def test_several_drivers_are_refused_in_one_line(tmp_path, capsys):
+    """`plot --scene` sweeps one crank's turn: several drivers are refused (issue 18)."""
+    assert plot.main(['--scene', 'five_bar', '-o', str(tmp_path / 'p.png')]) == 2
+    err = capsys.readouterr().err
+    assert err == ('error: Expected a scene driven by one crank to plot over its turn, got '
+                   'scene "five_bar" with 2 drivers (left_crank, right_crank): plot a bag the '
+                   'node recorded instead\n')
+    assert not (tmp_path / 'p.png').exists()
