@@ -463,3 +463,17 @@ def test_packaged_array_path_equals_the_scalar_path(name):
                                            (motion.position, motion.velocity,
                                             motion.acceleration), rtol=1e-13, atol=1e-15)
     assert many.valid.sum() >= 25
+
+
+def test_a_plain_dyad_downstream_of_an_actuator_is_bounded_against_the_reference():
+    """One cylinder, the stick's cylinder held at 3.2 m (a plain RRR on the boom): bounded."""
+    data = yaml.safe_load(scene_text('excavator'))
+    data['inputs'] = data['inputs'][:1]
+    data['dyads'][1]['links'][1] = {'name': 'stick_cyl_body', 'from': 'S', 'length': 3.2}
+    held = mk.parse_scene(data)
+    for length in (2.05, 2.6, 3.25):
+        state, exact = assert_bounded(held, length, 0.2, -0.1)
+        assert state is not None and exact is not None
+        moving = mk.solve(mk.load_scene('excavator'), [length, 3.2], [0.2, 0.0], [-0.1, 0.0])
+        np.testing.assert_allclose(state.points['bucket_tip'].velocity,
+                                   moving.points['bucket_tip'].velocity, rtol=1e-13)

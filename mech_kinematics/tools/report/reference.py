@@ -874,10 +874,13 @@ def reference(scene: Scene | Model, theta: Any, omega: Any | None = None,
             columns = model.jacobian_columns(p, q, th)
             theta_jet = _jet(th, om, al)
             _, res = model.evaluate(p, q, theta_jet)
-            qdot = [-x for x in _mp_solve(columns, [r.c1 for r in res])]
+            # (a dyad no driver moves directly has a plain residual: rate 0)
+            qdot = [-x for x in _mp_solve(columns, [r.c1 if isinstance(r, Jet) else 0 * r
+                                                    for r in res])]
             _, res = model.evaluate(p, [Jet(x, v) for x, v in zip(q, qdot, strict=True)],
                                     theta_jet)
-            qddot = [-2 * x for x in _mp_solve(columns, [r.c2 for r in res])]
+            qddot = [-2 * x for x in _mp_solve(columns, [r.c2 if isinstance(r, Jet) else 0 * r
+                                                         for r in res])]
         state = _state(model, p, q, qdot, qddot, th, om, al)
         return Reference(model.scene.name, th, om, al, q, qdot, qddot, state[0], state[1],
                          dict(model.joint_types), measures, singular, residual, iterations,
