@@ -115,6 +115,14 @@ def test_bad_drivers_are_refused_in_one_line(changes, match):
     assert '\n' not in str(info.value)
 
 
+def test_an_actuator_no_link_uses_is_refused():
+    """An actuator must be the length of an RRR link: else one line saying so."""
+    with pytest.raises(mk.SceneError, match=r'inputs\[1\]\.actuator: Expected actuator "ram" '
+                       r'to be the length of an RRR link'):
+        scene(BOOM, inputs=[{'actuator': 'cyl', 'length': 2600},
+                            {'actuator': 'ram', 'length': 100}])
+
+
 def test_an_unknown_actuator_is_refused():
     """An RRR link naming no actuator of inputs is refused, naming the known ones."""
     text = BOOM.replace('actuator: cyl}', 'actuator: ram}')
