@@ -38,9 +38,11 @@ import numpy as np
 import numpy.typing as npt
 
 from .instant_centres import (bodies_from_scene, BodyKind, check_full_state, full_scene, GROUND,
-                              instant_centres_from_state, InstantCentres, Topology)
+                              instant_centres_from_state, InstantCentres, Topology,
+                              varying_links)
 from ..errors import NearSingularWarning
 from ..solver import Scene, solve, State
+from ..units import turns_from_degrees
 
 __all__ = [
     'ActuatorShape', 'COLOURS', 'Diagram', 'DriverValues', 'GuideLine', 'LinkShape',
@@ -381,18 +383,15 @@ def _coincident(pin: str) -> str:
     return f"{pin}'"
 
 
-def _driven_links(scene: Scene) -> dict[str, dict[str, complex]]:
-    """Return each crank driver's link: its centre and tip in its frame (an actuator none)."""
-    ground = {name: complex(*xy) for name, xy in scene.ground.items()}
-    links: dict[str, dict[str, complex]] = {}
-    for driver in scene.drivers:
-        links.update(driver.local(ground))
-    return links
+def _driven_links(scene: Scene) -> dict[str, tuple[str, str]]:
+    """Return each crank driver's link: its centre and tip (an actuator has none of its own)."""
+    return {body: (members[0], members[1]) for driver in scene.drivers
+            for body, _, members, _ in driver.members(GROUND)}
 
 
 def _edges(scene: Scene, state: State) -> list[_Edge]:
     """Every link's relative motions, in the order the solver places the points."""
-    edges = [_Edge(link, *members) for link, members in _driven_links(scene).items()]
+    edges = [_Edge(link, *ends) for link, ends in _driven_links(scene).items()]
     for item in (*scene.dyads, *scene.points):
         for body, start, end, slider in item.edges():
             edges.append(_Edge(body, start, end) if slider is None else
@@ -608,32 +607,43 @@ def acceleration_polygon_from_state(scene: Scene, state: State) -> Polygon:
 
 
 def _outline(xy: Array) -> Array:
-    """Segment through collinear points, or their convex hull (counter-clockwise)."""
+    """Segment through collinear points, or their convex hull (counter-clockwise).
+
+    Computed on the points moved to their centre and divided by their extent,
+    so that the SVD and the hull's cross products stay in range for any size
+    (a Geneva wheel of radius 1e300 m); the points returned are the originals.
+    """
     centre = xy.mean(axis=0)
+    if not np.isfinite(centre).all():  # the sum overflowed: the middle of the extent instead
+        centre = xy.min(axis=0) / 2 + xy.max(axis=0) / 2
     d = xy - centre
     size = float(np.abs(d).max()) if len(xy) else 0.0
+    if size == 0.0:
+        return np.array([xy[0], xy[0]])
+    d = d / size
     _, _, vt = np.linalg.svd(d)
     axis = vt[0]
     across = d @ np.array([-axis[1], axis[0]])
-    if size == 0.0 or float(np.abs(across).max()) <= 1e-9 * size:
+    if float(np.abs(across).max()) <= 1e-9:
         along = d @ axis
         return np.array([xy[int(np.argmin(along))], xy[int(np.argmax(along))]])
-    pts = sorted(map(tuple, xy))
+    order = sorted(range(len(d)), key=lambda i: (d[i, 0], d[i, 1]))
 
-    def turn(o: tuple[float, ...], a: tuple[float, ...], b: tuple[float, ...]) -> float:
-        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+    def turn(o: int, a: int, b: int) -> float:
+        return float((d[a, 0] - d[o, 0]) * (d[b, 1] - d[o, 1])
+                     - (d[a, 1] - d[o, 1]) * (d[b, 0] - d[o, 0]))
 
-    lower: list[tuple[float, ...]] = []
-    upper: list[tuple[float, ...]] = []
-    for p in pts:
+    lower: list[int] = []
+    upper: list[int] = []
+    for p in order:
         while len(lower) >= 2 and turn(lower[-2], lower[-1], p) <= 0:
             lower.pop()
         lower.append(p)
-    for p in reversed(pts):
+    for p in reversed(order):
         while len(upper) >= 2 and turn(upper[-2], upper[-1], p) <= 0:
             upper.pop()
         upper.append(p)
-    return np.array(lower[:-1] + upper[:-1])
+    return xy[lower[:-1] + upper[:-1]]
 
 
 def strokes_from_scene(scene: Scene,
@@ -650,12 +660,14 @@ def strokes_from_scene(scene: Scene,
     Returns
     -------
     dict of str to (float, float)
-        ``(s_min, s_max)`` over the angles at which the mechanism assembles.
+        ``(s_min, s_max)`` over the angles at which the mechanism assembles;
+        empty for a scene with several drivers (no one crank's turn: guides
+        are then drawn around their blocks).
     """
     scene = full_scene(scene)
     sliders = [body for d in scene.dyads for body, _, _, guide in d.members(GROUND)
                if guide == GROUND]
-    if not sliders:
+    if not sliders or scene.input is None or len(scene.drivers) > 1:
         return {}
     angles = np.linspace(0.0, 2.0 * math.pi, samples, endpoint=False)
     with warnings.catch_warnings():
@@ -765,8 +777,8 @@ def arrows_from_state(scene: Scene, state: State, velocity_scale: float,
 
 def _values(scene: Scene, state: State,
             topology: Topology) -> tuple[tuple[LinkValues, ...], tuple[SliderValues, ...]]:
-    lengths: dict[str, float | None] = {link: max(abs(z) for z in members.values())
-                                        for link, members in _driven_links(scene).items()}
+    lengths: dict[str, float | None] = {driver.name: driver.length for driver in scene.drivers
+                                        if driver.joint_type == 'revolute'}
     for dyad in scene.dyads:
         lengths.update(dyad.link_lengths())
     links = []
@@ -791,20 +803,6 @@ def _pins(scene: Scene, state: State) -> tuple[PinValues, ...]:
     return tuple(PinValues(point, bodies, radii[point], float(state.rubbing[point]) / radii[point],
                            float(state.rubbing[point]))
                  for point, bodies in scene.pin_bodies.items())
-
-
-def varying_links(scene: Scene) -> tuple[str, ...]:
-    """Return the links whose length varies (an actuator's): no polygon is built through them.
-
-    The relative velocity of a link's end about its start is ``omega x r`` only
-    for a rigid link; a cylinder's adds its extension rate along it. (A slotted
-    lever's length varies too, but its pin's sliding is drawn: it has a slider.)
-    """
-    rigid = {body for dyad in scene.dyads for body, _, _, slider in dyad.edges()
-             if slider is None}
-    return tuple(name for dyad in scene.dyads
-                 for name, length in dyad.link_lengths().items()
-                 if length is None and name in rigid)
 
 
 def diagram_from_scene(scene: Scene, angle: float | None = None, speed: float | None = None,
@@ -865,9 +863,13 @@ def diagram_from_scene(scene: Scene, angle: float | None = None, speed: float | 
                  else solve(scene, xs, vs, accs))
         theta = xs[0]
     else:
-        theta = scene.input.angle if angle is None else (
-            math.radians(angle) if degrees else float(angle))
-        state = solve(scene, theta, speed, accel)
+        if angle is None:
+            theta, turns = scene.input.angle, scene.input.turns
+        elif degrees and abs(angle) > 360.0:  # counted from the start: whole turns read exactly
+            theta, turns = turns_from_degrees(angle)
+        else:
+            theta, turns = (math.radians(angle) if degrees else float(angle)), 0
+        state = solve(scene, theta, speed, accel, turns=turns)
     motions = state.drivers
     values = tuple(DriverValues(d.name, d.joint_type, float(motions[d.name].position),
                                 float(motions[d.name].velocity),

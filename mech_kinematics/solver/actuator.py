@@ -133,6 +133,14 @@ class Actuator:
         stroke = None if self.stroke is None else (scale(self.stroke[0]), scale(self.stroke[1]))
         return replace(self, length=scale(self.length), stroke=stroke)
 
+    def members(self, ground: str) -> tuple[tuple[str, str, tuple[str, ...], str | None], ...]:
+        """Return no body of its own: its cylinder is the RRR link it drives (:mod:`.rrr`)."""
+        return ()
+
+    def frames(self) -> tuple[tuple[str, str, str | None, float], ...]:
+        """Return no frame: the RRR whose link it drives gives its rod's (:mod:`.rrr`)."""
+        return ()
+
     def defined(self) -> tuple[tuple[str, str], ...]:
         """Return (name, kind) of the names it defines: its prismatic joint."""
         return ((self.actuator, 'actuator'),)

@@ -32,11 +32,16 @@ class Crank:
     length : float
         Crank length, m.
     angle : float
-        Crank angle at time zero, rad.
+        Crank angle at time zero, rad (within its turn when ``turns`` is not 0).
     speed : float
         Default angular velocity, rad/s, + CCW.
     accel : float
         Default angular acceleration, rad/s^2, + CCW.
+    turns : int
+        Whole turns to add to ``angle``: the crank angle at time zero is
+        ``angle + 2 pi turns``, the sum never formed in floating point (a scene
+        file's angle far out, as 1e17 deg, is read as an angle within a turn
+        plus whole turns; only an intermittent drive tells the turns apart).
     """
 
     link: str
@@ -46,6 +51,7 @@ class Crank:
     angle: float = 0.0
     speed: float = 0.0
     accel: float = 0.0
+    turns: int = 0
 
     def __post_init__(self) -> None:
         """Validate the fields."""
@@ -56,6 +62,9 @@ class Crank:
         _check_finite(self.angle, 'the crank angle', (self, 'angle'))
         _check_finite(self.speed, 'the crank speed', (self, 'speed'))
         _check_finite(self.accel, 'the crank acceleration', (self, 'accel'))
+        if not isinstance(self.turns, int) or isinstance(self.turns, bool):
+            msg = f'Expected the crank whole turns to be an int, got {self.turns!r}'
+            raise SceneError(msg, (self, 'turns'))
 
     @property
     def name(self) -> str:
@@ -71,6 +80,11 @@ class Crank:
     def start(self) -> float:
         """The driver's position at time zero: the crank angle, rad."""
         return self.angle
+
+    @property
+    def shown(self) -> float:
+        """The crank angle at time zero as one float, rad, for messages only."""
+        return self.angle + math.tau * self.turns
 
     @property
     def stroke(self) -> tuple[float, float] | None:
@@ -89,6 +103,14 @@ class Crank:
     def scaled(self, scale: Callable[[float], float]) -> Crank:
         """Return it with its length scaled."""
         return replace(self, length=scale(self.length))
+
+    def members(self, ground: str) -> tuple[tuple[str, str, tuple[str, ...], str | None], ...]:
+        """Return its body (:data:`~.base.Member`): the crank, carrying its centre and tip."""
+        return ((self.link, 'crank', (self.center, self.point), None),)
+
+    def frames(self) -> tuple[tuple[str, str, str | None, float], ...]:
+        """Return its joint's frame (:data:`~.base.Frame`): at its centre, along it."""
+        return ((self.link, self.center, self.link, 0.0),)
 
     def defined(self) -> tuple[tuple[str, str], ...]:
         """Return (name, kind) of the names it defines: its link and its tip."""

@@ -29,6 +29,7 @@ from .scaling import _ANGULAR, _exponent, _LINEAR, _scaled, _size, _SIZE_RANGE
 from .solve import _execute, _execute_drivers, TRUST_TEST
 from ..bounds import U
 from ..errors import AssemblyError, NearSingularWarning, SceneError
+from ..imu import imu_outputs, ImuSpec
 
 
 class _Solver:
@@ -156,7 +157,7 @@ class Scene:
     """A planar mechanism: ground points, the driving crank, dyads, carried points.
 
     Construction validates names and dependencies and checks that the
-    mechanism assembles at ``input.angle``; a failure raises
+    mechanism assembles at ``input.angle`` (plus ``input.turns``); a failure raises
     :class:`SceneError`.
 
     Parameters
@@ -181,6 +182,9 @@ class Scene:
         Pins whose rubbing velocity is reported (``State.rubbing``).
     units : SceneUnits
         The units the scene was written in, for messages (its values are SI).
+    imus : tuple of ImuSpec
+        Inertial sensors on moving links (:mod:`mech_kinematics.imu`); the
+        outputs always hold each one's link and point.
     inputs : tuple of Crank or Actuator
         The drivers of a scene with several (or with an actuator), in order;
         a scene has ``input`` or ``inputs``, not both. Each is named by its
@@ -197,6 +201,7 @@ class Scene:
     description: str = ''
     pins: tuple[Pin, ...] = ()
     units: SceneUnits = SceneUnits()
+    imus: tuple[ImuSpec, ...] = ()
     inputs: tuple[Crank | Actuator, ...] = ()
     _plan: _Plan = field(init=False, repr=False, compare=False)
     _solver: _Solver = field(init=False, repr=False, compare=False)
@@ -227,7 +232,8 @@ class Scene:
             with warnings.catch_warnings():
                 warnings.simplefilter('ignore', NearSingularWarning)
                 if solver.single:
-                    _execute(solver, drivers[0].start, 0.0, 0.0)  # positions only
+                    _execute(solver, drivers[0].start, 0.0, 0.0,  # positions only
+                             self.input.turns)
                 else:
                     zeros = (0.0,) * len(drivers)
                     _execute_drivers(solver, tuple(d.start for d in drivers), zeros, zeros)
@@ -235,7 +241,7 @@ class Scene:
             dyad = next((step.dyad for step in full.steps
                          if step.owner is None and step.label == error.dyad), None)
             if solver.single:
-                at = f'the initial crank angle {self.units.angle_text(drivers[0].start)}'
+                at = f'the initial crank angle {self.units.angle_text(self.input.shown)}'
             else:
                 at = "the drivers' start positions " + ', '.join(
                     f'{d.name} = {d.position_text(d.start, self.units)}' for d in drivers)
@@ -246,10 +252,13 @@ class Scene:
             msg = (f'Expected the mechanism to assemble at {at}, got '
                    f'{assembly_text(error, self.units)}')
             raise SceneError(msg, where if dyad is None else (dyad, '')) from None
-        if self.outputs_joints is None and self.outputs_points is None:
+        object.__setattr__(self, 'imus', tuple(self.imus))
+        joints, points = imu_outputs(self, full.joint_types, self.outputs_joints,
+                                     self.outputs_points)
+        if joints is None and points is None:
             plan = full
         else:
-            plan = _compile(self, self.outputs_joints, self.outputs_points)
+            plan = _compile(self, joints, points)
             solver = _Solver(self, plan)
         object.__setattr__(self, '_plan', plan)
         object.__setattr__(self, '_solver', solver)

@@ -176,6 +176,12 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
         msg = f'Expected dyads and points solvable in order, got a cycle among [{_names(keys)}]'
         raise SceneError(msg, (left[0], ''))
 
+    used = {name for step in steps for name in step.uses}
+    for driver in drivers:
+        if driver.joint_type == 'prismatic' and driver.name not in used:
+            msg = (f'Expected actuator "{driver.name}" to be the length of an RRR link '
+                   f'(actuator: {driver.name} in place of length:), got no link using it')
+            raise SceneError(msg, (driver, 'actuator'))
     order = [*ground, *(name for driver in drivers for name, kind in driver.defined()
                         if kind == 'point'),
              *(name for step in steps for name in step.new_points)]

@@ -16,6 +16,7 @@ import numpy.typing as npt
 from .model import Number, Vector
 from .scaling import _ANGULAR, _LINEAR
 from ..bounds import ErrorBound
+from ..imu import imu_reading, ImuReading, ImuSpec
 
 
 class JointMotion:
@@ -162,6 +163,8 @@ class State:
         counted from the start (rad, not wrapped: ``angle + 2 pi turns``),
         speed and acceleration; an actuator's length (m), extension rate and
         its derivative.
+    imu_specs : tuple of ImuSpec
+        The scene's inertial sensors, whose readings :attr:`imus` gives.
     """
 
     scene: str
@@ -179,6 +182,12 @@ class State:
     intermittent: dict[str, Engagement] = field(default_factory=dict)
     jumps: dict[str, Any] = field(default_factory=dict)
     drivers: dict[str, JointMotion] = field(default_factory=dict)
+    imu_specs: tuple[ImuSpec, ...] = ()
+
+    @cached_property
+    def imus(self) -> dict[str, ImuReading]:
+        """What each of the scene's IMUs reads, with its bounds (:func:`.imu.imu_reading`)."""
+        return {spec.name: imu_reading(self, spec) for spec in self.imu_specs}
 
     @cached_property
     def points(self) -> dict[str, PointState]:
@@ -271,7 +280,12 @@ class State:
                           'points': {name: {'acceleration': pair(x['acceleration'])}
                                      for name, x in self.jumps['points'].items()}}}
                if self.jumps else {}),
-            'error_bound': self.error_bound.as_dict(vector),
+            **({'imus': {name: r.as_dict(vector) for name, r in self.imus.items()}}
+               if self.imu_specs else {}),
+            'error_bound': {**self.error_bound.as_dict(vector),
+                            **({'imus': {name: r.bounds_dict(vector)
+                                         for name, r in self.imus.items()}}
+                               if self.imu_specs else {})},
         }
 
 

@@ -10,12 +10,16 @@ from __future__ import annotations
 
 import math
 
+from helpers import assert_bounded
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 import numpy as np
 import pytest
 import yaml
 
 import mech_kinematics as mk
 from mech_kinematics.scene import scene_text
+from mech_kinematics.tools.report import reference as ref
 
 pytestmark = pytest.mark.filterwarnings('ignore::mech_kinematics.NearSingularWarning')
 
@@ -109,6 +113,14 @@ def test_bad_drivers_are_refused_in_one_line(changes, match):
     with pytest.raises(mk.SceneError, match=match) as info:
         scene(BOOM, **changes)
     assert '\n' not in str(info.value)
+
+
+def test_an_actuator_no_link_uses_is_refused():
+    """An actuator must be the length of an RRR link: else one line saying so."""
+    with pytest.raises(mk.SceneError, match=r'inputs\[1\]\.actuator: Expected actuator "ram" '
+                       r'to be the length of an RRR link'):
+        scene(BOOM, inputs=[{'actuator': 'cyl', 'length': 2600},
+                            {'actuator': 'ram', 'length': 100}])
 
 
 def test_an_unknown_actuator_is_refused():
@@ -253,3 +265,223 @@ def test_time_is_rescaled_for_every_driver_at_once():
     for name, joint in slow.joints.items():
         assert fast.joints[name].velocity == joint.velocity * k
         assert fast.joints[name].acceleration == joint.acceleration * k * k
+
+
+# --- the packaged several-driver scenes: five_bar and excavator -----------------------
+
+EPS = np.finfo(float).eps
+#: Constraint closure: a few ulps of the mechanism's size (m).
+RTOL_CLOSURE = 8 * EPS
+#: Central differences in time with step H (s): error O(H^2) of the scale, well below this.
+H = 1e-5
+RTOL_DIFFERENCE = 1e-6
+SETTINGS = settings(max_examples=40, deadline=None, derandomize=True)
+
+
+def closure_residuals(scene, state):
+    """Yield (link, |pin - start| - its length) of every RRR link, in m, and each crank's."""
+    points = state.complex_points
+    for driver in scene.drivers:
+        if driver.joint_type == 'revolute':
+            yield driver.name, abs(points[driver.point][0] - points[driver.center][0]) \
+                - driver.length
+    for dyad in scene.dyads:
+        for link, actuator in zip(dyad.links, dyad.actuators, strict=True):
+            length = link.length if actuator is None else state.drivers[actuator].position
+            yield link.name, abs(points[dyad.point][0] - points[link.start][0]) - length
+
+
+def motion_at(positions, speeds, accels, t):
+    """Return every driver's position, speed and acceleration at time t (constant accel)."""
+    return ([x + v * t + a * t * t / 2 for x, v, a in zip(positions, speeds, accels,
+                                                          strict=True)],
+            [v + a * t for v, a in zip(speeds, accels, strict=True)], list(accels))
+
+
+five_bar_poses = st.tuples(st.floats(math.radians(60), math.radians(150)),
+                           st.floats(math.radians(30), math.radians(120)),
+                           st.floats(-6.0, 6.0), st.floats(-6.0, 6.0),
+                           st.floats(-20.0, 20.0), st.floats(-20.0, 20.0))
+excavator_poses = st.tuples(st.floats(2.01, 3.29), st.floats(2.51, 3.89),
+                            st.floats(-0.3, 0.3), st.floats(-0.3, 0.3),
+                            st.floats(-0.5, 0.5), st.floats(-0.5, 0.5))
+
+
+def split(pose):
+    """Return (positions, speeds, accels) of a two-driver pose."""
+    return list(pose[:2]), list(pose[2:4]), list(pose[4:])
+
+
+@pytest.mark.parametrize(('name', 'poses'), [('five_bar', five_bar_poses),
+                                             ('excavator', excavator_poses)])
+@given(data=st.data())
+@SETTINGS
+def test_constraints_close_and_rates_are_the_derivatives_of_positions(name, poses, data):
+    """Both drivers moving at once: lengths closed to rounding, v and a = differences of p."""
+    scene = mk.load_scene(name)
+    positions, speeds, accels = split(data.draw(poses))
+    try:
+        states = [mk.solve(scene, *motion_at(positions, speeds, accels, t))
+                  for t in (-H, 0.0, H)]
+    except mk.AssemblyError:
+        assume(False)
+    before, now, after = states
+    size = now.error_bound.size
+    for link, residual in closure_residuals(scene, now):
+        assert abs(residual) <= RTOL_CLOSURE * size, (link, residual)
+    scales = now.scales
+    # What the differences' own rounding can be: an ulp of a position (or velocity) over H.
+    rounding = {'velocity': 4 * EPS * size / H,
+                'acceleration': 4 * EPS * scales['velocity'] / H,
+                'angular velocity': 4 * EPS * math.pi / H,
+                'angular acceleration': 4 * EPS * scales['angular velocity'] / H}
+    tol = {kind: RTOL_DIFFERENCE * scales[kind] + rounding[kind] for kind in rounding}
+    for name_, (_, v, a) in now.complex_points.items():
+        dp = (after.complex_points[name_][0] - before.complex_points[name_][0]) / (2 * H)
+        dv = (after.complex_points[name_][1] - before.complex_points[name_][1]) / (2 * H)
+        assert abs(dp - v) <= tol['velocity'], name_
+        assert abs(dv - a) <= tol['acceleration'], name_
+    for joint, motion in now.joints.items():
+        angular = motion.type == 'revolute'
+        dp = after.joints[joint].position - before.joints[joint].position
+        if angular:
+            dp = math.remainder(dp, math.tau)
+        dv = after.joints[joint].velocity - before.joints[joint].velocity
+        kinds = ('angular velocity', 'angular acceleration') if angular else (
+            'velocity', 'acceleration')
+        assert abs(dp / (2 * H) - motion.velocity) <= tol[kinds[0]], joint
+        assert abs(dv / (2 * H) - motion.acceleration) <= tol[kinds[1]], joint
+
+
+@pytest.mark.parametrize(('name', 'poses'), [('five_bar', five_bar_poses),
+                                             ('excavator', excavator_poses)])
+@given(data=st.data())
+@settings(max_examples=15, deadline=None, derandomize=True)
+def test_bounds_are_never_below_the_error_against_the_50_digit_reference(name, poses, data):
+    """Every value is within its bound of the independent mpmath reference (both moving)."""
+    scene = mk.load_scene(name)
+    state, exact = assert_bounded(scene, *split(data.draw(poses)))
+    assume(state is not None)
+
+
+@pytest.mark.parametrize('name', ['five_bar', 'excavator'])
+def test_packaged_scene_is_answered_wherever_it_assembles(name):
+    """Over a grid of both drivers, nothing is untrusted; refusals are where nothing assembles."""
+    scene = mk.load_scene(name)
+    first, second = scene.drivers
+    if name == 'five_bar':
+        a, b = np.meshgrid(np.linspace(0, math.tau, 60), np.linspace(0, math.tau, 60))
+    else:
+        a, b = np.meshgrid(np.linspace(1.9, 3.4, 40), np.linspace(2.4, 4.0, 40))
+    state = mk.solve(scene, [a.ravel(), b.ravel()], [1.0, -0.5], [0.3, 0.2])
+    assert all(' (' not in key for key in state.failures), state.failures  # none untrusted
+    # The grid passes close to where the distal links (or a cylinder and its link) fall
+    # in line, where the bounds grow as 1 / measure^2: still far within the tolerance.
+    assert np.nanmax(state.relative_error_bound) < 1e-7
+    assert 0.2 < state.valid.mean() < 1.0
+    for index in np.flatnonzero(~state.valid)[::37]:
+        x = [float(a.ravel()[index]), float(b.ravel()[index])]
+        inside = all(d.stroke is None or d.stroke[0] <= v <= d.stroke[1]
+                     for d, v in zip(scene.drivers, x, strict=True))
+        if inside:  # not a stroke refusal: the reference finds no configuration either
+            with pytest.raises(ref.NoAssembly):
+                ref.reference(scene, x)
+
+
+def test_five_bar_golden_end_effector():
+    """Golden (by hand): cranks at 120, 60 deg put P at (50, 120 sin 60 + sqrt(160^2 - 110^2)) mm.
+
+    B = (-60, 103.92) and D = (160, 103.92) mm are 220 mm apart, so P is
+    sqrt(160^2 - 110^2) = 116.19 mm above their midpoint.
+    """
+    scene = mk.load_scene('five_bar')
+    state = mk.solve(scene, [math.radians(120), math.radians(60)], [0.0, 0.0], [0.0, 0.0])
+    expected = (0.05, 0.12 * math.sin(math.radians(60)) + math.sqrt(0.16**2 - 0.11**2))
+    np.testing.assert_allclose(state.points['P'].position, expected, rtol=0, atol=1e-16)
+    assert expected[1] == pytest.approx(0.2201125, abs=1e-7)
+
+
+def test_five_bar_default_drive_stays_assembled():
+    """Both motors at 30 rpm, 30 deg apart: assembled over a whole turn (the node's default)."""
+    scene = mk.load_scene('five_bar')
+    t = np.linspace(0.0, 2.0, 721)  # one turn at 30 rpm
+    starts = [d.start + d.speed * t for d in scene.drivers]
+    state = mk.solve(scene, starts)
+    assert state.valid.all()
+    assert np.min(np.abs(state.singularity['P'])) > 0.2
+
+
+def test_excavator_golden_boom_angle():
+    """Golden: the boom's angle from the law of cosines in the triangle O, F, Q."""
+    scene = mk.load_scene('excavator')
+    of = math.hypot(0.4, 1.1)
+    for length in (2.0, 2.6, 3.3):
+        gamma = math.acos((2.6**2 + of**2 - length**2) / (2 * 2.6 * of))
+        state = mk.solve(scene, [length, 3.0], [0.0, 0.0], [0.0, 0.0])
+        boom = state.joints['boom'].position
+        assert boom == pytest.approx(math.atan2(-1.1, 0.4) + gamma, abs=4e-16)
+    # Half-way out, the boom stands 6.97 deg above the horizon (printed to 2 decimals).
+    assert math.degrees(mk.solve(scene, [2.6, 3.0]).joints['boom'].position) == \
+        pytest.approx(6.97, abs=0.005)
+
+
+def test_excavator_strokes_are_refused_outside():
+    """Each cylinder's stroke ends are answered; beyond them, one line naming it and its stroke."""
+    scene = mk.load_scene('excavator')
+    for lengths in ([2.0, 2.5], [3.3, 3.9]):
+        mk.solve(scene, lengths)
+    with pytest.raises(mk.AssemblyError, match=r'expected the length of actuator stick_cyl '
+                       r'within its stroke \[2\.5, 3\.9\] m, got 3\.95 m'):
+        mk.solve(scene, [2.6, 3.95])
+
+
+def test_five_bar_assembly_refusal_names_the_drivers():
+    """Cranks pointing apart: the distal links cannot reach; the message says where both are."""
+    scene = mk.load_scene('five_bar')
+    with pytest.raises(mk.AssemblyError, match=r'RRR P cannot be solved at left_crank = '
+                       r'3\.14159 rad, right_crank = 0 rad: the circles about B') as info:
+        mk.solve(scene, [math.pi, 0.0])
+    assert mk.assembly_text(info.value, scene.units) == (
+        'links left_distal (160 mm) and right_distal (160 mm) cannot reach from B to D '
+        '(340 mm apart, more than 320 mm)')
+
+
+@pytest.mark.parametrize('name', ['five_bar', 'excavator'])
+def test_packaged_array_path_equals_the_scalar_path(name):
+    """On a grid, the array path's values equal single solves (bits for the cylinders)."""
+    scene = mk.load_scene(name)
+    rng = np.random.default_rng(7)
+    if name == 'five_bar':
+        x = [rng.uniform(1.2, 2.4, 30), rng.uniform(0.6, 1.6, 30)]
+    else:
+        x = [rng.uniform(2.0, 3.3, 30), rng.uniform(2.5, 3.9, 30)]
+    speeds, accels = [0.2, rng.uniform(-0.2, 0.2, 30)], [rng.uniform(-1, 1, 30), 0.1]
+    many = mk.solve(scene, x, speeds, accels)
+    for i in np.flatnonzero(many.valid):
+        one = mk.solve(scene, [x[0][i], x[1][i]], [0.2, speeds[1][i]], [accels[0][i], 0.1])
+        for joint, motion in one.joints.items():
+            got = many.joints[joint]
+            if name == 'excavator':  # no cos or sin: the same bits (angles to an ulp of atan2)
+                assert (got.velocity[i], got.acceleration[i]) == (motion.velocity,
+                                                                  motion.acceleration)
+                assert abs(got.position[i] - motion.position) <= np.spacing(abs(motion.position))
+            else:
+                np.testing.assert_allclose((got.position[i], got.velocity[i],
+                                            got.acceleration[i]),
+                                           (motion.position, motion.velocity,
+                                            motion.acceleration), rtol=1e-13, atol=1e-15)
+    assert many.valid.sum() >= 25
+
+
+def test_a_plain_dyad_downstream_of_an_actuator_is_bounded_against_the_reference():
+    """One cylinder, the stick's cylinder held at 3.2 m (a plain RRR on the boom): bounded."""
+    data = yaml.safe_load(scene_text('excavator'))
+    data['inputs'] = data['inputs'][:1]
+    data['dyads'][1]['links'][1] = {'name': 'stick_cyl_body', 'from': 'S', 'length': 3.2}
+    held = mk.parse_scene(data)
+    for length in (2.05, 2.6, 3.25):
+        state, exact = assert_bounded(held, length, 0.2, -0.1)
+        assert state is not None and exact is not None
+        moving = mk.solve(mk.load_scene('excavator'), [length, 3.2], [0.2, 0.0], [-0.1, 0.0])
+        np.testing.assert_allclose(state.points['bucket_tip'].velocity,
+                                   moving.points['bucket_tip'].velocity, rtol=1e-13)

@@ -56,10 +56,11 @@ def lines(ax) -> dict:
 
 
 def write_bag(path: Path, scene, angles, *, storage='mcap', topics=tuple(TYPES), dt=0.002,
-              namespaces=('',), skip=(), scene_text=None):
+              namespaces=('',), skip=(), scene_text=None, imus=False):
     """Write what the node would publish at ``angles`` (one tick per dt s) to a new bag.
 
-    With ``scene_text``, also the node's latched ``scene`` topic holding it.
+    With ``scene_text``, also the node's latched ``scene`` topic holding it; with
+    ``imus``, the scene's ``imu/NAME`` topics (the node's own bytes).
     """
     from rosbags.rosbag2 import StoragePlugin, Writer
     from rosbags.typesys import get_typestore, Stores
@@ -88,6 +89,20 @@ def write_bag(path: Path, scene, angles, *, storage='mcap', topics=tuple(TYPES),
                                                rihs01=store.hash_rihs01(string))
             message = store.types[string](data=scene_text)
             writer.write(connection, start, store.serialize_cdr(message, string))
+        sensors = {}
+        if imus:
+            from mech_kinematics.ros.imus import ImuMessages
+            from mech_kinematics.ros.ticker import values_from_state
+
+            imu_type = 'sensor_msgs/msg/Imu'
+            text = bag_recorder.message_definition(imu_type)[1]
+            store.register(get_types_from_msg(text, imu_type))
+            sensors = {spec.name: writer.add_connection(f'/imu/{spec.name}', imu_type,
+                                                        msgdef=text,
+                                                        rihs01=store.hash_rihs01(imu_type))
+                       for spec in scene.imus}
+            imu_messages = ImuMessages(scene.imus, scene.output_joints, scene.output_points,
+                                       'mechanism')
         for i, angle in enumerate(angles):
             if i in skip:
                 continue
@@ -96,6 +111,11 @@ def write_bag(path: Path, scene, angles, *, storage='mcap', topics=tuple(TYPES),
             rendered = dict(zip(TYPES, ticks.render(state, *divmod(stamp, 10**9)), strict=True))
             for (_, topic), connection in connections.items():
                 writer.write(connection, stamp, rendered[topic])
+            if sensors:
+                values = values_from_state(state, scene.output_joints, scene.output_points)
+                for connection, data in zip(sensors.values(), imu_messages.render_values(
+                        values, *divmod(stamp, 10**9)), strict=True):
+                    writer.write(connection, stamp, data)
     return path
 
 
