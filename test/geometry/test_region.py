@@ -15,7 +15,7 @@ import cmath
 import math
 import warnings
 
-from helpers import BOOM_CYLINDER as BOOM, FIVE_BAR_TWO_CRANKS as FIVE_BAR
+from helpers import BOOM_CYLINDER as BOOM, driver_scene_names, FIVE_BAR_TWO_CRANKS as FIVE_BAR
 import numpy as np
 import pytest
 import yaml
@@ -156,3 +156,40 @@ def test_a_bad_pair_is_refused_in_one_line(pair):
     with pytest.raises(mk.SceneError, match=r'Expected 2 different drivers of five for the '
                        r'grid \(left, right\), got'):
         region_from_scene(scene(FIVE_BAR), grid=4, pair=pair)
+
+
+# --- the packaged scenes with several drivers ----------------------------------------
+
+
+@pytest.mark.parametrize('name', driver_scene_names())
+def test_packaged_grid_agrees_with_a_brute_force_solve(name):
+    """Every packaged scene with several drivers: the grid is a scalar solve's answer."""
+    sc = mk.load_scene(name)
+    region = region_from_scene(sc, grid=24)
+    assert np.array_equal(region.assembles, brute_force(sc, region.grid, region.axes))
+    assert region.grid == tuple(d.name for d in sc.drivers[:2])
+
+
+def test_packaged_five_bar_grid_is_where_the_distal_links_reach():
+    """five_bar: it assembles exactly where |BD| < 320 mm (the distal links' sum), by hand."""
+    region = region_from_scene(mk.load_scene('five_bar'), grid=60)
+    left, right = np.meshgrid(*region.axes, indexing='ij')
+    bd = np.abs(0.1 + 0.12 * np.exp(1j * right) - 0.12 * np.exp(1j * left))
+    assert np.array_equal(region.assembles, bd < 0.32)
+    for piece in region.slices:  # at the other's start the cranks turn fully
+        assert piece.everywhere and piece.ends == (('turn', 'turn'),)
+
+
+def test_packaged_excavator_closes_over_both_strokes():
+    """Excavator: each cylinder closes within [|l - d|, l + d], wider than its stroke."""
+    sc = mk.load_scene('excavator')
+    region = region_from_scene(sc, grid=12)
+    assert region.fraction == 1.0
+    boom, stick = region.slices
+    assert boom.ranges == ((2.0, 3.3),) and stick.ranges == ((2.5, 3.9),)
+    assert boom.ends == stick.ends == (('stroke', 'stroke'),)
+    # The boom cylinder's dyad: boom 2.6 m from O, the cylinder from F, |OF| = 1.17 m.
+    assert 2.6 - OF < 2.0 and 3.3 < 2.6 + OF
+    # The stick cylinder's dyad: stick 0.9 m from T, the cylinder from S, both on the boom.
+    ts = math.hypot(5.68 - 2.5, 0.55 - 0.9)
+    assert ts - 0.9 < 2.5 and 3.9 < ts + 0.9

@@ -222,3 +222,17 @@ def test_a_bad_grid_size_is_refused(grid, capsys):
     with pytest.raises(SystemExit):
         main(['check', 'four_bar_coupler_points', '--grid', grid])
     assert 'expected a whole number of grid points from 2 to 2000' in capsys.readouterr().err
+
+
+@pytest.mark.parametrize('name', ['five_bar', 'excavator'])
+def test_packaged_scenes_with_several_drivers(name, capsys):
+    """The packaged five-bar and excavator: their region in text, every grid point counted."""
+    assert main(['check', name, '--json', '--grid', '20']) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data['grid']['points'] == [20, 20]
+    assert all(s['everywhere'] for s in data['slices'])
+    if name == 'excavator':
+        assert data['grid']['assembling'] == 400
+        assert [d['stroke'] for d in data['drivers']] == [[2.0, 3.3], [2.5, 3.9]]
+    else:
+        assert 0 < data['grid']['assembling'] < 400
