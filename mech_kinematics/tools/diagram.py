@@ -24,6 +24,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .cli import add_scene_argument, finite_float, positive_int, run_tool
+from .solve import _by_driver, _drive, named_value
 from ..errors import AssemblyError, NearSingularWarning, SceneError
 from ..geometry.diagrams import (arrows_from_state, colours_from_scene, Diagram,
                                  diagram_from_scene, fmt_sense, fmt_value, nice_scale, POLE,
@@ -767,9 +768,17 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                              'with --animate, the first frame')
     parser.add_argument('--speed-rpm', type=finite_float, metavar='N',
                         help="signed crank speed in rpm, + CCW (default: the scene's)")
-    parser.add_argument('--accel', type=finite_float, metavar='A',
-                        help='crank angular acceleration in rad/s^2, + CCW (default: the '
+    parser.add_argument('--accel', type=named_value, action='append', metavar='[NAME=]A',
+                        help='crank angular acceleration in rad/s^2, + CCW; NAME=A for a '
+                             "driver of several (an actuator's in m/s^2) (default: the "
                              "scene's)")
+    parser.add_argument('--input', type=named_value, action='append', metavar='NAME=VALUE',
+                        help="a driver's position, as solve takes it: a crank's angle in "
+                             "degrees, an actuator's length in the scene's length unit "
+                             "(repeatable; default: the scene's)")
+    parser.add_argument('--speed', type=named_value, action='append', metavar='NAME=VALUE',
+                        help="a driver's speed, as solve takes it: rpm for a crank, m/s for an "
+                             "actuator (repeatable; default: the scene's)")
     parser.add_argument('--instant-centres', action='store_true',
                         help='also compute the instant centres, mark them on the space '
                              'diagram and list them')
@@ -816,16 +825,17 @@ def _handle(args: argparse.Namespace) -> int:
     try:
         scene = load_scene(args.scene)
         drivers = scene.drivers
-        if len(drivers) > 1 or drivers[0].joint_type != 'revolute':
+        if len(drivers) > 1 or drivers[0].joint_type != 'revolute' or args.input or args.speed:
             return _handle_drivers(args, scene, output)
+        accel = _by_driver(scene, '--accel', args.accel).get(drivers[0].name)
         if args.animate:
             if args.angle_deg is not None:
                 scene = _with_angle(scene, args.angle_deg)
             count = write_animation(scene, output, frames=args.frames, speed=speed,
-                                    accel=args.accel, instant_centres=args.instant_centres)
+                                    accel=accel, instant_centres=args.instant_centres)
             print(f'wrote {output} ({count} frames)')
         else:
-            diagram = diagram_from_scene(scene, args.angle_deg, speed, args.accel,
+            diagram = diagram_from_scene(scene, args.angle_deg, speed, accel,
                                          degrees=True, instant_centres=args.instant_centres)
             write_diagram(diagram, scene, output)
             print(f'wrote {output}')
@@ -836,16 +846,22 @@ def _handle(args: argparse.Namespace) -> int:
 
 
 def _handle_drivers(args: argparse.Namespace, scene: Scene, output: Path) -> int:
-    """Draw a scene with several drivers (or an actuator) at its drivers' start positions."""
-    names = ', '.join(d.name for d in scene.drivers)
-    for flag, used in (('--animate', args.animate), ('--angle-deg', args.angle_deg is not None),
-                       ('--speed-rpm', args.speed_rpm is not None),
-                       ('--accel', args.accel is not None)):
-        if used:
-            msg = (f'Expected no {flag} for {scene.name}, which has several drivers or an '
-                   f"actuator ({names}): it is drawn at its drivers' start positions")
-            raise ValueError(msg)
-    diagram = diagram_from_scene(scene, inputs={}, instant_centres=args.instant_centres)
+    """Draw a scene at ``--input``, ``--speed`` and ``--accel NAME=VALUE`` (as ``solve``)."""
+    if args.animate:
+        names = ', '.join(d.name for d in scene.drivers)
+        msg = (f'Expected no --animate for {scene.name} with --input or --speed, or with '
+               f'several drivers or an actuator ({names}): --animate turns one crank')
+        raise ValueError(msg)
+    positions, rates, accels, turns, _ = _drive(scene, args)
+    drivers = scene.drivers
+    if scene.input is not None and len(drivers) == 1:  # one crank: _drive's scalars
+        positions, rates, accels, turns = [positions], [rates], [accels], [turns]
+    inputs = {d.name: float(x) + (2.0 * math.pi * int(t) if t else 0.0)
+              for d, x, t in zip(drivers, positions, turns, strict=True)}
+    speeds = {d.name: float(v) for d, v in zip(drivers, rates, strict=True) if v is not None}
+    accel = {d.name: float(a) for d, a in zip(drivers, accels, strict=True) if a is not None}
+    diagram = diagram_from_scene(scene, inputs=inputs, speeds=speeds, accels=accel,
+                                 instant_centres=args.instant_centres)
     write_diagram(diagram, scene, output)
     if diagram.refused:
         print(f'{scene.name}: {diagram.refused}')

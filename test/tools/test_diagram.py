@@ -521,13 +521,47 @@ def test_cli_draws_several_drivers_and_says_why_polygons_are_left_out(tmp_path, 
     assert _png_size(tmp_path / 'boom.png')[0] >= MIN_PNG_SIZE[0]
 
 
-@pytest.mark.parametrize('flag', [['--animate'], ['--angle-deg', '30'], ['--speed-rpm', '5']])
-def test_cli_refuses_one_crank_options_for_several_drivers(flag, tmp_path, capsys):
-    """--animate, --angle-deg, --speed-rpm have one crank's meaning: one error line, exit 2."""
+@pytest.mark.parametrize(('flag', 'message'), [
+    (['--animate'], 'Expected no --animate for five with --input or --speed, or with several '
+                    'drivers or an actuator (left, right): --animate turns one crank'),
+    (['--angle-deg', '30'], 'Expected --input, --speed and --accel NAME=VALUE for a scene with '
+                            'several drivers (left, right), got --angle-deg'),
+    (['--speed-rpm', '5'], 'Expected --input, --speed and --accel NAME=VALUE for a scene with '
+                           'several drivers (left, right), got --speed-rpm'),
+    (['--input', 'x=3'], 'Expected --input NAME=VALUE with NAME one of the drivers (left, '
+                         "right), got 'x'"),
+])
+def test_cli_refuses_one_crank_options_for_several_drivers(flag, message, tmp_path, capsys):
+    """--animate, --angle-deg, --speed-rpm, an unknown driver: one error line, exit 2."""
     path = tmp_path / 'five.yaml'
     path.write_text(FIVE_BAR_TWO_CRANKS)
     out = tmp_path / ('five.gif' if flag == ['--animate'] else 'five.png')
     assert dg.main([str(path), '-o', str(out), *flag]) == 2
-    err = capsys.readouterr().err
-    assert err.startswith(f'error: Expected no {flag[0]} for five, which has several drivers')
+    assert capsys.readouterr().err == f'error: {message}\n'
     assert not out.exists()
+
+
+def test_cli_draws_the_packaged_five_bar_where_solve_puts_it(tmp_path, monkeypatch):
+    """--input, --speed, --accel NAME=VALUE as solve takes them: the drawn state is solve's."""
+    calls = []
+    original = geo.diagram_from_scene
+
+    def spy(*args, **kwargs):
+        calls.append(original(*args, **kwargs))
+        return calls[-1]
+
+    monkeypatch.setattr(dg, 'diagram_from_scene', spy)
+    out = tmp_path / 'five_bar.png'
+    assert dg.main(['five_bar', '-o', str(out), '--input', 'left_crank=100', '--speed',
+                    'right_crank=-20', '--accel', 'left_crank=3']) == 0
+    (diagram,) = calls
+    scene = mk.load_scene('five_bar')
+    omega = 2 * math.pi * 30 / 60
+    state = mk.solve(scene, [math.radians(100), math.radians(60)], [omega, -2 * math.pi / 3],
+                     [3.0, 0.0])
+    left, right = diagram.drivers
+    assert left.position == pytest.approx(math.radians(100), rel=1e-15) and left.accel == 3.0
+    assert right.speed == pytest.approx(-2 * math.pi / 3, rel=1e-15)
+    np.testing.assert_allclose(diagram.velocity.letters['p'],
+                               _xy(complex(state.complex_points['P'][1])), rtol=1e-12)
+    assert _png_size(out)[0] >= MIN_PNG_SIZE[0]
