@@ -37,6 +37,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .cli import finite_float, positive_float, PROG, run_tool
+from .solve import _by_driver, named_value
 from ..errors import MechKinematicsError
 from ..ros import topics
 from ..ros.cdr import stamp_from_cdr
@@ -151,7 +152,8 @@ class Motion:
 
 def motion_from_scene(scene: Any, *, samples: int = DEFAULT_SAMPLES,
                       speed: float | None = None, accel: float | None = None,
-                      x: str = 'angle', duration: float | None = None) -> Motion:
+                      x: str = 'angle', duration: float | None = None,
+                      speeds: Mapping[str, float] | None = None) -> Motion:
     """Solve ``scene`` over one crank cycle (several drivers: along a path in time).
 
     A scene with several drivers (or an actuator) is solved along the path
@@ -176,6 +178,9 @@ def motion_from_scene(scene: Any, *, samples: int = DEFAULT_SAMPLES,
 
     duration : float, optional
         Several drivers: the time plotted, s (default: :func:`drivers_period`).
+    speeds : mapping of str to float, optional
+        Several drivers: speeds by driver name (rad/s, m/s) replacing the
+        defaults.
 
     Returns
     -------
@@ -188,7 +193,7 @@ def motion_from_scene(scene: Any, *, samples: int = DEFAULT_SAMPLES,
         msg = f'Expected at least 2 samples, got {samples}'
         raise PlotError(msg)
     if len(scene.drivers) > 1 or scene.drivers[0].joint_type != 'revolute':
-        return _motion_of_drivers(scene, samples, speed, accel, x, duration)
+        return _motion_of_drivers(scene, samples, speed, accel, x, duration, speeds)
     speed = scene.input.speed if speed is None else float(speed)
     accel = scene.input.accel if accel is None else float(accel)
     time = None
@@ -234,18 +239,19 @@ def _first_time(v: float, a: float, distance: float) -> float:
     return min(times, default=math.inf)
 
 
-def drivers_period(scene: Any) -> tuple[float, str]:
+def drivers_period(scene: Any, speeds: Mapping[str, float] | None = None
+                   ) -> tuple[float, str]:
     """Return the time (s) of the quickest driver's period, and which driver and what it does.
 
     A crank's period is the time it takes to turn once either way from its
     start at its default speed and acceleration; an actuator's, the time it
     takes to reach the end of its stroke it moves toward (one without stroke
     limits has none). The shortest of these keeps every actuator within its
-    stroke.
+    stroke. ``speeds`` (by driver name, rad/s or m/s) replace the defaults.
     """
     best, what = math.inf, ''
     for driver in scene.drivers:
-        v, a = driver.speed, driver.accel
+        v, a = (speeds or {}).get(driver.name, driver.speed), driver.accel
         if driver.joint_type == 'revolute':
             t = min(_first_time(v, a, 2.0 * math.pi), _first_time(v, a, -2.0 * math.pi))
             doing = f'{driver.name} turning once'
@@ -259,14 +265,20 @@ def drivers_period(scene: Any) -> tuple[float, str]:
             best, what = t, doing
     if not math.isfinite(best):
         msg = (f'Expected a driver of {scene.name} that turns or reaches the end of its stroke '
-               f'at its default speed and acceleration, got none: give --duration SECONDS')
+               f'at its speed and acceleration, got none: give --speed NAME=VALUE or '
+               f'--duration SECONDS')
         raise PlotError(msg)
     return best, what
 
 
 def _motion_of_drivers(scene: Any, samples: int, speed: float | None, accel: float | None,
-                       x: str, duration: float | None) -> Motion:
-    """Solve a scene with several drivers (or an actuator) along its drivers' default path."""
+                       x: str, duration: float | None,
+                       given: Mapping[str, float] | None) -> Motion:
+    """Solve a scene with several drivers (or an actuator) along its drivers' path.
+
+    Each driver moves from its start at its speed (``given`` by name, SI, or
+    its default) and its default acceleration.
+    """
     import mech_kinematics as mk
 
     if x != 'time':
@@ -275,17 +287,23 @@ def _motion_of_drivers(scene: Any, samples: int, speed: float | None, accel: flo
         raise PlotError(msg)
     if speed is not None or accel is not None:
         msg = (f'Expected no --speed-rpm or --accel for {scene.name}: each of its drivers '
-               f'moves at its own default speed and acceleration')
+               f'moves at its own speed (--speed NAME=VALUE) and default acceleration')
         raise PlotError(msg)
     if duration is None:
-        duration, what = drivers_period(scene)
+        duration, what = drivers_period(scene, given)
         span = f'{duration:.6g} s ({what})'
     else:
         span = f'{duration:.6g} s'
     time = np.linspace(0.0, duration, samples)
     drivers = scene.drivers
-    positions = [d.start + d.speed * time + 0.5 * d.accel * time * time for d in drivers]
-    speeds = [d.speed + d.accel * time for d in drivers]
+    unknown = sorted(set(given or {}) - {d.name for d in drivers})
+    if unknown:
+        msg = (f'Expected --speed NAME=VALUE with NAME one of the drivers '
+               f'({", ".join(d.name for d in drivers)}), got {", ".join(unknown)}')
+        raise PlotError(msg)
+    rate = {d.name: (given or {}).get(d.name, d.speed) for d in drivers}
+    positions = [d.start + rate[d.name] * time + 0.5 * d.accel * time * time for d in drivers]
+    speeds = [rate[d.name] + d.accel * time for d in drivers]
     accels = [np.full_like(time, d.accel) for d in drivers]
     with warnings.catch_warnings():
         warnings.simplefilter('ignore', mk.NearSingularWarning)
@@ -318,10 +336,10 @@ def _motion_of_drivers(scene: Any, samples: int, speed: float | None, accel: flo
     joints = {name: (j.position, j.velocity, j.acceleration) for name, j in state.joints.items()}
     points = {name: (p.position, p.velocity, p.acceleration) for name, p in state.points.items()}
     rates = ', '.join(
-        f'{d.name} {rpm_from_rad_per_s(d.speed):.6g} rpm' if d.joint_type == 'revolute'
-        else f'{d.name} {d.speed:.6g} m/s' for d in drivers)
-    title = (f'{scene.name}: solver, every driver from its start at its default speed '
-             f'({rates}) for {span}')
+        f'{d.name} {rpm_from_rad_per_s(rate[d.name]):.6g} rpm' if d.joint_type == 'revolute'
+        else f'{d.name} {rate[d.name]:.6g} m/s' for d in drivers)
+    title = (f'{scene.name}: solver, every driver from its start at its speed ({rates}) for '
+             f'{span}')
     jumps = np.zeros(samples - 1, dtype=bool)
     for engagement in state.intermittent.values():
         engaged = np.asarray(engagement.engaged, dtype=bool)
@@ -873,12 +891,20 @@ def _handle(args: argparse.Namespace) -> int:
         else:
             several = len(scene.drivers) > 1 or scene.drivers[0].joint_type != 'revolute'
             x = args.x or ('time' if several else 'angle')
-            if args.duration is not None and not several:
-                msg = (f'Expected --duration only for a scene with several drivers or an '
-                       f'actuator, got {scene.name}, driven by one crank: drop --duration')
+            if (args.duration is not None or args.speed) and not several:
+                msg = (f'Expected --duration and --speed NAME=VALUE only for a scene with '
+                       f'several drivers or an actuator, got {scene.name}, driven by one crank: '
+                       f'use --speed-rpm')
                 raise PlotError(msg)
+            try:
+                rates = _by_driver(scene, '--speed', args.speed)
+            except ValueError as error:
+                raise PlotError(str(error)) from None
+            given = {d.name: rad_per_s_from_rpm(rates[d.name]) if d.joint_type == 'revolute'
+                     else rates[d.name] for d in scene.drivers if d.name in rates}
             motion = motion_from_scene(scene, samples=args.samples, speed=speed,
-                                       accel=args.accel, x=x, duration=args.duration)
+                                       accel=args.accel, x=x, duration=args.duration,
+                                       speeds=given)
             save_figure(figure_from_motion(motion, x=x), output)
             print(f'{scene.name}: {motion.note}')  # where it does not assemble, if anywhere
     except (PlotError, mk.SceneError) as error:
@@ -923,6 +949,9 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="crank speed for --scene, rpm (default: the scene's)")
     parser.add_argument('--accel', type=finite_float, metavar='A',
                         help="crank acceleration for --scene, rad/s^2 (default: the scene's)")
+    parser.add_argument('--speed', type=named_value, action='append', metavar='NAME=VALUE',
+                        help="--scene with several drivers: a driver's speed, as solve takes "
+                             "it (rpm for a crank, m/s for an actuator; default: the scene's)")
     parser.add_argument('--duration', type=positive_float, metavar='SECONDS',
                         help='--scene with several drivers: the time plotted (default: the '
                              "quickest driver's turn or stroke)")

@@ -397,8 +397,8 @@ def test_several_drivers_are_plotted_along_their_path_in_time(tmp_path):
     fig = plot.plot_scene(scene, tmp_path / 'five.png', samples=61)
     assert_png(tmp_path / 'five.png')
     assert fig._suptitle.get_text().startswith(
-        'five: solver, every driver from its start at its default speed (left 10 rpm, right '
-        '10 rpm) for 6 s (left turning once)')
+        'five: solver, every driver from its start at its speed (left 10 rpm, right 10 rpm) '
+        'for 6 s (left turning once)')
     time = np.linspace(0.0, 6.0, 61)
     omega = 2 * math.pi / 6
     state = mk.solve(scene, [math.radians(120) + omega * time, math.radians(60) + omega * time],
@@ -454,7 +454,7 @@ def test_duration_with_one_crank_is_refused(tmp_path, capsys):
     """--duration is for several drivers: one line, exit 2."""
     assert plot.main(['--scene', 'khurmi_four_bar_ad150', '-o', str(tmp_path / 'p.png'),
                       '--duration', '1']) == 2
-    assert 'Expected --duration only for a scene with several drivers' in (
+    assert 'Expected --duration and --speed NAME=VALUE only for a scene with several' in (
         capsys.readouterr().err)
 
 
@@ -470,3 +470,38 @@ def test_bag_of_a_scene_with_several_drivers_plots_against_time_only(tmp_path, c
     assert ('Expected a recording of a scene driven by one crank to plot against crank angle, '
             'got five, with several drivers or an actuator: use --x time') in (
         capsys.readouterr().err)
+
+
+def test_packaged_excavator_plotted_at_given_cylinder_speeds(tmp_path, capsys):
+    """Its cylinders rest by default: refused saying so; --speed moves them to a stroke's end."""
+    out = tmp_path / 'excavator.png'
+    assert plot.main(['--scene', 'excavator', '-o', str(out)]) == 2
+    assert capsys.readouterr().err == (
+        'error: Expected a driver of excavator that turns or reaches the end of its stroke at '
+        'its speed and acceleration, got none: give --speed NAME=VALUE or --duration SECONDS\n')
+    scene = mk.load_scene('excavator')
+    motion = plot.motion_from_scene(scene, samples=31, x='time',
+                                    speeds={'boom_cyl': 0.1, 'stick_cyl': -0.05})
+    # boom_cyl reaches 3.3 m from 2.6 m in 7 s; stick_cyl 2.5 m from 3.0 m only in 10 s
+    assert motion.time[-1] == pytest.approx(7.0, rel=1e-14)
+    assert 'for 7 s (boom_cyl reaching the end of its stroke)' in motion.title
+    np.testing.assert_allclose(motion.joints['stick_cyl'][0], 3.0 - 0.05 * motion.time,
+                               rtol=1e-15)
+    assert plot.main(['--scene', 'excavator', '-o', str(out), '--speed', 'boom_cyl=0.1',
+                      '--speed', 'stick_cyl=-0.05']) == 0
+    assert_png(out)
+    assert plot.main(['--scene', 'excavator', '-o', str(out), '--speed', 'arm=1']) == 2
+    assert ('Expected --speed NAME=VALUE with NAME one of the drivers (boom_cyl, stick_cyl), '
+            "got 'arm'") in capsys.readouterr().err
+
+
+def test_packaged_five_bar_plots_both_cranks_turning_together(tmp_path):
+    """five_bar's cranks at 30 rpm CCW, 30 deg apart: one 2 s turn, |BD| as the closed form."""
+    motion = plot.motion_from_scene(mk.load_scene('five_bar'), samples=41, x='time')
+    assert motion.time[-1] == pytest.approx(2.0, rel=1e-14)
+    b, d = motion.points['B'][0], motion.points['D'][0]
+    bd = np.hypot(*(b - d).T)
+    # B - D = 0.12 e^(i left) (1 - e^(-i 30 deg)) - 0.1 m: |BD| within 0.1 -+ 0.24 sin 15 deg
+    half = 0.24 * math.sin(math.radians(15))
+    assert bd.min() >= 0.1 - half - 1e-12 and bd.max() <= 0.1 + half + 1e-12
+    assert bd.max() - bd.min() == pytest.approx(2 * half, rel=1e-2)
