@@ -314,3 +314,13 @@ def test_a_cylinder_is_drawn_as_a_link_between_its_pins():
         assert any(set(strip) == ends for strip in strips), (start, pin)
     joints = next(m for m in array.markers if m.ns == 'joints')
     assert len(joints.points) == len(points)
+
+
+def test_the_excavator_has_a_cylinder_per_actuator():
+    """Both of the excavator's cylinders are CYLINDER markers as long as the actuators are."""
+    scene = full_scene(mk.load_scene('excavator'))
+    state = mk.solve(scene, [2.9, 3.4])
+    array = marker_array_from_state(scene, state)
+    cylinders = [m for m in array.markers if m.ns == 'actuators']
+    assert [(m.id, m.type) for m in cylinders] == [(0, Marker.CYLINDER), (1, Marker.CYLINDER)]
+    assert [m.scale.z for m in cylinders] == pytest.approx([2.9, 3.4], rel=1e-14)
