@@ -233,7 +233,7 @@ class Scene:
                 warnings.simplefilter('ignore', NearSingularWarning)
                 if solver.single:
                     _execute(solver, drivers[0].start, 0.0, 0.0,  # positions only
-                             self.input.turns)
+                             cast(Crank, self.input).turns)
                 else:
                     zeros = (0.0,) * len(drivers)
                     _execute_drivers(solver, tuple(d.start for d in drivers), zeros, zeros)
@@ -241,7 +241,8 @@ class Scene:
             dyad = next((step.dyad for step in full.steps
                          if step.owner is None and step.label == error.dyad), None)
             if solver.single:
-                at = f'the initial crank angle {self.units.angle_text(self.input.shown)}'
+                shown = cast(Crank, self.input).shown
+                at = f'the initial crank angle {self.units.angle_text(shown)}'
             else:
                 at = "the drivers' start positions " + ', '.join(
                     f'{d.name} = {d.position_text(d.start, self.units)}' for d in drivers)

@@ -24,7 +24,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .cli import add_scene_argument, finite_float, positive_int, run_tool
-from .solve import _by_driver, _drive, named_value
+from .cli import drive_from_args, named_value, values_by_driver
 from ..errors import AssemblyError, NearSingularWarning, SceneError
 from ..geometry.diagrams import (arrows_from_state, colours_from_scene, Diagram,
                                  diagram_from_scene, fmt_sense, fmt_value, nice_scale, POLE,
@@ -827,7 +827,7 @@ def _handle(args: argparse.Namespace) -> int:
         drivers = scene.drivers
         if len(drivers) > 1 or drivers[0].joint_type != 'revolute' or args.input or args.speed:
             return _handle_drivers(args, scene, output)
-        accel = _by_driver(scene, '--accel', args.accel).get(drivers[0].name)
+        accel = values_by_driver(scene, '--accel', args.accel).get(drivers[0].name)
         if args.animate:
             if args.angle_deg is not None:
                 scene = _with_angle(scene, args.angle_deg)
@@ -852,9 +852,9 @@ def _handle_drivers(args: argparse.Namespace, scene: Scene, output: Path) -> int
         msg = (f'Expected no --animate for {scene.name} with --input or --speed, or with '
                f'several drivers or an actuator ({names}): --animate turns one crank')
         raise ValueError(msg)
-    positions, rates, accels, turns, _ = _drive(scene, args)
+    positions, rates, accels, turns, _ = drive_from_args(scene, args)
     drivers = scene.drivers
-    if scene.input is not None and len(drivers) == 1:  # one crank: _drive's scalars
+    if scene.input is not None and len(drivers) == 1:  # one crank: drive_from_args's scalars
         positions, rates, accels, turns = [positions], [rates], [accels], [turns]
     inputs = {d.name: float(x) + (2.0 * math.pi * int(t) if t else 0.0)
               for d, x, t in zip(drivers, positions, turns, strict=True)}

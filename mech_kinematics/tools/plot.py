@@ -37,7 +37,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .cli import finite_float, positive_float, PROG, run_tool
-from .solve import _by_driver, named_value
+from .cli import named_value, values_by_driver
 from ..errors import MechKinematicsError
 from ..ros import topics
 from ..ros.cdr import stamp_from_cdr
@@ -897,7 +897,7 @@ def _handle(args: argparse.Namespace) -> int:
                        f'use --speed-rpm')
                 raise PlotError(msg)
             try:
-                rates = _by_driver(scene, '--speed', args.speed)
+                rates = values_by_driver(scene, '--speed', args.speed)
             except ValueError as error:
                 raise PlotError(str(error)) from None
             given = {d.name: rad_per_s_from_rpm(rates[d.name]) if d.joint_type == 'revolute'
