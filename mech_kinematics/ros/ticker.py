@@ -261,7 +261,7 @@ def _compile_drivers(scene: lk.Scene, plan: hooks.TickPlan, joints: tuple[str, .
         '_ctx_check': _refuse, '_ctx_check_margin': _refuse, '_Refused': _Refused,
         '_shown': hooks.shown, '_slow': _general(scene, joints, points, frames),
         '_driver_limits': plan.driver_limits, '_rates_shift': hooks.rates_shift,
-        'inf': math.inf, '_float': float,
+        'inf': math.inf, '_float': float, '_SEQUENCE': (list, tuple),
     }
     for step in (*plan.drivers, *plan.steps):
         for cls in type(step).__mro__:
@@ -332,7 +332,9 @@ def _compile_drivers(scene: lk.Scene, plan: hooks.TickPlan, joints: tuple[str, .
                             returns=None)
     outer = ast.parse(
         'def tick(theta, omega, alpha, tol, turns=0):\n'
-        f'    if len(theta) != {count} or len(omega) != {count} or len(alpha) != {count} or '
+        '    if not (isinstance(theta, _SEQUENCE) and isinstance(omega, _SEQUENCE) '
+        'and isinstance(alpha, _SEQUENCE)) or '
+        f'len(theta) != {count} or len(omega) != {count} or len(alpha) != {count} or '
         '_rates_shift(omega, alpha):\n'
         '        return _slow(theta, omega, alpha, tol, turns)\n'
         '    try:\n'
