@@ -1058,13 +1058,28 @@ def scales(ref: Reference) -> dict[str, float]:
     velocities, ``a (omega**2 + |alpha|)`` for accelerations, ``|omega|`` and
     ``omega**2 + |alpha|`` for angular ones (a parallelogram's links have no
     angular acceleration at all); 1 rad for angles; 1 if all that is zero.
+    With several drivers, the largest of what each sets: each crank's as
+    above, an actuator's rate ``|v|`` and ``|a|``.
     """
     expected = _by_kind(ref)
-    crank = abs(ref.inputs.get('crank.length', 0))
-    omega, alpha = abs(ref.omega), abs(ref.alpha)
-    floors = {'position': crank, 'angle': 1, 'velocity': crank * omega,
-              'angular velocity': omega, 'acceleration': crank * (omega * omega + alpha),
-              'angular acceleration': omega * omega + alpha}
+    if isinstance(ref.omega, tuple):
+        floors = dict.fromkeys(KINDS, mpmath.mpf(0))
+        floors['angle'] = 1
+        for name, w, al in zip(ref.joint_types, ref.omega, ref.alpha):  # drivers come first
+            w, al = abs(w), abs(al)
+            if ref.joint_types[name] == 'revolute':
+                a = abs(ref.inputs[f'crank.{name}.length'])
+                mine = {'position': a, 'velocity': a * w, 'angular velocity': w,
+                        'acceleration': a * (w * w + al), 'angular acceleration': w * w + al}
+            else:
+                mine = {'velocity': w, 'acceleration': al}
+            floors.update((kind, max(floors[kind], value)) for kind, value in mine.items())
+    else:
+        crank = abs(ref.inputs.get('crank.length', 0))
+        omega, alpha = abs(ref.omega), abs(ref.alpha)
+        floors = {'position': crank, 'angle': 1, 'velocity': crank * omega,
+                  'angular velocity': omega, 'acceleration': crank * (omega * omega + alpha),
+                  'angular acceleration': omega * omega + alpha}
     out = {}
     for kind, values in expected.items():
         largest = max([abs(v) for v in values.values()] + [floors[kind]])
