@@ -497,3 +497,9 @@ def test_errors_relative_to_the_scales_are_a_few_ulps(name, positions):
     errors = ref.compare(mk.solve(scene, positions, speeds, accels), exact)
     assert set(errors) == set(ref.KINDS)
     assert max(errors.values()) <= 20 * EPS, errors
+    # Backward stable: within a few eps times the condition number in every input
+    # (each driver's position, speed and acceleration perturbed on its own).
+    kappa = ref.condition(scene, exact)
+    for kind, error in errors.items():
+        assert 1.0 <= kappa[kind] < 100.0, (kind, kappa)
+        assert error <= 4 * EPS * kappa[kind], (kind, error, kappa[kind])

@@ -1180,21 +1180,29 @@ def condition(scene: Scene | Model, ref: Reference,
         totals: dict[str, dict[str, Any]] = {
             kind: dict.fromkeys(v, mpmath.mpf(0)) for kind, v in base.items()}
         inputs: list[tuple[str, Any]] = [(key, value) for key, value in ref.inputs.items()]
-        inputs += [('@theta', ref.theta), ('@omega', ref.omega), ('@alpha', ref.alpha)]
+        several = isinstance(ref.theta, tuple)  # one value per driver: each perturbed
+        for label, given in (('@theta', ref.theta), ('@omega', ref.omega),
+                             ('@alpha', ref.alpha)):
+            inputs += ([(f'{label}{k}', x) for k, x in enumerate(given)] if several
+                       else [(label, given)])
         for key, value in inputs:
             if value == 0:
                 continue
             values = dict(ref.inputs)
-            th, om, al = ref.theta, ref.omega, ref.alpha
+            motion = {'@theta': ref.theta, '@omega': ref.omega, '@alpha': ref.alpha}
             delta = value * eta
-            if key == '@theta':
-                th = th + delta
-            elif key == '@omega':
-                om = om + delta
-            elif key == '@alpha':
-                al = al + delta
+            which = key.rstrip('0123456789')
+            if which in motion:
+                given = motion[which]
+                if several:
+                    k = int(key[len(which):])
+                    given = (*given[:k], given[k] + delta, *given[k + 1:])
+                else:
+                    given = given + delta
+                motion[which] = given
             else:
                 values[key] = value + delta
+            th, om, al = motion['@theta'], motion['@omega'], motion['@alpha']
             moved = _by_kind(reference(model, th, om, al, values=values, seed=ref.q, dps=dps))
             for kind, items in base.items():
                 for name, x in items.items():
