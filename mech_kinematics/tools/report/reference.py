@@ -1065,7 +1065,8 @@ def scales(ref: Reference) -> dict[str, float]:
     if isinstance(ref.omega, tuple):
         floors = dict.fromkeys(KINDS, mpmath.mpf(0))
         floors['angle'] = 1
-        for name, w, al in zip(ref.joint_types, ref.omega, ref.alpha):  # drivers come first
+        drivers = list(ref.joint_types)[:len(ref.omega)]  # the drivers' joints come first
+        for name, w, al in zip(drivers, ref.omega, ref.alpha, strict=True):
             w, al = abs(w), abs(al)
             if ref.joint_types[name] == 'revolute':
                 a = abs(ref.inputs[f'crank.{name}.length'])
