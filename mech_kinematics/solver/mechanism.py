@@ -51,6 +51,8 @@ class _Solver:
         self.crank_length = 0.0 if crank is None else crank.length
         #: Whether the scene has one driver, a crank (the v1 path of solve).
         self.single = crank is not None and len(scene.drivers) == 1
+        #: That crank's default speed and acceleration (the single path's, read once).
+        self.defaults = (crank.speed, crank.accel) if crank is not None else (0.0, 0.0)
         self.shift = _exponent(self.size, *_SIZE_RANGE)
         run = plan
         if self.shift:
