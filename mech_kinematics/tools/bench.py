@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from .cli import positive_int, run_tool
+from .peer import measure_peer, PEER_SCENES, peer_table, PEERS
 from ..scene import load_scene, scene_names
 from ..solver import solve
 
@@ -142,46 +143,63 @@ def slider_crank_numpy(theta: Any, w: float, al: float,
     return x, phi, v, wr, a, ar, bx, by, vbx, vby, abx, aby
 
 
-def hand_written(scene: Any) -> tuple[Callable[..., Any], Callable[..., Any]] | None:
-    """Return the hand-written scalar and NumPy forms of ``scene``, or None.
+def geometry_of(scene: Any) -> tuple[str, tuple[float, ...]] | None:
+    """Return (dyad kind, geometry) of a scene with hand-written forms, or None.
 
-    A scene has them when it is one crank driving one dyad: an RRR (a
-    four-bar) or an RRP on a horizontal guide (a slider-crank). Its carried
-    points are not computed by them (the solver computes them too).
+    A scene has them when it is one crank driving one dyad: an RRR on the
+    crank's tip and a ground pivot (a four-bar, :data:`FOUR_BAR_GEOMETRY`'s
+    layout) or an RRP on the crank's tip and a horizontal guide (a
+    slider-crank, :data:`SLIDER_CRANK_GEOMETRY`'s).
     """
     if len(scene.dyads) != 1:
         return None
-    baseline = _BASELINES.get(scene.dyads[0].kind)
-    return None if baseline is None else baseline(scene, scene.dyads[0], scene.input)
+    dyad, crank = scene.dyads[0], scene.input
+    baseline = _GEOMETRIES.get(dyad.kind)
+    geometry = None if baseline is None else baseline(scene, dyad, crank)
+    return None if geometry is None else (dyad.kind, geometry)
 
 
-def _four_bar(scene: Any, dyad: Any, crank: Any) -> Any:
-    """Return the four-bar's forms, for an RRR on the crank's tip and a ground pivot."""
+def hand_written(scene: Any) -> tuple[Callable[..., Any], Callable[..., Any]] | None:
+    """Return the hand-written scalar and NumPy forms of ``scene``, or None.
+
+    See :func:`geometry_of` for the scenes that have them. Their carried
+    points are not computed by them (the solver computes them too).
+    """
+    found = geometry_of(scene)
+    if found is None:
+        return None
+    kind, geometry = found
+    scalar, vector = _FORMS[kind]
+    return partial(scalar, geometry=geometry), partial(vector, geometry=geometry)
+
+
+def _four_bar(scene: Any, dyad: Any, crank: Any) -> tuple[float, ...] | None:
+    """Return the four-bar's geometry, for an RRR on the crank's tip and a ground pivot."""
     first, second = dyad.links
     if first.start != crank.point or second.start not in scene.ground:
         return None
     ox, oy = scene.ground[crank.center]
     dx, dy = scene.ground[second.start]
-    geometry = (ox, oy, crank.length, first.length, second.length, dx, dy,
-                float(dyad.branch.value))
-    return partial(four_bar_math, geometry=geometry), partial(four_bar_numpy, geometry=geometry)
+    return (ox, oy, crank.length, first.length, second.length, dx, dy,
+            float(dyad.branch.value))
 
 
-def _slider_crank(scene: Any, dyad: Any, crank: Any) -> Any:
-    """Return the slider-crank's forms, for an RRP on the crank's tip and a horizontal guide."""
+def _slider_crank(scene: Any, dyad: Any, crank: Any) -> tuple[float, ...] | None:
+    """Return the slider-crank's geometry, for an RRP on the crank's tip and a horizontal guide."""
     if dyad.guide_angle != 0.0 or dyad.link.start != crank.point \
             or dyad.through not in scene.ground:
         return None
     ox, oy = scene.ground[crank.center]
     guide = scene.ground[dyad.through][1]
-    geometry = (ox, oy, crank.length, dyad.link.length, guide, float(dyad.branch.value))
-    return partial(slider_crank_math, geometry=geometry), partial(slider_crank_numpy,
-                                                                  geometry=geometry)
+    return (ox, oy, crank.length, dyad.link.length, guide, float(dyad.branch.value))
 
 
-#: The hand-written baselines there are, by the scene's dyad ``type:``.
-_BASELINES: dict[str, Callable[[Any, Any, Any], Any]] = {'RRR': _four_bar,
-                                                         'RRP': _slider_crank}
+#: The hand-written baselines there are, by the scene's dyad ``type:``: the geometry's
+#: reader, and the scalar and NumPy forms.
+_GEOMETRIES: dict[str, Callable[[Any, Any, Any], tuple[float, ...] | None]] = {
+    'RRR': _four_bar, 'RRP': _slider_crank}
+_FORMS: dict[str, tuple[Callable[..., Any], Callable[..., Any]]] = {
+    'RRR': (four_bar_math, four_bar_numpy), 'RRP': (slider_crank_math, slider_crank_numpy)}
 
 
 #: Issue 19's targets, bounds included: the array path per configuration over the
@@ -280,6 +298,8 @@ def table(rows: list[dict[str, Any]], angles: int, repeat: int) -> list[str]:
 
 def _handle(args: argparse.Namespace) -> int:
     """Print the table of ``measure`` with the ratios to the hand-written baselines."""
+    if args.peer is not None:
+        return _handle_peer(args)
     rows = measure(scene_names(), args.angles, args.repeat)
     if args.json:
         print(json.dumps({'angles': args.angles, 'repeat': args.repeat, 'rows': rows},
@@ -287,6 +307,28 @@ def _handle(args: argparse.Namespace) -> int:
     else:
         print('\n'.join(table(rows, args.angles, args.repeat)))
     return 0
+
+
+def _handle_peer(args: argparse.Namespace) -> int:
+    """Print the side-by-side table against a peer package (:mod:`.peer`)."""
+    rows = measure_peers(args.repeat)
+    if args.json:
+        print(json.dumps({'peer': args.peer, 'repeat': args.repeat, 'rows': rows}, indent=1))
+    else:
+        print('\n'.join(peer_table(rows, args.repeat)))
+    return 0
+
+
+def measure_peers(repeat: int, names: Sequence[str] = PEER_SCENES) -> list[dict[str, Any]]:
+    """Return :func:`.peer.measure_peer`'s row of every scene timed against pylinkage."""
+    def forms(scene: Any) -> tuple[str, tuple[float, ...]]:
+        found = geometry_of(scene)
+        if found is None:
+            msg = f'Expected a four-bar or a slider-crank for the peer, got scene {scene.name}'
+            raise ValueError(msg)
+        return found
+
+    return [measure_peer(name, forms, repeat) for name in names]
 
 
 def add_parser(subparsers: Any) -> argparse.ArgumentParser:
@@ -300,6 +342,10 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
                         help='angles in the array path (default 1e5)')
     parser.add_argument('--repeat', type=positive_int, default=7,
                         help='runs for the min / median / max (default 7)')
+    parser.add_argument('--peer', choices=PEERS, default=None,
+                        help='time the packaged four-bar and slider-crank side by side with '
+                             'a peer package instead (pylinkage 1.3.0: a development '
+                             'dependency), after checking its answers equal ours')
     parser.add_argument('--json', action='store_true',
                         help='print the rows as JSON (times as [min, median, max] µs)')
     parser.set_defaults(handler=_handle)
