@@ -120,8 +120,8 @@ def check_same_answers(scene: Any, linkage: Any, steps: int) -> float:
             diff = float(np.nanmax(np.abs(theirs[:, column, :] - mine))) / scale
             if not diff <= RTOL_PEER:
                 msg = (f'Expected the {what} of {name} from pylinkage on {scene.name} to '
-                       f'equal ours within {RTOL_PEER:g} of its scale {scale:.3g}, got a difference of '
-                       f'{diff:.3g} times it: not the same geometry')
+                       f'equal ours within {RTOL_PEER:g} of its scale {scale:.3g}, got a '
+                       f'difference of {diff:.3g} times it: not the same geometry')
                 raise ValueError(msg)
             worst = max(worst, diff)
     return worst
