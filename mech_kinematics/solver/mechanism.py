@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 import math
-from typing import cast
+from typing import Any, cast
 import warnings
 
 from .base import Intermittent, Item
@@ -83,11 +83,16 @@ class _Solver:
         self.levers = {step.key: cast(Intermittent, step) for step in plan.steps
                        if step.intermittent}
         self.jumping = {lever: _jumping(plan, lever) for lever in self.levers}
+        self.joint_names = tuple(plan.joint_types)
         self.out_links = tuple(n for n, k in plan.joint_types.items() if k == 'revolute')
         self.out_sliders = tuple(n for n, k in plan.joint_types.items() if k == 'prismatic')
         # The quick trust test's groups (TRUST_TEST), with their names, the empty ones left out.
         self.trust = tuple((table, getattr(self, names), limits)
                            for table, names, limits in TRUST_TEST if getattr(self, names))
+        # The compiled single-angle solve (:mod:`.compiled`): None until compiled, False
+        # where the scene does not compile; and the single-angle solves until then.
+        self.single: Any = None
+        self.single_solves = 0
 
 
 def _jumping(plan: _Plan, lever: str) -> tuple[tuple[str, ...], tuple[str, ...]]:

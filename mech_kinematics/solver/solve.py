@@ -17,6 +17,7 @@ import warnings
 import numpy as np
 import numpy.typing as npt
 
+from .compiled import bounds_from_entries, COMPILE_AFTER, compile_single
 from .context import _Context, NEAR_SINGULAR
 from .scaling import (_ACCEL_HIGH, _ldexp, _QUANTITIES, _rate_exponent, _RATE_HIGH, _RATE_LOW,
                       _rescale)
@@ -265,6 +266,17 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
                    f'{omega!r}, {alpha!r}')
             raise ValueError(msg)
         whole = int(whole)
+        fast = solver.single if solver.single is not None else _compiled(scene, solver)
+        if fast:
+            parts = fast(theta, omega, alpha, tol, whole)
+            if parts is not None:
+                joints, points, measures, entries = parts
+                _warn_near_singular(measures, False, True)
+                bound = ErrorBound(bounds_from_entries, (solver.joint_names, solver.out_points,
+                                                         entries),
+                                   solver.size, solver.crank_length)
+                return _new_state(scene.name, theta, omega, alpha, joints, points, True,
+                                  measures, {}, bound, whole, {}, {}, {})
         ctx = _execute(solver, theta, omega, alpha, whole)
         if not _trusted(solver, ctx, omega, alpha, tol):
             _refuse(solver, ctx, omega, alpha, tol)
@@ -289,7 +301,7 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
         omega, alpha = np.broadcast_to(omega, shape), np.broadcast_to(alpha, shape)
         valid = np.broadcast_to(np.asarray(ctx.valid, dtype=bool), shape).copy()
         jumps = _jumps(solver, ctx, theta, omega, alpha, whole, valid) if ctx.jumps else {}
-    _warn_near_singular(ctx)
+    _warn_near_singular(ctx.measures, ctx.vector, ctx.valid)
     return _state(scene, solver, ctx, theta, omega, alpha, valid, whole, jumps)
 
 
@@ -416,10 +428,23 @@ def _is_scalar(x: Any) -> bool:
     return isinstance(x, (float, int)) or np.ndim(x) == 0
 
 
-def _warn_near_singular(ctx: _Context) -> None:
-    for key, measure in ctx.measures.items():
+def _compiled(scene: Scene, solver: _Solver) -> Any:
+    """Return the scene's compiled single-angle solve once it is worth it, else None or False.
+
+    See :mod:`.compiled`: compiled after :data:`.compiled.COMPILE_AFTER`
+    single-angle solves, False where the scene does not compile.
+    """
+    solver.single_solves += 1
+    if solver.single_solves < COMPILE_AFTER:
+        return None
+    solver.single = compile_single(scene) or False
+    return solver.single
+
+
+def _warn_near_singular(measures: dict[str, Any], vector: bool, valid: Any) -> None:
+    for key, measure in measures.items():
         low = measure < NEAR_SINGULAR
-        if low if not ctx.vector else (low & ctx.valid).any():
+        if low if not vector else (low & valid).any():
             msg = (f'dyad at "{key}" is near-singular (measure below {NEAR_SINGULAR:g}): '
                    f'its velocities and accelerations lose accuracy')
             warnings.warn(msg, NearSingularWarning, stacklevel=3)

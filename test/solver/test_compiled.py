@@ -1,0 +1,109 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The solver's compiled single-angle path against its general one: the same state, bit for bit.
+
+``solve(scene, angle)`` compiles a scene it has solved at single angles often
+enough (``solver/compiled.py``, issue 19's "bounds that cost little"): its
+states, bounds, warnings and refusals must be the general path's exactly.
+"""
+
+import math
+import warnings
+
+from helpers import general_only, state_facts
+import numpy as np
+import pytest
+
+import mech_kinematics as mk
+from mech_kinematics.solver.compiled import COMPILE_AFTER, compile_single
+from mech_kinematics.tools.report.common import MODES
+from mech_kinematics.tools.report.extreme import extreme_cases
+
+#: Crank angles over two turns and a bit, both signs.
+ANGLES = np.linspace(-7.0, 7.0, 141)
+TOLERANCES = (1e-6, 1e-12, math.inf)
+
+
+def _pair(scene_of):
+    """Return the same scene twice: compiled now, and never compiled."""
+    fast, slow = scene_of(), general_only(scene_of())
+    fast._solver.single = compile_single(fast)
+    return fast, slow
+
+
+def _outcome(scene, *args, **kwargs):
+    """Return the state's facts and the warnings raised, or the error's type, text and facts."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter('always')
+        try:
+            state = mk.solve(scene, *args, **kwargs)
+        except mk.AssemblyError as error:
+            return (type(error), str(error), error.dyad, repr(error.angle),
+                    getattr(error, 'facts', None), getattr(error, 'quantity', None))
+    return state_facts(state), [(w.category, str(w.message), w.filename) for w in caught]
+
+
+def _assert_same(fast, slow, angles, speeds=(None,), turns=(0,)):
+    refused = 0
+    for theta in angles:
+        for speed in speeds:
+            for tol in TOLERANCES:
+                for k in turns:
+                    args = (float(theta), speed)
+                    expected = _outcome(slow, *args, turns=k, max_error=tol)
+                    assert _outcome(fast, *args, turns=k, max_error=tol) == expected, (
+                        fast.name, theta, speed, tol, k)
+                    refused += isinstance(expected[0], type)
+    return refused
+
+
+@pytest.mark.parametrize('name', mk.scene_names())
+def test_every_packaged_scene_solves_alike_compiled(name):
+    """Over two turns, three speeds and three tolerances: identical states, bounds, refusals."""
+    fast, slow = _pair(lambda: mk.load_scene(name))
+    if name != 'geneva':    # its state reports the lever's engagement: the general path's
+        assert fast._solver.single, f'{name} does not compile'
+    refused = _assert_same(fast, slow, ANGLES, speeds=(None, -3.5, 1e4), turns=(0, 3))
+    if name == 'four_bar_coupler_points':
+        assert refused > 0      # the triple rocker's unassemblable angles, refused alike
+
+
+def test_the_extreme_suite_refuses_and_answers_alike():
+    """Toggles, change points, grazing guides, a pin at the pivot: same states and refusals."""
+    compiled = 0
+    for case in extreme_cases(MODES['smoke']):
+        fast, slow = _pair(lambda case=case: case.scene)
+        compiled += bool(fast._solver.single)
+        speed = case.speed if case.speed is not None else case.scene.input.speed
+        _assert_same(fast, slow, case.angles, speeds=(speed,))
+    assert compiled > 0
+
+
+@pytest.mark.parametrize('angle', [np.float64(1.25), np.float32(1.25), 1, np.int64(-2)])
+def test_any_real_angle_gives_the_state_of_the_float_it_equals(angle):
+    """An np.float64, np.float32 or int angle is solved as float(angle), compiled or not."""
+    fast, slow = _pair(lambda: mk.load_scene('khurmi_four_bar_ad150'))
+    expected = state_facts(mk.solve(slow, float(angle)))
+    assert state_facts(mk.solve(fast, angle)) == expected
+    assert state_facts(mk.solve(slow, angle)) == expected
+
+
+def test_a_scene_is_compiled_after_its_first_single_angle_solves():
+    """The first COMPILE_AFTER - 1 solves run the general path; the next compiles the scene."""
+    scene = mk.load_scene('slider_crank_150_600')
+    for _ in range(COMPILE_AFTER - 1):
+        mk.solve(scene, 0.5)
+        assert scene._solver.single is None
+    mk.solve(scene, 0.5)
+    assert callable(scene._solver.single)
+    mk.solve(scene, np.linspace(0.0, 1.0, 5))       # the array path does not count
+    assert callable(scene._solver.single)
+
+
+def test_a_held_state_is_not_changed_by_later_solves():
+    """A state from the compiled path keeps its values when the scene is solved again."""
+    fast, _ = _pair(lambda: mk.load_scene('khurmi_four_bar_ad150'))
+    first = mk.solve(fast, 0.3)
+    facts = state_facts(first)
+    mk.solve(fast, 2.0)
+    assert state_facts(first) == facts
