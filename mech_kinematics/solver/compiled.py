@@ -24,6 +24,8 @@ from __future__ import annotations
 
 import ast
 from collections.abc import Callable
+import ctypes
+import platform
 from typing import Any, TYPE_CHECKING
 
 from .specialize import plan_body, TABLES, Unsupported
@@ -32,12 +34,16 @@ from .state import JointMotion
 if TYPE_CHECKING:
     from .mechanism import Scene
 
-__all__ = ['COMPILE_AFTER', 'SingleFunction', 'compile_single']
+__all__ = ['ArrayFunction', 'COMPILE_AFTER', 'KEEP_FREED', 'LARGE_BATCH', 'SingleFunction',
+           'compile_array', 'compile_single', 'keep_freed_memory']
 
 #: Single-angle solves of one scene on the general path before it is compiled: a
 #: compilation costs about as much as a thousand solves, so a scene solved once or
 #: twice (most scenes a test builds) is never compiled.
 COMPILE_AFTER = 16
+
+#: ``array(theta, omega, alpha, turns, ctx) -> None``; see :func:`compile_array`.
+ArrayFunction = Callable[[Any, Any, Any, Any, Any], None]
 
 #: ``single(theta, omega, alpha, max_error, turns) -> (joints, points, measures, entries)``
 #: or ``None``; see :func:`compile_single`.
@@ -134,3 +140,80 @@ def compile_single(scene: Scene) -> SingleFunction | None:
     exec(compile(module, f'<compiled solve of {scene.name}>', 'exec'), namespace)  # noqa: S102
     single: SingleFunction = namespace['single']
     return single
+
+
+def compile_array(scene: Scene) -> ArrayFunction | None:
+    """Return the steps of ``scene``'s array path as one straight-line function, or ``None``.
+
+    The function ``array(theta, omega, alpha, turns, ctx)`` does what running
+    the crank's and every step's ``run`` on ``ctx`` (a vector
+    :class:`._Context`) does: the same NumPy operations in the same order,
+    without the dispatch, the dictionaries and the attribute reads between
+    them; it masks and records failures on ``ctx`` as the steps do, and leaves
+    every value in ``ctx``'s tables. ``None`` for the scenes
+    :func:`compile_single` leaves out.
+    """
+    from . import tick as hooks     # the tick's hooks import the solve this serves
+
+    plan = hooks.tick_plan(scene)
+    if not plan.compilable or scene._solver.levers:
+        return None
+    namespace: dict[str, Any] = {}
+    names: dict[str, str] = {}
+    try:
+        body = plan_body(plan, names, namespace, vector=True)
+    except Unsupported:
+        return None
+    tables: dict[str, list[str]] = {prefix: [] for prefix in TABLES.values()}
+    for key, local in names.items():
+        prefix, name = key.split('_', 1)
+        tables[prefix].append(f'{name!r}: {local}')
+    lines = [f'ctx.{table} = {{{", ".join(tables[prefix])}}}'
+             for table, prefix in TABLES.items()]
+    function = ast.FunctionDef(
+        name='array', args=ast.arguments(
+            posonlyargs=[], args=[ast.arg(a) for a in ('theta', 'omega', 'alpha', 'turns',
+                                                       'ctx')],
+            kwonlyargs=[], kw_defaults=[], defaults=[]),
+        body=body + ast.parse('\n'.join(lines)).body, decorator_list=[], returns=None)
+    module = ast.fix_missing_locations(ast.Module(body=[function], type_ignores=[]))
+    exec(compile(module, f'<compiled array solve of {scene.name}>', 'exec'),  # noqa: S102
+         namespace)
+    array: ArrayFunction = namespace['array']
+    return array
+
+
+#: An array solve of at least this many angles keeps freed memory for the next
+#: (:func:`keep_freed_memory`).
+LARGE_BATCH = 4096
+#: The C library's settings for that: (``M_TRIM_THRESHOLD``, bytes of free memory kept
+#: at the top of the heap), (``M_MMAP_THRESHOLD``, the size from which a block is mapped
+#: on its own, returned to the system when freed: glibc's own upper limit, 32 MiB).
+KEEP_FREED = ((-1, 256 << 20), (-3, 32 << 20))
+_kept: list[bool] = []
+
+
+def keep_freed_memory() -> bool:
+    """Let the C library keep freed memory for reuse, once per process; return whether it does.
+
+    An array solve over many angles makes a few hundred temporary arrays of
+    the batch's size, and glibc by default maps each large one on its own and
+    trims the heap once they are freed, so the next solve of the same size
+    pays a page fault on every 4 KiB of every temporary again: at 100,000
+    angles that is most of its time. With :data:`KEEP_FREED` the freed blocks
+    stay in the heap and the next solve's temporaries reuse them, as buffers
+    reused across calls would, and no returned array ever shares memory with
+    another call's (each is still a fresh allocation). The process keeps up to
+    256 MiB of freed memory. Elsewhere than glibc (``platform.libc_ver``) it
+    does nothing and returns False.
+    """
+    if not _kept:
+        done = False
+        if platform.libc_ver()[0] == 'glibc':
+            try:
+                libc = ctypes.CDLL(None)
+                done = all(libc.mallopt(param, value) == 1 for param, value in KEEP_FREED)
+            except (OSError, AttributeError):
+                done = False
+        _kept.append(done)
+    return _kept[0]

@@ -93,6 +93,10 @@ class _Solver:
         # where the scene does not compile; and the single-angle solves until then.
         self.single: Any = None
         self.single_solves = 0
+        # Likewise the compiled array path, and the scene both compile from.
+        self.array: Any = None
+        self.array_solves = 0
+        self.scene = scene
 
 
 def _jumping(plan: _Plan, lever: str) -> tuple[tuple[str, ...], tuple[str, ...]]:

@@ -17,7 +17,8 @@ import warnings
 import numpy as np
 import numpy.typing as npt
 
-from .compiled import bounds_from_entries, COMPILE_AFTER, compile_single
+from .compiled import (bounds_from_entries, COMPILE_AFTER, compile_array, compile_single,
+                       keep_freed_memory, LARGE_BATCH)
 from .context import _Context, NEAR_SINGULAR
 from .scaling import (_ACCEL_HIGH, _ldexp, _QUANTITIES, _rate_exponent, _RATE_HIGH, _RATE_LOW,
                       _rescale)
@@ -38,6 +39,11 @@ def _run(solver: _Solver, angle: Any, speed: Any, accel: Any, turns: Any,
     jump (see :func:`solve`).
     """
     ctx = _Context(angle, not isinstance(angle, float), turns, flip)
+    if ctx.vector and not flip:
+        fast = solver.array if solver.array is not None else _compiled_array(solver)
+        if fast:
+            fast(angle, speed, accel, turns, ctx)
+            return ctx
     # Ground points stay complex scalars in both paths: NumPy broadcasts them.
     ctx.points.update(solver.ground)
     plan = solver.run_plan
@@ -60,8 +66,10 @@ def _execute(solver: _Solver, theta: Any, omega: Any, alpha: Any, turns: Any = 0
     lengths (:class:`_Solver`); both are exact, so the answers are the same
     bits as if every product had stayed in range.
     """
-    w = abs(omega)
-    if isinstance(w, float) and _RATE_LOW <= w <= _RATE_HIGH and abs(alpha) <= _ACCEL_HIGH:
+    w, a = abs(omega), abs(alpha)
+    # (an array's abs is not a float: an array of rates is judged by _rate_exponent)
+    if isinstance(w, float) and isinstance(a, float) and _RATE_LOW <= w <= _RATE_HIGH \
+            and a <= _ACCEL_HIGH:
         shift = 0  # the single-angle path's usual case, decided without a call
     else:
         shift = _rate_exponent(omega, alpha)
@@ -288,21 +296,25 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
         if len(shape) != 1:
             msg = f'Expected `angle` to be a float or a 1-D array, got shape {shape}'
             raise ValueError(msg)
-        if not (np.isfinite(theta).all() and np.isfinite(omega).all()
-                and np.isfinite(alpha).all()):
+        if not (np.isfinite(theta).all() and _finite(omega) and _finite(alpha)):
             msg = 'Expected `angle`, `speed` and `accel` to be finite'
             raise ValueError(msg)
-        theta = np.broadcast_to(theta, shape)
-        whole = np.broadcast_to(np.asarray(whole, dtype=np.int64), shape)
+        if shape[0] >= LARGE_BATCH:
+            keep_freed_memory()
+        given = (theta, omega, alpha)       # maybe the caller's own arrays
+        theta = _read_only(theta, shape)
+        whole = _read_only(np.asarray(whole, dtype=np.int64), shape)
         with np.errstate(all='ignore'):
             # A constant speed or acceleration stays a scalar through the steps.
             ctx = _execute(solver, theta, omega, alpha, whole)
             _judge(solver, ctx, omega, alpha, tol, shape)
-        omega, alpha = np.broadcast_to(omega, shape), np.broadcast_to(alpha, shape)
-        valid = np.broadcast_to(np.asarray(ctx.valid, dtype=bool), shape).copy()
+        omega, alpha = _read_only(omega, shape), _read_only(alpha, shape)
+        valid = (np.ones(shape, dtype=bool) if ctx.valid is True
+                 else np.broadcast_to(np.asarray(ctx.valid, dtype=bool), shape).copy())
         jumps = _jumps(solver, ctx, theta, omega, alpha, whole, valid) if ctx.jumps else {}
     _warn_near_singular(ctx.measures, ctx.vector, ctx.valid)
-    return _state(scene, solver, ctx, theta, omega, alpha, valid, whole, jumps)
+    return _state(scene, solver, ctx, theta, omega, alpha, valid, whole, jumps,
+                  given if ctx.vector else ())
 
 
 def _jumps(solver: _Solver, ctx: _Context, theta: Any, omega: Any, alpha: Any, turns: Any,
@@ -423,6 +435,22 @@ def _turns(turns: Any) -> Any:
     raise ValueError(msg)
 
 
+def _finite(x: Any) -> bool:
+    """Return whether every value of ``x`` (an array of doubles) is finite."""
+    return math.isfinite(x) if x.ndim == 0 else bool(np.isfinite(x).all())
+
+
+def _read_only(x: Any, shape: tuple[int, ...]) -> Any:
+    """Return ``x`` broadcast to ``shape`` as a read-only view (``np.broadcast_to``'s result)."""
+    if x.ndim == 0:
+        return _constant(x, shape)
+    if x.shape != shape:
+        return np.broadcast_to(x, shape)
+    view = x.view()
+    view.flags.writeable = False
+    return view
+
+
 def _is_scalar(x: Any) -> bool:
     # The cheap test first: the node's tick passes plain floats.
     return isinstance(x, (float, int)) or np.ndim(x) == 0
@@ -441,17 +469,36 @@ def _compiled(scene: Scene, solver: _Solver) -> Any:
     return solver.single
 
 
+def _compiled_array(solver: _Solver) -> Any:
+    """Return the scene's compiled array path once it is worth it, else None or False.
+
+    See :mod:`.compiled`: compiled after :data:`.compiled.COMPILE_AFTER`
+    array solves, False where the scene does not compile.
+    """
+    solver.array_solves += 1
+    if solver.array_solves < COMPILE_AFTER:
+        return None
+    solver.array = compile_array(solver.scene) or False
+    return solver.array
+
+
 def _warn_near_singular(measures: dict[str, Any], vector: bool, valid: Any) -> None:
     for key, measure in measures.items():
-        low = measure < NEAR_SINGULAR
-        if low if not vector else (low & valid).any():
+        if not vector:
+            low = measure < NEAR_SINGULAR
+        elif valid is True:     # nothing refused: the least measure (NaN left out) decides
+            low = np.fmin.reduce(measure, axis=None) < NEAR_SINGULAR
+        else:
+            low = (np.less(measure, NEAR_SINGULAR) & valid).any()
+        if low:
             msg = (f'dyad at "{key}" is near-singular (measure below {NEAR_SINGULAR:g}): '
                    f'its velocities and accelerations lose accuracy')
             warnings.warn(msg, NearSingularWarning, stacklevel=3)
 
 
 def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any, alpha: Any,
-           valid: Any, turns: Any, jumps: dict[str, Any]) -> State:
+           valid: Any, turns: Any, jumps: dict[str, Any],
+           given: tuple[Any, ...] = ()) -> State:
     vector = ctx.vector
     plan = solver.plan
     joints = {}
@@ -468,18 +515,18 @@ def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any,
     if vector:
         shape = theta.shape
         bad = None if valid.all() else ~valid
-        inputs = (id(theta), id(omega), id(alpha))
+        inputs = (id(theta), id(omega), id(alpha), *map(id, given))
 
         def finish(x: Any) -> Any:
             # A constant (a ground point, a constant crank speed) becomes a
             # read-only broadcast view; a copy only where NaN must go in, and
             # never the caller's own input arrays.
-            if id(x) in inputs:
-                x = np.array(x)
-            elif np.shape(x) != shape:
-                x = np.broadcast_to(x, shape)
+            if getattr(x, 'shape', ()) != shape:
+                x = _constant(x, shape)
                 if bad is None:
                     return x
+                x = np.array(x)
+            elif id(x) in inputs:
                 x = np.array(x)
             if bad is not None:
                 x[bad] = np.nan
@@ -534,6 +581,19 @@ def _new_state(scene: str, angle: Any, speed: Any, accel: Any, joints: dict[str,
     fields['rubbing'], fields['intermittent'] = rubbing, intermittent
     fields['jumps'] = jumps
     return state
+
+
+def _constant(x: Any, shape: tuple[int, ...]) -> Any:
+    """Return one value (a number or a 0-d array) as a read-only array of ``shape``.
+
+    What ``np.broadcast_to`` returns (every element the one value, no copy),
+    built directly: a state holds a dozen of them, and ``broadcast_to`` costs
+    several times this.
+    """
+    one = np.array(x)
+    view: Any = np.ndarray(shape, one.dtype, one, 0, (0,) * len(shape))
+    view.flags.writeable = False
+    return view
 
 
 def _table_bounds(plan: _Plan, ctx: _Context) -> tuple[Table, Table]:

@@ -9,7 +9,9 @@ kernels out for one scene instead, as the statements of one function:
 
 - ``ctx.vector`` becomes a constant (``False`` for the single-angle path,
   ``True`` for the array path) and every branch it decides is folded away;
-- ``self.<attribute>`` of each step becomes the step's value (a constant);
+- ``self.<attribute>`` of each step becomes the step's value, and a name
+  of a number the kernel's module defines (``U``, ``ROUNDING_MARGIN``) its
+  value: constants;
 - ``ctx.points[name]``, ``ctx.links[name]``, ``ctx.sliders[name]`` and
   ``ctx.measures[name]`` become local variables (:data:`TABLES`);
 - one-line helpers of the solver package are written out in place;
@@ -215,6 +217,9 @@ class _Specializer(ast.NodeTransformer):
             return ast.copy_location(ast.Name(self.arguments[node.id], node.ctx), node)
         if node.id in self.locals:
             return ast.copy_location(ast.Name(f'{node.id}{self.suffix}', node.ctx), node)
+        value = self.namespace.get(node.id)
+        if type(value) in (float, int, complex) and isinstance(node.ctx, ast.Load):
+            return ast.copy_location(ast.Constant(value), node)     # a module's constant
         if node.id == 'ctx' and self.vector and isinstance(node.ctx, ast.Load):
             return node         # the receiver of a real context's attribute or method
         if node.id in ('ctx', 'self'):

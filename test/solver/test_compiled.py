@@ -8,6 +8,7 @@ states, bounds, warnings and refusals must be the general path's exactly.
 """
 
 import math
+import sys
 import warnings
 
 from helpers import general_only, state_facts
@@ -15,7 +16,9 @@ import numpy as np
 import pytest
 
 import mech_kinematics as mk
-from mech_kinematics.solver.compiled import COMPILE_AFTER, compile_single
+from mech_kinematics.solver import compiled as compiled_module
+from mech_kinematics.solver.compiled import (COMPILE_AFTER, compile_array, compile_single,
+                                             LARGE_BATCH)
 from mech_kinematics.tools.report.common import MODES
 from mech_kinematics.tools.report.extreme import extreme_cases
 
@@ -28,6 +31,7 @@ def _pair(scene_of):
     """Return the same scene twice: compiled now, and never compiled."""
     fast, slow = scene_of(), general_only(scene_of())
     fast._solver.single = compile_single(fast)
+    fast._solver.array = compile_array(fast)
     return fast, slow
 
 
@@ -79,6 +83,42 @@ def test_the_extreme_suite_refuses_and_answers_alike():
     assert compiled > 0
 
 
+def _array_outcome(scene, *args, **kwargs):
+    """Return the array solve's facts and warnings."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter('always')
+        state = mk.solve(scene, *args, **kwargs)
+    return state_facts(state), [(w.category, str(w.message), w.filename) for w in caught]
+
+
+@pytest.mark.parametrize('name', mk.scene_names())
+def test_every_packaged_scene_solves_arrays_alike_compiled(name):
+    """Arrays of angles, speeds and turns, three tolerances: identical states, masks, bounds."""
+    fast, slow = _pair(lambda: mk.load_scene(name))
+    if name != 'geneva':
+        assert fast._solver.array, f'{name} does not compile'
+    speeds = np.linspace(-20.0, 30.0, ANGLES.size)
+    for kwargs in ({}, {'speed': speeds}, {'speed': 3.0, 'accel': speeds},
+                   {'turns': np.arange(ANGLES.size) % 3}, {'max_error': 1e-12},
+                   {'max_error': math.inf}):
+        for angles in (ANGLES, ANGLES[:1], ANGLES[::-7]):
+            cut = {key: value[:angles.size] if np.ndim(value) else value
+                   for key, value in kwargs.items()}
+            if 'speed' in cut and np.ndim(cut['speed']):
+                cut['speed'] = speeds[:angles.size]
+            assert _array_outcome(fast, angles, **cut) == _array_outcome(slow, angles, **cut), (
+                name, angles.size, kwargs)
+
+
+def test_the_extreme_suite_solves_arrays_alike():
+    """The extreme cases over their angles as one array: same states, masks and bounds."""
+    for case in extreme_cases(MODES['smoke']):
+        fast, slow = _pair(lambda case=case: case.scene)
+        speed = case.speed if case.speed is not None else case.scene.input.speed
+        angles = np.asarray(case.angles, dtype=float)
+        assert _array_outcome(fast, angles, speed) == _array_outcome(slow, angles, speed)
+
+
 @pytest.mark.parametrize('angle', [np.float64(1.25), np.float32(1.25), 1, np.int64(-2)])
 def test_any_real_angle_gives_the_state_of_the_float_it_equals(angle):
     """An np.float64, np.float32 or int angle is solved as float(angle), compiled or not."""
@@ -96,14 +136,63 @@ def test_a_scene_is_compiled_after_its_first_single_angle_solves():
         assert scene._solver.single is None
     mk.solve(scene, 0.5)
     assert callable(scene._solver.single)
-    mk.solve(scene, np.linspace(0.0, 1.0, 5))       # the array path does not count
-    assert callable(scene._solver.single)
+    mk.solve(scene, np.linspace(0.0, 1.0, 5))       # the array path counts apart
+    assert callable(scene._solver.single) and scene._solver.array is None
 
 
 def test_a_held_state_is_not_changed_by_later_solves():
     """A state from the compiled path keeps its values when the scene is solved again."""
     fast, _ = _pair(lambda: mk.load_scene('khurmi_four_bar_ad150'))
-    first = mk.solve(fast, 0.3)
-    facts = state_facts(first)
-    mk.solve(fast, 2.0)
-    assert state_facts(first) == facts
+    for one, other in ((0.3, 2.0), (np.linspace(0, 1, 50), np.linspace(2, 3, 50))):
+        first = mk.solve(fast, one)
+        facts = state_facts(first)
+        mk.solve(fast, other)
+        assert state_facts(first) == facts
+
+
+@pytest.mark.parametrize('compiled', [False, True])
+def test_the_callers_arrays_are_never_written(compiled):
+    """Angles, speeds and accelerations given as arrays keep their values, some angles refused.
+
+    The array path wrote NaN into the caller's speed array at the refused
+    angles (it masked the crank's rate in place), and failed for an array of
+    accelerations with a constant speed.
+    """
+    scene = mk.load_scene('four_bar_coupler_points')
+    if compiled:
+        scene._solver.array = compile_array(scene)
+    else:
+        general_only(scene)
+    angles, speeds = ANGLES.copy(), np.linspace(-20.0, 30.0, ANGLES.size)
+    for args in ((angles, speeds), (angles, 3.0, speeds.copy()), (angles, speeds, speeds)):
+        before = [np.array(x) for x in args]
+        state = mk.solve(scene, *args)
+        assert not state.valid.all() and state.valid.any()
+        for x, was in zip(args, before, strict=True):
+            assert np.array_equal(x, was)
+        for index in (5, 60):
+            one = mk.solve(scene, *(float(np.broadcast_to(x, angles.shape)[index])
+                                    for x in args))
+            assert state.joints['crank'].acceleration[index] == one.joints['crank'].acceleration
+
+
+def test_a_large_batch_keeps_freed_memory_once(monkeypatch):
+    """An array solve of LARGE_BATCH angles asks the C library once to keep freed memory."""
+    calls = []
+    monkeypatch.setattr(compiled_module, 'keep_freed_memory', lambda: calls.append(1) or True)
+    solve_module = sys.modules['mech_kinematics.solver.solve']
+    monkeypatch.setattr(solve_module, 'keep_freed_memory', compiled_module.keep_freed_memory)
+    scene = mk.load_scene('khurmi_four_bar_ad150')
+    mk.solve(scene, np.linspace(0.0, 1.0, LARGE_BATCH - 1))
+    assert not calls
+    mk.solve(scene, np.linspace(0.0, 1.0, LARGE_BATCH))
+    assert calls == [1]
+
+
+def test_keeping_freed_memory_is_set_once_on_glibc():
+    """On glibc the two settings are accepted, and asking again changes nothing."""
+    import platform
+
+    first = compiled_module.keep_freed_memory()
+    assert first == (platform.libc_ver()[0] == 'glibc')
+    assert compiled_module.keep_freed_memory() == first
