@@ -9,6 +9,9 @@ same run where the scene is one crank and one dyad (:func:`hand_written`:
 a four-bar, or a slider-crank on a horizontal guide), and prints the ratios
 to them against issue 19's targets (:data:`SINGLE_TARGET`, :data:`ARRAY_TARGET`). The
 machine is shared and noisy, so what matters is the ratios of one run.
+
+``bench --peer pylinkage`` times the packaged four-bar and slider-crank side
+by side with pylinkage 1.3.0's numba path instead (:mod:`.peer`, issue 22).
 """
 
 from __future__ import annotations
@@ -19,13 +22,14 @@ from functools import partial
 import json
 import math
 import statistics
+import sys
 import time
 from typing import Any
 
 import numpy as np
 
 from .cli import positive_int, run_tool
-from .peer import measure_peer, PEER_SCENES, peer_table, PEERS
+from .peer import available, BATCHES, measure_peer, PEER_SCENES, peer_table, PEERS
 from ..scene import load_scene, scene_names
 from ..solver import solve
 
@@ -202,6 +206,11 @@ _FORMS: dict[str, tuple[Callable[..., Any], Callable[..., Any]]] = {
     'RRR': (four_bar_math, four_bar_numpy), 'RRP': (slider_crank_math, slider_crank_numpy)}
 
 
+#: The clock of every timing: the process's CPU time. On the shared machine the wall
+#: clock also counts the time other processes hold the cores; every solve timed here
+#: (ours, the hand-written forms, pylinkage's numba kernels) runs on one thread.
+CLOCK = time.process_time
+
 #: Issue 19's targets, bounds included: the array path per configuration over the
 #: hand-written NumPy closed form, the single angle over the hand-written scalar one.
 ARRAY_TARGET = 1.5
@@ -214,15 +223,15 @@ def _spread_times(funcs: list[Callable[[], Any]], number: int,
 
     The functions are timed in turn: interleaving the repeats makes a load
     change on the shared machine hit every function alike, so their ratios
-    stay meaningful.
+    stay meaningful. Times are the process's CPU time (:data:`CLOCK`).
     """
     times: list[list[float]] = [[] for _ in funcs]
     for _ in range(repeat):
         for func, samples in zip(funcs, times, strict=True):
-            start = time.perf_counter()
+            start = CLOCK()
             for _ in range(number):
                 func()
-            samples.append((time.perf_counter() - start) / number)
+            samples.append((CLOCK() - start) / number)
     return [(min(s), statistics.median(s), max(s)) for s in times]
 
 
@@ -311,6 +320,10 @@ def _handle(args: argparse.Namespace) -> int:
 
 def _handle_peer(args: argparse.Namespace) -> int:
     """Print the side-by-side table against a peer package (:mod:`.peer`)."""
+    if not available():
+        print('bench: expected pylinkage 1.3.0 installed for --peer pylinkage (a development '
+              'dependency: `make install`), got none', file=sys.stderr)
+        return 2
     rows = measure_peers(args.repeat)
     if args.json:
         print(json.dumps({'peer': args.peer, 'repeat': args.repeat, 'rows': rows}, indent=1))
@@ -319,7 +332,8 @@ def _handle_peer(args: argparse.Namespace) -> int:
     return 0
 
 
-def measure_peers(repeat: int, names: Sequence[str] = PEER_SCENES) -> list[dict[str, Any]]:
+def measure_peers(repeat: int, names: Sequence[str] = PEER_SCENES,
+                  batches: tuple[int, ...] = BATCHES) -> list[dict[str, Any]]:
     """Return :func:`.peer.measure_peer`'s row of every scene timed against pylinkage."""
     def forms(scene: Any) -> tuple[str, tuple[float, ...]]:
         found = geometry_of(scene)
@@ -328,7 +342,7 @@ def measure_peers(repeat: int, names: Sequence[str] = PEER_SCENES) -> list[dict[
             raise ValueError(msg)
         return found
 
-    return [measure_peer(name, forms, repeat) for name in names]
+    return [measure_peer(name, forms, repeat, batches) for name in names]
 
 
 def add_parser(subparsers: Any) -> argparse.ArgumentParser:

@@ -129,45 +129,67 @@ def check_same_answers(scene: Any, linkage: Any, steps: int) -> float:
 
 def _times(funcs: list[Callable[[], Any]], number: list[int],
            repeat: int) -> list[list[float]]:
-    """Return [min, median, max] seconds per call of each function, the repeats interleaved."""
+    """Return [min, median, max] seconds per call of each function, the repeats interleaved.
+
+    Seconds of the process's CPU time, as :data:`.bench.CLOCK`: both sides run
+    on one thread.
+    """
     samples: list[list[float]] = [[] for _ in funcs]
     for _ in range(repeat):
         for func, count, times in zip(funcs, number, samples, strict=True):
-            start = time.perf_counter()
+            start = time.process_time()
             for _ in range(count):
                 func()
-            times.append((time.perf_counter() - start) / count)
+            times.append((time.process_time() - start) / count)
     return [[min(s), float(np.median(s)), max(s)] for s in samples]
 
 
-def measure_peer(name: str, forms: Callable[[Any], Any], repeat: int) -> dict[str, Any]:
+def available() -> bool:
+    """Return whether the peer (pylinkage) is installed."""
+    try:
+        _pylinkage()
+    except ValueError:
+        return False
+    return True
+
+
+def work_items(batches: tuple[int, ...] = BATCHES) -> list[tuple[str, str]]:
+    """Return (key, label) of each work item of a row: one angle, then each batch size."""
+    return [('single', 'one angle per call (ours p+v+a+bounds; theirs positions)'),
+            *((f'batch_{n}', f'{n:,} angles in one call, p+v+a, per configuration')
+              for n in batches)]
+
+
+def measure_peer(name: str, forms: Callable[[Any], Any], repeat: int,
+                 batches: tuple[int, ...] = BATCHES) -> dict[str, Any]:
     """Time ``name``'s packaged scene against pylinkage; return one row of the table.
 
     ``forms(scene)`` returns ``(kind, geometry)`` for :func:`peer_linkage`
     (:func:`.bench.geometry_of`). The row holds ``cold_s`` (their first call),
     ``max_difference`` (:func:`check_same_answers`), and per work item
-    (``single``, ``batch_360``, ``batch_100000``) ``ours_us`` and
-    ``theirs_us``: [min, median, max] microseconds per configuration.
+    (:func:`work_items`: ``single``, ``batch_<n>`` for each of ``batches``)
+    ``ours_us`` and ``theirs_us``: [min, median, max] microseconds per
+    configuration.
     """
     scene = load_scene(name)
     kind, geometry = forms(scene)
     theta0, speed = scene.input.angle, scene.input.speed
     start = tuple(float(x) for x in solve(scene, theta0).points[_output(scene)].position)
     built = {steps: peer_linkage(kind, geometry, theta0, speed, steps, start)[0]
-             for steps in (1, *BATCHES)}
-    began = time.perf_counter()
+             for steps in (1, *batches)}
+    began = time.process_time()
     built[1].step_fast(iterations=1)
     built[1].step_fast_with_kinematics(iterations=1)
-    cold = time.perf_counter() - began
+    cold = time.process_time() - began
     difference = check_same_answers(scene, peer_linkage(kind, geometry, theta0, speed, 360,
                                                         start)[0], 360)
-    sweeps = {steps: theta0 + math.tau / steps * np.arange(1, steps + 1) for steps in BATCHES}
+    sweeps = {steps: theta0 + math.tau / steps * np.arange(1, steps + 1) for steps in batches}
     row: dict[str, Any] = {'scene': name, 'cold_s': cold, 'max_difference': difference}
     single = _times([lambda: solve(scene, theta0), lambda: built[1].step_fast(iterations=1)],
                     [1000, 1000], repeat)
     row['single'] = {'ours_us': [t * 1e6 for t in single[0]],
                      'theirs_us': [t * 1e6 for t in single[1]]}
-    for steps in BATCHES:
+    for steps in batches:
         sweep, linkage = sweeps[steps], built[steps]
         calls = max(1, 36_000 // steps)
         both = _times([lambda sweep=sweep: solve(scene, sweep),
@@ -179,13 +201,8 @@ def measure_peer(name: str, forms: Callable[[Any], Any], repeat: int) -> dict[st
     return row
 
 
-#: The work items of a row, with their labels in the table.
-WORK = (('single', 'one angle per call (ours p+v+a+bounds; theirs positions)'),
-        ('batch_360', '360 angles in one call, p+v+a, per configuration'),
-        ('batch_100000', '100,000 angles in one call, p+v+a, per configuration'))
-
-
-def peer_table(rows: list[dict[str, Any]], repeat: int) -> list[str]:
+def peer_table(rows: list[dict[str, Any]], repeat: int,
+               batches: tuple[int, ...] = BATCHES) -> list[str]:
     """Return the lines ``bench --peer pylinkage`` prints for the rows of :func:`measure_peer`."""
     lines = [f'pylinkage 1.3.0 (numba) side by side, one process; min / median / max of '
              f'{repeat} runs, µs; ratio: their median over ours (> 1: ours faster)']
@@ -194,7 +211,7 @@ def peer_table(rows: list[dict[str, Any]], repeat: int) -> list[str]:
                      f'their cold start (first calls: numba compile or cache load) '
                      f'{row["cold_s"]:.2f} s')
         lines.append(f'  {"work":58s} {"ours":>22s} {"pylinkage":>22s} {"ratio":>6s}')
-        for key, label in WORK:
+        for key, label in work_items(batches):
             ours, theirs = row[key]['ours_us'], row[key]['theirs_us']
             lines.append(f'  {label:58s} {"/".join(f"{t:.3g}" for t in ours):>22s} '
                          f'{"/".join(f"{t:.3g}" for t in theirs):>22s} '

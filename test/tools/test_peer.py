@@ -53,7 +53,7 @@ def test_peer_mode_prints_every_work_item_of_both_scenes(capsys):
     assert [row['scene'] for row in data['rows']] == list(peer.PEER_SCENES)
     for row in data['rows']:
         assert 0 <= row['max_difference'] <= peer.RTOL_PEER and row['cold_s'] >= 0
-        for key, _ in peer.WORK:
+        for key, _ in peer.work_items():
             for side in ('ours_us', 'theirs_us'):
                 low, mid, high = row[key][side]
                 assert 0 < low <= mid <= high
@@ -63,7 +63,7 @@ def test_peer_table_gives_their_median_over_ours():
     """The ratio column is their median over ours (above 1 where ours is faster)."""
     spread = {'ours_us': [1.0, 2.0, 3.0], 'theirs_us': [4.0, 5.0, 6.0]}
     row = {'scene': 's', 'cold_s': 1.5, 'max_difference': 1e-15,
-           **{key: spread for key, _ in peer.WORK}}
+           **{key: spread for key, _ in peer.work_items()}}
     lines = peer.peer_table([row], 7)
     assert 'of 7 runs' in lines[0] and '1.50 s' in lines[1]
     assert [line.split()[-3:] for line in lines[3:]] == [['1/2/3', '4/5/6', '2.50']] * 3
@@ -73,3 +73,15 @@ def test_peer_mode_refuses_a_scene_without_a_peer_twin():
     """A scene that is not a four-bar or slider-crank is refused with one line."""
     with pytest.raises(ValueError, match='Expected a four-bar or a slider-crank'):
         bench.measure_peers(1, ['geneva'])
+
+
+def test_peer_mode_without_pylinkage_says_how_to_install_it(monkeypatch, capsys):
+    """Where pylinkage is not installed: one line naming the dev dependency, exit 2."""
+    def missing():
+        msg = 'Expected pylinkage 1.3.0 installed, got No module named pylinkage'
+        raise ValueError(msg)
+
+    monkeypatch.setattr(peer, '_pylinkage', missing)
+    assert bench.main(['--peer', 'pylinkage']) == 2
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1 and 'make install' in err
