@@ -196,8 +196,8 @@ def assert_bounded(scene, angle, speed=None, accel=None):
 
 def general_only(scene: mk.Scene) -> mk.Scene:
     """Return ``scene`` set never to use the solver's compiled paths (its general solve)."""
-    scene._solver.single = False
-    scene._solver.array = False
+    scene._solver.compiled_single = False
+    scene._solver.compiled_array = False
     return scene
 
 

@@ -91,10 +91,10 @@ class _Solver:
                            for table, names, limits in TRUST_TEST if getattr(self, names))
         # The compiled single-angle solve (:mod:`.compiled`): None until compiled, False
         # where the scene does not compile; and the single-angle solves until then.
-        self.single: Any = None
+        self.compiled_single: Any = None
         self.single_solves = 0
         # Likewise the compiled array path, and the scene both compile from.
-        self.array: Any = None
+        self.compiled_array: Any = None
         self.array_solves = 0
         self.scene = scene
 

@@ -40,7 +40,9 @@ def _run(solver: _Solver, angle: Any, speed: Any, accel: Any, turns: Any,
     """
     ctx = _Context(angle, not isinstance(angle, float), turns, flip)
     if ctx.vector and not flip:
-        fast = solver.array if solver.array is not None else _compiled_array(solver)
+        fast = solver.compiled_array
+        if fast is None:
+            fast = _compiled_array(solver)
         if fast:
             fast(angle, speed, accel, turns, ctx)
             return ctx
@@ -173,6 +175,9 @@ def _judge(solver: _Solver, ctx: _Context, omega: Any, alpha: Any, tol: float,
     floors = {'position': solver.size, 'angle': 1.0, 'velocity': a * w, 'angular velocity': w,
               'acceleration': a * rate, 'angular acceleration': rate}
     lims = {kind: tol * floor for kind, floor in floors.items()}
+    if ctx.valid is True and np.ndim(omega) == 0 and np.ndim(alpha) == 0 \
+            and _within(solver, ctx, lims):
+        return  # nothing refused, one rate, the largest bounds within the floors: as below
     failed = np.logical_not(ctx.valid)  # already refused: not judged again
     if all(bool(((entry[3] <= lims[kinds[0]]) & (entry[4] <= lims[kinds[1]])
                  & (entry[5] <= lims[kinds[2]]) | failed).all())
@@ -190,6 +195,28 @@ def _judge(solver: _Solver, ctx: _Context, omega: Any, alpha: Any, tol: float,
         ctx.mask(np.broadcast_to(ok, shape), f'{label} (untrusted)')
     for name, (_, bound) in ctx.rubbing.items():
         ctx.mask(np.broadcast_to(bound <= lims['velocity'], shape), f'pin {name} (untrusted)')
+
+
+def _within(solver: _Solver, ctx: _Context, lims: dict[str, float]) -> bool:
+    """Return whether every reported bound of a vector solve is within its kind's floor.
+
+    ``lims``: the floors times the tolerance, one number each (one crank rate).
+
+    The largest of each array (``np.maximum.reduce``: NaN is the largest and
+    fails), one reduction per bound where :func:`_judge`'s test takes five
+    operations.
+    """
+    largest = np.maximum.reduce
+    for table, name, _, _, kinds in solver.outputs:
+        entry = getattr(ctx, table)[name]
+        for index in (0, 1, 2):
+            bound = entry[3 + index]
+            if getattr(bound, 'ndim', 0):
+                bound = largest(bound)
+            if not bound <= lims[kinds[index]]:
+                return False
+    lim = lims['velocity']
+    return all(bool(largest(bound, axis=None) <= lim) for _, bound in ctx.rubbing.values())
 
 
 def _angle(e: Any, vector: bool) -> Any:
@@ -274,7 +301,9 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
                    f'{omega!r}, {alpha!r}')
             raise ValueError(msg)
         whole = int(whole)
-        fast = solver.single if solver.single is not None else _compiled(scene, solver)
+        fast = solver.compiled_single
+        if fast is None:
+            fast = _compiled(scene, solver)
         if fast:
             parts = fast(theta, omega, alpha, tol, whole)
             if parts is not None:
@@ -465,8 +494,8 @@ def _compiled(scene: Scene, solver: _Solver) -> Any:
     solver.single_solves += 1
     if solver.single_solves < COMPILE_AFTER:
         return None
-    solver.single = compile_single(scene) or False
-    return solver.single
+    solver.compiled_single = compile_single(scene) or False
+    return solver.compiled_single
 
 
 def _compiled_array(solver: _Solver) -> Any:
@@ -478,8 +507,8 @@ def _compiled_array(solver: _Solver) -> Any:
     solver.array_solves += 1
     if solver.array_solves < COMPILE_AFTER:
         return None
-    solver.array = compile_array(solver.scene) or False
-    return solver.array
+    solver.compiled_array = compile_array(solver.scene) or False
+    return solver.compiled_array
 
 
 def _warn_near_singular(measures: dict[str, Any], vector: bool, valid: Any) -> None:

@@ -30,8 +30,8 @@ TOLERANCES = (1e-6, 1e-12, math.inf)
 def _pair(scene_of):
     """Return the same scene twice: compiled now, and never compiled."""
     fast, slow = scene_of(), general_only(scene_of())
-    fast._solver.single = compile_single(fast)
-    fast._solver.array = compile_array(fast)
+    fast._solver.compiled_single = compile_single(fast)
+    fast._solver.compiled_array = compile_array(fast)
     return fast, slow
 
 
@@ -66,7 +66,7 @@ def test_every_packaged_scene_solves_alike_compiled(name):
     """Over two turns, three speeds and three tolerances: identical states, bounds, refusals."""
     fast, slow = _pair(lambda: mk.load_scene(name))
     if name != 'geneva':    # its state reports the lever's engagement: the general path's
-        assert fast._solver.single, f'{name} does not compile'
+        assert fast._solver.compiled_single, f'{name} does not compile'
     refused = _assert_same(fast, slow, ANGLES, speeds=(None, -3.5, 1e4), turns=(0, 3))
     if name == 'four_bar_coupler_points':
         assert refused > 0      # the triple rocker's unassemblable angles, refused alike
@@ -77,7 +77,7 @@ def test_the_extreme_suite_refuses_and_answers_alike():
     compiled = 0
     for case in extreme_cases(MODES['smoke']):
         fast, slow = _pair(lambda case=case: case.scene)
-        compiled += bool(fast._solver.single)
+        compiled += bool(fast._solver.compiled_single)
         speed = case.speed if case.speed is not None else case.scene.input.speed
         _assert_same(fast, slow, case.angles, speeds=(speed,))
     assert compiled > 0
@@ -96,7 +96,7 @@ def test_every_packaged_scene_solves_arrays_alike_compiled(name):
     """Arrays of angles, speeds and turns, three tolerances: identical states, masks, bounds."""
     fast, slow = _pair(lambda: mk.load_scene(name))
     if name != 'geneva':
-        assert fast._solver.array, f'{name} does not compile'
+        assert fast._solver.compiled_array, f'{name} does not compile'
     speeds = np.linspace(-20.0, 30.0, ANGLES.size)
     for kwargs in ({}, {'speed': speeds}, {'speed': 3.0, 'accel': speeds},
                    {'turns': np.arange(ANGLES.size) % 3}, {'max_error': 1e-12},
@@ -133,11 +133,11 @@ def test_a_scene_is_compiled_after_its_first_single_angle_solves():
     scene = mk.load_scene('slider_crank_150_600')
     for _ in range(COMPILE_AFTER - 1):
         mk.solve(scene, 0.5)
-        assert scene._solver.single is None
+        assert scene._solver.compiled_single is None
     mk.solve(scene, 0.5)
-    assert callable(scene._solver.single)
+    assert callable(scene._solver.compiled_single)
     mk.solve(scene, np.linspace(0.0, 1.0, 5))       # the array path counts apart
-    assert callable(scene._solver.single) and scene._solver.array is None
+    assert callable(scene._solver.compiled_single) and scene._solver.compiled_array is None
 
 
 def test_a_held_state_is_not_changed_by_later_solves():
@@ -160,7 +160,7 @@ def test_the_callers_arrays_are_never_written(compiled):
     """
     scene = mk.load_scene('four_bar_coupler_points')
     if compiled:
-        scene._solver.array = compile_array(scene)
+        scene._solver.compiled_array = compile_array(scene)
     else:
         general_only(scene)
     angles, speeds = ANGLES.copy(), np.linspace(-20.0, 30.0, ANGLES.size)
