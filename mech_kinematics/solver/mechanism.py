@@ -97,6 +97,8 @@ class _Solver:
         self.compiled_array: Any = None
         self.array_solves = 0
         self.scene = scene
+        # Per array shape, the ground points' values as read-only arrays (solve._state).
+        self.ground_arrays: dict[tuple[int, ...], dict[int, tuple[Any, Any]]] = {}
 
 
 def _jumping(plan: _Plan, lever: str) -> tuple[tuple[str, ...], tuple[str, ...]]:

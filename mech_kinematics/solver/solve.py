@@ -546,12 +546,22 @@ def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any,
         bad = None if valid.all() else ~valid
         inputs = (id(theta), id(omega), id(alpha), *map(id, given))
 
+        # The ground points' values (the same objects every solve) as read-only arrays,
+        # made once per shape; they live as long as the solver, so their ids stay theirs.
+        ground = solver.ground_arrays.get(shape)
+        if ground is None:
+            if len(solver.ground_arrays) >= 8:
+                solver.ground_arrays.clear()
+            ground = solver.ground_arrays[shape] = {
+                id(x): (x, _constant(x, shape)) for entry in solver.ground.values() for x in entry}
+
         def finish(x: Any) -> Any:
             # A constant (a ground point, a constant crank speed) becomes a
             # read-only broadcast view; a copy only where NaN must go in, and
             # never the caller's own input arrays.
             if getattr(x, 'shape', ()) != shape:
-                x = _constant(x, shape)
+                hit = ground.get(id(x))
+                x = hit[1] if hit is not None and hit[0] is x else _constant(x, shape)
                 if bad is None:
                     return x
                 x = np.array(x)
