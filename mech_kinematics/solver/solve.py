@@ -321,7 +321,10 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
         jumps = _jumps(solver, ctx, theta, omega, alpha, whole, None) if ctx.jumps else {}
     else:
         theta, omega, alpha = (np.asarray(x, dtype=np.float64) for x in (angle, speed, accel))
-        shape = np.broadcast_shapes(theta.shape, omega.shape, alpha.shape, np.shape(whole))
+        if omega.ndim == 0 and alpha.ndim == 0 and whole.__class__ is int:
+            shape = theta.shape     # the usual case: one rate, whole turns 0 (or any int)
+        else:
+            shape = np.broadcast_shapes(theta.shape, omega.shape, alpha.shape, np.shape(whole))
         if len(shape) != 1:
             msg = f'Expected `angle` to be a float or a 1-D array, got shape {shape}'
             raise ValueError(msg)
