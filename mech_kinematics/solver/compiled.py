@@ -1,23 +1,30 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""The solver's own compiled single-angle path: a scene's solve as one straight-line function.
+"""The solver's own compiled paths: a scene's solve as one straight-line function.
 
-:func:`mech_kinematics.solve` at one crank angle runs every step's kernel
-through the dictionaries of a context. Once a scene has been solved at single
-angles :data:`COMPILE_AFTER` times, it compiles the scene's kernels instead
-(:func:`compile_single`, by :mod:`.specialize`, as the node's tick is
-compiled) into one function that returns what a :class:`.State` holds: the
-reported joints, points, measures and the entries their bounds come from.
+:func:`mech_kinematics.solve` runs every step's kernel through the
+dictionaries of a context. Once a scene has been solved :data:`COMPILE_AFTER`
+times on one path, it compiles the scene's kernels for that path instead
+(by :mod:`.specialize`, as the node's tick is compiled):
 
-The same operations run in the same order on the same doubles, so the
+- the single-angle path (:func:`compile_single`) into one function that
+  returns what a :class:`.State` holds: the reported joints, points,
+  measures and the entries their bounds come from;
+- the array path (:func:`compile_array`) into one function of NumPy
+  operations that fills a vector context as the steps would.
+
+The same operations run in the same order on the same values, so the
 answers, their bounds and the errors raised are those of the general path
-(``test_compiled`` compares them on every packaged scene). The function
-answers ``None`` where the general path must decide: a bound beyond the
-quick trust test (:func:`.solve.trust_limits`: the general path refuses with
-the full reason, or answers), a crank rate it would rescale. Scenes it does
-not compile (rescaled lengths, pins to bound, an intermittent lever whose
-engagement the state reports, a kernel outside the subset) keep the general
-path.
+(``test_compiled`` compares them on every packaged scene and the extreme
+suite). The single-angle function answers ``None`` where the general path
+must decide: a bound beyond the quick trust test (:func:`.solve.trust_limits`:
+the general path refuses with the full reason, or answers), a crank rate it
+would rescale. Scenes neither path compiles (rescaled lengths, pins to bound,
+an intermittent lever whose engagement the state reports, a kernel outside the
+subset) keep the general path.
+
+Large array solves also keep freed memory for the next one
+(:func:`keep_freed_memory`).
 """
 
 from __future__ import annotations
