@@ -283,9 +283,9 @@ def _ratio(row: dict[str, Any], key: str, target: float) -> str:
 
 def table(rows: list[dict[str, Any]], angles: int, repeat: int) -> list[str]:
     """Return the lines ``make bench`` prints for the rows of :func:`measure`."""
-    lines = [f'min / median / max of {repeat} runs; array path over {angles} angles, per '
-             'configuration; position, velocity and acceleration of every output, bounds '
-             'included',
+    lines = [f'min / median / max of {repeat} runs (CPU time of this process); array path '
+             f'over {angles} angles, per configuration; position, velocity and acceleration of '
+             'every output, bounds included',
              f'ratio: median over the hand-written closed form of the same scene (targets: '
              f'single <= {SINGLE_TARGET:g}x, array <= {ARRAY_TARGET:g}x); "-": no '
              'hand-written form of that scene',

@@ -205,7 +205,7 @@ def peer_table(rows: list[dict[str, Any]], repeat: int,
                batches: tuple[int, ...] = BATCHES) -> list[str]:
     """Return the lines ``bench --peer pylinkage`` prints for the rows of :func:`measure_peer`."""
     lines = [f'pylinkage 1.3.0 (numba) side by side, one process; min / median / max of '
-             f'{repeat} runs, µs; ratio: their median over ours (> 1: ours faster)']
+             f'{repeat} runs, µs of CPU time; ratio: their median over ours (> 1: ours faster)']
     for row in rows:
         lines.append(f'{row["scene"]}: answers equal to {row["max_difference"]:.1e} of scale; '
                      f'their cold start (first calls: numba compile or cache load) '
