@@ -284,6 +284,19 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
     omega: Any
     alpha: Any
     solver = scene._solver
+    fast = solver.compiled_single
+    first: Any = angle
+    count: Any = turns
+    tolerance: Any = max_error
+    if fast and first.__class__ is float and speed is None and accel is None \
+            and count.__class__ is int and tolerance.__class__ is float and tolerance > 0.0 \
+            and math.isfinite(first):
+        # The usual call of a compiled scene (a float angle at the scene's rates): the
+        # checks below would pass; its answer, or the general path's where it has none.
+        parts = fast(first, scene.input.speed, scene.input.accel, tolerance, count)
+        if parts is not None:
+            return _compiled_state(scene, solver, first, scene.input.speed, scene.input.accel,
+                                   count, parts)
     speed = scene.input.speed if speed is None else speed
     accel = scene.input.accel if accel is None else accel
     if not (isinstance(max_error, (float, int)) and max_error > 0.0):
@@ -307,13 +320,7 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
         if fast:
             parts = fast(theta, omega, alpha, tol, whole)
             if parts is not None:
-                joints, points, measures, entries = parts
-                _warn_near_singular(measures, False, True)
-                bound = ErrorBound(bounds_from_entries, (solver.joint_names, solver.out_points,
-                                                         entries),
-                                   solver.size, solver.crank_length)
-                return _new_state(scene.name, theta, omega, alpha, joints, points, True,
-                                  measures, {}, bound, whole, {}, {}, {})
+                return _compiled_state(scene, solver, theta, omega, alpha, whole, parts)
         ctx = _execute(solver, theta, omega, alpha, whole)
         if not _trusted(solver, ctx, omega, alpha, tol):
             _refuse(solver, ctx, omega, alpha, tol)
@@ -486,6 +493,17 @@ def _read_only(x: Any, shape: tuple[int, ...]) -> Any:
 def _is_scalar(x: Any) -> bool:
     # The cheap test first: the node's tick passes plain floats.
     return isinstance(x, (float, int)) or np.ndim(x) == 0
+
+
+def _compiled_state(scene: Scene, solver: _Solver, theta: float, omega: float, alpha: float,
+                    turns: int, parts: Any) -> State:
+    """Return the state of one crank angle from what the compiled solve returned."""
+    joints, points, measures, entries = parts
+    _warn_near_singular(measures, False, True)
+    bound = ErrorBound(bounds_from_entries, (solver.joint_names, solver.out_points, entries),
+                       solver.size, solver.crank_length)
+    return _new_state(scene.name, theta, omega, alpha, joints, points, True, measures, {},
+                      bound, turns, {}, {}, {})
 
 
 def _compiled(scene: Scene, solver: _Solver) -> Any:

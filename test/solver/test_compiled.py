@@ -196,3 +196,18 @@ def test_keeping_freed_memory_is_set_once_on_glibc():
     first = compiled_module.keep_freed_memory()
     assert first == (platform.libc_ver()[0] == 'glibc')
     assert compiled_module.keep_freed_memory() == first
+
+
+@pytest.mark.parametrize('args, kwargs', [((math.nan,), {}), ((math.inf,), {}),
+                                          ((0.5,), {'max_error': 0.0}),
+                                          ((0.5,), {'max_error': -1e-6}),
+                                          ((0.5,), {'turns': 1.5})])
+def test_bad_input_is_refused_alike_compiled(args, kwargs):
+    """A non-finite angle, a tolerance that is not positive, fractional turns: the same error."""
+    fast, slow = _pair(lambda: mk.load_scene('khurmi_four_bar_ad150'))
+    errors = []
+    for scene in (fast, slow):
+        with pytest.raises(ValueError) as caught:
+            mk.solve(scene, *args, **kwargs)
+        errors.append(str(caught.value))
+    assert errors[0] == errors[1] and errors[0].startswith('Expected')
