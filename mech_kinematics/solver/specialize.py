@@ -314,7 +314,9 @@ def plan_body(plan: Any, names: dict[str, str], namespace: dict[str, Any],
         body += _body(plan.crank, type(plan.crank).run, '_0', names, namespace, arguments,
                       vector)
         for index, step in enumerate(plan.steps, 1):
-            for part, kernel in enumerate(step.kernels()):
+            # Step.kernels names the single-angle path; the array path is ``run`` itself.
+            kernels = (type(step).run,) if vector else step.kernels()
+            for part, kernel in enumerate(kernels):
                 body += _body(step, kernel, f'_{index}_{part}', names, namespace, {}, vector)
     except (OSError, TypeError) as error:
         raise Unsupported(str(error)) from error

@@ -211,3 +211,21 @@ def test_bad_input_is_refused_alike_compiled(args, kwargs):
             mk.solve(scene, *args, **kwargs)
         errors.append(str(caught.value))
     assert errors[0] == errors[1] and errors[0].startswith('Expected')
+
+
+def test_the_array_path_compiles_run_and_the_single_angle_path_the_kernels(monkeypatch):
+    """Step.kernels names the single-angle path only: the array path compiles ``run``.
+
+    A kernel outside the subset (a loop) makes the single-angle path fall back
+    (``None``) while the array path, compiled from ``run``, still compiles.
+    """
+    scene = mk.load_scene('khurmi_four_bar_ad150')
+    step = type(scene._solver.run_plan.steps[0])
+
+    def looping(self, ctx):
+        for _ in range(1):
+            ctx.measures[self.key] = 1.0
+
+    monkeypatch.setattr(step, 'kernels', classmethod(lambda cls: (looping,)))
+    assert compile_single(scene) is None
+    assert compile_array(scene) is not None
