@@ -31,6 +31,29 @@ ROOT = HERE.parent
 SCENES = HERE.parent / 'config' / 'scenes'
 
 
+# --- the packaged scenes by their drivers ----------------------------------------------
+# Tests that sweep one crank's angle (geometry, diagrams, the reference's time
+# differences) take the scenes driven by one crank; test/solver/test_drivers.py
+# and the several-driver tests of each tool take the others (issue 18).
+
+
+def crank_scene_names() -> list[str]:
+    """Return the packaged scenes driven by one crank (``input:``), sorted."""
+    return [name for name in mk.scene_names() if len(mk.load_scene(name).drivers) == 1
+            and mk.load_scene(name).input is not None]
+
+
+def start_positions(scene: Any) -> Any:
+    """Return where ``scene``'s drivers start: the crank angle, or one position per driver."""
+    drivers = scene.drivers
+    return drivers[0].start if len(drivers) == 1 else [d.start for d in drivers]
+
+
+def driver_scene_names() -> list[str]:
+    """Return the packaged scenes with several drivers or an actuator (``inputs:``), sorted."""
+    return sorted(set(mk.scene_names()) - set(crank_scene_names()))
+
+
 # --- the published 50-digit reference cases ------------------------------------
 # Used by test_linkage_golden.py (the solver against them) and test_reference.py
 # (the mpmath reference against them).
@@ -190,6 +213,56 @@ def assert_bounded(scene, angle, speed=None, accel=None):
     return state, exact
 
 
+def first_order_spreads(scene, angle, speed=None, accel=None, exact=None):
+    """Return, per value ``actual_errors`` names, what a 1-ulp change of every input moves it.
+
+    ``U * sum over inputs |d value / d x| |x|``: every geometry value and the
+    crank's angle, speed and acceleration changed by half an ulp (relative
+    ``U``), first order, from the 50-digit reference (``exact`` if given).
+    """
+    model = ref.Model(scene)
+    base = ref.reference(model, angle, speed, accel) if exact is None else exact
+    eta = mpmath.mpf('1e-25')
+    unit = 2.0 ** -53
+
+    def flat(r):
+        out = {}
+        for table, prefix in ((r.points, 'points'), (r.joints, 'joints')):
+            for name, values in table.items():
+                for index, quantity in enumerate(('position', 'velocity', 'acceleration')):
+                    if values[index] is not None:
+                        out[f'{prefix}.{name}.{quantity}'] = values[index]
+        return out
+
+    with mpmath.workdps(ref.DPS):
+        values = flat(base)
+        totals = dict.fromkeys(values, mpmath.mpf(0))
+        inputs = [*base.inputs.items(), ('@theta', base.theta), ('@omega', base.omega),
+                  ('@alpha', base.alpha)]
+        for key, value in inputs:
+            if value == 0:
+                continue
+            given = dict(base.inputs)
+            theta, omega, alpha = base.theta, base.omega, base.alpha
+            delta = value * eta
+            if key == '@theta':
+                theta += delta
+            elif key == '@omega':
+                omega += delta
+            elif key == '@alpha':
+                alpha += delta
+            else:
+                given[key] = value + delta
+            moved = flat(ref.reference(model, theta, omega, alpha, values=given, seed=base.q))
+            for path, x in values.items():
+                diff = moved[path] - x
+                if path.startswith('joints.') and path.endswith('.position') \
+                        and not isinstance(diff, mpmath.mpc):
+                    diff = ref._wrap(diff)
+                totals[path] += abs(diff) / eta
+        return {path: float(total) * unit for path, total in totals.items()}
+
+
 # --- the solver's compiled paths against its general one ----------------------
 # Used by test_compiled.py (the compiled single-angle and array solves) and
 # test_ticker.py (the node's tick against the general solver).
@@ -228,4 +301,5 @@ def state_facts(state: mk.State) -> Any:
                    'bounds': (bound.joints, bound.points, bound.rubbing, bound.size,
                               bound.crank_length),
                    'rubbing': state.rubbing, 'intermittent': state.intermittent,
-                   'jumps': state.jumps})
+                   'jumps': state.jumps, 'drivers': state.drivers,
+                   'imus': state.__dict__.get('imu_specs')})

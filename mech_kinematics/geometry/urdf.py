@@ -15,7 +15,10 @@ publishes them):
   pose comes from ``/tf``), drawn in the frame's own coordinates: a bar
   (box) from the frame's origin to every other point of the body, a pin at
   each of its points; a slotted lever reaches as far as its pin goes in a
-  turn; a slider is a block along its x axis (the guide).
+  turn; a slider is a block along its x axis (the guide);
+- one link per IMU with a frame of its own (``angle`` not 0),
+  ``<prefix>/<name>``, nothing drawn, a fixed joint to its link's frame at
+  the sensor's point, turned by ``angle`` (as the node's ``/tf`` has it).
 
 The body's points are read off the solved scene at the first crank angle
 that assembles, in the frame's coordinates; they are fixed on the body, so
@@ -27,13 +30,14 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 import math
+from typing import Any
 import warnings
 import xml.etree.ElementTree as ET
 
 import numpy as np
 
 from .diagrams import space_from_state
-from .frames import child_frame, frames_from_scene, FrameSpec, poses_from_state
+from .frames import child_frame, frames_from_scene, FrameSpec, poses_from_state, sensor_offsets
 from .instant_centres import bodies_from_scene, BodyKind, full_scene
 from ..errors import AssemblyError, NearSingularWarning
 from ..solver import Scene, solve, State
@@ -91,7 +95,15 @@ def _pin(x: float, y: float, radius: float) -> Visual:
 
 
 def _assembled(scene: Scene) -> State:
-    """Return the full state at the scene's crank angle, or the first angle that assembles."""
+    """Return the full state at the scene's crank angle, or the first angle that assembles.
+
+    A scene with several drivers (or an actuator) is drawn where its drivers start.
+    """
+    drivers = scene.drivers
+    if scene.input is None or len(drivers) > 1:
+        with warnings.catch_warnings():
+            warnings.simplefilter('ignore', NearSingularWarning)
+            return solve(scene, [driver.start for driver in drivers])
     angles = scene.input.angle + np.linspace(0.0, 2 * math.pi, SAMPLES, endpoint=False)
     with warnings.catch_warnings():
         warnings.simplefilter('ignore', NearSingularWarning)
@@ -102,6 +114,11 @@ def _assembled(scene: Scene) -> State:
                    f'URDF, got none of {SAMPLES} angles over a turn')
             raise AssemblyError(msg)
         return solve(scene, float(angles[valid[0]]))
+
+
+def _stroke(actuator: Any) -> tuple[float, float]:
+    """Return an actuator's shortest and longest lengths, m (its start where it has no stroke)."""
+    return actuator.stroke if actuator.stroke is not None else (actuator.start, actuator.start)
 
 
 def _local(origin: complex, angle: float, point: complex) -> tuple[float, float]:
@@ -138,19 +155,37 @@ def visuals_from_scene(scene: Scene, frames: Sequence[FrameSpec] | None = None,
     size = float(np.hypot(*(high - low))) or 1.0
     width, radius = BAR_WIDTH * size, PIN_RADIUS * size
     topology = bodies_from_scene(full)
+    # An actuator is a prismatic joint between its two pins: the cylinder's body (the
+    # link it drives, at its start pin) is drawn as a barrel as long as the actuator
+    # at its shortest, its rod (the actuator's frame, at the other pin) reaching back
+    # by the stroke.
+    actuators = {d.name: d for d in full.drivers if d.joint_type == 'prismatic'}
+    cylinders = {frame.angle_of: actuators[frame.joint] for frame in frames_from_scene(
+        full, tuple(full.joint_types)) if frame.joint in actuators}
     # A link whose length varies (a slotted lever) is drawn out to the farthest its
     # pin slides: each kind says which of its links vary and between which points.
     levers = {}
     for item in full.dyads:
-        varying = {link for link, length in item.link_lengths().items() if length is None}
+        varying = {link for link, length in item.link_lengths().items()
+                   if length is None and link not in cylinders}
         levers.update({link: (start, end) for link, start, end, _ in item.edges()
                        if link in varying})
     points = {name: complex(p) for name, (p, _, _) in state.complex_points.items()}
     visuals: dict[str, list[Visual]] = {}
     for frame, pose in zip(frames, poses_from_state(frames, state), strict=True):
         origin = complex(pose.x, pose.y)
-        body = topology.bodies[frame.joint]
         shapes: list[Visual] = []
+        if frame.joint in actuators or frame.joint in cylinders:
+            shortest, longest = _stroke(actuators.get(frame.joint) or cylinders[frame.joint])
+            if frame.joint in actuators:  # the rod, from its pin back into the barrel
+                shapes.append(_bar(-(longest - shortest) - 0.1 * shortest, 0.0, 0.6 * width,
+                                   'slider'))
+            else:  # the barrel, from its pin
+                shapes.append(_bar(0.9 * shortest, 0.0, 1.8 * width, 'link'))
+            shapes.append(_pin(0.0, 0.0, radius))
+            visuals[frame.joint] = shapes
+            continue
+        body = topology.bodies[frame.joint]
         if body.kind is BodyKind.SLIDER:
             shapes.append(Visual('box', (BLOCK_LENGTH * size, 2.5 * width, 1.5 * width),
                                  (0.0, 0.0, 0.0), 0.0, 'slider'))
@@ -202,7 +237,8 @@ def urdf_from_scene(scene: Scene, frame_id: str = 'mechanism', prefix: str = '')
     -------
     str
         The URDF document, one link per frame on ``/tf`` and ``/tf_static``
-        plus the root, each attached to the root by one joint.
+        plus the root, each attached to the root by one joint (an IMU's own
+        frame to its link's).
 
     Raises
     ------
@@ -222,14 +258,48 @@ def urdf_from_scene(scene: Scene, frame_id: str = 'mechanism', prefix: str = '')
         for name, (x, y) in scene.ground.items()]
     attachments += [(child_frame(prefix, joint), shapes, None)
                     for joint, shapes in visuals.items()]
+    # An actuator's rod hangs on its cylinder's body by a prismatic joint along it.
+    rods = {child_frame(prefix, frame.joint): (child_frame(prefix, frame.angle_of), frame.joint)
+            for frame in frames_from_scene(scene) if frame.angle_of is not None
+            and scene.joint_types.get(frame.joint) == 'prismatic'
+            and frame.joint in {d.name for d in scene.drivers}}
     for child, shapes, at in attachments:
         link = ET.SubElement(robot, 'link', name=child)
         _add_visuals(link, shapes)
+        if child in rods:
+            body, name = rods[child]
+            element = ET.SubElement(robot, 'joint', name=joint_name(child), type='prismatic')
+            ET.SubElement(element, 'parent', link=body)
+            ET.SubElement(element, 'child', link=child)
+            ET.SubElement(element, 'axis', xyz='1 0 0')
+            low, high = _stroke(next(d for d in scene.drivers if d.name == name))
+            ET.SubElement(element, 'limit', lower=_fmt(low), upper=_fmt(high), effort='0',
+                          velocity='0')
+            continue
         element = ET.SubElement(robot, 'joint', name=joint_name(child),
                                 type='floating' if at is None else 'fixed')
         ET.SubElement(element, 'parent', link=frame_id)
         ET.SubElement(element, 'child', link=child)
         if at is not None:
             ET.SubElement(element, 'origin', xyz=_fmt(*at, 0.0), rpy='0 0 0')
+    _add_sensors(robot, scene, prefix)
     ET.indent(robot)
     return '<?xml version="1.0"?>\n' + ET.tostring(robot, encoding='unicode') + '\n'
+
+
+def _add_sensors(robot: ET.Element, scene: Scene, prefix: str) -> None:
+    """Add a link and a fixed joint for every IMU with a frame of its own (``angle`` not 0)."""
+    own = [spec for spec in scene.imus if spec.angle != 0.0]
+    if not own:
+        return
+    full = full_scene(scene)
+    frames = {f.joint: f for f in frames_from_scene(full, [spec.link for spec in own])}
+    offsets = sensor_offsets(own, frames, _assembled(full))
+    for spec in own:
+        child = child_frame(prefix, spec.name)
+        ET.SubElement(robot, 'link', name=child)
+        element = ET.SubElement(robot, 'joint', name=joint_name(child), type='fixed')
+        ET.SubElement(element, 'parent', link=child_frame(prefix, spec.link))
+        ET.SubElement(element, 'child', link=child)
+        ET.SubElement(element, 'origin', xyz=_fmt(*offsets[spec.name], 0.0),
+                      rpy=_fmt(0.0, 0.0, spec.angle))

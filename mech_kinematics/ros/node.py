@@ -31,6 +31,7 @@ from __future__ import annotations
 import ctypes
 from dataclasses import replace
 import gc
+import math
 import random
 import sys
 import threading
@@ -51,7 +52,7 @@ from rclpy.logging import get_logger
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSDurabilityPolicy, QoSHistoryPolicy, QoSProfile, QoSReliabilityPolicy
 from rclpy.qos_overriding_options import QoSOverridingOptions, QoSPolicyKind
-from sensor_msgs.msg import JointState
+from sensor_msgs.msg import Imu, JointState
 from std_msgs.msg import String
 from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
 from visualization_msgs.msg import MarkerArray
@@ -60,6 +61,7 @@ import mech_kinematics as mk
 from . import topics
 from .diagnostics import solver_status, Status, TickStats, timing_status
 from .driver import TickDriver
+from .imus import ImuFrames, ImuMessages
 from .markers import marker_array_from_state, marker_size_from_space, MarkerThrottle
 from .messages import TickMessages
 from .parameters import (CATCH_UP, catch_up_window_ns, joint_refusal, PARAMETERS, ParameterSpec,
@@ -70,7 +72,7 @@ from .ticker import tick_function
 from .timebase import CrankSample
 from ..geometry.assembly import assembly_summary
 from ..geometry.diagrams import space_from_state, strokes_from_scene
-from ..geometry.frames import angle_joints, frames_from_scene, origin_points
+from ..geometry.frames import angle_joints, frames_from_scene, origin_points, sensor_offsets
 from ..geometry.instant_centres import full_scene
 from ..geometry.urdf import urdf_from_scene
 from ..scene import scene_text
@@ -206,6 +208,8 @@ class KinematicsNode(LifecycleNode):
                                   spec('late_ticks').default == CATCH_UP)
         self._state_publishers: list[Any] = []
         self._pub_markers: Any = None
+        self._imus: ImuMessages | None = None
+        self._imu_frames: ImuFrames | None = None
         self._failure_guard = self.create_guard_condition(self._on_failure)
         self.add_pre_set_parameters_callback(self._pre_set)
         self.add_on_set_parameters_callback(self._validate)
@@ -356,11 +360,13 @@ class KinematicsNode(LifecycleNode):
         try:    # what `solve` refuses at the start, the node refuses to start with
             mk.solve(scene, scene.input.angle,
                      speed['speed'] if own_speed else rad_per_s_from_rpm(speed['speed_rpm']),
-                     self._value('crank_accel'), max_error=self._max_error)
+                     self._value('crank_accel'), turns=scene.input.turns,
+                     max_error=self._max_error)
         except mk.AssemblyError as error:
             msg = f'{scene.name}: {error}'
             raise mk.SceneError(msg) from None
-        self._driver.add_drive(CRANK, angle=scene.input.angle, accel=self._value('crank_accel'),
+        self._driver.add_drive(CRANK, angle=scene.input.angle, turns=scene.input.turns,
+                               accel=self._value('crank_accel'),
                                max_speed_rpm=self._value('max_crank_speed_rpm'), **speed)
         self._messages = TickMessages(scene.output_joints, scene.output_points, self.frame_id)
         self._pub_joint_states = self.create_publisher(
@@ -375,6 +381,7 @@ class KinematicsNode(LifecycleNode):
                                   self._pub_point_accel]
         self._publish_state = tuple(p.publish for p in self._state_publishers)
         tick_scene = self._setup_tf(scene)
+        self._setup_imus(scene, tick_scene)
         self._publish_descriptions(scene)
         # The scene's solve, compiled into one straight-line function (ros/ticker.py).
         frames = [(f.origin, f.angle_of, f.angle) for f in self._tf_frames]
@@ -424,6 +431,36 @@ class KinematicsNode(LifecycleNode):
             return scene
         return replace(scene, outputs_points=(*scene.output_points, *points),
                        outputs_joints=(*scene.output_joints, *joints))
+
+    def _setup_imus(self, scene: mk.Scene, tick_scene: mk.Scene) -> None:
+        """Create a publisher on ``imu/NAME`` for each of the scene's sensors, and their frames.
+
+        A sensor turned on its link (``angle`` not 0) has a frame of its own,
+        published on ``/tf`` with the link frames (when ``/tf`` is on).
+        """
+        self._imus = self._imu_frames = None
+        if not scene.imus:
+            return
+        prefix = self._value('tf_prefix') or self.frame_id
+        self._imus = ImuMessages(scene.imus, scene.output_joints, scene.output_points, prefix)
+        publishers = [self.create_publisher(Imu, topics.imu_topic(spec.name), _state_qos(),
+                                            qos_overriding_options=_qos_options())
+                      for spec in scene.imus]
+        self._state_publishers += publishers
+        self._publish_imu = tuple(p.publish for p in publishers)
+        if self._tf is not None:
+            state = mk.solve(tick_scene, scene.input.angle, 0.0, 0.0, max_error=math.inf)
+            frames = {f.joint: f for f in self._tf_frames}
+            transforms = self._imus.frame_transforms(sensor_offsets(scene.imus, frames, state))
+            if transforms:
+                self._imu_frames = ImuFrames(transforms)
+
+    def _publish_imus(self, values: list[float], sec: int, nanosec: int) -> None:
+        """Publish every sensor's ``Imu`` of a tick's values."""
+        assert self._imus is not None
+        for publish, data in zip(self._publish_imu,
+                                 self._imus.render_values(values, sec, nanosec), strict=True):
+            publish(data)
 
     def _publish_descriptions(self, scene: mk.Scene) -> None:
         """Publish the URDF on ``robot_description`` and the scene's text on ``scene``, latched.
@@ -489,7 +526,8 @@ class KinematicsNode(LifecycleNode):
         self._marker_strokes = strokes_from_scene(self._marker_scene)
         try:
             self._marker_size: float | None = marker_size_from_space(space_from_state(
-                self._marker_scene, mk.solve(self._marker_scene, scene.input.angle)))
+                self._marker_scene, mk.solve(self._marker_scene, scene.input.angle,
+                                             turns=scene.input.turns)))
         except mk.AssemblyError:
             self._marker_size = None    # the part beyond the outputs cannot assemble here
         self._marker_throttle = MarkerThrottle()
@@ -624,11 +662,15 @@ class KinematicsNode(LifecycleNode):
         publish_js(joint_states)
         publish_jt(joint_accel)
         publish_pt(point_accel)
+        if self._imus is not None:
+            self._publish_imus(values, sec, nanosec)
         if stamp >= self._next_tf:
             tf_period = self._tf_period_ns
             if self._tf is not None and tf_period is not None:
                 self._pub_tf.publish(self._tf.render_values(values, self._tf_first, sec,
                                                             nanosec))
+                if self._imu_frames is not None:
+                    self._pub_tf.publish(self._imu_frames.render(sec, nanosec))
                 self._next_tf = stamp + tf_period
             else:
                 self._next_tf = stamp + NS_PER_S    # off: look again in a second

@@ -8,9 +8,9 @@ and remaps apply; ``/tf`` and ``/tf_static`` are absolute, as tf2 expects.
 
 from __future__ import annotations
 
-__all__ = ['DIAGNOSTICS', 'JOINT_ACCELERATIONS', 'JOINT_STATES', 'MARKERS',
+__all__ = ['DIAGNOSTICS', 'IMU', 'IMU_TYPE', 'JOINT_ACCELERATIONS', 'JOINT_STATES', 'MARKERS',
            'POINT_ACCELERATIONS', 'ROBOT_DESCRIPTION', 'SCENE', 'STATE_TOPICS', 'TF',
-           'TF_STATIC', 'TYPES']
+           'TF_STATIC', 'TYPES', 'imu_topic']
 
 JOINT_STATES = 'joint_states'
 JOINT_ACCELERATIONS = 'joint_accelerations'
@@ -23,6 +23,11 @@ TF_STATIC = '/tf_static'
 ROBOT_DESCRIPTION = 'robot_description'
 #: The scene file's text, latched, so that a bag carries its own scene.
 SCENE = 'scene'
+
+#: The namespace of the inertial sensors' topics: ``imu/NAME``, one per entry of a scene's
+#: ``imus``, each of type :data:`IMU_TYPE`.
+IMU = 'imu'
+IMU_TYPE = 'sensor_msgs/msg/Imu'
 
 #: The topics of the kinematic state, published together at every instant.
 STATE_TOPICS = (JOINT_STATES, JOINT_ACCELERATIONS, POINT_ACCELERATIONS)
@@ -39,3 +44,8 @@ TYPES = {
     ROBOT_DESCRIPTION: 'std_msgs/msg/String',
     SCENE: 'std_msgs/msg/String',
 }
+
+
+def imu_topic(name: str) -> str:
+    """Return the topic of the scene's sensor ``name``: ``imu/NAME`` (relative)."""
+    return f'{IMU}/{name}'

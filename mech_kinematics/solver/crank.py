@@ -4,15 +4,17 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, replace
 import math
 from typing import Any
 
 import numpy as np
 
 from .context import _Context, _U2, _U4
-from .model import _check_finite, _check_length, _check_name
+from .model import _check_finite, _check_length, _check_name, SceneUnits
 from ..bounds import U
+from ..errors import SceneError
 
 
 @dataclass(frozen=True)
@@ -30,11 +32,16 @@ class Crank:
     length : float
         Crank length, m.
     angle : float
-        Crank angle at time zero, rad.
+        Crank angle at time zero, rad (within its turn when ``turns`` is not 0).
     speed : float
         Default angular velocity, rad/s, + CCW.
     accel : float
         Default angular acceleration, rad/s^2, + CCW.
+    turns : int
+        Whole turns to add to ``angle``: the crank angle at time zero is
+        ``angle + 2 pi turns``, the sum never formed in floating point (a scene
+        file's angle far out, as 1e17 deg, is read as an angle within a turn
+        plus whole turns; only an intermittent drive tells the turns apart).
     """
 
     link: str
@@ -44,6 +51,7 @@ class Crank:
     angle: float = 0.0
     speed: float = 0.0
     accel: float = 0.0
+    turns: int = 0
 
     def __post_init__(self) -> None:
         """Validate the fields."""
@@ -54,6 +62,9 @@ class Crank:
         _check_finite(self.angle, 'the crank angle', (self, 'angle'))
         _check_finite(self.speed, 'the crank speed', (self, 'speed'))
         _check_finite(self.accel, 'the crank acceleration', (self, 'accel'))
+        if not isinstance(self.turns, int) or isinstance(self.turns, bool):
+            msg = f'Expected the crank whole turns to be an int, got {self.turns!r}'
+            raise SceneError(msg, (self, 'turns'))
 
     @property
     def name(self) -> str:
@@ -71,18 +82,65 @@ class Crank:
         return self.angle
 
     @property
+    def shown(self) -> float:
+        """The crank angle at time zero as one float, rad, for messages only."""
+        return self.angle + math.tau * self.turns
+
+    @property
     def stroke(self) -> tuple[float, float] | None:
         """A crank has no stroke limits."""
         return None
 
+    @property
+    def reach(self) -> float:
+        """Its length, m: what it adds to the mechanism's size."""
+        return self.length
+
+    def position_text(self, value: float, units: SceneUnits) -> str:
+        """Return an angle (rad) of it as text in the scene's unit."""
+        return units.angle_text(value)
+
+    def scaled(self, scale: Callable[[float], float]) -> Crank:
+        """Return it with its length scaled."""
+        return replace(self, length=scale(self.length))
+
+    def members(self, ground: str) -> tuple[tuple[str, str, tuple[str, ...], str | None], ...]:
+        """Return its body (:data:`~.base.Member`): the crank, carrying its centre and tip."""
+        return ((self.link, 'crank', (self.center, self.point), None),)
+
+    def frames(self) -> tuple[tuple[str, str, str | None, float], ...]:
+        """Return its joint's frame (:data:`~.base.Frame`): at its centre, along it."""
+        return ((self.link, self.center, self.link, 0.0),)
+
+    def defined(self) -> tuple[tuple[str, str], ...]:
+        """Return (name, kind) of the names it defines: its link and its tip."""
+        return (self.link, 'link'), (self.point, 'point')
+
+    def local(self, ground: Mapping[str, complex]) -> dict[str, dict[str, complex]]:
+        """Return the points fixed on its link: its centre and its tip."""
+        return {self.link: {self.center: 0j, self.point: complex(self.length)}}
+
+    def step(self, ground: Mapping[str, complex]) -> _CrankStep:
+        """Return its step; its centre must be a ground point."""
+        if self.center not in ground:
+            msg = f'Expected the crank center to be a ground point, got "{self.center}"'
+            raise SceneError(msg, (self, 'center'))
+        return _CrankStep(self, ground[self.center])
+
 
 class _CrankStep:
+    joint_type = 'revolute'
+
     def __init__(self, crank: Crank, center: complex) -> None:
+        self.name = crank.link
+        self.label = f'input {crank.link}'
+        self.unit = 1.0
         self.link = crank.link
         self.point = crank.point
         self.center = center
         self.length = crank.length
         self.uses: tuple[str, ...] = (crank.center,)
+        self.defines = (crank.link, crank.point)
         # The tip's sum ``center + r``: the centre's rounding and the sum's.
         self.e_center = U * (2.0 * abs(center) + crank.length)
         # r = length * e: the length's rounding and the product's; then those of
@@ -110,6 +168,16 @@ class _CrankStep:
                                   re + self.e_r + self.e_center, w * (re + self.e_v),
                                   (abs(alpha) + w * w) * (re + self.e_a))
         ctx.links[self.link] = (e, omega, alpha, ee + _U4, U * w, U * abs(alpha))
+
+    def floors(self, speed: Any, accel: Any, size: float) -> tuple[Any, Any, Any, Any]:
+        """Return what it adds to the least scales: its tip's speed and acceleration, its rates.
+
+        ``a |omega|``, ``a (omega^2 + |alpha|)``, ``|omega|`` and
+        ``omega^2 + |alpha|`` for its length ``a``.
+        """
+        w = abs(speed)
+        rate = w * w + abs(accel)
+        return self.length * w, self.length * rate, w, rate
 
 
 # Every complex product below has one real factor or a purely imaginary one

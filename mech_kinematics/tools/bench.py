@@ -159,7 +159,9 @@ def geometry_of(scene: Any) -> tuple[str, tuple[float, ...]] | None:
         return None
     dyad, crank = scene.dyads[0], scene.input
     baseline = _GEOMETRIES.get(dyad.kind)
-    geometry = None if baseline is None else baseline(scene, dyad, crank)
+    if baseline is None or crank is None or len(scene.drivers) > 1:
+        return None
+    geometry = baseline(scene, dyad, crank)
     return None if geometry is None else (dyad.kind, geometry)
 
 
@@ -247,10 +249,19 @@ def measure(names: list[str], angles: int, repeat: int) -> list[dict[str, Any]]:
     rows = []
     for name in names:
         scene = load_scene(name)
-        theta, w, al = scene.input.angle, scene.input.speed, scene.input.accel
-        singles = [partial(solve, scene, theta)]
-        arrays = [partial(solve, scene, sweep)]
-        forms = hand_written(scene)
+        drivers = scene.drivers
+        if scene.input is None or len(drivers) > 1:
+            # Several drivers: one configuration, their start, and the array path over
+            # as many copies of it as a crank's sweep has angles.
+            starts = [driver.start for driver in drivers]
+            singles = [partial(solve, scene, starts)]
+            arrays = [partial(solve, scene, [np.full(angles, x) for x in starts])]
+            forms = None
+        else:
+            theta, w, al = scene.input.angle, scene.input.speed, scene.input.accel
+            singles = [partial(solve, scene, theta)]
+            arrays = [partial(solve, scene, sweep)]
+            forms = hand_written(scene)
         if forms is not None:
             # Where a scene does not assemble at every angle, the array path is timed
             # over the angles where it does (the hand-written forms cannot refuse).

@@ -11,7 +11,7 @@ import math
 import sys
 import warnings
 
-from helpers import general_only, state_facts
+from helpers import crank_scene_names, driver_scene_names, general_only, state_facts
 import numpy as np
 import pytest
 
@@ -61,7 +61,7 @@ def _assert_same(fast, slow, angles, speeds=(None,), turns=(0,)):
     return refused
 
 
-@pytest.mark.parametrize('name', mk.scene_names())
+@pytest.mark.parametrize('name', crank_scene_names())
 def test_every_packaged_scene_solves_alike_compiled(name):
     """Over two turns, three speeds and three tolerances: identical states, bounds, refusals."""
     fast, slow = _pair(lambda: mk.load_scene(name))
@@ -91,7 +91,7 @@ def _array_outcome(scene, *args, **kwargs):
     return state_facts(state), [(w.category, str(w.message), w.filename) for w in caught]
 
 
-@pytest.mark.parametrize('name', mk.scene_names())
+@pytest.mark.parametrize('name', crank_scene_names())
 def test_every_packaged_scene_solves_arrays_alike_compiled(name):
     """Arrays of angles, speeds and turns, three tolerances: identical states, masks, bounds."""
     fast, slow = _pair(lambda: mk.load_scene(name))
@@ -229,3 +229,18 @@ def test_the_array_path_compiles_run_and_the_single_angle_path_the_kernels(monke
     monkeypatch.setattr(step, 'kernels', classmethod(lambda cls: (looping,)))
     assert compile_single(scene) is None
     assert compile_array(scene) is not None
+
+
+@pytest.mark.parametrize('name', driver_scene_names())
+def test_a_scene_of_several_drivers_keeps_the_general_path(name):
+    """Several drivers or an actuator: neither path compiles, and solving often changes nothing."""
+    scene = mk.load_scene(name)
+    assert compile_single(scene) is None and compile_array(scene) is None
+    positions = [driver.start for driver in scene.drivers]
+    first = state_facts(mk.solve(scene, positions))
+    for _ in range(COMPILE_AFTER + 1):
+        mk.solve(scene, positions)
+        mk.solve(scene, [np.full(3, x) for x in positions])
+    assert state_facts(mk.solve(scene, positions)) == first
+    assert scene._solver.compiled_single in (None, False)
+    assert scene._solver.compiled_array in (None, False)
