@@ -147,13 +147,46 @@ def slider_crank_numpy(theta: Any, w: float, al: float,
     return x, phi, v, wr, a, ar, bx, by, vbx, vby, abx, aby
 
 
+#: A Scotch yoke's: crank centre (x, y) on the yoke's horizontal guide, crank length. The
+#: default is the packaged one (crank 50 mm).
+SCOTCH_YOKE_GEOMETRY = (0.0, 0.0, 0.05)
+
+
+def scotch_yoke_math(theta: float, w: float, al: float,
+                     geometry: tuple[float, ...] = SCOTCH_YOKE_GEOMETRY) -> tuple[float, ...]:
+    """Hand-written Scotch yoke (horizontal guide through the crank centre, vertical slot).
+
+    Returns the yoke's x and the pin's height in the slot with their rates and
+    accelerations, then B's position, velocity and acceleration.
+    """
+    ox, oy, r = geometry
+    c, s = math.cos(theta), math.sin(theta)
+    x, y = r * c, r * s
+    vx, vy = -w * y, w * x
+    ax, ay = -al * y - w * w * x, al * x - w * w * y
+    return x, y, vx, vy, ax, ay, ox + x, oy + y, vx, vy, ax, ay
+
+
+def scotch_yoke_numpy(theta: Any, w: float, al: float,
+                      geometry: tuple[float, ...] = SCOTCH_YOKE_GEOMETRY) -> tuple[Any, ...]:
+    """Solve the same Scotch yoke with NumPy over an array of crank angles."""
+    ox, oy, r = geometry
+    c, s = np.cos(theta), np.sin(theta)
+    x, y = r * c, r * s
+    vx, vy = -w * y, w * x
+    ax, ay = -al * y - w * w * x, al * x - w * w * y
+    return x, y, vx, vy, ax, ay, ox + x, oy + y, vx, vy, ax, ay
+
+
 def geometry_of(scene: Any) -> tuple[str, tuple[float, ...]] | None:
     """Return (dyad kind, geometry) of a scene with hand-written forms, or None.
 
     A scene has them when it is one crank driving one dyad: an RRR on the
     crank's tip and a ground pivot (a four-bar, :data:`FOUR_BAR_GEOMETRY`'s
-    layout) or an RRP on the crank's tip and a horizontal guide (a
-    slider-crank, :data:`SLIDER_CRANK_GEOMETRY`'s).
+    layout), an RRP on the crank's tip and a horizontal guide (a
+    slider-crank, :data:`SLIDER_CRANK_GEOMETRY`'s), or an RPP of a vertical
+    slot on a horizontal guide through the crank centre (a Scotch yoke,
+    :data:`SCOTCH_YOKE_GEOMETRY`'s).
     """
     if len(scene.dyads) != 1:
         return None
@@ -200,12 +233,25 @@ def _slider_crank(scene: Any, dyad: Any, crank: Any) -> tuple[float, ...] | None
     return (ox, oy, crank.length, dyad.link.length, guide, float(dyad.branch.value))
 
 
+def _scotch_yoke(scene: Any, dyad: Any, crank: Any) -> tuple[float, ...] | None:
+    """Return the Scotch yoke's geometry, for an RPP of a vertical slot on the crank's tip.
+
+    Its guide is horizontal, through the crank centre.
+    """
+    if dyad.guide_angle != 0.0 or dyad.slot_angle != 0.5 * math.pi \
+            or dyad.through != crank.point or dyad.guide_through != crank.center:
+        return None
+    ox, oy = scene.ground[crank.center]
+    return (ox, oy, crank.length)
+
+
 #: The hand-written baselines there are, by the scene's dyad ``type:``: the geometry's
 #: reader, and the scalar and NumPy forms.
 _GEOMETRIES: dict[str, Callable[[Any, Any, Any], tuple[float, ...] | None]] = {
-    'RRR': _four_bar, 'RRP': _slider_crank}
+    'RRR': _four_bar, 'RRP': _slider_crank, 'RPP': _scotch_yoke}
 _FORMS: dict[str, tuple[Callable[..., Any], Callable[..., Any]]] = {
-    'RRR': (four_bar_math, four_bar_numpy), 'RRP': (slider_crank_math, slider_crank_numpy)}
+    'RRR': (four_bar_math, four_bar_numpy), 'RRP': (slider_crank_math, slider_crank_numpy),
+    'RPP': (scotch_yoke_math, scotch_yoke_numpy)}
 
 
 #: The clock of every timing: the process's CPU time. On the shared machine the wall
@@ -348,7 +394,7 @@ def measure_peers(repeat: int, names: Sequence[str] = PEER_SCENES,
     """Return :func:`.peer.measure_peer`'s row of every scene timed against pylinkage."""
     def forms(scene: Any) -> tuple[str, tuple[float, ...]]:
         found = geometry_of(scene)
-        if found is None:
+        if found is None or found[0] not in ('RRR', 'RRP'):
             msg = f'Expected a four-bar or a slider-crank for the peer, got scene {scene.name}'
             raise ValueError(msg)
         return found

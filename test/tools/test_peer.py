@@ -71,8 +71,9 @@ def test_peer_table_gives_their_median_over_ours():
 
 def test_peer_mode_refuses_a_scene_without_a_peer_twin():
     """A scene that is not a four-bar or slider-crank is refused with one line."""
-    with pytest.raises(ValueError, match='Expected a four-bar or a slider-crank'):
-        bench.measure_peers(1, ['geneva'])
+    for name in ('geneva', 'scotch_yoke'):
+        with pytest.raises(ValueError, match='Expected a four-bar or a slider-crank'):
+            bench.measure_peers(1, [name])
 
 
 def test_peer_mode_without_pylinkage_says_how_to_install_it(monkeypatch, capsys):

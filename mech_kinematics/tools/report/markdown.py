@@ -497,7 +497,8 @@ def _bench(data: dict[str, Any]) -> list[str]:
             'positions, velocities and accelerations of every output, error bounds and the '
             'tolerance check included (the hand-written forms have neither). Ratio: median '
             'over the hand-written form of the same scene, which exists for every scene of one '
-            'crank and one dyad (four-bars, and slider-cranks on a horizontal guide; it leaves '
+            'crank and one dyad (four-bars, slider-cranks on a horizontal guide and the Scotch '
+            'yoke; it leaves '
             "out their carried points, which the solver computes). Issue 19's targets: "
             f'one angle <= {SINGLE_TARGET:g}x, '
             f'arrays <= {ARRAY_TARGET:g}x.', '', render_block('bench', data).rstrip('\n'), '',
