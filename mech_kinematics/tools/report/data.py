@@ -65,8 +65,12 @@ def _range(values: Sequence[float]) -> dict[str, float]:
 
 def collect(mode: Any, elapsed: float, load: Sequence[float], checks: Any, golden: Any,
             wp: Any, clock: Any, clock_check: Any, extreme: Any, cost: Any, bounds: Any,
-            refused: Any, bench: dict[str, Any] | None = None) -> dict[str, Any]:
-    """Return the data file's figures from the report's computed sections."""
+            refused: Any, bench: dict[str, Any] | None = None,
+            peer: dict[str, Any] | None = None) -> dict[str, Any]:
+    """Return the data file's figures from the report's computed sections.
+
+    ``peer``: ``bench --peer``'s side-by-side table, where the peer is installed.
+    """
     from .baselines import headline
     from .bounds import bound_statistics, TOLERANCES
     from .common import slug
@@ -124,6 +128,8 @@ def collect(mode: Any, elapsed: float, load: Sequence[float], checks: Any, golde
                     'chain_slope_single': cost.chain_slope_single}
     if bench is not None:
         data['bench'] = bench
+    if peer is not None:
+        data['peer'] = peer
     return data
 
 
@@ -153,14 +159,21 @@ def read_data(path: str | os.PathLike[str]) -> dict[str, Any]:
 
 def write_data(outdir: str | os.PathLike[str], data: dict[str, Any],
                long_run: str | os.PathLike[str] | None = None) -> Path:
-    """Write ``outdir/data.json``; keep the previous file's ``long_run`` unless given anew."""
+    """Write ``outdir/data.json``; keep the previous file's ``long_run`` unless given anew.
+
+    Likewise its ``peer`` (``bench --peer``'s table) where this run had no peer
+    installed.
+    """
     path = Path(outdir) / DATA_FILE
+    previous = read_data(path) if path.exists() else {}
     if long_run is not None:
         data['long_run'] = read_data(long_run)
-    elif path.exists():
-        previous = read_data(path)
-        if 'long_run' in previous:
-            data['long_run'] = previous['long_run']
+    elif 'long_run' in previous:
+        data['long_run'] = previous['long_run']
+    if data.get('peer') is None:
+        data.pop('peer', None)
+        if 'peer' in previous:
+            data['peer'] = previous['peer']
     path.write_text(json.dumps(data, indent=1, sort_keys=True) + '\n', encoding='utf-8')
     return path
 
@@ -328,9 +341,24 @@ def _long_run_block(data: dict[str, Any]) -> str:
         f'{_g(run["max_state_error"])} |']) + '\n'
 
 
+def _peer_block(data: dict[str, Any]) -> str:
+    peer = lookup(data, 'peer')
+    lines = [f'| scene | work | ours, µs (min / median / max) | {peer["peer"]}, µs '
+             '(min / median / max) | theirs / ours (medians) |', '|---|---|---|---|---|']
+    for row in peer['rows']:
+        for key, label in peer['work']:
+            ours, theirs = row[key]['ours_us'], row[key]['theirs_us']
+            lines.append(f'| {row["scene"]} | {label} | {" / ".join(f"{t:.3g}" for t in ours)} '
+                         f'| {" / ".join(f"{t:.3g}" for t in theirs)} | '
+                         f'{theirs[1] / ours[1]:.2f} |')
+        lines.append(f'| {row["scene"]} | their cold start (first calls) | | '
+                     f'{row["cold_s"]:.2f} s | |')
+    return '\n'.join(lines) + '\n'
+
+
 #: The generated blocks: name -> function of the data returning the block's text.
 BLOCKS = {'refused': _refused_block, 'bench': _bench_block, 'clock': _clock_block,
-          'long_run': _long_run_block}
+          'long_run': _long_run_block, 'peer': _peer_block}
 
 
 def render_block(name: str, data: dict[str, Any]) -> str:
