@@ -32,6 +32,7 @@ from __future__ import annotations
 import ast
 from collections.abc import Callable
 import ctypes
+import os
 import platform
 from typing import Any, TYPE_CHECKING
 
@@ -212,12 +213,15 @@ def keep_freed_memory() -> bool:
     stay in the heap and the next solve's temporaries reuse them, as buffers
     reused across calls would, and no returned array ever shares memory with
     another call's (each is still a fresh allocation). The process keeps up to
-    256 MiB of freed memory. Elsewhere than glibc (``platform.libc_ver``) it
-    does nothing and returns False.
+    256 MiB of freed memory. Elsewhere than glibc (``platform.libc_ver``), or
+    with the environment variable ``MECH_KINEMATICS_KEEP_FREED_MEMORY=0`` (for a
+    process whose allocator settings are its own), it does nothing and returns
+    False.
     """
     if not _kept:
         done = False
-        if platform.libc_ver()[0] == 'glibc':
+        if (platform.libc_ver()[0] == 'glibc'
+                and os.environ.get('MECH_KINEMATICS_KEEP_FREED_MEMORY', '1') != '0'):
             try:
                 libc = ctypes.CDLL(None)
                 done = all(libc.mallopt(param, value) == 1 for param, value in KEEP_FREED)

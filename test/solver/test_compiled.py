@@ -244,3 +244,18 @@ def test_a_scene_of_several_drivers_keeps_the_general_path(name):
     assert state_facts(mk.solve(scene, positions)) == first
     assert scene._solver.compiled_single in (None, False)
     assert scene._solver.compiled_array in (None, False)
+
+
+def test_keeping_freed_memory_can_be_declined():
+    """MECH_KINEMATICS_KEEP_FREED_MEMORY=0: the process's allocator settings are left alone."""
+    import os
+    import subprocess
+
+    code = ('from mech_kinematics.solver.compiled import keep_freed_memory as k\n'
+            'import platform\n'
+            'print(k(), platform.libc_ver()[0] == "glibc")')
+    for value, kept in (('0', 'False'), ('1', None)):
+        env = {**os.environ, 'MECH_KINEMATICS_KEEP_FREED_MEMORY': value}
+        out = subprocess.run([sys.executable, '-c', code], env=env, capture_output=True,
+                             text=True, check=True).stdout.split()
+        assert out[0] == (kept if kept is not None else out[1])
