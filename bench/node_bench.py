@@ -28,11 +28,16 @@ Usage (with the package importable, e.g. ``make``'s .venv)::
 
     python bench/node_bench.py [--rates 1000 5000] [--seconds 60] [--repeat 3]
     python bench/node_bench.py --chains [--seconds 20]
+
+``--data docs/report/data.json`` stores the figures in the report's data file
+(under ``node_rates``, or ``node_chains`` with ``--chains``; the report keeps
+them), from which docs/accuracy.md quotes them.
 """
 
 from __future__ import annotations
 
 import argparse
+import datetime
 import json
 import math
 import os
@@ -242,6 +247,47 @@ def _table(rows: list[dict[str, float]], key: str) -> list[str]:
     return lines
 
 
+def _fit_slope(xs: list[float], ys: list[float]) -> float:
+    """Return the least-squares slope of ``ys`` against ``xs``."""
+    mx, my = statistics.fmean(xs), statistics.fmean(ys)
+    return (sum((x - mx) * (y - my) for x, y in zip(xs, ys, strict=True))
+            / sum((x - mx) ** 2 for x in xs))
+
+
+def section(rows: list[dict[str, float]], key: str, args: argparse.Namespace) -> dict:
+    """Return the figures of ``rows`` for the data file: per ``key`` value, both kinds' runs.
+
+    Each entry: CPU % of every run of the floor and the node, the ratio of
+    their medians, and the worst run's delivered fraction (%) of each. With
+    ``key`` ``'dyads'`` also the growth per dyad (least squares over the
+    medians): % of a core, and µs per tick at 1 kHz.
+    """
+    entries: dict[str, dict[str, object]] = {}
+    medians: dict[str, list[float]] = {'floor': [], 'node': []}
+    for value in dict.fromkeys(r[key] for r in rows):
+        entry: dict[str, object] = {}
+        for kind in ('floor', 'node'):
+            runs = [r for r in rows if r[key] == value and r['kind'] == kind]
+            cpu = [r['cpu'] for r in runs]
+            medians[kind].append(statistics.median(cpu))
+            entry[f'{kind}_cpu_pct'] = cpu
+            entry[f'{kind}_delivered_pct'] = 100 * min(r['delivered'] for r in runs)
+        entry['ratio'] = medians['node'][-1] / medians['floor'][-1]
+        entries[f'{value:g}'] = entry
+    out: dict[str, object] = {
+        'date': datetime.date.today().isoformat(), 'seconds': args.seconds,
+        'warmup': args.warmup, 'repeat': args.repeat, 'cpus': os.cpu_count(),
+        'load': os.getloadavg()[0], 'scene': SCENE if key == 'rate' else 'chain_N',
+        'rows': entries}
+    if key == 'dyads':
+        sizes = [float(v) for v in entries]
+        for kind in ('floor', 'node'):
+            out[f'{kind}_pct_per_dyad'] = _fit_slope(sizes, medians[kind])
+        # % of a core at 1 kHz -> µs a tick: 1 % of 1 s over 1000 ticks is 10 µs
+        out['node_us_per_dyad_tick'] = 10.0 * _fit_slope(sizes, medians['node'])
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the benchmark and print Markdown tables."""
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
@@ -252,6 +298,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument('--chains', action='store_true',
                         help=f'scenes of {", ".join(map(str, CHAIN_SIZES))} dyads at 1 kHz')
     parser.add_argument('--json', action='store_true', help='also print the rows as JSON')
+    parser.add_argument('--data', metavar='FILE',
+                        help='store the figures in this data file (docs/report/data.json) '
+                             'under node_rates, or node_chains with --chains')
     parser.add_argument('--subscribe', nargs=3, help=argparse.SUPPRESS)
     parser.add_argument('--floor', nargs=3, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
@@ -297,6 +346,11 @@ def main(argv: list[str] | None = None) -> int:
     print('\n'.join(_table(rows, key)))
     if args.json:
         print(json.dumps(rows, indent=1))
+    if args.data:
+        from mech_kinematics.tools.report.data import store_section
+        name = 'node_chains' if args.chains else 'node_rates'
+        store_section(args.data, name, section(rows, key, args))
+        print(f'stored under {name} in {args.data}', file=sys.stderr)
     return 0
 
 

@@ -8,6 +8,10 @@ key (:func:`collect`). Timings are ``[min, median, max]`` of repeated runs.
 Measurements that take longer than a report run (``long_run``: one real run
 of the node, ``bench/long_run.py``) are copied in from a file
 (``report --long-run FILE``) or kept from the folder's previous data file.
+Scripts that measure on their own (:data:`STORED`: the node against the rclpy
+floor, ``bench/node_bench.py --data FILE``; the recorder, the viewer, ``check``'s
+grid study and ``reindex``, ``bench/docs_bench.py``) write their section into
+the data file with :func:`store_section`; a report keeps them.
 
 The documentation quotes them in two forms that :func:`check_text` checks:
 
@@ -32,11 +36,13 @@ from pathlib import Path
 import re
 from typing import Any
 
-__all__ = ['BLOCKS', 'DATA_FILE', 'SPREAD_RULE', 'check_text', 'collect', 'lookup',
-           'read_data', 'render_block', 'update_text', 'write_data']
+__all__ = ['BLOCKS', 'DATA_FILE', 'SPREAD_RULE', 'STORED', 'check_text', 'collect', 'lookup',
+           'read_data', 'render_block', 'store_section', 'update_text', 'write_data']
 
 #: The data file's name in the report's folder.
 DATA_FILE = 'data.json'
+#: Sections that scripts of bench/ write with :func:`store_section`: a report keeps them.
+STORED = ('node_rates', 'node_chains', 'recorder', 'viewer', 'check_grid', 'reindex')
 #: How a quoted timing is checked (also in docs/accuracy.md).
 SPREAD_RULE = ('a timing quoted from [min, median, max] of repeated runs passes when it lies '
                'between the min and the max, at the precision it is written with')
@@ -162,7 +168,7 @@ def write_data(outdir: str | os.PathLike[str], data: dict[str, Any],
     """Write ``outdir/data.json``; keep the previous file's ``long_run`` unless given anew.
 
     Likewise its ``peer`` (``bench --peer``'s table) where this run had no peer
-    installed.
+    installed, and every :data:`STORED` section (measured by its own script).
     """
     path = Path(outdir) / DATA_FILE
     previous = read_data(path) if path.exists() else {}
@@ -174,6 +180,24 @@ def write_data(outdir: str | os.PathLike[str], data: dict[str, Any],
         data.pop('peer', None)
         if 'peer' in previous:
             data['peer'] = previous['peer']
+    for key in STORED:
+        if key in previous:
+            data[key] = previous[key]
+    path.write_text(json.dumps(data, indent=1, sort_keys=True) + '\n', encoding='utf-8')
+    return path
+
+
+def store_section(path: str | os.PathLike[str], key: str, section: dict[str, Any]) -> Path:
+    """Write ``section`` under top-level ``key`` of the data file at ``path``; keep the rest.
+
+    ``key`` must be one of :data:`STORED` (a report keeps only those).
+    """
+    if key not in STORED:
+        raise ValueError(f'Expected a section a report keeps ({", ".join(STORED)}), '
+                         f'got {key!r}')
+    path = Path(path)
+    data = read_data(path) if path.exists() else {}
+    data[key] = section
     path.write_text(json.dumps(data, indent=1, sort_keys=True) + '\n', encoding='utf-8')
     return path
 
@@ -356,9 +380,33 @@ def _peer_block(data: dict[str, Any]) -> str:
     return '\n'.join(lines) + '\n'
 
 
+def _node_block(data: dict[str, Any], key: str, label: str) -> str:
+    section = lookup(data, key)
+    runs = section['repeat']
+    lines = [f'| {label} | floor CPU, % ({runs} run{"s" * (runs > 1)}) | node CPU, % | '
+             'node / floor (medians) | grid instants delivered, floor / node (worst run) |',
+             '|---:|---:|---:|---:|---:|']
+    for value, row in section['rows'].items():
+        shown = f'{float(value) / 1000:g} kHz' if key == 'node_rates' else value
+        floor, node = (' / '.join(f'{c:.1f}' for c in row[f'{kind}_cpu_pct'])
+                       for kind in ('floor', 'node'))
+        lines.append(f'| {shown} | {floor} | {node} | {row["ratio"]:.2f} | '
+                     f'{row["floor_delivered_pct"]:.3f} % / {row["node_delivered_pct"]:.3f} % |')
+    return '\n'.join(lines) + '\n'
+
+
+def _node_rates_block(data: dict[str, Any]) -> str:
+    return _node_block(data, 'node_rates', 'rate')
+
+
+def _node_chains_block(data: dict[str, Any]) -> str:
+    return _node_block(data, 'node_chains', 'dyads')
+
+
 #: The generated blocks: name -> function of the data returning the block's text.
 BLOCKS = {'refused': _refused_block, 'bench': _bench_block, 'clock': _clock_block,
-          'long_run': _long_run_block, 'peer': _peer_block}
+          'long_run': _long_run_block, 'peer': _peer_block, 'node_rates': _node_rates_block,
+          'node_chains': _node_chains_block}
 
 
 def render_block(name: str, data: dict[str, Any]) -> str:

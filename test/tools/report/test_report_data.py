@@ -26,6 +26,15 @@ REQUIRED_KEYS = ('summary.ours_acceleration', 'summary.golden_max',
                  'bounds.values', 'bounds.min', 'bounds.median', 'bounds.tightness',
                  'cost.batch_slope', 'long_run.run_time_s', 'elapsed_s')
 
+#: Keys other docs must quote, each from the script that measures it (bench/node_bench.py,
+#: bench/docs_bench.py): doc -> keys.
+REQUIRED_ELSEWHERE = {
+    'commands.md': ('check_grid.five_bar.ms', 'check_grid.excavator.ms', 'check_grid.repeat'),
+    'robustness.md': ('reindex.messages', 'reindex.mcap.mb', 'reindex.mcap.s',
+                      'reindex.mcap.kept', 'reindex.mcap.dropped', 'reindex.sqlite3.mb',
+                      'reindex.sqlite3.s', 'reindex.sqlite3.kept', 'reindex.sqlite3.dropped'),
+}
+
 SAMPLE = {'a': {'b': 2.83e-7, 'n': 2886}, 't': [0.30, 0.32, 0.36],
           'bench': {'angles': 10, 'repeat': 3, 'rows': [
               {'scene': 's', 'single_us': [1.0, 2.0, 3.0], 'array_us': [0.1, 0.2, 0.3],
@@ -56,6 +65,15 @@ def test_accuracy_doc_quotes_the_data_file(committed):
         data_mod.lookup(committed, key)
     for block in ('bench', 'refused', 'long_run'):
         assert f'<!--data:{block}-->' in text, block
+
+
+@pytest.mark.parametrize('doc', sorted(REQUIRED_ELSEWHERE))
+def test_measured_docs_keep_their_keys(doc, committed):
+    """Docs whose measured figures come from a bench script keep quoting them from the data."""
+    text = (ROOT / 'docs' / doc).read_text(encoding='utf-8')
+    for key in REQUIRED_ELSEWHERE[doc]:
+        assert f'<!--={key}-->' in text, key
+        data_mod.lookup(committed, key)
 
 
 def test_the_real_run_of_the_node_is_recorded(committed):
@@ -108,6 +126,26 @@ def test_write_data_keeps_the_long_run(tmp_path):
     data_mod.write_data(tmp_path, {'x': 2})
     written = data_mod.read_data(tmp_path / data_mod.DATA_FILE)
     assert written == {'x': 2, 'long_run': {'date': '2026-11-24', 'run_time_s': 600.0}}
+
+
+def test_store_section_writes_one_key_and_a_report_keeps_it(tmp_path):
+    """A bench script's section goes in beside the rest; a later report keeps it."""
+    path = tmp_path / data_mod.DATA_FILE
+    path.write_text(json.dumps({'x': 1, 'reindex': {'old': True}}))
+    data_mod.store_section(path, 'reindex', {'mcap': {'mb': 13.9}})
+    data_mod.store_section(path, 'check_grid', {'repeat': 7})
+    assert data_mod.read_data(path) == {'x': 1, 'reindex': {'mcap': {'mb': 13.9}},
+                                        'check_grid': {'repeat': 7}}
+    data_mod.write_data(tmp_path, {'x': 2})
+    assert data_mod.read_data(path) == {'x': 2, 'reindex': {'mcap': {'mb': 13.9}},
+                                        'check_grid': {'repeat': 7}}
+
+
+def test_store_section_refuses_a_key_a_report_would_drop(tmp_path):
+    """Only the sections a report keeps may be stored (one line naming the key)."""
+    with pytest.raises(ValueError, match="got 'summary'"):
+        data_mod.store_section(tmp_path / data_mod.DATA_FILE, 'summary', {})
+    assert not (tmp_path / data_mod.DATA_FILE).exists()
 
 
 def test_update_text_rewrites_figures_in_their_written_form():
