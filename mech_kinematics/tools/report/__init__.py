@@ -57,7 +57,7 @@ from .clock import (clock_errors, CLOCK_TICKS, ClockRow, EPOCH_NS, naive_accumul
 from .common import DURATIONS, EPS, ERROR_FLOOR, Mode, MODES, slug, spread_time, WP_SCENES
 from .cost import chain_scene, CHUNK, cost_growth, CostGrowth
 from .data import (BLOCKS, check_text, collect, DATA_FILE, lookup, read_data, render_block,
-                   SPREAD_RULE, update_text, write_data)
+                   SPREAD_RULE, store_section, STORED, update_text, write_data)
 from .extreme import (AngleResult, BOUND_FACTOR, Case, CaseResult, digits_lost, evaluate_angle,
                       evaluate_case, extreme_cases, formula_audit, FormulaAudit)
 from .figures import (plot_bounds, plot_clock, plot_cost, plot_extreme, plot_refused,
@@ -66,9 +66,9 @@ from .markdown import bench_text, write_report
 from ..cli import run_tool
 
 __all__ = [
-    'BLOCKS', 'DATA_FILE', 'EPOCH_NS', 'ORDERS', 'SPREAD_RULE', 'by_order', 'check_text',
-    'collect', 'lookup', 'node_clock', 'read_data', 'render_block', 'spread_time', 'update_text',
-    'write_data',
+    'BLOCKS', 'DATA_FILE', 'EPOCH_NS', 'ORDERS', 'SPREAD_RULE', 'STORED', 'by_order',
+    'check_text', 'collect', 'lookup', 'node_clock', 'read_data', 'render_block', 'spread_time',
+    'store_section', 'update_text', 'write_data',
     'AngleResult', 'BOUND_FACTOR', 'BoundCase', 'BoundStats', 'BoundValue', 'CHUNK', 'CLOCK_TICKS',
     'Case', 'CaseBounds', 'CaseResult', 'ClockRow', 'Configurations', 'CostGrowth', 'DURATIONS',
     'EPS', 'ERROR_FLOOR', 'FormulaAudit', 'GoldenCheck', 'HAND_TIME', 'KAPPA_WELL', 'MODES',

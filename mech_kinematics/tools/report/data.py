@@ -386,7 +386,7 @@ def _node_block(data: dict[str, Any], key: str, label: str) -> str:
     lines = [f'| {label} | floor CPU, % ({runs} run{"s" * (runs > 1)}) | node CPU, % | '
              'node / floor (medians) | grid instants delivered, floor / node (worst run) |',
              '|---:|---:|---:|---:|---:|']
-    for value, row in section['rows'].items():
+    for value, row in sorted(section['rows'].items(), key=lambda item: float(item[0])):
         shown = f'{float(value) / 1000:g} kHz' if key == 'node_rates' else value
         floor, node = (' / '.join(f'{c:.1f}' for c in row[f'{kind}_cpu_pct'])
                        for kind in ('floor', 'node'))

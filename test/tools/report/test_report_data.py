@@ -24,7 +24,9 @@ REQUIRED_KEYS = ('summary.ours_acceleration', 'summary.golden_max',
                  'summary.newton_cost_ratio.min', 'summary.single_over_newton.max',
                  'clock.timebase_year.max', 'clock.naive_1h.min', 'clock.naive_year.max',
                  'bounds.values', 'bounds.min', 'bounds.median', 'bounds.tightness',
-                 'cost.batch_slope', 'long_run.run_time_s', 'elapsed_s')
+                 'cost.batch_slope', 'long_run.run_time_s', 'elapsed_s',
+                 'node_rates.seconds', 'node_chains.node_pct_per_dyad',
+                 'node_chains.node_us_per_dyad_tick', 'node_chains.floor_pct_per_dyad')
 
 #: Keys other docs must quote, each from the script that measures it (bench/node_bench.py,
 #: bench/docs_bench.py): doc -> keys.
@@ -63,7 +65,7 @@ def test_accuracy_doc_quotes_the_data_file(committed):
     for key in REQUIRED_KEYS:
         assert f'<!--={key}-->' in text, key
         data_mod.lookup(committed, key)
-    for block in ('bench', 'refused', 'long_run'):
+    for block in ('bench', 'refused', 'long_run', 'node_rates', 'node_chains'):
         assert f'<!--data:{block}-->' in text, block
 
 
@@ -116,6 +118,22 @@ def test_generated_blocks_are_checked_and_rewritten():
     assert '| s | 1.00 / 2.00 / 3.00 | 2.00× | 0.100 / 0.200 / 0.300 | 2.00× |' in fresh
     assert 'block nope needs' in data_mod.check_text('<!--data:nope-->\n<!--data:end-->',
                                                      SAMPLE)[0]
+
+
+def test_the_node_blocks_list_each_rate_and_size_in_order():
+    """The node-against-floor tables: every run's CPU, the medians' ratio, the worst delivery."""
+    row = {'floor_cpu_pct': [10.0, 11.0, 12.0], 'node_cpu_pct': [13.0, 13.2, 14.0],
+           'ratio': 1.2, 'floor_delivered_pct': 99.998, 'node_delivered_pct': 100.0}
+    data = {'node_rates': {'repeat': 3, 'rows': {'5000': row, '1000': row}},
+            'node_chains': {'repeat': 1, 'rows': {'16': row, '4': row}}}
+    rates = data_mod.render_block('node_rates', data).splitlines()
+    assert rates[0].startswith('| rate | floor CPU, % (3 runs) | node CPU, % |')
+    assert rates[2] == ('| 1 kHz | 10.0 / 11.0 / 12.0 | 13.0 / 13.2 / 14.0 | 1.20 | '
+                        '99.998 % / 100.000 % |')
+    assert rates[3].startswith('| 5 kHz |')
+    chains = data_mod.render_block('node_chains', data).splitlines()
+    assert chains[0].startswith('| dyads | floor CPU, % (1 run) |')
+    assert [line.split(' |')[0] for line in chains[2:]] == ['| 4', '| 16']
 
 
 def test_write_data_keeps_the_long_run(tmp_path):
