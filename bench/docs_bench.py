@@ -13,12 +13,23 @@
   of ``reindex()`` (``[min, median, max]`` of ``--repeat`` repairs of fresh
   copies, s) and the messages it kept.
 
+- ``recorder``: the node at 1 kHz recorded by three recorders (mcap, sqlite3,
+  and an mcap *witness*; the default EventsExecutor): the CPU of the mcap and
+  sqlite3 recorders over ``--record`` s (user + system over wall time, % of
+  one core, from /proc, from 2 s after they subscribed), then both killed
+  with ``kill -9``, the witness stopped normally 0.2 s later and the two bags
+  reindexed (timed): of the state messages the witness received before the
+  kill (from when both recorded), the share each reindexed bag holds, and how
+  long before the kill its newest was received, and the share of those
+  received at least 1 s before the kill; the witness's bag size per minute.
+
 ``--data docs/report/data.json`` stores each section under its key (a report
 keeps them); without it the figures are printed as JSON.
 
 Usage (with the package importable, e.g. ``make``'s .venv)::
 
-    python bench/docs_bench.py [check_grid] [reindex] [--repeat 7] [--data FILE]
+    python bench/docs_bench.py [check_grid] [reindex] [recorder] [--repeat 7]
+                               [--record 10] [--data FILE]
 """
 
 from __future__ import annotations
@@ -29,10 +40,13 @@ import datetime
 import json
 import os
 from pathlib import Path
+import random
 import shutil
+import signal
 import sqlite3
 import statistics
 import struct
+import subprocess
 import sys
 import tempfile
 import time
@@ -173,7 +187,125 @@ def reindex_repair(repeat: int) -> dict[str, Any]:
     return out
 
 
-SECTIONS = {'check_grid': check_grid, 'reindex': reindex_repair}
+NS = 1_000_000_000
+STATE_TOPICS = ('/joint_states', '/joint_accelerations', '/point_accelerations')
+
+
+def _cpu_seconds(pid: int) -> float:
+    fields = Path(f'/proc/{pid}/stat').read_text().rsplit(')', 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
+
+
+def _wait_for(file: Path, text: str, process: subprocess.Popen, timeout: float = 30.0) -> None:
+    deadline = time.monotonic() + timeout
+    while text not in file.read_text():
+        if process.poll() is not None or time.monotonic() > deadline:
+            raise RuntimeError(f'no {text!r} from {file.name}:\n{file.read_text()}')
+        time.sleep(0.05)
+
+
+def _received(bag: Path) -> dict[str, dict[int, int]]:
+    """Return topic -> {header stamp: receive time} of the state topics of ``bag``, ns."""
+    from rosbags.highlevel import AnyReader
+
+    from mech_kinematics.ros.cdr import stamp_from_cdr
+
+    out: dict[str, dict[int, int]] = {topic: {} for topic in STATE_TOPICS}
+    with AnyReader([bag]) as reader:
+        connections = [c for c in reader.connections if c.topic in out]
+        for connection, timestamp, raw in reader.messages(connections=connections):
+            out[connection.topic][stamp_from_cdr(raw)] = timestamp
+    return out
+
+
+def recorder(record_s: float = 10.0) -> dict[str, Any]:
+    """Return the recorders' CPU at 1 kHz and what kill -9 and reindex leave of their bags."""
+    from mech_kinematics.bag import reindex
+
+    env = dict(os.environ, ROS_DOMAIN_ID=str(random.SystemRandom().randint(101, 200)),
+               ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', PYTHONUNBUFFERED='1')
+    repo = str(Path(__file__).resolve().parents[1])
+    env['PYTHONPATH'] = os.pathsep.join(filter(None, [repo, env.get('PYTHONPATH')]))
+    out: dict[str, Any] = {'rate_hz': 1000.0, 'record_s': record_s}
+    with tempfile.TemporaryDirectory() as tmp_name:
+        tmp = Path(tmp_name)
+        processes: dict[str, subprocess.Popen] = {}
+        logs: dict[str, Path] = {}
+
+        def start(name: str, *argv: str) -> None:
+            logs[name] = tmp / f'{name}.log'
+            with open(logs[name], 'w') as log:
+                processes[name] = subprocess.Popen([sys.executable, *argv], env=env, stdout=log,
+                                                   stderr=subprocess.STDOUT, cwd=tmp)
+
+        try:
+            for name, storage in (('mcap', 'mcap'), ('sqlite3', 'sqlite3'), ('witness', 'mcap')):
+                start(name, '-m', 'mech_kinematics', 'record', '-o', str(tmp / name),
+                      '--storage', storage, '--progress', '0')
+            for name in ('mcap', 'sqlite3', 'witness'):
+                _wait_for(logs[name], 'recording to', processes[name])
+            start('node', '-m', 'mech_kinematics.kinematics_node', '--ros-args',
+                  '-p', 'rate_hz:=1000.0', '--log-level', 'warn')
+            for name in ('mcap', 'sqlite3', 'witness'):
+                _wait_for(logs[name], 'subscribed to /diagnostics', processes[name])
+            time.sleep(2.0)
+            killed = ('mcap', 'sqlite3')
+            cpu0 = {n: _cpu_seconds(processes[n].pid) for n in killed}
+            wall0 = time.monotonic()
+            time.sleep(record_s)
+            cpu1 = {n: _cpu_seconds(processes[n].pid) for n in killed}
+            wall = time.monotonic() - wall0
+            kill_ns = time.time_ns()
+            for name in killed:
+                processes[name].kill()
+            for name in killed:
+                processes[name].wait(timeout=10)
+            time.sleep(0.2)     # the witness gets what was on the way at the kill
+            processes['witness'].send_signal(signal.SIGINT)
+            processes['witness'].wait(timeout=30)
+        finally:
+            for process in processes.values():
+                if process.poll() is None:
+                    process.send_signal(signal.SIGINT)
+                    try:
+                        process.wait(timeout=15)
+                    except subprocess.TimeoutExpired:
+                        process.kill()
+                        process.wait()
+        witness = _received(tmp / 'witness')
+        first, last = (min(min(v.values()) for v in witness.values()),
+                       max(max(v.values()) for v in witness.values()))
+        size = sum(f.stat().st_size for f in (tmp / 'witness').iterdir())
+        out['witness_mb_per_minute'] = size / 1e6 * 60 * NS / (last - first)
+        for name in killed:
+            start_s = time.perf_counter()
+            reindex(tmp / name)
+            reindex_s = time.perf_counter() - start_s
+            got = _received(tmp / name)
+            recovered = owed = old_kept = old = 0
+            for topic in STATE_TOPICS:
+                begin = max(min(got[topic]), min(witness[topic]))     # both recording
+                window = {s for s, t in witness[topic].items() if s >= begin and t <= kill_ns}
+                recovered += len(window & set(got[topic]))
+                owed += len(window)
+                older = {s for s in window if witness[topic][s] <= kill_ns - NS}
+                old_kept += len(older & set(got[topic]))
+                old += len(older)
+            newest = max(max(v.values()) for v in got.values())
+            out[name] = {'cpu_pct': 100 * (cpu1[name] - cpu0[name]) / wall,
+                         'recovered_pct': 100 * recovered / owed, 'owed': owed,
+                         'older_than_1s_pct': 100 * old_kept / old,
+                         'newest_ms': (kill_ns - newest) / 1e6, 'reindex_s': reindex_s,
+                         'mb': sum(f.stat().st_size for f in (tmp / name).iterdir()
+                                   if f.suffix in ('.mcap', '.db3')) / 1e6}
+    return out
+
+
+#: name -> the measurement, of the command line's arguments.
+SECTIONS: dict[str, Callable[[argparse.Namespace], dict[str, Any]]] = {
+    'check_grid': lambda args: check_grid(args.repeat),
+    'reindex': lambda args: reindex_repair(args.repeat),
+    'recorder': lambda args: recorder(args.record)}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -182,6 +314,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument('sections', nargs='*', metavar='SECTION',
                         help=f'what to measure: {", ".join(SECTIONS)} (default: all)')
     parser.add_argument('--repeat', type=int, default=7, help='timed runs of each')
+    parser.add_argument('--record', type=float, default=10.0,
+                        help='recorder: seconds of the CPU measurement before kill -9')
     parser.add_argument('--data', metavar='FILE',
                         help='store each section in this data file (docs/report/data.json)')
     args = parser.parse_args(argv)
@@ -189,7 +323,7 @@ def main(argv: list[str] | None = None) -> int:
     if unknown:
         parser.error(f'Expected sections among {", ".join(SECTIONS)}, got {", ".join(unknown)}')
     for name in args.sections or SECTIONS:
-        section = SECTIONS[name](args.repeat)
+        section = SECTIONS[name](args)
         section.update(date=datetime.date.today().isoformat(), cpus=os.cpu_count(),
                        load=os.getloadavg()[0])
         if args.data:

@@ -31,6 +31,12 @@ REQUIRED_KEYS = ('summary.ours_acceleration', 'summary.golden_max',
 #: Keys other docs must quote, each from the script that measures it (bench/node_bench.py,
 #: bench/docs_bench.py): doc -> keys.
 REQUIRED_ELSEWHERE = {
+    'bags.md': ('recorder.witness_mb_per_minute', 'recorder.mcap.cpu_pct',
+                'recorder.sqlite3.cpu_pct', 'recorder.mcap.older_than_1s_pct',
+                'recorder.sqlite3.older_than_1s_pct', 'recorder.mcap.recovered_pct',
+                'recorder.sqlite3.recovered_pct', 'recorder.mcap.newest_ms',
+                'recorder.sqlite3.newest_ms', 'recorder.mcap.reindex_s',
+                'recorder.sqlite3.reindex_s'),
     'commands.md': ('check_grid.five_bar.ms', 'check_grid.excavator.ms', 'check_grid.repeat'),
     'robustness.md': ('reindex.messages', 'reindex.mcap.mb', 'reindex.mcap.s',
                       'reindex.mcap.kept', 'reindex.mcap.dropped', 'reindex.sqlite3.mb',
