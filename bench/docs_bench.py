@@ -1,6 +1,6 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""Figures that docs/commands.md and docs/robustness.md quote (a script, not a test).
+"""Figures that docs/commands.md, robustness.md, bags.md and view.md quote (a script).
 
 - ``check_grid``: the time of ``check``'s study of the assembly region
   (:func:`mech_kinematics.geometry.region.region_from_scene`, 180 x 180 grid
@@ -23,12 +23,16 @@
   long before the kill its newest was received, and the share of those
   received at least 1 s before the kill; the witness's bag size per minute.
 
+- ``viewer``: the default node (100 Hz) and ``view`` on a free port: after
+  the first frame and 5 s of traces, 100 requests of ``/state`` one after
+  another, their times (ms: median and 90th percentile) and the answer's size.
+
 ``--data docs/report/data.json`` stores each section under its key (a report
 keeps them); without it the figures are printed as JSON.
 
 Usage (with the package importable, e.g. ``make``'s .venv)::
 
-    python bench/docs_bench.py [check_grid] [reindex] [recorder] [--repeat 7]
+    python bench/docs_bench.py [check_grid] [reindex] [recorder] [viewer] [--repeat 7]
                                [--record 10] [--data FILE]
 """
 
@@ -204,6 +208,14 @@ def _wait_for(file: Path, text: str, process: subprocess.Popen, timeout: float =
         time.sleep(0.05)
 
 
+def _ros_env() -> dict[str, str]:
+    env = dict(os.environ, ROS_DOMAIN_ID=str(random.SystemRandom().randint(101, 200)),
+               ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', PYTHONUNBUFFERED='1')
+    repo = str(Path(__file__).resolve().parents[1])
+    env['PYTHONPATH'] = os.pathsep.join(filter(None, [repo, env.get('PYTHONPATH')]))
+    return env
+
+
 def _received(bag: Path) -> dict[str, dict[int, int]]:
     """Return topic -> {header stamp: receive time} of the state topics of ``bag``, ns."""
     from rosbags.highlevel import AnyReader
@@ -222,10 +234,7 @@ def recorder(record_s: float = 10.0) -> dict[str, Any]:
     """Return the recorders' CPU at 1 kHz and what kill -9 and reindex leave of their bags."""
     from mech_kinematics.bag import reindex
 
-    env = dict(os.environ, ROS_DOMAIN_ID=str(random.SystemRandom().randint(101, 200)),
-               ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', PYTHONUNBUFFERED='1')
-    repo = str(Path(__file__).resolve().parents[1])
-    env['PYTHONPATH'] = os.pathsep.join(filter(None, [repo, env.get('PYTHONPATH')]))
+    env = _ros_env()
     out: dict[str, Any] = {'rate_hz': 1000.0, 'record_s': record_s}
     with tempfile.TemporaryDirectory() as tmp_name:
         tmp = Path(tmp_name)
@@ -301,11 +310,53 @@ def recorder(record_s: float = 10.0) -> dict[str, Any]:
     return out
 
 
+def viewer(requests: int = 100) -> dict[str, Any]:
+    """Return the times (ms) and size (kB) of ``/state`` from ``view`` beside the default node."""
+    import re
+    import urllib.request
+
+    env = _ros_env()
+    with tempfile.TemporaryDirectory() as tmp_name:
+        log = Path(tmp_name) / 'view.log'
+        with open(log, 'w') as out:
+            node = subprocess.Popen([sys.executable, '-m', 'mech_kinematics.kinematics_node',
+                                     '--ros-args', '--log-level', 'warn'], env=env,
+                                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            view = subprocess.Popen([sys.executable, '-m', 'mech_kinematics', 'view', '--port',
+                                     '0'], env=env, stdout=out, stderr=subprocess.STDOUT)
+        try:
+            _wait_for(log, '(Ctrl-C stops it)', view)
+            url = re.search(r'(http://\S+/)', log.read_text()).group(1)    # type: ignore
+            deadline = time.monotonic() + 30
+            while json.loads(urllib.request.urlopen(url + 'state').read())['frame'] is None:
+                if time.monotonic() > deadline:
+                    raise RuntimeError('no frame from view within 30 s')
+                time.sleep(0.1)
+            time.sleep(5.0)     # the traces fill
+            times, sizes = [], []
+            for _ in range(requests):
+                start = time.perf_counter()
+                sizes.append(len(urllib.request.urlopen(url + 'state').read()))
+                times.append(1e3 * (time.perf_counter() - start))
+        finally:
+            for process in (view, node):
+                process.send_signal(signal.SIGINT)
+                try:
+                    process.wait(timeout=15)
+                except subprocess.TimeoutExpired:
+                    process.kill()
+                    process.wait()
+    deciles = statistics.quantiles(times, n=10)
+    return {'requests': requests, 'median_ms': statistics.median(times), 'p90_ms': deciles[-1],
+            'kb': statistics.median(sizes) / 1e3}
+
+
 #: name -> the measurement, of the command line's arguments.
 SECTIONS: dict[str, Callable[[argparse.Namespace], dict[str, Any]]] = {
     'check_grid': lambda args: check_grid(args.repeat),
     'reindex': lambda args: reindex_repair(args.repeat),
-    'recorder': lambda args: recorder(args.record)}
+    'recorder': lambda args: recorder(args.record),
+    'viewer': lambda args: viewer()}
 
 
 def main(argv: list[str] | None = None) -> int:
