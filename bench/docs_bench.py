@@ -1,6 +1,6 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""Figures that docs/commands.md, robustness.md, bags.md and view.md quote (a script).
+"""Figures that docs/commands.md, robustness.md, bags.md, view.md, install.md quote.
 
 - ``check_grid``: the time of ``check``'s study of the assembly region
   (:func:`mech_kinematics.geometry.region.region_from_scene`, 180 x 180 grid
@@ -27,12 +27,17 @@
   the first frame and 5 s of traces, 100 requests of ``/state`` one after
   another, their times (ms: median and 90th percentile) and the answer's size.
 
+- ``tf2_build``: ``scripts/build_tf2_msgs.py --force`` (docs/install.md), the
+  build of ``tf2_msgs`` into the running ``.venv``, ``[min, median, max]`` of
+  ``--repeat`` runs, s.
+
 ``--data docs/report/data.json`` stores each section under its key (a report
 keeps them); without it the figures are printed as JSON.
 
 Usage (with the package importable, e.g. ``make``'s .venv)::
 
-    python bench/docs_bench.py [check_grid] [reindex] [recorder] [viewer] [--repeat 7]
+    python bench/docs_bench.py [check_grid] [reindex] [recorder] [viewer] [tf2_build]
+                               [--repeat 7]
                                [--record 10] [--data FILE]
 """
 
@@ -351,12 +356,20 @@ def viewer(requests: int = 100) -> dict[str, Any]:
             'kb': statistics.median(sizes) / 1e3}
 
 
+def tf2_build(repeat: int) -> dict[str, Any]:
+    """Return the times (s) of rebuilding tf2_msgs into this Python's virtualenv."""
+    script = Path(__file__).resolve().parents[1] / 'scripts' / 'build_tf2_msgs.py'
+    return {'repeat': repeat, 's': _spread([_timed(lambda: subprocess.run(
+        [sys.executable, str(script), '--force'], check=True)) for _ in range(repeat)])}
+
+
 #: name -> the measurement, of the command line's arguments.
 SECTIONS: dict[str, Callable[[argparse.Namespace], dict[str, Any]]] = {
     'check_grid': lambda args: check_grid(args.repeat),
     'reindex': lambda args: reindex_repair(args.repeat),
     'recorder': lambda args: recorder(args.record),
-    'viewer': lambda args: viewer()}
+    'viewer': lambda args: viewer(),
+    'tf2_build': lambda args: tf2_build(args.repeat)}
 
 
 def main(argv: list[str] | None = None) -> int:

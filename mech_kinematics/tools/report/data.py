@@ -9,9 +9,10 @@ Measurements that take longer than a report run (``long_run``: one real run
 of the node, ``bench/long_run.py``) are copied in from a file
 (``report --long-run FILE``) or kept from the folder's previous data file.
 Scripts that measure on their own (:data:`STORED`: the node against the rclpy
-floor, ``bench/node_bench.py --data FILE``; the recorder, the viewer, ``check``'s
-grid study and ``reindex``, ``bench/docs_bench.py``) write their section into
-the data file with :func:`store_section`; a report keeps them.
+floor, ``bench/node_bench.py --data FILE``; the recorder, the viewer,
+``check``'s grid study, ``reindex`` and the build of tf2_msgs,
+``bench/docs_bench.py``) write their section into the data file with
+:func:`store_section`; a report keeps them.
 
 The documentation quotes them in two forms that :func:`check_text` checks:
 
@@ -42,7 +43,8 @@ __all__ = ['BLOCKS', 'DATA_FILE', 'SPREAD_RULE', 'STORED', 'check_text', 'collec
 #: The data file's name in the report's folder.
 DATA_FILE = 'data.json'
 #: Sections that scripts of bench/ write with :func:`store_section`: a report keeps them.
-STORED = ('node_rates', 'node_chains', 'recorder', 'viewer', 'check_grid', 'reindex')
+STORED = ('node_rates', 'node_chains', 'recorder', 'viewer', 'check_grid', 'reindex',
+          'tf2_build')
 #: How a quoted timing is checked (also in docs/accuracy.md).
 SPREAD_RULE = ('a timing quoted from [min, median, max] of repeated runs passes when it lies '
                'between the min and the max, at the precision it is written with')

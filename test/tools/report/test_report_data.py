@@ -37,6 +37,7 @@ REQUIRED_ELSEWHERE = {
                 'recorder.sqlite3.recovered_pct', 'recorder.mcap.newest_ms',
                 'recorder.sqlite3.newest_ms', 'recorder.mcap.reindex_s',
                 'recorder.sqlite3.reindex_s'),
+    'install.md': ('tf2_build.s', 'tf2_build.repeat'),
     'view.md': ('viewer.median_ms', 'viewer.p90_ms', 'viewer.kb', 'viewer.requests'),
     'commands.md': ('check_grid.five_bar.ms', 'check_grid.excavator.ms', 'check_grid.repeat'),
     'robustness.md': ('reindex.messages', 'reindex.mcap.mb', 'reindex.mcap.s',
