@@ -63,11 +63,12 @@ from .driver import TickDriver
 from .markers import marker_array_from_state, marker_size_from_space, MarkerThrottle
 from .messages import TickMessages
 from .parameters import (CATCH_UP, catch_up_window_ns, joint_refusal, PARAMETERS, ParameterSpec,
-                         refusal, spec, STATE_DEPTH)
+                         refusal, spec, STATE_DEPTH, TOPIC)
 from .schedule import period_ns_from_rate
 from .tf import static_tf_message, TfMessages
 from .ticker import tick_function
 from .timebase import CrankSample
+from .topic_drive import RefusedInput, TopicDrive, TopicInput
 from ..geometry.assembly import assembly_summary
 from ..geometry.diagrams import space_from_state, strokes_from_scene
 from ..geometry.frames import angle_joints, frames_from_scene, origin_points
@@ -97,6 +98,10 @@ DRIVE = ('crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm')
 CRANK = 'crank'
 CRANK_KEYS = {'crank_speed_rpm': 'speed_rpm', 'crank_accel': 'accel',
               'max_crank_speed_rpm': 'max_speed_rpm'}
+#: Parameters whose values one rule ties together (parameters.joint_refusal).
+JOINT_RULES = (*DRIVE, 'drive', 'markers')
+#: History depth of the input_joint_states subscription (100 ms of input at 1 kHz).
+INPUT_DEPTH = 100
 DOUBLES = frozenset(p.name for p in PARAMETERS if p.kind == 'double')
 READ_ONLY = frozenset(p.name for p in PARAMETERS if p.read_only)
 
@@ -206,6 +211,8 @@ class KinematicsNode(LifecycleNode):
                                   spec('late_ticks').default == CATCH_UP)
         self._state_publishers: list[Any] = []
         self._pub_markers: Any = None
+        self._topic: TopicDrive | None = None
+        self._input: Any = None
         self._failure_guard = self.create_guard_condition(self._on_failure)
         self.add_pre_set_parameters_callback(self._pre_set)
         self.add_on_set_parameters_callback(self._validate)
@@ -272,8 +279,9 @@ class KinematicsNode(LifecycleNode):
             if reason is not None:
                 break
         if reason is None:
-            current = {name: self._value(name) for name in DRIVE if self.has_parameter(name)}
-            current.update((p.name, p.value) for p in parameters if p.name in DRIVE)
+            current = {name: self._value(name) for name in JOINT_RULES
+                       if self.has_parameter(name)}
+            current.update((p.name, p.value) for p in parameters if p.name in JOINT_RULES)
             if None not in current.values():
                 reason = joint_refusal(current)
         if reason is None:
@@ -389,6 +397,7 @@ class KinematicsNode(LifecycleNode):
             self.get_logger().info('the scene is solved by the general solver (not compiled)')
         if self._value('markers'):
             self._setup_markers(scene)
+        self._setup_topic_drive(scene)
         self.scene = scene
         self._log_start()
 
@@ -445,9 +454,9 @@ class KinematicsNode(LifecycleNode):
     def _log_start(self) -> None:
         scene = self.scene
         assert scene is not None
-        names = ('scene', 'crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm', 'rate_hz',
-                 'late_ticks', 'max_catch_up_s', 'max_lateness_ms', 'max_relative_error',
-                 'frame_id', 'tf_rate_hz', 'tf_prefix',
+        names = ('scene', 'drive', 'crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm',
+                 'rate_hz', 'late_ticks', 'max_catch_up_s', 'max_lateness_ms',
+                 'max_relative_error', 'frame_id', 'tf_rate_hz', 'tf_prefix',
                  'use_sim_time', 'markers', 'managed')
         settings = ', '.join(f'{name}={self._value(name)!r}' for name in names[1:])
         self.get_logger().info(
@@ -481,6 +490,7 @@ class KinematicsNode(LifecycleNode):
                 self.destroy_publisher(publisher)
         self._state_publishers = []
         self._pub_markers = None
+        self._topic = None
         self.scene = None
 
     def _setup_markers(self, scene: mk.Scene) -> None:
@@ -502,7 +512,10 @@ class KinematicsNode(LifecycleNode):
     # -- the tick thread ------------------------------------------------------
 
     def start(self) -> None:
-        """Start the tick thread."""
+        """Start the tick thread (with ``drive: topic``, the input subscription instead)."""
+        if self._topic is not None:
+            self._start_topic_drive()
+            return
         self._stop.clear()
         self._driver.resume()
         self._thread = threading.Thread(target=self._run, name='mech_kinematics_tick',
@@ -511,6 +524,7 @@ class KinematicsNode(LifecycleNode):
 
     def stop(self) -> None:
         """Stop the tick thread and wait for it; apply what it left pending."""
+        self._stop_topic_drive()
         self._stop.set()
         self._clock_event.set()
         thread, self._thread = self._thread, None
@@ -645,6 +659,75 @@ class KinematicsNode(LifecycleNode):
                 f'near-singular pose at crank angle {angle:.6f} rad: measure {measure:.3g}',
                 throttle_duration_sec=1.0)
 
+    # -- driven from a topic --------------------------------------------------
+
+    def _setup_topic_drive(self, scene: mk.Scene) -> None:
+        """With ``drive: topic``, prepare the rules and the messages without accelerations."""
+        self._topic = None
+        if self._value('drive') != TOPIC:
+            return
+        joints, points = scene.output_joints, scene.output_points
+        # What the input determines: positions always, velocities when a message has them.
+        self._topic_messages = {
+            known: TickMessages(joints, points, self.frame_id, velocities=known,
+                                accelerations=False) for known in (True, False)}
+        self._topic = TopicDrive(scene.drivers)
+
+    def _start_topic_drive(self) -> None:
+        """Subscribe to ``input_joint_states``: each message is solved and published."""
+        if self._input is None:
+            qos = QoSProfile(history=QoSHistoryPolicy.KEEP_LAST, depth=INPUT_DEPTH,
+                             reliability=QoSReliabilityPolicy.RELIABLE,
+                             durability=QoSDurabilityPolicy.VOLATILE)
+            self._input = self.create_subscription(
+                JointState, topics.INPUT_JOINT_STATES, self._on_input, qos,
+                qos_overriding_options=_qos_options())
+
+    def _stop_topic_drive(self) -> None:
+        subscription, self._input = self._input, None
+        if subscription is not None:
+            self.destroy_subscription(subscription)
+
+    def _on_input(self, msg: JointState) -> None:
+        """Publish the state of one input message with its stamp, or say why not."""
+        received = time.monotonic_ns()
+        topic = self._topic
+        if topic is None:
+            return      # cleaned up while the message waited
+        stamp = msg.header.stamp
+        stamp_ns = stamp.sec * NS_PER_S + stamp.nanosec
+        try:
+            given = topic.read(stamp.sec, stamp.nanosec, msg.name, msg.position, msg.velocity)
+            values, measure = self._solve_input(given)
+        except (RefusedInput, mk.AssemblyError) as exc:
+            kind = 'refused input' if isinstance(exc, RefusedInput) else \
+                'not trusted' if isinstance(exc, mk.UntrustedError) else 'cannot assemble'
+            self._stats.record(stamp_ns, time.monotonic_ns() - received, False, error=str(exc),
+                               refusal=kind)
+            self.get_logger().warning(f'no state published: {exc}', throttle_duration_sec=1.0)
+            return
+        sec, nanosec = divmod(given.stamp_ns, NS_PER_S)
+        messages = self._topic_messages[given.speeds is not None]
+        for publish, data in zip(self._publish_state,
+                                 messages.render_values(values, sec, nanosec), strict=True):
+            publish(data)
+        if self._tf is not None and self._tf_period_ns is not None \
+                and given.stamp_ns >= self._next_tf:
+            self._pub_tf.publish(self._tf.render_values(values, self._tf_first, sec, nanosec))
+            self._next_tf = given.stamp_ns + self._tf_period_ns
+        topic.published(given.stamp_ns)
+        self._stats.record(given.stamp_ns, time.monotonic_ns() - received, False,
+                           measure=measure, near_singular=measure < mk.NEAR_SINGULAR)
+
+    def _solve_input(self, given: TopicInput) -> tuple[Any, float]:
+        """Return (the tick function's values, the singularity measure) for one input.
+
+        Unknown velocities are solved as zero and left out of what is published;
+        the accelerations are never published.
+        """
+        speed = 0.0 if given.speeds is None else given.speeds[0]
+        return self._solve(given.positions[0], speed, 0.0, self._max_error, 0)
+
     # -- markers --------------------------------------------------------------
 
     def _publish_markers(self) -> None:
@@ -674,7 +757,7 @@ class KinematicsNode(LifecycleNode):
         hardware_id = self.scene.name if self.scene is not None else self._value('scene')
         if self.scene is None:
             waiting = 'configure (lifecycle)'
-        elif self._thread is None:
+        elif self._thread is None and self._input is None:
             waiting = 'activate (lifecycle)' if self.managed else 'the start'
         elif self._waiting_for_clock:
             waiting = '/clock'

@@ -22,14 +22,18 @@ from ..bounds import MAX_ERROR
 from ..scene import DEFAULT_SCENE
 from ..units import NS_PER_S
 
-__all__ = ['CATCH_UP', 'LATE_TICKS', 'PARAMETERS', 'ParameterSpec', 'SHOWN_CHARS', 'SKIP',
-           'STATE_DEPTH', 'catch_up_window_ns', 'depth_refusal', 'frame_refusal',
-           'joint_refusal', 'refusal', 'shown', 'spec']
+__all__ = ['CATCH_UP', 'DRIVE_MODES', 'LATE_TICKS', 'PARAMETERS', 'ParameterSpec',
+           'SHOWN_CHARS', 'SKIP', 'STATE_DEPTH', 'TIME', 'TOPIC', 'catch_up_window_ns',
+           'depth_refusal', 'frame_refusal', 'joint_refusal', 'refusal', 'shown', 'spec']
 
 #: ``late_ticks`` values: publish every missed grid instant, or only the latest.
 CATCH_UP = 'catch_up'
 SKIP = 'skip'
 LATE_TICKS = (CATCH_UP, SKIP)
+#: ``drive`` values: the drivers as exact functions of the clock, or read from a topic.
+TIME = 'time'
+TOPIC = 'topic'
+DRIVE_MODES = (TIME, TOPIC)
 
 
 @dataclass(frozen=True)
@@ -84,6 +88,11 @@ PARAMETERS = (
                   'Follow the ROS 2 node lifecycle: configure loads the scene, activate '
                   'starts publishing (default: configure and activate at start)',
                   read_only=True),
+    ParameterSpec('drive', 'string', TIME,
+                  'Where the drivers come from: time (each an exact function of the clock, '
+                  'on the rate_hz grid) or topic (the positions, and velocities if given, of '
+                  'each message on input_joint_states, published with its stamp)',
+                  choices=DRIVE_MODES, read_only=True),
     ParameterSpec('crank_speed_rpm', 'double', None,
                   'Crank speed, + CCW, from the tick at which it is applied (the crank angle '
                   "stays continuous). Defaults to the scene's input.speed_rpm",
@@ -252,6 +261,9 @@ def joint_refusal(values: Mapping[str, Any]) -> str | None:
     ``values`` holds the values the parameters would have (new ones merged
     over current ones); missing names are not checked.
     """
+    if values.get('drive') == TOPIC and values.get('markers') is True:
+        return ('markers: expected false with drive: topic (the arrows would show '
+                'velocities and accelerations the input does not give), got true')
     speed, bound = values.get('crank_speed_rpm'), values.get('max_crank_speed_rpm')
     if speed is not None and bound is not None and abs(float(speed)) > float(bound):
         return (f'crank_speed_rpm: expected |crank_speed_rpm| <= max_crank_speed_rpm '

@@ -8,7 +8,7 @@ and remaps apply; ``/tf`` and ``/tf_static`` are absolute, as tf2 expects.
 
 from __future__ import annotations
 
-__all__ = ['DIAGNOSTICS', 'JOINT_ACCELERATIONS', 'JOINT_STATES', 'MARKERS',
+__all__ = ['DIAGNOSTICS', 'INPUT_JOINT_STATES', 'JOINT_ACCELERATIONS', 'JOINT_STATES', 'MARKERS',
            'POINT_ACCELERATIONS', 'ROBOT_DESCRIPTION', 'SCENE', 'STATE_TOPICS', 'TF',
            'TF_STATIC', 'TYPES']
 
@@ -24,6 +24,9 @@ ROBOT_DESCRIPTION = 'robot_description'
 #: The scene file's text, latched, so that a bag carries its own scene.
 SCENE = 'scene'
 
+#: The drivers' positions (and velocities) that drive the node with ``drive: topic``.
+INPUT_JOINT_STATES = 'input_joint_states'
+
 #: The topics of the kinematic state, published together at every instant.
 STATE_TOPICS = (JOINT_STATES, JOINT_ACCELERATIONS, POINT_ACCELERATIONS)
 
@@ -38,4 +41,5 @@ TYPES = {
     TF_STATIC: 'tf2_msgs/msg/TFMessage',
     ROBOT_DESCRIPTION: 'std_msgs/msg/String',
     SCENE: 'std_msgs/msg/String',
+    INPUT_JOINT_STATES: 'sensor_msgs/msg/JointState',
 }

@@ -19,6 +19,8 @@ from mech_kinematics.ros.parameters import joint_refusal, PARAMETERS, refusal, s
     ('frame_id', 5, 'frame_id: expected a string, got number 5'),
     ('markers', 'yes', "markers: expected true or false, got string 'yes'"),
     ('late_ticks', 'later', "late_ticks: expected one of catch_up, skip, got 'later'"),
+    ('drive', 'topics', "drive: expected one of time, topic, got 'topics'"),
+    ('drive', 1, 'drive: expected a string, got number 1'),
     ('max_catch_up_s', -1.0, 'max_catch_up_s: expected 0 <= value <= 10 s, got -1.0'),
 ])
 def test_bad_values_are_refused_with_a_reason(name, value, reason):
@@ -38,6 +40,16 @@ def test_the_speed_may_not_exceed_its_bound():
     assert joint_refusal({'crank_speed_rpm': -3000.0, 'max_crank_speed_rpm': 3000.0}) is None
     assert 'max_crank_speed_rpm (2000 rpm), got -3000 rpm' in joint_refusal(
         {'crank_speed_rpm': -3000.0, 'max_crank_speed_rpm': 2000.0})
+
+
+def test_markers_are_refused_with_drive_topic():
+    """The arrows would show values a topic does not give: markers need drive: time (issue 18)."""
+    assert joint_refusal({'drive': 'time', 'markers': True}) is None
+    assert joint_refusal({'drive': 'topic', 'markers': False}) is None
+    assert joint_refusal({'drive': 'topic', 'markers': True}) == (
+        'markers: expected false with drive: topic (the arrows would show velocities and '
+        'accelerations the input does not give), got true')
+    assert spec('drive').default == 'time' and spec('drive').read_only
 
 
 def test_every_parameter_is_described():
