@@ -100,8 +100,9 @@ CRANK_KEYS = {'crank_speed_rpm': 'speed_rpm', 'crank_accel': 'accel',
               'max_crank_speed_rpm': 'max_speed_rpm'}
 #: Parameters whose values one rule ties together (parameters.joint_refusal).
 JOINT_RULES = (*DRIVE, 'drive', 'markers')
-#: History depth of the input_joint_states subscription (100 ms of input at 1 kHz).
-INPUT_DEPTH = 100
+#: History depth of the input_joint_states subscription (a second of input at 1 kHz, as the
+#: state publishers keep: a stall of the executor loses no message).
+INPUT_DEPTH = 1000
 DOUBLES = frozenset(p.name for p in PARAMETERS if p.kind == 'double')
 READ_ONLY = frozenset(p.name for p in PARAMETERS if p.read_only)
 
@@ -213,6 +214,7 @@ class KinematicsNode(LifecycleNode):
         self._pub_markers: Any = None
         self._topic: TopicDrive | None = None
         self._input: Any = None
+        self._input_active = False
         self._failure_guard = self.create_guard_condition(self._on_failure)
         self.add_pre_set_parameters_callback(self._pre_set)
         self.add_on_set_parameters_callback(self._validate)
@@ -490,7 +492,7 @@ class KinematicsNode(LifecycleNode):
                 self.destroy_publisher(publisher)
         self._state_publishers = []
         self._pub_markers = None
-        self._topic = None
+        self._drop_topic_drive()
         self.scene = None
 
     def _setup_markers(self, scene: mk.Scene) -> None:
@@ -672,18 +674,25 @@ class KinematicsNode(LifecycleNode):
             known: TickMessages(joints, points, self.frame_id, velocities=known,
                                 accelerations=False) for known in (True, False)}
         self._topic = TopicDrive(scene.drivers)
+        # Subscribed at configure (its QoS overrides are declared with the others); a
+        # message is published only while active.
+        qos = QoSProfile(history=QoSHistoryPolicy.KEEP_LAST, depth=INPUT_DEPTH,
+                         reliability=QoSReliabilityPolicy.RELIABLE,
+                         durability=QoSDurabilityPolicy.VOLATILE)
+        self._input = self.create_subscription(
+            JointState, topics.INPUT_JOINT_STATES, self._on_input, qos,
+            qos_overriding_options=_qos_options())
 
     def _start_topic_drive(self) -> None:
-        """Subscribe to ``input_joint_states``: each message is solved and published."""
-        if self._input is None:
-            qos = QoSProfile(history=QoSHistoryPolicy.KEEP_LAST, depth=INPUT_DEPTH,
-                             reliability=QoSReliabilityPolicy.RELIABLE,
-                             durability=QoSDurabilityPolicy.VOLATILE)
-            self._input = self.create_subscription(
-                JointState, topics.INPUT_JOINT_STATES, self._on_input, qos,
-                qos_overriding_options=_qos_options())
+        """Publish a state for each message on ``input_joint_states`` from now on."""
+        self._input_active = True
 
     def _stop_topic_drive(self) -> None:
+        self._input_active = False
+
+    def _drop_topic_drive(self) -> None:
+        self._input_active = False
+        self._topic = None
         subscription, self._input = self._input, None
         if subscription is not None:
             self.destroy_subscription(subscription)
@@ -692,8 +701,8 @@ class KinematicsNode(LifecycleNode):
         """Publish the state of one input message with its stamp, or say why not."""
         received = time.monotonic_ns()
         topic = self._topic
-        if topic is None:
-            return      # cleaned up while the message waited
+        if topic is None or not self._input_active:
+            return      # inactive (lifecycle), or cleaned up while the message waited
         stamp = msg.header.stamp
         stamp_ns = stamp.sec * NS_PER_S + stamp.nanosec
         try:
@@ -757,7 +766,7 @@ class KinematicsNode(LifecycleNode):
         hardware_id = self.scene.name if self.scene is not None else self._value('scene')
         if self.scene is None:
             waiting = 'configure (lifecycle)'
-        elif self._thread is None and self._input is None:
+        elif self._thread is None and not self._input_active:
             waiting = 'activate (lifecycle)' if self.managed else 'the start'
         elif self._waiting_for_clock:
             waiting = '/clock'

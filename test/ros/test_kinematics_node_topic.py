@@ -14,6 +14,8 @@ import math
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from lifecycle_msgs.msg import Transition
+from lifecycle_msgs.srv import ChangeState
 import numpy as np
 import pytest
 from rclpy.parameter import Parameter
@@ -48,7 +50,7 @@ def ros():
 class TopicNode:
     """A node with drive: topic in a namespace of its own, and what it publishes, as received."""
 
-    def __init__(self, ros, tmp_path, name, *args, input_topic=None):
+    def __init__(self, ros, tmp_path, name, *args, input_topic=None, wait=True):
         self.ns = f'{SESSION}/{name}'
         self.prefix = f'{SESSION[1:]}_{name}'
         self.js = ros.collect(JointState, f'{self.ns}/joint_states')
@@ -61,6 +63,10 @@ class TopicNode:
         self.proc = NodeProcess(tmp_path, '-r', f'__ns:={self.ns}', '-p', f'scene:={SCENE}',
                                 '-p', 'drive:=topic', '-p', 'tf_rate_hz:=10000.0',
                                 '-p', f'tf_prefix:={self.prefix}', *args)
+        if wait:
+            self.wait_for_subscription()
+
+    def wait_for_subscription(self):
         wait_for(lambda: self.input.get_subscription_count() > 0 or self.proc.proc.poll(),
                  STARTUP_S, 'the node subscribing to input_joint_states')
         assert self.proc.proc.poll() is None, self.proc.output()
@@ -185,6 +191,34 @@ def test_bad_messages_are_refused_on_diagnostics_and_the_node_goes_on(ros, tmp_p
     assert [stamp_ns(m) for m in node.pt] == published
     assert int(values['unsolved_ticks_total']) == len(bad)
     assert 'Traceback' not in node.proc.output()
+
+
+def test_a_managed_node_publishes_only_while_active(ros, tmp_path):
+    """managed:=true: subscribed from configure, a state per message only while active."""
+    node = TopicNode(ros, tmp_path, 'topic_managed', '-p', 'managed:=true', wait=False)
+    change = ros.node.create_client(ChangeState, f'{node.ns}/mech_kinematics/change_state')
+
+    def transition(transition_id):
+        request = ChangeState.Request(transition=Transition(id=transition_id))
+        assert ros.call(change.call_async(request)).success
+
+    try:
+        assert change.wait_for_service(timeout_sec=STARTUP_S)
+        transition(Transition.TRANSITION_CONFIGURE)
+        node.wait_for_subscription()
+        node.send(T0 + 1, ['crank'], [0.1])       # inactive: nothing
+        transition(Transition.TRANSITION_ACTIVATE)
+        node.send(T0 + 2, ['crank'], [0.2])
+        wait_for(lambda: node.js, ANSWER_S, 'a state once active')
+        transition(Transition.TRANSITION_DEACTIVATE)
+        node.send(T0 + 3, ['crank'], [0.3])       # inactive again: nothing
+        transition(Transition.TRANSITION_ACTIVATE)
+        node.send(T0 + 4, ['crank'], [0.4])
+        wait_for(lambda: len(node.js) >= 2, ANSWER_S, 'a state once active again')
+        time.sleep(0.3)
+    finally:
+        node.stop()
+    assert [stamp_ns(m) for m in node.js] == [T0 + 2, T0 + 4]
 
 
 def test_the_input_topic_is_remapped_and_drive_is_read_only(ros, tmp_path):
