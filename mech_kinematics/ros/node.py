@@ -28,6 +28,7 @@ Run it with ``ros2 run mech_kinematics kinematics_node`` or
 
 from __future__ import annotations
 
+import copy
 import ctypes
 from dataclasses import replace
 import gc
@@ -36,7 +37,7 @@ import sys
 import threading
 import time
 import traceback
-from typing import Any
+from typing import Any, NamedTuple
 import warnings
 
 from builtin_interfaces.msg import Time
@@ -62,12 +63,13 @@ from .diagnostics import solver_status, Status, TickStats, timing_status
 from .driver import TickDriver
 from .markers import marker_array_from_state, marker_size_from_space, MarkerThrottle
 from .messages import TickMessages
-from .parameters import (CATCH_UP, catch_up_window_ns, joint_refusal, PARAMETERS, ParameterSpec,
-                         refusal, spec, STATE_DEPTH, TOPIC)
+from .parameters import (CATCH_UP, catch_up_window_ns, driver_parameters, first_crank_aliases,
+                         joint_refusal, PARAMETERS, ParameterSpec, refusal, rpm_parameter, spec,
+                         STATE_DEPTH, TOPIC)
 from .schedule import period_ns_from_rate
 from .tf import static_tf_message, TfMessages
 from .ticker import tick_function
-from .timebase import CrankSample
+from .timebase import ActuatorTimebase, CrankSample, CrankTimebase
 from .topic_drive import RefusedInput, TopicDrive, TopicInput
 from ..geometry.assembly import assembly_summary
 from ..geometry.diagrams import space_from_state, strokes_from_scene
@@ -75,7 +77,7 @@ from ..geometry.frames import angle_joints, frames_from_scene, origin_points
 from ..geometry.instant_centres import full_scene
 from ..geometry.urdf import urdf_from_scene
 from ..scene import scene_text
-from ..units import NS_PER_S, rad_per_s_from_rpm, rpm_from_rad_per_s
+from ..units import NS_PER_S, rad_per_s_from_rpm
 
 __all__ = ['KinematicsNode', 'NODE_NAME', 'TickThreadError', 'main']
 
@@ -92,12 +94,13 @@ SWITCH_INTERVAL_S = 0.0005
 #: The node-private, hidden topic on which each node says when it started (transient local,
 #: so that a newcomer of the same name hears an older node as soon as they are matched).
 INSTANCE_TOPIC = '~/_instance'
-#: The drive parameters, applied by the tick thread at an instant it has not published.
+#: The drive parameters, applied by the tick thread at an instant it has not published
+#: (with each driver's ``inputs.NAME.*``, declared when the scene is loaded).
 DRIVE = ('crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm')
-#: The crank's name in the driver, and what each drive parameter sets there.
-CRANK = 'crank'
-CRANK_KEYS = {'crank_speed_rpm': 'speed_rpm', 'crank_accel': 'accel',
-              'max_crank_speed_rpm': 'max_speed_rpm'}
+#: What the bound on the crank speed sets in each crank's time base.
+MAX_SPEED_KEY = 'max_speed_rpm'
+#: A crank's joint type (``Driver.joint_type``); an actuator's is prismatic.
+REVOLUTE = 'revolute'
 #: Parameters whose values one rule ties together (parameters.joint_refusal).
 JOINT_RULES = (*DRIVE, 'drive', 'markers')
 #: History depth of the input_joint_states subscription (a second of input at 1 kHz, as the
@@ -114,11 +117,6 @@ QOS_OVERRIDES = QoSPolicyKind.HISTORY, QoSPolicyKind.DEPTH, QoSPolicyKind.RELIAB
 
 _LEVELS = {0: DiagnosticStatus.OK, 1: DiagnosticStatus.WARN, 2: DiagnosticStatus.ERROR,
            3: DiagnosticStatus.STALE}
-
-
-def rpm_parameter(speed: float) -> float:
-    """Return ``speed`` (rad/s) in rpm, rounded to 12 significant digits (-120, not -119.99...)."""
-    return float(f'{rpm_from_rad_per_s(speed):.12g}')
 
 
 def _set_timer_slack(ns: int) -> None:
@@ -215,6 +213,12 @@ class KinematicsNode(LifecycleNode):
         self._topic: TopicDrive | None = None
         self._input: Any = None
         self._input_active = False
+        # The scene's drivers' parameters, set at configure (parameters.driver_parameters).
+        self._driver_specs: dict[str, ParameterSpec] = {}
+        self._aliases: dict[str, str] = {}
+        self._drive_keys: dict[str, list[tuple[str, str]]] = {}
+        self._drivers_by_name: dict[str, Any] = {}
+        self._declaring = False
         self._failure_guard = self.create_guard_condition(self._on_failure)
         self.add_pre_set_parameters_callback(self._pre_set)
         self.add_on_set_parameters_callback(self._validate)
@@ -256,6 +260,9 @@ class KinematicsNode(LifecycleNode):
     def _value(self, name: str) -> Any:
         return self.get_parameter(name).value
 
+    def _is_double(self, name: str) -> bool:
+        return name in DOUBLES or name in self._driver_specs
+
     def _pre_set(self, parameters: list[Parameter]) -> list[Parameter]:
         """Turn an integer given for a double into a double (rclcpp#979); log read-only sets.
 
@@ -266,9 +273,29 @@ class KinematicsNode(LifecycleNode):
             if p.name in READ_ONLY and not self.starting:
                 self.get_logger().warning(
                     f'parameter refused: {p.name}: read-only (set it at start), got {p.value!r}')
-        return [Parameter(p.name, Parameter.Type.DOUBLE, float(p.value))
-                if p.name in DOUBLES and p.type_ == Parameter.Type.INTEGER else p
-                for p in parameters]
+        parameters = [Parameter(p.name, Parameter.Type.DOUBLE, float(p.value))
+                      if self._is_double(p.name) and p.type_ == Parameter.Type.INTEGER else p
+                      for p in parameters]
+        return self._with_aliases(parameters)
+
+    def _with_aliases(self, parameters: list[Parameter]) -> list[Parameter]:
+        """Add the other name of the first crank's speed or acceleration, set to the same value.
+
+        ``crank_speed_rpm`` and ``inputs.FIRST.speed_rpm`` (and ``crank_accel``
+        and ``inputs.FIRST.accel``) are one value: setting either sets both,
+        atomically. Given both with different values, the second is refused.
+        """
+        if not self._aliases or self._declaring:
+            return parameters
+        names = {p.name for p in parameters}
+        added = []
+        for old, new in self._aliases.items():
+            for given, other in ((old, new), (new, old)):
+                if given in names and other not in names:
+                    value = next(p for p in parameters if p.name == given).value
+                    added.append(Parameter(other, Parameter.Type.DOUBLE, value)
+                                 if isinstance(value, float) else Parameter(other, value=value))
+        return [*parameters, *added]
 
     def _validate(self, parameters: list[Parameter]) -> SetParametersResult:
         """Refuse a value of the wrong type or out of range, or one that breaks a joint rule."""
@@ -277,15 +304,18 @@ class KinematicsNode(LifecycleNode):
             if p.type_ == Parameter.Type.NOT_SET and not self.has_parameter(p.name) \
                     and spec_default_is_none(p.name):
                 continue    # declared unset: the scene gives it at configure
-            reason = refusal(p.name, p.value)
+            reason = refusal(p.name, p.value, self._driver_specs if self.scene else None)
             if reason is not None:
                 break
         if reason is None:
-            current = {name: self._value(name) for name in JOINT_RULES
-                       if self.has_parameter(name)}
-            current.update((p.name, p.value) for p in parameters if p.name in JOINT_RULES)
-            if None not in current.values():
-                reason = joint_refusal(current)
+            rules = (*JOINT_RULES, *self._driver_specs)
+            # The values being set first, so that a refusal names what was set.
+            current = {p.name: p.value for p in parameters if p.name in rules}
+            current.update((name, self._value(name)) for name in rules
+                           if name not in current and self.has_parameter(name))
+            reason = joint_refusal({k: v for k, v in current.items() if v is not None})
+        if reason is None:
+            reason = self._stroke_refusal(parameters)
         if reason is None:
             return SetParametersResult(successful=True)
         # Every refusal is logged once, with its reason, besides the service's answer
@@ -313,11 +343,15 @@ class KinematicsNode(LifecycleNode):
             self._tf_period_ns = self._tf_period(changes['tf_rate_hz'])
         if 'max_relative_error' in changes:
             self._max_error = float(changes['max_relative_error'])
-        drive = {CRANK_KEYS[name]: float(changes[name]) for name in DRIVE if name in changes}
-        if drive and CRANK in driver.drives:
-            driver.request(CRANK, **drive)
-            if self._thread is None:
-                self._apply_now()   # not ticking: from the current instant
+        requests: dict[str, dict[str, float]] = {}
+        for name, value in changes.items():
+            for drive, key in self._drive_keys.get(name, ()):
+                requests.setdefault(drive, {})[key] = float(value)
+        for drive, request in requests.items():
+            if drive in driver.drives:
+                driver.request(drive, **request)
+        if requests and self._thread is None:
+            self._apply_now()   # not ticking: from the current instant
         logged = ', '.join(f'{p.name}={p.value!r}' for p in parameters)
         if self.scene is not None:
             self.get_logger().info(f'parameters set: {logged}')
@@ -343,35 +377,34 @@ class KinematicsNode(LifecycleNode):
 
     def _configure(self) -> None:
         scene = mk.load_scene(self._value('scene'))
-        scene_rpm = rpm_parameter(scene.input.speed)
+        drivers = scene.drivers
+        first = drivers[0] if drivers[0].joint_type == REVOLUTE else None
+        crank_rpms = [rpm_parameter(d.speed) for d in drivers if d.joint_type == REVOLUTE]
         given_rpm = self._value('crank_speed_rpm')      # a speed set at start raises the bound
-        defaults = {
-            'max_crank_speed_rpm': max(DEFAULT_MAX_CRANK_SPEED_RPM, abs(scene_rpm),
-                                       abs(given_rpm or 0.0)),
-            'crank_speed_rpm': scene_rpm,
-            'crank_accel': scene.input.accel,
-        }
+        given = {name for name in DRIVE[:2] if self._value(name) is not None}
+        defaults = {'max_crank_speed_rpm': max([DEFAULT_MAX_CRANK_SPEED_RPM, abs(given_rpm or 0.0),
+                                                *map(abs, crank_rpms)])}
+        if first is not None:
+            defaults.update(crank_speed_rpm=rpm_parameter(first.speed), crank_accel=first.accel)
         unset = [Parameter(name, Parameter.Type.DOUBLE, float(value))
                  for name, value in defaults.items() if self._value(name) is None]
-        # The scene's own speed is driven in its own unit (rad/s), so that the node
-        # publishes what `solve` prints to the bit; the parameter shows it in rpm.
-        own_speed = self._value('crank_speed_rpm') is None \
-            and abs(scene_rpm) < DEFAULT_MAX_CRANK_SPEED_RPM
         if unset:
             result = self.set_parameters_atomically(unset)
             if not result.successful:
                 raise mk.SceneError(f'{scene.name}: {result.reason}')
-        speed = {'speed': scene.input.speed} if own_speed else \
-            {'speed_rpm': self._value('crank_speed_rpm')}
+        self._declare_drivers(scene, given)
+        starts = [self._drive_start(d, d is first and given_rpm is None) for d in drivers]
         try:    # what `solve` refuses at the start, the node refuses to start with
-            mk.solve(scene, scene.input.angle,
-                     speed['speed'] if own_speed else rad_per_s_from_rpm(speed['speed_rpm']),
-                     self._value('crank_accel'), max_error=self._max_error)
+            if len(drivers) == 1:
+                mk.solve(scene, *starts[0][1:], max_error=self._max_error)
+            else:
+                mk.solve(scene, *zip(*(start[1:] for start in starts), strict=True),
+                         max_error=self._max_error)
         except mk.AssemblyError as error:
             msg = f'{scene.name}: {error}'
             raise mk.SceneError(msg) from None
-        self._driver.add_drive(CRANK, angle=scene.input.angle, accel=self._value('crank_accel'),
-                               max_speed_rpm=self._value('max_crank_speed_rpm'), **speed)
+        for d, (timebase, *_) in zip(drivers, starts, strict=True):
+            self._driver.add_drive(d.name, timebase.kind, **timebase.start)
         self._messages = TickMessages(scene.output_joints, scene.output_points, self.frame_id)
         self._pub_joint_states = self.create_publisher(
             JointState, topics.JOINT_STATES, _state_qos(), qos_overriding_options=_qos_options())
@@ -402,6 +435,112 @@ class KinematicsNode(LifecycleNode):
         self._setup_topic_drive(scene)
         self.scene = scene
         self._log_start()
+
+    def _declare_drivers(self, scene: mk.Scene, given: set[str]) -> None:
+        """Declare each driver's ``inputs.NAME.*`` (the scene's defaults); note what they set.
+
+        The first crank's take ``crank_speed_rpm`` and ``crank_accel`` as their
+        defaults (the two are one value each, see :meth:`_with_aliases`); given
+        both names at start (``given``: the v1 names given) with different
+        values, the node refuses to start.
+        """
+        specs = driver_parameters(scene.drivers)
+        self._aliases = first_crank_aliases(scene.drivers)
+        self._driver_specs = {p.name: p for p in specs}
+        self._drivers_by_name = {d.name: d for d in scene.drivers}
+        aliased = {new: old for old, new in self._aliases.items()}
+        self._declaring = True
+        try:
+            for p in specs:
+                if self.has_parameter(p.name):
+                    continue
+                default = self._value(aliased[p.name]) if p.name in aliased else p.default
+                descriptor = ParameterDescriptor(description=_description(p),
+                                                 dynamic_typing=True)
+                value = self.declare_parameter(p.name, default, descriptor).value
+                if type(value) is int:
+                    self.set_parameters([Parameter(p.name, Parameter.Type.DOUBLE, float(value))])
+            for old, new in self._aliases.items():
+                if self._value(old) == self._value(new):
+                    continue
+                if old in given:
+                    msg = (f'{old} and {new} are the same value: expected one of them or equal '
+                           f'values, got {self._value(old)!r} and {self._value(new)!r}')
+                    raise mk.SceneError(msg)
+                result = self.set_parameters_atomically(
+                    [Parameter(old, Parameter.Type.DOUBLE, float(self._value(new)))])
+                if not result.successful:
+                    raise mk.SceneError(f'{scene.name}: {result.reason}')
+        finally:
+            self._declaring = False
+        keys: dict[str, list[tuple[str, str]]] = {}
+        for d in scene.drivers:
+            for p in specs:
+                if p.name.startswith(f'inputs.{d.name}.'):
+                    keys[p.name] = [(d.name, p.name.rsplit('.', 1)[1])]
+        for old, new in self._aliases.items():
+            keys[old] = keys[new]
+        keys[DRIVE[2]] = [(d.name, MAX_SPEED_KEY) for d in scene.drivers
+                          if d.joint_type == REVOLUTE]
+        self._drive_keys = keys
+
+    def _drive_start(self, d: Any, own_speed: bool) -> tuple[Any, float, float, float]:
+        """Return driver ``d``'s time base start, and its (position, speed, accel) at the start.
+
+        The scene's own crank speed is driven in its own unit (rad/s), so that
+        the node publishes what ``solve`` prints to the bit; the parameter shows
+        it in rpm. ``own_speed``: the first crank's speed was not given.
+        """
+        base = f'inputs.{d.name}.'
+        accel = float(self._value(base + 'accel'))
+        if d.joint_type != REVOLUTE:
+            speed = float(self._value(base + 'speed'))
+            return (_Start(ActuatorTimebase, {'length': d.start, 'speed': speed, 'accel': accel}),
+                    d.start, speed, accel)
+        rpm = float(self._value(base + 'speed_rpm'))
+        if own_speed or rpm == rpm_parameter(d.speed):
+            own_speed = abs(rpm) < DEFAULT_MAX_CRANK_SPEED_RPM
+        start = {'angle': d.start, 'accel': accel,
+                 'max_speed_rpm': self._value('max_crank_speed_rpm')}
+        if own_speed:
+            start['speed'] = d.speed
+            return _Start(CrankTimebase, start), d.start, d.speed, accel
+        start['speed_rpm'] = rpm
+        return _Start(CrankTimebase, start), d.start, rad_per_s_from_rpm(rpm), accel
+
+    def _stroke_refusal(self, parameters: list[Parameter]) -> str | None:
+        """Return why a change of an actuator's drive is refused: it leaves the stroke at once.
+
+        From the next instant, the length is exactly known; a drive that takes
+        it out of its stroke there (at a limit, moving out) is refused. Later
+        exits are the ticks' to report (the solver refuses them, and
+        ``diagnostics`` says so).
+        """
+        changes = {}
+        for p in parameters:
+            for drive, key in self._drive_keys.get(p.name, ()):
+                if key in ActuatorTimebase.CHANGES and isinstance(p.value, (int, float)):
+                    changes.setdefault(drive, {})[key] = (p.name, float(p.value))
+        for name, change in changes.items():
+            d = self._drivers_by_name[name]
+            if d.stroke is None or d.joint_type == REVOLUTE:
+                continue
+            current = self._driver.drives.get(name)
+            timebase = current.timebase if current is not None else None
+            now = self.get_clock().now().nanoseconds
+            if timebase is None:
+                start = {'length': d.start, 'speed': float(self._value(f'inputs.{name}.speed')),
+                         'accel': float(self._value(f'inputs.{name}.accel'))}
+                timebase, now = ActuatorTimebase(0, **start), 0
+            trial = copy.deepcopy(timebase)
+            trial.update(now, **{key: value for key, (_, value) in change.items()})
+            if trial.leaves(now, d.stroke) == 0.0:
+                length = float(trial.length(now))
+                given = ', '.join(f'{n} = {v!r}' for n, v in change.values())
+                return (f'{given}: expected a drive that keeps actuator {name} within its '
+                        f'stroke [{d.stroke[0]:g}, {d.stroke[1]:g}] m, got one that leaves it '
+                        f'at once (at {length:.6g} m)')
+        return None
 
     def _setup_tf(self, scene: mk.Scene) -> mk.Scene:
         """Create the /tf and /tf_static publishers; return the scene the ticks solve.
@@ -615,7 +754,11 @@ class KinematicsNode(LifecycleNode):
         self._stats.skip(skipped)
         late_ns = min(self._driver.period_ns // 2, LATE_NS)
         for stamp in instants:
-            [(turns, sample)] = self._driver.state_at(stamp)
+            states = self._driver.state_at(stamp)
+            if len(states) == 1:
+                [(turns, sample)] = states
+            else:   # several drivers: their positions, speeds, accels and turns, in scene order
+                turns, sample = _transposed(states)
             lateness = woke - stamp
             self._tick(stamp, lateness, lateness > late_ns, turns, sample)
 
@@ -658,7 +801,7 @@ class KinematicsNode(LifecycleNode):
                               self._jumps_at is not None and self._jumps_at(angle, turns=turns))
         if measure < mk.NEAR_SINGULAR:
             self.get_logger().warning(
-                f'near-singular pose at crank angle {angle:.6f} rad: measure {measure:.3g}',
+                f'near-singular pose at {_position(angle)}: measure {measure:.3g}',
                 throttle_duration_sec=1.0)
 
     # -- driven from a topic --------------------------------------------------
@@ -734,8 +877,11 @@ class KinematicsNode(LifecycleNode):
         Unknown velocities are solved as zero and left out of what is published;
         the accelerations are never published.
         """
-        speed = 0.0 if given.speeds is None else given.speeds[0]
-        return self._solve(given.positions[0], speed, 0.0, self._max_error, 0)
+        n = len(given.positions)
+        speeds = (0.0,) * n if given.speeds is None else given.speeds
+        if n == 1:
+            return self._solve(given.positions[0], speeds[0], 0.0, self._max_error, 0)
+        return self._solve(given.positions, speeds, (0.0,) * n, self._max_error, (0,) * n)
 
     # -- markers --------------------------------------------------------------
 
@@ -784,6 +930,26 @@ class KinematicsNode(LifecycleNode):
         msg.header.stamp = self.get_clock().now().to_msg()
         msg.header.frame_id = self.frame_id
         self._pub_diagnostics.publish(msg)
+
+
+def _transposed(states: list[tuple[int, Any]]) -> tuple[tuple[int, ...], Any]:
+    """Return the drivers' (turns, state) as (turns, (positions, speeds, accels)), in order."""
+    turns = tuple(t for t, _ in states)
+    return turns, tuple(zip(*(state for _, state in states), strict=True))
+
+
+def _position(angle: Any) -> str:
+    """Return the drivers' position for a log line: one crank's angle, or every driver's."""
+    if isinstance(angle, tuple):
+        return f'driver positions {", ".join(f"{a:.6f}" for a in angle)}'
+    return f'crank angle {angle:.6f} rad'
+
+
+class _Start(NamedTuple):
+    """A driver's time base class and its start values (``TickDriver.add_drive``)."""
+
+    kind: Any
+    start: dict[str, Any]
 
 
 def spec_default_is_none(name: str) -> bool:
