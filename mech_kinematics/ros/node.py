@@ -106,6 +106,8 @@ JOINT_RULES = (*DRIVE, 'drive', 'markers')
 #: History depth of the input_joint_states subscription (a second of input at 1 kHz, as the
 #: state publishers keep: a stall of the executor loses no message).
 INPUT_DEPTH = 1000
+#: Input messages one call of the subscription's callback takes from its queue at most.
+INPUT_BURST = 100
 DOUBLES = frozenset(p.name for p in PARAMETERS if p.kind == 'double')
 READ_ONLY = frozenset(p.name for p in PARAMETERS if p.read_only)
 
@@ -841,6 +843,27 @@ class KinematicsNode(LifecycleNode):
             self.destroy_subscription(subscription)
 
     def _on_input(self, msg: JointState) -> None:
+        """Publish the state of each input message waiting, from ``msg`` on, with its stamp.
+
+        rclpy's executor rebuilds its wait set of every service, timer and
+        subscription of the node for each message it hands over: behind by a
+        burst, the node would pay that per message. Each call takes up to
+        :data:`INPUT_BURST` more messages waiting in the subscription's queue
+        (as the executor takes them), then lets the executor serve the rest.
+        """
+        self._input_message(msg)
+        subscription = self._input
+        for _ in range(INPUT_BURST):
+            if subscription is None or self._input is not subscription:
+                return
+            with subscription.handle:
+                taken = subscription.handle.take_message(subscription.msg_type,
+                                                         subscription.raw)
+            if taken is None:
+                return
+            self._input_message(taken[0])
+
+    def _input_message(self, msg: JointState) -> None:
         """Publish the state of one input message with its stamp, or say why not."""
         received = time.monotonic_ns()
         topic = self._topic
