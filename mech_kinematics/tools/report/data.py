@@ -5,9 +5,11 @@
 ``report -o DIR`` writes ``DIR/data.json`` (:data:`DATA_FILE`) beside
 ``REPORT.md``: every figure the documentation quotes, under a stable dotted
 key (:func:`collect`). Timings are ``[min, median, max]`` of repeated runs.
-Measurements that take longer than a report run (``long_run``: one real run
-of the node, ``bench/long_run.py``) are copied in from a file
-(``report --long-run FILE``) or kept from the folder's previous data file.
+Measurements that take longer than a report run (:data:`KEPT`: ``long_run``,
+one real run of the node, ``bench/long_run.py``; ``topic_drive``, the
+latency and CPU of the node driven from a topic, ``bench/topic_bench.py``)
+are copied in from a file (``report --long-run FILE``, ``--topic-drive
+FILE``) or kept from the folder's previous data file.
 
 The documentation quotes them in two forms that :func:`check_text` checks:
 
@@ -32,11 +34,13 @@ from pathlib import Path
 import re
 from typing import Any
 
-__all__ = ['BLOCKS', 'DATA_FILE', 'SPREAD_RULE', 'check_text', 'collect', 'lookup',
+__all__ = ['BLOCKS', 'DATA_FILE', 'KEPT', 'SPREAD_RULE', 'check_text', 'collect', 'lookup',
            'read_data', 'render_block', 'update_text', 'write_data']
 
 #: The data file's name in the report's folder.
 DATA_FILE = 'data.json'
+#: Keys measured outside a report run: copied in from a file, else kept from the last one.
+KEPT = ('long_run', 'topic_drive')
 #: How a quoted timing is checked (also in docs/accuracy.md).
 SPREAD_RULE = ('a timing quoted from [min, median, max] of repeated runs passes when it lies '
                'between the min and the max, at the precision it is written with')
@@ -152,15 +156,21 @@ def read_data(path: str | os.PathLike[str]) -> dict[str, Any]:
 
 
 def write_data(outdir: str | os.PathLike[str], data: dict[str, Any],
-               long_run: str | os.PathLike[str] | None = None) -> Path:
-    """Write ``outdir/data.json``; keep the previous file's ``long_run`` unless given anew."""
+               long_run: str | os.PathLike[str] | None = None,
+               topic_drive: str | os.PathLike[str] | None = None) -> Path:
+    """Write ``outdir/data.json``; keep the previous file's :data:`KEPT` keys unless given anew.
+
+    ``long_run``, ``topic_drive``: JSON files of ``bench/long_run.py`` and
+    ``bench/topic_bench.py`` to store under those keys.
+    """
     path = Path(outdir) / DATA_FILE
-    if long_run is not None:
-        data['long_run'] = read_data(long_run)
-    elif path.exists():
-        previous = read_data(path)
-        if 'long_run' in previous:
-            data['long_run'] = previous['long_run']
+    given = {'long_run': long_run, 'topic_drive': topic_drive}
+    previous = read_data(path) if path.exists() else {}
+    for key in KEPT:
+        if given[key] is not None:
+            data[key] = read_data(given[key])   # type: ignore[arg-type]
+        elif key in previous:
+            data[key] = previous[key]
     path.write_text(json.dumps(data, indent=1, sort_keys=True) + '\n', encoding='utf-8')
     return path
 
@@ -328,9 +338,25 @@ def _long_run_block(data: dict[str, Any]) -> str:
         f'{_g(run["max_state_error"])} |']) + '\n'
 
 
+def _topic_drive_block(data: dict[str, Any]) -> str:
+    run = lookup(data, 'topic_drive')
+    lines = ['| input rate | latency, median: floor / node | node / floor | latency, p99: '
+             'floor / node | CPU: floor / node | node / floor | answered (worst run) |',
+             '|---:|---:|---:|---:|---:|---:|---:|']
+    for rate, row in run['rates'].items():
+        f, n = row['floor'], row['node']
+        answered = 100 * min(f['answered_min'], n['answered_min'])
+        lines.append(
+            f'| {rate} Hz | {f["latency_median_us"]:.0f} / {n["latency_median_us"]:.0f} µs | '
+            f'{row["latency_ratio"]:.2f} | {f["latency_p99_us"]:.0f} / '
+            f'{n["latency_p99_us"]:.0f} µs | {f["cpu_pct"]:.1f} / {n["cpu_pct"]:.1f} % | '
+            f'{row["cpu_ratio"]:.2f} | {answered:.2f} % |')
+    return '\n'.join(lines) + '\n'
+
+
 #: The generated blocks: name -> function of the data returning the block's text.
 BLOCKS = {'refused': _refused_block, 'bench': _bench_block, 'clock': _clock_block,
-          'long_run': _long_run_block}
+          'long_run': _long_run_block, 'topic_drive': _topic_drive_block}
 
 
 def render_block(name: str, data: dict[str, Any]) -> str:
