@@ -332,7 +332,7 @@ def test_a_driver_that_does_not_turn_has_a_time_base_of_its_own():
 
 
 def test_the_actuator_time_base_drives_an_actuator_beside_the_crank():
-    """ActuatorTimebase in the driver: start values, a change at the next instant (issue 18)."""
+    """The actuator time base in the driver: start values, changes at the next instant."""
     driver = crank_driver(period_ns=MS)
     driver.add_drive('boom_cyl', ActuatorTimebase, length=1.2, speed=0.05, accel=0.0)
     publish(driver, driver.step(0, monotonic_ns=0))

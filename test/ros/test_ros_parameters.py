@@ -160,7 +160,7 @@ def test_each_driver_has_its_parameters_with_the_scenes_defaults():
 @pytest.mark.parametrize('name, value, reason', [
     ('inputs.left.speed_rpm', 2e5, 'inputs.left.speed_rpm: expected -100000 <= value <= 100000 '
      'rpm, got 200000.0'),
-    ('inputs.boom_cyl.speed', 'fast', "inputs.boom_cyl.speed: expected a number (m/s), got "
+    ('inputs.boom_cyl.speed', 'fast', 'inputs.boom_cyl.speed: expected a number (m/s), got '
      "string 'fast'"),
     ('inputs.boom_cyl.accel', math.inf, 'inputs.boom_cyl.accel: expected a finite number, got '
      'inf'),

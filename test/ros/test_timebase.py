@@ -360,7 +360,7 @@ def test_actuator_says_when_it_leaves_its_stroke(length0, speed, accel, at_s, ex
     ({'length': 1.0, 'speed': 0.0, 'accel': -math.inf}, '`accel` to be finite'),
 ])
 def test_actuator_bad_values_are_refused(kwargs, match):
-    """NaN or inf start values are refused, naming the value."""
+    """A NaN or inf start value is refused, naming the value."""
     with pytest.raises(ValueError, match=match):
         ActuatorTimebase(0, **kwargs)
     with pytest.raises(ValueError, match='`speed` to be finite'):
