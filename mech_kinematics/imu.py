@@ -24,6 +24,7 @@ of the rotation itself. Scalars for one crank angle, arrays for many.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 import math
 from typing import Any
@@ -31,8 +32,9 @@ from typing import Any
 import numpy as np
 
 from .bounds import U
+from .errors import SceneError
 
-__all__ = ['ImuReading', 'ImuSpec', 'imu_reading']
+__all__ = ['ImuReading', 'ImuSpec', 'imu_links', 'imu_outputs', 'imu_reading', 'imu_values']
 
 #: Rounding of ``R(-phi) v`` with ``cos``/``sin`` and two products and a sum per
 #: component, relative to ``|v|``: a few units of roundoff, taken generously.
@@ -120,3 +122,87 @@ def imu_reading(state: Any, spec: ImuSpec) -> ImuReading:
                           float(e_phi), float(joint_bound.velocity), float(e_accel))
     return ImuReading(phi, np.asarray(joint.velocity), reading, e_phi,
                       np.asarray(joint_bound.velocity), e_accel)
+
+
+def imu_links(scene: Any) -> dict[str, tuple[str, ...]]:
+    """Return every moving link of ``scene`` and the points fixed on it, in scene order.
+
+    A point is fixed on a link when it is one of the link's pins (the crank's
+    centre and tip, a dyad link's start and new pin, a lever's pivot) or a
+    point carried by it (``points:``); a pin sliding in a slotted lever is not.
+    """
+    crank = scene.input
+    fixed: dict[str, list[str]] = {crank.link: [crank.center, crank.point]}
+    for dyad in scene.dyads:
+        for body, kind, members, _ in dyad.members(''):
+            if kind in ('link', 'lever'):
+                fixed.setdefault(body, []).extend(members)
+    for carried in scene.points:
+        fixed.setdefault(carried.link, []).append(carried.name)
+    return {link: tuple(dict.fromkeys(points)) for link, points in fixed.items()}
+
+
+def imu_outputs(scene: Any, joint_types: dict[str, str], joints: Sequence[str] | None,
+                points: Sequence[str] | None
+                ) -> tuple[tuple[str, ...] | None, tuple[str, ...] | None]:
+    """Check ``scene.imus``; return the outputs with what every sensor needs added.
+
+    Each sensor's link must be a moving link (a revolute joint of
+    ``joint_types``, the whole scene's) and its point a point fixed on that
+    link (:func:`imu_links`). Listed outputs (``None``: everything) gain the
+    sensors' links and points they leave out, after the listed ones.
+
+    Raises
+    ------
+    SceneError
+        Naming the sensor's ``link`` or ``point`` field (``where`` is the spec).
+    """
+    specs = tuple(scene.imus)
+    if not specs:
+        return joints, points
+    fixed = imu_links(scene)
+    taken = {*scene.ground, *joint_types, *(p for on in fixed.values() for p in on)}
+    for spec in specs:
+        if spec.name in taken:
+            msg = (f'Expected a sensor name not used for a point, link or slider, got '
+                   f'"{spec.name}"')
+            raise SceneError(msg, (spec, 'name'))
+        if joint_types.get(spec.link) != 'revolute':
+            moving = ', '.join(name for name, kind in joint_types.items() if kind == 'revolute')
+            got = (f'slider "{spec.link}", which does not turn' if spec.link in joint_types
+                   else f'ground point "{spec.link}", which does not move'
+                   if spec.link in scene.ground else f'unknown "{spec.link}"')
+            msg = f'Expected a moving link ({moving}), got {got}'
+            raise SceneError(msg, (spec, 'link'))
+        on = fixed.get(spec.link, ())
+        if spec.point not in on:
+            msg = (f'Expected a point carried by or lying on link "{spec.link}" '
+                   f'({", ".join(on)}), got "{spec.point}"')
+            raise SceneError(msg, (spec, 'point'))
+    if joints is not None:
+        joints = (*joints, *(name for name in dict.fromkeys(s.link for s in specs)
+                             if name not in joints))
+    if points is not None:
+        points = (*points, *(name for name in dict.fromkeys(s.point for s in specs)
+                             if name not in points))
+    return joints, points
+
+
+def imu_values(theta: float, omega: float, ax: float, ay: float,
+               spec: ImuSpec) -> tuple[float, float, float, float]:
+    """Return one instant's (orientation, angular velocity, x, y acceleration) of a sensor.
+
+    ``theta`` (rad) and ``omega`` (rad/s) are its link's angle and angular
+    velocity, ``ax, ay`` (m/s^2) its point's acceleration in the ground frame:
+    the readings of :func:`imu_reading` for plain floats, without bounds (the
+    node's tick). The same formulas, in :mod:`math`.
+    """
+    phi = theta + spec.angle
+    if phi > math.pi:
+        phi -= 2 * math.pi
+    elif phi <= -math.pi:
+        phi += 2 * math.pi
+    c, s = math.cos(phi), math.sin(phi)
+    gx, gy = spec.gravity
+    x, y = ax - gx, ay - gy
+    return phi, omega, c * x + s * y, c * y - s * x

@@ -12,7 +12,8 @@ Limits
 Each limit is a module constant named in the refusal: :data:`MAX_FILE_BYTES`,
 :data:`MAX_YAML_NODES` (counted with aliases expanded, so a "billion laughs"
 file is refused), :data:`MAX_DEPTH`, :data:`MAX_INTEGER_DIGITS`,
-:data:`MAX_GROUND_POINTS`, :data:`MAX_DYADS` and :data:`MAX_CARRIED_POINTS`.
+:data:`MAX_GROUND_POINTS`, :data:`MAX_DYADS`, :data:`MAX_CARRIED_POINTS`,
+:data:`MAX_PINS` and :data:`MAX_IMUS`.
 Only regular files are read: a FIFO, a device or a directory is refused
 before anything is read from it, and the read stops one byte past
 :data:`MAX_FILE_BYTES`.
@@ -31,16 +32,20 @@ from typing import Any, TypedDict, TypeVar
 
 
 from .errors import SceneError
+from .imu import ImuSpec
 from .solver import Branch, CarriedPoint, Crank, Link, Pin, Scene, SceneUnits
 from .solver.base import Item
+from .solver.model import IDENTIFIER
 from .solver.registry import KINDS
-from .units import ANGLE_UNITS, LENGTH_UNITS, rad_per_s_from_rpm
+from .units import (ANGLE_UNITS, LENGTH_UNITS, rad_per_s_from_rpm, reduce_radians,
+                    turns_from_degrees)
 from .yaml12 import (_brief, _join, MAX_DEPTH, MAX_INTEGER_DIGITS, MAX_YAML_NODES,
                      read_scene_yaml, SceneLoader)
 
 __all__ = [
     'DEFAULT_SCENE', 'MAX_CARRIED_POINTS', 'MAX_DEPTH', 'MAX_DYADS', 'MAX_FILE_BYTES',
-    'MAX_GROUND_POINTS', 'MAX_INTEGER_DIGITS', 'MAX_MESSAGE', 'MAX_PINS', 'MAX_YAML_NODES',
+    'MAX_GROUND_POINTS', 'MAX_IMUS', 'MAX_INTEGER_DIGITS', 'MAX_MESSAGE', 'MAX_PINS',
+    'MAX_YAML_NODES',
     'SceneLoader',
     'load_scene', 'parse_scene', 'read_scene_yaml', 'scene_dirs', 'scene_names', 'scene_text',
 ]
@@ -59,6 +64,8 @@ MAX_DYADS = 10_000
 MAX_CARRIED_POINTS = 10_000
 #: Most pins (``pins:``) in a scene.
 MAX_PINS = 10_000
+#: Most inertial sensors (``imus:``) in a scene.
+MAX_IMUS = 10_000
 
 #: The two spellings of ``units`` every refusal of a missing or bad one shows.
 UNITS_EXAMPLES = 'units: {length: mm, angle: deg} or units: {length: m, angle: rad}'
@@ -97,6 +104,16 @@ class SceneDict(TypedDict, total=False):
     points: dict[str, dict[str, Any]]
     outputs: dict[str, list[str]]
     pins: dict[str, Any]
+    imus: dict[str, dict[str, Any]]
+
+
+class ImuDict(TypedDict, total=False):
+    """An entry of ``imus``: a sensor on a moving link (``gravity`` m/s^2, ``angle``)."""
+
+    link: str
+    point: str
+    gravity: list[float]
+    angle: float
 
 
 class _Reader:
@@ -155,6 +172,19 @@ class _Reader:
     def angle(self, mapping: Any, key: str, where: str, default: Any = ...) -> float:
         value = self.number(mapping, key, where, default)
         return math.radians(value) if self.degrees else value
+
+    def start_angle(self, mapping: Any, key: str, where: str) -> tuple[float, int]:
+        """Return the crank angle at ``key`` as (rad within a turn, whole turns).
+
+        An angle beyond a turn is reduced exactly (in degrees as written, or
+        in rad with 2 pi to 400 digits), so that 1e308 deg is the same crank
+        position as ``solve --angle-deg 1e308``; within a turn it is read as
+        :meth:`angle` reads it, with no turns.
+        """
+        value = self.number(mapping, key, where, 0.0)
+        if self.degrees:
+            return turns_from_degrees(value) if abs(value) > 360.0 else (math.radians(value), 0)
+        return reduce_radians(value) if abs(value) > math.tau else (value, 0)
 
     def name(self, mapping: Any, key: str, where: str) -> str:
         value = self.get(mapping, key, where)
@@ -255,11 +285,12 @@ def parse_scene(data: Any) -> Scene:
     raw = reader.get(data, 'input', '')
     _check_keys(raw if isinstance(raw, dict) else {}, set(InputDict.__annotations__), 'input')
     rpm = reader.number(raw, 'speed_rpm', 'input', 0.0)
+    angle, turns = reader.start_angle(raw, 'angle', 'input')
     crank = keys.build(
         'input', {'speed': 'speed_rpm'}, Crank,
         link=reader.name(raw, 'link', 'input'), center=reader.name(raw, 'center', 'input'),
         point=reader.name(raw, 'point', 'input'), length=reader.length(raw, 'length', 'input'),
-        angle=reader.angle(raw, 'angle', 'input', 0.0), speed=rad_per_s_from_rpm(rpm),
+        angle=angle, turns=turns, speed=rad_per_s_from_rpm(rpm),
         accel=reader.number(raw, 'accel', 'input', 0.0))
 
     dyads_data = data.get('dyads', []) or []
@@ -283,6 +314,7 @@ def parse_scene(data: Any) -> Scene:
     _check_count('pins', pins_data, MAX_PINS, 'MAX_PINS', 'pins')
     pins = [_pin(reader, keys, str(key), value, f'pins.{key}')
             for key, value in pins_data.items()]
+    imus = _imus(reader, keys, data.get('imus', {}))
 
     outputs = data.get('outputs', {}) or {}
     if not isinstance(outputs, dict):
@@ -300,7 +332,7 @@ def parse_scene(data: Any) -> Scene:
         return Scene(name=name, ground=ground, input=crank, dyads=tuple(dyads),
                      points=tuple(points), outputs_joints=selected['joints'],
                      outputs_points=selected['points'], description=description,
-                     pins=tuple(pins), units=reader.units)
+                     pins=tuple(pins), units=reader.units, imus=imus)
     except SceneError as error:
         raise SceneError(f'{keys.key(error)}: {error}') from None
 
@@ -386,6 +418,37 @@ def _pin(reader: _Reader, keys: _Keys, name: str, raw: Any, where: str) -> Pin:
         radius = reader.length({name: raw}, name, 'pins')
     return keys.build(where, {'radius': 'radius', 'bodies': 'between', 'point': ''}, Pin,
                       point=name, radius=radius, bodies=bodies)
+
+
+def _imus(reader: _Reader, keys: _Keys, raw: Any) -> tuple[ImuSpec, ...]:
+    """Read ``imus:``: name -> {link, point, gravity (m/s^2), angle (scene unit)}."""
+    raw = raw or {}
+    if not isinstance(raw, dict):
+        raise SceneError(f'imus: expected a mapping of sensor names to {{link, point}}, got '
+                         f'{_kind(raw)}')
+    _check_count('imus', raw, MAX_IMUS, 'MAX_IMUS', 'sensors')
+    specs = []
+    for key, value in raw.items():
+        where = f'imus.{key}'
+        if not isinstance(value, dict):
+            raise SceneError(f'{where}: expected a mapping such as {{link: coupler, point: C, '
+                             f'gravity: [0, -9.80665]}}, got {_kind(value)} {_brief(value)}')
+        _check_keys(value, set(ImuDict.__annotations__), where)
+        gravity = reader.get(value, 'gravity', where, [0.0, 0.0])
+        if not isinstance(gravity, list) or len(gravity) != 2:
+            raise SceneError(f'{where}.gravity: expected [gx, gy] in m/s^2, got '
+                             f'{_brief(gravity)}')
+        gx, gy = (reader.number({f'[{i}]': g}, f'[{i}]', f'{where}.gravity')
+                  for i, g in enumerate(gravity))
+        name = str(key)
+        if not IDENTIFIER.match(name):
+            raise SceneError(f'{where}: expected a sensor name ([A-Za-z_][A-Za-z0-9_]*), got '
+                             f'{_brief(key)}')
+        specs.append(keys.build(where, {'name': ''}, ImuSpec, name=name,
+                                link=reader.name(value, 'link', where),
+                                point=reader.name(value, 'point', where), gravity=(gx, gy),
+                                angle=reader.angle(value, 'angle', where, 0.0)))
+    return tuple(specs)
 
 
 def scene_dirs() -> list[Path]:

@@ -11,12 +11,13 @@ reference uses the same formulas as the solver.
 
 from __future__ import annotations
 
+from fractions import Fraction
 import math
 from typing import Any
 
 __all__ = [
     'ANGLE_UNITS', 'LENGTH_UNITS', 'NS_PER_S', 'degrees_from_radians', 'rad_per_s_from_rpm',
-    'radians_from_degrees', 'rpm_from_rad_per_s',
+    'radians_from_degrees', 'rpm_from_rad_per_s', 'turns_from_degrees', 'reduce_radians',
 ]
 
 #: Length units a scene may use: name -> how many of them make one metre.
@@ -25,6 +26,14 @@ LENGTH_UNITS = {'m': 1.0, 'mm': 1000.0}
 ANGLE_UNITS = ('deg', 'rad')
 #: Nanoseconds per second (ROS stamps are integer nanoseconds).
 NS_PER_S = 1_000_000_000
+#: 2 pi as an exact rational to 400 significant digits: enough to reduce any double
+#: (below 2**1024) to within a turn with every bit right (:func:`reduce_radians`).
+_TWO_PI = 2 * Fraction(
+    '3.14159265358979323846264338327950288419716939937510582097494459230781640628620899862803'
+    '4825342117067982148086513282306647093844609550582231725359408128481117450284102701938521'
+    '1055596446229489549303819644288109756659334461284756482337867831652712019091456485669234'
+    '6034861045432664821339360726024914127372458700660631558817488152092096282925409171536436'
+    '789259036001133053054882046652138414695194151160')
 
 
 def rad_per_s_from_rpm(rpm: Any, pi: Any = math.pi) -> Any:
@@ -55,3 +64,32 @@ def radians_from_degrees(angle: Any, pi: Any = math.pi) -> Any:
 def degrees_from_radians(angle: Any, pi: Any = math.pi) -> Any:
     """Return an angle in radians as degrees."""
     return angle * (180 / pi)
+
+
+def turns_from_degrees(degrees: float) -> tuple[float, int]:
+    """Split a crank angle in degrees, counted from the start, into (rad within a turn, turns).
+
+    ``degrees = 360 * turns + rest`` exactly (IEEE remainder), ``rest`` in
+    [-180, 180]; the angle is ``rest`` in radians. So 450 is 90 deg in turn 1,
+    and 36000090 is 90 deg in turn 100000, with no rounding of the whole turns
+    (counted exactly, as the float difference would round beyond 2**53 turns).
+    """
+    rest = math.remainder(degrees, 360.0)
+    if abs(degrees) <= 2.0 ** 53:
+        return radians_from_degrees(rest), round((degrees - rest) / 360.0)
+    return radians_from_degrees(rest), int((Fraction(degrees) - Fraction(rest)) / 360)
+
+
+def reduce_radians(angle: float) -> tuple[float, int]:
+    """Split a crank angle in rad, counted from the start, into (rad within a turn, turns).
+
+    ``angle = rest + 2 pi turns`` with the float ``angle`` taken as exact and
+    ``rest`` in [-pi, pi] correctly rounded: the reduction uses 2 pi to 400
+    digits, so even 1e308 rad keeps every bit of its place within the turn
+    (a float 2 pi would be off by 2.4e-16 rad per turn).
+    """
+    if abs(angle) <= math.pi:
+        return angle, 0
+    exact = Fraction(angle)
+    turns = round(exact / _TWO_PI)
+    return float(exact - turns * _TWO_PI), turns

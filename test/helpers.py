@@ -188,3 +188,53 @@ def assert_bounded(scene, angle, speed=None, accel=None):
     for path, _, error, bound, _ in actual_errors(state, exact):
         assert error <= bound, (scene.name, angle, path, error, bound)
     return state, exact
+
+
+def first_order_spreads(scene, angle, speed=None, accel=None, exact=None):
+    """Return, per value ``actual_errors`` names, what a 1-ulp change of every input moves it.
+
+    ``U * sum over inputs |d value / d x| |x|``: every geometry value and the
+    crank's angle, speed and acceleration changed by half an ulp (relative
+    ``U``), first order, from the 50-digit reference (``exact`` if given).
+    """
+    model = ref.Model(scene)
+    base = ref.reference(model, angle, speed, accel) if exact is None else exact
+    eta = mpmath.mpf('1e-25')
+    unit = 2.0 ** -53
+
+    def flat(r):
+        out = {}
+        for table, prefix in ((r.points, 'points'), (r.joints, 'joints')):
+            for name, values in table.items():
+                for index, quantity in enumerate(('position', 'velocity', 'acceleration')):
+                    if values[index] is not None:
+                        out[f'{prefix}.{name}.{quantity}'] = values[index]
+        return out
+
+    with mpmath.workdps(ref.DPS):
+        values = flat(base)
+        totals = dict.fromkeys(values, mpmath.mpf(0))
+        inputs = [*base.inputs.items(), ('@theta', base.theta), ('@omega', base.omega),
+                  ('@alpha', base.alpha)]
+        for key, value in inputs:
+            if value == 0:
+                continue
+            given = dict(base.inputs)
+            theta, omega, alpha = base.theta, base.omega, base.alpha
+            delta = value * eta
+            if key == '@theta':
+                theta += delta
+            elif key == '@omega':
+                omega += delta
+            elif key == '@alpha':
+                alpha += delta
+            else:
+                given[key] = value + delta
+            moved = flat(ref.reference(model, theta, omega, alpha, values=given, seed=base.q))
+            for path, x in values.items():
+                diff = moved[path] - x
+                if path.startswith('joints.') and path.endswith('.position') \
+                        and not isinstance(diff, mpmath.mpc):
+                    diff = ref._wrap(diff)
+                totals[path] += abs(diff) / eta
+        return {path: float(total) * unit for path, total in totals.items()}

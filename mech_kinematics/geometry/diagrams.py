@@ -41,6 +41,7 @@ from .instant_centres import (bodies_from_scene, BodyKind, check_full_state, ful
                               instant_centres_from_state, InstantCentres, Topology)
 from ..errors import NearSingularWarning
 from ..solver import Scene, solve, State
+from ..units import turns_from_degrees
 
 __all__ = [
     'COLOURS', 'Diagram', 'GuideLine', 'LinkShape', 'LinkValues', 'PinValues', 'Pivot',
@@ -568,32 +569,43 @@ def acceleration_polygon_from_state(scene: Scene, state: State) -> Polygon:
 
 
 def _outline(xy: Array) -> Array:
-    """Segment through collinear points, or their convex hull (counter-clockwise)."""
+    """Segment through collinear points, or their convex hull (counter-clockwise).
+
+    Computed on the points moved to their centre and divided by their extent,
+    so that the SVD and the hull's cross products stay in range for any size
+    (a Geneva wheel of radius 1e300 m); the points returned are the originals.
+    """
     centre = xy.mean(axis=0)
+    if not np.isfinite(centre).all():  # the sum overflowed: the middle of the extent instead
+        centre = xy.min(axis=0) / 2 + xy.max(axis=0) / 2
     d = xy - centre
     size = float(np.abs(d).max()) if len(xy) else 0.0
+    if size == 0.0:
+        return np.array([xy[0], xy[0]])
+    d = d / size
     _, _, vt = np.linalg.svd(d)
     axis = vt[0]
     across = d @ np.array([-axis[1], axis[0]])
-    if size == 0.0 or float(np.abs(across).max()) <= 1e-9 * size:
+    if float(np.abs(across).max()) <= 1e-9:
         along = d @ axis
         return np.array([xy[int(np.argmin(along))], xy[int(np.argmax(along))]])
-    pts = sorted(map(tuple, xy))
+    order = sorted(range(len(d)), key=lambda i: (d[i, 0], d[i, 1]))
 
-    def turn(o: tuple[float, ...], a: tuple[float, ...], b: tuple[float, ...]) -> float:
-        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+    def turn(o: int, a: int, b: int) -> float:
+        return float((d[a, 0] - d[o, 0]) * (d[b, 1] - d[o, 1])
+                     - (d[a, 1] - d[o, 1]) * (d[b, 0] - d[o, 0]))
 
-    lower: list[tuple[float, ...]] = []
-    upper: list[tuple[float, ...]] = []
-    for p in pts:
+    lower: list[int] = []
+    upper: list[int] = []
+    for p in order:
         while len(lower) >= 2 and turn(lower[-2], lower[-1], p) <= 0:
             lower.pop()
         lower.append(p)
-    for p in reversed(pts):
+    for p in reversed(order):
         while len(upper) >= 2 and turn(upper[-2], upper[-1], p) <= 0:
             upper.pop()
         upper.append(p)
-    return np.array(lower[:-1] + upper[:-1])
+    return xy[lower[:-1] + upper[:-1]]
 
 
 def strokes_from_scene(scene: Scene,
@@ -781,10 +793,12 @@ def diagram_from_scene(scene: Scene, angle: float | None = None, speed: float | 
     """
     scene = full_scene(scene)
     if angle is None:
-        theta = scene.input.angle
+        theta, turns = scene.input.angle, scene.input.turns
+    elif degrees and abs(angle) > 360.0:  # counted from the start: whole turns read exactly
+        theta, turns = turns_from_degrees(angle)
     else:
-        theta = math.radians(angle) if degrees else float(angle)
-    state = solve(scene, theta, speed, accel)
+        theta, turns = (math.radians(angle) if degrees else float(angle)), 0
+    state = solve(scene, theta, speed, accel, turns=turns)
     topology = bodies_from_scene(scene)
     links, sliders = _values(scene, state, topology)
     centres = instant_centres_from_state(scene, state) if instant_centres else None

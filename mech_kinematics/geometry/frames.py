@@ -16,13 +16,15 @@ reads their poses off a solved state. Pure geometry: NumPy only.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+import math
+from typing import Any
 
 from ..solver import Scene, State
 
 __all__ = ['FrameSpec', 'Pose', 'angle_joints', 'child_frame', 'frames_from_scene',
-           'origin_points', 'poses_from_state']
+           'origin_points', 'poses_from_state', 'sensor_offsets']
 
 
 @dataclass(frozen=True)
@@ -98,3 +100,23 @@ def poses_from_state(frames: Sequence[FrameSpec], state: State) -> list[Pose]:
         angle = f.angle if f.angle_of is None else float(joints[f.angle_of].position)
         poses.append(Pose(f.joint, float(p.real), float(p.imag), angle))
     return poses
+
+
+def sensor_offsets(specs: Sequence[Any], frames: Mapping[str, FrameSpec],
+                   state: State) -> dict[str, tuple[float, float]]:
+    """Return each IMU's point in its link's frame (``frames[spec.link]``), m.
+
+    ``specs`` are :class:`~mech_kinematics.imu.ImuSpec`; the point is fixed on
+    the link, so one solved instant gives the coordinates of every instant (to
+    rounding). ``state`` must hold each frame's origin, its link and point: a
+    sensor's own frame (``angle`` not 0) is this offset, turned by ``angle``.
+    """
+    offsets = {}
+    for spec in specs:
+        frame = frames[spec.link]
+        theta = float(state.joints[spec.link].position)
+        d = complex(state.complex_points[spec.point][0]) - complex(
+            state.complex_points[frame.origin][0])
+        z = d * complex(math.cos(theta), -math.sin(theta))
+        offsets[spec.name] = (z.real, z.imag)
+    return offsets

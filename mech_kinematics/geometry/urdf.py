@@ -15,7 +15,10 @@ publishes them):
   pose comes from ``/tf``), drawn in the frame's own coordinates: a bar
   (box) from the frame's origin to every other point of the body, a pin at
   each of its points; a slotted lever reaches as far as its pin goes in a
-  turn; a slider is a block along its x axis (the guide).
+  turn; a slider is a block along its x axis (the guide);
+- one link per IMU with a frame of its own (``angle`` not 0),
+  ``<prefix>/<name>``, nothing drawn, a fixed joint to its link's frame at
+  the sensor's point, turned by ``angle`` (as the node's ``/tf`` has it).
 
 The body's points are read off the solved scene at the first crank angle
 that assembles, in the frame's coordinates; they are fixed on the body, so
@@ -33,7 +36,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from .diagrams import space_from_state
-from .frames import child_frame, frames_from_scene, FrameSpec, poses_from_state
+from .frames import child_frame, frames_from_scene, FrameSpec, poses_from_state, sensor_offsets
 from .instant_centres import bodies_from_scene, BodyKind, full_scene
 from ..errors import AssemblyError, NearSingularWarning
 from ..solver import Scene, solve, State
@@ -202,7 +205,8 @@ def urdf_from_scene(scene: Scene, frame_id: str = 'mechanism', prefix: str = '')
     -------
     str
         The URDF document, one link per frame on ``/tf`` and ``/tf_static``
-        plus the root, each attached to the root by one joint.
+        plus the root, each attached to the root by one joint (an IMU's own
+        frame to its link's).
 
     Raises
     ------
@@ -231,5 +235,24 @@ def urdf_from_scene(scene: Scene, frame_id: str = 'mechanism', prefix: str = '')
         ET.SubElement(element, 'child', link=child)
         if at is not None:
             ET.SubElement(element, 'origin', xyz=_fmt(*at, 0.0), rpy='0 0 0')
+    _add_sensors(robot, scene, prefix)
     ET.indent(robot)
     return '<?xml version="1.0"?>\n' + ET.tostring(robot, encoding='unicode') + '\n'
+
+
+def _add_sensors(robot: ET.Element, scene: Scene, prefix: str) -> None:
+    """Add a link and a fixed joint for every IMU with a frame of its own (``angle`` not 0)."""
+    own = [spec for spec in scene.imus if spec.angle != 0.0]
+    if not own:
+        return
+    full = full_scene(scene)
+    frames = {f.joint: f for f in frames_from_scene(full, [spec.link for spec in own])}
+    offsets = sensor_offsets(own, frames, _assembled(full))
+    for spec in own:
+        child = child_frame(prefix, spec.name)
+        ET.SubElement(robot, 'link', name=child)
+        element = ET.SubElement(robot, 'joint', name=joint_name(child), type='fixed')
+        ET.SubElement(element, 'parent', link=child_frame(prefix, spec.link))
+        ET.SubElement(element, 'child', link=child)
+        ET.SubElement(element, 'origin', xyz=_fmt(*offsets[spec.name], 0.0),
+                      rpy=_fmt(0.0, 0.0, spec.angle))

@@ -32,6 +32,7 @@ import copy
 import ctypes
 from dataclasses import replace
 import gc
+import math
 import random
 import sys
 import threading
@@ -52,7 +53,7 @@ from rclpy.logging import get_logger
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSDurabilityPolicy, QoSHistoryPolicy, QoSProfile, QoSReliabilityPolicy
 from rclpy.qos_overriding_options import QoSOverridingOptions, QoSPolicyKind
-from sensor_msgs.msg import JointState
+from sensor_msgs.msg import Imu, JointState
 from std_msgs.msg import String
 from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
 from visualization_msgs.msg import MarkerArray
@@ -61,6 +62,7 @@ import mech_kinematics as mk
 from . import topics
 from .diagnostics import solver_status, Status, TickStats, timing_status
 from .driver import TickDriver
+from .imus import ImuFrames, ImuMessages
 from .markers import marker_array_from_state, marker_size_from_space, MarkerThrottle
 from .messages import TickMessages
 from .parameters import (CATCH_UP, catch_up_window_ns, driver_parameters, first_crank_aliases,
@@ -73,7 +75,7 @@ from .timebase import ActuatorTimebase, CrankSample, CrankTimebase
 from .topic_drive import RefusedInput, TopicDrive, TopicInput
 from ..geometry.assembly import assembly_summary
 from ..geometry.diagrams import space_from_state, strokes_from_scene
-from ..geometry.frames import angle_joints, frames_from_scene, origin_points
+from ..geometry.frames import angle_joints, frames_from_scene, origin_points, sensor_offsets
 from ..geometry.instant_centres import full_scene
 from ..geometry.urdf import urdf_from_scene
 from ..scene import scene_text
@@ -212,6 +214,8 @@ class KinematicsNode(LifecycleNode):
                                   spec('late_ticks').default == CATCH_UP)
         self._state_publishers: list[Any] = []
         self._pub_markers: Any = None
+        self._imus: ImuMessages | None = None
+        self._imu_frames: ImuFrames | None = None
         self._topic: TopicDrive | None = None
         self._input: Any = None
         self._input_active = False
@@ -398,9 +402,11 @@ class KinematicsNode(LifecycleNode):
         starts = [self._drive_start(d, d is first and given_rpm is None) for d in drivers]
         try:    # what `solve` refuses at the start, the node refuses to start with
             if len(drivers) == 1:
-                mk.solve(scene, *starts[0][1:], max_error=self._max_error)
+                [(_, position, speed, accel, turns)] = starts
+                mk.solve(scene, position, speed, accel, turns=turns, max_error=self._max_error)
             else:
-                mk.solve(scene, *zip(*(start[1:] for start in starts), strict=True),
+                _, positions, speeds, accels, turns = zip(*starts, strict=True)
+                mk.solve(scene, positions, speeds, accels, turns=turns,
                          max_error=self._max_error)
         except mk.AssemblyError as error:
             msg = f'{scene.name}: {error}'
@@ -420,6 +426,7 @@ class KinematicsNode(LifecycleNode):
                                   self._pub_point_accel]
         self._publish_state = tuple(p.publish for p in self._state_publishers)
         tick_scene = self._setup_tf(scene)
+        self._setup_imus(scene, tick_scene)
         self._publish_descriptions(scene)
         # The scene's solve, compiled into one straight-line function (ros/ticker.py).
         frames = [(f.origin, f.angle_of, f.angle) for f in self._tf_frames]
@@ -486,8 +493,8 @@ class KinematicsNode(LifecycleNode):
                           if d.joint_type == REVOLUTE]
         self._drive_keys = keys
 
-    def _drive_start(self, d: Any, own_speed: bool) -> tuple[Any, float, float, float]:
-        """Return driver ``d``'s time base start, and its (position, speed, accel) at the start.
+    def _drive_start(self, d: Any, own_speed: bool) -> tuple[Any, float, float, float, int]:
+        """Return driver ``d``'s time base start, and its (position, speed, accel, turns) then.
 
         The scene's own crank speed is driven in its own unit (rad/s), so that
         the node publishes what ``solve`` prints to the bit; the parameter shows
@@ -498,17 +505,19 @@ class KinematicsNode(LifecycleNode):
         if d.joint_type != REVOLUTE:
             speed = float(self._value(base + 'speed'))
             return (_Start(ActuatorTimebase, {'length': d.start, 'speed': speed, 'accel': accel}),
-                    d.start, speed, accel)
+                    d.start, speed, accel, 0)
         rpm = float(self._value(base + 'speed_rpm'))
         if own_speed or rpm == rpm_parameter(d.speed):
             own_speed = abs(rpm) < DEFAULT_MAX_CRANK_SPEED_RPM
-        start = {'angle': d.start, 'accel': accel,
+        # A start angle beyond a turn is whole turns plus an angle within one (Crank.turns).
+        turns = d.turns
+        start = {'angle': d.start, 'turns': turns, 'accel': accel,
                  'max_speed_rpm': self._value('max_crank_speed_rpm')}
         if own_speed:
             start['speed'] = d.speed
-            return _Start(CrankTimebase, start), d.start, d.speed, accel
+            return _Start(CrankTimebase, start), d.start, d.speed, accel, turns
         start['speed_rpm'] = rpm
-        return _Start(CrankTimebase, start), d.start, rad_per_s_from_rpm(rpm), accel
+        return _Start(CrankTimebase, start), d.start, rad_per_s_from_rpm(rpm), accel, turns
 
     def _stroke_refusal(self, parameters: list[Parameter]) -> str | None:
         """Return why a change of an actuator's drive is refused: it leaves the stroke at once.
@@ -577,6 +586,36 @@ class KinematicsNode(LifecycleNode):
         return replace(scene, outputs_points=(*scene.output_points, *points),
                        outputs_joints=(*scene.output_joints, *joints))
 
+    def _setup_imus(self, scene: mk.Scene, tick_scene: mk.Scene) -> None:
+        """Create a publisher on ``imu/NAME`` for each of the scene's sensors, and their frames.
+
+        A sensor turned on its link (``angle`` not 0) has a frame of its own,
+        published on ``/tf`` with the link frames (when ``/tf`` is on).
+        """
+        self._imus = self._imu_frames = None
+        if not scene.imus:
+            return
+        prefix = self._value('tf_prefix') or self.frame_id
+        self._imus = ImuMessages(scene.imus, scene.output_joints, scene.output_points, prefix)
+        publishers = [self.create_publisher(Imu, topics.imu_topic(spec.name), _state_qos(),
+                                            qos_overriding_options=_qos_options())
+                      for spec in scene.imus]
+        self._state_publishers += publishers
+        self._publish_imu = tuple(p.publish for p in publishers)
+        if self._tf is not None:
+            state = mk.solve(tick_scene, scene.input.angle, 0.0, 0.0, max_error=math.inf)
+            frames = {f.joint: f for f in self._tf_frames}
+            transforms = self._imus.frame_transforms(sensor_offsets(scene.imus, frames, state))
+            if transforms:
+                self._imu_frames = ImuFrames(transforms)
+
+    def _publish_imus(self, values: list[float], sec: int, nanosec: int) -> None:
+        """Publish every sensor's ``Imu`` of a tick's values."""
+        assert self._imus is not None
+        for publish, data in zip(self._publish_imu,
+                                 self._imus.render_values(values, sec, nanosec), strict=True):
+            publish(data)
+
     def _publish_descriptions(self, scene: mk.Scene) -> None:
         """Publish the URDF on ``robot_description`` and the scene's text on ``scene``, latched.
 
@@ -642,7 +681,8 @@ class KinematicsNode(LifecycleNode):
         self._marker_strokes = strokes_from_scene(self._marker_scene)
         try:
             self._marker_size: float | None = marker_size_from_space(space_from_state(
-                self._marker_scene, mk.solve(self._marker_scene, scene.input.angle)))
+                self._marker_scene, mk.solve(self._marker_scene, scene.input.angle,
+                                             turns=scene.input.turns)))
         except mk.AssemblyError:
             self._marker_size = None    # the part beyond the outputs cannot assemble here
         self._marker_throttle = MarkerThrottle()
@@ -785,11 +825,15 @@ class KinematicsNode(LifecycleNode):
         publish_js(joint_states)
         publish_jt(joint_accel)
         publish_pt(point_accel)
+        if self._imus is not None:
+            self._publish_imus(values, sec, nanosec)
         if stamp >= self._next_tf:
             tf_period = self._tf_period_ns
             if self._tf is not None and tf_period is not None:
                 self._pub_tf.publish(self._tf.render_values(values, self._tf_first, sec,
                                                             nanosec))
+                if self._imu_frames is not None:
+                    self._pub_tf.publish(self._imu_frames.render(sec, nanosec))
                 self._next_tf = stamp + tf_period
             else:
                 self._next_tf = stamp + NS_PER_S    # off: look again in a second
@@ -889,6 +933,8 @@ class KinematicsNode(LifecycleNode):
         if self._tf is not None and self._tf_period_ns is not None \
                 and given.stamp_ns >= self._next_tf:
             self._pub_tf.publish(self._tf.render_values(values, self._tf_first, sec, nanosec))
+            if self._imu_frames is not None:    # a sensor's frame is a position: known here
+                self._pub_tf.publish(self._imu_frames.render(sec, nanosec))
             self._next_tf = given.stamp_ns + self._tf_period_ns
         topic.published(given.stamp_ns)
         self._stats.record(given.stamp_ns, time.monotonic_ns() - received, False,

@@ -207,6 +207,9 @@ class CrankTimebase:
     speed : float, optional
         Crank speed at ``t0`` in rad/s instead of ``speed_rpm`` (a scene's own
         speed, kept in the unit the scene holds it in).
+    turns : int, optional
+        Whole turns to add to ``angle`` (a scene's start far out: its crank's
+        ``turns``), added exactly. Default 0.
 
     Notes
     -----
@@ -221,7 +224,7 @@ class CrankTimebase:
     CHANGES = ('speed_rpm', 'speed', 'accel', 'max_speed_rpm')
 
     def __init__(self, t0: int, angle: float, speed_rpm: float | None, accel: float,
-                 max_speed_rpm: float, *, speed: float | None = None) -> None:
+                 max_speed_rpm: float, *, speed: float | None = None, turns: int = 0) -> None:
         if (speed_rpm is None) == (speed is None):
             msg = f'Expected one of `speed_rpm` and `speed`, got {speed_rpm!r} and {speed!r}'
             raise ValueError(msg)
@@ -235,7 +238,7 @@ class CrankTimebase:
             raise ValueError(msg)
         w0, w0_float = _speed_given(speed_rpm, speed)
         w_max, w_max_float = _speed_given(max_speed_rpm, None)
-        self._segment = _Segment(int(t0), turns_from_radians(angle), w0,
+        self._segment = _Segment(int(t0), turns_from_radians(angle) + int(turns), w0,
                                  turns_from_radians(accel), w_max, None, w0_float, w_max_float)
 
     def _at(self, t: int) -> tuple[_Segment, int]:

@@ -8,9 +8,10 @@ and remaps apply; ``/tf`` and ``/tf_static`` are absolute, as tf2 expects.
 
 from __future__ import annotations
 
-__all__ = ['DIAGNOSTICS', 'INPUT_JOINT_STATES', 'JOINT_ACCELERATIONS', 'JOINT_STATES', 'MARKERS',
+__all__ = ['DIAGNOSTICS', 'IMU', 'IMU_TYPE', 'INPUT_JOINT_STATES', 'JOINT_ACCELERATIONS',
+           'JOINT_STATES', 'MARKERS',
            'POINT_ACCELERATIONS', 'ROBOT_DESCRIPTION', 'SCENE', 'STATE_TOPICS', 'TF',
-           'TF_STATIC', 'TYPES']
+           'TF_STATIC', 'TYPES', 'imu_topic']
 
 JOINT_STATES = 'joint_states'
 JOINT_ACCELERATIONS = 'joint_accelerations'
@@ -26,6 +27,10 @@ SCENE = 'scene'
 
 #: The drivers' positions (and velocities) that drive the node with ``drive: topic``.
 INPUT_JOINT_STATES = 'input_joint_states'
+#: The namespace of the inertial sensors' topics: ``imu/NAME``, one per entry of a scene's
+#: ``imus``, each of type :data:`IMU_TYPE`.
+IMU = 'imu'
+IMU_TYPE = 'sensor_msgs/msg/Imu'
 
 #: The topics of the kinematic state, published together at every instant.
 STATE_TOPICS = (JOINT_STATES, JOINT_ACCELERATIONS, POINT_ACCELERATIONS)
@@ -43,3 +48,8 @@ TYPES = {
     SCENE: 'std_msgs/msg/String',
     INPUT_JOINT_STATES: 'sensor_msgs/msg/JointState',
 }
+
+
+def imu_topic(name: str) -> str:
+    """Return the topic of the scene's sensor ``name``: ``imu/NAME`` (relative)."""
+    return f'{IMU}/{name}'

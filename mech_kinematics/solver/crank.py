@@ -13,6 +13,7 @@ import numpy as np
 from .context import _Context, _U2, _U4
 from .model import _check_finite, _check_length, _check_name
 from ..bounds import U
+from ..errors import SceneError
 
 
 @dataclass(frozen=True)
@@ -30,11 +31,16 @@ class Crank:
     length : float
         Crank length, m.
     angle : float
-        Crank angle at time zero, rad.
+        Crank angle at time zero, rad (within its turn when ``turns`` is not 0).
     speed : float
         Default angular velocity, rad/s, + CCW.
     accel : float
         Default angular acceleration, rad/s^2, + CCW.
+    turns : int
+        Whole turns to add to ``angle``: the crank angle at time zero is
+        ``angle + 2 pi turns``, the sum never formed in floating point (a scene
+        file's angle far out, as 1e17 deg, is read as an angle within a turn
+        plus whole turns; only an intermittent drive tells the turns apart).
     """
 
     link: str
@@ -44,6 +50,7 @@ class Crank:
     angle: float = 0.0
     speed: float = 0.0
     accel: float = 0.0
+    turns: int = 0
 
     def __post_init__(self) -> None:
         """Validate the fields."""
@@ -54,6 +61,9 @@ class Crank:
         _check_finite(self.angle, 'the crank angle', (self, 'angle'))
         _check_finite(self.speed, 'the crank speed', (self, 'speed'))
         _check_finite(self.accel, 'the crank acceleration', (self, 'accel'))
+        if not isinstance(self.turns, int) or isinstance(self.turns, bool):
+            msg = f'Expected the crank whole turns to be an int, got {self.turns!r}'
+            raise SceneError(msg, (self, 'turns'))
 
     @property
     def name(self) -> str:
@@ -69,6 +79,11 @@ class Crank:
     def start(self) -> float:
         """The driver's position at time zero: the crank angle, rad."""
         return self.angle
+
+    @property
+    def shown(self) -> float:
+        """The crank angle at time zero as one float, rad, for messages only."""
+        return self.angle + math.tau * self.turns
 
     @property
     def stroke(self) -> tuple[float, float] | None:

@@ -26,6 +26,7 @@ from .scaling import _ANGULAR, _exponent, _LINEAR, _scaled, _size, _SIZE_RANGE
 from .solve import _execute, TRUST_TEST
 from ..bounds import U
 from ..errors import AssemblyError, NearSingularWarning, SceneError
+from ..imu import imu_outputs, ImuSpec
 
 
 class _Solver:
@@ -122,7 +123,7 @@ class Scene:
     """A planar mechanism: ground points, the driving crank, dyads, carried points.
 
     Construction validates names and dependencies and checks that the
-    mechanism assembles at ``input.angle``; a failure raises
+    mechanism assembles at ``input.angle`` (plus ``input.turns``); a failure raises
     :class:`SceneError`.
 
     Parameters
@@ -145,6 +146,9 @@ class Scene:
         Pins whose rubbing velocity is reported (``State.rubbing``).
     units : SceneUnits
         The units the scene was written in, for messages (its values are SI).
+    imus : tuple of ImuSpec
+        Inertial sensors on moving links (:mod:`mech_kinematics.imu`); the
+        outputs always hold each one's link and point.
     """
 
     name: str
@@ -157,6 +161,7 @@ class Scene:
     description: str = ''
     pins: tuple[Pin, ...] = ()
     units: SceneUnits = SceneUnits()
+    imus: tuple[ImuSpec, ...] = ()
     _plan: _Plan = field(init=False, repr=False, compare=False)
     _solver: _Solver = field(init=False, repr=False, compare=False)
 
@@ -171,18 +176,21 @@ class Scene:
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter('ignore', NearSingularWarning)
-                _execute(solver, self.input.angle, 0.0, 0.0)  # positions only
+                _execute(solver, self.input.angle, 0.0, 0.0, self.input.turns)  # positions only
         except AssemblyError as error:
             dyad = next((step.dyad for step in full.steps
                          if step.owner is None and step.label == error.dyad), None)
             msg = (f'Expected the mechanism to assemble at the initial crank angle '
-                   f'{self.units.angle_text(self.input.angle)}, got '
+                   f'{self.units.angle_text(self.input.shown)}, got '
                    f'{assembly_text(error, self.units)}')
             raise SceneError(msg, (self.input, 'angle') if dyad is None else (dyad, '')) from None
-        if self.outputs_joints is None and self.outputs_points is None:
+        object.__setattr__(self, 'imus', tuple(self.imus))
+        joints, points = imu_outputs(self, full.joint_types, self.outputs_joints,
+                                     self.outputs_points)
+        if joints is None and points is None:
             plan = full
         else:
-            plan = _compile(self, self.outputs_joints, self.outputs_points)
+            plan = _compile(self, joints, points)
             solver = _Solver(self, plan)
         object.__setattr__(self, '_plan', plan)
         object.__setattr__(self, '_solver', solver)

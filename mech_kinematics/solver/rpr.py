@@ -175,7 +175,9 @@ class RPR(Item):
         centre, wheel, pin = (points[name] for name in names)
         distance = float(np.hypot(*(wheel - centre)))
         radius = float(np.hypot(*(pin - centre)))
-        mouth = math.sqrt(max(distance * distance - radius * radius, 0.0))
+        # The slot's length to its mouth, sqrt(l^2 - R^2), with l and R divided by l
+        # first: the squares stay in range whatever the wheel's size (1e300 m).
+        mouth = distance * math.sqrt(max(1.0 - (radius / distance) ** 2, 0.0))
         inner = 0.85 * (distance - radius)
         angle = float(state.joints[self.link].position)
         slots = []

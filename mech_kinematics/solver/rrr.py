@@ -146,6 +146,11 @@ def _pair_text(facts: dict[str, Any], units: SceneUnits) -> str:
     (a, b), (la, lb), (p, q) = facts['links'], facts['lengths'], facts['points']
     distance = facts['distance']
     pair = f'links {a} ({text(la)}) and {b} ({text(lb)})'
+    if 'inputs' in facts:
+        return (f'{pair} between {p} and {q} ({text(distance)} apart) are '
+                f'{text(facts["margin"])} in |{p}{q}| from being in line, but the error bounds '
+                f'of {p} and {q} ({text(facts["inputs"])} together) exceed '
+                f'1/{ROUNDING_MARGIN:g} of that: their position cannot be trusted')
     if facts['kind'] == 'in line':
         return (f'{pair} in line between {p} and {q} ({text(distance)} apart): a toggle '
                 f'position, where the mechanism locks')
@@ -183,12 +188,24 @@ class _RRRStep(Step):
         self.defines = (dyad.point, first.name, second.name)
         self.new_points = (dyad.point,)
 
-    def facts(self, dist: float, touching: bool) -> dict[str, Any]:
-        """Return why the circles do not meet, for a message in the scene's units."""
+    def facts(self, dist: float, touching: bool, margin: float = 0.0,
+              inputs: float = 0.0) -> dict[str, Any]:
+        """Return why the circles do not meet, for a message in the scene's units.
+
+        ``margin`` and ``inputs`` (the error bounds of the links' starts) are
+        given where the circles meet but within rounding of a limit: where the
+        starts' bounds alone make it so, the message blames them, not a toggle.
+        """
         m = self.unit
-        return {'kind': 'in line' if touching else 'apart', 'links': (self.link1, self.link2),
-                'lengths': (self.l1 * m, self.l2 * m), 'points': (self.start1, self.start2),
-                'distance': float(dist) * m}
+        facts = {'kind': 'in line' if touching else 'apart', 'links': (self.link1, self.link2),
+                 'lengths': (self.l1 * m, self.l2 * m), 'points': (self.start1, self.start2),
+                 'distance': float(dist) * m}
+        # A margin above 1e-6 of the lengths is not a toggle (the links are 0.1 deg or
+        # more from in line): only its starts' bounds (1e7 times this step's own
+        # rounding at least) can have brought it within rounding of the limit.
+        if margin > 1e-6 * (self.l1 + self.l2):
+            facts.update(margin=float(margin) * m, inputs=float(inputs) * m)
+        return facts
 
     def margins(self, points: Mapping[str, tuple[Any, ...]]) -> tuple[tuple[Any, Any], ...]:
         """Return the circles' margins ``l1 + l2 - d`` and ``d - |l1 - l2|`` and their rates.
@@ -285,7 +302,7 @@ class _RRRStep(Step):
                 f'|{self.start1}{self.start2}|, |{self.start1}{self.start2}| - '
                 f'{_g(abs(ldiff) * m)} m) = {margin * m:.3g} m to exceed '
                 f'{ROUNDING_MARGIN:g} times its error bound {spread * m:.3g} m'),
-                lambda: self.facts(dist, True))
+                lambda: self.facts(dist, True, margin, ep1 + ep2))
         root = np.sqrt(k) if ctx.vector else math.sqrt(k)
         # sin of the angle between the two links (the transmission angle).
         measure = root / (2.0 * l1 * l2)

@@ -483,8 +483,11 @@ def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any,
         if solver.levers:
             intermittent = {name: step.engagement(ctx, omega, None)
                             for name, step in solver.levers.items()}
-    return _new_state(scene.name, theta, omega, alpha, joints, points, valid, dict(measures),
-                      dict(ctx.failures), bound, turns, rubbing, intermittent, jumps)
+    state = _new_state(scene.name, theta, omega, alpha, joints, points, valid, dict(measures),
+                       dict(ctx.failures), bound, turns, rubbing, intermittent, jumps)
+    if scene.imus:  # read from the state when asked (State.imus)
+        state.__dict__['imu_specs'] = scene.imus
+    return state
 
 
 def _new_state(scene: str, angle: Any, speed: Any, accel: Any, joints: dict[str, JointMotion],

@@ -16,6 +16,7 @@ import numpy.typing as npt
 from .model import Number, Vector
 from .scaling import _ANGULAR, _LINEAR
 from ..bounds import ErrorBound
+from ..imu import imu_reading, ImuReading, ImuSpec
 
 
 class JointMotion:
@@ -155,6 +156,8 @@ class State:
         ``{'joints': {name: {'acceleration': x}}, 'points': {name:
         {'acceleration': ndarray, shape (2,)}}}``. For arrays, shapes (n,) and
         (n, 2), NaN at the angles where nothing jumps.
+    imu_specs : tuple of ImuSpec
+        The scene's inertial sensors, whose readings :attr:`imus` gives.
     """
 
     scene: str
@@ -171,6 +174,12 @@ class State:
     rubbing: dict[str, Number] = field(default_factory=dict)
     intermittent: dict[str, Engagement] = field(default_factory=dict)
     jumps: dict[str, Any] = field(default_factory=dict)
+    imu_specs: tuple[ImuSpec, ...] = ()
+
+    @cached_property
+    def imus(self) -> dict[str, ImuReading]:
+        """What each of the scene's IMUs reads, with its bounds (:func:`.imu.imu_reading`)."""
+        return {spec.name: imu_reading(self, spec) for spec in self.imu_specs}
 
     @cached_property
     def points(self) -> dict[str, PointState]:
@@ -255,7 +264,12 @@ class State:
                           'points': {name: {'acceleration': pair(x['acceleration'])}
                                      for name, x in self.jumps['points'].items()}}}
                if self.jumps else {}),
-            'error_bound': self.error_bound.as_dict(vector),
+            **({'imus': {name: r.as_dict(vector) for name, r in self.imus.items()}}
+               if self.imu_specs else {}),
+            'error_bound': {**self.error_bound.as_dict(vector),
+                            **({'imus': {name: r.bounds_dict(vector)
+                                         for name, r in self.imus.items()}}
+                               if self.imu_specs else {})},
         }
 
 

@@ -31,7 +31,7 @@ from ..geometry.diagrams import (arrows_from_state, colours_from_scene, Diagram,
 from ..geometry.instant_centres import (bodies_from_scene, BodyKind, full_scene,
                                         instant_centres_from_state)
 from ..solver import Scene, solve
-from ..units import rad_per_s_from_rpm, rpm_from_rad_per_s
+from ..units import rad_per_s_from_rpm, rpm_from_rad_per_s, turns_from_degrees
 
 __all__ = ['add_parser', 'figure_from_diagram', 'main', 'write_animation', 'write_diagram']
 
@@ -617,7 +617,8 @@ def write_animation(scene: Scene, path: str | Path, *, frames: int = 72, fps: in
         warnings.simplefilter('ignore', NearSingularWarning)
         for theta in _cycle_angles(scene, frames):
             try:
-                states.append(solve(scene, float(theta), speed, accel))
+                states.append(solve(scene, float(theta), speed, accel,
+                                    turns=scene.input.turns))
             except AssemblyError:
                 continue
     if not states:
@@ -765,7 +766,7 @@ def _handle(args: argparse.Namespace) -> int:
         scene = load_scene(args.scene)
         if args.animate:
             if args.angle_deg is not None:
-                scene = _with_angle(scene, math.radians(args.angle_deg))
+                scene = _with_angle(scene, args.angle_deg)
             count = write_animation(scene, output, frames=args.frames, speed=speed,
                                     accel=args.accel, instant_centres=args.instant_centres)
             print(f'wrote {output} ({count} frames)')
@@ -780,10 +781,13 @@ def _handle(args: argparse.Namespace) -> int:
     return 0
 
 
-def _with_angle(scene: Scene, angle: float) -> Scene:
+def _with_angle(scene: Scene, degrees: float) -> Scene:
+    """Return ``scene`` started at ``degrees``, whole turns beyond one read exactly."""
     from dataclasses import replace
 
-    return replace(scene, input=replace(scene.input, angle=angle))
+    angle, turns = (turns_from_degrees(degrees) if abs(degrees) > 360.0
+                    else (math.radians(degrees), 0))
+    return replace(scene, input=replace(scene.input, angle=angle, turns=turns))
 
 
 def main(argv: Sequence[str] | None = None) -> int:

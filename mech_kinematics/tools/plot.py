@@ -10,7 +10,10 @@ time or crank angle, in SI units:
 - joint angles, angular velocities and angular accelerations (revolute joints);
 - slider positions, velocities and accelerations (prismatic joints, if any);
 - the paths of the points, and the magnitudes of their velocities and
-  accelerations.
+  accelerations;
+- what the scene's IMUs read (orientation, angular velocity, the x and y of
+  the linear acceleration in each sensor's frame), if it has any: from a bag,
+  its ``imu/NAME`` topics.
 
 Figures are built with Matplotlib's object API (``Figure``, no pyplot), so no
 display or backend choice is involved: PNG goes through Agg. Matplotlib and
@@ -21,7 +24,7 @@ from __future__ import annotations
 
 import argparse
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 import math
 import os
 from pathlib import Path
@@ -65,6 +68,9 @@ TITLES = {
     'slider_position': 'Slider positions',
     'slider_velocity': 'Slider velocities',
     'slider_acceleration': 'Slider accelerations',
+    'imu_orientation': 'IMU orientations',
+    'imu_angular_velocity': 'IMU angular velocities',
+    'imu_acceleration': 'IMU linear accelerations (sensor frame)',
 }
 YLABELS = {
     'joint_position': 'angle [rad]',
@@ -76,6 +82,9 @@ YLABELS = {
     'slider_position': 'position [m]',
     'slider_velocity': 'velocity [m/s]',
     'slider_acceleration': 'acceleration [m/s²]',
+    'imu_orientation': 'angle [rad]',
+    'imu_angular_velocity': 'angular velocity [rad/s]',
+    'imu_acceleration': 'acceleration [m/s²]',
 }
 XLABELS = {'time': 'time [s]', 'angle': 'crank angle θ [rad]', 'path': 'x [m]'}
 #: The node's topics, by message type.
@@ -119,6 +128,10 @@ class Motion:
         A line under the title: where the mechanism does not assemble.
     gaps : tuple of (float, float)
         Crank-angle ranges (rad) where it does not assemble, shaded.
+    imus : dict of str to (ndarray, ndarray, ndarray)
+        Per IMU of the scene: orientation (rad) and angular velocity (rad/s),
+        shape (n,), linear acceleration in the sensor frame (m/s²), shape
+        (n, 2); NaN where a recording has no reading.
     """
 
     title: str
@@ -130,6 +143,7 @@ class Motion:
     jumps: Array | None = None
     note: str = ''
     gaps: tuple[tuple[float, float], ...] = ()
+    imus: Mapping[str, tuple[Array, Array, Array]] = field(default_factory=dict)
 
 
 # -- from the solver -------------------------------------------------------------
@@ -188,8 +202,10 @@ def motion_from_scene(scene: Any, *, samples: int = DEFAULT_SAMPLES,
     title = (f'{scene.name}: solver, one crank cycle at {rpm:.6g} rpm'
              + (f', {accel:.6g} rad/s²' if accel else ''))
     _, gaps = assembly_ranges(scene)
+    imus = {name: (r.orientation, r.angular_velocity, r.linear_acceleration)
+            for name, r in state.imus.items()}
     return Motion(title, np.asarray(angle, dtype=np.float64), time, scene.joint_types, joints,
-                  points, jumps, summary_from_gaps(gaps, scene.units), gaps)
+                  points, jumps, summary_from_gaps(gaps, scene.units), gaps, imus)
 
 
 # -- from a bag ------------------------------------------------------------------
@@ -222,6 +238,41 @@ def _pick(connections: Sequence[Any], type_name: str, namespace: str | None) -> 
         msg = f'Expected one {_TOPICS[type_name]} topic, got {topics}: pass --namespace'
         raise PlotError(msg)
     return found[0] if found else None
+
+
+def _imu_connections(connections: Sequence[Any], namespace: str | None) -> dict[str, Any]:
+    """Return the node's IMU topics, ``<namespace>/imu/NAME``, by sensor name."""
+    found: dict[str, Any] = {}
+    for c in connections:
+        parts = c.topic.rsplit('/', 2)
+        if c.msgtype != topics.IMU_TYPE or len(parts) != 3 or parts[1] != topics.IMU or (
+                namespace is not None and parts[0] != namespace.rstrip('/')):
+            continue
+        if parts[2] in found:
+            msg = (f'Expected one {topics.imu_topic(parts[2])} topic, got '
+                   f'{found[parts[2]].topic}, {c.topic}: pass --namespace')
+            raise PlotError(msg)
+        found[parts[2]] = c
+    return found
+
+
+def _imu_arrays(reader: Any, connections: Mapping[str, Any],
+                ticks: Sequence[int]) -> dict[str, tuple[Array, Array, Array]]:
+    """Return each IMU's readings at ``ticks`` (header stamps, ns); NaN where it has none."""
+    at = {stamp: i for i, stamp in enumerate(ticks)}
+    out = {}
+    for name, connection in connections.items():
+        values = np.full((len(ticks), 4), np.nan)
+        decode = _decoder(reader.typestore, connection.msgtype)
+        for _, _, raw in reader.messages(connections=[connection]):
+            i = at.get(stamp_from_cdr(raw))
+            if i is not None:
+                m = decode(raw)
+                q, a = m.orientation, m.linear_acceleration
+                values[i] = (2.0 * math.atan2(q.z, q.w), m.angular_velocity.z, a.x, a.y)
+        orientation = np.remainder(values[:, 0] + math.pi, 2.0 * math.pi) - math.pi
+        out[name] = (orientation, values[:, 1], values[:, 2:4])
+    return out
 
 
 def _stored_scene(reader: Any, connection: Any, path: Path) -> Any:
@@ -346,6 +397,8 @@ def motion_from_bag(path: str | os.PathLike[str], *, scene: Any = None,
                 stamp = stamp_from_cdr(raw)
                 if stamp in chosen and stamp not in rows[connection.id]:
                     rows[connection.id][stamp] = decoders[connection.id](raw)
+            imus = _imu_arrays(reader, _imu_connections(reader.connections, namespace),
+                               sorted(chosen))
             scene_name = ''
             stored = picked[_SCENE]
             if stored is not None and scene is None:
@@ -393,7 +446,7 @@ def motion_from_bag(path: str | os.PathLike[str], *, scene: Any = None,
     time = (stamps_ns - stamps_ns[0]) / NS_PER_S if len(ticks) else np.zeros(0)
     label = scene.name if scene is not None else (scene_name or 'unknown scene')
     title = f'{label}: recording {path.name}, {time[-1] if len(time) else 0:.3g} s'
-    return Motion(title, crank_angle, time, types, joints, points)
+    return Motion(title, crank_angle, time, types, joints, points, imus=imus)
 
 
 def _joint_arrays(msgs: list[Any], connection: Any) -> tuple[list[str], list[Any]]:
@@ -472,8 +525,9 @@ def figure_from_motion(motion: Motion, *, x: str = 'time') -> Any:
 
     Columns: revolute joints (angle, angular velocity, angular acceleration),
     points (path, speed, acceleration magnitude) and, if the mechanism has
-    any, prismatic joints (position, velocity, acceleration). Every axis is
-    labelled with its unit.
+    any, prismatic joints (position, velocity, acceleration) and IMUs
+    (orientation, angular velocity, linear acceleration's x and y). Every
+    axis is labelled with its unit.
     """
     from matplotlib.figure import Figure
 
@@ -500,6 +554,8 @@ def figure_from_motion(motion: Motion, *, x: str = 'time') -> Any:
                ('point_path', 'point_speed', 'point_acceleration')]
     if prismatic:
         columns.append(('slider_position', 'slider_velocity', 'slider_acceleration'))
+    if motion.imus:
+        columns.append(('imu_orientation', 'imu_angular_velocity', 'imu_acceleration'))
     gaps = _gaps(motion.time, len(motion.crank_angle))
     if motion.jumps is not None:
         gaps = gaps | motion.jumps  # an acceleration's jump: no line across it
@@ -509,6 +565,8 @@ def figure_from_motion(motion: Motion, *, x: str = 'time') -> Any:
 
     def series(kind: str) -> list[tuple[str, Array | None, bool]]:
         """(label, values, values wrap at ±π) per line of a panel against ``x``."""
+        if kind.startswith('imu'):
+            return _imu_series(motion, kind)
         if kind.startswith('joint') or kind.startswith('slider'):
             names = revolute if kind.startswith('joint') else prismatic
             k = ('position', 'velocity', 'acceleration').index(kind.split('_')[1])
@@ -551,6 +609,15 @@ def figure_from_motion(motion: Motion, *, x: str = 'time') -> Any:
                 ax.text(0.5, 0.5, 'no data', transform=ax.transAxes, ha='center',
                         va='center', color='0.5')
     return fig
+
+
+def _imu_series(motion: Motion, kind: str) -> list[tuple[str, Array | None, bool]]:
+    """(label, values, wraps) of an IMU panel: one line per sensor, x and y for accelerations."""
+    if kind == 'imu_acceleration':
+        return [(f'{name} {axis}', readings[2][:, k], False)
+                for name, readings in motion.imus.items() for k, axis in enumerate('xy')]
+    k = 0 if kind == 'imu_orientation' else 1
+    return [(name, readings[k], k == 0) for name, readings in motion.imus.items()]
 
 
 def _draw_paths(ax: Any, motion: Motion, gaps: Any) -> None:

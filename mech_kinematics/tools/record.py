@@ -61,7 +61,8 @@ from ..units import NS_PER_S
 
 __all__ = [
     'BAG_VERSIONS', 'BagRecorder', 'DEFAULT_BAG_VERSION', 'DEFAULT_EXECUTOR',
-    'DEFAULT_PROGRESS_S', 'DEFAULT_STORAGE', 'DEFAULT_TOPICS', 'EXECUTORS', 'RecorderError',
+    'DEFAULT_NAMESPACES', 'DEFAULT_PROGRESS_S', 'DEFAULT_STORAGE', 'DEFAULT_TOPICS',
+    'EXECUTORS', 'RecorderError',
     'STORAGES', 'TopicStats', 'WAIT_REPORT_INTERVAL_S', 'add_parser', 'main',
     'message_definition', 'record', '_handle',
 ]
@@ -71,6 +72,9 @@ __all__ = [
 #: recorder's namespace; /tf and /tf_static are absolute, as every TF broadcaster's.
 DEFAULT_TOPICS = (*topics.STATE_TOPICS, topics.DIAGNOSTICS, topics.TF, topics.TF_STATIC,
                   topics.MARKERS, topics.ROBOT_DESCRIPTION, topics.SCENE)
+#: Namespaces whose every topic is recorded with the default topics, as each appears: the
+#: scene's IMUs (``imu/NAME``, one per sensor, named by the scene).
+DEFAULT_NAMESPACES = (topics.IMU,)
 #: Default topics the node publishes only with a parameter on: their absence is no fault.
 OPTIONAL_TOPICS = {topics.MARKERS: 'the node publishes it with markers:=true'}
 #: The bag writer's storages and versions (it checks them).
@@ -327,6 +331,10 @@ class BagRecorder:
         which is also used where this rclpy has no ``EventsExecutor``.
     progress : float
         Seconds between progress lines while recording; 0 for none.
+    namespaces : sequence of str, optional
+        Namespaces whose every topic is recorded too, as it appears (relative
+        names resolved like ``topics``). Default: :data:`DEFAULT_NAMESPACES`
+        with the default topics, none with topics of your choosing.
 
     Attributes
     ----------
@@ -345,7 +353,8 @@ class BagRecorder:
     def __init__(self, output: str | os.PathLike[str], topics: Sequence[str] = DEFAULT_TOPICS,
                  *, storage: str = DEFAULT_STORAGE, version: int = DEFAULT_BAG_VERSION,
                  args: list[str] | None = None, executor: str = DEFAULT_EXECUTOR,
-                 progress: float = DEFAULT_PROGRESS_S) -> None:
+                 progress: float = DEFAULT_PROGRESS_S,
+                 namespaces: Sequence[str] | None = None) -> None:
         self.output = Path(output)
         try:
             bag.check_new_bag(self.output)      # before ROS starts
@@ -368,6 +377,11 @@ class BagRecorder:
         self._stop = threading.Event()
         self._rclpy_args = args
         self._requested = list(dict.fromkeys(topics))
+        if namespaces is None:
+            namespaces = DEFAULT_NAMESPACES if tuple(topics) == DEFAULT_TOPICS else ()
+        self._namespaces = tuple(namespaces)
+        #: The namespaces resolved, each ending in '/'.
+        self._prefixes: tuple[str, ...] = ()
         self._topics: dict[str, _Topic] = {}
         self._node: Any = None
         self._context: Any = None
@@ -406,6 +420,8 @@ class BagRecorder:
                     msg = f'Expected a valid topic name, got {name!r}: {error}'
                     raise RecorderError(msg) from None
                 self._topics.setdefault(resolved, _Topic(TopicStats(resolved)))
+            self._prefixes = tuple(f'{self._node.resolve_topic_name(ns).rstrip("/")}/'
+                                   for ns in self._namespaces)
             self._executor = _make_executor(self.executor, self._context)
             self._executor.add_node(self._node)
             writer = BagWriter(self.output, storage=self.storage, version=self.version)
@@ -574,13 +590,23 @@ class BagRecorder:
     # -- topics -------------------------------------------------------------------
 
     def _discover(self) -> None:
-        """Subscribe to every requested topic that has publishers now (polled)."""
+        """Subscribe to every requested topic that has publishers now (polled).
+
+        A topic that appears in one of the recorded namespaces is requested too.
+        """
         from ..bag import BagError
 
+        types: dict[str, list[str]] | None = None
+        if self._prefixes and self._writer is not None:
+            types = dict(self._node.get_topic_names_and_types())
+            for name in types:
+                if name.startswith(self._prefixes) and name not in self._topics:
+                    self._topics[name] = _Topic(TopicStats(name))
         pending = [t for t in self._topics.values() if t.subscription is None and not t.failed]
         if not pending or self._writer is None:
             return
-        types = dict(self._node.get_topic_names_and_types())
+        if types is None:
+            types = dict(self._node.get_topic_names_and_types())
         for topic in pending:
             name = topic.stats.name
             offers = self._node.get_publishers_info_by_topic(name)
@@ -730,8 +756,9 @@ def _handle(args: argparse.Namespace) -> int:
 
 RECORD_HELP = """\
 Record the node's topics (by default everything it publishes: the state,
-/tf, /tf_static, diagnostics, markers when on, robot_description and the
-scene's text on `scene`, so the bag replays whole) to a new rosbag2 directory,
+/tf, /tf_static, diagnostics, markers when on, robot_description, the
+scene's text on `scene` and every imu/NAME of the scene's IMUs, so the bag
+replays whole) to a new rosbag2 directory,
 readable by `ros2 bag info`, `ros2 bag play` and Foxglove: metadata.yaml plus
 one .mcap or .db3 file. Messages are stored as received (serialized CDR),
 stamped with the receive time. Topics not published yet are waited for and

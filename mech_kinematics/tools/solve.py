@@ -7,7 +7,6 @@ from __future__ import annotations
 import argparse
 from collections.abc import Sequence
 import json
-import math
 import sys
 from typing import Any
 import warnings
@@ -17,7 +16,7 @@ from ..bounds import MAX_ERROR
 from ..errors import AssemblyError, NearSingularWarning, SceneError, UntrustedError
 from ..scene import load_scene
 from ..solver import assembly_text, solve
-from ..units import rad_per_s_from_rpm, radians_from_degrees
+from ..units import rad_per_s_from_rpm, turns_from_degrees
 
 __all__ = ['add_parser', 'main', 'turns_from_degrees']
 
@@ -28,27 +27,17 @@ velocity, acceleration: rad for revolute joints, m for sliders), every
 output point (position, velocity, acceleration as [x, y]), "rubbing" (the
 rubbing velocity at each of the scene's pins, m/s), "intermittent" (each
 Geneva wheel: engaged or locked, its engagement window and where its
-acceleration jumps) and "error_bound", the absolute error bound of each of
-those values (one number per value; for a point, the bound on the length of
-its error vector), all in SI units.
+acceleration jumps), "imus" (each of the scene's inertial sensors: angular
+velocity rad/s, linear acceleration [x, y] m/s^2 in the sensor's frame,
+orientation rad) and "error_bound", the absolute error bound of each of
+those values (one number per value; for a point or an acceleration, the
+bound on the length of its error vector), all in SI units.
 Options left out take the scene's own values. On a position that cannot be
 solved, or whose answer cannot be trusted (a value's error bound above
 --max-error times its kind's scale, a dyad within rounding of an assembly
 limit, a value beyond the range of doubles), it prints a one-line error and
 exits with status 2.
 """
-
-
-def turns_from_degrees(degrees: float) -> tuple[float, int]:
-    """Split a crank angle in degrees, counted from the start, into (rad within a turn, turns).
-
-    ``degrees = 360 * turns + rest`` exactly (IEEE remainder), ``rest`` in
-    [-180, 180]; the angle is ``rest`` in radians. So ``--angle-deg 450`` is
-    90 deg in turn 1, and ``36000090`` is 90 deg in turn 100000, with no
-    rounding of the whole turns.
-    """
-    rest = math.remainder(degrees, 360.0)
-    return radians_from_degrees(rest), round((degrees - rest) / 360.0)
 
 
 def _handle(args: argparse.Namespace) -> int:
@@ -58,7 +47,7 @@ def _handle(args: argparse.Namespace) -> int:
         print(f'error: {error}', file=sys.stderr)
         return 2
     if args.angle_deg is None:
-        angle, turns = scene.input.angle, 0
+        angle, turns = scene.input.angle, scene.input.turns
     else:
         angle, turns = turns_from_degrees(args.angle_deg)
     speed = None if args.speed_rpm is None else rad_per_s_from_rpm(args.speed_rpm)
@@ -67,7 +56,7 @@ def _handle(args: argparse.Namespace) -> int:
             warnings.simplefilter('always', NearSingularWarning)
             state = solve(scene, angle, speed, args.accel, turns=turns, max_error=args.max_error)
     except AssemblyError as error:
-        shown = scene.units.angle_text(scene.input.angle) if args.angle_deg is None else \
+        shown = scene.units.angle_text(scene.input.shown) if args.angle_deg is None else \
             f'{args.angle_deg:.15g} deg'
         reason = error.reason if isinstance(error, UntrustedError) or error.facts is None \
             else assembly_text(error, scene.units)

@@ -120,3 +120,48 @@ def test_urdf_tool_writes_the_same_document(tmp_path, capsys):
     assert cli_main(['urdf', 'no_such_scene']) == 2
     err = capsys.readouterr().err
     assert err.count('\n') == 1 and 'no_such_scene' in err
+
+
+IMU_SCENE = """\
+name: imu_urdf
+units: {length: mm, angle: deg}
+ground: {A: [0, 0], D: [150, 0]}
+input: {link: crank, center: A, point: B, length: 40, angle: 60, speed_rpm: -120}
+dyads:
+  - type: RRR
+    point: C
+    links:
+      - {name: coupler, from: B, length: 150}
+      - {name: rocker, from: D, length: 80}
+points:
+  E: {link: coupler, origin: B, xaxis: C, local: [30, 20]}
+imus:
+  tip: {link: coupler, point: E, angle: 30}
+  arm: {link: rocker, point: C}
+"""
+
+
+def test_an_imu_turned_on_its_link_has_a_fixed_link_at_its_point(tmp_path):
+    """Issue 18: imus.tip (angle 30 deg) is a link fixed to the coupler's, at E, turned 30 deg.
+
+    A sensor with angle 0 uses its link's frame: no link of its own.
+    """
+    path = tmp_path / 'imu_urdf.yaml'
+    path.write_text(IMU_SCENE)
+    scene = mk.load_scene(path)
+    robot, links, joints = _links_and_joints(urdf_from_scene(scene, 'base', 'r'))
+    assert 'r/tip' in links and 'r/arm' not in links
+    joint = joints['r/tip']
+    assert joint.get('type') == 'fixed' and joint.find('parent').get('link') == 'r/coupler'
+    origin = joint.find('origin')
+    x, y, z = (float(v) for v in origin.get('xyz').split())
+    assert [float(v) for v in origin.get('rpy').split()] == [0.0, 0.0, math.radians(30)]
+    # Placed by the coupler's pose at other crank angles, (x, y) lands on E.
+    frames = frames_from_scene(scene, ['coupler'])
+    for angle in np.linspace(0.0, 2 * np.pi, 7):
+        state = mk.solve(full_scene(scene), float(angle))
+        [pose] = poses_from_state(frames, state)
+        c, s = math.cos(pose.angle), math.sin(pose.angle)
+        np.testing.assert_allclose([pose.x + c * x - s * y, pose.y + s * x + c * y],
+                                   state.points['E'].position, rtol=0, atol=1e-15)
+    assert z == 0.0

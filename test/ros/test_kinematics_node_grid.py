@@ -214,3 +214,44 @@ def test_a_stall_is_caught_up_to_the_bound_and_the_rest_counted(ros, tmp_path):
     skipped, holes, stall_gap, _ = results['skip']
     assert 0.49e9 <= stall_gap <= 0.6e9, results
     assert skipped >= stall_gap // period - 1, results
+
+
+def test_a_10_s_stop_at_1_khz_is_one_burst_a_keep_last_1000_reader_gets_whole(ros, tmp_path):
+    """Issue 21, item 7, with a real SIGSTOP: 10 s at 1 kHz with max_catch_up_s:=10.
+
+    The burst used to be 10,001 instants and a KEEP_LAST 1000 reader lost 1,712 of them.
+    The burst is now capped at the history's 1000 messages (docs/robustness.md): the
+    reader gets every instant from the burst's first on, and the older ones are skipped
+    and counted on diagnostics.
+    """
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+    period = 1_000_000
+    stream = Stream(ros, tmp_path, 'stop_10s', '-p', 'rate_hz:=1000', '-p',
+                    'max_catch_up_s:=10.0')
+    reader = ros.collect_raw(JointState, f'{stream.ns}/joint_states',
+                             QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE))
+    try:
+        wait_for(lambda: len(reader) > 100, STARTUP_S, 'the KEEP_LAST 1000 reader')
+        wait_for(lambda: len(stream.diag) >= 2, STARTUP_S, 'diagnostics')
+        skipped_before = diagnostic_value(stream.diag, 'skipped_ticks_total')
+        start = len(reader) - 1
+        _stall(stream, 10.0)
+        time.sleep(2.0)
+        count = len(stream.diag)
+        wait_for(lambda: len(stream.diag) > count + 1, 5.0, 'diagnostics after the stop')
+        skipped = diagnostic_value(stream.diag, 'skipped_ticks_total') - skipped_before
+        stamps = sorted(set(stamps_of(reader[start:])))
+    finally:
+        stream.stop()
+    gaps = [(b - a, i) for i, (a, b) in enumerate(zip(stamps, stamps[1:], strict=False))]
+    stop_gap, at = max(gaps)
+    # The stop: older instants skipped (counted), then 1000 instants in one burst at most
+    # (uncapped, the burst would have left no gap at all; a late wake-up widens it).
+    assert 8.5e9 <= stop_gap <= 12e9, stop_gap
+    assert stop_gap // period - 1 <= skipped
+    after = stamps[at + 1:]
+    assert len(after) >= 1000 + 500
+    # Nothing lost by the reader from the burst on: every instant, none missing.
+    assert _holes(after, period) == 0, [b - a for a, b in zip(after, after[1:], strict=False)
+                                        if b - a != period][:10]

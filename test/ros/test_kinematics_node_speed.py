@@ -51,3 +51,40 @@ def test_the_crank_speed_on_joint_states_is_what_solve_prints(ros, tmp_path, sce
     assert speeds == {expected}, (speeds, expected)
     if scene == 'geneva' and rpm is None:
         assert expected == 10.0
+
+
+def test_a_tiny_speed_set_at_run_time_is_published(ros, tmp_path):
+    """Issue 21, item 2: 1e-160 and 1e-300 rpm set on a running node are published.
+
+    They used to be accepted and then nothing was published ("at most 1e-06 x 0
+    m/s^2 ... got 9.88e-324"): each is now answered, its crank velocity what
+    `solve --speed-rpm` prints.
+    """
+    from rclpy.parameter import Parameter
+    from rclpy.parameter_client import AsyncParameterClient
+    from ros_helpers import wait_for_parameters
+
+    ns = f'{SESSION}/tiny_speed'
+    js = ros.collect(JointState, f'{ns}/joint_states')
+    proc = NodeProcess(tmp_path, '-r', f'__ns:={ns}', '-p', 'scene:=khurmi_four_bar_ad150')
+    try:
+        wait_for(lambda: js, STARTUP_S, 'joint_states')
+        params = AsyncParameterClient(ros.node, f'{ns}/mech_kinematics')
+        wait_for_parameters(params)
+        for rpm in ('1e-160', '1e-300'):
+            expected = solve_speed('khurmi_four_bar_ad150', '--speed-rpm', rpm)
+            assert 0.0 < expected < 1e-158
+            response = ros.call(params.set_parameters([Parameter('crank_speed_rpm',
+                                                                 value=float(rpm))]))
+            assert response.results[0].successful, response.results[0].reason
+            wait_for(lambda expected=expected: any(
+                m.velocity[list(m.name).index('crank')] == expected for m in js),
+                STARTUP_S, f'a state at {rpm} rpm')
+            seen = len(js)
+            wait_for(lambda seen=seen: len(js) > seen + 10, STARTUP_S, f'states at {rpm} rpm')
+            assert js[-1].velocity[list(js[-1].name).index('crank')] == expected
+        assert proc.proc.poll() is None
+    finally:
+        status, _ = proc.stop(signal.SIGINT)
+    assert status == 0, proc.output()
+    assert 'cannot be trusted' not in proc.output()

@@ -12,7 +12,7 @@ import time
 
 import pytest
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-from ros_helpers import NodeProcess, NS, Ros, SESSION, stamp_ns, STARTUP_S, wait_for
+from ros_helpers import NodeProcess, NS, REPO, Ros, SESSION, stamp_ns, STARTUP_S, wait_for
 from sensor_msgs.msg import JointState
 from std_msgs.msg import String
 
@@ -190,3 +190,32 @@ def test_of_two_nodes_started_together_exactly_one_goes_on(ros, tmp_path):
     finally:
         statuses = [p.stop(signal.SIGINT)[0] for p in procs]
     assert sorted(statuses) == [0, 1], [p.output() for p in procs]
+
+
+def test_a_scene_started_far_out_starts_the_node_at_its_whole_turns(ros, tmp_path):
+    """A Geneva scene whose crank starts at 1e17 deg: the wheel published as solve answers it.
+
+    Issue 21, item 2: such a scene used to be refused; the node's time base starts at the
+    scene's whole turns, so at rest the wheel is held where ``solve`` holds it.
+    """
+    import math
+
+    import mech_kinematics as mk
+
+    ns = f'{SESSION}/far_start'
+    text = (REPO / 'config' / 'scenes' / 'geneva.yaml').read_text()
+    path = tmp_path / 'geneva_far.yaml'
+    path.write_text(text.replace('  angle: 150\n', '  angle: 1e17\n'))
+    scene = mk.load_scene(path)
+    expected = mk.solve(scene, scene.input.angle, 0.0, turns=scene.input.turns)
+    js = ros.collect(JointState, f'{ns}/joint_states')
+    proc = NodeProcess(tmp_path / 'node', '-r', f'__ns:={ns}', '-p', f'scene:={path}',
+                       '-p', 'crank_speed_rpm:=0.0', '-p', f'rate_hz:={RATE_HZ}')
+    try:
+        wait_for(lambda: js, STARTUP_S, 'joint_states')
+    finally:
+        status, _ = proc.stop(signal.SIGINT)
+    assert status == 0, proc.output()
+    names = list(js[0].name)
+    assert js[0].position[names.index('driver')] == math.radians(-80.0)
+    assert js[0].position[names.index('wheel')] == expected.joints['wheel'].position

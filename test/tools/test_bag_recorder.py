@@ -726,3 +726,68 @@ def test_recorder_without_publishers_names_them_every_five_seconds(crashes):
     info = yaml.safe_load((crashes.path('idle') / 'metadata.yaml').read_text())[
         'rosbag2_bagfile_information']
     assert info['message_count'] == 0 and info['topics_with_message_count'] == []
+
+
+IMU_SCENE = """\
+name: imu_bag
+units: {length: mm, angle: deg}
+ground: {A: [0, 0], D: [150, 0]}
+input: {link: crank, center: A, point: B, length: 40, angle: 60, speed_rpm: -120}
+dyads:
+  - type: RRR
+    point: C
+    links:
+      - {name: coupler, from: B, length: 150}
+      - {name: rocker, from: D, length: 80}
+imus:
+  tip: {link: coupler, point: C, gravity: [0, -9.80665]}
+"""
+
+
+def test_default_recording_holds_the_scenes_imu_topics(tmp_path):
+    """The default topics bring every imu/NAME as it appears: one Imu per joint_states stamp.
+
+    Issue 18: the IMU topics are named by the scene, so the recorder records the
+    ``imu`` namespace; explicit --topics record what they name and no more.
+    """
+    scene = tmp_path / 'imu_bag.yaml'
+    scene.write_text(IMU_SCENE)
+    ns = '/imu_bag'
+    recorders = {
+        'default': Process('default', tmp_path, '-m', 'mech_kinematics.tools.record', '-o',
+                           str(tmp_path / 'default'), '--duration', '2', '--ros-args', '-r',
+                           f'__ns:={ns}'),
+        'chosen': Process('chosen', tmp_path, '-m', 'mech_kinematics.tools.record', '-o',
+                          str(tmp_path / 'chosen'), '--duration', '2', '--topics',
+                          'joint_states', '--ros-args', '-r', f'__ns:={ns}')}
+    try:
+        for recorder in recorders.values():
+            recorder.wait_for_output('recording to', STARTUP_S)
+        node = Process('node', tmp_path, '-m', 'mech_kinematics.kinematics_node', '--ros-args',
+                       '-r', f'__ns:={ns}', '-p', f'scene:={scene}', '-p', 'rate_hz:=200')
+        try:
+            statuses = {name: r.stop(timeout=STARTUP_S + 2) for name, r in recorders.items()}
+        finally:
+            assert node.stop(signal.SIGINT) == 0, node.output()
+    finally:
+        _kill_left_over(recorders.values())
+    assert statuses == {'default': 0, 'chosen': 0}, recorders['default'].output()
+    bag = decoded(tmp_path / 'default')
+    imu = bag[f'{ns}/imu/tip']
+    assert len(imu) >= 100
+    assert Recording('default', tmp_path / 'default', 0, recorders['default'].output(),
+                     8).summary()[f'{ns}/imu/tip'][0] == 'sensor_msgs/msg/Imu'
+    states = {stamp_ns(m) for _, m in bag[f'{ns}/joint_states']}
+    stamps = [stamp_ns(m) for _, m in imu]
+    assert len(set(stamps)) == len(stamps)
+    # Subscribed a little apart: the stamps the two topics share are all but the ends.
+    assert len(set(stamps) & states) >= min(len(stamps), len(states)) - 100
+    assert all(m.header.frame_id == 'mechanism/coupler' for _, m in imu)
+    assert set(decoded(tmp_path / 'chosen')) == {f'{ns}/joint_states'}
+    # plot reads the recorded readings back, at the ticks it draws.
+    motion = plot.motion_from_bag(tmp_path / 'default', namespace=ns)
+    recorded = {(m.linear_acceleration.x, m.linear_acceleration.y) for _, m in imu}
+    accel = motion.imus['tip'][2]
+    drawn = accel[np.isfinite(accel).all(axis=1)]
+    assert len(drawn) >= len(accel) - 100
+    assert {(float(x), float(y)) for x, y in drawn} <= recorded

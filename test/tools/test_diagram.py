@@ -423,3 +423,49 @@ def test_import_needs_no_matplotlib():
             'mech_kinematics.geometry.instant_centres; '
             "assert 'matplotlib' not in sys.modules and 'rclpy' not in sys.modules")
     subprocess.run([sys.executable, '-c', code], check=True, timeout=60)
+
+
+def test_a_geneva_wheel_of_radius_1e300_is_drawn(tmp_path, capsys):
+    """Issue 21, item 5: "SVD did not converge" used to be all `diagram` said.
+
+    The wheel's outline and slots are computed in units of its own extent, so
+    the drawing is the packaged wheel's scaled by 1e300 / 0.05: its slot mouths
+    at sqrt(l^2 - R^2) = 1e300 m from the wheel's centre.
+    """
+    text = (Path(__file__).resolve().parents[2] / 'config' / 'scenes' / 'geneva.yaml')
+    text = text.read_text().replace('units: {length: mm,', 'units: {length: m,')
+    text = text.replace('-70.71067811865476', '-1.4142135623730951e300')
+    text = text.replace('  length: 50\n', '  length: 1e300\n')
+    path = tmp_path / 'huge.yaml'
+    path.write_text(text)
+    scene = mk.load_scene(path)
+    diagram = geo.diagram_from_scene(scene)
+    small = geo.diagram_from_scene(mk.load_scene('geneva'))
+    wheel = next(link for link in diagram.space.links if link.name == 'wheel')
+    little = next(link for link in small.space.links if link.name == 'wheel')
+    s = diagram.space.points['S']
+    for (_, mouth), (_, low) in zip(wheel.slots, little.slots, strict=True):
+        assert float(np.hypot(*(mouth - s))) == pytest.approx(1e300, rel=1e-12)
+        assert mouth / 2e301 == pytest.approx(low, rel=1e-9, abs=1e-12)
+    assert len(wheel.outline) == len(little.outline) and np.isfinite(wheel.outline).all()
+    png = tmp_path / 'huge.png'
+    assert dg.main([str(path), '-o', str(png)]) == 0
+    assert _png_size(png)[0] >= MIN_PNG_SIZE[0]
+    assert capsys.readouterr().err == ''
+
+
+def test_a_diagram_far_out_is_drawn_where_solve_puts_it(tmp_path):
+    """`diagram --angle-deg 1e17` answers as `solve --angle-deg 1e17` (it said "pin on pivot").
+
+    1e17 deg is -80 deg after 277777777777778 whole turns, read exactly: the Geneva
+    wheel is held at the index it has there, as for the scene started at that angle.
+    """
+    scene = mk.load_scene('geneva')
+    diagram = geo.diagram_from_scene(scene, 1e17, degrees=True)
+    solved = mk.solve(scene, math.radians(-80.0), turns=277777777777778)
+    wheel = next(link for link in diagram.links if link.name == 'wheel')
+    assert wheel.angle == solved.joints['wheel'].position and wheel.engaged is False
+    assert dg.main(['geneva', '--angle-deg', '1e17', '-o', str(tmp_path / 'far.png')]) == 0
+    gif = tmp_path / 'far.gif'
+    assert dg.main(['geneva', '--angle-deg', '1e17', '--animate', '--frames', '4', '-o',
+                    str(gif)]) == 0

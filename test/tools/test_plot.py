@@ -54,10 +54,11 @@ def lines(ax) -> dict:
 
 
 def write_bag(path: Path, scene, angles, *, storage='mcap', topics=tuple(TYPES), dt=0.002,
-              namespaces=('',), skip=(), scene_text=None):
+              namespaces=('',), skip=(), scene_text=None, imus=False):
     """Write what the node would publish at ``angles`` (one tick per dt s) to a new bag.
 
-    With ``scene_text``, also the node's latched ``scene`` topic holding it.
+    With ``scene_text``, also the node's latched ``scene`` topic holding it; with
+    ``imus``, the scene's ``imu/NAME`` topics (the node's own bytes).
     """
     from rosbags.rosbag2 import StoragePlugin, Writer
     from rosbags.typesys import get_typestore, Stores
@@ -86,6 +87,20 @@ def write_bag(path: Path, scene, angles, *, storage='mcap', topics=tuple(TYPES),
                                                rihs01=store.hash_rihs01(string))
             message = store.types[string](data=scene_text)
             writer.write(connection, start, store.serialize_cdr(message, string))
+        sensors = {}
+        if imus:
+            from mech_kinematics.ros.imus import ImuMessages
+            from mech_kinematics.ros.ticker import values_from_state
+
+            imu_type = 'sensor_msgs/msg/Imu'
+            text = bag_recorder.message_definition(imu_type)[1]
+            store.register(get_types_from_msg(text, imu_type))
+            sensors = {spec.name: writer.add_connection(f'/imu/{spec.name}', imu_type,
+                                                        msgdef=text,
+                                                        rihs01=store.hash_rihs01(imu_type))
+                       for spec in scene.imus}
+            imu_messages = ImuMessages(scene.imus, scene.output_joints, scene.output_points,
+                                       'mechanism')
         for i, angle in enumerate(angles):
             if i in skip:
                 continue
@@ -94,6 +109,11 @@ def write_bag(path: Path, scene, angles, *, storage='mcap', topics=tuple(TYPES),
             rendered = dict(zip(TYPES, ticks.render(state, *divmod(stamp, 10**9)), strict=True))
             for (_, topic), connection in connections.items():
                 writer.write(connection, stamp, rendered[topic])
+            if sensors:
+                values = values_from_state(state, scene.output_joints, scene.output_points)
+                for connection, data in zip(sensors.values(), imu_messages.render_values(
+                        values, *divmod(stamp, 10**9)), strict=True):
+                    writer.write(connection, stamp, data)
     return path
 
 
@@ -359,3 +379,44 @@ def copied_by_the_recorders_writer(bag: Path, destination: Path) -> Path:
             writer.write(topics[c.id], timestamp, bytes(raw))
     writer.close()
     return destination
+
+
+IMU_PANELS = {'IMU orientations', 'IMU angular velocities',
+              'IMU linear accelerations (sensor frame)'}
+
+
+def test_scene_with_imus_adds_the_imu_column(tmp_path):
+    """Issue 18: the gripper's fingertip IMU: orientation, gyro, accelerometer x and y panels."""
+    scene = mk.load_scene('gripper')
+    fig = plot.plot_scene(scene, tmp_path / 'g.png', samples=91)
+    assert set(panels(fig)) == JOINT_PANELS | POINT_PANELS | IMU_PANELS
+    assert_units_everywhere(fig)
+    state = mk.solve(scene, np.linspace(0.0, 2 * math.pi, 91))
+    reading = state.imus['fingertip']
+    accel = lines(panels(fig)['IMU linear accelerations (sensor frame)'])
+    assert set(accel) == {'fingertip x', 'fingertip y'}
+    np.testing.assert_allclose(accel['fingertip y'].get_ydata(),
+                               reading.linear_acceleration[:, 1], rtol=RTOL, atol=0)
+    gyro = lines(panels(fig)['IMU angular velocities'])['fingertip'].get_ydata()
+    np.testing.assert_allclose(gyro, reading.angular_velocity, rtol=0, atol=0)
+    # A scene without IMUs keeps its columns (test_scene_plot_has_every_panel_with_units).
+
+
+def test_bag_plot_shows_the_recorded_imu_readings(tmp_path):
+    """From a bag holding imu/fingertip: the readings drawn are those published at each tick."""
+    scene = mk.load_scene('gripper')
+    angles = scene.input.angle + scene.input.speed * 0.002 * np.arange(120)
+    bag = write_bag(tmp_path / 'bag', scene, angles, imus=True)
+    motion = plot.motion_from_bag(bag, scene=scene)
+    orientation, gyro, accel = motion.imus['fingertip']
+    expected = [mk.solve(scene, a).imus['fingertip'] for a in angles]
+    np.testing.assert_allclose(accel, [r.linear_acceleration for r in expected], rtol=RTOL,
+                               atol=0)
+    np.testing.assert_allclose(orientation, [r.orientation for r in expected], rtol=0,
+                               atol=1e-15)
+    np.testing.assert_allclose(gyro, [r.angular_velocity for r in expected], rtol=0, atol=0)
+    fig = plot.plot_bag(bag, tmp_path / 'bag.png', scene=scene)
+    assert set(panels(fig)) == JOINT_PANELS | POINT_PANELS | IMU_PANELS
+    # A bag without IMU topics has no IMU column.
+    plain = write_bag(tmp_path / 'plain', scene, angles)
+    assert not plot.motion_from_bag(plain, scene=scene).imus
