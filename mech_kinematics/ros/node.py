@@ -266,6 +266,10 @@ class KinematicsNode(LifecycleNode):
     def _value(self, name: str) -> Any:
         return self.get_parameter(name).value
 
+    def _declared(self, name: str, default: float) -> float:
+        """Return parameter ``name``'s value, or ``default`` while it is not declared yet."""
+        return float(self._value(name)) if self.has_parameter(name) else float(default)
+
     def _is_double(self, name: str) -> bool:
         return name in DOUBLES or name in self._driver_specs
 
@@ -458,6 +462,16 @@ class KinematicsNode(LifecycleNode):
         self._driver_specs = {p.name: p for p in specs}
         self._drivers_by_name = {d.name: d for d in scene.drivers}
         aliased = {new: old for old, new in self._aliases.items()}
+        keys: dict[str, list[tuple[str, str]]] = {}
+        for d in scene.drivers:
+            for p in specs:
+                if p.name.startswith(f'inputs.{d.name}.'):
+                    keys[p.name] = [(d.name, p.name.rsplit('.', 1)[1])]
+        for old, new in self._aliases.items():
+            keys[old] = keys[new]
+        keys[DRIVE[2]] = [(d.name, MAX_SPEED_KEY) for d in scene.drivers
+                          if d.joint_type == REVOLUTE]
+        self._drive_keys = keys
         self._declaring = True
         try:
             for p in specs:
@@ -482,16 +496,6 @@ class KinematicsNode(LifecycleNode):
                     raise mk.SceneError(f'{scene.name}: {result.reason}')
         finally:
             self._declaring = False
-        keys: dict[str, list[tuple[str, str]]] = {}
-        for d in scene.drivers:
-            for p in specs:
-                if p.name.startswith(f'inputs.{d.name}.'):
-                    keys[p.name] = [(d.name, p.name.rsplit('.', 1)[1])]
-        for old, new in self._aliases.items():
-            keys[old] = keys[new]
-        keys[DRIVE[2]] = [(d.name, MAX_SPEED_KEY) for d in scene.drivers
-                          if d.joint_type == REVOLUTE]
-        self._drive_keys = keys
 
     def _drive_start(self, d: Any, own_speed: bool) -> tuple[Any, float, float, float, int]:
         """Return driver ``d``'s time base start, and its (position, speed, accel, turns) then.
@@ -539,9 +543,10 @@ class KinematicsNode(LifecycleNode):
             current = self._driver.drives.get(name)
             timebase = current.timebase if current is not None else None
             now = self.get_clock().now().nanoseconds
-            if timebase is None:
-                start = {'length': d.start, 'speed': float(self._value(f'inputs.{name}.speed')),
-                         'accel': float(self._value(f'inputs.{name}.accel'))}
+            if timebase is None:    # not started: from the start values
+                start = {'length': d.start,
+                         'speed': self._declared(f'inputs.{name}.speed', d.speed),
+                         'accel': self._declared(f'inputs.{name}.accel', d.accel)}
                 timebase, now = ActuatorTimebase(0, **start), 0
             trial = copy.deepcopy(timebase)
             trial.update(now, **{key: value for key, (_, value) in change.items()})
