@@ -526,10 +526,10 @@ class KinematicsNode(LifecycleNode):
     def _stroke_refusal(self, parameters: list[Parameter]) -> str | None:
         """Return why a change of an actuator's drive is refused: it leaves the stroke at once.
 
-        From the next instant, the length is exactly known; a drive that takes
-        it out of its stroke there (at a limit, moving out) is refused. Later
-        exits are the ticks' to report (the solver refuses them, and
-        ``diagnostics`` says so).
+        The length now is exactly known; a drive that takes it out of its
+        stroke from there (at or beyond a limit, not moving back) is refused.
+        Later exits are the ticks' to report (the solver refuses them, and
+        ``diagnostics`` says so); a drive that brings the length back is taken.
         """
         changes = {}
         for p in parameters:
@@ -550,7 +550,7 @@ class KinematicsNode(LifecycleNode):
                 timebase, now = ActuatorTimebase(0, **start), 0
             trial = copy.deepcopy(timebase)
             trial.update(now, **{key: value for key, (_, value) in change.items()})
-            if trial.leaves(now, d.stroke) == 0.0:
+            if trial.moves_out(now, d.stroke):
                 length = float(trial.length(now))
                 given = ', '.join(f'{n} = {v!r}' for n, v in change.values())
                 return (f'{given}: expected a drive that keeps actuator {name} within its '

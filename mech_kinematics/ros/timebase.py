@@ -471,6 +471,24 @@ class ActuatorTimebase:
                  if root > 0]
         return float(min(times)) if times else None
 
+    def moves_out(self, t: int, stroke: tuple[float, float]) -> bool:
+        """Return whether the drive takes the length out of ``stroke`` at ``t`` (ns) at once.
+
+        True at or beyond a limit unless the drive moves it back inside (or
+        holds it still exactly at the limit); False within the stroke, even if
+        it reaches a limit later (:meth:`leaves` says when).
+        """
+        stretch, tau = self._at(t)
+        low, high = (Fraction(x) for x in stroke)
+        x, v, a = stretch.length(tau), stretch.exact_speed(tau), stretch.a
+        if low < x < high:
+            return False
+        # The sign of the motion at t: the speed's, or the acceleration's from rest.
+        motion = v if v != 0 else a
+        if x >= high:
+            return motion > 0 or (x > high and motion == 0)
+        return motion < 0 or (x < low and motion == 0)
+
     def update(self, t: int, speed: float | None = None, accel: float | None = None) -> None:
         """From instant ``t`` (ns) on, drive with the given values; ``None`` keeps one.
 

@@ -365,3 +365,20 @@ def test_actuator_bad_values_are_refused(kwargs, match):
         ActuatorTimebase(0, **kwargs)
     with pytest.raises(ValueError, match='`speed` to be finite'):
         ActuatorTimebase(0, 1.0, 0.0, 0.0).update(5, speed=math.nan)
+
+
+@pytest.mark.parametrize('length0, speed, accel, at_s, out', [
+    (1.2, 0.05, 0.0, 0.0, False),       # inside: it leaves later, not at once
+    (1.8, 0.05, 0.0, 0.0, True),        # at the end, moving out
+    (1.8, 0.0, 0.1, 0.0, True),         # at the end, accelerating out from rest
+    (1.8, 0.0, 0.0, 0.0, False),        # held still exactly at the end
+    (1.8, -0.05, 0.0, 0.0, False),      # at the end, moving back in
+    (1.0, -0.01, 0.0, 0.0, True),       # at the other end, moving out
+    (1.2, 0.05, 0.0, 13.0, True),       # beyond the end, still moving out
+    (1.9, 0.0, 0.0, 0.0, True),         # beyond the end, at rest
+    (1.9, -0.05, 0.0, 0.0, False),      # beyond the end, coming back
+])
+def test_actuator_says_whether_a_drive_moves_out_at_once(length0, speed, accel, at_s, out):
+    """At or beyond a limit and not moving back inside: out at once; inside: not yet."""
+    base = ActuatorTimebase(0, length0, speed, accel)
+    assert base.moves_out(round(at_s * NS), (1.0, 1.8)) is out
