@@ -50,7 +50,8 @@ def ros():
 class TopicNode:
     """A node with drive: topic in a namespace of its own, and what it publishes, as received."""
 
-    def __init__(self, ros, tmp_path, name, *args, input_topic=None, wait=True):
+    def __init__(self, ros, tmp_path, name, *args, input_topic=None, wait=True,
+                 input_qos=INPUT_QOS):
         self.ns = f'{SESSION}/{name}'
         self.prefix = f'{SESSION[1:]}_{name}'
         self.js = ros.collect(JointState, f'{self.ns}/joint_states')
@@ -59,7 +60,7 @@ class TopicNode:
         self.tf = ros.collect(TFMessage, '/tf')
         self.diag = ros.collect(DiagnosticArray, f'{self.ns}/diagnostics')
         self.input = ros.node.create_publisher(
-            JointState, input_topic or f'{self.ns}/input_joint_states', INPUT_QOS)
+            JointState, input_topic or f'{self.ns}/input_joint_states', input_qos)
         self.proc = NodeProcess(tmp_path, '-r', f'__ns:={self.ns}', '-p', f'scene:={SCENE}',
                                 '-p', 'drive:=topic', '-p', 'tf_rate_hz:=10000.0',
                                 '-p', f'tf_prefix:={self.prefix}', *args)
@@ -251,6 +252,32 @@ def test_the_input_topic_is_remapped_and_drive_is_read_only(ros, tmp_path):
     assert node.js[1].position[0] == 0.5 and not node.js[1].velocity
     assert any('parameter refused: drive: read-only' in line
                for line in node.proc.output().splitlines())
+
+
+def test_the_input_qos_is_overridden_like_the_publishers(ros, tmp_path):
+    """A best-effort publisher drives a node whose input's reliability is overridden.
+
+    ``qos_overrides./NS/input_joint_states.subscription.reliability:=best_effort``
+    (a reliable subscription would not match that publisher).
+    """
+    ns = f'{SESSION}/topic_qos'
+    node = TopicNode(ros, tmp_path, 'topic_qos', '-p',
+                     f'qos_overrides.{ns}/input_joint_states.subscription.reliability:='
+                     'best_effort', input_qos=QoSProfile(
+                         depth=10, reliability=ReliabilityPolicy.BEST_EFFORT))
+    sent = []
+
+    def send_until_answered():
+        # Best effort: a message sent before the match is complete is lost; send again.
+        sent.append(T0 + len(sent))
+        node.send(sent[-1], ['crank'], [0.2])
+        return node.js
+
+    try:
+        wait_for(send_until_answered, ANSWER_S, 'a state from a best-effort input')
+    finally:
+        node.stop()
+    assert stamp_ns(node.js[0]) in sent
 
 
 @pytest.mark.parametrize('args, words', [
