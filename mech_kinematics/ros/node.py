@@ -314,7 +314,7 @@ class KinematicsNode(LifecycleNode):
             if p.type_ == Parameter.Type.NOT_SET and not self.has_parameter(p.name) \
                     and spec_default_is_none(p.name):
                 continue    # declared unset: the scene gives it at configure
-            reason = refusal(p.name, p.value, self._driver_specs if self.scene else None)
+            reason = refusal(p.name, p.value, self._driver_specs or None)
             if reason is not None:
                 break
         if reason is None:
@@ -403,7 +403,7 @@ class KinematicsNode(LifecycleNode):
             if not result.successful:
                 raise mk.SceneError(f'{scene.name}: {result.reason}')
         self._declare_drivers(scene, given)
-        starts = [self._drive_start(d, d is first and given_rpm is None) for d in drivers]
+        starts = [self._drive_start(d, d is not first or given_rpm is None) for d in drivers]
         try:    # what `solve` refuses at the start, the node refuses to start with
             if len(drivers) == 1:
                 [(_, position, speed, accel, turns)] = starts
@@ -502,7 +502,8 @@ class KinematicsNode(LifecycleNode):
 
         The scene's own crank speed is driven in its own unit (rad/s), so that
         the node publishes what ``solve`` prints to the bit; the parameter shows
-        it in rpm. ``own_speed``: the first crank's speed was not given.
+        it in rpm. ``own_speed``: its speed was not given as ``crank_speed_rpm``
+        (the scene's, unless ``inputs.NAME.speed_rpm`` differs from it).
         """
         base = f'inputs.{d.name}.'
         accel = float(self._value(base + 'accel'))
@@ -511,8 +512,8 @@ class KinematicsNode(LifecycleNode):
             return (_Start(ActuatorTimebase, {'length': d.start, 'speed': speed, 'accel': accel}),
                     d.start, speed, accel, 0)
         rpm = float(self._value(base + 'speed_rpm'))
-        if own_speed or rpm == rpm_parameter(d.speed):
-            own_speed = abs(rpm) < DEFAULT_MAX_CRANK_SPEED_RPM
+        own_speed = own_speed and rpm == rpm_parameter(d.speed) \
+            and abs(rpm) < DEFAULT_MAX_CRANK_SPEED_RPM
         # A start angle beyond a turn is whole turns plus an angle within one (Crank.turns).
         turns = d.turns
         start = {'angle': d.start, 'turns': turns, 'accel': accel,
@@ -645,6 +646,7 @@ class KinematicsNode(LifecycleNode):
                  'rate_hz', 'late_ticks', 'max_catch_up_s', 'max_lateness_ms',
                  'max_relative_error', 'frame_id', 'tf_rate_hz', 'tf_prefix',
                  'use_sim_time', 'markers', 'managed')
+        names += tuple(self._driver_specs)
         settings = ', '.join(f'{name}={self._value(name)!r}' for name in names[1:])
         self.get_logger().info(
             f'scene {scene.name!r} ({self._value("scene")}): joints {list(scene.output_joints)}, '
