@@ -16,15 +16,16 @@ from .bounds import Bounds, ErrorBound, MAX_ERROR
 from .errors import (AssemblyError, MechKinematicsError, NearSingularWarning, SceneError,
                      UntrustedError)
 from .scene import DEFAULT_SCENE, load_scene, parse_scene, scene_names
-from .solver import (assembly_text, Branch, CarriedPoint, Crank, Engagement, JointMotion, Link,
-                     MAX_SLOTS, NEAR_SINGULAR, Pin, PointState, RPR, RRP, RRR, Scene, SceneUnits,
-                     SINGULAR, solve, State, TANGENCY_TOLERANCE)
+from .solver import (Actuator, assembly_text, Branch, CarriedPoint, Crank, Engagement,
+                     JointMotion, Link, MAX_SLOTS, NEAR_SINGULAR, Pin, PointState, RPR, RRP, RRR,
+                     Scene, SceneUnits, SINGULAR, solve, State, TANGENCY_TOLERANCE)
 
 #: The former name of :class:`SceneUnits` (the units a scene was written in), kept working.
 Units = SceneUnits
 
 __all__ = [
-    'AssemblyError', 'Bounds', 'Branch', 'CarriedPoint', 'Crank', 'DEFAULT_SCENE', 'Engagement',
+    'Actuator', 'AssemblyError', 'Bounds', 'Branch', 'CarriedPoint', 'Crank', 'DEFAULT_SCENE',
+    'Engagement',
     'ErrorBound', 'JointMotion', 'Link', 'MAX_ERROR', 'MAX_SLOTS', 'MechKinematicsError',
     'NEAR_SINGULAR', 'NearSingularWarning', 'Pin', 'PointState', 'RPR', 'RRP', 'RRR', 'SINGULAR',
     'Scene', 'SceneError', 'SceneUnits', 'State', 'TANGENCY_TOLERANCE', 'Units', 'UntrustedError',

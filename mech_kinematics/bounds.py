@@ -147,12 +147,19 @@ class ErrorBound:
     rubbing : dict of str to float or ndarray
         Per pin of the scene's ``pins``: the bound of its rubbing velocity, m/s
         (judged on the velocity scale).
+    floors : tuple or None
+        With several drivers (or an actuator): the least scales of speed
+        (m/s), acceleration (m/s^2), angular speed (rad/s) and angular
+        acceleration (rad/s^2) that the drivers set; ``None`` for one crank,
+        whose ``crank_length`` and rates set them.
     """
 
-    __slots__ = ('_build', '_args', '_raw', '_records', 'size', 'crank_length', 'rubbing')
+    __slots__ = ('_build', '_args', '_raw', '_records', 'size', 'crank_length', 'rubbing',
+                 'floors')
 
     def __init__(self, build: Callable[..., tuple[Table, Table]], args: tuple[Any, ...],
-                 size: float, crank_length: float) -> None:
+                 size: float, crank_length: float,
+                 floors: tuple[Any, Any, Any, Any] | None = None) -> None:
         self._build = build
         self._args = args
         self._raw: tuple[Table, Table] | None = None
@@ -160,6 +167,7 @@ class ErrorBound:
         self.size = size
         self.crank_length = crank_length
         self.rubbing: dict[str, Any] = _NO_PINS
+        self.floors = floors
 
     def raw(self) -> tuple[Table, Table]:
         """Return the joints' and the points' bounds: (position, velocity, acceleration)."""

@@ -60,6 +60,18 @@ class AssemblyError(MechKinematicsError):
         msg = f'{dyad} cannot be solved at crank angle {angle:.6g} rad: {reason}'
         super().__init__(msg)
 
+    def located(self, where: str) -> AssemblyError:
+        """Return a copy whose message says where the drivers stand (``where``).
+
+        For a scene with several drivers (or an actuator), where no single
+        crank angle says it: ``RRR C cannot be solved at crank = 0.5 rad,
+        cyl = 1.2 m: ...``.
+        """
+        copy = type(self).__new__(type(self))
+        copy.__dict__.update(self.__dict__)
+        copy.args = (f'{self.dyad} cannot be solved at {where}: {self.reason}',)
+        return copy
+
 
 class UntrustedError(AssemblyError):
     """The mechanism's state at a given crank angle cannot be trusted, so it is refused.

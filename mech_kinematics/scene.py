@@ -33,7 +33,7 @@ from typing import Any, TypedDict, TypeVar
 
 from .errors import SceneError
 from .imu import ImuSpec
-from .solver import Branch, CarriedPoint, Crank, Link, Pin, Scene, SceneUnits
+from .solver import Actuator, Branch, CarriedPoint, Crank, Link, Pin, Scene, SceneUnits
 from .solver.base import Item
 from .solver.model import IDENTIFIER
 from .solver.registry import KINDS
@@ -43,9 +43,9 @@ from .yaml12 import (_brief, _join, MAX_DEPTH, MAX_INTEGER_DIGITS, MAX_YAML_NODE
                      read_scene_yaml, SceneLoader)
 
 __all__ = [
-    'DEFAULT_SCENE', 'MAX_CARRIED_POINTS', 'MAX_DEPTH', 'MAX_DYADS', 'MAX_FILE_BYTES',
-    'MAX_GROUND_POINTS', 'MAX_IMUS', 'MAX_INTEGER_DIGITS', 'MAX_MESSAGE', 'MAX_PINS',
-    'MAX_YAML_NODES',
+    'DEFAULT_SCENE', 'MAX_CARRIED_POINTS', 'MAX_DEPTH', 'MAX_DRIVERS', 'MAX_DYADS',
+    'MAX_FILE_BYTES', 'MAX_GROUND_POINTS', 'MAX_IMUS', 'MAX_INTEGER_DIGITS', 'MAX_MESSAGE',
+    'MAX_PINS', 'MAX_YAML_NODES',
     'SceneLoader',
     'load_scene', 'parse_scene', 'read_scene_yaml', 'scene_dirs', 'scene_names', 'scene_text',
 ]
@@ -66,6 +66,8 @@ MAX_CARRIED_POINTS = 10_000
 MAX_PINS = 10_000
 #: Most inertial sensors (``imus:``) in a scene.
 MAX_IMUS = 10_000
+#: Most drivers (``inputs:``) in a scene.
+MAX_DRIVERS = 100
 
 #: The two spellings of ``units`` every refusal of a missing or bad one shows.
 UNITS_EXAMPLES = 'units: {length: mm, angle: deg} or units: {length: m, angle: rad}'
@@ -100,6 +102,7 @@ class SceneDict(TypedDict, total=False):
     units: dict[str, str]
     ground: dict[str, list[float]]
     input: InputDict
+    inputs: list[dict[str, Any]]
     dyads: list[dict[str, Any]]
     points: dict[str, dict[str, Any]]
     outputs: dict[str, list[str]]
@@ -282,23 +285,25 @@ def parse_scene(data: Any) -> Scene:
               for key, value in ground_data.items()}
 
     keys = _Keys()
-    raw = reader.get(data, 'input', '')
-    _check_keys(raw if isinstance(raw, dict) else {}, set(InputDict.__annotations__), 'input')
-    rpm = reader.number(raw, 'speed_rpm', 'input', 0.0)
-    angle, turns = reader.start_angle(raw, 'angle', 'input')
-    crank = keys.build(
-        'input', {'speed': 'speed_rpm'}, Crank,
-        link=reader.name(raw, 'link', 'input'), center=reader.name(raw, 'center', 'input'),
-        point=reader.name(raw, 'point', 'input'), length=reader.length(raw, 'length', 'input'),
-        angle=angle, turns=turns, speed=rad_per_s_from_rpm(rpm),
-        accel=reader.number(raw, 'accel', 'input', 0.0))
+    if 'input' in data and 'inputs' in data:
+        raise SceneError('inputs: expected either input (one crank) or inputs (a list of '
+                         'drivers), got both')
+    if 'input' not in data and 'inputs' not in data:
+        raise SceneError('input: missing required key (or inputs: a list of drivers)')
+    crank: Crank | None = None
+    drivers: tuple[Crank | Actuator, ...] = ()
+    reading = _Reading(reader, keys)
+    if 'input' in data:
+        crank = _crank(reader, keys, data['input'], 'input')
+    else:
+        drivers = _drivers(reading, data['inputs'])
+        reading.actuators = {d.name: d.start for d in drivers if d.joint_type == 'prismatic'}
 
     dyads_data = data.get('dyads', []) or []
     if not isinstance(dyads_data, list):
         raise SceneError(f'dyads: expected a list, got {_kind(dyads_data)}')
     _check_count('dyads', dyads_data, MAX_DYADS, 'MAX_DYADS', 'dyads')
-    dyads = [_dyad(reader, keys, item, f'dyads[{index}]')
-             for index, item in enumerate(dyads_data)]
+    dyads = [_dyad(reading, item, f'dyads[{index}]') for index, item in enumerate(dyads_data)]
 
     points_data = data.get('points', {}) or {}
     if not isinstance(points_data, dict):
@@ -332,7 +337,7 @@ def parse_scene(data: Any) -> Scene:
         return Scene(name=name, ground=ground, input=crank, dyads=tuple(dyads),
                      points=tuple(points), outputs_joints=selected['joints'],
                      outputs_points=selected['points'], description=description,
-                     pins=tuple(pins), units=reader.units, imus=imus)
+                     pins=tuple(pins), units=reader.units, imus=imus, inputs=drivers)
     except SceneError as error:
         raise SceneError(f'{keys.key(error)}: {error}') from None
 
@@ -345,14 +350,46 @@ def _link(reader: _Reader, keys: _Keys, raw: Any, where: str) -> Link:
                       length=reader.length(raw, 'length', where))
 
 
-def _dyad(reader: _Reader, keys: _Keys, raw: Any, where: str) -> Item:
-    kind = reader.get(raw, 'type', where)
+def _crank(reader: _Reader, keys: _Keys, raw: Any, where: str) -> Crank:
+    """Return the crank written at ``where`` (``input``, or an entry of ``inputs``)."""
+    _check_keys(raw if isinstance(raw, dict) else {}, set(InputDict.__annotations__), where)
+    rpm = reader.number(raw, 'speed_rpm', where, 0.0)
+    angle, turns = reader.start_angle(raw, 'angle', where)
+    return keys.build(
+        where, {'speed': 'speed_rpm'}, Crank,
+        link=reader.name(raw, 'link', where), center=reader.name(raw, 'center', where),
+        point=reader.name(raw, 'point', where), length=reader.length(raw, 'length', where),
+        angle=angle, turns=turns, speed=rad_per_s_from_rpm(rpm),
+        accel=reader.number(raw, 'accel', where, 0.0))
+
+
+def _drivers(reading: _Reading, raw: Any) -> tuple[Crank | Actuator, ...]:
+    """Return the drivers of ``inputs``: cranks (``link:``) and actuators (``actuator:``)."""
+    if not isinstance(raw, list) or not raw:
+        raise SceneError(f'inputs: expected a list of at least one driver (a crank with link: '
+                         f'or an actuator with actuator:), got {_brief(raw)}')
+    _check_count('inputs', raw, MAX_DRIVERS, 'MAX_DRIVERS', 'drivers')
+    drivers: list[Crank | Actuator] = []
+    for index, item in enumerate(raw):
+        where = f'inputs[{index}]'
+        if isinstance(item, dict) and 'actuator' in item:
+            drivers.append(Actuator.from_scene(reading, item, where))
+        elif isinstance(item, dict) and 'link' in item:
+            drivers.append(_crank(reading.reader, reading.keys, item, where))
+        else:
+            raise SceneError(f'{where}: expected a crank (with link:) or an actuator (with '
+                             f'actuator:), got {_brief(item)}')
+    return tuple(drivers)
+
+
+def _dyad(reading: _Reading, raw: Any, where: str) -> Item:
+    kind = reading.get(raw, 'type', where)
     item = KINDS.get(kind) if isinstance(kind, str) else None
     if item is None:
         *first, last = KINDS
         raise SceneError(f'{where}.type: expected {", ".join(first)} or {last}, got '
                          f'{_brief(kind)}')
-    return item.from_scene(_Reading(reader, keys), raw, where)
+    return item.from_scene(reading, raw, where)
 
 
 class _Reading:
@@ -361,8 +398,19 @@ class _Reading:
     def __init__(self, reader: _Reader, keys: _Keys) -> None:
         self.reader, self.keys = reader, keys
         self.get, self.name, self.length = reader.get, reader.name, reader.length
+        self.number = reader.number
         self.angle, self.branch = reader.angle, reader.branch
         self.build = keys.build
+        #: The scene's actuators: name -> length at time zero, m.
+        self.actuators: dict[str, float] = {}
+
+    def actuator_length(self, name: str, where: str) -> float:
+        """Return the length at time zero, m, of the scene's actuator ``name``."""
+        if name not in self.actuators:
+            known = ', '.join(self.actuators) or 'none'
+            raise SceneError(f'{where}: expected the name of an actuator of inputs ({known}), '
+                             f'got {_brief(name)}')
+        return self.actuators[name]
 
     @staticmethod
     def check_keys(mapping: Any, allowed: set[str], where: str) -> None:

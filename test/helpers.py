@@ -31,6 +31,29 @@ ROOT = HERE.parent
 SCENES = HERE.parent / 'config' / 'scenes'
 
 
+# --- the packaged scenes by their drivers ----------------------------------------------
+# Tests that sweep one crank's angle (geometry, diagrams, the reference's time
+# differences) take the scenes driven by one crank; test/solver/test_drivers.py
+# and the several-driver tests of each tool take the others (issue 18).
+
+
+def crank_scene_names() -> list[str]:
+    """Return the packaged scenes driven by one crank (``input:``), sorted."""
+    return [name for name in mk.scene_names() if len(mk.load_scene(name).drivers) == 1
+            and mk.load_scene(name).input is not None]
+
+
+def start_positions(scene: Any) -> Any:
+    """Return where ``scene``'s drivers start: the crank angle, or one position per driver."""
+    drivers = scene.drivers
+    return drivers[0].start if len(drivers) == 1 else [d.start for d in drivers]
+
+
+def driver_scene_names() -> list[str]:
+    """Return the packaged scenes with several drivers or an actuator (``inputs:``), sorted."""
+    return sorted(set(mk.scene_names()) - set(crank_scene_names()))
+
+
 # --- the published 50-digit reference cases ------------------------------------
 # Used by test_linkage_golden.py (the solver against them) and test_reference.py
 # (the mpmath reference against them).

@@ -176,6 +176,8 @@ def test_quoted_solve_errors_are_the_real_ones():
                                                           '--angle-deg', '150'),
         'input crank cannot be solved at crank angle 60 deg': ('khurmi_four_bar_ad150',
                                                                '--speed-rpm', '1e160'),
+        'input stick_cyl cannot be solved at boom_cyl = 2.6 m, stick_cyl = 4.2 m': (
+            'excavator', '--input', 'stick_cyl=4.2'),
     }
     for line in quoted:
         args = next((a for key, a in commands.items() if key in line), None)

@@ -20,7 +20,7 @@ import re
 import subprocess
 import sys
 
-from helpers import BASE_SCENE as BASE
+from helpers import BASE_SCENE as BASE, start_positions
 import numpy as np
 import pytest
 import yaml
@@ -293,7 +293,7 @@ def test_packaged_scene_loads_and_solves(path):
     """Every packaged scene loads by path and by name and solves at its initial angle."""
     scene = mk.load_scene(path)
     assert mk.load_scene(path.stem) == scene
-    state = mk.solve(scene, scene.input.angle)
+    state = mk.solve(scene, start_positions(scene))
     for point in state.points.values():
         for value in (point.position, point.velocity, point.acceleration):
             assert np.all(np.isfinite(value))
@@ -328,7 +328,7 @@ def test_solve_command_answers_every_packaged_scene(path):
         status = main(['solve', path.stem])
     assert status == 0
     scene = mk.load_scene(path)
-    assert_same(json.loads(out.getvalue()), mk.solve(scene, scene.input.angle).as_dict())
+    assert_same(json.loads(out.getvalue()), mk.solve(scene, start_positions(scene)).as_dict())
 
 
 # --- units and outputs ----------------------------------------------------------------

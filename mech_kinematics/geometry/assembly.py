@@ -59,7 +59,7 @@ import warnings
 import numpy as np
 import numpy.typing as npt
 
-from .instant_centres import full_scene
+from .instant_centres import full_scene, one_driver
 from ..errors import AssemblyError, NearSingularWarning
 from ..solver import assembly_margins, Scene, SceneUnits, solve
 
@@ -250,6 +250,7 @@ def assembly_from_scene(scene: Scene, samples: int = SAMPLES) -> Assembly:
     -------
     Assembly
     """
+    one_driver(scene, "assembly over one crank's turn")
     probe = _Probe(scene, samples)
     ranges = _ranges(probe)
     gaps = _gaps(ranges)

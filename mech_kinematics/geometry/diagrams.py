@@ -38,7 +38,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .instant_centres import (bodies_from_scene, BodyKind, check_full_state, full_scene, GROUND,
-                              instant_centres_from_state, InstantCentres, Topology)
+                              instant_centres_from_state, InstantCentres, one_driver, Topology)
 from ..errors import NearSingularWarning
 from ..solver import Scene, solve, State
 from ..units import turns_from_degrees
@@ -352,7 +352,9 @@ def _coincident(pin: str) -> str:
 
 def _edges(scene: Scene, state: State) -> list[_Edge]:
     """Every link's relative motions, in the order the solver places the points."""
+    one_driver(scene, "velocity and acceleration polygons (one driver's)")
     crank = scene.input
+    assert crank is not None  # one_driver refuses a scene without
     edges = [_Edge(crank.link, crank.center, crank.point)]
     for item in (*scene.dyads, *scene.points):
         for body, start, end, slider in item.edges():
@@ -622,12 +624,14 @@ def strokes_from_scene(scene: Scene,
     Returns
     -------
     dict of str to (float, float)
-        ``(s_min, s_max)`` over the angles at which the mechanism assembles.
+        ``(s_min, s_max)`` over the angles at which the mechanism assembles;
+        empty for a scene with several drivers (no one crank's turn: guides
+        are then drawn around their blocks).
     """
     scene = full_scene(scene)
     sliders = [body for d in scene.dyads for body, _, _, guide in d.members(GROUND)
                if guide == GROUND]
-    if not sliders:
+    if not sliders or scene.input is None or len(scene.drivers) > 1:
         return {}
     angles = np.linspace(0.0, 2.0 * math.pi, samples, endpoint=False)
     with warnings.catch_warnings():
@@ -734,7 +738,8 @@ def arrows_from_state(scene: Scene, state: State, velocity_scale: float,
 
 def _values(scene: Scene, state: State,
             topology: Topology) -> tuple[tuple[LinkValues, ...], tuple[SliderValues, ...]]:
-    lengths: dict[str, float | None] = {scene.input.link: scene.input.length}
+    lengths: dict[str, float | None] = {driver.name: driver.length for driver in scene.drivers
+                                        if driver.joint_type == 'revolute'}
     for dyad in scene.dyads:
         lengths.update(dyad.link_lengths())
     links = []
@@ -792,6 +797,7 @@ def diagram_from_scene(scene: Scene, angle: float | None = None, speed: float | 
         If the mechanism cannot be assembled at ``angle``.
     """
     scene = full_scene(scene)
+    one_driver(scene, "velocity and acceleration polygons (one driver's)")
     if angle is None:
         theta, turns = scene.input.angle, scene.input.turns
     elif degrees and abs(angle) > 360.0:  # counted from the start: whole turns read exactly

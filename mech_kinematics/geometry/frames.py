@@ -68,8 +68,9 @@ def child_frame(prefix: str, name: str) -> str:
 def frames_from_scene(scene: Scene, joints: Sequence[str] | None = None) -> tuple[FrameSpec, ...]:
     """Return the frames of ``joints`` (default: the scene's output joints), in that order."""
     specs: dict[str, FrameSpec] = {}
-    crank = scene.input
-    specs[crank.link] = FrameSpec(crank.link, crank.center, crank.link)
+    for driver in scene.drivers:
+        for joint, origin, angle_of, angle in driver.frames():
+            specs[joint] = FrameSpec(joint, origin, angle_of, angle)
     for dyad in scene.dyads:
         for joint, origin, angle_of, angle in dyad.frames():
             specs[joint] = FrameSpec(joint, origin, angle_of, angle)

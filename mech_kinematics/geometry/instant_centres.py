@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from ..errors import SceneError
 from ..solver import Scene, State
 
 __all__ = [
@@ -159,8 +160,9 @@ def bodies_from_scene(scene: Scene) -> Topology:
         fixed = points.setdefault(body, [])
         fixed.extend(member for member in members if member not in fixed)
 
-    crank = scene.input
-    add(crank.link, BodyKind.CRANK, crank.center, crank.point)
+    for driver in scene.drivers:
+        for body, kind, members, _ in driver.members(ground):
+            add(body, BodyKind(kind), *members)
     slides: list[tuple[str, str]] = []
     for dyad in scene.dyads:
         for body, kind, members, guide in dyad.members(ground):
@@ -182,7 +184,7 @@ def bodies_from_scene(scene: Scene) -> Topology:
 
 
 def _names(scene: Scene) -> set[str]:
-    names = {scene.input.link}
+    names = {driver.name for driver in scene.drivers}
     for dyad in scene.dyads:
         names.update(dyad.joint_types())
     return names
@@ -302,6 +304,20 @@ def _pairs(topology: Topology) -> list[tuple[str, str]]:
     return list(itertools.combinations(topology.bodies, 2))
 
 
+def one_driver(scene: Scene, what: str) -> None:
+    """Refuse, in one line, a scene with several drivers where ``what`` needs one crank.
+
+    Velocity polygons and Kennedy's instant centres describe a mechanism of
+    one degree of freedom driven by one crank (issue 18).
+    """
+    drivers = scene.drivers
+    if scene.input is None or len(drivers) > 1:
+        names = ', '.join(driver.name for driver in drivers)
+        msg = (f'Expected a scene driven by one crank for {what}, got scene "{scene.name}" '
+               f'with {len(drivers)} driver{"s" * (len(drivers) > 1)} ({names})')
+        raise SceneError(msg)
+
+
 def check_full_state(topology: Topology, scene: Scene, state: State) -> None:
     """Refuse anything but the state of one crank angle of the full ``scene``."""
     if isinstance(state.valid, np.ndarray):
@@ -378,6 +394,7 @@ def instant_centres_from_state(scene: Scene, state: State) -> InstantCentres:
         If ``state`` is not of one crank angle or misses points or joints, or
         two bodies that share no joint have the same motion.
     """
+    one_driver(scene, "instant centres (one driver's)")
     topology = bodies_from_scene(scene)
     check_full_state(topology, scene, state)
     size = _size(state)
@@ -465,6 +482,7 @@ def instant_centres_from_kennedy(scene: Scene, state: State) -> InstantCentres:
         The centres that could be found (all of them for a four-bar or a
         slider-crank), in Kennedy numbering order.
     """
+    one_driver(scene, "instant centres (one driver's)")
     topology = bodies_from_scene(scene)
     check_full_state(topology, scene, state)
     size = _size(state)

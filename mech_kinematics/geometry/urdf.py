@@ -30,6 +30,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 import math
+from typing import Any
 import warnings
 import xml.etree.ElementTree as ET
 
@@ -94,7 +95,15 @@ def _pin(x: float, y: float, radius: float) -> Visual:
 
 
 def _assembled(scene: Scene) -> State:
-    """Return the full state at the scene's crank angle, or the first angle that assembles."""
+    """Return the full state at the scene's crank angle, or the first angle that assembles.
+
+    A scene with several drivers (or an actuator) is drawn where its drivers start.
+    """
+    drivers = scene.drivers
+    if scene.input is None or len(drivers) > 1:
+        with warnings.catch_warnings():
+            warnings.simplefilter('ignore', NearSingularWarning)
+            return solve(scene, [driver.start for driver in drivers])
     angles = scene.input.angle + np.linspace(0.0, 2 * math.pi, SAMPLES, endpoint=False)
     with warnings.catch_warnings():
         warnings.simplefilter('ignore', NearSingularWarning)
@@ -105,6 +114,11 @@ def _assembled(scene: Scene) -> State:
                    f'URDF, got none of {SAMPLES} angles over a turn')
             raise AssemblyError(msg)
         return solve(scene, float(angles[valid[0]]))
+
+
+def _stroke(actuator: Any) -> tuple[float, float]:
+    """Return an actuator's shortest and longest lengths, m (its start where it has no stroke)."""
+    return actuator.stroke if actuator.stroke is not None else (actuator.start, actuator.start)
 
 
 def _local(origin: complex, angle: float, point: complex) -> tuple[float, float]:
@@ -141,19 +155,37 @@ def visuals_from_scene(scene: Scene, frames: Sequence[FrameSpec] | None = None,
     size = float(np.hypot(*(high - low))) or 1.0
     width, radius = BAR_WIDTH * size, PIN_RADIUS * size
     topology = bodies_from_scene(full)
+    # An actuator is a prismatic joint between its two pins: the cylinder's body (the
+    # link it drives, at its start pin) is drawn as a barrel as long as the actuator
+    # at its shortest, its rod (the actuator's frame, at the other pin) reaching back
+    # by the stroke.
+    actuators = {d.name: d for d in full.drivers if d.joint_type == 'prismatic'}
+    cylinders = {frame.angle_of: actuators[frame.joint] for frame in frames_from_scene(
+        full, tuple(full.joint_types)) if frame.joint in actuators}
     # A link whose length varies (a slotted lever) is drawn out to the farthest its
     # pin slides: each kind says which of its links vary and between which points.
     levers = {}
     for item in full.dyads:
-        varying = {link for link, length in item.link_lengths().items() if length is None}
+        varying = {link for link, length in item.link_lengths().items()
+                   if length is None and link not in cylinders}
         levers.update({link: (start, end) for link, start, end, _ in item.edges()
                        if link in varying})
     points = {name: complex(p) for name, (p, _, _) in state.complex_points.items()}
     visuals: dict[str, list[Visual]] = {}
     for frame, pose in zip(frames, poses_from_state(frames, state), strict=True):
         origin = complex(pose.x, pose.y)
-        body = topology.bodies[frame.joint]
         shapes: list[Visual] = []
+        if frame.joint in actuators or frame.joint in cylinders:
+            shortest, longest = _stroke(actuators.get(frame.joint) or cylinders[frame.joint])
+            if frame.joint in actuators:  # the rod, from its pin back into the barrel
+                shapes.append(_bar(-(longest - shortest) - 0.1 * shortest, 0.0, 0.6 * width,
+                                   'slider'))
+            else:  # the barrel, from its pin
+                shapes.append(_bar(0.9 * shortest, 0.0, 1.8 * width, 'link'))
+            shapes.append(_pin(0.0, 0.0, radius))
+            visuals[frame.joint] = shapes
+            continue
+        body = topology.bodies[frame.joint]
         if body.kind is BodyKind.SLIDER:
             shapes.append(Visual('box', (BLOCK_LENGTH * size, 2.5 * width, 1.5 * width),
                                  (0.0, 0.0, 0.0), 0.0, 'slider'))
@@ -226,9 +258,24 @@ def urdf_from_scene(scene: Scene, frame_id: str = 'mechanism', prefix: str = '')
         for name, (x, y) in scene.ground.items()]
     attachments += [(child_frame(prefix, joint), shapes, None)
                     for joint, shapes in visuals.items()]
+    # An actuator's rod hangs on its cylinder's body by a prismatic joint along it.
+    rods = {child_frame(prefix, frame.joint): (child_frame(prefix, frame.angle_of), frame.joint)
+            for frame in frames_from_scene(scene) if frame.angle_of is not None
+            and scene.joint_types.get(frame.joint) == 'prismatic'
+            and frame.joint in {d.name for d in scene.drivers}}
     for child, shapes, at in attachments:
         link = ET.SubElement(robot, 'link', name=child)
         _add_visuals(link, shapes)
+        if child in rods:
+            body, name = rods[child]
+            element = ET.SubElement(robot, 'joint', name=joint_name(child), type='prismatic')
+            ET.SubElement(element, 'parent', link=body)
+            ET.SubElement(element, 'child', link=child)
+            ET.SubElement(element, 'axis', xyz='1 0 0')
+            low, high = _stroke(next(d for d in scene.drivers if d.name == name))
+            ET.SubElement(element, 'limit', lower=_fmt(low), upper=_fmt(high), effort='0',
+                          velocity='0')
+            continue
         element = ET.SubElement(robot, 'joint', name=joint_name(child),
                                 type='floating' if at is None else 'fixed')
         ET.SubElement(element, 'parent', link=frame_id)

@@ -25,8 +25,8 @@ The package holds one module per concern and one per step kind:
 - :mod:`.base`: the protocol every step kind follows (and the kernel subset
   of a step's ``run`` the node's tick compiles); :mod:`.registry` maps the
   scene's ``type:`` to the kind;
-- :mod:`.crank`, :mod:`.rrr`, :mod:`.rrp`, :mod:`.rpr`, :mod:`.geneva`, :mod:`.rpp`,
-  :mod:`.carried`, :mod:`.rubbing`: the kinds, each with its item, its
+- :mod:`.crank`, :mod:`.actuator`, :mod:`.rrr`, :mod:`.rrp`, :mod:`.rpr`,
+  :mod:`.geneva`, :mod:`.rpp`, :mod:`.carried`, :mod:`.rubbing`: the kinds, each with its item, its
   validation and its step (kernel and error bounds);
 - :mod:`.context`: one solve's values and the roundoff constants;
 - :mod:`.plan`: the plan compiler; :mod:`.scaling`: power-of-two rescaling;
@@ -34,6 +34,7 @@ The package holds one module per concern and one per step kind:
   :mod:`.state`: :class:`State` and what it holds.
 """
 
+from .actuator import Actuator
 from .carried import CarriedPoint
 from .context import NEAR_SINGULAR, SINGULAR
 from .crank import Crank
@@ -49,7 +50,8 @@ from .solve import assembly_margins, solve
 from .state import Engagement, JointMotion, PointState, State
 
 __all__ = [
-    'Branch', 'CarriedPoint', 'Crank', 'Engagement', 'JointMotion', 'Link', 'MAX_SLOTS',
+    'Actuator', 'Branch', 'CarriedPoint', 'Crank', 'Engagement', 'JointMotion', 'Link',
+    'MAX_SLOTS',
     'NEAR_SINGULAR', 'Pin', 'PointState', 'RPP', 'RPR', 'RRP', 'RRR', 'SINGULAR', 'Scene', 'State',
     'SceneUnits', 'TANGENCY_TOLERANCE', 'assembly_margins', 'assembly_text', 'solve',
 ]

@@ -220,11 +220,17 @@ class Reading(Protocol):
     def length(self, mapping: Any, key: str, where: str, positive: bool = True) -> float:
         """Return the length at ``key``, m."""
 
+    def number(self, mapping: Any, key: str, where: str, default: Any = ...) -> float:
+        """Return the finite number at ``key``, as written (no unit applied)."""
+
     def angle(self, mapping: Any, key: str, where: str, default: Any = ...) -> float:
         """Return the angle at ``key``, rad."""
 
     def branch(self, mapping: Any, where: str) -> Branch:
         """Return the ``branch`` key (default +1)."""
+
+    def actuator_length(self, name: str, where: str) -> float:
+        """Return the length at time zero, m, of the scene's actuator ``name``."""
 
     def check_keys(self, mapping: Any, allowed: set[str], where: str) -> None:
         """Refuse any key of ``mapping`` outside ``allowed``."""

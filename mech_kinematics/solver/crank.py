@@ -4,14 +4,15 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, replace
 import math
 from typing import Any
 
 import numpy as np
 
 from .context import _Context, _U2, _U4
-from .model import _check_finite, _check_length, _check_name
+from .model import _check_finite, _check_length, _check_name, SceneUnits
 from ..bounds import U
 from ..errors import SceneError
 
@@ -90,14 +91,56 @@ class Crank:
         """A crank has no stroke limits."""
         return None
 
+    @property
+    def reach(self) -> float:
+        """Its length, m: what it adds to the mechanism's size."""
+        return self.length
+
+    def position_text(self, value: float, units: SceneUnits) -> str:
+        """Return an angle (rad) of it as text in the scene's unit."""
+        return units.angle_text(value)
+
+    def scaled(self, scale: Callable[[float], float]) -> Crank:
+        """Return it with its length scaled."""
+        return replace(self, length=scale(self.length))
+
+    def members(self, ground: str) -> tuple[tuple[str, str, tuple[str, ...], str | None], ...]:
+        """Return its body (:data:`~.base.Member`): the crank, carrying its centre and tip."""
+        return ((self.link, 'crank', (self.center, self.point), None),)
+
+    def frames(self) -> tuple[tuple[str, str, str | None, float], ...]:
+        """Return its joint's frame (:data:`~.base.Frame`): at its centre, along it."""
+        return ((self.link, self.center, self.link, 0.0),)
+
+    def defined(self) -> tuple[tuple[str, str], ...]:
+        """Return (name, kind) of the names it defines: its link and its tip."""
+        return (self.link, 'link'), (self.point, 'point')
+
+    def local(self, ground: Mapping[str, complex]) -> dict[str, dict[str, complex]]:
+        """Return the points fixed on its link: its centre and its tip."""
+        return {self.link: {self.center: 0j, self.point: complex(self.length)}}
+
+    def step(self, ground: Mapping[str, complex]) -> _CrankStep:
+        """Return its step; its centre must be a ground point."""
+        if self.center not in ground:
+            msg = f'Expected the crank center to be a ground point, got "{self.center}"'
+            raise SceneError(msg, (self, 'center'))
+        return _CrankStep(self, ground[self.center])
+
 
 class _CrankStep:
+    joint_type = 'revolute'
+
     def __init__(self, crank: Crank, center: complex) -> None:
+        self.name = crank.link
+        self.label = f'input {crank.link}'
+        self.unit = 1.0
         self.link = crank.link
         self.point = crank.point
         self.center = center
         self.length = crank.length
         self.uses: tuple[str, ...] = (crank.center,)
+        self.defines = (crank.link, crank.point)
         # The tip's sum ``center + r``: the centre's rounding and the sum's.
         self.e_center = U * (2.0 * abs(center) + crank.length)
         # r = length * e: the length's rounding and the product's; then those of
@@ -125,6 +168,16 @@ class _CrankStep:
                                   re + self.e_r + self.e_center, w * (re + self.e_v),
                                   (abs(alpha) + w * w) * (re + self.e_a))
         ctx.links[self.link] = (e, omega, alpha, ee + _U4, U * w, U * abs(alpha))
+
+    def floors(self, speed: Any, accel: Any, size: float) -> tuple[Any, Any, Any, Any]:
+        """Return what it adds to the least scales: its tip's speed and acceleration, its rates.
+
+        ``a |omega|``, ``a (omega^2 + |alpha|)``, ``|omega|`` and
+        ``omega^2 + |alpha|`` for its length ``a``.
+        """
+        w = abs(speed)
+        rate = w * w + abs(accel)
+        return self.length * w, self.length * rate, w, rate
 
 
 # Every complex product below has one real factor or a purely imaginary one

@@ -234,6 +234,10 @@ def _index_step(plan: Placing, item: RPR) -> _IndexStep:
     """Return the step of an intermittent lever; check its pin and its tangential entry."""
     scene, ground, size = plan.scene, plan.ground, plan.size
     crank = scene.input
+    if crank is None or len(scene.drivers) != 1:
+        msg = (f'Expected the intermittent RPR "{item.link}" in a scene driven by one crank, '
+               f'got {len(scene.drivers)} drivers')
+        raise SceneError(msg, (item, 'slots'))
     crank_local = plan.local[crank.link]
     units: SceneUnits = getattr(scene, 'units', SceneUnits())
     n = cast(int, item.slots)

@@ -12,9 +12,12 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 import math
-from typing import cast
+from typing import Any, cast
 import warnings
 
+import numpy as np
+
+from .actuator import Actuator
 from .base import Intermittent, Item
 from .carried import CarriedPoint
 from .crank import Crank
@@ -23,7 +26,7 @@ from .plan import _compile, _Plan
 from .registry import FACT_TEXTS
 from .rubbing import Pin
 from .scaling import _ANGULAR, _exponent, _LINEAR, _scaled, _size, _SIZE_RANGE
-from .solve import _execute, TRUST_TEST
+from .solve import _execute, _execute_drivers, TRUST_TEST
 from ..bounds import U
 from ..errors import AssemblyError, NearSingularWarning, SceneError
 from ..imu import imu_outputs, ImuSpec
@@ -42,7 +45,12 @@ class _Solver:
     def __init__(self, scene: Scene, plan: _Plan) -> None:
         self.plan = plan
         self.size = _size(scene)
-        self.crank_length = scene.input.length
+        crank = scene.input
+        # The first driver's length where it is a crank (0 in a scene driven by actuators
+        # only): with the crank's rates, the least scale of the linear kinds.
+        self.crank_length = 0.0 if crank is None else crank.length
+        #: Whether the scene has one driver, a crank (the v1 path of solve).
+        self.single = crank is not None and len(scene.drivers) == 1
         self.shift = _exponent(self.size, *_SIZE_RANGE)
         run = plan
         if self.shift:
@@ -59,8 +67,9 @@ class _Solver:
         self.run_plan = run
         # Ground points are inputs: known to U |g|.
         self.ground = {name: (z, 0j, 0j, U * abs(z), 0.0, 0.0) for name, z in run.ground.items()}
-        crank = scene.input
-        labels = dict.fromkeys((crank.link, crank.point), f'input {crank.link}')
+        labels: dict[str, str] = {}
+        for driver in plan.drivers:
+            labels.update(dict.fromkeys(driver.defines, driver.label))
         labels.update((name, f'ground {name}') for name in plan.ground)
         rank = dict.fromkeys(labels, 0)
         self.measure_keys: dict[str, str] = {}
@@ -89,6 +98,31 @@ class _Solver:
         # The quick trust test's groups (TRUST_TEST), with their names, the empty ones left out.
         self.trust = tuple((table, getattr(self, names), limits)
                            for table, names, limits in TRUST_TEST if getattr(self, names))
+        # The drivers' steps (in the plan's units) and the names they report.
+        self.drivers = run.drivers
+        self.driver_names = tuple(driver.name for driver in run.drivers)
+        self.driver_types = tuple(driver.joint_type for driver in run.drivers)
+
+    def floors(self, speeds: Any, accels: Any) -> tuple[Any, Any, Any, Any]:
+        """Return the least scales of speed, acceleration and turning rates from the drivers.
+
+        Each driver's floors (its step's ``floors``: a crank's tip speed and
+        rates, an actuator's rate), the largest of each kind; SI units.
+        ``speeds`` and ``accels`` are the drivers' rates, SI.
+        """
+        size = self.size
+        result: list[Any] = []
+        for step, speed, accel in zip(self.plan.drivers, speeds, accels, strict=True):
+            floors = step.floors(speed, accel, size)
+            if not result:
+                result = list(floors)
+                continue
+            for index, value in enumerate(floors):
+                if isinstance(value, np.ndarray) or isinstance(result[index], np.ndarray):
+                    result[index] = np.fmax(result[index], value)
+                else:
+                    result[index] = max(result[index], value)
+        return result[0], result[1], result[2], result[3]
 
 
 def _jumping(plan: _Plan, lever: str) -> tuple[tuple[str, ...], tuple[str, ...]]:
@@ -132,8 +166,10 @@ class Scene:
         Identifier of the scene.
     ground : mapping of str to (float, float)
         Fixed points, m.
-    input : Crank
-        The driving crank.
+    input : Crank or None
+        The driving crank of a scene with one crank (``inputs`` empty). Given
+        ``inputs``, it is set to their first driver where that is a crank,
+        else ``None``.
     dyads : tuple of RRR, RRP or RPR
         The dyads, solved in dependency order (file order where free).
     points : tuple of CarriedPoint
@@ -149,11 +185,15 @@ class Scene:
     imus : tuple of ImuSpec
         Inertial sensors on moving links (:mod:`mech_kinematics.imu`); the
         outputs always hold each one's link and point.
+    inputs : tuple of Crank or Actuator
+        The drivers of a scene with several (or with an actuator), in order;
+        a scene has ``input`` or ``inputs``, not both. Each is named by its
+        crank link or its actuator, a name used once in the scene.
     """
 
     name: str
     ground: Mapping[str, tuple[float, float]]
-    input: Crank
+    input: Crank | None = None
     dyads: tuple[Item, ...] = ()
     points: tuple[CarriedPoint, ...] = ()
     outputs_joints: tuple[str, ...] | None = None
@@ -162,28 +202,56 @@ class Scene:
     pins: tuple[Pin, ...] = ()
     units: SceneUnits = SceneUnits()
     imus: tuple[ImuSpec, ...] = ()
+    inputs: tuple[Crank | Actuator, ...] = ()
     _plan: _Plan = field(init=False, repr=False, compare=False)
     _solver: _Solver = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         """Validate the fields."""
         _check_name(self.name, 'the scene name', (self, 'name'))
+        inputs = tuple(self.inputs)
+        object.__setattr__(self, 'inputs', inputs)
+        first = inputs[0] if inputs else None
+        if inputs and self.input is not None and self.input != first:
+            msg = ('Expected a scene to have either input (one crank) or inputs (a list of '
+                   'drivers), got both')
+            raise SceneError(msg, (self, 'inputs'))
+        if not inputs and self.input is None:
+            msg = 'Expected a scene to have input (one crank) or inputs (a list of drivers)'
+            raise SceneError(msg, (self, 'input'))
+        if first is not None:
+            crank = cast(Crank, first) if first.joint_type == 'revolute' else None
+            object.__setattr__(self, 'input', crank)
         object.__setattr__(self, 'dyads', tuple(self.dyads))
         object.__setattr__(self, 'points', tuple(self.points))
         object.__setattr__(self, 'pins', tuple(self.pins))
         full = _compile(self, None, None)
         solver = _Solver(self, full)
+        drivers = self.drivers
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter('ignore', NearSingularWarning)
-                _execute(solver, self.input.angle, 0.0, 0.0, self.input.turns)  # positions only
+                if solver.single:
+                    _execute(solver, drivers[0].start, 0.0, 0.0,  # positions only
+                             self.input.turns)
+                else:
+                    zeros = (0.0,) * len(drivers)
+                    _execute_drivers(solver, tuple(d.start for d in drivers), zeros, zeros)
         except AssemblyError as error:
             dyad = next((step.dyad for step in full.steps
                          if step.owner is None and step.label == error.dyad), None)
-            msg = (f'Expected the mechanism to assemble at the initial crank angle '
-                   f'{self.units.angle_text(self.input.shown)}, got '
+            if solver.single:
+                at = f'the initial crank angle {self.units.angle_text(self.input.shown)}'
+            else:
+                at = "the drivers' start positions " + ', '.join(
+                    f'{d.name} = {d.position_text(d.start, self.units)}' for d in drivers)
+            where = (drivers[0], 'angle' if solver.single else 'length')
+            culprit = next((d for d in drivers if f'input {d.name}' == error.dyad), None)
+            if culprit is not None:
+                where = (culprit, 'length' if culprit.joint_type == 'prismatic' else 'angle')
+            msg = (f'Expected the mechanism to assemble at {at}, got '
                    f'{assembly_text(error, self.units)}')
-            raise SceneError(msg, (self.input, 'angle') if dyad is None else (dyad, '')) from None
+            raise SceneError(msg, where if dyad is None else (dyad, '')) from None
         object.__setattr__(self, 'imus', tuple(self.imus))
         joints, points = imu_outputs(self, full.joint_types, self.outputs_joints,
                                      self.outputs_points)
@@ -196,9 +264,18 @@ class Scene:
         object.__setattr__(self, '_solver', solver)
 
     @property
-    def drivers(self) -> tuple[Crank, ...]:
-        """The drivers in scene order (each has ``name``, ``joint_type``, ``start``, ...)."""
-        return (self.input,)
+    def drivers(self) -> tuple[Crank | Actuator, ...]:
+        """The drivers in scene order (each has ``name``, ``joint_type``, ``start``, ...).
+
+        A crank or an actuator each: ``name`` (its crank link or actuator, also
+        a joint of ``State.joints``), ``joint_type`` (``'revolute'`` or
+        ``'prismatic'``), ``start`` (rad or m), ``speed`` and ``accel`` (the
+        defaults: rad/s and rad/s^2, or m/s and m/s^2) and ``stroke``
+        (inclusive limits, m, or ``None``).
+        """
+        if self.inputs:
+            return self.inputs
+        return (cast(Crank, self.input),)
 
     @property
     def output_joints(self) -> tuple[str, ...]:

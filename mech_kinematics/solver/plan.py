@@ -15,7 +15,6 @@ import math
 from typing import Any, TYPE_CHECKING
 
 from .base import Item, Step
-from .crank import _CrankStep
 from .model import _check_finite, _check_name, _names, Where
 from .rubbing import _rub_steps, _RubStep
 from ..errors import SceneError
@@ -26,15 +25,26 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True)
 class _Plan:
-    """A scene compiled to an ordered list of steps."""
+    """A scene compiled to an ordered list of steps.
 
-    crank: _CrankStep
+    ``crank`` is the first driver's step (a crank's, in a scene with one crank)
+    and ``extra`` the other drivers' steps, in scene order: each runs as
+    ``run(ctx, position, speed, accel)`` before the steps.
+    """
+
+    crank: Any
     steps: tuple[Step, ...]
     ground: dict[str, complex]
     joint_types: dict[str, str]
     output_joints: tuple[str, ...]
     output_points: tuple[str, ...]
     rubs: tuple[_RubStep, ...] = ()
+    extra: tuple[Any, ...] = ()
+
+    @property
+    def drivers(self) -> tuple[Any, ...]:
+        """Every driver's step, in scene order."""
+        return (self.crank, *self.extra)
 
 
 class _Names:
@@ -102,13 +112,13 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
         _check_finite(y, f'ground point "{name}" y', (scene, f'ground.{name}'))
         define(name, 'point', (scene, f'ground.{name}'))
         ground[name] = complex(x, y)
-    crank = scene.input
-    if crank.center not in ground:
-        msg = f'Expected the crank center to be a ground point, got "{crank.center}"'
-        raise SceneError(msg, (crank, 'center'))
-    define(crank.link, 'link', (crank, 'link'))
-    define(crank.point, 'point', (crank, 'point'))
-    joint_types = {crank.link: 'revolute'}
+    drivers = scene.drivers
+    driver_steps = tuple(driver.step(ground) for driver in drivers)
+    joint_types = {}
+    for driver in drivers:
+        for name, kind in driver.defined():
+            define(name, kind, (driver, {'point': 'point', 'link': 'link'}.get(kind, kind)))
+        joint_types[driver.name] = driver.joint_type
     for dyad in scene.dyads:
         for name, kind, where in dyad.defined():
             define(name, kind, where)
@@ -117,14 +127,15 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
         for name, kind, where in carried.defined():
             define(name, kind, where)
 
-    size = max([crank.length, _diameter(ground.values())]
+    size = max([*(driver.reach for driver in drivers), _diameter(ground.values())]
                + [length for d in scene.dyads for length in d.lengths()])
 
     # Local coordinates of the points fixed on each link, in the frame at the
     # link's start with x along the link; and the slot pin of each RPR lever.
-    placing = _Placing(ground, {crank.link: {crank.center: 0j,
-                                             crank.point: complex(crank.length)}},
-                       {}, size, scene)
+    local: dict[str, dict[str, complex]] = {}
+    for driver in drivers:
+        local.update(driver.local(ground))
+    placing = _Placing(ground, local, {}, size, scene)
     names = _Names(kinds, ground)
     steps: list[Step] = []
     produces: dict[str, int] = {}  # point, link or slider -> index of its step
@@ -142,7 +153,7 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
     # the file first (file order wherever it is free): a heap of the ready
     # items and, per name, the items waiting for it. O(n log n) in all.
     pending: list[Item] = [*scene.dyads, *scene.points]
-    known = {*ground, crank.point, crank.link}
+    known = {*ground, *(name for step in driver_steps for name in step.defines)}
     waiting: dict[str, list[int]] = {}
     missing = [0] * len(pending)
     for index, item in enumerate(pending):
@@ -165,13 +176,20 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
         msg = f'Expected dyads and points solvable in order, got a cycle among [{_names(keys)}]'
         raise SceneError(msg, (left[0], ''))
 
-    order = [*ground, crank.point, *(name for step in steps
-                                     for name in step.new_points)]
+    used = {name for step in steps for name in step.uses}
+    for driver in drivers:
+        if driver.joint_type == 'prismatic' and driver.name not in used:
+            msg = (f'Expected actuator "{driver.name}" to be the length of an RRR link '
+                   f'(actuator: {driver.name} in place of length:), got no link using it')
+            raise SceneError(msg, (driver, 'actuator'))
+    order = [*ground, *(name for driver in drivers for name, kind in driver.defined()
+                        if kind == 'point'),
+             *(name for step in steps for name in step.new_points)]
     all_joints = tuple(joint_types)
     out_joints = all_joints if joints is None else tuple(joints)
     out_points = tuple(order) if points is None else tuple(points)
     for name in out_joints:
-        if kinds.get(name) not in ('link', 'slider'):
+        if kinds.get(name) not in ('link', 'slider', 'actuator'):
             got = f'unknown "{name}"' if name not in kinds else f'{kinds[name]} "{name}"'
             msg = f'Expected outputs.joints to list links and sliders, got {got}'
             raise SceneError(msg, (scene, 'outputs.joints'))
@@ -193,12 +211,12 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
             continue
         needed.add(index)
         step = steps[index]
-        # (the crank is no step: its link and point are produced by none)
+        # (the drivers are no steps: their names are produced by none)
         todo.extend(produces[name] for name in step.requires if name in produces)
     kept = tuple(step for index, step in enumerate(steps) if index in needed)
-    return _Plan(_CrankStep(crank, ground[crank.center]), kept, ground,
+    return _Plan(driver_steps[0], kept, ground,
                  {name: joint_types[name] for name in out_joints}, out_joints, out_points,
-                 rubs)
+                 rubs, driver_steps[1:])
 
 
 def _diameter(points: Iterable[complex]) -> float:

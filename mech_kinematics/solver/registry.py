@@ -10,6 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from .actuator import Actuator
 from .base import Item
 from .model import SceneUnits
 from .rpp import RPP
@@ -22,4 +23,6 @@ KINDS: dict[str, type[Item]] = {kind.kind: kind for kind in (RRR, RRP, RPR, RPP)
 
 #: The ``kind`` of an :class:`~mech_kinematics.errors.AssemblyError`'s facts -> their text.
 FACT_TEXTS: dict[str, Callable[[dict[str, Any], SceneUnits], str]] = {
-    fact: text for kind in KINDS.values() for fact, text in kind.fact_texts().items()}
+    fact: text for texts in (*(kind.fact_texts() for kind in KINDS.values()),
+                             Actuator.fact_texts())
+    for fact, text in texts.items()}

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from .base import Edge, Frame, Item, Member, Names, Placing, Reading, Step
-from .context import _Context, _dot, _sum_root, _U16, _U2, _U3, _U7, SINGULAR
+from .context import _Context, _dot, _sum_root, _U16, _U2, _U3, _U4, _U7, SINGULAR
 from .model import _check_name, _g, Branch, Link, SceneUnits, Where
 from ..bounds import ROUNDING_MARGIN, U
 from ..errors import SceneError
@@ -28,6 +28,10 @@ class RRR(Item):
     point: str
     links: tuple[Link, Link]
     branch: Branch = Branch.PLUS
+    #: Per link, the actuator whose length it has (``None``: its fixed ``length``). An
+    #: actuated link's ``length`` is its nominal length (the actuator's at time zero), which
+    #: counts in the mechanism's size only.
+    actuators: tuple[str | None, str | None] = (None, None)
 
     def __post_init__(self) -> None:
         """Validate the fields."""
@@ -37,18 +41,51 @@ class RRR(Item):
             msg = f'Expected RRR "{self.point}" to have 2 links, got {count}'
             raise SceneError(msg, (self, 'links'))
         object.__setattr__(self, 'branch', Branch(self.branch))
+        actuators = tuple(self.actuators)
+        if len(actuators) != 2:
+            msg = f'Expected RRR "{self.point}" to name 2 actuators or None, got {actuators!r}'
+            raise SceneError(msg, (self, 'actuators'))
+        for name in actuators:
+            if name is not None:
+                _check_name(name, f'the actuator of a link of RRR "{self.point}"',
+                            (self, 'actuators'))
+        if actuators[0] is not None and actuators[0] == actuators[1]:
+            msg = (f'Expected the two links of RRR "{self.point}" to have different actuators, '
+                   f'got "{actuators[0]}" twice')
+            raise SceneError(msg, (self, 'actuators'))
+        object.__setattr__(self, 'actuators', actuators)
 
     @classmethod
     def from_scene(cls, read: Reading, raw: Any, where: str) -> RRR:
-        """Return the RRR at ``where``: ``point``, ``links`` (two), ``branch``."""
+        """Return the RRR at ``where``: ``point``, ``links`` (two), ``branch``.
+
+        A link may say ``actuator: NAME`` instead of ``length:``: its length is
+        that actuator's (a driver of the scene's ``inputs``).
+        """
         read.check_keys(raw, {'type', 'point', 'links', 'branch'}, where)
         links = read.get(raw, 'links', where)
         if not isinstance(links, list) or len(links) != 2:
             raise SceneError(f'{where}.links: expected a list of 2 links, got '
                              f'{read.brief(links)}')
-        first, second = (read.link(link, f'{where}.links[{i}]') for i, link in enumerate(links))
-        built: RRR = read.build(where, {}, cls, point=read.name(raw, 'point', where),
-                                links=(first, second), branch=read.branch(raw, where))
+        pair: list[Link] = []
+        actuators: list[str | None] = []
+        for i, raw_link in enumerate(links):
+            at = f'{where}.links[{i}]'
+            if isinstance(raw_link, dict) and 'actuator' in raw_link:
+                read.check_keys(raw_link, {'name', 'from', 'actuator'}, at)
+                actuator = read.name(raw_link, 'actuator', at)
+                nominal = read.actuator_length(actuator, f'{at}.actuator')
+                pair.append(read.build(at, {'start': 'from', 'length': 'actuator'}, Link,
+                                       name=read.name(raw_link, 'name', at),
+                                       start=read.name(raw_link, 'from', at), length=nominal))
+                actuators.append(actuator)
+            else:
+                pair.append(read.link(raw_link, at))
+                actuators.append(None)
+        built: RRR = read.build(where, {'actuators': 'links'}, cls,
+                                point=read.name(raw, 'point', where), links=(pair[0], pair[1]),
+                                branch=read.branch(raw, where),
+                                actuators=(actuators[0], actuators[1]))
         return built
 
     @staticmethod
@@ -72,15 +109,35 @@ class RRR(Item):
         return {link.name: 'revolute' for link in self.links}
 
     def prerequisites(self, names: Names) -> set[str]:
-        """Return the start points of its links."""
-        return {names.point(link.start, f'the start of link "{link.name}"', (link, 'start'))
-                for link in self.links}
+        """Return the start points of its links (and the actuators of actuated links)."""
+        needed = {names.point(link.start, f'the start of link "{link.name}"', (link, 'start'))
+                  for link in self.links}
+        for link, actuator in zip(self.links, self.actuators, strict=True):
+            if actuator is not None:
+                if names.kinds.get(actuator) != 'actuator':
+                    kind = names.kinds.get(actuator)
+                    got = f'unknown "{actuator}"' if kind is None else f'{kind} "{actuator}"'
+                    msg = (f'Expected the actuator of link "{link.name}" to be an actuator of '
+                           f'inputs, got {got}')
+                    raise SceneError(msg, (self, 'actuators'))
+                needed.add(actuator)
+        return needed
 
     def place(self, plan: Placing) -> Step:
-        """Return its step; its links carry their start and the new point."""
-        for link in self.links:
-            plan.local[link.name] = {link.start: 0j, self.point: complex(link.length)}
-        return _RRRStep(self)
+        """Return its step; its links carry their start and the new point.
+
+        An actuated link's length varies: its start is fixed on it, and the new
+        point lies along it (as a slotted lever's pin, :attr:`~.base.Placing.slot`).
+        """
+        for link, actuator in zip(self.links, self.actuators, strict=True):
+            if actuator is None:
+                plan.local[link.name] = {link.start: 0j, self.point: complex(link.length)}
+            else:
+                plan.local[link.name] = {link.start: 0j}
+                plan.slot[link.name] = (link.start, self.point)
+        if self.actuators == (None, None):
+            return _RRRStep(self)
+        return _ActuatedRRRStep(self)
 
     def lengths(self) -> tuple[float, ...]:
         """Return its two link lengths."""
@@ -92,9 +149,17 @@ class RRR(Item):
         return replace(self, links=(first, second))
 
     def frames(self) -> Iterator[Frame]:
-        """Yield each link's frame: at its start, along it."""
+        """Yield each link's frame: at its start, along it; an actuator's at its rod's pin.
+
+        An actuated link is a cylinder's body (at its start pin) and the
+        actuator a prismatic joint whose frame, the rod's, sits at the dyad's
+        new pin, along the link.
+        """
         for link in self.links:
             yield link.name, link.start, link.name, 0.0
+        for link, actuator in zip(self.links, self.actuators, strict=True):
+            if actuator is not None:
+                yield actuator, self.point, link.name, 0.0
 
     def members(self, ground: str) -> Iterator[Member]:
         """Yield its two links, each carrying its start and the new pin."""
@@ -107,8 +172,9 @@ class RRR(Item):
             yield link.name, link.start, self.point, None
 
     def link_lengths(self) -> dict[str, float | None]:
-        """Return its two links' lengths."""
-        return {link.name: link.length for link in self.links}
+        """Return its two links' lengths (``None`` for an actuated link, whose length varies)."""
+        return {link.name: None if actuator is not None else link.length
+                for link, actuator in zip(self.links, self.actuators, strict=True)}
 
     def toggle(self) -> tuple[str, str, tuple[str, ...]] | None:
         """Return its measure (the sine of the angle between its links), label and links."""
@@ -136,7 +202,9 @@ class RRR(Item):
                 yield self.point, link.name, True
 
     def four_bar(self) -> tuple[str, Link, Link] | None:
-        """Return its new pin and two links: an RRR can close a four-bar loop."""
+        """Return its new pin and two links: an RRR of fixed links can close a four-bar loop."""
+        if self.actuators != (None, None):
+            return None
         return self.point, *self.links
 
 
@@ -357,3 +425,136 @@ class _RRRStep(Step):
         ctx.links[self.link1] = (r1 * (1.0 / l1), w1, al1, er * inv_l1 + _U7, ew1, ta * inv_l1)
         ctx.links[self.link2] = (r2 * (1.0 / l2), w2, al2, er * inv_l2 + _U7, t * inv_l2,
                                  ta * inv_l2)
+
+
+class _ActuatedRRRStep(_RRRStep):
+    """An RRR with one or both link lengths an actuator's: the variable-length closed form.
+
+    The position is the fixed RRR's closed form on the current lengths. With
+    ``e1 = r1 / l1`` the unit vector along a link and ``l1'``, ``l1''`` its
+    length's rates, the pin moves as ``v1 + l1' e1 + i w1 r1`` and
+    ``a1 + l1'' e1 + 2 i w1 l1' e1 + i al1 r1 - w1^2 r1`` (the extension
+    rate, Coriolis and extension-acceleration terms), so the right sides of
+    the velocity and acceleration systems gain ``l2' e2 - l1' e1`` and
+    ``l2'' e2 + 2 i w2 l2' e2 - l1'' e1 - 2 i w1 l1' e1``. A fixed link has
+    rates 0 and the fixed RRR's kernel (:class:`_RRRStep`) is kept for
+    dyads with no actuator, bit for bit.
+    """
+
+    def __init__(self, dyad: RRR) -> None:
+        super().__init__(dyad)
+        self.act1, self.act2 = dyad.actuators
+        # A fixed link's length, known to half an ulp (the actuators' come with their bounds).
+        self.fixed1 = (self.l1, 0.0, 0.0, U * self.l1, 0.0, 0.0)
+        self.fixed2 = (self.l2, 0.0, 0.0, U * self.l2, 0.0, 0.0)
+        self.uses = (*self.uses, *(name for name in dyad.actuators if name is not None))
+
+    def facts_at(self, dist: float, l1: float, l2: float, touching: bool) -> dict[str, Any]:
+        """Return why the circles do not meet at the current lengths, in SI (see ``facts``)."""
+        facts = self.facts(dist, touching)
+        m = self.unit
+        facts['lengths'] = (float(l1) * m, float(l2) * m)
+        return facts
+
+    def margins(self, points: Mapping[str, tuple[Any, ...]]) -> tuple[tuple[Any, Any], ...]:
+        """Return no margins in one crank's angle: its lengths are other drivers' inputs."""
+        return ()
+
+    def crank_margins(self, tip: str, center: complex, radius: float,
+                      ground: Mapping[str, complex]
+                      ) -> Callable[[Any], tuple[tuple[Any, Any], ...]] | None:
+        """Return none (see :meth:`margins`)."""
+        return None
+
+    def run(self, ctx: _Context) -> None:
+        l1, ld1, ldd1, el1, eld1, eldd1 = (self.fixed1 if self.act1 is None
+                                           else ctx.sliders[self.act1])
+        l2, ld2, ldd2, el2, eld2, eldd2 = (self.fixed2 if self.act2 is None
+                                           else ctx.sliders[self.act2])
+        p1, v1, a1, ep1, ev1, ea1 = ctx.points[self.start1]
+        p2, v2, a2, ep2, ev2, ea2 = ctx.points[self.start2]
+        d = p2 - p1
+        dist = np.hypot(d.real, d.imag) if ctx.vector else abs(d)
+        lsum = l1 + l2
+        ldiff = l1 - l2
+        k = (lsum + dist) * (lsum - dist) * (dist + ldiff) * (dist - ldiff)
+        # As the fixed RRR's, the lengths' errors being the actuators' bounds (or half an
+        # ulp of a fixed length) and the rounding of lsum and ldiff.
+        spread = ep1 + ep2 + el1 + el2 + _U2 * lsum + _U2 * dist
+        outer = lsum - dist
+        inner = dist - abs(ldiff)
+        margin = np.minimum(outer, inner) if ctx.vector else (
+            outer if outer < inner else inner)
+        ok = margin > ROUNDING_MARGIN * spread
+        m = self.unit
+        if not (ctx.vector or ok or margin > -ROUNDING_MARGIN * spread):
+            ctx.check(False, self.label, lambda: (
+                f'the circles about {self.start1} (radius {_g(l1 * m)} m) and {self.start2} '
+                f'(radius {_g(l2 * m)} m) do not meet: expected '
+                f'|{_g(ldiff * m, dist * m)}| < |{self.start1}{self.start2}| < '
+                f'{_g(lsum * m, dist * m)} m, got |{self.start1}{self.start2}| = '
+                f'{_g(dist * m, lsum * m, abs(ldiff) * m)} m'),
+                lambda: self.facts_at(dist, l1, l2, False))
+        if ctx.vector or not ok:
+            ctx.check_margin(ok, self.label, margin * m, spread * m, lambda: (
+                f'the circles about {self.start1} and {self.start2} are within rounding of '
+                f'meeting at one point: expected the margin min({_g(lsum * m)} m - '
+                f'|{self.start1}{self.start2}|, |{self.start1}{self.start2}| - '
+                f'{_g(abs(ldiff) * m)} m) = {margin * m:.3g} m to exceed '
+                f'{ROUNDING_MARGIN:g} times its error bound {spread * m:.3g} m'),
+                lambda: self.facts_at(dist, l1, l2, True))
+        root = np.sqrt(k) if ctx.vector else math.sqrt(k)
+        measure = root / (2.0 * l1 * l2)
+        ok = measure > SINGULAR
+        if ctx.vector or not ok:
+            ctx.check(ok, self.label, lambda: (
+                f'links {self.link1} and {self.link2} are in line (singular): expected the '
+                f'sine of the angle between them > {SINGULAR:g}, got {measure:.3g}'),
+                lambda: self.facts_at(dist, l1, l2, True))
+        ctx.measures[self.key] = measure
+        half = 0.5 / dist
+        shared = ldiff * lsum
+        height = self.branch * root * half
+        u = d * (1.0 / dist)
+        across = 1j * height * u
+        r1 = (shared + dist * dist) * half * u + across
+        r2 = (shared - dist * dist) * half * u + across
+        inv_l1, inv_l2 = 1.0 / l1, 1.0 / l2
+        e1, e2 = r1 * inv_l1, r2 * inv_l2
+        inv = 2.0 * self.branch / root  # 1 / cross(r1, r2)
+        dv = v2 - v1 + ld2 * e2 - ld1 * e1
+        w1 = _dot(dv, r2) * inv
+        w2 = _dot(dv, r1) * inv
+        w1sq, w2sq = w1 * w1, w2 * w2
+        c1, c2 = 1j * (2.0 * w1 * ld1) * e1, 1j * (2.0 * w2 * ld2) * e2  # Coriolis
+        da = a2 - a1 + w1sq * r1 - w2sq * r2 + ldd2 * e2 + c2 - ldd1 * e1 - c1
+        al1 = _dot(da, r2) * inv
+        al2 = _dot(da, r1) * inv
+        # Bounds, as the fixed RRR's (see _RRRStep.run), with the lengths' rates: the
+        # right side of the velocity system moves by their bounds and by |l'| times the
+        # error of the unit vectors (erp / l); that of the acceleration system likewise
+        # by the bounds of l'' and by the Coriolis terms' (2 |w| |l'|, with all three's).
+        inv_m = 1.0 / measure
+        er = spread * inv_m + _U16 * lsum
+        erp = er + 8.0 * U * lsum
+        ee1, ee2 = erp * inv_l1 + _U4, erp * inv_l2 + _U4
+        ald1, ald2 = abs(ld1), abs(ld2)
+        aw1 = abs(w1)
+        aw2 = abs(w2)
+        aws = aw1 + aw2
+        t = (ev1 + ev2 + eld1 + eld2 + ald1 * ee1 + ald2 * ee2 + aws * erp) * inv_m
+        ew1, ew2 = t * inv_l1, t * inv_l2
+        aa1 = abs(al1)
+        grow1 = eldd1 + abs(ldd1) * ee1 + 2.0 * (aw1 * eld1 + ald1 * ew1 + aw1 * ald1 * ee1)
+        grow2 = eldd2 + abs(ldd2) * ee2 + 2.0 * (aw2 * eld2 + ald2 * ew2 + aw2 * ald2 * ee2)
+        ta = (ea1 + ea2 + grow1 + grow2 + (2.0 * aws + t * (inv_l1 + inv_l2)) * t
+              + (w1sq + w2sq + aa1 + abs(al2)) * erp) * inv_m
+        ctx.points[self.point] = (
+            p1 + r1, v1 + ld1 * e1 + 1j * w1 * r1,
+            a1 + ldd1 * e1 + c1 + 1j * al1 * r1 - w1 * w1 * r1, er + ep1,
+            ev1 + U * (abs(v1.real) + abs(v1.imag)) + t + aw1 * erp + eld1 + ald1 * ee1
+            + _U2 * ald1,
+            ea1 + _U2 * (abs(a1.real) + abs(a1.imag)) + ta + (2.0 * aw1 + ew1) * t
+            + (aa1 + w1sq) * erp + grow1 + _U4 * (abs(ldd1) + 2.0 * aw1 * ald1))
+        ctx.links[self.link1] = (e1, w1, al1, er * inv_l1 + _U7, ew1, ta * inv_l1)
+        ctx.links[self.link2] = (e2, w2, al2, er * inv_l2 + _U7, ew2, ta * inv_l2)

@@ -44,13 +44,17 @@ _QUANTITIES = ('position', 'velocity', 'acceleration')
 def _size(scene: Scene) -> float:
     """Return the mechanism's size, m: the scale its positions are judged on.
 
-    The largest of the crank length, the RRR and RRP link lengths, the
-    distances of the ground points from the crank's centre and the lengths of
-    the carried points' local offsets.
+    The largest of the crank length (every driver's reach: a crank's length,
+    an actuator's longest length), the RRR and RRP link lengths, the
+    distances of the ground points from the crank's centre (the first ground
+    point's, in a scene driven by actuators only) and the lengths of the
+    carried points' local offsets.
     """
     crank = scene.input
-    centre = complex(*scene.ground[crank.center])
-    size = crank.length
+    drivers = scene.drivers
+    centre = complex(*(scene.ground[crank.center] if crank is not None
+                       else next(iter(scene.ground.values()))))
+    size = max(driver.reach for driver in drivers) if len(drivers) > 1 else drivers[0].reach
     for x, y in scene.ground.values():
         size = max(size, abs(complex(x, y) - centre))
     for dyad in scene.dyads:
@@ -79,12 +83,31 @@ def _scaled(scene: Scene, shift: int) -> Scene:
         return math.ldexp(x, -shift)
 
     dyads = [dyad.scaled(scale) for dyad in scene.dyads]
+    drivers = tuple(driver.scaled(scale) for driver in scene.drivers)
     return cast('Scene', SimpleNamespace(
         name=scene.name,
         ground={name: (scale(x), scale(y)) for name, (x, y) in scene.ground.items()},
-        input=replace(scene.input, length=scale(scene.input.length)), dyads=tuple(dyads),
+        input=None if scene.input is None else drivers[0], drivers=drivers,
+        dyads=tuple(dyads),
         points=tuple(p.scaled(scale) for p in scene.points),
         pins=tuple(replace(p, radius=scale(p.radius)) for p in scene.pins), units=scene.units))
+
+
+def _rates_exponent(speeds: Any, accels: Any) -> int:
+    """Return the exponent of time's scaling for several drivers: the same for every one.
+
+    ``speeds`` and ``accels`` are the drivers' rates in the plan's units (an
+    actuator's divided by the scene's length scale): 1/s and 1/s^2.
+    """
+    w = a = 0.0
+    for speed, accel in zip(speeds, accels, strict=True):
+        ws, as_ = abs(speed), abs(accel)
+        if isinstance(ws, np.ndarray):
+            ws = float(np.max(ws, initial=0.0))
+        if isinstance(as_, np.ndarray):
+            as_ = float(np.max(as_, initial=0.0))
+        w, a = max(w, float(ws)), max(a, float(as_))
+    return _rate_exponent(w, a)
 
 
 def _rate_exponent(omega: Any, alpha: Any) -> int:

@@ -19,10 +19,10 @@ import numpy.typing as npt
 
 from .context import _Context, NEAR_SINGULAR
 from .scaling import (_ACCEL_HIGH, _ldexp, _QUANTITIES, _rate_exponent, _RATE_HIGH, _RATE_LOW,
-                      _rescale)
-from .state import _scales, _xy, Engagement, JointMotion, State
+                      _rates_exponent, _rescale)
+from .state import _crank_floors, _scales, _xy, Engagement, JointMotion, State
 from ..bounds import ErrorBound, limit, MAX_ERROR, SCALE_MEANINGS, Table, UNITS
-from ..errors import NearSingularWarning, UntrustedError
+from ..errors import AssemblyError, NearSingularWarning, UntrustedError
 
 if TYPE_CHECKING:
     from .mechanism import _Solver, Scene
@@ -30,17 +30,21 @@ if TYPE_CHECKING:
 
 
 def _run(solver: _Solver, angle: Any, speed: Any, accel: Any, turns: Any,
-         flip: bool = False) -> _Context:
+         flip: bool = False, extra: tuple[tuple[Any, Any, Any], ...] = ()) -> _Context:
     """Run every step of the solver's plan; the caller chose scalar or vector inputs.
 
     With ``flip``, a value that jumps at the instant takes its side before the
-    jump (see :func:`solve`).
+    jump (see :func:`solve`). ``angle``, ``speed`` and ``accel`` drive the
+    first driver, ``extra`` holds (position, speed, accel) of each other one.
     """
     ctx = _Context(angle, not isinstance(angle, float), turns, flip)
     # Ground points stay complex scalars in both paths: NumPy broadcasts them.
     ctx.points.update(solver.ground)
     plan = solver.run_plan
     plan.crank.run(ctx, angle, speed, accel)
+    if extra:
+        for driver, (x, v, a) in zip(plan.extra, extra, strict=True):
+            driver.run(ctx, x, v, a)
     for step in plan.steps:
         step.run(ctx)
     if plan.rubs:
@@ -72,8 +76,35 @@ def _execute(solver: _Solver, theta: Any, omega: Any, alpha: Any, turns: Any = 0
     return ctx
 
 
-def _context_scales(solver: _Solver, ctx: _Context, omega: Any, alpha: Any) -> dict[str, Any]:
-    return _scales(solver.size, solver.crank_length, omega, alpha,
+def _execute_drivers(solver: _Solver, positions: tuple[Any, ...], speeds: tuple[Any, ...],
+                     accels: tuple[Any, ...], flip: bool = False) -> _Context:
+    """Run the solver on several drivers' values (SI), as :func:`_execute` on one crank's.
+
+    An actuator's length and rates are scaled with the scene's lengths
+    (``solver.shift``); then time is scaled by one power of two for every
+    driver where the fastest rate is out of range (:func:`_rates_exponent`).
+    """
+    xs, vs, accs = list(positions), list(speeds), list(accels)
+    s = solver.shift
+    if s:
+        for index, kind in enumerate(solver.driver_types):
+            if kind == 'prismatic':
+                xs[index], vs[index], accs[index] = (
+                    _ldexp(x, -s) for x in (xs[index], vs[index], accs[index]))
+    shift = _rates_exponent(vs, accs)
+    if shift:
+        vs = [_ldexp(v, -shift) for v in vs]
+        accs = [_ldexp(a, -2 * shift) for a in accs]
+    extra = tuple(zip(xs[1:], vs[1:], accs[1:], strict=True))
+    ctx = _run(solver, xs[0], vs[0], accs[0], 0, flip, extra)
+    if s or shift:
+        _rescale(solver, ctx, shift)
+    return ctx
+
+
+def _context_scales(solver: _Solver, ctx: _Context, floors: tuple[Any, Any, Any, Any]
+                    ) -> dict[str, Any]:
+    return _scales(solver.size, floors,
                    [ctx.points[name][1:3] for name in solver.out_points],
                    [ctx.sliders[name][1:3] for name in solver.out_sliders],
                    [ctx.links[name][1:3] for name in solver.out_links], ctx.vector)
@@ -103,13 +134,22 @@ TRUST_TEST = (('points', 'out_points', (0, 1, 2)), ('links', 'out_links', (3, 4,
               ('sliders', 'out_sliders', (0, 1, 2)))
 
 
-def _trusted(solver: _Solver, ctx: _Context, omega: float, alpha: float, tol: float) -> bool:
-    """Return True if every reported bound is within ``tol`` of its kind's smallest scale.
+def _limits(tol: float, size: float, floors: tuple[Any, Any, Any, Any]
+            ) -> tuple[float, float, float, float, float, float]:
+    """Return the quick trust test's six limits from the drivers' floors (several drivers).
 
-    A quick sufficient test for the single-angle path (:func:`trust_limits`);
-    NaN fails.
+    As :func:`trust_limits` (which gives the same for one crank), in the same order.
     """
-    lim = trust_limits(tol, omega, alpha, solver.size, solver.crank_length)
+    speed, accel, turn, turn_accel = floors
+    return (tol * size, tol * speed, tol * accel, tol, tol * turn, tol * turn_accel)
+
+
+def _trusted(solver: _Solver, ctx: _Context,
+             lim: tuple[float, float, float, float, float, float]) -> bool:
+    """Return True if every reported bound is within its limit ``lim`` (:func:`trust_limits`).
+
+    A quick sufficient test for the single-angle path; NaN fails.
+    """
     for table, names, (i, j, k) in solver.trust:
         entries = getattr(ctx, table)
         li, lj, lk = lim[i], lim[j], lim[k]
@@ -123,9 +163,10 @@ def _trusted(solver: _Solver, ctx: _Context, omega: float, alpha: float, tol: fl
     return True
 
 
-def _refuse(solver: _Solver, ctx: _Context, omega: float, alpha: float, tol: float) -> None:
+def _refuse(solver: _Solver, ctx: _Context, floors: tuple[Any, Any, Any, Any],
+            tol: float) -> None:
     """Raise :class:`UntrustedError` for the first reported value whose bound exceeds ``tol``."""
-    scales = _context_scales(solver, ctx, omega, alpha)
+    scales = _context_scales(solver, ctx, floors)
     for table, name, path, label, kinds in solver.outputs:
         entry = getattr(ctx, table)[name]
         for index, kind in enumerate(kinds):
@@ -155,15 +196,14 @@ def _refuse(solver: _Solver, ctx: _Context, omega: float, alpha: float, tol: flo
                                  float(bound), float(lim))
 
 
-def _judge(solver: _Solver, ctx: _Context, omega: Any, alpha: Any, tol: float,
+def _judge(solver: _Solver, ctx: _Context, floors: tuple[Any, Any, Any, Any], tol: float,
            shape: tuple[int, ...]) -> None:
     """Mask the angles of a vector solve where a reported bound exceeds ``tol``."""
-    w = abs(omega)
-    rate = w * w + abs(alpha)
-    a = solver.crank_length
-    floors = {'position': solver.size, 'angle': 1.0, 'velocity': a * w, 'angular velocity': w,
-              'acceleration': a * rate, 'angular acceleration': rate}
-    lims = {kind: tol * floor for kind, floor in floors.items()}
+    speed, accel, turn, turn_accel = floors
+    least = {'position': solver.size, 'angle': 1.0, 'velocity': speed,
+             'angular velocity': turn, 'acceleration': accel,
+             'angular acceleration': turn_accel}
+    lims = {kind: tol * floor for kind, floor in least.items()}
     failed = np.logical_not(ctx.valid)  # already refused: not judged again
     if all(bool(((entry[3] <= lims[kinds[0]]) & (entry[4] <= lims[kinds[1]])
                  & (entry[5] <= lims[kinds[2]]) | failed).all())
@@ -172,7 +212,7 @@ def _judge(solver: _Solver, ctx: _Context, omega: Any, alpha: Any, tol: float,
                bool(((bound <= lims['velocity']) | failed).all())
                for _, bound in ctx.rubbing.values()):
         return  # within the floors of the scales (as _trusted): no norms needed
-    scales = _context_scales(solver, ctx, omega, alpha)
+    scales = _context_scales(solver, ctx, floors)
     lims = {kind: limit(tol, scale) for kind, scale in scales.items()}
     for table, name, _, label, kinds in solver.outputs:
         entry = getattr(ctx, table)[name]
@@ -248,12 +288,15 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
     omega: Any
     alpha: Any
     solver = scene._solver
-    speed = scene.input.speed if speed is None else speed
-    accel = scene.input.accel if accel is None else accel
     if not (isinstance(max_error, (float, int)) and max_error > 0.0):
         msg = f'Expected `max_error` to be a positive number, got {max_error!r}'
         raise ValueError(msg)
     tol = float(max_error)
+    if not solver.single:
+        return _solve_drivers(scene, solver, angle, speed, accel, turns, tol)
+    crank = scene.drivers[0]
+    speed = crank.speed if speed is None else speed
+    accel = crank.accel if accel is None else accel
     whole: Any = turns
     if whole.__class__ is not int:  # an int is the usual case, decided without a call
         whole = _turns(whole)
@@ -266,10 +309,12 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
             raise ValueError(msg)
         whole = int(whole)
         ctx = _execute(solver, theta, omega, alpha, whole)
-        if not _trusted(solver, ctx, omega, alpha, tol):
-            _refuse(solver, ctx, omega, alpha, tol)
+        if not _trusted(solver, ctx, trust_limits(tol, omega, alpha, solver.size,
+                                                  solver.crank_length)):
+            _refuse(solver, ctx, _crank_floors(solver.crank_length, omega, alpha), tol)
         valid: Any = True
         jumps = _jumps(solver, ctx, theta, omega, alpha, whole, None) if ctx.jumps else {}
+        counted: Any = theta + math.tau * whole if whole else theta
     else:
         theta, omega, alpha = (np.asarray(x, dtype=np.float64) for x in (angle, speed, accel))
         shape = np.broadcast_shapes(theta.shape, omega.shape, alpha.shape, np.shape(whole))
@@ -285,12 +330,117 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
         with np.errstate(all='ignore'):
             # A constant speed or acceleration stays a scalar through the steps.
             ctx = _execute(solver, theta, omega, alpha, whole)
-            _judge(solver, ctx, omega, alpha, tol, shape)
+            _judge(solver, ctx, _crank_floors(solver.crank_length, omega, alpha), tol, shape)
         omega, alpha = np.broadcast_to(omega, shape), np.broadcast_to(alpha, shape)
         valid = np.broadcast_to(np.asarray(ctx.valid, dtype=bool), shape).copy()
         jumps = _jumps(solver, ctx, theta, omega, alpha, whole, valid) if ctx.jumps else {}
+        counted = theta + math.tau * whole if whole.any() else np.array(theta)
     _warn_near_singular(ctx)
-    return _state(scene, solver, ctx, theta, omega, alpha, valid, whole, jumps)
+    drivers = {solver.driver_names[0]: JointMotion('revolute', counted, omega, alpha)}
+    return _state(scene, solver, ctx, theta, omega, alpha, valid, whole, jumps, drivers)
+
+
+def _per_driver(values: Any, defaults: tuple[float, ...], what: str) -> list[Any]:
+    """Return one value per driver from a sequence (or an array of shape (n, ...)).
+
+    ``None`` (the whole argument or one entry) takes the scene's default.
+    """
+    n = len(defaults)
+    if values is None:
+        return list(defaults)
+    if n == 1:
+        return [defaults[0] if values is None else values]
+    if isinstance(values, (str, bytes, float, int)) or (
+            isinstance(values, np.ndarray) and values.ndim == 0) or not hasattr(
+                values, '__len__'):
+        msg = f'Expected `{what}` to be a sequence of {n} values (one per driver), got {values!r}'
+        raise ValueError(msg)
+    items = list(values)
+    if len(items) != n:
+        msg = (f'Expected `{what}` to hold {n} values (one per driver), got {len(items)}')
+        raise ValueError(msg)
+    pairs = zip(items, defaults, strict=True)
+    return [default if item is None else item for item, default in pairs]
+
+
+def _solve_drivers(scene: Scene, solver: _Solver, positions: Any, speeds: Any, accels: Any,
+                   turns: Any, tol: float) -> State:
+    """Solve a scene with several drivers (or an actuator): :func:`solve`'s general path."""
+    drivers = scene.drivers
+    names = solver.driver_names
+    xs = _per_driver(positions, tuple(d.start for d in drivers), 'positions')
+    vs = _per_driver(speeds, tuple(d.speed for d in drivers), 'speeds')
+    accs = _per_driver(accels, tuple(d.accel for d in drivers), 'accels')
+    count = len(drivers)
+    if isinstance(turns, (int, np.integer)):  # one number: every crank's
+        listed: list[Any] = [turns if kind == 'revolute' else 0 for kind in solver.driver_types]
+    else:
+        listed = _per_driver(turns, (0,) * count, 'turns')
+    wholes = [_turns(t) for t in listed]
+    for whole, kind, name in zip(wholes, solver.driver_types, names, strict=True):
+        if kind == 'prismatic' and np.any(whole):
+            msg = f'Expected no whole turns for actuator {name}, got {whole!r}'
+            raise ValueError(msg)
+    values = [*xs, *vs, *accs]
+    if all(_is_scalar(x) for x in values) and all(_is_scalar(t) for t in wholes):
+        floats = [float(x) for x in values]
+        if not all(math.isfinite(x) for x in floats):
+            msg = (f'Expected the positions, speeds and accels of the drivers to be finite, got '
+                   f'{floats!r}')
+            raise ValueError(msg)
+        n = len(drivers)
+        xs, vs, accs = floats[:n], floats[n:2 * n], floats[2 * n:]
+        try:
+            ctx = _execute_drivers(solver, tuple(xs), tuple(vs), tuple(accs))
+            floors = solver.floors(vs, accs)
+            if not _trusted(solver, ctx, _limits(tol, solver.size, floors)):
+                _refuse(solver, ctx, floors, tol)
+        except AssemblyError as error:
+            raise error.located(_where(drivers, xs)) from None
+        valid: Any = True
+        counted: list[Any] = [x + math.tau * int(w) if w else x
+                              for x, w in zip(xs, wholes, strict=True)]
+    else:
+        arrays = [np.asarray(x, dtype=np.float64) for x in values]
+        try:
+            shape = np.broadcast_shapes(*(a.shape for a in arrays),
+                                        *(np.shape(w) for w in wholes))
+        except ValueError:
+            shape = ()
+        if len(shape) != 1:
+            msg = (f'Expected the positions, speeds and accels of the drivers to be floats or '
+                   f'1-D arrays of one length, got shapes {[a.shape for a in arrays]}')
+            raise ValueError(msg)
+        if not all(np.isfinite(a).all() for a in arrays):
+            msg = 'Expected the positions, speeds and accels of the drivers to be finite'
+            raise ValueError(msg)
+        n = len(drivers)
+        # Copies: the state's arrays get NaN where refused, never the caller's own.
+        xs = [np.array(np.broadcast_to(a, shape)) for a in arrays[:n]]
+        vs, accs = [np.array(a) for a in arrays[n:2 * n]], [np.array(a) for a in arrays[2 * n:]]
+        with np.errstate(all='ignore'):
+            ctx = _execute_drivers(solver, tuple(xs), tuple(vs), tuple(accs))
+            floors = solver.floors(vs, accs)
+            _judge(solver, ctx, floors, tol, shape)
+        vs = [np.broadcast_to(a, shape) for a in vs]
+        accs = [np.broadcast_to(a, shape) for a in accs]
+        valid = np.broadcast_to(np.asarray(ctx.valid, dtype=bool), shape).copy()
+        counted = [np.array(x) + math.tau * np.asarray(w) if np.any(w) else np.array(x)
+                   for x, w in zip(xs, wholes, strict=True)]
+        vs = [np.array(v) for v in vs]
+        accs = [np.array(a) for a in accs]
+    _warn_near_singular(ctx)
+    motions = {name: JointMotion(kind, x, v, a) for name, kind, x, v, a
+               in zip(names, solver.driver_types, counted, vs, accs, strict=True)}
+    whole = wholes[0]
+    return _state(scene, solver, ctx, xs[0], vs[0], accs[0], valid, whole, {}, motions, floors)
+
+
+def _where(drivers: Any, positions: list[float]) -> str:
+    """Return where several drivers stand, for a message: ``crank = 0.5 rad, cyl = 1.2 m``."""
+    units = {'revolute': 'rad', 'prismatic': 'm'}
+    return ', '.join(f'{d.name} = {x:.6g} {units[d.joint_type]}'
+                     for d, x in zip(drivers, positions, strict=True))
 
 
 def _jumps(solver: _Solver, ctx: _Context, theta: Any, omega: Any, alpha: Any, turns: Any,
@@ -426,7 +576,8 @@ def _warn_near_singular(ctx: _Context) -> None:
 
 
 def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any, alpha: Any,
-           valid: Any, turns: Any, jumps: dict[str, Any]) -> State:
+           valid: Any, turns: Any, jumps: dict[str, Any], drivers: dict[str, JointMotion],
+           floors: tuple[Any, Any, Any, Any] | None = None) -> State:
     vector = ctx.vector
     plan = solver.plan
     joints = {}
@@ -439,7 +590,7 @@ def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any,
     table = ctx.points
     points = {name: table[name][:3] for name in plan.output_points}
     measures = ctx.measures
-    bound = ErrorBound(_table_bounds, (plan, ctx), solver.size, solver.crank_length)
+    bound = ErrorBound(_table_bounds, (plan, ctx), solver.size, solver.crank_length, floors)
     if vector:
         shape = theta.shape
         bad = None if valid.all() else ~valid
@@ -470,11 +621,14 @@ def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any,
                                      for name, (a, b, c) in joint_bounds.items()},
                                     {name: (finish(a), finish(b), finish(c))
                                      for name, (a, b, c) in point_bounds.items()}),
-                           solver.size, solver.crank_length)
+                           solver.size, solver.crank_length, floors)
         rubbing = {name: finish(value) for name, (value, _) in ctx.rubbing.items()}
         bound.rubbing = {name: finish(b) for name, (_, b) in ctx.rubbing.items()}
         intermittent = {name: step.engagement(ctx, omega, finish)
                         for name, step in solver.levers.items()}
+        drivers = {name: JointMotion(joint.type, finish(joint.position),
+                                     finish(joint.velocity), finish(joint.acceleration))
+                   for name, joint in drivers.items()}
     else:
         rubbing = intermittent = {}
         if ctx.rubbing:
@@ -484,7 +638,7 @@ def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any,
             intermittent = {name: step.engagement(ctx, omega, None)
                             for name, step in solver.levers.items()}
     state = _new_state(scene.name, theta, omega, alpha, joints, points, valid, dict(measures),
-                       dict(ctx.failures), bound, turns, rubbing, intermittent, jumps)
+                       dict(ctx.failures), bound, turns, rubbing, intermittent, jumps, drivers)
     if scene.imus:  # read from the state when asked (State.imus)
         state.__dict__['imu_specs'] = scene.imus
     return state
@@ -494,7 +648,7 @@ def _new_state(scene: str, angle: Any, speed: Any, accel: Any, joints: dict[str,
                points: dict[str, Any], valid: Any, singularity: dict[str, Any],
                failures: dict[str, Any], error_bound: ErrorBound, turns: Any,
                rubbing: dict[str, Any], intermittent: dict[str, Engagement],
-               jumps: dict[str, Any]) -> State:
+               jumps: dict[str, Any], drivers: dict[str, JointMotion]) -> State:
     """Return ``State(...)`` of these fields, built without the dataclass's ``__init__``.
 
     A frozen dataclass's ``__init__`` sets each field through
@@ -510,7 +664,7 @@ def _new_state(scene: str, angle: Any, speed: Any, accel: Any, joints: dict[str,
     fields['singularity'], fields['failures'] = singularity, failures
     fields['error_bound'], fields['turns'] = error_bound, turns
     fields['rubbing'], fields['intermittent'] = rubbing, intermittent
-    fields['jumps'] = jumps
+    fields['jumps'], fields['drivers'] = jumps, drivers
     return state
 
 

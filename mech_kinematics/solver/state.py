@@ -117,7 +117,8 @@ class State:
         Scene name.
     angle, speed, accel : float or ndarray
         The crank's angle (rad, as given), angular velocity (rad/s) and
-        angular acceleration (rad/s^2).
+        angular acceleration (rad/s^2); with several drivers, the first
+        driver's position (rad or m), speed and acceleration.
     joints : dict of str to JointMotion
         Every reported joint.
     complex_points : dict of str to (p, v, a)
@@ -156,6 +157,12 @@ class State:
         ``{'joints': {name: {'acceleration': x}}, 'points': {name:
         {'acceleration': ndarray, shape (2,)}}}``. For arrays, shapes (n,) and
         (n, 2), NaN at the angles where nothing jumps.
+    drivers : dict of str to JointMotion
+        Every driver's own motion, in scene order, as given to the solve
+        (whether or not the scene's outputs report its joint): a crank's angle
+        counted from the start (rad, not wrapped: ``angle + 2 pi turns``),
+        speed and acceleration; an actuator's length (m), extension rate and
+        its derivative.
     imu_specs : tuple of ImuSpec
         The scene's inertial sensors, whose readings :attr:`imus` gives.
     """
@@ -174,6 +181,7 @@ class State:
     rubbing: dict[str, Number] = field(default_factory=dict)
     intermittent: dict[str, Engagement] = field(default_factory=dict)
     jumps: dict[str, Any] = field(default_factory=dict)
+    drivers: dict[str, JointMotion] = field(default_factory=dict)
     imu_specs: tuple[ImuSpec, ...] = ()
 
     @cached_property
@@ -201,7 +209,9 @@ class State:
         """
         bound = self.error_bound
         vector = not isinstance(self.valid, bool)
-        return _scales(bound.size, bound.crank_length, self.speed, self.accel,
+        floors = bound.floors if bound.floors is not None else _crank_floors(
+            bound.crank_length, self.speed, self.accel)
+        return _scales(bound.size, floors,
                        [(v, a) for _, v, a in self.complex_points.values()],
                        [(j.velocity, j.acceleration) for j in self.joints.values()
                         if j.type == 'prismatic'],
@@ -243,10 +253,16 @@ class State:
 
         turns = self.turns
         angle = self.angle if not np.any(turns) else self.angle + math.tau * turns
+        if len(self.drivers) > 1:
+            driven: dict[str, Any] = {'inputs': {
+                name: {'position': value(j.position), 'speed': value(j.velocity),
+                       'accel': value(j.acceleration)} for name, j in self.drivers.items()}}
+        else:
+            driven = {'input': {'angle': value(angle), 'speed': value(self.speed),
+                                'accel': value(self.accel)}}
         return {
             'scene': self.scene,
-            'input': {'angle': value(angle), 'speed': value(self.speed),
-                      'accel': value(self.accel)},
+            **driven,
             'joints': {name: {'type': j.type, 'position': value(j.position),
                               'velocity': value(j.velocity),
                               'acceleration': value(j.acceleration)}
@@ -273,15 +289,28 @@ class State:
         }
 
 
-def _scales(size: float, crank_length: float, omega: Any, alpha: Any,
-            points: Iterable[tuple[Any, Any]], sliders: Iterable[tuple[Any, Any]],
-            links: Iterable[tuple[Any, Any]], vector: bool) -> dict[str, Any]:
-    """Return each kind's scale (see :attr:`State.scales`) from the reported values."""
-    biggest: Any = np.fmax if vector else max
+def _crank_floors(crank_length: float, omega: Any, alpha: Any) -> tuple[Any, Any, Any, Any]:
+    """Return the least scales of speed, acceleration and turning rates from one crank.
+
+    ``a |omega|``, ``a (omega^2 + |alpha|)``, ``|omega|`` and
+    ``omega^2 + |alpha|`` for the crank's length ``a``.
+    """
     w = abs(omega)
     rate = w * w + abs(alpha)
-    speed, accel = crank_length * w, crank_length * rate
-    turn, turn_accel = w, rate
+    return crank_length * w, crank_length * rate, w, rate
+
+
+def _scales(size: float, floors: tuple[Any, Any, Any, Any],
+            points: Iterable[tuple[Any, Any]], sliders: Iterable[tuple[Any, Any]],
+            links: Iterable[tuple[Any, Any]], vector: bool) -> dict[str, Any]:
+    """Return each kind's scale (see :attr:`State.scales`) from the reported values.
+
+    ``floors`` are the least scales of speed, acceleration, angular speed and
+    angular acceleration that the drivers set (:func:`_crank_floors` for one
+    crank).
+    """
+    biggest: Any = np.fmax if vector else max
+    speed, accel, turn, turn_accel = floors
     for v, a in points:
         if vector:
             speed = biggest(speed, np.hypot(v.real, v.imag))

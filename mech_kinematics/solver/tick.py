@@ -44,7 +44,8 @@ class TickPlan:
     ----------
     compilable : bool
         False where the general solver must serve the scene: its lengths are
-        rescaled (a size beyond 2**60 of 1 m) or it has pins to bound.
+        rescaled (a size beyond 2**60 of 1 m), it has pins to bound, or it
+        has several drivers or an actuator (the tick takes one crank's angle).
     ground : mapping of str to tuple
         Every ground point's context entry ``(p, v, a, bounds...)``.
     crank : object
@@ -74,7 +75,8 @@ def tick_plan(scene: Scene) -> TickPlan:
     """Return ``scene``'s compiled plan as the tick sees it."""
     solver = scene._solver
     plan = solver.run_plan
-    return TickPlan(not (solver.shift or plan.rubs), dict(solver.ground), plan.crank,
+    return TickPlan(solver.single and not (solver.shift or plan.rubs), dict(solver.ground),
+                    plan.crank,
                     plan.steps, dict(plan.joint_types),
                     {'points': solver.out_points, 'links': solver.out_links,
                      'sliders': solver.out_sliders}, solver.size, solver.crank_length)

@@ -152,7 +152,9 @@ def hand_written(scene: Any) -> tuple[Callable[..., Any], Callable[..., Any]] | 
     if len(scene.dyads) != 1:
         return None
     baseline = _BASELINES.get(scene.dyads[0].kind)
-    return None if baseline is None else baseline(scene, scene.dyads[0], scene.input)
+    if baseline is None or scene.input is None or len(scene.drivers) > 1:
+        return None
+    return baseline(scene, scene.dyads[0], scene.input)
 
 
 def _four_bar(scene: Any, dyad: Any, crank: Any) -> Any:
@@ -220,10 +222,19 @@ def measure(names: list[str], angles: int, repeat: int) -> list[dict[str, Any]]:
     rows = []
     for name in names:
         scene = load_scene(name)
-        theta, w, al = scene.input.angle, scene.input.speed, scene.input.accel
-        singles = [partial(solve, scene, theta)]
-        arrays = [partial(solve, scene, sweep)]
-        forms = hand_written(scene)
+        drivers = scene.drivers
+        if scene.input is None or len(drivers) > 1:
+            # Several drivers: one configuration, their start, and the array path over
+            # as many copies of it as a crank's sweep has angles.
+            starts = [driver.start for driver in drivers]
+            singles = [partial(solve, scene, starts)]
+            arrays = [partial(solve, scene, [np.full(angles, x) for x in starts])]
+            forms = None
+        else:
+            theta, w, al = scene.input.angle, scene.input.speed, scene.input.accel
+            singles = [partial(solve, scene, theta)]
+            arrays = [partial(solve, scene, sweep)]
+            forms = hand_written(scene)
         if forms is not None:
             # Where a scene does not assemble at every angle, the array path is timed
             # over the angles where it does (the hand-written forms cannot refuse).

@@ -176,6 +176,12 @@ def motion_from_scene(scene: Any, *, samples: int = DEFAULT_SAMPLES,
     if samples < 2:
         msg = f'Expected at least 2 samples, got {samples}'
         raise PlotError(msg)
+    drivers = scene.drivers
+    if scene.input is None or len(drivers) > 1:
+        msg = (f'Expected a scene driven by one crank to plot over its turn, got scene '
+               f'"{scene.name}" with {len(drivers)} drivers '
+               f'({", ".join(d.name for d in drivers)}): plot a bag the node recorded instead')
+        raise PlotError(msg)
     speed = scene.input.speed if speed is None else float(speed)
     accel = scene.input.accel if accel is None else float(accel)
     time = None
@@ -431,7 +437,7 @@ def motion_from_bag(path: str | os.PathLike[str], *, scene: Any = None,
             scene = candidate
     if scene is not None:
         types = {n: scene.joint_types.get(n, 'revolute') for n in names}
-        crank = scene.input.link
+        crank = scene.drivers[0].name  # the first driver: a crank, or an actuator
     else:
         if any(names):
             warnings.warn(f'{path}: no scene given or named in the bag; plotting every joint '

@@ -7,8 +7,10 @@ from __future__ import annotations
 from dataclasses import replace
 import itertools
 import math
+import re
 import warnings
 
+from helpers import crank_scene_names
 import numpy as np
 import pytest
 
@@ -25,7 +27,7 @@ ATOL_COLLINEAR = 1e-9
 #: Velocity of a point against omega x (P - I), relative to the largest speed.
 RTOL_VELOCITY = 1e-9
 
-SCENES = tuple(mk.scene_names())
+SCENES = tuple(crank_scene_names())  # Kennedy's polygons are one crank's (issue 18)
 #: Crank angles tried besides each scene's own, degrees.
 ANGLES_DEG = (0.0, 37.0, 95.0, 160.0, 215.0, 290.0)
 
@@ -200,3 +202,18 @@ def test_pruned_state_is_refused():
         instant_centres_from_kennedy(scene, state)
     full = full_scene(scene)
     assert len(instant_centres_from_state(full, mk.solve(full, scene.input.angle))) == 15
+
+
+@pytest.mark.parametrize('name', ['five_bar', 'excavator'])
+def test_several_drivers_are_refused_in_one_line(name):
+    """Instant centres are one driver's (issue 18): a clear SceneError, not a crash."""
+    scene = full_scene(mk.load_scene(name))
+    state = mk.solve(scene, [d.start for d in scene.drivers])
+    names = ', '.join(d.name for d in scene.drivers)
+    for method in (instant_centres_from_state, instant_centres_from_kennedy):
+        with pytest.raises(mk.SceneError, match=re.escape(
+                f"Expected a scene driven by one crank for instant centres (one driver's), got "
+                f'scene "{name}" with 2 drivers ({names})')):
+            method(scene, state)
+    assert {body.name for body in bodies_from_scene(scene).bodies.values()} >= {
+        d.name for d in scene.drivers if d.joint_type == 'revolute'}

@@ -10,6 +10,7 @@ the scene's points at every crank angle, not only the one it was built at.
 import math
 import xml.etree.ElementTree as ET
 
+from helpers import crank_scene_names
 import numpy as np
 import pytest
 
@@ -21,7 +22,7 @@ from mech_kinematics.geometry.urdf import urdf_from_scene
 
 #: Drawn pins against solved points, m (relative to the mechanism's size).
 RTOL_PLACE = 1e-12
-SCENES = mk.scene_names()
+SCENES = crank_scene_names()  # several drivers: test_drivers (issue 18)
 
 
 def _links_and_joints(text):
@@ -165,3 +166,48 @@ def test_an_imu_turned_on_its_link_has_a_fixed_link_at_its_point(tmp_path):
         np.testing.assert_allclose([pose.x + c * x - s * y, pose.y + s * x + c * y],
                                    state.points['E'].position, rtol=0, atol=1e-15)
     assert z == 0.0
+
+
+# --- several drivers: an actuator is a prismatic joint between its two pins (issue 18) ---
+
+
+def test_an_actuator_is_a_prismatic_joint_between_its_two_pins():
+    """The rod hangs on the cylinder's body by a prismatic joint along x, limited to the stroke.
+
+    Its /tf frame sits at the rod's pin, along the cylinder: the actuator's length
+    from the body's frame, at every pose.
+    """
+    scene = mk.load_scene('excavator')
+    _, links, joints = _links_and_joints(urdf_from_scene(scene))
+    for actuator, body in (('boom_cyl', 'boom_cyl_body'), ('stick_cyl', 'stick_cyl_body')):
+        joint = joints[f'mechanism/{actuator}']
+        assert joint.get('type') == 'prismatic'
+        assert joint.find('parent').get('link') == f'mechanism/{body}'
+        assert joint.find('child').get('link') == f'mechanism/{actuator}'
+        assert joint.find('axis').get('xyz') == '1 0 0'
+        stroke = next(d.stroke for d in scene.drivers if d.name == actuator)
+        limit = joint.find('limit')
+        assert (float(limit.get('lower')), float(limit.get('upper'))) == stroke
+        assert f'mechanism/{actuator}' in links
+    frames = frames_from_scene(scene)
+    for lengths in ([2.0, 2.5], [2.6, 3.0], [3.3, 3.9]):
+        poses = {p.joint: p for p in poses_from_state(frames, mk.solve(scene, lengths))}
+        for actuator, body, length in (('boom_cyl', 'boom_cyl_body', lengths[0]),
+                                       ('stick_cyl', 'stick_cyl_body', lengths[1])):
+            rod, base = poses[actuator], poses[body]
+            assert rod.angle == base.angle
+            along = complex(rod.x - base.x, rod.y - base.y) * complex(
+                math.cos(base.angle), -math.sin(base.angle))
+            assert along.real == pytest.approx(length, rel=1e-14)
+            assert along.imag == pytest.approx(0.0, abs=1e-14)
+
+
+@pytest.mark.parametrize('name', ['five_bar', 'excavator'])
+def test_several_driver_scenes_have_a_urdf_on_their_frames(name):
+    """One URDF link per /tf frame and ground point, as for one crank (issue 18)."""
+    scene = mk.load_scene(name)
+    _, links, joints = _links_and_joints(urdf_from_scene(scene))
+    frames = {f'mechanism/{f.joint}' for f in frames_from_scene(scene)}
+    ground = {f'mechanism/{name_}' for name_ in scene.ground}
+    assert set(links) == {'mechanism', *frames, *ground}
+    assert len(joints) == len(frames) + len(ground)

@@ -275,3 +275,18 @@ def test_node_without_markers_has_no_markers_publisher(ros, tmp_path):
     finally:
         if proc.proc.poll() is None:
             proc.proc.kill()
+
+
+def test_a_cylinder_is_drawn_as_a_link_between_its_pins():
+    """Excavator: each cylinder is a line strip between its two pins; the arm's points joints."""
+    scene = mk.load_scene('excavator')
+    full = full_scene(scene)
+    state = mk.solve(full, [2.9, 3.4])
+    array = marker_array_from_state(full, state, points=scene.output_points)
+    strips = [[tuple(_xy(p)) for p in m.points] for m in array.markers if m.ns == 'links']
+    points = state.points
+    for start, pin in (('F', 'Q'), ('S', 'K')):
+        ends = {tuple(points[start].position), tuple(points[pin].position)}
+        assert any(set(strip) == ends for strip in strips), (start, pin)
+    joints = next(m for m in array.markers if m.ns == 'joints')
+    assert len(joints.points) == len(points)

@@ -4,8 +4,10 @@
 
 import math
 from pathlib import Path
+import re
 import warnings
 
+from helpers import crank_scene_names, driver_scene_names
 import numpy as np
 import pytest
 import yaml
@@ -62,7 +64,7 @@ def _assert_same(scene, tick, angles, speeds=(None,), turns=(0,), **kwargs):
     return refused
 
 
-@pytest.mark.parametrize('name', mk.scene_names())
+@pytest.mark.parametrize('name', crank_scene_names())
 def test_every_packaged_scene_compiles_to_the_same_bits(name):
     """Over two turns, at three tolerances, the compiled tick answers as mk.solve does.
 
@@ -76,6 +78,31 @@ def test_every_packaged_scene_compiles_to_the_same_bits(name):
     refused = _assert_same(scene, tick, ANGLES, speeds=(None, -3.5, 1e4), turns=(0, 3, -40))
     if name == 'four_bar_coupler_points':
         assert refused > 0      # the triple rocker's unassemblable angles, refused alike
+
+
+@pytest.mark.parametrize('name', driver_scene_names())
+def test_several_driver_scenes_fall_back_to_the_general_solver(name):
+    """A scene with several drivers or an actuator is not compiled (issue 18), cleanly.
+
+    The compiled tick takes one crank's angle; such a scene falls back to
+    the general solver, whose tick function takes one value per driver (a
+    sequence each) and answers exactly as mk.solve does, refusals alike.
+    """
+    scene = mk.load_scene(name)
+    tick, compiled = tick_function(scene)
+    assert not compiled
+    starts = [d.start for d in scene.drivers]
+    speeds = [0.5 if d.joint_type == 'revolute' else 0.01 for d in scene.drivers]
+    values, measure = tick(starts, speeds, [0.0] * len(starts), 1e-6, 0)
+    state = mk.solve(scene, starts, speeds, [0.0] * len(starts))
+    assert values == values_from_state(state, scene.output_joints, scene.output_points, ())
+    assert measure == min(state.singularity.values())
+    # Cranks pointing apart (the distal links cannot reach); a boom cylinder beyond its stroke.
+    apart = {'five_bar': [math.pi, 0.0], 'excavator': [10.0, 3.0]}[name]
+    with pytest.raises(mk.AssemblyError) as info:
+        tick(apart, speeds, [0.0] * len(starts), 1e-6, 0)
+    with pytest.raises(mk.AssemblyError, match=re.escape(str(info.value))):
+        mk.solve(scene, apart, speeds, [0.0] * len(starts))
 
 
 def test_a_step_outside_the_kernel_subset_falls_back(monkeypatch):

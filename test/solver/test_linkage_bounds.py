@@ -38,7 +38,7 @@ import subprocess
 import sys
 import warnings
 
-from helpers import actual_errors, assert_bounded, first_order_spreads
+from helpers import actual_errors, assert_bounded, crank_scene_names, first_order_spreads
 from hypothesis import assume, given, HealthCheck, settings
 from hypothesis import strategies as st
 import mpmath
@@ -469,7 +469,7 @@ NEVER_WELL_CONDITIONED = {
 }
 
 
-@pytest.mark.parametrize('name', mk.scene_names())
+@pytest.mark.parametrize('name', crank_scene_names())  # several drivers: test_drivers
 def test_bound_is_tight_on_the_packaged_scenes(name):
     """Where well-conditioned, a packaged scene's bounds are within 1e3 x (error + 1 ulp)."""
     scene = mk.load_scene(name)
@@ -478,7 +478,7 @@ def test_bound_is_tight_on_the_packaged_scenes(name):
     assert any(checked) or name in NEVER_WELL_CONDITIONED
 
 
-@pytest.mark.parametrize('name', mk.scene_names())
+@pytest.mark.parametrize('name', crank_scene_names())  # several drivers: test_drivers
 def test_bound_covers_the_actual_error_on_the_packaged_scenes(name):
     """At eight angles of a turn, no value of a packaged scene is off by more than its bound."""
     scene = mk.load_scene(name)
@@ -505,7 +505,7 @@ def test_bound_is_tight_where_well_conditioned(scene, motion, angle):
 # --- the packaged scenes, both paths, the API --------------------------------------------
 
 
-@pytest.mark.parametrize('name', mk.scene_names())
+@pytest.mark.parametrize('name', crank_scene_names())  # several drivers: test_drivers
 def test_packaged_scenes_are_answered_wherever_they_assemble(name):
     """Over 3600 angles every packaged scene is answered except where it cannot assemble."""
     scene = mk.load_scene(name)

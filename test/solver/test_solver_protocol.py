@@ -55,6 +55,9 @@ FACTS = {
                'distance': 0.2, 'guide_angle': 0.0},
               'link rod (100 mm) cannot reach the guide through E at 0 deg from B (200 mm from '
               'the guide)'),
+    'stroke': ({'kind': 'stroke', 'actuator': 'boom_cyl', 'stroke': (1.9, 3.2), 'length': 3.5},
+               'actuator boom_cyl: expected a length within its stroke [1900 mm, 3200 mm], '
+               'got 3500 mm'),
 }
 
 

@@ -147,3 +147,13 @@ def test_a_crank_that_cannot_turn_has_no_strokes(capsys):
     """The triple rocker cannot make a whole turn: no strokes, no time ratio."""
     assert main(['check', 'four_bar_coupler_points', '--json']) == 0
     assert json.loads(capsys.readouterr().out)['strokes'] == []
+
+
+@pytest.mark.parametrize('name', ['five_bar', 'excavator'])
+def test_several_drivers_are_refused_in_one_line(name, capsys):
+    """`check` sweeps one crank's turn: a scene with several drivers is refused (issue 18)."""
+    assert main(['check', name]) == 2
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1
+    assert err.startswith('error: Expected a scene driven by one crank for assembly over one '
+                          f'crank\'s turn, got scene "{name}" with 2 drivers')

@@ -13,6 +13,7 @@ import subprocess
 import sys
 import warnings
 
+from helpers import crank_scene_names
 import numpy as np
 import pytest
 
@@ -29,9 +30,9 @@ ATOL_POSITION = 1e-12
 #: Smallest sensible PNG: the three panels need room (pixels).
 MIN_PNG_SIZE = (1200, 600)
 
-SCENES = tuple(mk.scene_names())
-SCENE_FILES = sorted((Path(__file__).resolve().parents[2] / 'config' / 'scenes')
-                     .glob('*.yaml'))
+SCENES = tuple(crank_scene_names())  # a velocity polygon is one driver's (issue 18)
+SCENE_DIR = Path(__file__).resolve().parents[2] / 'config' / 'scenes'
+SCENE_FILES = sorted(path for path in SCENE_DIR.glob('*.yaml') if path.stem in SCENES)
 #: Crank angles tried besides each scene's own, degrees.
 ANGLES_DEG = (20.0, 100.0, 200.0, 300.0)
 KHURMI = 'khurmi_four_bar_ad150'
@@ -469,3 +470,16 @@ def test_a_diagram_far_out_is_drawn_where_solve_puts_it(tmp_path):
     gif = tmp_path / 'far.gif'
     assert dg.main(['geneva', '--angle-deg', '1e17', '--animate', '--frames', '4', '-o',
                     str(gif)]) == 0
+
+
+@pytest.mark.parametrize('name', ['five_bar', 'excavator'])
+def test_several_drivers_are_refused_in_one_line(name, tmp_path):
+    """Velocity polygons are one driver's (issue 18): the diagram refuses, in one line."""
+    scene = mk.load_scene(name)
+    with pytest.raises(mk.SceneError, match='Expected a scene driven by one crank for velocity '
+                       'and acceleration polygons'):
+        geo.diagram_from_scene(scene)
+    status = subprocess.run([sys.executable, '-m', 'mech_kinematics', 'diagram', name, '-o',
+                             str(tmp_path / 'd.png')], capture_output=True, text=True, check=False)
+    assert status.returncode == 2
+    assert status.stderr.count('\n') == 1 and 'driven by one crank' in status.stderr

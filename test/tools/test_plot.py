@@ -420,3 +420,13 @@ def test_bag_plot_shows_the_recorded_imu_readings(tmp_path):
     # A bag without IMU topics has no IMU column.
     plain = write_bag(tmp_path / 'plain', scene, angles)
     assert not plot.motion_from_bag(plain, scene=scene).imus
+
+
+def test_several_drivers_are_refused_in_one_line(tmp_path, capsys):
+    """`plot --scene` sweeps one crank's turn: several drivers are refused (issue 18)."""
+    assert plot.main(['--scene', 'five_bar', '-o', str(tmp_path / 'p.png')]) == 2
+    err = capsys.readouterr().err
+    assert err == ('error: Expected a scene driven by one crank to plot over its turn, got '
+                   'scene "five_bar" with 2 drivers (left_crank, right_crank): plot a bag the '
+                   'node recorded instead\n')
+    assert not (tmp_path / 'p.png').exists()

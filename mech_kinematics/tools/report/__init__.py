@@ -108,7 +108,7 @@ def run(outdir: str | os.PathLike[str], mode: str | Mode = 'full',
     start = time.perf_counter()
     load = [os.getloadavg()[0]]
     from ...scene import scene_names
-    n_checks = len(mode.check_scenes or scene_names())
+    n_checks = len(mode.check_scenes or scene_names())  # at most: the crank scenes
     cases = bound_cases(mode)
     total = (n_checks + 1 + 5 * len(mode.wp_mechanisms) + len(mode.clock_rpms) + 1
              + len(mode.batch_sizes) + len(mode.chain_lengths) + len(cases) + 2)

@@ -254,18 +254,29 @@ class Model:
 
     def __init__(self, scene: Scene) -> None:
         self.scene = scene
-        crank = scene.input
         values: dict[str, float] = {}
         for name, (x, y) in scene.ground.items():
             values[f'ground.{name}.x'] = float(x)
             values[f'ground.{name}.y'] = float(y)
-        values['crank.length'] = crank.length
-        self.links: dict[str, Any] = {crank.link: None}   # link -> unknown index or None
+        drivers = scene.drivers
+        #: One crank (the v1 scene): ``theta`` is its angle; else a sequence, one per driver.
+        self.single = scene.input is not None and len(drivers) == 1
+        self.links: dict[str, Any] = {}   # link -> unknown index, or None for a crank's
         self.sliders: dict[str, int] = {}
-        self.joint_types: dict[str, str] = {crank.link: 'revolute'}
+        self.joint_types: dict[str, str] = {}
+        #: Per actuator, the RRR links whose length is its length.
+        self.actuated: dict[str, list[str]] = {}
+        known = set(scene.ground)
+        for driver in drivers:
+            self.joint_types[driver.name] = driver.joint_type
+            if driver.joint_type == 'revolute':
+                values[self.crank_key(driver.name)] = driver.length
+                self.links[driver.name] = None
+                known.add(driver.point)  # type: ignore[union-attr]
+            else:
+                self.actuated[driver.name] = []
         self.unknown_names: list[str] = []
         self.unknown_is_length: list[bool] = []
-        known = set(scene.ground) | {crank.point}
         pending: list[Any] = [*scene.dyads, *scene.points]
         elements: list[_Element] = []
         while pending:
@@ -280,10 +291,36 @@ class Model:
                 raise ValueError(msg)
         self.elements = tuple(elements)
         self.values = values
-        lengths = [crank.length] + [v for k, v in values.items()
-                                    if k.startswith('link.') and k.endswith('.length')]
+        lengths = [driver.reach for driver in drivers] + [
+            v for k, v in values.items() if k.startswith('link.') and k.endswith('.length')]
         ground = [complex(x, y) for x, y in scene.ground.values()]
         self.size = max(lengths + [abs(a - b) for a in ground for b in ground])
+
+    def crank_key(self, name: str) -> str:
+        """Return the key of crank ``name``'s length in :attr:`values`."""
+        return 'crank.length' if self.single else f'crank.{name}.length'
+
+    def driven(self, p: Mapping[str, Any],
+               theta: Any) -> tuple[Mapping[str, Any], dict[str, Any]]:
+        """Return the parameters with every actuated link's length, and the cranks' tips.
+
+        ``theta`` is the crank angle of a 1-crank scene, else one value per
+        driver (a crank's angle, an actuator's length): numbers or jets.
+        """
+        scene = self.scene
+        points: dict[str, Any] = {name: p[f'ground.{name}.x'] + 1j * p[f'ground.{name}.y']
+                                  for name in scene.ground}
+        values = (theta,) if self.single else tuple(theta) if isinstance(
+            theta, (list, tuple)) else (theta,)
+        lengths: dict[str, Any] = {}
+        for driver, value in zip(scene.drivers, values, strict=True):
+            if driver.joint_type == 'revolute':
+                tip = p[self.crank_key(driver.name)] * expi(value)
+                points[driver.point] = points[driver.center] + tip  # type: ignore[union-attr]
+            else:
+                for link in self.actuated[driver.name]:
+                    lengths[f'link.{link}.length'] = value
+        return ({**p, **lengths} if lengths else p), points
 
     def _unknowns(self, *names: tuple[str, bool]) -> None:
         for name, is_length in names:
@@ -313,11 +350,7 @@ class Model:
         ``p`` are the parameters (:attr:`values` or :meth:`mp_values`), ``q``
         the unknowns and ``theta`` the crank angle: numbers, arrays or jets.
         """
-        scene = self.scene
-        crank = scene.input
-        points: dict[str, Any] = {name: p[f'ground.{name}.x'] + 1j * p[f'ground.{name}.y']
-                                  for name in scene.ground}
-        points[crank.point] = points[crank.center] + p['crank.length'] * expi(theta)
+        p, points = self.driven(p, theta)
         residuals: list[Any] = []
         for element in self.elements:
             element.equations.evaluate(element.item, element.index, p, q, points, residuals)
@@ -334,11 +367,8 @@ class Model:
         NoAssembly
             Where circles do not meet or a guide is out of reach.
         """
-        scene = self.scene
-        crank = scene.input
-        pts: dict[str, Any] = {name: mpmath.mpc(p[f'ground.{name}.x'], p[f'ground.{name}.y'])
-                               for name in scene.ground}
-        pts[crank.point] = pts[crank.center] + p['crank.length'] * mpmath.expj(theta)
+        p, pts = self.driven(p, theta)
+        pts = {name: mpmath.mpc(z) for name, z in pts.items()}
         q: list[Any] = [None] * self.n
         tiny = mpmath.mpf(10) ** (-(mpmath.mp.dps - 8))
         for element in self.elements:
@@ -410,6 +440,9 @@ class _RRR(_Kind):
             return False
         values[f'link.{first.name}.length'] = first.length
         values[f'link.{second.name}.length'] = second.length
+        for link, actuator in zip(item.links, item.actuators, strict=True):
+            if actuator is not None:  # its length is the actuator's (Model.driven)
+                model.actuated[actuator].append(link.name)
         model.links[first.name], model.links[second.name] = index, index + 1
         model.joint_types[first.name] = model.joint_types[second.name] = 'revolute'
         model._unknowns((f'{first.name} angle', False), (f'{second.name} angle', False))
@@ -814,42 +847,74 @@ def reference(scene: Scene | Model, theta: Any, omega: Any | None = None,
         If the mechanism has no real configuration there.
     """
     model = scene if isinstance(scene, Model) else Model(scene)
-    crank = model.scene.input
+    drivers = model.scene.drivers
+    th: Any
+    om: Any
+    al: Any
     with _precision(dps):
         p = model.mp_values() if values is None else {k: mpmath.mpf(v) for k, v in values.items()}
-        th = mpmath.mpf(theta)
-        om = mpmath.mpf(crank.speed if omega is None else omega)
-        al = mpmath.mpf(crank.accel if alpha is None else alpha)
+        if model.single:
+            th = mpmath.mpf(theta)
+            om = mpmath.mpf(drivers[0].speed if omega is None else omega)
+            al = mpmath.mpf(drivers[0].accel if alpha is None else alpha)
+        else:
+            th, om, al = (tuple(mpmath.mpf(getattr(d, attr) if x is None else x)
+                                for d, x in zip(drivers, _each(given, len(drivers)),
+                                                strict=True))
+                          for given, attr in ((theta, 'start'), (omega, 'speed'),
+                                              (alpha, 'accel')))
         q, iterations = _solve_positions(model, p, th, seed)
         points, res = model.evaluate(p, q, th)
         _check_branch(model, p, points, q)
-        measures = _measures(model, p, points, q)
+        measures = _measures(model, model.driven(p, th)[0], points, q)
         residual = max((abs(r) for r in res), default=mpmath.mpf(0)) / model.size
         singular = bool(measures) and min(measures.values()) < SINGULAR_MEASURE
         qdot = qddot = None
         if not singular:
             columns = model.jacobian_columns(p, q, th)
-            theta_jet = Jet(th, om, al / 2)
+            theta_jet = _jet(th, om, al)
             _, res = model.evaluate(p, q, theta_jet)
-            qdot = [-x for x in _mp_solve(columns, [r.c1 for r in res])]
+            # (a dyad no driver moves directly has a plain residual: rate 0)
+            qdot = [-x for x in _mp_solve(columns, [r.c1 if isinstance(r, Jet) else 0 * r
+                                                    for r in res])]
             _, res = model.evaluate(p, [Jet(x, v) for x, v in zip(q, qdot, strict=True)],
                                     theta_jet)
-            qddot = [-2 * x for x in _mp_solve(columns, [r.c2 for r in res])]
+            qddot = [-2 * x for x in _mp_solve(columns, [r.c2 if isinstance(r, Jet) else 0 * r
+                                                         for r in res])]
         state = _state(model, p, q, qdot, qddot, th, om, al)
         return Reference(model.scene.name, th, om, al, q, qdot, qddot, state[0], state[1],
                          dict(model.joint_types), measures, singular, residual, iterations,
                          dict(p))
 
 
+def _each(given: Any, n: int) -> list[Any]:
+    """Return one value per driver: ``None`` for each, a sequence, or one value (n = 1)."""
+    if given is None:
+        return [None] * n
+    if isinstance(given, (list, tuple)):
+        return list(given)
+    return [given]
+
+
+def _jet(th: Any, om: Any, al: Any) -> Any:
+    """Return the drivers' motion as jets: one, or a tuple of one per driver."""
+    if isinstance(th, tuple):
+        return tuple(Jet(x, v, a / 2) for x, v, a in zip(th, om, al, strict=True))
+    return Jet(th, om, al / 2)
+
+
 def _state(model: Model, p: Mapping[str, Any], q: list[Any], qdot: list[Any] | None,
            qddot: list[Any] | None, th: Any, om: Any,
            al: Any) -> tuple[dict[str, Any], dict[str, Any]]:
     """Points and joints with derivatives from the jets of q (or positions only)."""
-    crank = model.scene.input
+    drivers = model.scene.drivers
     if qdot is None or qddot is None:
         points, _ = model.evaluate(p, q, th)
         point_states = {name: (z, None, None) for name, z in points.items()}
-        joints: dict[str, Any] = {crank.link: (_wrap(th), None, None)}
+        joints: dict[str, Any] = {}
+        for driver, x in zip(drivers, (th,) if model.single else th, strict=True):
+            revolute = driver.joint_type == 'revolute'
+            joints[driver.name] = (_wrap(x) if revolute else x, None, None)
         for name, index in model.links.items():
             if index is not None:
                 joints[name] = (_wrap(q[index]), None, None)
@@ -857,14 +922,18 @@ def _state(model: Model, p: Mapping[str, Any], q: list[Any], qdot: list[Any] | N
             joints[name] = (q[index], None, None)
         return point_states, joints
     jets = [Jet(x, v, a / 2) for x, v, a in zip(q, qdot, qddot, strict=True)]
-    theta_jet = Jet(th, om, al / 2)
+    theta_jet = _jet(th, om, al)
     points, _ = model.evaluate(p, jets, theta_jet)
     point_states = {name: (z.derivatives() if isinstance(z, Jet) else (z, 0 * z, 0 * z))
                     for name, z in points.items()}
     joints = {}
+    for driver, jet in zip(drivers, (theta_jet,) if model.single else theta_jet, strict=True):
+        x, v, a = jet.derivatives()
+        joints[driver.name] = (_wrap(x) if driver.joint_type == 'revolute' else x, v, a)
     for name, index in model.links.items():
-        x, v, a = theta_jet.derivatives() if index is None else jets[index].derivatives()
-        joints[name] = (_wrap(x), v, a)
+        if index is not None:
+            x, v, a = jets[index].derivatives()
+            joints[name] = (_wrap(x), v, a)
     for name, index in model.sliders.items():
         joints[name] = jets[index].derivatives()
     return point_states, joints
@@ -890,6 +959,9 @@ def check_by_differences(scene: Scene | Model, ref: Reference,
         kind's largest magnitude (:func:`compare`'s normalisation).
     """
     model = scene if isinstance(scene, Model) else Model(scene)
+    if not model.single:
+        msg = f'Expected a scene driven by one crank, got {len(model.scene.drivers)} drivers'
+        raise ValueError(msg)
     if ref.qdot is None:
         msg = 'Expected a regular pose, got a singular one (no velocities to check)'
         raise ValueError(msg)

@@ -1,0 +1,101 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The ``solve`` command with several drivers: --input, --speed, --accel NAME=VALUE (issue 18).
+
+The one-crank flags are tested with the scene reader (test/test_scene.py).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import math
+
+import pytest
+
+import mech_kinematics as mk
+from mech_kinematics.__main__ import main
+from mech_kinematics.units import rad_per_s_from_rpm
+
+
+def run(*args):
+    """Return (status, stdout, stderr) of ``python -m mech_kinematics solve ARGS``."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        status = main(['solve', *args])
+    return status, out.getvalue(), err.getvalue()
+
+
+def test_drivers_by_name_in_their_units():
+    """--input in degrees or the scene's length unit, --speed in rpm or m/s, --accel SI."""
+    status, out, _ = run('five_bar', '--input', 'left_crank=120', '--input', 'right_crank=420',
+                         '--speed', 'left_crank=60', '--accel', 'right_crank=-2')
+    assert status == 0
+    data = json.loads(out)
+    assert 'input' not in data
+    left, right = data['inputs']['left_crank'], data['inputs']['right_crank']
+    assert left == {'position': math.radians(120), 'speed': rad_per_s_from_rpm(60.0),
+                    'accel': 0.0}
+    assert right['position'] == pytest.approx(math.radians(420), rel=1e-15)
+    assert (right['speed'], right['accel']) == (rad_per_s_from_rpm(30.0), -2.0)  # the scene's
+    scene = mk.load_scene('five_bar')
+    expected = mk.solve(scene, [math.radians(120), math.radians(60)],
+                        [rad_per_s_from_rpm(60.0), None],
+                        [None, -2.0], turns=[0, 1]).as_dict()
+    assert data['points']['P'] == {key: list(value) for key, value in
+                                   expected['points']['P'].items()}
+    status, out, _ = run('excavator', '--input', 'boom_cyl=2.8', '--speed', 'stick_cyl=-0.05',
+                         '--accel', 'stick_cyl=0.1')
+    cylinder = json.loads(out)['inputs']['stick_cyl']
+    assert (status, cylinder) == (0, {'position': 3.0, 'speed': -0.05, 'accel': 0.1})
+
+
+def test_an_actuator_length_is_in_the_scenes_unit(tmp_path):
+    """In a scene written in mm, --input cyl=2800 is 2.8 m."""
+    text = mk.scene.scene_text('excavator').replace('units: {length: m, angle: deg}',
+                                                    'units: {length: mm, angle: deg}')
+    for old, new in (('2.6', '2600'), ('3.0', '3000'), ('[2.0, 3.3]', '[2000, 3300]'),
+                     ('[2.5, 3.9]', '[2500, 3900]'), ('0.4', '400'), ('-1.1', '-1100'),
+                     ('length: 0.9', 'length: 900'), ('5.68, 0.55', '5680, 550'),
+                     ('2.5, 0.9', '2500, 900'), ('-2.9, 0.0', '-2900, 0'),
+                     ('-4.0, 0.5', '-4000, 500')):
+        text = text.replace(old, new)
+    path = tmp_path / 'excavator_mm.yaml'
+    path.write_text(text)
+    status, out, _ = run(str(path), '--input', 'boom_cyl=2800')
+    assert status == 0 and json.loads(out)['inputs']['boom_cyl']['position'] == 2.8
+
+
+@pytest.mark.parametrize(('args', 'message'), [
+    (('--input', 'boom=3'), 'error: Expected --input NAME=VALUE with NAME one of the drivers '
+                            "(boom_cyl, stick_cyl), got 'boom'\n"),
+    (('--speed', 'arm=3'), 'error: Expected --speed NAME=VALUE with NAME one of the drivers '
+                           "(boom_cyl, stick_cyl), got 'arm'\n"),
+    (('--angle-deg', '30'), 'error: Expected --input, --speed and --accel NAME=VALUE for a '
+                            'scene with several drivers (boom_cyl, stick_cyl), got '
+                            '--angle-deg\n'),
+    (('--accel', '3'), 'error: Expected --accel NAME=VALUE with NAME one of the drivers '
+                       '(boom_cyl, stick_cyl), got --accel 3\n'),
+    (('--input', 'stick_cyl=3.95'), 'error: input stick_cyl cannot be solved at boom_cyl = '
+                                    '2.6 m, stick_cyl = 3.95 m: actuator stick_cyl: expected '
+                                    'a length within its stroke [2.5 m, 3.9 m], got 3.95 m\n'),
+])
+def test_bad_driver_flags_are_refused_in_one_line(args, message):
+    """An unknown driver, a one-crank flag or a length beyond the stroke: one line, exit 2."""
+    status, out, err = run('excavator', *args)
+    assert (status, out, err) == (2, '', message)
+
+
+def test_one_crank_usage_is_unchanged_and_takes_its_name_too():
+    """--angle-deg, --speed-rpm, --accel A as before; --input crank=DEG says the same."""
+    _, plain, _ = run('khurmi_four_bar_ad150', '--angle-deg', '400', '--speed-rpm', '90',
+                      '--accel', '2')
+    _, named, _ = run('khurmi_four_bar_ad150', '--input', 'crank=400', '--speed', 'crank=90',
+                      '--accel', 'crank=2')
+    assert plain == named
+    data = json.loads(plain)
+    assert data['input'] == {'angle': math.radians(40) + 2 * math.pi,
+                             'speed': rad_per_s_from_rpm(90.0), 'accel': 2.0}
+    status, _, err = run('khurmi_four_bar_ad150', '--angle-deg', '40', '--input', 'crank=40')
+    assert (status, err) == (2, 'error: Expected --angle-deg or --input crank=DEG, got both\n')
