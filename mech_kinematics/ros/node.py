@@ -440,7 +440,9 @@ class KinematicsNode(LifecycleNode):
         # Instants where a value jumps (a Geneva wheel's) are published one-sided and counted.
         self._jumps_at = tick_scene.jumps_at if tick_scene.intermittent else None
         # Where the scene cannot assemble, in one line, for the diagnostics.
-        self._assembly = assembly_summary(scene)
+        # (a crank's turn: a scene of several drivers, or an actuator, has none to sweep).
+        self._assembly = assembly_summary(scene) \
+            if len(scene.drivers) == 1 and scene.input is not None else ''
         if not compiled:
             self.get_logger().info('the scene is solved by the general solver (not compiled)')
         if self._value('markers'):

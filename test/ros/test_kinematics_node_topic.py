@@ -280,6 +280,55 @@ def test_the_input_qos_is_overridden_like_the_publishers(ros, tmp_path):
     assert stamp_ns(node.js[0]) in sent
 
 
+def test_several_drivers_from_one_message(ros, tmp_path):
+    """Five-bar: both cranks in one message give the whole state; one missing is refused."""
+    scene = mk.load_scene('five_bar')
+    node = TopicNode(ros, tmp_path, 'topic_five_bar', '-p', 'scene:=five_bar')
+    poses = [(1.5 + 0.01 * i, 1.0 - 0.02 * i, 0.5 * i - 2.0, 1.0) for i in range(10)]
+    try:
+        for i, (left, right, v_left, v_right) in enumerate(poses):
+            # The message's order need not be the scene's.
+            node.send(T0 + i, ['right_crank', 'left_crank'], [right, left], [v_right, v_left])
+        wait_for(lambda: len(node.pt) >= len(poses), ANSWER_S, 'the five-bar states')
+        seen = len(node.diag)
+        node.send(T0 + 100, ['left_crank'], [1.5])
+        status = wait_for(lambda: node.refusal(seen, "got none for 'right_crank'"), ANSWER_S,
+                          'the refusal of a message missing a crank')
+        assert status.level == DiagnosticStatus.ERROR
+    finally:
+        node.stop()
+    assert [stamp_ns(m) for m in node.js] == [T0 + i for i in range(len(poses))]
+    for msg, (left, right, v_left, v_right) in zip(node.js, poses, strict=True):
+        state = mk.solve(scene, [left, right], [v_left, v_right], [0.0, 0.0])
+        np.testing.assert_allclose(msg.position, [state.joints[n].position for n in msg.name],
+                                   rtol=0, atol=ATOL)
+        np.testing.assert_allclose(msg.velocity, [state.joints[n].velocity for n in msg.name],
+                                   rtol=0, atol=ATOL)
+
+
+def test_an_actuator_length_outside_its_stroke_is_refused(ros, tmp_path):
+    """Excavator: cylinder lengths in, the arm out; a length beyond the stroke is refused."""
+    scene = mk.load_scene('excavator')
+    node = TopicNode(ros, tmp_path, 'topic_excavator', '-p', 'scene:=excavator')
+    try:
+        node.send(T0, ['boom_cyl', 'stick_cyl'], [2.8, 3.1])
+        wait_for(lambda: node.js, ANSWER_S, 'the excavator state')
+        seen = len(node.diag)
+        node.send(T0 + 1, ['boom_cyl', 'stick_cyl'], [3.4, 3.1])
+        reason = "expected 'boom_cyl' within its stroke [2, 3.3] m, got 3.4 m"
+        wait_for(lambda: node.refusal(seen, reason), ANSWER_S, 'the stroke refusal')
+        node.send(T0 + 2, ['boom_cyl', 'stick_cyl'], [3.3, 2.5])     # both limits: inclusive
+        wait_for(lambda: len(node.js) >= 2, ANSWER_S, 'a state at the stroke limits')
+    finally:
+        node.stop()
+    assert [stamp_ns(m) for m in node.js] == [T0, T0 + 2]
+    state = mk.solve(scene, [3.3, 2.5])
+    msg = node.js[1]
+    assert not msg.velocity
+    np.testing.assert_allclose(msg.position, [state.joints[n].position for n in msg.name],
+                               rtol=0, atol=ATOL)
+
+
 @pytest.mark.parametrize('args, words', [
     (['-p', 'drive:=topic', '-p', 'markers:=true'], ['markers: expected false with drive: topic']),
     (['-p', 'drive:=stream'], ["drive: expected one of time, topic, got 'stream'"]),
