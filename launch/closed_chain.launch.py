@@ -18,5 +18,5 @@ def generate_launch_description():
     """Return the node, driven by /motors/joint_states."""
     return LaunchDescription([Node(
         package='mech_kinematics', executable='kinematics_node',
-        parameters=[{'scene': 'four_bar_coupler_points', 'drive': 'topic'}],
+        parameters=[{'scene': 'five_bar', 'drive': 'topic'}],
         remappings=[('input_joint_states', '/motors/joint_states')])])

@@ -352,7 +352,7 @@ def test_messages_leave_out_what_the_input_does_not_determine(name, velocities):
     accelerations, and the velocities only when the input message has them.
     """
     scene = mk.load_scene(name)
-    state = mk.solve(scene, scene.input.angle + 0.3)
+    state = mk.solve(scene, start_positions(scene))
     joints, points = scene.output_joints, scene.output_points
     rendered = TickMessages(joints, points, FRAME_ID, velocities=velocities,
                             accelerations=False).render(state, 11, 12)
