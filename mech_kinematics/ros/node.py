@@ -690,8 +690,7 @@ class KinematicsNode(LifecycleNode):
         self._marker_strokes = strokes_from_scene(self._marker_scene)
         try:
             self._marker_size: float | None = marker_size_from_space(space_from_state(
-                self._marker_scene, mk.solve(self._marker_scene, scene.input.angle,
-                                             turns=scene.input.turns)))
+                self._marker_scene, _solve_at_start(self._marker_scene)))
         except mk.AssemblyError:
             self._marker_size = None    # the part beyond the outputs cannot assemble here
         self._marker_throttle = MarkerThrottle()
@@ -1008,6 +1007,15 @@ class KinematicsNode(LifecycleNode):
         msg.header.stamp = self.get_clock().now().to_msg()
         msg.header.frame_id = self.frame_id
         self._pub_diagnostics.publish(msg)
+
+
+def _solve_at_start(scene: mk.Scene) -> Any:
+    """Return ``scene`` solved with its drivers at their start (a crank with its whole turns)."""
+    drivers = scene.drivers
+    turns = [getattr(d, 'turns', 0) for d in drivers]
+    if len(drivers) == 1:
+        return mk.solve(scene, drivers[0].start, turns=turns[0])
+    return mk.solve(scene, [d.start for d in drivers], turns=turns)
 
 
 def _transposed(states: list[tuple[int, Any]]) -> tuple[tuple[int, ...], Any]:

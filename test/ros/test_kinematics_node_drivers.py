@@ -16,6 +16,7 @@ from rclpy.parameter_client import AsyncParameterClient
 from ros_helpers import (NodeProcess, NS, Ros, SESSION, stamp_ns, STARTUP_S, wait_for,
                          wait_for_parameters, wrap)
 from sensor_msgs.msg import JointState
+from visualization_msgs.msg import MarkerArray
 
 import mech_kinematics as mk
 from mech_kinematics.scene import scene_text
@@ -204,3 +205,18 @@ def test_excavator_at_a_stroke_end_refuses_to_start_moving_out(tmp_path):
     fatal = [line for line in output.splitlines() if 'cannot start' in line]
     assert status == 1 and len(fatal) == 1, output
     assert 'keeps actuator boom_cyl within its stroke [2, 3.3] m' in fatal[0]
+
+
+@pytest.mark.parametrize('scene', ['five_bar', 'excavator'])
+def test_markers_of_a_scene_of_several_drivers(ros, tmp_path, scene):
+    """markers:=true on a scene of several drivers: it starts, ticks and draws."""
+    node = Node(ros, tmp_path, f'drivers_markers_{scene}', '-p', f'scene:={scene}',
+                '-p', 'markers:=true')
+    markers = ros.collect(MarkerArray, f'{node.ns}/markers')
+    try:
+        wait_for(lambda: len(markers) >= 3 and len(node.js) >= 3, STARTUP_S,
+                 'markers and joint_states')
+    finally:
+        node.stop()
+    assert all(m.markers for m in markers)
+    assert 'Traceback' not in node.proc.output()
