@@ -287,6 +287,7 @@ def exact_length(length0: float, speed: float, accel: float, t_ns: int) -> float
 @given(st.floats(0.1, 5.0), st.floats(-1.0, 1.0), st.floats(-2.0, 2.0),
        st.integers(0, 30 * DAY_NS))
 @example(1.2, 0.05, 0.0, 30 * DAY_NS)
+@example(0.5, 1.0, 0.0, 30 * DAY_NS)
 def test_actuator_length_is_exact(length0, speed, accel, t):
     """The length is L0 + v t + a t^2 / 2 correctly rounded, after any time (30 days too)."""
     base = ActuatorTimebase(7, length0, speed, accel)
