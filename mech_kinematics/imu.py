@@ -159,7 +159,8 @@ def imu_outputs(scene: Any, joint_types: dict[str, str], joints: Sequence[str] |
     """
     specs = tuple(scene.imus)
     if not specs:
-        return joints, points
+        return (None if joints is None else tuple(joints),
+                None if points is None else tuple(points))
     fixed = imu_links(scene)
     taken = {*scene.ground, *joint_types, *(p for on in fixed.values() for p in on)}
     for spec in specs:

@@ -105,6 +105,40 @@ points:
   F: {link: coupler, origin: B, xaxis: C, local: [40, -30]}
 """
 
+# --- small scenes with several drivers (issue 18) ---------------------------------
+# Used by geometry/test_region.py and tools/test_check.py (and the plot and diagram tests).
+#: A five-bar with two cranks whose distal links straighten (|BD| = 0.28 m) within a turn.
+FIVE_BAR_TWO_CRANKS = """\
+name: five
+units: {length: m, angle: deg}
+ground: {A: [0, 0], E: [0.1, 0]}
+inputs:
+  - {link: left, center: A, point: B, length: 0.12, angle: 120, speed_rpm: 10}
+  - {link: right, center: E, point: D, length: 0.12, angle: 60, speed_rpm: -10}
+dyads:
+  - type: RRR
+    point: P
+    links: [{name: ldist, from: B, length: 0.14}, {name: rdist, from: D, length: 0.14}]
+    branch: 1
+"""
+
+#: A cylinder (an actuator on an RRR link) lifting a boom; its stroke reaches past
+#: where the boom and cylinder come in line (L = 2600 mm + |OF|).
+BOOM_CYLINDER = """\
+name: boom
+units: {length: mm, angle: deg}
+ground: {O: [0, 0], F: [400, -1100]}
+inputs:
+  - {actuator: cyl, length: 2600, speed: 0.05, stroke: [2000, 5000]}
+dyads:
+  - type: RRR
+    point: Q
+    links: [{name: boom, from: O, length: 2600}, {name: body, from: F, actuator: cyl}]
+    branch: 1
+points:
+  T: {link: boom, origin: O, xaxis: Q, local: [5680, 550]}
+"""
+
 # --- what setup.py installs and which parameters the node declares ---------------
 # Used by test_launch.py and test_packaging.py.
 #: Parameters every rclpy node declares itself.

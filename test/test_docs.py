@@ -254,3 +254,41 @@ def test_readme_lists_every_executable():
     table = README.read_text().split('## Executables', 1)[1].split('\n## ', 1)[0]
     rows = set(re.findall(r'^\| `(\w+)` \|', table, re.MULTILINE))
     assert rows == set(scripts)
+
+
+def _python_block(text: str, heading: str) -> str:
+    """Return the first ```python block after ``heading`` in ``text``."""
+    start = text.index(heading)
+    match = re.search(r'```python\n(.*?)```', text[start:], re.S)
+    assert match is not None, heading
+    return match.group(1)
+
+
+def test_readme_python_example_prints_what_its_comments_say():
+    """The Python API example of README runs, and every value its comments give is returned.
+
+    A line ``expr  # 1.5 rad/s`` or ``expr  # [1.5, 2.5] m/s`` (a number or a list
+    of numbers first in the comment) is evaluated and compared to the digits given.
+    """
+    block = _python_block(README.read_text(encoding='utf-8'), '## The Python API')
+    namespace: dict[str, object] = {}
+    checked = 0
+    number = r'-?\d+(?:\.\d+)?(?:e-?\d+)?'
+    for line in block.splitlines():
+        code, _, comment = line.partition('#')
+        code = code.strip()
+        if not code:
+            continue
+        values = re.match(rf'\s*(\[\s*{number}(?:,\s*{number})*\s*\]|{number})(?=\s|$)',
+                          comment)
+        if values is None or '=' in code.split('(')[0]:
+            exec(code, namespace)  # noqa: S102 - README's own example
+            continue
+        written = re.findall(number, values.group(1))
+        got = [float(v) for v in __import__('numpy').ravel(eval(code, namespace))]  # noqa: S307
+        assert len(got) == len(written), line
+        for value, text in zip(got, written, strict=True):
+            digits = len(text.split('.')[1]) if '.' in text else 0
+            assert abs(value - float(text)) <= 0.5 * 10.0 ** -digits, line
+        checked += 1
+    assert checked >= 2

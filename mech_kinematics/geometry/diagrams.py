@@ -38,17 +38,19 @@ import numpy as np
 import numpy.typing as npt
 
 from .instant_centres import (bodies_from_scene, BodyKind, check_full_state, full_scene, GROUND,
-                              instant_centres_from_state, InstantCentres, one_driver, Topology)
+                              instant_centres_from_state, InstantCentres, Topology,
+                              varying_links)
 from ..errors import NearSingularWarning
 from ..solver import Scene, solve, State
 from ..units import turns_from_degrees
 
 __all__ = [
-    'COLOURS', 'Diagram', 'GuideLine', 'LinkShape', 'LinkValues', 'PinValues', 'Pivot',
-    'Polygon', 'SliderShape', 'SliderValues', 'SpaceDiagram', 'Table', 'Vector', 'VectorKind',
-    'acceleration_polygon_from_state', 'arrows_from_state', 'colours_from_scene',
-    'diagram_from_scene', 'space_from_state', 'strokes_from_scene', 'tables_from_diagram',
-    'fmt_sense', 'fmt_value', 'nice_scale', 'scale_text', 'velocity_polygon_from_state',
+    'ActuatorShape', 'COLOURS', 'Diagram', 'DriverValues', 'GuideLine', 'LinkShape',
+    'LinkValues', 'PinValues', 'Pivot', 'Polygon', 'SliderShape', 'SliderValues', 'SpaceDiagram',
+    'Table', 'Vector', 'VectorKind', 'acceleration_polygon_from_state', 'arrows_from_state',
+    'colours_from_scene', 'diagram_from_scene', 'space_from_state', 'strokes_from_scene',
+    'tables_from_diagram', 'fmt_sense', 'fmt_value', 'nice_scale', 'scale_text', 'varying_links',
+    'velocity_polygon_from_state',
 ]
 
 Array = npt.NDArray[np.float64]
@@ -211,6 +213,15 @@ class GuideLine:
 
 
 @dataclass(frozen=True)
+class ActuatorShape:
+    """A link whose length is an actuator's (a cylinder), from ``start`` to ``end``, m."""
+
+    link: str
+    start: Array
+    end: Array
+
+
+@dataclass(frozen=True)
 class SpaceDiagram:
     """The mechanism at one instant (positions in m).
 
@@ -228,6 +239,8 @@ class SpaceDiagram:
         Every slider block.
     guides : tuple of GuideLine
         Fixed guides.
+    actuators : tuple of ActuatorShape
+        The links whose length is an actuator's (:func:`varying_links`), also in ``links``.
     """
 
     points: dict[str, Array]
@@ -236,6 +249,7 @@ class SpaceDiagram:
     pivots: tuple[Pivot, ...]
     sliders: tuple[SliderShape, ...]
     guides: tuple[GuideLine, ...]
+    actuators: tuple[ActuatorShape, ...] = ()
 
     def extent(self) -> tuple[Array, Array]:
         """Return the lower-left and upper-right corners of everything drawn, m."""
@@ -286,6 +300,17 @@ class PinValues:
 
 
 @dataclass(frozen=True)
+class DriverValues:
+    """A driver's position (rad or m), speed and acceleration (per s, per s^2), its joint type."""
+
+    name: str
+    joint_type: str
+    position: float
+    speed: float
+    accel: float
+
+
+@dataclass(frozen=True)
 class Diagram:
     """The three diagrams of a scene at one crank angle.
 
@@ -308,6 +333,12 @@ class Diagram:
         The instant centres, if requested.
     pins : tuple of PinValues
         The rubbing velocity at every pin of the scene's ``pins``.
+    drivers : tuple of DriverValues
+        Every driver's position and rates, in scene order (``angle``,
+        ``speed`` and ``accel`` are the first one's).
+    refused : str
+        Why the velocity and acceleration polygons are not drawn (then both
+        are ``None``), or ''.
     """
 
     scene: str
@@ -315,12 +346,14 @@ class Diagram:
     speed: float
     accel: float
     space: SpaceDiagram
-    velocity: Polygon
-    acceleration: Polygon
+    velocity: Polygon | None
+    acceleration: Polygon | None
     links: tuple[LinkValues, ...]
     sliders: tuple[SliderValues, ...]
     instant_centres: InstantCentres | None = None
     pins: tuple[PinValues, ...] = ()
+    drivers: tuple[DriverValues, ...] = ()
+    refused: str = ''
 
 
 # --- geometry -------------------------------------------------------------
@@ -350,12 +383,15 @@ def _coincident(pin: str) -> str:
     return f"{pin}'"
 
 
+def _driven_links(scene: Scene) -> dict[str, tuple[str, str]]:
+    """Return each crank driver's link: its centre and tip (an actuator has none of its own)."""
+    return {body: (members[0], members[1]) for driver in scene.drivers
+            for body, _, members, _ in driver.members(GROUND)}
+
+
 def _edges(scene: Scene, state: State) -> list[_Edge]:
     """Every link's relative motions, in the order the solver places the points."""
-    one_driver(scene, "velocity and acceleration polygons (one driver's)")
-    crank = scene.input
-    assert crank is not None  # one_driver refuses a scene without
-    edges = [_Edge(crank.link, crank.center, crank.point)]
+    edges = [_Edge(link, *ends) for link, ends in _driven_links(scene).items()]
     for item in (*scene.dyads, *scene.points):
         for body, start, end, slider in item.edges():
             edges.append(_Edge(body, start, end) if slider is None else
@@ -694,8 +730,11 @@ def space_from_state(scene: Scene, state: State,
         sliders.extend(SliderShape(*block) for block in blocks)
         guides.extend(GuideLine(*guide)
                       for guide in dyad.guides(state, points, strokes or {}, size))
+    actuators = tuple(ActuatorShape(name, points[topology.bodies[name].points[0]],
+                                    points[topology.bodies[name].points[1]])
+                      for name in varying_links(scene))
     return SpaceDiagram(points, tuple(scene.ground), tuple(links), pivots, tuple(sliders),
-                        tuple(guides))
+                        tuple(guides), actuators)
 
 
 def arrows_from_state(scene: Scene, state: State, velocity_scale: float,
@@ -768,8 +807,11 @@ def _pins(scene: Scene, state: State) -> tuple[PinValues, ...]:
 
 def diagram_from_scene(scene: Scene, angle: float | None = None, speed: float | None = None,
                        accel: float | None = None, *, degrees: bool = False,
-                       instant_centres: bool = False) -> Diagram:
-    """Solve ``scene`` at one crank angle and build its three diagrams.
+                       instant_centres: bool = False,
+                       inputs: Mapping[str, float] | None = None,
+                       speeds: Mapping[str, float] | None = None,
+                       accels: Mapping[str, float] | None = None) -> Diagram:
+    """Solve ``scene`` at one crank angle (or drivers' positions) and build its three diagrams.
 
     Parameters
     ----------
@@ -785,34 +827,71 @@ def diagram_from_scene(scene: Scene, angle: float | None = None, speed: float | 
         Whether ``angle`` is in degrees.
     instant_centres : bool, keyword-only
         Whether to compute the instant centres too.
+    inputs, speeds, accels : mapping of str to float, keyword-only
+        For a scene with several drivers (or an actuator): positions (rad, or
+        m), speeds (rad/s or m/s) and accelerations by driver name, SI; a
+        driver left out takes the scene's default. ``angle``, ``speed`` and
+        ``accel`` are then not used.
 
     Returns
     -------
     Diagram
-        Space, velocity and acceleration diagrams and the links' values.
+        Space, velocity and acceleration diagrams and the links' values; the
+        polygons are ``None``, and ``refused`` says why, where a link's
+        length varies (:func:`varying_links`).
 
     Raises
     ------
     AssemblyError
-        If the mechanism cannot be assembled at ``angle``.
+        If the mechanism cannot be assembled at ``angle`` (or ``inputs``).
     """
     scene = full_scene(scene)
-    one_driver(scene, "velocity and acceleration polygons (one driver's)")
-    if angle is None:
-        theta, turns = scene.input.angle, scene.input.turns
-    elif degrees and abs(angle) > 360.0:  # counted from the start: whole turns read exactly
-        theta, turns = turns_from_degrees(angle)
+    drivers = scene.drivers
+    several = len(drivers) > 1 or drivers[0].joint_type != 'revolute'
+    if several or inputs is not None:
+        names = [d.name for d in drivers]
+        for given in (inputs, speeds, accels):
+            unknown = sorted(set(given or {}) - set(names))
+            if unknown:
+                msg = (f'Expected drivers of {scene.name} ({", ".join(names)}), got '
+                       f'{", ".join(unknown)}')
+                raise ValueError(msg)
+        xs = [float((inputs or {}).get(d.name, d.start)) for d in drivers]
+        vs = [float((speeds or {}).get(d.name, d.speed)) for d in drivers]
+        accs = [float((accels or {}).get(d.name, d.accel)) for d in drivers]
+        state = (solve(scene, xs[0], vs[0], accs[0]) if len(drivers) == 1
+                 else solve(scene, xs, vs, accs))
+        theta = xs[0]
     else:
-        theta, turns = (math.radians(angle) if degrees else float(angle)), 0
-    state = solve(scene, theta, speed, accel, turns=turns)
+        if angle is None:
+            theta, turns = scene.input.angle, scene.input.turns
+        elif degrees and abs(angle) > 360.0:  # counted from the start: whole turns read exactly
+            theta, turns = turns_from_degrees(angle)
+        else:
+            theta, turns = (math.radians(angle) if degrees else float(angle)), 0
+        state = solve(scene, theta, speed, accel, turns=turns)
+    motions = state.drivers
+    values = tuple(DriverValues(d.name, d.joint_type, float(motions[d.name].position),
+                                float(motions[d.name].velocity),
+                                float(motions[d.name].acceleration)) for d in drivers)
     topology = bodies_from_scene(scene)
     links, sliders = _values(scene, state, topology)
     centres = instant_centres_from_state(scene, state) if instant_centres else None
-    return Diagram(scene.name, theta, float(state.speed), float(state.accel),
+    varying = varying_links(scene)
+    refused = ''
+    velocity: Polygon | None = None
+    acceleration: Polygon | None = None
+    if varying:
+        refused = (f'no velocity or acceleration polygon: link{"s" if len(varying) > 1 else ""} '
+                   f'{", ".join(varying)} change{"" if len(varying) > 1 else "s"} length (an '
+                   f"actuator's), which these polygons do not draw")
+    else:
+        velocity = velocity_polygon_from_state(scene, state)
+        acceleration = acceleration_polygon_from_state(scene, state)
+    return Diagram(scene.name, theta, values[0].speed, values[0].accel,
                    space_from_state(scene, state, strokes_from_scene(scene)),
-                   velocity_polygon_from_state(scene, state),
-                   acceleration_polygon_from_state(scene, state), links, sliders, centres,
-                   _pins(scene, state))
+                   velocity, acceleration, links, sliders, centres, _pins(scene, state), values,
+                   refused)
 
 
 # --- value tables ---------------------------------------------------------
@@ -880,7 +959,7 @@ def tables_from_diagram(diagram: Diagram,
     -------
     dict of str to Table
         ``'space'`` (links: length, angle, omega, alpha, a Geneva wheel
-        marked engaged or locked; sliders; pins: radius, relative angular
+        marked engaged or locked; sliders; actuators: length, rates; pins: radius, relative angular
         speed, rubbing velocity; instant centres if computed),
         ``'velocity'`` and ``'acceleration'`` (every vector drawn: letters,
         quantity, magnitude, direction).
@@ -900,6 +979,10 @@ def tables_from_diagram(diagram: Diagram,
         rows.append((slider.name, 'slider', f's = {fmt_value(slider.s)}', '-',
                      f'{fmt_value(slider.velocity)} m/s',
                      f'{fmt_value(slider.acceleration)} m/s\u00b2'))
+    for driver in diagram.drivers:  # an actuator: its length and extension rate
+        if driver.joint_type == 'prismatic':
+            rows.append((driver.name, 'actuator', f'L = {fmt_value(driver.position)}', '-',
+                         f'{fmt_value(driver.speed)} m/s', f'{fmt_value(driver.accel)} m/s\u00b2'))
     for pin in diagram.pins:  # seed 001: rubbing velocity = |omega_a - omega_b| r
         rows.append((f'pin {pin.point}', '/'.join(pin.bodies), f'r = {fmt_value(pin.radius)}',
                      '-', f'\u0394\u03c9 {fmt_value(pin.relative_omega)}',
@@ -921,6 +1004,8 @@ def tables_from_diagram(diagram: Diagram,
         tables['centres'] = Table('Instant centres', ('centre', 'links', 'x m', 'y m'),
                                   tuple(rows))
     for polygon in (diagram.velocity, diagram.acceleration):
+        if polygon is None:  # refused (diagram.refused says why)
+            continue
         scale = None if scales is None else scales.get(polygon.quantity)
         unit = polygon.unit.replace('^2', '\u00b2')
         columns: tuple[str, ...] = ('vector', 'quantity', unit, 'dir \u00b0')

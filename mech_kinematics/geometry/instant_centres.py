@@ -41,7 +41,7 @@ from ..solver import Scene, State
 __all__ = [
     'GROUND', 'Body', 'BodyKind', 'Centre', 'InstantCentre', 'InstantCentres', 'Topology',
     'bodies_from_scene', 'centres_as_dict', 'full_scene', 'instant_centres_from_kennedy',
-    'instant_centres_from_state',
+    'instant_centres_from_state', 'varying_links',
 ]
 
 #: Name of the ground body (the frame), unless the scene uses it for a link.
@@ -160,7 +160,7 @@ def bodies_from_scene(scene: Scene) -> Topology:
         fixed = points.setdefault(body, [])
         fixed.extend(member for member in members if member not in fixed)
 
-    for driver in scene.drivers:
+    for driver in scene.drivers:  # a crank carries its centre and tip; an actuator nothing
         for body, kind, members, _ in driver.members(ground):
             add(body, BodyKind(kind), *members)
     slides: list[tuple[str, str]] = []
@@ -304,6 +304,20 @@ def _pairs(topology: Topology) -> list[tuple[str, str]]:
     return list(itertools.combinations(topology.bodies, 2))
 
 
+def varying_links(scene: Scene) -> tuple[str, ...]:
+    """Return the links whose length varies (an actuator's): not one rigid body.
+
+    The relative velocity of a link's end about its start is ``omega x r`` only
+    for a rigid link; a cylinder's adds its extension rate along it. (A slotted
+    lever's length varies too, but its pin's sliding is modelled: it has a slider.)
+    """
+    rigid = {body for dyad in scene.dyads for body, _, _, slider in dyad.edges()
+             if slider is None}
+    return tuple(name for dyad in scene.dyads
+                 for name, length in dyad.link_lengths().items()
+                 if length is None and name in rigid)
+
+
 def one_driver(scene: Scene, what: str) -> None:
     """Refuse, in one line, a scene with several drivers where ``what`` needs one crank.
 
@@ -393,8 +407,16 @@ def instant_centres_from_state(scene: Scene, state: State) -> InstantCentres:
     ValueError
         If ``state`` is not of one crank angle or misses points or joints, or
         two bodies that share no joint have the same motion.
+    SceneError
+        If a link changes length (:func:`varying_links`); any number of
+        drivers is fine.
     """
-    one_driver(scene, "instant centres (one driver's)")
+    varying = varying_links(scene)  # any number of drivers, but rigid bodies only
+    if varying:
+        msg = (f'Expected rigid links for instant centres, got scene "{scene.name}" whose link '
+               f'{", ".join(varying)} changes length (an actuator\'s: its barrel and rod are two '
+               f'bodies)')
+        raise SceneError(msg)
     topology = bodies_from_scene(scene)
     check_full_state(topology, scene, state)
     size = _size(state)

@@ -16,6 +16,8 @@ The array holds, in this order (``ns``, ``id``):
   for a link of more than two points);
 - ``guides``, 0: one ``LINE_LIST`` of the fixed slider guides (if any);
 - ``sliders``, 0 .. n-1: one ``CUBE`` per slider block, turned to its guide;
+- ``actuators``, 0 .. n-1: one ``CYLINDER`` per link whose length is a linear
+  actuator's, from pin to pin (its axis along the link);
 - ``joints``, 0: one ``SPHERE_LIST`` of every named point, ground points dark;
 - ``velocity``, 0 .. m-1: one ``ARROW`` per arrow point, from the point to
   point + ``velocity_scale`` * v;
@@ -47,7 +49,8 @@ DEFAULT_ACCELERATION_SCALE = 0.01
 #: Highest rate at which the node publishes markers, Hz.
 MAX_RATE_HZ = 30.0
 #: Marker namespaces, in the order of the array.
-NAMESPACES = ('links', 'guides', 'sliders', 'joints', 'velocity', 'acceleration')
+NAMESPACES = ('links', 'guides', 'sliders', 'actuators', 'joints', 'velocity',
+              'acceleration')
 
 # Sizes as fractions of the mechanism's size (marker_size_from_space).
 LINE_WIDTH = 0.012
@@ -56,12 +59,14 @@ SHAFT_DIAMETER = 0.010
 HEAD_DIAMETER = 0.025
 BLOCK_LENGTH = 0.07
 BLOCK_HEIGHT = 0.04
+ACTUATOR_DIAMETER = 0.03
 
 # Colours as (r, g, b, a).
 GROUND_RGBA = (0.2, 0.2, 0.2, 1.0)
 POINT_RGBA = (0.95, 0.95, 0.95, 1.0)
 GUIDE_RGBA = (0.35, 0.35, 0.35, 1.0)
 SLIDER_RGBA = (0.55, 0.55, 0.6, 0.9)
+ACTUATOR_RGBA = (0.9, 0.75, 0.1, 0.9)
 VELOCITY_RGBA = (0.0, 0.6, 0.2, 1.0)
 ACCELERATION_RGBA = (0.85, 0.1, 0.1, 1.0)
 
@@ -171,6 +176,19 @@ def marker_array_from_state(scene: Scene, state: State, *, frame_id: str = 'mech
         m.pose.position = point(slider.xy)
         m.pose.orientation.z = math.sin(slider.angle / 2.0)
         m.pose.orientation.w = math.cos(slider.angle / 2.0)
+    thick = ACTUATOR_DIAMETER * unit
+    for i, actuator in enumerate(space.actuators):
+        axis = actuator.end - actuator.start
+        m = marker('actuators', i, Marker.CYLINDER, ACTUATOR_RGBA,
+                   (thick, thick, float(math.hypot(*axis))))
+        m.pose.position = point((actuator.start + actuator.end) / 2.0)
+        # The cylinder's axis is its z: turned a quarter about y onto x, then about z.
+        half = math.atan2(axis[1], axis[0]) / 2.0
+        quarter = math.sqrt(0.5)
+        m.pose.orientation.w = math.cos(half) * quarter
+        m.pose.orientation.x = -math.sin(half) * quarter
+        m.pose.orientation.y = math.cos(half) * quarter
+        m.pose.orientation.z = math.sin(half) * quarter
     diameter = JOINT_DIAMETER * unit
     m = marker('joints', 0, Marker.SPHERE_LIST, POINT_RGBA, (diameter, diameter, diameter))
     ground = set(space.ground)

@@ -31,6 +31,12 @@ solver, which refuses it with the full reason or answers it. Scenes or rates
 the general solver rescales (sizes beyond 2**60, rates beyond 2**40), and any
 step whose code uses something this compiler does not know, are not compiled:
 :func:`compile_tick` returns ``None`` and the caller uses the general solver.
+
+A scene with several drivers (or an actuator, issue 18) compiles the same
+way, each driver's kernel on its own value: its tick takes one value per
+driver (sequences, as :func:`mech_kinematics.solve` does), and an instant
+that fails a check is handed to the general solver for its reason (the
+message names every driver's position).
 """
 
 from __future__ import annotations
@@ -89,6 +95,16 @@ def _fold(node: ast.AST) -> ast.AST:
             if len(values) == 1:
                 return values[0]
             node.values = values
+            return node
+
+        def visit_Compare(self, node: ast.Compare) -> ast.AST:
+            # ``None is None``, ``'cyl' is None``: a step attribute against a constant.
+            self.generic_visit(node)
+            if (len(node.ops) == 1 and isinstance(node.ops[0], (ast.Is, ast.IsNot))
+                    and isinstance(node.left, ast.Constant)
+                    and isinstance(node.comparators[0], ast.Constant)):
+                same = node.left.value is node.comparators[0].value
+                return ast.Constant(same if isinstance(node.ops[0], ast.Is) else not same)
             return node
 
         def visit_UnaryOp(self, node: ast.UnaryOp) -> ast.AST:
@@ -215,6 +231,120 @@ class _Specializer(ast.NodeTransformer):
         if node.id in ('ctx', 'self'):
             raise _Unsupported(f'{node.id} used as a value')
         return node
+
+
+class _Refused(Exception):
+    """A step of a several-driver tick found it cannot close: the general solver says why."""
+
+
+def _refuse(theta: Any, turns: Any, ok: Any, *args: Any, **kwargs: Any) -> None:
+    """Stand in for ``ctx.check`` in a several-driver tick: hand a failure to the solver."""
+    if not ok:
+        raise _Refused
+
+
+def _compile_drivers(scene: lk.Scene, plan: hooks.TickPlan, joints: tuple[str, ...],
+                     points: tuple[str, ...],
+                     frames: tuple[tuple[str, str | None, float], ...]) -> TickFunction | None:
+    """Return the tick of a scene with several drivers (or an actuator), or ``None``.
+
+    The same specialized kernels as :func:`compile_tick`'s, each driver's on
+    its own value: ``tick(positions, speeds, accels, max_error, turns=0)``
+    takes one value per driver (sequences, as :func:`mech_kinematics.solve`).
+    An instant the general solver would rescale in time, refuse (a failed
+    check raises inside, and the general solver is asked for its reason, so
+    the message names every driver's position) or judge beyond the quick
+    trust test is handed to the general solver.
+    """
+    count = len(plan.drivers)
+    namespace: dict[str, Any] = {
+        '_ctx_check': _refuse, '_ctx_check_margin': _refuse, '_Refused': _Refused,
+        '_shown': hooks.shown, '_slow': _general(scene, joints, points, frames),
+        '_driver_limits': plan.driver_limits, '_rates_shift': hooks.rates_shift,
+        'inf': math.inf, '_float': float, '_SEQUENCE': (list, tuple),
+    }
+    for step in (*plan.drivers, *plan.steps):
+        for cls in type(step).__mro__:
+            home = sys.modules[cls.__module__]
+            if home.__name__.startswith(_SOLVER):
+                namespace.update((k, v) for k, v in vars(home).items()
+                                 if not k.startswith('__'))
+    namespace['_wrapped_angle'] = hooks.wrapped_angle
+    names: dict[str, str] = {}
+    lines = [f'{", ".join(f"{x}_{k}" for k in range(count))}, = '
+             f'({", ".join(f"_float({arg}[{k}])" for k in range(count))},)'
+             for x, arg in (('x', 'theta'), ('v', 'omega'), ('a', 'alpha'))]
+    body: list[ast.stmt] = ast.parse('\n'.join(lines)).body
+    try:
+        for name, entry in plan.ground.items():
+            local = names.setdefault(f'P_{name}', f'P_{name}_{len(names)}')
+            namespace[f'_ground_{local}'] = entry
+            body.append(ast.parse(f'{local} = _ground_{local}').body[0])
+        for k, driver in enumerate(plan.drivers):
+            run = type(driver).run
+            parameters = list(inspect.signature(run).parameters)[2:]  # after self, ctx
+            arguments = dict(zip(parameters, (f'x_{k}', f'v_{k}', f'a_{k}'), strict=True))
+            body += _body(driver, run, f'_d{k}', names, namespace, arguments)
+        for index, step in enumerate(plan.steps, 1):
+            for part, kernel in enumerate(step.kernels()):
+                body += _body(step, kernel, f'_{index}_{part}', names, namespace, {})
+    except (_Unsupported, OSError, TypeError, ValueError) as error:
+        del error   # the general solver serves this scene
+        return None
+    kinds = dict(plan.joint_types)
+    tail = [f'_l0, _l1, _l2, _l3, _l4, _l5 = _driver_limits(tol, '
+            f'[{", ".join(f"v_{k}" for k in range(count))}], '
+            f'[{", ".join(f"a_{k}" for k in range(count))}])']
+    checks = []
+    for table, _, (i, j, k) in hooks.TRUST_TEST:
+        for name in plan.reported[table]:
+            e = names[f'{_TABLES[table]}_{name}']
+            checks.append(f'{e}[3] <= _l{i} and {e}[4] <= _l{j} and {e}[5] <= _l{k}')
+    if checks:
+        tail.append(f'if not ({" and ".join(checks)}):')
+        tail.append('    return _slow(theta, omega, alpha, tol, turns)')
+    values = []
+    for index in range(3):
+        for name in joints:
+            if kinds[name] == 'revolute':
+                e = names[f'L_{name}']
+                values.append(f'_wrapped_angle({e}[0])' if index == 0 else f'{e}[{index}]')
+            else:
+                values.append(f'{names[f"S_{name}"]}[{index}]')
+    for index in range(3):
+        for name in points:
+            e = names[f'P_{name}']
+            values += [f'{e}[{index}].real', f'{e}[{index}].imag']
+    for origin, angle_of, angle in frames:
+        e = names[f'P_{origin}']
+        values += [f'{e}[0].real', f'{e}[0].imag']
+        values.append(repr(angle) if angle_of is None
+                      else f'_wrapped_angle({names[f"L_{angle_of}"]}[0])')
+    measures = [names[key] for key in names if key.startswith('M_')]
+    measure = f'min({", ".join(measures)})' if len(measures) > 1 else (
+        measures[0] if measures else 'inf')
+    tail.append(f'return [{", ".join(values)}], {measure}')
+    signature = ast.arguments(posonlyargs=[], args=[ast.arg(a) for a in (
+        'theta', 'omega', 'alpha', 'tol', 'turns')], kwonlyargs=[], kw_defaults=[],
+        defaults=[ast.Constant(0)])
+    inner = ast.FunctionDef(name='_tick', args=signature,
+                            body=body + ast.parse('\n'.join(tail)).body, decorator_list=[],
+                            returns=None)
+    outer = ast.parse(
+        'def tick(theta, omega, alpha, tol, turns=0):\n'
+        '    if not (isinstance(theta, _SEQUENCE) and isinstance(omega, _SEQUENCE) '
+        'and isinstance(alpha, _SEQUENCE)) or '
+        f'len(theta) != {count} or len(omega) != {count} or len(alpha) != {count} or '
+        '_rates_shift(omega, alpha):\n'
+        '        return _slow(theta, omega, alpha, tol, turns)\n'
+        '    try:\n'
+        '        return _tick(theta, omega, alpha, tol, turns)\n'
+        '    except _Refused:\n'
+        '        return _slow(theta, omega, alpha, tol, turns)\n').body[0]
+    module = ast.fix_missing_locations(ast.Module(body=[inner, outer], type_ignores=[]))
+    exec(compile(module, f'<compiled tick of {scene.name}>', 'exec'), namespace)  # noqa: S102
+    tick: TickFunction = namespace['tick']
+    return tick
 
 
 def _inline(func: ast.expr, args: list[ast.expr],
@@ -362,6 +492,8 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
 
     if not plan.compilable:
         return None     # rescaled units, or rubbing to bound: the general solver's work
+    if plan.driver_limits is not None:
+        return _compile_drivers(scene, plan, joints, points, frames)
     namespace: dict[str, Any] = {
         '_ctx_check': hooks.check, '_ctx_check_margin': hooks.check_margin,
         '_shown': hooks.shown,

@@ -27,8 +27,8 @@ be written in the subset that the ticker understands. Anything else makes the
 scene fall back to the general solver, and ``test_ticker`` fails for a
 packaged scene that falls back:
 
-- a kernel is a plain function of ``(self, ctx)`` (the crank's of
-  ``(self, ctx, theta, omega, alpha)``): no ``for``/``while`` loop,
+- a kernel is a plain function of ``(self, ctx)`` (a driver's, a crank's or
+  an actuator's, of ``(self, ctx, position, speed, accel)``): no ``for``/``while`` loop,
   ``return``, ``try``, ``with``, ``yield``, nested ``def``, ``global`` or
   ``nonlocal``; lambdas only without arguments (deferred messages);
 - the context is used only as ``ctx.vector``, ``ctx.angle``, ``ctx.turns``,

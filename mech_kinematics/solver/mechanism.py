@@ -51,6 +51,8 @@ class _Solver:
         self.crank_length = 0.0 if crank is None else crank.length
         #: Whether the scene has one driver, a crank (the v1 path of solve).
         self.single = crank is not None and len(scene.drivers) == 1
+        #: That crank's default speed and acceleration (the single path's, read once).
+        self.defaults = (crank.speed, crank.accel) if crank is not None else (0.0, 0.0)
         self.shift = _exponent(self.size, *_SIZE_RANGE)
         run = plan
         if self.shift:
@@ -233,7 +235,7 @@ class Scene:
                 warnings.simplefilter('ignore', NearSingularWarning)
                 if solver.single:
                     _execute(solver, drivers[0].start, 0.0, 0.0,  # positions only
-                             self.input.turns)
+                             cast(Crank, self.input).turns)
                 else:
                     zeros = (0.0,) * len(drivers)
                     _execute_drivers(solver, tuple(d.start for d in drivers), zeros, zeros)
@@ -241,7 +243,8 @@ class Scene:
             dyad = next((step.dyad for step in full.steps
                          if step.owner is None and step.label == error.dyad), None)
             if solver.single:
-                at = f'the initial crank angle {self.units.angle_text(self.input.shown)}'
+                shown = cast(Crank, self.input).shown
+                at = f'the initial crank angle {self.units.angle_text(shown)}'
             else:
                 at = "the drivers' start positions " + ', '.join(
                     f'{d.name} = {d.position_text(d.start, self.units)}' for d in drivers)

@@ -294,9 +294,10 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
     tol = float(max_error)
     if not solver.single:
         return _solve_drivers(scene, solver, angle, speed, accel, turns, tol)
-    crank = scene.drivers[0]
-    speed = crank.speed if speed is None else speed
-    accel = crank.accel if accel is None else accel
+    if speed is None:
+        speed = solver.defaults[0]
+    if accel is None:
+        accel = solver.defaults[1]
     whole: Any = turns
     if whole.__class__ is not int:  # an int is the usual case, decided without a call
         whole = _turns(whole)

@@ -19,14 +19,14 @@ from typing import Any, TYPE_CHECKING
 
 from .base import Step
 from .context import _Context
-from .scaling import _ACCEL_HIGH, _RATE_HIGH, _RATE_LOW
-from .solve import _wrapped_angle, trust_limits, TRUST_TEST
+from .scaling import _ACCEL_HIGH, _RATE_HIGH, _RATE_LOW, _rates_exponent
+from .solve import _limits, _wrapped_angle, trust_limits, TRUST_TEST
 
 if TYPE_CHECKING:
     from .mechanism import Scene
 
-__all__ = ['RATES', 'TRUST_TEST', 'TickPlan', 'check', 'check_margin', 'shown', 'tick_plan',
-           'trust_limits', 'wrapped_angle']
+__all__ = ['RATES', 'TRUST_TEST', 'TickPlan', 'check', 'check_margin', 'rates_shift', 'shown',
+           'tick_plan', 'trust_limits', 'wrapped_angle']
 
 #: Crank rates solved unscaled: ``low <= |omega| <= high`` and ``|alpha| <= accel_high``
 #: (1/s, 1/s^2); outside, the general solver rescales time.
@@ -44,8 +44,7 @@ class TickPlan:
     ----------
     compilable : bool
         False where the general solver must serve the scene: its lengths are
-        rescaled (a size beyond 2**60 of 1 m), it has pins to bound, or it
-        has several drivers or an actuator (the tick takes one crank's angle).
+        rescaled (a size beyond 2**60 of 1 m) or it has pins to bound.
     ground : mapping of str to tuple
         Every ground point's context entry ``(p, v, a, bounds...)``.
     crank : object
@@ -59,6 +58,13 @@ class TickPlan:
         names the trust test judges (:data:`TRUST_TEST`).
     size, crank_length : float
         The mechanism's size and the crank's length, m (the trust test's scales).
+    drivers : tuple
+        Every driver's step, in scene order (``crank`` is the first); a scene
+        with several (or an actuator) takes one value per driver.
+    driver_limits : callable or None
+        For several drivers: ``(tol, speeds, accels) -> `` the quick trust
+        test's six limits from every driver's floors (:func:`trust_limits`'
+        order); ``None`` for one crank.
     """
 
     compilable: bool
@@ -69,17 +75,31 @@ class TickPlan:
     reported: dict[str, tuple[str, ...]]
     size: float
     crank_length: float
+    drivers: tuple[Any, ...] = ()
+    driver_limits: Callable[[float, Any, Any], tuple[float, ...]] | None = None
 
 
 def tick_plan(scene: Scene) -> TickPlan:
     """Return ``scene``'s compiled plan as the tick sees it."""
     solver = scene._solver
     plan = solver.run_plan
-    return TickPlan(solver.single and not (solver.shift or plan.rubs), dict(solver.ground),
-                    plan.crank,
+
+    def driver_limits(tol: float, speeds: Any, accels: Any) -> tuple[float, ...]:
+        return _limits(tol, solver.size, solver.floors(speeds, accels))
+
+    return TickPlan(not (solver.shift or plan.rubs), dict(solver.ground), plan.crank,
                     plan.steps, dict(plan.joint_types),
                     {'points': solver.out_points, 'links': solver.out_links,
-                     'sliders': solver.out_sliders}, solver.size, solver.crank_length)
+                     'sliders': solver.out_sliders}, solver.size, solver.crank_length,
+                    plan.drivers, None if solver.single else driver_limits)
+
+
+def rates_shift(speeds: Any, accels: Any) -> int:
+    """Return the power of two by which the general solver scales time for several drivers.
+
+    0 where it solves them unscaled (what the compiled tick may answer).
+    """
+    return _rates_exponent(speeds, accels)
 
 
 def check(theta: float, turns: int, *args: Any, **kwargs: Any) -> None:

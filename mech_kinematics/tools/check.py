@@ -5,7 +5,12 @@
 Prints where the mechanism assembles, its toggle and dead-centre positions,
 its minimum transmission angle and the Grashof class of every four-bar loop,
 from :func:`mech_kinematics.geometry.assembly.assembly_from_scene`: text in
-the scene's own units, or ``--json`` in SI units (rad, m).
+the scene's own units, or ``--json`` in SI units (rad, m). A scene with
+several drivers (or an actuator) gets its assembly region instead
+(:func:`mech_kinematics.geometry.region.region_from_scene`): the fraction of a
+grid over two drivers that assembles, each driver's ranges with the others
+at their start positions, stroke limits, and on request a map of the grid
+(``--map`` as text, ``--png FILE`` as a picture).
 """
 
 from __future__ import annotations
@@ -16,9 +21,33 @@ import json
 import sys
 from typing import Any
 
-from .cli import add_scene_argument, run_tool
+import numpy as np
 
-__all__ = ['add_parser', 'main', 'report_text', 'report_json']
+from .cli import add_scene_argument, run_tool
+from ..errors import SceneError
+from ..geometry.region import GRID
+
+__all__ = ['add_parser', 'grid_size', 'main', 'map_text', 'region_json', 'region_text',
+           'report_json', 'report_text', 'write_region_png']
+
+#: The text map's largest size, characters.
+MAP_COLUMNS = 72
+MAP_ROWS = 36
+#: The largest grid: N x N points are solved at once.
+GRID_MOST = 2000
+
+
+def grid_size(text: str) -> int:
+    """Parse a grid size (2 to :data:`GRID_MOST` points per driver), or tell argparse why not."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if not 2 <= value <= GRID_MOST:
+        msg = f'expected a whole number of grid points from 2 to {GRID_MOST}, got {text!r}'
+        raise argparse.ArgumentTypeError(msg)
+    return value
+
 
 CHECK_HELP = """\
 Study one full turn of a scene's crank (angles 0 to 360 deg, CCW from +x) and
@@ -40,6 +69,21 @@ print:
     indexes, by how much, and the arc in which it is locked.
 Text uses the scene's units; --json prints SI (rad, m). Exit status 2 on a
 scene that cannot be read.
+
+A scene with several drivers (inputs:) or a linear actuator gets instead:
+  - the fraction of a grid over two drivers (the first two, or --pair A,B;
+    each crank over a turn, each actuator over its stroke, --grid N points
+    each, limits included; other drivers at their start positions) at which
+    the mechanism assembles;
+  - each driver's ranges where it assembles with the others at their start
+    positions, their ends exact (the last position solve answers at, found
+    by bisection to adjacent doubles after sampling 3600 positions: a window
+    narrower than the stated step between two samples is not seen), and what
+    stops each end (a stroke limit or the dyad that stops closing);
+  - the stroke limits of every actuator (one without is swept over lengths
+    up to a length no closing position can exceed);
+  - with --map, the grid drawn in text (# assembles, . does not, + partly);
+    with --png FILE, as a picture.
 """
 
 
@@ -170,11 +214,207 @@ def report_json(assembly: Any, scene: Any) -> dict[str, Any]:
     }
 
 
+def _position_text(units: Any, kind: str, value: float) -> str:
+    """Return a driver's position (rad or m) in the scene's units, with the unit."""
+    return f'{_number_text(units, kind, value)} {_unit(units, kind)}'
+
+
+def _number_text(units: Any, kind: str, value: float) -> str:
+    """Return a driver's position (rad or m) in the scene's units, 6 digits, no unit."""
+    from ..geometry.assembly import angle_text
+    if kind == 'revolute':
+        return angle_text(units, value)
+    return units.length_text(value).split()[0]
+
+
+def _unit(units: Any, kind: str) -> str:
+    return units.angle if kind == 'revolute' else units.length
+
+
+def _span_text(units: Any, kind: str, low: float, high: float) -> str:
+    """Return ``low..high unit``."""
+    return (f'{_number_text(units, kind, low)}..{_number_text(units, kind, high)} '
+            f'{_unit(units, kind)}')
+
+
+def _domain_text(units: Any, scene: Any, name: str, kind: str,
+                 domain: tuple[float, float]) -> str:
+    if kind == 'revolute':
+        return 'over a turn'
+    driver = next(d for d in scene.drivers if d.name == name)
+    if driver.stroke is None:
+        return f'over lengths up to {_position_text(units, kind, domain[1])} (no stroke limits)'
+    return f'over its stroke {_span_text(units, kind, *domain)}'
+
+
+def _end_text(why: str) -> str:
+    return {'stroke': 'its stroke limit', 'turn': 'a full turn'}.get(
+        why, f'{why} stops closing' if why else 'the end of what was swept')
+
+
+def map_text(region: Any, width: int = MAP_COLUMNS, height: int = MAP_ROWS) -> list[str]:
+    """Return the grid drawn in text: ``#`` assembles, ``.`` does not, ``+`` partly.
+
+    The first grid driver runs left to right, the second bottom to top; each
+    character stands for a block of grid points when the grid is larger than
+    ``width`` by ``height``.
+    """
+    grid = region.assembles if region.assembles.ndim == 2 else region.assembles[:, None]
+    columns = min(width, grid.shape[0])
+    rows = min(height, grid.shape[1])
+    xs = np.array_split(np.arange(grid.shape[0]), columns)
+    ys = np.array_split(np.arange(grid.shape[1]), rows)
+    lines = []
+    for y in reversed(ys):
+        line = ''
+        for x in xs:
+            block = grid[np.ix_(x, y)]
+            line += '#' if block.all() else ('.' if not block.any() else '+')
+        lines.append(line)
+    return lines
+
+
+def region_text(region: Any, scene: Any, show_map: bool = False) -> str:
+    """Return the report of ``check`` on several drivers as lines of text, scene's units."""
+    units = region.units
+    kinds = {d.name: d.joint_type for d in scene.drivers}
+    described = []
+    for driver in scene.drivers:
+        if driver.joint_type == 'revolute':
+            described.append(f'{driver.name} (crank about {driver.center})')
+        else:
+            described.append(f'{driver.name} (actuator)')
+    count = len(scene.drivers)
+    lines = [f'{region.scene}: {count} driver{"s" if count > 1 else ""}: '
+             f'{", ".join(described)} (angles in {units.angle}, CCW from +x; lengths in '
+             f'{units.length})']
+    slices = {s.driver: s for s in region.slices}
+    axes = ' x '.join(
+        f'{name} {_domain_text(units, scene, name, kinds[name], slices[name].domain)}'
+        for name in region.grid)
+    size = ' x '.join(str(len(a)) for a in region.axes)
+    held = ', '.join(f'{name} at {_position_text(units, kinds[name], x)}'
+                     for name, x in region.at.items())
+    total = region.assembles.size
+    lines.append(f'grid: {axes} ({size} points{"; " + held if held else ""}): assembles at '
+                 f'{100.0 * region.fraction:.4g}% ({int(region.assembles.sum())} of {total})')
+    for piece in region.slices:
+        others = ', '.join(f'{name} at {_position_text(units, kinds[name], x)}'
+                           for name, x in piece.at.items())
+        head = f'{piece.driver}' + (f' (with {others})' if others else '')
+        step = _position_text(units, piece.kind, piece.step)
+        if piece.everywhere:
+            where = ('at every angle' if piece.kind == 'revolute' else
+                     f'over its whole stroke {_span_text(units, piece.kind, *piece.domain)}')
+            lines.append(f'{head}: assembles {where}')
+            continue
+        if not piece.ranges:
+            lines.append(f'{head}: assembles nowhere (sampled every {step})')
+            continue
+        parts = []
+        for (a, b), (why_a, why_b) in zip(piece.ranges, piece.ends, strict=True):
+            parts.append(f'{_span_text(units, piece.kind, a, b)} (from {_end_text(why_a)} '
+                         f'to {_end_text(why_b)})')
+        lines.append(f'{head}: assembles for {", ".join(parts)}; sampled every {step}, ends '
+                     f'exact')
+    strokes = []
+    for driver in scene.drivers:
+        if driver.joint_type != 'prismatic':
+            continue
+        if driver.stroke is None:
+            strokes.append(f'{driver.name} none')
+        else:
+            strokes.append(f'{driver.name} {_span_text(units, "prismatic", *driver.stroke)}')
+    lines.append(f'stroke limits: {", ".join(strokes) if strokes else "none (no actuator)"}')
+    if show_map:
+        across = region.grid[0]
+        up = f', {region.grid[1]} upward' if len(region.grid) > 1 else ''
+        lines.append(f'map (# assembles, . does not, + partly; {across} rightward{up}):')
+        lines.extend(map_text(region))
+    return '\n'.join(lines)
+
+
+def region_json(region: Any, scene: Any, show_map: bool = False) -> dict[str, Any]:
+    """Return the report of ``check --json`` on several drivers: SI units (rad, m)."""
+    slices = {s.driver: s for s in region.slices}
+    data: dict[str, Any] = {
+        'scene': region.scene,
+        'drivers': [{'name': d.name, 'type': d.joint_type, 'start': d.start,
+                     'stroke': None if d.stroke is None else list(d.stroke)}
+                    for d in scene.drivers],
+        'grid': {'drivers': list(region.grid), 'points': [len(a) for a in region.axes],
+                 'domains': [list(slices[name].domain) for name in region.grid],
+                 'held': dict(region.at), 'assembling': int(region.assembles.sum()),
+                 'fraction': region.fraction},
+        'slices': [{'driver': s.driver, 'type': s.kind, 'domain': list(s.domain),
+                    'at': dict(s.at), 'everywhere': s.everywhere,
+                    'ranges': [list(r) for r in s.ranges], 'ends': [list(e) for e in s.ends],
+                    'step': s.step} for s in region.slices],
+    }
+    if show_map:
+        data['map'] = map_text(region)
+    return data
+
+
+def write_region_png(region: Any, path: str) -> None:
+    """Write the grid as a PNG picture (the scene's units on the axes)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    units = region.units
+    kinds = {s.driver: s.kind for s in region.slices}
+
+    def shown(name: str, values: Any) -> Any:
+        if kinds[name] == 'revolute':
+            return np.array([units.angle_value(float(v)) for v in values])
+        return np.asarray(values) * (1000.0 if units.length == 'mm' else 1.0)
+
+    def label(name: str) -> str:
+        unit = units.angle if kinds[name] == 'revolute' else units.length
+        return f'{name} ({unit})'
+
+    figure = Figure(figsize=(6.0, 5.0))
+    FigureCanvasAgg(figure)
+    axes = figure.add_subplot()
+    grid = region.assembles if region.assembles.ndim == 2 else region.assembles[:, None]
+    x = shown(region.grid[0], region.axes[0])
+    y = shown(region.grid[1], region.axes[1]) if len(region.grid) > 1 else np.array([0.0, 1.0])
+    axes.pcolormesh(x, y if len(region.grid) > 1 else y[:1], grid.T.astype(float),
+                    cmap='Greens', vmin=-0.2, vmax=1.0, shading='nearest')
+    axes.set_xlabel(label(region.grid[0]))
+    if len(region.grid) > 1:
+        axes.set_ylabel(label(region.grid[1]))
+    axes.set_title(f'{region.scene}: where it assembles (green), '
+                   f'{100.0 * region.fraction:.4g}% of the grid')
+    figure.savefig(path, dpi=100)
+
+
+def _handle_region(args: argparse.Namespace, scene: Any) -> int:
+    from ..geometry.region import region_from_scene
+    pair = None if args.pair is None else [p.strip() for p in args.pair.split(',')]
+    region = region_from_scene(scene, args.grid, pair)
+    if args.json:
+        print(json.dumps(region_json(region, scene, args.map), indent=1, allow_nan=False))
+    else:
+        print(region_text(region, scene, args.map))
+    if args.png is not None:
+        write_region_png(region, args.png)
+    return 0
+
+
 def _handle(args: argparse.Namespace) -> int:
     from ..geometry.assembly import assembly_from_scene
     from ..scene import load_scene
 
     scene = load_scene(args.scene)  # a SceneError is one line, exit 2 (cli.run_handler)
+    if len(scene.drivers) > 1 or scene.drivers[0].joint_type != 'revolute':
+        return _handle_region(args, scene)
+    given = [flag for flag, value in (('--grid', args.grid != GRID), ('--pair', args.pair),
+                                      ('--map', args.map), ('--png', args.png)) if value]
+    if given:
+        msg = (f'Expected a scene with several drivers or an actuator for {", ".join(given)}, '
+               f'got {scene.name}, driven by one crank: drop {", ".join(given)}')
+        raise SceneError(msg)
     assembly = assembly_from_scene(scene)
     if args.json:
         print(json.dumps(report_json(assembly, scene), indent=1, allow_nan=False))
@@ -192,6 +432,16 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     add_scene_argument(parser)
     parser.add_argument('--json', action='store_true',
                         help='print one JSON object, in SI units (rad, m)')
+    parser.add_argument('--grid', type=grid_size, default=GRID, metavar='N',
+                        help=f'several drivers: grid points per driver (default {GRID}; a '
+                             f'crank every {360 // GRID} deg)')
+    parser.add_argument('--pair', metavar='A,B',
+                        help='several drivers: the two drivers of the grid (default the first '
+                             'two)')
+    parser.add_argument('--map', action='store_true',
+                        help='several drivers: draw the grid in text (also in --json)')
+    parser.add_argument('--png', metavar='FILE',
+                        help='several drivers: write the grid as a PNG picture')
     parser.set_defaults(handler=_handle)
     return parser
 

@@ -32,8 +32,10 @@ import traceback
 from typing import Any
 
 from ..errors import MechKinematicsError
+from ..units import LENGTH_UNITS, rad_per_s_from_rpm, turns_from_degrees
 
-__all__ = ['ArgumentParser', 'PROG', 'add_scene_argument', 'finite_float', 'positive_float',
+__all__ = ['ArgumentParser', 'PROG', 'add_scene_argument', 'drive_from_args', 'finite_float',
+           'named_value', 'positive_float', 'values_by_driver',
            'positive_int', 'positive_seconds', 'run_handler', 'run_tool', 'seconds_or_zero']
 
 #: The program name shown in usage lines.
@@ -166,3 +168,98 @@ def run_tool(add_parser: Callable[[Any], argparse.ArgumentParser],
     root = ArgumentParser(prog=PROG)
     parser = add_parser(root.add_subparsers(dest='command', required=True))
     return run_handler(parser.parse_args(sys.argv[1:] if argv is None else list(argv)))
+
+
+def named_value(text: str) -> tuple[str | None, float]:
+    """Parse ``NAME=VALUE`` (a driver's value) or a plain number, or tell argparse why not."""
+    name, sep, value = text.rpartition('=')
+    if not sep:
+        return None, finite_float(text)
+    if not name:
+        msg = f'expected NAME=VALUE (a driver of the scene and a number), got {text!r}'
+        raise argparse.ArgumentTypeError(msg)
+    return name, finite_float(value)
+
+
+def values_by_driver(scene: Any, flag: str, given: list[tuple[str | None, float]] | None
+                     ) -> dict[str, float]:
+    """Return ``{driver: value}`` of a repeatable ``--flag NAME=VALUE``; refuse unknown names."""
+    names = [driver.name for driver in scene.drivers]
+    out: dict[str, float] = {}
+    for name, value in given or ():
+        if name is None:
+            if len(names) > 1:
+                msg = (f'Expected {flag} NAME=VALUE with NAME one of the drivers '
+                       f'({", ".join(names)}), got {flag} {value:g}')
+                raise ValueError(msg)
+            name = names[0]
+        if name not in names:
+            msg = (f'Expected {flag} NAME=VALUE with NAME one of the drivers '
+                   f'({", ".join(names)}), got {name!r}')
+            raise ValueError(msg)
+        out[name] = value
+    return out
+
+
+def drive_from_args(scene: Any, args: argparse.Namespace) -> tuple[Any, Any, Any, Any, str]:
+    """Return solve's (positions, speeds, accels, turns) and the text of where it stands.
+
+    From the ``--input``, ``--speed`` and ``--accel NAME=VALUE`` options (and,
+    for one crank, ``--angle-deg`` and ``--speed-rpm``) that ``solve``,
+    ``diagram`` and ``plot`` share; a ValueError says what is wrong.
+    """
+    inputs = values_by_driver(scene, '--input', args.input)
+    speeds = values_by_driver(scene, '--speed', args.speed)
+    accels = values_by_driver(scene, '--accel', args.accel)
+    drivers = scene.drivers
+    single = scene.input is not None and len(drivers) == 1
+    if single:
+        crank = drivers[0]
+        if crank.name in inputs and args.angle_deg is not None:
+            msg = f'Expected --angle-deg or --input {crank.name}=DEG, got both'
+            raise ValueError(msg)
+        if crank.name in speeds and args.speed_rpm is not None:
+            msg = f'Expected --speed-rpm or --speed {crank.name}=RPM, got both'
+            raise ValueError(msg)
+        degrees = inputs.get(crank.name, args.angle_deg)
+        rpm = speeds.get(crank.name, args.speed_rpm)
+        if degrees is None:
+            angle, turns = crank.angle, crank.turns
+            shown = f'crank angle {scene.units.angle_text(crank.shown)}'
+        else:
+            angle, turns = turns_from_degrees(degrees)
+            shown = f'crank angle {degrees:.15g} deg'
+        speed = None if rpm is None else rad_per_s_from_rpm(rpm)
+        return angle, speed, accels.get(crank.name), turns, shown
+    for flag, used in (('--angle-deg', args.angle_deg), ('--speed-rpm', args.speed_rpm)):
+        if used is not None:
+            msg = (f'Expected --input, --speed and --accel NAME=VALUE for a scene with several '
+                   f'drivers ({", ".join(d.name for d in drivers)}), got {flag}')
+            raise ValueError(msg)
+    per_metre = LENGTH_UNITS[scene.units.length]
+    positions: list[Any] = []
+    rates: list[Any] = []
+    turns_list: list[int] = []
+    words = []
+    for driver in drivers:
+        revolute = driver.joint_type == 'revolute'
+        given = inputs.get(driver.name)
+        whole = 0
+        if given is None:
+            position = driver.start
+            text = driver.position_text(driver.start, scene.units)
+        elif revolute:
+            position, whole = turns_from_degrees(given)
+            text = f'{given:.15g} deg'
+        else:
+            position = given / per_metre
+            text = f'{given:.15g} {scene.units.length}'
+        speed = speeds.get(driver.name)
+        if speed is not None and revolute:
+            speed = rad_per_s_from_rpm(speed)
+        positions.append(position)
+        rates.append(speed)
+        turns_list.append(whole)
+        words.append(f'{driver.name} = {text}')
+    accel_list = [accels.get(driver.name) for driver in drivers]
+    return positions, rates, accel_list, turns_list, ', '.join(words)

@@ -16,6 +16,7 @@ from collections.abc import Mapping, Sequence
 import math
 from pathlib import Path
 import sys
+import textwrap
 from typing import Any
 import warnings
 
@@ -23,6 +24,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .cli import add_scene_argument, finite_float, positive_int, run_tool
+from .cli import drive_from_args, named_value, values_by_driver
 from ..errors import AssemblyError, NearSingularWarning, SceneError
 from ..geometry.diagrams import (arrows_from_state, colours_from_scene, Diagram,
                                  diagram_from_scene, fmt_sense, fmt_value, nice_scale, POLE,
@@ -33,7 +35,8 @@ from ..geometry.instant_centres import (bodies_from_scene, BodyKind, full_scene,
 from ..solver import Scene, solve
 from ..units import rad_per_s_from_rpm, rpm_from_rad_per_s, turns_from_degrees
 
-__all__ = ['add_parser', 'figure_from_diagram', 'main', 'write_animation', 'write_diagram']
+__all__ = ['add_parser', 'figure_from_diagram', 'main', 'title_from_diagram', 'write_animation',
+           'write_diagram']
 
 Array = npt.NDArray[np.float64]
 
@@ -53,6 +56,7 @@ ROW_H = 0.44             # cm per table row
 DPI = 110
 FONT = 8.5               # pt, labels
 TABLE_FONT = 7.5         # pt
+BARREL = 0.55            # of an actuator's length drawn as its barrel
 
 STYLE = {
     VectorKind.RELATIVE: ('-', 1.7), VectorKind.NORMAL: ('-', 1.5),
@@ -265,6 +269,11 @@ def _draw_mechanism(ax: Any, scene: Scene, space: SpaceDiagram, colours: Mapping
             ax.plot(xy[:, 0], xy[:, 1], color='white', lw=1.4, zorder=2.1)
         else:
             ax.plot(xy[:, 0], xy[:, 1], color=colour, lw=3.0, zorder=2, solid_capstyle='round')
+    for actuator in space.actuators:  # a cylinder: its barrel over the rod, from its base pin
+        start, end = actuator.start, actuator.end
+        barrel = start + BARREL * (end - start)
+        ax.plot([start[0], barrel[0]], [start[1], barrel[1]], color=colours[actuator.link],
+                lw=8.0, alpha=0.55, zorder=2.2, solid_capstyle='butt')
     for slider in space.sliders:
         corners = _block(slider.xy, slider.angle, block_l, block_h)
         ax.add_patch(Patch(corners, closed=True, facecolor=colours.get(slider.name, 'white'),
@@ -282,15 +291,29 @@ def _draw_mechanism(ax: Any, scene: Scene, space: SpaceDiagram, colours: Mapping
             ax.plot(*xy, marker='+', ms=6, color='#555555', zorder=5)
 
 
-def _crank_sense(ax: Any, scene: Scene, space: SpaceDiagram, speed: float,
+def _crank_senses(ax: Any, scene: Scene, diagram: Diagram,
+                  unit: float) -> list[tuple[Array, Array]]:
+    """Draw an arc arrow at each crank's pivot in its sense of rotation; return the chords."""
+    ground = {name: complex(*xy) for name, xy in scene.ground.items()}
+    speeds = {d.name: d.speed for d in diagram.drivers}
+    chords = []
+    for driver in scene.drivers:
+        for members in driver.local(ground).values():  # a crank's centre and tip
+            centre, tip = list(members)
+            chords += _crank_sense(ax, diagram.space, centre, tip,
+                                   speeds.get(driver.name, diagram.speed), unit)
+    return chords
+
+
+def _crank_sense(ax: Any, space: SpaceDiagram, centre: str, tip: str, speed: float,
                  unit: float) -> list[tuple[Array, Array]]:
-    """Draw an arc arrow at the crank's pivot in its sense of rotation; return its chords."""
+    """Draw an arc arrow at a crank's pivot in its sense of rotation; return its chords."""
     from matplotlib.patches import FancyArrowPatch
 
     if speed == 0.0:
         return []
-    c = space.points[scene.input.center]
-    p = space.points[scene.input.point]
+    c = space.points[centre]
+    p = space.points[tip]
     theta = math.atan2(p[1] - c[1], p[0] - c[0])
     sign = 1.0 if speed > 0 else -1.0
     r = 0.75 * unit
@@ -328,7 +351,7 @@ def _space_panel(ax: Any, scene: Scene, diagram: Diagram, colours: Mapping[str, 
     scale = _fit_scale(lo - [0, 0.7 * scale], hi)
     origin = _frame(ax, lo - [0, 0.7 * scale], hi, scale)
     _draw_mechanism(ax, scene, space, colours, scale)
-    sense = _crank_sense(ax, scene, space, diagram.speed, scale)
+    sense = _crank_senses(ax, scene, diagram, scale)
     segments = sense + [(link.outline[i], link.outline[(i + 1) % len(link.outline)])
                         for link in space.links
                         for i in range(len(link.outline) - (len(link.outline) == 2))]
@@ -507,7 +530,8 @@ def figure_from_diagram(diagram: Diagram, scene: Scene) -> Any:
     tables = tables_from_diagram(diagram)  # row counts; drawn again below with scales
     space_rows = len(tables['space'].rows) + (len(tables['centres'].rows) + 2
                                               if 'centres' in tables else 0)
-    rows = max(space_rows, len(tables['velocity'].rows), len(tables['acceleration'].rows)) + 1
+    rows = max([space_rows] + [len(tables[key].rows) for key in ('velocity', 'acceleration')
+                               if key in tables]) + 1
     table_h = rows * ROW_H + 0.6
     width = 2 * MARGIN + 3 * PANEL_W + 2 * PANEL_GAP
     height = TITLE_H + PANEL_H + 0.5 + table_h + 0.3
@@ -520,11 +544,17 @@ def figure_from_diagram(diagram: Diagram, scene: Scene) -> Any:
     panel_y = height - TITLE_H - PANEL_H
     xs = [MARGIN + i * (PANEL_W + PANEL_GAP) for i in range(3)]
     scales = {'space': _space_panel(axes(xs[0], panel_y, PANEL_W, PANEL_H), scene, diagram,
-                                    colours),
-              'velocity': _polygon_panel(axes(xs[1], panel_y, PANEL_W, PANEL_H),
-                                         diagram.velocity, colours),
-              'acceleration': _polygon_panel(axes(xs[2], panel_y, PANEL_W, PANEL_H),
-                                             diagram.acceleration, colours)}
+                                    colours)}
+    for x, key, polygon in ((xs[1], 'velocity', diagram.velocity),
+                            (xs[2], 'acceleration', diagram.acceleration)):
+        ax = axes(x, panel_y, PANEL_W, PANEL_H)
+        if polygon is None:  # refused: say why where it would be
+            ax.set_axis_off()
+            ax.set_title(f'{key.capitalize()} polygon', fontsize=FONT + 2)
+            ax.text(0.5, 0.5, '\n'.join(textwrap.wrap(diagram.refused, 48)),
+                    transform=ax.transAxes, ha='center', va='center', fontsize=FONT + 1)
+        else:
+            scales[key] = _polygon_panel(ax, polygon, colours)
     tables = tables_from_diagram(diagram, scales)
     top = panel_y - 0.55
     n = len(tables['space'].rows) + 1
@@ -534,16 +564,38 @@ def figure_from_diagram(diagram: Diagram, scene: Scene) -> Any:
         _table(axes(xs[0] + 1.5, top - (n + m) * ROW_H - 0.9, PANEL_W - 3.0, m * ROW_H),
                tables['centres'])
     for x, key in ((xs[1], 'velocity'), (xs[2], 'acceleration')):
+        if key not in tables:
+            continue
         n = len(tables[key].rows) + 1
         _table(axes(x, top - n * ROW_H, PANEL_W, n * ROW_H), tables[key], mathcols=(0, 1))
-    rpm = rpm_from_rad_per_s(diagram.speed)
-    fig.text(MARGIN / width, 1.0 - 0.5 / height,
-             f'{diagram.scene}: crank angle {fmt_value(math.degrees(diagram.angle))}\u00b0, '
-             f'\u03c9 = {fmt_value(diagram.speed)} rad/s{fmt_sense(diagram.speed)} '
-             f'({fmt_value(rpm)} rpm), '
-             f'\u03b1 = {fmt_value(diagram.accel)} rad/s\u00b2   (SI units; angles CCW from +x)',
+    fig.text(MARGIN / width, 1.0 - 0.5 / height, title_from_diagram(diagram),
              fontsize=FONT + 3, va='center', ha='left')
     return fig
+
+
+def title_from_diagram(diagram: Diagram) -> str:
+    """Return the figure's title: the scene and where its drivers stand, SI units.
+
+    One crank: its angle (deg), speed (rad/s and rpm) and acceleration;
+    several drivers (or an actuator): each one's position, speed and
+    acceleration.
+    """
+    drivers = diagram.drivers
+    if len(drivers) <= 1 and all(d.joint_type == 'revolute' for d in drivers):
+        rpm = rpm_from_rad_per_s(diagram.speed)
+        return (f'{diagram.scene}: crank angle {fmt_value(math.degrees(diagram.angle))}\u00b0, '
+                f'\u03c9 = {fmt_value(diagram.speed)} rad/s{fmt_sense(diagram.speed)} '
+                f'({fmt_value(rpm)} rpm), \u03b1 = {fmt_value(diagram.accel)} rad/s\u00b2   '
+                f'(SI units; angles CCW from +x)')
+    parts = []
+    for d in drivers:
+        if d.joint_type == 'revolute':
+            parts.append(f'{d.name} {fmt_value(math.degrees(d.position))}\u00b0, '
+                         f'{fmt_value(d.speed)} rad/s, {fmt_value(d.accel)} rad/s\u00b2')
+        else:
+            parts.append(f'{d.name} {fmt_value(d.position)} m, {fmt_value(d.speed)} m/s, '
+                         f'{fmt_value(d.accel)} m/s\u00b2')
+    return f'{diagram.scene}: {"; ".join(parts)}   (SI units; angles CCW from +x)'
 
 
 def write_diagram(diagram: Diagram, scene: Scene, path: str | Path) -> Path:
@@ -716,9 +768,17 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                              'with --animate, the first frame')
     parser.add_argument('--speed-rpm', type=finite_float, metavar='N',
                         help="signed crank speed in rpm, + CCW (default: the scene's)")
-    parser.add_argument('--accel', type=finite_float, metavar='A',
-                        help='crank angular acceleration in rad/s^2, + CCW (default: the '
+    parser.add_argument('--accel', type=named_value, action='append', metavar='[NAME=]A',
+                        help='crank angular acceleration in rad/s^2, + CCW; NAME=A for a '
+                             "driver of several (an actuator's in m/s^2) (default: the "
                              "scene's)")
+    parser.add_argument('--input', type=named_value, action='append', metavar='NAME=VALUE',
+                        help="a driver's position, as solve takes it: a crank's angle in "
+                             "degrees, an actuator's length in the scene's length unit "
+                             "(repeatable; default: the scene's)")
+    parser.add_argument('--speed', type=named_value, action='append', metavar='NAME=VALUE',
+                        help="a driver's speed, as solve takes it: rpm for a crank, m/s for an "
+                             "actuator (repeatable; default: the scene's)")
     parser.add_argument('--instant-centres', action='store_true',
                         help='also compute the instant centres, mark them on the space '
                              'diagram and list them')
@@ -764,20 +824,48 @@ def _handle(args: argparse.Namespace) -> int:
     speed = None if args.speed_rpm is None else rad_per_s_from_rpm(args.speed_rpm)
     try:
         scene = load_scene(args.scene)
+        drivers = scene.drivers
+        if len(drivers) > 1 or drivers[0].joint_type != 'revolute' or args.input or args.speed:
+            return _handle_drivers(args, scene, output)
+        accel = values_by_driver(scene, '--accel', args.accel).get(drivers[0].name)
         if args.animate:
             if args.angle_deg is not None:
                 scene = _with_angle(scene, args.angle_deg)
             count = write_animation(scene, output, frames=args.frames, speed=speed,
-                                    accel=args.accel, instant_centres=args.instant_centres)
+                                    accel=accel, instant_centres=args.instant_centres)
             print(f'wrote {output} ({count} frames)')
         else:
-            diagram = diagram_from_scene(scene, args.angle_deg, speed, args.accel,
+            diagram = diagram_from_scene(scene, args.angle_deg, speed, accel,
                                          degrees=True, instant_centres=args.instant_centres)
             write_diagram(diagram, scene, output)
             print(f'wrote {output}')
     except (SceneError, AssemblyError, ValueError, OSError) as error:
         print(f'error: {error}', file=sys.stderr)
         return 2
+    return 0
+
+
+def _handle_drivers(args: argparse.Namespace, scene: Scene, output: Path) -> int:
+    """Draw a scene at ``--input``, ``--speed`` and ``--accel NAME=VALUE`` (as ``solve``)."""
+    if args.animate:
+        names = ', '.join(d.name for d in scene.drivers)
+        msg = (f'Expected no --animate for {scene.name} with --input or --speed, or with '
+               f'several drivers or an actuator ({names}): --animate turns one crank')
+        raise ValueError(msg)
+    positions, rates, accels, turns, _ = drive_from_args(scene, args)
+    drivers = scene.drivers
+    if scene.input is not None and len(drivers) == 1:  # one crank: drive_from_args's scalars
+        positions, rates, accels, turns = [positions], [rates], [accels], [turns]
+    inputs = {d.name: float(x) + (2.0 * math.pi * int(t) if t else 0.0)
+              for d, x, t in zip(drivers, positions, turns, strict=True)}
+    speeds = {d.name: float(v) for d, v in zip(drivers, rates, strict=True) if v is not None}
+    accel = {d.name: float(a) for d, a in zip(drivers, accels, strict=True) if a is not None}
+    diagram = diagram_from_scene(scene, inputs=inputs, speeds=speeds, accels=accel,
+                                 instant_centres=args.instant_centres)
+    write_diagram(diagram, scene, output)
+    if diagram.refused:
+        print(f'{scene.name}: {diagram.refused}')
+    print(f'wrote {output}')
     return 0
 
 

@@ -36,7 +36,8 @@ import warnings
 import numpy as np
 import numpy.typing as npt
 
-from .cli import finite_float, PROG, run_tool
+from .cli import finite_float, positive_float, PROG, run_tool
+from .cli import named_value, values_by_driver
 from ..errors import MechKinematicsError
 from ..ros import topics
 from ..ros.cdr import stamp_from_cdr
@@ -44,8 +45,8 @@ from ..units import NS_PER_S, rad_per_s_from_rpm, rpm_from_rad_per_s
 
 __all__ = [
     'DEFAULT_MAX_SAMPLES', 'DEFAULT_SAMPLES', 'Motion', 'PlotError', 'add_parser',
-    'figure_from_motion', 'main', 'motion_from_bag', 'motion_from_scene', 'plot_bag',
-    'plot_scene', '_handle', 'save_figure',
+    'drivers_period', 'figure_from_motion', 'main', 'motion_from_bag', 'motion_from_scene',
+    'plot_bag', 'plot_scene', '_handle', 'save_figure',
 ]
 
 Array = npt.NDArray[np.float64]
@@ -151,8 +152,17 @@ class Motion:
 
 def motion_from_scene(scene: Any, *, samples: int = DEFAULT_SAMPLES,
                       speed: float | None = None, accel: float | None = None,
-                      x: str = 'angle') -> Motion:
-    """Solve ``scene`` over one crank cycle.
+                      x: str = 'angle', duration: float | None = None,
+                      speeds: Mapping[str, float] | None = None) -> Motion:
+    """Solve ``scene`` over one crank cycle (several drivers: along a path in time).
+
+    A scene with several drivers (or an actuator) is solved along the path
+    each driver takes from its start at its default speed and acceleration,
+    for the shortest of the drivers' periods (a crank's turn, an actuator's
+    travel to the end of its stroke it moves toward; :func:`drivers_period`)
+    or ``duration`` (s); against time only. A path that leaves the region where
+    the mechanism assembles (or its answers cannot be trusted) is refused with
+    where and why.
 
     Parameters
     ----------
@@ -166,6 +176,12 @@ def motion_from_scene(scene: Any, *, samples: int = DEFAULT_SAMPLES,
         ``'angle'``: crank angles 0 to 2π. ``'time'``: one period 2π/|speed|
         from the scene's initial angle, turning at the constant ``speed``.
 
+    duration : float, optional
+        Several drivers: the time plotted, s (default: :func:`drivers_period`).
+    speeds : mapping of str to float, optional
+        Several drivers: speeds by driver name (rad/s, m/s) replacing the
+        defaults.
+
     Returns
     -------
     Motion
@@ -176,12 +192,8 @@ def motion_from_scene(scene: Any, *, samples: int = DEFAULT_SAMPLES,
     if samples < 2:
         msg = f'Expected at least 2 samples, got {samples}'
         raise PlotError(msg)
-    drivers = scene.drivers
-    if scene.input is None or len(drivers) > 1:
-        msg = (f'Expected a scene driven by one crank to plot over its turn, got scene '
-               f'"{scene.name}" with {len(drivers)} drivers '
-               f'({", ".join(d.name for d in drivers)}): plot a bag the node recorded instead')
-        raise PlotError(msg)
+    if len(scene.drivers) > 1 or scene.drivers[0].joint_type != 'revolute':
+        return _motion_of_drivers(scene, samples, speed, accel, x, duration, speeds)
     speed = scene.input.speed if speed is None else float(speed)
     accel = scene.input.accel if accel is None else float(accel)
     time = None
@@ -212,6 +224,128 @@ def motion_from_scene(scene: Any, *, samples: int = DEFAULT_SAMPLES,
             for name, r in state.imus.items()}
     return Motion(title, np.asarray(angle, dtype=np.float64), time, scene.joint_types, joints,
                   points, jumps, summary_from_gaps(gaps, scene.units), gaps, imus)
+
+
+def _first_time(v: float, a: float, distance: float) -> float:
+    """Return the first t > 0 with v t + a t^2 / 2 = distance (s), or inf if never."""
+    if a == 0.0:
+        t = distance / v if v != 0.0 else math.inf
+        return t if t > 0.0 else math.inf
+    disc = v * v + 2.0 * a * distance
+    if disc < 0.0:
+        return math.inf
+    root = math.sqrt(disc)
+    times = [t for t in ((-v - root) / a, (-v + root) / a) if t > 0.0]
+    return min(times, default=math.inf)
+
+
+def drivers_period(scene: Any, speeds: Mapping[str, float] | None = None
+                   ) -> tuple[float, str]:
+    """Return the time (s) of the quickest driver's period, and which driver and what it does.
+
+    A crank's period is the time it takes to turn once either way from its
+    start at its default speed and acceleration; an actuator's, the time it
+    takes to reach the end of its stroke it moves toward (one without stroke
+    limits has none). The shortest of these keeps every actuator within its
+    stroke. ``speeds`` (by driver name, rad/s or m/s) replace the defaults.
+    """
+    best, what = math.inf, ''
+    for driver in scene.drivers:
+        v, a = (speeds or {}).get(driver.name, driver.speed), driver.accel
+        if driver.joint_type == 'revolute':
+            t = min(_first_time(v, a, 2.0 * math.pi), _first_time(v, a, -2.0 * math.pi))
+            doing = f'{driver.name} turning once'
+        elif driver.stroke is not None:
+            low, high = driver.stroke
+            t = min(_first_time(v, a, high - driver.start), _first_time(v, a, low - driver.start))
+            doing = f'{driver.name} reaching the end of its stroke'
+        else:
+            t = math.inf
+        if t < best:
+            best, what = t, doing
+    if not math.isfinite(best):
+        msg = (f'Expected a driver of {scene.name} that turns or reaches the end of its stroke '
+               f'at its speed and acceleration, got none: give --speed NAME=VALUE or '
+               f'--duration SECONDS')
+        raise PlotError(msg)
+    return best, what
+
+
+def _motion_of_drivers(scene: Any, samples: int, speed: float | None, accel: float | None,
+                       x: str, duration: float | None,
+                       given: Mapping[str, float] | None) -> Motion:
+    """Solve a scene with several drivers (or an actuator) along its drivers' path.
+
+    Each driver moves from its start at its speed (``given`` by name, SI, or
+    its default) and its default acceleration.
+    """
+    import mech_kinematics as mk
+
+    if x != 'time':
+        msg = (f'Expected --x time for {scene.name}, which has several drivers or an actuator '
+               f'(no one crank angle to plot against), got --x {x}')
+        raise PlotError(msg)
+    if speed is not None or accel is not None:
+        msg = (f'Expected no --speed-rpm or --accel for {scene.name}: each of its drivers '
+               f'moves at its own speed (--speed NAME=VALUE) and default acceleration')
+        raise PlotError(msg)
+    if duration is None:
+        duration, what = drivers_period(scene, given)
+        span = f'{duration:.6g} s ({what})'
+    else:
+        span = f'{duration:.6g} s'
+    time = np.linspace(0.0, duration, samples)
+    drivers = scene.drivers
+    unknown = sorted(set(given or {}) - {d.name for d in drivers})
+    if unknown:
+        msg = (f'Expected --speed NAME=VALUE with NAME one of the drivers '
+               f'({", ".join(d.name for d in drivers)}), got {", ".join(unknown)}')
+        raise PlotError(msg)
+    rate = {d.name: (given or {}).get(d.name, d.speed) for d in drivers}
+    positions = [d.start + rate[d.name] * time + 0.5 * d.accel * time * time for d in drivers]
+    speeds = [rate[d.name] + d.accel * time for d in drivers]
+    accels = [np.full_like(time, d.accel) for d in drivers]
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore', mk.NearSingularWarning)
+        if len(drivers) == 1:
+            state = mk.solve(scene, positions[0], speeds[0], accels[0])
+        else:
+            state = mk.solve(scene, positions, speeds, accels)
+    valid = np.asarray(state.valid, dtype=bool)
+    if not valid.all():
+        index = int(np.flatnonzero(~valid)[0])
+        where = ', '.join(f'{d.name} = {d.position_text(float(p[index]), scene.units)}'
+                          for d, p in zip(drivers, positions, strict=True))
+        reason = 'its answer cannot be trusted'
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter('ignore', mk.NearSingularWarning)
+                at = [float(p[index]) for p in positions]
+                rates = [float(v[index]) for v in speeds]
+                rate2 = [float(a[index]) for a in accels]
+                if len(drivers) == 1:
+                    mk.solve(scene, at[0], rates[0], rate2[0])
+                else:
+                    mk.solve(scene, at, rates, rate2)
+        except mk.AssemblyError as error:
+            reason = error.reason
+        msg = (f"Expected the drivers' path of {scene.name} to stay where it assembles, got it "
+               f'leaving at t = {time[index]:.6g} s ({where}): {reason}; plot less with '
+               f'--duration SECONDS (at most {time[max(index - 1, 0)]:.6g} s)')
+        raise PlotError(msg)
+    joints = {name: (j.position, j.velocity, j.acceleration) for name, j in state.joints.items()}
+    points = {name: (p.position, p.velocity, p.acceleration) for name, p in state.points.items()}
+    rates = ', '.join(
+        f'{d.name} {rpm_from_rad_per_s(rate[d.name]):.6g} rpm' if d.joint_type == 'revolute'
+        else f'{d.name} {rate[d.name]:.6g} m/s' for d in drivers)
+    title = (f'{scene.name}: solver, every driver from its start at its speed ({rates}) for '
+             f'{span}')
+    jumps = np.zeros(samples - 1, dtype=bool)
+    for engagement in state.intermittent.values():
+        engaged = np.asarray(engagement.engaged, dtype=bool)
+        jumps |= engaged[1:] != engaged[:-1]
+    return Motion(title, np.asarray(positions[0], dtype=np.float64), time, scene.joint_types,
+                  joints, points, jumps, 'the path stays where it assembles')
 
 
 # -- from a bag ------------------------------------------------------------------
@@ -437,7 +571,10 @@ def motion_from_bag(path: str | os.PathLike[str], *, scene: Any = None,
             scene = candidate
     if scene is not None:
         types = {n: scene.joint_types.get(n, 'revolute') for n in names}
-        crank = scene.drivers[0].name  # the first driver: a crank, or an actuator
+        drivers = scene.drivers
+        # Several drivers (or an actuator): no one crank angle (NaN; --x angle is refused).
+        crank = drivers[0].name if len(drivers) == 1 and drivers[0].joint_type == 'revolute' \
+            else ''
     else:
         if any(names):
             warnings.warn(f'{path}: no scene given or named in the bag; plotting every joint '
@@ -662,18 +799,36 @@ def save_figure(fig: Any, output: str | os.PathLike[str]) -> Path:
 def plot_bag(path: str | os.PathLike[str], output: str | os.PathLike[str], *,
              x: str = 'time', scene: Any = None, namespace: str | None = None,
              max_samples: int | None = DEFAULT_MAX_SAMPLES) -> Any:
-    """Plot the recording at ``path`` to ``output``; return the Figure."""
+    """Plot the recording at ``path`` to ``output``; return the Figure.
+
+    A recording of a scene with several drivers (or an actuator) has no one
+    crank angle: ``x='angle'`` is refused.
+    """
     motion = motion_from_bag(path, scene=scene, namespace=namespace, max_samples=max_samples)
+    if x == 'angle' and motion.joints and not np.isfinite(motion.crank_angle).any():
+        msg = (f'Expected a recording of a scene driven by one crank to plot against crank '
+               f'angle, got {motion.title.split(":")[0]}, with several drivers or an '
+               f'actuator: use --x time')
+        raise PlotError(msg)
     fig = figure_from_motion(motion, x=x)
     save_figure(fig, output)
     return fig
 
 
-def plot_scene(scene: Any, output: str | os.PathLike[str], *, x: str = 'angle',
+def plot_scene(scene: Any, output: str | os.PathLike[str], *, x: str | None = None,
                samples: int = DEFAULT_SAMPLES, speed: float | None = None,
-               accel: float | None = None) -> Any:
-    """Plot one crank cycle of ``scene`` to ``output``; return the Figure."""
-    motion = motion_from_scene(scene, samples=samples, speed=speed, accel=accel, x=x)
+               accel: float | None = None, duration: float | None = None) -> Any:
+    """Plot one crank cycle of ``scene`` to ``output``; return the Figure.
+
+    ``x`` defaults to ``'angle'``, or ``'time'`` for a scene with several
+    drivers (or an actuator), which :func:`motion_from_scene` plots along its
+    drivers' path.
+    """
+    if x is None:
+        several = len(scene.drivers) > 1 or scene.drivers[0].joint_type != 'revolute'
+        x = 'time' if several else 'angle'
+    motion = motion_from_scene(scene, samples=samples, speed=speed, accel=accel, x=x,
+                               duration=duration)
     fig = figure_from_motion(motion, x=x)
     save_figure(fig, output)
     return fig
@@ -694,6 +849,13 @@ against time or crank angle, to an image file (PNG; no display needed).
   plot BAG --scene SCENE ...       a bag, with the scene telling sliders from
                                    revolute joints (by default the scene named
                                    in the bag's diagnostics is used)
+
+A scene with several drivers (or an actuator) is plotted against time along
+the path its drivers take from their start positions at their default speeds,
+for the quickest driver's period (a crank's turn, an actuator's travel to the
+end of its stroke it moves toward; the title says which) or --duration
+SECONDS; a path leaving the region where it assembles is refused, saying
+where and why.
 """
 
 
@@ -727,9 +889,22 @@ def _handle(args: argparse.Namespace) -> int:
             for warning in caught:      # one line each, not Python's warning format
                 print(f'warning: {warning.message}', file=sys.stderr)
         else:
-            x = args.x or 'angle'
+            several = len(scene.drivers) > 1 or scene.drivers[0].joint_type != 'revolute'
+            x = args.x or ('time' if several else 'angle')
+            if (args.duration is not None or args.speed) and not several:
+                msg = (f'Expected --duration and --speed NAME=VALUE only for a scene with '
+                       f'several drivers or an actuator, got {scene.name}, driven by one crank: '
+                       f'use --speed-rpm')
+                raise PlotError(msg)
+            try:
+                rates = values_by_driver(scene, '--speed', args.speed)
+            except ValueError as error:
+                raise PlotError(str(error)) from None
+            given = {d.name: rad_per_s_from_rpm(rates[d.name]) if d.joint_type == 'revolute'
+                     else rates[d.name] for d in scene.drivers if d.name in rates}
             motion = motion_from_scene(scene, samples=args.samples, speed=speed,
-                                       accel=args.accel, x=x)
+                                       accel=args.accel, x=x, duration=args.duration,
+                                       speeds=given)
             save_figure(figure_from_motion(motion, x=x), output)
             print(f'{scene.name}: {motion.note}')  # where it does not assemble, if anywhere
     except (PlotError, mk.SceneError) as error:
@@ -774,6 +949,12 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="crank speed for --scene, rpm (default: the scene's)")
     parser.add_argument('--accel', type=finite_float, metavar='A',
                         help="crank acceleration for --scene, rad/s^2 (default: the scene's)")
+    parser.add_argument('--speed', type=named_value, action='append', metavar='NAME=VALUE',
+                        help="--scene with several drivers: a driver's speed, as solve takes "
+                             "it (rpm for a crank, m/s for an actuator; default: the scene's)")
+    parser.add_argument('--duration', type=positive_float, metavar='SECONDS',
+                        help='--scene with several drivers: the time plotted (default: the '
+                             "quickest driver's turn or stroke)")
 
 
 def add_parser(subparsers: Any) -> argparse.ArgumentParser:

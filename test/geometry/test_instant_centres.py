@@ -205,15 +205,35 @@ def test_pruned_state_is_refused():
 
 
 @pytest.mark.parametrize('name', ['five_bar', 'excavator'])
-def test_several_drivers_are_refused_in_one_line(name):
-    """Instant centres are one driver's (issue 18): a clear SceneError, not a crash."""
+def test_kennedy_is_one_drivers_and_refuses_several_in_one_line(name):
+    """Kennedy's construction is one driver's (issue 18): a clear SceneError, not a crash."""
     scene = full_scene(mk.load_scene(name))
     state = mk.solve(scene, [d.start for d in scene.drivers])
     names = ', '.join(d.name for d in scene.drivers)
-    for method in (instant_centres_from_state, instant_centres_from_kennedy):
-        with pytest.raises(mk.SceneError, match=re.escape(
-                f"Expected a scene driven by one crank for instant centres (one driver's), got "
-                f'scene "{name}" with 2 drivers ({names})')):
-            method(scene, state)
+    with pytest.raises(mk.SceneError, match=re.escape(
+            f"Expected a scene driven by one crank for instant centres (one driver's), got "
+            f'scene "{name}" with 2 drivers ({names})')):
+        instant_centres_from_kennedy(scene, state)
     assert {body.name for body in bodies_from_scene(scene).bodies.values()} >= {
         d.name for d in scene.drivers if d.joint_type == 'revolute'}
+
+
+def test_five_bar_centres_from_velocities_with_both_cranks_moving():
+    """Two cranks at their own speeds: every centre's relative velocity is zero there."""
+    scene = full_scene(mk.load_scene('five_bar'))
+    state = mk.solve(scene, [1.9, 0.8], [2.0, -3.0], [0.0, 0.0])
+    centres = instant_centres_from_state(scene, state)
+    assert len(centres) == 10  # ground, two cranks, two distal links: 5 bodies
+    crank = next(c for c in centres if c.bodies == ('left_crank', 'right_crank'))
+    # on AE, dividing it as w2 / (w2 - w1) = -3 / -5
+    np.testing.assert_allclose(crank.point, [0.1 * 3 / 5, 0.0], atol=1e-15)
+
+
+def test_a_link_that_changes_length_has_no_instant_centres():
+    """The excavator's cylinders are not rigid bodies: refused in one line."""
+    scene = full_scene(mk.load_scene('excavator'))
+    state = mk.solve(scene, [d.start for d in scene.drivers])
+    with pytest.raises(mk.SceneError, match=re.escape(
+            'Expected rigid links for instant centres, got scene "excavator" whose link '
+            "boom_cyl_body, stick_cyl_body changes length (an actuator's")):
+        instant_centres_from_state(scene, state)

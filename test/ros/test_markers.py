@@ -16,12 +16,14 @@ import time
 import warnings
 
 from builtin_interfaces.msg import Time
+from helpers import BOOM_CYLINDER
 import numpy as np
 import pytest
 from ros_helpers import NodeProcess, Ros, SESSION, stamp_ns, STARTUP_S, wait_for
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import MultiDOFJointTrajectory
 from visualization_msgs.msg import Marker, MarkerArray
+import yaml
 
 import mech_kinematics as mk
 from mech_kinematics.geometry.diagrams import strokes_from_scene
@@ -277,6 +279,28 @@ def test_node_without_markers_has_no_markers_publisher(ros, tmp_path):
             proc.proc.kill()
 
 
+def test_an_actuator_is_a_cylinder_from_pin_to_pin():
+    """The boom's cylinder (issue 18): a CYLINDER whose axis runs from F to Q, as long as it is."""
+    scene = mk.parse_scene(yaml.safe_load(BOOM_CYLINDER))
+    state = mk.solve(scene, 3.0)
+    array = marker_array_from_state(scene, state, frame_id='test_frame')
+    (cylinder,) = [m for m in array.markers if m.ns == 'actuators']
+    assert (cylinder.id, cylinder.type) == (0, Marker.CYLINDER)
+    f, q = state.points['F'].position, state.points['Q'].position
+    np.testing.assert_allclose(_xy(cylinder.pose.position), (f + q) / 2, rtol=0,
+                               atol=ATOL_POSITION)
+    assert cylinder.scale.z == pytest.approx(3.0, rel=1e-15)
+    assert cylinder.scale.x == cylinder.scale.y > 0.0
+    o = cylinder.pose.orientation
+    w, x, y, z = o.w, o.x, o.y, o.z
+    assert w * w + x * x + y * y + z * z == pytest.approx(1.0, rel=1e-15)
+    axis = [2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y)]  # R e_z
+    np.testing.assert_allclose(axis, [*((q - f) / 3.0), 0.0], rtol=0, atol=1e-15)
+    assert [m.ns for m in array.markers] == sorted(
+        (m.ns for m in array.markers), key=NAMESPACES.index)
+    assert not any(m.ns == 'actuators' for m in _markers('quick_return')[3].markers)
+
+
 def test_a_cylinder_is_drawn_as_a_link_between_its_pins():
     """Excavator: each cylinder is a line strip between its two pins; the arm's points joints."""
     scene = mk.load_scene('excavator')
@@ -290,3 +314,13 @@ def test_a_cylinder_is_drawn_as_a_link_between_its_pins():
         assert any(set(strip) == ends for strip in strips), (start, pin)
     joints = next(m for m in array.markers if m.ns == 'joints')
     assert len(joints.points) == len(points)
+
+
+def test_the_excavator_has_a_cylinder_per_actuator():
+    """Both of the excavator's cylinders are CYLINDER markers as long as the actuators are."""
+    scene = full_scene(mk.load_scene('excavator'))
+    state = mk.solve(scene, [2.9, 3.4])
+    array = marker_array_from_state(scene, state)
+    cylinders = [m for m in array.markers if m.ns == 'actuators']
+    assert [(m.id, m.type) for m in cylinders] == [(0, Marker.CYLINDER), (1, Marker.CYLINDER)]
+    assert [m.scale.z for m in cylinders] == pytest.approx([2.9, 3.4], rel=1e-14)

@@ -485,3 +485,21 @@ def test_a_plain_dyad_downstream_of_an_actuator_is_bounded_against_the_reference
         moving = mk.solve(mk.load_scene('excavator'), [length, 3.2], [0.2, 0.0], [-0.1, 0.0])
         np.testing.assert_allclose(state.points['bucket_tip'].velocity,
                                    moving.points['bucket_tip'].velocity, rtol=1e-13)
+
+
+@pytest.mark.parametrize(('name', 'positions'), [('five_bar', [1.6, 1.0]),
+                                                 ('excavator', [2.6, 3.0])])
+def test_errors_relative_to_the_scales_are_a_few_ulps(name, positions):
+    """Against the reference, every kind's worst error is within 20 ulps of its scale."""
+    scene = mk.load_scene(name)
+    speeds, accels = [0.1, 0.2], [0.0, 0.1]
+    exact = ref.reference(scene, positions, speeds, accels)
+    errors = ref.compare(mk.solve(scene, positions, speeds, accels), exact)
+    assert set(errors) == set(ref.KINDS)
+    assert max(errors.values()) <= 20 * EPS, errors
+    # Backward stable: within a few eps times the condition number in every input
+    # (each driver's position, speed and acceleration perturbed on its own).
+    kappa = ref.condition(scene, exact)
+    for kind, error in errors.items():
+        assert 1.0 <= kappa[kind] < 100.0, (kind, kappa)
+        assert error <= 4 * EPS * kappa[kind], (kind, error, kappa[kind])

@@ -14,6 +14,7 @@ from pathlib import Path
 import subprocess
 import sys
 
+from helpers import BOOM_CYLINDER, FIVE_BAR_TWO_CRANKS
 import pytest
 
 import mech_kinematics as mk
@@ -149,11 +150,89 @@ def test_a_crank_that_cannot_turn_has_no_strokes(capsys):
     assert json.loads(capsys.readouterr().out)['strokes'] == []
 
 
-@pytest.mark.parametrize('name', ['five_bar', 'excavator'])
-def test_several_drivers_are_refused_in_one_line(name, capsys):
-    """`check` sweeps one crank's turn: a scene with several drivers is refused (issue 18)."""
-    assert main(['check', name]) == 2
+# --- several drivers (issue 18): the assembly region ---------------------------------
+
+OF = math.hypot(400, 1100)  # mm
+
+
+def write_scene(tmp_path, text):
+    """Write YAML ``text`` to a file in ``tmp_path``; return its path as text."""
+    path = tmp_path / 'scene.yaml'
+    path.write_text(text)
+    return str(path)
+
+
+def test_actuator_region_in_text(tmp_path, capsys):
+    """The boom cylinder: its grid, its range from its stroke to the boom in line, its stroke."""
+    assert main(['check', write_scene(tmp_path, BOOM_CYLINDER), '--grid', '31']) == 0
+    assert capsys.readouterr().out.splitlines() == [
+        'boom: 1 driver: cyl (actuator) (angles in deg, CCW from +x; lengths in mm)',
+        'grid: cyl over its stroke 2000..5000 mm (31 points): assembles at 58.06% (18 of 31)',
+        f'cyl: assembles for 2000..{2600 + OF:.6g} mm (from its stroke limit to RRR Q stops '
+        'closing); sampled every 0.833565 mm, ends exact',
+        'stroke limits: cyl 2000..5000 mm',
+    ]
+
+
+def test_five_bar_region_in_json_with_a_map(tmp_path, capsys):
+    """Two cranks: the grid's counts, each slice in rad, the map's rows (--json --map)."""
+    assert main(['check', write_scene(tmp_path, FIVE_BAR_TWO_CRANKS), '--json', '--map',
+                 '--grid', '8']) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert [d['name'] for d in data['drivers']] == ['left', 'right']
+    assert data['drivers'][0]['start'] == pytest.approx(math.radians(120), rel=1e-15)
+    grid = data['grid']
+    assert grid['drivers'] == ['left', 'right'] and grid['points'] == [8, 8]
+    assert grid['fraction'] == grid['assembling'] / 64
+    left, right = data['slices']
+    assert left['at'] == {'right': pytest.approx(math.radians(60), rel=1e-15)}
+    assert left['ends'] == [['RRR P', 'RRR P']] and left['everywhere'] is False
+    assert left['ranges'][0][0] < 0.0 < left['ranges'][0][1]  # through 0: starts below 0
+    # right at 0: |BD|^2 = 0.0628 - 0.0528 cos(left) m^2 exceeds 0.28^2 beyond 107.2 deg
+    assert data['map'][-1] == '###...##'
+    assert len(data['map']) == 8 and ''.join(data['map']).count('#') == grid['assembling']
+
+
+def test_map_and_png(tmp_path, capsys):
+    """--map draws the grid in text, the first driver rightward; --png writes a picture."""
+    png = tmp_path / 'region.png'
+    assert main(['check', write_scene(tmp_path, FIVE_BAR_TWO_CRANKS), '--map', '--grid', '4',
+                 '--png', str(png)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    start = lines.index('map (# assembles, . does not, + partly; left rightward, right '
+                        'upward):')
+    # Rows from right = 270 deg down to 0; columns left = 0, 90, 180, 270 deg: only
+    # left = 180 deg, right = 0 puts B and D further apart (0.34 m) than 0.28 m.
+    assert lines[start + 1:] == ['####', '####', '####', '##.#']
+    assert png.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
+
+
+def test_region_flags_on_a_one_crank_scene_are_refused(capsys):
+    """--map (or --grid, --pair, --png) on a scene with one crank: one line, exit 2."""
+    assert main(['check', 'four_bar_coupler_points', '--map', '--grid', '10']) == 2
     err = capsys.readouterr().err
-    assert err.count('\n') == 1
-    assert err.startswith('error: Expected a scene driven by one crank for assembly over one '
-                          f'crank\'s turn, got scene "{name}" with 2 drivers')
+    assert err.strip().splitlines() == [
+        'error: Expected a scene with several drivers or an actuator for --grid, --map, got '
+        'four_bar_coupler_points, driven by one crank: drop --grid, --map']
+
+
+@pytest.mark.parametrize('grid', ['1', 'x', '2001'])
+def test_a_bad_grid_size_is_refused(grid, capsys):
+    """--grid takes 2 to 2000 points per driver."""
+    with pytest.raises(SystemExit):
+        main(['check', 'four_bar_coupler_points', '--grid', grid])
+    assert 'expected a whole number of grid points from 2 to 2000' in capsys.readouterr().err
+
+
+@pytest.mark.parametrize('name', ['five_bar', 'excavator'])
+def test_packaged_scenes_with_several_drivers(name, capsys):
+    """The packaged five-bar and excavator: their region in text, every grid point counted."""
+    assert main(['check', name, '--json', '--grid', '20']) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data['grid']['points'] == [20, 20]
+    assert all(s['everywhere'] for s in data['slices'])
+    if name == 'excavator':
+        assert data['grid']['assembling'] == 400
+        assert [d['stroke'] for d in data['drivers']] == [[2.0, 3.3], [2.5, 3.9]]
+    else:
+        assert 0 < data['grid']['assembling'] < 400

@@ -13,9 +13,10 @@ import subprocess
 import sys
 import warnings
 
-from helpers import crank_scene_names
+from helpers import BOOM_CYLINDER, crank_scene_names, FIVE_BAR_TWO_CRANKS
 import numpy as np
 import pytest
+import yaml
 
 import mech_kinematics as mk
 from mech_kinematics.geometry import diagrams as geo
@@ -426,60 +427,141 @@ def test_import_needs_no_matplotlib():
     subprocess.run([sys.executable, '-c', code], check=True, timeout=60)
 
 
-def test_a_geneva_wheel_of_radius_1e300_is_drawn(tmp_path, capsys):
-    """Issue 21, item 5: "SVD did not converge" used to be all `diagram` said.
-
-    The wheel's outline and slots are computed in units of its own extent, so
-    the drawing is the packaged wheel's scaled by 1e300 / 0.05: its slot mouths
-    at sqrt(l^2 - R^2) = 1e300 m from the wheel's centre.
-    """
-    text = (Path(__file__).resolve().parents[2] / 'config' / 'scenes' / 'geneva.yaml')
-    text = text.read_text().replace('units: {length: mm,', 'units: {length: m,')
-    text = text.replace('-70.71067811865476', '-1.4142135623730951e300')
-    text = text.replace('  length: 50\n', '  length: 1e300\n')
-    path = tmp_path / 'huge.yaml'
-    path.write_text(text)
-    scene = mk.load_scene(path)
-    diagram = geo.diagram_from_scene(scene)
-    small = geo.diagram_from_scene(mk.load_scene('geneva'))
-    wheel = next(link for link in diagram.space.links if link.name == 'wheel')
-    little = next(link for link in small.space.links if link.name == 'wheel')
-    s = diagram.space.points['S']
-    for (_, mouth), (_, low) in zip(wheel.slots, little.slots, strict=True):
-        assert float(np.hypot(*(mouth - s))) == pytest.approx(1e300, rel=1e-12)
-        assert mouth / 2e301 == pytest.approx(low, rel=1e-9, abs=1e-12)
-    assert len(wheel.outline) == len(little.outline) and np.isfinite(wheel.outline).all()
-    png = tmp_path / 'huge.png'
-    assert dg.main([str(path), '-o', str(png)]) == 0
-    assert _png_size(png)[0] >= MIN_PNG_SIZE[0]
-    assert capsys.readouterr().err == ''
+# --- several drivers (issue 18) ---------------------------------------------------------
 
 
-def test_a_diagram_far_out_is_drawn_where_solve_puts_it(tmp_path):
-    """`diagram --angle-deg 1e17` answers as `solve --angle-deg 1e17` (it said "pin on pivot").
-
-    1e17 deg is -80 deg after 277777777777778 whole turns, read exactly: the Geneva
-    wheel is held at the index it has there, as for the scene started at that angle.
-    """
-    scene = mk.load_scene('geneva')
-    diagram = geo.diagram_from_scene(scene, 1e17, degrees=True)
-    solved = mk.solve(scene, math.radians(-80.0), turns=277777777777778)
-    wheel = next(link for link in diagram.links if link.name == 'wheel')
-    assert wheel.angle == solved.joints['wheel'].position and wheel.engaged is False
-    assert dg.main(['geneva', '--angle-deg', '1e17', '-o', str(tmp_path / 'far.png')]) == 0
-    gif = tmp_path / 'far.gif'
-    assert dg.main(['geneva', '--angle-deg', '1e17', '--animate', '--frames', '4', '-o',
-                    str(gif)]) == 0
+def _scene(text):
+    return mk.parse_scene(yaml.safe_load(text))
 
 
-@pytest.mark.parametrize('name', ['five_bar', 'excavator'])
-def test_several_drivers_are_refused_in_one_line(name, tmp_path):
-    """Velocity polygons are one driver's (issue 18): the diagram refuses, in one line."""
-    scene = mk.load_scene(name)
-    with pytest.raises(mk.SceneError, match='Expected a scene driven by one crank for velocity '
-                       'and acceleration polygons'):
-        geo.diagram_from_scene(scene)
-    status = subprocess.run([sys.executable, '-m', 'mech_kinematics', 'diagram', name, '-o',
-                             str(tmp_path / 'd.png')], capture_output=True, text=True, check=False)
-    assert status.returncode == 2
-    assert status.stderr.count('\n') == 1 and 'driven by one crank' in status.stderr
+def test_five_bar_polygons_at_given_driver_positions_and_rates():
+    """Both cranks given: each letter is the solved velocity and acceleration; links close."""
+    scene = _scene(FIVE_BAR_TWO_CRANKS)
+    diagram = geo.diagram_from_scene(scene, inputs={'left': 2.0}, speeds={'right': -2.0},
+                                     accels={'left': 3.0})
+    state = mk.solve(scene, [2.0, math.radians(60)], [2 * math.pi / 6, -2.0], [3.0, 0.0])
+    assert [(d.name, d.joint_type) for d in diagram.drivers] == [
+        ('left', 'revolute'), ('right', 'revolute')]
+    assert (diagram.drivers[1].position, diagram.drivers[1].speed) == (math.radians(60), -2.0)
+    assert diagram.refused == ''
+    for polygon, index in ((diagram.velocity, 1), (diagram.acceleration, 2)):
+        atol = _atol(polygon)
+        for point, values in state.complex_points.items():
+            np.testing.assert_allclose(polygon.letters[point.lower()], _xy(complex(values[index])),
+                                       atol=atol)
+    p = {n: complex(x[0]) for n, x in state.complex_points.items()}
+    for link, start, end in (('left', 'A', 'B'), ('right', 'E', 'D'), ('ldist', 'B', 'P'),
+                             ('rdist', 'D', 'P')):
+        vector = diagram.velocity.find(f'v_{end}{start}')
+        expected = _xy(1j * state.joints[link].velocity * (p[end] - p[start]))
+        np.testing.assert_allclose(vector.end - vector.start, expected,
+                                   atol=_atol(diagram.velocity))
+    assert [link.name for link in diagram.links] == ['left', 'right', 'ldist', 'rdist']
+    assert diagram.links[1].length == 0.12
+
+
+def test_instant_centre_of_two_cranks_is_on_the_line_of_their_pivots():
+    """Cranks at 1 and -0.5 rad/s about A and E: I(left, right) divides AE as -0.5 / -1.5."""
+    scene = _scene(FIVE_BAR_TWO_CRANKS)
+    diagram = geo.diagram_from_scene(scene, speeds={'left': 1.0, 'right': -0.5},
+                                     instant_centres=True)
+    centre = next(c for c in diagram.instant_centres if c.bodies == ('left', 'right'))
+    np.testing.assert_allclose(centre.point, [0.1 / 3, 0.0], atol=1e-15)
+
+
+def test_polygons_are_refused_in_one_line_through_an_actuator(tmp_path):
+    """The cylinder's link changes length: the mechanism is drawn, the polygons refused."""
+    scene = _scene(BOOM_CYLINDER)
+    diagram = geo.diagram_from_scene(scene, inputs={'cyl': 3.0}, speeds={'cyl': -0.1})
+    assert diagram.velocity is None and diagram.acceleration is None
+    assert diagram.refused == ('no velocity or acceleration polygon: link body changes length '
+                               "(an actuator's), which these polygons do not draw")
+    assert geo.varying_links(scene) == ('body',)
+    (cylinder,) = diagram.space.actuators
+    assert cylinder.link == 'body'
+    np.testing.assert_array_equal(cylinder.start, diagram.space.points['F'])
+    np.testing.assert_array_equal(cylinder.end, diagram.space.points['Q'])
+    assert geo.diagram_from_scene(_scene(FIVE_BAR_TWO_CRANKS)).space.actuators == ()
+    tables = geo.tables_from_diagram(diagram)
+    assert set(tables) == {'space'}
+    assert ('cyl', 'actuator', 'L = 3', '-', '-0.1 m/s', '0 m/s\u00b2') in tables['space'].rows
+    np.testing.assert_allclose(abs(complex(*(diagram.space.points['Q']
+                                             - diagram.space.points['F']))), 3.0, rtol=1e-15)
+    out = dg.write_diagram(diagram, scene, tmp_path / 'boom.png')
+    assert _png_size(out)[0] >= MIN_PNG_SIZE[0]
+    assert dg.title_from_diagram(diagram) == (
+        'boom: cyl 3 m, -0.1 m/s, 0 m/s\u00b2   (SI units; angles CCW from +x)')
+
+
+def test_five_bar_figure_title_lists_every_driver(tmp_path):
+    """The title gives each driver's angle, speed and acceleration."""
+    scene = _scene(FIVE_BAR_TWO_CRANKS)
+    diagram = geo.diagram_from_scene(scene, instant_centres=True)
+    assert dg.title_from_diagram(diagram) == (
+        'five: left 120\u00b0, 1.047 rad/s, 0 rad/s\u00b2; right 60\u00b0, -1.047 rad/s, '
+        '0 rad/s\u00b2   (SI units; angles CCW from +x)')
+    out = dg.write_diagram(diagram, scene, tmp_path / 'five.png')
+    assert out.stat().st_size > 30_000
+
+
+def test_unknown_driver_names_are_refused():
+    """A position for a driver the scene has not: one ValueError naming the drivers."""
+    with pytest.raises(ValueError, match=r'Expected drivers of five \(left, right\), got x'):
+        geo.diagram_from_scene(_scene(FIVE_BAR_TWO_CRANKS), inputs={'x': 1.0})
+
+
+def test_cli_draws_several_drivers_and_says_why_polygons_are_left_out(tmp_path, capsys):
+    """Diagram SCENE: the boom at its start, the polygons refused in one printed line."""
+    path = tmp_path / 'boom.yaml'
+    path.write_text(BOOM_CYLINDER)
+    assert dg.main([str(path), '-o', str(tmp_path / 'boom.png')]) == 0
+    assert capsys.readouterr().out.splitlines() == [
+        "boom: no velocity or acceleration polygon: link body changes length (an actuator's), "
+        'which these polygons do not draw', f'wrote {tmp_path / "boom.png"}']
+    assert _png_size(tmp_path / 'boom.png')[0] >= MIN_PNG_SIZE[0]
+
+
+@pytest.mark.parametrize(('flag', 'message'), [
+    (['--animate'], 'Expected no --animate for five with --input or --speed, or with several '
+                    'drivers or an actuator (left, right): --animate turns one crank'),
+    (['--angle-deg', '30'], 'Expected --input, --speed and --accel NAME=VALUE for a scene with '
+                            'several drivers (left, right), got --angle-deg'),
+    (['--speed-rpm', '5'], 'Expected --input, --speed and --accel NAME=VALUE for a scene with '
+                           'several drivers (left, right), got --speed-rpm'),
+    (['--input', 'x=3'], 'Expected --input NAME=VALUE with NAME one of the drivers (left, '
+                         "right), got 'x'"),
+])
+def test_cli_refuses_one_crank_options_for_several_drivers(flag, message, tmp_path, capsys):
+    """--animate, --angle-deg, --speed-rpm, an unknown driver: one error line, exit 2."""
+    path = tmp_path / 'five.yaml'
+    path.write_text(FIVE_BAR_TWO_CRANKS)
+    out = tmp_path / ('five.gif' if flag == ['--animate'] else 'five.png')
+    assert dg.main([str(path), '-o', str(out), *flag]) == 2
+    assert capsys.readouterr().err == f'error: {message}\n'
+    assert not out.exists()
+
+
+def test_cli_draws_the_packaged_five_bar_where_solve_puts_it(tmp_path, monkeypatch):
+    """--input, --speed, --accel NAME=VALUE as solve takes them: the drawn state is solve's."""
+    calls = []
+    original = geo.diagram_from_scene
+
+    def spy(*args, **kwargs):
+        calls.append(original(*args, **kwargs))
+        return calls[-1]
+
+    monkeypatch.setattr(dg, 'diagram_from_scene', spy)
+    out = tmp_path / 'five_bar.png'
+    assert dg.main(['five_bar', '-o', str(out), '--input', 'left_crank=100', '--speed',
+                    'right_crank=-20', '--accel', 'left_crank=3']) == 0
+    (diagram,) = calls
+    scene = mk.load_scene('five_bar')
+    omega = 2 * math.pi * 30 / 60
+    state = mk.solve(scene, [math.radians(100), math.radians(60)], [omega, -2 * math.pi / 3],
+                     [3.0, 0.0])
+    left, right = diagram.drivers
+    assert left.position == pytest.approx(math.radians(100), rel=1e-15) and left.accel == 3.0
+    assert right.speed == pytest.approx(-2 * math.pi / 3, rel=1e-15)
+    np.testing.assert_allclose(diagram.velocity.letters['p'],
+                               _xy(complex(state.complex_points['P'][1])), rtol=1e-12)
+    assert _png_size(out)[0] >= MIN_PNG_SIZE[0]

@@ -12,8 +12,10 @@ from pathlib import Path
 import subprocess
 import sys
 
+from helpers import BOOM_CYLINDER, FIVE_BAR_TWO_CRANKS
 import numpy as np
 import pytest
+import yaml
 
 import mech_kinematics as mk
 from mech_kinematics.tools import plot, record as bag_recorder
@@ -381,52 +383,125 @@ def copied_by_the_recorders_writer(bag: Path, destination: Path) -> Path:
     return destination
 
 
-IMU_PANELS = {'IMU orientations', 'IMU angular velocities',
-              'IMU linear accelerations (sensor frame)'}
+# --- several drivers (issue 18): along the drivers' path ------------------------------
+
+#: The five-bar's cranks turning together (60 deg apart: |BD| stays below 0.22 m).
+TOGETHER = FIVE_BAR_TWO_CRANKS.replace('speed_rpm: -10', 'speed_rpm: 10')
+#: The boom's cylinder retracting toward its shortest stroke (2000 mm, reached at 12 s).
+RETRACTING = BOOM_CYLINDER.replace('speed: 0.05', 'speed: -0.05')
 
 
-def test_scene_with_imus_adds_the_imu_column(tmp_path):
-    """Issue 18: the gripper's fingertip IMU: orientation, gyro, accelerometer x and y panels."""
-    scene = mk.load_scene('gripper')
-    fig = plot.plot_scene(scene, tmp_path / 'g.png', samples=91)
-    assert set(panels(fig)) == JOINT_PANELS | POINT_PANELS | IMU_PANELS
-    assert_units_everywhere(fig)
-    state = mk.solve(scene, np.linspace(0.0, 2 * math.pi, 91))
-    reading = state.imus['fingertip']
-    accel = lines(panels(fig)['IMU linear accelerations (sensor frame)'])
-    assert set(accel) == {'fingertip x', 'fingertip y'}
-    np.testing.assert_allclose(accel['fingertip y'].get_ydata(),
-                               reading.linear_acceleration[:, 1], rtol=RTOL, atol=0)
-    gyro = lines(panels(fig)['IMU angular velocities'])['fingertip'].get_ydata()
-    np.testing.assert_allclose(gyro, reading.angular_velocity, rtol=0, atol=0)
-    # A scene without IMUs keeps its columns (test_scene_plot_has_every_panel_with_units).
-
-
-def test_bag_plot_shows_the_recorded_imu_readings(tmp_path):
-    """From a bag holding imu/fingertip: the readings drawn are those published at each tick."""
-    scene = mk.load_scene('gripper')
-    angles = scene.input.angle + scene.input.speed * 0.002 * np.arange(120)
-    bag = write_bag(tmp_path / 'bag', scene, angles, imus=True)
-    motion = plot.motion_from_bag(bag, scene=scene)
-    orientation, gyro, accel = motion.imus['fingertip']
-    expected = [mk.solve(scene, a).imus['fingertip'] for a in angles]
-    np.testing.assert_allclose(accel, [r.linear_acceleration for r in expected], rtol=RTOL,
+def test_several_drivers_are_plotted_along_their_path_in_time(tmp_path):
+    """Each driver from its start at its speed for the quickest's period; the solver's values."""
+    scene = mk.parse_scene(yaml.safe_load(TOGETHER))
+    fig = plot.plot_scene(scene, tmp_path / 'five.png', samples=61)
+    assert_png(tmp_path / 'five.png')
+    assert fig._suptitle.get_text().startswith(
+        'five: solver, every driver from its start at its speed (left 10 rpm, right 10 rpm) '
+        'for 6 s (left turning once)')
+    time = np.linspace(0.0, 6.0, 61)
+    omega = 2 * math.pi / 6
+    state = mk.solve(scene, [math.radians(120) + omega * time, math.radians(60) + omega * time],
+                     [omega, omega], [0.0, 0.0])
+    ldist = lines(panels(fig)['Joint angular velocities'])['ldist']
+    np.testing.assert_allclose(ldist.get_xdata(), time, rtol=RTOL, atol=0)
+    np.testing.assert_allclose(ldist.get_ydata(), state.joints['ldist'].velocity, rtol=RTOL,
                                atol=0)
-    np.testing.assert_allclose(orientation, [r.orientation for r in expected], rtol=0,
-                               atol=1e-15)
-    np.testing.assert_allclose(gyro, [r.angular_velocity for r in expected], rtol=0, atol=0)
-    fig = plot.plot_bag(bag, tmp_path / 'bag.png', scene=scene)
-    assert set(panels(fig)) == JOINT_PANELS | POINT_PANELS | IMU_PANELS
-    # A bag without IMU topics has no IMU column.
-    plain = write_bag(tmp_path / 'plain', scene, angles)
-    assert not plot.motion_from_bag(plain, scene=scene).imus
+    assert set(lines(panels(fig)['Joint angles'])) == {'left', 'right', 'ldist', 'rdist'}
 
 
-def test_several_drivers_are_refused_in_one_line(tmp_path, capsys):
-    """`plot --scene` sweeps one crank's turn: several drivers are refused (issue 18)."""
-    assert plot.main(['--scene', 'five_bar', '-o', str(tmp_path / 'p.png')]) == 2
+def test_an_actuator_runs_to_the_end_of_its_stroke(tmp_path):
+    """The retracting cylinder is plotted for 12 s, to its shortest length, in the slider panel."""
+    scene = mk.parse_scene(yaml.safe_load(RETRACTING))
+    motion = plot.motion_from_scene(scene, samples=25, x='time')
+    assert motion.time[-1] == pytest.approx(12.0, rel=1e-14)
+    assert 'for 12 s (cyl reaching the end of its stroke)' in motion.title
+    position, velocity, _ = motion.joints['cyl']
+    np.testing.assert_allclose(position, 2.6 - 0.05 * motion.time, rtol=1e-15, atol=1e-15)
+    assert np.all(velocity == -0.05)
+
+
+def test_a_path_leaving_the_region_is_refused_saying_where(tmp_path, capsys):
+    """The cranks turning apart straighten the distal links at 0.31 s: one line, exit 2."""
+    path = tmp_path / 'five.yaml'
+    path.write_text(FIVE_BAR_TWO_CRANKS)
+    out = tmp_path / 'five.png'
+    assert plot.main(['--scene', str(path), '-o', str(out)]) == 2
     err = capsys.readouterr().err
-    assert err == ('error: Expected a scene driven by one crank to plot over its turn, got '
-                   'scene "five_bar" with 2 drivers (left_crank, right_crank): plot a bag the '
-                   'node recorded instead\n')
-    assert not (tmp_path / 'p.png').exists()
+    assert err.startswith("error: Expected the drivers' path of five to stay where it "
+                          'assembles, got it leaving at t = 0.316667 s (left = 139 deg, right '
+                          '= 41 deg): the circles about B (radius 0.14 m) and D (radius 0.14 '
+                          'm) do not meet')
+    assert err.rstrip().endswith('plot less with --duration SECONDS (at most 0.308333 s)')
+    assert len(err.strip().splitlines()) == 1 and not out.exists()
+    assert plot.main(['--scene', str(path), '-o', str(out), '--duration', '0.3']) == 0
+    assert_png(out)
+
+
+@pytest.mark.parametrize(('args', 'match'), [
+    (['--x', 'angle'], 'Expected --x time for five, which has several drivers'),
+    (['--speed-rpm', '5'], 'Expected no --speed-rpm or --accel for five'),
+])
+def test_options_that_mean_one_crank_are_refused(tmp_path, capsys, args, match):
+    """--x angle and --speed-rpm have no meaning with several drivers: one line, exit 2."""
+    path = tmp_path / 'five.yaml'
+    path.write_text(TOGETHER)
+    assert plot.main(['--scene', str(path), '-o', str(tmp_path / 'p.png'), *args]) == 2
+    assert match in capsys.readouterr().err
+
+
+def test_duration_with_one_crank_is_refused(tmp_path, capsys):
+    """--duration is for several drivers: one line, exit 2."""
+    assert plot.main(['--scene', 'khurmi_four_bar_ad150', '-o', str(tmp_path / 'p.png'),
+                      '--duration', '1']) == 2
+    assert 'Expected --duration and --speed NAME=VALUE only for a scene with several' in (
+        capsys.readouterr().err)
+
+
+def test_bag_of_a_scene_with_several_drivers_plots_against_time_only(tmp_path, capsys):
+    """A five-bar recording: each driver's joint against time; --x angle is refused (exit 2)."""
+    scene = mk.parse_scene(yaml.safe_load(TOGETHER))
+    positions = [[math.radians(120) + 0.01 * i, math.radians(60) + 0.01 * i] for i in range(50)]
+    bag = write_bag(tmp_path / 'five', scene, positions, scene_text=TOGETHER)
+    fig = plot.plot_bag(bag, tmp_path / 'five.png')
+    left = lines(panels(fig)['Joint angles'])['left']
+    np.testing.assert_allclose(left.get_ydata(), [p[0] for p in positions], rtol=1e-15)
+    assert plot.main([str(bag), '-o', str(tmp_path / 'a.png'), '--x', 'angle']) == 2
+    assert ('Expected a recording of a scene driven by one crank to plot against crank angle, '
+            'got five, with several drivers or an actuator: use --x time') in (
+        capsys.readouterr().err)
+
+
+def test_packaged_excavator_plotted_at_given_cylinder_speeds(tmp_path, capsys):
+    """Its cylinders rest by default: refused saying so; --speed moves them to a stroke's end."""
+    out = tmp_path / 'excavator.png'
+    assert plot.main(['--scene', 'excavator', '-o', str(out)]) == 2
+    assert capsys.readouterr().err == (
+        'error: Expected a driver of excavator that turns or reaches the end of its stroke at '
+        'its speed and acceleration, got none: give --speed NAME=VALUE or --duration SECONDS\n')
+    scene = mk.load_scene('excavator')
+    motion = plot.motion_from_scene(scene, samples=31, x='time',
+                                    speeds={'boom_cyl': 0.1, 'stick_cyl': -0.05})
+    # boom_cyl reaches 3.3 m from 2.6 m in 7 s; stick_cyl 2.5 m from 3.0 m only in 10 s
+    assert motion.time[-1] == pytest.approx(7.0, rel=1e-14)
+    assert 'for 7 s (boom_cyl reaching the end of its stroke)' in motion.title
+    np.testing.assert_allclose(motion.joints['stick_cyl'][0], 3.0 - 0.05 * motion.time,
+                               rtol=1e-15)
+    assert plot.main(['--scene', 'excavator', '-o', str(out), '--speed', 'boom_cyl=0.1',
+                      '--speed', 'stick_cyl=-0.05']) == 0
+    assert_png(out)
+    assert plot.main(['--scene', 'excavator', '-o', str(out), '--speed', 'arm=1']) == 2
+    assert ('Expected --speed NAME=VALUE with NAME one of the drivers (boom_cyl, stick_cyl), '
+            "got 'arm'") in capsys.readouterr().err
+
+
+def test_packaged_five_bar_plots_both_cranks_turning_together(tmp_path):
+    """five_bar's cranks at 30 rpm CCW, 30 deg apart: one 2 s turn, |BD| as the closed form."""
+    motion = plot.motion_from_scene(mk.load_scene('five_bar'), samples=41, x='time')
+    assert motion.time[-1] == pytest.approx(2.0, rel=1e-14)
+    b, d = motion.points['B'][0], motion.points['D'][0]
+    bd = np.hypot(*(b - d).T)
+    # B - D = 0.12 e^(i left) (1 - e^(-i 30 deg)) - 0.1 m: |BD| within 0.1 -+ 0.24 sin 15 deg
+    half = 0.24 * math.sin(math.radians(15))
+    assert bd.min() >= 0.1 - half - 1e-12 and bd.max() <= 0.1 + half + 1e-12
+    assert bd.max() - bd.min() == pytest.approx(2 * half, rel=1e-2)

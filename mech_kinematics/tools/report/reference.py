@@ -1058,13 +1058,29 @@ def scales(ref: Reference) -> dict[str, float]:
     velocities, ``a (omega**2 + |alpha|)`` for accelerations, ``|omega|`` and
     ``omega**2 + |alpha|`` for angular ones (a parallelogram's links have no
     angular acceleration at all); 1 rad for angles; 1 if all that is zero.
+    With several drivers, the largest of what each sets: each crank's as
+    above, an actuator's rate ``|v|`` and ``|a|``.
     """
     expected = _by_kind(ref)
-    crank = abs(ref.inputs.get('crank.length', 0))
-    omega, alpha = abs(ref.omega), abs(ref.alpha)
-    floors = {'position': crank, 'angle': 1, 'velocity': crank * omega,
-              'angular velocity': omega, 'acceleration': crank * (omega * omega + alpha),
-              'angular acceleration': omega * omega + alpha}
+    if isinstance(ref.omega, tuple):
+        floors = dict.fromkeys(KINDS, mpmath.mpf(0))
+        floors['angle'] = 1
+        drivers = list(ref.joint_types)[:len(ref.omega)]  # the drivers' joints come first
+        for name, w, al in zip(drivers, ref.omega, ref.alpha, strict=True):
+            w, al = abs(w), abs(al)
+            if ref.joint_types[name] == 'revolute':
+                a = abs(ref.inputs[f'crank.{name}.length'])
+                mine = {'position': a, 'velocity': a * w, 'angular velocity': w,
+                        'acceleration': a * (w * w + al), 'angular acceleration': w * w + al}
+            else:
+                mine = {'velocity': w, 'acceleration': al}
+            floors.update((kind, max(floors[kind], value)) for kind, value in mine.items())
+    else:
+        crank = abs(ref.inputs.get('crank.length', 0))
+        omega, alpha = abs(ref.omega), abs(ref.alpha)
+        floors = {'position': crank, 'angle': 1, 'velocity': crank * omega,
+                  'angular velocity': omega, 'acceleration': crank * (omega * omega + alpha),
+                  'angular acceleration': omega * omega + alpha}
     out = {}
     for kind, values in expected.items():
         largest = max([abs(v) for v in values.values()] + [floors[kind]])
@@ -1165,21 +1181,29 @@ def condition(scene: Scene | Model, ref: Reference,
         totals: dict[str, dict[str, Any]] = {
             kind: dict.fromkeys(v, mpmath.mpf(0)) for kind, v in base.items()}
         inputs: list[tuple[str, Any]] = [(key, value) for key, value in ref.inputs.items()]
-        inputs += [('@theta', ref.theta), ('@omega', ref.omega), ('@alpha', ref.alpha)]
+        several = isinstance(ref.theta, tuple)  # one value per driver: each perturbed
+        for label, given in (('@theta', ref.theta), ('@omega', ref.omega),
+                             ('@alpha', ref.alpha)):
+            inputs += ([(f'{label}{k}', x) for k, x in enumerate(given)] if several
+                       else [(label, given)])
         for key, value in inputs:
             if value == 0:
                 continue
             values = dict(ref.inputs)
-            th, om, al = ref.theta, ref.omega, ref.alpha
+            motion = {'@theta': ref.theta, '@omega': ref.omega, '@alpha': ref.alpha}
             delta = value * eta
-            if key == '@theta':
-                th = th + delta
-            elif key == '@omega':
-                om = om + delta
-            elif key == '@alpha':
-                al = al + delta
+            which = key.rstrip('0123456789')
+            if which in motion:
+                given = motion[which]
+                if several:
+                    k = int(key[len(which):])
+                    given = (*given[:k], given[k] + delta, *given[k + 1:])
+                else:
+                    given = given + delta
+                motion[which] = given
             else:
                 values[key] = value + delta
+            th, om, al = motion['@theta'], motion['@omega'], motion['@alpha']
             moved = _by_kind(reference(model, th, om, al, values=values, seed=ref.q, dps=dps))
             for kind, items in base.items():
                 for name, x in items.items():
