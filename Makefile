@@ -2,7 +2,7 @@
 #
 #   make run       start the node on the default scene (ARGS='...' appends arguments)
 #   make test      the whole test suite (PYTEST_ARGS='-k scene' narrows it)
-#   make bench     solver benchmark
+#   make bench     solver benchmark (ARGS='--peer pylinkage': side by side with pylinkage)
 #   make lint      ruff + flake8 + mypy --strict on the pure modules
 #   make install   set up .venv with everything (what run, test and lint need)
 #   make clean     remove .venv and every build/cache artefact

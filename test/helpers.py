@@ -295,3 +295,45 @@ def first_order_spreads(scene, angle, speed=None, accel=None, exact=None):
                     diff = ref._wrap(diff)
                 totals[path] += abs(diff) / eta
         return {path: float(total) * unit for path, total in totals.items()}
+
+
+# --- the solver's compiled paths against its general one ----------------------
+# Used by test_compiled.py (the compiled single-angle and array solves) and
+# test_ticker.py (the node's tick against the general solver).
+
+def general_only(scene: mk.Scene) -> mk.Scene:
+    """Return ``scene`` set never to use the solver's compiled paths (its general solve)."""
+    scene._solver.compiled_single = False
+    scene._solver.compiled_array = False
+    return scene
+
+
+def _facts(value: Any) -> Any:
+    """Return ``value`` as nested plain data in which equal means the same bits and types."""
+    import numpy as np
+
+    if isinstance(value, np.ndarray):
+        return ('ndarray', value.dtype.str, value.shape, value.tobytes())
+    if isinstance(value, dict):
+        return ('dict', tuple((key, _facts(item)) for key, item in value.items()))
+    if isinstance(value, (tuple, list)):
+        return (type(value).__name__, tuple(_facts(item) for item in value))
+    if isinstance(value, mk.Engagement) or hasattr(value, '__slots__'):
+        names = getattr(value, '__slots__', None) or vars(value)
+        return (type(value).__name__, tuple((name, _facts(getattr(value, name)))
+                                            for name in names if not name.startswith('_')))
+    return (type(value).__name__, repr(value))
+
+
+def state_facts(state: mk.State) -> Any:
+    """Return every field of a solved state, bounds included, for a bit-for-bit comparison."""
+    bound = state.error_bound
+    return _facts({'scene': state.scene, 'angle': state.angle, 'speed': state.speed,
+                   'accel': state.accel, 'turns': state.turns, 'valid': state.valid,
+                   'joints': state.joints, 'points': state.complex_points,
+                   'singularity': state.singularity, 'failures': state.failures,
+                   'bounds': (bound.joints, bound.points, bound.rubbing, bound.size,
+                              bound.crank_length),
+                   'rubbing': state.rubbing, 'intermittent': state.intermittent,
+                   'jumps': state.jumps, 'drivers': state.drivers,
+                   'imus': state.__dict__.get('imu_specs')})

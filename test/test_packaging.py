@@ -75,6 +75,9 @@ ROSDEP_KEYS = {
     'mcap': 'python3-mcap-pip',
     'mcap_ros2': 'python3-mcap-ros2-support-pip',
 }
+#: Modules the package imports only inside the functions of one development command, and
+#: the requirements-dev.txt pin that brings them: the peer of ``bench --peer`` (issue 22).
+DEV_PEERS = {'pylinkage': 'pylinkage'}
 #: Modules the venv gets from no wheel: built by scripts/build_tf2_msgs.py at set-up.
 BUILT_AT_SETUP = {'tf2_msgs'}
 #: Test and lint tools: requirements-dev.txt only, never requirements.txt.
@@ -83,8 +86,11 @@ DEV_TOOLS = {'pytest', 'hypothesis', 'mcap', 'mcap-ros2-support', 'flake8', 'fla
              'types-pyyaml'}
 
 
-def _imports(folder: Path) -> dict:
-    """Return {top-level module: first file importing it} for absolute imports under ``folder``."""
+def _imports(folder: Path, peers: bool = False) -> dict:
+    """Return {top-level module: first file importing it} for absolute imports under ``folder``.
+
+    The :data:`DEV_PEERS` are left out unless ``peers``.
+    """
     local = {path.stem for path in folder.glob('*.py')}     # test/ imports its own helpers
     found: dict = {}
     for path in sorted(folder.rglob('*.py')):
@@ -97,6 +103,8 @@ def _imports(folder: Path) -> dict:
                 continue
             for name in names:
                 top = name.split('.')[0]
+                if top in DEV_PEERS and not peers:
+                    continue
                 if top not in sys.stdlib_module_names and top not in local | {'mech_kinematics'}:
                     found.setdefault(top, path.relative_to(ROOT).as_posix())
     return found
@@ -169,6 +177,21 @@ def test_runtime_imports_are_installed_by_requirements_txt():
         assert names & set(runtime), (
             f'{path} imports {module} (from {sorted(names) or "no distribution"}), '
             'which requirements.txt does not pin')
+
+
+def test_dev_peers_are_pinned_for_development_and_imported_only_inside_functions():
+    """A peer package (bench --peer) comes from requirements-dev.txt and never loads on import."""
+    for distribution in DEV_PEERS.values():
+        assert distribution in _pins(REQUIREMENTS_DEV) and distribution not in _pins(REQUIREMENTS)
+    found = _imports(ROOT / 'mech_kinematics', peers=True)
+    assert set(DEV_PEERS) <= set(found), 'a peer no longer imported: drop it from DEV_PEERS'
+    for path in sorted((ROOT / 'mech_kinematics').rglob('*.py')):
+        tree = ast.parse(path.read_text(encoding='utf-8'))
+        for node in tree.body:      # top-level statements only: imports run on import
+            names = ([alias.name for alias in node.names] if isinstance(node, ast.Import)
+                     else [node.module] if isinstance(node, ast.ImportFrom) and node.module
+                     else [])
+            assert not {name.split('.')[0] for name in names} & set(DEV_PEERS), path
 
 
 def test_requirements_txt_holds_no_test_or_lint_tool():

@@ -9,18 +9,12 @@ runs. :func:`compile_tick` removes that overhead without writing the
 kinematics a second time: it specializes the solver's own step code (the
 kernels of the step kinds of :mod:`mech_kinematics.solver`, written in the
 subset that :mod:`mech_kinematics.solver.base` states) to the scalar path of
-one scene by partial evaluation of their syntax trees, and takes the rest from
-the solver's public hooks (:mod:`mech_kinematics.solver.tick`). It is the
-node's, so it lives in the ROS layer (it imports only the solver).
-
-- ``ctx.vector`` becomes ``False`` and every branch it decides is folded
-  away, so only the single-angle arithmetic is left;
-- ``self.<attribute>`` of each step becomes the step's value (a constant);
-- ``ctx.points[name]``, ``ctx.links[name]``, ``ctx.sliders[name]`` and
-  ``ctx.measures[name]`` become local variables;
-- each step's local names get the step's number as a suffix, and the steps
-  are laid out one after another in plan order in a single function, which
-  ends by packing the values the caller asked for into one flat list.
+one scene by partial evaluation of their syntax trees
+(:mod:`mech_kinematics.solver.specialize`, with ``ctx.vector`` false: only
+the single-angle arithmetic is left), and takes the rest from the solver's
+public hooks (:mod:`mech_kinematics.solver.tick`). It is the node's, so it
+lives in the ROS layer (it imports only the solver). The function ends by
+packing the values the caller asked for into one flat list.
 
 The same operations run in the same order on the same doubles, so the
 function returns the same bits as :func:`mech_kinematics.solve` (a test
@@ -44,360 +38,19 @@ from __future__ import annotations
 import ast
 from collections.abc import Callable, Sequence
 import inspect
-import itertools
 import math
 import sys
-import textwrap
-from typing import Any, cast
+from typing import Any
 
 from .. import solver as lk
 from ..solver import tick as hooks
+from ..solver.specialize import _body, _SOLVER, plan_body, TABLES, Unsupported
 
 __all__ = ['TickFunction', 'compile_tick', 'tick_function', 'values_from_state']
 
 #: ``tick(theta, omega, alpha, max_error, turns) -> (values, smallest near-singularity
 #: measure)``; ``theta + 2 pi turns`` is the crank angle counted from the start.
 TickFunction = Callable[[float, float, float, float, int], tuple[list[float], float]]
-
-_SOLVER = lk.__name__ + '.'
-#: The context's methods that record side facts (an intermittent lever's window, why a
-#: bound is large, a jump): the tick reports none, so their calls are dropped.
-_DROPPED = ('engage', 'note', 'jump')
-_TABLES = {'points': 'P', 'links': 'L', 'sliders': 'S', 'measures': 'M'}
-
-
-class _Unsupported(Exception):
-    """A step's code holds something the specializer does not handle."""
-
-
-def _fold(node: ast.AST) -> ast.AST:
-    """Fold the constants a substitution left: ``x if False else y``, ``False or x``..."""
-
-    class Folder(ast.NodeTransformer):
-        def visit_IfExp(self, node: ast.IfExp) -> ast.AST:
-            self.generic_visit(node)
-            if isinstance(node.test, ast.Constant):
-                return node.body if node.test.value else node.orelse
-            return node
-
-        def visit_BoolOp(self, node: ast.BoolOp) -> ast.AST:
-            self.generic_visit(node)
-            absorbing = isinstance(node.op, ast.Or)     # True absorbs an or, False an and
-            values = []
-            for value in node.values:
-                if isinstance(value, ast.Constant):
-                    if bool(value.value) == absorbing:
-                        return ast.Constant(absorbing)
-                    continue                              # the neutral constant drops out
-                values.append(value)
-            if not values:
-                return ast.Constant(not absorbing)
-            if len(values) == 1:
-                return values[0]
-            node.values = values
-            return node
-
-        def visit_Compare(self, node: ast.Compare) -> ast.AST:
-            # ``None is None``, ``'cyl' is None``: a step attribute against a constant.
-            self.generic_visit(node)
-            if (len(node.ops) == 1 and isinstance(node.ops[0], (ast.Is, ast.IsNot))
-                    and isinstance(node.left, ast.Constant)
-                    and isinstance(node.comparators[0], ast.Constant)):
-                same = node.left.value is node.comparators[0].value
-                return ast.Constant(same if isinstance(node.ops[0], ast.Is) else not same)
-            return node
-
-        def visit_UnaryOp(self, node: ast.UnaryOp) -> ast.AST:
-            self.generic_visit(node)
-            if isinstance(node.op, ast.Not) and isinstance(node.operand, ast.Constant):
-                return ast.Constant(not node.operand.value)
-            return node
-
-        def visit_If(self, node: ast.If) -> Any:
-            self.generic_visit(node)
-            if isinstance(node.test, ast.Constant):
-                return (node.body if node.test.value else node.orelse) or ast.Pass()
-            return node
-
-    folded: ast.AST = Folder().visit(node)
-    return folded
-
-
-class _Specializer(ast.NodeTransformer):
-    """Rewrite one step's ``run`` body for the scalar path of one scene (see the module)."""
-
-    def __init__(self, step: Any, suffix: str, names: dict[str, str],
-                 namespace: dict[str, Any], arguments: dict[str, str]) -> None:
-        self.step = step
-        self.suffix = suffix
-        self.names = names              # table entry -> local variable
-        self.namespace = namespace
-        self.arguments = arguments      # run() argument -> tick argument
-        self.locals: set[str] = set()
-
-    def constant(self, value: Any) -> ast.expr:
-        if value is None or isinstance(value, (bool, int, float, complex, str)):
-            return ast.Constant(value)
-        name = f'_k{len(self.namespace)}'
-        self.namespace[name] = value
-        return ast.Name(name, ast.Load())
-
-    def table_entry(self, node: ast.Subscript) -> str | None:
-        """Return the local variable of ``ctx.<table>[self.<attr>]``, or None."""
-        value = node.value
-        if not (isinstance(value, ast.Attribute) and isinstance(value.value, ast.Name)
-                and value.value.id == 'ctx' and value.attr in _TABLES):
-            return None
-        key = node.slice
-        if not (isinstance(key, ast.Attribute) and isinstance(key.value, ast.Name)
-                and key.value.id == 'self'):
-            raise _Unsupported('a table read with a key that is not a step attribute')
-        name = getattr(self.step, key.attr)
-        entry = f'{_TABLES[value.attr]}_{name}'
-        return self.names.setdefault(entry, f'{entry}_{len(self.names)}')
-
-    def visit_Subscript(self, node: ast.Subscript) -> ast.AST:
-        local = self.table_entry(node)
-        if local is not None:
-            return ast.copy_location(ast.Name(local, node.ctx), node)
-        return self.generic_visit(node)
-
-    def visit_Attribute(self, node: ast.Attribute) -> ast.AST:
-        if isinstance(node.value, ast.Name):
-            if node.value.id == 'self':
-                return ast.copy_location(self.constant(getattr(self.step, node.attr)), node)
-            if node.value.id == 'ctx':
-                if node.attr in ('vector', 'flip'):   # the tick answers the side after a jump
-                    return ast.Constant(False)
-                if node.attr == 'angle':
-                    return ast.Name('theta', ast.Load())
-                if node.attr == 'turns':
-                    return ast.Name('turns', ast.Load())
-                if node.attr == 'shown':    # the angle counted from the start, for messages
-                    return ast.Call(ast.Name('_shown', ast.Load()),
-                                    [ast.Name('theta', ast.Load()),
-                                     ast.Name('turns', ast.Load())], [])
-                raise _Unsupported(f'ctx.{node.attr}')
-        return self.generic_visit(node)
-
-    def visit_If(self, node: ast.If) -> Any:
-        # A branch ``ctx.vector`` decides is dropped before it is specialized: the
-        # array path may use what the tick does not (``ctx`` as a value, loops).
-        test = _fold(self.visit(node.test))
-        if isinstance(test, ast.Constant):
-            taken = node.body if test.value else node.orelse
-            return self.statements(taken) or ast.Pass()
-        node.test = cast(ast.expr, test)
-        node.body = self.statements(node.body) or [ast.Pass()]
-        node.orelse = self.statements(node.orelse)
-        return node
-
-    def statements(self, stmts: list[ast.stmt]) -> list[ast.stmt]:
-        """Return ``stmts`` specialized, a statement that became several spliced in."""
-        out: list[ast.stmt] = []
-        for stmt in stmts:
-            result = self.visit(stmt)
-            out.extend(result if isinstance(result, list) else [result])
-        return out
-
-    def visit_Expr(self, node: ast.Expr) -> Any:
-        value = node.value
-        if (isinstance(value, ast.Call) and isinstance(value.func, ast.Attribute)
-                and isinstance(value.func.value, ast.Name) and value.func.value.id == 'ctx'
-                and value.func.attr in _DROPPED):
-            return ast.Pass()       # a side fact the tick does not report
-        return self.generic_visit(node)
-
-    def visit_Call(self, node: ast.Call) -> ast.AST:
-        func = node.func
-        inlined = _inline(func, node.args, self.namespace) if not node.keywords else None
-        if inlined is not None:
-            result: ast.AST = self.visit(ast.copy_location(inlined, node))
-            return result
-        if (isinstance(func, ast.Attribute) and isinstance(func.value, ast.Name)
-                and func.value.id == 'ctx' and func.attr in ('check', 'check_margin')):
-            # The failure path: the general context's own check, at this angle.
-            call = ast.Call(ast.Name(f'_ctx_{func.attr}', ast.Load()),
-                            [ast.Name('theta', ast.Load()), ast.Name('turns', ast.Load()),
-                             *node.args], node.keywords)
-            return self.generic_visit(ast.copy_location(call, node))
-        return self.generic_visit(node)
-
-    def visit_Name(self, node: ast.Name) -> ast.AST:
-        if node.id in self.arguments:
-            return ast.copy_location(ast.Name(self.arguments[node.id], node.ctx), node)
-        if node.id in self.locals:
-            return ast.copy_location(ast.Name(f'{node.id}{self.suffix}', node.ctx), node)
-        if node.id in ('ctx', 'self'):
-            raise _Unsupported(f'{node.id} used as a value')
-        return node
-
-
-class _Refused(Exception):
-    """A step of a several-driver tick found it cannot close: the general solver says why."""
-
-
-def _refuse(theta: Any, turns: Any, ok: Any, *args: Any, **kwargs: Any) -> None:
-    """Stand in for ``ctx.check`` in a several-driver tick: hand a failure to the solver."""
-    if not ok:
-        raise _Refused
-
-
-def _compile_drivers(scene: lk.Scene, plan: hooks.TickPlan, joints: tuple[str, ...],
-                     points: tuple[str, ...],
-                     frames: tuple[tuple[str, str | None, float], ...]) -> TickFunction | None:
-    """Return the tick of a scene with several drivers (or an actuator), or ``None``.
-
-    The same specialized kernels as :func:`compile_tick`'s, each driver's on
-    its own value: ``tick(positions, speeds, accels, max_error, turns=0)``
-    takes one value per driver (sequences, as :func:`mech_kinematics.solve`).
-    An instant the general solver would rescale in time, refuse (a failed
-    check raises inside, and the general solver is asked for its reason, so
-    the message names every driver's position) or judge beyond the quick
-    trust test is handed to the general solver.
-    """
-    count = len(plan.drivers)
-    namespace: dict[str, Any] = {
-        '_ctx_check': _refuse, '_ctx_check_margin': _refuse, '_Refused': _Refused,
-        '_shown': hooks.shown, '_slow': _general(scene, joints, points, frames),
-        '_driver_limits': plan.driver_limits, '_rates_shift': hooks.rates_shift,
-        'inf': math.inf, '_float': float, '_SEQUENCE': (list, tuple),
-    }
-    for step in (*plan.drivers, *plan.steps):
-        for cls in type(step).__mro__:
-            home = sys.modules[cls.__module__]
-            if home.__name__.startswith(_SOLVER):
-                namespace.update((k, v) for k, v in vars(home).items()
-                                 if not k.startswith('__'))
-    namespace['_wrapped_angle'] = hooks.wrapped_angle
-    names: dict[str, str] = {}
-    lines = [f'{", ".join(f"{x}_{k}" for k in range(count))}, = '
-             f'({", ".join(f"_float({arg}[{k}])" for k in range(count))},)'
-             for x, arg in (('x', 'theta'), ('v', 'omega'), ('a', 'alpha'))]
-    body: list[ast.stmt] = ast.parse('\n'.join(lines)).body
-    try:
-        for name, entry in plan.ground.items():
-            local = names.setdefault(f'P_{name}', f'P_{name}_{len(names)}')
-            namespace[f'_ground_{local}'] = entry
-            body.append(ast.parse(f'{local} = _ground_{local}').body[0])
-        for k, driver in enumerate(plan.drivers):
-            run = type(driver).run
-            parameters = list(inspect.signature(run).parameters)[2:]  # after self, ctx
-            arguments = dict(zip(parameters, (f'x_{k}', f'v_{k}', f'a_{k}'), strict=True))
-            body += _body(driver, run, f'_d{k}', names, namespace, arguments)
-        for index, step in enumerate(plan.steps, 1):
-            for part, kernel in enumerate(step.kernels()):
-                body += _body(step, kernel, f'_{index}_{part}', names, namespace, {})
-    except (_Unsupported, OSError, TypeError, ValueError) as error:
-        del error   # the general solver serves this scene
-        return None
-    kinds = dict(plan.joint_types)
-    tail = [f'_l0, _l1, _l2, _l3, _l4, _l5 = _driver_limits(tol, '
-            f'[{", ".join(f"v_{k}" for k in range(count))}], '
-            f'[{", ".join(f"a_{k}" for k in range(count))}])']
-    checks = []
-    for table, _, (i, j, k) in hooks.TRUST_TEST:
-        for name in plan.reported[table]:
-            e = names[f'{_TABLES[table]}_{name}']
-            checks.append(f'{e}[3] <= _l{i} and {e}[4] <= _l{j} and {e}[5] <= _l{k}')
-    if checks:
-        tail.append(f'if not ({" and ".join(checks)}):')
-        tail.append('    return _slow(theta, omega, alpha, tol, turns)')
-    values = []
-    for index in range(3):
-        for name in joints:
-            if kinds[name] == 'revolute':
-                e = names[f'L_{name}']
-                values.append(f'_wrapped_angle({e}[0])' if index == 0 else f'{e}[{index}]')
-            else:
-                values.append(f'{names[f"S_{name}"]}[{index}]')
-    for index in range(3):
-        for name in points:
-            e = names[f'P_{name}']
-            values += [f'{e}[{index}].real', f'{e}[{index}].imag']
-    for origin, angle_of, angle in frames:
-        e = names[f'P_{origin}']
-        values += [f'{e}[0].real', f'{e}[0].imag']
-        values.append(repr(angle) if angle_of is None
-                      else f'_wrapped_angle({names[f"L_{angle_of}"]}[0])')
-    measures = [names[key] for key in names if key.startswith('M_')]
-    measure = f'min({", ".join(measures)})' if len(measures) > 1 else (
-        measures[0] if measures else 'inf')
-    tail.append(f'return [{", ".join(values)}], {measure}')
-    signature = ast.arguments(posonlyargs=[], args=[ast.arg(a) for a in (
-        'theta', 'omega', 'alpha', 'tol', 'turns')], kwonlyargs=[], kw_defaults=[],
-        defaults=[ast.Constant(0)])
-    inner = ast.FunctionDef(name='_tick', args=signature,
-                            body=body + ast.parse('\n'.join(tail)).body, decorator_list=[],
-                            returns=None)
-    outer = ast.parse(
-        'def tick(theta, omega, alpha, tol, turns=0):\n'
-        '    if not (isinstance(theta, _SEQUENCE) and isinstance(omega, _SEQUENCE) '
-        'and isinstance(alpha, _SEQUENCE)) or '
-        f'len(theta) != {count} or len(omega) != {count} or len(alpha) != {count} or '
-        '_rates_shift(omega, alpha):\n'
-        '        return _slow(theta, omega, alpha, tol, turns)\n'
-        '    try:\n'
-        '        return _tick(theta, omega, alpha, tol, turns)\n'
-        '    except _Refused:\n'
-        '        return _slow(theta, omega, alpha, tol, turns)\n').body[0]
-    module = ast.fix_missing_locations(ast.Module(body=[inner, outer], type_ignores=[]))
-    exec(compile(module, f'<compiled tick of {scene.name}>', 'exec'), namespace)  # noqa: S102
-    tick: TickFunction = namespace['tick']
-    return tick
-
-
-def _inline(func: ast.expr, args: list[ast.expr],
-            namespace: dict[str, Any]) -> ast.expr | None:
-    """Return the call of a one-line helper of the solver package written out, or None.
-
-    A module function whose body is ``return <expression>`` (``_dot``,
-    ``_cross``), called with plain names or constants, becomes its expression
-    with the arguments put in: the same operations, without the call.
-    """
-    simple = all(isinstance(a, (ast.Name, ast.Constant)) for a in args)
-    if not (isinstance(func, ast.Name) and simple):
-        return None
-    helper = namespace.get(func.id)
-    if not inspect.isfunction(helper) or not helper.__module__.startswith(_SOLVER):
-        return None
-    definition = ast.parse(textwrap.dedent(inspect.getsource(helper))).body[0]
-    if not (isinstance(definition, ast.FunctionDef) and len(definition.body) == 1
-            and isinstance(definition.body[0], ast.Return) and definition.body[0].value
-            and len(definition.args.args) == len(args) and not definition.args.defaults):
-        return None
-    bound = {p.arg: a for p, a in zip(definition.args.args, args, strict=True)}
-
-    class Substitute(ast.NodeTransformer):
-        def visit_Name(self, node: ast.Name) -> ast.AST:
-            return bound.get(node.id, node)
-
-    expression: ast.expr = Substitute().visit(definition.body[0].value)
-    return expression
-
-
-def _body(step: Any, method: Callable[..., Any], suffix: str, names: dict[str, str],
-          namespace: dict[str, Any], arguments: dict[str, str]) -> list[ast.stmt]:
-    """Return the statements of ``method`` (a step's ``run``) specialized to ``step``."""
-    tree = ast.parse(textwrap.dedent(inspect.getsource(method)))
-    function = tree.body[0]
-    if not isinstance(function, ast.FunctionDef):
-        raise _Unsupported('run is not a plain function')
-    specializer = _Specializer(step, suffix, names, namespace, arguments)
-    parameters = {a.arg for a in function.args.args}
-    specializer.locals = {n.id for n in ast.walk(function)
-                          if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Store)
-                          } - parameters - set(arguments)
-    for n in itertools.chain.from_iterable(ast.walk(stmt) for stmt in function.body):
-        if isinstance(n, ast.Lambda) and (n.args.args or n.args.vararg or n.args.kwarg):
-            raise _Unsupported('a lambda with arguments')
-        if isinstance(n, (ast.Global, ast.Nonlocal, ast.Return, ast.Yield, ast.For,
-                          ast.While, ast.Try, ast.With, ast.FunctionDef)):
-            raise _Unsupported(type(n).__name__)
-    module = ast.Module(body=[stmt for stmt in function.body if not (
-        isinstance(stmt, ast.Expr) and isinstance(stmt.value, ast.Constant))], type_ignores=[])
-    module = cast(ast.Module, _fold(specializer.visit(module)))
-    return [stmt for stmt in module.body if not isinstance(stmt, ast.Pass)]
 
 
 def values_from_state(state: lk.State, joints: Sequence[str], points: Sequence[str],
@@ -456,6 +109,120 @@ def _general(scene: lk.Scene, joints: Sequence[str] | None, points: Sequence[str
     return general
 
 
+class _Refused(Exception):
+    """A step of a several-driver tick found it cannot close: the general solver says why."""
+
+
+def _refuse(theta: Any, turns: Any, ok: Any, *args: Any, **kwargs: Any) -> None:
+    """Stand in for ``ctx.check`` in a several-driver tick: hand a failure to the solver."""
+    if not ok:
+        raise _Refused
+
+
+def _compile_drivers(scene: lk.Scene, plan: hooks.TickPlan, joints: tuple[str, ...],
+                     points: tuple[str, ...],
+                     frames: tuple[tuple[str, str | None, float], ...]) -> TickFunction | None:
+    """Return the tick of a scene with several drivers (or an actuator), or ``None``.
+
+    The same specialized kernels as :func:`compile_tick`'s, each driver's on
+    its own value: ``tick(positions, speeds, accels, max_error, turns=0)``
+    takes one value per driver (sequences, as :func:`mech_kinematics.solve`).
+    An instant the general solver would rescale in time, refuse (a failed
+    check raises inside, and the general solver is asked for its reason, so
+    the message names every driver's position) or judge beyond the quick
+    trust test is handed to the general solver.
+    """
+    count = len(plan.drivers)
+    namespace: dict[str, Any] = {
+        '_ctx_check': _refuse, '_ctx_check_margin': _refuse, '_Refused': _Refused,
+        '_shown': hooks.shown, '_slow': _general(scene, joints, points, frames),
+        '_driver_limits': plan.driver_limits, '_rates_shift': hooks.rates_shift,
+        'inf': math.inf, '_float': float, '_SEQUENCE': (list, tuple),
+    }
+    for step in (*plan.drivers, *plan.steps):
+        for cls in type(step).__mro__:
+            home = sys.modules[cls.__module__]
+            if home.__name__.startswith(_SOLVER):
+                namespace.update((k, v) for k, v in vars(home).items()
+                                 if not k.startswith('__'))
+    namespace['_wrapped_angle'] = hooks.wrapped_angle
+    names: dict[str, str] = {}
+    lines = [f'{", ".join(f"{x}_{k}" for k in range(count))}, = '
+             f'({", ".join(f"_float({arg}[{k}])" for k in range(count))},)'
+             for x, arg in (('x', 'theta'), ('v', 'omega'), ('a', 'alpha'))]
+    body: list[ast.stmt] = ast.parse('\n'.join(lines)).body
+    try:
+        for name, entry in plan.ground.items():
+            local = names.setdefault(f'P_{name}', f'P_{name}_{len(names)}')
+            namespace[f'_ground_{local}'] = entry
+            body.append(ast.parse(f'{local} = _ground_{local}').body[0])
+        for k, driver in enumerate(plan.drivers):
+            run = type(driver).run
+            parameters = list(inspect.signature(run).parameters)[2:]  # after self, ctx
+            arguments = dict(zip(parameters, (f'x_{k}', f'v_{k}', f'a_{k}'), strict=True))
+            body += _body(driver, run, f'_d{k}', names, namespace, arguments)
+        for index, step in enumerate(plan.steps, 1):
+            for part, kernel in enumerate(step.kernels()):
+                body += _body(step, kernel, f'_{index}_{part}', names, namespace, {})
+    except (Unsupported, OSError, TypeError, ValueError) as error:
+        del error   # the general solver serves this scene
+        return None
+    kinds = dict(plan.joint_types)
+    tail = [f'_l0, _l1, _l2, _l3, _l4, _l5 = _driver_limits(tol, '
+            f'[{", ".join(f"v_{k}" for k in range(count))}], '
+            f'[{", ".join(f"a_{k}" for k in range(count))}])']
+    checks = []
+    for table, _, (i, j, k) in hooks.TRUST_TEST:
+        for name in plan.reported[table]:
+            e = names[f'{TABLES[table]}_{name}']
+            checks.append(f'{e}[3] <= _l{i} and {e}[4] <= _l{j} and {e}[5] <= _l{k}')
+    if checks:
+        tail.append(f'if not ({" and ".join(checks)}):')
+        tail.append('    return _slow(theta, omega, alpha, tol, turns)')
+    values = []
+    for index in range(3):
+        for name in joints:
+            if kinds[name] == 'revolute':
+                e = names[f'L_{name}']
+                values.append(f'_wrapped_angle({e}[0])' if index == 0 else f'{e}[{index}]')
+            else:
+                values.append(f'{names[f"S_{name}"]}[{index}]')
+    for index in range(3):
+        for name in points:
+            e = names[f'P_{name}']
+            values += [f'{e}[{index}].real', f'{e}[{index}].imag']
+    for origin, angle_of, angle in frames:
+        e = names[f'P_{origin}']
+        values += [f'{e}[0].real', f'{e}[0].imag']
+        values.append(repr(angle) if angle_of is None
+                      else f'_wrapped_angle({names[f"L_{angle_of}"]}[0])')
+    measures = [names[key] for key in names if key.startswith('M_')]
+    measure = f'min({", ".join(measures)})' if len(measures) > 1 else (
+        measures[0] if measures else 'inf')
+    tail.append(f'return [{", ".join(values)}], {measure}')
+    signature = ast.arguments(posonlyargs=[], args=[ast.arg(a) for a in (
+        'theta', 'omega', 'alpha', 'tol', 'turns')], kwonlyargs=[], kw_defaults=[],
+        defaults=[ast.Constant(0)])
+    inner = ast.FunctionDef(name='_tick', args=signature,
+                            body=body + ast.parse('\n'.join(tail)).body, decorator_list=[],
+                            returns=None)
+    outer = ast.parse(
+        'def tick(theta, omega, alpha, tol, turns=0):\n'
+        '    if not (isinstance(theta, _SEQUENCE) and isinstance(omega, _SEQUENCE) '
+        'and isinstance(alpha, _SEQUENCE)) or '
+        f'len(theta) != {count} or len(omega) != {count} or len(alpha) != {count} or '
+        '_rates_shift(omega, alpha):\n'
+        '        return _slow(theta, omega, alpha, tol, turns)\n'
+        '    try:\n'
+        '        return _tick(theta, omega, alpha, tol, turns)\n'
+        '    except _Refused:\n'
+        '        return _slow(theta, omega, alpha, tol, turns)\n').body[0]
+    module = ast.fix_missing_locations(ast.Module(body=[inner, outer], type_ignores=[]))
+    exec(compile(module, f'<compiled tick of {scene.name}>', 'exec'), namespace)  # noqa: S102
+    tick: TickFunction = namespace['tick']
+    return tick
+
+
 def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
                  points: Sequence[str] | None = None,
                  frames: Sequence[tuple[str, str | None, float]] = ()) -> TickFunction | None:
@@ -501,28 +268,12 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
         '_trust_limits': hooks.trust_limits,
         'inf': math.inf,
     }
-    for step in (plan.crank, *plan.steps):
-        for cls in type(step).__mro__:
-            home = sys.modules[cls.__module__]
-            if home.__name__.startswith(_SOLVER):
-                namespace.update((k, v) for k, v in vars(home).items()
-                                 if not k.startswith('__'))
-    namespace['_wrapped_angle'] = hooks.wrapped_angle
     names: dict[str, str] = {}
-    body: list[ast.stmt] = []
     try:
-        for name, entry in plan.ground.items():
-            local = names.setdefault(f'P_{name}', f'P_{name}_{len(names)}')
-            namespace[f'_ground_{local}'] = entry
-            body.append(ast.parse(f'{local} = _ground_{local}').body[0])
-        arguments = {'theta': 'theta', 'omega': 'omega', 'alpha': 'alpha'}
-        body += _body(plan.crank, type(plan.crank).run, '_0', names, namespace, arguments)
-        for index, step in enumerate(plan.steps, 1):
-            for part, kernel in enumerate(step.kernels()):
-                body += _body(step, kernel, f'_{index}_{part}', names, namespace, {})
-    except (_Unsupported, OSError, TypeError) as error:
-        del error   # the general solver serves this scene
-        return None
+        body = plan_body(plan, names, namespace)
+    except Unsupported:
+        return None     # the general solver serves this scene
+    namespace['_wrapped_angle'] = hooks.wrapped_angle
 
     def var(table: str, name: str) -> str:
         return names[f'{table}_{name}']
@@ -536,7 +287,7 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
     checks = []
     for table, _, (i, j, k) in hooks.TRUST_TEST:
         for name in plan.reported[table]:
-            e = var(_TABLES[table], name)
+            e = var(TABLES[table], name)
             checks.append(f'{e}[3] <= _l{i} and {e}[4] <= _l{j} and {e}[5] <= _l{k}')
     if checks:
         lines.append(f'if not ({" and ".join(checks)}):')
@@ -565,6 +316,12 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
     tail = ast.parse('\n'.join(lines)).body
     low, high, accel_high = hooks.RATES
     guard = ast.parse(
+        # Any real number in (an np.float64, an int) is solved as the float it equals,
+        # as the general solver does: NumPy's scalars would slow every operation.
+        'if not (theta.__class__ is float and omega.__class__ is float\n'
+        '        and alpha.__class__ is float and turns.__class__ is int):\n'
+        '    theta, omega, alpha, turns = float(theta), float(omega), float(alpha), '
+        'int(turns)\n'
         f'if not ({low!r} <= abs(omega) <= {high!r} '
         f'and abs(alpha) <= {accel_high!r}):\n'
         '    return _slow(theta, omega, alpha, tol, turns)').body

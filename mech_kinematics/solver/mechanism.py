@@ -95,6 +95,7 @@ class _Solver:
         self.levers = {step.key: cast(Intermittent, step) for step in plan.steps
                        if step.intermittent}
         self.jumping = {lever: _jumping(plan, lever) for lever in self.levers}
+        self.joint_names = tuple(plan.joint_types)
         self.out_links = tuple(n for n, k in plan.joint_types.items() if k == 'revolute')
         self.out_sliders = tuple(n for n, k in plan.joint_types.items() if k == 'prismatic')
         # The quick trust test's groups (TRUST_TEST), with their names, the empty ones left out.
@@ -104,6 +105,16 @@ class _Solver:
         self.drivers = run.drivers
         self.driver_names = tuple(driver.name for driver in run.drivers)
         self.driver_types = tuple(driver.joint_type for driver in run.drivers)
+        # The compiled single-angle solve (:mod:`.compiled`): None until compiled, False
+        # where the scene does not compile; and the single-angle solves until then.
+        self.compiled_single: Any = None
+        self.single_solves = 0
+        # Likewise the compiled array path, and the scene both compile from.
+        self.compiled_array: Any = None
+        self.array_solves = 0
+        self.scene = scene
+        # Per array shape, the ground points' values as read-only arrays (solve._state).
+        self.ground_arrays: dict[tuple[int, ...], dict[int, tuple[Any, Any]]] = {}
 
     def floors(self, speeds: Any, accels: Any) -> tuple[Any, Any, Any, Any]:
         """Return the least scales of speed, acceleration and turning rates from the drivers.

@@ -112,8 +112,10 @@ def _rates_exponent(speeds: Any, accels: Any) -> int:
 
 def _rate_exponent(omega: Any, alpha: Any) -> int:
     w, a = abs(omega), abs(alpha)
-    if isinstance(w, np.ndarray):
-        w, a = float(np.max(w, initial=0.0)), float(np.max(a, initial=0.0))
+    if isinstance(w, np.ndarray):   # each alone: a constant speed with an array of accels
+        w = float(np.max(w, initial=0.0))
+    if isinstance(a, np.ndarray):
+        a = float(np.max(a, initial=0.0))
     if _RATE_LOW <= w <= _RATE_HIGH and a <= _ACCEL_HIGH:
         return 0
     return _exponent(max(w, math.sqrt(a)), _RATE_LOW, _RATE_HIGH)

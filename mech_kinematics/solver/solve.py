@@ -17,6 +17,8 @@ import warnings
 import numpy as np
 import numpy.typing as npt
 
+from .compiled import (bounds_from_entries, COMPILE_AFTER, compile_array, compile_single,
+                       keep_freed_memory, LARGE_BATCH)
 from .context import _Context, NEAR_SINGULAR
 from .scaling import (_ACCEL_HIGH, _ldexp, _QUANTITIES, _rate_exponent, _RATE_HIGH, _RATE_LOW,
                       _rates_exponent, _rescale)
@@ -38,6 +40,13 @@ def _run(solver: _Solver, angle: Any, speed: Any, accel: Any, turns: Any,
     first driver, ``extra`` holds (position, speed, accel) of each other one.
     """
     ctx = _Context(angle, not isinstance(angle, float), turns, flip)
+    if ctx.vector and not (flip or extra):
+        fast = solver.compiled_array
+        if fast is None:
+            fast = _compiled_array(solver)
+        if fast:
+            fast(angle, speed, accel, turns, ctx)
+            return ctx
     # Ground points stay complex scalars in both paths: NumPy broadcasts them.
     ctx.points.update(solver.ground)
     plan = solver.run_plan
@@ -63,8 +72,10 @@ def _execute(solver: _Solver, theta: Any, omega: Any, alpha: Any, turns: Any = 0
     lengths (:class:`_Solver`); both are exact, so the answers are the same
     bits as if every product had stayed in range.
     """
-    w = abs(omega)
-    if isinstance(w, float) and _RATE_LOW <= w <= _RATE_HIGH and abs(alpha) <= _ACCEL_HIGH:
+    w, a = abs(omega), abs(alpha)
+    # (an array's abs is not a float: an array of rates is judged by _rate_exponent)
+    if isinstance(w, float) and isinstance(a, float) and _RATE_LOW <= w <= _RATE_HIGH \
+            and a <= _ACCEL_HIGH:
         shift = 0  # the single-angle path's usual case, decided without a call
     else:
         shift = _rate_exponent(omega, alpha)
@@ -204,6 +215,9 @@ def _judge(solver: _Solver, ctx: _Context, floors: tuple[Any, Any, Any, Any], to
              'angular velocity': turn, 'acceleration': accel,
              'angular acceleration': turn_accel}
     lims = {kind: tol * floor for kind, floor in least.items()}
+    if ctx.valid is True and all(np.ndim(floor) == 0 for floor in floors) \
+            and _within(solver, ctx, lims):
+        return  # nothing refused, one rate, the largest bounds within the floors: as below
     failed = np.logical_not(ctx.valid)  # already refused: not judged again
     if all(bool(((entry[3] <= lims[kinds[0]]) & (entry[4] <= lims[kinds[1]])
                  & (entry[5] <= lims[kinds[2]]) | failed).all())
@@ -221,6 +235,28 @@ def _judge(solver: _Solver, ctx: _Context, floors: tuple[Any, Any, Any, Any], to
         ctx.mask(np.broadcast_to(ok, shape), f'{label} (untrusted)')
     for name, (_, bound) in ctx.rubbing.items():
         ctx.mask(np.broadcast_to(bound <= lims['velocity'], shape), f'pin {name} (untrusted)')
+
+
+def _within(solver: _Solver, ctx: _Context, lims: dict[str, float]) -> bool:
+    """Return whether every reported bound of a vector solve is within its kind's floor.
+
+    ``lims``: the floors times the tolerance, one number each (one crank rate).
+
+    The largest of each array (``np.maximum.reduce``: NaN is the largest and
+    fails), one reduction per bound where :func:`_judge`'s test takes five
+    operations.
+    """
+    largest = np.maximum.reduce
+    for table, name, _, _, kinds in solver.outputs:
+        entry = getattr(ctx, table)[name]
+        for index in (0, 1, 2):
+            bound = entry[3 + index]
+            if getattr(bound, 'ndim', 0):
+                bound = largest(bound)
+            if not bound <= lims[kinds[index]]:
+                return False
+    lim = lims['velocity']
+    return all(bool(largest(bound, axis=None) <= lim) for _, bound in ctx.rubbing.values())
 
 
 def _angle(e: Any, vector: bool) -> Any:
@@ -288,6 +324,19 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
     omega: Any
     alpha: Any
     solver = scene._solver
+    fast = solver.compiled_single
+    first: Any = angle
+    count: Any = turns
+    tolerance: Any = max_error
+    if fast and first.__class__ is float and speed is None and accel is None \
+            and count.__class__ is int and tolerance.__class__ is float and tolerance > 0.0 \
+            and math.isfinite(first):
+        # The usual call of a compiled scene (one crank: a float angle at the scene's
+        # rates): the checks below would pass; its answer, or the general path's.
+        crank: Any = scene.input     # a crank: a scene that compiles has one driver, a crank
+        parts = fast(first, crank.speed, crank.accel, tolerance, count)
+        if parts is not None:
+            return _compiled_state(scene, solver, first, crank.speed, crank.accel, count, parts)
     if not (isinstance(max_error, (float, int)) and max_error > 0.0):
         msg = f'Expected `max_error` to be a positive number, got {max_error!r}'
         raise ValueError(msg)
@@ -309,6 +358,13 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
                    f'{omega!r}, {alpha!r}')
             raise ValueError(msg)
         whole = int(whole)
+        fast = solver.compiled_single
+        if fast is None:
+            fast = _compiled(scene, solver)
+        if fast:
+            parts = fast(theta, omega, alpha, tol, whole)
+            if parts is not None:
+                return _compiled_state(scene, solver, theta, omega, alpha, whole, parts)
         ctx = _execute(solver, theta, omega, alpha, whole)
         if not _trusted(solver, ctx, trust_limits(tol, omega, alpha, solver.size,
                                                   solver.crank_length)):
@@ -318,27 +374,34 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
         counted: Any = theta + math.tau * whole if whole else theta
     else:
         theta, omega, alpha = (np.asarray(x, dtype=np.float64) for x in (angle, speed, accel))
-        shape = np.broadcast_shapes(theta.shape, omega.shape, alpha.shape, np.shape(whole))
+        if omega.ndim == 0 and alpha.ndim == 0 and whole.__class__ is int:
+            shape = theta.shape     # the usual case: one rate, whole turns 0 (or any int)
+        else:
+            shape = np.broadcast_shapes(theta.shape, omega.shape, alpha.shape, np.shape(whole))
         if len(shape) != 1:
             msg = f'Expected `angle` to be a float or a 1-D array, got shape {shape}'
             raise ValueError(msg)
-        if not (np.isfinite(theta).all() and np.isfinite(omega).all()
-                and np.isfinite(alpha).all()):
+        if not (np.isfinite(theta).all() and _finite(omega) and _finite(alpha)):
             msg = 'Expected `angle`, `speed` and `accel` to be finite'
             raise ValueError(msg)
-        theta = np.broadcast_to(theta, shape)
-        whole = np.broadcast_to(np.asarray(whole, dtype=np.int64), shape)
+        if shape[0] >= LARGE_BATCH:
+            keep_freed_memory()
+        given = (theta, omega, alpha)       # maybe the caller's own arrays
+        theta = _read_only(theta, shape)
+        whole = _read_only(np.asarray(whole, dtype=np.int64), shape)
         with np.errstate(all='ignore'):
             # A constant speed or acceleration stays a scalar through the steps.
             ctx = _execute(solver, theta, omega, alpha, whole)
             _judge(solver, ctx, _crank_floors(solver.crank_length, omega, alpha), tol, shape)
-        omega, alpha = np.broadcast_to(omega, shape), np.broadcast_to(alpha, shape)
-        valid = np.broadcast_to(np.asarray(ctx.valid, dtype=bool), shape).copy()
+        omega, alpha = _read_only(omega, shape), _read_only(alpha, shape)
+        valid = (np.ones(shape, dtype=bool) if ctx.valid is True
+                 else np.broadcast_to(np.asarray(ctx.valid, dtype=bool), shape).copy())
         jumps = _jumps(solver, ctx, theta, omega, alpha, whole, valid) if ctx.jumps else {}
         counted = theta + math.tau * whole if whole.any() else np.array(theta)
-    _warn_near_singular(ctx)
+    _warn_near_singular(ctx.measures, ctx.vector, ctx.valid)
     drivers = {solver.driver_names[0]: JointMotion('revolute', counted, omega, alpha)}
-    return _state(scene, solver, ctx, theta, omega, alpha, valid, whole, jumps, drivers)
+    return _state(scene, solver, ctx, theta, omega, alpha, valid, whole, jumps, drivers,
+                  given=given if ctx.vector else ())
 
 
 def _per_driver(values: Any, defaults: tuple[float, ...], what: str) -> list[Any]:
@@ -430,7 +493,7 @@ def _solve_drivers(scene: Scene, solver: _Solver, positions: Any, speeds: Any, a
                    for x, w in zip(xs, wholes, strict=True)]
         vs = [np.array(v) for v in vs]
         accs = [np.array(a) for a in accs]
-    _warn_near_singular(ctx)
+    _warn_near_singular(ctx.measures, ctx.vector, ctx.valid)
     motions = {name: JointMotion(kind, x, v, a) for name, kind, x, v, a
                in zip(names, solver.driver_types, counted, vs, accs, strict=True)}
     whole = wholes[0]
@@ -562,15 +625,82 @@ def _turns(turns: Any) -> Any:
     raise ValueError(msg)
 
 
+def _finite(x: Any) -> bool:
+    """Return whether every value of ``x`` (an array of doubles) is finite."""
+    return math.isfinite(x) if x.ndim == 0 else bool(np.isfinite(x).all())
+
+
+def _read_only(x: Any, shape: tuple[int, ...]) -> Any:
+    """Return ``x`` broadcast to ``shape`` as a read-only view (``np.broadcast_to``'s result)."""
+    if x.ndim == 0:
+        return _constant(x, shape)
+    if x.shape != shape:
+        return np.broadcast_to(x, shape)
+    view = x.view()
+    view.flags.writeable = False
+    return view
+
+
 def _is_scalar(x: Any) -> bool:
     # The cheap test first: the node's tick passes plain floats.
     return isinstance(x, (float, int)) or np.ndim(x) == 0
 
 
-def _warn_near_singular(ctx: _Context) -> None:
-    for key, measure in ctx.measures.items():
-        low = measure < NEAR_SINGULAR
-        if low if not ctx.vector else (low & ctx.valid).any():
+def _compiled_state(scene: Scene, solver: _Solver, theta: float, omega: float, alpha: float,
+                    turns: int, parts: Any) -> State:
+    """Return the state of one crank angle from what the compiled solve returned.
+
+    What :func:`_state` makes of the general path's context for a scene of one
+    crank with no pins nor intermittent levers (the scenes that compile).
+    """
+    joints, points, measures, entries = parts
+    _warn_near_singular(measures, False, True)
+    bound = ErrorBound(bounds_from_entries, (solver.joint_names, solver.out_points, entries),
+                       solver.size, solver.crank_length)
+    counted = theta + math.tau * turns if turns else theta
+    drivers = {solver.driver_names[0]: JointMotion('revolute', counted, omega, alpha)}
+    state = _new_state(scene.name, theta, omega, alpha, joints, points, True, measures, {},
+                       bound, turns, {}, {}, {}, drivers)
+    if scene.imus:  # read from the state when asked (State.imus), as _state does
+        state.__dict__['imu_specs'] = scene.imus
+    return state
+
+
+def _compiled(scene: Scene, solver: _Solver) -> Any:
+    """Return the scene's compiled single-angle solve once it is worth it, else None or False.
+
+    See :mod:`.compiled`: compiled after :data:`.compiled.COMPILE_AFTER`
+    single-angle solves, False where the scene does not compile.
+    """
+    solver.single_solves += 1
+    if solver.single_solves < COMPILE_AFTER:
+        return None
+    solver.compiled_single = compile_single(scene) or False
+    return solver.compiled_single
+
+
+def _compiled_array(solver: _Solver) -> Any:
+    """Return the scene's compiled array path once it is worth it, else None or False.
+
+    See :mod:`.compiled`: compiled after :data:`.compiled.COMPILE_AFTER`
+    array solves, False where the scene does not compile.
+    """
+    solver.array_solves += 1
+    if solver.array_solves < COMPILE_AFTER:
+        return None
+    solver.compiled_array = compile_array(solver.scene) or False
+    return solver.compiled_array
+
+
+def _warn_near_singular(measures: dict[str, Any], vector: bool, valid: Any) -> None:
+    for key, measure in measures.items():
+        if not vector:
+            low = measure < NEAR_SINGULAR
+        elif valid is True:     # nothing refused: the least measure (NaN left out) decides
+            low = np.fmin.reduce(measure, axis=None) < NEAR_SINGULAR
+        else:
+            low = (np.less(measure, NEAR_SINGULAR) & valid).any()
+        if low:
             msg = (f'dyad at "{key}" is near-singular (measure below {NEAR_SINGULAR:g}): '
                    f'its velocities and accelerations lose accuracy')
             warnings.warn(msg, NearSingularWarning, stacklevel=3)
@@ -578,7 +708,8 @@ def _warn_near_singular(ctx: _Context) -> None:
 
 def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any, alpha: Any,
            valid: Any, turns: Any, jumps: dict[str, Any], drivers: dict[str, JointMotion],
-           floors: tuple[Any, Any, Any, Any] | None = None) -> State:
+           floors: tuple[Any, Any, Any, Any] | None = None,
+           given: tuple[Any, ...] = ()) -> State:
     vector = ctx.vector
     plan = solver.plan
     joints = {}
@@ -595,18 +726,28 @@ def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any,
     if vector:
         shape = theta.shape
         bad = None if valid.all() else ~valid
-        inputs = (id(theta), id(omega), id(alpha))
+        inputs = (id(theta), id(omega), id(alpha), *map(id, given))
+
+        # The ground points' values (the same objects every solve) as read-only arrays,
+        # made once per shape; they live as long as the solver, so their ids stay theirs.
+        ground = solver.ground_arrays.get(shape)
+        if ground is None:
+            if len(solver.ground_arrays) >= 8:
+                solver.ground_arrays.clear()
+            ground = solver.ground_arrays[shape] = {
+                id(x): (x, _constant(x, shape)) for entry in solver.ground.values() for x in entry}
 
         def finish(x: Any) -> Any:
             # A constant (a ground point, a constant crank speed) becomes a
             # read-only broadcast view; a copy only where NaN must go in, and
             # never the caller's own input arrays.
-            if id(x) in inputs:
-                x = np.array(x)
-            elif np.shape(x) != shape:
-                x = np.broadcast_to(x, shape)
+            if getattr(x, 'shape', ()) != shape:
+                hit = ground.get(id(x))
+                x = hit[1] if hit is not None and hit[0] is x else _constant(x, shape)
                 if bad is None:
                     return x
+                x = np.array(x)
+            elif id(x) in inputs:
                 x = np.array(x)
             if bad is not None:
                 x[bad] = np.nan
@@ -667,6 +808,19 @@ def _new_state(scene: str, angle: Any, speed: Any, accel: Any, joints: dict[str,
     fields['rubbing'], fields['intermittent'] = rubbing, intermittent
     fields['jumps'], fields['drivers'] = jumps, drivers
     return state
+
+
+def _constant(x: Any, shape: tuple[int, ...]) -> Any:
+    """Return one value (a number or a 0-d array) as a read-only array of ``shape``.
+
+    What ``np.broadcast_to`` returns (every element the one value, no copy),
+    built directly: a state holds a dozen of them, and ``broadcast_to`` costs
+    several times this.
+    """
+    one = np.array(x)
+    view: Any = np.ndarray(shape, one.dtype, one, 0, (0,) * len(shape))
+    view.flags.writeable = False
+    return view
 
 
 def _table_bounds(plan: _Plan, ctx: _Context) -> tuple[Table, Table]:

@@ -9,6 +9,9 @@ same run where the scene is one crank and one dyad (:func:`hand_written`:
 a four-bar, or a slider-crank on a horizontal guide), and prints the ratios
 to them against issue 19's targets (:data:`SINGLE_TARGET`, :data:`ARRAY_TARGET`). The
 machine is shared and noisy, so what matters is the ratios of one run.
+
+``bench --peer pylinkage`` times the packaged four-bar and slider-crank side
+by side with pylinkage 1.3.0's numba path instead (:mod:`.peer`, issue 22).
 """
 
 from __future__ import annotations
@@ -19,12 +22,14 @@ from functools import partial
 import json
 import math
 import statistics
+import sys
 import time
 from typing import Any
 
 import numpy as np
 
 from .cli import positive_int, run_tool
+from .peer import available, BATCHES, measure_peer, PEER_SCENES, peer_table, PEERS
 from ..scene import load_scene, scene_names
 from ..solver import solve
 
@@ -142,49 +147,117 @@ def slider_crank_numpy(theta: Any, w: float, al: float,
     return x, phi, v, wr, a, ar, bx, by, vbx, vby, abx, aby
 
 
-def hand_written(scene: Any) -> tuple[Callable[..., Any], Callable[..., Any]] | None:
-    """Return the hand-written scalar and NumPy forms of ``scene``, or None.
+#: A Scotch yoke's: crank centre (x, y) on the yoke's horizontal guide, crank length. The
+#: default is the packaged one (crank 50 mm).
+SCOTCH_YOKE_GEOMETRY = (0.0, 0.0, 0.05)
 
-    A scene has them when it is one crank driving one dyad: an RRR (a
-    four-bar) or an RRP on a horizontal guide (a slider-crank). Its carried
-    points are not computed by them (the solver computes them too).
+
+def scotch_yoke_math(theta: float, w: float, al: float,
+                     geometry: tuple[float, ...] = SCOTCH_YOKE_GEOMETRY) -> tuple[float, ...]:
+    """Hand-written Scotch yoke (horizontal guide through the crank centre, vertical slot).
+
+    Returns the yoke's x and the pin's height in the slot with their rates and
+    accelerations, then B's position, velocity and acceleration.
+    """
+    ox, oy, r = geometry
+    c, s = math.cos(theta), math.sin(theta)
+    x, y = r * c, r * s
+    vx, vy = -w * y, w * x
+    ax, ay = -al * y - w * w * x, al * x - w * w * y
+    return x, y, vx, vy, ax, ay, ox + x, oy + y, vx, vy, ax, ay
+
+
+def scotch_yoke_numpy(theta: Any, w: float, al: float,
+                      geometry: tuple[float, ...] = SCOTCH_YOKE_GEOMETRY) -> tuple[Any, ...]:
+    """Solve the same Scotch yoke with NumPy over an array of crank angles."""
+    ox, oy, r = geometry
+    c, s = np.cos(theta), np.sin(theta)
+    x, y = r * c, r * s
+    vx, vy = -w * y, w * x
+    ax, ay = -al * y - w * w * x, al * x - w * w * y
+    return x, y, vx, vy, ax, ay, ox + x, oy + y, vx, vy, ax, ay
+
+
+def geometry_of(scene: Any) -> tuple[str, tuple[float, ...]] | None:
+    """Return (dyad kind, geometry) of a scene with hand-written forms, or None.
+
+    A scene has them when it is one crank driving one dyad: an RRR on the
+    crank's tip and a ground pivot (a four-bar, :data:`FOUR_BAR_GEOMETRY`'s
+    layout), an RRP on the crank's tip and a horizontal guide (a
+    slider-crank, :data:`SLIDER_CRANK_GEOMETRY`'s), or an RPP of a vertical
+    slot on a horizontal guide through the crank centre (a Scotch yoke,
+    :data:`SCOTCH_YOKE_GEOMETRY`'s).
     """
     if len(scene.dyads) != 1:
         return None
-    baseline = _BASELINES.get(scene.dyads[0].kind)
-    if baseline is None or scene.input is None or len(scene.drivers) > 1:
+    dyad, crank = scene.dyads[0], scene.input
+    baseline = _GEOMETRIES.get(dyad.kind)
+    if baseline is None or crank is None or len(scene.drivers) > 1:
         return None
-    return baseline(scene, scene.dyads[0], scene.input)
+    geometry = baseline(scene, dyad, crank)
+    return None if geometry is None else (dyad.kind, geometry)
 
 
-def _four_bar(scene: Any, dyad: Any, crank: Any) -> Any:
-    """Return the four-bar's forms, for an RRR on the crank's tip and a ground pivot."""
+def hand_written(scene: Any) -> tuple[Callable[..., Any], Callable[..., Any]] | None:
+    """Return the hand-written scalar and NumPy forms of ``scene``, or None.
+
+    See :func:`geometry_of` for the scenes that have them. Their carried
+    points are not computed by them (the solver computes them too).
+    """
+    found = geometry_of(scene)
+    if found is None:
+        return None
+    kind, geometry = found
+    scalar, vector = _FORMS[kind]
+    return partial(scalar, geometry=geometry), partial(vector, geometry=geometry)
+
+
+def _four_bar(scene: Any, dyad: Any, crank: Any) -> tuple[float, ...] | None:
+    """Return the four-bar's geometry, for an RRR on the crank's tip and a ground pivot."""
     first, second = dyad.links
     if first.start != crank.point or second.start not in scene.ground:
         return None
     ox, oy = scene.ground[crank.center]
     dx, dy = scene.ground[second.start]
-    geometry = (ox, oy, crank.length, first.length, second.length, dx, dy,
-                float(dyad.branch.value))
-    return partial(four_bar_math, geometry=geometry), partial(four_bar_numpy, geometry=geometry)
+    return (ox, oy, crank.length, first.length, second.length, dx, dy,
+            float(dyad.branch.value))
 
 
-def _slider_crank(scene: Any, dyad: Any, crank: Any) -> Any:
-    """Return the slider-crank's forms, for an RRP on the crank's tip and a horizontal guide."""
+def _slider_crank(scene: Any, dyad: Any, crank: Any) -> tuple[float, ...] | None:
+    """Return the slider-crank's geometry, for an RRP on the crank's tip and a horizontal guide."""
     if dyad.guide_angle != 0.0 or dyad.link.start != crank.point \
             or dyad.through not in scene.ground:
         return None
     ox, oy = scene.ground[crank.center]
     guide = scene.ground[dyad.through][1]
-    geometry = (ox, oy, crank.length, dyad.link.length, guide, float(dyad.branch.value))
-    return partial(slider_crank_math, geometry=geometry), partial(slider_crank_numpy,
-                                                                  geometry=geometry)
+    return (ox, oy, crank.length, dyad.link.length, guide, float(dyad.branch.value))
 
 
-#: The hand-written baselines there are, by the scene's dyad ``type:``.
-_BASELINES: dict[str, Callable[[Any, Any, Any], Any]] = {'RRR': _four_bar,
-                                                         'RRP': _slider_crank}
+def _scotch_yoke(scene: Any, dyad: Any, crank: Any) -> tuple[float, ...] | None:
+    """Return the Scotch yoke's geometry, for an RPP of a vertical slot on the crank's tip.
 
+    Its guide is horizontal, through the crank centre.
+    """
+    if dyad.guide_angle != 0.0 or dyad.slot_angle != 0.5 * math.pi \
+            or dyad.through != crank.point or dyad.guide_through != crank.center:
+        return None
+    ox, oy = scene.ground[crank.center]
+    return (ox, oy, crank.length)
+
+
+#: The hand-written baselines there are, by the scene's dyad ``type:``: the geometry's
+#: reader, and the scalar and NumPy forms.
+_GEOMETRIES: dict[str, Callable[[Any, Any, Any], tuple[float, ...] | None]] = {
+    'RRR': _four_bar, 'RRP': _slider_crank, 'RPP': _scotch_yoke}
+_FORMS: dict[str, tuple[Callable[..., Any], Callable[..., Any]]] = {
+    'RRR': (four_bar_math, four_bar_numpy), 'RRP': (slider_crank_math, slider_crank_numpy),
+    'RPP': (scotch_yoke_math, scotch_yoke_numpy)}
+
+
+#: The clock of every timing: the process's CPU time. On the shared machine the wall
+#: clock also counts the time other processes hold the cores; every solve timed here
+#: (ours, the hand-written forms, pylinkage's numba kernels) runs on one thread.
+CLOCK = time.process_time
 
 #: Issue 19's targets, bounds included: the array path per configuration over the
 #: hand-written NumPy closed form, the single angle over the hand-written scalar one.
@@ -198,15 +271,15 @@ def _spread_times(funcs: list[Callable[[], Any]], number: int,
 
     The functions are timed in turn: interleaving the repeats makes a load
     change on the shared machine hit every function alike, so their ratios
-    stay meaningful.
+    stay meaningful. Times are the process's CPU time (:data:`CLOCK`).
     """
     times: list[list[float]] = [[] for _ in funcs]
     for _ in range(repeat):
         for func, samples in zip(funcs, times, strict=True):
-            start = time.perf_counter()
+            start = CLOCK()
             for _ in range(number):
                 func()
-            samples.append((time.perf_counter() - start) / number)
+            samples.append((CLOCK() - start) / number)
     return [(min(s), statistics.median(s), max(s)) for s in times]
 
 
@@ -267,9 +340,9 @@ def _ratio(row: dict[str, Any], key: str, target: float) -> str:
 
 def table(rows: list[dict[str, Any]], angles: int, repeat: int) -> list[str]:
     """Return the lines ``make bench`` prints for the rows of :func:`measure`."""
-    lines = [f'min / median / max of {repeat} runs; array path over {angles} angles, per '
-             'configuration; position, velocity and acceleration of every output, bounds '
-             'included',
+    lines = [f'min / median / max of {repeat} runs (CPU time of this process); array path '
+             f'over {angles} angles, per configuration; position, velocity and acceleration of '
+             'every output, bounds included',
              f'ratio: median over the hand-written closed form of the same scene (targets: '
              f'single <= {SINGLE_TARGET:g}x, array <= {ARRAY_TARGET:g}x); "-": no '
              'hand-written form of that scene',
@@ -291,6 +364,8 @@ def table(rows: list[dict[str, Any]], angles: int, repeat: int) -> list[str]:
 
 def _handle(args: argparse.Namespace) -> int:
     """Print the table of ``measure`` with the ratios to the hand-written baselines."""
+    if args.peer is not None:
+        return _handle_peer(args)
     rows = measure(scene_names(), args.angles, args.repeat)
     if args.json:
         print(json.dumps({'angles': args.angles, 'repeat': args.repeat, 'rows': rows},
@@ -298,6 +373,33 @@ def _handle(args: argparse.Namespace) -> int:
     else:
         print('\n'.join(table(rows, args.angles, args.repeat)))
     return 0
+
+
+def _handle_peer(args: argparse.Namespace) -> int:
+    """Print the side-by-side table against a peer package (:mod:`.peer`)."""
+    if not available():
+        print('bench: expected pylinkage 1.3.0 installed for --peer pylinkage (a development '
+              'dependency: `make install`), got none', file=sys.stderr)
+        return 2
+    rows = measure_peers(args.repeat)
+    if args.json:
+        print(json.dumps({'peer': args.peer, 'repeat': args.repeat, 'rows': rows}, indent=1))
+    else:
+        print('\n'.join(peer_table(rows, args.repeat)))
+    return 0
+
+
+def measure_peers(repeat: int, names: Sequence[str] = PEER_SCENES,
+                  batches: tuple[int, ...] = BATCHES) -> list[dict[str, Any]]:
+    """Return :func:`.peer.measure_peer`'s row of every scene timed against pylinkage."""
+    def forms(scene: Any) -> tuple[str, tuple[float, ...]]:
+        found = geometry_of(scene)
+        if found is None or found[0] not in ('RRR', 'RRP'):
+            msg = f'Expected a four-bar or a slider-crank for the peer, got scene {scene.name}'
+            raise ValueError(msg)
+        return found
+
+    return [measure_peer(name, forms, repeat, batches) for name in names]
 
 
 def add_parser(subparsers: Any) -> argparse.ArgumentParser:
@@ -311,6 +413,10 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
                         help='angles in the array path (default 1e5)')
     parser.add_argument('--repeat', type=positive_int, default=7,
                         help='runs for the min / median / max (default 7)')
+    parser.add_argument('--peer', choices=PEERS, default=None,
+                        help='time the packaged four-bar and slider-crank side by side with '
+                             'a peer package instead (pylinkage 1.3.0: a development '
+                             'dependency), after checking its answers equal ours')
     parser.add_argument('--json', action='store_true',
                         help='print the rows as JSON (times as [min, median, max] µs)')
     parser.set_defaults(handler=_handle)

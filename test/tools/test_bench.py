@@ -48,7 +48,8 @@ def test_json_output(capsys):
 
 @pytest.mark.parametrize('scalar, vector', [(bench.four_bar_math, bench.four_bar_numpy),
                                             (bench.slider_crank_math,
-                                             bench.slider_crank_numpy)])
+                                             bench.slider_crank_numpy),
+                                            (bench.scotch_yoke_math, bench.scotch_yoke_numpy)])
 def test_hand_written_forms_agree(scalar, vector):
     angles = np.linspace(0.1, 2 * math.pi, 7, endpoint=False)
     arrays = vector(angles, -4.0, 3.0)
@@ -58,11 +59,12 @@ def test_hand_written_forms_agree(scalar, vector):
 
 
 HAND_WRITTEN = ('four_bar_coupler_points', 'khurmi_four_bar_ad150', 'offset_slider_crank',
-                'piston_300', 'rocking_lever', 'slider_crank_150_600', 'steam_engine_500_2000')
+                'piston_300', 'rocking_lever', 'scotch_yoke', 'slider_crank_150_600',
+                'steam_engine_500_2000')
 
 
 def test_which_scenes_have_hand_written_forms():
-    """One crank and one RRR, or one RRP on a horizontal guide; the others have none."""
+    """One crank and one RRR, one RRP on a horizontal guide, or a Scotch yoke; not the others."""
     from mech_kinematics.scene import scene_names
     have = tuple(n for n in scene_names() if bench.hand_written(load_scene(n)) is not None)
     assert have == HAND_WRITTEN
@@ -85,6 +87,13 @@ def test_hand_written_forms_give_the_solvers_answer(name):
             want = (coupler.position, rocker.position, coupler.velocity, rocker.velocity,
                     coupler.acceleration, rocker.acceleration, *point.position,
                     *point.velocity, *point.acceleration)
+        elif dyad.kind == 'RPP':    # Scotch yoke: the yoke's x, the pin's height, rates
+            yoke, pin = state.joints[dyad.slider], state.joints[dyad.slot_slider]
+            got = values
+            b = state.points[scene.input.point]
+            want = (yoke.position, pin.position, yoke.velocity, pin.velocity,
+                    yoke.acceleration, pin.acceleration, *b.position, *b.velocity,
+                    *b.acceleration)
         else:                       # slider-crank: piston x, rod angle, rates
             rod = state.joints[dyad.link.name]
             point = state.points[dyad.point]
@@ -93,6 +102,6 @@ def test_hand_written_forms_give_the_solvers_answer(name):
                     point.acceleration[0], rod.acceleration)
         scale = [max(abs(x) for x in want[i::2]) for i in range(2)]
         for k, (g, x) in enumerate(zip(got, want, strict=True)):
-            if k < 2 and len(values) == 18 or k == 1 and len(values) == 12:
+            if k < 2 and len(values) == 18 or k == 1 and dyad.kind == 'RRP':
                 g, x = math.remainder(g - x, 2 * math.pi), 0.0     # angles modulo 2 pi
             assert g == pytest.approx(x, abs=1e-12 * max(scale) + 1e-12), (name, k)

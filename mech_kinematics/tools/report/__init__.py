@@ -64,7 +64,7 @@ from .extreme import (AngleResult, BOUND_FACTOR, Case, CaseResult, digits_lost, 
                       evaluate_case, extreme_cases, formula_audit, FormulaAudit)
 from .figures import (plot_bounds, plot_clock, plot_cost, plot_extreme, plot_refused,
                       plot_work_precision)
-from .markdown import write_report
+from .markdown import bench_text, write_report
 from ..cli import run_tool
 
 __all__ = [
@@ -76,7 +76,9 @@ __all__ = [
     'EPS', 'ERROR_FLOOR', 'FormulaAudit', 'GoldenCheck', 'HAND_TIME', 'KAPPA_WELL', 'MODES',
     'Mode', 'NEWTON_TRACKING_STEP', 'OFFSETS', 'ReferenceCheck', 'RefusedFractions', 'TICK_HZ',
     'TOLERANCES', 'WP_PRINTED', 'WP_RANGES', 'WP_SCENES', 'WorkPoint', 'WorkPrecision',
-    'add_parser', 'bound_cases', 'bound_statistics', 'bound_values', 'chain_scene', 'clock_errors',
+    'add_parser', 'bench_section', 'bound_cases', 'bound_statistics', 'bound_values',
+    'chain_scene',
+    'clock_errors', 'refresh_bench',
     'configurations', 'cost_growth', 'digits_lost', 'evaluate_angle', 'evaluate_case',
     'extreme_cases', 'formula_audit', 'golden_checks', 'golden_folder', 'headline', 'main',
     'naive_accumulate', 'naive_cumsum', 'naive_wrapped', 'naive_wrapped_trace', 'newton_positions',
@@ -139,9 +141,7 @@ def run(outdir: str | os.PathLike[str], mode: str | Mode = 'full',
             refused.append(refused_fractions(case, mode))
             tick()
         bar.set_description('bench')
-        from ..bench import measure
-        bench = {'angles': mode.bench_angles, 'repeat': mode.bench_repeat,
-                 'rows': measure(scene_names(), mode.bench_angles, mode.bench_repeat)}
+        bench, peer = bench_section(mode)
         tick()
         bar.set_description('figures')
         for result in wp:
@@ -155,13 +155,63 @@ def run(outdir: str | os.PathLike[str], mode: str | Mode = 'full',
     elapsed = time.perf_counter() - start
     load.append(os.getloadavg()[0])
     data = collect(mode, elapsed, load, checks, golden, wp, clock, clock_check, extreme, cost,
-                   bounds, refused, bench)
+                   bounds, refused, bench, peer)
     write_data(out, data, long_run, topic_drive)
     write_report(out, mode, checks, golden, wp, clock, clock_check, extreme, audit, cost,
                  bounds, refused, elapsed, data)
     return {'checks': checks, 'golden': golden, 'work_precision': wp, 'clock': clock,
             'clock_check': clock_check, 'extreme': extreme, 'audit': audit, 'cost': cost,
             'bounds': bounds, 'refused': refused, 'elapsed': elapsed, 'data': data}
+
+
+def bench_section(mode: Mode) -> tuple[dict[str, Any], dict[str, Any] | None]:
+    """Return section 7's measurements: ``bench``'s table, and the peer's where installed.
+
+    The peer (pylinkage, ``bench --peer``) is a development dependency: without
+    it the second is None (and the data file keeps its previous table).
+    """
+    from ..bench import measure, measure_peers
+    from ..peer import available, work_items
+    from ...scene import scene_names
+    rows = measure(scene_names(), mode.bench_angles, mode.bench_repeat)
+    # Per scene with a hand-written form, and over them, the median ratios (for the docs).
+    ratios = {row['scene']: {'single': row['single_ratio'], 'array': row['array_ratio']}
+              for row in rows if 'single_ratio' in row}
+    bench = {'angles': mode.bench_angles, 'repeat': mode.bench_repeat, 'rows': rows,
+             'ratios': ratios, 'ratio_range': {
+                 kind: {'min': min(r[kind] for r in ratios.values()),
+                        'max': max(r[kind] for r in ratios.values())}
+                 for kind in ('single', 'array')}}
+    if not available():
+        return bench, None
+    batches = (360, mode.bench_angles)
+    work = work_items(batches)
+    rows = measure_peers(mode.bench_repeat, batches=batches)
+    # Their median over ours per scene and work item (> 1: ours faster), for the docs to quote.
+    ratios = {row['scene']: {key: row[key]['theirs_us'][1] / row[key]['ours_us'][1]
+                             for key, _ in work} for row in rows}
+    return bench, {'peer': 'pylinkage 1.3.0 (numba)', 'repeat': mode.bench_repeat,
+                   'work': work, 'rows': rows, 'ratios': ratios}
+
+
+def refresh_bench(outdir: str | os.PathLike[str], mode: str | Mode = 'full') -> Path:
+    """Measure section 7 again into ``outdir``'s data file and REPORT.md; keep the rest.
+
+    ``bench``'s timings change with the solver's code and nothing else of the
+    report does: this reruns :func:`bench_section` alone, stores it in
+    ``outdir/data.json`` and rewrites section 7 of ``outdir/REPORT.md`` from it.
+    Returns the data file's path.
+    """
+    mode = MODES[mode] if isinstance(mode, str) else mode
+    out = Path(outdir)
+    data = read_data(out / DATA_FILE)
+    data['bench'], data['peer'] = bench_section(mode)
+    path = write_data(out, data)
+    report = out / 'REPORT.md'
+    text = report.read_text(encoding='utf-8')
+    start = text.index('## 7. ')    # the last section (markdown.write_report)
+    report.write_text(text[:start] + bench_text(data), encoding='utf-8')
+    return path
 
 
 # --- command line ------------------------------------------------------------------
@@ -184,6 +234,13 @@ def _handle(args: argparse.Namespace) -> int:
             print(f'report: expected {option} to name the JSON file of {script}, got '
                   f'{given!r} (no such file)', file=sys.stderr)
             return 2
+    if args.bench_only:
+        if not (Path(args.output) / DATA_FILE).is_file():
+            print(f'report: expected --bench-only to find the data file of a report in '
+                  f'{args.output!r}, got none (run the report there first)', file=sys.stderr)
+            return 2
+        print(refresh_bench(args.output, args.mode))
+        return 0
     run(args.output, args.mode, progress=not args.no_progress, long_run=args.long_run,
         topic_drive=args.topic_drive)
     print(Path(args.output) / 'REPORT.md')
@@ -211,6 +268,10 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
                         help="store FILE (bench/topic_bench.py's JSON: latency and CPU of the "
                              'node driven from a topic) in DIR/data.json; without it the '
                              "folder's previous one is kept")
+    parser.add_argument('--bench-only', action='store_true',
+                        help="measure section 7 alone (make bench's table, and pylinkage side "
+                             "by side where installed) into DIR's data file and REPORT.md, "
+                             'keeping the rest')
     parser.set_defaults(handler=_handle, mode='full')
     return parser
 

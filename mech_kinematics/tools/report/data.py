@@ -69,8 +69,12 @@ def _range(values: Sequence[float]) -> dict[str, float]:
 
 def collect(mode: Any, elapsed: float, load: Sequence[float], checks: Any, golden: Any,
             wp: Any, clock: Any, clock_check: Any, extreme: Any, cost: Any, bounds: Any,
-            refused: Any, bench: dict[str, Any] | None = None) -> dict[str, Any]:
-    """Return the data file's figures from the report's computed sections."""
+            refused: Any, bench: dict[str, Any] | None = None,
+            peer: dict[str, Any] | None = None) -> dict[str, Any]:
+    """Return the data file's figures from the report's computed sections.
+
+    ``peer``: ``bench --peer``'s side-by-side table, where the peer is installed.
+    """
     from .baselines import headline
     from .bounds import bound_statistics, TOLERANCES
     from .common import slug
@@ -128,6 +132,8 @@ def collect(mode: Any, elapsed: float, load: Sequence[float], checks: Any, golde
                     'chain_slope_single': cost.chain_slope_single}
     if bench is not None:
         data['bench'] = bench
+    if peer is not None:
+        data['peer'] = peer
     return data
 
 
@@ -161,7 +167,8 @@ def write_data(outdir: str | os.PathLike[str], data: dict[str, Any],
     """Write ``outdir/data.json``; keep the previous file's :data:`KEPT` keys unless given anew.
 
     ``long_run``, ``topic_drive``: JSON files of ``bench/long_run.py`` and
-    ``bench/topic_bench.py`` to store under those keys.
+    ``bench/topic_bench.py`` to store under those keys. Likewise its ``peer``
+    (``bench --peer``'s table) where this run had no peer installed.
     """
     path = Path(outdir) / DATA_FILE
     given = {'long_run': long_run, 'topic_drive': topic_drive}
@@ -171,6 +178,10 @@ def write_data(outdir: str | os.PathLike[str], data: dict[str, Any],
             data[key] = read_data(given[key])   # type: ignore[arg-type]
         elif key in previous:
             data[key] = previous[key]
+    if data.get('peer') is None:
+        data.pop('peer', None)
+        if 'peer' in previous:
+            data['peer'] = previous['peer']
     path.write_text(json.dumps(data, indent=1, sort_keys=True) + '\n', encoding='utf-8')
     return path
 
@@ -354,9 +365,24 @@ def _topic_drive_block(data: dict[str, Any]) -> str:
     return '\n'.join(lines) + '\n'
 
 
+def _peer_block(data: dict[str, Any]) -> str:
+    peer = lookup(data, 'peer')
+    lines = [f'| scene | work | ours, µs (min / median / max) | {peer["peer"]}, µs '
+             '(min / median / max) | theirs / ours (medians) |', '|---|---|---|---|---|']
+    for row in peer['rows']:
+        for key, label in peer['work']:
+            ours, theirs = row[key]['ours_us'], row[key]['theirs_us']
+            lines.append(f'| {row["scene"]} | {label} | {" / ".join(f"{t:.3g}" for t in ours)} '
+                         f'| {" / ".join(f"{t:.3g}" for t in theirs)} | '
+                         f'{theirs[1] / ours[1]:.2f} |')
+        lines.append(f'| {row["scene"]} | their cold start (first calls) | | '
+                     f'{row["cold_s"]:.2f} s | |')
+    return '\n'.join(lines) + '\n'
+
+
 #: The generated blocks: name -> function of the data returning the block's text.
 BLOCKS = {'refused': _refused_block, 'bench': _bench_block, 'clock': _clock_block,
-          'long_run': _long_run_block, 'topic_drive': _topic_drive_block}
+          'long_run': _long_run_block, 'topic_drive': _topic_drive_block, 'peer': _peer_block}
 
 
 def render_block(name: str, data: dict[str, Any]) -> str:

@@ -506,10 +506,32 @@ def _bench(data: dict[str, Any]) -> list[str]:
             'positions, velocities and accelerations of every output, error bounds and the '
             'tolerance check included (the hand-written forms have neither). Ratio: median '
             'over the hand-written form of the same scene, which exists for every scene of one '
-            'crank and one dyad (four-bars, and slider-cranks on a horizontal guide; it leaves '
+            'crank and one dyad (four-bars, slider-cranks on a horizontal guide and the Scotch '
+            'yoke; it leaves '
             "out their carried points, which the solver computes). Issue 19's targets: "
             f'one angle <= {SINGLE_TARGET:g}x, '
-            f'arrays <= {ARRAY_TARGET:g}x.', '', render_block('bench', data).rstrip('\n'), '']
+            f'arrays <= {ARRAY_TARGET:g}x.', '', render_block('bench', data).rstrip('\n'), '',
+            *_peer(data)]
+
+
+def _peer(data: dict[str, Any]) -> list[str]:
+    """Return section 7's side-by-side table against the peer (``bench --peer``), if measured."""
+    if 'peer' not in data:
+        return []
+    peer = data['peer']
+    return [f'Side by side with {peer["peer"]} in one process (`make bench ARGS="--peer '
+            'pylinkage"`), on the same four-bar and slider-crank built in it, whose positions, '
+            'velocities and accelerations over a turn are first checked equal to ours (to '
+            f'{max(row["max_difference"] for row in peer["rows"]):.1e} of their scales); '
+            f'min / median / max of {peer["repeat"]} interleaved runs, per configuration. '
+            "Their numba kernels compile (or load from numba's cache) on the first calls, "
+            'timed apart as the cold start; in one process only the first scene pays it.', '',
+            render_block('peer', data).rstrip('\n'), '']
+
+
+def bench_text(data: dict[str, Any]) -> str:
+    """Return section 7 of REPORT.md (``bench``'s tables) from the data file."""
+    return '\n'.join(_bench(data))
 
 
 def _bounds(mode: Mode, bounds: Sequence[CaseBounds],

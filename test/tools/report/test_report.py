@@ -136,3 +136,41 @@ def test_quick_report_writes_its_data_file(quick_report):
     assert '## 7. Against hand-written closed forms' in text
     assert '| mechanism | positions | velocities | accelerations |' in text
     assert "The node's single-angle path (one call per tick) costs" in text
+
+
+def test_quick_report_has_the_peer_side_by_side(quick_report):
+    """With pylinkage installed, section 7 and the data file hold the side-by-side table."""
+    data = report.read_data(quick_report / report.DATA_FILE)
+    peer = data['peer']
+    assert [row['scene'] for row in peer['rows']] == ['khurmi_four_bar_ad150',
+                                                      'slider_crank_150_600']
+    assert [key for key, _ in peer['work']] == ['single', 'batch_360',
+                                                f'batch_{data["bench"]["angles"]}']
+    text = (quick_report / 'REPORT.md').read_text()
+    assert 'Side by side with pylinkage 1.3.0 (numba)' in text
+    assert report.render_block('peer', data) in text
+
+
+def test_bench_only_measures_section_7_again_and_keeps_the_rest(quick_report, tmp_path):
+    """`report -o DIR --bench-only --smoke`: new bench and peer tables, every other figure kept."""
+    for name in (report.DATA_FILE, 'REPORT.md'):
+        (tmp_path / name).write_bytes((quick_report / name).read_bytes())
+    before = report.read_data(tmp_path / report.DATA_FILE)
+    text = (tmp_path / 'REPORT.md').read_text()
+    assert report.main(['-o', str(tmp_path), '--smoke', '--bench-only']) == 0
+    after = report.read_data(tmp_path / report.DATA_FILE)
+    assert {k: v for k, v in after.items() if k not in ('bench', 'peer')} == \
+        {k: v for k, v in before.items() if k not in ('bench', 'peer')}
+    assert after['bench']['angles'] == report.MODES['smoke'].bench_angles \
+        != before['bench']['angles']
+    new_text = (tmp_path / 'REPORT.md').read_text()
+    head = text.split('## 7. ')[0]
+    assert new_text.startswith(head) and new_text != text
+    assert report.render_block('bench', after) in new_text
+    assert report.render_block('peer', after) in new_text
+
+
+def test_bench_only_needs_a_report_there(tmp_path, capsys):
+    """--bench-only in a folder with no data file: one line saying so, exit 2."""
+    assert report.main(['-o', str(tmp_path), '--bench-only']) == 2
+    assert 'expected --bench-only to find the data file' in capsys.readouterr().err

@@ -1,0 +1,231 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The solver's own compiled paths: a scene's solve as one straight-line function.
+
+:func:`mech_kinematics.solve` runs every step's kernel through the
+dictionaries of a context. Once a scene has been solved :data:`COMPILE_AFTER`
+times on one path, it compiles the scene's kernels for that path instead
+(by :mod:`.specialize`, as the node's tick is compiled):
+
+- the single-angle path (:func:`compile_single`) into one function that
+  returns what a :class:`.State` holds: the reported joints, points,
+  measures and the entries their bounds come from;
+- the array path (:func:`compile_array`) into one function of NumPy
+  operations that fills a vector context as the steps would.
+
+The same operations run in the same order on the same values, so the
+answers, their bounds and the errors raised are those of the general path
+(``test_compiled`` compares them on every packaged scene and the extreme
+suite). The single-angle function answers ``None`` where the general path
+must decide: a bound beyond the quick trust test (:func:`.solve.trust_limits`:
+the general path refuses with the full reason, or answers), a crank rate it
+would rescale. Scenes neither path compiles (rescaled lengths, pins to bound,
+an intermittent lever whose engagement the state reports, a kernel outside the
+subset) keep the general path.
+
+Large array solves also keep freed memory for the next one
+(:func:`keep_freed_memory`).
+"""
+
+from __future__ import annotations
+
+import ast
+from collections.abc import Callable
+import ctypes
+import os
+import platform
+from typing import Any, TYPE_CHECKING
+
+from .specialize import plan_body, TABLES, Unsupported
+from .state import JointMotion
+
+if TYPE_CHECKING:
+    from .mechanism import Scene
+
+__all__ = ['ArrayFunction', 'COMPILE_AFTER', 'KEEP_FREED', 'LARGE_BATCH', 'SingleFunction',
+           'compile_array', 'compile_single', 'keep_freed_memory']
+
+#: Single-angle solves of one scene on the general path before it is compiled: a
+#: compilation costs about as much as a thousand solves, so a scene solved once or
+#: twice (most scenes a test builds) is never compiled.
+COMPILE_AFTER = 16
+
+#: ``array(theta, omega, alpha, turns, ctx) -> None``; see :func:`compile_array`.
+ArrayFunction = Callable[[Any, Any, Any, Any, Any], None]
+
+#: ``single(theta, omega, alpha, max_error, turns) -> (joints, points, measures, entries)``
+#: or ``None``; see :func:`compile_single`.
+SingleFunction = Callable[[float, float, float, float, int],
+                          tuple[dict[str, JointMotion], dict[str, tuple[complex, ...]],
+                                dict[str, float], tuple[Any, ...]] | None]
+
+
+def bounds_from_entries(joints: tuple[str, ...], points: tuple[str, ...],
+                        entries: tuple[Any, ...]) -> tuple[dict[str, Any], dict[str, Any]]:
+    """Return the joints' and points' bounds from the entries a compiled solve returned.
+
+    ``entries`` holds the context entry of each joint, then of each point, in
+    the order of the names: the bounds are their last three values, as
+    :func:`.solve._table_bounds` takes them from a context.
+    """
+    count = len(joints)
+    return ({name: entry[3:] for name, entry in zip(joints, entries[:count], strict=True)},
+            {name: entry[3:] for name, entry in zip(points, entries[count:], strict=True)})
+
+
+def compile_single(scene: Scene) -> SingleFunction | None:
+    """Return ``scene``'s single-angle solve as one straight-line function, or ``None``.
+
+    The function takes the crank angle, speed and acceleration (floats, rad,
+    rad/s, rad/s^2), the tolerance ``max_error`` and whole turns (an int), and
+    returns ``(joints, points, measures, entries)``: the state's
+    :class:`.JointMotion` of every reported joint, (position, velocity,
+    acceleration) of every reported point as complex numbers, the
+    near-singularity measures, and the context entries of the reported joints
+    then points (:func:`bounds_from_entries`). It raises as the general path
+    does where a step cannot close, and returns ``None`` for the general path
+    to decide (see the module).
+    """
+    from . import tick as hooks     # the tick's hooks import the solve this serves
+
+    plan = hooks.tick_plan(scene)
+    solver = scene._solver
+    if not plan.compilable or solver.levers or plan.driver_limits is not None:
+        # An intermittent lever's state, or several drivers' (the node's tick compiles those)
+        return None
+    namespace: dict[str, Any] = {
+        '_ctx_check': hooks.check, '_ctx_check_margin': hooks.check_margin,
+        '_shown': hooks.shown, '_trust_limits': hooks.trust_limits, '_JM': JointMotion,
+    }
+    names: dict[str, str] = {}
+    try:
+        body = plan_body(plan, names, namespace)
+    except Unsupported:
+        return None
+    namespace['_wrapped_angle'] = hooks.wrapped_angle
+
+    def var(table: str, name: str) -> str:
+        return names[f'{table}_{name}']
+
+    lines = [f'_l0, _l1, _l2, _l3, _l4, _l5 = _trust_limits(tol, omega, alpha, '
+             f'{plan.size!r}, {plan.crank_length!r})']
+    checks = []
+    for table, _, (i, j, k) in hooks.TRUST_TEST:
+        for name in plan.reported[table]:
+            e = var(TABLES[table], name)
+            checks.append(f'{e}[3] <= _l{i} and {e}[4] <= _l{j} and {e}[5] <= _l{k}')
+    if checks:
+        lines.append(f'if not ({" and ".join(checks)}):')
+        lines.append('    return None')
+    joints, entries = [], []
+    for name, kind in plan.joint_types.items():
+        if kind == 'revolute':
+            e = var('L', name)
+            joints.append(f'{name!r}: _JM({kind!r}, _wrapped_angle({e}[0]), {e}[1], {e}[2])')
+        else:
+            e = var('S', name)
+            joints.append(f'{name!r}: _JM({kind!r}, {e}[0], {e}[1], {e}[2])')
+        entries.append(e)
+    points = []
+    for name in solver.plan.output_points:
+        e = var('P', name)
+        points.append(f'{name!r}: {e}[:3]')
+        entries.append(e)
+    measures = [f'{key[2:]!r}: {local}' for key, local in names.items() if key.startswith('M_')]
+    lines.append(f'return ({{{", ".join(joints)}}}, {{{", ".join(points)}}}, '
+                 f'{{{", ".join(measures)}}}, ({", ".join(entries)}{"," if entries else ""}))')
+    low, high, accel_high = hooks.RATES
+    guard = ast.parse(f'if not ({low!r} <= abs(omega) <= {high!r} '
+                      f'and abs(alpha) <= {accel_high!r}):\n'
+                      '    return None').body
+    function = ast.FunctionDef(
+        name='single', args=ast.arguments(
+            posonlyargs=[], args=[ast.arg(a) for a in ('theta', 'omega', 'alpha', 'tol',
+                                                       'turns')],
+            kwonlyargs=[], kw_defaults=[], defaults=[]),
+        body=guard + body + ast.parse('\n'.join(lines)).body, decorator_list=[],
+        returns=None)
+    module = ast.fix_missing_locations(ast.Module(body=[function], type_ignores=[]))
+    exec(compile(module, f'<compiled solve of {scene.name}>', 'exec'), namespace)  # noqa: S102
+    single: SingleFunction = namespace['single']
+    return single
+
+
+def compile_array(scene: Scene) -> ArrayFunction | None:
+    """Return the steps of ``scene``'s array path as one straight-line function, or ``None``.
+
+    The function ``array(theta, omega, alpha, turns, ctx)`` does what running
+    the crank's and every step's ``run`` on ``ctx`` (a vector
+    :class:`._Context`) does: the same NumPy operations in the same order,
+    without the dispatch, the dictionaries and the attribute reads between
+    them; it masks and records failures on ``ctx`` as the steps do, and leaves
+    every value in ``ctx``'s tables. ``None`` for the scenes
+    :func:`compile_single` leaves out.
+    """
+    from . import tick as hooks     # the tick's hooks import the solve this serves
+
+    plan = hooks.tick_plan(scene)
+    if not plan.compilable or scene._solver.levers or plan.driver_limits is not None:
+        return None
+    namespace: dict[str, Any] = {}
+    names: dict[str, str] = {}
+    try:
+        body = plan_body(plan, names, namespace, vector=True)
+    except Unsupported:
+        return None
+    tables: dict[str, list[str]] = {prefix: [] for prefix in TABLES.values()}
+    for key, local in names.items():
+        prefix, name = key.split('_', 1)
+        tables[prefix].append(f'{name!r}: {local}')
+    lines = [f'ctx.{table} = {{{", ".join(tables[prefix])}}}'
+             for table, prefix in TABLES.items()]
+    function = ast.FunctionDef(
+        name='array', args=ast.arguments(
+            posonlyargs=[], args=[ast.arg(a) for a in ('theta', 'omega', 'alpha', 'turns',
+                                                       'ctx')],
+            kwonlyargs=[], kw_defaults=[], defaults=[]),
+        body=body + ast.parse('\n'.join(lines)).body, decorator_list=[], returns=None)
+    module = ast.fix_missing_locations(ast.Module(body=[function], type_ignores=[]))
+    exec(compile(module, f'<compiled array solve of {scene.name}>', 'exec'),  # noqa: S102
+         namespace)
+    array: ArrayFunction = namespace['array']
+    return array
+
+
+#: An array solve of at least this many angles keeps freed memory for the next
+#: (:func:`keep_freed_memory`).
+LARGE_BATCH = 4096
+#: The C library's settings for that: (``M_TRIM_THRESHOLD``, bytes of free memory kept
+#: at the top of the heap), (``M_MMAP_THRESHOLD``, the size from which a block is mapped
+#: on its own, returned to the system when freed: glibc's own upper limit, 32 MiB).
+KEEP_FREED = ((-1, 256 << 20), (-3, 32 << 20))
+_kept: list[bool] = []
+
+
+def keep_freed_memory() -> bool:
+    """Let the C library keep freed memory for reuse, once per process; return whether it does.
+
+    An array solve over many angles makes a few hundred temporary arrays of
+    the batch's size, and glibc by default maps each large one on its own and
+    trims the heap once they are freed, so the next solve of the same size
+    pays a page fault on every 4 KiB of every temporary again: at 100,000
+    angles that is most of its time. With :data:`KEEP_FREED` the freed blocks
+    stay in the heap and the next solve's temporaries reuse them, as buffers
+    reused across calls would, and no returned array ever shares memory with
+    another call's (each is still a fresh allocation). The process keeps up to
+    256 MiB of freed memory. Elsewhere than glibc (``platform.libc_ver``), or
+    with the environment variable ``MECH_KINEMATICS_KEEP_FREED_MEMORY=0`` (for a
+    process whose allocator settings are its own), it does nothing and returns
+    False.
+    """
+    if not _kept:
+        done = False
+        if (platform.libc_ver()[0] == 'glibc'
+                and os.environ.get('MECH_KINEMATICS_KEEP_FREED_MEMORY', '1') != '0'):
+            try:
+                libc = ctypes.CDLL(None)
+                done = all(libc.mallopt(param, value) == 1 for param, value in KEEP_FREED)
+            except (OSError, AttributeError):
+                done = False
+        _kept.append(done)
+    return _kept[0]

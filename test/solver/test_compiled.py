@@ -1,0 +1,261 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The solver's compiled single-angle path against its general one: the same state, bit for bit.
+
+``solve(scene, angle)`` compiles a scene it has solved at single angles often
+enough (``solver/compiled.py``, issue 19's "bounds that cost little"): its
+states, bounds, warnings and refusals must be the general path's exactly.
+"""
+
+import math
+import sys
+import warnings
+
+from helpers import crank_scene_names, driver_scene_names, general_only, state_facts
+import numpy as np
+import pytest
+
+import mech_kinematics as mk
+from mech_kinematics.solver import compiled as compiled_module
+from mech_kinematics.solver.compiled import (COMPILE_AFTER, compile_array, compile_single,
+                                             LARGE_BATCH)
+from mech_kinematics.tools.report.common import MODES
+from mech_kinematics.tools.report.extreme import extreme_cases
+
+#: Crank angles over two turns and a bit, both signs.
+ANGLES = np.linspace(-7.0, 7.0, 141)
+TOLERANCES = (1e-6, 1e-12, math.inf)
+
+
+def _pair(scene_of):
+    """Return the same scene twice: compiled now, and never compiled."""
+    fast, slow = scene_of(), general_only(scene_of())
+    fast._solver.compiled_single = compile_single(fast)
+    fast._solver.compiled_array = compile_array(fast)
+    return fast, slow
+
+
+def _outcome(scene, *args, **kwargs):
+    """Return the state's facts and the warnings raised, or the error's type, text and facts."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter('always')
+        try:
+            state = mk.solve(scene, *args, **kwargs)
+        except mk.AssemblyError as error:
+            return (type(error), str(error), error.dyad, repr(error.angle),
+                    getattr(error, 'facts', None), getattr(error, 'quantity', None))
+    return state_facts(state), [(w.category, str(w.message), w.filename) for w in caught]
+
+
+def _assert_same(fast, slow, angles, speeds=(None,), turns=(0,)):
+    refused = 0
+    for theta in angles:
+        for speed in speeds:
+            for tol in TOLERANCES:
+                for k in turns:
+                    args = (float(theta), speed)
+                    expected = _outcome(slow, *args, turns=k, max_error=tol)
+                    assert _outcome(fast, *args, turns=k, max_error=tol) == expected, (
+                        fast.name, theta, speed, tol, k)
+                    refused += isinstance(expected[0], type)
+    return refused
+
+
+@pytest.mark.parametrize('name', crank_scene_names())
+def test_every_packaged_scene_solves_alike_compiled(name):
+    """Over two turns, three speeds and three tolerances: identical states, bounds, refusals."""
+    fast, slow = _pair(lambda: mk.load_scene(name))
+    if name != 'geneva':    # its state reports the lever's engagement: the general path's
+        assert fast._solver.compiled_single, f'{name} does not compile'
+    refused = _assert_same(fast, slow, ANGLES, speeds=(None, -3.5, 1e4), turns=(0, 3))
+    if name == 'four_bar_coupler_points':
+        assert refused > 0      # the triple rocker's unassemblable angles, refused alike
+
+
+def test_the_extreme_suite_refuses_and_answers_alike():
+    """Toggles, change points, grazing guides, a pin at the pivot: same states and refusals."""
+    compiled = 0
+    for case in extreme_cases(MODES['smoke']):
+        fast, slow = _pair(lambda case=case: case.scene)
+        compiled += bool(fast._solver.compiled_single)
+        speed = case.speed if case.speed is not None else case.scene.input.speed
+        _assert_same(fast, slow, case.angles, speeds=(speed,))
+    assert compiled > 0
+
+
+def _array_outcome(scene, *args, **kwargs):
+    """Return the array solve's facts and warnings."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter('always')
+        state = mk.solve(scene, *args, **kwargs)
+    return state_facts(state), [(w.category, str(w.message), w.filename) for w in caught]
+
+
+@pytest.mark.parametrize('name', crank_scene_names())
+def test_every_packaged_scene_solves_arrays_alike_compiled(name):
+    """Arrays of angles, speeds and turns, three tolerances: identical states, masks, bounds."""
+    fast, slow = _pair(lambda: mk.load_scene(name))
+    if name != 'geneva':
+        assert fast._solver.compiled_array, f'{name} does not compile'
+    speeds = np.linspace(-20.0, 30.0, ANGLES.size)
+    for kwargs in ({}, {'speed': speeds}, {'speed': 3.0, 'accel': speeds},
+                   {'turns': np.arange(ANGLES.size) % 3}, {'max_error': 1e-12},
+                   {'max_error': math.inf}):
+        for angles in (ANGLES, ANGLES[:1], ANGLES[::-7]):
+            cut = {key: value[:angles.size] if np.ndim(value) else value
+                   for key, value in kwargs.items()}
+            if 'speed' in cut and np.ndim(cut['speed']):
+                cut['speed'] = speeds[:angles.size]
+            assert _array_outcome(fast, angles, **cut) == _array_outcome(slow, angles, **cut), (
+                name, angles.size, kwargs)
+
+
+def test_the_extreme_suite_solves_arrays_alike():
+    """The extreme cases over their angles as one array: same states, masks and bounds."""
+    for case in extreme_cases(MODES['smoke']):
+        fast, slow = _pair(lambda case=case: case.scene)
+        speed = case.speed if case.speed is not None else case.scene.input.speed
+        angles = np.asarray(case.angles, dtype=float)
+        assert _array_outcome(fast, angles, speed) == _array_outcome(slow, angles, speed)
+
+
+@pytest.mark.parametrize('angle', [np.float64(1.25), np.float32(1.25), 1, np.int64(-2)])
+def test_any_real_angle_gives_the_state_of_the_float_it_equals(angle):
+    """An np.float64, np.float32 or int angle is solved as float(angle), compiled or not."""
+    fast, slow = _pair(lambda: mk.load_scene('khurmi_four_bar_ad150'))
+    expected = state_facts(mk.solve(slow, float(angle)))
+    assert state_facts(mk.solve(fast, angle)) == expected
+    assert state_facts(mk.solve(slow, angle)) == expected
+
+
+def test_a_scene_is_compiled_after_its_first_single_angle_solves():
+    """The first COMPILE_AFTER - 1 solves run the general path; the next compiles the scene."""
+    scene = mk.load_scene('slider_crank_150_600')
+    for _ in range(COMPILE_AFTER - 1):
+        mk.solve(scene, 0.5)
+        assert scene._solver.compiled_single is None
+    mk.solve(scene, 0.5)
+    assert callable(scene._solver.compiled_single)
+    mk.solve(scene, np.linspace(0.0, 1.0, 5))       # the array path counts apart
+    assert callable(scene._solver.compiled_single) and scene._solver.compiled_array is None
+
+
+def test_a_held_state_is_not_changed_by_later_solves():
+    """A state from the compiled path keeps its values when the scene is solved again."""
+    fast, _ = _pair(lambda: mk.load_scene('khurmi_four_bar_ad150'))
+    for one, other in ((0.3, 2.0), (np.linspace(0, 1, 50), np.linspace(2, 3, 50))):
+        first = mk.solve(fast, one)
+        facts = state_facts(first)
+        mk.solve(fast, other)
+        assert state_facts(first) == facts
+
+
+@pytest.mark.parametrize('compiled', [False, True])
+def test_the_callers_arrays_are_never_written(compiled):
+    """Angles, speeds and accelerations given as arrays keep their values, some angles refused.
+
+    The array path wrote NaN into the caller's speed array at the refused
+    angles (it masked the crank's rate in place), and failed for an array of
+    accelerations with a constant speed.
+    """
+    scene = mk.load_scene('four_bar_coupler_points')
+    if compiled:
+        scene._solver.compiled_array = compile_array(scene)
+    else:
+        general_only(scene)
+    angles, speeds = ANGLES.copy(), np.linspace(-20.0, 30.0, ANGLES.size)
+    for args in ((angles, speeds), (angles, 3.0, speeds.copy()), (angles, speeds, speeds)):
+        before = [np.array(x) for x in args]
+        state = mk.solve(scene, *args)
+        assert not state.valid.all() and state.valid.any()
+        for x, was in zip(args, before, strict=True):
+            assert np.array_equal(x, was)
+        for index in (5, 60):
+            one = mk.solve(scene, *(float(np.broadcast_to(x, angles.shape)[index])
+                                    for x in args))
+            assert state.joints['crank'].acceleration[index] == one.joints['crank'].acceleration
+
+
+def test_a_large_batch_keeps_freed_memory_once(monkeypatch):
+    """An array solve of LARGE_BATCH angles asks the C library once to keep freed memory."""
+    calls = []
+    monkeypatch.setattr(compiled_module, 'keep_freed_memory', lambda: calls.append(1) or True)
+    solve_module = sys.modules['mech_kinematics.solver.solve']
+    monkeypatch.setattr(solve_module, 'keep_freed_memory', compiled_module.keep_freed_memory)
+    scene = mk.load_scene('khurmi_four_bar_ad150')
+    mk.solve(scene, np.linspace(0.0, 1.0, LARGE_BATCH - 1))
+    assert not calls
+    mk.solve(scene, np.linspace(0.0, 1.0, LARGE_BATCH))
+    assert calls == [1]
+
+
+def test_keeping_freed_memory_is_set_once_on_glibc():
+    """On glibc the two settings are accepted, and asking again changes nothing."""
+    import platform
+
+    first = compiled_module.keep_freed_memory()
+    assert first == (platform.libc_ver()[0] == 'glibc')
+    assert compiled_module.keep_freed_memory() == first
+
+
+@pytest.mark.parametrize('args, kwargs', [((math.nan,), {}), ((math.inf,), {}),
+                                          ((0.5,), {'max_error': 0.0}),
+                                          ((0.5,), {'max_error': -1e-6}),
+                                          ((0.5,), {'turns': 1.5})])
+def test_bad_input_is_refused_alike_compiled(args, kwargs):
+    """A non-finite angle, a tolerance that is not positive, fractional turns: the same error."""
+    fast, slow = _pair(lambda: mk.load_scene('khurmi_four_bar_ad150'))
+    errors = []
+    for scene in (fast, slow):
+        with pytest.raises(ValueError) as caught:
+            mk.solve(scene, *args, **kwargs)
+        errors.append(str(caught.value))
+    assert errors[0] == errors[1] and errors[0].startswith('Expected')
+
+
+def test_the_array_path_compiles_run_and_the_single_angle_path_the_kernels(monkeypatch):
+    """Step.kernels names the single-angle path only: the array path compiles ``run``.
+
+    A kernel outside the subset (a loop) makes the single-angle path fall back
+    (``None``) while the array path, compiled from ``run``, still compiles.
+    """
+    scene = mk.load_scene('khurmi_four_bar_ad150')
+    step = type(scene._solver.run_plan.steps[0])
+
+    def looping(self, ctx):
+        for _ in range(1):
+            ctx.measures[self.key] = 1.0
+
+    monkeypatch.setattr(step, 'kernels', classmethod(lambda cls: (looping,)))
+    assert compile_single(scene) is None
+    assert compile_array(scene) is not None
+
+
+@pytest.mark.parametrize('name', driver_scene_names())
+def test_a_scene_of_several_drivers_keeps_the_general_path(name):
+    """Several drivers or an actuator: neither path compiles, and solving often changes nothing."""
+    scene = mk.load_scene(name)
+    assert compile_single(scene) is None and compile_array(scene) is None
+    positions = [driver.start for driver in scene.drivers]
+    first = state_facts(mk.solve(scene, positions))
+    for _ in range(COMPILE_AFTER + 1):
+        mk.solve(scene, positions)
+        mk.solve(scene, [np.full(3, x) for x in positions])
+    assert state_facts(mk.solve(scene, positions)) == first
+    assert scene._solver.compiled_single in (None, False)
+    assert scene._solver.compiled_array in (None, False)
+
+
+def test_keeping_freed_memory_can_be_declined():
+    """MECH_KINEMATICS_KEEP_FREED_MEMORY=0: the process's allocator settings are left alone."""
+    import os
+    import subprocess
+
+    code = ('from mech_kinematics.solver.compiled import keep_freed_memory as k\n'
+            'import platform\n'
+            'print(k(), platform.libc_ver()[0] == "glibc")')
+    for value, kept in (('0', 'False'), ('1', None)):
+        env = {**os.environ, 'MECH_KINEMATICS_KEEP_FREED_MEMORY': value}
+        out = subprocess.run([sys.executable, '-c', code], env=env, capture_output=True,
+                             text=True, check=True).stdout.split()
+        assert out[0] == (kept if kept is not None else out[1])
