@@ -26,6 +26,8 @@ from mech_kinematics.ros.parameters import spec
 ROOT = Path(__file__).resolve().parent.parent
 LAUNCH_PY = ROOT / 'launch' / 'kinematics.launch.py'
 LAUNCH_XML = ROOT / 'launch' / 'kinematics.launch.xml'
+#: The five-line example of docs/node.md: a node driven by the motors' joint_states (issue 18).
+CLOSED_CHAIN = ROOT / 'launch' / 'closed_chain.launch.py'
 RVIZ = ROOT / 'config' / 'mech_kinematics.rviz'
 NODE_SOURCE = ROOT / 'mech_kinematics' / 'ros' / 'node.py'
 PACKAGE = 'mech_kinematics'
@@ -213,7 +215,8 @@ def test_parameters_file_points_to_files_that_exist():
     assert set(values) <= node_parameters()
 
 
-@pytest.mark.parametrize('path', [LAUNCH_PY, LAUNCH_XML, RVIZ], ids=lambda p: p.name)
+@pytest.mark.parametrize('path', [LAUNCH_PY, LAUNCH_XML, CLOSED_CHAIN, RVIZ],
+                         ids=lambda p: p.name)
 def test_installed_by_setup_py(path):
     """setup.py installs the launch files to share/mech_kinematics/launch and the rviz config."""
     relative = path.relative_to(ROOT).as_posix()
@@ -243,3 +246,30 @@ def test_rviz_config_shows_the_nodes_frame_tf_and_markers():
     assert topics.ROBOT_DESCRIPTION == 'robot_description'
     assert 'create_publisher(String, topics.ROBOT_DESCRIPTION' in source
     assert 'Value: /' not in RVIZ.read_text(encoding='utf-8')     # no absolute topic
+
+
+def test_closed_chain_launch_drives_the_node_from_the_motors_topic():
+    """closed_chain.launch.py: kinematics_node, drive: topic, input remapped (issue 18).
+
+    It compiles, names a packaged scene and declared parameters only, and is
+    what docs/node.md shows.
+    """
+    source = CLOSED_CHAIN.read_text(encoding='utf-8')
+    tree = ast.parse(source)
+    compile(tree, str(CLOSED_CHAIN), 'exec')
+    [call] = [node for node in ast.walk(tree)
+              if isinstance(node, ast.Call) and getattr(node.func, 'id', '') == 'Node']
+    keywords = {kw.arg: ast.literal_eval(kw.value) for kw in call.keywords}
+    assert keywords['package'] == PACKAGE
+    assert keywords['executable'] == 'kinematics_node' in console_scripts()
+    [parameters] = keywords['parameters']
+    assert set(parameters) <= node_parameters()
+    assert parameters['drive'] == 'topic' and 'topic' in spec('drive').choices
+    assert parameters['scene'] in mk.scene_names()
+    assert keywords['remappings'] == [(topics.INPUT_JOINT_STATES, '/motors/joint_states')]
+    # docs/node.md shows this file's function, without its docstring: five lines.
+    function = tree.body[-1]
+    lines = ast.get_source_segment(source, function).splitlines()
+    shown = [lines[0], *lines[2:]]
+    assert len(shown) == 5
+    assert '\n'.join(shown) in (ROOT / 'docs' / 'node.md').read_text(encoding='utf-8')

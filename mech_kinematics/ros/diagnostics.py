@@ -221,7 +221,12 @@ def solver_status(window: Window, *, name: str, hardware_id: str, near_singular:
     ]
     if assembly:
         values.append(('assembly', assembly))
-    if w.last_sample is not None:
+    if w.last_sample is not None and isinstance(w.last_sample[0], tuple):
+        # Several drivers: each one's position, speed and acceleration, in scene order.
+        values += [(f'driver_{key}', ', '.join(map(repr, column)))
+                   for key, column in zip(('positions', 'speeds', 'accels'), w.last_sample,
+                                          strict=True)]
+    elif w.last_sample is not None:
         values += [('crank_angle', repr(w.last_sample[0])),
                    ('crank_speed', repr(w.last_sample[1])),
                    ('crank_accel', repr(w.last_sample[2]))]

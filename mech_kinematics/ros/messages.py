@@ -51,20 +51,25 @@ def _joint_trajectory(names: Sequence[str], frame_id: str, stamp: Time,
 
 def _multi_dof(names: Sequence[str], frame_id: str, stamp: Time,
                xy: Sequence[list[float]]) -> MultiDOFJointTrajectory:
-    """Build the point message; ``xy`` holds flat [x0, y0, x1, y1, ...] for p, v, a."""
+    """Build the point message; ``xy`` holds flat [x0, y0, x1, y1, ...] for p, v, a.
+
+    An empty ``v`` or ``a`` leaves that quantity out (no entries).
+    """
     p, v, a = xy
     point = MultiDOFJointTrajectoryPoint()
     for i in range(len(names)):
         transform = Transform()
         transform.translation.x, transform.translation.y = p[2 * i], p[2 * i + 1]
         transform.rotation.w = 1.0
-        velocity = Twist()
-        velocity.linear.x, velocity.linear.y = v[2 * i], v[2 * i + 1]
-        acceleration = Twist()
-        acceleration.linear.x, acceleration.linear.y = a[2 * i], a[2 * i + 1]
         point.transforms.append(transform)
-        point.velocities.append(velocity)
-        point.accelerations.append(acceleration)
+        if v:
+            velocity = Twist()
+            velocity.linear.x, velocity.linear.y = v[2 * i], v[2 * i + 1]
+            point.velocities.append(velocity)
+        if a:
+            acceleration = Twist()
+            acceleration.linear.x, acceleration.linear.y = a[2 * i], a[2 * i + 1]
+            point.accelerations.append(acceleration)
     msg = MultiDOFJointTrajectory(joint_names=list(names), points=[point])
     msg.header.stamp = stamp
     msg.header.frame_id = frame_id
@@ -117,25 +122,43 @@ class TickMessages:
         Point names, in publish order.
     frame_id : str
         ``header.frame_id`` of every message.
+    velocities, accelerations : bool, keyword-only
+        Whether the messages carry the velocities, the accelerations. A
+        quantity left out is an empty array (``velocity`` of a JointState,
+        ``velocities`` / ``accelerations`` of a trajectory point): what the
+        node publishes when it is driven from a topic whose messages do not
+        determine it (see :mod:`~mech_kinematics.ros.topic_drive`). The slots
+        keep their places in the values of a tick function either way.
+
+    Raises
+    ------
+    ValueError
+        If ``accelerations`` is asked without ``velocities``.
     """
 
-    def __init__(self, joints: Sequence[str], points: Sequence[str], frame_id: str) -> None:
+    def __init__(self, joints: Sequence[str], points: Sequence[str], frame_id: str, *,
+                 velocities: bool = True, accelerations: bool = True) -> None:
+        if accelerations and not velocities:
+            msg = 'Expected velocities with accelerations (a template keeps a prefix of slots)'
+            raise ValueError(msg)
         self.joints = tuple(joints)
         self.points = tuple(points)
         nj, npt = len(self.joints), len(self.points)
         stamp = _stamp(*STAMP_MARKER)
 
-        def slots(start: int, count: int) -> list[float]:
-            return [marker(i) for i in range(start, start + count)]
+        def slots(start: int, count: int, kept: bool = True) -> list[float]:
+            return [marker(i) for i in range(start, start + count)] if kept else []
 
+        v, a = velocities, accelerations
+        joint_slots = (slots(0, nj), slots(nj, nj, v), slots(2 * nj, nj, a))
+        point_slots = (slots(0, 2 * npt), slots(2 * npt, 2 * npt, v),
+                       slots(4 * npt, 2 * npt, a))
         self._joint_state = MessageTemplate(
-            _joint_state(self.joints, frame_id, stamp, slots(0, nj), slots(nj, nj)), 2 * nj)
+            _joint_state(self.joints, frame_id, stamp, *joint_slots[:2]), (1 + v) * nj)
         self._joint_trajectory = MessageTemplate(_joint_trajectory(
-            self.joints, frame_id, stamp, (slots(0, nj), slots(nj, nj), slots(2 * nj, nj))),
-            3 * nj)
-        self._points = MessageTemplate(_multi_dof(
-            self.points, frame_id, stamp,
-            (slots(0, 2 * npt), slots(2 * npt, 2 * npt), slots(4 * npt, 2 * npt))), 6 * npt)
+            self.joints, frame_id, stamp, joint_slots), sum(map(len, joint_slots)))
+        self._points = MessageTemplate(_multi_dof(self.points, frame_id, stamp, point_slots),
+                                       sum(map(len, point_slots)))
 
     def render(self, state: Any, sec: int, nanosec: int) -> tuple[bytes, bytes, bytes]:
         """Return (joint_states, joint_accelerations, point_accelerations) as CDR bytes."""

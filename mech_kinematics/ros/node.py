@@ -28,6 +28,7 @@ Run it with ``ros2 run mech_kinematics kinematics_node`` or
 
 from __future__ import annotations
 
+import copy
 import ctypes
 from dataclasses import replace
 import gc
@@ -37,7 +38,7 @@ import sys
 import threading
 import time
 import traceback
-from typing import Any
+from typing import Any, NamedTuple
 import warnings
 
 from builtin_interfaces.msg import Time
@@ -64,19 +65,21 @@ from .driver import TickDriver
 from .imus import ImuFrames, ImuMessages
 from .markers import marker_array_from_state, marker_size_from_space, MarkerThrottle
 from .messages import TickMessages
-from .parameters import (CATCH_UP, catch_up_window_ns, joint_refusal, PARAMETERS, ParameterSpec,
-                         refusal, spec, STATE_DEPTH)
+from .parameters import (CATCH_UP, catch_up_window_ns, driver_parameters, first_crank_aliases,
+                         joint_refusal, PARAMETERS, ParameterSpec, refusal, rpm_parameter, spec,
+                         STATE_DEPTH, TOPIC)
 from .schedule import period_ns_from_rate
 from .tf import static_tf_message, TfMessages
 from .ticker import tick_function
-from .timebase import CrankSample
+from .timebase import ActuatorTimebase, CrankSample, CrankTimebase
+from .topic_drive import RefusedInput, TopicDrive, TopicInput
 from ..geometry.assembly import assembly_summary
 from ..geometry.diagrams import space_from_state, strokes_from_scene
 from ..geometry.frames import angle_joints, frames_from_scene, origin_points, sensor_offsets
 from ..geometry.instant_centres import full_scene
 from ..geometry.urdf import urdf_from_scene
 from ..scene import scene_text
-from ..units import NS_PER_S, rad_per_s_from_rpm, rpm_from_rad_per_s
+from ..units import NS_PER_S, rad_per_s_from_rpm
 
 __all__ = ['KinematicsNode', 'NODE_NAME', 'TickThreadError', 'main']
 
@@ -93,12 +96,20 @@ SWITCH_INTERVAL_S = 0.0005
 #: The node-private, hidden topic on which each node says when it started (transient local,
 #: so that a newcomer of the same name hears an older node as soon as they are matched).
 INSTANCE_TOPIC = '~/_instance'
-#: The drive parameters, applied by the tick thread at an instant it has not published.
+#: The drive parameters, applied by the tick thread at an instant it has not published
+#: (with each driver's ``inputs.NAME.*``, declared when the scene is loaded).
 DRIVE = ('crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm')
-#: The crank's name in the driver, and what each drive parameter sets there.
-CRANK = 'crank'
-CRANK_KEYS = {'crank_speed_rpm': 'speed_rpm', 'crank_accel': 'accel',
-              'max_crank_speed_rpm': 'max_speed_rpm'}
+#: What the bound on the crank speed sets in each crank's time base.
+MAX_SPEED_KEY = 'max_speed_rpm'
+#: A crank's joint type (``Driver.joint_type``); an actuator's is prismatic.
+REVOLUTE = 'revolute'
+#: Parameters whose values one rule ties together (parameters.joint_refusal).
+JOINT_RULES = (*DRIVE, 'drive', 'markers')
+#: History depth of the input_joint_states subscription (a second of input at 1 kHz, as the
+#: state publishers keep: a stall of the executor loses no message).
+INPUT_DEPTH = 1000
+#: Input messages one call of the subscription's callback takes from its queue at most.
+INPUT_BURST = 100
 DOUBLES = frozenset(p.name for p in PARAMETERS if p.kind == 'double')
 READ_ONLY = frozenset(p.name for p in PARAMETERS if p.read_only)
 
@@ -110,11 +121,6 @@ QOS_OVERRIDES = QoSPolicyKind.HISTORY, QoSPolicyKind.DEPTH, QoSPolicyKind.RELIAB
 
 _LEVELS = {0: DiagnosticStatus.OK, 1: DiagnosticStatus.WARN, 2: DiagnosticStatus.ERROR,
            3: DiagnosticStatus.STALE}
-
-
-def rpm_parameter(speed: float) -> float:
-    """Return ``speed`` (rad/s) in rpm, rounded to 12 significant digits (-120, not -119.99...)."""
-    return float(f'{rpm_from_rad_per_s(speed):.12g}')
 
 
 def _set_timer_slack(ns: int) -> None:
@@ -210,6 +216,15 @@ class KinematicsNode(LifecycleNode):
         self._pub_markers: Any = None
         self._imus: ImuMessages | None = None
         self._imu_frames: ImuFrames | None = None
+        self._topic: TopicDrive | None = None
+        self._input: Any = None
+        self._input_active = False
+        # The scene's drivers' parameters, set at configure (parameters.driver_parameters).
+        self._driver_specs: dict[str, ParameterSpec] = {}
+        self._aliases: dict[str, str] = {}
+        self._drive_keys: dict[str, list[tuple[str, str]]] = {}
+        self._drivers_by_name: dict[str, Any] = {}
+        self._declaring = False
         self._failure_guard = self.create_guard_condition(self._on_failure)
         self.add_pre_set_parameters_callback(self._pre_set)
         self.add_on_set_parameters_callback(self._validate)
@@ -251,6 +266,13 @@ class KinematicsNode(LifecycleNode):
     def _value(self, name: str) -> Any:
         return self.get_parameter(name).value
 
+    def _declared(self, name: str, default: float) -> float:
+        """Return parameter ``name``'s value, or ``default`` while it is not declared yet."""
+        return float(self._value(name)) if self.has_parameter(name) else float(default)
+
+    def _is_double(self, name: str) -> bool:
+        return name in DOUBLES or name in self._driver_specs
+
     def _pre_set(self, parameters: list[Parameter]) -> list[Parameter]:
         """Turn an integer given for a double into a double (rclcpp#979); log read-only sets.
 
@@ -261,9 +283,29 @@ class KinematicsNode(LifecycleNode):
             if p.name in READ_ONLY and not self.starting:
                 self.get_logger().warning(
                     f'parameter refused: {p.name}: read-only (set it at start), got {p.value!r}')
-        return [Parameter(p.name, Parameter.Type.DOUBLE, float(p.value))
-                if p.name in DOUBLES and p.type_ == Parameter.Type.INTEGER else p
-                for p in parameters]
+        parameters = [Parameter(p.name, Parameter.Type.DOUBLE, float(p.value))
+                      if self._is_double(p.name) and p.type_ == Parameter.Type.INTEGER else p
+                      for p in parameters]
+        return self._with_aliases(parameters)
+
+    def _with_aliases(self, parameters: list[Parameter]) -> list[Parameter]:
+        """Add the other name of the first crank's speed or acceleration, set to the same value.
+
+        ``crank_speed_rpm`` and ``inputs.FIRST.speed_rpm`` (and ``crank_accel``
+        and ``inputs.FIRST.accel``) are one value: setting either sets both,
+        atomically. Given both with different values, the second is refused.
+        """
+        if not self._aliases or self._declaring:
+            return parameters
+        names = {p.name for p in parameters}
+        added = []
+        for old, new in self._aliases.items():
+            for given, other in ((old, new), (new, old)):
+                if given in names and other not in names:
+                    value = next(p for p in parameters if p.name == given).value
+                    added.append(Parameter(other, Parameter.Type.DOUBLE, value)
+                                 if isinstance(value, float) else Parameter(other, value=value))
+        return [*parameters, *added]
 
     def _validate(self, parameters: list[Parameter]) -> SetParametersResult:
         """Refuse a value of the wrong type or out of range, or one that breaks a joint rule."""
@@ -272,14 +314,18 @@ class KinematicsNode(LifecycleNode):
             if p.type_ == Parameter.Type.NOT_SET and not self.has_parameter(p.name) \
                     and spec_default_is_none(p.name):
                 continue    # declared unset: the scene gives it at configure
-            reason = refusal(p.name, p.value)
+            reason = refusal(p.name, p.value, self._driver_specs or None)
             if reason is not None:
                 break
         if reason is None:
-            current = {name: self._value(name) for name in DRIVE if self.has_parameter(name)}
-            current.update((p.name, p.value) for p in parameters if p.name in DRIVE)
-            if None not in current.values():
-                reason = joint_refusal(current)
+            rules = (*JOINT_RULES, *self._driver_specs)
+            # The values being set first, so that a refusal names what was set.
+            current = {p.name: p.value for p in parameters if p.name in rules}
+            current.update((name, self._value(name)) for name in rules
+                           if name not in current and self.has_parameter(name))
+            reason = joint_refusal({k: v for k, v in current.items() if v is not None})
+        if reason is None:
+            reason = self._stroke_refusal(parameters)
         if reason is None:
             return SetParametersResult(successful=True)
         # Every refusal is logged once, with its reason, besides the service's answer
@@ -307,11 +353,15 @@ class KinematicsNode(LifecycleNode):
             self._tf_period_ns = self._tf_period(changes['tf_rate_hz'])
         if 'max_relative_error' in changes:
             self._max_error = float(changes['max_relative_error'])
-        drive = {CRANK_KEYS[name]: float(changes[name]) for name in DRIVE if name in changes}
-        if drive and CRANK in driver.drives:
-            driver.request(CRANK, **drive)
-            if self._thread is None:
-                self._apply_now()   # not ticking: from the current instant
+        requests: dict[str, dict[str, float]] = {}
+        for name, value in changes.items():
+            for drive, key in self._drive_keys.get(name, ()):
+                requests.setdefault(drive, {})[key] = float(value)
+        for drive, request in requests.items():
+            if drive in driver.drives:
+                driver.request(drive, **request)
+        if requests and self._thread is None:
+            self._apply_now()   # not ticking: from the current instant
         logged = ', '.join(f'{p.name}={p.value!r}' for p in parameters)
         if self.scene is not None:
             self.get_logger().info(f'parameters set: {logged}')
@@ -337,37 +387,36 @@ class KinematicsNode(LifecycleNode):
 
     def _configure(self) -> None:
         scene = mk.load_scene(self._value('scene'))
-        scene_rpm = rpm_parameter(scene.input.speed)
+        drivers = scene.drivers
+        first = drivers[0] if drivers[0].joint_type == REVOLUTE else None
+        crank_rpms = [rpm_parameter(d.speed) for d in drivers if d.joint_type == REVOLUTE]
         given_rpm = self._value('crank_speed_rpm')      # a speed set at start raises the bound
-        defaults = {
-            'max_crank_speed_rpm': max(DEFAULT_MAX_CRANK_SPEED_RPM, abs(scene_rpm),
-                                       abs(given_rpm or 0.0)),
-            'crank_speed_rpm': scene_rpm,
-            'crank_accel': scene.input.accel,
-        }
+        given = {name for name in DRIVE[:2] if self._value(name) is not None}
+        defaults = {'max_crank_speed_rpm': max([DEFAULT_MAX_CRANK_SPEED_RPM, abs(given_rpm or 0.0),
+                                                *map(abs, crank_rpms)])}
+        if first is not None:
+            defaults.update(crank_speed_rpm=rpm_parameter(first.speed), crank_accel=first.accel)
         unset = [Parameter(name, Parameter.Type.DOUBLE, float(value))
                  for name, value in defaults.items() if self._value(name) is None]
-        # The scene's own speed is driven in its own unit (rad/s), so that the node
-        # publishes what `solve` prints to the bit; the parameter shows it in rpm.
-        own_speed = self._value('crank_speed_rpm') is None \
-            and abs(scene_rpm) < DEFAULT_MAX_CRANK_SPEED_RPM
         if unset:
             result = self.set_parameters_atomically(unset)
             if not result.successful:
                 raise mk.SceneError(f'{scene.name}: {result.reason}')
-        speed = {'speed': scene.input.speed} if own_speed else \
-            {'speed_rpm': self._value('crank_speed_rpm')}
+        self._declare_drivers(scene, given)
+        starts = [self._drive_start(d, d is not first or given_rpm is None) for d in drivers]
         try:    # what `solve` refuses at the start, the node refuses to start with
-            mk.solve(scene, scene.input.angle,
-                     speed['speed'] if own_speed else rad_per_s_from_rpm(speed['speed_rpm']),
-                     self._value('crank_accel'), turns=scene.input.turns,
-                     max_error=self._max_error)
+            if len(drivers) == 1:
+                [(_, position, speed, accel, turns)] = starts
+                mk.solve(scene, position, speed, accel, turns=turns, max_error=self._max_error)
+            else:
+                _, positions, speeds, accels, turns = zip(*starts, strict=True)
+                mk.solve(scene, positions, speeds, accels, turns=turns,
+                         max_error=self._max_error)
         except mk.AssemblyError as error:
             msg = f'{scene.name}: {error}'
             raise mk.SceneError(msg) from None
-        self._driver.add_drive(CRANK, angle=scene.input.angle, turns=scene.input.turns,
-                               accel=self._value('crank_accel'),
-                               max_speed_rpm=self._value('max_crank_speed_rpm'), **speed)
+        for d, (timebase, *_) in zip(drivers, starts, strict=True):
+            self._driver.add_drive(d.name, timebase.kind, **timebase.start)
         self._messages = TickMessages(scene.output_joints, scene.output_points, self.frame_id)
         self._pub_joint_states = self.create_publisher(
             JointState, topics.JOINT_STATES, _state_qos(), qos_overriding_options=_qos_options())
@@ -391,13 +440,126 @@ class KinematicsNode(LifecycleNode):
         # Instants where a value jumps (a Geneva wheel's) are published one-sided and counted.
         self._jumps_at = tick_scene.jumps_at if tick_scene.intermittent else None
         # Where the scene cannot assemble, in one line, for the diagnostics.
-        self._assembly = assembly_summary(scene)
+        # (a crank's turn: a scene of several drivers, or an actuator, has none to sweep).
+        self._assembly = assembly_summary(scene) \
+            if len(scene.drivers) == 1 and scene.input is not None else ''
         if not compiled:
             self.get_logger().info('the scene is solved by the general solver (not compiled)')
         if self._value('markers'):
             self._setup_markers(scene)
+        self._setup_topic_drive(scene)
         self.scene = scene
         self._log_start()
+
+    def _declare_drivers(self, scene: mk.Scene, given: set[str]) -> None:
+        """Declare each driver's ``inputs.NAME.*`` (the scene's defaults); note what they set.
+
+        The first crank's take ``crank_speed_rpm`` and ``crank_accel`` as their
+        defaults (the two are one value each, see :meth:`_with_aliases`); given
+        both names at start (``given``: the v1 names given) with different
+        values, the node refuses to start.
+        """
+        specs = driver_parameters(scene.drivers)
+        self._aliases = first_crank_aliases(scene.drivers)
+        self._driver_specs = {p.name: p for p in specs}
+        self._drivers_by_name = {d.name: d for d in scene.drivers}
+        aliased = {new: old for old, new in self._aliases.items()}
+        keys: dict[str, list[tuple[str, str]]] = {}
+        for d in scene.drivers:
+            for p in specs:
+                if p.name.startswith(f'inputs.{d.name}.'):
+                    keys[p.name] = [(d.name, p.name.rsplit('.', 1)[1])]
+        for old, new in self._aliases.items():
+            keys[old] = keys[new]
+        keys[DRIVE[2]] = [(d.name, MAX_SPEED_KEY) for d in scene.drivers
+                          if d.joint_type == REVOLUTE]
+        self._drive_keys = keys
+        self._declaring = True
+        try:
+            for p in specs:
+                if self.has_parameter(p.name):
+                    continue
+                default = self._value(aliased[p.name]) if p.name in aliased else p.default
+                descriptor = ParameterDescriptor(description=_description(p),
+                                                 dynamic_typing=True)
+                value = self.declare_parameter(p.name, default, descriptor).value
+                if type(value) is int:
+                    self.set_parameters([Parameter(p.name, Parameter.Type.DOUBLE, float(value))])
+            for old, new in self._aliases.items():
+                if self._value(old) == self._value(new):
+                    continue
+                if old in given:
+                    msg = (f'{old} and {new} are the same value: expected one of them or equal '
+                           f'values, got {self._value(old)!r} and {self._value(new)!r}')
+                    raise mk.SceneError(msg)
+                result = self.set_parameters_atomically(
+                    [Parameter(old, Parameter.Type.DOUBLE, float(self._value(new)))])
+                if not result.successful:
+                    raise mk.SceneError(f'{scene.name}: {result.reason}')
+        finally:
+            self._declaring = False
+
+    def _drive_start(self, d: Any, own_speed: bool) -> tuple[Any, float, float, float, int]:
+        """Return driver ``d``'s time base start, and its (position, speed, accel, turns) then.
+
+        The scene's own crank speed is driven in its own unit (rad/s), so that
+        the node publishes what ``solve`` prints to the bit; the parameter shows
+        it in rpm. ``own_speed``: its speed was not given as ``crank_speed_rpm``
+        (the scene's, unless ``inputs.NAME.speed_rpm`` differs from it).
+        """
+        base = f'inputs.{d.name}.'
+        accel = float(self._value(base + 'accel'))
+        if d.joint_type != REVOLUTE:
+            speed = float(self._value(base + 'speed'))
+            return (_Start(ActuatorTimebase, {'length': d.start, 'speed': speed, 'accel': accel}),
+                    d.start, speed, accel, 0)
+        rpm = float(self._value(base + 'speed_rpm'))
+        own_speed = own_speed and rpm == rpm_parameter(d.speed) \
+            and abs(rpm) < DEFAULT_MAX_CRANK_SPEED_RPM
+        # A start angle beyond a turn is whole turns plus an angle within one (Crank.turns).
+        turns = d.turns
+        start = {'angle': d.start, 'turns': turns, 'accel': accel,
+                 'max_speed_rpm': self._value('max_crank_speed_rpm')}
+        if own_speed:
+            start['speed'] = d.speed
+            return _Start(CrankTimebase, start), d.start, d.speed, accel, turns
+        start['speed_rpm'] = rpm
+        return _Start(CrankTimebase, start), d.start, rad_per_s_from_rpm(rpm), accel, turns
+
+    def _stroke_refusal(self, parameters: list[Parameter]) -> str | None:
+        """Return why a change of an actuator's drive is refused: it leaves the stroke at once.
+
+        The length now is exactly known; a drive that takes it out of its
+        stroke from there (at or beyond a limit, not moving back) is refused.
+        Later exits are the ticks' to report (the solver refuses them, and
+        ``diagnostics`` says so); a drive that brings the length back is taken.
+        """
+        changes = {}
+        for p in parameters:
+            for drive, key in self._drive_keys.get(p.name, ()):
+                if key in ActuatorTimebase.CHANGES and isinstance(p.value, (int, float)):
+                    changes.setdefault(drive, {})[key] = (p.name, float(p.value))
+        for name, change in changes.items():
+            d = self._drivers_by_name[name]
+            if d.stroke is None or d.joint_type == REVOLUTE:
+                continue
+            current = self._driver.drives.get(name)
+            timebase = current.timebase if current is not None else None
+            now = self.get_clock().now().nanoseconds
+            if timebase is None:    # not started: from the start values
+                start = {'length': d.start,
+                         'speed': self._declared(f'inputs.{name}.speed', d.speed),
+                         'accel': self._declared(f'inputs.{name}.accel', d.accel)}
+                timebase, now = ActuatorTimebase(0, **start), 0
+            trial = copy.deepcopy(timebase)
+            trial.update(now, **{key: value for key, (_, value) in change.items()})
+            if trial.moves_out(now, d.stroke):
+                length = float(trial.length(now))
+                given = ', '.join(f'{n} = {v!r}' for n, v in change.values())
+                return (f'{given}: expected a drive that keeps actuator {name} within its '
+                        f'stroke [{d.stroke[0]:g}, {d.stroke[1]:g}] m, got one that leaves it '
+                        f'at once (at {length:.6g} m)')
+        return None
 
     def _setup_tf(self, scene: mk.Scene) -> mk.Scene:
         """Create the /tf and /tf_static publishers; return the scene the ticks solve.
@@ -482,10 +644,11 @@ class KinematicsNode(LifecycleNode):
     def _log_start(self) -> None:
         scene = self.scene
         assert scene is not None
-        names = ('scene', 'crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm', 'rate_hz',
-                 'late_ticks', 'max_catch_up_s', 'max_lateness_ms', 'max_relative_error',
-                 'frame_id', 'tf_rate_hz', 'tf_prefix',
+        names = ('scene', 'drive', 'crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm',
+                 'rate_hz', 'late_ticks', 'max_catch_up_s', 'max_lateness_ms',
+                 'max_relative_error', 'frame_id', 'tf_rate_hz', 'tf_prefix',
                  'use_sim_time', 'markers', 'managed')
+        names += tuple(self._driver_specs)
         settings = ', '.join(f'{name}={self._value(name)!r}' for name in names[1:])
         self.get_logger().info(
             f'scene {scene.name!r} ({self._value("scene")}): joints {list(scene.output_joints)}, '
@@ -518,6 +681,7 @@ class KinematicsNode(LifecycleNode):
                 self.destroy_publisher(publisher)
         self._state_publishers = []
         self._pub_markers = None
+        self._drop_topic_drive()
         self.scene = None
 
     def _setup_markers(self, scene: mk.Scene) -> None:
@@ -526,8 +690,7 @@ class KinematicsNode(LifecycleNode):
         self._marker_strokes = strokes_from_scene(self._marker_scene)
         try:
             self._marker_size: float | None = marker_size_from_space(space_from_state(
-                self._marker_scene, mk.solve(self._marker_scene, scene.input.angle,
-                                             turns=scene.input.turns)))
+                self._marker_scene, _solve_at_start(self._marker_scene)))
         except mk.AssemblyError:
             self._marker_size = None    # the part beyond the outputs cannot assemble here
         self._marker_throttle = MarkerThrottle()
@@ -540,7 +703,10 @@ class KinematicsNode(LifecycleNode):
     # -- the tick thread ------------------------------------------------------
 
     def start(self) -> None:
-        """Start the tick thread."""
+        """Start the tick thread (with ``drive: topic``, the input subscription instead)."""
+        if self._topic is not None:
+            self._start_topic_drive()
+            return
         self._stop.clear()
         self._driver.resume()
         self._thread = threading.Thread(target=self._run, name='mech_kinematics_tick',
@@ -549,6 +715,7 @@ class KinematicsNode(LifecycleNode):
 
     def stop(self) -> None:
         """Stop the tick thread and wait for it; apply what it left pending."""
+        self._stop_topic_drive()
         self._stop.set()
         self._clock_event.set()
         thread, self._thread = self._thread, None
@@ -637,7 +804,11 @@ class KinematicsNode(LifecycleNode):
         self._stats.skip(skipped)
         late_ns = min(self._driver.period_ns // 2, LATE_NS)
         for stamp in instants:
-            [(turns, sample)] = self._driver.state_at(stamp)
+            states = self._driver.state_at(stamp)
+            if len(states) == 1:
+                [(turns, sample)] = states
+            else:   # several drivers: their positions, speeds, accels and turns, in scene order
+                turns, sample = _transposed(states)
             lateness = woke - stamp
             self._tick(stamp, lateness, lateness > late_ns, turns, sample)
 
@@ -684,8 +855,110 @@ class KinematicsNode(LifecycleNode):
                               self._jumps_at is not None and self._jumps_at(angle, turns=turns))
         if measure < mk.NEAR_SINGULAR:
             self.get_logger().warning(
-                f'near-singular pose at crank angle {angle:.6f} rad: measure {measure:.3g}',
+                f'near-singular pose at {_position(angle)}: measure {measure:.3g}',
                 throttle_duration_sec=1.0)
+
+    # -- driven from a topic --------------------------------------------------
+
+    def _setup_topic_drive(self, scene: mk.Scene) -> None:
+        """With ``drive: topic``, prepare the rules and the messages without accelerations."""
+        self._topic = None
+        if self._value('drive') != TOPIC:
+            return
+        joints, points = scene.output_joints, scene.output_points
+        # What the input determines: positions always, velocities when a message has them.
+        self._topic_messages = {
+            known: TickMessages(joints, points, self.frame_id, velocities=known,
+                                accelerations=False) for known in (True, False)}
+        self._topic = TopicDrive(scene.drivers)
+        # Subscribed at configure (its QoS overrides are declared with the others); a
+        # message is published only while active.
+        qos = QoSProfile(history=QoSHistoryPolicy.KEEP_LAST, depth=INPUT_DEPTH,
+                         reliability=QoSReliabilityPolicy.RELIABLE,
+                         durability=QoSDurabilityPolicy.VOLATILE)
+        self._input = self.create_subscription(
+            JointState, topics.INPUT_JOINT_STATES, self._on_input, qos,
+            qos_overriding_options=_qos_options())
+
+    def _start_topic_drive(self) -> None:
+        """Publish a state for each message on ``input_joint_states`` from now on."""
+        self._input_active = True
+
+    def _stop_topic_drive(self) -> None:
+        self._input_active = False
+
+    def _drop_topic_drive(self) -> None:
+        self._input_active = False
+        self._topic = None
+        subscription, self._input = self._input, None
+        if subscription is not None:
+            self.destroy_subscription(subscription)
+
+    def _on_input(self, msg: JointState) -> None:
+        """Publish the state of each input message waiting, from ``msg`` on, with its stamp.
+
+        rclpy's executor rebuilds its wait set of every service, timer and
+        subscription of the node for each message it hands over: behind by a
+        burst, the node would pay that per message. Each call takes up to
+        :data:`INPUT_BURST` more messages waiting in the subscription's queue
+        (as the executor takes them), then lets the executor serve the rest.
+        """
+        self._input_message(msg)
+        subscription = self._input
+        for _ in range(INPUT_BURST):
+            if subscription is None or self._input is not subscription:
+                return
+            with subscription.handle:
+                taken = subscription.handle.take_message(subscription.msg_type,
+                                                         subscription.raw)
+            if taken is None:
+                return
+            self._input_message(taken[0])
+
+    def _input_message(self, msg: JointState) -> None:
+        """Publish the state of one input message with its stamp, or say why not."""
+        received = time.monotonic_ns()
+        topic = self._topic
+        if topic is None or not self._input_active:
+            return      # inactive (lifecycle), or cleaned up while the message waited
+        stamp = msg.header.stamp
+        stamp_ns = stamp.sec * NS_PER_S + stamp.nanosec
+        try:
+            given = topic.read(stamp.sec, stamp.nanosec, msg.name, msg.position, msg.velocity)
+            values, measure = self._solve_input(given)
+        except (RefusedInput, mk.AssemblyError) as exc:
+            kind = 'refused input' if isinstance(exc, RefusedInput) else \
+                'not trusted' if isinstance(exc, mk.UntrustedError) else 'cannot assemble'
+            self._stats.record(stamp_ns, time.monotonic_ns() - received, False, error=str(exc),
+                               refusal=kind)
+            self.get_logger().warning(f'no state published: {exc}', throttle_duration_sec=1.0)
+            return
+        sec, nanosec = divmod(given.stamp_ns, NS_PER_S)
+        messages = self._topic_messages[given.speeds is not None]
+        for publish, data in zip(self._publish_state,
+                                 messages.render_values(values, sec, nanosec), strict=True):
+            publish(data)
+        if self._tf is not None and self._tf_period_ns is not None \
+                and given.stamp_ns >= self._next_tf:
+            self._pub_tf.publish(self._tf.render_values(values, self._tf_first, sec, nanosec))
+            if self._imu_frames is not None:    # a sensor's frame is a position: known here
+                self._pub_tf.publish(self._imu_frames.render(sec, nanosec))
+            self._next_tf = given.stamp_ns + self._tf_period_ns
+        topic.published(given.stamp_ns)
+        self._stats.record(given.stamp_ns, time.monotonic_ns() - received, False,
+                           measure=measure, near_singular=measure < mk.NEAR_SINGULAR)
+
+    def _solve_input(self, given: TopicInput) -> tuple[Any, float]:
+        """Return (the tick function's values, the singularity measure) for one input.
+
+        Unknown velocities are solved as zero and left out of what is published;
+        the accelerations are never published.
+        """
+        n = len(given.positions)
+        speeds = (0.0,) * n if given.speeds is None else given.speeds
+        if n == 1:
+            return self._solve(given.positions[0], speeds[0], 0.0, self._max_error, 0)
+        return self._solve(given.positions, speeds, (0.0,) * n, self._max_error, (0,) * n)
 
     # -- markers --------------------------------------------------------------
 
@@ -716,7 +989,7 @@ class KinematicsNode(LifecycleNode):
         hardware_id = self.scene.name if self.scene is not None else self._value('scene')
         if self.scene is None:
             waiting = 'configure (lifecycle)'
-        elif self._thread is None:
+        elif self._thread is None and not self._input_active:
             waiting = 'activate (lifecycle)' if self.managed else 'the start'
         elif self._waiting_for_clock:
             waiting = '/clock'
@@ -734,6 +1007,35 @@ class KinematicsNode(LifecycleNode):
         msg.header.stamp = self.get_clock().now().to_msg()
         msg.header.frame_id = self.frame_id
         self._pub_diagnostics.publish(msg)
+
+
+def _solve_at_start(scene: mk.Scene) -> Any:
+    """Return ``scene`` solved with its drivers at their start (a crank with its whole turns)."""
+    drivers = scene.drivers
+    turns = [getattr(d, 'turns', 0) for d in drivers]
+    if len(drivers) == 1:
+        return mk.solve(scene, drivers[0].start, turns=turns[0])
+    return mk.solve(scene, [d.start for d in drivers], turns=turns)
+
+
+def _transposed(states: list[tuple[int, Any]]) -> tuple[tuple[int, ...], Any]:
+    """Return the drivers' (turns, state) as (turns, (positions, speeds, accels)), in order."""
+    turns = tuple(t for t, _ in states)
+    return turns, tuple(zip(*(state for _, state in states), strict=True))
+
+
+def _position(angle: Any) -> str:
+    """Return the drivers' position for a log line: one crank's angle, or every driver's."""
+    if isinstance(angle, tuple):
+        return f'driver positions {", ".join(f"{a:.6f}" for a in angle)}'
+    return f'crank angle {angle:.6f} rad'
+
+
+class _Start(NamedTuple):
+    """A driver's time base class and its start values (``TickDriver.add_drive``)."""
+
+    kind: Any
+    start: dict[str, Any]
 
 
 def spec_default_is_none(name: str) -> bool:

@@ -11,25 +11,31 @@ two parameters together.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 import math
+import re
 from typing import Any
 
 from .diagnostics import DEFAULT_MAX_LATENESS_MS
 from .markers import DEFAULT_ACCELERATION_SCALE, DEFAULT_VELOCITY_SCALE
 from ..bounds import MAX_ERROR
 from ..scene import DEFAULT_SCENE
-from ..units import NS_PER_S
+from ..units import NS_PER_S, rpm_from_rad_per_s
 
-__all__ = ['CATCH_UP', 'LATE_TICKS', 'PARAMETERS', 'ParameterSpec', 'SHOWN_CHARS', 'SKIP',
-           'STATE_DEPTH', 'catch_up_window_ns', 'depth_refusal', 'frame_refusal',
-           'joint_refusal', 'refusal', 'shown', 'spec']
+__all__ = ['CATCH_UP', 'DRIVE_MODES', 'LATE_TICKS', 'PARAMETERS', 'ParameterSpec',
+           'SHOWN_CHARS', 'SKIP', 'STATE_DEPTH', 'TIME', 'TOPIC', 'catch_up_window_ns',
+           'depth_refusal', 'driver_parameters', 'first_crank_aliases', 'frame_refusal',
+           'joint_refusal', 'refusal', 'rpm_parameter', 'shown', 'spec']
 
 #: ``late_ticks`` values: publish every missed grid instant, or only the latest.
 CATCH_UP = 'catch_up'
 SKIP = 'skip'
 LATE_TICKS = (CATCH_UP, SKIP)
+#: ``drive`` values: the drivers as exact functions of the clock, or read from a topic.
+TIME = 'time'
+TOPIC = 'topic'
+DRIVE_MODES = (TIME, TOPIC)
 
 
 @dataclass(frozen=True)
@@ -84,6 +90,11 @@ PARAMETERS = (
                   'Follow the ROS 2 node lifecycle: configure loads the scene, activate '
                   'starts publishing (default: configure and activate at start)',
                   read_only=True),
+    ParameterSpec('drive', 'string', TIME,
+                  'Where the drivers come from: time (each an exact function of the clock, '
+                  'on the rate_hz grid) or topic (the positions, and velocities if given, of '
+                  'each message on input_joint_states, published with its stamp)',
+                  choices=DRIVE_MODES, read_only=True),
     ParameterSpec('crank_speed_rpm', 'double', None,
                   'Crank speed, + CCW, from the tick at which it is applied (the crank angle '
                   "stays continuous). Defaults to the scene's input.speed_rpm",
@@ -132,6 +143,62 @@ PARAMETERS = (
 )
 
 _BY_NAME = {p.name: p for p in PARAMETERS}
+
+#: Ranges of the drivers' parameters (``inputs.NAME.*``): a crank's as crank_speed_rpm's and
+#: crank_accel's; an actuator's extension rate (m/s) and acceleration (m/s^2).
+ACTUATOR_SPEED_RANGE = (-100.0, 100.0)
+ACTUATOR_ACCEL_RANGE = (-10_000.0, 10_000.0)
+_DRIVER_NAME = re.compile(r'^inputs\.([A-Za-z_][A-Za-z0-9_]*)\.(speed_rpm|speed|accel)$')
+
+
+def rpm_parameter(speed: float) -> float:
+    """Return ``speed`` (rad/s) in rpm, rounded to 12 significant digits (-120, not -119.99...)."""
+    return float(f'{rpm_from_rad_per_s(speed):.12g}')
+
+
+def driver_parameters(drivers: Sequence[Any]) -> tuple[ParameterSpec, ...]:
+    """Return the parameters of a scene's drivers, defaulting to the scene's values.
+
+    For each driver NAME (``Scene.drivers``: ``name``, ``joint_type``,
+    ``speed``, ``accel``): ``inputs.NAME.speed_rpm`` and ``inputs.NAME.accel``
+    for a crank (rpm, rad/s^2; the ranges of ``crank_speed_rpm`` and
+    ``crank_accel``), ``inputs.NAME.speed`` and ``inputs.NAME.accel`` for an
+    actuator (m/s, m/s^2). The node declares them when it loads the scene.
+    """
+    specs = []
+    speed_rpm, accel = spec('crank_speed_rpm'), spec('crank_accel')
+    for d in drivers:
+        base = f'inputs.{d.name}.'
+        if d.joint_type == 'revolute':
+            specs += [
+                ParameterSpec(base + 'speed_rpm', 'double', rpm_parameter(d.speed),
+                              f'Speed of crank {d.name}, + CCW, from the tick at which it is '
+                              "applied. Defaults to the scene's", 'rpm', speed_rpm.low,
+                              speed_rpm.high),
+                ParameterSpec(base + 'accel', 'double', float(d.accel),
+                              f'Angular acceleration of crank {d.name}, + CCW. Defaults to '
+                              "the scene's", 'rad/s^2', accel.low, accel.high)]
+        else:
+            specs += [
+                ParameterSpec(base + 'speed', 'double', float(d.speed),
+                              f'Extension rate of actuator {d.name}, from the tick at which '
+                              'it is applied (its length stays continuous). Defaults to the '
+                              "scene's", 'm/s', *ACTUATOR_SPEED_RANGE),
+                ParameterSpec(base + 'accel', 'double', float(d.accel),
+                              f'Extension acceleration of actuator {d.name}. Defaults to the '
+                              "scene's", 'm/s^2', *ACTUATOR_ACCEL_RANGE)]
+    return tuple(specs)
+
+
+def first_crank_aliases(drivers: Sequence[Any]) -> dict[str, str]:
+    """Return {``crank_speed_rpm``, ``crank_accel``: the first driver's names}, if it is a crank.
+
+    The two v1 names stay the first crank's: setting either name sets both.
+    """
+    if not drivers or drivers[0].joint_type != 'revolute':
+        return {}
+    base = f'inputs.{drivers[0].name}.'
+    return {'crank_speed_rpm': base + 'speed_rpm', 'crank_accel': base + 'accel'}
 
 
 def spec(name: str) -> ParameterSpec:
@@ -207,17 +274,24 @@ def depth_refusal(name: str, value: Any) -> str | None:
     return None
 
 
-def refusal(name: str, value: Any) -> str | None:
+def refusal(name: str, value: Any,
+            drivers: Mapping[str, ParameterSpec] | None = None) -> str | None:
     """Return why ``value`` is refused for parameter ``name``, or ``None`` if it is accepted.
 
-    Names the node does not own (``use_sim_time``, ``qos_overrides.*``) are
-    accepted here: rclpy checks them. An empty name is refused.
+    ``drivers``: the scene's driver parameters (:func:`driver_parameters`) by
+    name. An ``inputs.NAME.*`` name that is not among them is refused (no such
+    driver, or not its kind of parameter). Names the node does not own
+    (``use_sim_time``, ``qos_overrides.*``) are accepted here: rclpy checks
+    them. An empty name is refused.
     """
     if not name:
         return f'expected a parameter name, got an empty one (with value {shown(value)})'
     if name.startswith('qos_overrides.') and name.endswith('.depth'):
         return depth_refusal(name, value)
-    p = _BY_NAME.get(name)
+    p = _BY_NAME.get(name) or (drivers or {}).get(name)
+    if p is None and drivers is not None and name.startswith('inputs.'):
+        known = ', '.join(sorted(drivers)) or 'none'
+        return f'{name}: expected the parameter of a driver of the scene ({known}), got none'
     if p is None:
         return None
     if p.kind == 'double':
@@ -252,9 +326,17 @@ def joint_refusal(values: Mapping[str, Any]) -> str | None:
     ``values`` holds the values the parameters would have (new ones merged
     over current ones); missing names are not checked.
     """
-    speed, bound = values.get('crank_speed_rpm'), values.get('max_crank_speed_rpm')
-    if speed is not None and bound is not None and abs(float(speed)) > float(bound):
-        return (f'crank_speed_rpm: expected |crank_speed_rpm| <= max_crank_speed_rpm '
-                f'({float(bound):g} rpm), got {float(speed):g} rpm; set max_crank_speed_rpm '
-                f'(up to {spec("max_crank_speed_rpm").high:g}) first to go faster')
+    if values.get('drive') == TOPIC and values.get('markers') is True:
+        return ('markers: expected false with drive: topic (the arrows would show '
+                'velocities and accelerations the input does not give), got true')
+    bound = values.get('max_crank_speed_rpm')
+    if bound is None:
+        return None
+    # Every crank's speed: crank_speed_rpm (the first's) and inputs.NAME.speed_rpm.
+    for name, speed in values.items():
+        if (name == 'crank_speed_rpm' or name.endswith('.speed_rpm')) and speed is not None \
+                and abs(float(speed)) > float(bound):
+            return (f'{name}: expected |{name}| <= max_crank_speed_rpm ({float(bound):g} rpm), '
+                    f'got {float(speed):g} rpm; set max_crank_speed_rpm (up to '
+                    f'{spec("max_crank_speed_rpm").high:g}) first to go faster')
     return None

@@ -1,6 +1,11 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""The crank angle as an exact function of clock time (no ROS needed).
+"""Each driver's position as an exact function of clock time (no ROS needed).
+
+:class:`CrankTimebase` drives a crank (below); :class:`ActuatorTimebase` a
+linear actuator, whose length ``L0 + v t + a t**2 / 2`` is kept the same way
+(exact rationals in integer nanoseconds, one rounding at the end), without a
+wrap or a speed bound.
 
 The drive is a sequence of *segments*. A segment starts at a clock instant
 (integer nanoseconds) with an exact crank position, a speed and an angular
@@ -44,8 +49,8 @@ from typing import NamedTuple
 
 from ..units import NS_PER_S, rad_per_s_from_rpm
 
-__all__ = ['CrankSample', 'CrankTimebase', 'MAX_DENOMINATOR_BITS', 'POSITION_BITS', 'TWO_PI',
-           'turns_from_radians']
+__all__ = ['ActuatorSample', 'ActuatorTimebase', 'CrankSample', 'CrankTimebase',
+           'MAX_DENOMINATOR_BITS', 'POSITION_BITS', 'TWO_PI', 'turns_from_radians']
 
 #: Rounded positions are multiples of ``2**-POSITION_BITS`` turn.
 POSITION_BITS = 256
@@ -345,3 +350,188 @@ class CrankTimebase:
                                  self._segment.a, self._segment.w_max, None,
                                  seg.speed_float(tau), self._segment.w_max_float)
         return copy
+
+
+class ActuatorSample(NamedTuple):
+    """A linear actuator's state at one instant."""
+
+    length: float
+    """Length, m."""
+    speed: float
+    """Extension rate, m/s (+ extending)."""
+    accel: float
+    """Extension acceleration, m/s^2."""
+
+
+class _Stretch:
+    """An actuator's drive from instant ``t0`` (ns): length in m as an integer polynomial.
+
+    ``length(tau) = (n0 + n1*tau + n2*tau**2) / den`` with ``tau`` the integer
+    nanoseconds since ``t0``: exact, one correctly rounded division per sample.
+    """
+
+    __slots__ = ('t0', 'v', 'a', 'den', 'n0', 'n1', 'n2', 'speed', 'speed_slope', 'accel',
+                 'prev')
+
+    def __init__(self, t0: int, length: Fraction, v: Fraction, a: Fraction,
+                 v_float: float | None, prev: _Stretch | None) -> None:
+        per_ns = Fraction(1, NS_PER_S)
+        c0, c1, c2 = length, v * per_ns, a * per_ns * per_ns / 2
+        if c0.denominator.bit_length() > MAX_DENOMINATOR_BITS:
+            c0 = _rounded(c0)
+        den = math.lcm(c0.denominator, c1.denominator, c2.denominator)
+        self.t0, self.v, self.a, self.den, self.prev = t0, v, a, den, prev
+        self.n0 = c0.numerator * (den // c0.denominator)
+        self.n1 = c1.numerator * (den // c1.denominator)
+        self.n2 = c2.numerator * (den // c2.denominator)
+        # speed(tau) = v + a * tau / 1e9 in m/s, as floats; v as it was given when it was.
+        self.speed = float(v) if v_float is None else v_float
+        self.accel = float(a)
+        self.speed_slope = self.accel / NS_PER_S
+
+    def length(self, tau: int) -> Fraction:
+        return Fraction(self.n0 + tau * (self.n1 + tau * self.n2), self.den)
+
+    def exact_speed(self, tau: int) -> Fraction:
+        return self.v + self.a * Fraction(tau, NS_PER_S)
+
+
+class ActuatorTimebase:
+    """A linear actuator's length, extension rate and acceleration as exact functions of time.
+
+    Parameters
+    ----------
+    t0 : int
+        Clock instant of the start, ns. The actuator has ``length`` there.
+    length : float
+        Length at ``t0``, m.
+    speed : float
+        Extension rate at ``t0``, m/s (+ extending).
+    accel : float
+        Extension acceleration, m/s^2.
+
+    Notes
+    -----
+    The length is ``length + speed * t + accel * t**2 / 2`` computed from the
+    floats' exact values in integer nanoseconds, so it does not drift however
+    long the node runs; an actuator has no wrap and no speed bound (its
+    stroke is the solver's to refuse). Thread safety is argued as for
+    :class:`CrankTimebase`: :meth:`update` builds a new stretch and swaps it
+    in with one assignment, keeping the one before for earlier instants.
+    """
+
+    #: The keyword arguments :meth:`update` takes.
+    CHANGES = ('speed', 'accel')
+
+    def __init__(self, t0: int, length: float, speed: float, accel: float) -> None:
+        _check_finite(length=length, speed=speed, accel=accel)
+        self._stretch = _Stretch(int(t0), Fraction(length), Fraction(speed), Fraction(accel),
+                                 float(speed), None)
+
+    def _at(self, t: int) -> tuple[_Stretch, int]:
+        stretch = self._stretch
+        if t < stretch.t0 and stretch.prev is not None:
+            stretch = stretch.prev
+        return stretch, t - stretch.t0
+
+    def sample(self, t: int) -> ActuatorSample:
+        """Return the length (m), extension rate (m/s) and acceleration (m/s^2) at ``t`` ns."""
+        stretch, tau = self._at(t)
+        return ActuatorSample(
+            (stretch.n0 + tau * (stretch.n1 + tau * stretch.n2)) / stretch.den,
+            stretch.speed + stretch.speed_slope * tau, stretch.accel)
+
+    def sample_turns(self, t: int) -> tuple[int, ActuatorSample]:
+        """Return (0, the actuator's state) at ``t`` ns: an actuator makes no turns."""
+        return 0, self.sample(t)
+
+    def length(self, t: int) -> Fraction:
+        """Return the exact length at ``t`` ns, m."""
+        stretch, tau = self._at(t)
+        return stretch.length(tau)
+
+    def speed(self, t: int) -> Fraction:
+        """Return the exact extension rate at ``t`` ns, m/s."""
+        stretch, tau = self._at(t)
+        return stretch.exact_speed(tau)
+
+    def leaves(self, t: int, stroke: tuple[float, float]) -> float | None:
+        """Return the time from ``t`` (ns) until the length leaves ``stroke`` (s), or None.
+
+        0.0 when it is outside, or at a limit and moving out, at ``t``; None
+        when the drive stays within the inclusive limits for ever (at rest).
+        """
+        stretch, tau = self._at(t)
+        low, high = (Fraction(x) for x in stroke)
+        x, v, a = stretch.length(tau), stretch.exact_speed(tau), stretch.a
+        if not low <= x <= high or (x == high and (v > 0 or v == 0 and a > 0)) \
+                or (x == low and (v < 0 or v == 0 and a < 0)):
+            return 0.0
+        times = [root for limit in (low, high) for root in _roots(a / 2, v, x - limit)
+                 if root > 0]
+        return float(min(times)) if times else None
+
+    def moves_out(self, t: int, stroke: tuple[float, float]) -> bool:
+        """Return whether the drive takes the length out of ``stroke`` at ``t`` (ns) at once.
+
+        True at or beyond a limit unless the drive moves it back inside (or
+        holds it still exactly at the limit); False within the stroke, even if
+        it reaches a limit later (:meth:`leaves` says when).
+        """
+        stretch, tau = self._at(t)
+        low, high = (Fraction(x) for x in stroke)
+        x, v, a = stretch.length(tau), stretch.exact_speed(tau), stretch.a
+        if low < x < high:
+            return False
+        # The sign of the motion at t: the speed's, or the acceleration's from rest.
+        motion = v if v != 0 else a
+        if x >= high:
+            return motion > 0 or (x > high and motion == 0)
+        return motion < 0 or (x < low and motion == 0)
+
+    def update(self, t: int, speed: float | None = None, accel: float | None = None) -> None:
+        """From instant ``t`` (ns) on, drive with the given values; ``None`` keeps one.
+
+        The length at ``t`` is kept exactly; without ``speed`` the drive goes on
+        from its extension rate there.
+        """
+        _check_finite(speed=speed, accel=accel)
+        t = int(t)
+        old = self._stretch
+        stretch, tau = self._at(t)
+        before = copy.copy(old)
+        before.prev = None
+        if speed is None:
+            v, v_float = stretch.exact_speed(tau), None
+            if stretch.a == 0:
+                v_float = stretch.speed     # held: the float it was given as
+        else:
+            v, v_float = Fraction(speed), float(speed)
+        self._stretch = _Stretch(t, stretch.length(tau), v,
+                                 old.a if accel is None else Fraction(accel), v_float, before)
+
+    def moved(self, t_from: int, t_to: int) -> ActuatorTimebase:
+        """Return a copy whose drive at ``t_to`` continues this one's at ``t_from``."""
+        stretch, tau = self._at(int(t_from))
+        copy_ = object.__new__(ActuatorTimebase)
+        copy_._stretch = _Stretch(int(t_to), stretch.length(tau), stretch.exact_speed(tau),
+                                  stretch.a, stretch.speed if stretch.a == 0 else None, None)
+        return copy_
+
+
+def _check_finite(**values: float | None) -> None:
+    for what, value in values.items():
+        if value is not None and not math.isfinite(value):
+            msg = f'Expected `{what}` to be finite, got {value!r}'
+            raise ValueError(msg)
+
+
+def _roots(a: Fraction, b: Fraction, c: Fraction) -> list[float]:
+    """Return the real roots of ``a x**2 + b x + c`` (s), as floats."""
+    if a == 0:
+        return [] if b == 0 else [float(-c / b)]
+    disc = b * b - 4 * a * c
+    if disc < 0:
+        return []
+    root = math.sqrt(float(disc))
+    return [(-float(b) - root) / float(2 * a), (-float(b) + root) / float(2 * a)]

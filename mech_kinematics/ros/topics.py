@@ -8,7 +8,8 @@ and remaps apply; ``/tf`` and ``/tf_static`` are absolute, as tf2 expects.
 
 from __future__ import annotations
 
-__all__ = ['DIAGNOSTICS', 'IMU', 'IMU_TYPE', 'JOINT_ACCELERATIONS', 'JOINT_STATES', 'MARKERS',
+__all__ = ['DIAGNOSTICS', 'IMU', 'IMU_TYPE', 'INPUT_JOINT_STATES', 'JOINT_ACCELERATIONS',
+           'JOINT_STATES', 'MARKERS',
            'POINT_ACCELERATIONS', 'ROBOT_DESCRIPTION', 'SCENE', 'STATE_TOPICS', 'TF',
            'TF_STATIC', 'TYPES', 'imu_topic']
 
@@ -24,6 +25,8 @@ ROBOT_DESCRIPTION = 'robot_description'
 #: The scene file's text, latched, so that a bag carries its own scene.
 SCENE = 'scene'
 
+#: The drivers' positions (and velocities) that drive the node with ``drive: topic``.
+INPUT_JOINT_STATES = 'input_joint_states'
 #: The namespace of the inertial sensors' topics: ``imu/NAME``, one per entry of a scene's
 #: ``imus``, each of type :data:`IMU_TYPE`.
 IMU = 'imu'
@@ -43,6 +46,7 @@ TYPES = {
     TF_STATIC: 'tf2_msgs/msg/TFMessage',
     ROBOT_DESCRIPTION: 'std_msgs/msg/String',
     SCENE: 'std_msgs/msg/String',
+    INPUT_JOINT_STATES: 'sensor_msgs/msg/JointState',
 }
 
 

@@ -343,6 +343,43 @@ def test_messages_follow_the_contract(name):
         assert (msg.header.stamp.sec, msg.header.stamp.nanosec) == (5, 6)
 
 
+@pytest.mark.parametrize('velocities', [True, False])
+@pytest.mark.parametrize('name', SCENES)
+def test_messages_leave_out_what_the_input_does_not_determine(name, velocities):
+    """Without velocities or accelerations the arrays are empty, the rest as in a full tick.
+
+    What a node driven from a topic publishes (issue 18): its input never gives the
+    accelerations, and the velocities only when the input message has them.
+    """
+    scene = mk.load_scene(name)
+    state = mk.solve(scene, start_positions(scene))
+    joints, points = scene.output_joints, scene.output_points
+    rendered = TickMessages(joints, points, FRAME_ID, velocities=velocities,
+                            accelerations=False).render(state, 11, 12)
+    js = joint_state_from_state(state, joints, FRAME_ID, 11, 12)
+    jt = joint_trajectory_from_state(state, joints, FRAME_ID, 11, 12)
+    md = multi_dof_trajectory_from_state(state, points, FRAME_ID, 11, 12)
+    jt.points[0].accelerations = []
+    md.points[0].accelerations = []
+    if not velocities:
+        js.velocity = []
+        jt.points[0].velocities = []
+        md.points[0].velocities = []
+    for raw, msg in zip(rendered, (js, jt, md), strict=True):
+        typename = typename_of(msg)
+        assert raw == bytes(STORE.serialize_cdr(to_rosbags(msg), typename))
+        assert tree(deserialize_message(raw, type(msg))) == tree(msg)
+    decoded = deserialize_message(rendered[0], JointState)
+    assert list(decoded.position) == [state.joints[n].position for n in joints]
+    assert len(decoded.velocity) == (len(joints) if velocities else 0)
+
+
+def test_messages_refuse_accelerations_without_velocities():
+    """A template keeps a prefix of the slots: accelerations without velocities is refused."""
+    with pytest.raises(ValueError, match='velocities with accelerations'):
+        TickMessages(['a'], ['P'], FRAME_ID, velocities=False)
+
+
 def test_template_refuses_a_missing_marker():
     """A message without the markers it promises is refused, naming what is missing."""
     msg = JointState(name=['a'], position=[1.0])

@@ -154,3 +154,14 @@ def test_jump_instants_are_counted_at_level_ok():
     assert solver.value('jump_instants') == '2' == solver.value('jump_instants_total')
     later = solver_status(second, near_singular=1e-3, **NAME)
     assert later.value('jump_instants') == '1' and later.value('jump_instants_total') == '3'
+
+
+def test_several_drivers_are_listed_each_in_scene_order():
+    """A sample of several drivers: their positions, speeds, accels, not a crank's (issue 18)."""
+    stats = TickStats()
+    stats.published(1, 5_000, False, 0.5, ((1.5, 2.75), (0.5, -0.25), (0.0, 0.0)))
+    solver = solver_status(stats.take_window(stats._start + NS), near_singular=1e-3, **NAME)
+    assert solver.value('driver_positions') == '1.5, 2.75'
+    assert solver.value('driver_speeds') == '0.5, -0.25'
+    assert solver.value('driver_accels') == '0.0, 0.0'
+    assert 'crank_angle' not in dict(solver.values)

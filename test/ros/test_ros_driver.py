@@ -14,7 +14,8 @@ from hypothesis import given, strategies as st
 import pytest
 
 from mech_kinematics.ros.driver import CLOCK_JUMP_NS, TickDriver
-from mech_kinematics.ros.timebase import turns_from_radians, TWO_PI
+from mech_kinematics.ros.timebase import (ActuatorSample, ActuatorTimebase, turns_from_radians,
+                                          TWO_PI)
 from mech_kinematics.units import NS_PER_S, rad_per_s_from_rpm
 
 MS = 1_000_000
@@ -328,3 +329,17 @@ def test_a_driver_that_does_not_turn_has_a_time_base_of_its_own():
     assert ram == (0.25, -0.5)
     with pytest.raises(ValueError, match=r"^Expected drive changes among speed, got \['accel'\]$"):
         driver.request('ram', accel=1.0)
+
+
+def test_the_actuator_time_base_drives_an_actuator_beside_the_crank():
+    """The actuator time base in the driver: start values, changes at the next instant."""
+    driver = crank_driver(period_ns=MS)
+    driver.add_drive('boom_cyl', ActuatorTimebase, length=1.2, speed=0.05, accel=0.0)
+    publish(driver, driver.step(0, monotonic_ns=0))
+    driver.request('boom_cyl', speed=-0.05, accel=0.5)
+    (_, _), (turns, cyl) = driver.state_at(2 * MS)
+    assert turns == 0 and cyl == ActuatorSample(1.2 + 0.05 * 0.002, -0.05, 0.5)
+    (_, _), (_, cyl) = driver.state_at(4 * MS)
+    t = Fraction(2, 1000)
+    exact = Fraction(1.2) + Fraction(0.05) * t - Fraction(0.05) * t + Fraction(0.5) * t * t / 2
+    assert cyl.length == float(exact)

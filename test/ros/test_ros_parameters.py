@@ -2,11 +2,13 @@
 # SPDX-License-Identifier: Apache-2.0
 """The node's parameter table and its rules, without ROS."""
 
+from dataclasses import dataclass
 import math
 
 import pytest
 
-from mech_kinematics.ros.parameters import joint_refusal, PARAMETERS, refusal, spec
+from mech_kinematics.ros.parameters import (driver_parameters, first_crank_aliases,
+                                            joint_refusal, PARAMETERS, refusal, spec)
 
 
 @pytest.mark.parametrize('name, value, reason', [
@@ -19,6 +21,8 @@ from mech_kinematics.ros.parameters import joint_refusal, PARAMETERS, refusal, s
     ('frame_id', 5, 'frame_id: expected a string, got number 5'),
     ('markers', 'yes', "markers: expected true or false, got string 'yes'"),
     ('late_ticks', 'later', "late_ticks: expected one of catch_up, skip, got 'later'"),
+    ('drive', 'topics', "drive: expected one of time, topic, got 'topics'"),
+    ('drive', 1, 'drive: expected a string, got number 1'),
     ('max_catch_up_s', -1.0, 'max_catch_up_s: expected 0 <= value <= 10 s, got -1.0'),
 ])
 def test_bad_values_are_refused_with_a_reason(name, value, reason):
@@ -38,6 +42,16 @@ def test_the_speed_may_not_exceed_its_bound():
     assert joint_refusal({'crank_speed_rpm': -3000.0, 'max_crank_speed_rpm': 3000.0}) is None
     assert 'max_crank_speed_rpm (2000 rpm), got -3000 rpm' in joint_refusal(
         {'crank_speed_rpm': -3000.0, 'max_crank_speed_rpm': 2000.0})
+
+
+def test_markers_are_refused_with_drive_topic():
+    """The arrows would show values a topic does not give: markers need drive: time (issue 18)."""
+    assert joint_refusal({'drive': 'time', 'markers': True}) is None
+    assert joint_refusal({'drive': 'topic', 'markers': False}) is None
+    assert joint_refusal({'drive': 'topic', 'markers': True}) == (
+        'markers: expected false with drive: topic (the arrows would show velocities and '
+        'accelerations the input does not give), got true')
+    assert spec('drive').default == 'time' and spec('drive').read_only
 
 
 def test_every_parameter_is_described():
@@ -106,3 +120,74 @@ def test_a_catch_up_burst_fits_the_history(rate_hz, max_catch_up_s):
     wanted = min(round(max_catch_up_s * 1e9) // period + 1, STATE_DEPTH)
     assert len(due.instants) == wanted <= STATE_DEPTH
     assert window <= round(max_catch_up_s * 1e9)
+
+
+@dataclass(frozen=True)
+class Driver:
+    """A driver as the parameters see it (the drivers API of issue 18)."""
+
+    name: str
+    joint_type: str
+    speed: float
+    accel: float
+
+
+FIVE_BAR = (Driver('left', 'revolute', -4 * math.pi, 0.0),
+            Driver('right', 'revolute', 2 * math.pi, 1.5))
+EXCAVATOR = (Driver('boom_cyl', 'prismatic', 0.05, 0.0), Driver('stick_cyl', 'prismatic', -0.02,
+                                                                0.01))
+
+
+def test_each_driver_has_its_parameters_with_the_scenes_defaults():
+    """Cranks: inputs.NAME.speed_rpm, .accel; actuators: inputs.NAME.speed, .accel (issue 18)."""
+    specs = {p.name: p for p in driver_parameters(FIVE_BAR + EXCAVATOR)}
+    assert list(specs) == ['inputs.left.speed_rpm', 'inputs.left.accel',
+                           'inputs.right.speed_rpm', 'inputs.right.accel',
+                           'inputs.boom_cyl.speed', 'inputs.boom_cyl.accel',
+                           'inputs.stick_cyl.speed', 'inputs.stick_cyl.accel']
+    assert specs['inputs.left.speed_rpm'].default == -120.0     # rounded, not -119.99...
+    assert specs['inputs.right.speed_rpm'].default == 60.0
+    assert specs['inputs.right.accel'].default == 1.5
+    assert specs['inputs.boom_cyl.speed'].default == 0.05
+    assert specs['inputs.stick_cyl.accel'].default == 0.01
+    assert specs['inputs.left.speed_rpm'].unit == 'rpm'
+    assert specs['inputs.boom_cyl.speed'].unit == 'm/s'
+    assert specs['inputs.boom_cyl.accel'].unit == 'm/s^2'
+    assert all(p.kind == 'double' and not p.read_only and p.description
+               for p in specs.values())
+
+
+@pytest.mark.parametrize('name, value, reason', [
+    ('inputs.left.speed_rpm', 2e5, 'inputs.left.speed_rpm: expected -100000 <= value <= 100000 '
+     'rpm, got 200000.0'),
+    ('inputs.boom_cyl.speed', 'fast', 'inputs.boom_cyl.speed: expected a number (m/s), got '
+     "string 'fast'"),
+    ('inputs.boom_cyl.accel', math.inf, 'inputs.boom_cyl.accel: expected a finite number, got '
+     'inf'),
+    ('inputs.boom_cyl.speed_rpm', 1.0, 'inputs.boom_cyl.speed_rpm: expected the parameter of a '
+     'driver of the scene (inputs.boom_cyl.accel, inputs.boom_cyl.speed, inputs.left.accel, '
+     'inputs.left.speed_rpm), got none'),
+    ('inputs.wrist.speed', 1.0, 'inputs.wrist.speed: expected the parameter of a driver'),
+])
+def test_driver_parameters_are_refused_with_a_reason(name, value, reason):
+    """A bad value, or a parameter of a driver the scene lacks, is refused naming it."""
+    drivers = {p.name: p for p in driver_parameters(FIVE_BAR[:1] + EXCAVATOR[:1])}
+    assert refusal(name, value, drivers).startswith(reason)
+    assert refusal('inputs.boom_cyl.speed', -0.5, drivers) is None
+
+
+def test_crank_speed_rpm_stays_the_first_cranks_name():
+    """crank_speed_rpm and crank_accel alias the first driver's parameters when it is a crank."""
+    assert first_crank_aliases(FIVE_BAR) == {'crank_speed_rpm': 'inputs.left.speed_rpm',
+                                             'crank_accel': 'inputs.left.accel'}
+    assert first_crank_aliases(EXCAVATOR) == {}
+    assert first_crank_aliases(EXCAVATOR[:1] + FIVE_BAR) == {}
+
+
+def test_every_cranks_speed_is_bounded():
+    """max_crank_speed_rpm bounds every crank's inputs.NAME.speed_rpm too (issue 18)."""
+    assert joint_refusal({'inputs.right.speed_rpm': 3000.0, 'max_crank_speed_rpm': 3000.0}) is None
+    assert joint_refusal({'inputs.right.speed_rpm': -3001.0, 'max_crank_speed_rpm': 3000.0}) == (
+        'inputs.right.speed_rpm: expected |inputs.right.speed_rpm| <= max_crank_speed_rpm '
+        '(3000 rpm), got -3001 rpm; set max_crank_speed_rpm (up to 100000) first to go faster')
+    assert joint_refusal({'inputs.boom_cyl.speed': 500.0, 'max_crank_speed_rpm': 1.0}) is None

@@ -10,8 +10,8 @@ import random
 from hypothesis import example, given, strategies as st
 import pytest
 
-from mech_kinematics.ros.timebase import (CrankTimebase, MAX_DENOMINATOR_BITS, POSITION_BITS,
-                                          TWO_PI)
+from mech_kinematics.ros.timebase import (ActuatorSample, ActuatorTimebase, CrankTimebase,
+                                          MAX_DENOMINATOR_BITS, POSITION_BITS, TWO_PI)
 
 NS = 1_000_000_000
 DAY_NS = 86_400 * NS
@@ -270,3 +270,116 @@ def test_turns_count_every_turn_across_changes():
     tb.update(10 * NS, speed_rpm=-120.0)                # two turns a second, backwards
     assert tb.sample_turns(15 * NS)[0] == 0
     assert tb.sample_turns(20 * NS)[0] == -10
+
+
+# -- the actuator's time base (issue 18) ---------------------------------------------------
+
+#: An actuator length within a few ulp of 2 m, m.
+ATOL_LENGTH = 4 * math.ulp(2.0)  # m
+
+
+def exact_length(length0: float, speed: float, accel: float, t_ns: int) -> float:
+    """Return L0 + v t + a t**2 / 2 from the floats' exact values, rounded once."""
+    t = Fraction(t_ns, NS)
+    return float(Fraction(length0) + Fraction(speed) * t + Fraction(accel) * t * t / 2)
+
+
+@given(st.floats(0.1, 5.0), st.floats(-1.0, 1.0), st.floats(-2.0, 2.0),
+       st.integers(0, 30 * DAY_NS))
+@example(1.2, 0.05, 0.0, 30 * DAY_NS)
+@example(0.5, 1.0, 0.0, 30 * DAY_NS)
+def test_actuator_length_is_exact(length0, speed, accel, t):
+    """The length is L0 + v t + a t^2 / 2 correctly rounded, after any time (30 days too)."""
+    base = ActuatorTimebase(7, length0, speed, accel)
+    sample = base.sample(7 + t)
+    assert sample.length == exact_length(length0, speed, accel, t)
+    assert base.length(7 + t) == Fraction(length0) + Fraction(speed) * Fraction(t, NS) \
+        + Fraction(accel) * Fraction(t, NS) ** 2 / 2
+    assert sample.accel == accel
+    assert sample.speed == pytest.approx(speed + accel * t / NS, rel=1e-15, abs=1e-15)
+
+
+def test_actuator_starts_where_it_is_and_publishes_its_speed_as_given():
+    """At t0 the sample is the start values, the float speed exactly as given; no turns."""
+    base = ActuatorTimebase(5 * NS, 1.2, 0.05, 0.0)
+    assert base.sample_turns(5 * NS) == (0, ActuatorSample(1.2, 0.05, 0.0))
+    assert base.sample(5 * NS + 10 * NS) == ActuatorSample(exact_length(1.2, 0.05, 0, 10 * NS),
+                                                           0.05, 0.0)
+    assert ActuatorTimebase.CHANGES == ('speed', 'accel')
+
+
+@given(st.floats(-0.5, 0.5), st.floats(-0.5, 0.5), st.floats(-1, 1), st.floats(-1, 1),
+       st.integers(1, 10 * NS), st.integers(1, 10 * NS))
+def test_actuator_changes_keep_the_length_continuous(v1, v2, a1, a2, tc, dt):
+    """A change at tc keeps the exact length there; after it, the new drive from that length."""
+    base = ActuatorTimebase(0, 1.5, v1, a1)
+    at_change = base.length(tc)
+    base.update(tc, speed=v2)
+    assert base.length(tc) == at_change
+    assert base.speed(tc) == Fraction(v2)
+    t = Fraction(dt, NS)
+    assert base.length(tc + dt) == at_change + Fraction(v2) * t + Fraction(a1) * t * t / 2
+    base.update(tc + dt, accel=a2)      # the speed goes on from where it was
+    assert base.speed(tc + dt) == Fraction(v2) + Fraction(a1) * t
+    assert base.sample(tc + dt).accel == a2
+    # An instant before the last change is still the drive before it.
+    assert base.length(tc) == at_change
+
+
+def test_actuator_moved_continues_on_a_new_clock():
+    """A change of time source: the actuator goes on from its length and speed there."""
+    base = ActuatorTimebase(0, 1.0, 0.1, 0.02)
+    moved = base.moved(3 * NS, 1000 * NS)
+    assert moved.length(1000 * NS) == base.length(3 * NS)
+    assert moved.speed(1000 * NS) == base.speed(3 * NS)
+    assert moved.sample(1001 * NS).accel == 0.02
+
+
+@pytest.mark.parametrize('length0, speed, accel, at_s, expected', [
+    (1.2, 0.05, 0.0, 0.0, 12.0),        # extends to 1.8 m in 12 s
+    (1.2, -0.1, 0.0, 0.0, 2.0),         # retracts to 1.0 m in 2 s
+    (1.2, 0.0, 0.0, 0.0, None),         # at rest: never
+    (1.8, 0.05, 0.0, 0.0, 0.0),         # at the end and moving out: at once
+    (1.8, 0.0, 0.1, 0.0, 0.0),          # at the end, accelerating out: at once
+    (1.0, 0.0, 0.1, 0.0, math.sqrt(16)),  # 0.8 m at 0.1 m/s^2: 4 s
+    (1.2, 0.05, 0.0, 13.0, 0.0),        # already outside
+    (1.5, 0.1, -0.1, 0.0, 1 + math.sqrt(11)),   # up to 1.55 m, back down to 1.0 m
+])
+def test_actuator_says_when_it_leaves_its_stroke(length0, speed, accel, at_s, expected):
+    """The time until the drive leaves [1.0, 1.8] m: the exact root, 0 at once, None never."""
+    base = ActuatorTimebase(0, length0, speed, accel)
+    got = base.leaves(round(at_s * NS), (1.0, 1.8))
+    if expected is None:
+        assert got is None
+    else:
+        assert got == pytest.approx(expected, rel=1e-12, abs=1e-12)
+
+
+@pytest.mark.parametrize('kwargs, match', [
+    ({'length': math.nan, 'speed': 0.0, 'accel': 0.0}, '`length` to be finite'),
+    ({'length': 1.0, 'speed': math.inf, 'accel': 0.0}, '`speed` to be finite'),
+    ({'length': 1.0, 'speed': 0.0, 'accel': -math.inf}, '`accel` to be finite'),
+])
+def test_actuator_bad_values_are_refused(kwargs, match):
+    """A NaN or inf start value is refused, naming the value."""
+    with pytest.raises(ValueError, match=match):
+        ActuatorTimebase(0, **kwargs)
+    with pytest.raises(ValueError, match='`speed` to be finite'):
+        ActuatorTimebase(0, 1.0, 0.0, 0.0).update(5, speed=math.nan)
+
+
+@pytest.mark.parametrize('length0, speed, accel, at_s, out', [
+    (1.2, 0.05, 0.0, 0.0, False),       # inside: it leaves later, not at once
+    (1.8, 0.05, 0.0, 0.0, True),        # at the end, moving out
+    (1.8, 0.0, 0.1, 0.0, True),         # at the end, accelerating out from rest
+    (1.8, 0.0, 0.0, 0.0, False),        # held still exactly at the end
+    (1.8, -0.05, 0.0, 0.0, False),      # at the end, moving back in
+    (1.0, -0.01, 0.0, 0.0, True),       # at the other end, moving out
+    (1.2, 0.05, 0.0, 13.0, True),       # beyond the end, still moving out
+    (1.9, 0.0, 0.0, 0.0, True),         # beyond the end, at rest
+    (1.9, -0.05, 0.0, 0.0, False),      # beyond the end, coming back
+])
+def test_actuator_says_whether_a_drive_moves_out_at_once(length0, speed, accel, at_s, out):
+    """At or beyond a limit and not moving back inside: out at once; inside: not yet."""
+    base = ActuatorTimebase(0, length0, speed, accel)
+    assert base.moves_out(round(at_s * NS), (1.0, 1.8)) is out

@@ -21,7 +21,9 @@
 Beside it, ``DIR/data.json`` holds every figure the documentation quotes
 (:mod:`.data`), with ``bench``'s table (:mod:`mech_kinematics.tools.bench`)
 and the figures of one real run of the node (``--long-run FILE``, from
-``bench/long_run.py``; kept from the folder's previous data file otherwise).
+``bench/long_run.py``) and of the node driven from a topic (``--topic-drive
+FILE``, from ``bench/topic_bench.py``), each kept from the folder's previous
+data file otherwise.
 
 :mod:`.common` holds the run sizes (:data:`MODES`) and the shared timer,
 :mod:`.figures` draws, :mod:`.markdown` writes ``REPORT.md``; this module
@@ -56,8 +58,8 @@ from .clock import (clock_errors, CLOCK_TICKS, ClockRow, EPOCH_NS, naive_accumul
                     naive_cumsum, naive_wrapped, naive_wrapped_trace, node_clock, TICK_HZ)
 from .common import DURATIONS, EPS, ERROR_FLOOR, Mode, MODES, slug, spread_time, WP_SCENES
 from .cost import chain_scene, CHUNK, cost_growth, CostGrowth
-from .data import (BLOCKS, check_text, collect, DATA_FILE, lookup, read_data, render_block,
-                   SPREAD_RULE, store_section, STORED, update_text, write_data)
+from .data import (BLOCKS, check_text, collect, DATA_FILE, KEPT, lookup, read_data,
+                   render_block, SPREAD_RULE, store_section, STORED, update_text, write_data)
 from .extreme import (AngleResult, BOUND_FACTOR, Case, CaseResult, digits_lost, evaluate_angle,
                       evaluate_case, extreme_cases, formula_audit, FormulaAudit)
 from .figures import (plot_bounds, plot_clock, plot_cost, plot_extreme, plot_refused,
@@ -66,7 +68,7 @@ from .markdown import bench_text, write_report
 from ..cli import run_tool
 
 __all__ = [
-    'BLOCKS', 'DATA_FILE', 'EPOCH_NS', 'ORDERS', 'SPREAD_RULE', 'STORED', 'by_order',
+    'BLOCKS', 'DATA_FILE', 'EPOCH_NS', 'KEPT', 'ORDERS', 'SPREAD_RULE', 'STORED', 'by_order',
     'check_text', 'collect', 'lookup', 'node_clock', 'read_data', 'render_block', 'spread_time',
     'store_section', 'update_text', 'write_data',
     'AngleResult', 'BOUND_FACTOR', 'BoundCase', 'BoundStats', 'BoundValue', 'CHUNK', 'CLOCK_TICKS',
@@ -94,11 +96,13 @@ def _progress(total: int, enabled: bool) -> Any:
 
 def run(outdir: str | os.PathLike[str], mode: str | Mode = 'full',
         progress: bool = True,
-        long_run: str | os.PathLike[str] | None = None) -> dict[str, Any]:
+        long_run: str | os.PathLike[str] | None = None,
+        topic_drive: str | os.PathLike[str] | None = None) -> dict[str, Any]:
     """Compute every section, draw the figures, write ``outdir/REPORT.md`` and its data file.
 
-    ``long_run``: a JSON file of ``bench/long_run.py`` to store in the data
-    file. Returns the computed sections and the data (the tests read them).
+    ``long_run``, ``topic_drive``: JSON files of ``bench/long_run.py`` and
+    ``bench/topic_bench.py`` to store in the data file. Returns the computed
+    sections and the data (the tests read them).
     """
     mode = MODES[mode] if isinstance(mode, str) else mode
     out = Path(outdir)
@@ -152,7 +156,7 @@ def run(outdir: str | os.PathLike[str], mode: str | Mode = 'full',
     load.append(os.getloadavg()[0])
     data = collect(mode, elapsed, load, checks, golden, wp, clock, clock_check, extreme, cost,
                    bounds, refused, bench, peer)
-    write_data(out, data, long_run)
+    write_data(out, data, long_run, topic_drive)
     write_report(out, mode, checks, golden, wp, clock, clock_check, extreme, audit, cost,
                  bounds, refused, elapsed, data)
     return {'checks': checks, 'golden': golden, 'work_precision': wp, 'clock': clock,
@@ -224,10 +228,12 @@ documentation quotes. A few minutes; --quick in under one.
 
 
 def _handle(args: argparse.Namespace) -> int:
-    if args.long_run is not None and not Path(args.long_run).is_file():
-        print(f'report: expected --long-run to name the JSON file of bench/long_run.py, got '
-              f'{args.long_run!r} (no such file)', file=sys.stderr)
-        return 2
+    for given, option, script in ((args.long_run, '--long-run', 'bench/long_run.py'),
+                                  (args.topic_drive, '--topic-drive', 'bench/topic_bench.py')):
+        if given is not None and not Path(given).is_file():
+            print(f'report: expected {option} to name the JSON file of {script}, got '
+                  f'{given!r} (no such file)', file=sys.stderr)
+            return 2
     if args.bench_only:
         if not (Path(args.output) / DATA_FILE).is_file():
             print(f'report: expected --bench-only to find the data file of a report in '
@@ -235,7 +241,8 @@ def _handle(args: argparse.Namespace) -> int:
             return 2
         print(refresh_bench(args.output, args.mode))
         return 0
-    run(args.output, args.mode, progress=not args.no_progress, long_run=args.long_run)
+    run(args.output, args.mode, progress=not args.no_progress, long_run=args.long_run,
+        topic_drive=args.topic_drive)
     print(Path(args.output) / 'REPORT.md')
     return 0
 
@@ -257,6 +264,10 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     parser.add_argument('--long-run', metavar='FILE',
                         help="store FILE (bench/long_run.py's JSON: one real run of the node) "
                              "in DIR/data.json; without it the folder's previous one is kept")
+    parser.add_argument('--topic-drive', metavar='FILE',
+                        help="store FILE (bench/topic_bench.py's JSON: latency and CPU of the "
+                             'node driven from a topic) in DIR/data.json; without it the '
+                             "folder's previous one is kept")
     parser.add_argument('--bench-only', action='store_true',
                         help="measure section 7 alone (make bench's table, and pylinkage side "
                              "by side where installed) into DIR's data file and REPORT.md, "

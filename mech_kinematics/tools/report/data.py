@@ -5,14 +5,16 @@
 ``report -o DIR`` writes ``DIR/data.json`` (:data:`DATA_FILE`) beside
 ``REPORT.md``: every figure the documentation quotes, under a stable dotted
 key (:func:`collect`). Timings are ``[min, median, max]`` of repeated runs.
-Measurements that take longer than a report run (``long_run``: one real run
-of the node, ``bench/long_run.py``) are copied in from a file
-(``report --long-run FILE``) or kept from the folder's previous data file.
-Scripts that measure on their own (:data:`STORED`: the node against the rclpy
-floor, ``bench/node_bench.py --data FILE``; the recorder, the viewer,
-``check``'s grid study, ``reindex`` and the build of tf2_msgs,
-``bench/docs_bench.py``) write their section into the data file with
-:func:`store_section`; a report keeps them.
+Measurements that take longer than a report run (:data:`KEPT`: ``long_run``,
+one real run of the node, ``bench/long_run.py``; ``topic_drive``, the
+latency and CPU of the node driven from a topic, ``bench/topic_bench.py``)
+are copied in from a file (``report --long-run FILE``, ``--topic-drive
+FILE``) or kept from the folder's previous data file. Scripts that measure
+on their own (:data:`STORED`: the node against the rclpy floor,
+``bench/node_bench.py --data FILE``; the recorder, the viewer, ``check``'s
+grid study, ``reindex`` and the build of tf2_msgs, ``bench/docs_bench.py``)
+write their section into the data file with :func:`store_section`; a report
+keeps them too.
 
 The documentation quotes them in two forms that :func:`check_text` checks:
 
@@ -37,11 +39,13 @@ from pathlib import Path
 import re
 from typing import Any
 
-__all__ = ['BLOCKS', 'DATA_FILE', 'SPREAD_RULE', 'STORED', 'check_text', 'collect', 'lookup',
-           'read_data', 'render_block', 'store_section', 'update_text', 'write_data']
+__all__ = ['BLOCKS', 'DATA_FILE', 'KEPT', 'SPREAD_RULE', 'STORED', 'check_text', 'collect',
+           'lookup', 'read_data', 'render_block', 'store_section', 'update_text', 'write_data']
 
 #: The data file's name in the report's folder.
 DATA_FILE = 'data.json'
+#: Keys measured outside a report run: copied in from a file, else kept from the last one.
+KEPT = ('long_run', 'topic_drive')
 #: Sections that scripts of bench/ write with :func:`store_section`: a report keeps them.
 STORED = ('node_rates', 'node_chains', 'recorder', 'viewer', 'check_grid', 'reindex',
           'tf2_build')
@@ -166,18 +170,23 @@ def read_data(path: str | os.PathLike[str]) -> dict[str, Any]:
 
 
 def write_data(outdir: str | os.PathLike[str], data: dict[str, Any],
-               long_run: str | os.PathLike[str] | None = None) -> Path:
-    """Write ``outdir/data.json``; keep the previous file's ``long_run`` unless given anew.
+               long_run: str | os.PathLike[str] | None = None,
+               topic_drive: str | os.PathLike[str] | None = None) -> Path:
+    """Write ``outdir/data.json``; keep the previous file's :data:`KEPT` keys unless given anew.
 
-    Likewise its ``peer`` (``bench --peer``'s table) where this run had no peer
-    installed, and every :data:`STORED` section (measured by its own script).
+    ``long_run``, ``topic_drive``: JSON files of ``bench/long_run.py`` and
+    ``bench/topic_bench.py`` to store under those keys. Likewise its ``peer``
+    (``bench --peer``'s table) where this run had no peer installed, and
+    every :data:`STORED` section (measured by its own script).
     """
     path = Path(outdir) / DATA_FILE
+    given = {'long_run': long_run, 'topic_drive': topic_drive}
     previous = read_data(path) if path.exists() else {}
-    if long_run is not None:
-        data['long_run'] = read_data(long_run)
-    elif 'long_run' in previous:
-        data['long_run'] = previous['long_run']
+    for key in KEPT:
+        if given[key] is not None:
+            data[key] = read_data(given[key])   # type: ignore[arg-type]
+        elif key in previous:
+            data[key] = previous[key]
     if data.get('peer') is None:
         data.pop('peer', None)
         if 'peer' in previous:
@@ -367,6 +376,22 @@ def _long_run_block(data: dict[str, Any]) -> str:
         f'{_g(run["max_state_error"])} |']) + '\n'
 
 
+def _topic_drive_block(data: dict[str, Any]) -> str:
+    run = lookup(data, 'topic_drive')
+    lines = ['| input rate | latency, median: floor / node | node / floor | latency, p99: '
+             'floor / node | CPU: floor / node | node / floor | answered (worst run) |',
+             '|---:|---:|---:|---:|---:|---:|---:|']
+    for rate, row in run['rates'].items():
+        f, n = row['floor'], row['node']
+        answered = 100 * min(f['answered_min'], n['answered_min'])
+        lines.append(
+            f'| {rate} Hz | {f["latency_median_us"]:.0f} / {n["latency_median_us"]:.0f} µs | '
+            f'{row["latency_ratio"]:.2f} | {f["latency_p99_us"]:.0f} / '
+            f'{n["latency_p99_us"]:.0f} µs | {f["cpu_pct"]:.1f} / {n["cpu_pct"]:.1f} % | '
+            f'{row["cpu_ratio"]:.2f} | {answered:.2f} % |')
+    return '\n'.join(lines) + '\n'
+
+
 def _peer_block(data: dict[str, Any]) -> str:
     peer = lookup(data, 'peer')
     lines = [f'| scene | work | ours, µs (min / median / max) | {peer["peer"]}, µs '
@@ -407,8 +432,8 @@ def _node_chains_block(data: dict[str, Any]) -> str:
 
 #: The generated blocks: name -> function of the data returning the block's text.
 BLOCKS = {'refused': _refused_block, 'bench': _bench_block, 'clock': _clock_block,
-          'long_run': _long_run_block, 'peer': _peer_block, 'node_rates': _node_rates_block,
-          'node_chains': _node_chains_block}
+          'long_run': _long_run_block, 'topic_drive': _topic_drive_block, 'peer': _peer_block,
+          'node_rates': _node_rates_block, 'node_chains': _node_chains_block}
 
 
 def render_block(name: str, data: dict[str, Any]) -> str:

@@ -320,6 +320,15 @@ def _clock(mode: Mode, clock: Sequence[ClockRow], clock_check: dict[str, Any],
         w('')
         w(render_block('long_run', data).rstrip('\n'))
     w('')
+    if 'topic_drive' in data:
+        w(f'The node driven from a topic (`bench/topic_bench.py`, on '
+          f'{data["topic_drive"]["date"]}): one `JointState` in, the whole state out, '
+          'against a bare rclpy relay that republishes three pre-serialized messages '
+          "with the input's stamp (medians of the runs; latency = arrival of the last "
+          "state message minus the input's send time, one clock):")
+        w('')
+        w(render_block('topic_drive', data).rstrip('\n'))
+        w('')
     return lines
 
 

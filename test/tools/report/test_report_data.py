@@ -174,6 +174,48 @@ def test_store_section_refuses_a_key_a_report_would_drop(tmp_path):
     assert not (tmp_path / data_mod.DATA_FILE).exists()
 
 
+def test_write_data_keeps_the_topic_drive_figures(tmp_path):
+    """A new report keeps the topic drive's figures (bench/topic_bench.py) unless given anew."""
+    first, second = tmp_path / 'a.json', tmp_path / 'b.json'
+    first.write_text(json.dumps({'date': '2026-11-24', 'rates': {}}))
+    second.write_text(json.dumps({'date': '2026-11-25', 'rates': {}}))
+    data_mod.write_data(tmp_path, {'x': 1}, topic_drive=first)
+    data_mod.write_data(tmp_path, {'x': 2})
+    assert data_mod.read_data(tmp_path / data_mod.DATA_FILE)['topic_drive']['date'] == \
+        '2026-11-24'
+    data_mod.write_data(tmp_path, {'x': 3}, topic_drive=second)
+    assert data_mod.read_data(tmp_path / data_mod.DATA_FILE) == {
+        'x': 3, 'topic_drive': {'date': '2026-11-25', 'rates': {}}}
+
+
+def test_the_topic_drive_is_recorded_and_quoted(committed):
+    """Latency and CPU of topic drive at 100 Hz and 1 kHz, node and floor, quoted in node.md."""
+    rates = committed['topic_drive']['rates']
+    assert set(rates) == {'100', '1000'}
+    for row in rates.values():
+        for kind in ('floor', 'node'):
+            assert row[kind]['latency_median_us'] > 0 and row[kind]['cpu_pct'] > 0
+            assert len(row[kind]['runs']) == committed['topic_drive']['repeat']
+        assert row['cpu_ratio'] == row['node']['cpu_pct'] / row['floor']['cpu_pct']
+    text = (ROOT / 'docs' / 'node.md').read_text(encoding='utf-8')
+    assert '<!--data:topic_drive-->' in text
+    for key in ('topic_drive.rates.1000.node.latency_median_us',
+                'topic_drive.rates.1000.cpu_ratio', 'topic_drive.rates.100.cpu_ratio'):
+        assert f'<!--={key}-->' in text, key
+
+
+def test_the_topic_drive_block():
+    """The generated table has a row per input rate with floor / node figures and ratios."""
+    side = {'latency_median_us': 600.0, 'latency_p99_us': 3000.0, 'cpu_pct': 40.0,
+            'answered_min': 1.0}
+    node = {**side, 'latency_median_us': 650.0, 'cpu_pct': 52.0, 'answered_min': 0.9995}
+    data = {'topic_drive': {'rates': {'1000': {'floor': side, 'node': node,
+                                               'latency_ratio': 650 / 600, 'cpu_ratio': 1.3}}}}
+    block = data_mod.render_block('topic_drive', data)
+    assert block.splitlines()[2] == ('| 1000 Hz | 600 / 650 µs | 1.08 | 3000 / 3000 µs | '
+                                     '40.0 / 52.0 % | 1.30 | 99.95 % |')
+
+
 def test_update_text_rewrites_figures_in_their_written_form():
     """Figures keep their decimals, exponent and separators; timings become their median."""
     text = 'a 9.9e-9<!--=a.b--> b 1<!--=a.n--> c 1,000<!--=a.n--> d 0.000<!--=t-->'
