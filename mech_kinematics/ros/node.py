@@ -611,7 +611,12 @@ class KinematicsNode(LifecycleNode):
         self._state_publishers += publishers
         self._publish_imu = tuple(p.publish for p in publishers)
         if self._tf is not None:
-            state = mk.solve(tick_scene, scene.input.angle, 0.0, 0.0, max_error=math.inf)
+            # The sensors' offsets on their links, from any pose: the drivers' starts.
+            starts = [driver.start for driver in scene.drivers]
+            rest = [0.0] * len(starts)
+            state = (mk.solve(tick_scene, starts[0], 0.0, 0.0, max_error=math.inf)
+                     if len(starts) == 1 else
+                     mk.solve(tick_scene, starts, rest, rest, max_error=math.inf))
             frames = {f.joint: f for f in self._tf_frames}
             transforms = self._imus.frame_transforms(sensor_offsets(scene.imus, frames, state))
             if transforms:

@@ -9,6 +9,7 @@ state, in the link's frame (``angle: 0``) or a frame of its own on ``/tf``
 """
 
 import math
+from pathlib import Path
 import signal
 import xml.etree.ElementTree as ET
 
@@ -205,3 +206,50 @@ def test_the_gripper_runs_a_whole_turn_with_its_fingertip_imu(ros, tmp_path):
         assert abs(msg.angular_velocity.z) < 1e-14
         np.testing.assert_allclose([msg.linear_acceleration.x, msg.linear_acceleration.y],
                                    data['linear_acceleration'], rtol=0, atol=1e-12)
+
+
+def test_an_imu_on_a_scene_of_several_drivers(ros, tmp_path):
+    """The five-bar with a turned sensor at P on a distal link: readings equal solve's.
+
+    The sensor's frame on its link is placed from the drivers' start positions
+    (a scene of several drivers has no single crank angle to start from).
+    """
+    text = (Path(__file__).resolve().parents[2] / 'config' / 'scenes' / 'five_bar.yaml')
+    data = yaml.safe_load(text.read_text())
+    data['name'] = 'five_bar_imu'
+    data['imus'] = {'wrist': {'link': 'left_distal', 'point': 'P', 'angle': 45,
+                              'gravity': [0, -9.80665]}}
+    path = tmp_path / 'five_bar_imu.yaml'
+    path.write_text(yaml.safe_dump(data))
+    scene = mk.load_scene(path)
+    ns = f'{SESSION}/five_bar_imu'
+    qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+    imu = ros.collect(Imu, f'{ns}/imu/wrist', qos)
+    joints = ros.collect(JointState, f'{ns}/joint_states', qos)
+    proc = NodeProcess(tmp_path, '-r', f'__ns:={ns}', '-r', f'/tf:={ns}/tf',
+                       '-r', f'/tf_static:={ns}/tf_static', '-p', f'scene:={path}',
+                       '-p', 'rate_hz:=100')
+    try:
+        wait_for(lambda: len(imu) >= 30 and len(joints) >= 30, STARTUP_S,
+                 '30 Imu and joint_states messages')
+    finally:
+        status, _ = proc.stop(signal.SIGINT)
+    assert status == 0, proc.output()
+    at = {stamp_ns(m): [m.position[m.name.index(d.name)] for d in scene.drivers]
+          for m in joints}
+    speeds = [d.speed for d in scene.drivers]
+    checked = 0
+    for msg in imu:
+        if stamp_ns(msg) not in at:
+            continue
+        data = mk.solve(scene, at[stamp_ns(msg)], speeds).as_dict()['imus']['wrist']
+        assert msg.header.frame_id == 'mechanism/wrist'
+        assert 2 * math.atan2(msg.orientation.z, msg.orientation.w) == pytest.approx(
+            data['orientation'], abs=1e-12)
+        assert msg.angular_velocity.z == pytest.approx(data['angular_velocity'],
+                                                       rel=RTOL_READINGS)
+        a = msg.linear_acceleration
+        np.testing.assert_allclose([a.x, a.y], data['linear_acceleration'], rtol=0,
+                                   atol=RTOL_READINGS * np.hypot(*data['linear_acceleration']))
+        checked += 1
+    assert checked >= 20
