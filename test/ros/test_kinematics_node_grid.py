@@ -216,10 +216,11 @@ def test_a_stall_is_caught_up_to_the_bound_and_the_rest_counted(ros, tmp_path):
     assert skipped >= stall_gap // period - 1, results
 
 
-def test_a_10_s_stop_at_1_khz_is_one_burst_a_keep_last_1000_reader_gets_whole(ros, tmp_path):
-    """Issue 21, item 7, with a real SIGSTOP: 10 s at 1 kHz with max_catch_up_s:=10.
+def test_a_long_stop_at_1_khz_is_one_burst_a_keep_last_1000_reader_gets_whole(ros, tmp_path):
+    """Issue 21, item 7, with a real SIGSTOP: 4 s at 1 kHz with max_catch_up_s:=10.
 
-    The burst used to be 10,001 instants and a KEEP_LAST 1000 reader lost 1,712 of them.
+    A 10 s stop made a burst of 10,001 instants and a KEEP_LAST 1000 reader lost 1,712
+    of them; any stop longer than the history (here 4,000 instants owed) is the case.
     The burst is now capped at the history's 1000 messages (docs/robustness.md): the
     reader gets every instant from the burst's first on, and the older ones are skipped
     and counted on diagnostics.
@@ -236,7 +237,7 @@ def test_a_10_s_stop_at_1_khz_is_one_burst_a_keep_last_1000_reader_gets_whole(ro
         wait_for(lambda: len(stream.diag) >= 2, STARTUP_S, 'diagnostics')
         skipped_before = diagnostic_value(stream.diag, 'skipped_ticks_total')
         start = len(reader) - 1
-        _stall(stream, 10.0)
+        _stall(stream, 4.0)
         time.sleep(2.0)
         count = len(stream.diag)
         wait_for(lambda: len(stream.diag) > count + 1, 5.0, 'diagnostics after the stop')
@@ -248,7 +249,7 @@ def test_a_10_s_stop_at_1_khz_is_one_burst_a_keep_last_1000_reader_gets_whole(ro
     stop_gap, at = max(gaps)
     # The stop: older instants skipped (counted), then 1000 instants in one burst at most
     # (uncapped, the burst would have left no gap at all; a late wake-up widens it).
-    assert 8.5e9 <= stop_gap <= 12e9, stop_gap
+    assert 2.5e9 <= stop_gap <= 6e9, stop_gap
     assert stop_gap // period - 1 <= skipped
     after = stamps[at + 1:]
     assert len(after) >= 1000 + 500
