@@ -76,6 +76,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return run_tool(add_parser, argv)
     import rclpy
     from rclpy.executors import ExternalShutdownException
+    from rclpy.signals import SignalHandlerOptions
 
     from .live_view import LiveView
     from .view import DEFAULT_PORT, ViewServer
@@ -86,18 +87,23 @@ def main(argv: Sequence[str] | None = None) -> int:
     child = subprocess.Popen(command, start_new_session=True,
                              env=dict(os.environ, PYTHONUNBUFFERED='1'))
     ros_args = argv[argv.index('--ros-args'):] if '--ros-args' in argv else []
-    rclpy.init(args=['live', *ros_args])
+    # Ctrl-C only sets a flag, checked between spins: a KeyboardInterrupt raised
+    # inside rclpy (taking a message) would come out as a RuntimeError instead.
+    stopping: list[int] = []
+    rclpy.init(args=['live', *ros_args], signal_handler_options=SignalHandlerOptions.NO)
+    previous = signal.signal(signal.SIGINT, lambda number, frame: stopping.append(number))
     view = server = None
     try:
         view = LiveView()
         server = ViewServer(view, DEFAULT_PORT)
         print(f'mech_kinematics: node started (pid {child.pid}); Ctrl-C stops it.', flush=True)
         print(f'mech_kinematics: browser view on {server.url}', flush=True)
-        while child.poll() is None:
+        while child.poll() is None and not stopping:
             rclpy.spin_once(view, timeout_sec=0.05)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass  # Ctrl-C: stop the node below
     finally:
+        signal.signal(signal.SIGINT, previous)
         if server is not None:
             server.close()
         if view is not None:
