@@ -37,14 +37,12 @@ from __future__ import annotations
 
 import ast
 from collections.abc import Callable, Sequence
-import inspect
 import math
-import sys
 from typing import Any
 
 from .. import solver as lk
 from ..solver import tick as hooks
-from ..solver.specialize import _body, _SOLVER, plan_body, TABLES, Unsupported
+from ..solver.specialize import plan_body, Unsupported
 
 __all__ = ['TickFunction', 'compile_tick', 'tick_function', 'values_from_state']
 
@@ -109,6 +107,34 @@ def _general(scene: lk.Scene, joints: Sequence[str] | None, points: Sequence[str
     return general
 
 
+def _return_line(plan: hooks.TickPlan, names: dict[str, str], joints: tuple[str, ...],
+                 points: tuple[str, ...],
+                 frames: tuple[tuple[str, str | None, float], ...]) -> str:
+    """Return the tick's ``return [values...], measure`` line (:func:`compile_tick`'s order)."""
+    kinds = dict(plan.joint_types)
+    values = []
+    for index in range(3):
+        for name in joints:
+            if kinds[name] == 'revolute':
+                e = names[f'L_{name}']
+                values.append(f'_wrapped_angle({e}[0])' if index == 0 else f'{e}[{index}]')
+            else:
+                values.append(f'{names[f"S_{name}"]}[{index}]')
+    for index in range(3):
+        for name in points:
+            e = names[f'P_{name}']
+            values += [f'{e}[{index}].real', f'{e}[{index}].imag']
+    for origin, angle_of, angle in frames:
+        e = names[f'P_{origin}']
+        values += [f'{e}[0].real', f'{e}[0].imag']
+        values.append(repr(angle) if angle_of is None
+                      else f'_wrapped_angle({names[f"L_{angle_of}"]}[0])')
+    measures = [names[key] for key in names if key.startswith('M_')]
+    measure = f'min({", ".join(measures)})' if len(measures) > 1 else (
+        measures[0] if measures else 'inf')
+    return f'return [{", ".join(values)}], {measure}'
+
+
 class _Refused(Exception):
     """A step of a several-driver tick found it cannot close: the general solver says why."""
 
@@ -139,67 +165,22 @@ def _compile_drivers(scene: lk.Scene, plan: hooks.TickPlan, joints: tuple[str, .
         '_driver_limits': plan.driver_limits, '_rates_shift': hooks.rates_shift,
         'inf': math.inf, '_float': float, '_SEQUENCE': (list, tuple),
     }
-    for step in (*plan.drivers, *plan.steps):
-        for cls in type(step).__mro__:
-            home = sys.modules[cls.__module__]
-            if home.__name__.startswith(_SOLVER):
-                namespace.update((k, v) for k, v in vars(home).items()
-                                 if not k.startswith('__'))
-    namespace['_wrapped_angle'] = hooks.wrapped_angle
     names: dict[str, str] = {}
     lines = [f'{", ".join(f"{x}_{k}" for k in range(count))}, = '
              f'({", ".join(f"_float({arg}[{k}])" for k in range(count))},)'
              for x, arg in (('x', 'theta'), ('v', 'omega'), ('a', 'alpha'))]
     body: list[ast.stmt] = ast.parse('\n'.join(lines)).body
     try:
-        for name, entry in plan.ground.items():
-            local = names.setdefault(f'P_{name}', f'P_{name}_{len(names)}')
-            namespace[f'_ground_{local}'] = entry
-            body.append(ast.parse(f'{local} = _ground_{local}').body[0])
-        for k, driver in enumerate(plan.drivers):
-            run = type(driver).run
-            parameters = list(inspect.signature(run).parameters)[2:]  # after self, ctx
-            arguments = dict(zip(parameters, (f'x_{k}', f'v_{k}', f'a_{k}'), strict=True))
-            body += _body(driver, run, f'_d{k}', names, namespace, arguments)
-        for index, step in enumerate(plan.steps, 1):
-            for part, kernel in enumerate(step.kernels()):
-                body += _body(step, kernel, f'_{index}_{part}', names, namespace, {})
-    except (Unsupported, OSError, TypeError, ValueError) as error:
-        del error   # the general solver serves this scene
-        return None
-    kinds = dict(plan.joint_types)
-    tail = [f'_l0, _l1, _l2, _l3, _l4, _l5 = _driver_limits(tol, '
-            f'[{", ".join(f"v_{k}" for k in range(count))}], '
-            f'[{", ".join(f"a_{k}" for k in range(count))}])']
-    checks = []
-    for table, _, (i, j, k) in hooks.TRUST_TEST:
-        for name in plan.reported[table]:
-            e = names[f'{TABLES[table]}_{name}']
-            checks.append(f'{e}[3] <= _l{i} and {e}[4] <= _l{j} and {e}[5] <= _l{k}')
-    if checks:
-        tail.append(f'if not ({" and ".join(checks)}):')
-        tail.append('    return _slow(theta, omega, alpha, tol, turns)')
-    values = []
-    for index in range(3):
-        for name in joints:
-            if kinds[name] == 'revolute':
-                e = names[f'L_{name}']
-                values.append(f'_wrapped_angle({e}[0])' if index == 0 else f'{e}[{index}]')
-            else:
-                values.append(f'{names[f"S_{name}"]}[{index}]')
-    for index in range(3):
-        for name in points:
-            e = names[f'P_{name}']
-            values += [f'{e}[{index}].real', f'{e}[{index}].imag']
-    for origin, angle_of, angle in frames:
-        e = names[f'P_{origin}']
-        values += [f'{e}[0].real', f'{e}[0].imag']
-        values.append(repr(angle) if angle_of is None
-                      else f'_wrapped_angle({names[f"L_{angle_of}"]}[0])')
-    measures = [names[key] for key in names if key.startswith('M_')]
-    measure = f'min({", ".join(measures)})' if len(measures) > 1 else (
-        measures[0] if measures else 'inf')
-    tail.append(f'return [{", ".join(values)}], {measure}')
+        body += plan_body(plan, names, namespace, driver_values=[
+            (f'x_{k}', f'v_{k}', f'a_{k}') for k in range(count)])
+    except (Unsupported, ValueError):
+        return None     # the general solver serves this scene
+    namespace['_wrapped_angle'] = hooks.wrapped_angle
+    tail = hooks.trust_lines(
+        plan, names, f'_driver_limits(tol, [{", ".join(f"v_{k}" for k in range(count))}], '
+        f'[{", ".join(f"a_{k}" for k in range(count))}])',
+        'return _slow(theta, omega, alpha, tol, turns)')
+    tail.append(_return_line(plan, names, joints, points, frames))
     signature = ast.arguments(posonlyargs=[], args=[ast.arg(a) for a in (
         'theta', 'omega', 'alpha', 'tol', 'turns')], kwonlyargs=[], kw_defaults=[],
         defaults=[ast.Constant(0)])
@@ -275,44 +256,12 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
         return None     # the general solver serves this scene
     namespace['_wrapped_angle'] = hooks.wrapped_angle
 
-    def var(table: str, name: str) -> str:
-        return names[f'{table}_{name}']
-
-    kinds = dict(plan.joint_types)
-    lines = []
     # The general solver's quick trust test (hooks.trust_limits and hooks.TRUST_TEST, the
     # one source of both), on the reported values.
-    lines.append(f'_l0, _l1, _l2, _l3, _l4, _l5 = _trust_limits(tol, omega, alpha, '
-                 f'{plan.size!r}, {plan.crank_length!r})')
-    checks = []
-    for table, _, (i, j, k) in hooks.TRUST_TEST:
-        for name in plan.reported[table]:
-            e = var(TABLES[table], name)
-            checks.append(f'{e}[3] <= _l{i} and {e}[4] <= _l{j} and {e}[5] <= _l{k}')
-    if checks:
-        lines.append(f'if not ({" and ".join(checks)}):')
-        lines.append('    return _slow(theta, omega, alpha, tol, turns)')
-    values = []
-    for index in range(3):
-        for name in joints:
-            if kinds[name] == 'revolute':
-                e = var('L', name)
-                values.append(f'_wrapped_angle({e}[0])' if index == 0 else f'{e}[{index}]')
-            else:
-                values.append(f'{var("S", name)}[{index}]')
-    for index in range(3):
-        for name in points:
-            e = var('P', name)
-            values += [f'{e}[{index}].real', f'{e}[{index}].imag']
-    for origin, angle_of, angle in frames:
-        e = var('P', origin)
-        values += [f'{e}[0].real', f'{e}[0].imag']
-        values.append(repr(angle) if angle_of is None
-                      else f'_wrapped_angle({var("L", angle_of)}[0])')
-    measures = [names[key] for key in names if key.startswith('M_')]
-    measure = f'min({", ".join(measures)})' if len(measures) > 1 else (
-        measures[0] if measures else 'inf')
-    lines.append(f'return [{", ".join(values)}], {measure}')
+    lines = hooks.trust_lines(plan, names, f'_trust_limits(tol, omega, alpha, {plan.size!r}, '
+                              f'{plan.crank_length!r})',
+                              'return _slow(theta, omega, alpha, tol, turns)')
+    lines.append(_return_line(plan, names, joints, points, frames))
     tail = ast.parse('\n'.join(lines)).body
     low, high, accel_high = hooks.RATES
     guard = ast.parse(

@@ -107,16 +107,8 @@ def compile_single(scene: Scene) -> SingleFunction | None:
     def var(table: str, name: str) -> str:
         return names[f'{table}_{name}']
 
-    lines = [f'_l0, _l1, _l2, _l3, _l4, _l5 = _trust_limits(tol, omega, alpha, '
-             f'{plan.size!r}, {plan.crank_length!r})']
-    checks = []
-    for table, _, (i, j, k) in hooks.TRUST_TEST:
-        for name in plan.reported[table]:
-            e = var(TABLES[table], name)
-            checks.append(f'{e}[3] <= _l{i} and {e}[4] <= _l{j} and {e}[5] <= _l{k}')
-    if checks:
-        lines.append(f'if not ({" and ".join(checks)}):')
-        lines.append('    return None')
+    lines = hooks.trust_lines(plan, names, f'_trust_limits(tol, omega, alpha, {plan.size!r}, '
+                              f'{plan.crank_length!r})', 'return None')
     joints, entries = [], []
     for name, kind in plan.joint_types.items():
         if kind == 'revolute':

@@ -30,7 +30,7 @@ caller falls back to the general solver.
 from __future__ import annotations
 
 import ast
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 import functools
 import inspect
 import itertools
@@ -298,7 +298,8 @@ def _body(step: Any, method: Callable[..., Any], suffix: str, names: dict[str, s
 
 
 def plan_body(plan: Any, names: dict[str, str], namespace: dict[str, Any],
-              vector: bool = False) -> list[ast.stmt]:
+              vector: bool = False,
+              driver_values: Sequence[tuple[str, str, str]] | None = None) -> list[ast.stmt]:
     """Return the statements solving ``plan`` (a :class:`.tick.TickPlan`) in one function.
 
     The function's arguments are ``theta, omega, alpha, turns`` (and, on the
@@ -306,9 +307,14 @@ def plan_body(plan: Any, names: dict[str, str], namespace: dict[str, Any],
     statements leave every table entry in a local variable, ``names`` mapping
     ``'<table prefix>_<name>'`` (:data:`TABLES`) to it. ``namespace`` gets the
     globals the statements read (the kernels' modules', and the constants).
+    With ``driver_values`` (one (position, speed, accel) triple of names per
+    driver, a scalar tick of several drivers), each driver's kernel runs on its
+    own names instead of the crank's on ``theta, omega, alpha``.
     Raises :class:`Unsupported` where a kernel is outside the subset.
     """
-    for step in (plan.crank, *plan.steps):
+    drivers = (plan.crank,) if driver_values is None else plan.drivers
+    values = (('theta', 'omega', 'alpha'),) if driver_values is None else driver_values
+    for step in (*drivers, *plan.steps):
         for cls in type(step).__mro__:
             home = sys.modules[cls.__module__]
             if home.__name__.startswith(_SOLVER):
@@ -320,9 +326,12 @@ def plan_body(plan: Any, names: dict[str, str], namespace: dict[str, Any],
             local = names.setdefault(f'P_{name}', f'P_{name}_{len(names)}')
             namespace[f'_ground_{local}'] = entry
             body.append(ast.parse(f'{local} = _ground_{local}').body[0])
-        arguments = {'theta': 'theta', 'omega': 'omega', 'alpha': 'alpha'}
-        body += _body(plan.crank, type(plan.crank).run, '_0', names, namespace, arguments,
-                      vector)
+        for k, (driver, given) in enumerate(zip(drivers, values, strict=True)):
+            run = type(driver).run
+            parameters = list(inspect.signature(run).parameters)[2:]   # after self, ctx
+            arguments = dict(zip(parameters, given, strict=True))
+            body += _body(driver, run, f'_d{k}' if driver_values else '_0', names, namespace,
+                          arguments, vector)
         for index, step in enumerate(plan.steps, 1):
             # Step.kernels names the single-angle path; the array path is ``run`` itself.
             kernels = (type(step).run,) if vector else step.kernels()

@@ -21,11 +21,13 @@ from .base import Step
 from .context import _Context
 from .scaling import _ACCEL_HIGH, _RATE_HIGH, _RATE_LOW, _rates_exponent
 from .solve import _limits, _wrapped_angle, trust_limits, TRUST_TEST
+from .specialize import TABLES
 
 if TYPE_CHECKING:
     from .mechanism import Scene
 
 __all__ = ['RATES', 'TRUST_TEST', 'TickPlan', 'check', 'check_margin', 'rates_shift', 'shown',
+           'trust_lines',
            'tick_plan', 'trust_limits', 'wrapped_angle']
 
 #: Crank rates solved unscaled: ``low <= |omega| <= high`` and ``|alpha| <= accel_high``
@@ -115,3 +117,25 @@ def check_margin(theta: float, turns: int, *args: Any, **kwargs: Any) -> None:
 def shown(theta: float, turns: int) -> Any:
     """Return the crank angle counted from the start, as messages show it (``ctx.shown``)."""
     return _Context(theta, False, turns).shown
+
+
+def trust_lines(plan: TickPlan, names: Mapping[str, str], limits: str,
+                otherwise: str) -> list[str]:
+    """Return the source lines of the quick trust test on a compiled plan's reported values.
+
+    ``limits`` is the expression giving the six limits (:func:`trust_limits`,
+    or the several drivers' own); ``otherwise`` the statement run where a
+    reported bound is beyond them. ``names`` maps each table entry to its local
+    variable (:func:`.specialize.plan_body`). The one source of the test for
+    the node's tick and ``mk.solve``'s compiled path, with :data:`TRUST_TEST`.
+    """
+    lines = [f'_l0, _l1, _l2, _l3, _l4, _l5 = {limits}']
+    checks = []
+    for table, _, (i, j, k) in TRUST_TEST:
+        for name in plan.reported[table]:
+            e = names[f'{TABLES[table]}_{name}']
+            checks.append(f'{e}[3] <= _l{i} and {e}[4] <= _l{j} and {e}[5] <= _l{k}')
+    if checks:
+        lines.append(f'if not ({" and ".join(checks)}):')
+        lines.append(f'    {otherwise}')
+    return lines
