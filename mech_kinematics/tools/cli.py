@@ -34,9 +34,9 @@ from typing import Any
 from ..errors import MechKinematicsError
 from ..units import LENGTH_UNITS, rad_per_s_from_rpm, turns_from_degrees
 
-__all__ = ['ArgumentParser', 'PROG', 'add_scene_argument', 'drive_from_args', 'finite_float',
-           'named_value', 'positive_float', 'values_by_driver',
-           'positive_int', 'positive_seconds', 'run_handler', 'run_tool', 'seconds_or_zero']
+__all__ = ['ArgumentParser', 'PROG', 'add_driver_arguments', 'add_scene_argument',
+           'drive_from_args', 'finite_float', 'named_value', 'positive_float', 'positive_int',
+           'positive_seconds', 'run_handler', 'run_tool', 'seconds_or_zero', 'values_by_driver']
 
 #: The program name shown in usage lines.
 PROG = 'python -m mech_kinematics'
@@ -199,6 +199,25 @@ def values_by_driver(scene: Any, flag: str, given: list[tuple[str | None, float]
             raise ValueError(msg)
         out[name] = value
     return out
+
+
+def add_driver_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add ``--accel``, ``--input`` and ``--speed NAME=VALUE``: what :func:`drive_from_args` reads.
+
+    ``solve`` and ``diagram`` take a scene's drivers the same way (with
+    ``--angle-deg`` and ``--speed-rpm`` of their own for one crank).
+    """
+    parser.add_argument('--accel', type=named_value, action='append', metavar='[NAME=]A',
+                        help='crank angular acceleration in rad/s^2, + CCW; with several '
+                             'drivers, NAME=A per driver: rad/s^2 for a crank, m/s^2 for an '
+                             "actuator (repeatable; default: the scene's)")
+    parser.add_argument('--input', type=named_value, action='append', metavar='NAME=VALUE',
+                        help="a driver's position: a crank's angle in degrees (counted from "
+                             "the start), an actuator's length in the scene's length unit "
+                             "(repeatable, one per driver; default: the scene's)")
+    parser.add_argument('--speed', type=named_value, action='append', metavar='NAME=VALUE',
+                        help="a driver's speed: rpm for a crank (as --speed-rpm), m/s for an "
+                             "actuator's extension rate (repeatable; default: the scene's)")
 
 
 def drive_from_args(scene: Any, args: argparse.Namespace) -> tuple[Any, Any, Any, Any, str]:

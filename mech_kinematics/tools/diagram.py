@@ -23,8 +23,8 @@ import warnings
 import numpy as np
 import numpy.typing as npt
 
-from .cli import add_scene_argument, finite_float, positive_int, run_tool
-from .cli import drive_from_args, named_value, values_by_driver
+from .cli import (add_driver_arguments, add_scene_argument, drive_from_args, finite_float,
+                  positive_int, run_tool, values_by_driver)
 from ..errors import AssemblyError, NearSingularWarning, SceneError
 from ..geometry.diagrams import (arrows_from_state, colours_from_scene, Diagram,
                                  diagram_from_scene, fmt_sense, fmt_value, nice_scale, POLE,
@@ -768,17 +768,7 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                              'with --animate, the first frame')
     parser.add_argument('--speed-rpm', type=finite_float, metavar='N',
                         help="signed crank speed in rpm, + CCW (default: the scene's)")
-    parser.add_argument('--accel', type=named_value, action='append', metavar='[NAME=]A',
-                        help='crank angular acceleration in rad/s^2, + CCW; NAME=A for a '
-                             "driver of several (an actuator's in m/s^2) (default: the "
-                             "scene's)")
-    parser.add_argument('--input', type=named_value, action='append', metavar='NAME=VALUE',
-                        help="a driver's position, as solve takes it: a crank's angle in "
-                             "degrees, an actuator's length in the scene's length unit "
-                             "(repeatable; default: the scene's)")
-    parser.add_argument('--speed', type=named_value, action='append', metavar='NAME=VALUE',
-                        help="a driver's speed, as solve takes it: rpm for a crank, m/s for an "
-                             "actuator (repeatable; default: the scene's)")
+    add_driver_arguments(parser)
     parser.add_argument('--instant-centres', action='store_true',
                         help='also compute the instant centres, mark them on the space '
                              'diagram and list them')

@@ -11,7 +11,7 @@ import sys
 from typing import Any
 import warnings
 
-from .cli import (add_scene_argument, drive_from_args, finite_float, named_value,
+from .cli import (add_driver_arguments, add_scene_argument, drive_from_args, finite_float,
                   positive_float, run_tool)
 from ..bounds import MAX_ERROR
 from ..errors import AssemblyError, NearSingularWarning, SceneError, UntrustedError
@@ -95,17 +95,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
                              "intermittent drive; default: the scene's)")
     parser.add_argument('--speed-rpm', type=finite_float, metavar='N',
                         help="signed crank speed in rpm, + CCW (default: the scene's)")
-    parser.add_argument('--accel', type=named_value, action='append', metavar='[NAME=]A',
-                        help='crank angular acceleration in rad/s^2, + CCW; with several '
-                             'drivers, NAME=A per driver: rad/s^2 for a crank, m/s^2 for an '
-                             "actuator (repeatable; default: the scene's)")
-    parser.add_argument('--input', type=named_value, action='append', metavar='NAME=VALUE',
-                        help="a driver's position: a crank's angle in degrees (counted from "
-                             "the start), an actuator's length in the scene's length unit "
-                             "(repeatable, one per driver; default: the scene's)")
-    parser.add_argument('--speed', type=named_value, action='append', metavar='NAME=VALUE',
-                        help="a driver's speed: rpm for a crank (as --speed-rpm), m/s for an "
-                             "actuator's extension rate (repeatable; default: the scene's)")
+    add_driver_arguments(parser)
     parser.add_argument('--max-error', type=positive_float, default=MAX_ERROR, metavar='REL',
                         help="refuse (exit 2) where a value's error bound exceeds REL times "
                              "its kind's scale (the mechanism's size, its largest speed, its "
