@@ -171,6 +171,13 @@ def compile_array(scene: Scene) -> ArrayFunction | None:
         tables[prefix].append(f'{name!r}: {local}')
     lines = [f'ctx.{table} = {{{", ".join(tables[prefix])}}}'
              for table, prefix in TABLES.items()]
+    sums: dict[str, list[str]] = {}
+    for table, name, _, _, kinds in scene._solver.outputs:
+        local = names[f'{TABLES[table]}_{name}']
+        for index, kind in enumerate(kinds, 3):
+            sums.setdefault(kind, []).append(f'{local}[{index}]')
+    lines.append('ctx.sums = (' + ''.join(f'({kind!r}, {" + ".join(terms)}), '
+                                          for kind, terms in sums.items()) + ')')
     function = ast.FunctionDef(
         name='array', args=ast.arguments(
             posonlyargs=[], args=[ast.arg(a) for a in ('theta', 'omega', 'alpha', 'turns',

@@ -40,7 +40,7 @@ class _Context:
     """
 
     __slots__ = ('angle', 'turns', 'shown', 'vector', 'points', 'links', 'sliders', 'measures',
-                 'valid', 'failures', 'engagement', 'rubbing', 'notes', 'flip', 'jumps')
+                 'valid', 'failures', 'engagement', 'rubbing', 'notes', 'flip', 'jumps', 'sums')
 
     def __init__(self, angle: Any, vector: bool, turns: Any = 0, flip: bool = False) -> None:
         self.angle = angle
@@ -62,6 +62,9 @@ class _Context:
         # flip, the side before it. jumps: lever -> where it jumps (True, or a mask).
         self.flip = flip
         self.jumps: dict[str, Any] = _NOTHING
+        # A compiled array solve's reported bounds summed per kind, for the quick judgement
+        # (:func:`.compiled.compile_array`); None elsewhere.
+        self.sums: tuple[tuple[str, Any], ...] | None = None
 
     def jump(self, lever: str, where: Any) -> None:
         """Record that ``lever``'s values jump at the instant (``where``: True, or a mask).

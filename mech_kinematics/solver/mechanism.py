@@ -114,7 +114,7 @@ class _Solver:
         self.array_solves = 0
         self.scene = scene
         # Per array shape, the ground points' values as read-only arrays (solve._state).
-        self.ground_arrays: dict[tuple[int, ...], dict[int, tuple[Any, Any]]] = {}
+        self.constant_arrays: dict[tuple[int, ...], Any] = {}
 
     def floors(self, speeds: Any, accels: Any) -> tuple[Any, Any, Any, Any]:
         """Return the least scales of speed, acceleration and turning rates from the drivers.

@@ -84,6 +84,7 @@ def _execute(solver: _Solver, theta: Any, omega: Any, alpha: Any, turns: Any = 0
     ctx = _run(solver, theta, omega, alpha, turns, flip)
     if solver.shift or shift:
         _rescale(solver, ctx, shift)
+        ctx.sums = None     # summed before the rescaling
     return ctx
 
 
@@ -242,19 +243,30 @@ def _within(solver: _Solver, ctx: _Context, lims: dict[str, float]) -> bool:
 
     ``lims``: the floors times the tolerance, one number each (one crank rate).
 
-    The largest of each array (``np.maximum.reduce``: NaN is the largest and
-    fails), one reduction per bound where :func:`_judge`'s test takes five
-    operations.
+    A sufficient test, cheaper than one reduction per bound: the bounds of
+    each kind are added element by element (by the compiled solve itself,
+    ``ctx.sums``, where it ran), and the largest sum (``np.maximum.reduce``)
+    is compared with the kind's limit. Bounds are never negative, and a
+    rounded sum of numbers that are not negative is at least each of them,
+    so a sum within the limit holds every bound of the kind within it; NaN
+    makes its sum NaN, the largest, and fails. Where a sum exceeds the
+    limit, :func:`_judge` tests each bound.
     """
     largest = np.maximum.reduce
-    for table, name, _, _, kinds in solver.outputs:
-        entry = getattr(ctx, table)[name]
-        for index in (0, 1, 2):
-            bound = entry[3 + index]
-            if getattr(bound, 'ndim', 0):
-                bound = largest(bound)
-            if not bound <= lims[kinds[index]]:
-                return False
+    if ctx.sums is not None:    # summed by the compiled solve (compile_array)
+        if not all(largest(total, axis=None) <= lims[kind] for kind, total in ctx.sums):
+            return False
+    else:
+        sums: dict[str, Any] = {}
+        for table, name, _, _, kinds in solver.outputs:
+            entry = getattr(ctx, table)[name]
+            for kind, bound in zip(kinds, entry[3:], strict=True):
+                if kind in sums:
+                    sums[kind] = sums[kind] + bound
+                else:
+                    sums[kind] = bound
+        if not all(largest(total, axis=None) <= lims[kind] for kind, total in sums.items()):
+            return False
     lim = lims['velocity']
     return all(bool(largest(bound, axis=None) <= lim) for _, bound in ctx.rubbing.values())
 
@@ -387,17 +399,19 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
         if shape[0] >= LARGE_BATCH:
             keep_freed_memory()
         given = (theta, omega, alpha)       # maybe the caller's own arrays
-        theta = _read_only(theta, shape)
-        whole = _read_only(np.asarray(whole, dtype=np.int64), shape)
+        constant = _constants(solver, shape)
+        theta = _read_only(theta, shape, constant)
+        some = whole.__class__ is not int or whole != 0    # turns other than the usual 0
+        whole = _read_only(np.asarray(whole, dtype=np.int64), shape, constant)
         with np.errstate(all='ignore'):
             # A constant speed or acceleration stays a scalar through the steps.
             ctx = _execute(solver, theta, omega, alpha, whole)
             _judge(solver, ctx, _crank_floors(solver.crank_length, omega, alpha), tol, shape)
-        omega, alpha = _read_only(omega, shape), _read_only(alpha, shape)
+        omega, alpha = _read_only(omega, shape, constant), _read_only(alpha, shape, constant)
         valid = (np.ones(shape, dtype=bool) if ctx.valid is True
                  else np.broadcast_to(np.asarray(ctx.valid, dtype=bool), shape).copy())
         jumps = _jumps(solver, ctx, theta, omega, alpha, whole, valid) if ctx.jumps else {}
-        counted = theta + math.tau * whole if whole.any() else np.array(theta)
+        counted = theta + math.tau * whole if some and whole.any() else np.array(theta)
     _warn_near_singular(ctx.measures, ctx.vector, ctx.valid)
     drivers = {solver.driver_names[0]: JointMotion('revolute', counted, omega, alpha)}
     return _state(scene, solver, ctx, theta, omega, alpha, valid, whole, jumps, drivers,
@@ -630,10 +644,13 @@ def _finite(x: Any) -> bool:
     return math.isfinite(x) if x.ndim == 0 else bool(np.isfinite(x).all())
 
 
-def _read_only(x: Any, shape: tuple[int, ...]) -> Any:
-    """Return ``x`` broadcast to ``shape`` as a read-only view (``np.broadcast_to``'s result)."""
+def _read_only(x: Any, shape: tuple[int, ...], constant: Callable[[Any], Any]) -> Any:
+    """Return ``x`` broadcast to ``shape`` as a read-only view (``np.broadcast_to``'s result).
+
+    ``constant`` (:class:`_Constants` of ``shape``) makes the view of one value.
+    """
     if x.ndim == 0:
-        return _constant(x, shape)
+        return constant(x)
     if x.shape != shape:
         return np.broadcast_to(x, shape)
     view = x.view()
@@ -728,42 +745,38 @@ def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any,
         bad = None if valid.all() else ~valid
         inputs = (id(theta), id(omega), id(alpha), *map(id, given))
 
-        # The ground points' values (the same objects every solve) as read-only arrays,
-        # made once per shape; they live as long as the solver, so their ids stay theirs.
-        ground = solver.ground_arrays.get(shape)
-        if ground is None:
-            if len(solver.ground_arrays) >= 8:
-                solver.ground_arrays.clear()
-            ground = solver.ground_arrays[shape] = {
-                id(x): (x, _constant(x, shape)) for entry in solver.ground.values() for x in entry}
-
-        def finish(x: Any) -> Any:
-            # A constant (a ground point, a constant crank speed) becomes a
-            # read-only broadcast view; a copy only where NaN must go in, and
-            # never the caller's own input arrays.
-            if getattr(x, 'shape', ()) != shape:
-                hit = ground.get(id(x))
-                x = hit[1] if hit is not None and hit[0] is x else _constant(x, shape)
-                if bad is None:
-                    return x
-                x = np.array(x)
-            elif id(x) in inputs:
-                x = np.array(x)
-            if bad is not None:
+        constant = _constants(solver, shape)
+        ndarray = np.ndarray
+        if bad is None:
+            def finish(x: Any) -> Any:
+                # An array of the shape is the state's own, unless it is the caller's
+                # input (a copy then); a constant becomes a read-only broadcast view.
+                if x.__class__ is ndarray and x.shape == shape:
+                    return np.array(x) if id(x) in inputs else x
+                if getattr(x, 'shape', ()) == shape:
+                    return np.array(x) if id(x) in inputs else x
+                return constant(x)
+        else:
+            def finish(x: Any) -> Any:
+                # As above, with NaN where refused: a copy of a constant or an input.
+                if getattr(x, 'shape', ()) != shape:
+                    x = np.array(constant(x))
+                elif id(x) in inputs:
+                    x = np.array(x)
                 x[bad] = np.nan
-            return x
+                return x
 
         for name, joint in joints.items():
             joints[name] = JointMotion(joint.type, finish(joint.position),
                                        finish(joint.velocity), finish(joint.acceleration))
         points = {name: (finish(p), finish(v), finish(a)) for name, (p, v, a) in points.items()}
         measures = {key: finish(m) for key, m in measures.items()}
-        joint_bounds, point_bounds = _table_bounds(plan, ctx)
-        bound = ErrorBound(_given, ({name: (finish(a), finish(b), finish(c))
-                                     for name, (a, b, c) in joint_bounds.items()},
-                                    {name: (finish(a), finish(b), finish(c))
-                                     for name, (a, b, c) in point_bounds.items()}),
-                           solver.size, solver.crank_length, floors)
+        if bad is None:     # nothing to write NaN into: finished when first read
+            bound = ErrorBound(_finished_bounds, (plan, ctx, finish), solver.size,
+                               solver.crank_length, floors)
+        else:
+            bound = ErrorBound(_given, _finished_bounds(plan, ctx, finish), solver.size,
+                               solver.crank_length, floors)
         rubbing = {name: finish(value) for name, (value, _) in ctx.rubbing.items()}
         bound.rubbing = {name: finish(b) for name, (_, b) in ctx.rubbing.items()}
         intermittent = {name: step.engagement(ctx, omega, finish)
@@ -810,6 +823,51 @@ def _new_state(scene: str, angle: Any, speed: Any, accel: Any, joints: dict[str,
     return state
 
 
+class _Constants:
+    """Read-only arrays of one shape whose elements are one value, made once per value.
+
+    A vector state holds a dozen such arrays (the ground points' values, a
+    constant crank speed, its bounds, the whole turns); a solver keeps one of
+    these per shape it was solved at (``solver.constant_arrays``), so the
+    next solve of that shape reuses them. They are read-only, so states may
+    share them. The ground points' values are the same objects every solve
+    and are found by identity; any other value by its type and bytes (not by
+    equality, which would take -0.0 for 0.0).
+    """
+
+    __slots__ = ('shape', 'ground', 'seen')
+
+    def __init__(self, solver: _Solver, shape: tuple[int, ...]) -> None:
+        self.shape = shape
+        self.ground = {id(x): (x, _constant(x, shape)) for entry in solver.ground.values()
+                       for x in entry}
+        self.seen: dict[tuple[str, bytes], Any] = {}
+
+    def __call__(self, x: Any) -> Any:
+        """Return ``x`` (a number or a 0-d array) as a read-only array of the shape."""
+        hit = self.ground.get(id(x))
+        if hit is not None and hit[0] is x:
+            return hit[1]
+        one = np.asarray(x)
+        key = (one.dtype.char, one.tobytes())
+        view = self.seen.get(key)
+        if view is None:
+            if len(self.seen) >= 64:
+                self.seen.clear()
+            view = self.seen[key] = _constant(one, self.shape)
+        return view
+
+
+def _constants(solver: _Solver, shape: tuple[int, ...]) -> _Constants:
+    """Return the solver's :class:`_Constants` of ``shape`` (made at most once per shape)."""
+    constants = solver.constant_arrays.get(shape)
+    if constants is None:
+        if len(solver.constant_arrays) >= 8:
+            solver.constant_arrays.clear()
+        constants = solver.constant_arrays[shape] = _Constants(solver, shape)
+    return constants
+
+
 def _constant(x: Any, shape: tuple[int, ...]) -> Any:
     """Return one value (a number or a 0-d array) as a read-only array of ``shape``.
 
@@ -829,6 +887,14 @@ def _table_bounds(plan: _Plan, ctx: _Context) -> tuple[Table, Table]:
               for name, kind in plan.joint_types.items()}
     table = ctx.points
     return joints, {name: table[name][3:] for name in plan.output_points}
+
+
+def _finished_bounds(plan: _Plan, ctx: _Context,
+                     finish: Callable[[Any], Any]) -> tuple[Table, Table]:
+    """Return the reported bounds of a vector solve, each value passed through ``finish``."""
+    joints, points = _table_bounds(plan, ctx)
+    return ({name: (finish(a), finish(b), finish(c)) for name, (a, b, c) in joints.items()},
+            {name: (finish(a), finish(b), finish(c)) for name, (a, b, c) in points.items()})
 
 
 def _given(joints: Table, points: Table) -> tuple[Table, Table]:

@@ -259,3 +259,34 @@ def test_keeping_freed_memory_can_be_declined():
         out = subprocess.run([sys.executable, '-c', code], env=env, capture_output=True,
                              text=True, check=True).stdout.split()
         assert out[0] == (kept if kept is not None else out[1])
+
+
+def test_bounds_summed_over_a_limit_are_still_judged_one_by_one():
+    """The quick judgement adds each kind's bounds; a sum over the limit is not a refusal.
+
+    The tolerance is set so that the largest acceleration bound of one point is
+    within its limit while the sum of the points' acceleration bounds is not:
+    every angle must still be answered, as the general path answers it.
+    """
+    fast, slow = _pair(lambda: mk.load_scene('khurmi_four_bar_ad150'))
+    angles = np.linspace(0.0, 2 * math.pi, 360, endpoint=False)
+    loose = mk.solve(fast, angles, max_error=math.inf)
+    point_bounds = [loose.error_bound.points[name].acceleration for name in ('B', 'C')]
+    largest, summed = max(b.max() for b in point_bounds), (point_bounds[0] + point_bounds[1]).max()
+    floor = fast.input.length * fast.input.speed ** 2      # the acceleration's floor (no accel)
+    assert largest < summed
+    tol = (largest + summed) / 2 / floor
+    assert fast._solver.compiled_array
+    state = mk.solve(fast, angles, max_error=tol)
+    assert fast._solver.compiled_array and state.valid.all()
+    assert state_facts(state) == state_facts(mk.solve(slow, angles, max_error=tol))
+
+
+def test_a_constant_speed_keeps_its_sign_of_zero_in_an_array_state():
+    """The read-only arrays made once per value tell -0.0 from 0.0 (equal as numbers)."""
+    scene = mk.load_scene('khurmi_four_bar_ad150')
+    angles = np.linspace(0.0, 1.0, 7)
+    for speed in (0.0, -0.0, 0.0, -0.0):
+        state = mk.solve(scene, angles, speed)
+        assert not state.speed.flags.writeable
+        assert (np.signbit(state.speed) == np.signbit(speed)).all()
