@@ -34,11 +34,12 @@ from collections.abc import Callable, Sequence
 import functools
 import inspect
 import itertools
+import operator
 import sys
 import textwrap
 from typing import Any, cast
 
-__all__ = ['DROPPED', 'TABLES', 'Unsupported', 'fold', 'plan_body']
+__all__ = ['DROPPED', 'TABLES', 'Unsupported', 'fold', 'plan_body', 'propagate']
 
 _SOLVER = __name__.rsplit('.', 1)[0] + '.'
 #: The context's methods that record side facts (an intermittent lever's window, why a
@@ -339,4 +340,239 @@ def plan_body(plan: Any, names: dict[str, str], namespace: dict[str, Any],
                 body += _body(step, kernel, f'_{index}_{part}', names, namespace, {}, vector)
     except (OSError, TypeError) as error:
         raise Unsupported(str(error)) from error
-    return body
+    return propagate(body, namespace, set(names.values()))
+
+
+#: The numbers a folded constant may hold: what the runtime computes with Python's own
+#: arithmetic when both operands are such constants.
+_NUMBERS = (bool, int, float, complex)
+_BINARY: dict[type[ast.operator], Callable[[Any, Any], Any]] = {
+    ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul,
+    ast.Div: operator.truediv, ast.FloorDiv: operator.floordiv, ast.Mod: operator.mod,
+    ast.Pow: operator.pow,
+}
+_UNARY: dict[type[ast.unaryop], Callable[[Any], Any]] = {
+    ast.USub: operator.neg, ast.UAdd: operator.pos, ast.Not: operator.not_,
+}
+_COMPARE: dict[type[ast.cmpop], Callable[[Any, Any], Any]] = {
+    ast.Eq: operator.eq, ast.NotEq: operator.ne, ast.Lt: operator.lt, ast.LtE: operator.le,
+    ast.Gt: operator.gt, ast.GtE: operator.ge,
+}
+
+
+def _is_constant(value: Any) -> bool:
+    """Return whether ``value`` is a number, or a tuple of numbers, folding may use."""
+    if isinstance(value, tuple):
+        return all(type(v) in _NUMBERS for v in value)
+    return type(value) in _NUMBERS
+
+
+def _evaluated(function: Callable[..., Any], *operands: Any) -> ast.Constant | None:
+    """Return ``function(*operands)`` as a constant, or None where it raises or is no number."""
+    try:
+        value = function(*operands)
+    except (ArithmeticError, TypeError, ValueError):
+        return None
+    return ast.Constant(value) if type(value) in _NUMBERS else None
+
+
+class _Propagator(ast.NodeTransformer):
+    """Put in the constants of :func:`propagate` and fold what they make constant."""
+
+    def __init__(self, known: dict[str, Any], shadowed: set[str]) -> None:
+        self.known = known          # a local assigned once, from a constant -> its value
+        self.shadowed = shadowed    # builtins a local or the namespace redefines
+
+    def visit_Name(self, node: ast.Name) -> ast.AST:
+        if isinstance(node.ctx, ast.Load) and node.id in self.known:
+            return ast.copy_location(ast.Constant(self.known[node.id]), node)
+        return node
+
+    def visit_Attribute(self, node: ast.Attribute) -> ast.AST:
+        self.generic_visit(node)
+        value = node.value
+        if (isinstance(value, ast.Constant) and type(value.value) in _NUMBERS
+                and node.attr in ('real', 'imag') and isinstance(node.ctx, ast.Load)):
+            folded = _evaluated(getattr, value.value, node.attr)
+            if folded is not None:
+                return ast.copy_location(folded, node)
+        return node
+
+    def visit_Subscript(self, node: ast.Subscript) -> ast.AST:
+        self.generic_visit(node)
+        value, index = node.value, node.slice
+        entries: Any = value.value if isinstance(value, ast.Constant) else None
+        if (isinstance(entries, tuple) and isinstance(index, ast.Constant)
+                and type(index.value) is int and isinstance(node.ctx, ast.Load)):
+            folded = _evaluated(operator.getitem, entries, index.value)
+            if folded is not None:
+                return ast.copy_location(folded, node)
+        return node
+
+    def visit_Call(self, node: ast.Call) -> ast.AST:
+        self.generic_visit(node)
+        if (isinstance(node.func, ast.Name) and node.func.id == 'abs'
+                and 'abs' not in self.shadowed and len(node.args) == 1 and not node.keywords
+                and isinstance(node.args[0], ast.Constant)
+                and type(node.args[0].value) in _NUMBERS):
+            folded = _evaluated(abs, node.args[0].value)
+            if folded is not None:
+                return ast.copy_location(folded, node)
+        return node
+
+    def visit_UnaryOp(self, node: ast.UnaryOp) -> ast.AST:
+        self.generic_visit(node)
+        operand = node.operand
+        function = _UNARY.get(type(node.op))
+        if (function is not None and isinstance(operand, ast.Constant)
+                and type(operand.value) in _NUMBERS):
+            folded = _evaluated(function, operand.value)
+            if folded is not None:
+                return ast.copy_location(folded, node)
+        return node
+
+    def visit_BinOp(self, node: ast.BinOp) -> ast.AST:
+        self.generic_visit(node)
+        left, right = node.left, node.right
+        function = _BINARY.get(type(node.op))
+        if isinstance(node.op, ast.Pow) and not isinstance(getattr(right, 'value', 0), float):
+            function = None                         # an integer power could be huge
+        if (function is not None and isinstance(left, ast.Constant)
+                and isinstance(right, ast.Constant) and type(left.value) in _NUMBERS
+                and type(right.value) in _NUMBERS):
+            folded = _evaluated(function, left.value, right.value)
+            if folded is not None:
+                return ast.copy_location(folded, node)
+        return node
+
+    def visit_Compare(self, node: ast.Compare) -> ast.AST:
+        self.generic_visit(node)
+        operands = [node.left, *node.comparators]
+        functions = [_COMPARE.get(type(op)) for op in node.ops]
+        if not all(isinstance(o, ast.Constant) and type(o.value) in _NUMBERS
+                   for o in operands) or None in functions:
+            return node
+        values = [cast(ast.Constant, o).value for o in operands]
+        result = True
+        for function, left, right in zip(functions, values, values[1:], strict=False):
+            folded = _evaluated(cast(Callable[[Any, Any], Any], function), left, right)
+            if folded is None:
+                return node
+            if not folded.value:
+                result = False
+                break                               # a chain stops at its first false
+        return ast.copy_location(ast.Constant(result), node)
+
+
+def _stores(body: list[ast.stmt]) -> dict[str, int]:
+    """Return how many times each name is bound anywhere in ``body``."""
+    counts: dict[str, int] = {}
+    for stmt in body:
+        for n in ast.walk(stmt):
+            if isinstance(n, ast.Name) and not isinstance(n.ctx, ast.Load):
+                counts[n.id] = counts.get(n.id, 0) + 1
+            elif isinstance(n, ast.arg):
+                counts[n.arg] = counts.get(n.arg, 0) + 2    # never a constant
+    return counts
+
+
+def _targets(stmt: ast.stmt) -> list[tuple[str, ast.expr | None]] | None:
+    """Return the (name, value) pairs a plain assignment binds, or None for any other.
+
+    ``a = x`` gives ``[('a', x)]``, ``a, b = (x, y)`` gives ``[('a', x), ('b', y)]``
+    and ``a, b = t`` gives ``[('a', None), ('b', None)]`` (or the entries of ``t``
+    where it is a constant tuple).
+    """
+    if not (isinstance(stmt, ast.Assign) and len(stmt.targets) == 1):
+        return None
+    target, value = stmt.targets[0], stmt.value
+    if isinstance(target, ast.Name):
+        return [(target.id, value)]
+    if not (isinstance(target, ast.Tuple)
+            and all(isinstance(t, ast.Name) for t in target.elts)):
+        return None
+    names = [cast(ast.Name, t).id for t in target.elts]
+    if isinstance(value, ast.Tuple) and len(value.elts) == len(names) and not any(
+            isinstance(v, ast.Starred) for v in value.elts):
+        return list(zip(names, value.elts, strict=True))
+    entries: Any = value.value if isinstance(value, ast.Constant) else None
+    if isinstance(entries, tuple) and len(entries) == len(names):
+        return [(n, ast.Constant(v)) for n, v in zip(names, entries, strict=True)]
+    return [(n, None) for n in names]
+
+
+def _reads(body: list[ast.stmt]) -> set[str]:
+    """Return the names read anywhere in ``body`` (lambdas and f-strings included)."""
+    return {n.id for stmt in body for n in ast.walk(stmt)
+            if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
+
+
+def _pruned(stmt: ast.stmt, dead: set[str]) -> ast.stmt | None:
+    """Return ``stmt`` without the bindings of ``dead`` names to constants or names.
+
+    Only a binding whose value cannot raise or act (a constant, a name the
+    code has bound) is removed: any other value is still computed.
+    """
+    pairs = _targets(stmt)
+    if pairs is None:
+        return stmt
+    idle = [name in dead and isinstance(value, (ast.Constant, ast.Name))
+            for name, value in pairs]
+    if not any(idle):
+        return stmt
+    if all(idle):
+        return None
+    if any(value is None for _, value in pairs):
+        return stmt                                  # an unpacking of a tuple stays whole
+    kept = [(name, cast(ast.expr, value)) for (name, value), i in zip(pairs, idle, strict=True)
+            if not i]
+    if len(kept) == 1:
+        new: ast.stmt = ast.Assign([ast.Name(kept[0][0], ast.Store())], kept[0][1])
+    else:
+        new = ast.Assign([ast.Tuple([ast.Name(n, ast.Store()) for n, _ in kept], ast.Store())],
+                         ast.Tuple([v for _, v in kept], ast.Load()))
+    return ast.copy_location(new, stmt)
+
+
+def propagate(body: list[ast.stmt], namespace: dict[str, Any],
+              live: set[str]) -> list[ast.stmt]:
+    """Return ``body`` with its constants propagated and folded, and its idle constants dropped.
+
+    A local bound exactly once, at the top level of ``body``, to a constant
+    (a number, a tuple of numbers unpacked, or a ``_ground_*`` tuple of
+    ``namespace`` whose entries are Python numbers) is replaced by that
+    constant where it is read. ``.real`` and ``.imag`` of a constant,
+    ``abs()`` of one, a unary operation, and a binary operation or a
+    comparison whose operands are all constants are computed now, by the
+    same Python arithmetic the function would run (the operands are Python
+    numbers at run time too, so the result has the same bits and type); a fold
+    whose evaluation raises is not made, and the error stays where it was.
+    Then every binding of a local that is never read and not in ``live``
+    (the names the caller reads after ``body``) whose value is a constant or
+    a name is dropped: a value that calls, computes or may raise stays.
+    """
+    counts = _stores(body)
+    shadowed = {name for name in ('abs',) if name in namespace or name in counts}
+    known: dict[str, Any] = {}
+    propagator = _Propagator(known, shadowed)
+    out: list[ast.stmt] = []
+    for stmt in body:
+        if (isinstance(stmt, ast.Assign) and isinstance(stmt.value, ast.Name)
+                and stmt.value.id.startswith('_ground_') and stmt.value.id not in counts
+                and _is_constant(namespace.get(stmt.value.id))):
+            stmt.value = ast.copy_location(ast.Constant(namespace[stmt.value.id]), stmt.value)
+        stmt = cast(ast.stmt, fold(propagator.visit(stmt)))
+        if isinstance(stmt, ast.Pass):
+            continue
+        for name, value in _targets(stmt) or ():
+            if (counts.get(name) == 1 and isinstance(value, ast.Constant)
+                    and _is_constant(value.value)):
+                known[name] = value.value
+        out.append(stmt)
+    while True:
+        dead = {name for name in counts if name not in live} - _reads(out)
+        pruned = [p for p in (_pruned(stmt, dead) for stmt in out) if p is not None]
+        if len(pruned) == len(out) and all(
+                a is b for a, b in zip(pruned, out, strict=True)):
+            return pruned
+        out = pruned

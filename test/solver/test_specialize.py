@@ -1,0 +1,187 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The specializer's constant propagation (issues 19 and 22): fewer operations, the same bits.
+
+:func:`mech_kinematics.solver.specialize.propagate` folds what a scene's
+generated code computes from constants. Every fold must give the value, the
+type and the error the unfolded code gives for every input, signed zeros,
+NaNs, infinities, ints, complex numbers and NumPy arrays included: the
+property test runs random straight-line programs both ways.
+"""
+
+import ast
+import math
+
+from hypothesis import given, settings, strategies as st
+import numpy as np
+import pytest
+
+import mech_kinematics as mk
+from mech_kinematics.solver import tick as hooks
+from mech_kinematics.solver.specialize import plan_body, propagate
+
+SETTINGS = settings(max_examples=400, deadline=None, derandomize=True)
+
+
+def _propagated(source, live=('out',), namespace=None):
+    """Return the unparsed body of ``source`` after :func:`propagate`."""
+    body = ast.parse(source).body
+    return ast.unparse(ast.Module(propagate(body, namespace or {}, set(live)), []))
+
+
+def _function(body, namespace):
+    """Return ``f(x)`` running ``body`` and returning its ``out``."""
+    tree = ast.parse('def f(x):\n    return out')
+    tree.body[0].body[:0] = body
+    exec(compile(ast.fix_missing_locations(tree), '<test>', 'exec'), namespace)  # noqa: S102
+    return namespace['f']
+
+
+def _facts(value):
+    """Return what identifies ``value`` bit for bit: its type, and its bits or repr."""
+    if isinstance(value, np.ndarray):
+        return type(value), value.dtype, value.shape, value.tobytes()
+    if isinstance(value, np.generic):
+        return type(value), value.dtype, value.tobytes()
+    if isinstance(value, float) and math.isnan(value):
+        return float, 'nan'
+    return type(value), repr(value)
+
+
+def _run(function, x):
+    """Return the facts of each value ``function(x)`` returns, or what it raised."""
+    with np.errstate(all='ignore'):
+        try:
+            values = function(x)
+        except (ArithmeticError, TypeError, ValueError) as error:
+            return type(error), str(error)
+    return [_facts(v) for v in values]
+
+
+def test_constants_are_put_in_and_folded():
+    """A local bound once to a constant is replaced where read; constant operations fold."""
+    assert _propagated('a, b = (2.0, (1+0j))\n'
+                       'c = a * 3.0 - b.real\n'
+                       'out = x * c + abs(-b) + (a < 3.0)') == 'out = x * 5.0 + 1.0 + True'
+
+
+def test_a_fold_that_raises_is_left_to_raise():
+    """``1.0 / 0.0`` raises at run time: the division stays in place, and so does its binding."""
+    assert _propagated('a = 1.0 / 0.0\nout = x') == 'a = 1.0 / 0.0\nout = x'
+
+
+def test_a_signed_zero_folds_as_python_computes_it():
+    """``-0.0 + 0.0`` is ``0.0`` in Python, and ``-(0.0)`` is ``-0.0``: the folds keep both."""
+    assert _propagated('z = -0.0\nout = (x, z + 0.0, -(z + 0.0), z * -1.0)') == (
+        'out = (x, 0.0, -0.0, 0.0)')
+
+
+def test_bindings_read_twice_or_in_a_branch_are_not_constants():
+    """A name bound twice, or only inside an if, keeps every read."""
+    source = 'a = 1.0\nif x:\n    b = 2.0\na = 3.0\nout = a + b'
+    assert _propagated(source) == source.replace('\n', '\n', 4)
+
+
+def test_dead_bindings_go_only_where_nothing_is_lost():
+    """A dead constant or name binding goes; a dead call, expression or live name stays."""
+    source = ('k = 2.0\n'
+              'y = x\n'
+              'r = math.sqrt(x)\n'
+              'np.cos(x, out=e.real)\n'
+              'P = (k, x)\n'
+              'out = x')
+    assert _propagated(source, live=('out', 'P')) == (
+        'r = math.sqrt(x)\nnp.cos(x, out=e.real)\nP = (2.0, x)\nout = x')
+
+
+def test_a_tuple_binding_keeps_its_computed_entries():
+    """``a, b = (1.0, f(x))``: the constant entry goes, the call stays."""
+    assert _propagated('a, b = (1.0, f(x))\nout = a + b') == 'b = f(x)\nout = 1.0 + b'
+
+
+def test_ground_tuples_of_numbers_are_constants():
+    """A ``_ground_*`` tuple of Python numbers is unpacked into constants; others are not."""
+    namespace = {'_ground_P': ((1 + 0j), 0.5), '_ground_Q': (np.float64(1.0), 0.5)}
+    assert _propagated('P = _ground_P\np, e = P\nQ = _ground_Q\nout = p + e + Q[1]',
+                       live=('out', 'P', 'Q'), namespace=namespace) == (
+        'P = ((1+0j), 0.5)\nQ = _ground_Q\nout = (1.5+0j) + Q[1]')
+
+
+#: Constants a fold meets: signed zeros, units, infinities, NaN, ints, complex numbers.
+CONSTANTS = st.sampled_from([0.0, -0.0, 1.0, -1.0, 2.0, 0.5, 1e308, math.inf, -math.inf,
+                             math.nan, 0, 1, 2, 0j, -0j, complex(-0.0, 0.0), 1 + 0j,
+                             1j, complex(0.0, -0.0), complex(math.inf, 0.0), True])
+#: Arguments of every type the generated code is called with, and more.
+ARGUMENTS = [0.0, -0.0, 1.5, -2.0, math.inf, -math.inf, math.nan, 0, 3, True,
+             complex(-0.0, -0.0), complex(0.0, -0.0), complex(1.5, -0.0), complex(-2.0, 0.0),
+             complex(math.inf, -0.0), complex(math.nan, 1.0), np.float64(-0.0),
+             np.array(-0.0), np.array(complex(-1.0, -0.0)),
+             np.array([0.0, -0.0, 1.0, -math.inf, math.nan]),
+             np.array([complex(-0.0, -0.0), complex(-1.0, 0.0), complex(math.inf, -0.0)]),
+             np.array([1, -2]), np.array([0.5, -0.0], dtype=np.float32)]
+
+
+def _literal(value):
+    """Return source giving ``value``: a literal, or constants the propagation folds into it."""
+    if isinstance(value, complex):
+        return f'(-(-({_literal(value.real)}) - {_literal(value.imag)}j))'
+    if isinstance(value, float) and not math.isfinite(value):
+        return '(1e309 - 1e309)' if math.isnan(value) else '-1e309' if value < 0 else '1e309'
+    return repr(value)
+
+
+@st.composite
+def programs(draw):
+    """Return the source of a random straight-line program of ``x`` ending in ``out``."""
+    names = ['x']
+    lines = []
+
+    def expression(depth):
+        choice = draw(st.integers(0, 9 if depth < 3 else 1))
+        if choice == 0:
+            return _literal(draw(CONSTANTS))
+        if choice == 1:
+            return draw(st.sampled_from(names))
+        if choice == 2:
+            return f'-({expression(depth + 1)})'
+        if choice == 3:
+            return f'abs({expression(depth + 1)})'
+        if choice == 4:
+            return f'({expression(depth + 1)}).{draw(st.sampled_from(["real", "imag"]))}'
+        if choice == 5:
+            return f'complex(({expression(depth + 1)}).real, ({expression(depth + 1)}).real)'
+        op = draw(st.sampled_from(['+', '-', '*', '/', '<']))
+        return f'({expression(depth + 1)} {op} {expression(depth + 1)})'
+
+    for index in range(draw(st.integers(1, 6))):
+        if draw(st.booleans()):
+            lines.append(f'v{index}, w{index} = ({expression(0)}, {expression(0)})')
+            names += [f'v{index}', f'w{index}']
+        else:
+            lines.append(f'v{index} = {expression(0)}')
+            names.append(f'v{index}')
+    lines.append(f'out = ({", ".join(draw(st.lists(st.sampled_from(names), min_size=1)))},)')
+    return '\n'.join(lines)
+
+
+@SETTINGS
+@given(programs())
+def test_propagation_keeps_every_bit_type_and_error(source):
+    """A random program of constants and ``x`` gives the same results before and after."""
+    before = _function(ast.parse(source).body, {})
+    after = _function(propagate(ast.parse(source).body, {}, {'out'}), {})
+    for x in ARGUMENTS:
+        assert _run(after, x) == _run(before, x), (source, x)
+
+
+@pytest.mark.parametrize('vector', [False, True])
+def test_the_yoke_keeps_no_constant_tuple_or_binding(vector):
+    """The Scotch yoke's code binds no tuple of constants and no local to a bare constant."""
+    plan = hooks.tick_plan(mk.load_scene('scotch_yoke'))
+    names = {}
+    code = ast.unparse(ast.Module(plan_body(plan, names, {}, vector=vector), []))
+    assert '= ((1+0j), (6.123233995736766e-17+1j), 1.0, 1.0)' not in code
+    live = set(names.values())
+    for stmt in ast.parse(code).body:
+        if isinstance(stmt, ast.Assign) and isinstance(stmt.value, ast.Constant):
+            assert stmt.targets[0].id in live, ast.unparse(stmt)
