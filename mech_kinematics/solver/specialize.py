@@ -19,7 +19,40 @@ kernels out for one scene instead, as the statements of one function:
   are laid out one after another in plan order.
 
 The same operations run in the same order on the same values, so the code
-gives the same bits as the solve it replaces. What the caller does with the
+gives the same bits as the solve it replaces.
+
+Then :func:`propagate` removes the work whose result is known when the code
+is written (issues 19 and 22). A local bound once, at the top level, to a
+constant (a number, a tuple of numbers, a ground point's tuple of Python
+numbers) or to another local is read as that constant or local; ``.real``,
+``.imag``, ``abs()``, a unary operation, a binary operation or a comparison
+whose operands are all constants is computed now by the same Python
+arithmetic the code would run (the operands are Python numbers at run time
+on both paths), and a fold that raises is left to raise where it was. A
+binding nothing reads any more goes if its value is a constant or a name;
+every call, every expression statement and every value that may raise stays.
+
+Last, an operation that gives back its operand bit for bit is removed, where
+what the operand is (:class:`_Kinds`: a real float, any real, a complex;
+never assumed of a name whose bindings disagree or of an argument) makes it
+exact for every value it can hold, Python or NumPy, signed zeros, NaN and
+infinities included:
+
+- ``x * 1.0``, ``1.0 * x``, ``x / 1.0`` (and with the int ``1``), for ``x`` a
+  real float only: IEEE multiplication and division by one are exact and
+  keep a NaN. Not for a complex ``x`` (Python and NumPy turn ``1.0`` into
+  ``1+0j`` and multiply out: ``-0.0 - 0.0 * y`` can flip a zero's sign, and
+  ``inf * 0`` is NaN), nor for an int (``3 * 1.0`` is a float);
+- ``x - 0.0`` (or ``x - 0``), for a real float or complex ``x``:
+  ``-0.0 - 0.0`` is ``-0.0`` and each part of a complex is subtracted apart.
+  Not ``x + 0.0`` (``-0.0 + 0.0`` is ``0.0``), nor ``x + -0.0`` for a complex
+  ``x`` (the ``-0.0`` becomes ``-0.0+0j``, and its ``+0j`` flips an imaginary
+  ``-0.0``), nor ``x - -0.0``, nor ``0.0 * x``;
+- ``x - 0j``, for a complex ``x`` only (from a real it makes a complex).
+
+On the array path an operation is removed only where its value is an
+operand of another operation: the result is then a fresh array either way,
+and no two names come to share one array that used to be two. What the caller does with the
 statements (which values the function returns, how a failed check is
 reported) is the caller's: the node's tick (:mod:`mech_kinematics.ros.ticker`)
 and the solver's own compiled paths (:mod:`.compiled`). A step whose code uses
@@ -34,6 +67,7 @@ from collections.abc import Callable, Sequence
 import functools
 import inspect
 import itertools
+import math
 import operator
 import sys
 import textwrap
@@ -340,7 +374,7 @@ def plan_body(plan: Any, names: dict[str, str], namespace: dict[str, Any],
                 body += _body(step, kernel, f'_{index}_{part}', names, namespace, {}, vector)
     except (OSError, TypeError) as error:
         raise Unsupported(str(error)) from error
-    return propagate(body, namespace, set(names.values()))
+    return propagate(body, namespace, set(names.values()), vector)
 
 
 #: The numbers a folded constant may hold: what the runtime computes with Python's own
@@ -379,13 +413,17 @@ def _evaluated(function: Callable[..., Any], *operands: Any) -> ast.Constant | N
 class _Propagator(ast.NodeTransformer):
     """Put in the constants of :func:`propagate` and fold what they make constant."""
 
-    def __init__(self, known: dict[str, Any], shadowed: set[str]) -> None:
+    def __init__(self, known: dict[str, Any], copies: dict[str, str],
+                 shadowed: set[str]) -> None:
         self.known = known          # a local assigned once, from a constant -> its value
+        self.copies = copies        # a local assigned once, from a name -> that name
         self.shadowed = shadowed    # builtins a local or the namespace redefines
 
     def visit_Name(self, node: ast.Name) -> ast.AST:
         if isinstance(node.ctx, ast.Load) and node.id in self.known:
             return ast.copy_location(ast.Constant(self.known[node.id]), node)
+        if isinstance(node.ctx, ast.Load) and node.id in self.copies:
+            return ast.copy_location(ast.Name(self.copies[node.id], ast.Load()), node)
         return node
 
     def visit_Attribute(self, node: ast.Attribute) -> ast.AST:
@@ -534,8 +572,41 @@ def _pruned(stmt: ast.stmt, dead: set[str]) -> ast.stmt | None:
     return ast.copy_location(new, stmt)
 
 
-def propagate(body: list[ast.stmt], namespace: dict[str, Any],
-              live: set[str]) -> list[ast.stmt]:
+def _substituted(body: list[ast.stmt], namespace: dict[str, Any], counts: dict[str, int],
+                 shadowed: set[str]) -> list[ast.stmt]:
+    """Return ``body`` with its constants and copies put in where read, and folded.
+
+    A copy ``a = b`` (``a`` bound once, ``b`` bound once before it or never
+    in ``body``) has ``b`` read for ``a``: the same object.
+    """
+    known: dict[str, Any] = {}
+    copies: dict[str, str] = {}
+    propagator = _Propagator(known, copies, shadowed)
+    bound: set[str] = set()
+    out: list[ast.stmt] = []
+    for stmt in body:
+        if (isinstance(stmt, ast.Assign) and isinstance(stmt.value, ast.Name)
+                and stmt.value.id.startswith('_ground_') and stmt.value.id not in counts
+                and _is_constant(namespace.get(stmt.value.id))):
+            stmt.value = ast.copy_location(ast.Constant(namespace[stmt.value.id]), stmt.value)
+        stmt = cast(ast.stmt, fold(propagator.visit(stmt)))
+        if isinstance(stmt, ast.Pass):
+            continue
+        for name, value in _targets(stmt) or ():
+            if counts.get(name) != 1:
+                continue
+            if isinstance(value, ast.Constant) and _is_constant(value.value):
+                known[name] = value.value
+            elif isinstance(value, ast.Name) and (
+                    value.id in bound if value.id in counts else value.id not in namespace):
+                copies[name] = value.id         # a local or argument: a global reads slower
+            bound.add(name)
+        out.append(stmt)
+    return out
+
+
+def propagate(body: list[ast.stmt], namespace: dict[str, Any], live: set[str],
+              vector: bool = True) -> list[ast.stmt]:
     """Return ``body`` with its constants propagated and folded, and its idle constants dropped.
 
     A local bound exactly once, at the top level of ``body``, to a constant
@@ -553,22 +624,10 @@ def propagate(body: list[ast.stmt], namespace: dict[str, Any],
     """
     counts = _stores(body)
     shadowed = {name for name in ('abs',) if name in namespace or name in counts}
-    known: dict[str, Any] = {}
-    propagator = _Propagator(known, shadowed)
-    out: list[ast.stmt] = []
-    for stmt in body:
-        if (isinstance(stmt, ast.Assign) and isinstance(stmt.value, ast.Name)
-                and stmt.value.id.startswith('_ground_') and stmt.value.id not in counts
-                and _is_constant(namespace.get(stmt.value.id))):
-            stmt.value = ast.copy_location(ast.Constant(namespace[stmt.value.id]), stmt.value)
-        stmt = cast(ast.stmt, fold(propagator.visit(stmt)))
-        if isinstance(stmt, ast.Pass):
-            continue
-        for name, value in _targets(stmt) or ():
-            if (counts.get(name) == 1 and isinstance(value, ast.Constant)
-                    and _is_constant(value.value)):
-                known[name] = value.value
-        out.append(stmt)
+    out = _substituted(body, namespace, counts, shadowed)
+    identities = _Identities(_Kinds(out, namespace), vector)
+    out = _substituted([cast(ast.stmt, identities.visit(stmt)) for stmt in out], namespace,
+                       counts, shadowed)
     while True:
         dead = {name for name in counts if name not in live} - _reads(out)
         pruned = [p for p in (_pruned(stmt, dead) for stmt in out) if p is not None]
@@ -576,3 +635,194 @@ def propagate(body: list[ast.stmt], namespace: dict[str, Any],
                 a is b for a, b in zip(pruned, out, strict=True)):
             return pruned
         out = pruned
+
+
+#: What a value is known to be at run time, whatever the inputs: a real floating-point
+#: number (a Python float, a NumPy floating scalar or array), any real number (an int or a
+#: bool too), or a complex one.
+FLOAT, REAL, COMPLEX = 'float', 'real', 'complex'
+_Kind = str | tuple[Any, ...] | None
+#: Calls whose result is a real float for any arguments they accept: (module, name).
+_REAL_CALLS = {('math', n) for n in ('sqrt', 'cos', 'sin', 'atan2', 'hypot', 'fabs', 'exp',
+                                     'log', 'tan', 'asin', 'acos', 'atan')}
+#: NumPy functions whose result is floating point for real arguments (ints give float64).
+_NUMPY_REAL = ('sqrt', 'hypot', 'cos', 'sin', 'arctan2', 'exp', 'log')
+
+
+class _Kinds:
+    """The kinds (:data:`FLOAT`, :data:`COMPLEX`) of the names a body binds, where known.
+
+    A name's kind is the kind every one of its bindings gives (any read sees
+    one of them). It is unknown (``None``) where a binding is not a plain
+    assignment or where the bindings disagree. The code computes on Python
+    numbers and on NumPy numeric arrays (never object arrays): an operation
+    with a complex operand then gives a complex value or raises.
+    """
+
+    def __init__(self, body: list[ast.stmt], namespace: dict[str, Any]) -> None:
+        self.namespace = namespace
+        self.bindings: dict[str, list[tuple[ast.expr, int | None]]] = {}
+        self.opaque: set[str] = set()       # names bound otherwise than by a plain assignment
+        self.memo: dict[str, _Kind] = {}
+        for stmt in body:
+            for node in ast.walk(stmt):
+                if isinstance(node, ast.Assign):
+                    self.bind(node)
+                elif isinstance(node, (ast.AugAssign, ast.NamedExpr, ast.For,
+                                       ast.comprehension)) or (
+                        isinstance(node, ast.AnnAssign) and node.value is not None):
+                    self.opaque.update(n.id for n in ast.walk(node.target)
+                                       if isinstance(n, ast.Name))
+                elif isinstance(node, ast.arg):
+                    self.opaque.add(node.arg)
+
+    def bind(self, node: ast.Assign) -> None:
+        """Record the bindings of one assignment."""
+        for target in node.targets:
+            if isinstance(target, ast.Name):
+                self.bindings.setdefault(target.id, []).append((node.value, None))
+            elif isinstance(target, ast.Tuple) and all(isinstance(t, ast.Name)
+                                                       for t in target.elts):
+                for index, t in enumerate(target.elts):
+                    self.bindings.setdefault(cast(ast.Name, t).id, []).append(
+                        (node.value, index))
+            else:
+                self.opaque.update(n.id for n in ast.walk(target) if isinstance(n, ast.Name))
+
+    def name(self, name: str) -> _Kind:
+        """Return the kind of a name: the kind all its bindings agree on, or None."""
+        if name in self.memo:
+            return self.memo[name]
+        self.memo[name] = None                      # a binding that reads the name itself
+        if name in self.opaque or name not in self.bindings:
+            return None
+        kinds = {self.entry(value, index) for value, index in self.bindings[name]}
+        kind = kinds.pop() if len(kinds) == 1 else None
+        self.memo[name] = kind
+        return kind
+
+    def entry(self, value: ast.expr, index: int | None) -> _Kind:
+        """Return the kind of ``value``, or of its entry ``index`` where it is unpacked."""
+        kind = self.of(value)
+        if index is None:
+            return kind
+        return kind[index] if isinstance(kind, tuple) and index < len(kind) else None
+
+    def of(self, node: ast.expr) -> _Kind:
+        """Return the kind of an expression, or None where it is not known."""
+        if isinstance(node, ast.Constant):
+            value: Any = node.value
+            if isinstance(value, tuple):
+                return tuple(self.of(ast.Constant(v)) for v in value)
+            return {float: FLOAT, int: REAL, bool: REAL, complex: COMPLEX}.get(type(value))
+        if isinstance(node, ast.Name):
+            return self.name(node.id)
+        if isinstance(node, ast.Tuple):
+            return tuple(self.of(e) for e in node.elts)
+        if isinstance(node, ast.Attribute):
+            if node.attr in ('real', 'imag'):
+                return FLOAT if self.of(node.value) in (FLOAT, COMPLEX) else REAL
+            return None
+        if isinstance(node, ast.UnaryOp):
+            return self.of(node.operand) if isinstance(node.op, (ast.USub, ast.UAdd)) else None
+        arithmetic = (ast.Add, ast.Sub, ast.Mult, ast.Div)
+        if isinstance(node, ast.BinOp) and isinstance(node.op, arithmetic):
+            kinds = (self.of(node.left), self.of(node.right))
+            if COMPLEX in kinds:
+                return COMPLEX
+            if not set(kinds) <= {FLOAT, REAL}:
+                return None
+            return FLOAT if FLOAT in kinds or isinstance(node.op, ast.Div) else REAL
+        if isinstance(node, ast.IfExp):
+            body, orelse = self.of(node.body), self.of(node.orelse)
+            return body if body == orelse else None
+        if isinstance(node, ast.Call):
+            return self.call(node)
+        return None
+
+    def call(self, node: ast.Call) -> _Kind:
+        """Return the kind of a call's result, for the calls whose kind is known."""
+        func = node.func
+        if isinstance(func, ast.Name) and func.id not in self.namespace and not self.bindings.get(
+                func.id):
+            if func.id == 'abs' and len(node.args) == 1:
+                return FLOAT if self.of(node.args[0]) in (FLOAT, COMPLEX) else REAL
+            if func.id == 'complex' and node.args:
+                return COMPLEX
+            return None
+        if (isinstance(func, ast.Attribute) and isinstance(func.value, ast.Name)
+                and func.value.id not in self.bindings):
+            module = getattr(self.namespace.get(func.value.id), '__name__', None)
+            if (module, func.attr) in _REAL_CALLS:
+                return FLOAT
+            if module == 'numpy' and func.attr in _NUMPY_REAL and all(
+                    self.of(a) in (FLOAT, REAL) for a in node.args) and not node.keywords:
+                return FLOAT
+            if module == 'numpy' and func.attr in ('empty', 'zeros', 'ones') and any(
+                    k.arg == 'dtype' and isinstance(k.value, ast.Attribute)
+                    and k.value.attr in ('complex128', 'complex64') for k in node.keywords):
+                return COMPLEX
+        return None
+
+
+class _Identities(ast.NodeTransformer):
+    """Remove the operations that give back their operand, bit for bit (see the module).
+
+    On the array path an operation is removed only where its value is used
+    by another operation and never bound: removing ``x * 1.0`` there must not
+    leave two names on one array (a fresh array before).
+    """
+
+    def __init__(self, kinds: _Kinds, vector: bool) -> None:
+        self.kinds = kinds
+        self.vector = vector
+        self.consumed = False           # whether the node visited is an arithmetic operand
+
+    def generic_visit(self, node: ast.AST) -> ast.AST:
+        consumed = self.consumed
+        self.consumed = isinstance(node, (ast.BinOp, ast.UnaryOp, ast.Compare))
+        try:
+            return super().generic_visit(node)
+        finally:
+            self.consumed = consumed
+
+    def visit_BinOp(self, node: ast.BinOp) -> ast.AST:
+        consumed = self.consumed
+        self.generic_visit(node)
+        kept = _identity(node, self.kinds)
+        if kept is None:
+            return node
+        fresh = not isinstance(kept, (ast.Name, ast.Attribute, ast.Subscript, ast.Constant))
+        if self.vector and not (consumed or fresh):
+            return node
+        return kept
+
+
+def _is_zero(value: Any) -> bool:
+    """Return whether ``value`` is an int 0, or a float or complex zero of positive sign."""
+    if type(value) is int:
+        return value == 0
+    if type(value) is float:
+        return value == 0.0 and math.copysign(1.0, value) > 0
+    if type(value) is complex:
+        return _is_zero(value.real) and _is_zero(value.imag)
+    return False
+
+
+def _identity(node: ast.BinOp, kinds: _Kinds) -> ast.expr | None:
+    """Return the operand ``node`` gives back unchanged for every input, or None."""
+    left, right = node.left, node.right
+    right_value = right.value if isinstance(right, ast.Constant) else None
+    left_value = left.value if isinstance(left, ast.Constant) else None
+
+    def one(value: Any) -> bool:
+        return type(value) in (int, float) and value == 1
+
+    if isinstance(node.op, ast.Sub) and _is_zero(right_value):
+        wanted = (COMPLEX,) if type(right_value) is complex else (FLOAT, COMPLEX)
+        return left if kinds.of(left) in wanted else None
+    if isinstance(node.op, (ast.Mult, ast.Div)) and one(right_value):
+        return left if kinds.of(left) == FLOAT else None
+    if isinstance(node.op, ast.Mult) and one(left_value):
+        return right if kinds.of(right) == FLOAT else None
+    return None

@@ -11,6 +11,7 @@ property test runs random straight-line programs both ways.
 
 import ast
 import math
+import re
 
 from hypothesis import given, settings, strategies as st
 import numpy as np
@@ -107,6 +108,40 @@ def test_ground_tuples_of_numbers_are_constants():
         'P = ((1+0j), 0.5)\nQ = _ground_Q\nout = (1.5+0j) + Q[1]')
 
 
+#: (program, vector, its ``out`` line after the identities): each rule at its edge.
+IDENTITIES = [
+    # A complex number times 1.0 is a complex multiplication: a signed zero can flip.
+    ('z = complex(x.real, x.imag)\nout = (z * 1.0, 1.0 * z, z / 1.0, z * 1)', False,
+     'out = (z * 1.0, 1.0 * z, z / 1.0, z * 1)'),
+    ('f = x.real * 0.5\nout = (f * 1.0, 1 * f, f / 1.0, f - 0.0, f - 0, f * 1.0 * 1.0)', False,
+     'out = (f, f, f, f, f, f)'),
+    # z + -0.0 adds 0.0 to the imaginary part (-0.0 + 0.0 is 0.0); z - -0.0 adds 0.0.
+    ('z = complex(x.real, x.imag)\nout = (z - 0.0, z - 0j, z + -0.0, z - -0.0, z - -0j)', False,
+     'out = (z, z, z + -0.0, z - -0.0, z - (-0-0j))'),
+    ('f = x.real * 0.5\nout = (f - 0j, f + 0.0, 0.0 + f, 0.0 * f, f * -1.0)', False,
+     'out = (f - 0j, f + 0.0, 0.0 + f, 0.0 * f, f * -1.0)'),
+    # x.real and abs(x) may be ints: 1.0 * 3 is a float.
+    ('r = x.real\nn = abs(x) * 2\nout = (r * 1.0, r - 0.0, n * 1.0, n / 2 * 1.0)', False,
+     'out = (r * 1.0, r - 0.0, n * 1.0, n / 2)'),
+    ('c = math.sqrt(abs(x.real))\nout = (c * 1.0, abs(c) * 1.0)', False, 'out = (c, abs(c))'),
+    # Arrays: an operand left bound to a second name would share its array.
+    ('f = x.real * 0.5\ng = (f * 1.0) * 1.0\n'
+     'out = (f * 1.0 + 2.0, g, -(f * 1.0), (f + 1.0) * 1.0)', True,
+     'out = (f + 2.0, g, -f, f + 1.0)'),
+]
+
+
+@pytest.mark.parametrize(('source', 'vector', 'line'), IDENTITIES)
+def test_identities_are_removed_only_where_exact(source, vector, line):
+    """Each identity goes where it is the same bits for every input, and stays elsewhere."""
+    body = propagate(ast.parse(source).body, {'math': math}, {'out'}, vector)
+    assert ast.unparse(body[-1]) == line
+    before = _function(ast.parse(source).body, {'math': math})
+    after = _function(body, {'math': math})
+    for x in ARGUMENTS:
+        assert _run(after, x) == _run(before, x), (source, x)
+
+
 #: Constants a fold meets: signed zeros, units, infinities, NaN, ints, complex numbers.
 CONSTANTS = st.sampled_from([0.0, -0.0, 1.0, -1.0, 2.0, 0.5, 1e308, math.inf, -math.inf,
                              math.nan, 0, 1, 2, 0j, -0j, complex(-0.0, 0.0), 1 + 0j,
@@ -164,24 +199,43 @@ def programs(draw):
     return '\n'.join(lines)
 
 
+@pytest.mark.parametrize('vector', [False, True])
 @SETTINGS
-@given(programs())
-def test_propagation_keeps_every_bit_type_and_error(source):
+@given(source=programs())
+def test_propagation_keeps_every_bit_type_and_error(vector, source):
     """A random program of constants and ``x`` gives the same results before and after."""
     before = _function(ast.parse(source).body, {})
-    after = _function(propagate(ast.parse(source).body, {}, {'out'}), {})
+    after = _function(propagate(ast.parse(source).body, {}, {'out'}, vector), {})
     for x in ARGUMENTS:
         assert _run(after, x) == _run(before, x), (source, x)
+
+
+def _code(scene, vector):
+    """Return the generated code of ``scene`` on one path, and its table entries' locals."""
+    plan = hooks.tick_plan(mk.load_scene(scene))
+    names = {}
+    return ast.unparse(ast.Module(plan_body(plan, names, {}, vector=vector), [])), names
 
 
 @pytest.mark.parametrize('vector', [False, True])
 def test_the_yoke_keeps_no_constant_tuple_or_binding(vector):
     """The Scotch yoke's code binds no tuple of constants and no local to a bare constant."""
-    plan = hooks.tick_plan(mk.load_scene('scotch_yoke'))
-    names = {}
-    code = ast.unparse(ast.Module(plan_body(plan, names, {}, vector=vector), []))
+    code, names = _code('scotch_yoke', vector)
     assert '= ((1+0j), (6.123233995736766e-17+1j), 1.0, 1.0)' not in code
     live = set(names.values())
     for stmt in ast.parse(code).body:
-        if isinstance(stmt, ast.Assign) and isinstance(stmt.value, ast.Constant):
-            assert stmt.targets[0].id in live, ast.unparse(stmt)
+        if not isinstance(stmt, ast.Assign) or {
+                n.id for n in ast.walk(stmt.targets[0]) if isinstance(n, ast.Name)} <= live:
+            continue        # a table entry the caller reads, a ground point's constants
+        assert not isinstance(stmt.value, ast.Constant), ast.unparse(stmt)
+        assert not (isinstance(stmt.value, ast.Tuple)
+                    and any(isinstance(e, ast.Constant) for e in stmt.value.elts)), (
+            ast.unparse(stmt))
+
+
+@pytest.mark.parametrize('scene', ['scotch_yoke', 'khurmi_four_bar_ad150',
+                                   'slider_crank_150_600'])
+def test_single_angle_code_multiplies_by_no_one(scene):
+    """The single-angle code holds no ``* 1.0``, ``1.0 *`` or ``- 0j`` (the yoke had 14)."""
+    code, _ = _code(scene, False)
+    assert not re.findall(r'(?<![\d.e-])1\.0 \*|\* 1\.0(?!\d)|- 0j', code), code
