@@ -30,9 +30,9 @@ def _propagated(source, live=('out',), namespace=None):
     return ast.unparse(ast.Module(propagate(body, namespace or {}, set(live)), []))
 
 
-def _function(body, namespace):
-    """Return ``f(x)`` running ``body`` and returning its ``out``."""
-    tree = ast.parse('def f(x):\n    return out')
+def _function(body, namespace, arguments='x'):
+    """Return ``f(x)`` (or ``f(<arguments>)``) running ``body`` and returning its ``out``."""
+    tree = ast.parse(f'def f({arguments}):\n    return out')
     tree.body[0].body[:0] = body
     exec(compile(ast.fix_missing_locations(tree), '<test>', 'exec'), namespace)  # noqa: S102
     return namespace['f']
@@ -239,3 +239,33 @@ def test_single_angle_code_multiplies_by_no_one(scene):
     """The single-angle code holds no ``* 1.0``, ``1.0 *`` or ``- 0j`` (the yoke had 14)."""
     code, _ = _code(scene, False)
     assert not re.findall(r'(?<![\d.e-])1\.0 \*|\* 1\.0(?!\d)|- 0j', code), code
+
+
+def test_array_operations_take_zero_d_constants_with_the_same_bits():
+    """On the array path, a constant meeting an array of the angles becomes a 0-d array."""
+    source = ('e = np.empty(np.shape(theta), dtype=np.complex128)\n'
+              'np.cos(theta, out=e.real)\n'
+              'np.sin(theta, out=e.imag)\n'
+              'r = 0.05 * e\n'
+              'w = abs(omega)\n'
+              'd = np.hypot(r.real, r.imag)\n'
+              'out = (r, 1j * omega * r, 2.5e-17 * w, (0.3 + d) / 2.0, 1j - r, w * 0.5, '
+              'omega * 2.0, r.imag * -0.0, 1 * d)')
+    namespace = {'np': np}
+    body = propagate(ast.parse(source).body, namespace, {'out'}, vector=True)
+    zero_d = {name for name, value in namespace.items() if isinstance(value, np.ndarray)}
+    assert {namespace[name].item() for name in zero_d} == {0.05, 0.3, 2.0, 1j, -0.0}
+    assert all(namespace[name].ndim == 0 and not namespace[name].flags.writeable
+               for name in zero_d)
+    shown = re.sub(r'_z\d+', lambda m: f'Z({namespace[m.group()].item()!r})',
+                   ast.unparse(body))
+    assert '\nr = Z(0.05) * e\n' in shown
+    assert shown.splitlines()[-1] == (
+        'out = (r, 1j * omega * r, 2.5e-17 * w, (Z(0.3) + d) / Z(2.0), Z(1j) - r, w * 0.5, '
+        'omega * 2.0, r.imag * Z(-0.0), 1 * d)')
+    before = _function(ast.parse(source).body, {'np': np}, 'theta, omega')
+    after = _function(body, namespace, 'theta, omega')
+    theta = np.array([0.0, -0.0, 1.0, 2.5, -7.0])
+    for omega in (np.array(3.0), np.array(-0.0), np.float64(2.0), np.linspace(-1.0, 1.0, 5)):
+        assert [_facts(v) for v in after(theta, omega)] == [
+            _facts(v) for v in before(theta, omega)], omega
