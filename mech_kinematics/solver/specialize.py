@@ -425,9 +425,10 @@ class _Propagator(ast.NodeTransformer):
     """Put in the constants of :func:`propagate` and fold what they make constant."""
 
     def __init__(self, known: dict[str, Any], copies: dict[str, str],
-                 shadowed: set[str]) -> None:
+                 tuples: dict[str, list[ast.expr | None]], shadowed: set[str]) -> None:
         self.known = known          # a local assigned once, from a constant -> its value
         self.copies = copies        # a local assigned once, from a name -> that name
+        self.tuples = tuples        # a local assigned once, from a tuple display -> entries
         self.shadowed = shadowed    # builtins a local or the namespace redefines
 
     def visit_Name(self, node: ast.Name) -> ast.AST:
@@ -448,14 +449,33 @@ class _Propagator(ast.NodeTransformer):
         return node
 
     def visit_Subscript(self, node: ast.Subscript) -> ast.AST:
+        value, index = node.value, node.slice
+        if (isinstance(value, ast.Name) and value.id in self.tuples
+                and isinstance(index, ast.Constant) and type(index.value) is int
+                and isinstance(node.ctx, ast.Load)
+                and -len(self.tuples[value.id]) <= index.value < len(self.tuples[value.id])):
+            # An entry of a tuple bound once, that is a constant or a name bound once.
+            entry = self.tuples[value.id][index.value]
+            if entry is not None:
+                read: ast.AST = self.visit(ast.copy_location(_copy(entry), node))
+                return read
         self.generic_visit(node)
         value, index = node.value, node.slice
         entries: Any = value.value if isinstance(value, ast.Constant) else None
-        if (isinstance(entries, tuple) and isinstance(index, ast.Constant)
-                and type(index.value) is int and isinstance(node.ctx, ast.Load)):
+        if not (isinstance(entries, tuple) and isinstance(node.ctx, ast.Load)):
+            return node
+        if isinstance(index, ast.Constant) and type(index.value) is int:
             folded = _evaluated(operator.getitem, entries, index.value)
             if folded is not None:
                 return ast.copy_location(folded, node)
+        if isinstance(index, ast.Slice) and all(
+                part is None or (isinstance(part, ast.Constant) and type(part.value) is int)
+                for part in (index.lower, index.upper, index.step)):
+            bounds: list[Any] = [None if part is None else cast(ast.Constant, part).value
+                                 for part in (index.lower, index.upper, index.step)]
+            if bounds[2] != 0:
+                part_of: Any = entries[slice(*bounds)]
+                return ast.copy_location(ast.Constant(part_of), node)
         return node
 
     def visit_Call(self, node: ast.Call) -> ast.AST:
@@ -513,12 +533,22 @@ class _Propagator(ast.NodeTransformer):
         return ast.copy_location(ast.Constant(result), node)
 
 
+def _copy(node: ast.expr) -> ast.expr:
+    """Return a fresh node for a constant or a name read (one node is never in two places)."""
+    if isinstance(node, ast.Constant):
+        return ast.Constant(node.value)
+    return ast.Name(cast(ast.Name, node).id, ast.Load())
+
+
 def _stores(body: list[ast.stmt]) -> dict[str, int]:
     """Return how many times each name is bound anywhere in ``body``."""
     counts: dict[str, int] = {}
+    declared = {id(n.target) for stmt in body for n in ast.walk(stmt)
+                if isinstance(n, ast.AnnAssign) and n.value is None}   # ``e: Any`` binds none
     for stmt in body:
         for n in ast.walk(stmt):
-            if isinstance(n, ast.Name) and not isinstance(n.ctx, ast.Load):
+            if (isinstance(n, ast.Name) and not isinstance(n.ctx, ast.Load)
+                    and id(n) not in declared):
                 counts[n.id] = counts.get(n.id, 0) + 1
             elif isinstance(n, ast.arg):
                 counts[n.arg] = counts.get(n.arg, 0) + 2    # never a constant
@@ -556,8 +586,15 @@ def _reads(body: list[ast.stmt]) -> set[str]:
             if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
 
 
+def _inert(value: ast.expr | None) -> bool:
+    """Return whether computing ``value`` can neither raise nor act: names and constants."""
+    if isinstance(value, ast.Tuple):
+        return all(_inert(e) for e in value.elts)
+    return isinstance(value, (ast.Constant, ast.Name))
+
+
 def _pruned(stmt: ast.stmt, dead: set[str]) -> ast.stmt | None:
-    """Return ``stmt`` without the bindings of ``dead`` names to constants or names.
+    """Return ``stmt`` without the bindings of ``dead`` names to inert values (:func:`_inert`).
 
     Only a binding whose value cannot raise or act (a constant, a name the
     code has bound) is removed: any other value is still computed.
@@ -565,8 +602,7 @@ def _pruned(stmt: ast.stmt, dead: set[str]) -> ast.stmt | None:
     pairs = _targets(stmt)
     if pairs is None:
         return stmt
-    idle = [name in dead and isinstance(value, (ast.Constant, ast.Name))
-            for name, value in pairs]
+    idle = [name in dead and _inert(value) for name, value in pairs]
     if not any(idle):
         return stmt
     if all(idle):
@@ -592,8 +628,17 @@ def _substituted(body: list[ast.stmt], namespace: dict[str, Any], counts: dict[s
     """
     known: dict[str, Any] = {}
     copies: dict[str, str] = {}
-    propagator = _Propagator(known, copies, shadowed)
+    tuples: dict[str, list[ast.expr | None]] = {}
+    propagator = _Propagator(known, copies, tuples, shadowed)
     bound: set[str] = set()
+
+    def stable(entry: ast.expr) -> bool:
+        """Return whether ``entry`` reads the same anywhere after this point."""
+        if isinstance(entry, ast.Constant):
+            return True
+        return isinstance(entry, ast.Name) and (
+            entry.id in bound if entry.id in counts else entry.id not in namespace)
+
     out: list[ast.stmt] = []
     for stmt in body:
         if (isinstance(stmt, ast.Assign) and isinstance(stmt.value, ast.Name)
@@ -608,9 +653,14 @@ def _substituted(body: list[ast.stmt], namespace: dict[str, Any], counts: dict[s
                 continue
             if isinstance(value, ast.Constant) and _is_constant(value.value):
                 known[name] = value.value
-            elif isinstance(value, ast.Name) and (
-                    value.id in bound if value.id in counts else value.id not in namespace):
+            elif isinstance(value, ast.Tuple) and all(
+                    isinstance(e, ast.Constant) for e in value.elts) and _is_constant(
+                        entries := tuple(cast(ast.Constant, e).value for e in value.elts)):
+                known[name] = entries
+            elif isinstance(value, ast.Name) and stable(value):
                 copies[name] = value.id         # a local or argument: a global reads slower
+            elif isinstance(value, ast.Tuple):
+                tuples[name] = [_copy(e) if stable(e) else None for e in value.elts]
             bound.add(name)
         out.append(stmt)
     return out

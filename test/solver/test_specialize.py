@@ -100,6 +100,14 @@ def test_a_tuple_binding_keeps_its_computed_entries():
     assert _propagated('a, b = (1.0, f(x))\nout = a + b') == 'b = f(x)\nout = 1.0 + b'
 
 
+def test_tuple_entries_that_are_names_or_constants_are_read_directly():
+    """``P[0]`` of ``P = (a, f(x), 1.0)`` reads ``a``; a computed entry stays a subscript."""
+    assert _propagated('a = x.real\nP = (a, f(x), 1.0)\nQ = (0.0, 2.0)\n'
+                       'out = (P[0], P[1], P[2], P[-1], P[5], Q[:1], Q[::0], P)') == (
+        'a = x.real\nP = (a, f(x), 1.0)\nout = (a, P[1], 1.0, 1.0, P[5], (0.0,), '
+        '(0.0, 2.0)[::0], P)')
+
+
 def test_ground_tuples_of_numbers_are_constants():
     """A ``_ground_*`` tuple of Python numbers is unpacked into constants; others are not."""
     namespace = {'_ground_P': ((1 + 0j), 0.5), '_ground_Q': (np.float64(1.0), 0.5)}
@@ -188,7 +196,14 @@ def programs(draw):
         op = draw(st.sampled_from(['+', '-', '*', '/', '<']))
         return f'({expression(depth + 1)} {op} {expression(depth + 1)})'
 
+    tuples = []
     for index in range(draw(st.integers(1, 6))):
+        if tuples and draw(st.booleans()):
+            lines.append(f'v{index} = {draw(st.sampled_from(tuples))}[{draw(st.integers(-2, 1))}]')
+            names.append(f'v{index}')
+        if draw(st.booleans()):
+            lines.append(f't{index} = ({expression(0)}, {expression(0)})')
+            tuples.append(f't{index}')
         if draw(st.booleans()):
             lines.append(f'v{index}, w{index} = ({expression(0)}, {expression(0)})')
             names += [f'v{index}', f'w{index}']
