@@ -172,7 +172,7 @@ def _compile_drivers(scene: lk.Scene, plan: hooks.TickPlan, joints: tuple[str, .
     body: list[ast.stmt] = ast.parse('\n'.join(lines)).body
     try:
         body += plan_body(plan, names, namespace, driver_values=[
-            (f'x_{k}', f'v_{k}', f'a_{k}') for k in range(count)])
+            (f'x_{k}', f'v_{k}', f'a_{k}') for k in range(count)], propagated=False)
     except (Unsupported, ValueError):
         return None     # the general solver serves this scene
     namespace['_wrapped_angle'] = hooks.wrapped_angle
@@ -252,7 +252,7 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
     }
     names: dict[str, str] = {}
     try:
-        body = plan_body(plan, names, namespace)
+        body = plan_body(plan, names, namespace, propagated=False)
     except Unsupported:
         return None     # the general solver serves this scene
     namespace['_wrapped_angle'] = hooks.wrapped_angle

@@ -99,7 +99,7 @@ def compile_single(scene: Scene) -> SingleFunction | None:
     }
     names: dict[str, str] = {}
     try:
-        body = plan_body(plan, names, namespace)
+        body = plan_body(plan, names, namespace, propagated=False)
     except Unsupported:
         return None
     namespace['_wrapped_angle'] = hooks.wrapped_angle
@@ -163,7 +163,7 @@ def compile_array(scene: Scene) -> ArrayFunction | None:
     namespace: dict[str, Any] = {}
     names: dict[str, str] = {}
     try:
-        body = plan_body(plan, names, namespace, vector=True)
+        body = plan_body(plan, names, namespace, vector=True, propagated=False)
     except Unsupported:
         return None
     tables: dict[str, list[str]] = {prefix: [] for prefix in TABLES.values()}

@@ -72,6 +72,7 @@ caller falls back to the general solver.
 from __future__ import annotations
 
 import ast
+from collections import Counter
 from collections.abc import Callable, Sequence
 import functools
 import inspect
@@ -98,56 +99,61 @@ class Unsupported(Exception):
     """A step's code holds something the specializer does not handle."""
 
 
+class _Folder(ast.NodeTransformer):
+    """The folds of :func:`fold`."""
+
+    def visit_IfExp(self, node: ast.IfExp) -> ast.AST:
+        self.generic_visit(node)
+        if isinstance(node.test, ast.Constant):
+            return node.body if node.test.value else node.orelse
+        return node
+
+    def visit_BoolOp(self, node: ast.BoolOp) -> ast.AST:
+        self.generic_visit(node)
+        absorbing = isinstance(node.op, ast.Or)     # True absorbs an or, False an and
+        values = []
+        for value in node.values:
+            if isinstance(value, ast.Constant):
+                if bool(value.value) == absorbing:
+                    return ast.Constant(absorbing)
+                continue                              # the neutral constant drops out
+            values.append(value)
+        if not values:
+            return ast.Constant(not absorbing)
+        if len(values) == 1:
+            return values[0]
+        node.values = values
+        return node
+
+    def visit_Compare(self, node: ast.Compare) -> ast.AST:
+        # ``None is None``, ``'cyl' is None``: a step attribute against a constant.
+        self.generic_visit(node)
+        if (len(node.ops) == 1 and isinstance(node.ops[0], (ast.Is, ast.IsNot))
+                and isinstance(node.left, ast.Constant)
+                and isinstance(node.comparators[0], ast.Constant)):
+            same = node.left.value is node.comparators[0].value
+            return ast.Constant(same if isinstance(node.ops[0], ast.Is) else not same)
+        return node
+
+    def visit_UnaryOp(self, node: ast.UnaryOp) -> ast.AST:
+        self.generic_visit(node)
+        if isinstance(node.op, ast.Not) and isinstance(node.operand, ast.Constant):
+            return ast.Constant(not node.operand.value)
+        return node
+
+    def visit_If(self, node: ast.If) -> Any:
+        self.generic_visit(node)
+        if isinstance(node.test, ast.Constant):
+            return (node.body if node.test.value else node.orelse) or ast.Pass()
+        return node
+
+
+_FOLDER = _Folder()
+
+
 def fold(node: ast.AST) -> ast.AST:
     """Fold the constants a substitution left: ``x if False else y``, ``False or x``..."""
-
-    class Folder(ast.NodeTransformer):
-        def visit_IfExp(self, node: ast.IfExp) -> ast.AST:
-            self.generic_visit(node)
-            if isinstance(node.test, ast.Constant):
-                return node.body if node.test.value else node.orelse
-            return node
-
-        def visit_BoolOp(self, node: ast.BoolOp) -> ast.AST:
-            self.generic_visit(node)
-            absorbing = isinstance(node.op, ast.Or)     # True absorbs an or, False an and
-            values = []
-            for value in node.values:
-                if isinstance(value, ast.Constant):
-                    if bool(value.value) == absorbing:
-                        return ast.Constant(absorbing)
-                    continue                              # the neutral constant drops out
-                values.append(value)
-            if not values:
-                return ast.Constant(not absorbing)
-            if len(values) == 1:
-                return values[0]
-            node.values = values
-            return node
-
-        def visit_Compare(self, node: ast.Compare) -> ast.AST:
-            # ``None is None``, ``'cyl' is None``: a step attribute against a constant.
-            self.generic_visit(node)
-            if (len(node.ops) == 1 and isinstance(node.ops[0], (ast.Is, ast.IsNot))
-                    and isinstance(node.left, ast.Constant)
-                    and isinstance(node.comparators[0], ast.Constant)):
-                same = node.left.value is node.comparators[0].value
-                return ast.Constant(same if isinstance(node.ops[0], ast.Is) else not same)
-            return node
-
-        def visit_UnaryOp(self, node: ast.UnaryOp) -> ast.AST:
-            self.generic_visit(node)
-            if isinstance(node.op, ast.Not) and isinstance(node.operand, ast.Constant):
-                return ast.Constant(not node.operand.value)
-            return node
-
-        def visit_If(self, node: ast.If) -> Any:
-            self.generic_visit(node)
-            if isinstance(node.test, ast.Constant):
-                return (node.body if node.test.value else node.orelse) or ast.Pass()
-            return node
-
-    folded: ast.AST = Folder().visit(node)
+    folded: ast.AST = _FOLDER.visit(node)
     return folded
 
 
@@ -345,7 +351,8 @@ def _body(step: Any, method: Callable[..., Any], suffix: str, names: dict[str, s
 
 def plan_body(plan: Any, names: dict[str, str], namespace: dict[str, Any],
               vector: bool = False,
-              driver_values: Sequence[tuple[str, str, str]] | None = None) -> list[ast.stmt]:
+              driver_values: Sequence[tuple[str, str, str]] | None = None,
+              propagated: bool = True) -> list[ast.stmt]:
     """Return the statements solving ``plan`` (a :class:`.tick.TickPlan`) in one function.
 
     The function's arguments are ``theta, omega, alpha, turns`` (and, on the
@@ -355,7 +362,10 @@ def plan_body(plan: Any, names: dict[str, str], namespace: dict[str, Any],
     globals the statements read (the kernels' modules', and the constants).
     With ``driver_values`` (one (position, speed, accel) triple of names per
     driver, a scalar tick of several drivers), each driver's kernel runs on its
-    own names instead of the crank's on ``theta, omega, alpha``.
+    own names instead of the crank's on ``theta, omega, alpha``. The
+    statements are :func:`propagate`'d, every table entry's local kept; with
+    ``propagated`` false they are not, for a caller that runs
+    :func:`propagate` over the whole function it makes of them.
     Raises :class:`Unsupported` where a kernel is outside the subset.
     """
     drivers = (plan.crank,) if driver_values is None else plan.drivers
@@ -385,7 +395,7 @@ def plan_body(plan: Any, names: dict[str, str], namespace: dict[str, Any],
                 body += _body(step, kernel, f'_{index}_{part}', names, namespace, {}, vector)
     except (OSError, TypeError) as error:
         raise Unsupported(str(error)) from error
-    return propagate(body, namespace, set(names.values()), vector)
+    return propagate(body, namespace, set(names.values()), vector) if propagated else body
 
 
 #: The numbers a folded constant may hold: what the runtime computes with Python's own
@@ -421,8 +431,8 @@ def _evaluated(function: Callable[..., Any], *operands: Any) -> ast.Constant | N
     return ast.Constant(value) if type(value) in _NUMBERS else None
 
 
-class _Propagator(ast.NodeTransformer):
-    """Put in the constants of :func:`propagate` and fold what they make constant."""
+class _Propagator(_Folder):
+    """Put in the constants of :func:`propagate`, and fold what they make constant."""
 
     def __init__(self, known: dict[str, Any], copies: dict[str, str],
                  tuples: dict[str, list[ast.expr | None]], shadowed: set[str]) -> None:
@@ -449,6 +459,7 @@ class _Propagator(ast.NodeTransformer):
         return node
 
     def visit_Subscript(self, node: ast.Subscript) -> ast.AST:
+        node.slice = self.visit(node.slice)
         value, index = node.value, node.slice
         if (isinstance(value, ast.Name) and value.id in self.tuples
                 and isinstance(index, ast.Constant) and type(index.value) is int
@@ -498,6 +509,8 @@ class _Propagator(ast.NodeTransformer):
             folded = _evaluated(function, operand.value)
             if folded is not None:
                 return ast.copy_location(folded, node)
+        if isinstance(node.op, ast.Not) and isinstance(operand, ast.Constant):
+            return ast.Constant(not operand.value)
         return node
 
     def visit_BinOp(self, node: ast.BinOp) -> ast.AST:
@@ -520,14 +533,15 @@ class _Propagator(ast.NodeTransformer):
         functions = [_COMPARE.get(type(op)) for op in node.ops]
         if not all(isinstance(o, ast.Constant) and type(o.value) in _NUMBERS
                    for o in operands) or None in functions:
-            return node
+            folded: ast.AST = super().visit_Compare(node)   # ``None is None``
+            return folded
         values = [cast(ast.Constant, o).value for o in operands]
         result = True
         for function, left, right in zip(functions, values, values[1:], strict=False):
-            folded = _evaluated(cast(Callable[[Any, Any], Any], function), left, right)
-            if folded is None:
+            compared = _evaluated(cast(Callable[[Any, Any], Any], function), left, right)
+            if compared is None:
                 return node
-            if not folded.value:
+            if not compared.value:
                 result = False
                 break                               # a chain stops at its first false
         return ast.copy_location(ast.Constant(result), node)
@@ -543,15 +557,15 @@ def _copy(node: ast.expr) -> ast.expr:
 def _stores(body: list[ast.stmt]) -> dict[str, int]:
     """Return how many times each name is bound anywhere in ``body``."""
     counts: dict[str, int] = {}
-    declared = {id(n.target) for stmt in body for n in ast.walk(stmt)
-                if isinstance(n, ast.AnnAssign) and n.value is None}   # ``e: Any`` binds none
     for stmt in body:
         for n in ast.walk(stmt):
-            if (isinstance(n, ast.Name) and not isinstance(n.ctx, ast.Load)
-                    and id(n) not in declared):
+            if isinstance(n, ast.Name) and not isinstance(n.ctx, ast.Load):
                 counts[n.id] = counts.get(n.id, 0) + 1
             elif isinstance(n, ast.arg):
                 counts[n.arg] = counts.get(n.arg, 0) + 2    # never a constant
+            elif (isinstance(n, ast.AnnAssign) and n.value is None
+                  and isinstance(n.target, ast.Name)):
+                counts[n.target.id] = counts.get(n.target.id, 0) - 1   # ``e: Any`` binds none
     return counts
 
 
@@ -580,10 +594,10 @@ def _targets(stmt: ast.stmt) -> list[tuple[str, ast.expr | None]] | None:
     return [(n, None) for n in names]
 
 
-def _reads(body: list[ast.stmt]) -> set[str]:
-    """Return the names read anywhere in ``body`` (lambdas and f-strings included)."""
-    return {n.id for stmt in body for n in ast.walk(stmt)
-            if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
+def _reads(body: list[ast.stmt]) -> Counter[str]:
+    """Return how often each name is read in ``body`` (lambdas and f-strings included)."""
+    return Counter(n.id for stmt in body for n in ast.walk(stmt)
+                   if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load))
 
 
 def _inert(value: ast.expr | None) -> bool:
@@ -645,7 +659,7 @@ def _substituted(body: list[ast.stmt], namespace: dict[str, Any], counts: dict[s
                 and stmt.value.id.startswith('_ground_') and stmt.value.id not in counts
                 and _is_constant(namespace.get(stmt.value.id))):
             stmt.value = ast.copy_location(ast.Constant(namespace[stmt.value.id]), stmt.value)
-        stmt = cast(ast.stmt, fold(propagator.visit(stmt)))
+        stmt = cast(ast.stmt, propagator.visit(stmt))
         if isinstance(stmt, ast.Pass):
             continue
         for name, value in _targets(stmt) or ():
@@ -687,14 +701,24 @@ def propagate(body: list[ast.stmt], namespace: dict[str, Any], live: set[str],
     shadowed = {name for name in ('abs',) if name in namespace or name in counts}
     out = _substituted(body, namespace, counts, shadowed)
     identities = _Identities(_Kinds(out, namespace), vector)
-    out = _substituted([cast(ast.stmt, identities.visit(stmt)) for stmt in out], namespace,
-                       counts, shadowed)
+    out = [cast(ast.stmt, identities.visit(stmt)) for stmt in out]
+    if identities.removed:      # ``d = b - 0j`` became a copy
+        out = _substituted(out, namespace, counts, shadowed)
     if vector:
         zero_d = _ZeroD(_Arrays(out, namespace), namespace)
         out = [cast(ast.stmt, zero_d.visit(stmt)) for stmt in out]
+    reads = _reads(out)
     while True:
-        dead = {name for name in counts if name not in live} - _reads(out)
-        pruned = [p for p in (_pruned(stmt, dead) for stmt in out) if p is not None]
+        dead = {name for name in counts if name not in live and not reads[name]}
+        pruned: list[ast.stmt] = []
+        for stmt in out:
+            kept = _pruned(stmt, dead)
+            if kept is not stmt:
+                reads.subtract(_reads([stmt]))
+                if kept is not None:
+                    reads.update(_reads([kept]))
+            if kept is not None:
+                pruned.append(kept)
         if len(pruned) == len(out) and all(
                 a is b for a, b in zip(pruned, out, strict=True)):
             return pruned
@@ -841,6 +865,7 @@ class _Identities(ast.NodeTransformer):
         self.kinds = kinds
         self.vector = vector
         self.consumed = False           # whether the node visited is an arithmetic operand
+        self.removed = 0
 
     def generic_visit(self, node: ast.AST) -> ast.AST:
         consumed = self.consumed
@@ -859,6 +884,7 @@ class _Identities(ast.NodeTransformer):
         fresh = not isinstance(kept, (ast.Name, ast.Attribute, ast.Subscript, ast.Constant))
         if self.vector and not (consumed or fresh):
             return node
+        self.removed += 1
         return kept
 
 
