@@ -644,14 +644,19 @@ def _substituted(body: list[ast.stmt], namespace: dict[str, Any], counts: dict[s
     copies: dict[str, str] = {}
     tuples: dict[str, list[ast.expr | None]] = {}
     propagator = _Propagator(known, copies, tuples, shadowed)
-    bound: set[str] = set()
+    passed: Counter[str] = Counter()     # the bindings of each name before this point
 
     def stable(entry: ast.expr) -> bool:
-        """Return whether ``entry`` reads the same anywhere after this point."""
+        """Return whether ``entry`` reads the same anywhere after this point.
+
+        A constant does, and a local all of whose bindings are behind, or an
+        argument (a global reads slower than the local it would replace).
+        """
         if isinstance(entry, ast.Constant):
             return True
         return isinstance(entry, ast.Name) and (
-            entry.id in bound if entry.id in counts else entry.id not in namespace)
+            passed[entry.id] == counts[entry.id] if entry.id in counts
+            else entry.id not in namespace)
 
     out: list[ast.stmt] = []
     for stmt in body:
@@ -662,6 +667,14 @@ def _substituted(body: list[ast.stmt], namespace: dict[str, Any], counts: dict[s
         stmt = cast(ast.stmt, propagator.visit(stmt))
         if isinstance(stmt, ast.Pass):
             continue
+        if (isinstance(stmt, ast.Assign) and isinstance(stmt.value, ast.Name)
+                and isinstance(stmt.targets[0], ast.Tuple) and len(stmt.targets) == 1
+                and None not in tuples.get(stmt.value.id, [None])
+                and len(tuples[stmt.value.id]) == len(stmt.targets[0].elts)):
+            # ``a, b = P`` of ``P = (x, y)``: ``a, b = (x, y)``, the same objects.
+            stmt.value = ast.copy_location(ast.Tuple(
+                [_copy(cast(ast.expr, e)) for e in tuples[stmt.value.id]], ast.Load()),
+                stmt.value)
         for name, value in _targets(stmt) or ():
             if counts.get(name) != 1:
                 continue
@@ -672,10 +685,41 @@ def _substituted(body: list[ast.stmt], namespace: dict[str, Any], counts: dict[s
                         entries := tuple(cast(ast.Constant, e).value for e in value.elts)):
                 known[name] = entries
             elif isinstance(value, ast.Name) and stable(value):
-                copies[name] = value.id         # a local or argument: a global reads slower
+                copies[name] = value.id
             elif isinstance(value, ast.Tuple):
                 tuples[name] = [_copy(e) if stable(e) else None for e in value.elts]
-            bound.add(name)
+        passed.update(_stores([stmt]))
+        out.append(stmt)
+    return out
+
+
+def _hoisted(body: list[ast.stmt], counts: dict[str, int],
+             namespace: dict[str, Any]) -> list[ast.stmt]:
+    """Return ``body`` with the computed entries of its tuples bound to locals first.
+
+    ``P = (e0, n, e2)`` (``P`` bound once at the top level) becomes
+    ``_e0 = e0; _e1 = e2; P = (_e0, n, _e1)``: the entries are computed in the
+    same order, and ``P[2]`` or ``a, b, c = P`` then read locals instead of
+    indexing or unpacking the tuple. ``counts`` gets the new locals.
+    """
+    used = {n.id for stmt in body for n in ast.walk(stmt) if isinstance(n, ast.Name)}
+    fresh = (f'_e{k}' for k in itertools.count())
+    out: list[ast.stmt] = []
+    for stmt in body:
+        pairs = _targets(stmt)
+        if (pairs is not None and len(pairs) == 1 and counts.get(pairs[0][0]) == 1
+                and isinstance(pairs[0][1], ast.Tuple)):
+            entries: list[ast.expr] = []
+            for entry in pairs[0][1].elts:
+                if isinstance(entry, (ast.Constant, ast.Name, ast.Starred)):
+                    entries.append(entry)
+                    continue
+                name = next(n for n in fresh if n not in used and n not in namespace)
+                counts[name] = 1
+                out.append(ast.copy_location(ast.Assign([ast.Name(name, ast.Store())], entry),
+                                             stmt))
+                entries.append(ast.Name(name, ast.Load()))
+            pairs[0][1].elts = entries
         out.append(stmt)
     return out
 
@@ -702,8 +746,8 @@ def propagate(body: list[ast.stmt], namespace: dict[str, Any], live: set[str],
     out = _substituted(body, namespace, counts, shadowed)
     identities = _Identities(_Kinds(out, namespace), vector)
     out = [cast(ast.stmt, identities.visit(stmt)) for stmt in out]
-    if identities.removed:      # ``d = b - 0j`` became a copy
-        out = _substituted(out, namespace, counts, shadowed)
+    # Copies made by the identities (``d = b - 0j``), entries of the tuples hoisted.
+    out = _substituted(_hoisted(out, counts, namespace), namespace, counts, shadowed)
     if vector:
         zero_d = _ZeroD(_Arrays(out, namespace), namespace)
         out = [cast(ast.stmt, zero_d.visit(stmt)) for stmt in out]
