@@ -1058,3 +1058,16 @@ class _ZeroD(ast.NodeTransformer):
                     and self.arrays.of(left) == ARRAY):
                 node.right = self.zero_d(right)
         return node
+
+    def visit_Compare(self, node: ast.Compare) -> ast.AST:
+        # ``array > 1e-12``: an ordering against a float, the same bool array.
+        self.generic_visit(node)
+        if len(node.ops) == 1 and isinstance(node.ops[0], (ast.Lt, ast.LtE, ast.Gt, ast.GtE)):
+            left, right = node.left, node.comparators[0]
+            if (isinstance(left, ast.Constant) and type(left.value) is float
+                    and self.arrays.of(right) == ARRAY):
+                node.left = self.zero_d(left)
+            elif (isinstance(right, ast.Constant) and type(right.value) is float
+                    and self.arrays.of(left) == ARRAY):
+                node.comparators = [self.zero_d(right)]
+        return node

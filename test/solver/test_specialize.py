@@ -272,11 +272,11 @@ def test_array_operations_take_zero_d_constants_with_the_same_bits():
               'w = abs(omega)\n'
               'd = np.hypot(r.real, r.imag)\n'
               'out = [r, 1j * omega * r, 2.5e-17 * w, (0.3 + d) / 2.0, 1j - r, w * 0.5, '
-              'omega * 2.0, r.imag * -0.0, 1 * d]')
+              'omega * 2.0, r.imag * -0.0, 1 * d, d > 0.04, 0.04 <= d, w > 0.5, d == 0.05]')
     namespace = {'np': np}
     body = propagate(ast.parse(source).body, namespace, {'out'}, vector=True)
     zero_d = {name for name, value in namespace.items() if isinstance(value, np.ndarray)}
-    assert {namespace[name].item() for name in zero_d} == {0.05, 0.3, 2.0, 1j, -0.0}
+    assert {namespace[name].item() for name in zero_d} == {0.05, 0.3, 2.0, 1j, -0.0, 0.04}
     assert all(namespace[name].ndim == 0 and not namespace[name].flags.writeable
                for name in zero_d)
     shown = re.sub(r'_z\d+', lambda m: f'Z({namespace[m.group()].item()!r})',
@@ -284,7 +284,7 @@ def test_array_operations_take_zero_d_constants_with_the_same_bits():
     assert '\nr = Z(0.05) * e\n' in shown
     assert shown.splitlines()[-1] == (
         'out = [r, 1j * omega * r, 2.5e-17 * w, (Z(0.3) + d) / Z(2.0), Z(1j) - r, w * 0.5, '
-        'omega * 2.0, r.imag * Z(-0.0), 1 * d]')
+        'omega * 2.0, r.imag * Z(-0.0), 1 * d, d > Z(0.04), Z(0.04) <= d, w > 0.5, d == 0.05]')
     before = _function(ast.parse(source).body, {'np': np}, 'theta, omega')
     after = _function(body, namespace, 'theta, omega')
     theta = np.array([0.0, -0.0, 1.0, 2.5, -7.0])
