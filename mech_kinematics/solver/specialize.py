@@ -554,8 +554,8 @@ def _copy(node: ast.expr) -> ast.expr:
     return ast.Name(cast(ast.Name, node).id, ast.Load())
 
 
-def _stores(body: list[ast.stmt]) -> dict[str, int]:
-    """Return how many times each name is bound anywhere in ``body``."""
+def _stores(body: Sequence[ast.AST]) -> dict[str, int]:
+    """Return how many times each name is bound anywhere in ``body`` (statements or targets)."""
     counts: dict[str, int] = {}
     for stmt in body:
         for n in ast.walk(stmt):
@@ -688,7 +688,9 @@ def _substituted(body: list[ast.stmt], namespace: dict[str, Any], counts: dict[s
                 copies[name] = value.id
             elif isinstance(value, ast.Tuple):
                 tuples[name] = [_copy(e) if stable(e) else None for e in value.elts]
-        passed.update(_stores([stmt]))
+        # (An assignment's targets alone: a comprehension's variable, left uncounted,
+        # only keeps its name from ever being stable.)
+        passed.update(_stores(stmt.targets if isinstance(stmt, ast.Assign) else [stmt]))
         out.append(stmt)
     return out
 
