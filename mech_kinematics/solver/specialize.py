@@ -701,8 +701,10 @@ def _hoisted(body: list[ast.stmt], counts: dict[str, int],
 
     ``P = (e0, n, e2)`` (``P`` bound once at the top level) becomes
     ``_e0 = e0; _e1 = e2; P = (_e0, n, _e1)``: the entries are computed in the
-    same order, and ``P[2]`` or ``a, b, c = P`` then read locals instead of
-    indexing or unpacking the tuple. ``counts`` gets the new locals.
+    same order (a name the code has bound, or a constant, reads the same
+    before or after them; a tuple with a starred entry or a walrus stays), and
+    ``P[2]`` or ``a, b, c = P`` then read locals instead of indexing or
+    unpacking the tuple. ``counts`` gets the new locals.
     """
     used = {n.id for stmt in body for n in ast.walk(stmt) if isinstance(n, ast.Name)}
     fresh = (f'_e{k}' for k in itertools.count())
@@ -710,10 +712,12 @@ def _hoisted(body: list[ast.stmt], counts: dict[str, int],
     for stmt in body:
         pairs = _targets(stmt)
         if (pairs is not None and len(pairs) == 1 and counts.get(pairs[0][0]) == 1
-                and isinstance(pairs[0][1], ast.Tuple)):
+                and isinstance(pairs[0][1], ast.Tuple) and not any(
+                    isinstance(n, (ast.Starred, ast.NamedExpr))
+                    for n in ast.walk(pairs[0][1]))):
             entries: list[ast.expr] = []
             for entry in pairs[0][1].elts:
-                if isinstance(entry, (ast.Constant, ast.Name, ast.Starred)):
+                if isinstance(entry, (ast.Constant, ast.Name)):
                     entries.append(entry)
                     continue
                 name = next(n for n in fresh if n not in used and n not in namespace)
@@ -1043,7 +1047,9 @@ class _ZeroD(ast.NodeTransformer):
         key = (type(node.value), repr(node.value))
         name = self.made.get(key)
         if name is None:
-            name = self.made[key] = f'_z{len(self.namespace)}'
+            name = next(n for n in (f'_z{k}' for k in itertools.count(len(self.namespace)))
+                        if n not in self.namespace)
+            self.made[key] = name
             value = np.array(node.value)
             value.setflags(write=False)
             self.namespace[name] = value
