@@ -470,6 +470,19 @@ class _Propagator(_Folder):
             if entry is not None:
                 read: ast.AST = self.visit(ast.copy_location(_copy(entry), node))
                 return read
+        if (isinstance(value, ast.Name) and value.id in self.tuples
+                and isinstance(index, ast.Slice) and isinstance(node.ctx, ast.Load)
+                and index.step is None and all(
+                    part is None or (isinstance(part, ast.Constant) and type(part.value) is int)
+                    for part in (index.lower, index.upper))):
+            # ``P[:3]`` of ``P = (a, b, c, ...)``: the tuple ``(a, b, c)``.
+            lower, upper = (None if part is None else cast(ast.Constant, part).value
+                            for part in (index.lower, index.upper))
+            slice_of = self.tuples[value.id][slice(cast(Any, lower), cast(Any, upper))]
+            if None not in slice_of:
+                built: ast.AST = self.visit(ast.copy_location(ast.Tuple(
+                    [_copy(cast(ast.expr, e)) for e in slice_of], ast.Load()), node))
+                return built
         self.generic_visit(node)
         value, index = node.value, node.slice
         entries: Any = value.value if isinstance(value, ast.Constant) else None

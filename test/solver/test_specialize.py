@@ -103,9 +103,10 @@ def test_a_tuple_binding_keeps_its_computed_entries():
 def test_tuple_entries_are_read_from_locals():
     """``P[1]`` of ``P = (a, f(x), 1.0)`` reads the local computed first, in the same order."""
     assert _propagated('a = x.real\nP = (a, f(x), 1.0)\nQ = (0.0, 2.0)\n'
-                       'out = (P[0], P[1], P[2], P[-1], P[5], Q[:1], Q[::0], P)') == (
+                       'out = (P[0], P[1], P[2], P[-1], P[5], Q[:1], Q[::0], P, P[1:], P[::2])'
+                       ) == (
         'a = x.real\n_e0 = f(x)\nP = (a, _e0, 1.0)\n_e2 = P[5]\n_e3 = (0.0, 2.0)[::0]\n'
-        'out = (a, _e0, 1.0, 1.0, _e2, (0.0,), _e3, P)')
+        '_e4 = (_e0, 1.0)\n_e5 = P[::2]\nout = (a, _e0, 1.0, 1.0, _e2, (0.0,), _e3, P, _e4, _e5)')
 
 
 def test_an_unpacked_tuple_is_never_built():
