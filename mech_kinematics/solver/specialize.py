@@ -31,6 +31,10 @@ arithmetic the code would run (the operands are Python numbers at run time
 on both paths), and a fold that raises is left to raise where it was. A
 binding nothing reads any more goes if its value is a constant or a name;
 every call, every expression statement and every value that may raise stays.
+A tuple's computed entries are bound to locals first, in the same order, so
+that an entry read (``P[3]``, ``P[:3]``, ``a, b, c = P``) reads the local.
+The callers run :func:`propagate` over the whole function they build (the
+trust test and the returned values included).
 
 Last, an operation that gives back its operand bit for bit is removed, where
 what the operand is (:class:`_Kinds`: a real float, any real, a complex;
