@@ -42,7 +42,7 @@ from typing import Any
 
 from .. import solver as lk
 from ..solver import tick as hooks
-from ..solver.specialize import plan_body, Unsupported
+from ..solver.specialize import plan_body, propagate, Unsupported
 
 __all__ = ['TickFunction', 'compile_tick', 'tick_function', 'values_from_state']
 
@@ -172,7 +172,7 @@ def _compile_drivers(scene: lk.Scene, plan: hooks.TickPlan, joints: tuple[str, .
     body: list[ast.stmt] = ast.parse('\n'.join(lines)).body
     try:
         body += plan_body(plan, names, namespace, driver_values=[
-            (f'x_{k}', f'v_{k}', f'a_{k}') for k in range(count)])
+            (f'x_{k}', f'v_{k}', f'a_{k}') for k in range(count)], propagated=False)
     except (Unsupported, ValueError):
         return None     # the general solver serves this scene
     namespace['_wrapped_angle'] = hooks.wrapped_angle
@@ -185,8 +185,9 @@ def _compile_drivers(scene: lk.Scene, plan: hooks.TickPlan, joints: tuple[str, .
         'theta', 'omega', 'alpha', 'tol', 'turns')], kwonlyargs=[], kw_defaults=[],
         defaults=[ast.Constant(0)])
     inner = ast.FunctionDef(name='_tick', args=signature,
-                            body=body + ast.parse('\n'.join(tail)).body, decorator_list=[],
-                            returns=None)
+                            body=propagate(body + ast.parse('\n'.join(tail)).body, namespace,
+                                           set(), vector=False),
+                            decorator_list=[], returns=None)
     outer = ast.parse(
         'def tick(theta, omega, alpha, tol, turns=0):\n'
         '    if not (isinstance(theta, _SEQUENCE) and isinstance(omega, _SEQUENCE) '
@@ -251,7 +252,7 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
     }
     names: dict[str, str] = {}
     try:
-        body = plan_body(plan, names, namespace)
+        body = plan_body(plan, names, namespace, propagated=False)
     except Unsupported:
         return None     # the general solver serves this scene
     namespace['_wrapped_angle'] = hooks.wrapped_angle
@@ -279,7 +280,7 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
             posonlyargs=[],
             args=[ast.arg(a) for a in ('theta', 'omega', 'alpha', 'tol', 'turns')],
             kwonlyargs=[], kw_defaults=[], defaults=[ast.Constant(0)]),
-        body=guard + body + tail, decorator_list=[],
+        body=guard + propagate(body + tail, namespace, set(), vector=False), decorator_list=[],
         returns=None)
     module = ast.fix_missing_locations(ast.Module(body=[function], type_ignores=[]))
     exec(compile(module, f'<compiled tick of {scene.name}>', 'exec'), namespace)  # noqa: S102

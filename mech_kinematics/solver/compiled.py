@@ -36,7 +36,7 @@ import os
 import platform
 from typing import Any, TYPE_CHECKING
 
-from .specialize import plan_body, TABLES, Unsupported
+from .specialize import plan_body, propagate, TABLES, Unsupported
 from .state import JointMotion
 
 if TYPE_CHECKING:
@@ -99,7 +99,7 @@ def compile_single(scene: Scene) -> SingleFunction | None:
     }
     names: dict[str, str] = {}
     try:
-        body = plan_body(plan, names, namespace)
+        body = plan_body(plan, names, namespace, propagated=False)
     except Unsupported:
         return None
     namespace['_wrapped_angle'] = hooks.wrapped_angle
@@ -135,7 +135,8 @@ def compile_single(scene: Scene) -> SingleFunction | None:
             posonlyargs=[], args=[ast.arg(a) for a in ('theta', 'omega', 'alpha', 'tol',
                                                        'turns')],
             kwonlyargs=[], kw_defaults=[], defaults=[]),
-        body=guard + body + ast.parse('\n'.join(lines)).body, decorator_list=[],
+        body=guard + propagate(body + ast.parse('\n'.join(lines)).body, namespace, set(),
+                               vector=False), decorator_list=[],
         returns=None)
     module = ast.fix_missing_locations(ast.Module(body=[function], type_ignores=[]))
     exec(compile(module, f'<compiled solve of {scene.name}>', 'exec'), namespace)  # noqa: S102
@@ -162,7 +163,7 @@ def compile_array(scene: Scene) -> ArrayFunction | None:
     namespace: dict[str, Any] = {}
     names: dict[str, str] = {}
     try:
-        body = plan_body(plan, names, namespace, vector=True)
+        body = plan_body(plan, names, namespace, vector=True, propagated=False)
     except Unsupported:
         return None
     tables: dict[str, list[str]] = {prefix: [] for prefix in TABLES.values()}
@@ -183,7 +184,8 @@ def compile_array(scene: Scene) -> ArrayFunction | None:
             posonlyargs=[], args=[ast.arg(a) for a in ('theta', 'omega', 'alpha', 'turns',
                                                        'ctx')],
             kwonlyargs=[], kw_defaults=[], defaults=[]),
-        body=body + ast.parse('\n'.join(lines)).body, decorator_list=[], returns=None)
+        body=propagate(body + ast.parse('\n'.join(lines)).body, namespace, set()),
+        decorator_list=[], returns=None)
     module = ast.fix_missing_locations(ast.Module(body=[function], type_ignores=[]))
     exec(compile(module, f'<compiled array solve of {scene.name}>', 'exec'),  # noqa: S102
          namespace)
