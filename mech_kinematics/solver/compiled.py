@@ -177,8 +177,15 @@ def compile_array(scene: Scene) -> ArrayFunction | None:
         local = names[f'{TABLES[table]}_{name}']
         for index, kind in enumerate(kinds, 3):
             sums.setdefault(kind, []).append(f'{local}[{index}]')
-    lines.append('ctx.sums = (' + ''.join(f'({kind!r}, {" + ".join(terms)}), '
-                                          for kind, terms in sums.items()) + ')')
+    # Each kind's sum written into its row of one table (its last addition's ``out``), so
+    # that one reduction gives every kind's largest sum (solve._within).
+    lines.append(f'_sums = np.empty(({len(sums)}, *np.shape(theta)))')
+    for row, terms in enumerate(sums.values()):
+        if len(terms) == 1:
+            lines.append(f'_sums[{row}] = {terms[0]}')
+        else:
+            lines.append(f'np.add({" + ".join(terms[:-1])}, {terms[-1]}, out=_sums[{row}])')
+    lines.append(f'ctx.sums = ({tuple(sums)!r}, _sums)')
     function = ast.FunctionDef(
         name='array', args=ast.arguments(
             posonlyargs=[], args=[ast.arg(a) for a in ('theta', 'omega', 'alpha', 'turns',

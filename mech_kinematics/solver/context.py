@@ -63,8 +63,9 @@ class _Context:
         self.flip = flip
         self.jumps: dict[str, Any] = _NOTHING
         # A compiled array solve's reported bounds summed per kind, for the quick judgement
-        # (:func:`.compiled.compile_array`); None elsewhere.
-        self.sums: tuple[tuple[str, Any], ...] | None = None
+        # (:func:`.compiled.compile_array`): the kinds, and a table of one row each; None
+        # elsewhere.
+        self.sums: tuple[tuple[str, ...], Any] | None = None
 
     def jump(self, lever: str, where: Any) -> None:
         """Record that ``lever``'s values jump at the instant (``where``: True, or a mask).

@@ -53,6 +53,8 @@ class _Solver:
         self.single = crank is not None and len(scene.drivers) == 1
         #: That crank's default speed and acceleration (the single path's, read once).
         self.defaults = (crank.speed, crank.accel) if crank is not None else (0.0, 0.0)
+        # The same as read-only 0-d arrays, for array solves (one object each, every solve).
+        self.default_arrays = tuple(_read_only_scalar(x) for x in self.defaults)
         self.shift = _exponent(self.size, *_SIZE_RANGE)
         run = plan
         if self.shift:
@@ -325,3 +327,10 @@ class Scene:
     def pin_bodies(self) -> dict[str, tuple[str, str]]:
         """Pin point -> the two bodies it joins (a link, ``ground`` or a slider block)."""
         return {rub.point: rub.names for rub in self._plan.rubs}
+
+
+def _read_only_scalar(x: float) -> Any:
+    """Return ``x`` as a read-only 0-d float64 array."""
+    one = np.array(x, dtype=np.float64)
+    one.flags.writeable = False
+    return one

@@ -216,7 +216,7 @@ def _judge(solver: _Solver, ctx: _Context, floors: tuple[Any, Any, Any, Any], to
              'angular velocity': turn, 'acceleration': accel,
              'angular acceleration': turn_accel}
     lims = {kind: tol * floor for kind, floor in least.items()}
-    if ctx.valid is True and all(np.ndim(floor) == 0 for floor in floors) \
+    if ctx.valid is True and all(getattr(floor, 'ndim', 0) == 0 for floor in floors) \
             and _within(solver, ctx, lims):
         return  # nothing refused, one rate, the largest bounds within the floors: as below
     failed = np.logical_not(ctx.valid)  # already refused: not judged again
@@ -253,8 +253,10 @@ def _within(solver: _Solver, ctx: _Context, lims: dict[str, float]) -> bool:
     limit, :func:`_judge` tests each bound.
     """
     largest = np.maximum.reduce
-    if ctx.sums is not None:    # summed by the compiled solve (compile_array)
-        if not all(largest(total, axis=None) <= lims[kind] for kind, total in ctx.sums):
+    if ctx.sums is not None:    # summed by the compiled solve (compile_array), one row a kind
+        kinds, table = ctx.sums
+        if not all(most <= lims[kind] for kind, most
+                   in zip(kinds, largest(table, axis=1).tolist(), strict=True)):
             return False
     else:
         sums: dict[str, Any] = {}
@@ -275,7 +277,8 @@ def _angle(e: Any, vector: bool) -> Any:
     """Angle of unit complex ``e``, wrapped to (-pi, pi]."""
     if vector:
         theta = np.arctan2(e.imag, e.real)
-        theta[theta == -np.pi] = np.pi
+        if np.fmin.reduce(theta, axis=None) == -np.pi:    # the least, NaN left out
+            theta[theta == -np.pi] = np.pi
         return theta
     return _wrapped_angle(e)
 
@@ -357,8 +360,12 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
         return _solve_drivers(scene, solver, angle, speed, accel, turns, tol)
     if speed is None:
         speed = solver.defaults[0]
+        if angle.__class__ is np.ndarray:   # the same object every array solve
+            speed = solver.default_arrays[0]
     if accel is None:
         accel = solver.defaults[1]
+        if angle.__class__ is np.ndarray:
+            accel = solver.default_arrays[1]
     whole: Any = turns
     if whole.__class__ is not int:  # an int is the usual case, decided without a call
         whole = _turns(whole)
@@ -385,24 +392,35 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
         jumps = _jumps(solver, ctx, theta, omega, alpha, whole, None) if ctx.jumps else {}
         counted: Any = theta + math.tau * whole if whole else theta
     else:
-        theta, omega, alpha = (np.asarray(x, dtype=np.float64) for x in (angle, speed, accel))
-        if omega.ndim == 0 and alpha.ndim == 0 and whole.__class__ is int:
-            shape = theta.shape     # the usual case: one rate, whole turns 0 (or any int)
+        some = whole.__class__ is not int or whole != 0    # turns other than the usual 0
+        if not some and speed is solver.default_arrays[0] and accel is solver.default_arrays[1] \
+                and angle.__class__ is np.ndarray and angle.dtype == _FLOAT and angle.ndim == 1:
+            # The usual array call: float angles at the scene's rates (finite, 0-d).
+            theta, omega, alpha = angle, speed, accel
+            shape = theta.shape
+            if not np.isfinite(theta).all():
+                msg = 'Expected `angle`, `speed` and `accel` to be finite'
+                raise ValueError(msg)
         else:
-            shape = np.broadcast_shapes(theta.shape, omega.shape, alpha.shape, np.shape(whole))
-        if len(shape) != 1:
-            msg = f'Expected `angle` to be a float or a 1-D array, got shape {shape}'
-            raise ValueError(msg)
-        if not (np.isfinite(theta).all() and _finite(omega) and _finite(alpha)):
-            msg = 'Expected `angle`, `speed` and `accel` to be finite'
-            raise ValueError(msg)
+            theta, omega, alpha = (np.asarray(x, dtype=np.float64) for x in (angle, speed, accel))
+            if omega.ndim == 0 and alpha.ndim == 0 and whole.__class__ is int:
+                shape = theta.shape     # one rate, whole turns an int
+            else:
+                shape = np.broadcast_shapes(theta.shape, omega.shape, alpha.shape,
+                                            np.shape(whole))
+            if len(shape) != 1:
+                msg = f'Expected `angle` to be a float or a 1-D array, got shape {shape}'
+                raise ValueError(msg)
+            if not (np.isfinite(theta).all() and _finite(omega) and _finite(alpha)):
+                msg = 'Expected `angle`, `speed` and `accel` to be finite'
+                raise ValueError(msg)
         if shape[0] >= LARGE_BATCH:
             keep_freed_memory()
         given = (theta, omega, alpha)       # maybe the caller's own arrays
         constant = _constants(solver, shape)
         theta = _read_only(theta, shape, constant)
-        some = whole.__class__ is not int or whole != 0    # turns other than the usual 0
-        whole = _read_only(np.asarray(whole, dtype=np.int64), shape, constant)
+        whole = constant(_NO_TURNS) if not some else _read_only(
+            np.asarray(whole, dtype=np.int64), shape, constant)
         with np.errstate(all='ignore'):
             # A constant speed or acceleration stays a scalar through the steps.
             ctx = _execute(solver, theta, omega, alpha, whole)
@@ -416,6 +434,12 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
     drivers = {solver.driver_names[0]: JointMotion('revolute', counted, omega, alpha)}
     return _state(scene, solver, ctx, theta, omega, alpha, valid, whole, jumps, drivers,
                   given=given if ctx.vector else ())
+
+
+_FLOAT = np.dtype(np.float64)
+#: Whole turns 0, one object (:class:`_Constants` finds it by identity).
+_NO_TURNS = np.zeros((), dtype=np.int64)
+_NO_TURNS.flags.writeable = False
 
 
 def _per_driver(values: Any, defaults: tuple[float, ...], what: str) -> list[Any]:
@@ -742,7 +766,7 @@ def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any,
     bound = ErrorBound(_table_bounds, (plan, ctx), solver.size, solver.crank_length, floors)
     if vector:
         shape = theta.shape
-        bad = None if valid.all() else ~valid
+        bad = None if ctx.valid is True or valid.all() else ~valid
         inputs = (id(theta), id(omega), id(alpha), *map(id, given))
 
         constant = _constants(solver, shape)
@@ -835,17 +859,18 @@ class _Constants:
     equality, which would take -0.0 for 0.0).
     """
 
-    __slots__ = ('shape', 'ground', 'seen')
+    __slots__ = ('shape', 'known', 'seen')
 
     def __init__(self, solver: _Solver, shape: tuple[int, ...]) -> None:
         self.shape = shape
-        self.ground = {id(x): (x, _constant(x, shape)) for entry in solver.ground.values()
-                       for x in entry}
+        # By identity: (the object, kept alive so that its id stays its own, its view).
+        self.known = {id(x): (x, _constant(x, shape)) for entry in solver.ground.values()
+                      for x in entry}
         self.seen: dict[tuple[str, bytes], Any] = {}
 
     def __call__(self, x: Any) -> Any:
         """Return ``x`` (a number or a 0-d array) as a read-only array of the shape."""
-        hit = self.ground.get(id(x))
+        hit = self.known.get(id(x))
         if hit is not None and hit[0] is x:
             return hit[1]
         one = np.asarray(x)
@@ -855,6 +880,8 @@ class _Constants:
             if len(self.seen) >= 64:
                 self.seen.clear()
             view = self.seen[key] = _constant(one, self.shape)
+        if len(self.known) < 256:   # a compiled solve's constants: the same objects each time
+            self.known[id(x)] = (x, view)
         return view
 
 

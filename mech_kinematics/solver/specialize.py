@@ -76,6 +76,7 @@ caller falls back to the general solver.
 from __future__ import annotations
 
 import ast
+import copy
 from collections import Counter
 from collections.abc import Callable, Sequence
 import functools
@@ -275,6 +276,14 @@ class _Specializer(ast.NodeTransformer):
             call = ast.Call(ast.Name(f'_ctx_{func.attr}', ast.Load()),
                             [ast.Name('theta', ast.Load()), ast.Name('turns', ast.Load()),
                              *node.args], node.keywords)
+            return self.generic_visit(ast.copy_location(call, node))
+        if (isinstance(func, ast.Attribute) and isinstance(func.value, ast.Name)
+                and func.value.id == 'ctx' and func.attr in ('check', 'check_margin')
+                and self.vector and len(node.args) >= 2 and not node.keywords):
+            # A vector context's check only masks (``_Context.check``): the message's
+            # values and callables it would not read are not computed.
+            call = ast.Call(ast.Attribute(ast.Name('ctx', ast.Load()), 'mask', ast.Load()),
+                            node.args[:2], [])
             return self.generic_visit(ast.copy_location(call, node))
         return self.generic_visit(node)
 
@@ -788,6 +797,10 @@ def propagate(body: list[ast.stmt], namespace: dict[str, Any], live: set[str],
                 pruned.append(kept)
         if len(pruned) == len(out) and all(
                 a is b for a, b in zip(pruned, out, strict=True)):
+            if vector:
+                ufuncs = _Ufuncs(_Arrays(pruned, namespace), namespace)
+                # (on copies: the kinds are read from the statements as they were)
+                pruned = [cast(ast.stmt, ufuncs.visit(copy.deepcopy(stmt))) for stmt in pruned]
             return pruned
         out = pruned
 
@@ -1096,3 +1109,58 @@ class _ZeroD(ast.NodeTransformer):
                     and self.arrays.of(left) == ARRAY):
                 node.comparators = [self.zero_d(right)]
         return node
+
+
+class _Ufuncs(ast.NodeTransformer):
+    """Call the array path's array arithmetic's NumPy functions directly.
+
+    ``a + b`` with an array operand is ``np.add(a, b)`` (the array's
+    operator calls it, the other operand being a Python number, a NumPy
+    scalar or an array), with the same result; the call spares the
+    operator's dispatch, about a tenth of an operation on a few hundred
+    angles. Likewise ``-``, ``*``, ``/``, the orderings, unary minus and
+    ``abs``. Only where :class:`_Arrays` knows an operand is an array: on
+    two scalars the function would give a NumPy scalar where the operator
+    gives a Python number.
+    """
+
+    BINARY = {ast.Add: 'add', ast.Sub: 'subtract', ast.Mult: 'multiply', ast.Div: 'true_divide'}
+    ORDER = {ast.Lt: 'less', ast.LtE: 'less_equal', ast.Gt: 'greater', ast.GtE: 'greater_equal'}
+
+    def __init__(self, arrays: _Arrays, namespace: dict[str, Any]) -> None:
+        self.arrays = arrays
+        self.namespace = namespace
+
+    def function(self, name: str, node: ast.expr, args: list[ast.expr]) -> ast.expr:
+        local = f'_np_{name}'
+        self.namespace.setdefault(local, getattr(np, name))
+        return ast.copy_location(ast.Call(ast.Name(local, ast.Load()), args, []), node)
+
+    def visit_BinOp(self, node: ast.BinOp) -> ast.AST:
+        array = self.arrays.of(node) == ARRAY     # judged before its operands are rewritten
+        self.generic_visit(node)
+        name = self.BINARY.get(type(node.op))
+        if name is None or not array:
+            return node
+        return self.function(name, node, [node.left, node.right])
+
+    def visit_Compare(self, node: ast.Compare) -> ast.AST:
+        array = len(node.ops) == 1 and ARRAY in (self.arrays.of(node.left),
+                                                 self.arrays.of(node.comparators[0]))
+        self.generic_visit(node)
+        name = self.ORDER.get(type(node.ops[0]))
+        if name is None or not array:
+            return node
+        return self.function(name, node, [node.left, node.comparators[0]])
+
+    def visit_UnaryOp(self, node: ast.UnaryOp) -> ast.AST:
+        array = isinstance(node.op, ast.USub) and self.arrays.of(node.operand) == ARRAY
+        self.generic_visit(node)
+        return self.function('negative', node, [node.operand]) if array else node
+
+    def visit_Call(self, node: ast.Call) -> ast.AST:
+        array = (isinstance(node.func, ast.Name) and node.func.id == 'abs'
+                 and 'abs' not in self.namespace and len(node.args) == 1 and not node.keywords
+                 and self.arrays.of(node.args[0]) == ARRAY)
+        self.generic_visit(node)
+        return self.function('absolute', node, node.args) if array else node

@@ -282,10 +282,13 @@ def test_array_operations_take_zero_d_constants_with_the_same_bits():
                for name in zero_d)
     shown = re.sub(r'_z\d+', lambda m: f'Z({namespace[m.group()].item()!r})',
                    ast.unparse(body))
-    assert '\nr = Z(0.05) * e\n' in shown
+    # The operations on an array call NumPy's functions (_Ufuncs); those on scalars stay.
+    assert '\nr = _np_multiply(Z(0.05), e)\n' in shown
     assert shown.splitlines()[-1] == (
-        'out = [r, 1j * omega * r, 2.5e-17 * w, (Z(0.3) + d) / Z(2.0), Z(1j) - r, w * 0.5, '
-        'omega * 2.0, r.imag * Z(-0.0), 1 * d, d > Z(0.04), Z(0.04) <= d, w > 0.5, d == 0.05]')
+        'out = [r, _np_multiply(1j * omega, r), 2.5e-17 * w, '
+        '_np_true_divide(_np_add(Z(0.3), d), Z(2.0)), _np_subtract(Z(1j), r), w * 0.5, '
+        'omega * 2.0, _np_multiply(r.imag, Z(-0.0)), _np_multiply(1, d), '
+        '_np_greater(d, Z(0.04)), _np_less_equal(Z(0.04), d), w > 0.5, d == 0.05]')
     before = _function(ast.parse(source).body, {'np': np}, 'theta, omega')
     after = _function(body, namespace, 'theta, omega')
     theta = np.array([0.0, -0.0, 1.0, 2.5, -7.0])
