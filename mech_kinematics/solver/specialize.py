@@ -76,9 +76,9 @@ caller falls back to the general solver.
 from __future__ import annotations
 
 import ast
-import copy
 from collections import Counter
 from collections.abc import Callable, Sequence
+import copy
 import functools
 import inspect
 import itertools
