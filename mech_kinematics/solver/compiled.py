@@ -4,7 +4,8 @@
 
 :func:`mech_kinematics.solve` runs every step's kernel through the
 dictionaries of a context. Once a scene has been solved :data:`COMPILE_AFTER`
-times on one path, it compiles the scene's kernels for that path instead
+times at single angles (:data:`ARRAY_COMPILE_AFTER` times on arrays), it
+compiles the scene's kernels for that path instead
 (by :mod:`.specialize`, as the node's tick is compiled):
 
 - the single-angle path (:func:`compile_single`) into one function that
@@ -42,13 +43,17 @@ from .state import JointMotion
 if TYPE_CHECKING:
     from .mechanism import Scene
 
-__all__ = ['ArrayFunction', 'COMPILE_AFTER', 'KEEP_FREED', 'LARGE_BATCH', 'SingleFunction',
-           'compile_array', 'compile_single', 'keep_freed_memory']
+__all__ = ['ARRAY_COMPILE_AFTER', 'ArrayFunction', 'COMPILE_AFTER', 'KEEP_FREED', 'LARGE_BATCH',
+           'SingleFunction', 'compile_array', 'compile_single', 'keep_freed_memory']
 
 #: Single-angle solves of one scene on the general path before it is compiled: a
-#: compilation costs about as much as a thousand solves, so a scene solved once or
-#: twice (most scenes a test builds) is never compiled.
-COMPILE_AFTER = 16
+#: compilation (constants folded, 15-35 ms for a packaged scene) costs about as much as
+#: a few thousand single-angle solves, so a scene solved a few hundred times or less
+#: (most scenes a test builds) is never compiled.
+COMPILE_AFTER = 256
+#: Array solves of one scene before its array path is compiled: an array solve costs
+#: what a few dozen single angles do, or more.
+ARRAY_COMPILE_AFTER = 16
 
 #: ``array(theta, omega, alpha, turns, ctx) -> None``; see :func:`compile_array`.
 ArrayFunction = Callable[[Any, Any, Any, Any, Any], None]

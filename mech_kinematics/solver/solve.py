@@ -17,8 +17,8 @@ import warnings
 import numpy as np
 import numpy.typing as npt
 
-from .compiled import (bounds_from_entries, COMPILE_AFTER, compile_array, compile_single,
-                       keep_freed_memory, LARGE_BATCH)
+from .compiled import (ARRAY_COMPILE_AFTER, bounds_from_entries, COMPILE_AFTER, compile_array,
+                       compile_single, keep_freed_memory, LARGE_BATCH)
 from .context import _Context, NEAR_SINGULAR
 from .scaling import (_ACCEL_HIGH, _ldexp, _QUANTITIES, _rate_exponent, _RATE_HIGH, _RATE_LOW,
                       _rates_exponent, _rescale)
@@ -212,11 +212,11 @@ def _judge(solver: _Solver, ctx: _Context, floors: tuple[Any, Any, Any, Any], to
            shape: tuple[int, ...]) -> None:
     """Mask the angles of a vector solve where a reported bound exceeds ``tol``."""
     speed, accel, turn, turn_accel = floors
-    least = {'position': solver.size, 'angle': 1.0, 'velocity': speed,
-             'angular velocity': turn, 'acceleration': accel,
-             'angular acceleration': turn_accel}
-    lims = {kind: tol * floor for kind, floor in least.items()}
-    if ctx.valid is True and all(getattr(floor, 'ndim', 0) == 0 for floor in floors) \
+    lims = {'position': tol * solver.size, 'angle': tol * 1.0, 'velocity': tol * speed,
+            'angular velocity': tol * turn, 'acceleration': tol * accel,
+            'angular acceleration': tol * turn_accel}
+    if ctx.valid is True and getattr(speed, 'ndim', 0) == 0 and getattr(accel, 'ndim', 0) == 0 \
+            and getattr(turn, 'ndim', 0) == 0 and getattr(turn_accel, 'ndim', 0) == 0 \
             and _within(solver, ctx, lims):
         return  # nothing refused, one rate, the largest bounds within the floors: as below
     failed = np.logical_not(ctx.valid)  # already refused: not judged again
@@ -255,9 +255,9 @@ def _within(solver: _Solver, ctx: _Context, lims: dict[str, float]) -> bool:
     largest = np.maximum.reduce
     if ctx.sums is not None:    # summed by the compiled solve (compile_array), one row a kind
         kinds, table = ctx.sums
-        if not all(most <= lims[kind] for kind, most
-                   in zip(kinds, largest(table, axis=1).tolist(), strict=True)):
-            return False
+        for kind, most in zip(kinds, largest(table, axis=1).tolist(), strict=True):
+            if not most <= lims[kind]:
+                return False
     else:
         sums: dict[str, Any] = {}
         for table, name, _, _, kinds in solver.outputs:
@@ -723,11 +723,11 @@ def _compiled(scene: Scene, solver: _Solver) -> Any:
 def _compiled_array(solver: _Solver) -> Any:
     """Return the scene's compiled array path once it is worth it, else None or False.
 
-    See :mod:`.compiled`: compiled after :data:`.compiled.COMPILE_AFTER`
+    See :mod:`.compiled`: compiled after :data:`.compiled.ARRAY_COMPILE_AFTER`
     array solves, False where the scene does not compile.
     """
     solver.array_solves += 1
-    if solver.array_solves < COMPILE_AFTER:
+    if solver.array_solves < ARRAY_COMPILE_AFTER:
         return None
     solver.compiled_array = compile_array(solver.scene) or False
     return solver.compiled_array

@@ -78,7 +78,6 @@ from __future__ import annotations
 import ast
 from collections import Counter
 from collections.abc import Callable, Sequence
-import copy
 import functools
 import inspect
 import itertools
@@ -798,9 +797,8 @@ def propagate(body: list[ast.stmt], namespace: dict[str, Any], live: set[str],
         if len(pruned) == len(out) and all(
                 a is b for a, b in zip(pruned, out, strict=True)):
             if vector:
-                ufuncs = _Ufuncs(_Arrays(pruned, namespace), namespace)
-                # (on copies: the kinds are read from the statements as they were)
-                pruned = [cast(ast.stmt, ufuncs.visit(copy.deepcopy(stmt))) for stmt in pruned]
+                ufuncs = _Ufuncs(_Arrays(pruned, namespace), namespace, pruned)
+                pruned = [cast(ast.stmt, ufuncs.visit(stmt)) for stmt in pruned]
             return pruned
         out = pruned
 
@@ -1127,9 +1125,28 @@ class _Ufuncs(ast.NodeTransformer):
     BINARY = {ast.Add: 'add', ast.Sub: 'subtract', ast.Mult: 'multiply', ast.Div: 'true_divide'}
     ORDER = {ast.Lt: 'less', ast.LtE: 'less_equal', ast.Gt: 'greater', ast.GtE: 'greater_equal'}
 
-    def __init__(self, arrays: _Arrays, namespace: dict[str, Any]) -> None:
-        self.arrays = arrays
+    def __init__(self, arrays: _Arrays, namespace: dict[str, Any],
+                 body: list[ast.stmt]) -> None:
         self.namespace = namespace
+        # The operations to rewrite, judged on the whole body before any is rewritten
+        # (the kinds are read from the statements as they are).
+        self.marked = {id(node) for stmt in body for node in ast.walk(stmt)
+                       if self.on_array(node, arrays)}
+
+    def on_array(self, node: ast.AST, arrays: _Arrays) -> bool:
+        """Return whether ``node`` is an operation to call NumPy's function for."""
+        if isinstance(node, ast.BinOp):
+            return type(node.op) in self.BINARY and arrays.of(node) == ARRAY
+        if isinstance(node, ast.Compare):
+            return (len(node.ops) == 1 and type(node.ops[0]) in self.ORDER
+                    and ARRAY in (arrays.of(node.left), arrays.of(node.comparators[0])))
+        if isinstance(node, ast.UnaryOp):
+            return isinstance(node.op, ast.USub) and arrays.of(node.operand) == ARRAY
+        if isinstance(node, ast.Call):
+            return (isinstance(node.func, ast.Name) and node.func.id == 'abs'
+                    and 'abs' not in self.namespace and len(node.args) == 1
+                    and not node.keywords and arrays.of(node.args[0]) == ARRAY)
+        return False
 
     def function(self, name: str, node: ast.expr, args: list[ast.expr]) -> ast.expr:
         local = f'_np_{name}'
@@ -1137,30 +1154,23 @@ class _Ufuncs(ast.NodeTransformer):
         return ast.copy_location(ast.Call(ast.Name(local, ast.Load()), args, []), node)
 
     def visit_BinOp(self, node: ast.BinOp) -> ast.AST:
-        array = self.arrays.of(node) == ARRAY     # judged before its operands are rewritten
         self.generic_visit(node)
-        name = self.BINARY.get(type(node.op))
-        if name is None or not array:
+        if id(node) not in self.marked:
             return node
-        return self.function(name, node, [node.left, node.right])
+        return self.function(self.BINARY[type(node.op)], node, [node.left, node.right])
 
     def visit_Compare(self, node: ast.Compare) -> ast.AST:
-        array = len(node.ops) == 1 and ARRAY in (self.arrays.of(node.left),
-                                                 self.arrays.of(node.comparators[0]))
         self.generic_visit(node)
-        name = self.ORDER.get(type(node.ops[0]))
-        if name is None or not array:
+        if id(node) not in self.marked:
             return node
-        return self.function(name, node, [node.left, node.comparators[0]])
+        return self.function(self.ORDER[type(node.ops[0])], node,
+                             [node.left, node.comparators[0]])
 
     def visit_UnaryOp(self, node: ast.UnaryOp) -> ast.AST:
-        array = isinstance(node.op, ast.USub) and self.arrays.of(node.operand) == ARRAY
         self.generic_visit(node)
-        return self.function('negative', node, [node.operand]) if array else node
+        return self.function('negative', node, [node.operand]) if id(node) in self.marked \
+            else node
 
     def visit_Call(self, node: ast.Call) -> ast.AST:
-        array = (isinstance(node.func, ast.Name) and node.func.id == 'abs'
-                 and 'abs' not in self.namespace and len(node.args) == 1 and not node.keywords
-                 and self.arrays.of(node.args[0]) == ARRAY)
         self.generic_visit(node)
-        return self.function('absolute', node, node.args) if array else node
+        return self.function('absolute', node, node.args) if id(node) in self.marked else node

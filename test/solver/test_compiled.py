@@ -17,8 +17,8 @@ import pytest
 
 import mech_kinematics as mk
 from mech_kinematics.solver import compiled as compiled_module
-from mech_kinematics.solver.compiled import (COMPILE_AFTER, compile_array, compile_single,
-                                             LARGE_BATCH)
+from mech_kinematics.solver.compiled import (ARRAY_COMPILE_AFTER, COMPILE_AFTER, compile_array,
+                                             compile_single, LARGE_BATCH)
 from mech_kinematics.tools.report.common import MODES
 from mech_kinematics.tools.report.extreme import extreme_cases
 
@@ -138,6 +138,11 @@ def test_a_scene_is_compiled_after_its_first_single_angle_solves():
     assert callable(scene._solver.compiled_single)
     mk.solve(scene, np.linspace(0.0, 1.0, 5))       # the array path counts apart
     assert callable(scene._solver.compiled_single) and scene._solver.compiled_array is None
+    for _ in range(ARRAY_COMPILE_AFTER - 2):
+        mk.solve(scene, np.linspace(0.0, 1.0, 5))
+        assert scene._solver.compiled_array is None
+    mk.solve(scene, np.linspace(0.0, 1.0, 5))
+    assert callable(scene._solver.compiled_array)
 
 
 def test_a_held_state_is_not_changed_by_later_solves():
