@@ -47,8 +47,8 @@ __all__ = ['ARRAY_COMPILE_AFTER', 'ArrayFunction', 'COMPILE_AFTER', 'KEEP_FREED'
            'SingleFunction', 'compile_array', 'compile_single', 'keep_freed_memory']
 
 #: Single-angle solves of one scene on the general path before it is compiled: a
-#: compilation (constants folded, 15-35 ms for a packaged scene) costs about as much as
-#: a few thousand single-angle solves, so a scene solved a few hundred times or less
+#: compilation (constants folded) costs about as much as a few thousand single-angle
+#: solves, so a scene solved a few hundred times or less
 #: (most scenes a test builds) is never compiled.
 COMPILE_AFTER = 256
 #: Array solves of one scene before its array path is compiled: an array solve costs
