@@ -753,17 +753,8 @@ def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any,
            given: tuple[Any, ...] = ()) -> State:
     vector = ctx.vector
     plan = solver.plan
-    joints = {}
-    for name, kind in plan.joint_types.items():
-        if kind == 'revolute':
-            e, w, al = ctx.links[name][:3]
-            joints[name] = JointMotion(kind, _angle(e, vector), w, al)
-        else:
-            joints[name] = JointMotion(kind, *ctx.sliders[name][:3])
     table = ctx.points
-    points = {name: table[name][:3] for name in plan.output_points}
     measures = ctx.measures
-    bound = ErrorBound(_table_bounds, (plan, ctx), solver.size, solver.crank_length, floors)
     if vector:
         shape = theta.shape
         bad = None if ctx.valid is True or valid.all() else ~valid
@@ -790,10 +781,29 @@ def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any,
                 x[bad] = np.nan
                 return x
 
-        for name, joint in joints.items():
-            joints[name] = JointMotion(joint.type, finish(joint.position),
-                                       finish(joint.velocity), finish(joint.acceleration))
-        points = {name: (finish(p), finish(v), finish(a)) for name, (p, v, a) in points.items()}
+        joints = {}
+        for name, kind in plan.joint_types.items():
+            if kind == 'revolute':
+                e, w, al = ctx.links[name][:3]
+                joints[name] = JointMotion(kind, finish(_angle(e, True)), finish(w),
+                                           finish(al))
+            else:
+                x, v, a = ctx.sliders[name][:3]
+                joints[name] = JointMotion(kind, finish(x), finish(v), finish(a))
+        points = {}
+        for name in plan.output_points:
+            entry = table[name]
+            # A ground point's entry is the same tuple every solve: its views, made once.
+            known = constant.entries.get(id(entry)) if bad is None else None
+            if known is not None and known[0] is entry:
+                points[name] = known[1]
+            else:
+                points[name] = (finish(entry[0]), finish(entry[1]), finish(entry[2]))
+                if bad is None and entry[0].__class__ is not np.ndarray \
+                        and entry[1].__class__ is not np.ndarray \
+                        and entry[2].__class__ is not np.ndarray \
+                        and len(constant.entries) < 64:
+                    constant.entries[id(entry)] = (entry, points[name])
         measures = {key: finish(m) for key, m in measures.items()}
         if bad is None:     # nothing to write NaN into: finished when first read
             bound = ErrorBound(_finished_bounds, (plan, ctx, finish), solver.size,
@@ -809,6 +819,15 @@ def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any,
                                      finish(joint.velocity), finish(joint.acceleration))
                    for name, joint in drivers.items()}
     else:
+        joints = {}
+        for name, kind in plan.joint_types.items():
+            if kind == 'revolute':
+                e, w, al = ctx.links[name][:3]
+                joints[name] = JointMotion(kind, _wrapped_angle(e), w, al)
+            else:
+                joints[name] = JointMotion(kind, *ctx.sliders[name][:3])
+        points = {name: table[name][:3] for name in plan.output_points}
+        bound = ErrorBound(_table_bounds, (plan, ctx), solver.size, solver.crank_length, floors)
         rubbing = intermittent = {}
         if ctx.rubbing:
             rubbing = {name: value for name, (value, _) in ctx.rubbing.items()}
@@ -859,7 +878,7 @@ class _Constants:
     equality, which would take -0.0 for 0.0).
     """
 
-    __slots__ = ('shape', 'known', 'seen')
+    __slots__ = ('shape', 'known', 'seen', 'entries')
 
     def __init__(self, solver: _Solver, shape: tuple[int, ...]) -> None:
         self.shape = shape
@@ -867,6 +886,8 @@ class _Constants:
         self.known = {id(x): (x, _constant(x, shape)) for entry in solver.ground.values()
                       for x in entry}
         self.seen: dict[tuple[str, bytes], Any] = {}
+        # A point's (value, velocity, acceleration) of constants, by the entry's identity.
+        self.entries: dict[int, tuple[Any, Any]] = {}
 
     def __call__(self, x: Any) -> Any:
         """Return ``x`` (a number or a 0-d array) as a read-only array of the shape."""
