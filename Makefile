@@ -1,7 +1,7 @@
 # mech_kinematics: set-up, run and test with a local virtualenv.
 #
 #   make run       start the node on the default scene (ARGS='...' appends arguments)
-#   make test      the whole test suite (PYTEST_ARGS='-k scene' narrows it)
+#   make test      the whole test suite, two workers (PYTEST_ARGS='-k scene' narrows it)
 #   make bench     solver benchmark (ARGS='--peer pylinkage': side by side with pylinkage)
 #   make lint      ruff + flake8 + mypy --strict on the pure modules
 #   make install   set up .venv with everything (what run, test and lint need)
@@ -71,7 +71,7 @@ run: $(TF2_STAMP)
 	PYTHONUNBUFFERED=1 $(VPY) -m mech_kinematics run $(ARGS)
 
 test: $(TF2_STAMP) $(DEV_STAMP)
-	$(VPY) -m pytest -q --durations=10 $(PYTEST_ARGS)
+	$(VPY) -m pytest -q -n 2 --dist loadfile --durations=10 $(PYTEST_ARGS)
 
 bench: $(TF2_STAMP)
 	$(VPY) -m mech_kinematics bench $(ARGS)

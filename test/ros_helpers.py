@@ -31,8 +31,13 @@ NS = 1_000_000_000
 STARTUP_S = 20.0       # deadline for a node to come up and be discovered
 RELIABLE = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
 
-# A domain of this test session's own (set before rclpy.init, inherited by the nodes).
-os.environ['ROS_DOMAIN_ID'] = str(random.SystemRandom().randint(1, 100))
+# A domain of this test session's own (set before rclpy.init, inherited by the nodes);
+# with pytest-xdist (`make test` runs two workers) each worker's differs from the others'.
+_WORKER = os.environ.get('PYTEST_XDIST_WORKER', 'gw0')
+_WORKERS = int(os.environ.get('PYTEST_XDIST_WORKER_COUNT', '1'))
+os.environ['ROS_DOMAIN_ID'] = str(
+    1 + random.SystemRandom().randrange(100 // _WORKERS) * _WORKERS
+    + int(_WORKER[2:] if _WORKER[2:].isdigit() else 0) % _WORKERS)
 os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
 # Only 100 domains: every node here also runs in a namespace of this session's own, so
 # that another session that drew the same domain cannot mix its messages into ours.
