@@ -5,3 +5,28 @@
 The shared helpers (``helpers``, ``ros_helpers``) live here, in ``test/``; this
 file being here puts ``test/`` on ``sys.path`` for the test modules below it.
 """
+
+from pathlib import Path
+
+import pytest
+
+_HERE = Path(__file__).resolve().parent
+#: Test files outside test/ros/ that run the node or a browser against the clock.
+SERIAL_FILES = ('tools/test_bag_recorder.py', 'tools/test_view.py')
+
+
+def pytest_collection_modifyitems(config, items):
+    """Mark the tests that time the node (test/ros/, the recorder, the browser) ``serial``.
+
+    ``make test`` runs the other tests on two workers, then these alone in one
+    process: a node publishing at 1 kHz beside a worker's CPU-bound tests on a
+    2-core machine misses its deadlines.
+    """
+    for item in items:
+        path = Path(str(item.fspath)).resolve()
+        try:
+            relative = path.relative_to(_HERE).as_posix()
+        except ValueError:
+            continue
+        if relative.startswith('ros/') or relative in SERIAL_FILES:
+            item.add_marker(pytest.mark.serial)
