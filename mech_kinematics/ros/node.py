@@ -1135,8 +1135,11 @@ def main(args: list[str] | None = None) -> int:
         get_logger(exc.logger_name).fatal(f'cannot start: {exc.reason}')
         status = 1
     except Exception as exc:     # noqa: BLE001 - a start-up failure: one line, no traceback
-        logger.fatal(f'cannot start: {_one_line(exc)}')
-        status = 1
+        if rclpy.ok():
+            logger.fatal(f'cannot start: {_one_line(exc)}')
+            status = 1
+        # else a signal shut the context down while the node started (rclpy's own
+        # handler): what failed then is the shutdown asked for, a clean exit, status 0
     finally:
         if node is not None:
             node.destroy_node()

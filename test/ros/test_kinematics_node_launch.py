@@ -520,6 +520,40 @@ def test_signal_exits_zero_within_a_second(ros, tmp_path, sig):
     assert took < 1.0
 
 
+SIGNAL_BEFORE_SPIN = """\
+import sys
+import rclpy
+import rclpy.executors
+import mech_kinematics.ros.node as kn
+native = rclpy.executors._rclpy
+class Late:
+    def __getattr__(self, name):
+        return getattr(native, name)
+    def WaitSet(self, *args):
+        rclpy.shutdown()    # as rclpy's SIGTERM handler does, just before the wait set is made
+        return native.WaitSet(*args)
+rclpy.executors._rclpy = Late()
+sys.exit(kn.main())
+"""
+
+
+def test_a_signal_while_the_node_starts_is_a_clean_exit(tmp_path):
+    """SIGTERM between the first tick and the executor's first wait: status 0, no FATAL.
+
+    rclpy's signal handler shuts the context down; the executor then fails to
+    make its wait set ("the given context is not valid"), which the node used to
+    report as "cannot start" with status 1.
+    """
+    env = dict(os.environ)
+    env['PYTHONPATH'] = os.pathsep.join(filter(None, [str(REPO), env.get('PYTHONPATH')]))
+    result = subprocess.run(
+        [sys.executable, '-c', SIGNAL_BEFORE_SPIN, '--ros-args', '-r',
+         f'__ns:={SESSION}/signal_before_spin'],
+        env=env, capture_output=True, text=True, timeout=STARTUP_S, cwd=tmp_path)
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert 'FATAL' not in result.stderr and 'Traceback' not in result.stderr, result.stderr
+
+
 FAILING_TICK = """\
 import sys
 import mech_kinematics.ros.node as kn

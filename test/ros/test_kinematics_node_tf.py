@@ -154,7 +154,8 @@ def test_robot_description_and_scene_reach_a_late_subscriber(ros, tmp_path):
         description = ros.collect(String, f'{ns}/robot_description', latched)
         scene_text = ros.collect(String, f'{ns}/scene', latched)
         static = ros.collect(TFMessage, f'{ns}/tf_static', latched)
-        wait_for(lambda: description and scene_text and static, 5.0,
+        # (three new subscriptions to discover: the start-up deadline, as for any discovery)
+        wait_for(lambda: description and scene_text and static, STARTUP_S,
                  'robot_description, scene and /tf_static')
     finally:
         status, _ = proc.stop(signal.SIGINT)
