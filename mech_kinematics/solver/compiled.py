@@ -35,7 +35,7 @@ from collections.abc import Callable
 import ctypes
 import os
 import platform
-from typing import Any, TYPE_CHECKING
+from typing import Any, cast, TYPE_CHECKING
 
 from .specialize import plan_body, propagate, TABLES, Unsupported
 from .state import JointMotion
@@ -149,7 +149,19 @@ def compile_single(scene: Scene) -> SingleFunction | None:
     return single
 
 
-def compile_array(scene: Scene) -> ArrayFunction | None:
+class _ScalarRates(ast.NodeTransformer):
+    """``omega.ndim`` and ``alpha.ndim`` as 0: the rates are numbers (:func:`compile_array`)."""
+
+    def visit_Attribute(self, node: ast.Attribute) -> ast.AST:
+        self.generic_visit(node)
+        if (node.attr == 'ndim' and isinstance(node.value, ast.Name)
+                and node.value.id in ('omega', 'alpha')):
+            return ast.copy_location(ast.Constant(0), node)
+        return node
+
+
+def compile_array(scene: Scene, rates: tuple[float, float] | None = None
+                  ) -> ArrayFunction | None:
     """Return the steps of ``scene``'s array path as one straight-line function, or ``None``.
 
     The function ``array(theta, omega, alpha, turns, ctx)`` does what running
@@ -159,6 +171,12 @@ def compile_array(scene: Scene) -> ArrayFunction | None:
     them; it masks and records failures on ``ctx`` as the steps do, and leaves
     every value in ``ctx``'s tables. ``None`` for the scenes
     :func:`compile_single` leaves out.
+
+    With ``rates`` (the crank's speed and acceleration, floats: the scene's
+    own, :func:`.solve.solve`'s usual array call), the function is for those
+    rates alone: it ignores its ``omega`` and ``alpha`` (the same values as
+    0-d arrays) and folds what they make into constants, the same numbers
+    (a product of two floats is the same as of two 0-d arrays of them).
     """
     from . import tick as hooks     # the tick's hooks import the solve this serves
 
@@ -171,6 +189,12 @@ def compile_array(scene: Scene) -> ArrayFunction | None:
         body = plan_body(plan, names, namespace, vector=True, propagated=False)
     except Unsupported:
         return None
+    parameters = ('theta', 'omega', 'alpha', 'turns', 'ctx')
+    if rates is not None:
+        speed, accel = (float(x) for x in rates)
+        parameters = ('theta', '_omega', '_alpha', 'turns', 'ctx')
+        body = [*ast.parse(f'omega = {speed!r}\nalpha = {accel!r}').body,
+                *(cast(ast.stmt, _ScalarRates().visit(stmt)) for stmt in body)]
     tables: dict[str, list[str]] = {prefix: [] for prefix in TABLES.values()}
     for key, local in names.items():
         prefix, name = key.split('_', 1)
@@ -193,8 +217,7 @@ def compile_array(scene: Scene) -> ArrayFunction | None:
     lines.append(f'ctx.sums = ({tuple(sums)!r}, _sums)')
     function = ast.FunctionDef(
         name='array', args=ast.arguments(
-            posonlyargs=[], args=[ast.arg(a) for a in ('theta', 'omega', 'alpha', 'turns',
-                                                       'ctx')],
+            posonlyargs=[], args=[ast.arg(a) for a in parameters],
             kwonlyargs=[], kw_defaults=[], defaults=[]),
         body=propagate(body + ast.parse('\n'.join(lines)).body, namespace, set()),
         decorator_list=[], returns=None)

@@ -113,6 +113,10 @@ class _Solver:
         self.single_solves = 0
         # Likewise the compiled array path, and the scene both compile from.
         self.compiled_array: Any = None
+        # The array path compiled for the scene's own rates (solve._compile_usual), with the
+        # floors of those rates.
+        self.compiled_usual: Any = None
+        self.usual_floors: Any = None
         self.array_solves = 0
         self.scene = scene
         # Per array shape, the ground points' values as read-only arrays (solve._state).

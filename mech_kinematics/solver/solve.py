@@ -421,10 +421,18 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
         theta = _read_only(theta, shape, constant)
         whole = constant(_NO_TURNS) if not some else _read_only(
             np.asarray(whole, dtype=np.int64), shape, constant)
+        usual = solver.compiled_usual if speed is solver.default_arrays[0] \
+            and accel is solver.default_arrays[1] else None
         with np.errstate(all='ignore'):
-            # A constant speed or acceleration stays a scalar through the steps.
-            ctx = _execute(solver, theta, omega, alpha, whole)
-            _judge(solver, ctx, _crank_floors(solver.crank_length, omega, alpha), tol, shape)
+            if usual:   # compiled for the scene's own rates
+                ctx = _Context(theta, True, whole)
+                usual(theta, omega, alpha, whole, ctx)
+                floors = solver.usual_floors
+            else:
+                # A constant speed or acceleration stays a scalar through the steps.
+                ctx = _execute(solver, theta, omega, alpha, whole)
+                floors = _crank_floors(solver.crank_length, omega, alpha)
+            _judge(solver, ctx, floors, tol, shape)
         omega, alpha = _read_only(omega, shape, constant), _read_only(alpha, shape, constant)
         valid = (np.ones(shape, dtype=bool) if ctx.valid is True
                  else np.broadcast_to(np.asarray(ctx.valid, dtype=bool), shape).copy())
@@ -730,7 +738,21 @@ def _compiled_array(solver: _Solver) -> Any:
     if solver.array_solves < ARRAY_COMPILE_AFTER:
         return None
     solver.compiled_array = compile_array(solver.scene) or False
+    solver.compiled_usual = _compile_usual(solver) if solver.compiled_array else False
     return solver.compiled_array
+
+
+def _compile_usual(solver: _Solver) -> Any:
+    """Return the scene's array path compiled for its own rates (the usual call), or False.
+
+    False where those rates are solved with time rescaled (:func:`_execute`),
+    which the compiled function does not do. Sets ``solver.usual_floors``.
+    """
+    omega, alpha = solver.default_arrays
+    if _rate_exponent(omega, alpha) or solver.shift:
+        return False
+    solver.usual_floors = _crank_floors(solver.crank_length, omega, alpha)
+    return compile_array(solver.scene, solver.defaults) or False
 
 
 def _warn_near_singular(measures: dict[str, Any], vector: bool, valid: Any) -> None:

@@ -684,12 +684,18 @@ def _substituted(body: list[ast.stmt], namespace: dict[str, Any], counts: dict[s
             else entry.id not in namespace)
 
     out: list[ast.stmt] = []
-    for stmt in body:
+    pending = list(reversed(body))
+    while pending:
+        stmt = pending.pop()
         if (isinstance(stmt, ast.Assign) and isinstance(stmt.value, ast.Name)
                 and stmt.value.id.startswith('_ground_') and stmt.value.id not in counts
                 and _is_constant(namespace.get(stmt.value.id))):
             stmt.value = ast.copy_location(ast.Constant(namespace[stmt.value.id]), stmt.value)
-        stmt = cast(ast.stmt, propagator.visit(stmt))
+        visited = propagator.visit(stmt)
+        if isinstance(visited, list):       # an ``if`` whose test folded: its branch's
+            pending.extend(reversed(visited))   # statements, in turn (visited again: the same)
+            continue
+        stmt = cast(ast.stmt, visited)
         if isinstance(stmt, ast.Pass):
             continue
         if (isinstance(stmt, ast.Assign) and isinstance(stmt.value, ast.Name)

@@ -7,6 +7,7 @@ enough (``solver/compiled.py``, issue 19's "bounds that cost little"): its
 states, bounds, warnings and refusals must be the general path's exactly.
 """
 
+import importlib
 import math
 import sys
 import warnings
@@ -22,6 +23,9 @@ from mech_kinematics.solver.compiled import (ARRAY_COMPILE_AFTER, COMPILE_AFTER,
 from mech_kinematics.tools.report.common import MODES
 from mech_kinematics.tools.report.extreme import extreme_cases
 
+#: The module (``mech_kinematics.solver.solve`` is also the name of its function).
+solve_module = importlib.import_module('mech_kinematics.solver.solve')
+
 #: Crank angles over two turns and a bit, both signs.
 ANGLES = np.linspace(-7.0, 7.0, 141)
 TOLERANCES = (1e-6, 1e-12, math.inf)
@@ -32,6 +36,7 @@ def _pair(scene_of):
     fast, slow = scene_of(), general_only(scene_of())
     fast._solver.compiled_single = compile_single(fast)
     fast._solver.compiled_array = compile_array(fast)
+    fast._solver.compiled_usual = solve_module._compile_usual(fast._solver)
     return fast, slow
 
 
@@ -97,6 +102,8 @@ def test_every_packaged_scene_solves_arrays_alike_compiled(name):
     fast, slow = _pair(lambda: mk.load_scene(name))
     if name != 'geneva':
         assert fast._solver.compiled_array, f'{name} does not compile'
+        # ({} below: the usual call, at the scene's own rates, compiled for them)
+        assert fast._solver.compiled_usual, f'{name} has no compiled usual call'
     speeds = np.linspace(-20.0, 30.0, ANGLES.size)
     for kwargs in ({}, {'speed': speeds}, {'speed': 3.0, 'accel': speeds},
                    {'turns': np.arange(ANGLES.size) % 3}, {'max_error': 1e-12},
@@ -117,6 +124,8 @@ def test_the_extreme_suite_solves_arrays_alike():
         speed = case.speed if case.speed is not None else case.scene.input.speed
         angles = np.asarray(case.angles, dtype=float)
         assert _array_outcome(fast, angles, speed) == _array_outcome(slow, angles, speed)
+        if case.speed is None:      # at the scene's own rates: the usual call's compiled path
+            assert _array_outcome(fast, angles) == _array_outcome(slow, angles), case.name
 
 
 @pytest.mark.parametrize('angle', [np.float64(1.25), np.float32(1.25), 1, np.int64(-2)])
