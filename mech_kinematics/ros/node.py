@@ -1064,6 +1064,10 @@ class DuplicateNodeError(Exception):
     """An older node of the same fully qualified name is running: this one is the newcomer."""
 
 
+#: How many nodes' words on ``~/_instance`` a node keeps until its first spin reads them.
+INSTANCE_HISTORY = 100
+
+
 class Instance:
     """A node's start instant and random id, said on and heard from ``~/_instance``.
 
@@ -1077,7 +1081,11 @@ class Instance:
         self.key = start_ns, random.SystemRandom().getrandbits(64)
         qos = QoSProfile(depth=1, reliability=QoSReliabilityPolicy.RELIABLE,
                          durability=QoSDurabilityPolicy.TRANSIENT_LOCAL)
-        node.create_subscription(String, INSTANCE_TOPIC, self._heard, qos)
+        # The node hears its own word too, and all of them may arrive before its first
+        # spin (a slow start): a history of one would keep only the last, maybe its own.
+        heard = QoSProfile(depth=INSTANCE_HISTORY, reliability=QoSReliabilityPolicy.RELIABLE,
+                           durability=QoSDurabilityPolicy.TRANSIENT_LOCAL)
+        node.create_subscription(String, INSTANCE_TOPIC, self._heard, heard)
         node.create_publisher(String, INSTANCE_TOPIC, qos).publish(
             String(data=f'{self.key[0]} {self.key[1]}'))
 

@@ -178,8 +178,13 @@ def test_of_two_nodes_started_together_exactly_one_goes_on(ros, tmp_path):
     js = ros.collect(JointState, f'{ns}/joint_states', LATCHED)
     procs = [_node(tmp_path / 'a', ns), _node(tmp_path / 'b', ns)]
     try:
-        wait_for(lambda: any(p.proc.poll() is not None for p in procs), STARTUP_S,
-                 'one of the two nodes exiting')
+        try:
+            wait_for(lambda: any(p.proc.poll() is not None for p in procs), STARTUP_S,
+                     'one of the two nodes exiting')
+        except BaseException:
+            for p in procs:
+                p.proc.send_signal(signal.SIGINT)
+            pytest.fail(f'neither node exited: {[p.output() for p in procs]}')
         time.sleep(1.0)
         gone = [p for p in procs if p.proc.poll() is not None]
         assert len(gone) == 1, [p.output() for p in procs]
