@@ -65,6 +65,21 @@ def wait_for(predicate, timeout: float, what: str):
     pytest.fail(f'timed out after {timeout} s waiting for {what}')
 
 
+def exited(proc: 'NodeProcess') -> tuple[int, str]:
+    """Return a node's exit status and output, waited for up to STARTUP_S (killed after)."""
+    try:
+        status = proc.proc.wait(timeout=STARTUP_S)
+    finally:
+        if proc.proc.poll() is None:
+            proc.proc.kill()
+    return status, proc.output()
+
+
+def cannot_start(output: str) -> list[str]:
+    """Return the lines of a node's output that say it cannot start."""
+    return [line for line in output.splitlines() if 'cannot start' in line]
+
+
 def wait_for_parameters(params, timeout: float = STARTUP_S) -> None:
     """Wait until a node answers ``params`` (an AsyncParameterClient) on its services.
 

@@ -273,14 +273,15 @@ def _within(solver: _Solver, ctx: _Context, lims: dict[str, float]) -> bool:
     return all(bool(largest(bound, axis=None) <= lim) for _, bound in ctx.rubbing.values())
 
 
-def _angle(e: Any, vector: bool) -> Any:
-    """Angle of unit complex ``e``, wrapped to (-pi, pi]."""
-    if vector:
-        theta = np.arctan2(e.imag, e.real)
-        if np.fmin.reduce(theta, axis=None) == -np.pi:    # the least, NaN left out
-            theta[theta == -np.pi] = np.pi
-        return theta
-    return _wrapped_angle(e)
+def _angles(e: Any) -> Any:
+    """Angles of an array of unit complex numbers ``e``, wrapped to (-pi, pi].
+
+    The array path's :func:`_wrapped_angle`.
+    """
+    theta = np.arctan2(e.imag, e.real)
+    if np.fmin.reduce(theta, axis=None) == -np.pi:    # the least, NaN left out
+        theta[theta == -np.pi] = np.pi
+    return theta
 
 
 def _wrapped_angle(e: complex) -> float:
@@ -783,13 +784,10 @@ def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any,
         inputs = (id(theta), id(omega), id(alpha), *map(id, given))
 
         constant = _constants(solver, shape)
-        ndarray = np.ndarray
         if bad is None:
             def finish(x: Any) -> Any:
                 # An array of the shape is the state's own, unless it is the caller's
                 # input (a copy then); a constant becomes a read-only broadcast view.
-                if x.__class__ is ndarray and x.shape == shape:
-                    return np.array(x) if id(x) in inputs else x
                 if getattr(x, 'shape', ()) == shape:
                     return np.array(x) if id(x) in inputs else x
                 return constant(x)
@@ -807,7 +805,7 @@ def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any,
         for name, kind in plan.joint_types.items():
             if kind == 'revolute':
                 e, w, al = ctx.links[name][:3]
-                joints[name] = JointMotion(kind, finish(_angle(e, True)), finish(w),
+                joints[name] = JointMotion(kind, finish(_angles(e)), finish(w),
                                            finish(al))
             else:
                 x, v, a = ctx.sliders[name][:3]

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
-from ros_helpers import (NodeProcess, NS, Ros, SESSION, stamp_ns, STARTUP_S, wait_for,
-                         wait_for_parameters, wrap)
+from ros_helpers import (cannot_start, exited, NodeProcess, NS, SESSION, stamp_ns, STARTUP_S,
+                         wait_for, wait_for_parameters, wrap)
 from sensor_msgs.msg import JointState
 from visualization_msgs.msg import MarkerArray
 
@@ -28,13 +28,6 @@ CRANK = 'crank'
 ATOL_TIMEBASE = 1e-9
 #: The published state against the general solver at the published drivers (rad, rad/s).
 ATOL_STATE = 1e-9
-
-
-@pytest.fixture(scope='module')
-def ros():
-    ros = Ros()
-    yield ros
-    ros.close()
 
 
 class Node:
@@ -96,13 +89,8 @@ def test_both_names_given_different_values_is_one_line_and_exit_1(tmp_path):
     """-p crank_speed_rpm:=30 -p inputs.crank.speed_rpm:=40: refused at start, naming both."""
     proc = NodeProcess(tmp_path, '-r', f'__ns:={SESSION}/drivers_both', '-p',
                        'crank_speed_rpm:=30.0', '-p', f'inputs.{CRANK}.speed_rpm:=40.0')
-    try:
-        status = proc.proc.wait(timeout=STARTUP_S)
-    finally:
-        if proc.proc.poll() is None:
-            proc.proc.kill()
-    output = proc.output()
-    fatal = [line for line in output.splitlines() if 'cannot start' in line]
+    status, output = exited(proc)
+    fatal = cannot_start(output)
     assert status == 1 and len(fatal) == 1, output
     assert (f'crank_speed_rpm and inputs.{CRANK}.speed_rpm are the same value: expected one of '
             'them or equal values, got 30.0 and 40.0') in fatal[0]
@@ -199,13 +187,8 @@ def test_excavator_at_a_stroke_end_refuses_to_start_moving_out(tmp_path):
     path.write_text(text)
     proc = NodeProcess(tmp_path, '-r', f'__ns:={SESSION}/drivers_out', '-p', f'scene:={path}',
                        '-p', 'inputs.boom_cyl.speed:=0.1')
-    try:
-        status = proc.proc.wait(timeout=STARTUP_S)
-    finally:
-        if proc.proc.poll() is None:
-            proc.proc.kill()
-    output = proc.output()
-    fatal = [line for line in output.splitlines() if 'cannot start' in line]
+    status, output = exited(proc)
+    fatal = cannot_start(output)
     assert status == 1 and len(fatal) == 1, output
     assert 'keeps actuator boom_cyl within its stroke [2, 3.3] m' in fatal[0]
 

@@ -13,7 +13,6 @@ import signal
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray
-import pytest
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 from ros_helpers import (NodeProcess, NS, Ros, SESSION, stamp_ns, STARTUP_S, wait_for,
@@ -22,13 +21,6 @@ from sensor_msgs.msg import JointState
 
 #: Largest jump of the published crank angle allowed across a drive change, rad.
 ATOL_CONTINUITY = 1e-9
-
-
-@pytest.fixture(scope='module')
-def ros():
-    ros = Ros()
-    yield ros
-    ros.close()
 
 
 def diagnostic_value(msgs, key):

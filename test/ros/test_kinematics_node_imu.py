@@ -16,7 +16,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-from ros_helpers import NodeProcess, Ros, SESSION, stamp_ns, STARTUP_S, wait_for
+from ros_helpers import NodeProcess, SESSION, stamp_ns, STARTUP_S, wait_for
 from sensor_msgs.msg import Imu, JointState
 from std_msgs.msg import String
 from tf2_msgs.msg import TFMessage    # built by make install (scripts/build_tf2_msgs.py)
@@ -42,13 +42,6 @@ SCENE = {
     'imus': {'tip': {'link': 'coupler', 'point': 'E', 'gravity': [0, -9.80665], 'angle': 30},
              'arm': {'link': 'rocker', 'point': 'C', 'gravity': [0, -9.80665]}},
 }
-
-
-@pytest.fixture(scope='module')
-def ros():
-    ros = Ros()
-    yield ros
-    ros.close()
 
 
 def test_imu_topics_carry_the_readings_solve_prints(ros, tmp_path):

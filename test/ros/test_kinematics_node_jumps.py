@@ -17,7 +17,7 @@ import signal
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 import pytest
-from ros_helpers import NodeProcess, NS, Ros, SESSION, stamp_ns, STARTUP_S, wait_for
+from ros_helpers import NodeProcess, NS, SESSION, stamp_ns, STARTUP_S, wait_for
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
@@ -30,13 +30,6 @@ STEP_NS = 20 * PERIOD_NS        # the simulated clock advances by 20 ticks at a 
 SPAN_NS = 4 * NS                # at least 4 s of simulated time
 #: Published crank angles this close to 135 or 225 deg (mod 360) are engagement instants, rad.
 ATOL_INSTANT = 1e-9
-
-
-@pytest.fixture(scope='module')
-def ros():
-    ros = Ros()
-    yield ros
-    ros.close()
 
 
 def _decode(raw, msg_type):

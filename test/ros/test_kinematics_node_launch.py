@@ -46,13 +46,6 @@ FRAME_ID = 'test_frame'
 SCENE = mk.load_scene(mk.DEFAULT_SCENE)
 
 
-@pytest.fixture(scope='module')
-def ros():
-    ros = Ros()
-    yield ros
-    ros.close()
-
-
 class Running:
     """The shared node and what this process has received from it."""
 

@@ -18,28 +18,12 @@ import pytest
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 from rclpy.qos import QoSProfile, ReliabilityPolicy
-from ros_helpers import (NodeProcess, NS, Ros, SESSION, stamp_ns, STARTUP_S, wait_for,
-                         wait_for_parameters, wrap)
+from ros_helpers import (cannot_start, exited, NodeProcess, NS, Ros, SESSION, stamp_ns, STARTUP_S,
+                         wait_for, wait_for_parameters, wrap)
 from sensor_msgs.msg import JointState
 
 #: Tolerance of an angle that the time base fixes exactly, rad.
 ATOL_TIMEBASE = 1e-9
-
-
-@pytest.fixture(scope='module')
-def ros():
-    ros = Ros()
-    yield ros
-    ros.close()
-
-
-def _exited(proc: NodeProcess) -> tuple[int, str]:
-    try:
-        status = proc.proc.wait(timeout=STARTUP_S)
-    finally:
-        if proc.proc.poll() is None:
-            proc.proc.kill()
-    return status, proc.output()
 
 
 @pytest.mark.parametrize('args, words', [
@@ -57,10 +41,10 @@ def test_bad_start_parameters_are_one_line_and_exit_1(tmp_path, args, words):
     """Any bad -p at start stops the node with status 1 and one line naming it. See issue 12."""
     ns = f'{SESSION}/bad_start'
     args = [a.replace('/x/', f'{ns}/') for a in args]
-    status, output = _exited(NodeProcess(tmp_path, '-r', f'__ns:={ns}', *args))
+    status, output = exited(NodeProcess(tmp_path, '-r', f'__ns:={ns}', *args))
     assert status == 1, output
     assert 'Traceback' not in output
-    fatal = [line for line in output.splitlines() if 'cannot start' in line]
+    fatal = cannot_start(output)
     assert len(fatal) == 1, output
     for word in words:
         assert word in fatal[0], output
@@ -73,7 +57,7 @@ def test_a_second_node_of_the_same_name_exits_1(ros, tmp_path):
     first = NodeProcess(tmp_path / 'first', '-r', f'__ns:={ns}')
     try:
         wait_for(lambda: js, STARTUP_S, 'the first node publishing')
-        status, output = _exited(NodeProcess(tmp_path / 'second', '-r', f'__ns:={ns}'))
+        status, output = exited(NodeProcess(tmp_path / 'second', '-r', f'__ns:={ns}'))
         assert status == 1, output
         assert f'another node named {ns}/mech_kinematics is running' in output
         count = len(js)
@@ -346,8 +330,8 @@ def test_a_bad_start_is_one_line_with_the_nodes_own_name(tmp_path, args, reason)
     ns = f'{SESSION}/one_line'
     args = [a.replace('/x/', f'{ns}/') for a in args]
     reason = reason.replace('/x/', f'{ns}/')
-    status, output = _exited(NodeProcess(tmp_path, '-r', f'__ns:={ns}', '-r', '__node:=renamed',
-                                         *args))
+    status, output = exited(NodeProcess(tmp_path, '-r', f'__ns:={ns}', '-r', '__node:=renamed',
+                                        *args))
     assert status == 1, output
     lines = output.strip().splitlines()
     assert len(lines) == 1, output

@@ -12,15 +12,8 @@ import subprocess
 import sys
 
 import pytest
-from ros_helpers import NodeProcess, REPO, Ros, SESSION, STARTUP_S, wait_for
+from ros_helpers import NodeProcess, REPO, SESSION, STARTUP_S, wait_for
 from sensor_msgs.msg import JointState
-
-
-@pytest.fixture(scope='module')
-def ros():
-    ros = Ros()
-    yield ros
-    ros.close()
 
 
 def solve_speed(*args: str) -> float:

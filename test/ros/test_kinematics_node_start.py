@@ -12,7 +12,8 @@ import time
 
 import pytest
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-from ros_helpers import NodeProcess, NS, REPO, Ros, SESSION, stamp_ns, STARTUP_S, wait_for
+from ros_helpers import (cannot_start, exited, NodeProcess, NS, REPO, SESSION, stamp_ns, STARTUP_S,
+                         wait_for)
 from sensor_msgs.msg import JointState
 from std_msgs.msg import String
 
@@ -28,13 +29,6 @@ PERIOD_NS = NS // RATE_HZ
 #: A subscriber that also receives the history a publisher made transient local.
 LATCHED = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE,
                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
-
-
-@pytest.fixture(scope='module')
-def ros():
-    ros = Ros()
-    yield ros
-    ros.close()
 
 
 class FakeNode:
@@ -113,17 +107,8 @@ def _node(tmp, ns: str) -> NodeProcess:
                        'transient_local')
 
 
-def _exited(proc: NodeProcess) -> tuple[int, str]:
-    try:
-        status = proc.proc.wait(timeout=STARTUP_S)
-    finally:
-        if proc.proc.poll() is None:
-            proc.proc.kill()
-    return status, proc.output()
-
-
 def _one_refusal(output: str, ns: str) -> None:
-    lines = [line for line in output.splitlines() if 'cannot start' in line]
+    lines = cannot_start(output)
     assert len(lines) == 1, output
     assert f'another node named {ns}/mech_kinematics is running' in lines[0], output
     assert 'Traceback' not in output
@@ -158,7 +143,7 @@ def test_the_older_node_goes_on_without_a_gap_while_newcomers_are_refused(ros, t
     try:
         wait_for(lambda: js, STARTUP_S, 'the first node publishing')
         for k in range(3):
-            status, output = _exited(_node(tmp_path / f'second{k}', ns))
+            status, output = exited(_node(tmp_path / f'second{k}', ns))
             assert status == 1, output
             _one_refusal(output, ns)
             assert first.proc.poll() is None, first.output()

@@ -16,7 +16,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-from ros_helpers import NodeProcess, Ros, SESSION, stamp_ns, STARTUP_S, wait_for
+from ros_helpers import NodeProcess, SESSION, stamp_ns, STARTUP_S, wait_for
 from sensor_msgs.msg import JointState
 from std_msgs.msg import String
 from tf2_msgs.msg import TFMessage    # built by make install (scripts/build_tf2_msgs.py)
@@ -27,13 +27,6 @@ import mech_kinematics as mk
 #: Transforms composed against the published points, m (relative to the mechanism's size).
 RTOL_FRAMES = 1e-12
 FRAME_ID = 'base'
-
-
-@pytest.fixture(scope='module')
-def ros():
-    ros = Ros()
-    yield ros
-    ros.close()
 
 
 def _apply(transform, local):

@@ -21,8 +21,8 @@ import pytest
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 from rclpy.qos import QoSProfile, ReliabilityPolicy
-from ros_helpers import (NodeProcess, NS, Ros, SESSION, stamp_ns, STARTUP_S, wait_for,
-                         wait_for_parameters)
+from ros_helpers import (cannot_start, exited, NodeProcess, NS, SESSION, stamp_ns, STARTUP_S,
+                         wait_for, wait_for_parameters)
 from sensor_msgs.msg import JointState
 from tf2_msgs.msg import TFMessage
 from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
@@ -38,13 +38,6 @@ INPUT_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
 ANSWER_S = 10.0
 #: The first stamp sent, ns (any positive instant: the node never reads its own clock here).
 T0 = 1_700_000_000 * NS
-
-
-@pytest.fixture(scope='module')
-def ros():
-    ros = Ros()
-    yield ros
-    ros.close()
 
 
 class TopicNode:
@@ -336,13 +329,8 @@ def test_an_actuator_length_outside_its_stroke_is_refused(ros, tmp_path):
 def test_a_bad_drive_at_start_is_one_line_and_exit_1(tmp_path, args, words):
     """``drive`` takes time or topic; markers (velocity arrows) are refused with topic."""
     proc = NodeProcess(tmp_path, '-r', f'__ns:={SESSION}/topic_bad_start', *args)
-    try:
-        status = proc.proc.wait(timeout=STARTUP_S)
-    finally:
-        if proc.proc.poll() is None:
-            proc.proc.kill()
-    output = proc.output()
+    status, output = exited(proc)
     assert status == 1, output
-    fatal = [line for line in output.splitlines() if 'cannot start' in line]
+    fatal = cannot_start(output)
     assert len(fatal) == 1, output
     assert all(word in fatal[0] for word in words), output

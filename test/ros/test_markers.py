@@ -196,13 +196,6 @@ def test_throttle_holds_a_fast_simulated_clock():
 # -- the running node ---------------------------------------------------------
 
 
-@pytest.fixture(scope='module')
-def ros():
-    ros = Ros()
-    yield ros
-    ros.close()
-
-
 def _publisher_types(ros: Ros, topic: str) -> list[str]:
     return [info.topic_type for info in ros.node.get_publishers_info_by_topic(topic)]
 
