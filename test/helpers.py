@@ -185,6 +185,22 @@ def node_parameters() -> frozenset:
     return frozenset({p.name for p in PARAMETERS} | STANDARD_PARAMETERS)
 
 
+def strip_scene():
+    """Return a strip of six rigid triangles on a four-bar's coupler (RRRs on one link).
+
+    Each RRR after the four-bar's starts from two points fixed on one link: the
+    solver bounds it as carried by that link (docs/robustness.md, "Long chains").
+    """
+    dyads = [mk.RRR('C', (mk.Link('coupler', 'B', 2.0), mk.Link('rocker', 'D', 2.5)), 1)]
+    previous, current = 'B', 'C'
+    for k in range(6):
+        dyads.append(mk.RRR(f'P{k}', (mk.Link(f'a{k}', previous, 2.0),
+                                      mk.Link(f'b{k}', current, 1.7)), 1 - 2 * (k % 2)))
+        previous, current = current, f'P{k}'
+    return mk.Scene('strip', {'A': (0.0, 0.0), 'D': (3.0, 0.0)},
+                    mk.Crank('crank', 'A', 'B', 1.0, 0.4, 3.0, 0.7), tuple(dyads))
+
+
 # --- error bounds against the 50-digit reference ----------------------------------
 
 

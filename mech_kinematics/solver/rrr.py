@@ -128,7 +128,10 @@ class RRR(Item):
 
         An actuated link's length varies: its start is fixed on it, and the new
         point lies along it (as a slotted lever's pin, :attr:`~.base.Placing.slot`).
+        Where both starts are fixed on one link already placed, the dyad closes a
+        rigid triangle on it (:func:`_rigid_base`).
         """
+        base = _rigid_base(plan.local, self.links)
         for link, actuator in zip(self.links, self.actuators, strict=True):
             if actuator is None:
                 plan.local[link.name] = {link.start: 0j, self.point: complex(link.length)}
@@ -136,7 +139,7 @@ class RRR(Item):
                 plan.local[link.name] = {link.start: 0j}
                 plan.slot[link.name] = (link.start, self.point)
         if self.actuators == (None, None):
-            return _RRRStep(self)
+            return _RRRStep(self, base)
         return _ActuatedRRRStep(self)
 
     def lengths(self) -> tuple[float, ...]:
@@ -215,9 +218,11 @@ def _pair_text(facts: dict[str, Any], units: SceneUnits) -> str:
     distance = facts['distance']
     pair = f'links {a} ({text(la)}) and {b} ({text(lb)})'
     if 'inputs' in facts:
+        inputs = text(facts['inputs'])
+        blamed = (f'the error of |{p}{q}| ({inputs}) exceeds' if facts.get('rigid') else
+                  f'the error bounds of {p} and {q} ({inputs} together) exceed')
         return (f'{pair} between {p} and {q} ({text(distance)} apart) are '
-                f'{text(facts["margin"])} in |{p}{q}| from being in line, but the error bounds '
-                f'of {p} and {q} ({text(facts["inputs"])} together) exceed '
+                f'{text(facts["margin"])} in |{p}{q}| from being in line, but {blamed} '
                 f'1/{ROUNDING_MARGIN:g} of that: their position cannot be trusted')
     if facts['kind'] == 'in line':
         return (f'{pair} in line between {p} and {q} ({text(distance)} apart): a toggle '
@@ -229,9 +234,26 @@ def _pair_text(facts: dict[str, Any], units: SceneUnits) -> str:
             f'than the difference of their lengths ({text(abs(la - lb), distance)})')
 
 
+def _rigid_base(local: Mapping[str, Mapping[str, complex]],
+                links: tuple[Link, Link]) -> tuple[str, complex, complex, float] | None:
+    """Return a placed link carrying both starts, their places on it and its extent; else None.
+
+    The extent is the largest distance from the link's start of a point fixed on it.
+
+    A dyad whose two starts are fixed on one link closes a rigid triangle on it
+    (a truss, as a strip of triangles): its pin and links move with that link.
+    """
+    first, second = (link.start for link in links)
+    for name, fixed in local.items():
+        if first in fixed and second in fixed and first != second:
+            return name, fixed[first], fixed[second], max(abs(q) for q in fixed.values())
+    return None
+
+
 class _RRRStep(Step):
 
-    def __init__(self, dyad: RRR) -> None:
+    def __init__(self, dyad: RRR,
+                 base: tuple[str, complex, complex, float] | None = None) -> None:
         first, second = dyad.links
         self.dyad = dyad
         self.label = f'RRR {dyad.point}'
@@ -255,6 +277,44 @@ class _RRRStep(Step):
         self.uses = (first.start, second.start)
         self.defines = (dyad.point, first.name, second.name)
         self.new_points = (dyad.point,)
+        self.rigid = base is not None and self._on(*base)
+
+    def _on(self, base: str, q1: complex, q2: complex, extent: float) -> bool:
+        """Fix the triangle on link ``base``, its starts at ``q1`` and ``q2``; say if it closes.
+
+        The pin's place on the link relative to each start (``c1``, ``c2``, of
+        lengths l1 and l2) comes from the exact distance of the starts, to a
+        few ulps: a triangle that does not close (or is flat) is left to
+        ``run``, which refuses it. ``e_c`` bounds the error of ``c1`` and
+        ``c2``, with the starts' own places on the link known to 16 ulps of
+        its ``extent`` (a carried point's rounding) moving the pin by that
+        over the triangle's measure.
+        """
+        dx = Fraction(q2.real) - Fraction(q1.real)
+        dy = Fraction(q2.imag) - Fraction(q1.imag)
+        d2 = dx * dx + dy * dy
+        f1, f2 = Fraction(self.l1), Fraction(self.l2)
+        k = ((f1 + f2) ** 2 - d2) * (d2 - (f1 - f2) ** 2)  # 4 d^2 h^2
+        if k <= 0:
+            return False
+        dist = math.hypot(float(dx), float(dy))
+        along = float((f1 * f1 - f2 * f2 + d2) / (2 * d2)) * dist
+        height = self.branch * math.sqrt(float(k / (4 * d2 * d2))) * dist
+        ux, uy = float(dx) / dist, float(dy) / dist
+        c1 = complex(along * ux - height * uy, along * uy + height * ux)
+        c2 = c1 - (q2 - q1)
+        measure = abs(height) * dist / (self.l1 * self.l2)
+        self.base = base
+        self.uses = (*self.uses, base)
+        self.c1r, self.c1i, self.c2r, self.c2i = c1.real, c1.imag, c2.real, c2.imag
+        self.dist0 = dist
+        e_q = _U16 * extent
+        self.e_dist = _U2 * dist + 2.0 * e_q
+        e_c = _U16 * (self.l1 + self.l2 + dist) + 2.0 * e_q * (
+            1.0 / measure + max(self.l1, self.l2) / dist)
+        # The rigid forms' products and the measured differences round by a few U more.
+        self.e_c1, self.e_c2 = e_c + _U4 * self.l1, e_c + _U4 * self.l2
+        return True
 
     def facts(self, dist: float, touching: bool, margin: float = 0.0,
               inputs: float = 0.0) -> dict[str, Any]:
@@ -272,7 +332,8 @@ class _RRRStep(Step):
         # more from in line): only its starts' bounds (1e7 times this step's own
         # rounding at least) can have brought it within rounding of the limit.
         if margin > 1e-6 * (self.l1 + self.l2):
-            facts.update(margin=float(margin) * m, inputs=float(inputs) * m)
+            # (a rigid triangle's inputs are the error of its starts' distance)
+            facts.update(margin=float(margin) * m, inputs=float(inputs) * m, rigid=self.rigid)
         return facts
 
     def margins(self, points: Mapping[str, tuple[Any, ...]]) -> tuple[tuple[Any, Any], ...]:
@@ -349,7 +410,10 @@ class _RRRStep(Step):
         # step's rounding of d and dist (2 U dist) and of lsum and ldiff. The margin
         # is linear in them: beyond ROUNDING_MARGIN spreads of the limit no input
         # within its error can cross it; nearer, either way, it is not trusted.
-        spread = ep1 + ep2 + self.e_lengths + _U2 * dist
+        inputs = ep1 + ep2
+        if self.rigid:  # starts fixed on one link: only their distance's error counts
+            inputs = abs(dist - self.dist0) + self.e_dist
+        spread = inputs + self.e_lengths + _U2 * dist
         outer = lsum - dist
         inner = dist - abs(ldiff)
         margin = np.minimum(outer, inner) if ctx.vector else (
@@ -370,7 +434,7 @@ class _RRRStep(Step):
                 f'|{self.start1}{self.start2}|, |{self.start1}{self.start2}| - '
                 f'{_g(abs(ldiff) * m)} m) = {margin * m:.3g} m to exceed '
                 f'{ROUNDING_MARGIN:g} times its error bound {spread * m:.3g} m'),
-                lambda: self.facts(dist, True, margin, ep1 + ep2))
+                lambda: self.facts(dist, True, margin, inputs))
         root = np.sqrt(k) if ctx.vector else math.sqrt(k)
         # sin of the angle between the two links (the transmission angle).
         measure = root / (2.0 * l1 * l2)
@@ -415,16 +479,48 @@ class _RRRStep(Step):
         ta = (ea1 + ea2 + (2.0 * aws + t * self.inv_sum) * t
               + (w1sq + w2sq + aa1 + abs(al2)) * erp) * inv_m
         ew1 = t * inv_l1
-        # The pin's sums p1 + r1 etc. round by U |p1| + U l1 (in ep1 and er),
+        # The pin C = p1 + r1(p2 - p1) moves with its starts as J1 dp1 + J2 dp2, where
+        # J2 is r1's derivative and J1 = I - J2: each of norm 1 / measure (moving one
+        # start, the pin turns about the other), so the starts' bounds over the measure,
+        # in er, bound both terms (ep1 + er would count p1 twice). Its velocity and
+        # acceleration move likewise with (v1, v2) and (a1, a2), in t and ta.
+        # The sums p1 + r1 etc. round by U |p1| + U l1 (U l1 in er),
         # U |v1| + U |w1| l1 and 2 U |a1| + a few U (|al1| + w1^2) l1 (in erp).
+        bp = er + U * (abs(p1.real) + abs(p1.imag))
+        bv = U * (abs(v1.real) + abs(v1.imag)) + t + aw1 * erp
+        ba = (_U2 * (abs(a1.real) + abs(a1.imag)) + ta + (2.0 * aw1 + ew1) * t
+              + (aa1 + w1sq) * erp)
+        be1, bw1, bal1 = er * inv_l1 + _U7, ew1, ta * inv_l1
+        be2, bw2, bal2 = er * inv_l2 + _U7, t * inv_l2, ta * inv_l2
+        if self.rigid:
+            # A rigid triangle on link base (see _on): the truth moves with the base, the
+            # pin at c1 from start 1 and c2 from start 2 on it, both links at the base's
+            # rates. Each bound is the base's (its bounds carried over) plus how far the
+            # solved value lies from the base's motion so carried (measured here), plus
+            # rounding: no input's bound is divided by the measure, so a strip of such
+            # triangles keeps bounds that grow as its errors do (docs/robustness.md).
+            eb, wb, ab, eeb, ewb, eab = ctx.links[self.base]
+            awb = abs(wb)
+            aab = abs(ab)
+            rr1 = abs(r1 - (eb * self.c1r + 1j * eb * self.c1i)) + l1 * eeb + self.e_c1
+            rr2 = abs(r2 - (eb * self.c2r + 1j * eb * self.c2i)) + l2 * eeb + self.e_c2
+            rw1 = abs(w1 - wb) + ewb + _U2 * (aw1 + awb)
+            rw2 = abs(w2 - wb) + ewb + _U2 * (abs(w2) + awb)
+            ra1 = abs(al1 - ab) + eab + _U2 * (aa1 + aab)
+            ra2 = abs(al2 - ab) + eab + _U2 * (abs(al2) + aab)
+            reach = l1 + rr1  # |r1| at most
+            wt = awb + ewb  # the true |wb| at most
+            bp = ep1 + rr1 + U * (abs(p1.real) + abs(p1.imag))
+            bv = (ev1 + U * (abs(v1.real) + abs(v1.imag)) + _U2 * aw1 * l1 + rw1 * reach
+                  + wt * rr1)
+            ba = (ea1 + _U2 * (abs(a1.real) + abs(a1.imag)) + _U4 * (aa1 + w1sq) * l1
+                  + (ra1 + rw1 * (2.0 * aw1 + rw1)) * reach + (aab + eab + wt * wt) * rr1)
+            be1, bw1, bal1 = rr1 * inv_l1 + _U7, rw1, ra1
+            be2, bw2, bal2 = rr2 * inv_l2 + _U7, rw2, ra2
         ctx.points[self.point] = (
-            p1 + r1, v1 + 1j * w1 * r1, a1 + 1j * al1 * r1 - w1 * w1 * r1, er + ep1,
-            ev1 + U * (abs(v1.real) + abs(v1.imag)) + t + aw1 * erp,
-            ea1 + _U2 * (abs(a1.real) + abs(a1.imag)) + ta + (2.0 * aw1 + ew1) * t
-            + (aa1 + w1sq) * erp)
-        ctx.links[self.link1] = (r1 * (1.0 / l1), w1, al1, er * inv_l1 + _U7, ew1, ta * inv_l1)
-        ctx.links[self.link2] = (r2 * (1.0 / l2), w2, al2, er * inv_l2 + _U7, t * inv_l2,
-                                 ta * inv_l2)
+            p1 + r1, v1 + 1j * w1 * r1, a1 + 1j * al1 * r1 - w1 * w1 * r1, bp, bv, ba)
+        ctx.links[self.link1] = (r1 * (1.0 / l1), w1, al1, be1, bw1, bal1)
+        ctx.links[self.link2] = (r2 * (1.0 / l2), w2, al2, be2, bw2, bal2)
 
 
 class _ActuatedRRRStep(_RRRStep):

@@ -6,7 +6,7 @@ import math
 from pathlib import Path
 import warnings
 
-from helpers import crank_scene_names, driver_scene_names, general_only
+from helpers import crank_scene_names, driver_scene_names, general_only, strip_scene
 import numpy as np
 import pytest
 import yaml
@@ -159,6 +159,14 @@ def test_a_chain_of_sixty_four_dyads_and_its_frames():
     assert tick is not None
     _assert_same(scene, tick, ANGLES[::7], joints=scene.output_joints[:5],
                  points=scene.output_points[-3:], frames=frames)
+
+
+def test_a_strip_of_rigid_triangles_compiles_to_the_same_bits():
+    """Dyads whose starts are fixed on one link (bounded as carried by it) compile alike."""
+    scene = strip_scene()
+    tick, compiled = tick_function(scene)
+    assert compiled, 'a rigid triangle falls back to the general solver'
+    _assert_same(scene, tick, ANGLES, speeds=(None, -3.5), turns=(0, 3))
 
 
 def _tiny_four_bar(tmp_path):

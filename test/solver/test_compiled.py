@@ -12,7 +12,8 @@ import math
 import sys
 import warnings
 
-from helpers import crank_scene_names, driver_scene_names, general_only, state_facts
+from helpers import (crank_scene_names, driver_scene_names, general_only, state_facts,
+                     strip_scene)
 import numpy as np
 import pytest
 
@@ -115,6 +116,16 @@ def test_every_packaged_scene_solves_arrays_alike_compiled(name):
                 cut['speed'] = speeds[:angles.size]
             assert _array_outcome(fast, angles, **cut) == _array_outcome(slow, angles, **cut), (
                 name, angles.size, kwargs)
+
+
+def test_rigid_triangles_compile_and_solve_alike():
+    """Dyads whose starts are fixed on one link (a strip on a coupler): compiled alike."""
+    fast, slow = _pair(strip_scene)
+    assert fast._solver.compiled_single and fast._solver.compiled_array
+    assert fast._solver.compiled_usual
+    _assert_same(fast, slow, ANGLES, speeds=(None, -3.5), turns=(0, 3))
+    for kwargs in ({}, {'speed': np.linspace(-20.0, 30.0, ANGLES.size)}, {'max_error': 1e-12}):
+        assert _array_outcome(fast, ANGLES, **kwargs) == _array_outcome(slow, ANGLES, **kwargs)
 
 
 def test_the_extreme_suite_solves_arrays_alike():
