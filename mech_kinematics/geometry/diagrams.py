@@ -32,6 +32,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from enum import Enum
 import math
+from typing import Any
 import warnings
 
 import numpy as np
@@ -42,6 +43,7 @@ from .instant_centres import (bodies_from_scene, BodyKind, check_full_state, ful
                               varying_links)
 from ..errors import NearSingularWarning
 from ..solver import Scene, solve, State
+from ..solver.plan import diameter
 from ..units import turns_from_degrees
 
 __all__ = [
@@ -703,8 +705,12 @@ def space_from_state(scene: Scene, state: State,
     """
     topology = _check_state(scene, state)
     points = {name: _xy(complex(p)) for name, (p, _, _) in state.complex_points.items()}
-    size = max((float(np.hypot(*(a - b))) for a in points.values() for b in points.values()),
-               default=1.0) or 1.0
+    size = diameter(complex(p) for p, _, _ in state.complex_points.values()) or 1.0
+    # A dyad draws extra points or slots only on a body it adds (Item.outline).
+    adders: dict[str, list[Any]] = {}
+    for dyad in scene.dyads:
+        for member, *_ in dyad.members(topology.ground):
+            adders.setdefault(member, []).append(dyad)
     links = []
     locked = _locked(state)
     for body in topology.bodies.values():
@@ -712,7 +718,7 @@ def space_from_state(scene: Scene, state: State,
             continue
         xy = [points[name] for name in body.points]
         slots: tuple[tuple[Array, Array], ...] = ()
-        for dyad in scene.dyads:
+        for dyad in adders.get(body.name, ()):
             extra, slots_of = dyad.outline(body.name, scene, state, points)
             xy += [points[name] for name in extra]
             if slots_of:  # a Geneva wheel: the polygon of its slots' mouths

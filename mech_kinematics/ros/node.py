@@ -70,7 +70,7 @@ from .parameters import (CATCH_UP, catch_up_window_ns, driver_parameters, first_
                          STATE_DEPTH, TOPIC)
 from .schedule import period_ns_from_rate
 from .tf import static_tf_message, TfMessages
-from .ticker import tick_function
+from .ticker import compile_tick, general_tick, tick_function
 from .timebase import ActuatorTimebase, CrankSample, CrankTimebase
 from .topic_drive import RefusedInput, TopicDrive, TopicInput
 from ..geometry.assembly import assembly_summary
@@ -93,6 +93,9 @@ LATE_NS = 1_000_000
 MAX_SLEEP_NS = 50_000_000
 #: Longest time another thread may hold the GIL before the tick thread gets it, s.
 SWITCH_INTERVAL_S = 0.0005
+#: A scene of more dyads and points than this compiles its tick in the background (about
+#: 25 ms a step) while the general solver serves (:meth:`KinematicsNode._setup_solve`).
+BACKGROUND_STEPS = 16
 #: The node-private, hidden topic on which each node says when it started (transient local,
 #: so that a newcomer of the same name hears an older node as soon as they are matched).
 INSTANCE_TOPIC = '~/_instance'
@@ -214,6 +217,8 @@ class KinematicsNode(LifecycleNode):
                                   spec('late_ticks').default == CATCH_UP)
         self._state_publishers: list[Any] = []
         self._pub_markers: Any = None
+        self._compiling: object | None = None     # the scene whose tick compiles in the background
+        self._compile_later: threading.Thread | None = None
         self._imus: ImuMessages | None = None
         self._imu_frames: ImuFrames | None = None
         self._topic: TopicDrive | None = None
@@ -432,24 +437,75 @@ class KinematicsNode(LifecycleNode):
         tick_scene = self._setup_tf(scene)
         self._setup_imus(scene, tick_scene)
         self._publish_descriptions(scene)
-        # The scene's solve, compiled into one straight-line function (ros/ticker.py).
-        frames = [(f.origin, f.angle_of, f.angle) for f in self._tf_frames]
-        self._solve, compiled = tick_function(tick_scene, scene.output_joints,
-                                              scene.output_points, frames)
+        self._setup_solve(tick_scene, scene)
         self._tf_first = 3 * len(scene.output_joints) + 6 * len(scene.output_points)
         # Instants where a value jumps (a Geneva wheel's) are published one-sided and counted.
         self._jumps_at = tick_scene.jumps_at if tick_scene.intermittent else None
-        # Where the scene cannot assemble, in one line, for the diagnostics.
-        # (a crank's turn: a scene of several drivers, or an actuator, has none to sweep).
-        self._assembly = assembly_summary(scene) \
-            if len(scene.drivers) == 1 and scene.input is not None else ''
-        if not compiled:
-            self.get_logger().info('the scene is solved by the general solver (not compiled)')
         if self._value('markers'):
             self._setup_markers(scene)
         self._setup_topic_drive(scene)
         self.scene = scene
         self._log_start()
+        if self._compile_later is not None:
+            self._compile_later.start()
+            self._compile_later = None
+
+    def _setup_solve(self, tick_scene: mk.Scene, scene: mk.Scene) -> None:
+        """Set the tick's solve (compiled into one straight-line function) and the sweep.
+
+        The sweep is where the scene cannot assemble over a crank's turn, in one
+        line for the diagnostics (a scene of several drivers, or an actuator, has
+        none). Compiling takes about 25 ms a step (ros/ticker.py) and the sweep
+        about 3 ms a step. A scene of more than :data:`BACKGROUND_STEPS` dyads and
+        points starts on the general solver (the same answers, bit for bit) and a
+        daemon thread sweeps and compiles it; the compiled function takes over the
+        next tick after it is made, so a long chain is published from the start
+        instead of after minutes.
+        """
+        frames = [(f.origin, f.angle_of, f.angle) for f in self._tf_frames]
+        outputs = (tick_scene, scene.output_joints, scene.output_points, frames)
+        steps = len(scene.dyads) + len(scene.points)
+        sweep = len(scene.drivers) == 1 and scene.input is not None
+        self._compiling = token = object()     # a later scene's setup makes this one stale
+        self._compile_later = None
+        self._assembly = ''
+        if steps <= BACKGROUND_STEPS:
+            self._assembly = assembly_summary(scene) if sweep else ''
+            self._solve, compiled = tick_function(*outputs)
+            if not compiled:
+                self.get_logger().info('the scene is solved by the general solver (not compiled)')
+            return
+        self._solve = general_tick(*outputs)
+        self.get_logger().info(
+            f'the scene has {steps} dyads and points: the general solver serves while its '
+            'tick compiles in the background')
+
+        def compile_in_background() -> None:
+            started = time.monotonic()
+            if sweep:
+                summary = assembly_summary(scene)
+                if self._compiling is token:
+                    self._assembly = summary
+            try:
+                tick = compile_tick(*outputs)
+            except Exception as error:  # noqa: BLE001 (the general solver goes on)
+                tick, why = None, f' ({type(error).__name__}: {error})'
+            else:
+                why = ''
+            if self._compiling is not token:
+                return
+            if tick is None:
+                self.get_logger().info(
+                    f'the scene is solved by the general solver (not compiled){why}')
+                return
+            self._solve = tick
+            self.get_logger().info(f'the compiled tick serves from now (compiled in '
+                                   f'{time.monotonic() - started:.1f} s)')
+
+        # Started once the rest of the set-up is done: a thread holding the GIL slows
+        # every release and re-acquisition of it by this one (the assembly sweep's NumPy).
+        self._compile_later = threading.Thread(target=compile_in_background,
+                                               name='compile the tick', daemon=True)
 
     def _declare_drivers(self, scene: mk.Scene, given: set[str]) -> None:
         """Declare each driver's ``inputs.NAME.*`` (the scene's defaults); note what they set.
@@ -687,6 +743,7 @@ class KinematicsNode(LifecycleNode):
         self._state_publishers = []
         self._pub_markers = None
         self._drop_topic_drive()
+        self._compiling = None      # a compile still running is not installed
         self.scene = None
 
     def _setup_markers(self, scene: mk.Scene) -> None:

@@ -87,11 +87,12 @@ def tick_function(scene: lk.Scene, joints: Sequence[str] | None = None,
     tick = compile_tick(scene, joints, points, frames)
     if tick is not None:
         return tick, True
-    return _general(scene, joints, points, frames), False
+    return general_tick(scene, joints, points, frames), False
 
 
-def _general(scene: lk.Scene, joints: Sequence[str] | None, points: Sequence[str] | None,
-             frames: Sequence[tuple[str, str | None, float]]) -> TickFunction:
+def general_tick(scene: lk.Scene, joints: Sequence[str] | None,
+                 points: Sequence[str] | None,
+                 frames: Sequence[tuple[str, str | None, float]]) -> TickFunction:
     """Return a tick function around the general solver (same signature, same answers)."""
     joints = tuple(scene.output_joints if joints is None else joints)
     points = tuple(scene.output_points if points is None else points)
@@ -161,7 +162,7 @@ def _compile_drivers(scene: lk.Scene, plan: hooks.TickPlan, joints: tuple[str, .
     count = len(plan.drivers)
     namespace: dict[str, Any] = {
         '_ctx_check': _refuse, '_ctx_check_margin': _refuse, '_Refused': _Refused,
-        '_shown': hooks.shown, '_slow': _general(scene, joints, points, frames),
+        '_shown': hooks.shown, '_slow': general_tick(scene, joints, points, frames),
         '_driver_limits': plan.driver_limits, '_rates_shift': hooks.rates_shift,
         'inf': math.inf, '_float': float, '_SEQUENCE': (list, tuple),
     }
@@ -246,7 +247,7 @@ def compile_tick(scene: lk.Scene, joints: Sequence[str] | None = None,
     namespace: dict[str, Any] = {
         '_ctx_check': hooks.check, '_ctx_check_margin': hooks.check_margin,
         '_shown': hooks.shown,
-        '_slow': _general(scene, joints, points, frames),
+        '_slow': general_tick(scene, joints, points, frames),
         '_trust_limits': hooks.trust_limits,
         'inf': math.inf,
     }

@@ -193,8 +193,10 @@ class Placing(Protocol):
 
     ``ground`` maps ground points to positions; ``local[link]`` the points
     fixed on each link to their coordinates in the link's frame (origin at its
-    start, x along it; an item adds its own links); ``slot[lever]`` a slotted
-    lever's (pivot, pin); ``size`` the mechanism's size, m; ``scene`` the scene.
+    start, x along it; an item adds its own links); ``carriers[point]`` the
+    links a point is fixed on, in the order they were added to ``local``;
+    ``slot[lever]`` a slotted lever's (pivot, pin); ``size`` the mechanism's
+    size, m; ``scene`` the scene.
     """
 
     ground: Mapping[str, complex]
@@ -202,6 +204,7 @@ class Placing(Protocol):
     slot: dict[str, tuple[str, str]]
     size: float
     scene: Any
+    carriers: Mapping[str, list[str]]
 
 
 class Reading(Protocol):
@@ -349,8 +352,9 @@ class Item(ABC):
                 ) -> tuple[tuple[str, ...], tuple[tuple[Any, Any], ...]]:
         """Return the points besides its own that ``body``'s drawing runs through, and its slots.
 
-        ``points`` maps every point to its position (an array of shape (2,),
-        m); a slot is (inner end, mouth), positions likewise.
+        Asked only of a body it adds (:meth:`members`). ``points`` maps every
+        point to its position (an array of shape (2,), m); a slot is (inner end,
+        mouth), positions likewise.
         """
         return (), ()
 

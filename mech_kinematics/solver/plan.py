@@ -83,15 +83,53 @@ class _Names:
         return name
 
 
+class _Local(dict[str, dict[str, complex]]):
+    """:attr:`~.base.Placing.local`, which also keeps the links each point is fixed on.
+
+    Items write a link's points as a plain dict (``local[link] = {...}``) and add
+    carried points to it (``local[link][point] = ...``); ``carriers[point]``
+    lists, in that order, the links a point was fixed on: what an RRR asks to
+    find a link carrying both its starts without reading every link.
+    """
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.carriers: dict[str, list[str]] = {}
+
+    def __setitem__(self, link: str, fixed: dict[str, complex]) -> None:
+        super().__setitem__(link, _Fixed(self.carriers, link, fixed))
+
+    def update(self, *others: Any, **more: dict[str, complex]) -> None:
+        for link, fixed in dict(*others, **more).items():
+            self[link] = fixed
+
+
+class _Fixed(dict[str, complex]):
+    """The points fixed on one link (:class:`_Local`): adding one records its carrier."""
+
+    def __init__(self, carriers: dict[str, list[str]], link: str,
+                 fixed: Mapping[str, complex]) -> None:
+        super().__init__()
+        self._carriers, self._link = carriers, link
+        for point, where in fixed.items():
+            self[point] = where
+
+    def __setitem__(self, point: str, where: complex) -> None:
+        if point not in self:
+            self._carriers.setdefault(point, []).append(self._link)
+        super().__setitem__(point, where)
+
+
 @dataclass
 class _Placing:
     """What items build their steps from (:class:`~.base.Placing`)."""
 
     ground: Mapping[str, complex]
-    local: dict[str, dict[str, complex]]
+    local: dict[str, dict[str, complex]]    # a _Local
     slot: dict[str, tuple[str, str]]
     size: float
     scene: Any
+    carriers: Mapping[str, list[str]]       # the _Local's
 
 
 def _compile(scene: Scene, joints: tuple[str, ...] | None,
@@ -127,15 +165,15 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
         for name, kind, where in carried.defined():
             define(name, kind, where)
 
-    size = max([*(driver.reach for driver in drivers), _diameter(ground.values())]
+    size = max([*(driver.reach for driver in drivers), diameter(ground.values())]
                + [length for d in scene.dyads for length in d.lengths()])
 
     # Local coordinates of the points fixed on each link, in the frame at the
     # link's start with x along the link; and the slot pin of each RPR lever.
-    local: dict[str, dict[str, complex]] = {}
+    local = _Local()
     for driver in drivers:
         local.update(driver.local(ground))
-    placing = _Placing(ground, local, {}, size, scene)
+    placing = _Placing(ground, local, {}, size, scene, local.carriers)
     names = _Names(kinds, ground)
     steps: list[Step] = []
     produces: dict[str, int] = {}  # point, link or slider -> index of its step
@@ -219,7 +257,7 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
                  rubs, driver_steps[1:])
 
 
-def _diameter(points: Iterable[complex]) -> float:
+def diameter(points: Iterable[complex]) -> float:
     """Return the largest distance between two of ``points``, m (0 for fewer than two).
 
     The farthest pair is a pair of vertices of the convex hull (Andrew's

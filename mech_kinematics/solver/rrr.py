@@ -131,7 +131,7 @@ class RRR(Item):
         Where both starts are fixed on one link already placed, the dyad closes a
         rigid triangle on it (:func:`_rigid_base`).
         """
-        base = _rigid_base(plan.local, self.links)
+        base = _rigid_base(plan.local, plan.carriers, self.links)
         for link, actuator in zip(self.links, self.actuators, strict=True):
             if actuator is None:
                 plan.local[link.name] = {link.start: 0j, self.point: complex(link.length)}
@@ -235,17 +235,20 @@ def _pair_text(facts: dict[str, Any], units: SceneUnits) -> str:
 
 
 def _rigid_base(local: Mapping[str, Mapping[str, complex]],
+                carriers: Mapping[str, list[str]],
                 links: tuple[Link, Link]) -> tuple[str, complex, complex, float] | None:
     """Return a placed link carrying both starts, their places on it and its extent; else None.
 
+    ``carriers`` lists the links each point is fixed on (:class:`~.base.Placing`).
     The extent is the largest distance from the link's start of a point fixed on it.
 
     A dyad whose two starts are fixed on one link closes a rigid triangle on it
     (a truss, as a strip of triangles): its pin and links move with that link.
     """
     first, second = (link.start for link in links)
-    for name, fixed in local.items():
-        if first in fixed and second in fixed and first != second:
+    for name in carriers.get(first, ()):
+        fixed = local[name]
+        if second in fixed and first != second:
             return name, fixed[first], fixed[second], max(abs(q) for q in fixed.values())
     return None
 

@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 import mech_kinematics as mk
-from mech_kinematics.solver.plan import _diameter
+from mech_kinematics.solver.plan import diameter
 
 SETTINGS = settings(max_examples=300, deadline=None, derandomize=True)
 #: Relative tolerance of the diameter from the hull against all pairs, for
@@ -53,7 +53,7 @@ float_points = st.lists(st.builds(complex, st.floats(-1e6, 1e6), st.floats(-1e6,
 @example([complex(x, y) for x in range(4) for y in range(4)])  # a grid: parallel edges
 def test_diameter_on_a_grid_is_exactly_the_farthest_pair(points):
     """On integer points (exact orientation tests) the hull's diameter is all pairs' maximum."""
-    assert _diameter(points) == brute_diameter(points)
+    assert diameter(points) == brute_diameter(points)
 
 
 @SETTINGS
@@ -61,7 +61,7 @@ def test_diameter_on_a_grid_is_exactly_the_farthest_pair(points):
 def test_diameter_of_float_points_is_the_farthest_pair(points):
     """On float points the hull's diameter is all pairs' maximum to rounding."""
     expected = brute_diameter(points)
-    assert _diameter(points) == pytest.approx(expected, rel=RTOL_DIAMETER, abs=0.0)
+    assert diameter(points) == pytest.approx(expected, rel=RTOL_DIAMETER, abs=0.0)
 
 
 @pytest.mark.parametrize('points', [
@@ -71,7 +71,7 @@ def test_diameter_of_float_points_is_the_farthest_pair(points):
 ])
 def test_diameter_at_extreme_scales_is_the_farthest_pair(points):
     """Coordinates near the limits of a double give all pairs' maximum, and terminate."""
-    assert _diameter(points) == brute_diameter(points)
+    assert diameter(points) == brute_diameter(points)
 
 
 def test_diameter_of_points_on_a_circle():
@@ -79,7 +79,7 @@ def test_diameter_of_points_on_a_circle():
     rng = np.random.default_rng(12)
     z = 3.0 * np.exp(1j * np.sort(rng.uniform(0, 2 * np.pi, 2000))) + (1 - 2j)
     expected = float(np.max(np.abs(z[:, None] - z[None, :])))
-    assert _diameter(z.tolist()) == pytest.approx(expected, rel=RTOL_DIAMETER, abs=0.0)
+    assert diameter(z.tolist()) == pytest.approx(expected, rel=RTOL_DIAMETER, abs=0.0)
 
 
 def test_size_of_the_packaged_scenes_is_unchanged():
