@@ -84,6 +84,8 @@ TOUCH = 1e-14
 CHANGE_POINT = 1e-9
 #: Crank angles sampled at least in each range where it assembles, for dead centres.
 RANGE_SAMPLES = 64
+#: A local minimum of a sampled measure dips this much of its value below a neighbour.
+DIP = 1e-12
 _TURN = 2.0 * math.pi
 #: Roots closer than this (a few ulp of 2 pi), found from either side of a sample, are one.
 _SAME = 8 * math.ulp(_TURN)
@@ -116,12 +118,17 @@ class DeadCentre:
 
 @dataclass(frozen=True)
 class Transmission:
-    """The smallest transmission angle (rad) of ``dyad`` over the turn, at crank ``angle``."""
+    """The smallest transmission angle (rad) of ``dyad`` over the turn, at crank ``angle``.
+
+    ``constant``: the angle is the same, to rounding, wherever the dyad assembles (a
+    rigid triangle's); ``angle`` is then one crank angle of the sampled turn.
+    """
 
     dyad: str
     links: tuple[str, ...]
     minimum: float
     angle: float
+    constant: bool = False
 
 
 @dataclass(frozen=True)
@@ -576,10 +583,18 @@ def _inside(theta: Array, ranges: Sequence[tuple[float, float]]) -> Array:
 
 
 def _local_minima(values: Array) -> list[int]:
-    """Return the indices of the local minima of a cyclic sequence (finite ones only)."""
+    """Return the indices of the local minima of a cyclic sequence (finite ones only).
+
+    A minimum is a dip beyond rounding: at least :data:`DIP` of its value below a
+    neighbour. A measure that is constant (a rigid triangle's) has none, where its
+    rounding would make a third of its samples minima, each refined by solves.
+    """
     previous, following = np.roll(values, 1), np.roll(values, -1)
     finite = np.isfinite(values) & np.isfinite(previous) & np.isfinite(following)
-    return [int(i) for i in np.flatnonzero(finite & (values <= previous) & (values < following))]
+    with np.errstate(invalid='ignore'):
+        dip = np.maximum(previous, following) - values > DIP * np.abs(values)
+    return [int(i) for i in np.flatnonzero(finite & (values <= previous) & (values < following)
+                                           & dip)]
 
 
 def _golden(probe: _Probe, key: str, centre: float) -> tuple[float, float]:
@@ -683,7 +698,12 @@ def _transmission(probe: _Probe, ranges: Sequence[tuple[float, float]],
             continue
         measure = np.where(probe.valid, np.asarray(probe.state.singularity[key]), np.inf)
         index = int(np.argmin(measure))
-        angle, value = _golden(probe, key, float(probe.theta[index]))
+        angle, value = float(probe.theta[index]), float(measure[index])
+        finite = measure[np.isfinite(measure)]
+        constant = everywhere and finite.size > 0 and bool(
+            finite.max() - finite.min() <= DIP * finite.max())
+        if not constant:  # (a constant measure's every angle is its minimum)
+            angle, value = _golden(probe, key, angle)
         if not everywhere:  # an end of a range may be lower (a toggle: 0)
             for start, end in ranges:
                 for edge in (start, end):
@@ -693,7 +713,7 @@ def _transmission(probe: _Probe, ranges: Sequence[tuple[float, float]],
                         if m < value:
                             angle, value = edge, m
         result.append(Transmission(label, links, math.asin(min(1.0, max(0.0, value))),
-                                   angle % _TURN))
+                                   angle % _TURN, constant))
     return tuple(result)
 
 
@@ -728,6 +748,8 @@ def _loops(probe: _Probe) -> tuple[FourBarLoop, ...]:
             if driver is None or driver not in pivot or driver in (out.name, coupler.name):
                 continue
             o1, q, o2 = pivot[driver], coupler.start, out.start
+            if o1 == o2:  # the output turns about the driver's own pivot: a rigid triangle
+                continue
             ground = abs(position[o2] - position[o1])
             input_ = abs(position[q] - position[o1])
             loops.append(FourBarLoop((f'{o1}{o2}', driver, coupler.name, out.name),

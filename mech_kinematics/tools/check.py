@@ -136,13 +136,15 @@ def report_text(assembly: Any, scene: Any) -> str:
         centres.append(text + ')')
     lines.append(f'dead centres: {", ".join(centres) if centres else "none"}')
     if assembly.transmission:
+        def where(t: Any) -> str:
+            return 'at every crank angle' if t.constant else f'at crank angle {angle(t.angle)}'
+
         worst = min(assembly.transmission, key=lambda t: t.minimum)
-        lines.append(f'minimum transmission angle: {angle(worst.minimum)} at crank angle '
-                     f'{angle(worst.angle)} ({worst.dyad}: {" and ".join(worst.links)})')
+        lines.append(f'minimum transmission angle: {angle(worst.minimum)} {where(worst)} '
+                     f'({worst.dyad}: {" and ".join(worst.links)})')
         for other in assembly.transmission:
             if other is not worst:
-                lines.append(f'  {other.dyad}: {angle(other.minimum)} at crank angle '
-                             f'{angle(other.angle)}')
+                lines.append(f'  {other.dyad}: {angle(other.minimum)} {where(other)}')
     else:
         lines.append('minimum transmission angle: no RRR or RRP dyad')
     loops = [_loop_text(loop, units) for loop in assembly.loops]
@@ -195,7 +197,8 @@ def report_json(assembly: Any, scene: Any) -> dict[str, Any]:
                           'in_line': None if c.in_line is None else list(c.in_line)}
                          for c in assembly.dead_centres],
         'transmission': [{'dyad': t.dyad, 'links': list(t.links), 'minimum': t.minimum,
-                          'angle': t.angle} for t in assembly.transmission],
+                          'angle': t.angle, 'constant': t.constant}
+                         for t in assembly.transmission],
         'loops': [{'names': dict(zip(('ground', 'input', 'coupler', 'output'), loop.names,
                                      strict=True)),
                    'points': list(loop.points),

@@ -53,6 +53,7 @@ TITLE_H = 1.8            # cm above the panels
 FOOT_H = 1.0             # cm reserved at the bottom of a panel for its scale bar
 LABEL_PAD = 0.9          # cm kept free around a drawing for its labels
 ROW_H = 0.44             # cm per table row
+TABLE_ROWS = 60          # rows drawn of a table at most
 DPI = 110
 FONT = 8.5               # pt, labels
 TABLE_FONT = 7.5         # pt
@@ -109,7 +110,7 @@ class _Placer:
             samples.append(a_cm + t * (b_cm - a_cm))
         self.lines = np.concatenate(samples) if samples else np.zeros((0, 2))
         self.dots = np.array([self.cm(a) for a in anchors]) if anchors else np.zeros((0, 2))
-        self.boxes: list[tuple[float, float, float, float]] = []
+        self.boxes = np.zeros((0, 4))     # x0, x1, y0, y1 of every label placed
 
     def cm(self, xy: Array) -> Array:
         return (np.asarray(xy, dtype=np.float64) - self.origin) / self.scale
@@ -128,11 +129,12 @@ class _Placer:
             c = a + d * (reach + gap)
             x0, x1, y0, y1 = c[0] - w / 2, c[0] + w / 2, c[1] - h / 2, c[1] + h / 2
             cost = 0.0
-            for bx0, bx1, by0, by1 in self.boxes:
-                ox = min(x1, bx1) - max(x0, bx0)
-                oy = min(y1, by1) - max(y0, by0)
-                if ox > 0 and oy > 0:
-                    cost += 200.0 * (ox * oy + 0.1)
+            if len(self.boxes):
+                boxes = self.boxes
+                ox = np.minimum(x1, boxes[:, 1]) - np.maximum(x0, boxes[:, 0])
+                oy = np.minimum(y1, boxes[:, 3]) - np.maximum(y0, boxes[:, 2])
+                hit = (ox > 0) & (oy > 0)
+                cost += float(np.sum(200.0 * (ox[hit] * oy[hit] + 0.1)))
             if len(self.lines):
                 inside = ((self.lines[:, 0] > x0) & (self.lines[:, 0] < x1)
                           & (self.lines[:, 1] > y0) & (self.lines[:, 1] < y1))
@@ -153,7 +155,8 @@ class _Placer:
                 best = (cost, c)
         assert best is not None
         c = best[1]
-        self.boxes.append((c[0] - w / 2, c[0] + w / 2, c[1] - h / 2, c[1] + h / 2))
+        self.boxes = np.vstack([self.boxes, [c[0] - w / 2, c[0] + w / 2, c[1] - h / 2,
+                                             c[1] + h / 2]])
         xy = self.origin + c * self.scale
         self.ax.text(xy[0], xy[1], text, ha='center', va='center', fontsize=size, zorder=6,
                      **kwargs)
@@ -481,6 +484,16 @@ def _polygon_panel(ax: Any, polygon: Polygon, colours: Mapping[str, str]) -> flo
     return scale
 
 
+def _shown(tables: dict[str, Table]) -> dict[str, Table]:
+    """Return ``tables`` with at most :data:`TABLE_ROWS` rows each; a cut one's title says so.
+
+    A long chain's tables would make a figure metres tall (and minutes to draw).
+    """
+    return {key: table if len(table.rows) <= TABLE_ROWS else Table(
+        f'{table.title} (the first {TABLE_ROWS} of {len(table.rows)} rows; solve gives every '
+        'value)', table.columns, table.rows[:TABLE_ROWS]) for key, table in tables.items()}
+
+
 def _table(ax: Any, table: Table, mathcols: Sequence[int] = ()) -> None:
     ax.axis('off')
     rows = [list(row) for row in table.rows]
@@ -527,7 +540,7 @@ def figure_from_diagram(diagram: Diagram, scene: Scene) -> Any:
 
     scene = full_scene(scene)
     colours = colours_from_scene(scene)
-    tables = tables_from_diagram(diagram)  # row counts; drawn again below with scales
+    tables = _shown(tables_from_diagram(diagram))  # row counts; drawn again with scales
     space_rows = len(tables['space'].rows) + (len(tables['centres'].rows) + 2
                                               if 'centres' in tables else 0)
     rows = max([space_rows] + [len(tables[key].rows) for key in ('velocity', 'acceleration')
@@ -555,7 +568,7 @@ def figure_from_diagram(diagram: Diagram, scene: Scene) -> Any:
                     transform=ax.transAxes, ha='center', va='center', fontsize=FONT + 1)
         else:
             scales[key] = _polygon_panel(ax, polygon, colours)
-    tables = tables_from_diagram(diagram, scales)
+    tables = _shown(tables_from_diagram(diagram, scales))
     top = panel_y - 0.55
     n = len(tables['space'].rows) + 1
     _table(axes(xs[0], top - n * ROW_H, PANEL_W, n * ROW_H), tables['space'])
