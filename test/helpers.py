@@ -185,6 +185,22 @@ def node_parameters() -> frozenset:
     return frozenset({p.name for p in PARAMETERS} | STANDARD_PARAMETERS)
 
 
+def equilateral_chain(n, angle=0.3):
+    """Return a strip of ``n`` equilateral RRR dyads driven by a 1 m crank (issue 21, item 2).
+
+    Each dyad's links equal its base (the distance between its starts), 1 m: every
+    dyad's near-singularity measure is sin(60 deg) = 0.866, far from any toggle.
+    """
+    dyads = []
+    previous, current = 'A', 'B'
+    for k in range(n):
+        dyads.append(mk.RRR(f'P{k}', (mk.Link(f'a{k}', previous, 1.0),
+                                      mk.Link(f'b{k}', current, 1.0)), 1 - 2 * (k % 2)))
+        previous, current = current, f'P{k}'
+    crank = mk.Crank('crank', 'A', 'B', 1.0, angle, 2.0, 0.5)
+    return mk.Scene(f'chain{n}', {'A': (0.0, 0.0)}, crank, tuple(dyads))
+
+
 def strip_scene():
     """Return a strip of six rigid triangles on a four-bar's coupler (RRRs on one link).
 

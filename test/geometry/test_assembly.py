@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 
+from helpers import equilateral_chain
 import pytest
 
 import mech_kinematics as mk
@@ -163,18 +164,6 @@ def test_geneva_assembles_everywhere_without_dead_centres():
         ((), (), (), ())
 
 
-def _strip(dyads):
-    """Return a strip of ``dyads`` equilateral RRR triangles on a 1 m crank (one rigid body)."""
-    items = []
-    previous, current = 'A', 'B'
-    for k in range(dyads):
-        items.append(mk.RRR(f'P{k}', (mk.Link(f'a{k}', previous, 1.0),
-                                      mk.Link(f'b{k}', current, 1.0)), 1 - 2 * (k % 2)))
-        previous, current = current, f'P{k}'
-    return mk.Scene(f'strip{dyads}', {'A': (0.0, 0.0)}, mk.Crank('crank', 'A', 'B', 1.0, 0.3),
-                    tuple(items))
-
-
 def test_a_strip_of_rigid_triangles_is_checked_without_refining_its_constant_measures(
         monkeypatch):
     """40 triangles: their transmission angles are constant, no loop is a four-bar.
@@ -192,7 +181,7 @@ def test_a_strip_of_rigid_triangles_is_checked_without_refining_its_constant_mea
         return original(self, theta)
 
     monkeypatch.setattr(asm._Probe, 'solve', counted)
-    result = asm.assembly_from_scene(_strip(40))
+    result = asm.assembly_from_scene(equilateral_chain(40))
     assert len(solves) < 50, len(solves)
     assert result.toggles == () and result.dead_centres == () and result.loops == ()
     assert len(result.transmission) == 40
@@ -205,7 +194,7 @@ def test_check_says_a_constant_transmission_angle_holds_at_every_crank_angle():
     """The check's text and JSON of a strip: "at every crank angle", ``constant`` true."""
     from mech_kinematics.tools.check import report_json, report_text
 
-    scene = _strip(3)
+    scene = equilateral_chain(3)
     result = asm.assembly_from_scene(scene)
     text = report_text(result, scene)
     assert 'minimum transmission angle: 1.0472 rad at every crank angle (RRR P' in text

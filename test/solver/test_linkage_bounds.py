@@ -39,7 +39,8 @@ import subprocess
 import sys
 import warnings
 
-from helpers import actual_errors, assert_bounded, crank_scene_names, first_order_spreads, ROOT
+from helpers import (actual_errors, assert_bounded, crank_scene_names, equilateral_chain,
+                     first_order_spreads, ROOT)
 from hypothesis import assume, given, HealthCheck, settings
 from hypothesis import strategies as st
 import mpmath
@@ -770,22 +771,6 @@ def test_bound_is_within_1e3_of_a_1_ulp_change_of_the_inputs_where_well_conditio
     worst = max(bound / (spreads[path] + float(np.spacing(scale)))
                 for path, _, _, bound, scale in actual_errors(state, exact))
     assert worst <= TIGHTNESS, worst
-
-
-def equilateral_chain(n, angle=0.3):
-    """Return a strip of ``n`` equilateral RRR dyads driven by a 1 m crank (issue 21, item 2).
-
-    Each dyad's links equal its base (the distance between its starts), 1 m: every
-    dyad's near-singularity measure is sin(60 deg) = 0.866, far from any toggle.
-    """
-    dyads = []
-    previous, current = 'A', 'B'
-    for k in range(n):
-        dyads.append(mk.RRR(f'P{k}', (mk.Link(f'a{k}', previous, 1.0),
-                                      mk.Link(f'b{k}', current, 1.0)), 1 - 2 * (k % 2)))
-        previous, current = current, f'P{k}'
-    crank = mk.Crank('crank', 'A', 'B', 1.0, angle, 2.0, 0.5)
-    return mk.Scene(f'chain{n}', {'A': (0.0, 0.0)}, crank, tuple(dyads))
 
 
 def test_a_chain_of_equilateral_dyads_is_bounded_where_answered():
