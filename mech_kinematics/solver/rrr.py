@@ -280,7 +280,10 @@ class _RRRStep(Step):
         self.uses = (first.start, second.start)
         self.defines = (dyad.point, first.name, second.name)
         self.new_points = (dyad.point,)
-        self.rigid = base is not None and self._on(*base)
+        try:
+            self.rigid = base is not None and self._on(*base)
+        except (OverflowError, ZeroDivisionError):   # starts beyond doubles' range apart
+            self.rigid = False
 
     def _on(self, base: str, q1: complex, q2: complex, extent: float) -> bool:
         """Fix the triangle on link ``base``, its starts at ``q1`` and ``q2``; say if it closes.
@@ -306,7 +309,7 @@ class _RRRStep(Step):
         ux, uy = float(dx) / dist, float(dy) / dist
         c1 = complex(along * ux - height * uy, along * uy + height * ux)
         c2 = c1 - (q2 - q1)
-        measure = abs(height) * dist / (self.l1 * self.l2)
+        measure = (abs(height) / self.l1) * (dist / self.l2)  # (no product of lengths)
         self.base = base
         self.uses = (*self.uses, base)
         self.c1r, self.c1i, self.c2r, self.c2i = c1.real, c1.imag, c2.real, c2.imag

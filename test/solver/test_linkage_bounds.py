@@ -862,6 +862,25 @@ def test_long_chains_of_equilateral_dyads_are_answered_within_their_bounds(dyads
         assert joint.acceleration == pytest.approx(0.5, rel=1e-9), name
 
 
+@pytest.mark.parametrize('size', [1e-300, 1e-200, 1e200, 1e300])
+def test_strips_of_any_size_are_answered_alike(size):
+    """A strip of 1e-300 m triangles built (its lengths' product underflowed: ZeroDivisionError).
+
+    At every size the rigid triangles' bounds are those of the 1 m strip, to rounding.
+    """
+    unit = mk.solve(equilateral_chain(50), 0.3).relative_error_bound
+    dyads, previous, current = [], 'A', 'B'
+    for k in range(50):
+        dyads.append(mk.RRR(f'P{k}', (mk.Link(f'a{k}', previous, size),
+                                      mk.Link(f'b{k}', current, size)), 1 - 2 * (k % 2)))
+        previous, current = current, f'P{k}'
+    scene = mk.Scene('strip', {'A': (0.0, 0.0)},
+                     mk.Crank('crank', 'A', 'B', size, 0.3, 2.0, 0.5), tuple(dyads))
+    state = mk.solve(scene, 0.3)
+    assert state.relative_error_bound == pytest.approx(unit, rel=0.05)
+    assert state.joints['b49'].position == pytest.approx(0.3, abs=1e-13)
+
+
 def four_bar_chain(n, angle=0.3):
     """Return ``n`` four-bars in series, each driven by the previous one's rocker tip.
 
