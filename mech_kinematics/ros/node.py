@@ -28,6 +28,7 @@ Run it with ``ros2 run mech_kinematics kinematics_node`` or
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import ctypes
 from dataclasses import replace
@@ -494,13 +495,14 @@ class KinematicsNode(LifecycleNode):
                 why = ''
             if self._compiling is not token:
                 return
-            if tick is None:
+            if tick is not None:
+                self._solve = tick
+            # (the node may be shutting down: a log it cannot write is no error)
+            with contextlib.suppress(Exception):
                 self.get_logger().info(
-                    f'the scene is solved by the general solver (not compiled){why}')
-                return
-            self._solve = tick
-            self.get_logger().info(f'the compiled tick serves from now (compiled in '
-                                   f'{time.monotonic() - started:.1f} s)')
+                    f'the scene is solved by the general solver (not compiled){why}'
+                    if tick is None else f'the compiled tick serves from now (compiled in '
+                    f'{time.monotonic() - started:.1f} s)')
 
         # Started once the rest of the set-up is done: a thread holding the GIL slows
         # every release and re-acquisition of it by this one (the assembly sweep's NumPy).
