@@ -49,7 +49,7 @@ deep minimum within one step of the first is reported once.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 import itertools
 import math
@@ -61,7 +61,7 @@ import numpy.typing as npt
 
 from .instant_centres import full_scene, one_driver
 from ..errors import AssemblyError, NearSingularWarning
-from ..solver import assembly_margins, Scene, SceneUnits, solve
+from ..solver import assembly_margins, JointMotion, Scene, SceneUnits, solve
 
 __all__ = [
     'Assembly', 'DeadCentre', 'FourBarLoop', 'SAMPLES', 'TOLERANCE', 'Toggle', 'Transmission',
@@ -84,6 +84,8 @@ TOUCH = 1e-14
 CHANGE_POINT = 1e-9
 #: Crank angles sampled at least in each range where it assembles, for dead centres.
 RANGE_SAMPLES = 64
+#: Angles times steps solved in one array at most (about 400 bytes each).
+CELLS = 1_000_000
 #: A local minimum of a sampled measure dips this much of its value below a neighbour.
 DIP = 1e-12
 _TURN = 2.0 * math.pi
@@ -284,10 +286,20 @@ class _Probe:
         self.touches: list[tuple[float, str]] = []
 
     def solve(self, theta: float | Array) -> object:
-        """Solve at crank speed 1 rad/s, refusing only what does not assemble."""
+        """Solve at crank speed 1 rad/s, refusing only what does not assemble.
+
+        An array of more angles than :data:`CELLS` over the scene's steps is
+        solved in parts of that many, and only what the study reads of the
+        parts is joined (:class:`_Joined`): a long chain's whole state over a
+        turn would take gigabytes (3 GB for 2,000 dyads at 3600 angles).
+        """
         with warnings.catch_warnings():
             warnings.simplefilter('ignore', NearSingularWarning)
-            return solve(self.scene, theta, 1.0, 0.0, max_error=math.inf)
+            part = max(64, CELLS // max(1, len(self.scene.dyads) + len(self.scene.points)))
+            if np.ndim(theta) == 0 or len(theta) <= part:
+                return solve(self.scene, theta, 1.0, 0.0, max_error=math.inf)
+            return _Joined(solve(self.scene, theta[i:i + part], 1.0, 0.0, max_error=math.inf)
+                           for i in range(0, len(theta), part))
 
     def failure(self, theta: float) -> AssemblyError | None:
         try:
@@ -295,6 +307,32 @@ class _Probe:
         except AssemblyError as error:
             return error
         return None
+
+
+class _Joined:
+    """What the study reads of an array state (``valid``, ``singularity``, ``joints``).
+
+    Joined from the states of consecutive parts of the angles, each dropped once
+    read (``parts`` is an iterator).
+    """
+
+    def __init__(self, parts: Iterable[Any]) -> None:
+        valid: list[Array] = []
+        singularity: dict[str, list[Array]] = {}
+        joints: dict[str, tuple[str, list[Array], list[Array], list[Array]]] = {}
+        for part in parts:
+            valid.append(np.asarray(part.valid, dtype=bool))
+            for key, measure in part.singularity.items():
+                singularity.setdefault(key, []).append(np.asarray(measure))
+            for name, joint in part.joints.items():
+                kind, *fields = joints.setdefault(name, (joint.type, [], [], []))
+                for field, value in zip(fields, (joint.position, joint.velocity,
+                                                 joint.acceleration), strict=True):
+                    field.append(np.asarray(value))
+        self.valid = np.concatenate(valid)
+        self.singularity = {key: np.concatenate(v) for key, v in singularity.items()}
+        self.joints = {name: JointMotion(kind, *(np.concatenate(f) for f in fields))
+                       for name, (kind, *fields) in joints.items()}
 
 
 def _ranges(probe: _Probe) -> tuple[tuple[float, float], ...]:

@@ -22,7 +22,7 @@ must decide: a bound beyond the quick trust test (:func:`.solve.trust_limits`:
 the general path refuses with the full reason, or answers), a crank rate it
 would rescale. Scenes neither path compiles (rescaled lengths, pins to bound,
 an intermittent lever whose engagement the state reports, a kernel outside the
-subset) keep the general path.
+subset, more than :data:`COMPILE_STEPS` steps) keep the general path.
 
 Large array solves also keep freed memory for the next one
 (:func:`keep_freed_memory`).
@@ -43,8 +43,9 @@ from .state import JointMotion
 if TYPE_CHECKING:
     from .mechanism import Scene
 
-__all__ = ['ARRAY_COMPILE_AFTER', 'ArrayFunction', 'COMPILE_AFTER', 'KEEP_FREED', 'LARGE_BATCH',
-           'SingleFunction', 'compile_array', 'compile_single', 'keep_freed_memory']
+__all__ = ['ARRAY_COMPILE_AFTER', 'ArrayFunction', 'COMPILE_AFTER', 'COMPILE_STEPS', 'KEEP_FREED',
+           'LARGE_BATCH', 'SingleFunction', 'compile_array', 'compile_single',
+           'keep_freed_memory']
 
 #: Single-angle solves of one scene on the general path before it is compiled: a
 #: compilation (constants folded) costs about as much as a few thousand single-angle
@@ -55,6 +56,10 @@ COMPILE_AFTER = 256
 #: what a few dozen single angles do, or more.
 ARRAY_COMPILE_AFTER = 16
 
+#: Scenes of more steps than this keep the general path here: compiling grows faster
+#: than the steps (100 dyads about 3 s, 1,000 about 50 s), more than a scene solved a
+#: few thousand times saves. The node's tick compiles them in the background.
+COMPILE_STEPS = 128
 #: ``array(theta, omega, alpha, turns, ctx) -> None``; see :func:`compile_array`.
 ArrayFunction = Callable[[Any, Any, Any, Any, Any], None]
 
@@ -95,7 +100,8 @@ def compile_single(scene: Scene) -> SingleFunction | None:
 
     plan = hooks.tick_plan(scene)
     solver = scene._solver
-    if not plan.compilable or solver.levers or plan.driver_limits is not None:
+    if not plan.compilable or solver.levers or plan.driver_limits is not None \
+            or len(plan.steps) > COMPILE_STEPS:
         # An intermittent lever's state, or several drivers' (the node's tick compiles those)
         return None
     namespace: dict[str, Any] = {
@@ -181,7 +187,8 @@ def compile_array(scene: Scene, rates: tuple[float, float] | None = None
     from . import tick as hooks     # the tick's hooks import the solve this serves
 
     plan = hooks.tick_plan(scene)
-    if not plan.compilable or scene._solver.levers or plan.driver_limits is not None:
+    if not plan.compilable or scene._solver.levers or plan.driver_limits is not None \
+            or len(plan.steps) > COMPILE_STEPS:
         return None
     namespace: dict[str, Any] = {}
     names: dict[str, str] = {}

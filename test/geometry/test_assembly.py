@@ -201,3 +201,12 @@ def test_check_says_a_constant_transmission_angle_holds_at_every_crank_angle():
     assert '  RRR P1: 1.0472 rad at every crank angle' in text
     assert 'four-bar loops: none' in text
     assert [t['constant'] for t in report_json(result, scene)['transmission']] == [True] * 3
+
+
+@pytest.mark.parametrize('name', ['four_bar_coupler_points', 'quick_return', 'whitworth'])
+def test_the_study_in_parts_of_the_angles_is_the_study_in_one(monkeypatch, name):
+    """Solved in parts of 64 angles (as a long chain's turn is), every finding is the same."""
+    scene = mk.load_scene(name)
+    whole = asm.assembly_from_scene(scene)
+    monkeypatch.setattr(asm, 'CELLS', 1)
+    assert asm.assembly_from_scene(mk.load_scene(name)) == whole

@@ -315,3 +315,14 @@ def test_a_constant_speed_keeps_its_sign_of_zero_in_an_array_state():
         state = mk.solve(scene, angles, speed)
         assert not state.speed.flags.writeable
         assert (np.signbit(state.speed) == np.signbit(speed)).all()
+
+
+def test_a_scene_of_more_steps_than_compile_steps_keeps_the_general_path():
+    """A strip of COMPILE_STEPS + 1 dyads is never compiled by solve (it would take seconds)."""
+    from helpers import equilateral_chain
+
+    from mech_kinematics.solver.compiled import COMPILE_STEPS
+
+    assert compile_single(equilateral_chain(COMPILE_STEPS + 1)) is None
+    assert compile_array(equilateral_chain(COMPILE_STEPS + 1)) is None
+    assert compile_single(equilateral_chain(8)) is not None
