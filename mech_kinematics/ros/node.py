@@ -97,6 +97,8 @@ SWITCH_INTERVAL_S = 0.0005
 #: A scene of more dyads and points than this compiles its tick in the background (about
 #: 25 ms a step) while the general solver serves (:meth:`KinematicsNode._setup_solve`).
 BACKGROUND_STEPS = 16
+#: What the node logs of a scene whose tick does not compile.
+GENERAL_SOLVER = 'the scene is solved by the general solver (not compiled)'
 #: The node-private, hidden topic on which each node says when it started (transient local,
 #: so that a newcomer of the same name hears an older node as soon as they are matched).
 INSTANCE_TOPIC = '~/_instance'
@@ -474,7 +476,7 @@ class KinematicsNode(LifecycleNode):
             self._assembly = assembly_summary(scene) if sweep else ''
             self._solve, compiled = tick_function(*outputs)
             if not compiled:
-                self.get_logger().info('the scene is solved by the general solver (not compiled)')
+                self.get_logger().info(GENERAL_SOLVER)
             return
         self._solve = general_tick(*outputs)
         self.get_logger().info(
@@ -500,8 +502,8 @@ class KinematicsNode(LifecycleNode):
             # (the node may be shutting down: a log it cannot write is no error)
             with contextlib.suppress(Exception):
                 self.get_logger().info(
-                    f'the scene is solved by the general solver (not compiled){why}'
-                    if tick is None else f'the compiled tick serves from now (compiled in '
+                    f'{GENERAL_SOLVER}{why}' if tick is None else
+                    f'the compiled tick serves from now (compiled in '
                     f'{time.monotonic() - started:.1f} s)')
 
         # Started once the rest of the set-up is done: a thread holding the GIL slows

@@ -60,6 +60,7 @@ ARRAY_COMPILE_AFTER = 16
 #: than the steps (100 dyads about 3 s, 1,000 about 50 s), more than a scene solved a
 #: few thousand times saves. The node's tick compiles them in the background.
 COMPILE_STEPS = 128
+
 #: ``array(theta, omega, alpha, turns, ctx) -> None``; see :func:`compile_array`.
 ArrayFunction = Callable[[Any, Any, Any, Any, Any], None]
 
@@ -102,7 +103,8 @@ def compile_single(scene: Scene) -> SingleFunction | None:
     solver = scene._solver
     if not plan.compilable or solver.levers or plan.driver_limits is not None \
             or len(plan.steps) > COMPILE_STEPS:
-        # An intermittent lever's state, or several drivers' (the node's tick compiles those)
+        # An intermittent lever's state, several drivers' (the node's tick compiles those),
+        # or a scene too long to be worth compiling here
         return None
     namespace: dict[str, Any] = {
         '_ctx_check': hooks.check, '_ctx_check_margin': hooks.check_margin,

@@ -119,7 +119,7 @@ class _Solver:
         self.usual_floors: Any = None
         self.array_solves = 0
         self.scene = scene
-        # Per array shape, the ground points' values as read-only arrays (solve._state).
+        # Per array shape, its read-only arrays of one value each (solve._Constants).
         self.constant_arrays: dict[tuple[int, ...], Any] = {}
 
     def floors(self, speeds: Any, accels: Any) -> tuple[Any, Any, Any, Any]:

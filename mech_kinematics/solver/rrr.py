@@ -416,9 +416,10 @@ class _RRRStep(Step):
         # step's rounding of d and dist (2 U dist) and of lsum and ldiff. The margin
         # is linear in them: beyond ROUNDING_MARGIN spreads of the limit no input
         # within its error can cross it; nearer, either way, it is not trusted.
-        inputs = ep1 + ep2
-        if self.rigid:  # starts fixed on one link: only their distance's error counts
-            inputs = abs(dist - self.dist0) + self.e_dist
+        if self.rigid:  # noqa: SIM108 (the tick folds an ``if`` on self, not an if-else value)
+            inputs = abs(dist - self.dist0) + self.e_dist   # only the starts' distance's error
+        else:
+            inputs = ep1 + ep2
         spread = inputs + self.e_lengths + _U2 * dist
         outer = lsum - dist
         inner = dist - abs(ldiff)
@@ -474,30 +475,9 @@ class _RRRStep(Step):
         # (t also holds the rounding of the dot products and of w = dot * inv).
         # Likewise the acceleration system, whose right side
         # da = a2 - a1 + w1^2 r1 - w2^2 r2 moves with the w's.
-        inv_m = 1.0 / measure
-        er = spread * inv_m + self.e_forward
-        erp = er + self.e_round
         inv_l1, inv_l2 = self.inv_l1, self.inv_l2
         aw1 = abs(w1)
-        aws = aw1 + abs(w2)
-        t = (ev1 + ev2 + aws * erp) * inv_m
         aa1 = abs(al1)
-        ta = (ea1 + ea2 + (2.0 * aws + t * self.inv_sum) * t
-              + (w1sq + w2sq + aa1 + abs(al2)) * erp) * inv_m
-        ew1 = t * inv_l1
-        # The pin C = p1 + r1(p2 - p1) moves with its starts as J1 dp1 + J2 dp2, where
-        # J2 is r1's derivative and J1 = I - J2: each of norm 1 / measure (moving one
-        # start, the pin turns about the other), so the starts' bounds over the measure,
-        # in er, bound both terms (ep1 + er would count p1 twice). Its velocity and
-        # acceleration move likewise with (v1, v2) and (a1, a2), in t and ta.
-        # The sums p1 + r1 etc. round by U |p1| + U l1 (U l1 in er),
-        # U |v1| + U |w1| l1 and 2 U |a1| + a few U (|al1| + w1^2) l1 (in erp).
-        bp = er + U * (abs(p1.real) + abs(p1.imag))
-        bv = U * (abs(v1.real) + abs(v1.imag)) + t + aw1 * erp
-        ba = (_U2 * (abs(a1.real) + abs(a1.imag)) + ta + (2.0 * aw1 + ew1) * t
-              + (aa1 + w1sq) * erp)
-        be1, bw1, bal1 = er * inv_l1 + _U7, ew1, ta * inv_l1
-        be2, bw2, bal2 = er * inv_l2 + _U7, t * inv_l2, ta * inv_l2
         if self.rigid:
             # A rigid triangle on link base (see _on): the truth moves with the base, the
             # pin at c1 from start 1 and c2 from start 2 on it, both links at the base's
@@ -523,6 +503,28 @@ class _RRRStep(Step):
                   + (ra1 + rw1 * (2.0 * aw1 + rw1)) * reach + (aab + eab + wt * wt) * rr1)
             be1, bw1, bal1 = rr1 * inv_l1 + _U7, rw1, ra1
             be2, bw2, bal2 = rr2 * inv_l2 + _U7, rw2, ra2
+        else:
+            inv_m = 1.0 / measure
+            er = spread * inv_m + self.e_forward
+            erp = er + self.e_round
+            aws = aw1 + abs(w2)
+            t = (ev1 + ev2 + aws * erp) * inv_m
+            ta = (ea1 + ea2 + (2.0 * aws + t * self.inv_sum) * t
+                  + (w1sq + w2sq + aa1 + abs(al2)) * erp) * inv_m
+            ew1 = t * inv_l1
+            # The pin C = p1 + r1(p2 - p1) moves with its starts as J1 dp1 + J2 dp2, where
+            # J2 is r1's derivative and J1 = I - J2: each of norm 1 / measure (moving one
+            # start, the pin turns about the other), so the starts' bounds over the measure,
+            # in er, bound both terms (ep1 + er would count p1 twice). Its velocity and
+            # acceleration move likewise with (v1, v2) and (a1, a2), in t and ta.
+            # The sums p1 + r1 etc. round by U |p1| + U l1 (U l1 in er),
+            # U |v1| + U |w1| l1 and 2 U |a1| + a few U (|al1| + w1^2) l1 (in erp).
+            bp = er + U * (abs(p1.real) + abs(p1.imag))
+            bv = U * (abs(v1.real) + abs(v1.imag)) + t + aw1 * erp
+            ba = (_U2 * (abs(a1.real) + abs(a1.imag)) + ta + (2.0 * aw1 + ew1) * t
+                  + (aa1 + w1sq) * erp)
+            be1, bw1, bal1 = er * inv_l1 + _U7, ew1, ta * inv_l1
+            be2, bw2, bal2 = er * inv_l2 + _U7, t * inv_l2, ta * inv_l2
         ctx.points[self.point] = (
             p1 + r1, v1 + 1j * w1 * r1, a1 + 1j * al1 * r1 - w1 * w1 * r1, bp, bv, ba)
         ctx.links[self.link1] = (r1 * (1.0 / l1), w1, al1, be1, bw1, bal1)
