@@ -328,6 +328,8 @@ body { font: 14px sans-serif; margin: 0; display: flex; flex-direction: column; 
 header { padding: 6px 10px; background: #eee; display: flex; gap: 16px; align-items: center;
          flex-wrap: wrap; }
 canvas { flex: 1; width: 100%; min-height: 0; background: #fff; }
+/* two lines, always: a status whose text wraps differently must not move the drawing */
+#status { flex-basis: 100%; line-height: 1.2em; height: 2.4em; overflow: hidden; }
 #status span { margin-right: 12px; }
 .l0 { color: #1a7f37; } .l1 { color: #b35900; } .l2 { color: #c00; } .l3 { color: #777; }
 #drawn { display: none; }
