@@ -210,7 +210,15 @@ def _refuse(solver: _Solver, ctx: _Context, floors: tuple[Any, Any, Any, Any],
 
 def _judge(solver: _Solver, ctx: _Context, floors: tuple[Any, Any, Any, Any], tol: float,
            shape: tuple[int, ...]) -> None:
-    """Mask the angles of a vector solve where a reported bound exceeds ``tol``."""
+    """Mask the angles of a vector solve where a reported bound exceeds ``tol``.
+
+    Each kind's scale (:attr:`State.scales`) is at least its floor, and
+    :func:`.bounds.limit` grows with the scale, so an angle whose every bound
+    is within ``limit(tol, floor)`` passes; only the other angles (the
+    suspects) need the scales, which are norms of every reported value, and
+    they are judged there alone: the same masks as judging every angle, at
+    the cost of the few near a singular position.
+    """
     speed, accel, turn, turn_accel = floors
     lims = {'position': tol * solver.size, 'angle': tol * 1.0, 'velocity': tol * speed,
             'angular velocity': tol * turn, 'acceleration': tol * accel,
@@ -219,23 +227,51 @@ def _judge(solver: _Solver, ctx: _Context, floors: tuple[Any, Any, Any, Any], to
             and getattr(turn, 'ndim', 0) == 0 and getattr(turn_accel, 'ndim', 0) == 0 \
             and _within(solver, ctx, lims):
         return  # nothing refused, one rate, the largest bounds within the floors: as below
-    failed = np.logical_not(ctx.valid)  # already refused: not judged again
-    if all(bool(((entry[3] <= lims[kinds[0]]) & (entry[4] <= lims[kinds[1]])
-                 & (entry[5] <= lims[kinds[2]]) | failed).all())
-           for table, name, _, _, kinds in solver.outputs
-           for entry in (getattr(ctx, table)[name],)) and all(
-               bool(((bound <= lims['velocity']) | failed).all())
-               for _, bound in ctx.rubbing.values()):
-        return  # within the floors of the scales (as _trusted): no norms needed
-    scales = _context_scales(solver, ctx, floors)
+    floor_lims = {kind: limit(tol, floor) for kind, floor in
+                  _scales(solver.size, floors, (), (), (), True).items()}
+    suspect = np.zeros(shape, dtype=bool)
+    if ctx.sums is not None:    # the compiled solve's sums: each at least every bound it adds
+        kinds, table = ctx.sums
+        for kind, total in zip(kinds, table, strict=True):
+            suspect |= ~np.less_equal(total, floor_lims[kind])
+    else:
+        for table_name, name, _, _, kinds in solver.outputs:
+            entry = getattr(ctx, table_name)[name]
+            for kind, bound in zip(kinds, entry[3:], strict=True):
+                suspect |= ~np.less_equal(bound, floor_lims[kind])
+    for _, bound in ctx.rubbing.values():
+        suspect |= ~np.less_equal(bound, floor_lims['velocity'])
+    if ctx.valid is not True:
+        suspect &= ctx.valid    # already refused: not judged again
+    at = np.flatnonzero(suspect)
+    if not at.size:
+        return
+
+    def there(x: Any) -> Any:
+        return x if np.ndim(x) == 0 else np.broadcast_to(x, shape)[at]
+
+    speed, accel, turn, turn_accel = (there(floor) for floor in floors)
+    scales = _scales(solver.size, (speed, accel, turn, turn_accel),
+                     [tuple(map(there, ctx.points[name][1:3])) for name in solver.out_points],
+                     [tuple(map(there, ctx.sliders[name][1:3])) for name in solver.out_sliders],
+                     [tuple(map(there, ctx.links[name][1:3])) for name in solver.out_links],
+                     True)
     lims = {kind: limit(tol, scale) for kind, scale in scales.items()}
-    for table, name, _, label, kinds in solver.outputs:
-        entry = getattr(ctx, table)[name]
-        ok = ((entry[3] <= lims[kinds[0]]) & (entry[4] <= lims[kinds[1]])
-              & (entry[5] <= lims[kinds[2]]))
-        ctx.mask(np.broadcast_to(ok, shape), f'{label} (untrusted)')
+
+    def mask(ok: Any, label: str) -> None:
+        if not ok.all():
+            full = np.ones(shape, dtype=bool)
+            full[at] = ok
+            ctx.mask(full, label)
+
+    for table_name, name, _, label, kinds in solver.outputs:
+        entry = getattr(ctx, table_name)[name]
+        ok = ((there(entry[3]) <= lims[kinds[0]]) & (there(entry[4]) <= lims[kinds[1]])
+              & (there(entry[5]) <= lims[kinds[2]]))
+        mask(np.broadcast_to(ok, at.shape), f'{label} (untrusted)')
     for name, (_, bound) in ctx.rubbing.items():
-        ctx.mask(np.broadcast_to(bound <= lims['velocity'], shape), f'pin {name} (untrusted)')
+        ok = there(bound) <= lims['velocity']
+        mask(np.broadcast_to(ok, at.shape), f'pin {name} (untrusted)')
 
 
 def _within(solver: _Solver, ctx: _Context, lims: dict[str, float]) -> bool:

@@ -565,6 +565,45 @@ def test_paths_give_the_same_bounds_on_random_mechanisms(scene, motion):
     assert_paths_agree(scene, theta, *motion, max_errors=(1e-6, 1e-12))
 
 
+def test_the_array_path_judges_with_each_angles_own_scales():
+    """Angles whose bounds exceed the floors of the scales are judged with their own scales.
+
+    The array path judges only those angles (``_judge``), with the norms of
+    their values. At a tolerance that refuses about half of a coupler-point
+    four-bar's assembled angles, its refusals are exactly where the state's
+    relative bound exceeds the tolerance, as the single-angle path refuses,
+    and some angles answered have a bound beyond the tolerance times the
+    crank tip's speed (the floor): judged by the floor alone, they would be
+    refused.
+    """
+    scene = mk.load_scene('four_bar_coupler_points')
+    theta = np.linspace(0, 2 * np.pi, 720, endpoint=False)
+    everything = mk.solve(scene, theta, max_error=math.inf)
+    relative = everything.relative_error_bound
+    ordered = np.sort(relative[everything.valid])
+    middle = len(ordered) // 2
+    tol = float(np.sqrt(ordered[middle] * ordered[middle + 1]))  # between two samples
+    state = mk.solve(scene, theta, max_error=tol)
+    np.testing.assert_array_equal(state.valid, everything.valid & (relative <= tol))
+    assert 0 < state.valid.sum() < everything.valid.sum()
+    crank = scene.input
+    rate = crank.speed ** 2 + abs(crank.accel)
+    joints, points = everything.error_bound.raw()
+    against_floors = np.fmax.reduce(
+        [b[1] / (crank.length * abs(crank.speed)) for b in points.values()]
+        + [b[2] / (crank.length * rate) for b in points.values()]
+        + [b[1] / abs(crank.speed) for b in joints.values()]
+        + [b[2] / rate for b in joints.values()])
+    assert (state.valid & (against_floors > tol)).sum() > 20
+    for index in range(0, len(theta), 7):
+        try:
+            mk.solve(scene, float(theta[index]), max_error=tol)
+        except mk.AssemblyError:
+            assert not state.valid[index]
+        else:
+            assert state.valid[index]
+
+
 def test_refused_angles_name_the_reason_in_failures():
     """The array path marks untrusted angles invalid under '<dyad> (untrusted)'."""
     theta = np.array([0.3, 1e-6, -1e-6, 1e-2])
