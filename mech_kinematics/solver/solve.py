@@ -561,6 +561,8 @@ def _solve_drivers(scene: Scene, solver: _Solver, positions: Any, speeds: Any, a
         if not all(np.isfinite(a).all() for a in arrays):
             msg = 'Expected the positions, speeds and accels of the drivers to be finite'
             raise ValueError(msg)
+        if shape[0] >= LARGE_BATCH:
+            keep_freed_memory()
         n = len(drivers)
         # Copies: the state's arrays get NaN where refused, never the caller's own.
         xs = [np.array(np.broadcast_to(a, shape)) for a in arrays[:n]]
