@@ -9,7 +9,7 @@ within rounding of an assembly limit.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 import math
 from typing import Any, TYPE_CHECKING
 import warnings
@@ -114,12 +114,22 @@ def _execute_drivers(solver: _Solver, positions: tuple[Any, ...], speeds: tuple[
     return ctx
 
 
-def _context_scales(solver: _Solver, ctx: _Context, floors: tuple[Any, Any, Any, Any]
-                    ) -> dict[str, Any]:
-    return _scales(solver.size, floors,
-                   [ctx.points[name][1:3] for name in solver.out_points],
-                   [ctx.sliders[name][1:3] for name in solver.out_sliders],
-                   [ctx.links[name][1:3] for name in solver.out_links], ctx.vector)
+def _context_scales(solver: _Solver, ctx: _Context, floors: tuple[Any, Any, Any, Any],
+                    pick: Callable[[Any], Any] | None = None) -> dict[str, Any]:
+    """Return each kind's scale from the reported values; ``pick`` takes some angles of each."""
+    def chosen(values: Any) -> Any:
+        return values if pick is None else tuple(map(pick, values))
+
+    return _scales(solver.size, chosen(floors),
+                   [chosen(ctx.points[name][1:3]) for name in solver.out_points],
+                   [chosen(ctx.sliders[name][1:3]) for name in solver.out_sliders],
+                   [chosen(ctx.links[name][1:3]) for name in solver.out_links], ctx.vector)
+
+
+def _reported_bounds(solver: _Solver, ctx: _Context) -> Iterator[tuple[str, Any]]:
+    """Yield (kind, bound) of every reported value's bound, in the outputs' order."""
+    for table, name, _, _, kinds in solver.outputs:
+        yield from zip(kinds, getattr(ctx, table)[name][3:], strict=True)
 
 
 def trust_limits(tol: float, omega: float, alpha: float, size: float,
@@ -220,25 +230,18 @@ def _judge(solver: _Solver, ctx: _Context, floors: tuple[Any, Any, Any, Any], to
     the cost of the few near a singular position.
     """
     speed, accel, turn, turn_accel = floors
-    lims = {'position': tol * solver.size, 'angle': tol * 1.0, 'velocity': tol * speed,
-            'angular velocity': tol * turn, 'acceleration': tol * accel,
-            'angular acceleration': tol * turn_accel}
+    least = {'position': solver.size, 'angle': 1.0, 'velocity': speed, 'angular velocity': turn,
+             'acceleration': accel, 'angular acceleration': turn_accel}
     if ctx.valid is True and getattr(speed, 'ndim', 0) == 0 and getattr(accel, 'ndim', 0) == 0 \
             and getattr(turn, 'ndim', 0) == 0 and getattr(turn_accel, 'ndim', 0) == 0 \
-            and _within(solver, ctx, lims):
+            and _within(solver, ctx, {kind: tol * x for kind, x in least.items()}):
         return  # nothing refused, one rate, the largest bounds within the floors: as below
-    floor_lims = {kind: limit(tol, floor) for kind, floor in
-                  _scales(solver.size, floors, (), (), (), True).items()}
+    floor_lims = {kind: limit(tol, x) for kind, x in least.items()}
     suspect = np.zeros(shape, dtype=bool)
-    if ctx.sums is not None:    # the compiled solve's sums: each at least every bound it adds
-        kinds, table = ctx.sums
-        for kind, total in zip(kinds, table, strict=True):
-            suspect |= ~np.less_equal(total, floor_lims[kind])
-    else:
-        for table_name, name, _, _, kinds in solver.outputs:
-            entry = getattr(ctx, table_name)[name]
-            for kind, bound in zip(kinds, entry[3:], strict=True):
-                suspect |= ~np.less_equal(bound, floor_lims[kind])
+    pairs = (zip(*ctx.sums, strict=True) if ctx.sums is not None  # the compiled sums, each
+             else _reported_bounds(solver, ctx))  # at least every bound it adds
+    for kind, bound in pairs:
+        suspect |= ~np.less_equal(bound, floor_lims[kind])
     for _, bound in ctx.rubbing.values():
         suspect |= ~np.less_equal(bound, floor_lims['velocity'])
     if ctx.valid is not True:
@@ -250,13 +253,8 @@ def _judge(solver: _Solver, ctx: _Context, floors: tuple[Any, Any, Any, Any], to
     def there(x: Any) -> Any:
         return x if np.ndim(x) == 0 else np.broadcast_to(x, shape)[at]
 
-    speed, accel, turn, turn_accel = (there(floor) for floor in floors)
-    scales = _scales(solver.size, (speed, accel, turn, turn_accel),
-                     [tuple(map(there, ctx.points[name][1:3])) for name in solver.out_points],
-                     [tuple(map(there, ctx.sliders[name][1:3])) for name in solver.out_sliders],
-                     [tuple(map(there, ctx.links[name][1:3])) for name in solver.out_links],
-                     True)
-    lims = {kind: limit(tol, scale) for kind, scale in scales.items()}
+    lims = {kind: limit(tol, scale)
+            for kind, scale in _context_scales(solver, ctx, floors, there).items()}
 
     def mask(ok: Any, label: str) -> None:
         if not ok.all():
@@ -296,13 +294,8 @@ def _within(solver: _Solver, ctx: _Context, lims: dict[str, float]) -> bool:
                 return False
     else:
         sums: dict[str, Any] = {}
-        for table, name, _, _, kinds in solver.outputs:
-            entry = getattr(ctx, table)[name]
-            for kind, bound in zip(kinds, entry[3:], strict=True):
-                if kind in sums:
-                    sums[kind] = sums[kind] + bound
-                else:
-                    sums[kind] = bound
+        for kind, bound in _reported_bounds(solver, ctx):
+            sums[kind] = sums[kind] + bound if kind in sums else bound
         if not all(largest(total, axis=None) <= lims[kind] for kind, total in sums.items()):
             return False
     lim = lims['velocity']
