@@ -34,6 +34,37 @@ from ..scene import load_scene, scene_names
 from ..solver import solve
 
 
+#: The carried points of a hand-written form, in order: (link, from its start, u, v) each,
+#: the point at ``u + i v`` (m) in the frame with origin at one end of the link and
+#: x-axis toward the other: its start (from its start) or its end (the dyad's new point).
+Carried = tuple[tuple[int, bool, float, float], ...]
+
+
+def carry(carried: Carried, links: Sequence[tuple[Any, ...]],
+          ends: tuple[Any, ...]) -> tuple[Any, ...]:
+    """Return the position, velocity and acceleration (x, y each) of every carried point.
+
+    ``links[k]`` holds link k's start (x, y), its velocity and acceleration,
+    a vector from its start toward its end and that vector's length, its
+    angular velocity and acceleration; ``ends`` the end's position, velocity
+    and acceleration (the same for every link: the dyad's new point). Plain
+    arithmetic, the local coordinates scaled by the length once: floats or
+    arrays alike.
+    """
+    out: tuple[Any, ...] = ()
+    for link, forward, u, v in carried:
+        sx, sy, vsx, vsy, asx, asy, ux, uy, length, w, al = links[link]
+        if forward:
+            ox, oy, vox, voy, aox, aoy = sx, sy, vsx, vsy, asx, asy
+            u, v = u / length, v / length
+        else:
+            (ox, oy, vox, voy, aox, aoy), u, v = ends, -u / length, -v / length
+        dx, dy = u * ux - v * uy, u * uy + v * ux
+        out += (ox + dx, oy + dy, vox - w * dy, voy + w * dx,
+                aox - al * dy - w * w * dx, aoy + al * dx - w * w * dy)
+    return out
+
+
 #: A four-bar's geometry for the hand-written forms: crank centre (x, y), crank,
 #: coupler and rocker lengths, rocker pivot (x, y), branch sign (+1: C to the left
 #: of B -> D). The default is the packaged four-bar (AD = 150, AB = 40, BC = 150,
@@ -46,8 +77,13 @@ SLIDER_CRANK_GEOMETRY = (0.0, 0.0, 0.15, 0.6, 0.0, -1.0)
 
 
 def four_bar_math(theta: float, w: float, al: float,
-                  geometry: tuple[float, ...] = FOUR_BAR_GEOMETRY) -> tuple[float, ...]:
-    """Hand-written four-bar with :mod:`math`: link angles, rates, accelerations; B and C."""
+                  geometry: tuple[float, ...] = FOUR_BAR_GEOMETRY,
+                  carried: Carried = ()) -> tuple[float, ...]:
+    """Hand-written four-bar with :mod:`math`: link angles, rates, accelerations; B and C.
+
+    Then each ``carried`` point's position, velocity and acceleration (x, y
+    each; :func:`carry`): link 0 is the coupler B -> C, link 1 the rocker D -> C.
+    """
     ox, oy, a, b, c, dx, dy, side = geometry
     bx, by = ox + a * math.cos(theta), oy + a * math.sin(theta)
     vbx, vby = -w * (by - oy), w * (bx - ox)
@@ -69,12 +105,29 @@ def four_bar_math(theta: float, w: float, al: float,
     vcx, vcy = vbx - w1 * r1y, vby + w1 * r1x
     acx = abx - a1 * r1y - w1 * w1 * r1x
     acy = aby + a1 * r1x - w1 * w1 * r1y
-    return (math.atan2(r1y, r1x), math.atan2(r2y, r2x), w1, w2, a1, a2,
-            bx, by, vbx, vby, abx, aby, cx, cy, vcx, vcy, acx, acy)
+    values = (math.atan2(r1y, r1x), math.atan2(r2y, r2x), w1, w2, a1, a2,
+              bx, by, vbx, vby, abx, aby, cx, cy, vcx, vcy, acx, acy)
+    if not carried:
+        return values
+    return values + _four_bar_carried(values, (r1x, r1y, r2x, r2y), geometry, carried)
+
+
+def _four_bar_carried(values: tuple[Any, ...], links: tuple[Any, ...],
+                      geometry: tuple[float, ...], carried: Carried) -> tuple[Any, ...]:
+    """Return the ``carried`` points of a four-bar of these ``values`` (:func:`carry`).
+
+    ``links`` are the coupler's and the rocker's vectors toward C, (x, y) each.
+    """
+    w1, w2, a1, a2, bx, by, vbx, vby, abx, aby = values[2:12]
+    r1x, r1y, r2x, r2y = links
+    b, c, dx, dy = geometry[3:7]
+    return carry(carried, ((bx, by, vbx, vby, abx, aby, r1x, r1y, b, w1, a1),
+                           (dx, dy, 0.0, 0.0, 0.0, 0.0, r2x, r2y, c, w2, a2)), values[12:])
 
 
 def four_bar_numpy(theta: Any, w: float, al: float,
-                   geometry: tuple[float, ...] = FOUR_BAR_GEOMETRY) -> tuple[Any, ...]:
+                   geometry: tuple[float, ...] = FOUR_BAR_GEOMETRY,
+                   carried: Carried = ()) -> tuple[Any, ...]:
     """Solve the same four-bar with NumPy over an array of crank angles."""
     ox, oy, a, b, c, dx, dy, side = geometry
     cos, sin = np.cos(theta), np.sin(theta)
@@ -99,16 +152,21 @@ def four_bar_numpy(theta: Any, w: float, al: float,
     vcx, vcy = vbx - w1 * r1y, vby + w1 * r1x
     acx = abx - a1 * r1y - w1 * w1 * r1x
     acy = aby + a1 * r1x - w1 * w1 * r1y
-    return (np.arctan2(r1y, r1x), np.arctan2(r2y, r2x), w1, w2, a1, a2,
-            bx, by, vbx, vby, abx, aby, cx, cy, vcx, vcy, acx, acy)
+    values = (np.arctan2(r1y, r1x), np.arctan2(r2y, r2x), w1, w2, a1, a2,
+              bx, by, vbx, vby, abx, aby, cx, cy, vcx, vcy, acx, acy)
+    if not carried:
+        return values
+    return values + _four_bar_carried(values, (r1x, r1y, r2x, r2y), geometry, carried)
 
 
 def slider_crank_math(theta: float, w: float, al: float,
-                      geometry: tuple[float, ...] = SLIDER_CRANK_GEOMETRY) -> tuple[float, ...]:
+                      geometry: tuple[float, ...] = SLIDER_CRANK_GEOMETRY,
+                      carried: Carried = ()) -> tuple[float, ...]:
     """Hand-written slider-crank on a horizontal guide with :mod:`math`.
 
     Returns the piston's x, the rod's angle, their rates and accelerations,
-    and B's position, velocity and acceleration.
+    B's position, velocity and acceleration, then each ``carried`` point's
+    (:func:`carry`; link 0 is the rod B -> piston).
     """
     ox, oy, r, rod, guide, side = geometry
     s, c = math.sin(theta), math.cos(theta)
@@ -124,11 +182,16 @@ def slider_crank_math(theta: float, w: float, al: float,
     bx, by = ox + r * c, oy + r * s
     vbx, vby = -w * r * s, w * r * c
     abx, aby = -al * r * s - w * w * r * c, al * r * c - w * w * r * s
-    return x, phi, v, wr, a, ar, bx, by, vbx, vby, abx, aby
+    values = (x, phi, v, wr, a, ar, bx, by, vbx, vby, abx, aby)
+    if not carried:
+        return values
+    links = ((bx, by, vbx, vby, abx, aby, cp, sp, 1.0, wr, ar),)
+    return values + carry(carried, links, (x, guide, v, 0.0, a, 0.0))
 
 
 def slider_crank_numpy(theta: Any, w: float, al: float,
-                       geometry: tuple[float, ...] = SLIDER_CRANK_GEOMETRY) -> tuple[Any, ...]:
+                       geometry: tuple[float, ...] = SLIDER_CRANK_GEOMETRY,
+                       carried: Carried = ()) -> tuple[Any, ...]:
     """Solve the same slider-crank with NumPy over an array of crank angles."""
     ox, oy, r, rod, guide, side = geometry
     s, c = np.sin(theta), np.cos(theta)
@@ -144,7 +207,11 @@ def slider_crank_numpy(theta: Any, w: float, al: float,
     bx, by = ox + r * c, oy + r * s
     vbx, vby = -w * r * s, w * r * c
     abx, aby = -al * r * s - w * w * r * c, al * r * c - w * w * r * s
-    return x, phi, v, wr, a, ar, bx, by, vbx, vby, abx, aby
+    values = (x, phi, v, wr, a, ar, bx, by, vbx, vby, abx, aby)
+    if not carried:
+        return values
+    links = ((bx, by, vbx, vby, abx, aby, cp, sp, 1.0, wr, ar),)
+    return values + carry(carried, links, (x, guide, v, 0.0, a, 0.0))
 
 
 #: A Scotch yoke's: crank centre (x, y) on the yoke's horizontal guide, crank length. The
@@ -198,18 +265,46 @@ def geometry_of(scene: Any) -> tuple[str, tuple[float, ...]] | None:
     return None if geometry is None else (dyad.kind, geometry)
 
 
-def hand_written(scene: Any) -> tuple[Callable[..., Any], Callable[..., Any]] | None:
+def hand_written(scene: Any) -> tuple[partial[Any], partial[Any]] | None:
     """Return the hand-written scalar and NumPy forms of ``scene``, or None.
 
-    See :func:`geometry_of` for the scenes that have them. Their carried
-    points are not computed by them (the solver computes them too).
+    See :func:`geometry_of` for the scenes that have them; they also compute
+    every reported carried point (:func:`carried_of`), as the solver does.
+    Each is a partial of its form with the keywords ``geometry`` and, where
+    the scene has carried points, ``carried``, in the order of the form's
+    parameters.
     """
     found = geometry_of(scene)
     if found is None:
         return None
     kind, geometry = found
+    carried = carried_of(scene, _LINKS[kind](scene.dyads[0]))
+    if carried is None:
+        return None
     scalar, vector = _FORMS[kind]
-    return partial(scalar, geometry=geometry), partial(vector, geometry=geometry)
+    given = {'geometry': geometry, **({'carried': carried} if carried else {})}
+    return partial(scalar, **given), partial(vector, **given)
+
+
+def carried_of(scene: Any, links: Sequence[Any]) -> Carried | None:
+    """Return the reported carried points of ``scene`` as :data:`Carried`, or None.
+
+    ``links`` are the dyad's links, in the order of the hand-written form's;
+    each ends at the dyad's new point. None where a reported carried point
+    is not on one of them with its frame along it (origin and x-axis its two
+    ends).
+    """
+    end = scene.dyads[0].point
+    reported = set(scene.output_points)
+    found = []
+    for point in scene.points:
+        if point.name not in reported:
+            continue
+        where = [k for k, link in enumerate(links) if link.name == point.link]
+        if not where or {point.origin, point.xaxis} != {links[where[0]].start, end}:
+            return None
+        found.append((where[0], point.origin != end, *point.local))
+    return tuple(found)
 
 
 def _four_bar(scene: Any, dyad: Any, crank: Any) -> tuple[float, ...] | None:
@@ -249,6 +344,10 @@ def _scotch_yoke(scene: Any, dyad: Any, crank: Any) -> tuple[float, ...] | None:
 #: reader, and the scalar and NumPy forms.
 _GEOMETRIES: dict[str, Callable[[Any, Any, Any], tuple[float, ...] | None]] = {
     'RRR': _four_bar, 'RRP': _slider_crank, 'RPP': _scotch_yoke}
+#: The dyad's links that carry points, in the order of the hand-written form's ``links``.
+_LINKS: dict[str, Callable[[Any], tuple[Any, ...]]] = {
+    'RRR': lambda dyad: tuple(dyad.links), 'RRP': lambda dyad: (dyad.link,),
+    'RPP': lambda dyad: ()}
 _FORMS: dict[str, tuple[Callable[..., Any], Callable[..., Any]]] = {
     'RRR': (four_bar_math, four_bar_numpy), 'RRP': (slider_crank_math, slider_crank_numpy),
     'RPP': (scotch_yoke_math, scotch_yoke_numpy)}
@@ -315,9 +414,11 @@ def measure(names: list[str], angles: int, repeat: int) -> list[dict[str, Any]]:
                 ok = np.isfinite(forms[1](sweep, w, al)[0])
             if not ok.all():
                 arrays = [partial(solve, scene, sweep[ok])]
+            # Each form's geometry (and carried points) bound by position after the
+            # crank's, as ``solve``'s arguments are: no keywords merged at each call.
             scalar, vector = forms
-            singles.append(partial(scalar, theta, w, al))
-            arrays.append(partial(vector, sweep[ok], w, al))
+            singles.append(partial(scalar.func, theta, w, al, *scalar.keywords.values()))
+            arrays.append(partial(vector.func, sweep[ok], w, al, *vector.keywords.values()))
         count = len(sweep) if forms is None else int(ok.sum())
         one = [[t * 1e6 for t in spread] for spread in _spread_times(singles, 1000, repeat)]
         many = [[t * 1e6 / count for t in spread] for spread in _spread_times(arrays, 3, repeat)]

@@ -2,6 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """``bench``: spreads of repeated timings and the ratios to the hand-written forms."""
 
+from dataclasses import replace
 import json
 import math
 
@@ -10,18 +11,21 @@ import pytest
 
 import mech_kinematics as mk
 from mech_kinematics.scene import load_scene
+from mech_kinematics.solver.carried import CarriedPoint
 from mech_kinematics.tools import bench
 
 
 def test_rows_hold_min_median_max_and_median_ratios():
-    rows = bench.measure(['khurmi_four_bar_ad150', 'geneva'], 64, 3)
+    rows = bench.measure(['khurmi_four_bar_ad150', 'geneva', 'steam_engine_500_2000'], 64, 3)
     assert [r['scene'] for r in rows] == ['khurmi_four_bar_ad150',
-                                          'khurmi_four_bar_ad150 (hand-written)', 'geneva']
+                                          'khurmi_four_bar_ad150 (hand-written)', 'geneva',
+                                          'steam_engine_500_2000',
+                                          'steam_engine_500_2000 (hand-written)']
     for row in rows:
         for key in ('single_us', 'array_us'):
             low, mid, high = row[key]
             assert 0 < low <= mid <= high
-    solver, hand, geneva = rows
+    solver, hand, geneva = rows[:3]
     assert solver['single_ratio'] == solver['single_us'][1] / hand['single_us'][1]
     assert solver['array_ratio'] == solver['array_us'][1] / hand['array_us'][1]
     assert 'single_ratio' not in geneva and hand['baseline_of'] == 'khurmi_four_bar_ad150'
@@ -80,9 +84,9 @@ def test_hand_written_forms_give_the_solvers_answer(name):
         state = mk.solve(scene, float(theta))
         values = scalar(float(theta), w, al)
         dyad = scene.dyads[0]
-        if len(values) == 18:       # four-bar: coupler and rocker, B and C
+        if dyad.kind == 'RRR':      # four-bar: coupler and rocker, B and C
             coupler, rocker = (state.joints[link.name] for link in dyad.links)
-            got = values[:6] + values[12:]
+            got = values[:6] + values[12:18]
             point = state.points[dyad.point]
             want = (coupler.position, rocker.position, coupler.velocity, rocker.velocity,
                     coupler.acceleration, rocker.acceleration, *point.position,
@@ -102,6 +106,33 @@ def test_hand_written_forms_give_the_solvers_answer(name):
                     point.acceleration[0], rod.acceleration)
         scale = [max(abs(x) for x in want[i::2]) for i in range(2)]
         for k, (g, x) in enumerate(zip(got, want, strict=True)):
-            if k < 2 and len(values) == 18 or k == 1 and dyad.kind == 'RRP':
+            if k < 2 and dyad.kind == 'RRR' or k == 1 and dyad.kind == 'RRP':
                 g, x = math.remainder(g - x, 2 * math.pi), 0.0     # angles modulo 2 pi
             assert g == pytest.approx(x, abs=1e-12 * max(scale) + 1e-12), (name, k)
+        # Then every reported carried point, as the solver reports it.
+        carried = [p.name for p in scene.points if p.name in scene.output_points]
+        rest = values[18 if dyad.kind == 'RRR' else 12:]
+        assert len(rest) == 6 * len(carried)
+        for k, point in enumerate(carried):
+            p = state.points[point]
+            want = (*p.position, *p.velocity, *p.acceleration)
+            scale = max(np.abs(p.position).max(), np.abs(p.velocity).max(),
+                        np.abs(p.acceleration).max())
+            np.testing.assert_allclose(rest[6 * k:6 * k + 6], want, rtol=0,
+                                       atol=1e-13 * scale, err_msg=f'{name} {point}')
+
+
+def test_hand_written_forms_carry_the_reported_points_on_the_dyads_links():
+    """Coupler points on both links, either end as origin; a point elsewhere: no form."""
+    scene = load_scene('four_bar_coupler_points')
+    assert bench.carried_of(scene, scene.dyads[0].links) == (
+        (0, True, 0.04, 0.0), (0, True, 0.04, -0.03), (1, True, 0.03, -0.02))
+    steam = load_scene('steam_engine_500_2000')
+    assert [c[:2] for c in bench.carried_of(steam, (steam.dyads[0].link,))] == [(0, False)] * 2
+    on_e = CarriedPoint('H', 'coupler', 'E', 'C', (0.01, 0.0))   # its frame starts at E
+    moved = replace(scene, points=(*scene.points, on_e), outputs_points=None)
+    assert 'H' in moved.output_points and bench.hand_written(moved) is None
+    # Not reported: computed by neither the solver nor the hand-written form.
+    quiet = replace(moved, outputs_points=('A', 'B', 'C'))
+    assert bench.hand_written(quiet)[0].keywords == {
+        'geometry': bench.geometry_of(scene)[1]}

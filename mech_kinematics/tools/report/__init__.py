@@ -170,18 +170,23 @@ def bench_section(mode: Mode) -> tuple[dict[str, Any], dict[str, Any] | None]:
     The peer (pylinkage, ``bench --peer``) is a development dependency: without
     it the second is None (and the data file keeps its previous table).
     """
-    from ..bench import measure, measure_peers
+    from ..bench import ARRAY_TARGET, measure, measure_peers, SINGLE_TARGET
     from ..peer import available, work_items
     from ...scene import scene_names
     rows = measure(scene_names(), mode.bench_angles, mode.bench_repeat)
     # Per scene with a hand-written form, and over them, the median ratios (for the docs).
     ratios = {row['scene']: {'single': row['single_ratio'], 'array': row['array_ratio']}
               for row in rows if 'single_ratio' in row}
+    # and how many scenes are within each target.
+    targets = {'single': SINGLE_TARGET, 'array': ARRAY_TARGET}
     bench = {'angles': mode.bench_angles, 'repeat': mode.bench_repeat, 'rows': rows,
              'ratios': ratios, 'ratio_range': {
                  kind: {'min': min(r[kind] for r in ratios.values()),
                         'max': max(r[kind] for r in ratios.values())}
-                 for kind in ('single', 'array')}}
+                 for kind in targets},
+             'scenes': len(ratios),
+             'within': {kind: sum(r[kind] <= target for r in ratios.values())
+                        for kind, target in targets.items()}}
     if not available():
         return bench, None
     batches = (360, mode.bench_angles)

@@ -507,8 +507,8 @@ def _bench(data: dict[str, Any]) -> list[str]:
             'tolerance check included (the hand-written forms have neither). Ratio: median '
             'over the hand-written form of the same scene, which exists for every scene of one '
             'crank and one dyad (four-bars, slider-cranks on a horizontal guide and the Scotch '
-            'yoke; it leaves '
-            "out their carried points, which the solver computes). Issue 19's targets: "
+            'yoke; it computes their reported carried points too, as the solver does). '
+            "Issue 19's targets: "
             f'one angle <= {SINGLE_TARGET:g}x, '
             f'arrays <= {ARRAY_TARGET:g}x.', '', render_block('bench', data).rstrip('\n'), '',
             *_peer(data)]
