@@ -473,7 +473,8 @@ class KinematicsNode(LifecycleNode):
         self._compile_later = None
         self._assembly = ''
         if steps <= BACKGROUND_STEPS:
-            self._assembly = assembly_summary(scene) if sweep else ''
+            if sweep:
+                self._assembly = assembly_summary(scene)
             self._solve, compiled = tick_function(*outputs)
             if not compiled:
                 self.get_logger().info(GENERAL_SOLVER)

@@ -24,7 +24,7 @@ import math
 import statistics
 import sys
 import time
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -258,10 +258,10 @@ def geometry_of(scene: Any) -> tuple[str, tuple[float, ...]] | None:
     if len(scene.dyads) != 1:
         return None
     dyad, crank = scene.dyads[0], scene.input
-    baseline = _GEOMETRIES.get(dyad.kind)
+    baseline = _BASELINES.get(dyad.kind)
     if baseline is None or crank is None or len(scene.drivers) > 1:
         return None
-    geometry = baseline(scene, dyad, crank)
+    geometry = baseline.geometry(scene, dyad, crank)
     return None if geometry is None else (dyad.kind, geometry)
 
 
@@ -271,19 +271,31 @@ def hand_written(scene: Any) -> tuple[partial[Any], partial[Any]] | None:
     See :func:`geometry_of` for the scenes that have them; they also compute
     every reported carried point (:func:`carried_of`), as the solver does.
     Each is a partial of its form with the keywords ``geometry`` and, where
-    the scene has carried points, ``carried``, in the order of the form's
-    parameters.
+    the scene has carried points, ``carried``.
+    """
+    found = _forms(scene)
+    if found is None:
+        return None
+    scalar, vector, args = found
+    given = dict(zip(('geometry', 'carried'), args, strict=False))
+    return partial(scalar, **given), partial(vector, **given)
+
+
+def _forms(scene: Any) -> tuple[Callable[..., Any], Callable[..., Any], tuple[Any, ...]] | None:
+    """Return the scalar and NumPy forms of ``scene`` and their arguments after the crank's.
+
+    The arguments are the geometry, then the carried points where there are any;
+    None for a scene without forms (:func:`hand_written`).
     """
     found = geometry_of(scene)
     if found is None:
         return None
     kind, geometry = found
-    carried = carried_of(scene, _LINKS[kind](scene.dyads[0]))
+    baseline = _BASELINES[kind]
+    carried = carried_of(scene, baseline.links(scene.dyads[0]))
     if carried is None:
         return None
-    scalar, vector = _FORMS[kind]
-    given = {'geometry': geometry, **({'carried': carried} if carried else {})}
-    return partial(scalar, **given), partial(vector, **given)
+    return baseline.scalar, baseline.vector, (geometry, carried) if carried else (geometry,)
 
 
 def carried_of(scene: Any, links: Sequence[Any]) -> Carried | None:
@@ -340,17 +352,22 @@ def _scotch_yoke(scene: Any, dyad: Any, crank: Any) -> tuple[float, ...] | None:
     return (ox, oy, crank.length)
 
 
-#: The hand-written baselines there are, by the scene's dyad ``type:``: the geometry's
-#: reader, and the scalar and NumPy forms.
-_GEOMETRIES: dict[str, Callable[[Any, Any, Any], tuple[float, ...] | None]] = {
-    'RRR': _four_bar, 'RRP': _slider_crank, 'RPP': _scotch_yoke}
-#: The dyad's links that carry points, in the order of the hand-written form's ``links``.
-_LINKS: dict[str, Callable[[Any], tuple[Any, ...]]] = {
-    'RRR': lambda dyad: tuple(dyad.links), 'RRP': lambda dyad: (dyad.link,),
-    'RPP': lambda dyad: ()}
-_FORMS: dict[str, tuple[Callable[..., Any], Callable[..., Any]]] = {
-    'RRR': (four_bar_math, four_bar_numpy), 'RRP': (slider_crank_math, slider_crank_numpy),
-    'RPP': (scotch_yoke_math, scotch_yoke_numpy)}
+class _Baseline(NamedTuple):
+    """A kind of dyad's hand-written forms: its geometry's reader, links and forms."""
+
+    geometry: Callable[[Any, Any, Any], tuple[float, ...] | None]
+    #: The dyad's links that carry points, in the order of the forms' ``links``.
+    links: Callable[[Any], tuple[Any, ...]]
+    scalar: Callable[..., Any]
+    vector: Callable[..., Any]
+
+
+#: The hand-written baselines there are, by the scene's dyad ``type:``.
+_BASELINES: dict[str, _Baseline] = {
+    'RRR': _Baseline(_four_bar, lambda dyad: tuple(dyad.links), four_bar_math, four_bar_numpy),
+    'RRP': _Baseline(_slider_crank, lambda dyad: (dyad.link,), slider_crank_math,
+                     slider_crank_numpy),
+    'RPP': _Baseline(_scotch_yoke, lambda dyad: (), scotch_yoke_math, scotch_yoke_numpy)}
 
 
 #: The clock of every timing: the process's CPU time. On the shared machine the wall
@@ -406,19 +423,19 @@ def measure(names: list[str], angles: int, repeat: int) -> list[dict[str, Any]]:
             theta, w, al = scene.input.angle, scene.input.speed, scene.input.accel
             singles = [partial(solve, scene, theta)]
             arrays = [partial(solve, scene, sweep)]
-            forms = hand_written(scene)
+            forms = _forms(scene)
         if forms is not None:
+            # Each form's geometry (and carried points) bound by position after the
+            # crank's, as ``solve``'s arguments are: no keywords merged at each call.
+            scalar, vector, given = forms
             # Where a scene does not assemble at every angle, the array path is timed
             # over the angles where it does (the hand-written forms cannot refuse).
             with np.errstate(invalid='ignore'):
-                ok = np.isfinite(forms[1](sweep, w, al)[0])
+                ok = np.isfinite(vector(sweep, w, al, *given)[0])
             if not ok.all():
                 arrays = [partial(solve, scene, sweep[ok])]
-            # Each form's geometry (and carried points) bound by position after the
-            # crank's, as ``solve``'s arguments are: no keywords merged at each call.
-            scalar, vector = forms
-            singles.append(partial(scalar.func, theta, w, al, *scalar.keywords.values()))
-            arrays.append(partial(vector.func, sweep[ok], w, al, *vector.keywords.values()))
+            singles.append(partial(scalar, theta, w, al, *given))
+            arrays.append(partial(vector, sweep[ok], w, al, *given))
         count = len(sweep) if forms is None else int(ok.sum())
         one = [[t * 1e6 for t in spread] for spread in _spread_times(singles, 1000, repeat)]
         many = [[t * 1e6 / count for t in spread] for spread in _spread_times(arrays, 3, repeat)]
