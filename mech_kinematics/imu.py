@@ -131,15 +131,8 @@ def imu_links(scene: Any) -> dict[str, tuple[str, ...]]:
     centre and tip, a dyad link's start and new pin, a lever's pivot) or a
     point carried by it (``points:``); a pin sliding in a slotted lever is not.
     """
-    crank = scene.input
-    fixed: dict[str, list[str]] = {crank.link: [crank.center, crank.point]}
-    for dyad in scene.dyads:
-        for body, kind, members, _ in dyad.members(''):
-            if kind in ('link', 'lever'):
-                fixed.setdefault(body, []).extend(members)
-    for carried in scene.points:
-        fixed.setdefault(carried.link, []).append(carried.name)
-    return {link: tuple(dict.fromkeys(points)) for link, points in fixed.items()}
+    return {name: body.points for name, body in scene.graph.bodies.items()
+            if body.turns_with == name}
 
 
 def imu_outputs(scene: Any, joint_types: dict[str, str], joints: Sequence[str] | None,

@@ -61,7 +61,7 @@ import numpy.typing as npt
 
 from .instant_centres import full_scene, one_driver
 from ..errors import AssemblyError, NearSingularWarning
-from ..solver import assembly_margins, JointMotion, Scene, SceneUnits, solve
+from ..solver import assembly_margins, JointMotion, Link, Scene, SceneUnits, solve
 
 __all__ = [
     'Assembly', 'DeadCentre', 'FourBarLoop', 'SAMPLES', 'TOLERANCE', 'Toggle', 'Transmission',
@@ -664,10 +664,7 @@ def _golden(probe: _Probe, key: str, centre: float) -> tuple[float, float]:
 
 def _outputs(scene: Scene) -> dict[str, str]:
     """Output joints that can have dead centres: name -> 'revolute' or 'prismatic'."""
-    outputs = {}
-    for dyad in scene.dyads:
-        outputs.update(dyad.dead_centre_joints(scene.ground))
-    return outputs
+    return dict(scene.graph.reversing())
 
 
 def _dead_centres(probe: _Probe, ranges: Sequence[tuple[float, float]]
@@ -682,8 +679,11 @@ def _dead_centres(probe: _Probe, ranges: Sequence[tuple[float, float]]
     scene = probe.scene
     crank = scene.input
     starting = {}  # link from the crank's tip -> the joints of its dyad
-    for dyad in scene.dyads:
-        starting.update(dyad.tip_links(crank.point))
+    for fragment in scene.graph.fragments:
+        for body in fragment.bodies:
+            frame = body.frame
+            if frame is not None and frame.origin == crank.point and frame.angle_of == body.name:
+                starting[body.name] = tuple(fragment.coordinates)
     step = _TURN / len(probe.theta)
     grids = []
     for start, end in ranges:
@@ -757,28 +757,25 @@ def _transmission(probe: _Probe, ranges: Sequence[tuple[float, float]],
 
 def _loops(probe: _Probe) -> tuple[FourBarLoop, ...]:
     scene = probe.scene
-    crank = scene.input
     state = probe.solve(scene.input.angle)
     position = {name: complex(*p.position)  # type: ignore[attr-defined]
                 for name, p in state.points.items()}  # type: ignore[attr-defined]
-    pivot = {crank.link: crank.center}  # link turning about a ground pivot -> that pivot
-    for dyad in scene.dyads:
-        pivot.update(dyad.pivots(scene.ground))
-    fixed_on: dict[str, str] = {crank.point: crank.link}
-    for dyad in scene.dyads:
-        for point, link_name, preferred in dyad.pin_links(pivot):
-            if preferred:
-                fixed_on[point] = link_name
-            else:
-                fixed_on.setdefault(point, link_name)
-    for carried in scene.points:
-        fixed_on[carried.name] = carried.link
+    graph = scene.graph
+    pivot = graph.pivots()  # body turning about a ground pivot -> that pivot
+    fixed_on: dict[str, str] = {}  # point -> the body it is fixed on (one that pivots, first)
+    for body in graph.bodies.values():
+        if body.name != graph.ground:
+            for point in body.points:
+                if point not in fixed_on or (body.name in pivot and fixed_on[point] not in pivot):
+                    fixed_on[point] = body.name
     loops = []
-    for dyad in scene.dyads:
-        pair = dyad.four_bar()
-        if pair is None:
+    for fragment in graph.fragments:  # two links of fixed lengths meeting at a new pin
+        pair = [Link(body.name, body.frame.origin, body.length) for body in fragment.bodies
+                if body.length is not None and body.frame is not None
+                and body.points[1:2] == (fragment.key,)]
+        if len(pair) != 2:
             continue
-        point, first, second = pair
+        point, first, second = fragment.key, *pair
         for out, coupler in ((first, second), (second, first)):
             if out.start not in scene.ground or coupler.start in scene.ground:
                 continue

@@ -38,11 +38,12 @@ import warnings
 import numpy as np
 import numpy.typing as npt
 
-from .instant_centres import (bodies_from_scene, BodyKind, check_full_state, full_scene, GROUND,
-                              instant_centres_from_state, InstantCentres, Topology,
-                              varying_links)
+from .instant_centres import (bodies_from_scene, BodyKind, check_full_state, full_scene,
+                              instant_centres_from_state, InstantCentres,
+                              locked_bodies, slide_angle, Topology, varying_links)
 from ..errors import NearSingularWarning
 from ..solver import Scene, solve, State
+from ..solver.graph import Graph, Joint
 from ..solver.plan import diameter
 from ..units import turns_from_degrees
 
@@ -385,19 +386,11 @@ def _coincident(pin: str) -> str:
     return f"{pin}'"
 
 
-def _driven_links(scene: Scene) -> dict[str, tuple[str, str]]:
-    """Return each crank driver's link: its centre and tip (an actuator has none of its own)."""
-    return {body: (members[0], members[1]) for driver in scene.drivers
-            for body, _, members, _ in driver.members(GROUND)}
-
-
 def _edges(scene: Scene, state: State) -> list[_Edge]:
-    """Every link's relative motions, in the order the solver places the points."""
-    edges = [_Edge(link, *ends) for link, ends in _driven_links(scene).items()]
-    for item in (*scene.dyads, *scene.points):
-        for body, start, end, slider in item.edges():
-            edges.append(_Edge(body, start, end) if slider is None else
-                         _Edge(body, start, _coincident(end), end, slider))
+    """Every link's relative motions (the graph's), in the order the solver places the points."""
+    edges = [_Edge(m.body, m.start, m.end) if m.slider is None else
+             _Edge(m.body, m.start, _coincident(m.end), m.end, m.slider)
+             for m in scene.graph.motions]
     order = {name: index for index, name in enumerate(state.complex_points)}
 
     def rank(edge: _Edge) -> float:
@@ -424,8 +417,8 @@ def _sub(*names: str) -> str:
 
 def _pin_of(scene: Scene) -> dict[str, tuple[str, str, str]]:
     """Return the coincident point of every pin sliding in a body: (body, its start, the pin)."""
-    return {_coincident(end): (body, start, end) for d in scene.dyads
-            for body, start, end, slider in d.edges() if slider is not None}
+    return {_coincident(m.end): (m.body, m.start, m.end) for m in scene.graph.motions
+            if m.slider is not None}
 
 
 def _locked(state: State) -> set[str]:
@@ -464,14 +457,18 @@ def _slip_vectors(scene: Scene, state: State, letter: Mapping[str, str],
                   letters: Mapping[str, Array], index: int, symbol: str) -> list[Vector]:
     """Sliding along a fixed direction (a translating yoke's slot): the slider's rate."""
     vectors = []
-    for dyad in scene.dyads:
-        for slider, start, end, angle in dyad.slips():
-            joint = state.joints[slider]
-            rate = float(joint.velocity if index == 1 else joint.acceleration)
-            tail = letters[letter[start]]
-            vectors.append(Vector(letter[start], letter[end], tail,
-                                  tail + rate * np.array([math.cos(angle), math.sin(angle)]),
-                                  symbol.format(_sub(end, start)), VectorKind.SLIP, slider))
+    graph = scene.graph
+    for slip in graph.joints:  # a block sliding on a body that translates
+        line = slip.line
+        if line is None or slip.on == graph.ground or graph.bodies[slip.on].turns_with:
+            continue
+        start, end, angle = line.through, slip.at, line.angle
+        joint = state.joints[slip.name]
+        rate = float(joint.velocity if index == 1 else joint.acceleration)
+        tail = letters[letter[start]]
+        vectors.append(Vector(letter[start], letter[end], tail,
+                              tail + rate * np.array([math.cos(angle), math.sin(angle)]),
+                              symbol.format(_sub(end, start)), VectorKind.SLIP, slip.name))
     return vectors
 
 
@@ -667,8 +664,8 @@ def strokes_from_scene(scene: Scene,
         are then drawn around their blocks).
     """
     scene = full_scene(scene)
-    sliders = [body for d in scene.dyads for body, _, _, guide in d.members(GROUND)
-               if guide == GROUND]
+    graph = scene.graph
+    sliders = [name for name, guide in graph.slides() if guide == graph.ground]
     if not sliders or scene.input is None or len(scene.drivers) > 1:
         return {}
     angles = np.linspace(0.0, 2.0 * math.pi, samples, endpoint=False)
@@ -704,43 +701,101 @@ def space_from_state(scene: Scene, state: State,
         Points, links, ground pivots, slider blocks and guides, m.
     """
     topology = _check_state(scene, state)
+    graph = scene.graph
     points = {name: _xy(complex(p)) for name, (p, _, _) in state.complex_points.items()}
     size = diameter(complex(p) for p, _, _ in state.complex_points.values()) or 1.0
-    # A dyad draws extra points or slots only on a body it adds (Item.outline).
-    adders: dict[str, list[Any]] = {}
-    for dyad in scene.dyads:
-        for member, *_ in dyad.members(topology.ground):
-            adders.setdefault(member, []).append(dyad)
+    locked = set(locked_bodies(graph, state))
     links = []
-    locked = _locked(state)
     for body in topology.bodies.values():
         if body.kind in (BodyKind.GROUND, BodyKind.SLIDER):
             continue
-        xy = [points[name] for name in body.points]
+        drawn = _drawn_points(graph, body.name)
+        xy = [points[name] for name in drawn]
         slots: tuple[tuple[Array, Array], ...] = ()
-        for dyad in adders.get(body.name, ()):
-            extra, slots_of = dyad.outline(body.name, scene, state, points)
-            xy += [points[name] for name in extra]
-            if slots_of:  # a Geneva wheel: the polygon of its slots' mouths
-                slots = slots_of
+        for joint in graph.joints:  # the pins sliding in its slots
+            if joint.on != body.name or joint.line is None or joint.driver:
+                continue
+            if joint.copies == 1:
+                xy.append(points[joint.at])
+            else:  # a Geneva wheel: the polygon of its slots' mouths
+                slots = _slots(graph, joint, state, points)
                 xy += [mouth for _, mouth in slots]
-        links.append(LinkShape(body.name, body.kind, body.points, _outline(np.array(xy)),
-                               slots))
+        links.append(LinkShape(body.name, body.kind, drawn, _outline(np.array(xy)), slots))
     pinned = {point for a, b, point in topology.pins
               if topology.ground in (a, b)}
     pivots = tuple(Pivot(name, points[name]) for name in scene.ground if name in pinned)
     sliders = []
     guides = []
-    for dyad in scene.dyads:
-        blocks = dyad.blocks(state, points, topology.ground, locked)
-        sliders.extend(SliderShape(*block) for block in blocks)
-        guides.extend(GuideLine(*guide)
-                      for guide in dyad.guides(state, points, strokes or {}, size))
-    actuators = tuple(ActuatorShape(name, points[topology.bodies[name].points[0]],
-                                    points[topology.bodies[name].points[1]])
+    for joint in graph.joints:  # the blocks, and the fixed guides they slide on
+        line = joint.line
+        if line is None or joint.driver or joint.on in locked:
+            continue
+        sliders.append(SliderShape(joint.name, joint.at, points[joint.at],
+                                   slide_angle(graph, joint, state), joint.on))
+        if joint.on == graph.ground:
+            guides.append(GuideLine(*fixed_guide(joint.name, points[line.through], line.angle,
+                                                 state, strokes or {}, size)))
+    actuators = tuple(ActuatorShape(name, *(points[p] for p in _drawn_points(graph, name)[:2]))
                       for name in varying_links(scene))
     return SpaceDiagram(points, tuple(scene.ground), tuple(links), pivots, tuple(sliders),
                         tuple(guides), actuators)
+
+
+def _rods(graph: Graph) -> set[str]:
+    """Return the blocks a driver slides (a cylinder's rod: drawn with its barrel)."""
+    return {j.body for j in graph.joints if j.driver and j.line is not None}
+
+
+def _drawn_points(graph: Graph, body: str) -> tuple[str, ...]:
+    """Return a body's points as drawn: its own, then the pins its driven blocks carry.
+
+    A cylinder is drawn from its barrel's start to its rod's pin (a driven
+    block sliding along it), one link whose length varies.
+    """
+    return graph.bodies[body].points + tuple(
+        j.at for j in graph.joints if j.on == body and j.driver and j.line is not None)
+
+
+def _slots(graph: Graph, joint: Joint, state: State, points: Mapping[str, Array]
+           ) -> tuple[tuple[Array, Array], ...]:
+    """Return (inner end, mouth) of each of a joint's evenly spaced slots (a Geneva wheel's).
+
+    The slots reach from 85 % of the wheel's clearance of the pin's circle to
+    where that circle crosses them; the pin turns about the origin of the body
+    carrying it (the crank's centre).
+    """
+    line = joint.line
+    assert line is not None and line.angle_of is not None
+    carrier = next(j.on for j in graph.joints if j.body == joint.body and j.line is None)
+    frame = graph.bodies[carrier].frame
+    assert frame is not None
+    centre, wheel, pin = (points[name] for name in (frame.origin, line.through, joint.at))
+    distance = float(np.hypot(*(wheel - centre)))
+    radius = float(np.hypot(*(pin - centre)))
+    mouth = distance * math.sqrt(max(1.0 - (radius / distance) ** 2, 0.0))
+    inner = 0.85 * (distance - radius)
+    angle = float(state.joints[line.angle_of].position)
+    slots = []
+    for i in range(joint.copies):
+        turn = angle + 2 * math.pi * i / joint.copies
+        u = np.array([math.cos(turn), math.sin(turn)])
+        slots.append((wheel + inner * u, wheel + mouth * u))
+    return tuple(slots)
+
+
+def fixed_guide(slider: str, through: Any, angle: float, state: Any,
+                strokes: Mapping[str, tuple[float, float]], size: float
+                ) -> tuple[str, Any, Any]:
+    """Return (slider, start, end) of a fixed guide through ``through`` at ``angle`` (rad).
+
+    The guide is drawn over the slider's stroke (or around its place, where no
+    stroke is known), padded by 8 % of the drawing's ``size``.
+    """
+    u = np.array([math.cos(angle), math.sin(angle)])
+    s = float(state.joints[slider].position)
+    low, high = strokes.get(slider, (s, s))
+    pad = 0.08 * size
+    return slider, through + (min(low, s) - pad) * u, through + (max(high, s) + pad) * u
 
 
 def arrows_from_state(scene: Scene, state: State, velocity_scale: float,
@@ -783,23 +838,22 @@ def arrows_from_state(scene: Scene, state: State, velocity_scale: float,
 
 def _values(scene: Scene, state: State,
             topology: Topology) -> tuple[tuple[LinkValues, ...], tuple[SliderValues, ...]]:
-    lengths: dict[str, float | None] = {driver.name: driver.length for driver in scene.drivers
-                                        if driver.joint_type == 'revolute'}
-    for dyad in scene.dyads:
-        lengths.update(dyad.link_lengths())
+    graph = scene.graph
+    rods = _rods(graph)
     links = []
     sliders = []
     for name, body in topology.bodies.items():
-        if body.kind is BodyKind.GROUND:
-            continue
+        if body.kind is BodyKind.GROUND or name in rods:
+            continue  # (a cylinder's rod is its driver's row)
         joint = state.joints[name]
         if body.kind is BodyKind.SLIDER:
             sliders.append(SliderValues(name, float(joint.position), float(joint.velocity),
                                         float(joint.acceleration)))
         else:
             engagement = state.intermittent.get(name)
-            links.append(LinkValues(name, body.points, lengths[name], float(joint.position),
-                                    float(joint.velocity), float(joint.acceleration),
+            links.append(LinkValues(name, _drawn_points(graph, name), graph.bodies[name].length,
+                                    float(joint.position), float(joint.velocity),
+                                    float(joint.acceleration),
                                     None if engagement is None else bool(engagement.engaged)))
     return tuple(links), tuple(sliders)
 
@@ -1041,5 +1095,7 @@ COLOURS = ('#1f77b4', '#ff7f0e', '#2ca02c', '#d62728', '#9467bd', '#8c564b', '#e
 def colours_from_scene(scene: Scene) -> dict[str, str]:
     """Return the colour of every moving body of ``scene`` (Kennedy numbering order)."""
     bodies = bodies_from_scene(scene).bodies
-    moving = [name for name, body in bodies.items() if body.kind is not BodyKind.GROUND]
+    rods = _rods(scene.graph)
+    moving = [name for name, body in bodies.items()
+              if body.kind is not BodyKind.GROUND and name not in rods]
     return {name: COLOURS[i % len(COLOURS)] for i, name in enumerate(moving)}

@@ -67,13 +67,8 @@ def child_frame(prefix: str, name: str) -> str:
 
 def frames_from_scene(scene: Scene, joints: Sequence[str] | None = None) -> tuple[FrameSpec, ...]:
     """Return the frames of ``joints`` (default: the scene's output joints), in that order."""
-    specs: dict[str, FrameSpec] = {}
-    for driver in scene.drivers:
-        for joint, origin, angle_of, angle in driver.frames():
-            specs[joint] = FrameSpec(joint, origin, angle_of, angle)
-    for dyad in scene.dyads:
-        for joint, origin, angle_of, angle in dyad.frames():
-            specs[joint] = FrameSpec(joint, origin, angle_of, angle)
+    specs = {body: FrameSpec(body, frame.origin, frame.angle_of, frame.angle)
+             for body, frame in scene.graph.frames()}
     names = scene.output_joints if joints is None else joints
     return tuple(specs[name] for name in names)
 

@@ -37,15 +37,13 @@ import numpy.typing as npt
 
 from ..errors import SceneError
 from ..solver import Scene, State
+from ..solver.graph import Graph, GROUND, Joint, Role
 
 __all__ = [
     'GROUND', 'Body', 'BodyKind', 'Centre', 'InstantCentre', 'InstantCentres', 'Topology',
     'bodies_from_scene', 'centres_as_dict', 'full_scene', 'instant_centres_from_kennedy',
     'instant_centres_from_state', 'varying_links',
 ]
-
-#: Name of the ground body (the frame), unless the scene uses it for a link.
-GROUND = 'ground'
 
 #: A relative angular velocity below this fraction of ``|relative velocity| /
 #: size`` puts the centre at infinity (relative translation).
@@ -60,14 +58,8 @@ REL_MOTION = 1e-10
 DEGENERATE = 1e-9
 
 
-class BodyKind(Enum):
-    """What a body of the mechanism is."""
-
-    GROUND = 'ground'
-    CRANK = 'crank'
-    LINK = 'link'
-    LEVER = 'lever'     # slotted lever of an RPR dyad
-    SLIDER = 'slider'   # slider block (RRP: on a fixed guide; RPR: in a slot)
+#: What a body of the mechanism is (the graph's :class:`~mech_kinematics.solver.graph.Role`).
+BodyKind = Role
 
 
 class Centre(Enum):
@@ -149,45 +141,10 @@ def bodies_from_scene(scene: Scene) -> Topology:
         Ground first, then the crank, the dyads' links, levers and slider
         blocks in the scene's order.
     """
-    names = _names(scene)
-    ground = GROUND if GROUND not in names else '_' + GROUND
-    points: dict[str, list[str]] = {ground: list(scene.ground)}
-    kinds: dict[str, BodyKind] = {ground: BodyKind.GROUND}
-    guides: dict[str, str] = {}
-
-    def add(body: str, kind: BodyKind, *members: str) -> None:
-        kinds.setdefault(body, kind)
-        fixed = points.setdefault(body, [])
-        fixed.extend(member for member in members if member not in fixed)
-
-    for driver in scene.drivers:  # a crank carries its centre and tip; an actuator nothing
-        for body, kind, members, _ in driver.members(ground):
-            add(body, BodyKind(kind), *members)
-    slides: list[tuple[str, str]] = []
-    for dyad in scene.dyads:
-        for body, kind, members, guide in dyad.members(ground):
-            add(body, BodyKind(kind), *members)
-            if guide is not None:
-                guides[body] = guide
-                slides.append((body, guide))
-    for carried in scene.points:
-        points[carried.link].append(carried.name)
-    bodies = {name: Body(name, kinds[name], tuple(members), number, guides.get(name))
-              for number, (name, members) in enumerate(points.items(), start=1)}
-    owners: dict[str, list[str]] = {}
-    for body in bodies.values():
-        for point in body.points:
-            owners.setdefault(point, []).append(body.name)
-    pins = tuple((a, b, point) for point, owned in owners.items()
-                 for a, b in itertools.combinations(owned, 2))
-    return Topology(bodies, pins, tuple(slides), ground)
-
-
-def _names(scene: Scene) -> set[str]:
-    names = {driver.name for driver in scene.drivers}
-    for dyad in scene.dyads:
-        names.update(dyad.joint_types())
-    return names
+    graph = scene.graph
+    bodies = {name: Body(name, body.role, body.points, number, body.guide)
+              for number, (name, body) in enumerate(graph.bodies.items(), start=1)}
+    return Topology(bodies, tuple(graph.pins()), tuple(graph.slides()), graph.ground)
 
 
 @dataclass(frozen=True)
@@ -311,11 +268,8 @@ def varying_links(scene: Scene) -> tuple[str, ...]:
     for a rigid link; a cylinder's adds its extension rate along it. (A slotted
     lever's length varies too, but its pin's sliding is modelled: it has a slider.)
     """
-    rigid = {body for dyad in scene.dyads for body, _, _, slider in dyad.edges()
-             if slider is None}
-    return tuple(name for dyad in scene.dyads
-                 for name, length in dyad.link_lengths().items()
-                 if length is None and name in rigid)
+    return tuple(dict.fromkeys(joint.on for joint in scene.graph.joints
+                               if joint.driver and joint.line is not None))
 
 
 def one_driver(scene: Scene, what: str) -> None:
@@ -468,10 +422,9 @@ def _primary(topology: Topology, scene: Scene, state: State, size: float
     for a, b, point in topology.pins:
         p = complex(state.complex_points[point][0])
         put(a, b, np.array([p.real / size, p.imag / size, 1.0]), Centre.PIN)
-    owner = {slider: dyad for dyad in scene.dyads for slider, kind, _, _ in dyad.members('')
-             if kind == 'slider'}
+    graph = scene.graph
     for slider, guide in topology.slides:
-        angle = owner[slider].slide_angle(slider, scene, state)
+        angle = slide_angle(graph, graph.prismatic(slider), state)
         # normal to the slide: perpendicular to the direction of sliding
         put(slider, guide, np.array([-math.sin(angle), math.cos(angle), 0.0]), Centre.SLIDE)
     return known
@@ -510,7 +463,7 @@ def instant_centres_from_kennedy(scene: Scene, state: State) -> InstantCentres:
     size = _size(state)
     known = _primary(topology, scene, state, size)
     # A locked Geneva wheel moves with the ground: its centre with any body is the ground's.
-    locked = [lever for d in scene.dyads for lever in d.locked(state)]
+    locked = locked_bodies(scene.graph, state)
 
     pairs = _pairs(topology)
     while True:
@@ -554,6 +507,39 @@ def instant_centres_from_kennedy(scene: Scene, state: State) -> InstantCentres:
         infinite = abs(h[2]) <= DEGENERATE * math.hypot(h[0], h[1]) and method is not Centre.PIN
         centres[(a, b)] = _centre_from_homogeneous((a, b), h, size, method, infinite)
     return InstantCentres(topology, centres, size)
+
+
+def slide_angle(graph: Graph, joint: Joint, state: State) -> float:
+    """Return the direction, rad, in which a prismatic joint's block slides in a solved state.
+
+    Its line's angle (:class:`~mech_kinematics.solver.graph.Line`); for one of
+    several slots (a Geneva wheel's), the direction of the one the pin is in,
+    from the line's point. An intermittent slot out of engagement holds no
+    pin: the block then rides the pin's body across its radius (a Geneva
+    crank's pin between slots).
+    """
+    line = joint.line
+    assert line is not None
+    engagement = state.intermittent.get(joint.on) if joint.intermittent else None
+    start, turn = line.through, 0.0
+    if engagement is not None and not bool(engagement.engaged):
+        pin = next(j for j in graph.joints if j.body == joint.body and j.line is None)
+        frame = graph.bodies[pin.on].frame
+        assert frame is not None
+        start, turn = frame.origin, math.pi / 2
+    elif joint.copies == 1:
+        if line.angle_of is None:
+            return line.angle
+        angle = float(state.joints[line.angle_of].position)
+        return angle + line.angle if line.angle else angle
+    p, o = (complex(state.complex_points[name][0]) for name in (joint.at, start))
+    return math.atan2(p.imag - o.imag, p.real - o.real) + turn
+
+
+def locked_bodies(graph: Graph, state: State) -> tuple[str, ...]:
+    """Return the bodies an intermittent lock holds to the ground in a solved state."""
+    return tuple(joint.body for joint in graph.joints if joint.type.table is None
+                 and joint.intermittent and not bool(state.intermittent[joint.body].engaged))
 
 
 def centres_as_dict(centres: InstantCentres) -> dict[str, Mapping[str, Any]]:

@@ -159,17 +159,15 @@ def visuals_from_scene(scene: Scene, frames: Sequence[FrameSpec] | None = None,
     # link it drives, at its start pin) is drawn as a barrel as long as the actuator
     # at its shortest, its rod (the actuator's frame, at the other pin) reaching back
     # by the stroke.
-    actuators = {d.name: d for d in full.drivers if d.joint_type == 'prismatic'}
-    cylinders = {frame.angle_of: actuators[frame.joint] for frame in frames_from_scene(
-        full, tuple(full.joint_types)) if frame.joint in actuators}
+    graph = full.graph
+    drivers = {d.name: d for d in full.drivers}
+    slides = [j for j in graph.joints if j.line is not None]
+    actuators = {j.name: drivers[j.name] for j in slides if j.driver}
+    cylinders = {j.on: drivers[j.name] for j in slides if j.driver}
     # A link whose length varies (a slotted lever) is drawn out to the farthest its
-    # pin slides: each kind says which of its links vary and between which points.
-    levers = {}
-    for item in full.dyads:
-        varying = {link for link, length in item.link_lengths().items()
-                   if length is None and link not in cylinders}
-        levers.update({link: (start, end) for link, start, end, _ in item.edges()
-                       if link in varying})
+    # pin slides: from its slot's point to the pin.
+    levers = {j.on: (j.line.through, j.at) for j in slides  # type: ignore[union-attr]
+              if not j.driver and j.line.angle_of == j.on}  # type: ignore[union-attr]
     points = {name: complex(p) for name, (p, _, _) in state.complex_points.items()}
     visuals: dict[str, list[Visual]] = {}
     for frame, pose in zip(frames, poses_from_state(frames, state), strict=True):
@@ -259,10 +257,10 @@ def urdf_from_scene(scene: Scene, frame_id: str = 'mechanism', prefix: str = '')
     attachments += [(child_frame(prefix, joint), shapes, None)
                     for joint, shapes in visuals.items()]
     # An actuator's rod hangs on its cylinder's body by a prismatic joint along it.
-    rods = {child_frame(prefix, frame.joint): (child_frame(prefix, frame.angle_of), frame.joint)
-            for frame in frames_from_scene(scene) if frame.angle_of is not None
-            and scene.joint_types.get(frame.joint) == 'prismatic'
-            and frame.joint in {d.name for d in scene.drivers}}
+    outputs = set(scene.output_joints)
+    rods = {child_frame(prefix, j.body): (child_frame(prefix, j.on), j.name)
+            for j in scene.graph.joints if j.driver and j.line is not None
+            and j.body in outputs and j.on in outputs}
     for child, shapes, at in attachments:
         link = ET.SubElement(robot, 'link', name=child)
         _add_visuals(link, shapes)

@@ -42,7 +42,7 @@ from typing import Any
 
 from .. import solver as lk
 from ..solver import tick as hooks
-from ..solver.specialize import plan_body, propagate, Unsupported
+from ..solver.specialize import plan_body, propagate, TABLES, Unsupported
 
 __all__ = ['TickFunction', 'compile_tick', 'tick_function', 'values_from_state']
 
@@ -116,11 +116,9 @@ def _return_line(plan: hooks.TickPlan, names: dict[str, str], joints: tuple[str,
     values = []
     for index in range(3):
         for name in joints:
-            if kinds[name] == 'revolute':
-                e = names[f'L_{name}']
-                values.append(f'_wrapped_angle({e}[0])' if index == 0 else f'{e}[{index}]')
-            else:
-                values.append(f'{names[f"S_{name}"]}[{index}]')
+            e = names[f'{TABLES[kinds[name].table]}_{name}']
+            values.append(f'_wrapped_angle({e}[0])' if index == 0 and kinds[name].angular
+                          else f'{e}[{index}]')
     for index in range(3):
         for name in points:
             e = names[f'P_{name}']

@@ -18,12 +18,14 @@ it adds to the scales of a state, and the text of its refusal.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 from dataclasses import dataclass, replace
 import math
 from typing import Any
 
+from .base import Driver
 from .context import _Context
+from .graph import Fragment, JointType, PRISMATIC
 from .model import _check_finite, _check_length, _check_name, _g, SceneUnits
 from ..bounds import U
 from ..errors import SceneError
@@ -33,7 +35,7 @@ KEYS = {'actuator', 'length', 'speed', 'accel', 'stroke'}
 
 
 @dataclass(frozen=True)
-class Actuator:
+class Actuator(Driver):
     """A linear actuator driving the mechanism: its length is an input.
 
     Parameters
@@ -51,6 +53,8 @@ class Actuator:
         Inclusive limits ``(shortest, longest)`` of its length, m; ``None``: any
         positive length.
     """
+
+    position_key = 'length'
 
     actuator: str
     length: float
@@ -110,9 +114,9 @@ class Actuator:
         return self.actuator
 
     @property
-    def joint_type(self) -> str:
-        """The driver's joint type: ``'prismatic'``."""
-        return 'prismatic'
+    def joint_type(self) -> JointType:
+        """The driver's joint type: prismatic."""
+        return PRISMATIC
 
     @property
     def start(self) -> float:
@@ -133,13 +137,16 @@ class Actuator:
         stroke = None if self.stroke is None else (scale(self.stroke[0]), scale(self.stroke[1]))
         return replace(self, length=scale(self.length), stroke=stroke)
 
-    def members(self, ground: str) -> tuple[tuple[str, str, tuple[str, ...], str | None], ...]:
-        """Return no body of its own: its cylinder is the RRR link it drives (:mod:`.rrr`)."""
-        return ()
+    def fragment(self) -> Fragment:
+        """Return its part of the graph: its coordinate (its barrel and rod are an RRR's)."""
+        return Fragment(self.actuator, coordinates={self.actuator: PRISMATIC})
 
-    def frames(self) -> tuple[tuple[str, str, str | None, float], ...]:
-        """Return no frame: the RRR whose link it drives gives its rod's (:mod:`.rrr`)."""
-        return ()
+    def check_used(self, used: Collection[str]) -> None:
+        """Refuse it unless an RRR link's length is this actuator's."""
+        if self.actuator not in used:
+            msg = (f'Expected actuator "{self.actuator}" to be the length of an RRR link '
+                   f'(actuator: {self.actuator} in place of length:), got no link using it')
+            raise SceneError(msg, (self, 'actuator'))
 
     def defined(self) -> tuple[tuple[str, str], ...]:
         """Return (name, kind) of the names it defines: its prismatic joint."""
@@ -173,7 +180,7 @@ def _stroke_text(facts: dict[str, Any], units: SceneUnits) -> str:
 class _ActuatorStep:
     """The actuator's kernel: its length, rate and acceleration into ``ctx.sliders``."""
 
-    joint_type = 'prismatic'
+    joint_type = PRISMATIC
 
     def __init__(self, actuator: Actuator) -> None:
         self.name = actuator.actuator

@@ -51,32 +51,15 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Collection, Iterator, Mapping
-import math
 from typing import Any, ClassVar, Protocol, TYPE_CHECKING
-
-import numpy as np
 
 from ..errors import SceneError
 
 if TYPE_CHECKING:
     from .context import _Context
+    from .graph import Fragment, JointType
     from .model import Branch, Link, SceneUnits, Where
     from .state import Engagement
-
-#: A body at a pin, for rubbing: ``('link', name)``, ``('still', name)`` or ``('block', lever)``.
-Body = tuple[str, str]
-#: Where a joint's frame sits: (joint, origin point, joint whose position is its angle or
-#: ``None``, fixed angle in rad when that is ``None``); see :mod:`mech_kinematics.geometry.frames`.
-Frame = tuple[str, str, str | None, float]
-#: A body an item adds: (name, kind: ``'link'``, ``'lever'`` or ``'slider'``, the points
-#: fixed on it, and for a slider block the body it slides on, ``ground`` standing for
-#: the ground; else ``None``); see :mod:`mech_kinematics.geometry.instant_centres`.
-Member = tuple[str, str, tuple[str, ...], str | None]
-#: A relative motion on a body, for the polygons: (body, start point, end point, slider):
-#: the end moves on the body about the start; with a slider, the end is a pin sliding in
-#: the body and the motion is that of the body's point coinciding with it (b'), then the
-#: slider's sliding to the pin; see :mod:`mech_kinematics.geometry.diagrams`.
-Edge = tuple[str, str, str, str | None]
 
 
 class Step(ABC):
@@ -254,15 +237,18 @@ class Reading(Protocol):
 
 
 class Item(ABC):
-    """A scene item (a dyad or a carried point): what the solver and the geometry ask of its kind.
+    """A scene item (a dyad or a carried point): what the rest of the package asks of its kind.
 
-    A kind's item is a frozen dataclass deriving from this class. The abstract
-    methods say what it is (the solver's part); the others say what geometry/
-    and the reference need to know of it, and default to "nothing": a kind
-    with no slider, no locked body, no drawing of its own keeps them.
+    A kind's item is a frozen dataclass deriving from this class, and answers
+    only what the kind alone knows: its scene keys (:meth:`from_scene`), the
+    names it defines and needs, its step (the kernel with its bounds), its
+    scaling, its part of the mechanism's graph (:meth:`fragment`: every other
+    concern reads the graph), the words of its failures and what its
+    near-singularity measure means. Every method is abstract: a kind that
+    leaves one out cannot be built (``test_solver_protocol`` names it).
 
     ``kind`` is the scene's ``type:`` of the item (``'RRR'``, ...; ``'point'``
-    for a carried point): the reference solver and the registry key on it.
+    for a carried point): the registry keys on it.
     """
 
     kind: ClassVar[str]
@@ -283,10 +269,6 @@ class Item(ABC):
         """Yield (name, ``'point'``/``'link'``/``'slider'``, where) of every name it defines."""
 
     @abstractmethod
-    def joint_types(self) -> dict[str, str]:
-        """Return joint name -> ``'revolute'`` or ``'prismatic'`` of the joints it moves."""
-
-    @abstractmethod
     def prerequisites(self, names: Names) -> set[str]:
         """Check the names it refers to; return those its step waits for."""
 
@@ -298,113 +280,105 @@ class Item(ABC):
     def scaled(self, scale: Callable[[float], float]) -> Item:
         """Return it with every length ``x`` replaced by ``scale(x)``."""
 
+    @abstractmethod
+    def fragment(self) -> Fragment:
+        """Return its part of the mechanism's graph (:mod:`.graph`): bodies, joints, motions."""
+
+    @abstractmethod
     def lengths(self) -> tuple[float, ...]:
-        """Return its link lengths, m, which count in the mechanism's size."""
-        return ()
+        """Return its link lengths, m, which count in the mechanism's size (``()``: none)."""
 
     @staticmethod
+    @abstractmethod
     def fact_texts() -> dict[str, Callable[[dict[str, Any], SceneUnits], str]]:
         """Return, per ``kind`` of the facts its step's errors carry, their text in scene units.
 
         See :class:`~mech_kinematics.errors.AssemblyError` and
-        :func:`~.mechanism.assembly_text`.
+        :func:`~.mechanism.assembly_text` (``{}``: its errors carry none).
         """
-        return {}
 
-    def bodies(self) -> Iterator[tuple[str, str, Body]]:
-        """Yield (point, body name, body) of every body besides links it puts at a point."""
-        yield from ()
-
-    def frames(self) -> Iterator[Frame]:
-        """Yield the frame of every joint it moves (:data:`Frame`, for ``/tf``)."""
-        yield from ()
-
-    def members(self, ground: str) -> Iterator[Member]:
-        """Yield every body it adds to the mechanism (:data:`Member`, for instant centres)."""
-        yield from ()
-
-    def slide_angle(self, slider: str, scene: Any, state: Any) -> float:
-        """Return the direction, rad, in which its block ``slider`` slides, in a solved state."""
-        msg = f'Expected a slider block of "{self.key}", got "{slider}"'
-        raise KeyError(msg)
-
-    def locked(self, state: Any) -> tuple[str, ...]:
-        """Return its bodies that move with the ground in a solved state (a locked wheel)."""
-        return ()
-
-    def edges(self) -> Iterator[Edge]:
-        """Yield the relative motions it adds to the velocity and acceleration polygons."""
-        yield from ()
-
-    def slips(self) -> Iterator[tuple[str, str, str, float]]:
-        """Yield (slider, from point, to point, angle): sliding along a fixed direction, rad.
-
-        The motion of ``to`` relative to ``from`` is the slider's rate along
-        that direction (a translating body's slot; no Coriolis component).
-        """
-        yield from ()
-
-    def link_lengths(self) -> dict[str, float | None]:
-        """Return the length, m, of every link it moves (``None`` where it varies)."""
-        return {}
-
-    def outline(self, body: str, scene: Any, state: Any, points: Mapping[str, Any]
-                ) -> tuple[tuple[str, ...], tuple[tuple[Any, Any], ...]]:
-        """Return the points besides its own that ``body``'s drawing runs through, and its slots.
-
-        Asked only of a body it adds (:meth:`members`). ``points`` maps every
-        point to its position (an array of shape (2,), m); a slot is (inner end,
-        mouth), positions likewise.
-        """
-        return (), ()
-
-    def blocks(self, state: Any, points: Mapping[str, Any], ground: str,
-               locked: set[str]) -> Iterator[tuple[str, str, Any, float, str]]:
-        """Yield (name, point, position, sliding angle in rad, guide body) of its slider blocks."""
-        yield from ()
-
-    def guides(self, state: Any, points: Mapping[str, Any],
-               strokes: Mapping[str, tuple[float, float]], size: float
-               ) -> Iterator[tuple[str, Any, Any]]:
-        """Yield (slider, start, end) of every fixed guide it draws, over the slider's stroke."""
-        yield from ()
-
+    @abstractmethod
     def toggle(self) -> tuple[str, str, tuple[str, ...]] | None:
-        """Return (measure key, label, links) if its measure is a transmission angle's sine."""
-        return None
+        """Return (measure key, label, links) if its measure is a transmission angle's sine.
 
-    def dead_centre_joints(self, ground: Collection[str]) -> dict[str, str]:
-        """Return its output joints that can reverse (dead centres): name -> joint type."""
-        return {}
+        ``None`` where its near-singularity measure means something else, or
+        where it has none.
+        """
 
-    def tip_links(self, point: str) -> Iterator[tuple[str, tuple[str, ...]]]:
-        """Yield (link, the joints it moves) for each of its links starting at ``point``."""
-        yield from ()
-
-    def pivots(self, ground: Collection[str]) -> dict[str, str]:
-        """Return link -> ground pivot of its links that turn about a ground point."""
-        return {}
-
-    def pin_links(self, pivots: Mapping[str, str]) -> Iterator[tuple[str, str, bool]]:
-        """Yield (its new pin, a link it is on, whether that link is preferred)."""
-        yield from ()
-
-    def four_bar(self) -> tuple[str, Any, Any] | None:
-        """Return its new pin and two links (:class:`~.model.Link`) if it can close a four-bar."""
-        return None
+    def joint_types(self) -> dict[str, JointType]:
+        """Return the output joints it moves and their types (its fragment's coordinates)."""
+        return dict(self.fragment().coordinates)
 
 
-def fixed_guide(slider: str, through: Any, angle: float, state: Any,
-                strokes: Mapping[str, tuple[float, float]], size: float
-                ) -> tuple[str, Any, Any]:
-    """Return (slider, start, end) of a fixed guide through ``through`` at ``angle`` (rad).
+class Driver(ABC):
+    """A driver of the mechanism (a crank, a linear actuator): what the rest asks of its kind.
 
-    The guide is drawn over the slider's stroke (or around its place, where no
-    stroke is known), padded by 8 % of the drawing's ``size``: what
-    :meth:`Item.guides` yields for a slider on a fixed straight guide.
+    A driver's kind is a frozen dataclass deriving from this class, in a
+    module of its own (:mod:`.crank`, :mod:`.actuator`), registered in
+    :data:`~.registry.DRIVERS`; every method is abstract. Its fields
+    ``speed`` and ``accel`` are its default rates (rad/s and rad/s^2, or m/s
+    and m/s^2).
     """
-    u = np.array([math.cos(angle), math.sin(angle)])
-    s = float(state.joints[slider].position)
-    low, high = strokes.get(slider, (s, s))
-    pad = 0.08 * size
-    return slider, through + (min(low, s) - pad) * u, through + (max(high, s) + pad) * u
+
+    speed: float
+    accel: float
+    #: The scene key of its position at time zero (``'angle'``, ``'length'``), for messages.
+    position_key: ClassVar[str]
+
+    @property
+    @abstractmethod
+    def name(self) -> str:
+        """Its name: the output joint it moves (a crank's link, an actuator)."""
+
+    @property
+    @abstractmethod
+    def joint_type(self) -> JointType:
+        """The type of the joint it moves (:mod:`.graph`): what its position is."""
+
+    @property
+    @abstractmethod
+    def start(self) -> float:
+        """Its position at time zero, rad or m (a crank's within its turn)."""
+
+    @property
+    @abstractmethod
+    def stroke(self) -> tuple[float, float] | None:
+        """Its inclusive limits, m, or ``None`` where its position may be anything."""
+
+    @property
+    @abstractmethod
+    def reach(self) -> float:
+        """The length, m, it adds to the mechanism's size."""
+
+    @abstractmethod
+    def position_text(self, value: float, units: SceneUnits) -> str:
+        """Return a position of it (rad or m) as text in the scene's unit."""
+
+    @abstractmethod
+    def scaled(self, scale: Callable[[float], float]) -> Driver:
+        """Return it with every length ``x`` replaced by ``scale(x)``."""
+
+    @abstractmethod
+    def fragment(self) -> Fragment:
+        """Return its part of the mechanism's graph (:mod:`.graph`)."""
+
+    @abstractmethod
+    def defined(self) -> tuple[tuple[str, str], ...]:
+        """Return (name, ``'point'``/``'link'``/``'actuator'``) of every name it defines."""
+
+    @abstractmethod
+    def local(self, ground: Mapping[str, complex]) -> dict[str, dict[str, complex]]:
+        """Return the points fixed on the links it moves, in each link's frame."""
+
+    @abstractmethod
+    def step(self, ground: Mapping[str, complex]) -> Any:
+        """Return its step: ``run(ctx, position, speed, accel)`` at the head of every solve."""
+
+    @abstractmethod
+    def check_used(self, used: Collection[str]) -> None:
+        """Refuse it where it moves nothing: ``used`` are the names the scene's steps read."""
+
+    @staticmethod
+    @abstractmethod
+    def fact_texts() -> dict[str, Callable[[dict[str, Any], SceneUnits], str]]:
+        """Return, per ``kind`` of the facts its step's errors carry, their text in scene units."""

@@ -7,10 +7,12 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, replace
 import math
+from typing import Any
 
-from .base import Edge, Item, Names, Placing, Step
+from .base import Item, Names, Placing, Step
 from .context import _Context, _U16, _U2, _U4
-from .model import _check_finite, _check_name, _names, Where
+from .graph import Fragment, Motion
+from .model import _check_finite, _check_name, _names, SceneUnits, Where
 from ..bounds import U
 from ..errors import SceneError
 
@@ -52,10 +54,6 @@ class CarriedPoint(Item):
         """Yield the point."""
         yield self.name, 'point', (self, 'name')
 
-    def joint_types(self) -> dict[str, str]:
-        """Return no joint: a carried point moves none."""
-        return {}
-
     def prerequisites(self, names: Names) -> set[str]:
         """Return its link and the two points its frame is built on."""
         return {names.link(self.link, f'the link of point "{self.name}"', (self, 'link')),
@@ -92,9 +90,23 @@ class CarriedPoint(Item):
         """Return it with its local coordinates scaled."""
         return replace(self, local=(scale(self.local[0]), scale(self.local[1])))
 
-    def edges(self) -> Iterator[Edge]:
-        """Yield its motion on its link, from its frame's origin."""
-        yield self.link, self.origin, self.name, None
+    def toggle(self) -> None:
+        """Return ``None``: it has no measure (it cannot fail to close)."""
+        return None
+
+    def lengths(self) -> tuple[float, ...]:
+        """Return no length: its place on its link counts in its link's, not in the size."""
+        return ()
+
+    @staticmethod
+    def fact_texts() -> dict[str, Callable[[dict[str, Any], SceneUnits], str]]:
+        """Return none: its errors carry no facts (their reason is their text)."""
+        return {}
+
+    def fragment(self) -> Fragment:
+        """Return its part of the graph: the point fixed on its link, moving about its origin."""
+        return Fragment(self.name, carried=((self.link, self.name),),
+                        motions=(Motion(self.link, self.origin, self.name),))
 
 
 class _CarryStep(Step):

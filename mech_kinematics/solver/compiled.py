@@ -124,12 +124,10 @@ def compile_single(scene: Scene) -> SingleFunction | None:
                               f'{plan.crank_length!r})', 'return None')
     joints, entries = [], []
     for name, kind in plan.joint_types.items():
-        if kind == 'revolute':
-            e = var('L', name)
-            joints.append(f'{name!r}: _JM({kind!r}, _wrapped_angle({e}[0]), {e}[1], {e}[2])')
-        else:
-            e = var('S', name)
-            joints.append(f'{name!r}: _JM({kind!r}, {e}[0], {e}[1], {e}[2])')
+        namespace[f'_{kind}'] = kind  # (the JointType itself: a constant cannot be one)
+        e = var(TABLES[kind.table], name)
+        position = f'_wrapped_angle({e}[0])' if kind.angular else f'{e}[0]'
+        joints.append(f'{name!r}: _JM(_{kind}, {position}, {e}[1], {e}[2])')
         entries.append(e)
     points = []
     for name in solver.plan.output_points:

@@ -4,21 +4,23 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass, replace
 import math
 from typing import Any
 
 import numpy as np
 
+from .base import Driver
 from .context import _Context, _U2, _U4
+from .graph import Body, Fragment, Frame, JointType, Motion, pin, REVOLUTE, Role
 from .model import _check_finite, _check_length, _check_name, SceneUnits
 from ..bounds import U
 from ..errors import SceneError
 
 
 @dataclass(frozen=True)
-class Crank:
+class Crank(Driver):
     """The driving crank: a link turning about a ground point.
 
     Parameters
@@ -43,6 +45,8 @@ class Crank:
         file's angle far out, as 1e17 deg, is read as an angle within a turn
         plus whole turns; only an intermittent drive tells the turns apart).
     """
+
+    position_key = 'angle'
 
     link: str
     center: str
@@ -72,9 +76,9 @@ class Crank:
         return self.link
 
     @property
-    def joint_type(self) -> str:
-        """The driver's joint type: ``'revolute'``."""
-        return 'revolute'
+    def joint_type(self) -> JointType:
+        """The driver's joint type: revolute."""
+        return REVOLUTE
 
     @property
     def start(self) -> float:
@@ -104,13 +108,22 @@ class Crank:
         """Return it with its length scaled."""
         return replace(self, length=scale(self.length))
 
-    def members(self, ground: str) -> tuple[tuple[str, str, tuple[str, ...], str | None], ...]:
-        """Return its body (:data:`~.base.Member`): the crank, carrying its centre and tip."""
-        return ((self.link, 'crank', (self.center, self.point), None),)
+    def fragment(self) -> Fragment:
+        """Return its part of the graph: the crank, turned by its motor about its centre."""
+        crank = Body(self.link, Role.CRANK, (self.center, self.point),
+                     Frame(self.center, self.link), length=self.length)
+        return Fragment(self.link, bodies=(crank,),
+                        joints=(pin(self.link, self.center, driver=True, name=self.link),),
+                        coordinates={self.link: REVOLUTE},
+                        motions=(Motion(self.link, self.center, self.point),))
 
-    def frames(self) -> tuple[tuple[str, str, str | None, float], ...]:
-        """Return its joint's frame (:data:`~.base.Frame`): at its centre, along it."""
-        return ((self.link, self.center, self.link, 0.0),)
+    @staticmethod
+    def fact_texts() -> dict[str, Callable[[dict[str, Any], SceneUnits], str]]:
+        """Return none: a crank's step cannot fail (every angle places its tip)."""
+        return {}
+
+    def check_used(self, used: Collection[str]) -> None:
+        """Accept it: a crank moves its own link whatever the steps read."""
 
     def defined(self) -> tuple[tuple[str, str], ...]:
         """Return (name, kind) of the names it defines: its link and its tip."""
@@ -129,7 +142,7 @@ class Crank:
 
 
 class _CrankStep:
-    joint_type = 'revolute'
+    joint_type = REVOLUTE
 
     def __init__(self, crank: Crank, center: complex) -> None:
         self.name = crank.link

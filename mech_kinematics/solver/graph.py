@@ -7,7 +7,7 @@ each declare their part of the mechanism as a :class:`Fragment`: the bodies
 they add (a link, a slotted lever, a slider block, a cylinder's barrel and
 rod), the joints that join those to bodies already placed (revolute pins,
 prismatic contacts, a driver's joint, an intermittent drive's engagement and
-lock), the coordinates they move (the output joints of SCENE_FORMAT.md, each
+lock), the coordinates they move (the output joints of docs/scene_format.md, each
 of a :class:`JointType`) and the relative motions the velocity polygons walk.
 :func:`build_graph` joins the fragments into one :class:`Graph`, once, when a
 scene is loaded (:attr:`~.mechanism.Scene.graph`).
@@ -42,7 +42,8 @@ if TYPE_CHECKING:
     from .model import SceneUnits
 
 __all__ = ['Body', 'Frame', 'Fragment', 'GROUND', 'Graph', 'Joint', 'JointType', 'LOCK',
-           'Line', 'Motion', 'PRISMATIC', 'REVOLUTE', 'Role', 'THE_GROUND', 'build_graph', 'joint_type']
+           'Line', 'Motion', 'PRISMATIC', 'REVOLUTE', 'Role', 'THE_GROUND', 'build_graph',
+           'joint_type', 'pin', 'slide']
 
 #: The ground body's name, unless the scene uses it for a link or slider (then ``_ground``).
 GROUND = 'ground'
@@ -51,7 +52,7 @@ THE_GROUND = '<ground>'
 
 
 class JointType(str):
-    """What kind of joint a joint is, and what its coordinate means (a string, e.g. ``'revolute'``).
+    """A kind of joint, and what its coordinate means: a string, e.g. ``'revolute'``.
 
     A ``JointType`` equals its name (``REVOLUTE == 'revolute'``), prints and
     serializes as it, and carries the facts the rest of the package asks of

@@ -21,11 +21,12 @@ from .actuator import Actuator
 from .base import Intermittent, Item
 from .carried import CarriedPoint
 from .crank import Crank
+from .graph import Graph
 from .model import _check_name, SceneUnits
 from .plan import _compile, _Plan
 from .registry import FACT_TEXTS
 from .rubbing import Pin
-from .scaling import _ANGULAR, _exponent, _LINEAR, _scaled, _size, _SIZE_RANGE
+from .scaling import _exponent, _LINEAR, _scaled, _size, _SIZE_RANGE
 from .solve import _execute, _execute_drivers, TRUST_TEST
 from ..bounds import U
 from ..errors import AssemblyError, NearSingularWarning, SceneError
@@ -88,9 +89,8 @@ class _Solver:
         outputs = [(rank[name], 'points', name, f'points.{name}', labels[name], _LINEAR)
                    for name in plan.output_points]
         for name, kind in plan.joint_types.items():
-            revolute = kind == 'revolute'
-            outputs.append((rank[name], 'links' if revolute else 'sliders', name,
-                            f'joints.{name}', labels[name], _ANGULAR if revolute else _LINEAR))
+            outputs.append((rank[name], kind.table, name, f'joints.{name}', labels[name],
+                            kind.quantities))
         outputs.sort(key=lambda item: item[0])
         self.outputs = tuple(item[1:] for item in outputs)
         self.out_points = plan.output_points
@@ -98,8 +98,8 @@ class _Solver:
                        if step.intermittent}
         self.jumping = {lever: _jumping(plan, lever) for lever in self.levers}
         self.joint_names = tuple(plan.joint_types)
-        self.out_links = tuple(n for n, k in plan.joint_types.items() if k == 'revolute')
-        self.out_sliders = tuple(n for n, k in plan.joint_types.items() if k == 'prismatic')
+        self.out_links = tuple(n for n, k in plan.joint_types.items() if k.table == 'links')
+        self.out_sliders = tuple(n for n, k in plan.joint_types.items() if k.table == 'sliders')
         # The quick trust test's groups (TRUST_TEST), with their names, the empty ones left out.
         self.trust = tuple((table, getattr(self, names), limits)
                            for table, names, limits in TRUST_TEST if getattr(self, names))
@@ -239,7 +239,7 @@ class Scene:
             msg = 'Expected a scene to have input (one crank) or inputs (a list of drivers)'
             raise SceneError(msg, (self, 'input'))
         if first is not None:
-            crank = cast(Crank, first) if first.joint_type == 'revolute' else None
+            crank = cast(Crank, first) if first.joint_type.angular else None  # it turns
             object.__setattr__(self, 'input', crank)
         object.__setattr__(self, 'dyads', tuple(self.dyads))
         object.__setattr__(self, 'points', tuple(self.points))
@@ -268,11 +268,12 @@ class Scene:
             where = (drivers[0], 'angle' if solver.single else 'length')
             culprit = next((d for d in drivers if f'input {d.name}' == error.dyad), None)
             if culprit is not None:
-                where = (culprit, 'length' if culprit.joint_type == 'prismatic' else 'angle')
+                where = (culprit, culprit.position_key)
             msg = (f'Expected the mechanism to assemble at {at}, got '
                    f'{assembly_text(error, self.units)}')
             raise SceneError(msg, where if dyad is None else (dyad, '')) from None
         object.__setattr__(self, 'imus', tuple(self.imus))
+        object.__setattr__(self, '_plan', full)  # the graph, for the IMUs' links
         joints, points = imu_outputs(self, full.joint_types, self.outputs_joints,
                                      self.outputs_points)
         if joints is None and points is None:
@@ -296,6 +297,11 @@ class Scene:
         if self.inputs:
             return self.inputs
         return (cast(Crank, self.input),)
+
+    @property
+    def graph(self) -> Graph:
+        """The mechanism's bodies and joints (:mod:`.graph`): what every concern reads."""
+        return self._plan.graph
 
     @property
     def output_joints(self) -> tuple[str, ...]:

@@ -15,6 +15,7 @@ import math
 from typing import Any, TYPE_CHECKING
 
 from .base import Item, Step
+from .graph import build_graph, Graph
 from .model import _check_finite, _check_name, _names, Where
 from .rubbing import _rub_steps, _RubStep
 from ..errors import SceneError
@@ -38,6 +39,7 @@ class _Plan:
     joint_types: dict[str, str]
     output_joints: tuple[str, ...]
     output_points: tuple[str, ...]
+    graph: Graph
     rubs: tuple[_RubStep, ...] = ()
     extra: tuple[Any, ...] = ()
 
@@ -216,10 +218,7 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
 
     used = {name for step in steps for name in step.uses}
     for driver in drivers:
-        if driver.joint_type == 'prismatic' and driver.name not in used:
-            msg = (f'Expected actuator "{driver.name}" to be the length of an RRR link '
-                   f'(actuator: {driver.name} in place of length:), got no link using it')
-            raise SceneError(msg, (driver, 'actuator'))
+        driver.check_used(used)
     order = [*ground, *(name for driver in drivers for name, kind in driver.defined()
                         if kind == 'point'),
              *(name for step in steps for name in step.new_points)]
@@ -237,7 +236,9 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
             msg = f'Expected outputs.points to list points, got {got}'
             raise SceneError(msg, (scene, 'outputs.points'))
 
-    rubs = _rub_steps(scene, kinds, placing.local)
+    fragments = tuple(item.fragment() for item in (*drivers, *scene.dyads, *scene.points))
+    graph = build_graph(fragments, kinds, ground, (driver.name for driver in drivers))
+    rubs = _rub_steps(scene, kinds, graph)
 
     # Keep only the steps that the outputs (and the pins' rubbing) depend on.
     needed: set[int] = set()
@@ -254,7 +255,7 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
     kept = tuple(step for index, step in enumerate(steps) if index in needed)
     return _Plan(driver_steps[0], kept, ground,
                  {name: joint_types[name] for name in out_joints}, out_joints, out_points,
-                 rubs, driver_steps[1:])
+                 graph, rubs, driver_steps[1:])
 
 
 def diameter(points: Iterable[complex]) -> float:

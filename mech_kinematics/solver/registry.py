@@ -11,7 +11,8 @@ from collections.abc import Callable
 from typing import Any
 
 from .actuator import Actuator
-from .base import Item
+from .base import Driver, Item
+from .crank import Crank
 from .model import SceneUnits
 from .rpp import RPP
 from .rpr import RPR
@@ -21,8 +22,10 @@ from .rrr import RRR
 #: The scene's ``type:`` of a dyad -> its item class.
 KINDS: dict[str, type[Item]] = {kind.kind: kind for kind in (RRR, RRP, RPR, RPP)}
 
+#: The key that names a driver in the scene's ``inputs:`` -> its kind.
+DRIVERS: dict[str, type[Driver]] = {'link': Crank, 'actuator': Actuator}
+
 #: The ``kind`` of an :class:`~mech_kinematics.errors.AssemblyError`'s facts -> their text.
 FACT_TEXTS: dict[str, Callable[[dict[str, Any], SceneUnits], str]] = {
-    fact: text for texts in (*(kind.fact_texts() for kind in KINDS.values()),
-                             Actuator.fact_texts())
-    for fact, text in texts.items()}
+    fact: text for kind in (*KINDS.values(), *DRIVERS.values())
+    for fact, text in kind.fact_texts().items()}

@@ -22,16 +22,17 @@ near-singularity measure is ``|c|``.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Collection, Iterator, Mapping
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 import math
 from typing import Any
 
 import numpy as np
 
-from .base import Body, Edge, fixed_guide, Frame, Item, Member, Names, Placing, Reading, Step
+from .base import Item, Names, Placing, Reading, Step
 from .context import _Context, _cross, _U2, SINGULAR
-from .model import _check_finite, _check_name, Where
+from .graph import Body, Fragment, Frame, Line, pin, PRISMATIC, Role, slide, THE_GROUND
+from .model import _check_finite, _check_name, SceneUnits, Where
 from ..bounds import U
 from ..errors import SceneError
 
@@ -117,10 +118,6 @@ class RPP(Item):
         yield self.slider, 'slider', (self, 'slider')
         yield self.slot_slider, 'slider', (self, 'slot_slider')
 
-    def joint_types(self) -> dict[str, str]:
-        """Return its two sliders, prismatic joints."""
-        return {self.slider: 'prismatic', self.slot_slider: 'prismatic'}
-
     def prerequisites(self, names: Names) -> set[str]:
         """Check the guide's ground point; return the pin."""
         names.ground(self.guide_through, f'the guide point of RPP "{self.point}"',
@@ -135,49 +132,37 @@ class RPP(Item):
         """Return it unchanged: it holds no length."""
         return self
 
-    def bodies(self) -> Iterator[tuple[str, str, Body]]:
-        """Yield the yoke at Y and the block in its slot at B, neither turning."""
-        yield self.point, self.slider, ('still', self.slider)
-        yield self.through, self.slot_slider, ('still', self.slot_slider)
+    def toggle(self) -> None:
+        """Return ``None``: its measure is the sine of the slot's angle to the guide."""
+        return None
 
-    def frames(self) -> Iterator[Frame]:
-        """Yield the yoke's frame (at Y, along the guide), the block's (at B, along the slot)."""
-        yield self.slider, self.point, None, self.guide_angle
-        yield self.slot_slider, self.through, None, self.slot_angle
+    def lengths(self) -> tuple[float, ...]:
+        """Return no length: the yoke holds no length."""
+        return ()
 
-    def members(self, ground: str) -> Iterator[Member]:
-        """Yield the yoke, sliding on the ground, and the pin's block, sliding in the yoke."""
-        yield self.slider, 'slider', (self.point,), ground
-        yield self.slot_slider, 'slider', (self.through,), self.slider
+    @staticmethod
+    def fact_texts() -> dict[str, Callable[[dict[str, Any], SceneUnits], str]]:
+        """Return none: its errors carry no facts (their reason is their text)."""
+        return {}
 
-    def slide_angle(self, slider: str, scene: Any, state: Any) -> float:
-        """Return the guide's angle for the yoke, the slot's for the pin's block."""
-        return self.guide_angle if slider == self.slider else self.slot_angle
+    def fragment(self) -> Fragment:
+        """Return its part of the graph: the yoke on its guide, a block on the pin in its slot.
 
-    def edges(self) -> Iterator[Edge]:
-        """Yield nothing that turns: the yoke translates (see :meth:`slips`)."""
-        yield from ()
-
-    def slips(self) -> Iterator[tuple[str, str, str, float]]:
-        """Yield the pin's sliding in the slot: (slider, from Y, to B, the slot's angle)."""
-        yield self.slot_slider, self.point, self.through, self.slot_angle
-
-    def blocks(self, state: Any, points: Mapping[str, Any], ground: str,
-               locked: set[str]) -> Iterator[tuple[str, str, Any, float, str]]:
-        """Yield the yoke at Y along the guide and the pin's block at B along the slot."""
-        yield self.slider, self.point, points[self.point], self.guide_angle, ground
-        yield self.slot_slider, self.through, points[self.through], self.slot_angle, self.slider
-
-    def guides(self, state: Any, points: Mapping[str, Any],
-               strokes: Mapping[str, tuple[float, float]], size: float
-               ) -> Iterator[tuple[str, Any, Any]]:
-        """Yield the yoke's guide over its stroke (or around Y), padded by 8 % of ``size``."""
-        yield fixed_guide(self.slider, points[self.guide_through], self.guide_angle, state,
-                          strokes, size)
-
-    def dead_centre_joints(self, ground: Collection[str]) -> dict[str, str]:
-        """Return the yoke, which reverses at the ends of its stroke."""
-        return {self.slider: 'prismatic'}
+        Neither turns: the yoke's frame keeps the guide's angle, the block's
+        the slot's.
+        """
+        return Fragment(
+            self.point,
+            (Body(self.slider, Role.SLIDER, (self.point,),
+                  Frame(self.point, None, self.guide_angle), guide=THE_GROUND),
+             Body(self.slot_slider, Role.SLIDER, (self.through,),
+                  Frame(self.through, None, self.slot_angle), guide=self.slider)),
+            (slide(self.slider, self.point, self.slider,
+                   Line(self.guide_through, None, self.guide_angle), on=THE_GROUND),
+             pin(self.slot_slider, self.through),
+             slide(self.slot_slider, self.through, self.slot_slider,
+                   Line(self.point, None, self.slot_angle), on=self.slider)),
+            {self.slider: PRISMATIC, self.slot_slider: PRISMATIC})
 
 
 class _RPPStep(Step):

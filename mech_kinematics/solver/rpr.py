@@ -4,15 +4,16 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Collection, Iterator, Mapping
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
-import math
 from typing import Any
 
 import numpy as np
 
-from .base import Body, Edge, Frame, Item, Member, Names, Placing, Reading, Step
+from .base import Item, Names, Placing, Reading, Step
 from .context import _Context, _cross, _dot, _U2, _U4, _U7, SINGULAR
+from .graph import (Body, Fragment, Frame, Joint, Line, LOCK, Motion, pin, PRISMATIC, REVOLUTE,
+                    Role, slide, THE_GROUND)
 from .model import _check_name, SceneUnits, Where
 from ..bounds import ROUNDING_MARGIN, U
 from ..errors import SceneError
@@ -89,10 +90,6 @@ class RPR(Item):
         yield self.link, 'link', (self, 'link')
         yield self.slider, 'slider', (self, 'slider')
 
-    def joint_types(self) -> dict[str, str]:
-        """Return its lever (revolute) and its slider (prismatic)."""
-        return {self.link: 'revolute', self.slider: 'prismatic'}
-
     def prerequisites(self, names: Names) -> set[str]:
         """Check its ground pivot; return its pin."""
         names.ground(self.center, f'the center of RPR "{self.link}"', (self, 'center'))
@@ -114,86 +111,35 @@ class RPR(Item):
         """Return it unchanged: it holds no length."""
         return self
 
-    def bodies(self) -> Iterator[tuple[str, str, Body]]:
-        """Yield the slider block at the pin (it turns with the lever)."""
-        yield self.through, self.slider, ('block', self.link)
+    def toggle(self) -> None:
+        """Return ``None``: its measure is its pin's distance from the pivot (over the size)."""
+        return None
 
-    def frames(self) -> Iterator[Frame]:
-        """Yield the lever's frame (at its pivot) and the block's (at the pin), along the lever."""
-        yield self.link, self.center, self.link, 0.0
-        yield self.slider, self.through, self.link, 0.0
+    def lengths(self) -> tuple[float, ...]:
+        """Return no length: its lever's length (pivot to pin) varies."""
+        return ()
 
-    def members(self, ground: str) -> Iterator[Member]:
-        """Yield its lever (carrying its pivot) and its block, which slides in the lever."""
-        yield self.link, 'lever', (self.center,), None
-        yield self.slider, 'slider', (self.through,), self.link
+    def fragment(self) -> Fragment:
+        """Return its part of the graph: a lever on its pivot, a block on the pin in its slot.
 
-    def slide_angle(self, slider: str, scene: Any, state: Any) -> float:
-        """Return the slot's direction: the lever's, or for a Geneva wheel the pin's slot's."""
-        if self.link in state.intermittent:
-            # A Geneva wheel: the slot the pin is in (not slot 0) lies along the pivot-pin
-            # line; while the wheel is locked the pin, out of the slot, moves with the
-            # crank, across the crank's radius (the pin is on the crank).
-            pin = complex(state.complex_points[self.through][0])
-            engaged = state.intermittent[self.link].engaged
-            start = self.center if engaged else scene.input.center
-            o = complex(state.complex_points[start][0])
-            return math.atan2(pin.imag - o.imag, pin.real - o.real) + (
-                0.0 if engaged else math.pi / 2)
-        return float(state.joints[self.link].position)
-
-    def locked(self, state: Any) -> tuple[str, ...]:
-        """Return its lever while a Geneva wheel is locked (it then moves with the ground)."""
-        engagement = state.intermittent.get(self.link)
-        return () if engagement is None or engagement.engaged else (self.link,)
-
-    def edges(self) -> Iterator[Edge]:
-        """Yield the lever's point under the pin, about the pivot, then the pin's sliding."""
-        yield self.link, self.center, self.through, self.slider
-
-    def link_lengths(self) -> dict[str, float | None]:
-        """Return the lever, whose length (pivot to pin) varies."""
-        return {self.link: None}
-
-    def dead_centre_joints(self, ground: Collection[str]) -> dict[str, str]:
-        """Return its lever, which rocks (a Geneva wheel only indexes: none)."""
-        return {self.link: 'revolute'} if self.slots is None else {}
-
-    def pivots(self, ground: Collection[str]) -> dict[str, str]:
-        """Return its lever, which turns about its ground pivot."""
-        return {self.link: self.center}
-
-    def outline(self, body: str, scene: Any, state: Any, points: Mapping[str, Any]
-                ) -> tuple[tuple[str, ...], tuple[tuple[Any, Any], ...]]:
-        """Return the lever through the pin in its slot; a Geneva wheel's slots instead."""
-        if body != self.link:
-            return (), ()
-        n = self.slots
-        if n is None:
-            return (self.through,), ()
-        names = (scene.input.center, self.center, self.through)
-        centre, wheel, pin = (points[name] for name in names)
-        distance = float(np.hypot(*(wheel - centre)))
-        radius = float(np.hypot(*(pin - centre)))
-        # The slot's length to its mouth, sqrt(l^2 - R^2), with l and R divided by l
-        # first: the squares stay in range whatever the wheel's size (1e300 m).
-        mouth = distance * math.sqrt(max(1.0 - (radius / distance) ** 2, 0.0))
-        inner = 0.85 * (distance - radius)
-        angle = float(state.joints[self.link].position)
-        slots = []
-        for i in range(n):
-            turn = angle + 2 * math.pi * i / n
-            u = np.array([math.cos(turn), math.sin(turn)])
-            slots.append((wheel + inner * u, wheel + mouth * u))
-        return (), tuple(slots)
-
-    def blocks(self, state: Any, points: Mapping[str, Any], ground: str,
-               locked: set[str]) -> Iterator[tuple[str, str, Any, float, str]]:
-        """Yield its block along the lever (none while a Geneva wheel is locked)."""
-        if self.link not in locked:
-            e = points[self.through] - points[self.center]
-            yield (self.slider, self.through, points[self.through], math.atan2(e[1], e[0]),
-                   self.link)
+        A Geneva wheel's slot (``slots``: that many, evenly spaced) holds the
+        pin only while it is engaged, and a lock holds the wheel while it is
+        not: both joints are intermittent.
+        """
+        geneva = self.slots is not None
+        joints = [pin(self.link, self.center), pin(self.slider, self.through),
+                  slide(self.slider, self.through, self.slider, Line(self.center, self.link),
+                        on=self.link, intermittent=geneva, copies=self.slots or 1)]
+        if geneva:
+            joints.append(Joint(f'{self.link}/lock', LOCK, self.link, THE_GROUND, self.center,
+                                intermittent=True))
+        return Fragment(
+            self.link,
+            (Body(self.link, Role.LEVER, (self.center,), Frame(self.center, self.link)),
+             Body(self.slider, Role.SLIDER, (self.through,), Frame(self.through, self.link),
+                  guide=self.link)),
+            tuple(joints), {self.link: REVOLUTE, self.slider: PRISMATIC},
+            (Motion(self.link, self.center, self.through, self.slider),))
 
 
 def _pivot_text(facts: dict[str, Any], units: SceneUnits) -> str:

@@ -4,7 +4,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Collection, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, replace
 from fractions import Fraction
 import math
@@ -12,8 +12,10 @@ from typing import Any
 
 import numpy as np
 
-from .base import Body, Edge, fixed_guide, Frame, Item, Member, Names, Placing, Reading, Step
+from .base import Item, Names, Placing, Reading, Step
 from .context import _Context, _cross, _dot, _sum_root, _U2, _U3, _U5, _U7, SINGULAR
+from .graph import (Body, Fragment, Frame, Line, Motion, pin, PRISMATIC, REVOLUTE, Role, slide,
+                    THE_GROUND)
 from .model import _check_finite, _check_name, _g, Branch, Link, SceneUnits, Where
 from ..bounds import ROUNDING_MARGIN, U
 
@@ -72,10 +74,6 @@ class RRP(Item):
         yield self.link.name, 'link', (self.link, 'name')
         yield self.slider, 'slider', (self, 'slider')
 
-    def joint_types(self) -> dict[str, str]:
-        """Return its link (revolute) and its slider (prismatic)."""
-        return {self.link.name: 'revolute', self.slider: 'prismatic'}
-
     def prerequisites(self, names: Names) -> set[str]:
         """Check the guide's ground point; return the start of its link."""
         names.ground(self.through, f'the guide point of RRP "{self.point}"', (self, 'through'))
@@ -95,56 +93,24 @@ class RRP(Item):
         """Return it with its link's length scaled."""
         return replace(self, link=replace(self.link, length=scale(self.link.length)))
 
-    def bodies(self) -> Iterator[tuple[str, str, Body]]:
-        """Yield the slider block at the new point (it does not turn)."""
-        yield self.point, self.slider, ('still', self.slider)
-
-    def frames(self) -> Iterator[Frame]:
-        """Yield the link's frame (at its start, along it) and the block's (along the guide)."""
-        yield self.link.name, self.link.start, self.link.name, 0.0
-        yield self.slider, self.point, None, self.guide_angle
-
-    def members(self, ground: str) -> Iterator[Member]:
-        """Yield its link and its block, which slides on the ground."""
-        yield self.link.name, 'link', (self.link.start, self.point), None
-        yield self.slider, 'slider', (self.point,), ground
-
-    def slide_angle(self, slider: str, scene: Any, state: Any) -> float:
-        """Return the guide's angle."""
-        return self.guide_angle
-
-    def edges(self) -> Iterator[Edge]:
-        """Yield its link's motion from its start to the new pin."""
-        yield self.link.name, self.link.start, self.point, None
-
-    def link_lengths(self) -> dict[str, float | None]:
-        """Return its link's length."""
-        return {self.link.name: self.link.length}
+    def fragment(self) -> Fragment:
+        """Return its part of the graph: its link, pinned to a block on the fixed guide."""
+        link = self.link
+        block = Frame(self.point, None, self.guide_angle)
+        return Fragment(
+            self.point,
+            (Body(link.name, Role.LINK, (link.start, self.point), Frame(link.start, link.name),
+                  length=link.length),
+             Body(self.slider, Role.SLIDER, (self.point,), block, guide=THE_GROUND)),
+            (pin(link.name, link.start), pin(self.slider, self.point, on=link.name),
+             slide(self.slider, self.point, self.slider,
+                   Line(self.through, None, self.guide_angle), on=THE_GROUND)),
+            {link.name: REVOLUTE, self.slider: PRISMATIC}, (Motion(link.name, link.start,
+                                                                   self.point),))
 
     def toggle(self) -> tuple[str, str, tuple[str, ...]] | None:
         """Return its measure (the sine of the rod's angle to the guide normal), label, link."""
         return self.point, f'RRP {self.point}', (self.link.name,)
-
-    def dead_centre_joints(self, ground: Collection[str]) -> dict[str, str]:
-        """Return its slider, which reverses at the ends of its stroke."""
-        return {self.slider: 'prismatic'}
-
-    def tip_links(self, point: str) -> Iterator[tuple[str, tuple[str, ...]]]:
-        """Yield its link if it starts at ``point``, with its link and slider."""
-        if self.link.start == point:
-            yield self.link.name, (self.link.name, self.slider)
-
-    def blocks(self, state: Any, points: Mapping[str, Any], ground: str,
-               locked: set[str]) -> Iterator[tuple[str, str, Any, float, str]]:
-        """Yield its block, sliding along the guide on the ground."""
-        yield self.slider, self.point, points[self.point], self.guide_angle, ground
-
-    def guides(self, state: Any, points: Mapping[str, Any],
-               strokes: Mapping[str, tuple[float, float]], size: float
-               ) -> Iterator[tuple[str, Any, Any]]:
-        """Yield its guide over the stroke (or around the block), padded by 8 % of ``size``."""
-        yield fixed_guide(self.slider, points[self.through], self.guide_angle, state, strokes,
-                          size)
 
 
 def _reach_text(facts: dict[str, Any], units: SceneUnits) -> str:

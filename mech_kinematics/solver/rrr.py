@@ -4,7 +4,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Collection, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, replace
 from fractions import Fraction
 import math
@@ -12,8 +12,9 @@ from typing import Any
 
 import numpy as np
 
-from .base import Edge, Frame, Item, Member, Names, Placing, Reading, Step
+from .base import Item, Names, Placing, Reading, Step
 from .context import _Context, _dot, _sum_root, _U16, _U2, _U3, _U4, _U7, SINGULAR
+from .graph import Body, Fragment, Frame, Line, Motion, pin, REVOLUTE, Role, slide
 from .model import _check_name, _g, Branch, Link, SceneUnits, Where
 from ..bounds import ROUNDING_MARGIN, U
 from ..errors import SceneError
@@ -104,10 +105,6 @@ class RRR(Item):
         for link in self.links:
             yield link.name, 'link', (link, 'name')
 
-    def joint_types(self) -> dict[str, str]:
-        """Return its two links, revolute joints."""
-        return {link.name: 'revolute' for link in self.links}
-
     def prerequisites(self, names: Names) -> set[str]:
         """Return the start points of its links (and the actuators of actuated links)."""
         needed = {names.point(link.start, f'the start of link "{link.name}"', (link, 'start'))
@@ -151,64 +148,36 @@ class RRR(Item):
         first, second = (replace(link, length=scale(link.length)) for link in self.links)
         return replace(self, links=(first, second))
 
-    def frames(self) -> Iterator[Frame]:
-        """Yield each link's frame: at its start, along it; an actuator's at its rod's pin.
+    def fragment(self) -> Fragment:
+        """Return its part of the graph: two links pinned at their starts and at the new pin.
 
-        An actuated link is a cylinder's body (at its start pin) and the
-        actuator a prismatic joint whose frame, the rod's, sits at the dyad's
-        new pin, along the link.
+        An actuated link is a cylinder: its barrel (the link, pinned at its
+        start) and its rod (the actuator, carrying the new pin), which slides
+        along the barrel, driven.
         """
-        for link in self.links:
-            yield link.name, link.start, link.name, 0.0
+        bodies, joints, carrying = [], [], []
         for link, actuator in zip(self.links, self.actuators, strict=True):
-            if actuator is not None:
-                yield actuator, self.point, link.name, 0.0
-
-    def members(self, ground: str) -> Iterator[Member]:
-        """Yield its two links, each carrying its start and the new pin."""
-        for link in self.links:
-            yield link.name, 'link', (link.start, self.point), None
-
-    def edges(self) -> Iterator[Edge]:
-        """Yield each link's motion from its start to the new pin."""
-        for link in self.links:
-            yield link.name, link.start, self.point, None
-
-    def link_lengths(self) -> dict[str, float | None]:
-        """Return its two links' lengths (``None`` for an actuated link, whose length varies)."""
-        return {link.name: None if actuator is not None else link.length
-                for link, actuator in zip(self.links, self.actuators, strict=True)}
+            frame = Frame(link.start, link.name)
+            joints.append(pin(link.name, link.start))
+            if actuator is None:
+                bodies.append(Body(link.name, Role.LINK, (link.start, self.point), frame,
+                                   length=link.length))
+                carrying.append(link.name)
+            else:
+                bodies += [Body(link.name, Role.LINK, (link.start,), frame),
+                           Body(actuator, Role.SLIDER, (self.point,),
+                                Frame(self.point, link.name), guide=link.name)]
+                joints.append(slide(actuator, self.point, actuator,
+                                    Line(link.start, link.name), on=link.name, driver=True))
+                carrying.append(actuator)
+        joints.append(pin(carrying[1], self.point, on=carrying[0]))
+        return Fragment(self.point, tuple(bodies), tuple(joints),
+                        {link.name: REVOLUTE for link in self.links},
+                        tuple(Motion(link.name, link.start, self.point) for link in self.links))
 
     def toggle(self) -> tuple[str, str, tuple[str, ...]] | None:
         """Return its measure (the sine of the angle between its links), label and links."""
         return self.point, f'RRR {self.point}', tuple(link.name for link in self.links)
-
-    def dead_centre_joints(self, ground: Collection[str]) -> dict[str, str]:
-        """Return its links that turn about a ground point (rockers)."""
-        return {link.name: 'revolute' for link in self.links if link.start in ground}
-
-    def tip_links(self, point: str) -> Iterator[tuple[str, tuple[str, ...]]]:
-        """Yield its links starting at ``point``, with both its links."""
-        for link in self.links:
-            if link.start == point:
-                yield link.name, tuple(other.name for other in self.links)
-
-    def pivots(self, ground: Collection[str]) -> dict[str, str]:
-        """Return its links that turn about a ground point."""
-        return {link.name: link.start for link in self.links if link.start in ground}
-
-    def pin_links(self, pivots: Mapping[str, str]) -> Iterator[tuple[str, str, bool]]:
-        """Yield the new pin on its first link, and on any link turning about a ground pivot."""
-        yield self.point, self.links[0].name, False
-        for link in self.links:  # the pin is on both links
-            if link.name in pivots:
-                yield self.point, link.name, True
-
-    def four_bar(self) -> tuple[str, Link, Link] | None:
-        """Return its new pin and two links: an RRR of fixed links can close a four-bar loop."""
-        if self.actuators != (None, None):
-            return None
-        return self.point, *self.links
 
 
 def _pair_text(facts: dict[str, Any], units: SceneUnits) -> str:

@@ -14,6 +14,7 @@ from .model import _check_length, _check_name, _names
 from ..errors import SceneError
 
 if TYPE_CHECKING:
+    from .graph import Graph
     from .mechanism import Scene
 
 
@@ -88,27 +89,29 @@ class _RubStep:
         return entry[1], entry[4]
 
 
-def _rub_steps(scene: Scene, kinds: dict[str, str],
-               local: dict[str, dict[str, complex]]) -> tuple[_RubStep, ...]:
-    """Return the rubbing step of every pin of ``scene``, checking the bodies it joins."""
+def _rub_steps(scene: Scene, kinds: dict[str, str], graph: Graph) -> tuple[_RubStep, ...]:
+    """Return the rubbing step of every pin of ``scene``, checking the bodies it joins.
+
+    A pin joins the bodies its point is fixed on (:class:`~.graph.Graph`): a
+    link turns at its own rate, a block turns with the body it rides (an RPR
+    block with its lever, only while a Geneva wheel's pin is engaged), the
+    ground and a translating block not at all.
+    """
     pins: tuple[Pin, ...] = tuple(getattr(scene, 'pins', ()))
     if not pins:
         return ()
-    ground_body = 'ground' if 'ground' not in kinds else '_ground'
     at: dict[str, dict[str, tuple[str, str]]] = {}  # point -> body name -> body
-
-    def put(point: str, name: str, body: tuple[str, str]) -> None:
-        at.setdefault(point, {})[name] = body
-
-    for link, fixed in local.items():
-        for point in fixed:
-            put(point, link, ('link', link))
-    for dyad in scene.dyads:
-        for point, name, body in dyad.bodies():
-            put(point, name, body)
-    for point in scene.ground:
+    # The links first (each turning on its own), then the blocks, then the ground.
+    ground = graph.bodies[graph.ground]
+    moving = [body for body in graph.bodies.values() if body is not ground]
+    for body in sorted(moving, key=lambda b: b.turns_with != b.name):
+        turns = body.turns_with
+        kind = 'still' if turns is None else 'link' if turns == body.name else 'block'
+        for point in body.points:
+            at.setdefault(point, {})[body.name] = (kind, turns or body.name)
+    for point in ground.points:
         if point in at:  # a ground point that some link turns about
-            put(point, ground_body, ('still', ground_body))
+            at[point][ground.name] = ('still', ground.name)
     steps = []
     seen: set[str] = set()
     for pin in pins:

@@ -20,6 +20,7 @@ import numpy.typing as npt
 from .compiled import (ARRAY_COMPILE_AFTER, bounds_from_entries, COMPILE_AFTER, compile_array,
                        compile_single, keep_freed_memory, LARGE_BATCH)
 from .context import _Context, NEAR_SINGULAR
+from .graph import REVOLUTE
 from .scaling import (_ACCEL_HIGH, _ldexp, _QUANTITIES, _rate_exponent, _RATE_HIGH, _RATE_LOW,
                       _rates_exponent, _rescale)
 from .state import _crank_floors, _scales, _xy, Engagement, JointMotion, State
@@ -100,7 +101,7 @@ def _execute_drivers(solver: _Solver, positions: tuple[Any, ...], speeds: tuple[
     s = solver.shift
     if s:
         for index, kind in enumerate(solver.driver_types):
-            if kind == 'prismatic':
+            if not kind.angular:  # a length, scaled with the mechanism
                 xs[index], vs[index], accs[index] = (
                     _ldexp(x, -s) for x in (xs[index], vs[index], accs[index]))
     shift = _rates_exponent(vs, accs)
@@ -469,7 +470,7 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
         jumps = _jumps(solver, ctx, theta, omega, alpha, whole, valid) if ctx.jumps else {}
         counted = theta + math.tau * whole if some and whole.any() else np.array(theta)
     _warn_near_singular(ctx.measures, ctx.vector, ctx.valid)
-    drivers = {solver.driver_names[0]: JointMotion('revolute', counted, omega, alpha)}
+    drivers = {solver.driver_names[0]: JointMotion(REVOLUTE, counted, omega, alpha)}
     return _state(scene, solver, ctx, theta, omega, alpha, valid, whole, jumps, drivers,
                   given=given if ctx.vector else ())
 
@@ -513,12 +514,12 @@ def _solve_drivers(scene: Scene, solver: _Solver, positions: Any, speeds: Any, a
     accs = _per_driver(accels, tuple(d.accel for d in drivers), 'accels')
     count = len(drivers)
     if isinstance(turns, (int, np.integer)):  # one number: every crank's
-        listed: list[Any] = [turns if kind == 'revolute' else 0 for kind in solver.driver_types]
+        listed: list[Any] = [turns if kind.angular else 0 for kind in solver.driver_types]
     else:
         listed = _per_driver(turns, (0,) * count, 'turns')
     wholes = [_turns(t) for t in listed]
     for whole, kind, name in zip(wholes, solver.driver_types, names, strict=True):
-        if kind == 'prismatic' and np.any(whole):
+        if not kind.angular and np.any(whole):
             msg = f'Expected no whole turns for actuator {name}, got {whole!r}'
             raise ValueError(msg)
     values = [*xs, *vs, *accs]
@@ -580,8 +581,7 @@ def _solve_drivers(scene: Scene, solver: _Solver, positions: Any, speeds: Any, a
 
 def _where(drivers: Any, positions: list[float]) -> str:
     """Return where several drivers stand, for a message: ``crank = 0.5 rad, cyl = 1.2 m``."""
-    units = {'revolute': 'rad', 'prismatic': 'm'}
-    return ', '.join(f'{d.name} = {x:.6g} {units[d.joint_type]}'
+    return ', '.join(f'{d.name} = {x:.6g} {d.joint_type.units[0]}'
                      for d, x in zip(drivers, positions, strict=True))
 
 
@@ -603,7 +603,7 @@ def _jumps(solver: _Solver, ctx: _Context, theta: Any, omega: Any, alpha: Any, t
         for lever in ctx.jumps:
             names, carried = solver.jumping[lever]
             for name in names:
-                table = other.links if kinds[name] == 'revolute' else other.sliders
+                table = getattr(other, kinds[name].table)
                 joints[name] = {'acceleration': table[name][2]}
             for name in carried:
                 points[name] = {'acceleration': _xy(other.points[name][2])}
@@ -623,7 +623,7 @@ def _jumps(solver: _Solver, ctx: _Context, theta: Any, omega: Any, alpha: Any, t
         names, carried = solver.jumping[lever]
         mine = near[at]
         for name in names:
-            table = other.links if kinds[name] == 'revolute' else other.sliders
+            table = getattr(other, kinds[name].table)
             value = joints.setdefault(name, {'acceleration': np.full(shape, np.nan)})
             value['acceleration'][at[mine]] = np.broadcast_to(table[name][2], at.shape)[mine]
         for name in carried:
@@ -739,7 +739,7 @@ def _compiled_state(scene: Scene, solver: _Solver, theta: float, omega: float, a
     bound = ErrorBound(bounds_from_entries, (solver.joint_names, solver.out_points, entries),
                        solver.size, solver.crank_length)
     counted = theta + math.tau * turns if turns else theta
-    drivers = {solver.driver_names[0]: JointMotion('revolute', counted, omega, alpha)}
+    drivers = {solver.driver_names[0]: JointMotion(REVOLUTE, counted, omega, alpha)}
     state = _new_state(scene.name, theta, omega, alpha, joints, points, True, measures, {},
                        bound, turns, {}, {}, {}, drivers)
     if scene.imus:  # read from the state when asked (State.imus), as _state does
@@ -834,7 +834,7 @@ def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any,
 
         joints = {}
         for name, kind in plan.joint_types.items():
-            if kind == 'revolute':
+            if kind.angular:  # a unit complex number, its angle reported
                 e, w, al = ctx.links[name][:3]
                 joints[name] = JointMotion(kind, finish(_angles(e)), finish(w),
                                            finish(al))
@@ -872,7 +872,7 @@ def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any,
     else:
         joints = {}
         for name, kind in plan.joint_types.items():
-            if kind == 'revolute':
+            if kind.angular:  # a unit complex number, its angle reported
                 e, w, al = ctx.links[name][:3]
                 joints[name] = JointMotion(kind, _wrapped_angle(e), w, al)
             else:
@@ -982,8 +982,7 @@ def _constant(x: Any, shape: tuple[int, ...]) -> Any:
 
 def _table_bounds(plan: _Plan, ctx: _Context) -> tuple[Table, Table]:
     """Return the reported joints' and points' bounds from a solve's context."""
-    joints = {name: (ctx.links if kind == 'revolute' else ctx.sliders)[name][3:]
-              for name, kind in plan.joint_types.items()}
+    joints = {name: getattr(ctx, kind.table)[name][3:] for name, kind in plan.joint_types.items()}
     table = ctx.points
     return joints, {name: table[name][3:] for name in plan.output_points}
 

@@ -14,7 +14,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .model import Number, Vector
-from .scaling import _ANGULAR, _LINEAR
+from .scaling import _LINEAR
 from ..bounds import ErrorBound
 from ..imu import imu_reading, ImuReading, ImuSpec
 
@@ -214,9 +214,9 @@ class State:
         return _scales(bound.size, floors,
                        [(v, a) for _, v, a in self.complex_points.values()],
                        [(j.velocity, j.acceleration) for j in self.joints.values()
-                        if j.type == 'prismatic'],
+                        if not j.type.angular],
                        [(j.velocity, j.acceleration) for j in self.joints.values()
-                        if j.type == 'revolute'], vector)
+                        if j.type.angular], vector)
 
     @cached_property
     def relative_error_bound(self) -> Number:
@@ -229,8 +229,7 @@ class State:
         worst: Any = 0.0
         joints, points = self.error_bound.raw()
         records = [(b, _LINEAR) for b in points.values()]
-        records += [(joints[name], _ANGULAR if j.type == 'revolute' else _LINEAR)
-                    for name, j in self.joints.items()]
+        records += [(joints[name], j.type.quantities) for name, j in self.joints.items()]
         with np.errstate(divide='ignore', invalid='ignore'):
             for values, kinds in records:
                 for value, kind in zip(values, kinds, strict=True):

@@ -297,14 +297,14 @@ def _draw_mechanism(ax: Any, scene: Scene, space: SpaceDiagram, colours: Mapping
 def _crank_senses(ax: Any, scene: Scene, diagram: Diagram,
                   unit: float) -> list[tuple[Array, Array]]:
     """Draw an arc arrow at each crank's pivot in its sense of rotation; return the chords."""
-    ground = {name: complex(*xy) for name, xy in scene.ground.items()}
+    graph = scene.graph
     speeds = {d.name: d.speed for d in diagram.drivers}
     chords = []
-    for driver in scene.drivers:
-        for members in driver.local(ground).values():  # a crank's centre and tip
-            centre, tip = list(members)
-            chords += _crank_sense(ax, diagram.space, centre, tip,
-                                   speeds.get(driver.name, diagram.speed), unit)
+    for joint in graph.joints:  # a driven pin: a crank, from its centre to its tip
+        if joint.driver and joint.line is None:
+            crank = next(m for m in graph.motions if m.body == joint.body)
+            chords += _crank_sense(ax, diagram.space, crank.start, crank.end,
+                                   speeds.get(joint.name, diagram.speed), unit)
     return chords
 
 

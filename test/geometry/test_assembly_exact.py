@@ -209,7 +209,7 @@ def test_check_agrees_with_a_fine_sweep_at_every_end_and_a_coarse_one_elsewhere(
     state = solved(scene, coarse)
     expected = inside(coarse, result.ranges) if not result.everywhere else np.ones(36000, bool)
     assert (state.valid == expected).all(), name
-    outputs = {j for dyad in scene.dyads for j in dyad.dead_centre_joints(scene.ground)}
+    outputs = set(scene.graph.reversing())
     for joint in outputs | {c.joint for c in result.dead_centres}:
         centres = [c.angle for c in result.dead_centres if c.joint == joint]
         for angle in centres:
