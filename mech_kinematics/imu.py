@@ -31,19 +31,31 @@ from typing import Any
 
 import numpy as np
 
-from .bounds import U
+from .bounds import LARGEST, U
 from .errors import SceneError
+from .units import reduce_radians
 
-__all__ = ['ImuReading', 'ImuSpec', 'imu_links', 'imu_outputs', 'imu_reading', 'imu_values']
+__all__ = ['MAX_GRAVITY', 'ImuReading', 'ImuSpec', 'imu_links', 'imu_outputs', 'imu_reading',
+           'imu_values']
 
 #: Rounding of ``R(-phi) v`` with ``cos``/``sin`` and two products and a sum per
 #: component, relative to ``|v|``: a few units of roundoff, taken generously.
 _ROTATION_ROUNDING = 8.0 * U
+#: Largest ``|gx| + |gy|`` of a sensor's gravity, m/s^2 (half the largest double): at
+#: rest a reading is at most ``|gx| + |gy|`` and its bound sums ``|g|``, ``|gx|`` and
+#: ``|gy|``, so both stay finite. A larger gravity is refused when the scene is built.
+MAX_GRAVITY = LARGEST / 2
 
 
 @dataclass(frozen=True)
 class ImuSpec:
-    """A sensor ``name`` at ``point`` on ``link``; ``gravity`` m/s^2, ``angle`` rad."""
+    """A sensor ``name`` at ``point`` on ``link``; ``gravity`` m/s^2, ``angle`` rad.
+
+    ``angle`` is a direction: one beyond [-pi, pi] is kept reduced exactly to
+    within it (:func:`~.units.reduce_radians`), so that the orientation
+    ``theta_L + angle`` wraps to (-pi, pi] and its bound stays that of an
+    angle within a turn, however many turns were written.
+    """
 
     name: str
     link: str
@@ -52,12 +64,20 @@ class ImuSpec:
     angle: float = 0.0
 
     def __post_init__(self) -> None:
-        """Refuse a gravity or angle that is not a finite number."""
+        """Refuse a gravity or angle that is not a finite number, or a gravity that overflows."""
         for value, what in ((self.gravity[0], 'gravity[0]'), (self.gravity[1], 'gravity[1]'),
                             (self.angle, 'angle')):
             if not math.isfinite(value):
                 msg = f'imus.{self.name}.{what}: expected a finite number, got {value!r}'
                 raise ValueError(msg)
+        gx, gy = self.gravity
+        if not abs(gx) + abs(gy) <= MAX_GRAVITY:
+            msg = (f'Expected a gravity whose readings stay within the range of doubles '
+                   f'(abs(gx) + abs(gy) at most {MAX_GRAVITY:.6g} m/s^2), got '
+                   f'[{gx:.6g}, {gy:.6g}] m/s^2')
+            raise SceneError(msg, (self, 'gravity'))
+        if abs(self.angle) > math.pi:
+            object.__setattr__(self, 'angle', reduce_radians(float(self.angle))[0])
 
 
 @dataclass(frozen=True)
@@ -109,13 +129,14 @@ def imu_reading(state: Any, spec: ImuSpec) -> ImuReading:
     phi = np.where(phi > math.pi, phi - 2 * math.pi, np.where(phi <= -math.pi,
                                                               phi + 2 * math.pi, phi))
     c, s = np.cos(phi), np.sin(phi)
-    a = np.asarray(point.acceleration, dtype=np.float64) - np.asarray(spec.gravity)
-    ax, ay = a[..., 0], a[..., 1]
-    reading = np.stack((c * ax + s * ay, c * ay - s * ax), axis=-1)
-    size = np.hypot(ax, ay)
-    e_phi = np.asarray(joint_bound.position) + U * (abs(phi) + abs(spec.angle))
-    e_accel = (np.asarray(point_bound.acceleration) + size * e_phi
-               + _ROTATION_ROUNDING * (size + abs(spec.gravity[0]) + abs(spec.gravity[1])))
+    with np.errstate(over='ignore', invalid='ignore'):  # beyond doubles: inf, refused by solve
+        a = np.asarray(point.acceleration, dtype=np.float64) - np.asarray(spec.gravity)
+        ax, ay = a[..., 0], a[..., 1]
+        reading = np.stack((c * ax + s * ay, c * ay - s * ax), axis=-1)
+        size = np.hypot(ax, ay)
+        e_phi = np.asarray(joint_bound.position) + U * (abs(phi) + abs(spec.angle))
+        e_accel = (np.asarray(point_bound.acceleration) + size * e_phi
+                   + _ROTATION_ROUNDING * (size + abs(spec.gravity[0]) + abs(spec.gravity[1])))
     scalar = np.ndim(phi) == 0
     if scalar:
         return ImuReading(float(phi), float(joint.velocity), reading,
@@ -127,9 +148,11 @@ def imu_reading(state: Any, spec: ImuSpec) -> ImuReading:
 def imu_links(scene: Any) -> dict[str, tuple[str, ...]]:
     """Return every moving link of ``scene`` and the points fixed on it, in scene order.
 
-    A point is fixed on a link when it is one of the link's pins (the crank's
-    centre and tip, a dyad link's start and new pin, a lever's pivot) or a
-    point carried by it (``points:``); a pin sliding in a slotted lever is not.
+    The bodies of the mechanism's graph that turn on their own (every crank,
+    dyad link, slotted lever, a cylinder's barrel) and the points fixed on
+    each: its pins (a crank's centre and tip, a dyad link's start and new pin,
+    a lever's pivot) and the points carried by it (``points:``); a pin sliding
+    in a slotted lever or a cylinder's barrel is not fixed on it.
     """
     return {name: body.points for name, body in scene.graph.bodies.items()
             if body.turns_with == name}

@@ -83,7 +83,7 @@ class LinkDict(TypedDict):
 
 
 class InputDict(TypedDict, total=False):
-    """The ``input`` key: the driving crank."""
+    """The ``input`` key: the driving crank (its speed as ``speed_rpm`` or ``speed``, rad/s)."""
 
     link: str
     center: str
@@ -91,6 +91,7 @@ class InputDict(TypedDict, total=False):
     length: float
     angle: float
     speed_rpm: float
+    speed: float
     accel: float
 
 
@@ -173,8 +174,15 @@ class _Reader:
         return value / self.per_metre
 
     def angle(self, mapping: Any, key: str, where: str, default: Any = ...) -> float:
-        value = self.number(mapping, key, where, default)
-        return math.radians(value) if self.degrees else value
+        """Return the direction at ``key``, rad: beyond a turn, reduced exactly to within one.
+
+        Every angle key but the crank's start (:meth:`start_angle`) is a
+        direction (a guide's, a slot's, a sensor's axis), which whole turns do
+        not change: ``angle: 1e17`` (deg) is the direction -80 deg, read as
+        ``angle: -80`` is, to the bit (``math.radians(1e17)`` would be an
+        angle of 1.7e15 rad whose cosine has nothing to do with -80 deg).
+        """
+        return self._split(self.number(mapping, key, where, default))[0]
 
     def start_angle(self, mapping: Any, key: str, where: str) -> tuple[float, int]:
         """Return the crank angle at ``key`` as (rad within a turn, whole turns).
@@ -182,9 +190,12 @@ class _Reader:
         An angle beyond a turn is reduced exactly (in degrees as written, or
         in rad with 2 pi to 400 digits), so that 1e308 deg is the same crank
         position as ``solve --angle-deg 1e308``; within a turn it is read as
-        :meth:`angle` reads it, with no turns.
+        written, with no turns.
         """
-        value = self.number(mapping, key, where, 0.0)
+        return self._split(self.number(mapping, key, where, 0.0))
+
+    def _split(self, value: float) -> tuple[float, int]:
+        """Return an angle in the scene's unit as (rad within a turn, whole turns), exactly."""
         if self.degrees:
             return turns_from_degrees(value) if abs(value) > 360.0 else (math.radians(value), 0)
         return reduce_radians(value) if abs(value) > math.tau else (value, 0)
@@ -353,14 +364,30 @@ def _link(reader: _Reader, keys: _Keys, raw: Any, where: str) -> Link:
 def _crank(reader: _Reader, keys: _Keys, raw: Any, where: str) -> Crank:
     """Return the crank written at ``where`` (``input``, or an entry of ``inputs``)."""
     _check_keys(raw if isinstance(raw, dict) else {}, set(InputDict.__annotations__), where)
-    rpm = reader.number(raw, 'speed_rpm', where, 0.0)
+    speed, key = _crank_speed(reader, raw, where)
     angle, turns = reader.start_angle(raw, 'angle', where)
     return keys.build(
-        where, {'speed': 'speed_rpm'}, Crank,
+        where, {'speed': key}, Crank,
         link=reader.name(raw, 'link', where), center=reader.name(raw, 'center', where),
         point=reader.name(raw, 'point', where), length=reader.length(raw, 'length', where),
-        angle=angle, turns=turns, speed=rad_per_s_from_rpm(rpm),
-        accel=reader.number(raw, 'accel', where, 0.0))
+        angle=angle, turns=turns, speed=speed, accel=reader.number(raw, 'accel', where, 0.0))
+
+
+def _crank_speed(reader: _Reader, raw: Any, where: str) -> tuple[float, str]:
+    """Return a crank's speed, rad/s, and the key it was read from (``speed`` or ``speed_rpm``).
+
+    ``speed`` (rad/s) is taken as written, to the bit; ``speed_rpm`` is
+    converted (``rpm * pi / 30``). At most one of the two; neither is 0.
+    """
+    given = [key for key in ('speed', 'speed_rpm') if isinstance(raw, dict) and key in raw]
+    if len(given) == 2:
+        msg = (f'{where}.speed: expected the crank speed once, as speed (rad/s) or speed_rpm '
+               f'(rpm), got both (speed: {_brief(raw["speed"])}, speed_rpm: '
+               f'{_brief(raw["speed_rpm"])})')
+        raise SceneError(msg)
+    if given == ['speed']:
+        return reader.number(raw, 'speed', where), 'speed'
+    return rad_per_s_from_rpm(reader.number(raw, 'speed_rpm', where, 0.0)), 'speed_rpm'
 
 
 def _drivers(reading: _Reading, raw: Any) -> tuple[Crank | Actuator, ...]:
@@ -379,6 +406,12 @@ def _drivers(reading: _Reading, raw: Any) -> tuple[Crank | Actuator, ...]:
         else:
             raise SceneError(f'{where}: expected a crank (with link:) or an actuator (with '
                              f'actuator:), got {_brief(item)}')
+        first = next((i for i, d in enumerate(drivers[:-1]) if d.name == drivers[-1].name), None)
+        if first is not None:
+            key = 'actuator' if drivers[-1].joint_type == 'prismatic' else 'link'
+            msg = (f'{where}.{key}: Expected every driver to have a name of its own, got '
+                   f'"{drivers[-1].name}" again (the name of inputs[{first}])')
+            raise SceneError(msg)
     return tuple(drivers)
 
 
@@ -403,13 +436,24 @@ class _Reading:
         self.build = keys.build
         #: The scene's actuators: name -> length at time zero, m.
         self.actuators: dict[str, float] = {}
+        #: The key of the link each actuator drives, as the dyads name them.
+        self.driven: dict[str, str] = {}
 
     def actuator_length(self, name: str, where: str) -> float:
-        """Return the length at time zero, m, of the scene's actuator ``name``."""
+        """Return the length at time zero, m, of the scene's actuator ``name``.
+
+        Each actuator is the length of one link: a second link naming it is
+        refused at its own key (``where``).
+        """
         if name not in self.actuators:
             known = ', '.join(self.actuators) or 'none'
             raise SceneError(f'{where}: expected the name of an actuator of inputs ({known}), '
                              f'got {_brief(name)}')
+        if name in self.driven:
+            msg = (f'{where}: Expected each actuator to be the length of one link, got '
+                   f'"{name}" again (the actuator of {self.driven[name]})')
+            raise SceneError(msg)
+        self.driven[name] = where.removesuffix('.actuator')
         return self.actuators[name]
 
     @staticmethod

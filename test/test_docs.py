@@ -70,6 +70,8 @@ dyads:
   - {type: RPP, point: Y, through: B, guide: {through: A, angle: 0}, slot_angle: 90,
      slider: yoke, slot_slider: pin_in_slot}
 """
+#: The packaged excavator (two cylinders), whose actuators the table names wrongly twice.
+EXCAVATOR = (ROOT / 'config' / 'scenes' / 'excavator.yaml').read_text()
 #: Each mistake of the reference's error table, as the scene text that makes it.
 MISTAKES = {
     'no_units': BASE.replace('units: {length: mm, angle: deg}\n', ''),
@@ -93,6 +95,12 @@ MISTAKES = {
     'pin_off_crank': GENEVA.replace('slots: 5', 'slots: 6').replace('through: P', 'through: S'),
     'compound': COMPOUND,
     'parallel_slot': YOKE.replace('slot_angle: 90', 'slot_angle: 180'),
+    'speed_twice': BASE.replace('speed_rpm: -120', 'speed_rpm: -120, speed: -12.566'),
+    'gravity': BASE + 'imus:\n  tip: {link: coupler, point: C, gravity: [0, 1e308]}\n',
+    'actuator_twice': EXCAVATOR.replace('actuator: stick_cyl\n    length: 3.0',
+                                        'actuator: boom_cyl\n    length: 3.0'),
+    'actuator_two_links': EXCAVATOR.replace('{name: stick_cyl_body, from: S, actuator: stick_cyl}',
+                                            '{name: stick_cyl_body, from: S, actuator: boom_cyl}'),
 }
 
 

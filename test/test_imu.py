@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import math
 
+from helpers import BOOM_CYLINDER
 from hypothesis import example, given, settings, strategies as st
 import mpmath
 import numpy as np
@@ -344,3 +345,108 @@ def test_the_number_of_imus_is_bounded(monkeypatch):
                                             r'got 2'):
         imu_scene({'a': {'link': 'coupler', 'point': 'E'}, 'b': {'link': 'rocker',
                                                                  'point': 'C'}})
+
+
+# -- the edges of the format (issue 33) -----------------------------------------------------
+
+#: Whole turns of the angle written in rad beyond which reduce_radians' 2 pi to 400
+#: digits is needed (a float 2 pi is off by 2.4e-16 rad a turn).
+FAR_RAD = 1e17
+
+
+def gripper_with(**fingertip):
+    """Return the packaged gripper with its fingertip sensor's keys replaced by ``fingertip``."""
+    data = mk.scene.read_scene_yaml(mk.scene.scene_text('gripper'))
+    data['imus']['fingertip'].update(fingertip)
+    return mk.parse_scene(data)
+
+
+@pytest.mark.parametrize('far, near', [(1e17, -80.0), (360.0 * 2 ** 40 + 30, 30.0),
+                                       (-725.5, -5.5)])
+def test_an_imu_angle_beyond_a_turn_is_the_direction_it_names(far, near):
+    """Issue 33: 1e17 deg is the direction -80 deg; the readings are -80 deg's, to the bit.
+
+    It was read as 1.7e15 rad: orientation 1.7e15 rad, the acceleration 7.5 deg
+    off, bounds of 0.39 rad, all published at level OK.
+    """
+    assert math.remainder(far, 360.0) == near
+    far_state, near_state = (mk.solve(scene, scene.input.angle)
+                             for scene in (gripper_with(angle=far), gripper_with(angle=near)))
+    assert far_state.as_dict()['imus'] == near_state.as_dict()['imus']
+    assert far_state.as_dict()['error_bound'] == near_state.as_dict()['error_bound']
+    orientation = far_state.imus['fingertip'].orientation
+    assert -math.pi < orientation <= math.pi
+    assert far_state.imus['fingertip'].orientation_bound < 1e-13
+
+
+def test_an_imu_angle_in_rad_beyond_a_turn_is_reduced_exactly():
+    """1e17 rad (a spec of the API, or a scene in rad) is reduced with 2 pi to 50 digits here.
+
+    The orientation is the link's angle plus 1e17 mod 2 pi, wrapped: checked
+    against mpmath at 60 digits, within the reading's own bound.
+    """
+    spec = ImuSpec('far', 'coupler', 'C', G, FAR_RAD)
+    assert -math.pi <= spec.angle <= math.pi
+    with mpmath.workdps(60):
+        turn = 2 * mpmath.pi
+        exact = mpmath.mpf(FAR_RAD) - turn * mpmath.nint(mpmath.mpf(FAR_RAD) / turn)
+        assert spec.angle == float(exact)
+        state = mk.solve(SCENE, SCENE.input.angle)
+        reading = imu_reading(state, spec)
+        theta = mpmath.mpf(state.joints['coupler'].position) + exact
+        expected = float(theta - 2 * mpmath.pi * mpmath.nint(theta / (2 * mpmath.pi)))
+    assert abs(reading.orientation - expected) <= reading.orientation_bound
+    assert reading.orientation_bound < 1e-14
+    data = mk.scene.read_scene_yaml(mk.scene.scene_text('gripper'))
+    data['units']['angle'] = 'rad'
+    data['input']['angle'] = math.radians(data['input']['angle'])
+    data['imus']['fingertip']['angle'] = FAR_RAD
+    assert mk.parse_scene(data).imus[0].angle == spec.angle
+
+
+def test_a_gravity_whose_readings_would_overflow_is_refused_at_load():
+    """Issue 33: gravity [0, 1e308] crashed `solve` (inf in its JSON); now one line at load.
+
+    At the limit (|gx| + |gy| = MAX_GRAVITY, half the largest double) the
+    readings at rest and their bounds are finite.
+    """
+    from mech_kinematics.imu import MAX_GRAVITY
+
+    with pytest.raises(mk.SceneError) as caught:
+        gripper_with(gravity=[0.0, 1e308])
+    message = str(caught.value)
+    assert message.startswith('imus.fingertip.gravity: Expected a gravity whose readings stay '
+                              'within the range of doubles (abs(gx) + abs(gy) at most '
+                              '8.98847e+307 m/s^2), got [0, 1e+308] m/s^2')
+    assert '\n' not in message
+    with pytest.raises(mk.SceneError, match='imus.fingertip.gravity: Expected a gravity'):
+        gripper_with(gravity=[-6e307, 6e307])
+    scene = gripper_with(gravity=[MAX_GRAVITY / 2, -MAX_GRAVITY / 2])
+    state = mk.solve(scene, scene.input.angle, 0.0, 0.0)
+    data = state.as_dict()
+    json.dumps(data, allow_nan=False)   # every reading and bound finite
+    assert math.hypot(*data['imus']['fingertip']['linear_acceleration']) == pytest.approx(
+        math.hypot(MAX_GRAVITY / 2, MAX_GRAVITY / 2), rel=1e-15)
+
+
+def test_imus_on_a_scene_of_drivers_are_read_on_every_crank_and_link():
+    """A sensor on a boom (one actuator, no crank): read; on a five-bar's second crank.
+
+    ``imu_links`` asked ``scene.input`` for the crank: a scene of actuators
+    alone raised AttributeError at load, and a second crank carried no point.
+    """
+    data = yaml.safe_load(BOOM_CYLINDER)
+    data['imus'] = {'boom_head': {'link': 'boom', 'point': 'T', 'gravity': [0, -9.80665]}}
+    boom = mk.parse_scene(data)
+    state = mk.solve(boom, 3.1, 0.0, 0.0)
+    reading = state.imus['boom_head']
+    assert reading.orientation == state.joints['boom'].position
+    np.testing.assert_allclose(reading.linear_acceleration,
+                               [9.80665 * math.sin(reading.orientation),
+                                9.80665 * math.cos(reading.orientation)], rtol=0, atol=1e-14)
+    data = mk.scene.read_scene_yaml(mk.scene.scene_text('five_bar'))
+    second = data['inputs'][1]
+    data['imus'] = {'wrist': {'link': second['link'], 'point': second['point']}}
+    arm = mk.parse_scene(data)
+    assert mk.solve(arm, [d.start for d in arm.drivers]).imus['wrist'].orientation == \
+        pytest.approx(arm.drivers[1].start, abs=1e-15)

@@ -148,8 +148,10 @@ BAD_SCENES = [
      r"unknown key.*'colour'"),
     ('unknown_link_key', edit(setitem([*LINK1, 'lenght'], 80)), 'dyads[0].links[1]',
      r"unknown key.*'lenght'"),
-    ('unknown_input_key', edit(setitem(['input', 'speed'], 3)), 'input',
-     r"unknown key.*'speed'"),
+    ('unknown_input_key', edit(setitem(['input', 'speed_rps'], 3)), 'input',
+     r"unknown key.*'speed_rps'"),
+    ('crank_speed_in_two_units', edit(setitem(['input', 'speed'], 3)), 'input.speed',
+     r'expected the crank speed once, as speed \(rad/s\) or speed_rpm \(rpm\), got both'),
     ('guide_through_moving_point', edit(setitem(['dyads', 1, 'guide', 'through'], 'B')),
      'dyads[1].guide.through', r'ground point.*moving point "B"'),
     ('crank_center_moving', edit(setitem(['input', 'center'], 'C')), 'input.center',
@@ -541,3 +543,134 @@ def test_solve_command_rejects_a_bad_scene_in_one_line(tmp_path):
     assert result.returncode != 0
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and str(path) in lines[0], result.stderr
+
+
+# --- the edges of the format (issue 33) -----------------------------------------------
+
+
+def packaged_data(name):
+    """Return the mapping of the packaged scene ``name``, as read from its file."""
+    return mk.scene.read_scene_yaml(mk.scene.scene_text(name))
+
+
+def at(data, path, value):
+    """Return a copy of ``data`` with the key at ``path`` (a list of keys) set to ``value``."""
+    data = copy.deepcopy(data)
+    node = data
+    for key in path[:-1]:
+        node = node[key]
+    node[path[-1]] = value
+    return data
+
+
+@pytest.mark.parametrize('name, path, far, near', [
+    ('offset_slider_crank', ['dyads', 0, 'guide', 'angle'], 1e17, -80.0),    # RRP's guide
+    ('scotch_yoke', ['dyads', 0, 'guide', 'angle'], 1e17, -80.0),            # RPP's guide
+    ('scotch_yoke', ['dyads', 0, 'slot_angle'], 360.0 * 2 ** 40 + 90, 90.0),  # RPP's slot
+    ('gripper', ['imus', 'fingertip', 'angle'], -1e17, 80.0),                # a sensor's axis
+])
+def test_a_direction_beyond_a_turn_is_read_as_the_direction_it_names(name, path, far, near):
+    """Issue 33: every angle key but the crank's start is a direction, reduced exactly.
+
+    1e17 deg is -80 deg (IEEE remainder): the scene solves to the bits of the
+    one written -80. A guide at 1e17 deg was read as 1.7e15 rad, whose cosine has
+    nothing to do with -80 deg (the slider crank's rod then could not reach it).
+    """
+    assert math.remainder(far, 360.0) == near
+    data = packaged_data(name)
+    far_scene, near_scene = (mk.parse_scene(at(data, path, value)) for value in (far, near))
+    assert far_scene == near_scene
+    far_state, near_state = (mk.solve(scene, scene.input.angle)
+                             for scene in (far_scene, near_scene))
+    assert far_state.as_dict() == near_state.as_dict()
+
+
+def test_a_direction_in_rad_beyond_a_turn_is_reduced_with_2_pi_to_400_digits():
+    """A guide at 1e17 rad (a scene in rad) is 1e17 mod 2 pi correctly rounded (mpmath, 60 digits).
+
+    A float 2 pi is off by 2.4e-16 rad a turn: 1.6e16 turns would put it 4 rad off.
+    """
+    import mpmath
+
+    data = si_scene(base())
+    data['dyads'][1]['guide']['angle'] = 1e17
+    with mpmath.workdps(60):
+        turn = 2 * mpmath.pi
+        exact = float(mpmath.mpf(1e17) - turn * mpmath.nint(mpmath.mpf(1e17) / turn))
+    assert mk.parse_scene(data).dyads[1].guide_angle == exact
+
+
+def test_a_crank_speed_in_rad_per_s_is_taken_as_written():
+    """Issue 33: `speed: 300` (rad/s, signed) on a crank, as the course gives it; exact.
+
+    speed_rpm stays; `speed` is its alternative (both given: refused, see the
+    bad scenes). The value is kept in rad/s to the bit, for `solve` and the API.
+    """
+    data = base()
+    del data['input']['speed_rpm']
+    for value in (300, -300.0, 1e-300, 0):
+        data['input']['speed'] = value
+        scene = mk.parse_scene(data)
+        assert scene.input.speed == float(value)
+        assert mk.solve(scene, scene.input.angle).as_dict()['input']['speed'] == float(value)
+    five = packaged_data('five_bar')
+    del five['inputs'][1]['speed_rpm']
+    five['inputs'][1]['speed'] = -2.5
+    assert mk.parse_scene(five).drivers[1].speed == -2.5
+    five['inputs'][1]['speed_rpm'] = 10
+    with pytest.raises(mk.SceneError, match=r'^inputs\[1\]\.speed: expected the crank speed '
+                                            r'once, .* got both \(speed: -2\.5, speed_rpm: 10\)'):
+        mk.parse_scene(five)
+    data['input']['speed'] = 'fast'
+    with pytest.raises(mk.SceneError, match=r"^input\.speed: expected a number, got str 'fast'"):
+        mk.parse_scene(data)
+
+
+def test_an_actuator_named_twice_is_refused_at_its_second_name():
+    """Issue 33: the second `actuator: boom_cyl` of inputs is named, not the dyad using the first.
+
+    It said `dyads[1].links[1].actuator: expected the name of an actuator of
+    inputs (boom_cyl), got 'stick_cyl'`: the wrong key and the wrong actuator.
+    """
+    data = at(packaged_data('excavator'), ['inputs', 1, 'actuator'], 'boom_cyl')
+    with pytest.raises(mk.SceneError) as caught:
+        mk.parse_scene(data)
+    assert str(caught.value) == ('inputs[1].actuator: Expected every driver to have a name of '
+                                 'its own, got "boom_cyl" again (the name of inputs[0])')
+    five = at(packaged_data('five_bar'), ['inputs', 1, 'link'], 'left_crank')
+    with pytest.raises(mk.SceneError, match=r'^inputs\[1\]\.link: Expected every driver to have '
+                                            r'a name of its own, got "left_crank" again'):
+        mk.parse_scene(five)
+
+
+def test_an_actuator_used_by_two_links_is_refused_at_the_second_link():
+    """Issue 33: the second link naming boom_cyl is blamed, not the actuator left unused.
+
+    It said `inputs[1].actuator: Expected actuator "stick_cyl" to be the length
+    of an RRR link ..., got no link using it`. Built through the API, the scene
+    names both dyads.
+    """
+    data = at(packaged_data('excavator'), ['dyads', 1, 'links', 1, 'actuator'], 'boom_cyl')
+    with pytest.raises(mk.SceneError) as caught:
+        mk.parse_scene(data)
+    assert str(caught.value) == (
+        'dyads[1].links[1].actuator: Expected each actuator to be the length of one link, got '
+        '"boom_cyl" again (the actuator of dyads[0].links[1])')
+    excavator = mk.load_scene('excavator')
+    stick = excavator.dyads[1]
+    from dataclasses import replace
+
+    with pytest.raises(mk.SceneError) as caught:
+        mk.Scene(name='x', ground=excavator.ground, inputs=excavator.drivers,
+                 dyads=(excavator.dyads[0], replace(stick, actuators=(None, 'boom_cyl'))),
+                 points=excavator.points, units=excavator.units)
+    assert str(caught.value) == ('Expected each actuator to be the length of one link, got '
+                                 '"boom_cyl" in RRR Q and again in RRR K')
+
+
+def test_the_readme_describes_every_packaged_scene():
+    """Each packaged scene has its row in the README's table of packaged scenes."""
+    table = (ROOT / 'README.md').read_text(encoding='utf-8').split(
+        'Packaged scenes (`config/scenes/`)', 1)[1].split('\n\n', 2)[1]
+    listed = set(re.findall(r'^\| `(\w+)`', table, flags=re.MULTILINE))
+    assert listed == {path.stem for path in PACKAGED}

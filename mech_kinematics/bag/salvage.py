@@ -2,10 +2,10 @@
 # SPDX-License-Identifier: Apache-2.0
 """A damaged storage file replaced by its repaired copy, the original kept beside it.
 
-When ``reindex`` finds damage that it cannot cut off at the end of a storage
-file (a damaged chunk with intact ones after it, an unreadable page of an
-sqlite3 database), it never repairs the file in place: it writes what is
-readable to a new file (:func:`new_copy_path`), syncs it, and
+When ``reindex`` must change a storage file (an MCAP file with no summary or
+with damage, an unreadable page of an sqlite3 database), it never repairs the
+file in place: it writes what is readable to a new file in the same
+directory (:func:`new_copy_path`), syncs it, and
 :func:`replace_keeping_original` then keeps the original under the name
 ``NAME.damaged`` (a hard link, so it is never absent) and atomically puts the
 copy in its place. At every moment the storage file's name holds either the
@@ -50,15 +50,23 @@ def replace_keeping_original(path: Path, copy: Path) -> Path:
     Raises
     ------
     OSError
-        If the original cannot be kept (then nothing was changed).
+        If the original cannot be kept or the copy cannot take its name (then
+        nothing was changed).
     """
     kept = _kept_name(path)
-    if not kept.exists():
+    made = not kept.exists()
+    if made:
         try:
             os.link(path, kept)
         except OSError:
             shutil.copyfile(path, kept)     # a file system without hard links
-    os.replace(copy, path)
+    try:
+        os.replace(copy, path)
+    except OSError:
+        if made:        # nothing changed: the directory as it was
+            with contextlib.suppress(OSError):
+                kept.unlink()
+        raise
     directory = os.open(path.parent, os.O_RDONLY)
     try:
         os.fsync(directory)

@@ -27,18 +27,25 @@ write error) scans a file record by record and keeps every intact chunk
 byte, a length that runs past the file, an unknown opcode) it searches the
 following bytes for the next intact chunk (its CRC matches) or Schema or
 Channel record and goes on from there, so every intact chunk after a damaged
-one is kept. Then:
+one is kept. Closing records (metadata, data end, summary, footer) end the
+scan only if they are the file's own: they end the file with its footer and
+index exactly the chunks before them. Closing records with data after them (a
+summary written into a file that was still being written) or that do not
+match are dropped like damage, and the scan goes on. Then:
 
-- if what is dropped is only the end of an interrupted recording (a record
-  cut short, zeroes, message indexes cut short, an old summary), the file is
-  truncated after the last intact chunk, the message indexes of that chunk
-  rewritten if they were cut, and the summary that a normal close writes
-  appended (built by the same function). If the file system has no room for
-  the summary, the last chunks are dropped until it fits;
-- otherwise (damage with intact data after it, or a damaged last chunk) the
-  original is not changed: the kept records are copied to a new file with new
-  message indexes and a summary, which takes the original's name, and the
-  original is kept as ``NAME.damaged`` (:mod:`.salvage`).
+- a file closed normally, whole, is left as it is;
+- otherwise ``reindex`` never changes the file: the kept records are copied
+  to a new file with their message indexes and a summary, synced, which takes
+  the original's name, and the original is kept as ``NAME.damaged``
+  (:mod:`.salvage`). If the copy cannot be written whole (no room, a
+  read-only directory), the original is left as it was;
+- only the writer of the file, after its own write error and while it holds
+  the file's lock (``in_place``), finishes it in place when what is dropped
+  is just the end of its recording (a record cut short, message indexes cut
+  short): it truncates the file after its last intact chunk, rewrites that
+  chunk's message indexes if they were cut, and appends the summary that a
+  normal close writes (built by the same function), dropping its last chunks
+  if the file system has no room for it.
 
 Each dropped range is noted: its offsets, why, and how many messages of which
 topics a dropped chunk held if its records can still be parsed.
@@ -46,7 +53,7 @@ topics a dropped chunk held if its records can still be parsed.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 import contextlib
 from dataclasses import dataclass, field
 import errno
@@ -555,10 +562,10 @@ def _intact_at(stream: BinaryIO, window: bytes, i: int, at: int, size: int) -> b
 class RecoveredMcap:
     """An MCAP file scanned to its last intact chunk, to be finished with a summary.
 
-    Opening scans the file (nothing is written); :meth:`finish` truncates what
-    follows the data section and appends the metadata record, the summary and
-    the footer. A file that was closed normally keeps every message: only
-    its summary is rewritten.
+    Opening scans the file (nothing is written); :meth:`finish` writes the
+    kept records, the metadata record, the summary and the footer to a new
+    file that replaces it (the original kept as ``NAME.damaged``). A file that
+    was closed normally and is whole is left as it is.
 
     Attributes
     ----------
@@ -570,6 +577,9 @@ class RecoveredMcap:
         Log times of the first and last of them, ns (0 if none).
     stored_version : int or None
         Bag version of the embedded rosbag2 metadata, if the file was closed.
+    whole : bool
+        The file was closed normally and nothing is dropped: :meth:`finish`
+        leaves it as it is.
     qos_texts : list of str
         The stored offered QoS profiles (their format tells the bag version).
     notes : list of str
@@ -587,7 +597,9 @@ class RecoveredMcap:
         self._entries: dict[int, dict[int, bytearray]] = {}
         self._drops: list[_Drop] = []
         self._records: list[tuple[int, int]] = []
-        self._copy = False
+        self._damaged = False
+        self._stale_summary: tuple[int, str] | None = None
+        self.whole = False
         try:
             with open(path, 'rb') as stream:
                 size = os.fstat(stream.fileno()).st_size
@@ -735,15 +747,23 @@ class RecoveredMcap:
                     pos = resume
                     continue
                 if name == _ROSBAG2:
-                    self.stored_version = stored_version(values.get('serialized_metadata', ''))
-                    closed = True
-                    break
+                    closed, resume = self._closing(stream, pos, size)
+                    if closed:
+                        self.stored_version = stored_version(
+                            values.get('serialized_metadata', ''))
+                    if closed or resume is None:
+                        break
+                    pos = resume
+                    continue
                 self._records.append((pos, end))
                 self.data_end = end
             elif op in (DATA_END, FOOTER, CHUNK_INDEX, STATISTICS, METADATA_INDEX,
                         SUMMARY_OFFSET):
-                closed = True
-                break
+                closed, resume = self._closing(stream, pos, size)
+                if closed or resume is None:
+                    break
+                pos = resume
+                continue
             elif op in (ATTACHMENT, ATTACHMENT_INDEX):
                 self._records.append((pos, end))    # attachments stay as they are
                 self.data_end = end
@@ -760,17 +780,23 @@ class RecoveredMcap:
             if not closed and size > self.data_end:
                 self._drops.append(_Drop(self.data_end, size, 'message indexes cut short',
                                          cut=True))
-        # Repaired in place only if what is dropped is the end of an interrupted recording.
-        self._copy = (any(not d.cut for d in self._drops)
-                      or any(u is not self.chunks[-1] for u in self._unindexed))
+        # Its writer may finish it in place if what is dropped is the end of its recording.
+        self._damaged = (any(not d.cut for d in self._drops) or self._stale_summary is not None
+                         or any(u is not self.chunks[-1] for u in self._unindexed))
+        self.whole = (closed and not self._drops and not self._unindexed
+                      and self._stale_summary is None)
         self._note_drops(closed, size)
+        if self._stale_summary is not None and not self._drops:
+            at, problem = self._stale_summary
+            self.notes.append(f'replaced the closing records {problem} (from offset {at} to '
+                              f'the end)')
 
     def _note_drops(self, closed: bool, size: int) -> None:
         for drop in self._drops:
             what = f'{drop.end - drop.start} bytes from offset {drop.start}: {drop.reason}'
             if drop.messages:
                 what += f' holding {drop.messages}'
-            if drop.cut and not self._copy and drop.end == size:
+            if drop.cut and drop.end == size:
                 what += ' (the recording was interrupted)'
             self.notes.append(f'dropped {what}')
         if not self._drops and not closed and size > self.data_end:
@@ -778,14 +804,99 @@ class RecoveredMcap:
                               f'{self.data_end}: a record cut short '
                               f'(the recording was interrupted)')
 
+    def _closing(self, stream: BinaryIO, pos: int, size: int) -> tuple[bool, int | None]:
+        """Judge the closing records that start at ``pos``; return (closed, where to go on).
+
+        They close the file if they end it (a footer and the magic at its
+        end); if they do not index exactly the chunks kept before them, the
+        file is not whole (they are written anew). Closing records followed by
+        more data (written into a file that was still being written) are
+        dropped as far as they go, and the scan goes on after them; closing
+        records that are cut short, up to the next intact record, if any.
+        """
+        stop, complete = _walk_closing(stream, pos, size)
+        if complete and stop == size:
+            problem = self._summary_problem(stream, pos, size)
+            if problem:
+                self._stale_summary = (pos, problem)
+            return True, None
+        if complete:
+            self._drops.append(_Drop(pos, stop, 'closing records with more data after them '
+                                                '(a summary written before the recording '
+                                                'went on)'))
+            return False, stop
+        return False, self._drop(stream, pos, size, 'closing records cut short', cut=True,
+                                 search_from=stop)
+
+    def _summary_problem(self, stream: BinaryIO, pos: int, size: int) -> str:
+        """Say why the closing records from ``pos`` to the end are not the file's ('' if they are).
+
+        They must be Metadata records and a DataEnd, then the summary the
+        footer points to, whose CRC (if any) matches, whose chunk indexes are
+        the chunks kept (offsets, lengths, message index offsets) and whose
+        statistics count their messages.
+        """
+        footer_at = size - len(MAGIC) - _FOOTER.size - 4
+        stream.seek(footer_at)
+        tail = stream.read(_FOOTER.size + 4)
+        _, _, summary_start, offsets_start = _FOOTER.unpack_from(tail)
+        (crc,) = _U32.unpack_from(tail, _FOOTER.size)
+        if not pos < summary_start <= footer_at:
+            return 'with no summary that the footer points to'
+        if not (offsets_start == 0 or summary_start <= offsets_start <= footer_at):
+            return 'whose footer points outside the summary'
+        stream.seek(pos)
+        before = stream.read(summary_start - pos)
+        ops = [op for op, _ in _records_in(before)]
+        if not ops or ops[-1] != DATA_END or set(ops) - {METADATA, DATA_END} \
+                or sum(_RECORD.size + n for _, n in _records_in(before)) != len(before):
+            return 'with no data end before the summary'
+        stream.seek(summary_start)
+        summary = stream.read(footer_at + _FOOTER.size - summary_start)
+        if crc and zlib.crc32(summary) != crc:
+            return 'whose summary CRC does not match'
+        end = (offsets_start or footer_at) - summary_start
+        indexed, channels, counted = [], set(), None
+        walked = 0
+        try:
+            for op, body in _bodies_in(memoryview(summary)[:end]):
+                walked += _RECORD.size + len(body)
+                fields = _Fields(body)
+                if op == CHUNK_INDEX:
+                    _, _, offset, length = fields.unpack(_CHUNK_INDEX)
+                    entries = _Fields(fields.take(fields.unpack(_U32)[0]))
+                    offsets = {}
+                    while entries.pos < len(entries.data):
+                        cid, at = entries.unpack(_CHANNEL_U64)
+                        offsets[cid] = at
+                    indexed.append((offset, length, offsets))
+                elif op == CHANNEL:
+                    channels.add(fields.unpack(_U16)[0])
+                elif op == STATISTICS:
+                    counted = fields.unpack(_U64)[0]
+        except _Corrupt as error:
+            return f'with a damaged summary ({error})'
+        if walked != end:
+            return 'with a damaged summary (a record runs past it)'
+        kept = [(c.offset, c.length, c.index_offsets) for c in self.chunks]
+        if sorted(indexed, key=lambda i: i[0]) != kept:
+            return 'that do not index the chunks before them'
+        if not set(self._channels) <= channels:
+            return 'that do not list the channels before them'
+        if counted is not None and counted != sum(sum(c.counts.values()) for c in self.chunks):
+            return 'whose statistics do not count the messages before them'
+        return ''
+
     def _drop(self, stream: BinaryIO, pos: int, size: int, reason: str, *, cut: bool = False,
-              body: memoryview | None = None, counted: bool = True) -> int | None:
+              body: memoryview | None = None, counted: bool = True,
+              search_from: int | None = None) -> int | None:
         """Record that the bytes from ``pos`` are dropped; return where the next record starts.
 
         The next record is the next intact chunk (its CRC checked) or Schema or
-        Channel record after ``pos``; None if there is none (the rest is dropped).
+        Channel record after ``pos`` (from ``search_from`` if given); None if
+        there is none (the rest is dropped).
         """
-        resume = _next_record(stream, pos + 1, size)
+        resume = _next_record(stream, pos + 1 if search_from is None else search_from, size)
         end = size if resume is None else resume
         messages = _describe(body, self._channels) if body is not None else ''
         if body is not None and counted and not messages:
@@ -802,11 +913,17 @@ class RecoveredMcap:
         self._entries[chunk.offset] = parsed.entries
 
     def _index_matches(self, body: memoryview, pending: _ParsedChunk, missing: set[int]) -> bool:
+        """Tell whether ``body`` is a message index of ``pending`` holding its chunk's entries."""
         if len(body) < 6:
             return False
         cid, nbytes = struct.unpack_from('<HI', body)
-        return (cid in missing and nbytes + 6 == len(body)
-                and nbytes == _INDEX_ENTRY.size * pending.chunk.counts[cid])
+        if not (cid in missing and nbytes + 6 == len(body)
+                and nbytes == _INDEX_ENTRY.size * pending.chunk.counts[cid]):
+            return False
+        expected = pending.entries[cid]
+        return (body[6:] == expected      # as written here; other writers may sort by time
+                or sorted(_INDEX_ENTRY.iter_unpack(body[6:]))
+                == sorted(_INDEX_ENTRY.iter_unpack(expected)))
 
     def _keep(self, parsed: _ParsedChunk, end: int) -> None:
         for schema in parsed.schemas:
@@ -824,24 +941,29 @@ class RecoveredMcap:
         self.notes.append(f'dropped the last chunk ({sum(chunk.counts.values())} messages) '
                           f'to make room for the summary')
 
-    def finish(self, metadata: Callable[[], str]) -> None:
+    def finish(self, metadata: Callable[[], str], *, in_place: bool = False) -> None:
         """Make the file readable with every chunk kept, a summary at its end; sync it.
 
-        If only the end of an interrupted recording is dropped, the file is
-        truncated after its data section and the summary appended. Otherwise
-        (damage with intact data after it) the kept records are copied to a
-        new file, which replaces the original; the original is kept as
-        ``NAME.damaged`` (see :mod:`.salvage`). ``metadata()`` is the rosbag2
-        metadata to embed; it is called again whenever a chunk had to be
-        dropped for lack of space.
+        A whole file (:attr:`whole`) is left as it is. Otherwise the kept
+        records are copied to a new file, synced, which replaces the original;
+        the original is kept as ``NAME.damaged`` (see :mod:`.salvage`).
+        ``metadata()`` is the rosbag2 metadata to embed.
+
+        ``in_place`` is for the file's own writer, which holds its lock: if
+        only the end of its recording is dropped, the file is truncated after
+        its data section and the summary appended, and ``metadata()`` is
+        called again whenever a chunk had to be dropped for lack of space.
 
         Raises
         ------
         OSError
-            If even a summary of no chunk at all cannot be written, or (when
-            copying) the copy does not fit: then the original is unchanged.
+            If the copy cannot be written whole (then the original is
+            unchanged and no copy is left), or in place, if even a summary of
+            no chunk at all cannot be written.
         """
-        if self._copy:
+        if self.whole:
+            return
+        if self._damaged or not in_place:
             self._finish_copy(metadata)
             return
         fd = os.open(self.path, os.O_RDWR)
@@ -886,7 +1008,14 @@ class RecoveredMcap:
         self.notes.append(f'rewrote the message indexes of the last chunk (offset {chunk.offset})')
 
     def _finish_copy(self, metadata: Callable[[], str]) -> None:
+        """Copy the kept records to a new file, with a summary; it replaces the original.
+
+        A chunk's message indexes, checked entry by entry by the scan, are
+        copied as they are (their entries are offsets inside the chunk); those
+        of a chunk whose indexes were missing or damaged are built again.
+        """
         copy = new_copy_path(self.path)
+        rebuilt = {c.offset for c in self._unindexed}
         try:
             with open(self.path, 'rb') as source, open(copy, 'xb') as out:
                 source.seek(0)
@@ -898,19 +1027,26 @@ class RecoveredMcap:
                               key=lambda item: item[0])
                 for start, length, chunk in kept:
                     source.seek(start)
-                    data = source.read(length)
-                    out.write(data)
-                    if chunk is not None:
-                        parsed = _parse_chunk(memoryview(data)[_RECORD.size:], offset)
-                        new = parsed.chunk
+                    if chunk is None:
+                        out.write(source.read(length))
+                        offset += length
+                        continue
+                    new = Chunk(offset, chunk.length, chunk.start, chunk.end, chunk.size,
+                                dict(chunk.counts))
+                    if start in rebuilt:
+                        out.write(source.read(length))
                         position = offset + length
-                        for cid, record in _message_indexes(parsed.entries):
+                        for cid, record in _message_indexes(self._entries[start]):
                             new.index_offsets[cid] = position + new.index_length
                             new.index_length += len(record)
                             out.write(record)
-                        chunks.append(new)
-                        length += new.index_length
-                    offset += length
+                    else:       # the chunk and its message indexes, which follow it
+                        out.write(source.read(length + chunk.index_length))
+                        new.index_offsets = {cid: at - start + offset
+                                             for cid, at in chunk.index_offsets.items()}
+                        new.index_length = chunk.index_length
+                    chunks.append(new)
+                    offset += length + new.index_length
                 self.chunks = chunks
                 out.write(closing_records(list(self._schemas.values()),
                                           list(self._channels.values()), chunks, offset,
@@ -922,9 +1058,55 @@ class RecoveredMcap:
             with contextlib.suppress(OSError):
                 copy.unlink()
             raise
-        self.notes.append(f'wrote the {len(chunks)} intact chunks to a new "{self.path.name}" '
-                          f'with new message indexes; the original file is kept as '
+        again = f' (built again for {len(rebuilt)} of them)' if rebuilt else ''
+        self.notes.append(f'wrote the {len(chunks)} intact chunks and their message indexes'
+                          f'{again} to a new "{self.path.name}"; the original file is kept as '
                           f'"{kept_as.name}"')
+
+
+_CLOSING_OPS = frozenset({METADATA, DATA_END, SCHEMA, CHANNEL, CHUNK_INDEX, METADATA_INDEX,
+                          STATISTICS, SUMMARY_OFFSET, ATTACHMENT_INDEX})
+
+
+def _walk_closing(stream: BinaryIO, pos: int, size: int) -> tuple[int, bool]:
+    """Walk the closing records from ``pos``; return where they stop and if they are complete.
+
+    Complete: they end with a Footer record and the magic (the position
+    returned is after the magic). Otherwise the position is that of the first
+    record that is cut short or is not a closing record.
+    """
+    while pos + _RECORD.size <= size:
+        stream.seek(pos)
+        op, length = _RECORD.unpack(stream.read(_RECORD.size))
+        end = pos + _RECORD.size + length
+        if end > size:
+            break
+        if op == FOOTER:
+            stream.seek(end)
+            if length == _FOOTER.size - _RECORD.size + 4 and stream.read(len(MAGIC)) == MAGIC:
+                return end + len(MAGIC), True
+            break
+        if op not in _CLOSING_OPS:
+            break
+        pos = end
+    return pos, False
+
+
+def _bodies_in(data: memoryview) -> Iterator[tuple[int, memoryview]]:
+    """Yield (opcode, body) of the records that fill ``data`` one after another (as many fit)."""
+    pos = 0
+    while pos + _RECORD.size <= len(data):
+        op, length = _RECORD.unpack_from(data, pos)
+        end = pos + _RECORD.size + length
+        if end > len(data):
+            return
+        yield op, data[pos + _RECORD.size:end]
+        pos = end
+
+
+def _records_in(data: bytes) -> list[tuple[int, int]]:
+    """Return (opcode, body length) of the records that fill ``data`` (as many fit)."""
+    return [(op, len(body)) for op, body in _bodies_in(memoryview(data))]
 
 
 def _pwrite_all(fd: int, data: bytes, offset: int) -> None:

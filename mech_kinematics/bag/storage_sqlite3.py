@@ -299,11 +299,13 @@ class RecoveredSqlite3:
                 '(SELECT id FROM topics)').fetchone()
             self.start, self.end = (start or 0), (end or 0)
         self.stored_version = None
+        self._stored: tuple[int, str] | None = None
         if 'metadata' in tables:
             row = conn.execute('SELECT metadata_version, metadata FROM metadata '
                                'ORDER BY id DESC LIMIT 1').fetchone()
             if row is not None:
                 self.stored_version = stored_version(row[1]) or row[0]
+                self._stored = (row[0], row[1])
 
     def _count_readable(self, known: set[int], problem: str) -> None:
         """Count the readable rows of a damaged database, and note those that are not."""
@@ -327,6 +329,9 @@ class RecoveredSqlite3:
     def finish(self, version: int, metadata: Callable[[], str]) -> None:
         """Store ``metadata()`` in the ``metadata`` table (skipped, with a note, if it fails).
 
+        The table is written in one transaction, and only if it holds
+        something else: on a bag that is already whole nothing is written.
+
         A damaged database is not changed: its readable rows are copied to a
         new database, with the metadata, which takes its name; the original is
         kept as ``NAME.damaged`` (see :mod:`.salvage`).
@@ -340,8 +345,11 @@ class RecoveredSqlite3:
         if self._damaged:
             self._finish_copy(version, metadata)
             return
+        text = metadata()
+        if self._stored == (version, text):
+            return
         try:
-            _write_metadata(self.conn, version, metadata())
+            _write_metadata(self.conn, version, text)
         except sqlite3.Error as error:
             self.notes.append(f'left the metadata table as it was ({error})')
 

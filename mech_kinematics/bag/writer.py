@@ -11,10 +11,20 @@ If the writer dies (``kill -9``, a crash, a power cut), everything flushed is
 in the file, and :func:`reindex` (``python -m mech_kinematics reindex BAG``,
 the counterpart of ``ros2 bag reindex``) rebuilds ``metadata.yaml`` from it.
 
+The writer holds an exclusive lock on its storage file until it has closed
+the bag (:mod:`.lock`); :func:`reindex` refuses a bag whose storage file is
+locked or open in another process, and never changes a storage file in
+place: what it repairs is written whole to a new file, which takes the
+storage file's name, the original being kept as ``NAME.damaged``
+(:mod:`.salvage`). A bag that is already whole is left as it is.
+
 A write error (a full disk, a file size limit, an I/O error) does not lose
 the bag either: the writer stops accepting messages, and :meth:`BagWriter.close`
-closes the storage with what it holds -- by running :func:`reindex` on it --
-so that ``metadata.yaml`` counts exactly the messages that can be read. So
+closes the storage with what it holds -- recovering it as :func:`reindex`
+does, but in place, still holding the lock: only the writer itself, which
+knows that nothing else writes the file, cuts its own unfinished last chunk
+and appends the summary (there may be no room for a copy) -- so that
+``metadata.yaml`` counts exactly the messages that can be read. So
 that a full disk still has room for ``metadata.yaml`` (and the MCAP summary,
 and sqlite3's last journal), the writer fills a file of :data:`RESERVE_BYTES`
 (:data:`RESERVE_FILE`) at open and deletes it before it closes the bag;
@@ -23,7 +33,7 @@ and sqlite3's last journal), the writer fills a file of :data:`RESERVE_BYTES`
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 import contextlib
 import os
 from pathlib import Path
@@ -33,6 +43,7 @@ from typing import Any
 
 import yaml
 
+from . import lock
 from .metadata import (bag_version_of_qos, BAG_VERSIONS, BagError, BagInfo, METADATA_FILE,
                        metadata_text, qos_text, ros_distro, Topic, write_metadata_yaml)
 from .storage_mcap import McapStorage, RecoveredMcap
@@ -109,7 +120,8 @@ class BagWriter:
     Notes
     -----
     Not thread safe: call every method from one thread (the recorder calls
-    them from its executor's thread).
+    them from its executor's thread). From :meth:`open` to :meth:`close` the
+    storage file is locked (:func:`.lock.hold`): ``reindex`` refuses it.
     """
 
     def __init__(self, path: str | Path, *, storage: str = 'mcap',
@@ -125,6 +137,7 @@ class BagWriter:
         self.topics: list[Topic] = []
         self.failure: str | None = None
         self._storage: Any = None
+        self._lock: int | None = None
         self._due = 0.0
 
     def open(self) -> None:
@@ -143,11 +156,13 @@ class BagWriter:
                 self._storage = McapStorage(self.file, library=LIBRARY)
             else:
                 self._storage = Sqlite3Storage(self.file, distro=ros_distro())
+            self._lock = lock.hold(self.file)
             _reserve(self.path / RESERVE_FILE)
         except _WRITE_ERRORS as error:
             if self._storage is not None:
                 self._storage.abort()
                 self._storage = None
+            self._unlock()
             msg = f'Could not create "{self.file}": {_reason(error)}'
             raise BagError(msg) from None
         self._due = time.monotonic() + self.flush_interval
@@ -222,6 +237,12 @@ class BagWriter:
         if storage is None:
             msg = f'Expected an open bag, got "{self.path}", which is not open'
             raise BagError(msg)
+        try:
+            return self._close(storage)
+        finally:
+            self._unlock()      # after the storage is closed: sqlite3's own locks stay whole
+
+    def _close(self, storage: Any) -> BagInfo:
         _release(self.path / RESERVE_FILE)
         if self.failure is None:
             try:
@@ -243,11 +264,16 @@ class BagWriter:
                 return info
         storage.abort()
         try:
-            return reindex(self.path, version=self.version)
+            return _rebuild(self.path, self.file, self.version, in_place=True)
         except BagError as error:
             msg = (f'{self.failure}; closing the bag failed too ({error}); remove the cause '
                    f'and run `python -m mech_kinematics reindex {self.path}`')
             raise BagError(msg) from None
+
+    def _unlock(self) -> None:
+        fd, self._lock = self._lock, None
+        if fd is not None:
+            os.close(fd)
 
     def _check(self) -> None:
         if self.failure is not None:
@@ -301,24 +327,67 @@ def _version_in_metadata_yaml(path: Path) -> int | None:
 def reindex(path: str | Path, *, version: int | None = None) -> BagInfo:
     """Rebuild ``metadata.yaml`` of the bag ``path`` from its storage file; return it.
 
-    The storage is made readable first: an MCAP file is truncated after its
-    last intact chunk and given a summary; an sqlite3 database has a cut
-    transaction rolled back. The bag version is ``version`` if given, else
-    the one stored in the file (a closed bag), in an existing
-    ``metadata.yaml``, or told by the stored QoS format, else 8.
+    The storage is made readable first, never in place: if it must change (an
+    MCAP file with no summary or with damage, an sqlite3 database with
+    unreadable pages), what it holds is written whole to a new file, synced,
+    and renamed over it, the original being kept as ``NAME.damaged``
+    (:mod:`.salvage`); a storage file that is already whole is not written.
+    An sqlite3 database has a cut transaction rolled back (by SQLite, from its
+    journal) and its ``metadata`` table rewritten in one transaction if it
+    differs. The bag version is ``version`` if given, else the one stored in
+    the file (a closed bag), in an existing ``metadata.yaml``, or told by the
+    stored QoS format, else 8.
 
     Raises
     ------
     BagError
         If ``path`` is not a bag directory with one storage file, the file is
-        not a rosbag2 storage, or the result cannot be written.
+        locked or open in another process (a recorder still writing it,
+        :mod:`.lock`), it is not a rosbag2 storage, or the result cannot be
+        written (then the storage file is as it was).
     """
     path = Path(path)
     if version is not None and version not in BAG_VERSIONS:
         msg = f'Expected bag version to be one of {BAG_VERSIONS}, got {version!r}'
         raise BagError(msg)
     file = _storage_file(path)
-    _release(path / RESERVE_FILE)     # left by a writer that was killed
+    with _alone(path, file):
+        _release(path / RESERVE_FILE)     # left by a writer that was killed
+        return _rebuild(path, file, version, in_place=False)
+
+
+@contextlib.contextmanager
+def _alone(path: Path, file: Path) -> Iterator[None]:
+    """Hold the lock of the storage ``file``; raise :class:`BagError` if another process has it."""
+    refused = (f'Expected a bag that no other process holds open, got "{path}": its storage '
+               f'file {file.name}')
+    try:
+        fd = lock.hold(file)
+    except BlockingIOError:
+        who = lock.describe(lock.holders(file, include_self=True))
+        msg = (f'{refused} is locked: {who or "another process has it locked"} (a recording '
+               f'still running?); run reindex once it has ended')
+        raise BagError(msg) from None
+    except OSError as error:
+        msg = f'Could not open "{file}": {_reason(error)}'
+        raise BagError(msg) from None
+    try:
+        others = lock.holders(file)
+        if others:
+            msg = (f'{refused} is in use: {lock.describe(others)}; run reindex once it is '
+                   f'closed')
+            raise BagError(msg)
+        yield
+    finally:
+        os.close(fd)
+
+
+def _rebuild(path: Path, file: Path, version: int | None, *, in_place: bool) -> BagInfo:
+    """Make the storage ``file`` of the bag ``path`` readable, write ``metadata.yaml``; return it.
+
+    ``in_place``: the caller is the writer of ``file`` (it holds the lock),
+    which may cut an unfinished end of its own MCAP file instead of copying it.
+    """
     storage = 'mcap' if file.suffix == STORAGES['mcap'] else 'sqlite3'
     recovered: Any = RecoveredMcap(file) if storage == 'mcap' else RecoveredSqlite3(file)
 
@@ -331,11 +400,16 @@ def reindex(path: str | Path, *, version: int | None = None) -> BagInfo:
               or bag_version_of_qos(recovered.qos_texts) or DEFAULT_VERSION)
     try:
         if storage == 'mcap':
-            recovered.finish(lambda: metadata_text(info()))
+            recovered.finish(lambda: metadata_text(info()), in_place=in_place)
+            if recovered.whole and recovered.stored_version not in (None, chosen):
+                recovered.notes.append(
+                    f'left {file.name} as it is, whole, with its stored metadata of bag '
+                    f'version {recovered.stored_version}; metadata.yaml is version {chosen}')
         else:
             recovered.finish(chosen, lambda: metadata_text(info()))
-    except OSError as error:
-        msg = f'Could not finish "{file}": {_reason(error)}'
+    except (OSError, sqlite3.Error) as error:
+        kept = '' if in_place else '; the file is as it was'
+        msg = f'Could not finish "{file}": {_reason(error)}{kept}'
         raise BagError(msg) from None
     finally:
         if storage == 'sqlite3':

@@ -39,7 +39,7 @@ import numpy as np
 from .diagrams import space_from_state
 from .frames import child_frame, frames_from_scene, FrameSpec, poses_from_state, sensor_offsets
 from .instant_centres import bodies_from_scene, BodyKind, full_scene
-from ..errors import AssemblyError, NearSingularWarning
+from ..errors import NearSingularWarning
 from ..solver import Scene, solve, State
 
 __all__ = ['Visual', 'joint_name', 'urdf_from_scene', 'visuals_from_scene']
@@ -98,21 +98,28 @@ def _assembled(scene: Scene) -> State:
     """Return the full state at the scene's crank angle, or the first angle that assembles.
 
     A scene with several drivers (or an actuator) is drawn where its drivers start.
+
+    Raises
+    ------
+    AssemblyError
+        The solver's, where the drivers start (or, for one crank, at its
+        angle, when no angle over a turn can be solved).
     """
     drivers = scene.drivers
     if scene.input is None or len(drivers) > 1:
+        starts = [driver.start for driver in drivers]
         with warnings.catch_warnings():
             warnings.simplefilter('ignore', NearSingularWarning)
-            return solve(scene, [driver.start for driver in drivers])
+            # One driver (an actuator) takes solve's one-driver signature: a bare value.
+            return solve(scene, starts[0] if len(starts) == 1 else starts)
     angles = scene.input.angle + np.linspace(0.0, 2 * math.pi, SAMPLES, endpoint=False)
     with warnings.catch_warnings():
         warnings.simplefilter('ignore', NearSingularWarning)
         states = solve(scene, angles)
         valid = np.flatnonzero(states.valid)
         if not valid.size:
-            msg = (f'Expected scene {scene.name!r} to assemble at some crank angle to draw its '
-                   f'URDF, got none of {SAMPLES} angles over a turn')
-            raise AssemblyError(msg)
+            # None of them: the solver's own refusal at the scene's crank angle says why.
+            return solve(scene, scene.input.angle, turns=scene.input.turns)
         return solve(scene, float(angles[valid[0]]))
 
 

@@ -106,12 +106,20 @@ class ImuMessages:
                                                 5) for frame in self.frames)
         self.prefix = prefix
 
-    def render_values(self, values: Sequence[float], sec: int, nanosec: int) -> list[bytes]:
-        """Return every sensor's serialized ``Imu`` from a tick's flat ``values``."""
-        return [template.render(sec, nanosec, _slots(values[i], values[j], values[k],
-                                                     values[m], spec))
-                for template, spec, (i, j, k, m) in zip(self._templates, self.specs,
-                                                        self.indices, strict=True)]
+    def render_values(self, values: Sequence[float], sec: int,
+                      nanosec: int) -> list[bytes | None]:
+        """Return every sensor's serialized ``Imu`` from a tick's flat ``values``.
+
+        ``None`` for a sensor whose reading is beyond the range of doubles (its
+        point's acceleration less its gravity overflows): never an ``inf``.
+        """
+        out: list[bytes | None] = []
+        for template, spec, (i, j, k, m) in zip(self._templates, self.specs, self.indices,
+                                                strict=True):
+            slots = _slots(values[i], values[j], values[k], values[m], spec)
+            out.append(template.render(sec, nanosec, slots)
+                       if all(map(math.isfinite, slots)) else None)
+        return out
 
     def frame_transforms(self, local: dict[str, tuple[float, float]]) -> list[Any]:
         """Return the ``TransformStamped`` of every sensor with a frame of its own (stamp unset).

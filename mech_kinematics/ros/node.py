@@ -684,11 +684,16 @@ class KinematicsNode(LifecycleNode):
                 self._imu_frames = ImuFrames(transforms)
 
     def _publish_imus(self, values: list[float], sec: int, nanosec: int) -> None:
-        """Publish every sensor's ``Imu`` of a tick's values."""
+        """Publish every sensor's ``Imu`` of a tick's values (none whose reading overflows)."""
         assert self._imus is not None
-        for publish, data in zip(self._publish_imu,
-                                 self._imus.render_values(values, sec, nanosec), strict=True):
-            publish(data)
+        for publish, data, sensor in zip(self._publish_imu,
+                                         self._imus.render_values(values, sec, nanosec),
+                                         self._imus.specs, strict=True):
+            if data is None:
+                self.get_logger().warning(f'imu/{sensor.name}: no reading published: beyond '
+                                          f'the range of doubles', throttle_duration_sec=1.0)
+            else:
+                publish(data)
 
     def _publish_descriptions(self, scene: mk.Scene) -> None:
         """Publish the URDF on ``robot_description`` and the scene's text on ``scene``, latched.

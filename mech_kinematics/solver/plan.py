@@ -178,6 +178,7 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
     placing = _Placing(ground, local, {}, size, scene, local.carriers)
     names = _Names(kinds, ground)
     steps: list[Step] = []
+    owners: list[Item] = []  # the item of each step
     produces: dict[str, int] = {}  # point, link or slider -> index of its step
 
     def place(item: Item) -> tuple[str, ...]:
@@ -185,6 +186,7 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
         index = len(steps)
         step = item.place(placing)
         steps.append(step)
+        owners.append(item)
         for name in step.defines:
             produces[name] = index
         return step.defines
@@ -217,6 +219,16 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
         raise SceneError(msg, (left[0], ''))
 
     used = {name for step in steps for name in step.uses}
+    actuated = {d.name for d in drivers if d.joint_type == 'prismatic'}
+    driving: dict[str, Item] = {}
+    for item, step in zip(owners, steps, strict=True):
+        for name in actuated.intersection(step.uses):
+            if name in driving:
+                msg = (f'Expected each actuator to be the length of one link, got "{name}" in '
+                       f'{driving[name].kind} {driving[name].key} and again in {item.kind} '
+                       f'{item.key}')
+                raise SceneError(msg, (item, ''))
+            driving[name] = item
     for driver in drivers:
         driver.check_used(used)
     order = [*ground, *(name for driver in drivers for name, kind in driver.defined()

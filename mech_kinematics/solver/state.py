@@ -252,7 +252,8 @@ class State:
 
         turns = self.turns
         angle = self.angle if not np.any(turns) else self.angle + math.tau * turns
-        if len(self.drivers) > 1:
+        # Several drivers, or an actuator (a length, not a crank's "angle"): by name.
+        if len(self.drivers) > 1 or any(j.type != 'revolute' for j in self.drivers.values()):
             driven: dict[str, Any] = {'inputs': {
                 name: {'position': value(j.position), 'speed': value(j.velocity),
                        'accel': value(j.acceleration)} for name, j in self.drivers.items()}}

@@ -415,9 +415,12 @@ def measure(names: list[str], angles: int, repeat: int) -> list[dict[str, Any]]:
         if scene.input is None or len(drivers) > 1:
             # Several drivers: one configuration, their start, and the array path over
             # as many copies of it as a crank's sweep has angles.
-            starts = [driver.start for driver in drivers]
+            starts: Any = [driver.start for driver in drivers]
+            many: Any = [np.full(angles, x) for x in starts]
+            if len(drivers) == 1:   # an actuator alone: solve's one-driver signature
+                starts, many = starts[0], many[0]
             singles = [partial(solve, scene, starts)]
-            arrays = [partial(solve, scene, [np.full(angles, x) for x in starts])]
+            arrays = [partial(solve, scene, many)]
             forms = None
         else:
             theta, w, al = scene.input.angle, scene.input.speed, scene.input.accel

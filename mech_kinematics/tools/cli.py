@@ -225,7 +225,9 @@ def drive_from_args(scene: Any, args: argparse.Namespace) -> tuple[Any, Any, Any
 
     From the ``--input``, ``--speed`` and ``--accel NAME=VALUE`` options (and,
     for one crank, ``--angle-deg`` and ``--speed-rpm``) that ``solve``,
-    ``diagram`` and ``plot`` share; a ValueError says what is wrong.
+    ``diagram`` and ``plot`` share; a ValueError says what is wrong. A scene
+    of one driver (a crank or an actuator) gets one value each (``None``:
+    the scene's), as ``solve`` takes them; a scene of several, one list each.
     """
     inputs = values_by_driver(scene, '--input', args.input)
     speeds = values_by_driver(scene, '--speed', args.speed)
@@ -281,4 +283,6 @@ def drive_from_args(scene: Any, args: argparse.Namespace) -> tuple[Any, Any, Any
         turns_list.append(whole)
         words.append(f'{driver.name} = {text}')
     accel_list = [accels.get(driver.name) for driver in drivers]
+    if len(drivers) == 1:   # one actuator: solve's one-driver signature takes its values bare
+        return positions[0], rates[0], accel_list[0], turns_list[0], words[0]
     return positions, rates, accel_list, turns_list, ', '.join(words)

@@ -857,7 +857,7 @@ def _handle_drivers(args: argparse.Namespace, scene: Scene, output: Path) -> int
         raise ValueError(msg)
     positions, rates, accels, turns, _ = drive_from_args(scene, args)
     drivers = scene.drivers
-    if scene.input is not None and len(drivers) == 1:  # one crank: drive_from_args's scalars
+    if len(drivers) == 1:  # one driver: drive_from_args's scalars
         positions, rates, accels, turns = [positions], [rates], [accels], [turns]
     inputs = {d.name: float(x) + (2.0 * math.pi * int(t) if t else 0.0)
               for d, x, t in zip(drivers, positions, turns, strict=True)}

@@ -115,12 +115,12 @@ class Motion:
         Time from the first sample, s; None where it means nothing.
     joint_types : dict of str to str
         ``'revolute'`` or ``'prismatic'`` per joint, in order.
-    joints : dict of str to (ndarray, ndarray, ndarray or None)
+    joints : dict of str to (ndarray, ndarray or None, ndarray or None)
         Position (rad or m), velocity and acceleration (None if not
-        available), each of shape (n,).
-    points : dict of str to (ndarray, ndarray, ndarray or None)
-        Position (m), velocity (m/s) and acceleration (m/s², None if not
-        available), each of shape (n, 2).
+        available; NaN at an instant without it), each of shape (n,).
+    points : dict of str to (ndarray, ndarray or None, ndarray or None)
+        Position (m), velocity (m/s) and acceleration (m/s²; None if not
+        available, NaN at an instant without it), each of shape (n, 2).
     jumps : ndarray of bool, shape (n - 1,), or None
         Where an acceleration jumps between two samples (a Geneva wheel's pin
         entering or leaving a slot): no line is drawn across, so a jump is
@@ -139,8 +139,8 @@ class Motion:
     crank_angle: Array
     time: Array | None
     joint_types: Mapping[str, str]
-    joints: Mapping[str, tuple[Array, Array, Array | None]]
-    points: Mapping[str, tuple[Array, Array, Array | None]]
+    joints: Mapping[str, tuple[Array, Array | None, Array | None]]
+    points: Mapping[str, tuple[Array, Array | None, Array | None]]
     jumps: Array | None = None
     note: str = ''
     gaps: tuple[tuple[float, float], ...] = ()
@@ -562,6 +562,11 @@ def motion_from_bag(path: str | os.PathLike[str], *, scene: Any = None,
     points_msgs = [rows[points_conn.id][t] for t in ticks] if points_conn is not None else []
     names, joint_arrays = _joint_arrays(joints_msgs, joints_conn)
     point_names, point_arrays = _point_arrays(points_msgs)
+    missing = _missing(joint_arrays, point_arrays, joints_conn)
+    if missing:
+        warnings.warn(f'{path}: no {missing} in the recording (empty in every message, as a '
+                      f'node driven from a topic publishes them): their panels say so',
+                      stacklevel=2)
     if scene is None and scene_name:
         try:
             candidate = mk.load_scene(scene_name)
@@ -592,36 +597,89 @@ def motion_from_bag(path: str | os.PathLike[str], *, scene: Any = None,
     return Motion(title, crank_angle, time, types, joints, points, imus=imus)
 
 
+def _rows(rows: Sequence[Sequence[float]], width: int) -> Array | None:
+    """Return ``rows`` as an array of shape (n, width); None if no row has ``width`` values.
+
+    A row of another length (a quantity a message leaves out: an empty array,
+    as a node driven from a topic publishes its accelerations) is NaN.
+    """
+    if all(len(row) == width for row in rows):
+        return np.array(rows, dtype=np.float64).reshape(len(rows), width)
+    if not any(len(row) == width for row in rows):
+        return None
+    out = np.full((len(rows), width), np.nan)
+    for i, row in enumerate(rows):
+        if len(row) == width:
+            out[i] = row
+    return out
+
+
 def _joint_arrays(msgs: list[Any], connection: Any) -> tuple[list[str], list[Any]]:
+    """Return the joints' names and (position, velocity, acceleration) arrays, shape (n,).
+
+    Velocity or acceleration is None where no message has it (``joint_states``
+    has no accelerations).
+    """
     if not msgs:
         return [], []
     if connection.msgtype == _JOINT_TRAJECTORY:
         names = list(msgs[0].joint_names)
-        pos = np.array([m.points[0].positions for m in msgs], dtype=np.float64)
-        vel = np.array([m.points[0].velocities for m in msgs], dtype=np.float64)
-        acc = np.array([m.points[0].accelerations for m in msgs], dtype=np.float64)
+        points = [m.points[0] for m in msgs]
+        pos = _rows([p.positions for p in points], len(names))
+        vel = _rows([p.velocities for p in points], len(names))
+        acc = _rows([p.accelerations for p in points], len(names))
     else:
         names = list(msgs[0].name)
-        pos = np.array([m.position for m in msgs], dtype=np.float64)
-        vel = np.array([m.velocity for m in msgs], dtype=np.float64)
+        pos = _rows([m.position for m in msgs], len(names))
+        vel = _rows([m.velocity for m in msgs], len(names))
         acc = None
-    arrays = [(pos[:, i], vel[:, i], None if acc is None else acc[:, i])
+    if pos is None:
+        msg = (f'Expected the {len(names)} positions of the joints in each message, got '
+               f'messages of other lengths')
+        raise PlotError(msg)
+    arrays = [(pos[:, i], None if vel is None else vel[:, i], None if acc is None else acc[:, i])
               for i in range(len(names))]
     return names, arrays
 
 
 def _point_arrays(msgs: list[Any]) -> tuple[list[str], list[Any]]:
+    """Return the points' names and (position, velocity, acceleration) arrays, shape (n, 2).
+
+    Velocity or acceleration is None where no message has it.
+    """
     if not msgs:
         return [], []
     names = list(msgs[0].joint_names)
-    values = np.array([[(t.translation.x, t.translation.y, v.linear.x, v.linear.y,
-                         a.linear.x, a.linear.y)
-                        for t, v, a in zip(m.points[0].transforms, m.points[0].velocities,
-                                           m.points[0].accelerations, strict=True)]
-                       for m in msgs], dtype=np.float64)    # (n, points, 6)
-    arrays = [(values[:, i, 0:2], values[:, i, 2:4], values[:, i, 4:6])
+    width = 2 * len(names)
+    points = [m.points[0] for m in msgs]
+    pos = _rows([[x for t in p.transforms for x in (t.translation.x, t.translation.y)]
+                 for p in points], width)
+    vel, acc = (_rows([[x for v in vectors for x in (v.linear.x, v.linear.y)]
+                       for vectors in column], width)
+                for column in ([p.velocities for p in points], [p.accelerations for p in points]))
+    if pos is None:
+        msg = (f'Expected the positions of the {len(names)} points in each message, got '
+               f'messages of other lengths')
+        raise PlotError(msg)
+    arrays = [tuple(None if a is None else a[:, 2 * i:2 * i + 2] for a in (pos, vel, acc))
               for i in range(len(names))]
     return names, arrays
+
+
+def _missing(joints: Sequence[Any], points: Sequence[Any], connection: Any) -> str:
+    """Say which quantities the recording leaves out ('' if none): 'velocities or accelerations'.
+
+    A bag of ``joint_states`` alone has no accelerations by nature: not said.
+    """
+    series = [*joints, *points]
+    if not series:
+        return ''
+    gone = [word for k, word in ((1, 'velocities'), (2, 'accelerations'))
+            if all(values[k] is None for values in series)]
+    if gone == ['accelerations'] and not points and connection is not None \
+            and connection.msgtype == _JOINT_STATE:
+        return ''
+    return ' or '.join(gone)
 
 
 # -- the figure ------------------------------------------------------------------
@@ -690,9 +748,7 @@ def figure_from_motion(motion: Motion, *, x: str = 'time') -> Any:
     revolute = [n for n, t in motion.joint_types.items() if t == 'revolute' and n in motion.joints]
     prismatic = [n for n, t in motion.joint_types.items()
                  if t == 'prismatic' and n in motion.joints]
-    moving = [n for n, (_, v, a) in motion.points.items()
-              if np.nanmax(np.abs(v), initial=0.0) > 0.0
-              or (a is not None and np.nanmax(np.abs(a), initial=0.0) > 0.0)]
+    moving = [n for n, (p, v, a) in motion.points.items() if _moves(p, v, a)]
     columns = [('joint_position', 'joint_velocity', 'joint_acceleration'),
                ('point_path', 'point_speed', 'point_acceleration')]
     if prismatic:
@@ -739,9 +795,10 @@ def figure_from_motion(motion: Motion, *, x: str = 'time') -> Any:
                     for shift in (-2.0 * math.pi, 0.0, 2.0 * math.pi):
                         ax.axvspan(start + shift, end + shift, color='0.9', zorder=0)
                 _angle_ticks(ax)  # the spans must not widen the axis
-            drawn = 0
+            drawn = absent = 0
             for label, values, wraps in series(kind):
                 if values is None:
+                    absent += 1
                     continue
                 px, py = _broken(xs, values, gaps, x_wraps=x == 'angle', y_wraps=wraps)
                 ax.plot(px, py, label=label, linewidth=1.0)
@@ -749,9 +806,17 @@ def figure_from_motion(motion: Motion, *, x: str = 'time') -> Any:
             if drawn:
                 _legend(ax)
             else:
-                ax.text(0.5, 0.5, 'no data', transform=ax.transAxes, ha='center',
-                        va='center', color='0.5')
+                ax.text(0.5, 0.5, 'not in the recording' if absent else 'no data',
+                        transform=ax.transAxes, ha='center', va='center', color='0.5')
     return fig
+
+
+def _moves(p: Array, v: Array | None, a: Array | None) -> bool:
+    """Return whether a point moves: a velocity or acceleration not 0 (without both, its path)."""
+    if v is None and a is None:
+        known = p[np.isfinite(p).all(axis=1)]
+        return bool(len(known)) and bool((known.max(axis=0) - known.min(axis=0)).max() > 0.0)
+    return any(x is not None and np.nanmax(np.abs(x), initial=0.0) > 0.0 for x in (v, a))
 
 
 def _imu_series(motion: Motion, kind: str) -> list[tuple[str, Array | None, bool]]:
@@ -766,8 +831,8 @@ def _imu_series(motion: Motion, kind: str) -> list[tuple[str, Array | None, bool
 def _draw_paths(ax: Any, motion: Motion, gaps: Any) -> None:
     ax.set_xlabel(XLABELS['path'])
     ax.set_aspect('equal', adjustable='datalim')
-    for name, (p, v, _) in motion.points.items():
-        fixed = not np.nanmax(np.abs(v), initial=0.0) > 0.0
+    for name, (p, v, a) in motion.points.items():
+        fixed = not _moves(p, v, a)
         finite = np.isfinite(p).all(axis=1)
         if not finite.any():
             continue

@@ -10,11 +10,11 @@ but the last half second of the recording), by
 :func:`mech_kinematics.bag.reindex`:
 
 - MCAP: the file is scanned and every intact chunk kept, also those after a
-  damaged one. If only the end of an interrupted recording is dropped, the
-  file is truncated after its last intact chunk (whose message indexes are
-  rewritten if they were cut) and the summary and footer appended; if damage
-  is dropped with intact data after it, the kept chunks are copied to a new
-  file and the original is kept as ``NAME.damaged``;
+  damaged one (or after a summary with more data after it). Unless the file
+  was closed normally and is whole, the kept chunks are copied to a new file
+  with their message indexes and a summary, which takes the file's name; the
+  original is kept as ``NAME.damaged``. The storage file is never cut or
+  changed in place;
 - sqlite3: opening the database for writing rolls back the transaction that
   was cut, then the tables are checked and counted; if pages are unreadable,
   every readable row is copied to a new database and the original is kept as
@@ -22,9 +22,16 @@ but the last half second of the recording), by
 
 Each note printed says what was dropped (offsets or row ids) and why.
 
+A bag whose storage file another process locks (a recording still running)
+or holds open is refused with one line naming the process, and nothing is
+written (:mod:`mech_kinematics.bag.lock`). If the repaired file cannot be
+written whole (a full disk, a read-only directory), the storage file is left
+as it was.
+
 Topics, types, message definitions, type hashes, offered QoS, message counts,
 time range, storage identifier and bag version are taken from the storage
-file. Running it on a bag that was closed normally rewrites the same metadata.
+file. Running it on a bag that is already whole (closed normally, or
+reindexed) writes nothing but the same metadata.
 """
 
 from __future__ import annotations
@@ -42,14 +49,16 @@ REINDEX_HELP = """\
 Rebuild metadata.yaml of the bag directory BAG from its storage file (.mcap or
 .db3), as `ros2 bag reindex` does, e.g. after the recorder was killed: the
 bag becomes readable by rosbags, `ros2 bag` and Foxglove with every message
-that reached the file. An MCAP file is truncated after its last intact chunk
-and given a summary; an sqlite3 database has its interrupted transaction
-rolled back. Damage with intact data after it (a changed byte in a chunk, an
-unreadable database page) is never repaired in place: every intact chunk or
-readable row is copied to a new file and the original is kept beside it as
-NAME.damaged. Each note says what was dropped and why. The bag version is
---bag-version if given, else the one stored in the bag, else the one its QoS
-profiles are written in, else 8.
+that reached the file. A storage file is never cut or repaired in place: an
+MCAP file that needs a summary, and damage (a changed byte in a chunk, an
+unreadable database page), are written whole to a new file that takes its
+name, with every intact chunk or readable row, and the original is kept
+beside it as NAME.damaged; an sqlite3 database has its interrupted
+transaction rolled back by SQLite. A bag that is already whole is left as it
+is. A bag that another process locks or holds open (a recording still
+running) is refused, exit status 2. Each note says what was dropped and why.
+The bag version is --bag-version if given, else the one stored in the bag,
+else the one its QoS profiles are written in, else 8.
 """
 
 

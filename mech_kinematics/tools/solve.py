@@ -5,8 +5,9 @@
 from __future__ import annotations
 
 import argparse
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 import json
+import math
 import sys
 from typing import Any
 import warnings
@@ -41,8 +42,8 @@ m/s and m/s^2 for an actuator. Its JSON has "inputs": {NAME: {"position",
 Options left out take the scene's own values. On a position that cannot be
 solved, or whose answer cannot be trusted (a value's error bound above
 --max-error times its kind's scale, a dyad within rounding of an assembly
-limit, a value beyond the range of doubles), it prints a one-line error and
-exits with status 2.
+limit, a value beyond the range of doubles, anywhere in the JSON: an IMU's
+reading too), it prints a one-line error and exits with status 2.
 """
 
 
@@ -79,8 +80,25 @@ def _handle(args: argparse.Namespace) -> int:
     if args.diagnostics:
         result['singularity'] = {key: float(m) for key, m in state.singularity.items()}
         result['relative_error_bound'] = float(state.relative_error_bound)
+    path, value = next(_not_finite(result), ('', 0.0))
+    if path:
+        print(f'error: Expected every value of the state at {shown} to be finite, got {path} = '
+              f'{value!r} (beyond the range of doubles)', file=sys.stderr)
+        return 2
     print(json.dumps(result, indent=args.indent, allow_nan=False))
     return 0
+
+
+def _not_finite(value: Any, path: str = '') -> Iterator[tuple[str, float]]:
+    """Yield (path, value) of every number of the JSON ``value`` that is not finite."""
+    if isinstance(value, dict):
+        for key, item in value.items():
+            yield from _not_finite(item, f'{path}.{key}' if path else str(key))
+    elif isinstance(value, (list, tuple)):
+        for index, item in enumerate(value):
+            yield from _not_finite(item, f'{path}[{index}]')
+    elif isinstance(value, float) and not math.isfinite(value):
+        yield path, value
 
 
 def add_parser(subparsers: Any) -> argparse.ArgumentParser:

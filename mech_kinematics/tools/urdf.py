@@ -31,11 +31,24 @@ must match the node's parameters of the same names.
 
 
 def _handle(args: argparse.Namespace) -> int:
+    from ..errors import AssemblyError, UntrustedError
     from ..geometry.urdf import urdf_from_scene
     from ..scene import load_scene
+    from ..solver import assembly_text
 
     scene = load_scene(args.scene)  # a SceneError is one line, exit 2 (cli.run_handler)
-    text = urdf_from_scene(scene, frame_id=args.frame_id, prefix=args.tf_prefix)
+    try:
+        text = urdf_from_scene(scene, frame_id=args.frame_id, prefix=args.tf_prefix)
+    except AssemblyError as error:  # no pose to draw it in: why, in the scene's units
+        crank = scene.input
+        where = (f'crank angle {scene.units.angle_text(crank.shown)}, nor at any of a turn'
+                 if crank is not None and len(scene.drivers) == 1
+                 else "its drivers' start positions")
+        reason = error.reason if isinstance(error, UntrustedError) or error.facts is None \
+            else assembly_text(error, scene.units)
+        print(f'error: {scene.name}: Expected a pose to draw its URDF in, got none: '
+              f'{error.dyad} cannot be solved at its {where}: {reason}', file=sys.stderr)
+        return 2
     if args.output is None:
         sys.stdout.write(text)
     else:

@@ -18,6 +18,7 @@ import os
 from pathlib import Path
 import shutil
 import signal
+import struct
 import subprocess
 import sys
 
@@ -289,11 +290,30 @@ def test_mcap_cut_message_indexes_are_written_again(tmp_path):
     """A chunk whose message indexes were cut keeps its messages; its indexes are rewritten."""
     data, chunks = unclosed_mcap(tmp_path)
     last = chunks[-1]
-    info = reindex(cut_bag(tmp_path, 'bag', data[:last.offset + last.length + 5]))
+    cut = data[:last.offset + last.length + 5]
+    info = reindex(cut_bag(tmp_path, 'bag', cut))
     assert info.count('/js') == 2000
-    assert any('rewrote the message indexes' in note for note in info.notes)
+    assert ('wrote the 10 intact chunks and their message indexes (built again for 1 of them) '
+            'to a new "bag.mcap"; the original file is kept as "bag.mcap.damaged"') in info.notes
     assert_prefix(tmp_path / 'bag', 2000)
     assert foxglove_count(tmp_path / 'bag') == 2000
+    assert (tmp_path / 'bag' / 'bag.mcap.damaged').read_bytes() == cut
+
+
+@pytest.mark.parametrize('fraction', [0.0, 0.3, 0.999])
+def test_reindex_never_shortens_the_storage_file(tmp_path, fraction):
+    """A killed recording is copied, never cut in place: its file is kept whole as NAME.damaged."""
+    data, chunks = unclosed_mcap(tmp_path)
+    last = chunks[-1]
+    cut = data[:round(last.offset + fraction * last.length)]      # the last chunk cut short
+    bag = cut_bag(tmp_path, 'bag', cut)
+    inode = (bag / 'bag.mcap').stat().st_ino
+    info = reindex(bag)
+    assert info.count('/js') == 1800
+    assert (bag / 'bag.mcap.damaged').stat().st_ino == inode
+    assert (bag / 'bag.mcap.damaged').read_bytes() == cut
+    assert info.notes[-1].endswith('the original file is kept as "bag.mcap.damaged"')
+    assert_prefix(bag, 1800)
 
 
 @functools.cache
@@ -348,16 +368,65 @@ def test_mcap_damaged_chunk_loses_nothing_else(tmp_path, which, where, closed):
     assert again.count('/js') == 1800 and again.notes == ()
 
 
-def test_mcap_damaged_message_index_keeps_its_chunk(tmp_path):
+#: Where a byte is flipped in a chunk's message index: its size field, an entry's offset.
+INDEX_FLIPS = {'size': 12, 'entry offset': 15 + 8 + 20 * 16}
+
+
+@pytest.mark.parametrize('where', sorted(INDEX_FLIPS))
+def test_mcap_damaged_message_index_keeps_its_chunk(tmp_path, where):
     """A flipped byte in a message index (outside the CRC): the chunk is kept, indexes new."""
     data, chunks = unclosed_mcap(tmp_path)
     middle = chunks[4]
-    bag = cut_bag(tmp_path, 'bag', damaged_copy(data, middle.offset + middle.length + 12))
+    flipped = middle.offset + middle.length + INDEX_FLIPS[where]
+    bag = cut_bag(tmp_path, 'bag', damaged_copy(data, flipped))
     info = reindex(bag)
     assert info.count('/js') == 2000
     assert_prefix(bag, 2000)
     assert foxglove_count(bag) == 2000
     assert any('a message index that does not match its chunk' in n for n in info.notes)
+    assert info.notes[-1].startswith('wrote the 10 intact chunks and their message indexes '
+                                     '(built again for 1 of them)')
+    closed = storage_mcap.RecoveredMcap(bag / 'bag.mcap')
+    index = closed.chunks[4]
+    with open(bag / 'bag.mcap', 'rb') as stream:    # the rebuilt index points at message 820
+        stream.seek(index.offset + index.length + 15 + 20 * 16)
+        log_time, offset = struct.unpack('<QQ', stream.read(16))
+        stream.seek(index.offset + 9 + 40 + offset + 9 + 6)
+        assert struct.unpack('<Q', stream.read(8))[0] == log_time == T0 + 820 * DT
+
+
+@pytest.mark.parametrize('overwritten', [False, True], ids=['inserted', 'overwritten'])
+def test_mcap_summary_inside_the_data_loses_nothing_after_it(tmp_path, overwritten):
+    """Closing records amid the data (a reindex of a file still being written): the scan goes on.
+
+    What an unlocked reindex left in a recorder's file (issue 33): a summary
+    of the first five chunks written where the sixth was being written, then
+    the recorder's later chunks. Every intact chunk after it is kept (the
+    sixth too if the summary did not overwrite it), the original is kept, and
+    a second reindex changes nothing.
+    """
+    data, chunks = unclosed_mcap(tmp_path)
+    at = chunks[5].offset
+    closing = storage_mcap.RecoveredMcap(tmp_path / 'source' / 'source.mcap')
+    summary = storage_mcap.closing_records(
+        list(closing._schemas.values()), list(closing._channels.values()), chunks[:5], at,
+        'version: 8\n')
+    rest = data[at + len(summary):] if overwritten else data[at:]
+    bag = cut_bag(tmp_path, 'bag', data[:at] + summary + rest)
+    info = reindex(bag)
+    lost = set(range(1000, 1200)) if overwritten else set()
+    kept = [i for i in range(2000) if i not in lost]
+    assert info.count('/js') == len(kept)
+    got = assert_truthful(bag)
+    assert [stamp for _, stamp in got['/js']] == kept
+    assert foxglove_count(bag) == len(kept)
+    assert (bag / 'bag.mcap.damaged').read_bytes() == data[:at] + summary + rest
+    before = (bag / 'bag.mcap').read_bytes()
+    again = reindex(bag)
+    assert again.count('/js') == len(kept) and again.notes == ()
+    assert (bag / 'bag.mcap').read_bytes() == before
+    assert sorted(p.name for p in bag.iterdir()) == ['bag.mcap', 'bag.mcap.damaged',
+                                                     'metadata.yaml']
 
 
 def test_mcap_repair_that_does_not_fit_leaves_the_original(tmp_path, monkeypatch):
@@ -572,10 +641,12 @@ def test_mcap_full_disk_closes_with_what_fit(tmp_path, monkeypatch):
 
 
 def test_mcap_summary_that_does_not_fit_drops_chunks(tmp_path, monkeypatch):
-    """No room for the summary: the last chunks are dropped until it fits; counts agree."""
-    data, chunks = unclosed_mcap(tmp_path)
-    bag = cut_bag(tmp_path, 'bag', data)
-    limit = len(data) + 200             # the summary needs more than 200 bytes
+    """The writer's own full disk, no room for the summary: its last chunks go until it fits."""
+    writer, topic = open_writer(tmp_path / 'bag', 'mcap', flush_interval=3600.0)
+    for start in range(0, 2000, 200):
+        write(writer, topic, range(start, start + 200))
+        writer.flush()
+    limit = (tmp_path / 'bag' / 'bag.mcap').stat().st_size + 200    # the summary needs more
     real = storage_mcap._pwrite_all
 
     def pwrite_all(fd, data, offset):
@@ -584,10 +655,33 @@ def test_mcap_summary_that_does_not_fit_drops_chunks(tmp_path, monkeypatch):
         real(fd, data, offset)
 
     monkeypatch.setattr(storage_mcap, '_pwrite_all', pwrite_all)
-    info = reindex(bag)
+    writer._storage._file = FullDisk(writer._storage._file, 0)
+    write(writer, topic, [2000])
+    with pytest.raises(BagError, match='No space left on device'):
+        writer.flush()
+    info = writer.close()
     assert info.notes[0].startswith('dropped the last chunk (200 messages)')
     assert info.count('/js') == 1800
-    assert_prefix(bag, 1800)
+    assert_prefix(tmp_path / 'bag', 1800)
+    assert sorted(p.name for p in (tmp_path / 'bag').iterdir()) == ['bag.mcap', 'metadata.yaml']
+
+
+def test_reindex_that_cannot_copy_leaves_the_original(tmp_path, monkeypatch):
+    """No room for the copy of a killed recording: BagError, the file untouched, nothing left."""
+    data, chunks = unclosed_mcap(tmp_path)
+    cut = data[:chunks[-1].offset + 100]
+    bag = cut_bag(tmp_path, 'bag', cut)
+    real_open = open
+
+    def full_open(path, mode='r', *args, **kwargs):
+        stream = real_open(path, mode, *args, **kwargs)
+        return FullDisk(stream, len(cut) // 2) if 'x' in mode else stream
+
+    monkeypatch.setattr(storage_mcap, 'open', full_open, raising=False)
+    with pytest.raises(BagError, match=r'No space left on device; the file is as it was$'):
+        reindex(bag)
+    assert sorted(p.name for p in bag.iterdir()) == ['bag.mcap']
+    assert (bag / 'bag.mcap').read_bytes() == cut
 
 
 def test_sqlite3_full_disk_closes_with_what_was_committed(tmp_path, monkeypatch):

@@ -10,7 +10,7 @@ the scene's points at every crank angle, not only the one it was built at.
 import math
 import xml.etree.ElementTree as ET
 
-from helpers import crank_scene_names
+from helpers import crank_scene_names, driver_scene_names
 import numpy as np
 import pytest
 
@@ -202,12 +202,47 @@ def test_an_actuator_is_a_prismatic_joint_between_its_two_pins():
             assert along.imag == pytest.approx(0.0, abs=1e-14)
 
 
-@pytest.mark.parametrize('name', ['five_bar', 'excavator'])
+@pytest.mark.parametrize('name', driver_scene_names())
 def test_several_driver_scenes_have_a_urdf_on_their_frames(name):
-    """One URDF link per /tf frame and ground point, as for one crank (issue 18)."""
+    """One URDF link per /tf frame and ground point, as for one crank (issue 18).
+
+    The packaged boom too, whose one driver is an actuator (issue 33: it raised
+    "Expected the state of one crank angle, got an array of shape (1,)").
+    """
     scene = mk.load_scene(name)
     _, links, joints = _links_and_joints(urdf_from_scene(scene))
     frames = {f'mechanism/{f.joint}' for f in frames_from_scene(scene)}
     ground = {f'mechanism/{name_}' for name_ in scene.ground}
     assert set(links) == {'mechanism', *frames, *ground}
     assert len(joints) == len(frames) + len(ground)
+
+
+# --- a scene whose every state is refused (issue 33) --------------------------------------
+
+
+def test_a_scene_refused_at_every_angle_is_one_line_not_a_type_error(tmp_path, capsys):
+    """A Scotch yoke whose slot is 1e-9 deg off its guide: no state to draw, one line, exit 2.
+
+    Its yoke is 2.9e9 m out and every state's bound is refused (untrusted). The
+    URDF code built ``AssemblyError(msg)``, whose signature is (dyad, angle,
+    reason): a TypeError. It now raises the solver's own refusal at the scene's
+    angle, and the tool says it in the scene's units.
+    """
+    data = mk.scene.read_scene_yaml(mk.scene.scene_text('scotch_yoke'))
+    data['dyads'][0]['slot_angle'] = 1e-9
+    path = tmp_path / 'yoke.yaml'
+    path.write_text(mk.scene.scene_text('scotch_yoke').replace('slot_angle: 90',
+                                                               'slot_angle: 1e-9'))
+    scene = mk.load_scene(path)
+    assert scene == mk.parse_scene(data)
+    with pytest.raises(mk.UntrustedError) as caught:
+        urdf_from_scene(scene)
+    assert caught.value.dyad == 'RPP Y' and caught.value.angle == scene.input.angle
+    assert cli_main(['urdf', str(path)]) == 2
+    out, err = capsys.readouterr()
+    assert out == ''
+    assert err.startswith('error: scotch_yoke: Expected a pose to draw its URDF in, got none: '
+                          'RPP Y cannot be solved at its crank angle 30 deg, nor at any of a '
+                          'turn: the position of points.Y cannot be trusted: expected its error '
+                          'bound to be at most 1e-06 x 0.05 m')
+    assert err.count('\n') == 1

@@ -158,6 +158,33 @@ def test_rendered_imu_bytes_are_the_canonical_cdr_of_the_message():
             assert back.angular_velocity.z == data[spec.name]['angular_velocity']
 
 
+def test_a_reading_beyond_the_range_of_doubles_is_not_rendered():
+    """Issue 33: a sensor whose a_P - g overflows gets no message (None), never an inf.
+
+    The crank's tip accelerates at 1.44e308 m/s^2 toward A (a state the solver
+    answers); gravity 8e307 upward (within MAX_GRAVITY) takes the reading beyond
+    the doubles. A sensor beside it, without gravity, is rendered as usual. The
+    node publishes nothing for the first that tick (a throttled warning says so).
+    """
+    from mech_kinematics.ros.imus import ImuMessages
+    from mech_kinematics.ros.ticker import values_from_state
+
+    scene = mk.parse_scene({
+        'name': 'imu_overflow', 'units': {'length': 'm', 'angle': 'deg'},
+        'ground': {'A': [0, 0]},
+        'input': {'link': 'crank', 'center': 'A', 'point': 'B', 'length': 1, 'angle': 90,
+                  'speed': 1.2e154},
+        'imus': {'up': {'link': 'crank', 'point': 'B', 'gravity': [0, 8e307]},
+                 'free': {'link': 'crank', 'point': 'B'}}})
+    state = mk.solve(scene, scene.input.angle)
+    values = values_from_state(state, scene.output_joints, scene.output_points)
+    assert all(math.isfinite(v) for v in values)
+    messages = ImuMessages(scene.imus, scene.output_joints, scene.output_points, 'p')
+    up, free = messages.render_values(values, 7, 123)
+    assert up is None
+    assert isinstance(free, bytes)
+
+
 def test_the_gripper_runs_a_whole_turn_with_its_fingertip_imu(ros, tmp_path):
     """The packaged gripper at its own 30 rpm: one Imu per state over a turn, none refused.
 

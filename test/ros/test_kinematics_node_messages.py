@@ -271,13 +271,17 @@ def solve_or_skip(scene, angle, speed, accel):
     """Solve, or tell hypothesis to skip an angle where the scene cannot assemble.
 
     Several drivers (issue 18) move all at once from their start: a crank by
-    ``angle``, an actuator by ``angle`` cm, each at ``speed`` and ``accel``.
+    ``angle``, an actuator by ``angle`` cm, each at ``speed`` and ``accel``; so
+    does an actuator alone (the packaged boom), with the one-driver signature's
+    bare values.
     """
     drivers = scene.drivers
     if len(drivers) > 1:
         angle = [d.start + (angle if d.joint_type == 'revolute' else 0.01 * angle)
                  for d in drivers]
         speed, accel = [speed] * len(drivers), [accel] * len(drivers)
+    elif drivers[0].joint_type != 'revolute':
+        angle = drivers[0].start + 0.01 * angle
     try:
         return mk.solve(scene, angle, speed, accel)
     except mk.AssemblyError:

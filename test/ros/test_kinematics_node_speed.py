@@ -81,3 +81,34 @@ def test_a_tiny_speed_set_at_run_time_is_published(ros, tmp_path):
         status, _ = proc.stop(signal.SIGINT)
     assert status == 0, proc.output()
     assert 'cannot be trusted' not in proc.output()
+
+
+def test_a_crank_speed_given_in_rad_per_s_is_published_as_given(ros, tmp_path):
+    """Issue 33: a scene's `speed: 300` (rad/s) is driven at 300.0 rad/s exactly.
+
+    The node's parameter stays `crank_speed_rpm`: it shows the speed in rpm
+    (300 x 30 / pi, to 12 digits), and the time base runs on the scene's own
+    rad/s, so joint_states carries what `solve` prints, to the bit.
+    """
+    from rclpy.parameter_client import AsyncParameterClient
+    from ros_helpers import wait_for_parameters
+
+    from mech_kinematics.scene import scene_text
+
+    scene = tmp_path / 'piston_rad_s.yaml'
+    scene.write_text(scene_text('piston_300').replace('speed_rpm: 2864.7889756541163',
+                                                      'speed: 300'))
+    assert solve_speed(str(scene)) == 300.0
+    ns = f'{SESSION}/speed_rad_s'
+    js = ros.collect(JointState, f'{ns}/joint_states')
+    proc = NodeProcess(tmp_path / 'node', '-r', f'__ns:={ns}', '-p', f'scene:={scene}')
+    try:
+        wait_for(lambda: len(js) > 20, STARTUP_S, 'joint_states')
+        params = AsyncParameterClient(ros.node, f'{ns}/mech_kinematics')
+        wait_for_parameters(params)
+        [rpm] = ros.call(params.get_parameters(['crank_speed_rpm'])).values
+    finally:
+        status, _ = proc.stop(signal.SIGINT)
+    assert status == 0, proc.output()
+    assert {m.velocity[list(m.name).index('crank')] for m in js} == {300.0}
+    assert rpm.double_value == 2864.78897565

@@ -503,3 +503,94 @@ def test_errors_relative_to_the_scales_are_a_few_ulps(name, positions):
     for kind, error in errors.items():
         assert 1.0 <= kappa[kind] < 100.0, (kind, kappa)
         assert error <= 4 * EPS * kappa[kind], (kind, error, kappa[kind])
+
+
+# --- the packaged boom: one actuator, its only driver (issue 33) ------------------------
+
+#: The packaged boom's geometry, m: boom OQ, cylinder base F (scene file).
+BOOM_OQ, BOOM_F, BOOM_HEAD = 1.5, (0.35, -1.1), 5.0
+
+
+def boom_closed_form(length, rate, accel):
+    """Return the boom's angle, rate and acceleration by hand (law of cosines), rad.
+
+    In the triangle O, F, Q: L^2 = a^2 + d^2 - 2 a d cos(gamma), the boom at
+    angle(F - O) + gamma (Q left of O -> F: branch +1). Differentiating,
+    gamma' = L L' / (a d sin gamma) and gamma'' = (L'^2 + L L'' - a d cos(gamma)
+    gamma'^2) / (a d sin gamma).
+    """
+    a, d = BOOM_OQ, math.hypot(*BOOM_F)
+    gamma = math.acos((a * a + d * d - length * length) / (2 * a * d))
+    s = a * d * math.sin(gamma)
+    w = length * rate / s
+    alpha = (rate * rate + length * accel - a * d * math.cos(gamma) * w * w) / s
+    return math.atan2(BOOM_F[1], BOOM_F[0]) + gamma, w, alpha
+
+
+@pytest.mark.parametrize('length, rate, accel', [(1.45, 0.0, 0.0), (1.9, 0.05, 0.0),
+                                                 (2.1, -0.08, 0.3), (2.35, 0.0, 0.0)])
+def test_packaged_boom_is_the_law_of_cosines_through_the_api(length, rate, accel):
+    """Golden: the boom's angle, rate and acceleration by hand, at the stroke's ends and within.
+
+    One actuator, its only driver: ``solve(scene, length, speed, accel)`` (the
+    one-driver signature) answers floats, the boom head moving with the boom.
+    """
+    scene = mk.load_scene('boom')
+    assert scene.input is None and [d.name for d in scene.drivers] == ['lift_cyl']
+    state = mk.solve(scene, length, rate, accel)
+    theta, w, alpha = boom_closed_form(length, rate, accel)
+    boom = state.joints['boom']
+    assert boom.position == pytest.approx(theta, abs=4e-16)
+    assert boom.velocity == pytest.approx(w, rel=1e-13, abs=1e-17)
+    assert boom.acceleration == pytest.approx(alpha, rel=1e-12, abs=1e-16)
+    head = state.points['T']
+    np.testing.assert_allclose(head.position, [BOOM_HEAD * math.cos(theta),
+                                               BOOM_HEAD * math.sin(theta)], rtol=0, atol=4e-15)
+    np.testing.assert_allclose(head.velocity, [-BOOM_HEAD * w * math.sin(theta),
+                                               BOOM_HEAD * w * math.cos(theta)],
+                               rtol=0, atol=1e-14)
+    motion = state.drivers['lift_cyl']
+    assert (motion.type, motion.position, motion.velocity, motion.acceleration) == (
+        'prismatic', length, rate, accel)
+    data = state.as_dict()
+    assert data['inputs'] == {'lift_cyl': {'position': length, 'speed': rate, 'accel': accel}}
+    assert 'input' not in data  # a length is no crank "angle"
+
+
+def test_packaged_boom_figures_of_its_description():
+    """The boom swings from -7.65 to 51.7 deg over the stroke, transmission 46 deg down to 24.
+
+    The figures of config/scenes/boom.yaml and the README; at time zero the
+    cylinder is 1.9 m (the boom at 18.1 deg) and reaches 2.35 m in 9 s.
+    """
+    scene = mk.load_scene('boom')
+    (cylinder,) = scene.drivers
+    assert (cylinder.start, cylinder.speed, cylinder.accel) == (1.9, 0.05, 0.0)
+    assert (cylinder.stroke[1] - cylinder.start) / cylinder.speed == pytest.approx(9.0)
+
+    def pose(length):
+        state = mk.solve(scene, length, 0.0, 0.0)
+        theta = state.joints['boom'].position
+        between = theta - state.joints['lift_cyl_body'].position
+        return math.degrees(theta), abs(math.degrees(math.remainder(between, math.tau)))
+
+    low, high = (pose(x) for x in cylinder.stroke)
+    assert (round(low[0], 2), round(high[0], 1)) == (-7.65, 51.7)
+    assert (round(low[1]), round(high[1])) == (46, 24)
+    assert round(pose(1.9)[0], 1) == 18.1
+    with pytest.raises(mk.AssemblyError, match=r'expected the length of actuator lift_cyl '
+                       r'within its stroke \[1\.45, 2\.35\] m, got 2\.4 m'):
+        mk.solve(scene, 2.4)
+
+
+def test_packaged_boom_array_path_gives_the_scalar_bits():
+    """A sweep of the cylinder (the one-driver signature's array) is the single solves' bits."""
+    scene = mk.load_scene('boom')
+    lengths = np.linspace(1.3, 2.5, 25)
+    many = mk.solve(scene, lengths, 0.04, -0.01)
+    assert list(many.valid) == [1.45 <= x <= 2.35 for x in lengths]
+    for i in np.flatnonzero(many.valid):
+        one = mk.solve(scene, float(lengths[i]), 0.04, -0.01)
+        assert many.joints['boom'].velocity[i] == one.joints['boom'].velocity
+        assert abs(many.joints['boom'].position[i] - one.joints['boom'].position) <= \
+            np.spacing(abs(one.joints['boom'].position))

@@ -13,7 +13,11 @@ joins DDS itself.
 
 What the node published comes from its own diagnostics, recorded in the same
 bag: ``published_total`` counts the state messages of each topic. The SIGINT
-recorder logs a progress line a second (``--progress 1``).
+recorder logs a progress line a second (``--progress 1``). While the SIGINT
+and SIGTERM recorders write, once their storage holds a message, ``reindex``
+(the function, in this process) is run on their bags and must refuse them
+(issue 33): the same tests then check that each bag holds every message its
+recorder received.
 
 A second set of recorders meets a node at 1 kHz for the crash-safety tests
 (issue 12): two are killed with SIGKILL a few seconds into the recording
@@ -24,6 +28,7 @@ must end with one ``error:`` line and a bag whose metadata tells the truth;
 one, in a namespace where nothing publishes, must say what it waits for.
 """
 
+import contextlib
 from dataclasses import dataclass
 import os
 from pathlib import Path
@@ -41,6 +46,7 @@ import pytest
 import yaml
 
 import mech_kinematics as mk
+from mech_kinematics.bag import BagError, reindex
 from mech_kinematics.tools import plot, record as bag_recorder
 
 REPO = Path(__file__).resolve().parents[2]
@@ -71,6 +77,8 @@ RECORDERS = {
     'sigint_mcap': (['--storage', 'mcap', '--progress', '1'], signal.SIGINT, 8),
     'sigterm_sqlite3_v9': (['--storage', 'sqlite3', '--bag-version', '9'], signal.SIGTERM, 9),
 }
+#: The recorders whose bags reindex is run on while they write (issue 33).
+REINDEXED_WHILE_RECORDING = ('sigint_mcap', 'sigterm_sqlite3_v9')
 SUMMARY_LINE = re.compile(r'^(/\S+)\s+(\S+)\s+(\d+)\s+(\d+)$', re.MULTILINE)
 
 # A domain of this module's own (1..100 is test_kinematics_node_launch's range).
@@ -122,6 +130,9 @@ class Recording:
     status: int
     output: str
     version: int
+    pid: int = 0
+    #: What ``reindex`` of the bag said while this recorder wrote it (its error, or the result).
+    reindexed_while_recording: object = None
 
     def summary(self) -> dict:
         """Topic -> (type, received, written), as the recorder printed them."""
@@ -141,6 +152,7 @@ def recordings(tmp_path_factory):
     """Record the node with four recorders started before it; return them by name."""
     tmp = tmp_path_factory.mktemp('recordings')
     recorders = {}
+    reindexed = {}
     try:
         for name, (extra, _, _) in RECORDERS.items():
             recorders[name] = Process(name, tmp, '-m', 'mech_kinematics.tools.record',
@@ -152,6 +164,12 @@ def recordings(tmp_path_factory):
         node = Process('node', tmp, '-m', 'mech_kinematics.kinematics_node', '--ros-args',
                        '-p', f'rate_hz:={RATE_HZ}')
         try:
+            for name in REINDEXED_WHILE_RECORDING:     # in this process: no start-up to load
+                _wait_for_a_written_message(tmp / name, recorders[name])
+                try:
+                    reindexed[name] = reindex(tmp / name)
+                except BagError as error:
+                    reindexed[name] = str(error)
             statuses = {name: recorders[name].stop(timeout=STARTUP_S + DURATION_S)
                         for name, (_, sig, _) in RECORDERS.items() if sig is None}
             for name, (_, sig, _) in RECORDERS.items():
@@ -164,7 +182,34 @@ def recordings(tmp_path_factory):
     finally:
         _kill_left_over(recorders.values())
     return {name: Recording(name, tmp / name, statuses[name], recorders[name].output(),
-                            RECORDERS[name][2]) for name in RECORDERS}
+                            RECORDERS[name][2], recorders[name].proc.pid, reindexed.get(name))
+            for name in RECORDERS}
+
+
+def _wait_for_a_written_message(path: Path, recorder: Process) -> None:
+    """Wait until the storage file of the bag ``path`` holds a message (read without a lock)."""
+    import sqlite3
+
+    from mech_kinematics.bag import storage_mcap
+
+    deadline = time.monotonic() + STARTUP_S
+    while True:
+        for file in path.glob(f'{path.name}.*'):
+            try:
+                if file.suffix == '.mcap':
+                    if storage_mcap.RecoveredMcap(file).chunks:
+                        return
+                elif file.suffix == '.db3':
+                    with contextlib.closing(sqlite3.connect(f'file:{file}?mode=ro',
+                                                            uri=True)) as db:
+                        if db.execute('SELECT COUNT(*) FROM messages').fetchone()[0]:
+                            return
+            except (BagError, sqlite3.Error):
+                pass        # caught while the recorder writes: read again
+        if recorder.proc.poll() is not None or time.monotonic() > deadline:
+            pytest.fail(f'{recorder.name}: no message in {path} within {STARTUP_S} s:\n'
+                        f'{recorder.output()}')
+        time.sleep(0.05)
 
 
 def _wait_for_two_diagnostics(recorder: Process) -> None:
@@ -231,6 +276,37 @@ def test_bag_holds_every_message_received(recordings, contents, name):
     for topic, (_, received, _) in recording.summary().items():
         assert len(contents[name][topic]) == counts[topic] == received, topic
     assert info['message_count'] == sum(counts.values())
+
+
+@pytest.mark.parametrize('name', REINDEXED_WHILE_RECORDING)
+def test_reindex_of_a_bag_being_recorded_is_refused(recordings, name, tmp_path):
+    """A reindex while a real recorder writes is refused, one line naming the bag and recorder.
+
+    The recording goes on undisturbed: the recorder closes its bag, which
+    holds every message it wrote (rosbags reads them all), with no other
+    file; reindex after the recorder has ended changes not a byte (issue 33).
+    """
+    recording = recordings[name]
+    said = recording.reindexed_while_recording
+    (file,) = [p for p in recording.path.iterdir() if p.suffix in ('.mcap', '.db3')]
+    assert isinstance(said, str), f'reindex answered {said}'
+    assert '\n' not in said
+    assert said.startswith(
+        f'Expected a bag that no other process holds open, got "{recording.path}": its '
+        f'storage file {file.name} is locked: process {recording.pid} (')
+    assert 'mech_kinematics.tools.record -o' in said
+    assert said.endswith(') has it locked and open (a recording still running?); run reindex '
+                         'once it has ended')
+    assert recording.status == 0, recording.output
+    assert sorted(p.name for p in recording.path.iterdir()) == sorted([file.name,
+                                                                       'metadata.yaml'])
+    written = {topic: n for topic, (_, _, n) in recording.summary().items()}
+    assert readable_counts(recording.path) == written
+    copy = shutil.copytree(recording.path, tmp_path / name)
+    before = {p.name: p.read_bytes() for p in copy.iterdir() if p.name != 'metadata.yaml'}
+    info = reindex(copy)
+    assert info.notes == () and info.message_count == sum(written.values())
+    assert {p.name: p.read_bytes() for p in copy.iterdir() if p.name != 'metadata.yaml'} == before
 
 
 @pytest.mark.parametrize('name', RECORDERS)

@@ -505,3 +505,79 @@ def test_packaged_five_bar_plots_both_cranks_turning_together(tmp_path):
     half = 0.24 * math.sin(math.radians(15))
     assert bd.min() >= 0.1 - half - 1e-12 and bd.max() <= 0.1 + half + 1e-12
     assert bd.max() - bd.min() == pytest.approx(2 * half, rel=1e-2)
+
+
+# --- a recording of a node driven from a topic (issue 33) -------------------------------
+
+
+def topic_driven_bag(path: Path, scene, positions, *, velocities: bool) -> Path:
+    """Write what a topic-driven node publishes, with the project's bag writer (``record``'s).
+
+    Its messages carry no accelerations (empty arrays, as the contract says),
+    and no velocities either when the input messages had none.
+    """
+    from mech_kinematics.bag import BagWriter
+    from mech_kinematics.bag.metadata import type_hash_from_definition
+    from mech_kinematics.ros.messages import TickMessages
+
+    ticks = TickMessages(scene.output_joints, scene.output_points, 'mechanism',
+                         velocities=velocities, accelerations=False)
+    writer = BagWriter(path, storage='mcap')
+    writer.open()
+    ids = {}
+    for topic, msgtype in TYPES.items():
+        encoding, text = bag_recorder.message_definition(msgtype)
+        ids[topic] = writer.add_topic(f'/{topic}', msgtype, definition=text, encoding=encoding,
+                                      type_hash=type_hash_from_definition(msgtype, text,
+                                                                          encoding))
+    start = 1_700_000_000 * 10**9
+    for i, x in enumerate(positions):
+        stamp = start + i * 10**7    # 100 Hz
+        for topic, data in zip(TYPES, ticks.render(mk.solve(scene, x), *divmod(stamp, 10**9)),
+                               strict=True):
+            writer.write(ids[topic], stamp, data)
+    writer.close()
+    return path
+
+
+@pytest.mark.parametrize('velocities', [True, False])
+def test_a_bag_without_accelerations_plots_what_is_there_and_says_what_is_not(
+        tmp_path, capsys, velocities):
+    """Issue 33: `plot` on a topic-driven recording failed with "unexpected IndexError".
+
+    Positions (and velocities when recorded) are drawn, the solver's values;
+    each panel of what is not in the recording says so, and so does one
+    warning line.
+    """
+    scene = mk.load_scene('boom')
+    lengths = 1.9 + 0.004 * np.arange(60)
+    bag = topic_driven_bag(tmp_path / 'topic', scene, lengths, velocities=velocities)
+    with pytest.warns(UserWarning) as caught:
+        fig = plot.plot_bag(bag, tmp_path / 'topic.png', scene=scene)
+    missing = 'velocities or accelerations' if not velocities else 'accelerations'
+    assert [str(w.message) for w in caught] == [
+        f'{bag}: no {missing} in the recording (empty in every message, as a node driven from a '
+        f'topic publishes them): their panels say so']
+    boom = lines(panels(fig)['Joint angles'])['boom']
+    np.testing.assert_allclose(boom.get_ydata(), [mk.solve(scene, x).joints['boom'].position
+                                                  for x in lengths], rtol=RTOL, atol=0)
+    cylinder = lines(panels(fig)['Slider positions'])['lift_cyl']
+    np.testing.assert_array_equal(cylinder.get_ydata(), lengths)
+    empty = ['Joint angular accelerations', 'Point accelerations |a|', 'Slider accelerations']
+    if velocities:
+        speed = lines(panels(fig)['Point speeds |v|'])['T']
+        expected = [math.hypot(*mk.solve(scene, x).points['T'].velocity) for x in lengths]
+        np.testing.assert_allclose(speed.get_ydata(), expected, rtol=RTOL, atol=0)
+    else:
+        empty += ['Joint angular velocities', 'Point speeds |v|', 'Slider velocities']
+        assert 'T' in lines(panels(fig)['Point paths'])  # a moving point, from its path alone
+    for title in empty:
+        ax = panels(fig)[title]
+        assert not lines(ax), title
+        assert [t.get_text() for t in ax.texts] == ['not in the recording'], title
+    out = tmp_path / 'cli.png'
+    assert plot.main([str(bag), '-o', str(out), '--scene', 'boom']) == 0
+    assert_png(out)
+    assert capsys.readouterr().err == (
+        f'warning: {bag}: no {missing} in the recording (empty in every message, as a node '
+        f'driven from a topic publishes them): their panels say so\n')

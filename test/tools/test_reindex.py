@@ -1,13 +1,19 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""The ``reindex`` command: ``python -m mech_kinematics reindex BAG`` (see issue 12).
+"""The ``reindex`` command: ``python -m mech_kinematics reindex BAG`` (see issues 12 and 33).
 
 Its recovery is tested in ``test_bag_storage.py`` (in-process) and
-``test_bag_recorder.py`` (after ``kill -9`` of a real recording); here: the
-command line, its output and its errors.
+``test_bag_recorder.py`` (after ``kill -9`` of a real recording, and while a
+real recording runs); here: the command line, its output and its errors, and
+what it does with a bag that another process holds or that it cannot write.
 """
 
+import ctypes
+import os
 from pathlib import Path
+import resource
+import shutil
+import signal
 import subprocess
 import sys
 
@@ -15,10 +21,42 @@ import pytest
 import yaml
 
 from mech_kinematics.__main__ import build_parser, TOOLS
-from mech_kinematics.bag import BagWriter
+from mech_kinematics.bag import BagError, BagWriter, reindex as reindex_bag
+from mech_kinematics.bag.writer import RESERVE_FILE, STORAGES
 from mech_kinematics.tools import reindex
 
 REPO = Path(__file__).resolve().parents[2]
+
+#: A bag written by a BagWriter in another process, flushed, then held open until killed.
+WRITER = """
+import sys
+from pathlib import Path
+sys.path.insert(0, {here!r})
+from test_reindex import unclosed_bag
+writer = unclosed_bag(Path(sys.argv[1]), sys.argv[2], int(sys.argv[3]))
+print('holding', flush=True)
+sys.stdin.read()
+"""
+#: A process that holds the storage file ``sys.argv[1]`` open, as ``sys.argv[2]`` says.
+HOLDER = """
+import ctypes, os, sqlite3, sys
+path, how = sys.argv[1], sys.argv[2]
+if how == 'sqlite3':
+    held = sqlite3.connect(path)
+    held.execute('SELECT COUNT(*) FROM messages').fetchone()
+elif how == 'open':
+    held = open(path, 'rb')
+else:       # mapped, its descriptor closed (Python's mmap would keep a duplicate open)
+    libc = ctypes.CDLL(None, use_errno=True)
+    libc.mmap.restype = ctypes.c_void_p
+    libc.mmap.argtypes = [ctypes.c_void_p, ctypes.c_size_t, ctypes.c_int, ctypes.c_int,
+                          ctypes.c_int, ctypes.c_long]
+    fd = os.open(path, os.O_RDONLY)
+    assert libc.mmap(None, os.fstat(fd).st_size, 1, 1, fd, 0) not in (None, 2**64 - 1)
+    os.close(fd)
+print('holding', flush=True)
+sys.stdin.read()
+"""
 
 
 def unclosed_bag(path: Path, storage: str, messages: int):
@@ -36,6 +74,34 @@ def unclosed_bag(path: Path, storage: str, messages: int):
     return writer
 
 
+def killed_bag(path: Path, storage: str, messages: int) -> Path:
+    """Return ``path``: a bag of ``messages`` messages as kill -9 of its writer leaves it."""
+    writer = unclosed_bag(path.with_name(path.name + '_source'), storage, messages)
+    shutil.copytree(writer.path, path)
+    writer.close()
+    return path
+
+
+def storage_file(path: Path, storage: str) -> Path:
+    """Return the storage file of the bag ``path`` (named after the bag it was copied from)."""
+    (file,) = path.glob(f'*{STORAGES[storage]}')
+    return file
+
+
+def run_reindex(path: Path, **popen) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, '-m', 'mech_kinematics', 'reindex', str(path)],
+                          cwd=REPO, capture_output=True, text=True, **popen)
+
+
+def assert_one_error_line(result: subprocess.CompletedProcess, *parts: str) -> None:
+    """Exit 2, nothing on stdout, one ``error:`` line holding every one of ``parts``."""
+    assert result.returncode == 2, result.stdout + result.stderr
+    assert result.stdout == ''
+    assert result.stderr.count('\n') == 1 and result.stderr.startswith('error: ')
+    for part in parts:
+        assert part in result.stderr
+
+
 def _string_hash(text: str) -> str:
     from mech_kinematics.bag.metadata import type_hash_from_definition
 
@@ -45,7 +111,7 @@ def _string_hash(text: str) -> str:
 @pytest.mark.parametrize('storage', ['mcap', 'sqlite3'])
 def test_reindex_prints_what_the_bag_holds(tmp_path, capsys, storage):
     """Exit 0; a line with storage, version and count, then a table of the topics."""
-    writer = unclosed_bag(tmp_path / 'bag', storage, 25)
+    killed_bag(tmp_path / 'bag', storage, 25)
     assert reindex.main([str(tmp_path / 'bag')]) == 0
     out = capsys.readouterr().out.splitlines()
     assert out[0] == f'reindexed {tmp_path / "bag"} ({storage}, bag version 8): 25 messages ' \
@@ -58,17 +124,141 @@ def test_reindex_prints_what_the_bag_holds(tmp_path, capsys, storage):
     with AnyReader([tmp_path / 'bag']) as bag:
         texts = [bag.deserialize(raw, c.msgtype).data for c, _, raw in bag.messages()]
     assert texts == [f'hello {i}' for i in range(25)]
-    writer.close()
 
 
 def test_reindex_takes_the_bag_version(tmp_path, capsys):
     """--bag-version 9 writes version 9 metadata (QoS by name)."""
-    writer = unclosed_bag(tmp_path / 'bag', 'mcap', 3)
+    killed_bag(tmp_path / 'bag', 'mcap', 3)
     assert reindex.main([str(tmp_path / 'bag'), '--bag-version', '9']) == 0
     assert '(mcap, bag version 9)' in capsys.readouterr().out
     meta = yaml.safe_load((tmp_path / 'bag' / 'metadata.yaml').read_text())
     assert meta['rosbag2_bagfile_information']['version'] == 9
-    writer.close()
+
+
+# -- a bag that another process holds (issue 33) ----------------------------------------
+
+
+@pytest.mark.parametrize('storage', ['mcap', 'sqlite3'])
+def test_a_bag_being_written_is_refused(tmp_path, storage):
+    """An open BagWriter (of this test) locks its bag: reindex exits 2, the bag untouched."""
+    writer = unclosed_bag(tmp_path / 'bag', storage, 40)
+    file = storage_file(tmp_path / 'bag', storage)
+    before = file.read_bytes()
+    result = run_reindex(tmp_path / 'bag')
+    assert_one_error_line(result, f'Expected a bag that no other process holds open, got '
+                                  f'"{tmp_path / "bag"}": its storage file {file.name} is locked: '
+                                  f'process {os.getpid()} (', ') has it locked and open (a '
+                                  'recording still running?); run reindex once it has ended')
+    with pytest.raises(BagError, match=rf'is locked: this process \({os.getpid()}\) has it '
+                                       rf'locked \(a recording still running\?\)'):
+        reindex_bag(tmp_path / 'bag')
+    assert file.read_bytes() == before
+    assert sorted(p.name for p in (tmp_path / 'bag').iterdir()) == sorted([file.name,
+                                                                           RESERVE_FILE])
+    info = writer.close()
+    assert info.count('/chatter') == 40 and info.notes == ()
+
+
+def hold(argv: list, tmp: Path) -> subprocess.Popen:
+    """Start ``python -c argv...`` and return it once it says it holds the file."""
+    process = subprocess.Popen([sys.executable, '-c', *argv], cwd=tmp, stdin=subprocess.PIPE,
+                               stdout=subprocess.PIPE, text=True)
+    said = process.stdout.readline()
+    if said != 'holding\n':
+        process.kill()
+        process.communicate()
+        pytest.fail(f'expected the holder to say "holding", got {said!r}')
+    return process
+
+
+@pytest.mark.parametrize('how', ['writer', 'open', 'mapped', 'sqlite3'])
+def test_a_bag_another_process_holds_is_refused_until_it_ends(tmp_path, how):
+    """Locked, open or mapped by another process: exit 2 naming it; once it is killed, reindexed.
+
+    ``writer``: our BagWriter in another process (its lock); ``open`` and
+    ``mapped``: a reader that takes no lock; ``sqlite3``: an idle connection.
+    """
+    storage = 'sqlite3' if how == 'sqlite3' else 'mcap'
+    bag = tmp_path / 'bag'
+    if how == 'writer':
+        code = WRITER.format(here=str(Path(__file__).parent))
+        holder = hold([code, str(bag), storage, '30'], tmp_path)
+        file = storage_file(bag, storage)
+        said = 'has it locked and open'
+    else:
+        file = storage_file(killed_bag(bag, storage, 30), storage)
+        holder = hold([HOLDER, str(file), how], tmp_path)
+        said = 'has it mapped' if how == 'mapped' else 'has it open'
+    try:
+        before = file.read_bytes()
+        result = run_reindex(bag)
+        assert_one_error_line(result, f'got "{bag}": its storage file {file.name} ',
+                              f'process {holder.pid} ({Path(sys.executable).name} -c ', said)
+        assert file.read_bytes() == before
+        assert not (bag / 'metadata.yaml').exists()
+    finally:
+        holder.kill()
+        holder.communicate()
+    assert holder.returncode == -signal.SIGKILL
+    result = run_reindex(bag)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.startswith(f'reindexed {bag} ({storage}, bag version 8): 30 messages')
+
+
+# -- reindex twice, and a reindex that cannot write -------------------------------------
+
+
+@pytest.mark.parametrize('storage', ['mcap', 'sqlite3'])
+def test_reindex_twice_changes_nothing_the_second_time(tmp_path, storage):
+    """The second reindex of a killed recording: the same messages, not a byte written."""
+    bag = killed_bag(tmp_path / 'bag', storage, 500)
+    assert run_reindex(bag).returncode == 0
+    files = {p.name: p.read_bytes() for p in bag.iterdir()}
+    result = run_reindex(bag)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.startswith(f'reindexed {bag} ({storage}, bag version 8): 500 messages')
+    assert {p.name: p.read_bytes() for p in bag.iterdir()} == files
+
+
+def _cannot_write(cause: str, limit: int):
+    """Return the preexec_fn of a reindex that cannot write: a file size limit, or no rights."""
+    def preexec() -> None:
+        if cause == 'file size limit':
+            resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+        elif os.geteuid() == 0:     # root writes into a read-only directory unless it drops
+            libc = ctypes.CDLL(None, use_errno=True)
+            for capability in (1, 2):       # CAP_DAC_OVERRIDE, CAP_DAC_READ_SEARCH
+                if libc.prctl(24, capability, 0, 0, 0) != 0:     # PR_CAPBSET_DROP
+                    raise OSError(ctypes.get_errno(), 'prctl(PR_CAPBSET_DROP)')
+    return preexec
+
+
+@pytest.mark.parametrize('cause', ['read-only directory', 'file size limit'])
+@pytest.mark.parametrize('storage', ['mcap', 'sqlite3'])
+def test_a_reindex_that_cannot_write_leaves_the_bag_as_it_was(tmp_path, storage, cause):
+    """No rights in the directory, or no room (RLIMIT_FSIZE of 4 KiB): the file unchanged.
+
+    The storage file of a killed recording keeps every byte, no copy or
+    ``.damaged`` file is left; if reindex cannot finish, it says why in one
+    line (exit 2).
+    """
+    bag = killed_bag(tmp_path / 'bag', storage, 3000)
+    file = storage_file(bag, storage)
+    before = file.read_bytes()
+    if cause == 'read-only directory':
+        bag.chmod(0o555)
+    try:
+        result = run_reindex(bag, preexec_fn=_cannot_write(cause, 4096))
+    finally:
+        bag.chmod(0o755)
+    assert file.read_bytes() == before
+    assert {p.name for p in bag.iterdir()} <= {file.name, 'metadata.yaml', RESERVE_FILE}
+    if storage == 'mcap' or cause == 'read-only directory':
+        reason = 'File too large' if cause == 'file size limit' else 'Permission denied'
+        assert_one_error_line(result, reason)
+    else:       # sqlite3: the metadata table left as it was, metadata.yaml written
+        assert result.returncode == 0, result.stderr
+        assert 'left the metadata table as it was' in result.stdout
 
 
 def bad_bags(tmp: Path) -> dict:

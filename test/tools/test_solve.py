@@ -99,3 +99,84 @@ def test_one_crank_usage_is_unchanged_and_takes_its_name_too():
                              'speed': rad_per_s_from_rpm(90.0), 'accel': 2.0}
     status, _, err = run('khurmi_four_bar_ad150', '--angle-deg', '40', '--input', 'crank=40')
     assert (status, err) == (2, 'error: Expected --angle-deg or --input crank=DEG, got both\n')
+
+
+# --- the edges (issue 33) ----------------------------------------------------------------
+
+
+def test_an_actuator_alone_is_driven_by_name_and_by_the_scenes_values():
+    """The packaged boom (one cylinder, its only driver): `solve` answers what mk.solve does.
+
+    `--input lift_cyl=2 --speed lift_cyl=0 --accel lift_cyl=0` failed with
+    "unexpected TypeError: Object of type ndarray is not JSON serializable" (the
+    values were passed on as a list of one, an array of one configuration), and
+    the scene's own values with "Expected the positions, speeds and accels of the
+    drivers to be finite" (a list [None] for the speed).
+    """
+    scene = mk.load_scene('boom')
+    status, out, err = run('boom', '--input', 'lift_cyl=2', '--speed', 'lift_cyl=0',
+                           '--accel', 'lift_cyl=0')
+    assert (status, err) == (0, '')
+    assert json.loads(out) == json.loads(json.dumps(mk.solve(scene, 2.0, 0.0, 0.0).as_dict()))
+    assert json.loads(out)['inputs'] == {'lift_cyl': {'position': 2.0, 'speed': 0.0,
+                                                      'accel': 0.0}}
+    status, out, err = run('boom')
+    assert (status, err) == (0, '')
+    assert json.loads(out) == json.loads(json.dumps(mk.solve(scene, 1.9).as_dict()))
+    status, out, err = run('boom', '--input', 'lift_cyl=0.85', '--speed', 'lift_cyl=0')
+    assert (status, out) == (2, '')
+    assert err == ('error: input lift_cyl cannot be solved at lift_cyl = 0.85 m: actuator '
+                   'lift_cyl: expected a length within its stroke [1.45 m, 2.35 m], got 0.85 m\n')
+
+
+@pytest.mark.parametrize('args, expected', [
+    (['check', 'boom'], 'lift_cyl: assembles over its whole stroke 1.45..2.35 m'),
+    (['urdf', 'boom'], '<robot name="boom">'),
+    (['diagram', 'boom', '--input', 'lift_cyl=2.2', '-o', '{tmp}/boom.png'], 'wrote'),
+    (['diagram', 'boom', '-o', '{tmp}/boom.svg'], 'wrote'),
+    (['plot', '--scene', 'boom', '-o', '{tmp}/plot.png'], 'the path stays where it assembles'),
+])
+def test_every_command_answers_the_boom(tmp_path, args, expected):
+    """check, urdf, diagram and plot answer a scene whose only driver is an actuator.
+
+    `urdf` failed with "unexpected ValueError: Expected the state of one crank
+    angle, got an array of shape (1,)".
+    """
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        status = main([arg.format(tmp=tmp_path) for arg in args])
+    assert (status, err.getvalue()) == (0, '')
+    assert expected in out.getvalue()
+    for arg in args:
+        if arg.startswith('{tmp}'):
+            assert (tmp_path / arg.split('/', 1)[1]).stat().st_size > 1000
+
+
+IMU_OVERFLOW = """\
+name: imu_overflow
+units: {length: m, angle: deg}
+ground: {A: [0, 0]}
+input: {link: crank, center: A, point: B, length: 1, angle: 90, speed: 1.2e154}
+imus:
+  tip: {link: crank, point: B, gravity: [0, 8e307]}
+"""
+
+
+def test_a_value_beyond_the_range_of_doubles_is_refused_in_one_line(tmp_path):
+    """Issue 33: a reading that overflows is one line and exit 2, never "unexpected ValueError".
+
+    The crank's tip accelerates at 1.44e308 m/s^2 toward A, the sensor's
+    gravity is 8e307 upward (within MAX_GRAVITY): a_B - g is beyond the
+    doubles. `solve` printed "unexpected ValueError: Out of range float values
+    are not JSON compliant".
+    """
+    path = tmp_path / 'imu_overflow.yaml'
+    path.write_text(IMU_OVERFLOW)
+    status, out, err = run(str(path))
+    assert (status, out) == (2, '')
+    assert err == ('error: Expected every value of the state at crank angle 90 deg to be '
+                   'finite, got imus.tip.linear_acceleration[0] = -inf (beyond the range of '
+                   'doubles)\n')
+    status, out, err = run(str(path), '--speed-rpm', '1e150')   # slower: answered
+    assert (status, err) == (0, '')
+    assert all(math.isfinite(x) for x in json.loads(out)['imus']['tip']['linear_acceleration'])
