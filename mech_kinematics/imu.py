@@ -184,8 +184,8 @@ def imu_outputs(scene: Any, joint_types: dict[str, str], joints: Sequence[str] |
             msg = (f'Expected a sensor name not used for a point, link or slider, got '
                    f'"{spec.name}"')
             raise SceneError(msg, (spec, 'name'))
-        if joint_types.get(spec.link) != 'revolute':
-            moving = ', '.join(name for name, kind in joint_types.items() if kind == 'revolute')
+        if spec.link not in fixed:
+            moving = ', '.join(fixed)
             got = (f'slider "{spec.link}", which does not turn' if spec.link in joint_types
                    else f'ground point "{spec.link}", which does not move'
                    if spec.link in scene.ground else f'unknown "{spec.link}"')

@@ -33,11 +33,12 @@ from typing import Any, TypedDict, TypeVar
 
 from .errors import SceneError
 from .imu import ImuSpec
-from .solver import Actuator, Branch, CarriedPoint, Crank, Link, Pin, Scene, SceneUnits
-from .solver.base import Item
+from .solver import Branch, CarriedPoint, Crank, Link, Pin, Scene, SceneUnits
+from .solver.base import Driver, Item
+from .solver.crank import CrankDict
 from .solver.model import IDENTIFIER
-from .solver.registry import KINDS
-from .units import (ANGLE_UNITS, LENGTH_UNITS, rad_per_s_from_rpm, reduce_radians,
+from .solver.registry import DRIVERS, KINDS
+from .units import (ANGLE_UNITS, LENGTH_UNITS, reduce_radians,
                     turns_from_degrees)
 from .yaml12 import (_brief, _join, MAX_DEPTH, MAX_INTEGER_DIGITS, MAX_YAML_NODES,
                      read_scene_yaml, SceneLoader)
@@ -82,19 +83,6 @@ class LinkDict(TypedDict):
     length: float
 
 
-class InputDict(TypedDict, total=False):
-    """The ``input`` key: the driving crank (its speed as ``speed_rpm`` or ``speed``, rad/s)."""
-
-    link: str
-    center: str
-    point: str
-    length: float
-    angle: float
-    speed_rpm: float
-    speed: float
-    accel: float
-
-
 class SceneDict(TypedDict, total=False):
     """A scene file's top level."""
 
@@ -102,7 +90,7 @@ class SceneDict(TypedDict, total=False):
     description: str
     units: dict[str, str]
     ground: dict[str, list[float]]
-    input: InputDict
+    input: CrankDict
     inputs: list[dict[str, Any]]
     dyads: list[dict[str, Any]]
     points: dict[str, dict[str, Any]]
@@ -302,13 +290,13 @@ def parse_scene(data: Any) -> Scene:
     if 'input' not in data and 'inputs' not in data:
         raise SceneError('input: missing required key (or inputs: a list of drivers)')
     crank: Crank | None = None
-    drivers: tuple[Crank | Actuator, ...] = ()
+    drivers: tuple[Driver, ...] = ()
     reading = _Reading(reader, keys)
     if 'input' in data:
-        crank = _crank(reader, keys, data['input'], 'input')
+        crank = Crank.from_scene(reading, data['input'], 'input')
     else:
         drivers = _drivers(reading, data['inputs'])
-        reading.actuators = {d.name: d.start for d in drivers if d.joint_type == 'prismatic'}
+        reading.drivers = {d.name: d for d in drivers}
 
     dyads_data = data.get('dyads', []) or []
     if not isinstance(dyads_data, list):
@@ -361,58 +349,31 @@ def _link(reader: _Reader, keys: _Keys, raw: Any, where: str) -> Link:
                       length=reader.length(raw, 'length', where))
 
 
-def _crank(reader: _Reader, keys: _Keys, raw: Any, where: str) -> Crank:
-    """Return the crank written at ``where`` (``input``, or an entry of ``inputs``)."""
-    _check_keys(raw if isinstance(raw, dict) else {}, set(InputDict.__annotations__), where)
-    speed, key = _crank_speed(reader, raw, where)
-    angle, turns = reader.start_angle(raw, 'angle', where)
-    return keys.build(
-        where, {'speed': key}, Crank,
-        link=reader.name(raw, 'link', where), center=reader.name(raw, 'center', where),
-        point=reader.name(raw, 'point', where), length=reader.length(raw, 'length', where),
-        angle=angle, turns=turns, speed=speed, accel=reader.number(raw, 'accel', where, 0.0))
-
-
-def _crank_speed(reader: _Reader, raw: Any, where: str) -> tuple[float, str]:
-    """Return a crank's speed, rad/s, and the key it was read from (``speed`` or ``speed_rpm``).
-
-    ``speed`` (rad/s) is taken as written, to the bit; ``speed_rpm`` is
-    converted (``rpm * pi / 30``). At most one of the two; neither is 0.
-    """
-    given = [key for key in ('speed', 'speed_rpm') if isinstance(raw, dict) and key in raw]
-    if len(given) == 2:
-        msg = (f'{where}.speed: expected the crank speed once, as speed (rad/s) or speed_rpm '
-               f'(rpm), got both (speed: {_brief(raw["speed"])}, speed_rpm: '
-               f'{_brief(raw["speed_rpm"])})')
-        raise SceneError(msg)
-    if given == ['speed']:
-        return reader.number(raw, 'speed', where), 'speed'
-    return rad_per_s_from_rpm(reader.number(raw, 'speed_rpm', where, 0.0)), 'speed_rpm'
-
-
-def _drivers(reading: _Reading, raw: Any) -> tuple[Crank | Actuator, ...]:
-    """Return the drivers of ``inputs``: cranks (``link:``) and actuators (``actuator:``)."""
+def _drivers(reading: _Reading, raw: Any) -> tuple[Driver, ...]:
+    """Return the drivers of ``inputs``, each read by the kind its key names (``DRIVERS``)."""
+    kinds = ' or '.join(f'{_article(kind.__name__)} {kind.__name__.lower()} (with {key}:)'
+                        for key, kind in DRIVERS.items())
     if not isinstance(raw, list) or not raw:
-        raise SceneError(f'inputs: expected a list of at least one driver (a crank with link: '
-                         f'or an actuator with actuator:), got {_brief(raw)}')
+        raise SceneError(f'inputs: expected a list of at least one driver ({kinds}), got '
+                         f'{_brief(raw)}')
     _check_count('inputs', raw, MAX_DRIVERS, 'MAX_DRIVERS', 'drivers')
-    drivers: list[Crank | Actuator] = []
+    drivers: list[Driver] = []
     for index, item in enumerate(raw):
         where = f'inputs[{index}]'
-        if isinstance(item, dict) and 'actuator' in item:
-            drivers.append(Actuator.from_scene(reading, item, where))
-        elif isinstance(item, dict) and 'link' in item:
-            drivers.append(_crank(reading.reader, reading.keys, item, where))
-        else:
-            raise SceneError(f'{where}: expected a crank (with link:) or an actuator (with '
-                             f'actuator:), got {_brief(item)}')
+        named = [kind for key, kind in DRIVERS.items() if isinstance(item, dict) and key in item]
+        if len(named) != 1:
+            raise SceneError(f'{where}: expected {kinds}, got {_brief(item)}')
+        drivers.append(named[0].from_scene(reading, item, where))
         first = next((i for i, d in enumerate(drivers[:-1]) if d.name == drivers[-1].name), None)
         if first is not None:
-            key = 'actuator' if drivers[-1].joint_type == 'prismatic' else 'link'
-            msg = (f'{where}.{key}: Expected every driver to have a name of its own, got '
-                   f'"{drivers[-1].name}" again (the name of inputs[{first}])')
+            msg = (f'{where}.{drivers[-1].scene_key}: Expected every driver to have a name of its '
+                   f'own, got "{drivers[-1].name}" again (the name of inputs[{first}])')
             raise SceneError(msg)
     return tuple(drivers)
+
+
+def _article(word: str) -> str:
+    return 'an' if word[:1].lower() in 'aeiou' else 'a'
 
 
 def _dyad(reading: _Reading, raw: Any, where: str) -> Item:
@@ -434,8 +395,9 @@ class _Reading:
         self.number = reader.number
         self.angle, self.branch = reader.angle, reader.branch
         self.build = keys.build
-        #: The scene's actuators: name -> length at time zero, m.
-        self.actuators: dict[str, float] = {}
+        self.start_angle = reader.start_angle
+        #: The scene's drivers by name (what a link's ``actuator:`` may name).
+        self.drivers: dict[str, Driver] = {}
         #: The key of the link each actuator drives, as the dyads name them.
         self.driven: dict[str, str] = {}
 
@@ -445,8 +407,9 @@ class _Reading:
         Each actuator is the length of one link: a second link naming it is
         refused at its own key (``where``).
         """
-        if name not in self.actuators:
-            known = ', '.join(self.actuators) or 'none'
+        lengths = {n: d.link_length for n, d in self.drivers.items() if d.link_length is not None}
+        if name not in lengths:
+            known = ', '.join(lengths) or 'none'
             raise SceneError(f'{where}: expected the name of an actuator of inputs ({known}), '
                              f'got {_brief(name)}')
         if name in self.driven:
@@ -454,7 +417,7 @@ class _Reading:
                    f'"{name}" again (the actuator of {self.driven[name]})')
             raise SceneError(msg)
         self.driven[name] = where.removesuffix('.actuator')
-        return self.actuators[name]
+        return lengths[name]
 
     @staticmethod
     def check_keys(mapping: Any, allowed: set[str], where: str) -> None:

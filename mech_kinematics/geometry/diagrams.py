@@ -907,7 +907,7 @@ def diagram_from_scene(scene: Scene, angle: float | None = None, speed: float | 
     """
     scene = full_scene(scene)
     drivers = scene.drivers
-    several = len(drivers) > 1 or drivers[0].joint_type != 'revolute'
+    several = not scene.single_crank
     if several or inputs is not None:
         names = [d.name for d in drivers]
         for given in (inputs, speeds, accels):
@@ -1040,7 +1040,7 @@ def tables_from_diagram(diagram: Diagram,
                      f'{fmt_value(slider.velocity)} m/s',
                      f'{fmt_value(slider.acceleration)} m/s\u00b2'))
     for driver in diagram.drivers:  # an actuator: its length and extension rate
-        if driver.joint_type == 'prismatic':
+        if not driver.joint_type.angular:
             rows.append((driver.name, 'actuator', f'L = {fmt_value(driver.position)}', '-',
                          f'{fmt_value(driver.speed)} m/s', f'{fmt_value(driver.accel)} m/s\u00b2'))
     for pin in diagram.pins:  # seed 001: rubbing velocity = |omega_a - omega_b| r

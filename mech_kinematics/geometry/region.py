@@ -40,6 +40,7 @@ import numpy.typing as npt
 
 from ..errors import AssemblyError, NearSingularWarning, SceneError
 from ..solver import Scene, SceneUnits, solve
+from ..solver.graph import JointType
 
 __all__ = ['GRID', 'Region', 'SLICE_SAMPLES', 'Slice', 'assembles_at', 'domain', 'free_length',
            'region_from_scene']
@@ -62,7 +63,7 @@ class Slice:
     driver : str
         The driver that moves.
     kind : str
-        Its joint type: ``'revolute'`` (positions rad) or ``'prismatic'`` (m).
+        Its driver's joint type (a crank's positions rad, an actuator's m).
     domain : (float, float)
         What was swept: ``(0, 2 pi)`` for a crank; an actuator's stroke, or
         ``(0, free_length)`` for one without.
@@ -81,7 +82,7 @@ class Slice:
     """
 
     driver: str
-    kind: str
+    kind: JointType
     domain: tuple[float, float]
     at: dict[str, float]
     ranges: tuple[tuple[float, float], ...]
@@ -94,7 +95,7 @@ class Slice:
         if not self.ranges:
             return False
         low, high = self.domain
-        if self.kind == 'revolute':
+        if self.kind.angular:
             return self.ranges[0][1] - self.ranges[0][0] >= _TURN
         return self.ranges == ((low, high),)
 
@@ -158,7 +159,7 @@ def free_length(scene: Scene) -> float:
 
 def domain(scene: Scene, driver: Any) -> tuple[float, float]:
     """Return what a driver is swept over: a turn, its stroke or ``(0, free_length)``."""
-    if driver.joint_type == 'revolute':
+    if driver.joint_type.angular:
         return (0.0, _TURN)
     if driver.stroke is not None:
         return (float(driver.stroke[0]), float(driver.stroke[1]))
@@ -166,7 +167,7 @@ def domain(scene: Scene, driver: Any) -> tuple[float, float]:
 
 
 def _samples(kind: str, low: float, high: float, count: int) -> Array:
-    if kind == 'revolute':
+    if kind.angular:
         return np.linspace(low, high, count, endpoint=False)
     values = np.linspace(low, high, count)
     if low == 0.0:  # a length must be positive: start one step in
@@ -234,7 +235,7 @@ def _slice(scene: Scene, driver: Any, samples: int) -> Slice:
     at = {d.name: float(d.start) for d in scene.drivers if d.name != name}
     ok = _grid_valid(scene, {name: x})
     step = float(x[1] - x[0])
-    if kind == 'revolute':
+    if kind.angular:
         return _crank_slice(scene, driver, x, ok, at, step)
     ranges: list[tuple[float, float]] = []
     ends: list[tuple[str, str]] = []
@@ -262,11 +263,11 @@ def _crank_slice(scene: Scene, driver: Any, x: Array, ok: npt.NDArray[np.bool_],
                  at: dict[str, float], step: float) -> Slice:
     name = driver.name
     if ok.all():
-        return Slice(name, 'revolute', (0.0, _TURN), at, ((0.0, _TURN),), (('turn', 'turn'),),
-                     step)
+        return Slice(name, driver.joint_type, (0.0, _TURN), at, ((0.0, _TURN),),
+                     (('turn', 'turn'),), step)
     n = len(x)
     if not ok.any():
-        return Slice(name, 'revolute', (0.0, _TURN), at, (), (), step)
+        return Slice(name, driver.joint_type, (0.0, _TURN), at, (), (), step)
     # Start at a refused sample so that every range has both ends in the loop; the ends
     # are bisected where they are reported (a range through 0 starting below 0), so that
     # each is the last double at which solve answers.
@@ -291,7 +292,7 @@ def _crank_slice(scene: Scene, driver: Any, x: Array, ok: npt.NDArray[np.bool_],
         high, why_high = _end(scene, name, last + offset, after + offset)
         pieces.append(((low, high), (why_low, why_high)))
     pieces.sort()
-    return Slice(name, 'revolute', (0.0, _TURN), at, tuple(r for r, _ in pieces),
+    return Slice(name, driver.joint_type, (0.0, _TURN), at, tuple(r for r, _ in pieces),
                  tuple(w for _, w in pieces), step)
 
 

@@ -18,10 +18,10 @@ it adds to the scales of a state, and the text of its refusal.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Collection
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 import math
-from typing import Any
+from typing import Any, TYPE_CHECKING
 
 from .base import Driver
 from .context import _Context
@@ -29,6 +29,9 @@ from .graph import Fragment, JointType, PRISMATIC
 from .model import _check_finite, _check_length, _check_name, _g, SceneUnits
 from ..bounds import U
 from ..errors import SceneError
+
+if TYPE_CHECKING:
+    from .base import Item
 
 #: The scene keys of an actuator in ``inputs:``.
 KEYS = {'actuator', 'length', 'speed', 'accel', 'stroke'}
@@ -55,6 +58,7 @@ class Actuator(Driver):
     """
 
     position_key = 'length'
+    scene_key = 'actuator'
 
     actuator: str
     length: float
@@ -109,6 +113,11 @@ class Actuator(Driver):
         return built
 
     @property
+    def link_length(self) -> float:
+        """Its length at time zero, m: the nominal length of the RRR link it sets."""
+        return self.length
+
+    @property
     def name(self) -> str:
         """The driver's name: the actuator (its prismatic joint)."""
         return self.actuator
@@ -141,12 +150,18 @@ class Actuator(Driver):
         """Return its part of the graph: its coordinate (its barrel and rod are an RRR's)."""
         return Fragment(self.actuator, coordinates={self.actuator: PRISMATIC})
 
-    def check_used(self, used: Collection[str]) -> None:
-        """Refuse it unless an RRR link's length is this actuator's."""
-        if self.actuator not in used:
-            msg = (f'Expected actuator "{self.actuator}" to be the length of an RRR link '
-                   f'(actuator: {self.actuator} in place of length:), got no link using it')
+    def check_used(self, users: Sequence[Item]) -> None:
+        """Refuse it unless the length of exactly one RRR link is this actuator's."""
+        name = self.actuator
+        if not users:
+            msg = (f'Expected actuator "{name}" to be the length of an RRR link '
+                   f'(actuator: {name} in place of length:), got no link using it')
             raise SceneError(msg, (self, 'actuator'))
+        if len(users) > 1:
+            first, again = users[:2]
+            msg = (f'Expected each actuator to be the length of one link, got "{name}" in '
+                   f'{first.kind} {first.key} and again in {again.kind} {again.key}')
+            raise SceneError(msg, (again, ''))
 
     def defined(self) -> tuple[tuple[str, str], ...]:
         """Return (name, kind) of the names it defines: its prismatic joint."""

@@ -50,7 +50,7 @@ needs are the public hooks of :mod:`.tick`.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from collections.abc import Callable, Collection, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from typing import Any, ClassVar, Protocol, TYPE_CHECKING
 
 from ..errors import SceneError
@@ -210,7 +210,10 @@ class Reading(Protocol):
         """Return the finite number at ``key``, as written (no unit applied)."""
 
     def angle(self, mapping: Any, key: str, where: str, default: Any = ...) -> float:
-        """Return the angle at ``key``, rad."""
+        """Return the direction at ``key``, rad (whole turns reduced exactly)."""
+
+    def start_angle(self, mapping: Any, key: str, where: str) -> tuple[float, int]:
+        """Return a crank's angle at ``key`` as (rad within a turn, whole turns)."""
 
     def branch(self, mapping: Any, where: str) -> Branch:
         """Return the ``branch`` key (default +1)."""
@@ -324,6 +327,18 @@ class Driver(ABC):
     accel: float
     #: The scene key of its position at time zero (``'angle'``, ``'length'``), for messages.
     position_key: ClassVar[str]
+    #: The key that names it in an entry of the scene's ``inputs:`` (``'link'``, ...).
+    scene_key: ClassVar[str]
+
+    @classmethod
+    @abstractmethod
+    def from_scene(cls, read: Reading, raw: Any, where: str) -> Driver:
+        """Return the driver written at ``where`` in a scene file (its keys, checked)."""
+
+    @property
+    @abstractmethod
+    def link_length(self) -> float | None:
+        """The length, m, it gives a dyad link at time zero (an actuator's); else ``None``."""
 
     @property
     @abstractmethod
@@ -375,8 +390,8 @@ class Driver(ABC):
         """Return its step: ``run(ctx, position, speed, accel)`` at the head of every solve."""
 
     @abstractmethod
-    def check_used(self, used: Collection[str]) -> None:
-        """Refuse it where it moves nothing: ``used`` are the names the scene's steps read."""
+    def check_used(self, users: Sequence[Item]) -> None:
+        """Refuse it where the items that read it (``users``, in plan order) cannot be driven."""
 
     @staticmethod
     @abstractmethod

@@ -4,10 +4,10 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Collection, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 import math
-from typing import Any
+from typing import Any, TYPE_CHECKING, TypedDict
 
 import numpy as np
 
@@ -17,6 +17,27 @@ from .graph import Body, Fragment, Frame, JointType, Motion, pin, REVOLUTE, Role
 from .model import _check_finite, _check_length, _check_name, SceneUnits
 from ..bounds import U
 from ..errors import SceneError
+from ..units import rad_per_s_from_rpm
+
+if TYPE_CHECKING:
+    from .base import Item, Reading
+
+
+class CrankDict(TypedDict, total=False):
+    """A crank's scene keys (``input:``, or an entry of ``inputs:`` with ``link:``).
+
+    Its speed is ``speed_rpm`` (rpm) or ``speed`` (rad/s), at most one; its
+    ``accel`` is in rad/s^2; ``length`` and ``angle`` in the scene's units.
+    """
+
+    link: str
+    center: str
+    point: str
+    length: float
+    angle: float
+    speed_rpm: float
+    speed: float
+    accel: float
 
 
 @dataclass(frozen=True)
@@ -47,6 +68,7 @@ class Crank(Driver):
     """
 
     position_key = 'angle'
+    scene_key = 'link'
 
     link: str
     center: str
@@ -69,6 +91,39 @@ class Crank(Driver):
         if not isinstance(self.turns, int) or isinstance(self.turns, bool):
             msg = f'Expected the crank whole turns to be an int, got {self.turns!r}'
             raise SceneError(msg, (self, 'turns'))
+
+    @classmethod
+    def from_scene(cls, read: Reading, raw: Any, where: str) -> Crank:
+        """Return the crank written at ``where`` (``input``, or an entry of ``inputs``).
+
+        Its speed is read as written: ``speed`` (rad/s) to the bit, ``speed_rpm``
+        converted (``rpm * pi / 30``); at most one of the two, neither is 0.
+        """
+        read.check_keys(raw if isinstance(raw, dict) else {}, set(CrankDict.__annotations__),
+                        where)
+        given = [key for key in ('speed', 'speed_rpm') if isinstance(raw, dict) and key in raw]
+        if len(given) == 2:
+            msg = (f'{where}.speed: expected the crank speed once, as speed (rad/s) or '
+                   f'speed_rpm (rpm), got both (speed: {read.brief(raw["speed"])}, speed_rpm: '
+                   f'{read.brief(raw["speed_rpm"])})')
+            raise SceneError(msg)
+        if given == ['speed']:
+            speed, key = read.number(raw, 'speed', where), 'speed'
+        else:
+            speed = rad_per_s_from_rpm(read.number(raw, 'speed_rpm', where, 0.0))
+            key = 'speed_rpm'
+        angle, turns = read.start_angle(raw, 'angle', where)
+        built: Crank = read.build(
+            where, {'speed': key}, cls,
+            link=read.name(raw, 'link', where), center=read.name(raw, 'center', where),
+            point=read.name(raw, 'point', where), length=read.length(raw, 'length', where),
+            angle=angle, turns=turns, speed=speed, accel=read.number(raw, 'accel', where, 0.0))
+        return built
+
+    @property
+    def link_length(self) -> None:
+        """None: a crank sets no dyad link's length."""
+        return None
 
     @property
     def name(self) -> str:
@@ -122,8 +177,8 @@ class Crank(Driver):
         """Return none: a crank's step cannot fail (every angle places its tip)."""
         return {}
 
-    def check_used(self, used: Collection[str]) -> None:
-        """Accept it: a crank moves its own link whatever the steps read."""
+    def check_used(self, users: Sequence[Item]) -> None:
+        """Accept it: a crank moves its own link, whatever reads it."""
 
     def defined(self) -> tuple[tuple[str, str], ...]:
         """Return (name, kind) of the names it defines: its link and its tip."""

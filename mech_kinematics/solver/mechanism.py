@@ -304,6 +304,11 @@ class Scene:
         return self._plan.graph
 
     @property
+    def single_crank(self) -> bool:
+        """Whether one crank drives it (``input:``, or ``inputs:`` of one crank)."""
+        return self._solver.single
+
+    @property
     def output_joints(self) -> tuple[str, ...]:
         """Names of the joints reported, in order."""
         return self._plan.output_joints

@@ -218,19 +218,12 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
         msg = f'Expected dyads and points solvable in order, got a cycle among [{_names(keys)}]'
         raise SceneError(msg, (left[0], ''))
 
-    used = {name for step in steps for name in step.uses}
-    actuated = {d.name for d in drivers if d.joint_type == 'prismatic'}
-    driving: dict[str, Item] = {}
+    users: dict[str, list[Item]] = {driver.name: [] for driver in drivers}
     for item, step in zip(owners, steps, strict=True):
-        for name in actuated.intersection(step.uses):
-            if name in driving:
-                msg = (f'Expected each actuator to be the length of one link, got "{name}" in '
-                       f'{driving[name].kind} {driving[name].key} and again in {item.kind} '
-                       f'{item.key}')
-                raise SceneError(msg, (item, ''))
-            driving[name] = item
+        for name in users.keys() & set(step.uses):
+            users[name].append(item)
     for driver in drivers:
-        driver.check_used(used)
+        driver.check_used(users[driver.name])
     order = [*ground, *(name for driver in drivers for name, kind in driver.defined()
                         if kind == 'point'),
              *(name for step in steps for name in step.new_points)]

@@ -23,7 +23,7 @@ from .rrr import RRR
 KINDS: dict[str, type[Item]] = {kind.kind: kind for kind in (RRR, RRP, RPR, RPP)}
 
 #: The key that names a driver in the scene's ``inputs:`` -> its kind.
-DRIVERS: dict[str, type[Driver]] = {'link': Crank, 'actuator': Actuator}
+DRIVERS: dict[str, type[Driver]] = {kind.scene_key: kind for kind in (Crank, Actuator)}
 
 #: The ``kind`` of an :class:`~mech_kinematics.errors.AssemblyError`'s facts -> their text.
 FACT_TEXTS: dict[str, Callable[[dict[str, Any], SceneUnits], str]] = {

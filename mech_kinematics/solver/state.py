@@ -253,7 +253,7 @@ class State:
         turns = self.turns
         angle = self.angle if not np.any(turns) else self.angle + math.tau * turns
         # Several drivers, or an actuator (a length, not a crank's "angle"): by name.
-        if len(self.drivers) > 1 or any(j.type != 'revolute' for j in self.drivers.values()):
+        if len(self.drivers) > 1 or any(not j.type.angular for j in self.drivers.values()):
             driven: dict[str, Any] = {'inputs': {
                 name: {'position': value(j.position), 'speed': value(j.velocity),
                        'accel': value(j.acceleration)} for name, j in self.drivers.items()}}
@@ -263,7 +263,7 @@ class State:
         return {
             'scene': self.scene,
             **driven,
-            'joints': {name: {'type': j.type, 'position': value(j.position),
+            'joints': {name: {'type': str(j.type), 'position': value(j.position),
                               'velocity': value(j.velocity),
                               'acceleration': value(j.acceleration)}
                        for name, j in self.joints.items()},

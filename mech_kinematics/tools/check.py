@@ -26,6 +26,7 @@ import numpy as np
 from .cli import add_scene_argument, run_tool
 from ..errors import SceneError
 from ..geometry.region import GRID
+from ..solver.graph import JointType
 
 __all__ = ['add_parser', 'grid_size', 'main', 'map_text', 'region_json', 'region_text',
            'report_json', 'report_text', 'write_region_png']
@@ -128,7 +129,7 @@ def report_text(assembly: Any, scene: Any) -> str:
     lines.append(f'toggle positions: {", ".join(toggles) if toggles else "none"}')
     centres = []
     for centre in assembly.dead_centres:
-        where = (f'{angle_text(units, centre.position)} {unit}' if centre.kind == 'revolute'
+        where = (f'{angle_text(units, centre.position)} {unit}' if centre.kind.angular
                  else f's = {units.length_text(centre.position)}')
         text = f'{angle(centre.angle)} ({centre.joint} reverses at {where}'
         if centre.in_line is not None:
@@ -165,7 +166,7 @@ def _strokes_text(scene: Any, assembly: Any, angle: Any) -> list[str]:
         lines.append(f'strokes (the crank turning {way}; time ratio = slower stroke / quicker):')
     for output in outputs:
         def where(x: float) -> str:
-            return (f'{angle_text(units, x)} {unit}' if output.kind == 'revolute'  # noqa: B023
+            return (f'{angle_text(units, x)} {unit}' if output.kind.angular  # noqa: B023
                     else units.length_text(x))
         parts = [f'{where(s.start_position)} -> {where(s.end_position)} over crank '
                  f'{angle_text(units, s.start)}..{angle_text(units, s.end)} {unit} '
@@ -192,7 +193,7 @@ def report_json(assembly: Any, scene: Any) -> dict[str, Any]:
         'summary': assembly.summary(),
         'toggles': [{'angle': t.angle, 'dyad': t.dyad, 'links': list(t.links)}
                     for t in assembly.toggles],
-        'dead_centres': [{'angle': c.angle, 'joint': c.joint, 'type': c.kind,
+        'dead_centres': [{'angle': c.angle, 'joint': c.joint, 'type': str(c.kind),
                           'position': c.position,
                           'in_line': None if c.in_line is None else list(c.in_line)}
                          for c in assembly.dead_centres],
@@ -205,7 +206,7 @@ def report_json(assembly: Any, scene: Any) -> dict[str, Any]:
                    'lengths': dict(zip(('ground', 'input', 'coupler', 'output'), loop.lengths,
                                        strict=True)),
                    'class': loop.grashof} for loop in assembly.loops],
-        'strokes': [{'joint': s.joint, 'type': s.kind, 'time_ratio': s.time_ratio,
+        'strokes': [{'joint': s.joint, 'type': str(s.kind), 'time_ratio': s.time_ratio,
                      'strokes': [{'from_angle': x.start, 'to_angle': x.end,
                                   'crank_travel': x.crank_travel,
                                   'from_position': x.start_position,
@@ -217,32 +218,32 @@ def report_json(assembly: Any, scene: Any) -> dict[str, Any]:
     }
 
 
-def _position_text(units: Any, kind: str, value: float) -> str:
+def _position_text(units: Any, kind: JointType, value: float) -> str:
     """Return a driver's position (rad or m) in the scene's units, with the unit."""
     return f'{_number_text(units, kind, value)} {_unit(units, kind)}'
 
 
-def _number_text(units: Any, kind: str, value: float) -> str:
+def _number_text(units: Any, kind: JointType, value: float) -> str:
     """Return a driver's position (rad or m) in the scene's units, 6 digits, no unit."""
     from ..geometry.assembly import angle_text
-    if kind == 'revolute':
+    if kind.angular:
         return angle_text(units, value)
     return units.length_text(value).split()[0]
 
 
-def _unit(units: Any, kind: str) -> str:
-    return units.angle if kind == 'revolute' else units.length
+def _unit(units: Any, kind: JointType) -> str:
+    return units.angle if kind.angular else units.length
 
 
-def _span_text(units: Any, kind: str, low: float, high: float) -> str:
+def _span_text(units: Any, kind: JointType, low: float, high: float) -> str:
     """Return ``low..high unit``."""
     return (f'{_number_text(units, kind, low)}..{_number_text(units, kind, high)} '
             f'{_unit(units, kind)}')
 
 
-def _domain_text(units: Any, scene: Any, name: str, kind: str,
+def _domain_text(units: Any, scene: Any, name: str, kind: JointType,
                  domain: tuple[float, float]) -> str:
-    if kind == 'revolute':
+    if kind.angular:
         return 'over a turn'
     driver = next(d for d in scene.drivers if d.name == name)
     if driver.stroke is None:
@@ -283,7 +284,7 @@ def region_text(region: Any, scene: Any, show_map: bool = False) -> str:
     kinds = {d.name: d.joint_type for d in scene.drivers}
     described = []
     for driver in scene.drivers:
-        if driver.joint_type == 'revolute':
+        if driver.joint_type.angular:
             described.append(f'{driver.name} (crank about {driver.center})')
         else:
             described.append(f'{driver.name} (actuator)')
@@ -307,7 +308,7 @@ def region_text(region: Any, scene: Any, show_map: bool = False) -> str:
         head = f'{piece.driver}' + (f' (with {others})' if others else '')
         step = _position_text(units, piece.kind, piece.step)
         if piece.everywhere:
-            where = ('at every angle' if piece.kind == 'revolute' else
+            where = ('at every angle' if piece.kind.angular else
                      f'over its whole stroke {_span_text(units, piece.kind, *piece.domain)}')
             lines.append(f'{head}: assembles {where}')
             continue
@@ -322,12 +323,12 @@ def region_text(region: Any, scene: Any, show_map: bool = False) -> str:
                      f'exact')
     strokes = []
     for driver in scene.drivers:
-        if driver.joint_type != 'prismatic':
+        if driver.joint_type.angular:
             continue
         if driver.stroke is None:
             strokes.append(f'{driver.name} none')
         else:
-            strokes.append(f'{driver.name} {_span_text(units, "prismatic", *driver.stroke)}')
+            strokes.append(f'{driver.name} {_span_text(units, driver.joint_type, *driver.stroke)}')
     lines.append(f'stroke limits: {", ".join(strokes) if strokes else "none (no actuator)"}')
     if show_map:
         across = region.grid[0]
@@ -368,12 +369,12 @@ def write_region_png(region: Any, path: str) -> None:
     kinds = {s.driver: s.kind for s in region.slices}
 
     def shown(name: str, values: Any) -> Any:
-        if kinds[name] == 'revolute':
+        if kinds[name].angular:
             return np.array([units.angle_value(float(v)) for v in values])
         return np.asarray(values) * (1000.0 if units.length == 'mm' else 1.0)
 
     def label(name: str) -> str:
-        unit = units.angle if kinds[name] == 'revolute' else units.length
+        unit = units.angle if kinds[name].angular else units.length
         return f'{name} ({unit})'
 
     figure = Figure(figsize=(6.0, 5.0))
@@ -410,7 +411,7 @@ def _handle(args: argparse.Namespace) -> int:
     from ..scene import load_scene
 
     scene = load_scene(args.scene)  # a SceneError is one line, exit 2 (cli.run_handler)
-    if len(scene.drivers) > 1 or scene.drivers[0].joint_type != 'revolute':
+    if not scene.single_crank:
         return _handle_region(args, scene)
     given = [flag for flag, value in (('--grid', args.grid != GRID), ('--pair', args.pair),
                                       ('--map', args.map), ('--png', args.png)) if value]

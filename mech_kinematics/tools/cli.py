@@ -263,7 +263,7 @@ def drive_from_args(scene: Any, args: argparse.Namespace) -> tuple[Any, Any, Any
     turns_list: list[int] = []
     words = []
     for driver in drivers:
-        revolute = driver.joint_type == 'revolute'
+        revolute = driver.joint_type.angular
         given = inputs.get(driver.name)
         whole = 0
         if given is None:

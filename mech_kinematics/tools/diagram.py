@@ -594,7 +594,7 @@ def title_from_diagram(diagram: Diagram) -> str:
     acceleration.
     """
     drivers = diagram.drivers
-    if len(drivers) <= 1 and all(d.joint_type == 'revolute' for d in drivers):
+    if len(drivers) <= 1 and all(d.joint_type.angular for d in drivers):
         rpm = rpm_from_rad_per_s(diagram.speed)
         return (f'{diagram.scene}: crank angle {fmt_value(math.degrees(diagram.angle))}\u00b0, '
                 f'\u03c9 = {fmt_value(diagram.speed)} rad/s{fmt_sense(diagram.speed)} '
@@ -602,7 +602,7 @@ def title_from_diagram(diagram: Diagram) -> str:
                 f'(SI units; angles CCW from +x)')
     parts = []
     for d in drivers:
-        if d.joint_type == 'revolute':
+        if d.joint_type.angular:
             parts.append(f'{d.name} {fmt_value(math.degrees(d.position))}\u00b0, '
                          f'{fmt_value(d.speed)} rad/s, {fmt_value(d.accel)} rad/s\u00b2')
         else:
@@ -828,7 +828,7 @@ def _handle(args: argparse.Namespace) -> int:
     try:
         scene = load_scene(args.scene)
         drivers = scene.drivers
-        if len(drivers) > 1 or drivers[0].joint_type != 'revolute' or args.input or args.speed:
+        if not scene.single_crank or args.input or args.speed:
             return _handle_drivers(args, scene, output)
         accel = values_by_driver(scene, '--accel', args.accel).get(drivers[0].name)
         if args.animate:

@@ -41,6 +41,7 @@ from .cli import named_value, values_by_driver
 from ..errors import MechKinematicsError
 from ..ros import topics
 from ..ros.cdr import stamp_from_cdr
+from ..solver.graph import REVOLUTE
 from ..units import NS_PER_S, rad_per_s_from_rpm, rpm_from_rad_per_s
 
 __all__ = [
@@ -192,7 +193,7 @@ def motion_from_scene(scene: Any, *, samples: int = DEFAULT_SAMPLES,
     if samples < 2:
         msg = f'Expected at least 2 samples, got {samples}'
         raise PlotError(msg)
-    if len(scene.drivers) > 1 or scene.drivers[0].joint_type != 'revolute':
+    if not scene.single_crank:
         return _motion_of_drivers(scene, samples, speed, accel, x, duration, speeds)
     speed = scene.input.speed if speed is None else float(speed)
     accel = scene.input.accel if accel is None else float(accel)
@@ -252,7 +253,7 @@ def drivers_period(scene: Any, speeds: Mapping[str, float] | None = None
     best, what = math.inf, ''
     for driver in scene.drivers:
         v, a = (speeds or {}).get(driver.name, driver.speed), driver.accel
-        if driver.joint_type == 'revolute':
+        if driver.joint_type.angular:
             t = min(_first_time(v, a, 2.0 * math.pi), _first_time(v, a, -2.0 * math.pi))
             doing = f'{driver.name} turning once'
         elif driver.stroke is not None:
@@ -336,7 +337,7 @@ def _motion_of_drivers(scene: Any, samples: int, speed: float | None, accel: flo
     joints = {name: (j.position, j.velocity, j.acceleration) for name, j in state.joints.items()}
     points = {name: (p.position, p.velocity, p.acceleration) for name, p in state.points.items()}
     rates = ', '.join(
-        f'{d.name} {rpm_from_rad_per_s(rate[d.name]):.6g} rpm' if d.joint_type == 'revolute'
+        f'{d.name} {rpm_from_rad_per_s(rate[d.name]):.6g} rpm' if d.joint_type.angular
         else f'{d.name} {rate[d.name]:.6g} m/s' for d in drivers)
     title = (f'{scene.name}: solver, every driver from its start at its speed ({rates}) for '
              f'{span}')
@@ -575,16 +576,16 @@ def motion_from_bag(path: str | os.PathLike[str], *, scene: Any = None,
         if candidate is not None and set(candidate.output_joints) == set(names):
             scene = candidate
     if scene is not None:
-        types = {n: scene.joint_types.get(n, 'revolute') for n in names}
+        types = {n: scene.joint_types.get(n, REVOLUTE) for n in names}
         drivers = scene.drivers
         # Several drivers (or an actuator): no one crank angle (NaN; --x angle is refused).
-        crank = drivers[0].name if len(drivers) == 1 and drivers[0].joint_type == 'revolute' \
+        crank = drivers[0].name if len(drivers) == 1 and drivers[0].joint_type.angular \
             else ''
     else:
         if any(names):
             warnings.warn(f'{path}: no scene given or named in the bag; plotting every joint '
                           f'as revolute and "{names[0]}" as the crank', stacklevel=2)
-        types = dict.fromkeys(names, 'revolute')
+        types = dict.fromkeys(names, REVOLUTE)
         crank = names[0] if names else ''
     joints = {n: joint_arrays[i] for i, n in enumerate(names)}
     points = {n: point_arrays[i] for i, n in enumerate(point_names)}
@@ -745,9 +746,9 @@ def figure_from_motion(motion: Motion, *, x: str = 'time') -> Any:
         angle = np.asarray(motion.crank_angle, dtype=np.float64)
         inside = (angle >= 0.0) & (angle <= 2.0 * math.pi)
         xs = np.where(inside, angle, np.mod(angle, 2.0 * math.pi))
-    revolute = [n for n, t in motion.joint_types.items() if t == 'revolute' and n in motion.joints]
+    revolute = [n for n, t in motion.joint_types.items() if t.angular and n in motion.joints]
     prismatic = [n for n, t in motion.joint_types.items()
-                 if t == 'prismatic' and n in motion.joints]
+                 if not t.angular and n in motion.joints]
     moving = [n for n, (p, v, a) in motion.points.items() if _moves(p, v, a)]
     columns = [('joint_position', 'joint_velocity', 'joint_acceleration'),
                ('point_path', 'point_speed', 'point_acceleration')]
@@ -890,7 +891,7 @@ def plot_scene(scene: Any, output: str | os.PathLike[str], *, x: str | None = No
     drivers' path.
     """
     if x is None:
-        several = len(scene.drivers) > 1 or scene.drivers[0].joint_type != 'revolute'
+        several = not scene.single_crank
         x = 'time' if several else 'angle'
     motion = motion_from_scene(scene, samples=samples, speed=speed, accel=accel, x=x,
                                duration=duration)
@@ -954,7 +955,7 @@ def _handle(args: argparse.Namespace) -> int:
             for warning in caught:      # one line each, not Python's warning format
                 print(f'warning: {warning.message}', file=sys.stderr)
         else:
-            several = len(scene.drivers) > 1 or scene.drivers[0].joint_type != 'revolute'
+            several = not scene.single_crank
             x = args.x or ('time' if several else 'angle')
             if (args.duration is not None or args.speed) and not several:
                 msg = (f'Expected --duration and --speed NAME=VALUE only for a scene with '
@@ -965,7 +966,7 @@ def _handle(args: argparse.Namespace) -> int:
                 rates = values_by_driver(scene, '--speed', args.speed)
             except ValueError as error:
                 raise PlotError(str(error)) from None
-            given = {d.name: rad_per_s_from_rpm(rates[d.name]) if d.joint_type == 'revolute'
+            given = {d.name: rad_per_s_from_rpm(rates[d.name]) if d.joint_type.angular
                      else rates[d.name] for d in scene.drivers if d.name in rates}
             motion = motion_from_scene(scene, samples=args.samples, speed=speed,
                                        accel=args.accel, x=x, duration=args.duration,

@@ -37,7 +37,9 @@ def _states(scene):
             positions = [d.start + spread * (0.1 if not d.joint_type.angular else 1.0)
                          * (k + 1) for k, d in enumerate(drivers)]
             speeds = [0.3 * (k + 1) for k in range(len(drivers))]
-            state = mk.solve(scene, positions, speeds, [0.2] * len(drivers))
+            accels = [0.2] * len(drivers)
+            state = (mk.solve(scene, positions[0], speeds[0], accels[0]) if len(drivers) == 1
+                     else mk.solve(scene, positions, speeds, accels))
     return state
 
 

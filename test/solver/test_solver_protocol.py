@@ -4,6 +4,7 @@
 
 from __future__ import annotations
 
+import ast
 from pathlib import Path
 import re
 
@@ -31,6 +32,51 @@ def test_no_module_tests_which_kind_a_step_is():
             if KIND_TEST.search(line):
                 found.append(f'{path.relative_to(PACKAGE)}:{number}: {line.strip()}')
     assert not found, found
+
+
+#: The joint types' names and constants (solver/graph.py): what a switch on a joint type tests.
+JOINT_TYPES = {'revolute', 'prismatic', 'lock'}
+JOINT_CONSTANTS = {'REVOLUTE', 'PRISMATIC', 'LOCK'}
+#: Where a joint type may be compared: its home and the kinds that declare joints.
+TYPE_HOMES = OWN | {'graph.py', 'actuator.py'}
+
+
+def _compares_a_joint_type(node: ast.AST) -> bool:
+    """Whether ``node`` compares something with a joint type's name or constant."""
+    if not isinstance(node, ast.Compare):
+        return False
+    for side in (node.left, *node.comparators):
+        if isinstance(side, ast.Constant) and side.value in JOINT_TYPES:
+            return True
+        if isinstance(side, (ast.Tuple, ast.List, ast.Set)) and any(
+                isinstance(e, ast.Constant) and e.value in JOINT_TYPES for e in side.elts):
+            return True
+        name = side.attr if isinstance(side, ast.Attribute) else getattr(side, 'id', None)
+        if name in JOINT_CONSTANTS:
+            return True
+    return False
+
+
+def test_no_module_switches_on_a_joint_type():
+    """Outside solver/graph.py and the kinds, nothing compares a joint type: it asks the type."""
+    found = []
+    for path in sorted(PACKAGE.rglob('*.py')):
+        if path.parent.name == 'solver' and path.name in TYPE_HOMES:
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            if _compares_a_joint_type(node):
+                found.append(f'{path.relative_to(PACKAGE)}:{node.lineno}: '
+                             f'{ast.unparse(node)}')
+    assert not found, found
+
+
+def test_the_joint_type_test_finds_a_switch():
+    """The test above sees the forms a switch takes (a check that the check can fail)."""
+    for source in ("kind == 'revolute'", "'prismatic' != j.type", "t in ('revolute', 'x')",
+                   'kind is REVOLUTE', 'kind is graph.PRISMATIC'):
+        assert _compares_a_joint_type(ast.parse(source).body[0].value), source
+    for source in ('kind.angular', "name == 'crank'", 'table == kind.table'):
+        assert not _compares_a_joint_type(ast.parse(source).body[0].value), source
 
 
 def test_the_registry_holds_every_dyad_type_of_the_scene_format():
