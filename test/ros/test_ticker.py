@@ -12,8 +12,9 @@ import pytest
 import yaml
 
 import mech_kinematics as mk
-from mech_kinematics.ros.ticker import compile_tick, tick_function, values_from_state
-from mech_kinematics.solver import tick as hooks
+from mech_kinematics.ros.ticker import (compile_tick, compiled_tick, tick_function,
+                                        values_from_state)
+from mech_kinematics.solver.compiler import NotCompiled, scene_plan
 from mech_kinematics.tools.report.common import MODES
 from mech_kinematics.tools.report.cost import chain_scene
 from mech_kinematics.tools.report.extreme import extreme_cases
@@ -126,9 +127,9 @@ def test_several_driver_scenes_compile_to_the_same_bits(name):
 
 
 def test_a_step_outside_the_kernel_subset_falls_back(monkeypatch):
-    """A kernel with a loop is not compiled: the scene falls back (what the test above catches)."""
+    """A kernel with a loop is not compiled: the scene falls back, saying why in one line."""
     scene = mk.load_scene('khurmi_four_bar_ad150')
-    step = type(hooks.tick_plan(scene).steps[0])
+    step = type(scene_plan(scene).steps[0])
 
     def looping(self, ctx):
         for _ in range(1):
@@ -137,6 +138,8 @@ def test_a_step_outside_the_kernel_subset_falls_back(monkeypatch):
     assert tick_function(scene)[1]
     monkeypatch.setattr(step, 'kernels', classmethod(lambda cls: (looping,)))
     assert not tick_function(scene)[1]
+    assert compiled_tick(scene) == NotCompiled(
+        'step RRR C: kernel uses `for` (not in the kernel subset)')
 
 
 def test_the_extreme_suite_refuses_and_answers_alike():
@@ -189,6 +192,9 @@ def test_a_scene_the_solver_rescales_is_served_by_the_general_solver(tmp_path):
     """Lengths of 1e-300 m are not compiled; tick_function falls back with the same answers."""
     scene = _tiny_four_bar(tmp_path)
     assert compile_tick(scene) is None
+    assert compiled_tick(scene).reason == (
+        'scene rescaled: its size 1.5e-298 m is beyond 2**60 of 1 m (its lengths are solved '
+        'scaled by a power of two)')
     tick, compiled = tick_function(scene)
     assert not compiled
     _assert_same(scene, tick, ANGLES[::10])

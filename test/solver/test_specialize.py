@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import mech_kinematics as mk
-from mech_kinematics.solver import tick as hooks
+from mech_kinematics.solver.compiler import scene_plan
 from mech_kinematics.solver.specialize import plan_body, propagate
 
 SETTINGS = settings(max_examples=400, deadline=None, derandomize=True)
@@ -235,7 +235,7 @@ def test_propagation_keeps_every_bit_type_and_error(vector, source):
 
 def _code(scene, vector):
     """Return the generated code of ``scene`` on one path, and its table entries' locals."""
-    plan = hooks.tick_plan(mk.load_scene(scene))
+    plan = scene_plan(mk.load_scene(scene))
     names = {}
     return ast.unparse(ast.Module(plan_body(plan, names, {}, vector=vector), [])), names
 
