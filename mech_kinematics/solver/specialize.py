@@ -272,7 +272,7 @@ class _Specializer(ast.NodeTransformer):
             return ast.Pass()       # a side fact the scalar path does not report
         helper = self.helper(value)
         if helper is not None:
-            return self.inline(*helper, None)
+            return self.inline(*helper, None, node)
         return self.generic_visit(node)
 
     def visit_Assign(self, node: ast.Assign) -> Any:
@@ -283,7 +283,7 @@ class _Specializer(ast.NodeTransformer):
             raise Unsupported(f'the result of helper {helper[0].__name__} assigned to '
                               f'{len(node.targets)} targets at once')
         target = cast(ast.expr, self.visit(node.targets[0]))
-        return self.inline(*helper, target)
+        return self.inline(*helper, target, node)
 
     def helper(self, value: ast.expr) -> tuple[Callable[..., Any], list[ast.expr]] | None:
         """Return (the method, its arguments after ``ctx``) of ``self.<method>(ctx, ...)``.
@@ -305,7 +305,7 @@ class _Specializer(ast.NodeTransformer):
         return method, value.args[1:]
 
     def inline(self, method: Callable[..., Any], args: list[ast.expr],
-               target: ast.expr | None) -> list[ast.stmt]:
+               target: ast.expr | None, call: ast.stmt) -> list[ast.stmt]:
         """Return the statements of the helper ``method`` called on ``args``, written out.
 
         A helper is a method of the step taking ``(self, ctx, ...)``, in the
@@ -313,8 +313,9 @@ class _Specializer(ast.NodeTransformer):
         suffix of their own (a caller's names are never touched); an argument
         that is a name is read for its parameter where the helper never binds
         it, any other is bound to the parameter first, in order; the final
-        ``return`` value is assigned to ``target`` (the calling statement's).
-        The same operations in the same order as the call: the same bits.
+        ``return`` value is assigned to ``target`` (the calling statement's,
+        ``call``). The same operations in the same order as the call: the
+        same bits.
         """
         name = method.__name__
         if self.depth >= _HELPER_DEPTH:
@@ -347,8 +348,8 @@ class _Specializer(ast.NodeTransformer):
                 arguments[parameter] = value.id
             else:
                 stored.add(parameter)
-                bindings.append(ast.Assign([ast.Name(f'{parameter}{suffix}', ast.Store())],
-                                           value))
+                bindings.append(ast.copy_location(ast.Assign(
+                    [ast.Name(f'{parameter}{suffix}', ast.Store())], value), call))
         inner = _Specializer(self.step, suffix, self.names, self.namespace, arguments,
                              self.vector)
         inner.depth = self.depth + 1
@@ -357,11 +358,11 @@ class _Specializer(ast.NodeTransformer):
         if final is not None and final.value is not None:
             value = cast(ast.expr, inner.visit(final.value))
             if target is not None:
-                out.append(ast.Assign([target], value))
+                out.append(ast.copy_location(ast.Assign([target], value), call))
             elif not _inert(value):
-                out.append(ast.Expr(value))
+                out.append(ast.copy_location(ast.Expr(value), call))
         elif target is not None:
-            out.append(ast.Assign([target], ast.Constant(None)))
+            out.append(ast.copy_location(ast.Assign([target], ast.Constant(None)), call))
         return out
 
     def visit_Call(self, node: ast.Call) -> ast.AST:
