@@ -196,7 +196,10 @@ class Placing(Protocol):
     start, x along it; an item adds its own links); ``carriers[point]`` the
     links a point is fixed on, in the order they were added to ``local``;
     ``slot[lever]`` a slotted lever's (pivot, pin); ``size`` the mechanism's
-    size, m; ``scene`` the scene.
+    size, m; ``scene`` the scene; ``intermittent(placing, item)`` the step of
+    an RPR whose lever has slots (a Geneva wheel's, :mod:`.geneva`, which
+    builds on :mod:`.rpr`: lent here so that the base kind imports none of its
+    variants).
     """
 
     ground: Mapping[str, complex]
@@ -205,6 +208,10 @@ class Placing(Protocol):
     size: float
     scene: Any
     carriers: Mapping[str, list[str]]
+
+    @property
+    def intermittent(self) -> Callable[[Placing, Any], Step]:
+        """Return the function building an RPR's step whose lever has slots."""
 
 
 class Reading(Protocol):
