@@ -19,7 +19,7 @@ import pytest
 from mech_kinematics.memory import KEEP_FREED
 
 #: Run first in each subprocess: ``CALLS`` holds the (param, value) of every mallopt call.
-RECORDER = '''
+RECORDER = """
 import ctypes, json
 CALLS = []
 _real = ctypes.CDLL
@@ -34,7 +34,7 @@ class _Recording(_real):
         setattr(self, name, mallopt)    # (CDLL keeps the function it found as an attribute)
         return mallopt
 ctypes.CDLL = _Recording
-'''
+"""
 
 GLIBC = platform.libc_ver()[0] == 'glibc'
 
@@ -49,7 +49,7 @@ def _calls(code: str, **env: str) -> list:
 
 def test_solving_large_arrays_leaves_the_allocator_alone():
     """mk.solve of 100,000 angles (one crank, and a five-bar's two drivers) calls no mallopt."""
-    code = '''
+    code = """
 import numpy as np
 import mech_kinematics as mk
 scene = mk.load_scene('khurmi_four_bar_ad150')
@@ -59,7 +59,7 @@ five_bar = mk.load_scene('five_bar')
 mk.solve(five_bar, [np.full(100_000, d.start) for d in five_bar.drivers])
 import mech_kinematics.memory as memory
 assert memory._kept == [], memory._kept
-'''
+"""
     assert _calls(code) == []
 
 

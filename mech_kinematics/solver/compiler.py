@@ -315,8 +315,11 @@ def _refusal(scene: Scene, target: Single | Array | Tick) -> str | None:
         return (f"an intermittent lever's engagement is reported "
                 f'({", ".join(solver.levers)}): the general path\'s')
     if not solver.single:
-        return (f'{len(solver.drivers)} drivers ({", ".join(solver.driver_names)}): '
-                "mk.solve compiles one crank (the node's tick compiles several)")
+        names = solver.driver_names
+        drivers = (f'its driver {names[0]} is not a crank' if len(names) == 1
+                   else f'{len(names)} drivers ({", ".join(names)})')
+        return (f"{drivers}: mk.solve compiles one crank's paths alone (the node's tick "
+                'compiles any drivers)')
     steps = len(solver.run_plan.steps)
     if target.max_steps is not None and steps > target.max_steps:
         return (f'more than {target.max_steps} steps ({steps}): compiling would cost more '
@@ -569,13 +572,16 @@ def _tick_drivers(scene: Scene, plan: ScenePlan, target: Tick) -> TickFunction:
 
     The same specialized kernels as :func:`_tick`'s, each driver's on its own
     value: ``tick(positions, speeds, accels, max_error, turns=0)`` takes one
-    value per driver (sequences, as :func:`mech_kinematics.solve`). An
+    value per driver (sequences, as :func:`mech_kinematics.solve`), and a
+    scene of one driver (an actuator) its bare values, as ``mk.solve`` and
+    the node give them (a sequence there is handed to the fallback). An
     instant the general solver would rescale in time, refuse (a failed check
     raises inside, and the fallback is asked for its reason, so the message
     names every driver's position) or judge beyond the quick trust test is
     handed to the fallback.
     """
     count = len(plan.drivers)
+    one = count == 1
     namespace: dict[str, Any] = {
         '_ctx_check': _refuse, '_ctx_check_margin': _refuse, '_Refused': _Refused,
         '_shown': shown, '_slow': target.fallback,
@@ -583,7 +589,8 @@ def _tick_drivers(scene: Scene, plan: ScenePlan, target: Tick) -> TickFunction:
         'inf': math.inf, '_float': float, '_SEQUENCE': (list, tuple),
     }
     names: dict[str, str] = {}
-    lines = [f'{", ".join(f"{x}_{k}" for k in range(count))}, = '
+    lines = [f'{x}_0 = _float({arg})' if one else
+             f'{", ".join(f"{x}_{k}" for k in range(count))}, = '
              f'({", ".join(f"_float({arg}[{k}])" for k in range(count))},)'
              for x, arg in (('x', 'theta'), ('v', 'omega'), ('a', 'alpha'))]
     body: list[ast.stmt] = ast.parse('\n'.join(lines)).body
@@ -598,12 +605,16 @@ def _tick_drivers(scene: Scene, plan: ScenePlan, target: Tick) -> TickFunction:
     parameters = ('theta', 'omega', 'alpha', 'tol', 'turns')
     inner = _function('_tick', parameters, propagate(
         body + ast.parse('\n'.join(tail)).body, namespace, set(), vector=False), (0,))
-    outer = ast.parse(
-        'def tick(theta, omega, alpha, tol, turns=0):\n'
-        '    if not (isinstance(theta, _SEQUENCE) and isinstance(omega, _SEQUENCE) '
+    served = (  # the instants the fallback serves
+        'isinstance(theta, _SEQUENCE) or isinstance(omega, _SEQUENCE) or '
+        'isinstance(alpha, _SEQUENCE) or _rates_shift((omega,), (alpha,))' if one else
+        'not (isinstance(theta, _SEQUENCE) and isinstance(omega, _SEQUENCE) '
         'and isinstance(alpha, _SEQUENCE)) or '
         f'len(theta) != {count} or len(omega) != {count} or len(alpha) != {count} or '
-        '_rates_shift(omega, alpha):\n'
+        '_rates_shift(omega, alpha)')
+    outer = ast.parse(
+        'def tick(theta, omega, alpha, tol, turns=0):\n'
+        f'    if {served}:\n'
         '        return _slow(theta, omega, alpha, tol, turns)\n'
         '    try:\n'
         '        return _tick(theta, omega, alpha, tol, turns)\n'

@@ -6,7 +6,8 @@ import math
 from pathlib import Path
 import warnings
 
-from helpers import crank_scene_names, driver_scene_names, general_only, strip_scene
+from helpers import (crank_scene_names, driver_scene_names, general_tick_outcome, strip_scene,
+                     tick_outcome)
 import numpy as np
 import pytest
 import yaml
@@ -24,35 +25,6 @@ ANGLES = np.linspace(-7.0, 7.0, 351)
 TOLERANCES = (1e-6, 1e-12, math.inf)
 
 
-def _general(scene, theta, omega, alpha, tol, turns=0, joints=None, points=None, frames=()):
-    """Return what the general solver answers, in a tick function's terms, or its error.
-
-    The solver's own compiled path is turned off (``general_only``): the tick is
-    held to the general solve, not to code compiled the same way.
-    """
-    general_only(scene)
-    with warnings.catch_warnings():
-        warnings.simplefilter('ignore', mk.NearSingularWarning)
-        try:
-            state = mk.solve(scene, theta, omega, alpha, turns=turns, max_error=tol)
-        except mk.AssemblyError as error:
-            return type(error), str(error)
-    measures = state.singularity.values()
-    joints = scene.output_joints if joints is None else joints
-    points = scene.output_points if points is None else points
-    return (values_from_state(state, joints, points, frames),
-            min(measures) if measures else math.inf)
-
-
-def _compiled(tick, theta, omega, alpha, tol, turns=0):
-    with warnings.catch_warnings():
-        warnings.simplefilter('ignore', mk.NearSingularWarning)
-        try:
-            return tick(theta, omega, alpha, tol, turns)
-        except mk.AssemblyError as error:
-            return type(error), str(error)
-
-
 def _assert_same(scene, tick, angles, speeds=(None,), turns=(0,), **kwargs):
     """Every instant: identical values (bit for bit), measure, or error and message."""
     refused = 0
@@ -61,9 +33,9 @@ def _assert_same(scene, tick, angles, speeds=(None,), turns=(0,), **kwargs):
             omega = scene.input.speed if speed is None else speed
             for tol in TOLERANCES:
                 for k in turns:
-                    expected = _general(scene, float(theta), omega, scene.input.accel, tol, k,
-                                        **kwargs)
-                    got = _compiled(tick, float(theta), omega, scene.input.accel, tol, k)
+                    expected = general_tick_outcome(scene, float(theta), omega,
+                                                    scene.input.accel, tol, k, **kwargs)
+                    got = tick_outcome(tick, float(theta), omega, scene.input.accel, tol, k)
                     assert repr(got) == repr(expected), (scene.name, theta, tol, k)
                     refused += isinstance(expected[0], type)
     return refused

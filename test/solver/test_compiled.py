@@ -11,10 +11,9 @@ why (issue 30).
 
 import importlib
 import math
-import warnings
 
-from helpers import (crank_scene_names, driver_scene_names, general_only, state_facts,
-                     strip_scene)
+from helpers import (array_outcome, crank_scene_names, driver_scene_names, general_only,
+                     solve_outcome, state_facts, strip_scene)
 import numpy as np
 import pytest
 
@@ -42,18 +41,6 @@ def _pair(scene_of):
     return fast, slow
 
 
-def _outcome(scene, *args, **kwargs):
-    """Return the state's facts and the warnings raised, or the error's type, text and facts."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter('always')
-        try:
-            state = mk.solve(scene, *args, **kwargs)
-        except mk.AssemblyError as error:
-            return (type(error), str(error), error.dyad, repr(error.angle),
-                    getattr(error, 'facts', None), getattr(error, 'quantity', None))
-    return state_facts(state), [(w.category, str(w.message), w.filename) for w in caught]
-
-
 def _assert_same(fast, slow, angles, speeds=(None,), turns=(0,)):
     refused = 0
     for theta in angles:
@@ -61,8 +48,8 @@ def _assert_same(fast, slow, angles, speeds=(None,), turns=(0,)):
             for tol in TOLERANCES:
                 for k in turns:
                     args = (float(theta), speed)
-                    expected = _outcome(slow, *args, turns=k, max_error=tol)
-                    assert _outcome(fast, *args, turns=k, max_error=tol) == expected, (
+                    expected = solve_outcome(slow, *args, turns=k, max_error=tol)
+                    assert solve_outcome(fast, *args, turns=k, max_error=tol) == expected, (
                         fast.name, theta, speed, tol, k)
                     refused += isinstance(expected[0], type)
     return refused
@@ -93,14 +80,6 @@ def test_the_extreme_suite_refuses_and_answers_alike():
     assert compiled > 0
 
 
-def _array_outcome(scene, *args, **kwargs):
-    """Return the array solve's facts and warnings."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter('always')
-        state = mk.solve(scene, *args, **kwargs)
-    return state_facts(state), [(w.category, str(w.message), w.filename) for w in caught]
-
-
 @pytest.mark.parametrize('name', crank_scene_names())
 def test_every_packaged_scene_solves_arrays_alike_compiled(name):
     """Arrays of angles, speeds and turns, three tolerances: identical states, masks, bounds."""
@@ -118,7 +97,7 @@ def test_every_packaged_scene_solves_arrays_alike_compiled(name):
                    for key, value in kwargs.items()}
             if 'speed' in cut and np.ndim(cut['speed']):
                 cut['speed'] = speeds[:angles.size]
-            assert _array_outcome(fast, angles, **cut) == _array_outcome(slow, angles, **cut), (
+            assert array_outcome(fast, angles, **cut) == array_outcome(slow, angles, **cut), (
                 name, angles.size, kwargs)
 
 
@@ -129,7 +108,7 @@ def test_rigid_triangles_compile_and_solve_alike():
     assert fast._solver.compiled_usual
     _assert_same(fast, slow, ANGLES, speeds=(None, -3.5), turns=(0, 3))
     for kwargs in ({}, {'speed': np.linspace(-20.0, 30.0, ANGLES.size)}, {'max_error': 1e-12}):
-        assert _array_outcome(fast, ANGLES, **kwargs) == _array_outcome(slow, ANGLES, **kwargs)
+        assert array_outcome(fast, ANGLES, **kwargs) == array_outcome(slow, ANGLES, **kwargs)
 
 
 def test_the_extreme_suite_solves_arrays_alike():
@@ -138,9 +117,9 @@ def test_the_extreme_suite_solves_arrays_alike():
         fast, slow = _pair(lambda case=case: case.scene)
         speed = case.speed if case.speed is not None else case.scene.input.speed
         angles = np.asarray(case.angles, dtype=float)
-        assert _array_outcome(fast, angles, speed) == _array_outcome(slow, angles, speed)
+        assert array_outcome(fast, angles, speed) == array_outcome(slow, angles, speed)
         if case.speed is None:      # at the scene's own rates: the usual call's compiled path
-            assert _array_outcome(fast, angles) == _array_outcome(slow, angles), case.name
+            assert array_outcome(fast, angles) == array_outcome(slow, angles), case.name
 
 
 @pytest.mark.parametrize('angle', [np.float64(1.25), np.float32(1.25), 1, np.int64(-2)])
@@ -244,8 +223,8 @@ def test_a_scene_of_several_drivers_keeps_the_general_path(name):
     """Several drivers or an actuator: neither path compiles, and solving often changes nothing."""
     scene = mk.load_scene(name)
     names = ', '.join(driver.name for driver in scene.drivers)
-    why = NotCompiled(f'{len(scene.drivers)} drivers ({names}): mk.solve compiles one crank '
-                      "(the node's tick compiles several)")
+    why = NotCompiled(f"{len(scene.drivers)} drivers ({names}): mk.solve compiles one crank's "
+                      "paths alone (the node's tick compiles any drivers)")
     assert compile_scene(scene, SINGLE) == why and compile_scene(scene, ARRAY) == why
     positions = [driver.start for driver in scene.drivers]
     first = state_facts(mk.solve(scene, positions))
