@@ -149,7 +149,7 @@ def _reported_bounds(solver: _Solver, ctx: _Context) -> Iterator[tuple[str, Any]
 
 def _trusted(solver: _Solver, ctx: _Context,
              lim: tuple[float, float, float, float, float, float]) -> bool:
-    """Return True if every reported bound is within its limit ``lim`` (:func:`.trust_limits`).
+    """Return True if every reported bound is within its limit ``lim`` (:mod:`.trust`).
 
     A quick sufficient test for the single-angle path; NaN fails.
     """

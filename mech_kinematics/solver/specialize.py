@@ -14,7 +14,10 @@ kernels out for one scene instead, as the statements of one function:
   value: constants;
 - ``ctx.points[name]``, ``ctx.links[name]``, ``ctx.sliders[name]`` and
   ``ctx.measures[name]`` become local variables (:data:`TABLES`);
-- one-line helpers of the solver package are written out in place;
+- one-line helpers of the solver package are written out in place, and so
+  are the step's methods a kernel calls as ``self.<helper>(ctx, ...)`` in a
+  statement (their locals get a suffix of their own, their arguments are
+  bound in order, their final ``return`` assigns the statement's targets);
 - each step's local names get the step's number as a suffix, and the steps
   are laid out one after another in plan order.
 
@@ -67,10 +70,11 @@ which a 0-d array operand is about eight times slower than a Python number
 (0.54 against 0.06 µs) and turns ``1j * x`` from a Python complex into a
 ``np.complex128``. What the caller does with the
 statements (which values the function returns, how a failed check is
-reported) is the caller's: the node's tick (:mod:`mech_kinematics.ros.ticker`)
-and the solver's own compiled paths (:mod:`.compiled`). A step whose code uses
-something this module does not know raises :class:`Unsupported`, and the
-caller falls back to the general solver.
+reported) is the caller's: the one compiler (:mod:`.compiler`), whose targets
+are ``mk.solve``'s paths and the node's tick. A step whose code uses
+something this module does not know raises :class:`Unsupported` with the
+reason (naming the step), which the compiler returns as why it did not
+compile the scene; the caller keeps the general solver.
 """
 
 from __future__ import annotations
