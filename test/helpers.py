@@ -23,7 +23,7 @@ import setuptools
 
 import mech_kinematics as mk
 from mech_kinematics.ros.parameters import PARAMETERS
-from mech_kinematics.tools.report import reference as ref
+from mech_kinematics.verify import reference as ref
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent

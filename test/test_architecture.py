@@ -1,10 +1,13 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""The layers and their arrows: core <- geometry <- ROS layer and tools. See issue 9.
+"""The layers and their arrows: core <- geometry, verify <- ROS layer and tools. See issue 9.
 
 - the solver core (errors, units, the solver package, scene, textbook) imports only NumPy,
   PyYAML and the standard library;
 - geometry imports the core only, and never matplotlib;
+- the verification room (``verify/``: the 50-digit reference, the extreme suite) sits
+  beside geometry: it imports the core and geometry, never a tool or the ROS layer; the
+  tools (the report) import it (issue 30);
 - the ROS layer never imports a tool (drawing, report, recorder) nor matplotlib;
 - the bag writer (``bag/``) imports the core only; the tools use it;
 - building the command line for ``solve`` imports no heavy dependency.
@@ -24,8 +27,9 @@ CORE_PACKAGES = ('solver',)
 HEAVY = ('rclpy', 'matplotlib', 'mpmath', 'scipy', 'rosbags', 'tqdm')
 
 #: Layer of each subpackage (modules at the top are the core), and what each may import.
-LAYERS = {'core': set(), 'data': set(), 'geometry': {'core'}, 'ros': {'core', 'geometry'},
-          'bag': {'core'}, 'tools': {'core', 'geometry', 'ros', 'data', 'bag'}}
+LAYERS = {'core': set(), 'data': set(), 'geometry': {'core'}, 'verify': {'core', 'geometry'},
+          'ros': {'core', 'geometry'}, 'bag': {'core'},
+          'tools': {'core', 'geometry', 'ros', 'data', 'bag', 'verify'}}
 
 
 def _modules_after(code: str) -> set:

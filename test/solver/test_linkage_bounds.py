@@ -5,7 +5,7 @@
 Every value the solver returns carries an absolute error bound
 (``State.error_bound``). These tests measure the actual error of every
 returned value against the 50-digit reference of
-``mech_kinematics.tools.report.reference`` (the exact answer for the scene's
+``mech_kinematics.verify.reference`` (the exact answer for the scene's
 doubles) and check that
 
 - the bound is never below the actual error: over an extreme suite built
@@ -48,8 +48,8 @@ import numpy as np
 import pytest
 
 import mech_kinematics as mk
-from mech_kinematics.tools.report import reference as ref
 from mech_kinematics.units import rad_per_s_from_rpm
+from mech_kinematics.verify import reference as ref
 
 pytestmark = pytest.mark.filterwarnings('ignore::mech_kinematics.NearSingularWarning')
 

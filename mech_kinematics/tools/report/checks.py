@@ -40,7 +40,7 @@ class ReferenceCheck:
 def reference_checks(mode: Mode, tick: Callable[[], None] = lambda: None
                      ) -> list[ReferenceCheck]:
     """Check the reference on the packaged scenes: residual, second route, solver."""
-    from . import reference as ref_mod
+    from ...verify import reference as ref_mod
     from ...scene import scene_names
     rows = []
     # The packaged scenes driven by one crank (its angle swept); several drivers:
@@ -107,7 +107,7 @@ def golden_checks(folder: Path | None = None) -> list[GoldenCheck]:
 
     import mpmath
 
-    from . import reference as ref_mod
+    from ...verify import reference as ref_mod
     folder = folder or golden_folder()
     rows = []
     for path in sorted(folder.glob('*.json')) if folder.is_dir() else []:

@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """The 50-digit reference: golden cases, its second route, and its own arithmetic.
 
-The reference (``mech_kinematics.tools.report.reference``) solves the loop-closure
+The reference (``mech_kinematics.verify.reference``) solves the loop-closure
 equations by Newton-Raphson in mpmath and differentiates them; the report's
 errors are measured against it, so it is checked here against the published
 golden files (50-digit values rounded to doubles), against finite
@@ -24,8 +24,8 @@ import numpy as np
 import pytest
 
 import mech_kinematics as mk
-from mech_kinematics.tools.report import reference as ref
 from mech_kinematics.units import rad_per_s_from_rpm, radians_from_degrees
+from mech_kinematics.verify import reference as ref
 
 EPS = float(np.finfo(float).eps)
 #: From the decimal inputs as written, the reference rounded to double is the
@@ -297,7 +297,7 @@ def test_measures_match_the_solver():
 def test_reference_does_not_use_the_solver():
     """The reference module imports the solver's dataclasses only, never its steps."""
     source = Path(ref.__file__).read_text()
-    assert 'from ...solver import Scene' in source
+    assert 'from ..solver import Scene' in source
     for name in ('solve', '_RRRStep', '_RRPStep', '_RPRStep', '_run'):
         assert not hasattr(ref, name)
 
@@ -349,6 +349,6 @@ def test_condition_number_of_a_toggle_grows_as_measure_squared():
 
 def test_import_needs_no_plotting():
     """Importing the reference pulls in mpmath but neither matplotlib nor SciPy."""
-    code = ('import sys, mech_kinematics.tools.report.reference; '
+    code = ('import sys, mech_kinematics.verify.reference; '
             "assert 'matplotlib' not in sys.modules and 'scipy' not in sys.modules")
     subprocess.run([sys.executable, '-c', code], check=True, timeout=60)

@@ -47,10 +47,10 @@ import mpmath
 import numpy as np
 import yaml
 
-from ...errors import SceneError
-from ...scene import read_scene_yaml
-from ...solver import Scene
-from ...units import ANGLE_UNITS, LENGTH_UNITS, radians_from_degrees
+from ..errors import SceneError
+from ..scene import read_scene_yaml
+from ..solver import Scene
+from ..units import ANGLE_UNITS, LENGTH_UNITS, radians_from_degrees
 
 __all__ = ['DIGITS', 'DPS', 'Jet', 'Model', 'NoAssembly', 'Reference', 'as_float_dict',
            'check_by_differences', 'compare', 'condition', 'decimal_values', 'reference',
