@@ -7,7 +7,8 @@ both (the report, ``tools/report/``, and the tests import it; it imports the
 solver core and geometry only, never a tool or the ROS layer):
 
 - :mod:`.reference`: every scene written as its loop-closure equations and
-  solved at 64 digits in mpmath, none of the solver's formulas;
+  solved at 64 digits in mpmath, one model of equations per kind of the
+  registries, none of the solver's formulas;
 - :mod:`.extreme`: the stiff and extreme configurations of issue 5 and the
   solver judged against the reference on them;
 - :mod:`.cases`: the mechanisms both build (four-bars, slider-cranks, chains)

@@ -24,6 +24,7 @@ import numpy as np
 from .common import ERROR_FLOOR, Mode, quiet_solve, spread_time, WP_SCENES
 from ...scene import load_scene
 from ...solver import JointMotion, Scene, solve
+from ...solver.graph import joint_type
 from ...textbook import find_answer, PointNorm
 from ...units import radians_from_degrees
 
@@ -145,9 +146,10 @@ def _float_kinematics(model: Any, q: list[Any], theta: Any, omega: Any, alpha: A
 
     joints = {}
     for name, index in model.links.items():
-        joints[name] = motion('revolute', theta_jet if index is None else jets[index])
+        joints[name] = motion(model.joint_types[name],
+                              theta_jet if index is None else jets[index])
     for name, index in model.sliders.items():
-        joints[name] = motion('prismatic', jets[index])
+        joints[name] = motion(model.joint_types[name], jets[index])
     return _State(out_points, joints)
 
 
@@ -288,7 +290,7 @@ def work_precision(mechanism: str, mode: Mode,
             joints = {}
             for name, joint in mid.joints.items():
                 xm, x0, xp = (s.joints[name].position for s in (minus, mid, plus))
-                if joint.type == 'revolute':
+                if joint_type(joint.type).angular:
                     lo, hi = np.remainder(x0 - xm + np.pi, 2 * np.pi) - np.pi, \
                         np.remainder(xp - x0 + np.pi, 2 * np.pi) - np.pi
                 else:
