@@ -134,3 +134,23 @@ def test_each_fact_is_spelled_in_its_home_only(literal, home):
     spelled = sorted(str(p.relative_to(PACKAGE)) for p in PACKAGE.rglob('*.py')
                      if literal in p.read_text(encoding='utf-8'))
     assert spelled == [home]
+
+
+#: The step kinds and drivers: each is one module with a test file of its own.
+KIND_MODULES = ('crank', 'actuator', 'rrr', 'rrp', 'rpr', 'rpp', 'geneva', 'carried')
+
+
+def test_every_kind_module_has_its_own_test_file():
+    """Tests mirror the package: each kind's module has test/solver/test_<kind>.py."""
+    tests = Path(__file__).resolve().parent / 'solver'
+    for kind in KIND_MODULES:
+        assert (PACKAGE / 'solver' / f'{kind}.py').is_file(), kind
+        assert (tests / f'test_{kind}.py').is_file(), f'no test/solver/test_{kind}.py'
+
+
+def test_no_test_file_is_named_after_a_module_that_does_not_exist():
+    """A test/solver/test_X*.py names an existing solver module X (or the solver's solve)."""
+    modules = {path.stem for path in (PACKAGE / 'solver').glob('*.py')}
+    for path in (Path(__file__).resolve().parent / 'solver').glob('test_*.py'):
+        name = path.stem.removeprefix('test_')
+        assert any(name == m or name.startswith(m + '_') for m in modules), path.name

@@ -888,7 +888,7 @@ class _Geneva(_RPR):
     pin (its slot 0, continued beyond the engagement window): the engaged
     values of every window follow by turning it back ``2 pi k / n``, and the
     dwell between windows is held exactly still (the solver's closed forms,
-    checked against this in ``test/solver/test_intermittent.py``).
+    checked against this in ``test/solver/test_geneva.py``).
     """
 
 

@@ -321,7 +321,7 @@ def test_golden_case_from_double_inputs(name, case):
         assert abs(value - expected) <= RTOL_GOLDEN * (abs(expected) + scale)
 
 
-@pytest.mark.parametrize('name', crank_scene_names())  # several drivers: test_drivers
+@pytest.mark.parametrize('name', crank_scene_names())  # several drivers: test_solve_drivers
 def test_second_route_agrees(name):
     """Velocities and accelerations match 64-digit differences in time to 1e-30."""
     scene = mk.load_scene(name)
@@ -342,7 +342,7 @@ def test_second_route_with_crank_acceleration():
     assert max(ref.check_by_differences(scene, exact).values()) <= RTOL_ROUTES
 
 
-@pytest.mark.parametrize('name', crank_scene_names())  # several drivers: test_drivers
+@pytest.mark.parametrize('name', crank_scene_names())  # several drivers: test_solve_drivers
 def test_newton_sets_the_digits(name):
     """Positions come from Newton-Raphson on the constraints, not from the 20-digit start."""
     scene = mk.load_scene(name)
@@ -351,7 +351,7 @@ def test_newton_sets_the_digits(name):
     assert float(exact.residual) <= ATOL_RESIDUAL
 
 
-@pytest.mark.parametrize('name', crank_scene_names())  # several drivers: test_drivers
+@pytest.mark.parametrize('name', crank_scene_names())  # several drivers: test_solve_drivers
 def test_solver_within_conditioning_on_packaged_scenes(name):
     """The solver's error per kind is within 4 eps * max(1, kappa) on every packaged scene."""
     scene = mk.load_scene(name)
@@ -399,7 +399,7 @@ def test_singular_pose_has_positions_only():
 
 def test_measures_match_the_solver():
     """The exact near-singularity measures are the solver's, to rounding."""
-    for name in crank_scene_names():  # several drivers: test_drivers
+    for name in crank_scene_names():  # several drivers: test_solve_drivers
         scene = mk.load_scene(name)
         exact = ref.reference(scene, scene.input.angle)
         with warnings.catch_warnings():

@@ -56,7 +56,7 @@ REFINE = tuple(10.0 ** (-k / 20) for k in range(20, 301))
 #: Each edge of a refused interval is located to this crank angle, rad.
 EDGE = 1e-14
 #: An instant is well-conditioned when the reference's condition number of every kind
-#: of value is at most this (``reference.condition``; issue 10, test_linkage_bounds):
+#: of value is at most this (``reference.condition``; issue 10, test_solve_bounds):
 #: there the bound must be within 1e3 x (actual error + 1 ulp of the scale).
 KAPPA_WELL = 10.0
 #: Below this near-singularity measure kappa exceeds KAPPA_WELL anyway: not computed.
@@ -126,7 +126,7 @@ def _spaced(count: int, start: float = 0.3) -> tuple[float, ...]:
 def bound_cases(mode: Mode | None = None) -> list[BoundCase]:
     """Return the extreme suite of issue 10: every kind of singular position, ratio, scale, speed.
 
-    The mechanisms follow ``test/test_linkage_bounds.py``'s suite and the
+    The mechanisms follow ``test/solver/test_solve_bounds.py``'s suite and the
     extreme cases of section 4; every length is in m, every angle in rad.
     """
     import mpmath

@@ -45,7 +45,7 @@ def reference_checks(mode: Mode, tick: Callable[[], None] = lambda: None
     from ...scene import scene_names
     rows = []
     # The packaged scenes driven by one crank (its angle swept); several drivers:
-    # test/solver/test_drivers.py checks them against the reference.
+    # test/solver/test_solve_drivers.py checks them against the reference.
     names = mode.check_scenes or tuple(name for name in scene_names()
                                        if load_scene(name).input is not None
                                        and len(load_scene(name).drivers) == 1)
