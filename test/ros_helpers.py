@@ -65,6 +65,26 @@ def wait_for(predicate, timeout: float, what: str):
     pytest.fail(f'timed out after {timeout} s waiting for {what}')
 
 
+def send_until(send, predicate, timeout: float, what: str, every: float = 0.5):
+    """Call ``send``, then again every ``every`` s, until ``predicate`` is true; return it.
+
+    A message sent before the other side has matched this one is lost (each side
+    discovers the other on its own; ``get_subscription_count`` says only that
+    this side has): resend until answered. Fails naming ``what`` after ``timeout`` s.
+    """
+    deadline = time.monotonic() + timeout
+    while True:
+        send()
+        again = min(deadline, time.monotonic() + every)
+        while time.monotonic() < again:
+            value = predicate()
+            if value:
+                return value
+            time.sleep(0.01)
+        if time.monotonic() >= deadline:
+            pytest.fail(f'timed out after {timeout} s waiting for {what}')
+
+
 def exited(proc: 'NodeProcess') -> tuple[int, str]:
     """Return a node's exit status and output, waited for up to STARTUP_S (killed after)."""
     try:

@@ -361,6 +361,8 @@ class KinematicsNode(LifecycleNode):
             self._tf_period_ns = self._tf_period(changes['tf_rate_hz'])
         if 'max_relative_error' in changes:
             self._max_error = float(changes['max_relative_error'])
+        if 'stamp_jump_back_s' in changes and self._topic is not None:
+            self._topic.jump_back_ns = round(changes['stamp_jump_back_s'] * NS_PER_S)
         requests: dict[str, dict[str, float]] = {}
         for name, value in changes.items():
             for drive, key in self._drive_keys.get(name, ()):
@@ -713,7 +715,7 @@ class KinematicsNode(LifecycleNode):
         names = ('scene', 'drive', 'crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm',
                  'rate_hz', 'late_ticks', 'max_catch_up_s', 'max_lateness_ms',
                  'max_relative_error', 'frame_id', 'tf_rate_hz', 'tf_prefix',
-                 'use_sim_time', 'markers', 'managed')
+                 'use_sim_time', 'markers', 'managed', 'extra_joints', 'stamp_jump_back_s')
         names += tuple(self._driver_specs)
         settings = ', '.join(f'{name}={self._value(name)!r}' for name in names[1:])
         self.get_logger().info(
@@ -937,7 +939,10 @@ class KinematicsNode(LifecycleNode):
         self._topic_messages = {
             known: TickMessages(joints, points, self.frame_id, velocities=known,
                                 accelerations=False) for known in (True, False)}
-        self._topic = TopicDrive(scene.drivers)
+        self._topic = TopicDrive(
+            scene.drivers, extra_joints=self._value('extra_joints'),
+            jump_back_ns=round(self._value('stamp_jump_back_s') * NS_PER_S),
+            published_joints=joints)
         # Subscribed at configure (its QoS overrides are declared with the others); a
         # message is published only while active.
         qos = QoSProfile(history=QoSHistoryPolicy.KEEP_LAST, depth=INPUT_DEPTH,
@@ -991,7 +996,8 @@ class KinematicsNode(LifecycleNode):
         stamp = msg.header.stamp
         stamp_ns = stamp.sec * NS_PER_S + stamp.nanosec
         try:
-            given = topic.read(stamp.sec, stamp.nanosec, msg.name, msg.position, msg.velocity)
+            given = topic.read(stamp.sec, stamp.nanosec, msg.name, msg.position, msg.velocity,
+                               msg.effort)
             values, measure = self._solve_input(given)
         except (RefusedInput, mk.AssemblyError) as exc:
             kind = 'refused input' if isinstance(exc, RefusedInput) else \
@@ -1002,9 +1008,19 @@ class KinematicsNode(LifecycleNode):
             return
         sec, nanosec = divmod(given.stamp_ns, NS_PER_S)
         messages = self._topic_messages[given.speeds is not None]
-        for publish, data in zip(self._publish_state,
-                                 messages.render_values(values, sec, nanosec), strict=True):
+        rendered = messages.render_values(values, sec, nanosec)
+        if given.passed is not None:    # extra_joints: pass: names that change per message
+            rendered = (self._joint_state_passed(topic, given, values, sec, nanosec),
+                        *rendered[1:])
+        for publish, data in zip(self._publish_state, rendered, strict=True):
             publish(data)
+        if given.jumped_from_ns is not None:
+            self._next_tf = 0   # /tf's rate counts from the new order
+            self.get_logger().warning(
+                f'{topics.INPUT_JOINT_STATES}: the stamp jumped back '
+                f'{(given.jumped_from_ns - given.stamp_ns) / NS_PER_S:.9g} s (more than '
+                'stamp_jump_back_s): published, the order starts again from it',
+                throttle_duration_sec=1.0)
         if self._tf is not None and self._tf_period_ns is not None \
                 and given.stamp_ns >= self._next_tf:
             self._pub_tf.publish(self._tf.render_values(values, self._tf_first, sec, nanosec))
@@ -1014,6 +1030,17 @@ class KinematicsNode(LifecycleNode):
         topic.published(given.stamp_ns)
         self._stats.record(given.stamp_ns, time.monotonic_ns() - received, False,
                            measure=measure, near_singular=measure < mk.NEAR_SINGULAR)
+        self._stats.topic_input(given.stamp_ns, given.jumped_from_ns, given.ignored,
+                                given.passed.names if given.passed is not None else ())
+
+    def _joint_state_passed(self, topic: TopicDrive, given: TopicInput, values: Any, sec: int,
+                            nanosec: int) -> JointState:
+        """Return ``joint_states`` with the input's other joints after the mechanism's."""
+        name, position, velocity, effort = topic.joint_state_arrays(given, values)
+        msg = JointState(name=name, position=position, velocity=velocity, effort=effort)
+        msg.header.stamp = Time(sec=sec, nanosec=nanosec)
+        msg.header.frame_id = self.frame_id
+        return msg
 
     def _solve_input(self, given: TopicInput) -> tuple[Any, float]:
         """Return (the tick function's values, the singularity measure) for one input.
@@ -1065,7 +1092,8 @@ class KinematicsNode(LifecycleNode):
         statuses = [
             solver_status(window, name=name, hardware_id=hardware_id,
                           near_singular=mk.NEAR_SINGULAR, waiting_for=waiting,
-                          assembly=self._assembly),
+                          assembly=self._assembly,
+                          extra_joints=self._value('extra_joints') if self._topic else ''),
             timing_status(window, name=name, hardware_id=hardware_id,
                           rate_hz=self._value('rate_hz'),
                           max_lateness_ms=self._value('max_lateness_ms')),
