@@ -48,7 +48,7 @@ from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
 import rclpy
 from rclpy.clock import Clock, ClockType, JumpThreshold
 from rclpy.duration import Duration
-from rclpy.executors import ExternalShutdownException
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
 from rclpy.logging import get_logger
 from rclpy.parameter import Parameter
@@ -70,6 +70,7 @@ from .parameters import (CATCH_UP, catch_up_window_ns, driver_parameters, first_
                          joint_refusal, PARAMETERS, ParameterSpec, refusal, rpm_parameter, spec,
                          STATE_DEPTH, TOPIC)
 from .schedule import period_ns_from_rate
+from .startup import catch_stop_signals, start_refusal, stop_asked
 from .tf import static_tf_message, TfMessages
 from .ticker import compile_tick, general_tick, tick_function
 from .timebase import ActuatorTimebase, CrankSample, CrankTimebase
@@ -1191,14 +1192,34 @@ class Instance:
                 '(remap the name with -r __node:=NAME or the namespace with -r __ns:=/NS)')
 
 
+class _Executor(SingleThreadedExecutor):
+    """rclpy's executor; one half built (a signal shut its context down) deletes quietly."""
+
+    # Executor.__del__ reads it: without this, an executor whose __init__ failed prints
+    # "Exception ignored ... AttributeError" when it is collected.
+    _sigint_gc = None
+
+
 def main(args: list[str] | None = None) -> int:
-    """Run the node until Ctrl-C or SIGTERM; return the exit status."""
+    """Run the node until Ctrl-C or SIGTERM; return the exit status.
+
+    0 when stopped (a SIGINT or SIGTERM at any point of the start included), 1 if
+    it cannot start, 2 if a file its arguments name may not be read
+    (:mod:`~mech_kinematics.ros.startup`).
+    """
+    catch_stop_signals()
     # The node reports near-singular poses on diagnostics and in its log.
     warnings.filterwarnings('ignore', category=mk.NearSingularWarning)
     # The tick thread must not wait long for the GIL when it wakes (default 5 ms).
     sys.setswitchinterval(SWITCH_INTERVAL_S)
     logger = get_logger(NODE_NAME)
     start_ns = time.time_ns()
+    refused = start_refusal(sys.argv if args is None else args)
+    if refused is not None:
+        logger.fatal(f'cannot start: {refused}')
+        return 2
+    if stop_asked():
+        return 0
     try:
         rclpy.init(args=args)
     except Exception as exc:     # noqa: BLE001 - rclpy's argument errors come in several kinds
@@ -1207,21 +1228,29 @@ def main(args: list[str] | None = None) -> int:
     node = None
     status = 0
     try:
+        # A stop asked at any point from here on (before rclpy's handler, or by it: it
+        # calls ours too) is a clean exit, whatever it made fail.
+        if stop_asked():
+            return 0
         node = KinematicsNode()
         logger = node.get_logger()
         Instance(node, start_ns)
         if not node.managed:
             node.trigger_configure()
             if node.scene is None:
-                logger.fatal(f'cannot start: {node.configure_error}')
-                return 1
+                if not stop_asked():
+                    logger.fatal(f'cannot start: {node.configure_error}')
+                    status = 1
+                return status
         node.starting = False
         if not node.managed:
             node.trigger_activate()
         # Everything built so far lives as long as the node: keep it out of the
         # garbage collector's full passes, which would otherwise delay ticks.
         gc.freeze()
-        rclpy.spin(node)
+        executor = _Executor()
+        executor.add_node(node)
+        executor.spin()
     except (KeyboardInterrupt, ExternalShutdownException):
         pass  # Ctrl-C or shutdown: a clean exit, status 0
     except TickThreadError:
@@ -1230,10 +1259,11 @@ def main(args: list[str] | None = None) -> int:
         logger.fatal(f'cannot start: {exc}')
         status = 1
     except StartError as exc:
-        get_logger(exc.logger_name).fatal(f'cannot start: {exc.reason}')
-        status = 1
+        if not stop_asked():
+            get_logger(exc.logger_name).fatal(f'cannot start: {exc.reason}')
+            status = 1
     except Exception as exc:     # noqa: BLE001 - a start-up failure: one line, no traceback
-        if rclpy.ok():
+        if rclpy.ok() and not stop_asked():
             logger.fatal(f'cannot start: {_one_line(exc)}')
             status = 1
         # else a signal shut the context down while the node started (rclpy's own
