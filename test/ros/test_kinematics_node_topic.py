@@ -20,14 +20,14 @@ import time
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from lifecycle_msgs.msg import Transition
-from lifecycle_msgs.srv import ChangeState
 import numpy as np
 import pytest
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 from rclpy.qos import QoSProfile, ReliabilityPolicy
-from ros_helpers import (cannot_start, exited, NodeProcess, NS, RELIABLE, send_until,
-                         SESSION, stamp_ns, STARTUP_S, wait_for, wait_for_parameters)
+from ros_helpers import (cannot_start, exited, Lifecycle, NodeProcess, NS, RELIABLE,
+                         send_until, SESSION, stamp_ns, STARTUP_S, wait_for,
+                         wait_for_parameters)
 from sensor_msgs.msg import JointState
 from tf2_msgs.msg import TFMessage
 from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
@@ -230,14 +230,12 @@ def test_bad_messages_are_refused_on_diagnostics_and_the_node_goes_on(ros, tmp_p
 def test_a_managed_node_publishes_only_while_active(ros, tmp_path):
     """managed:=true: subscribed from configure, a state per message only while active."""
     node = TopicNode(ros, tmp_path, 'topic_managed', '-p', 'managed:=true', wait=False)
-    change = ros.node.create_client(ChangeState, f'{node.ns}/mech_kinematics/change_state')
 
     def transition(transition_id):
-        request = ChangeState.Request(transition=Transition(id=transition_id))
-        assert ros.call(change.call_async(request)).success
+        assert life.transition(transition_id)
 
     try:
-        assert change.wait_for_service(timeout_sec=STARTUP_S)
+        life = Lifecycle(ros, f'{node.ns}/mech_kinematics')
         transition(Transition.TRANSITION_CONFIGURE)
         node.wait_for_subscription()
         transition(Transition.TRANSITION_ACTIVATE)
