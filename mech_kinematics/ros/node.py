@@ -54,6 +54,7 @@ from rclpy.logging import get_logger
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSDurabilityPolicy, QoSHistoryPolicy, QoSProfile, QoSReliabilityPolicy
 from rclpy.qos_overriding_options import QoSOverridingOptions, QoSPolicyKind
+from rclpy.signals import install_signal_handlers, SignalHandlerOptions
 from sensor_msgs.msg import Imu, JointState
 from std_msgs.msg import String
 from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
@@ -1221,33 +1222,37 @@ def main(args: list[str] | None = None) -> int:
     if stop_asked():
         return 0
     try:
-        rclpy.init(args=args)
+        # Until the spin a signal is only noted (startup.catch_stop_signals), and the start
+        # stops at its next step: rclpy's handler would shut the context down under the
+        # step running (a SIGINT while configuring crashed the process with SIGSEGV).
+        rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     except Exception as exc:     # noqa: BLE001 - rclpy's argument errors come in several kinds
         logger.fatal(f'cannot start: bad arguments: {_one_line(exc)}')
         return 1
     node = None
     status = 0
     try:
-        # A stop asked at any point from here on (before rclpy's handler, or by it: it
-        # calls ours too) is a clean exit, whatever it made fail.
         if stop_asked():
             return 0
         node = KinematicsNode()
         logger = node.get_logger()
         Instance(node, start_ns)
-        if not node.managed:
+        if not node.managed and not stop_asked():
             node.trigger_configure()
-            if node.scene is None:
-                if not stop_asked():
-                    logger.fatal(f'cannot start: {node.configure_error}')
-                    status = 1
-                return status
+            if node.scene is None and not stop_asked():
+                logger.fatal(f'cannot start: {node.configure_error}')
+                return 1
         node.starting = False
-        if not node.managed:
+        if not node.managed and not stop_asked():
             node.trigger_activate()
         # Everything built so far lives as long as the node: keep it out of the
         # garbage collector's full passes, which would otherwise delay ticks.
         gc.freeze()
+        # From now on rclpy's handler ends the spin on a signal (and calls ours); a signal
+        # noted before it was installed is seen here.
+        install_signal_handlers(SignalHandlerOptions.ALL)
+        if stop_asked():
+            return 0
         executor = _Executor()
         executor.add_node(node)
         executor.spin()

@@ -16,12 +16,16 @@ A SIGINT or SIGTERM while the node starts must end it cleanly (status 0, no
 traceback), wherever it lands. :func:`catch_stop_signals` replaces Python's
 handlers (SIGINT's raises KeyboardInterrupt wherever the main thread is,
 SIGTERM's kills the process) by one that only notes the signal
-(:func:`stop_asked`); the starting code looks at that note between its steps.
-``rclpy.init`` installs rclpy's own handler, which shuts the context down and
-then calls the one it replaced: this one, so the note stays true once a stop
-is asked. Before :func:`catch_stop_signals` runs (Python importing the
-package, NumPy among it, about 0.4 s), a SIGTERM ends the process by its
-default action (killed by the signal, no output).
+(:func:`stop_asked`); the starting code looks at that note between its steps
+(``rclpy.init`` is told to install no handler of its own). rclpy's handler,
+which shuts the context down from another thread, is installed only when the
+node is about to spin: shutting the context down under a step of the start
+made that step fail ("cannot start"), leave a half-built executor (a
+traceback), or crash the process (SIGSEGV). rclpy's handler calls the one it
+replaced, this one, so the note stays true once a stop is asked. Before
+:func:`catch_stop_signals` runs (Python importing the package, NumPy among
+it), a SIGTERM ends the process by its default action (killed by the signal,
+no output).
 
 Thread use: the main thread only (signal handlers run there).
 """
