@@ -244,12 +244,12 @@ class TopicDrive:
         Returns
         -------
         tuple of list
-            The mechanism's joints (``published_joints``), then the passed ones. ``velocity`` is
-            empty when the message has none (then no velocity is known);
-            ``effort`` is empty unless the message has one per name: then it
-            is NaN (unknown) for each of the mechanism's joints, as ros2_control's
-            joint_state_broadcaster marks a value a joint does not have, and
-            the message's for the passed ones.
+            The mechanism's joints (``published_joints``), then the passed
+            ones. ``velocity`` is empty when the message has none (then no
+            velocity is known); ``effort`` is empty unless the message has one
+            per name: then it is NaN (unknown) for each of the mechanism's
+            joints, as ros2_control's joint_state_broadcaster marks a value a
+            joint does not have, and the message's for the passed ones.
         """
         joints = self.published_joints
         n = len(joints)

@@ -15,6 +15,7 @@ import time
 from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
+from rclpy.qos import QoSProfile, ReliabilityPolicy
 from ros_helpers import (NodeProcess, NS, Ros, SESSION, stamp_ns, STARTUP_S, wait_for,
                          wait_for_parameters, wrap)
 from sensor_msgs.msg import JointState
@@ -36,13 +37,19 @@ def stamps_of(raw) -> list:
     return [stamp_ns(deserialize_message(data, JointState)) for data in raw]
 
 
+#: History of this process's joint_states readers: 10 s at 1 kHz, so that a reader late on a
+#: loaded machine (the node's history is 1000) loses nothing the node published.
+READER_DEPTH = 10_000
+
+
 class Stream:
     """A node of its own and its joint_states (serialized) and diagnostics, as received here."""
 
-    def __init__(self, ros: Ros, tmp, name: str, *args: str) -> None:
+    def __init__(self, ros: Ros, tmp, name: str, *args: str, depth: int = READER_DEPTH) -> None:
         self.ros = ros
         self.ns = f'{SESSION}/{name}'
-        self.js = ros.collect_raw(JointState, f'{self.ns}/joint_states')    # decoded later
+        self.js = ros.collect_raw(JointState, f'{self.ns}/joint_states',
+                                  QoSProfile(depth=depth, reliability=ReliabilityPolicy.RELIABLE))
         self.diag = ros.collect(DiagnosticArray, f'{self.ns}/diagnostics')
         self.process = NodeProcess(tmp, '-r', f'__ns:={self.ns}', *args)
         self.params = AsyncParameterClient(ros.node, f'{self.ns}/mech_kinematics')
@@ -214,7 +221,8 @@ def test_a_stall_is_caught_up_to_the_bound_and_the_rest_counted(ros, tmp_path):
             _stall(stream, 0.5)
             _states_until(stream.js, time.time_ns() + NS // 2)
             count = len(stream.diag)
-            wait_for(lambda n=count: len(stream.diag) > n + 1, 5.0, 'diagnostics after the stall')
+            wait_for(lambda n=count: len(stream.diag) > n + 1, STARTUP_S,
+                     'diagnostics after the stall')
             skipped = diagnostic_value(stream.diag, 'skipped_ticks_total') - skipped_before
             stamps = sorted(stamps_of(stream.js[start:]))
             gaps = sorted(b - a for a, b in zip(stamps, stamps[1:], strict=False) if b > a)
@@ -243,9 +251,9 @@ def test_a_long_stop_at_1_khz_is_one_burst_a_keep_last_1000_reader_gets_whole(ro
     """
     period = 1_000_000
     stream = Stream(ros, tmp_path, 'stop_10s', '-p', 'rate_hz:=1000', '-p',
-                    'max_catch_up_s:=10.0')
-    # The stream's own subscription is one: reliable, KEEP_LAST 1000 (a second reader would
-    # only halve what this process keeps up with on a loaded machine).
+                    'max_catch_up_s:=10.0', depth=1000)
+    # The stream's own subscription is the reader: reliable, KEEP_LAST 1000 (a second one at
+    # 1 kHz would halve what this process keeps up with on a loaded machine).
     reader = stream.js
     try:
         wait_for(lambda: len(reader) > 100, STARTUP_S, 'the KEEP_LAST 1000 reader')
@@ -255,7 +263,7 @@ def test_a_long_stop_at_1_khz_is_one_burst_a_keep_last_1000_reader_gets_whole(ro
         _stall(stream, 4.0)
         _states_until(reader, time.time_ns() + NS)
         count = len(stream.diag)
-        wait_for(lambda: len(stream.diag) > count + 1, 5.0, 'diagnostics after the stop')
+        wait_for(lambda: len(stream.diag) > count + 1, STARTUP_S, 'diagnostics after the stop')
         skipped = diagnostic_value(stream.diag, 'skipped_ticks_total') - skipped_before
         stamps = sorted(set(stamps_of(reader[start:])))
     finally:

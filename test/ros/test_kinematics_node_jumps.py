@@ -80,7 +80,7 @@ def test_every_grid_instant_is_published_at_engagement_instants(ros, tmp_path):
             wait_for(lambda owed=owed: all(len(r) >= owed for r in raw.values()), 10.0,
                      f'{owed} instants on every topic')
         published = len(diagnostics)
-        wait_for(lambda: len(diagnostics) > published + 1, 5.0, 'diagnostics after the run')
+        wait_for(lambda: len(diagnostics) > published + 1, STARTUP_S, 'diagnostics after the run')
     finally:
         status, _ = proc.stop(signal.SIGINT)
         ros.node.destroy_publisher(clock)

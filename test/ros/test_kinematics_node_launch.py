@@ -198,7 +198,7 @@ def test_every_message_agrees_with_the_solver(node):
 def test_sensor_data_subscriber_receives_joint_states(node):
     """A best-effort SensorDataQoS subscriber gets joint_states from the reliable publisher."""
     start = len(node.sensor_joint_states)
-    wait_for(lambda: len(node.sensor_joint_states) >= start + 20, 5.0,
+    wait_for(lambda: len(node.sensor_joint_states) >= start + 20, STARTUP_S,
              'joint_states on a SensorDataQoS subscription')
 
 
@@ -281,7 +281,8 @@ def test_bad_values_are_refused_and_publishing_goes_on(node):
         else:
             assert sum(result.reason in line for line in refused) >= 1, (result.reason, refused)
     start = len(node.joint_states)
-    wait_for(lambda: len(node.joint_states) >= start + 20, 5.0, 'joint_states after refusals')
+    wait_for(lambda: len(node.joint_states) >= start + 20, STARTUP_S,
+             'joint_states after refusals')
 
 
 def test_rate_change(node):
@@ -329,7 +330,7 @@ def test_acceleration_is_held_at_the_bound(node):
 def test_diagnostics_report_status_and_timing(node):
     """The diagnostics carry solver status ok, the achieved rate and the late-tick counts."""
     start = len(node.diagnostics)
-    wait_for(lambda: len(node.diagnostics) >= start + 2, 5.0, 'diagnostics')
+    wait_for(lambda: len(node.diagnostics) >= start + 2, STARTUP_S, 'diagnostics')
     msg = node.diagnostics[-1]
     status = {s.name: s for s in msg.status}
     solver = status['mech_kinematics: solver']
@@ -408,7 +409,7 @@ def test_sim_time_drives_the_angle_exactly(ros, tmp_path):
         count = len(js_list)
         clock_pub.publish(Clock(clock=Time(sec=big // NS, nanosec=big % NS)))
         last = big // period * period
-        wait_for(lambda: js_list and stamp_ns(js_list[-1]) == last, 5.0,
+        wait_for(lambda: js_list and stamp_ns(js_list[-1]) == last, STARTUP_S,
                  'the ticks after the 30-day jump')
         time.sleep(0.3)
         assert len(js_list) == count + 11, 'ticked without the clock moving'
@@ -465,9 +466,10 @@ def test_unsolvable_ticks_publish_nothing_and_the_node_carries_on(ros, tmp_path)
             return any(s.level == DiagnosticStatus.ERROR for m in diag for s in m.status)
         wait_for(saw_error, STARTUP_S, 'a cannot-assemble status on diagnostics')
         start = len(remapped)
-        wait_for(lambda: len(remapped) >= start + 30, 5.0, 'states after an unsolvable stretch')
+        wait_for(lambda: len(remapped) >= start + 30, STARTUP_S,
+                 'states after an unsolvable stretch')
         # The same ticks on the other two topics (each topic arrives on its own).
-        wait_for(lambda: len(ticks(remapped[start:], jt_list, md_list)) >= 30, 5.0,
+        wait_for(lambda: len(ticks(remapped[start:], jt_list, md_list)) >= 30, STARTUP_S,
                  'the same 30 ticks on joint_accelerations and point_accelerations')
         solver = [s for m in diag for s in m.status if s.level == DiagnosticStatus.ERROR][0]
         assert 'cannot assemble' in solver.message and 'RRR' in solver.message

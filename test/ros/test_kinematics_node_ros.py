@@ -60,7 +60,7 @@ def test_a_second_node_of_the_same_name_exits_1(ros, tmp_path):
         assert status == 1, output
         assert f'another node named {ns}/mech_kinematics is running' in output
         count = len(js)
-        wait_for(lambda: len(js) > count + 50, 5.0, 'the first node still publishing')
+        wait_for(lambda: len(js) > count + 50, STARTUP_S, 'the first node still publishing')
     finally:
         status, _ = first.stop(signal.SIGINT)
     assert status == 0, first.output()
@@ -161,7 +161,7 @@ def test_managed_node_with_a_bad_scene_fails_to_configure(ros, tmp_path):
         life = Lifecycle(ros, f'{ns}/mech_kinematics')
         assert not life.transition(Transition.TRANSITION_CONFIGURE)
         assert life.state() == 'unconfigured'
-        wait_for(lambda: 'cannot configure' in proc.output(), 5.0, 'the reason in the log')
+        wait_for(lambda: 'cannot configure' in proc.output(), STARTUP_S, 'the reason in the log')
         assert 'no_such_scene' in proc.output()
     finally:
         status, _ = proc.stop(signal.SIGINT)
@@ -190,7 +190,7 @@ def test_untrusted_ticks_publish_nothing_and_say_why(ros, tmp_path):
         # machine's clock, as the node's).
         changed = time.time_ns()
         start = len(diag)
-        wait_for(lambda: len(diag) > start + 1, 5.0, 'diagnostics after the change')
+        wait_for(lambda: len(diag) > start + 1, STARTUP_S, 'diagnostics after the change')
         count = len(js)
         assert not [m for m in js if stamp_ns(m) > changed], \
             'published while every tick is untrusted'
@@ -202,7 +202,7 @@ def test_untrusted_ticks_publish_nothing_and_say_why(ros, tmp_path):
         response = ros.call(params.set_parameters(
             [Parameter('max_relative_error', value=1e-6)]))
         assert response.results[0].successful
-        wait_for(lambda: len(js) > count + 50, 5.0, 'joint_states again')
+        wait_for(lambda: len(js) > count + 50, STARTUP_S, 'joint_states again')
     finally:
         status, _ = proc.stop(signal.SIGINT)
     assert status == 0, proc.output()
@@ -296,7 +296,7 @@ def test_switching_to_sim_time_and_back_keeps_the_crank_where_it_was(ros, tmp_pa
             assert abs(wrap(b.position[ci] - a.position[ci] - 2 * math.pi * dt)) < ATOL_TIMEBASE
         assert ros.call(params.set_parameters(
             [Parameter('use_sim_time', value=False)])).results[0].successful
-        wait_for(lambda: any(stamp_ns(m) > 100_000 * NS for m in js[first_sim:]), 5.0,
+        wait_for(lambda: any(stamp_ns(m) > 100_000 * NS for m in js[first_sim:]), STARTUP_S,
                  'joint_states on the wall clock again')
         last_sim = [m for m in js[first_sim:] if stamp_ns(m) < 100_000 * NS][-1]
         first_wall = next(m for m in js[first_sim:] if stamp_ns(m) > 100_000 * NS)

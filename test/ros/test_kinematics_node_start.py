@@ -150,7 +150,7 @@ def test_the_older_node_goes_on_without_a_gap_while_newcomers_are_refused(ros, t
             _one_refusal(output, ns)
             assert first.proc.poll() is None, first.output()
         count = len(js)
-        wait_for(lambda: len(js) > count + 50, 5.0, 'the first node still publishing')
+        wait_for(lambda: len(js) > count + 50, STARTUP_S, 'the first node still publishing')
         assert first.proc.poll() is None, first.output()
     finally:
         status, _ = first.stop(signal.SIGINT)
@@ -178,7 +178,7 @@ def test_of_two_nodes_started_together_exactly_one_goes_on(ros, tmp_path):
         assert gone[0].proc.returncode == 1, gone[0].output()
         _one_refusal(gone[0].output(), ns)
         count = len(js)
-        wait_for(lambda: len(js) > count + 50, 5.0, 'the remaining node still publishing')
+        wait_for(lambda: len(js) > count + 50, STARTUP_S, 'the remaining node still publishing')
     finally:
         statuses = [p.stop(signal.SIGINT)[0] for p in procs]
     assert sorted(statuses) == [0, 1], [p.output() for p in procs]
@@ -250,7 +250,7 @@ def test_a_long_chain_is_published_while_its_tick_compiles(ros, tmp_path):
         wait_for(lambda: 'the compiled tick serves from now' in proc.output(), 60.0,
                  'the compiled tick')
         count = len(js)
-        wait_for(lambda: len(js) > count + 25, 5.0, 'states from the compiled tick')
+        wait_for(lambda: len(js) > count + 25, STARTUP_S, 'states from the compiled tick')
     finally:
         status, _ = proc.stop(signal.SIGINT)
     output = proc.output()

@@ -225,7 +225,7 @@ def test_node_publishes_markers_at_most_30_hz_stamped_like_the_state(ros, tmp_pa
         stamps = [stamp_ns(msg.markers[0]) for _, msg in window]
         # The states of the markers' ticks (published before them, on topics of their own).
         wait_for(lambda: set(stamps) <= {stamp_ns(m) for m in js_list}
-                 and set(stamps) <= {stamp_ns(m) for m in md_list}, 5.0,
+                 and set(stamps) <= {stamp_ns(m) for m in md_list}, STARTUP_S,
                  "the states of the markers' ticks")
         status, _ = proc.stop(signal.SIGINT)
         assert status == 0, proc.output()
