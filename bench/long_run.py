@@ -54,12 +54,12 @@ def run(seconds: float, rate: float, scene_name: str, keep_s: float) -> dict[str
 
     import mech_kinematics as mk
     from mech_kinematics.ros.cdr import stamp_from_cdr
+    from mech_kinematics.ros.parameters import rate_default
     from mech_kinematics.scene import load_scene
-    from mech_kinematics.ros.node import rpm_parameter
     from mech_kinematics.units import rad_per_s_from_rpm
 
     scene = load_scene(scene_name)
-    rpm = rpm_parameter(scene.input.speed)  # the node's default crank_speed_rpm
+    rpm = rate_default(scene.input)  # the node's default crank_speed_rpm
     namespace = f'/long_run_{os.getpid()}_{random.randrange(10 ** 6)}'
     rclpy.init()
     sub = rclpy.create_node('long_run_subscriber', namespace=namespace)

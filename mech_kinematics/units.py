@@ -7,6 +7,11 @@ lengths in mm, angles in degrees and crank speeds in rpm; these helpers turn
 them into SI and back. They accept floats, NumPy arrays and ``mpmath``
 numbers alike (pass ``pi=mpmath.pi`` for the latter), so the 50-digit
 reference uses the same formulas as the solver.
+
+A driver's rate keeps the unit it was given in (a crank's ``speed_rpm`` its
+rpm, its ``speed`` its rad/s, an actuator's ``speed`` its m/s) until the
+one conversion to SI (:func:`si_from_rate`), where it is used: the node's time
+base converts it there, exactly.
 """
 
 from __future__ import annotations
@@ -16,14 +21,17 @@ import math
 from typing import Any
 
 __all__ = [
-    'ANGLE_UNITS', 'LENGTH_UNITS', 'NS_PER_S', 'degrees_from_radians', 'rad_per_s_from_rpm',
-    'radians_from_degrees', 'rpm_from_rad_per_s', 'turns_from_degrees', 'reduce_radians',
+    'ANGLE_UNITS', 'LENGTH_UNITS', 'NS_PER_S', 'RATE_UNITS', 'degrees_from_radians',
+    'rad_per_s_from_rpm', 'radians_from_degrees', 'rate_from_si', 'reduce_radians',
+    'rpm_from_rad_per_s', 'si_from_rate', 'turns_from_degrees',
 ]
 
 #: Length units a scene may use: name -> how many of them make one metre.
 LENGTH_UNITS = {'m': 1.0, 'mm': 1000.0}
 #: Angle units a scene may use.
 ANGLE_UNITS = ('deg', 'rad')
+#: Units a driver's rate may be given in: name -> the SI unit it is converted to.
+RATE_UNITS = {'rpm': 'rad/s', 'rad/s': 'rad/s', 'm/s': 'm/s'}
 #: Nanoseconds per second (ROS stamps are integer nanoseconds).
 NS_PER_S = 1_000_000_000
 #: 2 pi as an exact rational to 400 significant digits: enough to reduce any double
@@ -54,6 +62,32 @@ def rpm_from_rad_per_s(speed: Any, pi: Any = math.pi) -> Any:
     if isinstance(rpm, float) and math.isinf(rpm) and math.isfinite(speed):
         return speed / pi * 30
     return rpm
+
+
+def si_from_rate(value: Any, unit: str) -> Any:
+    """Return a driver's rate given in ``unit`` (:data:`RATE_UNITS`) in SI: rad/s or m/s.
+
+    Only rpm is converted (:func:`rad_per_s_from_rpm`); a rate in rad/s or m/s
+    is returned as it is, to the bit.
+    """
+    if unit == 'rpm':
+        return rad_per_s_from_rpm(value)
+    _check_rate_unit(unit)
+    return value
+
+
+def rate_from_si(value: Any, unit: str) -> Any:
+    """Return a driver's rate in SI (rad/s or m/s) in ``unit`` (:data:`RATE_UNITS`)."""
+    if unit == 'rpm':
+        return rpm_from_rad_per_s(value)
+    _check_rate_unit(unit)
+    return value
+
+
+def _check_rate_unit(unit: str) -> None:
+    if unit not in RATE_UNITS:
+        msg = f'Expected a rate unit in {", ".join(RATE_UNITS)}, got {unit!r}'
+        raise ValueError(msg)
 
 
 def radians_from_degrees(angle: Any, pi: Any = math.pi) -> Any:

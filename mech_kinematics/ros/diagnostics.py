@@ -24,7 +24,7 @@ import time
 from ..units import NS_PER_S
 
 __all__ = ['DEFAULT_MAX_LATENESS_MS', 'ERROR', 'OK', 'STALE', 'Status', 'TickStats', 'WARN',
-           'Window', 'lateness_p99_ns', 'solver_status', 'timing_status']
+           'Window', 'lateness_p99_ns', 'solver_status', 'timing_status', 'waiting_for']
 
 OK, WARN, ERROR, STALE = 0, 1, 2, 3
 
@@ -225,8 +225,23 @@ def lateness_p99_ns(window: Window) -> int | None:
     return _quantile_ns(window.lateness_ns, 0.99)
 
 
+def waiting_for(*, configured: bool, publishing: bool, managed: bool, clock: bool) -> str:
+    """Return what the node waits for before it publishes ('' for nothing).
+
+    ``configured``: a scene is loaded; ``publishing``: the tick thread runs
+    or the input is active; ``managed``: it follows the lifecycle;
+    ``clock``: simulated time has no ``/clock`` yet.
+    """
+    if not configured:
+        return 'configure (lifecycle)'
+    if not publishing:
+        return 'activate (lifecycle)' if managed else 'the start'
+    return '/clock' if clock else ''
+
+
 def solver_status(window: Window, *, name: str, hardware_id: str, near_singular: float,
-                  waiting_for: str = '', assembly: str = '', extra_joints: str = '') -> Status:
+                  waiting_for: str = '', assembly: str = '', extra_joints: str = '',
+                  solver_path: str = '') -> Status:
     """Return the solver status of ``window``.
 
     ERROR if any instant could not be solved or was refused (with the last
@@ -242,7 +257,9 @@ def solver_status(window: Window, *, name: str, hardware_id: str, near_singular:
     engagement instants), are counted (keys ``jump_instants``,
     ``jump_instants_total``) and do not change the level.
     ``assembly`` says in one line where the scene cannot assemble (key
-    ``assembly``).
+    ``assembly``). ``solver_path`` says which function solves the ticks (key
+    ``solver_path``): ``compiled``, or ``general: REASON`` where the tick
+    does not compile (:mod:`~mech_kinematics.ros.solver_path`).
     """
     w = window
     if waiting_for:
@@ -270,6 +287,8 @@ def solver_status(window: Window, *, name: str, hardware_id: str, near_singular:
         ('jump_instants_total', str(w.totals.get('jump_instants', 0))),
         ('last_error', w.last_error),
     ]
+    if solver_path:
+        values.append(('solver_path', solver_path))
     if assembly:
         values.append(('assembly', assembly))
     if extra_joints:

@@ -36,8 +36,6 @@ __all__ = ['Drive', 'TickDriver', 'Timebase', 'Wake']
 
 #: A change of the system clock against the monotonic clock beyond this is a jump, ns.
 CLOCK_JUMP_NS = 10_000_000
-#: Ways of giving one speed: setting one drops the other.
-_SPEEDS = ('speed_rpm', 'speed')
 
 
 class Wake(NamedTuple):
@@ -60,6 +58,8 @@ class Timebase(Protocol):
 
     #: The keyword arguments ``update`` takes.
     CHANGES: tuple[str, ...]
+    #: The keywords that each give its speed (in their own units): one given replaces another.
+    RATES: tuple[str, ...]
 
     def update(self, t: int, **changes: Any) -> None:
         """From instant ``t`` (ns) on, drive with ``changes``, keeping the position there."""
@@ -89,8 +89,9 @@ class Drive:
     def fold(self) -> None:
         """Take the pending changes into the start values (no instant published yet)."""
         changes, self.pending = self.pending, {}
-        if any(key in changes for key in _SPEEDS):
-            self.start.update((key, None) for key in _SPEEDS if key in self.start)
+        rates = self.kind.RATES
+        if any(key in changes for key in rates):
+            self.start.update((key, None) for key in rates if key in self.start)
         self.start.update(changes)
 
     def apply(self, at_ns: int) -> None:
@@ -133,8 +134,7 @@ class TickDriver:
         The time base is built at the driver's first published instant ``t0``
         as ``kind(t0, **start)``.
         """
-        if kind is CrankTimebase:
-            start = {'speed_rpm': None, 'speed': None, **start}
+        start = {**dict.fromkeys(kind.RATES), **start}
         with self._lock:
             if name not in self.drives:
                 self.drives[name] = Drive(name, start, kind)
@@ -147,9 +147,10 @@ class TickDriver:
             msg = (f'Expected drive changes among {", ".join(drive.kind.CHANGES)}, '
                    f'got {sorted(unknown)}')
             raise ValueError(msg)
+        rates = drive.kind.RATES
         with self._lock:
-            if any(key in changes for key in _SPEEDS):
-                for key in _SPEEDS:
+            if any(key in changes for key in rates):
+                for key in rates:
                     drive.pending.pop(key, None)
             drive.pending.update(changes)
 

@@ -14,21 +14,23 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 import math
-import re
-from typing import Any
+from typing import Any, TYPE_CHECKING
 
 from .diagnostics import DEFAULT_MAX_LATENESS_MS
 from .markers import DEFAULT_ACCELERATION_SCALE, DEFAULT_VELOCITY_SCALE
 from .topic_drive import DEFAULT_JUMP_BACK_S, EXTRA_JOINTS, REFUSE
 from ..bounds import MAX_ERROR
 from ..scene import DEFAULT_SCENE
-from ..units import NS_PER_S, rpm_from_rad_per_s
+from ..units import NS_PER_S, rate_from_si, si_from_rate
 
-__all__ = ['CATCH_UP', 'DRIVE_MODES', 'LATE_TICKS', 'MAX_NAME_CHARS', 'MAX_PATH_CHARS',
-           'PARAMETERS', 'ParameterSpec', 'SHOWN_CHARS', 'SKIP', 'STATE_DEPTH', 'TIME', 'TOPIC',
-           'catch_up_window_ns',
-           'depth_refusal', 'driver_parameters', 'first_crank_aliases', 'frame_refusal',
-           'joint_refusal', 'refusal', 'rpm_parameter', 'shown', 'spec']
+if TYPE_CHECKING:
+    from ..solver.base import Driver
+
+__all__ = ['CATCH_UP', 'DRIVE_MODES', 'DRIVER_RATES', 'DriverRates', 'LATE_TICKS',
+           'MAX_NAME_CHARS', 'MAX_PATH_CHARS', 'PARAMETERS', 'ParameterSpec', 'SHOWN_CHARS',
+           'SKIP', 'STATE_DEPTH', 'TIME', 'TOPIC', 'bounded_by_max_crank_speed',
+           'catch_up_window_ns', 'depth_refusal', 'driver_parameters', 'first_crank_aliases',
+           'frame_refusal', 'joint_refusal', 'rate_default', 'refusal', 'shown', 'spec']
 
 #: ``late_ticks`` values: publish every missed grid instant, or only the latest.
 CATCH_UP = 'catch_up'
@@ -164,61 +166,109 @@ PARAMETERS = (
 
 _BY_NAME = {p.name: p for p in PARAMETERS}
 
-#: Ranges of the drivers' parameters (``inputs.NAME.*``): a crank's as crank_speed_rpm's and
-#: crank_accel's; an actuator's extension rate (m/s) and acceleration (m/s^2).
-ACTUATOR_SPEED_RANGE = (-100.0, 100.0)
-ACTUATOR_ACCEL_RANGE = (-10_000.0, 10_000.0)
-_DRIVER_NAME = re.compile(r'^inputs\.([A-Za-z_][A-Za-z0-9_]*)\.(speed_rpm|speed|accel)$')
+
+def _range(name: str) -> tuple[float, float]:
+    low, high = _BY_NAME[name].low, _BY_NAME[name].high
+    assert low is not None and high is not None
+    return low, high
 
 
-def rpm_parameter(speed: float) -> float:
-    """Return ``speed`` (rad/s) in rpm, rounded to 12 significant digits (-120, not -119.99...)."""
-    return float(f'{rpm_from_rad_per_s(speed):.12g}')
+@dataclass(frozen=True)
+class DriverRates:
+    """What a driver's two parameters (``inputs.NAME.<rate key>``, ``inputs.NAME.accel``) allow.
+
+    Attributes
+    ----------
+    speed_range, accel_range : (float, float)
+        Inclusive ranges of the rate (in the unit of the kind's
+        ``rate_parameter``) and of the acceleration (its joint type's unit).
+    speed_text, accel_text : str
+        Their descriptions, ``{name}`` standing for the driver's.
+    """
+
+    speed_range: tuple[float, float]
+    accel_range: tuple[float, float]
+    speed_text: str
+    accel_text: str
 
 
-def driver_parameters(drivers: Sequence[Any]) -> tuple[ParameterSpec, ...]:
+#: A driver's parameters by the unit its kind sets its rate in (``Driver.rate_parameter``):
+#: a crank's in rpm (the ranges of crank_speed_rpm and crank_accel), an actuator's in m/s.
+DRIVER_RATES = {
+    'rpm': DriverRates(
+        _range('crank_speed_rpm'), _range('crank_accel'),
+        'Speed of crank {name}, + CCW, from the tick at which it is applied. Defaults to the '
+        "scene's", "Angular acceleration of crank {name}, + CCW. Defaults to the scene's"),
+    'm/s': DriverRates(
+        (-100.0, 100.0), (-10_000.0, 10_000.0),
+        'Extension rate of actuator {name}, from the tick at which it is applied (its length '
+        "stays continuous). Defaults to the scene's",
+        "Extension acceleration of actuator {name}. Defaults to the scene's"),
+}
+
+
+def rate_default(driver: Driver) -> float:
+    """Return the default of ``driver``'s rate parameter: the scene's rate in that unit.
+
+    A rate given in the parameter's unit is kept as given, to the bit (a
+    crank's ``speed_rpm: 7`` is 7.0 rpm); one given in another unit is
+    converted and rounded to 12 significant digits (a crank's ``speed:`` of
+    -4 pi rad/s is -120 rpm, not -119.99...).
+    """
+    rate, unit = driver.rate, driver.rate_parameter.unit
+    if rate.unit == unit:
+        return float(rate.value)
+    return float(f'{rate_from_si(si_from_rate(rate.value, rate.unit), unit):.12g}')
+
+
+def _driver_rates(driver: Driver) -> DriverRates:
+    unit = driver.rate_parameter.unit
+    try:
+        return DRIVER_RATES[unit]
+    except KeyError:
+        msg = (f'Expected driver {driver.name} to set its rate in one of '
+               f'{", ".join(DRIVER_RATES)}, got {unit!r}')
+        raise ValueError(msg) from None
+
+
+def driver_parameters(drivers: Sequence[Driver]) -> tuple[ParameterSpec, ...]:
     """Return the parameters of a scene's drivers, defaulting to the scene's values.
 
-    For each driver NAME (``Scene.drivers``: ``name``, ``joint_type``,
-    ``speed``, ``accel``): ``inputs.NAME.speed_rpm`` and ``inputs.NAME.accel``
-    for a crank (rpm, rad/s^2; the ranges of ``crank_speed_rpm`` and
-    ``crank_accel``), ``inputs.NAME.speed`` and ``inputs.NAME.accel`` for an
-    actuator (m/s, m/s^2). The node declares them when it loads the scene.
+    For each driver NAME (``Scene.drivers``): ``inputs.NAME.<key>`` with the
+    key and unit of its kind's ``rate_parameter`` (a crank's ``speed_rpm``,
+    rpm; an actuator's ``speed``, m/s; :func:`rate_default`), and
+    ``inputs.NAME.accel`` in its joint type's unit (rad/s^2, m/s^2), with the
+    ranges and words of :data:`DRIVER_RATES`. The node declares them when it
+    loads the scene.
     """
     specs = []
-    speed_rpm, accel = spec('crank_speed_rpm'), spec('crank_accel')
     for d in drivers:
-        base = f'inputs.{d.name}.'
-        if d.joint_type == 'revolute':
-            specs += [
-                ParameterSpec(base + 'speed_rpm', 'double', rpm_parameter(d.speed),
-                              f'Speed of crank {d.name}, + CCW, from the tick at which it is '
-                              "applied. Defaults to the scene's", 'rpm', speed_rpm.low,
-                              speed_rpm.high),
-                ParameterSpec(base + 'accel', 'double', float(d.accel),
-                              f'Angular acceleration of crank {d.name}, + CCW. Defaults to '
-                              "the scene's", 'rad/s^2', accel.low, accel.high)]
-        else:
-            specs += [
-                ParameterSpec(base + 'speed', 'double', float(d.speed),
-                              f'Extension rate of actuator {d.name}, from the tick at which '
-                              'it is applied (its length stays continuous). Defaults to the '
-                              "scene's", 'm/s', *ACTUATOR_SPEED_RANGE),
-                ParameterSpec(base + 'accel', 'double', float(d.accel),
-                              f'Extension acceleration of actuator {d.name}. Defaults to the '
-                              "scene's", 'm/s^2', *ACTUATOR_ACCEL_RANGE)]
+        base, rates, (key, unit) = f'inputs.{d.name}.', _driver_rates(d), d.rate_parameter
+        specs += [
+            ParameterSpec(base + key, 'double', rate_default(d),
+                          rates.speed_text.format(name=d.name), unit, *rates.speed_range),
+            ParameterSpec(base + 'accel', 'double', float(d.accel),
+                          rates.accel_text.format(name=d.name), d.joint_type.units[2],
+                          *rates.accel_range)]
     return tuple(specs)
 
 
-def first_crank_aliases(drivers: Sequence[Any]) -> dict[str, str]:
+def bounded_by_max_crank_speed(driver: Driver) -> bool:
+    """Return whether ``max_crank_speed_rpm`` bounds ``driver``: its rate is set in rpm."""
+    return driver.rate_parameter.unit == spec('max_crank_speed_rpm').unit
+
+
+def first_crank_aliases(drivers: Sequence[Driver]) -> dict[str, str]:
     """Return {``crank_speed_rpm``, ``crank_accel``: the first driver's names}, if it is a crank.
 
-    The two v1 names stay the first crank's: setting either name sets both.
+    The two v1 names stay the first crank's (a first driver whose rate is set
+    in rpm): setting either name sets both.
     """
-    if not drivers or drivers[0].joint_type != 'revolute':
+    if not drivers or not bounded_by_max_crank_speed(drivers[0]):
         return {}
     base = f'inputs.{drivers[0].name}.'
-    return {'crank_speed_rpm': base + 'speed_rpm', 'crank_accel': base + 'accel'}
+    return {'crank_speed_rpm': base + drivers[0].rate_parameter.key,
+            'crank_accel': base + 'accel'}
 
 
 def spec(name: str) -> ParameterSpec:

@@ -222,6 +222,10 @@ class CrankTimebase:
 
     #: The keyword arguments :meth:`update` takes.
     CHANGES = ('speed_rpm', 'speed', 'accel', 'max_speed_rpm')
+    #: The keywords that each give the speed, in their own unit (rpm, rad/s): one at a time,
+    #: and one given replaces the other (the keys of a crank's :class:`~mech_kinematics.
+    #: solver.base.Rate`).
+    RATES = ('speed_rpm', 'speed')
 
     def __init__(self, t0: int, angle: float, speed_rpm: float | None, accel: float,
                  max_speed_rpm: float, *, speed: float | None = None, turns: int = 0) -> None:
@@ -422,6 +426,8 @@ class ActuatorTimebase:
 
     #: The keyword arguments :meth:`update` takes.
     CHANGES = ('speed', 'accel')
+    #: The keyword that gives the extension rate (m/s).
+    RATES = ('speed',)
 
     def __init__(self, t0: int, length: float, speed: float, accel: float) -> None:
         _check_finite(length=length, speed=speed, accel=accel)

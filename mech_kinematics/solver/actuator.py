@@ -23,7 +23,7 @@ from dataclasses import dataclass, replace
 import math
 from typing import Any, TYPE_CHECKING
 
-from .base import Driver
+from .base import Driver, Rate, RateParameter
 from .context import _Context
 from .graph import Fragment, JointType, PRISMATIC
 from .model import _check_finite, _check_length, _check_name, _g, SceneUnits
@@ -131,6 +131,21 @@ class Actuator(Driver):
     def start(self) -> float:
         """The driver's position at time zero: its length, m."""
         return self.length
+
+    @property
+    def turns(self) -> int:
+        """0: an actuator does not turn."""
+        return 0
+
+    @property
+    def rate(self) -> Rate:
+        """Its extension rate as the scene gives it: ``speed``, m/s."""
+        return Rate('speed', self.speed, 'm/s')
+
+    @property
+    def rate_parameter(self) -> RateParameter:
+        """Its extension rate is set in m/s, as ``speed``."""
+        return RateParameter('speed', 'm/s')
 
     @property
     def reach(self) -> float:

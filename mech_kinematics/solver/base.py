@@ -55,7 +55,7 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Iterator, Mapping, Sequence
-from typing import Any, ClassVar, Protocol, TYPE_CHECKING
+from typing import Any, ClassVar, NamedTuple, Protocol, TYPE_CHECKING
 
 from ..errors import SceneError
 
@@ -324,14 +324,36 @@ class Item(ABC):
         return dict(self.fragment().coordinates)
 
 
+class Rate(NamedTuple):
+    """A driver's rate as it was given: its ``key``, its ``value`` in its own ``unit``.
+
+    A crank's ``speed_rpm: 7`` is ``Rate('speed_rpm', 7.0, 'rpm')``: it stays 7.0
+    rpm (never 7 pi / 30 rad/s and back) from the scene to the node's time base,
+    which converts it once (:func:`~mech_kinematics.units.si_from_rate`). The
+    key is the scene's and the time base's keyword for that unit.
+    """
+
+    key: str
+    value: float
+    unit: str
+
+
+class RateParameter(NamedTuple):
+    """The last part of the name and the unit of the parameter that sets a driver's rate."""
+
+    key: str
+    unit: str
+
+
 class Driver(ABC):
     """A driver of the mechanism (a crank, a linear actuator): what the rest asks of its kind.
 
     A driver's kind is a frozen dataclass deriving from this class, in a
     module of its own (:mod:`.crank`, :mod:`.actuator`), registered in
     :data:`~.registry.DRIVERS`; every method is abstract. Its fields
-    ``speed`` and ``accel`` are its default rates (rad/s and rad/s^2, or m/s
-    and m/s^2).
+    ``speed`` and ``accel`` are its default rates in SI (rad/s and rad/s^2,
+    or m/s and m/s^2), what the solver takes; :attr:`rate` is its speed as
+    the scene gave it, in the unit it was given in.
     """
 
     speed: float
@@ -370,6 +392,21 @@ class Driver(ABC):
     @abstractmethod
     def stroke(self) -> tuple[float, float] | None:
         """Its inclusive limits, m, or ``None`` where its position may be anything."""
+
+    @property
+    @abstractmethod
+    def turns(self) -> int:
+        """Whole turns to add to :attr:`start` (a crank's start far out); 0 if it does not turn."""
+
+    @property
+    @abstractmethod
+    def rate(self) -> Rate:
+        """Its default speed as the scene gave it: key, value and unit (:class:`Rate`)."""
+
+    @property
+    @abstractmethod
+    def rate_parameter(self) -> RateParameter:
+        """The key and unit its speed is set in (``inputs.NAME.<key>``, the node's parameter)."""
 
     @property
     @abstractmethod

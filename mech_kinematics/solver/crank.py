@@ -11,7 +11,7 @@ from typing import Any, TYPE_CHECKING, TypedDict
 
 import numpy as np
 
-from .base import Driver
+from .base import Driver, Rate, RateParameter
 from .context import _Context, _U2, _U4
 from .graph import Body, Fragment, Frame, JointType, Motion, pin, REVOLUTE, Role
 from .model import _check_finite, _check_length, _check_name, SceneUnits
@@ -65,6 +65,10 @@ class Crank(Driver):
         ``angle + 2 pi turns``, the sum never formed in floating point (a scene
         file's angle far out, as 1e17 deg, is read as an angle within a turn
         plus whole turns; only an intermittent drive tells the turns apart).
+    rpm : float or None
+        The speed as the scene gave it in rpm (``speed_rpm``), kept as written;
+        ``speed`` is then ``rad_per_s_from_rpm(rpm)``. ``None`` where the speed
+        was given in rad/s (``speed``).
     """
 
     position_key = 'angle'
@@ -78,6 +82,7 @@ class Crank(Driver):
     speed: float = 0.0
     accel: float = 0.0
     turns: int = 0
+    rpm: float | None = None
 
     def __post_init__(self) -> None:
         """Validate the fields."""
@@ -91,6 +96,10 @@ class Crank(Driver):
         if not isinstance(self.turns, int) or isinstance(self.turns, bool):
             msg = f'Expected the crank whole turns to be an int, got {self.turns!r}'
             raise SceneError(msg, (self, 'turns'))
+        if self.rpm is not None and self.speed != rad_per_s_from_rpm(self.rpm):
+            msg = (f'Expected the crank speed to be its rpm ({self.rpm!r}) in rad/s, '
+                   f'{rad_per_s_from_rpm(self.rpm)!r}, got {self.speed!r}')
+            raise SceneError(msg, (self, 'speed'))
 
     @classmethod
     def from_scene(cls, read: Reading, raw: Any, where: str) -> Crank:
@@ -107,17 +116,19 @@ class Crank(Driver):
                    f'speed_rpm (rpm), got both (speed: {read.brief(raw["speed"])}, speed_rpm: '
                    f'{read.brief(raw["speed_rpm"])})')
             raise SceneError(msg)
+        rpm = None
         if given == ['speed']:
             speed, key = read.number(raw, 'speed', where), 'speed'
         else:
-            speed = rad_per_s_from_rpm(read.number(raw, 'speed_rpm', where, 0.0))
-            key = 'speed_rpm'
+            rpm = read.number(raw, 'speed_rpm', where, 0.0)
+            speed, key = rad_per_s_from_rpm(rpm), 'speed_rpm'
         angle, turns = read.start_angle(raw, 'angle', where)
         built: Crank = read.build(
-            where, {'speed': key}, cls,
+            where, {'speed': key, 'rpm': key}, cls,
             link=read.name(raw, 'link', where), center=read.name(raw, 'center', where),
             point=read.name(raw, 'point', where), length=read.length(raw, 'length', where),
-            angle=angle, turns=turns, speed=speed, accel=read.number(raw, 'accel', where, 0.0))
+            angle=angle, turns=turns, speed=speed, accel=read.number(raw, 'accel', where, 0.0),
+            rpm=rpm)
         return built
 
     @property
@@ -149,6 +160,18 @@ class Crank(Driver):
     def stroke(self) -> tuple[float, float] | None:
         """A crank has no stroke limits."""
         return None
+
+    @property
+    def rate(self) -> Rate:
+        """Its speed as the scene gave it: ``speed_rpm`` in rpm, or ``speed`` in rad/s."""
+        if self.rpm is not None:
+            return Rate('speed_rpm', self.rpm, 'rpm')
+        return Rate('speed', self.speed, 'rad/s')
+
+    @property
+    def rate_parameter(self) -> RateParameter:
+        """Its speed is set in rpm, as ``speed_rpm``."""
+        return RateParameter('speed_rpm', 'rpm')
 
     @property
     def reach(self) -> float:

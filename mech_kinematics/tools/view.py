@@ -57,7 +57,8 @@ import warnings
 
 from .cli import run_tool
 from ..ros import topics
-from ..units import NS_PER_S, rpm_from_rad_per_s
+from ..ros.parameters import first_crank_aliases
+from ..units import NS_PER_S, rate_from_si
 
 __all__ = ['DEFAULT_PORT', 'PAGE', 'TOKEN_HEADER', 'ViewServer', 'add_parser',
            'frame_from_state', 'main', 'scene_bounds']
@@ -111,7 +112,7 @@ def _driver_samples(driver: Any, count: int) -> Any:
     import numpy as np
 
     start = float(driver.start)
-    if driver.joint_type == 'revolute':
+    if driver.joint_type.angular:
         values = np.linspace(0.0, 2.0 * math.pi, count, endpoint=False)
     elif driver.stroke is not None:
         values = np.linspace(float(driver.stroke[0]), float(driver.stroke[1]), count)
@@ -454,21 +455,22 @@ class ViewServer:
         # Before joint_states: the node's own report of its crank's speed, where it is a number.
         reported = _finite(values.get('crank_speed'))
         if reported is not None:
-            out['crank_speed_rpm'] = rpm_from_rad_per_s(reported)
+            out['crank_speed_rpm'] = rate_from_si(reported, 'rpm')
         if scene is None:
             return out
         joints = joints or {}
         positions: list[float] = []
         speeds: list[float] = []
         missing = []
+        first_crank = bool(first_crank_aliases(scene.drivers))
         for index, driver in enumerate(scene.drivers):
             position, speed = joints.get(driver.name, (None, None))
-            crank = driver.joint_type == 'revolute'
-            shown = None if speed is None else rpm_from_rad_per_s(speed) if crank else speed
-            out['drivers'].append({'name': driver.name, 'kind': 'crank' if crank else 'actuator',
-                                   'unit': 'rpm' if crank else 'm/s', 'position': position,
-                                   'speed': shown})
-            if index == 0 and crank and shown is not None:
+            # The speed in the unit the node's parameter sets it in (rpm, m/s).
+            unit = driver.rate_parameter.unit
+            shown = None if speed is None else rate_from_si(speed, unit)
+            out['drivers'].append({'name': driver.name, 'kind': type(driver).__name__.lower(),
+                                   'unit': unit, 'position': position, 'speed': shown})
+            if index == 0 and first_crank and shown is not None:
                 out['crank_speed_rpm'] = shown
             if position is None:
                 missing.append(driver.name)
@@ -521,9 +523,10 @@ class ViewServer:
             msg = f'Expected a driver of the scene ({", ".join(names)}), got {driver!r}'
             raise ValueError(msg)
         index = names.index(driver)
-        if drivers[index].joint_type != 'revolute':
-            return f'inputs.{driver}.speed', 'm/s'
-        return ('crank_speed_rpm' if index == 0 else f'inputs.{driver}.speed_rpm'), 'rpm'
+        key, unit = drivers[index].rate_parameter
+        if index == 0 and first_crank_aliases(drivers):
+            return 'crank_speed_rpm', unit
+        return f'inputs.{driver}.{key}', unit
 
     def set_speed(self, value: float, driver: str | None = None) -> dict[str, Any]:
         """Ask the node to set a driver's speed; return {'successful', 'reason'}.

@@ -14,6 +14,7 @@ from fractions import Fraction
 import math
 import os
 from pathlib import Path
+import re
 import signal
 import subprocess
 import sys
@@ -339,6 +340,7 @@ def test_diagnostics_report_status_and_timing(node):
     solver_values = {kv.key: kv.value for kv in solver.values}
     assert 0 < float(solver_values['worst_singularity_measure']) <= 1
     assert solver_values['assembly'] == 'assembles at every crank angle'      # issue 11
+    assert solver_values['solver_path'] == 'compiled'                          # issue 30
     values = {kv.key: kv.value for kv in timing.values}
     assert float(values['achieved_rate_hz']) == pytest.approx(RATE_HZ, rel=0.3)
     for key in ('late_ticks', 'skipped_ticks', 'late_ticks_total', 'skipped_ticks_total'):
@@ -428,6 +430,50 @@ def test_sim_time_drives_the_angle_exactly(ros, tmp_path):
         if proc.proc.poll() is None:
             proc.proc.kill()
         ros.node.destroy_publisher(clock_pub)
+
+
+PINNED_SCENE = """\
+name: pinned_four_bar
+description: The Khurmi four-bar with a pin of 5 mm at C, whose rubbing velocities are bound.
+units: {length: mm, angle: deg}
+ground:
+  A: [0, 0]
+  D: [150, 0]
+input: {link: crank, center: A, point: B, length: 40, angle: 60, speed_rpm: -120}
+dyads:
+  - type: RRR
+    point: C
+    links:
+      - {name: coupler, from: B, length: 150}
+      - {name: rocker, from: D, length: 80}
+    branch: 1
+pins:
+  C: 5
+"""
+
+
+def test_a_tick_that_does_not_compile_says_why_on_diagnostics_and_in_the_log(ros, tmp_path):
+    """Pins to bound: solver_path 'general: REASON' on diagnostics, the reason logged at info.
+
+    Issue 30: the node used to log only that the general solver served.
+    """
+    ns = f'{SESSION}/pinned'
+    path = tmp_path / 'pinned.yaml'
+    path.write_text(PINNED_SCENE)
+    diag = ros.collect(DiagnosticArray, f'{ns}/diagnostics')
+    js = ros.collect(JointState, f'{ns}/joint_states')
+    proc = NodeProcess(tmp_path / 'node', '-r', f'__ns:={ns}', '-p', f'scene:={path}',
+                       '-p', 'rate_hz:=50.0')
+    reason = "pins to bound: the rubbing velocities at C are the general path's"
+    try:
+        wait_for(lambda: js and diag, STARTUP_S, 'joint_states and diagnostics')
+        solver = next(s for s in diag[-1].status if s.name.endswith(': solver'))
+        assert {kv.key: kv.value for kv in solver.values}['solver_path'] == f'general: {reason}'
+    finally:
+        status, _ = proc.stop(signal.SIGINT)
+    assert status == 0, proc.output()
+    assert re.search(rf'\[INFO\] \[[0-9.]+\] \[[^]]*\]: solved by the general solver: '
+                     rf'{re.escape(reason)}\n', proc.output()), proc.output()
 
 
 PARTIAL_SCENE = """\
@@ -538,7 +584,7 @@ SIGNAL_BEFORE_SPIN = """\
 import sys
 import rclpy
 import rclpy.executors
-import mech_kinematics.ros.node as kn
+from mech_kinematics.ros.main import main
 native = rclpy.executors._rclpy
 class Late:
     def __getattr__(self, name):
@@ -547,7 +593,7 @@ class Late:
         rclpy.shutdown()    # as rclpy's SIGTERM handler does, just before the wait set is made
         return native.WaitSet(*args)
 rclpy.executors._rclpy = Late()
-sys.exit(kn.main())
+sys.exit(main())
 """
 
 
@@ -570,11 +616,12 @@ def test_a_signal_while_the_node_starts_is_a_clean_exit(tmp_path):
 
 FAILING_TICK = """\
 import sys
-import mech_kinematics.ros.node as kn
+from mech_kinematics.ros.main import main
+from mech_kinematics.ros.tick_thread import TickThread
 def fail(self, *args):
     raise RuntimeError('injected failure')
-kn.KinematicsNode._tick = fail
-sys.exit(kn.main())
+TickThread.tick = fail
+sys.exit(main())
 """
 
 

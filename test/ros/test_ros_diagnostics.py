@@ -6,7 +6,7 @@ import math
 
 from mech_kinematics.ros.diagnostics import (DEFAULT_MAX_LATENESS_MS, ERROR, lateness_p99_ns,
                                              OK, solver_status, STALE, TickStats,
-                                             timing_status, WARN)
+                                             timing_status, waiting_for, WARN)
 
 NS = 1_000_000_000
 NAME = {'name': 'mech_kinematics', 'hardware_id': 'four_bar'}
@@ -206,3 +206,25 @@ def test_the_joints_ignored_and_passed_are_said_in_topic_drive_only():
     assert solver.value('passed_joints') == ', '.join(f'j{k}' for k in range(20)) + ' and 5 more'
     keys = dict(solver_status(window, near_singular=1e-3, **NAME).values)
     assert not {'extra_joints', 'passed_joints', 'stamp_jumps_back'} & set(keys)
+
+
+def test_the_solver_path_says_which_function_solves_and_why():
+    """Key solver_path: 'compiled', or 'general: REASON' (issue 30); absent before a scene."""
+    w = window()
+    reason = "general: pins to bound: the rubbing velocities at C are the general path's"
+    status = solver_status(w, near_singular=1e-3, solver_path=reason, **NAME)
+    assert status.level == OK and status.value('solver_path') == reason
+    assert solver_status(w, near_singular=1e-3, solver_path='compiled',
+                         **NAME).value('solver_path') == 'compiled'
+    assert 'solver_path' not in dict(solver_status(w, near_singular=1e-3, **NAME).values)
+
+
+def test_what_the_node_waits_for_before_it_publishes():
+    """The lifecycle's configure, then its activate (or the start), then a simulated clock."""
+    node = {'managed': True, 'clock': False}
+    assert waiting_for(configured=False, publishing=False, **node) == 'configure (lifecycle)'
+    assert waiting_for(configured=True, publishing=False, **node) == 'activate (lifecycle)'
+    assert waiting_for(configured=True, publishing=False, managed=False,
+                       clock=False) == 'the start'
+    assert waiting_for(configured=True, publishing=True, managed=False, clock=True) == '/clock'
+    assert waiting_for(configured=True, publishing=True, **node) == ''

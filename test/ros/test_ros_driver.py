@@ -299,6 +299,7 @@ class LinearTimebase:
     """A stand-in actuator time base (m, m/s): what a driver that does not turn provides."""
 
     CHANGES = ('speed',)
+    RATES = ('speed',)
 
     def __init__(self, t0, position, speed):
         self.t0, self.position, self.speed = t0, Fraction(position), Fraction(speed)

@@ -2,13 +2,16 @@
 # SPDX-License-Identifier: Apache-2.0
 """The node's parameter table and its rules, without ROS."""
 
-from dataclasses import dataclass
 import math
 
 import pytest
 
-from mech_kinematics.ros.parameters import (driver_parameters, first_crank_aliases,
-                                            joint_refusal, PARAMETERS, refusal, spec)
+from mech_kinematics.ros.parameters import (bounded_by_max_crank_speed, driver_parameters,
+                                            first_crank_aliases, joint_refusal, PARAMETERS,
+                                            rate_default, refusal, spec)
+from mech_kinematics.solver.actuator import Actuator
+from mech_kinematics.solver.crank import Crank
+from mech_kinematics.units import rad_per_s_from_rpm
 
 
 @pytest.mark.parametrize('name, value, reason', [
@@ -134,20 +137,9 @@ def test_a_catch_up_burst_fits_the_history(rate_hz, max_catch_up_s):
     assert window <= round(max_catch_up_s * 1e9)
 
 
-@dataclass(frozen=True)
-class Driver:
-    """A driver as the parameters see it (the drivers API of issue 18)."""
-
-    name: str
-    joint_type: str
-    speed: float
-    accel: float
-
-
-FIVE_BAR = (Driver('left', 'revolute', -4 * math.pi, 0.0),
-            Driver('right', 'revolute', 2 * math.pi, 1.5))
-EXCAVATOR = (Driver('boom_cyl', 'prismatic', 0.05, 0.0), Driver('stick_cyl', 'prismatic', -0.02,
-                                                                0.01))
+FIVE_BAR = (Crank('left', 'A', 'B', 0.1, speed=-4 * math.pi),
+            Crank('right', 'E', 'D', 0.1, speed=2 * math.pi, accel=1.5))
+EXCAVATOR = (Actuator('boom_cyl', 1.0, 0.05, 0.0), Actuator('stick_cyl', 1.0, -0.02, 0.01))
 
 
 def test_each_driver_has_its_parameters_with_the_scenes_defaults():
@@ -186,6 +178,21 @@ def test_driver_parameters_are_refused_with_a_reason(name, value, reason):
     drivers = {p.name: p for p in driver_parameters(FIVE_BAR[:1] + EXCAVATOR[:1])}
     assert refusal(name, value, drivers).startswith(reason)
     assert refusal('inputs.boom_cyl.speed', -0.5, drivers) is None
+
+
+def test_a_rate_keeps_the_unit_the_scene_gave_it():
+    """A crank's speed_rpm is its parameter's default to the bit; rad/s are rounded rpm."""
+    rpm = 7.123456789012345     # more digits than 12: a round trip through rad/s rounded them
+    crank = Crank('c', 'A', 'B', 0.1, speed=rad_per_s_from_rpm(rpm), rpm=rpm)
+    assert crank.rate == ('speed_rpm', rpm, 'rpm')
+    assert rate_default(crank) == rpm
+    [speed, _] = driver_parameters([crank])
+    assert (speed.name, speed.default, speed.unit) == ('inputs.c.speed_rpm', rpm, 'rpm')
+    assert rate_default(FIVE_BAR[0]) == -120.0
+    assert FIVE_BAR[0].rate == ('speed', -4 * math.pi, 'rad/s')
+    assert rate_default(EXCAVATOR[1]) == -0.02
+    bounded = [bounded_by_max_crank_speed(d) for d in FIVE_BAR + EXCAVATOR]
+    assert bounded == [True, True, False, False]
 
 
 def test_crank_speed_rpm_stays_the_first_cranks_name():

@@ -32,6 +32,13 @@ def test_the_link_is_as_long_as_the_actuator():
     assert boom().drivers[0].joint_type is g.PRISMATIC
 
 
+def test_its_rate_is_its_extension_rate_in_m_per_s():
+    """Its rate as the scene gives it, set as speed in m/s; it does not turn (issue 30)."""
+    cyl = mk.Actuator('cyl', 1.5, -0.25, 0.5)
+    assert cyl.rate == ('speed', -0.25, 'm/s') and cyl.rate_parameter == ('speed', 'm/s')
+    assert cyl.turns == 0
+
+
 def test_a_length_outside_the_stroke_is_refused_with_the_stroke():
     """A length beyond the stroke is refused like a position that cannot assemble."""
     with pytest.raises(mk.AssemblyError, match=r'within its stroke'):

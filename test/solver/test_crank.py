@@ -12,6 +12,7 @@ import pytest
 import mech_kinematics as mk
 from mech_kinematics.scene import parse_scene
 from mech_kinematics.solver import graph as g
+from mech_kinematics.units import rad_per_s_from_rpm
 
 ATOL = 1e-15
 
@@ -50,6 +51,23 @@ def test_its_speed_is_given_once_in_rpm_or_rad_per_s():
         == pytest.approx(2 * math.pi)
     with pytest.raises(mk.SceneError, match='input.speed: expected the crank speed once'):
         parse_scene({**base, 'input': {**base['input'], 'speed': 1, 'speed_rpm': 1}})
+
+
+def test_its_rate_keeps_the_unit_the_scene_gave_it():
+    """speed_rpm is kept as written (Crank.rpm), speed in rad/s as given (issue 30)."""
+    base = {'name': 's', 'units': {'length': 'm', 'angle': 'rad'}, 'ground': {'A': [0, 0]},
+            'input': {'link': 'crank', 'center': 'A', 'point': 'B', 'length': 0.05}}
+    rpm = parse_scene({**base, 'input': {**base['input'], 'speed_rpm': 7}}).input
+    assert (rpm.rpm, rpm.speed) == (7.0, rad_per_s_from_rpm(7.0))
+    assert rpm.rate == ('speed_rpm', 7.0, 'rpm')
+    rad = parse_scene({**base, 'input': {**base['input'], 'speed': 300}}).input
+    assert rad.rpm is None and rad.rate == ('speed', 300.0, 'rad/s')
+    still = parse_scene(base).input
+    assert still.rate == ('speed_rpm', 0.0, 'rpm')
+    assert rpm.rate_parameter == rad.rate_parameter == ('speed_rpm', 'rpm')
+    with pytest.raises(mk.SceneError, match=r'^Expected the crank speed to be its rpm \(7\.0\) '
+                                            r'in rad/s, 0\.7330382858376184, got 1\.0$'):
+        mk.Crank('crank', 'A', 'B', 0.05, speed=1.0, rpm=7.0)
 
 
 def test_its_centre_must_be_on_the_ground():

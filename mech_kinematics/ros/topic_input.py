@@ -1,0 +1,186 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""``drive: topic`` on the node: the ``input_joint_states`` subscription, a state per message.
+
+The rules of one input message are :mod:`~mech_kinematics.ros.topic_drive`'s
+(pure); :class:`InputSubscription` is their node side. It subscribes at
+configure (so that the subscription's QoS overrides are declared with the
+others) and publishes only while active: for each message it reads the
+drivers (or the one-line reason it is refused), solves them with the
+function that serves (:class:`~mech_kinematics.ros.solver_path.SolverPath`),
+and publishes the state with the message's stamp (the state topics, without
+accelerations, and ``/tf`` by ``tf_rate_hz`` of the input's time), counting
+it in the diagnostics' :class:`~mech_kinematics.ros.diagnostics.TickStats`.
+
+rclpy's executor rebuilds its wait set of every service, timer and
+subscription of the node for each message it hands over: behind by a burst,
+the node would pay that per message. Each call of the callback takes up to
+:data:`INPUT_BURST` more messages waiting in the subscription's queue (as the
+executor takes them), then lets the executor serve the rest.
+
+Thread use: the executor's thread only.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any, TYPE_CHECKING
+
+from builtin_interfaces.msg import Time
+from rclpy.qos import QoSDurabilityPolicy, QoSHistoryPolicy, QoSProfile, QoSReliabilityPolicy
+from sensor_msgs.msg import JointState
+
+from . import topics
+from .messages import TickMessages
+from .publishing import qos_options
+from .topic_drive import RefusedInput, TopicDrive, TopicInput
+from ..errors import AssemblyError, UntrustedError
+from ..solver.context import NEAR_SINGULAR
+from ..units import NS_PER_S
+
+if TYPE_CHECKING:
+    from .diagnostics import TickStats
+    from .publishing import Publishing
+    from .solver_path import SolverPath
+
+__all__ = ['INPUT_BURST', 'INPUT_DEPTH', 'InputSubscription']
+
+#: History depth of the input_joint_states subscription (a second of input at 1 kHz, as the
+#: state publishers keep: a stall of the executor loses no message).
+INPUT_DEPTH = 1000
+#: Input messages one call of the subscription's callback takes from its queue at most.
+INPUT_BURST = 100
+
+
+class InputSubscription:
+    """The node driven from ``input_joint_states``: one state published per message.
+
+    Parameters
+    ----------
+    node : rclpy.node.Node
+        Where the subscription is created; its logger says what is refused.
+    scene : Scene
+        The scene loaded.
+    solver : SolverPath
+        The function that solves the drivers.
+    publishing : Publishing
+        The scene's publishers.
+    stats : TickStats
+        The diagnostics' counters.
+    frame_id, extra_joints : str
+        The ground frame; what an input's other joints do (``refuse``,
+        ``ignore``, ``pass``).
+    jump_back_s : float
+        ``stamp_jump_back_s``: an earlier stamp by more than this resets the order.
+
+    Attributes
+    ----------
+    topic : TopicDrive
+        The per-message rules.
+    active : bool
+        Whether messages are published (the node's lifecycle: active).
+    """
+
+    def __init__(self, node: Any, scene: Any, solver: SolverPath, publishing: Publishing,
+                 stats: TickStats, *, frame_id: str, extra_joints: str,
+                 jump_back_s: float) -> None:
+        self.node, self.solver, self.publishing, self.stats = node, solver, publishing, stats
+        self.frame_id = frame_id
+        joints, points = scene.output_joints, scene.output_points
+        # What the input determines: positions always, velocities when a message has them.
+        self.messages = {known: TickMessages(joints, points, frame_id, velocities=known,
+                                             accelerations=False) for known in (True, False)}
+        self.topic = TopicDrive(scene.drivers, extra_joints=extra_joints,
+                                jump_back_ns=round(jump_back_s * NS_PER_S),
+                                published_joints=joints)
+        self.active = False
+        qos = QoSProfile(history=QoSHistoryPolicy.KEEP_LAST, depth=INPUT_DEPTH,
+                         reliability=QoSReliabilityPolicy.RELIABLE,
+                         durability=QoSDurabilityPolicy.VOLATILE)
+        self.subscription: Any = node.create_subscription(
+            JointState, topics.INPUT_JOINT_STATES, self.on_input, qos,
+            qos_overriding_options=qos_options())
+
+    def close(self) -> None:
+        """Stop publishing and destroy the subscription."""
+        self.active = False
+        subscription, self.subscription = self.subscription, None
+        if subscription is not None:
+            self.node.destroy_subscription(subscription)
+
+    def on_input(self, msg: JointState) -> None:
+        """Publish the state of each input message waiting, from ``msg`` on, with its stamp."""
+        self.message(msg)
+        subscription = self.subscription
+        for _ in range(INPUT_BURST):
+            if subscription is None or self.subscription is not subscription:
+                return
+            with subscription.handle:
+                taken = subscription.handle.take_message(subscription.msg_type,
+                                                         subscription.raw)
+            if taken is None:
+                return
+            self.message(taken[0])
+
+    def message(self, msg: JointState) -> None:
+        """Publish the state of one input message with its stamp, or say why not."""
+        received = time.monotonic_ns()
+        if not self.active:
+            return      # inactive (lifecycle), or cleaned up while the message waited
+        topic, stats, publishing = self.topic, self.stats, self.publishing
+        stamp = msg.header.stamp
+        stamp_ns = stamp.sec * NS_PER_S + stamp.nanosec
+        try:
+            given = topic.read(stamp.sec, stamp.nanosec, msg.name, msg.position, msg.velocity,
+                               msg.effort)
+            values, measure = self._solve(given)
+        except (RefusedInput, AssemblyError) as exc:
+            kind = 'refused input' if isinstance(exc, RefusedInput) else \
+                'not trusted' if isinstance(exc, UntrustedError) else 'cannot assemble'
+            stats.record(stamp_ns, time.monotonic_ns() - received, False, error=str(exc),
+                         refusal=kind)
+            self.node.get_logger().warning(f'no state published: {exc}',
+                                           throttle_duration_sec=1.0)
+            return
+        sec, nanosec = divmod(given.stamp_ns, NS_PER_S)
+        rendered = self.messages[given.speeds is not None].render_values(values, sec, nanosec)
+        if given.passed is not None:    # extra_joints: pass: names that change per message
+            rendered = (self._joint_state_passed(given, values, sec, nanosec), *rendered[1:])
+        for publish, data in zip(publishing.publish_state, rendered, strict=True):
+            publish(data)
+        if given.jumped_from_ns is not None:
+            publishing.next_tf = 0   # /tf's rate counts from the new order
+            self.node.get_logger().warning(
+                f'{topics.INPUT_JOINT_STATES}: the stamp jumped back '
+                f'{(given.jumped_from_ns - given.stamp_ns) / NS_PER_S:.9g} s (more than '
+                'stamp_jump_back_s): published, the order starts again from it',
+                throttle_duration_sec=1.0)
+        if publishing.tf_due(given.stamp_ns):
+            publishing.tf_frames(values, sec, nanosec)
+        topic.published(given.stamp_ns)
+        stats.record(given.stamp_ns, time.monotonic_ns() - received, False, measure=measure,
+                     near_singular=measure < NEAR_SINGULAR)
+        stats.topic_input(given.stamp_ns, given.jumped_from_ns, given.ignored,
+                          given.passed.names if given.passed is not None else ())
+
+    def _joint_state_passed(self, given: TopicInput, values: Any, sec: int,
+                            nanosec: int) -> JointState:
+        """Return ``joint_states`` with the input's other joints after the mechanism's."""
+        name, position, velocity, effort = self.topic.joint_state_arrays(given, values)
+        msg = JointState(name=name, position=position, velocity=velocity, effort=effort)
+        msg.header.stamp = Time(sec=sec, nanosec=nanosec)
+        msg.header.frame_id = self.frame_id
+        return msg
+
+    def _solve(self, given: TopicInput) -> tuple[Any, float]:
+        """Return (the tick function's values, the singularity measure) for one input.
+
+        Unknown velocities are solved as zero and left out of what is published;
+        the accelerations are never published.
+        """
+        solver, n = self.solver, len(given.positions)
+        speeds = (0.0,) * n if given.speeds is None else given.speeds
+        assert solver.solve is not None
+        if n == 1:
+            return solver.solve(given.positions[0], speeds[0], 0.0, solver.max_error, 0)
+        return solver.solve(given.positions, speeds, (0.0,) * n, solver.max_error, (0,) * n)
