@@ -214,6 +214,61 @@ class Lifecycle:
         return len(futures) > 1 and self.state() == self.GOALS[transition_id]
 
 
+#: A minimal rclpy publisher: start rclpy, publish one JointState stamped with the clock on
+#: ``NAMESPACE/joint_states`` (transient local), spin until stopped. What the first message of
+#: any Python node costs on this machine (the interpreter, rclpy, the message package, DDS).
+MINIMAL_PUBLISHER = """
+import sys
+
+import rclpy
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import JointState
+
+rclpy.init()
+node = rclpy.create_node('first_message', namespace=sys.argv[1])
+publisher = node.create_publisher(JointState, 'joint_states', QoSProfile(
+    depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL))
+msg = JointState()
+msg.header.stamp = node.get_clock().now().to_msg()
+publisher.publish(msg)
+try:
+    rclpy.spin(node)
+except KeyboardInterrupt:
+    pass
+"""
+
+
+def first_message_s(ros: 'Ros', namespace: str) -> float:
+    """Return how long a minimal rclpy publisher process takes to stamp its first message, s.
+
+    From the process's start to the stamp of the message it publishes at once
+    (:data:`MINIMAL_PUBLISHER`), measured as a node's first state is: the floor,
+    on this machine and at this moment, under any node's first message.
+    """
+    from rclpy.qos import DurabilityPolicy
+    from sensor_msgs.msg import JointState
+
+    received = ros.collect(JointState, f'{namespace}/joint_states', QoSProfile(
+        depth=1, reliability=ReliabilityPolicy.RELIABLE,
+        durability=DurabilityPolicy.TRANSIENT_LOCAL))
+    started_ns = time.time_ns()
+    proc = subprocess.Popen([sys.executable, '-c', MINIMAL_PUBLISHER, namespace],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    try:
+        wait_for(lambda: received or proc.poll() is not None, STARTUP_S,
+                 'the minimal publisher')
+        assert received, proc.stderr.read().decode() if proc.stderr else proc.returncode
+    finally:
+        if proc.poll() is None:
+            proc.send_signal(signal.SIGINT)
+        try:
+            proc.communicate(timeout=STARTUP_S)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.communicate()
+    return (stamp_ns(received[0]) - started_ns) / NS
+
+
 class NodeProcess:
     """A kinematics_node subprocess with its output in files."""
 

@@ -62,6 +62,8 @@ class Window:
     late: int = 0
     skipped: int = 0            # grid instants dropped
     clock_jumps: int = 0
+    publish_failures: int = 0   # instants the middleware refused to publish (not delivered)
+    last_publish_failure: str = ''
     lateness_ns: list[int] = field(default_factory=list)   # sorted
     worst_measure: float = math.inf
     last_error: str = ''
@@ -78,7 +80,7 @@ class Window:
 
 
 _TOTALS = ('instants', 'published', 'unsolved', 'late', 'skipped', 'clock_jumps',
-           'jump_instants', 'stamp_jumps_back')
+           'jump_instants', 'stamp_jumps_back', 'publish_failures')
 #: How many joint names a diagnostics value lists before it says how many more there are.
 SHOWN_JOINTS = 20
 
@@ -182,6 +184,17 @@ class TickStats:
                     f'{(jumped_from_ns - stamp_ns) / NS_PER_S:.9g} s back')
             w.ignored_joints = tuple(ignored)
             w.passed_joints = tuple(passed)
+
+    def publish_failed(self, stamp_ns: int, lateness_ns: int, late: bool, reason: str) -> None:
+        """Count one grid instant solved whose publish the middleware refused (not delivered)."""
+        with self._lock:
+            w = self._window
+            w.instants += 1
+            w.lateness_ns.append(lateness_ns)
+            if late:
+                w.late += 1
+            w.publish_failures += 1
+            w.last_publish_failure = f'at {_seconds(stamp_ns)}: {reason}'
 
     def skip(self, count: int) -> None:
         """Count ``count`` grid instants dropped."""
@@ -314,7 +327,9 @@ def timing_status(window: Window, *, name: str, hardware_id: str, rate_hz: float
                   max_lateness_ms: float = DEFAULT_MAX_LATENESS_MS) -> Status:
     """Return the timing status of ``window``.
 
-    WARN only when a subscriber sees something wrong: a grid instant was
+    WARN only when a subscriber sees something wrong: the middleware refused
+    to publish an instant's state (a reliable subscriber too slow for the
+    rate, shared memory full: counted, the node goes on), a grid instant was
     skipped (never published), the window's p99 lateness exceeds
     ``max_lateness_ms``, or a clock jump restarted the grid. Late ticks that
     were caught up (a burst after a stall) are OK: every instant was published
@@ -330,6 +345,10 @@ def timing_status(window: Window, *, name: str, hardware_id: str, rate_hz: float
     bound = f'{max_lateness_ms:g} ms'
     if w.clock_jumps:
         level, message = WARN, f'clock jumped {w.clock_jumps} time(s): grid restarted; {counts}'
+    elif w.publish_failures:
+        level = WARN
+        message = (f'{w.publish_failures} state(s) not delivered: the middleware refused the '
+                   f'publish (last {w.last_publish_failure}); {counts}')
     elif w.skipped:
         level, message = WARN, f'{w.skipped} instant(s) skipped: {counts}'
     elif p99 is not None and p99 > max_lateness_ms * 1e6:
@@ -356,5 +375,8 @@ def timing_status(window: Window, *, name: str, hardware_id: str, rate_hz: float
         ('late_ticks_total', str(w.totals.get('late', 0))),
         ('skipped_ticks_total', str(w.totals.get('skipped', 0))),
         ('clock_jumps_total', str(w.totals.get('clock_jumps', 0))),
+        ('publish_failures', str(w.publish_failures)),
+        ('publish_failures_total', str(w.totals.get('publish_failures', 0))),
+        ('last_publish_failure', w.last_publish_failure),
     )
     return Status(level, f'{name}: timing', message, hardware_id, values)

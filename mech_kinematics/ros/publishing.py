@@ -29,6 +29,7 @@ from typing import Any
 
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.qos import QoSDurabilityPolicy, QoSHistoryPolicy, QoSProfile, QoSReliabilityPolicy
 from rclpy.qos_overriding_options import QoSOverridingOptions, QoSPolicyKind
 from sensor_msgs.msg import Imu, JointState
@@ -54,7 +55,7 @@ from ..scene import scene_text
 from ..solver.solve import solve
 from ..units import NS_PER_S
 
-__all__ = ['Markers', 'Publishing', 'QOS_OVERRIDES', 'TF_DEPTH', 'diagnostic_array',
+__all__ = ['Markers', 'Publishing', 'QOS_OVERRIDES', 'RCLError', 'TF_DEPTH', 'diagnostic_array',
            'diagnostic_status_from', 'qos_options', 'state_qos', 'tf_period_ns', 'tf_qos']
 
 #: /tf and /tf_static as tf2's broadcasters offer them.
@@ -65,6 +66,11 @@ QOS_OVERRIDES = QoSPolicyKind.HISTORY, QoSPolicyKind.DEPTH, QoSPolicyKind.RELIAB
 
 _LEVELS = {0: DiagnosticStatus.OK, 1: DiagnosticStatus.WARN, 2: DiagnosticStatus.ERROR,
            3: DiagnosticStatus.STALE}
+
+#: What rclpy raises when the middleware refuses a publish (a reliable subscriber too slow
+#: for the rate filled the writer's history, shared memory is full): the tick thread and the
+#: topic input count it and go on.
+RCLError = rclpy_implementation.RCLError
 
 
 def qos_options() -> QoSOverridingOptions:

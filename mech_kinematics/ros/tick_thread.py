@@ -10,7 +10,12 @@ instant with the function that serves (:class:`~mech_kinematics.ros.solver_path.
 and publishes it (:class:`~mech_kinematics.ros.publishing.Publishing`),
 counting everything in the diagnostics' :class:`~mech_kinematics.ros.diagnostics.TickStats`.
 A tick that cannot be solved publishes nothing and says why (a warning, at
-most one a second, and ``diagnostics``).
+most one a second, and ``diagnostics``). A publish the middleware refuses
+(``RCLError``: a reliable subscriber too slow for the rate filled the
+writer's history, its shared memory is full) loses that instant's state,
+not the node: it is counted (``publish_failures`` on ``diagnostics``, timing
+WARN) and said (a warning, at most one a second), and the next instant is
+published as usual.
 
 Thread use: :meth:`TickThread.start` and :meth:`TickThread.stop` from the
 executor's thread; the loop in its own daemon thread. A jump of the node's
@@ -34,6 +39,7 @@ import traceback
 from typing import Any, TYPE_CHECKING
 
 from .drive import position_text, transposed
+from .publishing import RCLError
 from ..errors import AssemblyError, UntrustedError
 from ..solver.context import NEAR_SINGULAR
 from ..units import NS_PER_S
@@ -224,7 +230,17 @@ class TickThread:
             self.logger.warning(f'no state published: {exc}', throttle_duration_sec=1.0)
             return
         sec, nanosec = divmod(stamp, NS_PER_S)
-        self.publishing.tick(values, stamp, sec, nanosec)
+        try:
+            self.publishing.tick(values, stamp, sec, nanosec)
+        except RCLError as exc:
+            if self._stop.is_set() or self.shutting_down():
+                raise       # the context went away under a publish: the loop ends
+            reason = str(exc).split(',', 1)[0]
+            self.stats.publish_failed(stamp, lateness, late, reason)
+            self.logger.warning(f'a state was not delivered ({reason}): a reliable subscriber '
+                                'may be too slow for rate_hz; counted on diagnostics '
+                                '(publish_failures)', throttle_duration_sec=1.0)
+            return
         if self.markers is not None:
             # Built in the executor's thread, so that this thread keeps its deadlines.
             self.markers.request(self.driver.period_ns, sec, nanosec, angle, speed, accel)

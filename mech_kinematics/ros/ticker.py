@@ -28,8 +28,12 @@ import math
 from .. import solver as lk
 from ..solver.compiler import compile_scene, FrameSpec, NotCompiled, Tick, TickFunction
 
-__all__ = ['TickFunction', 'compile_tick', 'compiled_tick', 'general_tick', 'tick_function',
-           'values_from_state']
+__all__ = ['NOT_IN_THE_TICK', 'TickFunction', 'compile_tick', 'compiled_tick', 'general_tick',
+           'tick_function', 'values_from_state']
+
+#: Why a scene the general tick solves is not compiled by ``mk.solve`` (:func:`general_tick`).
+NOT_IN_THE_TICK = ("the node's tick never compiles in its own thread (ros.ticker.general_tick): "
+                   'it compiles through compiled_tick')
 
 
 def values_from_state(state: lk.State, joints: Sequence[str], points: Sequence[str],
@@ -59,7 +63,22 @@ def values_from_state(state: lk.State, joints: Sequence[str], points: Sequence[s
 def general_tick(scene: lk.Scene, joints: Sequence[str] | None,
                  points: Sequence[str] | None,
                  frames: Sequence[FrameSpec]) -> TickFunction:
-    """Return a tick function around the general solver (same signature, same answers)."""
+    """Return a tick function around the general solver (same signature, same answers).
+
+    It never compiles in the thread that calls it. :func:`mech_kinematics.solve`
+    compiles a scene's single-angle path in its caller's thread once it has
+    solved it :data:`~mech_kinematics.solver.solve.COMPILE_AFTER` times; in the
+    node's tick thread that compile was a stall of the stream: a 100-dyad strip,
+    served by this function while its tick compiled in the background, published
+    nothing from its 256th instant until that compile was done (about 3 s on an
+    idle machine, 14 to 21 s beside two CPU hogs); a crank at rest, whose every
+    instant the compiled tick hands over here, stalled likewise. So ``scene``'s
+    single-angle path is settled as not compiled (:data:`NOT_IN_THE_TICK`) unless
+    it already is; ``mk.solve`` then answers ``scene`` by its general path, the
+    same bits (``test_compiler_solve``).
+    """
+    if scene._solver.compiled_single is None:
+        scene._solver.compiled_single = NotCompiled(NOT_IN_THE_TICK)
     joints = tuple(scene.output_joints if joints is None else joints)
     points = tuple(scene.output_points if points is None else points)
     frames = tuple(frames)

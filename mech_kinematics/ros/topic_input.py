@@ -32,7 +32,7 @@ from sensor_msgs.msg import JointState
 
 from . import topics
 from .messages import TickMessages
-from .publishing import qos_options
+from .publishing import qos_options, RCLError
 from .topic_drive import RefusedInput, TopicDrive, TopicInput
 from ..errors import AssemblyError, UntrustedError
 from ..solver.context import NEAR_SINGULAR
@@ -146,8 +146,17 @@ class InputSubscription:
         rendered = self.messages[given.speeds is not None].render_values(values, sec, nanosec)
         if given.passed is not None:    # extra_joints: pass: names that change per message
             rendered = (self._joint_state_passed(given, values, sec, nanosec), *rendered[1:])
-        for publish, data in zip(publishing.publish_state, rendered, strict=True):
-            publish(data)
+        try:
+            for publish, data in zip(publishing.publish_state, rendered, strict=True):
+                publish(data)
+        except RCLError as exc:    # the middleware refused: this input's state is lost
+            reason = str(exc).split(',', 1)[0]
+            stats.publish_failed(given.stamp_ns, time.monotonic_ns() - received, False, reason)
+            self.node.get_logger().warning(
+                f'a state was not delivered ({reason}): a reliable subscriber may be too slow '
+                'for the input; counted on diagnostics (publish_failures)',
+                throttle_duration_sec=1.0)
+            return
         if given.jumped_from_ns is not None:
             publishing.next_tf = 0   # /tf's rate counts from the new order
             self.node.get_logger().warning(

@@ -44,7 +44,11 @@ from __future__ import annotations
 import ast
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+import marshal
 import math
+import subprocess
+import sys
+from types import CodeType
 from typing import Any, cast, overload, TYPE_CHECKING
 
 from .base import Step
@@ -390,8 +394,131 @@ def _function(name: str, parameters: Sequence[str], body: list[ast.stmt],
 def _made(functions: list[ast.stmt], label: str, namespace: dict[str, Any], name: str) -> Any:
     """Return the function ``name`` defined by ``functions`` in ``namespace``."""
     module = ast.fix_missing_locations(ast.Module(body=functions, type_ignores=[]))
-    exec(compile(module, label, 'exec'), namespace)  # noqa: S102
+    exec(module_code(module, label), namespace)  # noqa: S102
     return namespace[name]
+
+
+# --- compiling off this process's GIL --------------------------------------------
+# Python's compile() is one C call that holds the GIL throughout: 0.26 s for a 100-dyad
+# strip's tick (110,000 nodes) on an idle 2-core machine, 0.36 to 0.47 s beside two CPU
+# hogs. The node compiles such a tick in a background thread while its tick thread
+# publishes; for that long, the tick thread could not run a line. So a large module is
+# compiled by a child process (the same interpreter, ``sys.executable``) from its syntax
+# tree sent as marshal data: one record a statement, each encoded in Python here (which
+# lets other threads run between bytecodes), and the code object comes back marshalled.
+# The same tree compiled with the same flags by the same interpreter is the same code
+# object (``test_compiler`` compares them); where the child cannot answer, this process
+# compiles the tree itself.
+
+#: Modules whose functions hold more statements than this are compiled in a child process
+#: (:func:`module_code`). A statement of the compiled kernels is about 22 syntax-tree nodes
+#: and compile() takes about 2.4 us a node on an idle machine, so a module this size holds
+#: the GIL about 25 ms, about what starting the child costs. (The packaged scenes' ticks
+#: hold 43 to 184 statements; a 100-dyad strip's, 5,017.)
+APART_STATEMENTS = 500
+#: The compiler flags of every compiled module: this module's own ``from __future__ import
+#: annotations`` (what compile() inherited here before modules were compiled apart), given
+#: explicitly to both compiles.
+COMPILE_FLAGS = annotations.compiler_flag
+
+#: The child's program: read the header and each function's statements (marshal records),
+#: rebuild the tree, compile it, write (version, marshalled code). Started with -I -S:
+#: it imports nothing but ast and marshal.
+_CHILD = """
+import ast, marshal, sys
+def node(data):
+    if isinstance(data, list):
+        return [node(item) for item in data]
+    if not isinstance(data, tuple):
+        return data
+    name, fields, attributes = data
+    cls = getattr(ast, name)
+    made = cls()
+    if cls is ast.Constant:
+        made.value, made.kind = fields
+    else:
+        for field, value in zip(cls._fields, fields, strict=True):
+            setattr(made, field, node(value))
+    for attribute, value in zip(cls._attributes, attributes, strict=True):
+        setattr(made, attribute, value)
+    return made
+source = sys.stdin.buffer
+version, label, flags, count = marshal.load(source)
+functions = []
+for _ in range(count):
+    function, statements = marshal.load(source)
+    function = node(function)
+    function.body = [node(marshal.load(source)) for _ in range(statements)]
+    functions.append(function)
+module = ast.Module(body=functions, type_ignores=[])
+code = compile(module, label, 'exec', flags, True)
+sys.stdout.buffer.write(marshal.dumps((sys.hexversion, code)))
+"""
+
+
+def module_code(module: ast.Module, label: str) -> Any:
+    """Return ``module`` compiled (named ``label``), by a child process when it is large.
+
+    A module whose functions hold more than :data:`APART_STATEMENTS` statements
+    is compiled by :func:`compiled_apart`, so that this process's other threads
+    run meanwhile; where that answers ``None``, and for a smaller module, by
+    compile() here. Both give the same code object.
+    """
+    statements = sum(len(f.body) for f in module.body if isinstance(f, ast.FunctionDef))
+    if statements > APART_STATEMENTS:
+        code = compiled_apart(module, label)
+        if code is not None:
+            return code
+    return compile(module, label, 'exec', COMPILE_FLAGS, True)
+
+
+def _encoded(node: Any) -> Any:
+    """Return a syntax tree as marshal data: a node as (class name, fields, attributes)."""
+    if isinstance(node, ast.AST):
+        attributes = tuple(getattr(node, a, None) for a in node._attributes)
+        if isinstance(node, ast.Constant):     # its value is data, never a node
+            return 'Constant', (node.value, node.kind), attributes
+        return (type(node).__name__, tuple(_encoded(getattr(node, f, None)) for f in node._fields),
+                attributes)
+    if isinstance(node, list):
+        return [_encoded(item) for item in node]
+    return node
+
+
+def compiled_apart(module: ast.Module, label: str) -> Any:
+    """Return ``module`` compiled by a child process, or ``None`` where it cannot answer.
+
+    The module holds function definitions (what the compiler makes). Each
+    statement of their bodies is one marshal record, so that no single step
+    here holds the GIL for long; waiting for the child releases it. ``None``
+    (the caller compiles here) where the child cannot be started, fails, or is
+    not this interpreter's version; a tree compile() refuses then raises here,
+    as it would have.
+    """
+    functions = [f for f in module.body if isinstance(f, ast.FunctionDef)]
+    if not sys.executable or len(functions) != len(module.body):
+        return None
+    records = [marshal.dumps((sys.hexversion, label, COMPILE_FLAGS, len(functions)))]
+    for function in functions:
+        head = ('FunctionDef', tuple([] if f == 'body' else _encoded(getattr(function, f, None))
+                                     for f in function._fields),
+                tuple(getattr(function, a, None) for a in function._attributes))
+        records.append(marshal.dumps((head, len(function.body))))
+        records += [marshal.dumps(_encoded(statement)) for statement in function.body]
+    try:
+        # A session of its own: a Ctrl-C meant for this process's group is not its.
+        child = subprocess.run([sys.executable, '-I', '-S', '-c', _CHILD],
+                               input=b''.join(records), capture_output=True, check=False,
+                               start_new_session=True)
+    except (OSError, ValueError):     # no such interpreter, out of processes: compiled here
+        return None
+    if child.returncode != 0:
+        return None
+    try:
+        version, code = marshal.loads(child.stdout)
+    except (EOFError, ValueError, TypeError):
+        return None
+    return code if version == sys.hexversion and isinstance(code, CodeType) else None
 
 
 def _single(scene: Scene, plan: ScenePlan) -> SingleFunction:

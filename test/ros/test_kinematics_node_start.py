@@ -13,16 +13,22 @@ import re
 import signal
 import time
 
+from diagnostic_msgs.msg import DiagnosticArray
 import pytest
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-from ros_helpers import (cannot_start, exited, NodeProcess, NS, REPO, SESSION, stamp_ns, STARTUP_S,
-                         wait_for)
+from ros_helpers import (cannot_start, exited, first_message_s, NodeProcess, NS, REPO, SESSION,
+                         stamp_ns, STARTUP_S, wait_for)
 from sensor_msgs.msg import JointState
 
-#: Bound on the time from the process's start to its first published state, s. The target is
-#: 0.5 s (0.49 s median of 5 starts measured on a 2-core machine); the bound leaves room for load
-#: and is still well below the 2.5 s the node used to look for another of its name first.
-FIRST_STATE_S = 1.5
+#: Bound on the time from the process's start to its first published state, in multiples of
+#: the floor: what a minimal rclpy publisher process takes to stamp its first message on the
+#: same machine, measured once just before the node and twice just after (the largest, as
+#: the load of the moment varies). The node also imports NumPy and the solver, loads and
+#: compiles its scene and declares its parameters: 1.3 to 3.4 floors in 13 starts, idle and
+#: beside two CPU hogs (0.8 to 3.8 s against floors of 0.24 to 1.7 s). The 2.5 s the node
+#: used to wait for another of its name before publishing made it 8.8 floors on an idle
+#: machine (simulated: the same start, 2.5 s later).
+FIRST_STATE_FLOORS = 4
 #: A rate whose history (1000 messages) holds the first 20 s of a node's states.
 RATE_HZ = 50
 PERIOD_NS = NS // RATE_HZ
@@ -47,14 +53,22 @@ def _one_refusal(output: str, ns: str) -> None:
     assert 'Traceback' not in output
 
 
-def _gaps(stamps: list[int]) -> list[int]:
+def _gaps(stamps: list[int], period_ns: int = PERIOD_NS) -> list[int]:
     unique = sorted(set(stamps))
-    return [b - a for a, b in zip(unique[:-1], unique[1:], strict=True) if b - a != PERIOD_NS]
+    return [b - a for a, b in zip(unique[:-1], unique[1:], strict=True) if b - a != period_ns]
 
 
-def test_the_first_state_is_published_within_half_a_second(ros, tmp_path):
-    """The earliest stamp (the node's history holds it) follows the process's start at once."""
+def test_the_first_state_is_published_at_once(ros, tmp_path):
+    """The earliest stamp follows the process's start within 4 floors (FIRST_STATE_FLOORS).
+
+    The earliest state's stamp (the node's history holds it) is judged against
+    the machine's floor at that moment: how long a minimal rclpy publisher
+    process takes to stamp its first message, measured just before and just
+    after the node. (A bound of 1.5 s failed beside two CPU hogs, at 1.6 to
+    5.6 s, where the floor itself had grown to 0.7 to 1.7 s.)
+    """
     ns = f'{SESSION}/first_state'
+    before = first_message_s(ros, f'{SESSION}/floor_before')
     js = ros.collect(JointState, f'{ns}/joint_states', LATCHED)
     started_ns = time.time_ns()
     proc = _node(tmp_path, ns)
@@ -64,8 +78,13 @@ def test_the_first_state_is_published_within_half_a_second(ros, tmp_path):
     finally:
         status, _ = proc.stop(signal.SIGINT)
     assert status == 0, proc.output()
+    after = [first_message_s(ros, f'{SESSION}/floor_after{k}') for k in range(2)]
+    latency = (first - started_ns) / NS
+    floor = max(before, *after)
+    print(f'first state {latency:.3f} s, floor {before:.3f} s before and {after} s after: '
+          f'{latency / floor:.2f} floors')
     # The first tick is the next multiple of the period: up to one period after the start.
-    assert 0 < first - started_ns < FIRST_STATE_S * NS + PERIOD_NS, (first - started_ns) / NS
+    assert 0 < latency < FIRST_STATE_FLOORS * floor + PERIOD_NS / NS, (latency, before, after)
 
 
 def test_the_older_node_goes_on_without_a_gap_while_newcomers_are_refused(ros, tmp_path):
@@ -159,12 +178,29 @@ def _strip_yaml(dyads: int) -> str:
     return '\n'.join(lines) + '\n'
 
 
+#: The long chain's rate: mk.solve compiles a scene once it has solved it 256 times
+#: (COMPILE_AFTER); at 100 Hz a general tick asks that 2.56 s after the start, before the strip's
+#: tick is compiled (4.5 s and more), so a tick thread that compiled would stall in the test.
+LONG_CHAIN_RATE_HZ = 100
+#: Bound on the stream's longest stall while the tick compiles (the node's worst lateness on
+#: diagnostics), as a share of that compile's duration (the node's "compiled in X s"), both
+#: measured in the same run. A tick thread that waits for a step of the compile waits a good
+#: part of it: compiling mk.solve's path in the tick thread stalled it for most of the
+#: compile (idle, about 7.5 s: a hole of 2.51 s beyond max_catch_up_s; beside two CPU hogs,
+#: holes of 14 to 21 s); compile() itself held the GIL 0.26 s idle, 0.36 to 0.47 s beside the
+#: hogs. What is left, garbage collections of the tree being built and the machine's own
+#: stalls, measured 0.006 to 0.07 of the compile in 5 runs, idle and beside two CPU hogs.
+STALL_SHARE = 0.25
+
+
 def test_a_long_chain_is_published_while_its_tick_compiles(ros, tmp_path):
     """A strip of 100 triangles (compiling takes seconds) is published from the start.
 
-    The general solver serves while a thread compiles the tick; the compiled tick takes
-    over without a gap, and every state is the rigid strip's: its last link keeps its
-    angle to the crank (the strip is one body).
+    The general solver serves while a thread compiles the tick (compile() itself
+    in a child process); the compiled tick takes over without a gap, and every
+    state is the rigid strip's: its last link keeps its angle to the crank (the
+    strip is one body). No instant waits for the compile: the stream's longest
+    stall while it runs is below a quarter of its duration (STALL_SHARE).
     """
     import math
 
@@ -172,16 +208,24 @@ def test_a_long_chain_is_published_while_its_tick_compiles(ros, tmp_path):
     path = tmp_path / 'strip.yaml'
     path.write_text(_strip_yaml(100))
     js = ros.collect(JointState, f'{ns}/joint_states', LATCHED)
+    diagnostics = ros.collect(DiagnosticArray, f'{ns}/diagnostics', LATCHED)
     proc = NodeProcess(tmp_path / 'node', '-r', f'__ns:={ns}', '-p', f'scene:={path}',
-                       '-p', f'rate_hz:={RATE_HZ}', '-p', 'max_catch_up_s:=5.0',
+                       '-p', f'rate_hz:={LONG_CHAIN_RATE_HZ}', '-p', 'max_catch_up_s:=5.0',
                        '-p', f'qos_overrides.{ns}/joint_states.publisher.durability:='
-                       'transient_local')
+                       'transient_local',
+                       '-p', f'qos_overrides.{ns}/diagnostics.publisher.durability:='
+                       'transient_local',
+                       '-p', f'qos_overrides.{ns}/diagnostics.publisher.depth:=1000')
     try:
         wait_for(lambda: js, STARTUP_S, 'joint_states')
-        wait_for(lambda: 'the compiled tick serves from now' in proc.output(), 60.0,
+        wait_for(lambda: 'the compiled tick serves from now' in proc.output(), 120.0,
                  'the compiled tick')
         count = len(js)
-        wait_for(lambda: len(js) > count + 25, STARTUP_S, 'states from the compiled tick')
+        wait_for(lambda: len(js) > count + 50, STARTUP_S, 'states from the compiled tick')
+        # The window in which the compiled tick took over, and the next: every stall of
+        # the compile's time has been published and counted by then.
+        count = len(diagnostics)
+        wait_for(lambda: len(diagnostics) > count + 1, STARTUP_S, 'diagnostics after it')
     finally:
         status, _ = proc.stop(signal.SIGINT)
     output = proc.output()
@@ -192,17 +236,28 @@ def test_a_long_chain_is_published_while_its_tick_compiles(ros, tmp_path):
     # Published before the compile was done (it used to come after: 2.6 s and more): the
     # earliest state's stamp (the history holds it, whenever discovery delivers it)
     # precedes the log line's own stamp.
-    compiled = re.search(r'\[INFO\] \[(\d+)\.(\d{9})\] \[[^]]*\]: the compiled tick serves',
-                         output)
+    compiled = re.search(r'\[INFO\] \[(\d+)\.(\d{9})\] \[[^]]*\]: the compiled tick serves from '
+                         r'now \(compiled in ([0-9.]+) s\)', output)
     assert compiled is not None, output
     assert min(stamp_ns(m) for m in js) < int(compiled[1]) * NS + int(compiled[2]), output
-    assert _gaps([stamp_ns(m) for m in js]) == []
+    assert _gaps([stamp_ns(m) for m in js], NS // LONG_CHAIN_RATE_HZ) == []
+    worst_s = max(_lateness_max_s(msg) for msg in diagnostics)
+    compile_s = float(compiled[3])
+    print(f'longest stall {worst_s:.3f} s while the tick compiled for {compile_s} s')
+    assert worst_s < STALL_SHARE * compile_s, (worst_s, compile_s)
     offsets = []
     for msg in js:
         names = list(msg.name)
         turn = msg.position[names.index('b99')] - msg.position[names.index('crank')]
         offsets.append(math.remainder(turn, math.tau))
     assert max(offsets) - min(offsets) < 1e-9, (min(offsets), max(offsets))
+
+
+def _lateness_max_s(msg: DiagnosticArray) -> float:
+    """Return the largest lateness of a diagnostics window's ticks, s (0 where it has none)."""
+    values = {kv.key: kv.value for status in msg.status for kv in status.values}
+    value = values.get('lateness_max_us', 'n/a')
+    return 0.0 if value == 'n/a' else float(value) / 1e6
 
 
 def _params_file(path, **values) -> str:

@@ -14,8 +14,9 @@ import time
 import pytest
 
 import mech_kinematics as mk
-from mech_kinematics.ros.diagnostics import TickStats
+from mech_kinematics.ros.diagnostics import TickStats, timing_status, WARN
 from mech_kinematics.ros.driver import TickDriver
+from mech_kinematics.ros.publishing import RCLError
 from mech_kinematics.ros.tick_thread import LATE_NS, TickThread
 from mech_kinematics.ros.timebase import CrankTimebase
 from mech_kinematics.units import NS_PER_S, rad_per_s_from_rpm
@@ -184,3 +185,52 @@ def test_an_unexpected_error_stops_the_thread_loudly():
     assert 'RuntimeError: injected' in text
     ticks.stop()
     assert not ticks.running
+
+
+class RefusingPublishing(Publishing):
+    """A publisher the middleware refuses at the stamps given (rclpy's RCLError)."""
+
+    def __init__(self, refused):
+        super().__init__()
+        self.refused = set(refused)
+
+    def tick(self, values, stamp, sec, nanosec):
+        if stamp in self.refused:
+            raise RCLError('Failed to publish: cannot publish data, at '
+                           '/project/src/rmw_publish.cpp:120')
+        super().tick(values, stamp, sec, nanosec)
+
+
+def test_a_publish_the_middleware_refuses_loses_that_state_not_the_node():
+    """RCLError on a publish: counted and said, the next instants published, no failure.
+
+    A reliable subscriber too slow for 5 kHz made Fast DDS refuse a publish in
+    one CI run, and the node stopped (the tick thread's fatal error).
+    """
+    ticks, stats, logger, failures = _thread()
+    ticks.publishing = RefusingPublishing({MS})
+    ticks.publish(range(0, 3 * MS, MS), skipped=0, woke=2 * MS)
+    assert [stamp for _, stamp, _, _ in ticks.publishing.ticks] == [0, 2 * MS]
+    assert failures == [] and not ticks.failed
+    window = stats.take_window()
+    assert (window.instants, window.published, window.publish_failures) == (3, 2, 1)
+    assert window.last_publish_failure == ('at 0.001000000 s: Failed to publish: cannot '
+                                           'publish data')
+    assert window.totals['publish_failures'] == 1
+    [(level, text)] = logger.lines
+    assert level == 'warning' and text.startswith(
+        'a state was not delivered (Failed to publish: cannot publish data)')
+    status = timing_status(window, name='n', hardware_id='h', rate_hz=1000.0)
+    values = dict(status.values)
+    assert status.level == WARN and status.message.startswith('1 state(s) not delivered')
+    assert (values['publish_failures'], values['publish_failures_total']) == ('1', '1')
+
+
+def test_a_refused_publish_while_stopping_ends_the_loop_quietly():
+    """The context going away under a publish is the stop, not a state lost."""
+    ticks, stats, logger, _ = _thread()
+    ticks.publishing = RefusingPublishing({0})
+    ticks._stop.set()
+    with pytest.raises(RCLError):
+        ticks.publish(range(1), skipped=0, woke=0)
+    assert stats.take_window().publish_failures == 0 and logger.lines == []

@@ -2,6 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """The compiled tick against the general solver: the same bits, the same refusals (issue 14)."""
 
+import importlib
 import math
 from pathlib import Path
 import warnings
@@ -13,8 +14,8 @@ import pytest
 import yaml
 
 import mech_kinematics as mk
-from mech_kinematics.ros.ticker import (compile_tick, compiled_tick, tick_function,
-                                        values_from_state)
+from mech_kinematics.ros.ticker import (compile_tick, compiled_tick, general_tick,
+                                        NOT_IN_THE_TICK, tick_function, values_from_state)
 from mech_kinematics.solver.compiler import NotCompiled, scene_plan
 from mech_kinematics.verify.cases import chain_scene
 from mech_kinematics.verify.extreme import extreme_cases
@@ -210,3 +211,36 @@ def test_any_real_angle_is_ticked_as_the_float_it_equals(kind):
         got = tick(angle, np.float64(scene.input.speed), np.float64(0.0), 1e-6, np.int64(2))
         assert repr(got) == repr(expected)
         assert all(type(value) is float for value in got[0])
+
+
+def test_the_general_tick_never_compiles_in_its_callers_thread(monkeypatch):
+    """Asked past mk.solve's COMPILE_AFTER, the general tick compiles nothing; same answers.
+
+    mk.solve compiles a scene solved often in its caller's thread. The node's tick thread,
+    serving a 100-dyad strip on the general tick while the tick compiled in the background,
+    compiled that scene's single-angle path itself at its 256th instant and published
+    nothing until done (14 to 21 s beside two CPU hogs); a crank at rest, whose every
+    instant the compiled tick hands over, did the same. A scene already compiled keeps it.
+    """
+    solve_module = importlib.import_module('mech_kinematics.solver.solve')
+    compiles = []
+    real = solve_module.compile_scene
+    monkeypatch.setattr(solve_module, 'compile_scene',
+                        lambda *args: compiles.append(args) or real(*args))
+    scene = mk.load_scene('khurmi_four_bar_ad150')
+    general = general_tick(scene, None, None, ())
+    angles = np.linspace(0.0, 2 * np.pi, solve_module.COMPILE_AFTER + 10)
+    answers = [general(float(theta), scene.input.speed, scene.input.accel, 1e-6)
+               for theta in angles]
+    assert compiles == []
+    assert scene._solver.compiled_single == NotCompiled(NOT_IN_THE_TICK)
+    for theta, answer in list(zip(angles, answers, strict=True))[::25]:
+        assert repr(answer) == repr(general_tick_outcome(scene, float(theta), scene.input.speed,
+                                                         scene.input.accel, 1e-6))
+    compiled = mk.load_scene('khurmi_four_bar_ad150')
+    for theta in angles:
+        mk.solve(compiled, float(theta))
+    assert len(compiles) == 1
+    fast = compiled._solver.compiled_single
+    general_tick(compiled, None, None, ())
+    assert callable(fast) and compiled._solver.compiled_single is fast

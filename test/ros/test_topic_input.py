@@ -17,7 +17,7 @@ from sensor_msgs.msg import JointState
 
 import mech_kinematics as mk
 from mech_kinematics.ros.diagnostics import TickStats
-from mech_kinematics.ros.publishing import Publishing
+from mech_kinematics.ros.publishing import Publishing, RCLError
 from mech_kinematics.ros.solver_path import SolverPath
 from mech_kinematics.ros.topic_input import INPUT_DEPTH, InputSubscription
 
@@ -185,3 +185,25 @@ def test_an_inactive_node_publishes_nothing():
     subscription.active = False
     subscription.message(_message(5, ['left_crank', 'right_crank'], [1.5, 1.0]))
     assert node.publishers['joint_states'].sent == [] and stats.take_window().instants == 0
+
+
+def test_a_publish_the_middleware_refuses_is_counted_and_the_next_message_published():
+    """RCLError on a publish (a reliable reader too slow): counted, said, the node goes on."""
+    node, subscription, stats = _input('five_bar')
+    publishing = subscription.publishing
+    sent, refuse = [], [True]
+
+    def publish(data):
+        if refuse.pop() if refuse else False:
+            raise RCLError('Failed to publish: cannot publish data, at rmw_publish.cpp:120')
+        sent.append(data)
+
+    publishing.publish_state = (publish, *publishing.publish_state[1:])
+    names = ['left_crank', 'right_crank']
+    subscription.message(_message(5, names, [1.5, 1.0]))
+    subscription.message(_message(6, names, [1.5, 1.0]))
+    assert len(sent) == 1
+    window = stats.take_window()
+    assert (window.instants, window.published, window.publish_failures) == (2, 1, 1)
+    assert node.logger.lines[0].startswith(
+        'a state was not delivered (Failed to publish: cannot publish data)')

@@ -19,13 +19,14 @@ generator here fails, named.
 import importlib
 import math
 
-from helpers import (array_outcome, general_only, general_tick_outcome, solve_outcome,
-                     tick_outcome)
+from helpers import (array_outcome, equilateral_chain, general_only, general_tick_outcome,
+                     solve_outcome, tick_outcome)
 import numpy as np
 import pytest
 
 import mech_kinematics as mk
 from mech_kinematics.ros.ticker import general_tick
+from mech_kinematics.solver import compiler
 from mech_kinematics.solver.compiler import (ARRAY, Array, compile_scene, NotCompiled, SINGLE,
                                              Tick)
 from mech_kinematics.solver.registry import KINDS
@@ -256,3 +257,74 @@ def test_the_reasons_a_scene_is_not_compiled_are_one_line_each():
         'more than 0 steps (1): compiling would cost more than the solves it speeds up')
     for compiled in (why, compile_scene(scene, Array(max_steps=0))):
         assert not compiled and '\n' not in compiled.reason and str(compiled) == compiled.reason
+
+
+#: A chain whose tick holds more than compiler.APART_STATEMENTS statements (about 50 a dyad).
+APART_DYADS = 12
+
+
+def _compiled_apart(monkeypatch):
+    """Record each (module, label, code or None) compiler.compiled_apart answers."""
+    seen = []
+    real = compiler.compiled_apart
+
+    def recording(module, label):
+        code = real(module, label)
+        seen.append((module, label, code))
+        return code
+
+    monkeypatch.setattr(compiler, 'compiled_apart', recording)
+    return seen
+
+
+def _assert_tick_answers_as_the_general_path(scene, tick):
+    """At angles over two turns and every tolerance: the general path's values or refusal."""
+    for theta in ANGLES[::4]:
+        for tol in TOLERANCES:
+            expected = general_tick_outcome(scene, float(theta), scene.input.speed,
+                                            scene.input.accel, tol)
+            got = tick_outcome(tick, float(theta), scene.input.speed, scene.input.accel, tol)
+            assert repr(got) == repr(expected), (theta, tol)
+
+
+def test_a_large_module_is_compiled_apart_to_the_same_code(monkeypatch):
+    """A 12-dyad chain's tick is compiled by a child process: compile()'s code object here.
+
+    compile() holds the GIL for the whole call (0.26 s for a 100-dyad strip's tick, 0.36 to
+    0.47 s beside two CPU hogs), and the node compiles a long chain's tick in a thread beside
+    its tick thread; so a large module is compiled in a child process from its syntax tree.
+    The code object that comes back is the one compiled here, equal field by field (its
+    bytecode, constants, names, line table), and the tick answers as the general path does.
+    """
+    scene = equilateral_chain(APART_DYADS)
+    seen = _compiled_apart(monkeypatch)
+    tick = compile_scene(scene, Tick(scene.output_joints, scene.output_points, (),
+                                     general_tick(scene, None, None, ())))
+    [(module, label, code)] = seen
+    assert sum(len(f.body) for f in module.body) > compiler.APART_STATEMENTS
+    assert code is not None, 'the child process did not answer'
+    assert code == compile(module, label, 'exec', compiler.COMPILE_FLAGS, True)
+    _assert_tick_answers_as_the_general_path(scene, tick)
+
+
+def test_a_small_module_is_compiled_here(monkeypatch):
+    """Every packaged scene's tick is below the size compiled apart: no child process starts."""
+    seen = _compiled_apart(monkeypatch)
+    for name in mk.scene_names():
+        scene = mk.load_scene(name)
+        compile_scene(scene, Tick(scene.output_joints, scene.output_points, (),
+                                  general_tick(scene, None, None, ())))
+    assert seen == []
+
+
+@pytest.mark.parametrize('executable', ['', '/nonexistent/python', '/bin/false'])
+def test_where_no_child_can_compile_the_module_this_process_does(monkeypatch, executable):
+    """No interpreter, one that cannot start, or one that fails: compiled here, same answers."""
+    monkeypatch.setattr(compiler.sys, 'executable', executable)
+    scene = equilateral_chain(APART_DYADS)
+    seen = _compiled_apart(monkeypatch)
+    tick = compile_scene(scene, Tick(scene.output_joints, scene.output_points, (),
+                                     general_tick(scene, None, None, ())))
+    assert [code for _, _, code in seen] == [None]
+    assert callable(tick)
+    _assert_tick_answers_as_the_general_path(scene, tick)
