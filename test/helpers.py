@@ -330,8 +330,9 @@ def first_order_spreads(scene, angle, speed=None, accel=None, exact=None):
 
 
 # --- the solver's compiled paths against its general one ----------------------
-# Used by test_compiled.py (the compiled single-angle and array solves) and
-# test_ticker.py (the node's tick against the general solver).
+# Used by test_compiled.py (the compiled single-angle and array solves),
+# test_ticker.py (the node's tick against the general solver) and
+# test_compiler.py (every registered kind, compiled for every target).
 
 def general_only(scene: mk.Scene) -> mk.Scene:
     """Return ``scene`` set never to use the solver's compiled paths (its general solve)."""
@@ -369,3 +370,70 @@ def state_facts(state: mk.State) -> Any:
                    'rubbing': state.rubbing, 'intermittent': state.intermittent,
                    'jumps': state.jumps, 'drivers': state.drivers,
                    'imus': state.__dict__.get('imu_specs')})
+
+
+def solve_outcome(scene: mk.Scene, *args: Any, **kwargs: Any) -> Any:
+    """Return mk.solve's state facts and warnings, or the error's type, text and facts."""
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter('always')
+        try:
+            state = mk.solve(scene, *args, **kwargs)
+        except mk.AssemblyError as error:
+            return (type(error), str(error), error.dyad, repr(error.angle),
+                    getattr(error, 'facts', None), getattr(error, 'quantity', None))
+    return state_facts(state), [(w.category, str(w.message), w.filename) for w in caught]
+
+
+def array_outcome(scene: mk.Scene, *args: Any, **kwargs: Any) -> Any:
+    """Return an array solve's state facts and warnings."""
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter('always')
+        state = mk.solve(scene, *args, **kwargs)
+    return state_facts(state), [(w.category, str(w.message), w.filename) for w in caught]
+
+
+def general_tick_outcome(scene: mk.Scene, theta: Any, omega: Any, alpha: Any, tol: float,
+                         turns: int = 0, joints: Any = None, points: Any = None,
+                         frames: Any = ()) -> Any:
+    """Return what the general solver answers, in a tick function's terms, or its error.
+
+    The solver's own compiled path is turned off (:func:`general_only`): a tick is
+    held to the general solve, not to code compiled the same way. ``theta``,
+    ``omega`` and ``alpha`` are one value each, or lists of one per driver.
+    """
+    import warnings
+
+    from mech_kinematics.ros.ticker import values_from_state
+
+    general_only(scene)
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore', mk.NearSingularWarning)
+        try:
+            if isinstance(theta, list):
+                state = mk.solve(scene, theta, omega, alpha, max_error=tol)
+            else:
+                state = mk.solve(scene, theta, omega, alpha, turns=turns, max_error=tol)
+        except mk.AssemblyError as error:
+            return type(error), str(error)
+    measures = state.singularity.values()
+    joints = scene.output_joints if joints is None else joints
+    points = scene.output_points if points is None else points
+    return (values_from_state(state, joints, points, frames),
+            min(measures) if measures else math.inf)
+
+
+def tick_outcome(tick: Any, theta: Any, omega: Any, alpha: Any, tol: float,
+                 turns: int = 0) -> Any:
+    """Return what a tick function answers, or its error's type and text."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore', mk.NearSingularWarning)
+        try:
+            return tick(theta, omega, alpha, tol, turns)
+        except mk.AssemblyError as error:
+            return type(error), str(error)

@@ -31,7 +31,11 @@ The package holds one module per concern and one per step kind:
 - :mod:`.context`: one solve's values and the roundoff constants;
 - :mod:`.plan`: the plan compiler; :mod:`.scaling`: power-of-two rescaling;
 - :mod:`.mechanism`: :class:`Scene`; :mod:`.solve`: :func:`solve`;
-  :mod:`.state`: :class:`State` and what it holds.
+  :mod:`.state`: :class:`State` and what it holds; :mod:`.trust`: the quick
+  trust test and a revolute joint's angle, below :func:`solve`;
+- :mod:`.compiler`: the one compiler (``mk.solve``'s compiled paths and the
+  node's tick, or the reason a scene is not compiled), over the partial
+  evaluator :mod:`.specialize`.
 """
 
 from .actuator import Actuator

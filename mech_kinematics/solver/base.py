@@ -20,12 +20,13 @@ scene's ``type:`` to the item class
 
 The kernel subset of ``Step.run``
 ---------------------------------
-The node's tick (:mod:`mech_kinematics.ros.ticker`) partially evaluates the
-bodies of every step's kernels (:meth:`Step.kernels`: ``run`` itself unless
-the step names its scalar path) into one straight-line function, so they must
-be written in the subset that the ticker understands. Anything else makes the
-scene fall back to the general solver, and ``test_ticker`` fails for a
-packaged scene that falls back:
+The compiler (:mod:`.compiler`: the node's tick and ``mk.solve``'s compiled
+paths) partially evaluates the bodies of every step's kernels
+(:meth:`Step.kernels`: ``run`` itself unless the step names its scalar path)
+into one straight-line function, so they must be written in the subset that
+it understands. Anything else makes the scene fall back to the general
+solver, with the reason (:class:`.compiler.NotCompiled`), and
+``test_compiler`` fails for a kind that falls back:
 
 - a kernel is a plain function of ``(self, ctx)`` (a driver's, a crank's or
   an actuator's, of ``(self, ctx, position, speed, accel)``): no ``for``/``while`` loop,
@@ -39,12 +40,15 @@ packaged scene that falls back:
   table keys are ``self.<attribute>`` (a name fixed when the step is built);
 - ``self.<attribute>`` is read only (it becomes a constant); helpers whose
   body is one ``return <expression>`` (as ``_dot`` of :mod:`.context`) are
-  written out in place; other names are the kernel module's globals.
+  written out in place; other names are the kernel module's globals;
+- a kernel may call a method of its step that takes ``(self, ctx, ...)``, in
+  the same subset, as a statement (``r1, r2 = self._meet(ctx, d, ...)``, or
+  on its own): it is written out in place, and may end with one ``return``
+  (the two RRR kinds share their kernel so).
 
 ``ctx.vector`` is ``False`` in the tick function: a branch it decides is
 dropped before the rest is specialized (the array path may use anything), so
-a step keeps its scalar and array paths in one ``run``. The tick's other
-needs are the public hooks of :mod:`.tick`.
+a step keeps its scalar and array paths in one ``run``.
 """
 
 from __future__ import annotations
@@ -179,7 +183,10 @@ class Placing(Protocol):
     start, x along it; an item adds its own links); ``carriers[point]`` the
     links a point is fixed on, in the order they were added to ``local``;
     ``slot[lever]`` a slotted lever's (pivot, pin); ``size`` the mechanism's
-    size, m; ``scene`` the scene.
+    size, m; ``scene`` the scene; ``intermittent(placing, item)`` the step of
+    an RPR whose lever has slots (a Geneva wheel's, :mod:`.geneva`, which
+    builds on :mod:`.rpr`: lent here so that the base kind imports none of its
+    variants).
     """
 
     ground: Mapping[str, complex]
@@ -188,6 +195,10 @@ class Placing(Protocol):
     size: float
     scene: Any
     carriers: Mapping[str, list[str]]
+
+    @property
+    def intermittent(self) -> Callable[[Placing, Any], Step]:
+        """Return the function building an RPR's step whose lever has slots."""
 
 
 class Reading(Protocol):

@@ -63,7 +63,7 @@ class _Context:
         self.flip = flip
         self.jumps: dict[str, Any] = _NOTHING
         # A compiled array solve's reported bounds summed per kind, for the quick judgement
-        # (:func:`.compiled.compile_array`): the kinds, and a table of one row each; None
+        # (:class:`.compiler.Array`): the kinds, and a table of one row each; None
         # elsewhere.
         self.sums: tuple[tuple[str, ...], Any] | None = None
 

@@ -27,7 +27,8 @@ from .plan import _compile, _Plan
 from .registry import FACT_TEXTS
 from .rubbing import Pin
 from .scaling import _exponent, _LINEAR, _scaled, _size, _SIZE_RANGE
-from .solve import _execute, _execute_drivers, TRUST_TEST
+from .solve import _execute, _execute_drivers
+from .trust import TRUST_TEST
 from ..bounds import U
 from ..errors import AssemblyError, NearSingularWarning, SceneError
 from ..imu import imu_outputs, ImuSpec
@@ -107,8 +108,9 @@ class _Solver:
         self.drivers = run.drivers
         self.driver_names = tuple(driver.name for driver in run.drivers)
         self.driver_types = tuple(driver.joint_type for driver in run.drivers)
-        # The compiled single-angle solve (:mod:`.compiled`): None until compiled, False
-        # where the scene does not compile; and the single-angle solves until then.
+        # The compiled single-angle solve (:mod:`.compiler`): None until compiled, a falsy
+        # NotCompiled (why) where the scene does not compile; and the single-angle solves
+        # until then.
         self.compiled_single: Any = None
         self.single_solves = 0
         # Likewise the compiled array path, and the scene both compile from.

@@ -8,13 +8,14 @@ for its step; it never tests which kind an item is.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 import heapq
 import math
 from typing import Any, TYPE_CHECKING
 
 from .base import Item, Step
+from .geneva import _index_step
 from .graph import build_graph, Graph
 from .model import _check_finite, _check_name, _names, Where
 from .rubbing import _rub_steps, _RubStep
@@ -132,6 +133,7 @@ class _Placing:
     size: float
     scene: Any
     carriers: Mapping[str, list[str]]       # the _Local's
+    intermittent: Callable[[Any, Any], Step] = _index_step
 
 
 def _compile(scene: Scene, joints: tuple[str, ...] | None,

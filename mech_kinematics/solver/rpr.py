@@ -101,8 +101,7 @@ class RPR(Item):
         if self.slots is None:
             step = _RPRStep(self, plan.ground[self.center], plan.size)
         else:
-            from .geneva import _index_step  # the Geneva kind builds on this one
-            step = _index_step(plan, self)
+            step = plan.intermittent(plan, self)     # the Geneva kind's (it builds on this one)
         plan.local[self.link] = {self.center: 0j}
         plan.slot[self.link] = (self.center, self.through)
         return step

@@ -370,13 +370,23 @@ class _RRRStep(Step):
 
         return margins
 
-    def run(self, ctx: _Context) -> None:
-        l1, l2 = self.l1, self.l2
-        p1, v1, a1, ep1, ev1, ea1 = ctx.points[self.start1]
-        p2, v2, a2, ep2, ev2, ea2 = ctx.points[self.start2]
-        d = p2 - p1
-        dist = np.hypot(d.real, d.imag) if ctx.vector else abs(d)
-        lsum = l1 + l2
+    def facts_at(self, dist: float, l1: float, l2: float, touching: bool,
+                 margin: float = 0.0, inputs: float = 0.0) -> dict[str, Any]:
+        """Return why the circles do not meet (:meth:`facts`; ``l1``, ``l2`` are its own)."""
+        return self.facts(dist, touching, margin, inputs)
+
+    def _meet(self, ctx: _Context, d: Any, dist: Any, l1: Any, l2: Any, lsum: Any,
+              inputs: Any, lengths: Any) -> tuple[Any, Any, Any, Any, Any]:
+        """Return where circles of radii ``l1`` and ``l2`` about two starts meet; check they do.
+
+        The kernel both RRR kinds share (a helper the compiler writes out in
+        their ``run``): ``d`` is the second start less the first, ``dist`` its
+        length, ``lsum`` ``l1 + l2``; ``inputs`` and ``lengths`` the error of
+        ``dist`` from the starts and from the lengths. Returns ``(r1, r2, root,
+        measure, spread)``: the pin less each start, ``4 dist^2 h^2``'s square
+        root, the sine of the angle between the links, and the error of
+        ``dist`` and the lengths together.
+        """
         ldiff = l1 - l2
         # 4 * dist^2 * h^2 as a product of factors: no cancellation near toggle.
         k = (lsum + dist) * (lsum - dist) * (dist + ldiff) * (dist - ldiff)
@@ -385,11 +395,7 @@ class _RRRStep(Step):
         # step's rounding of d and dist (2 U dist) and of lsum and ldiff. The margin
         # is linear in them: beyond ROUNDING_MARGIN spreads of the limit no input
         # within its error can cross it; nearer, either way, it is not trusted.
-        if self.rigid:  # noqa: SIM108 (the tick folds an ``if`` on self, not an if-else value)
-            inputs = abs(dist - self.dist0) + self.e_dist   # only the starts' distance's error
-        else:
-            inputs = ep1 + ep2
-        spread = inputs + self.e_lengths + _U2 * dist
+        spread = inputs + lengths + _U2 * dist
         outer = lsum - dist
         inner = dist - abs(ldiff)
         margin = np.minimum(outer, inner) if ctx.vector else (
@@ -402,7 +408,8 @@ class _RRRStep(Step):
                 f'(radius {_g(l2 * m)} m) do not meet: expected '
                 f'|{_g(ldiff * m, dist * m)}| < |{self.start1}{self.start2}| < '
                 f'{_g(lsum * m, dist * m)} m, got |{self.start1}{self.start2}| = '
-                f'{_g(dist * m, lsum * m, abs(ldiff) * m)} m'), lambda: self.facts(dist, False))
+                f'{_g(dist * m, lsum * m, abs(ldiff) * m)} m'),
+                lambda: self.facts_at(dist, l1, l2, False))
         if ctx.vector or not ok:
             ctx.check_margin(ok, self.label, margin * m, spread * m, lambda: (
                 f'the circles about {self.start1} and {self.start2} are within rounding of '
@@ -410,7 +417,7 @@ class _RRRStep(Step):
                 f'|{self.start1}{self.start2}|, |{self.start1}{self.start2}| - '
                 f'{_g(abs(ldiff) * m)} m) = {margin * m:.3g} m to exceed '
                 f'{ROUNDING_MARGIN:g} times its error bound {spread * m:.3g} m'),
-                lambda: self.facts(dist, True, margin, inputs))
+                lambda: self.facts_at(dist, l1, l2, True, margin, inputs))
         root = np.sqrt(k) if ctx.vector else math.sqrt(k)
         # sin of the angle between the two links (the transmission angle).
         measure = root / (2.0 * l1 * l2)
@@ -419,7 +426,7 @@ class _RRRStep(Step):
             ctx.check(ok, self.label, lambda: (
                 f'links {self.link1} and {self.link2} are in line (singular): expected the '
                 f'sine of the angle between them > {SINGULAR:g}, got {measure:.3g}'),
-                lambda: self.facts(dist, True))
+                lambda: self.facts_at(dist, l1, l2, True))
         ctx.measures[self.key] = measure
         half = 0.5 / dist
         shared = ldiff * lsum
@@ -428,6 +435,21 @@ class _RRRStep(Step):
         across = 1j * height * u
         r1 = (shared + dist * dist) * half * u + across
         r2 = (shared - dist * dist) * half * u + across
+        return r1, r2, root, measure, spread
+
+    def run(self, ctx: _Context) -> None:
+        l1, l2 = self.l1, self.l2
+        p1, v1, a1, ep1, ev1, ea1 = ctx.points[self.start1]
+        p2, v2, a2, ep2, ev2, ea2 = ctx.points[self.start2]
+        d = p2 - p1
+        dist = np.hypot(d.real, d.imag) if ctx.vector else abs(d)
+        lsum = l1 + l2
+        if self.rigid:  # noqa: SIM108 (the tick folds an ``if`` on self, not an if-else value)
+            inputs = abs(dist - self.dist0) + self.e_dist   # only the starts' distance's error
+        else:
+            inputs = ep1 + ep2
+        r1, r2, root, measure, spread = self._meet(ctx, d, dist, l1, l2, lsum, inputs,
+                                                   self.e_lengths)
         inv = 2.0 * self.branch / root  # 1 / cross(r1, r2)
         dv = v2 - v1
         w1 = _dot(dv, r2) * inv
@@ -522,8 +544,13 @@ class _ActuatedRRRStep(_RRRStep):
         self.fixed2 = (self.l2, 0.0, 0.0, U * self.l2, 0.0, 0.0)
         self.uses = (*self.uses, *(name for name in dyad.actuators if name is not None))
 
-    def facts_at(self, dist: float, l1: float, l2: float, touching: bool) -> dict[str, Any]:
-        """Return why the circles do not meet at the current lengths, in SI (see ``facts``)."""
+    def facts_at(self, dist: float, l1: float, l2: float, touching: bool,
+                 margin: float = 0.0, inputs: float = 0.0) -> dict[str, Any]:
+        """Return why the circles do not meet at the current lengths, in SI (see ``facts``).
+
+        The starts are never blamed for a margin within rounding (``margin``
+        and ``inputs`` are not read): the actuators' bounds are in its spread.
+        """
         facts = self.facts(dist, touching)
         m = self.unit
         facts['lengths'] = (float(l1) * m, float(l2) * m)
@@ -549,49 +576,11 @@ class _ActuatedRRRStep(_RRRStep):
         d = p2 - p1
         dist = np.hypot(d.real, d.imag) if ctx.vector else abs(d)
         lsum = l1 + l2
-        ldiff = l1 - l2
-        k = (lsum + dist) * (lsum - dist) * (dist + ldiff) * (dist - ldiff)
-        # As the fixed RRR's, the lengths' errors being the actuators' bounds (or half an
-        # ulp of a fixed length) and the rounding of lsum and ldiff.
-        spread = ep1 + ep2 + el1 + el2 + _U2 * lsum + _U2 * dist
-        outer = lsum - dist
-        inner = dist - abs(ldiff)
-        margin = np.minimum(outer, inner) if ctx.vector else (
-            outer if outer < inner else inner)
-        ok = margin > ROUNDING_MARGIN * spread
-        m = self.unit
-        if not (ctx.vector or ok or margin > -ROUNDING_MARGIN * spread):
-            ctx.check(False, self.label, lambda: (
-                f'the circles about {self.start1} (radius {_g(l1 * m)} m) and {self.start2} '
-                f'(radius {_g(l2 * m)} m) do not meet: expected '
-                f'|{_g(ldiff * m, dist * m)}| < |{self.start1}{self.start2}| < '
-                f'{_g(lsum * m, dist * m)} m, got |{self.start1}{self.start2}| = '
-                f'{_g(dist * m, lsum * m, abs(ldiff) * m)} m'),
-                lambda: self.facts_at(dist, l1, l2, False))
-        if ctx.vector or not ok:
-            ctx.check_margin(ok, self.label, margin * m, spread * m, lambda: (
-                f'the circles about {self.start1} and {self.start2} are within rounding of '
-                f'meeting at one point: expected the margin min({_g(lsum * m)} m - '
-                f'|{self.start1}{self.start2}|, |{self.start1}{self.start2}| - '
-                f'{_g(abs(ldiff) * m)} m) = {margin * m:.3g} m to exceed '
-                f'{ROUNDING_MARGIN:g} times its error bound {spread * m:.3g} m'),
-                lambda: self.facts_at(dist, l1, l2, True))
-        root = np.sqrt(k) if ctx.vector else math.sqrt(k)
-        measure = root / (2.0 * l1 * l2)
-        ok = measure > SINGULAR
-        if ctx.vector or not ok:
-            ctx.check(ok, self.label, lambda: (
-                f'links {self.link1} and {self.link2} are in line (singular): expected the '
-                f'sine of the angle between them > {SINGULAR:g}, got {measure:.3g}'),
-                lambda: self.facts_at(dist, l1, l2, True))
-        ctx.measures[self.key] = measure
-        half = 0.5 / dist
-        shared = ldiff * lsum
-        height = self.branch * root * half
-        u = d * (1.0 / dist)
-        across = 1j * height * u
-        r1 = (shared + dist * dist) * half * u + across
-        r2 = (shared - dist * dist) * half * u + across
+        # As the fixed RRR's (the same kernel, _meet), the lengths' errors being the
+        # actuators' bounds (or half an ulp of a fixed length) and the rounding of lsum
+        # and ldiff.
+        r1, r2, root, measure, spread = self._meet(ctx, d, dist, l1, l2, lsum,
+                                                   ep1 + ep2 + el1 + el2, _U2 * lsum)
         inv_l1, inv_l2 = 1.0 / l1, 1.0 / l2
         e1, e2 = r1 * inv_l1, r2 * inv_l2
         inv = 2.0 * self.branch / root  # 1 / cross(r1, r2)

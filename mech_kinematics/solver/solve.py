@@ -5,6 +5,12 @@
 Every value comes with an absolute error bound; :func:`solve` refuses a state
 whose bounds exceed a tolerance relative to each kind's scale, or that lies
 within rounding of an assembly limit.
+
+A scene solved often runs compiled: after :data:`COMPILE_AFTER` single-angle
+solves (:data:`ARRAY_COMPILE_AFTER` array solves) its kernels are compiled for
+that path (:func:`.compiler.compile_scene`), with the same bits, bounds and
+refusals; where the scene does not compile, the solver keeps the reason
+(``scene._solver.compiled_single.reason``) and the general path.
 """
 
 from __future__ import annotations
@@ -17,19 +23,28 @@ import warnings
 import numpy as np
 import numpy.typing as npt
 
-from .compiled import (ARRAY_COMPILE_AFTER, bounds_from_entries, COMPILE_AFTER, compile_array,
-                       compile_single, keep_freed_memory, LARGE_BATCH)
+from .compiler import ARRAY, Array, bounds_from_entries, compile_scene, NotCompiled, SINGLE
 from .context import _Context, NEAR_SINGULAR
 from .graph import REVOLUTE
 from .scaling import (_ACCEL_HIGH, _ldexp, _QUANTITIES, _rate_exponent, _RATE_HIGH, _RATE_LOW,
                       _rates_exponent, _rescale)
 from .state import _crank_floors, _scales, _xy, Engagement, JointMotion, State
+from .trust import floor_limits, trust_limits, wrapped_angle, wrapped_angles
 from ..bounds import ErrorBound, limit, MAX_ERROR, SCALE_MEANINGS, Table, UNITS
 from ..errors import AssemblyError, NearSingularWarning, UntrustedError
 
 if TYPE_CHECKING:
     from .mechanism import _Solver, Scene
     from .plan import _Plan
+
+#: Single-angle solves of one scene on the general path before it is compiled
+#: (:func:`.compiler.compile_scene`): a compilation (constants folded) costs about as much
+#: as a few thousand single-angle solves, so a scene solved a few hundred times or less
+#: (most scenes a test builds) is never compiled.
+COMPILE_AFTER = 256
+#: Array solves of one scene before its array path is compiled: an array solve costs
+#: what a few dozen single angles do, or more.
+ARRAY_COMPILE_AFTER = 16
 
 
 def _run(solver: _Solver, angle: Any, speed: Any, accel: Any, turns: Any,
@@ -133,43 +148,9 @@ def _reported_bounds(solver: _Solver, ctx: _Context) -> Iterator[tuple[str, Any]
         yield from zip(kinds, getattr(ctx, table)[name][3:], strict=True)
 
 
-def trust_limits(tol: float, omega: float, alpha: float, size: float,
-                 crank_length: float) -> tuple[float, float, float, float, float, float]:
-    """Return the quick trust test's six limits: ``tol`` times each kind's floor.
-
-    In order: position, velocity and acceleration (``size``, the crank tip's
-    speed ``a |omega|`` and acceleration ``a (omega^2 + |alpha|)``), angle,
-    angular velocity and angular acceleration (1 rad, ``|omega|``,
-    ``omega^2 + |alpha|``). The floors are at most the scales
-    (:attr:`State.scales`), so a state whose reported bounds are all within
-    them passes :func:`_refuse`'s exact test. With :data:`TRUST_TEST` the one
-    source of the test for :func:`_trusted` and the node's compiled tick.
-    """
-    w = abs(omega)
-    rate = w * w + abs(alpha)
-    return (tol * size, tol * (crank_length * w), tol * (crank_length * rate), tol, tol * w,
-            tol * rate)
-
-
-#: The quick trust test: per context table, the solver's attribute listing the
-#: reported names in it, and which :func:`trust_limits` bound their values' bounds.
-TRUST_TEST = (('points', 'out_points', (0, 1, 2)), ('links', 'out_links', (3, 4, 5)),
-              ('sliders', 'out_sliders', (0, 1, 2)))
-
-
-def _limits(tol: float, size: float, floors: tuple[Any, Any, Any, Any]
-            ) -> tuple[float, float, float, float, float, float]:
-    """Return the quick trust test's six limits from the drivers' floors (several drivers).
-
-    As :func:`trust_limits` (which gives the same for one crank), in the same order.
-    """
-    speed, accel, turn, turn_accel = floors
-    return (tol * size, tol * speed, tol * accel, tol, tol * turn, tol * turn_accel)
-
-
 def _trusted(solver: _Solver, ctx: _Context,
              lim: tuple[float, float, float, float, float, float]) -> bool:
-    """Return True if every reported bound is within its limit ``lim`` (:func:`trust_limits`).
+    """Return True if every reported bound is within its limit ``lim`` (:mod:`.trust`).
 
     A quick sufficient test for the single-angle path; NaN fails.
     """
@@ -288,7 +269,7 @@ def _within(solver: _Solver, ctx: _Context, lims: dict[str, float]) -> bool:
     limit, :func:`_judge` tests each bound.
     """
     largest = np.maximum.reduce
-    if ctx.sums is not None:    # summed by the compiled solve (compile_array), one row a kind
+    if ctx.sums is not None:    # summed by the compiled array solve, one row a kind
         kinds, table = ctx.sums
         for kind, most in zip(kinds, largest(table, axis=1).tolist(), strict=True):
             if not most <= lims[kind]:
@@ -301,23 +282,6 @@ def _within(solver: _Solver, ctx: _Context, lims: dict[str, float]) -> bool:
             return False
     lim = lims['velocity']
     return all(bool(largest(bound, axis=None) <= lim) for _, bound in ctx.rubbing.values())
-
-
-def _angles(e: Any) -> Any:
-    """Angles of an array of unit complex numbers ``e``, wrapped to (-pi, pi].
-
-    The array path's :func:`_wrapped_angle`.
-    """
-    theta = np.arctan2(e.imag, e.real)
-    if np.fmin.reduce(theta, axis=None) == -np.pi:    # the least, NaN left out
-        theta[theta == -np.pi] = np.pi
-    return theta
-
-
-def _wrapped_angle(e: complex) -> float:
-    """Angle of unit complex ``e`` (one value), wrapped to (-pi, pi]."""
-    theta = math.atan2(e.imag, e.real)
-    return math.pi if theta == -math.pi else theta
 
 
 def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None,
@@ -445,8 +409,6 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
             if not (np.isfinite(theta).all() and _finite(omega) and _finite(alpha)):
                 msg = 'Expected `angle`, `speed` and `accel` to be finite'
                 raise ValueError(msg)
-        if shape[0] >= LARGE_BATCH:
-            keep_freed_memory()
         given = (theta, omega, alpha)       # maybe the caller's own arrays
         constant = _constants(solver, shape)
         theta = _read_only(theta, shape, constant)
@@ -534,7 +496,7 @@ def _solve_drivers(scene: Scene, solver: _Solver, positions: Any, speeds: Any, a
         try:
             ctx = _execute_drivers(solver, tuple(xs), tuple(vs), tuple(accs))
             floors = solver.floors(vs, accs)
-            if not _trusted(solver, ctx, _limits(tol, solver.size, floors)):
+            if not _trusted(solver, ctx, floor_limits(tol, solver.size, floors)):
                 _refuse(solver, ctx, floors, tol)
         except AssemblyError as error:
             raise error.located(_where(drivers, xs)) from None
@@ -555,8 +517,6 @@ def _solve_drivers(scene: Scene, solver: _Solver, positions: Any, speeds: Any, a
         if not all(np.isfinite(a).all() for a in arrays):
             msg = 'Expected the positions, speeds and accels of the drivers to be finite'
             raise ValueError(msg)
-        if shape[0] >= LARGE_BATCH:
-            keep_freed_memory()
         n = len(drivers)
         # Copies: the state's arrays get NaN where refused, never the caller's own.
         xs = [np.array(np.broadcast_to(a, shape)) for a in arrays[:n]]
@@ -748,43 +708,45 @@ def _compiled_state(scene: Scene, solver: _Solver, theta: float, omega: float, a
 
 
 def _compiled(scene: Scene, solver: _Solver) -> Any:
-    """Return the scene's compiled single-angle solve once it is worth it, else None or False.
+    """Return the scene's compiled single-angle solve once it is worth it, else None or why not.
 
-    See :mod:`.compiled`: compiled after :data:`.compiled.COMPILE_AFTER`
-    single-angle solves, False where the scene does not compile.
+    Compiled (:mod:`.compiler`, :data:`.compiler.SINGLE`) after
+    :data:`COMPILE_AFTER` single-angle solves; a :class:`.compiler.NotCompiled`
+    (falsy, with its reason) where the scene does not compile.
     """
     solver.single_solves += 1
     if solver.single_solves < COMPILE_AFTER:
         return None
-    solver.compiled_single = compile_single(scene) or False
+    solver.compiled_single = compile_scene(scene, SINGLE)
     return solver.compiled_single
 
 
 def _compiled_array(solver: _Solver) -> Any:
-    """Return the scene's compiled array path once it is worth it, else None or False.
+    """Return the scene's compiled array path once it is worth it, else None or why not.
 
-    See :mod:`.compiled`: compiled after :data:`.compiled.ARRAY_COMPILE_AFTER`
-    array solves, False where the scene does not compile.
+    Compiled (:data:`.compiler.ARRAY`) after :data:`ARRAY_COMPILE_AFTER` array
+    solves; a :class:`.compiler.NotCompiled` where the scene does not compile.
     """
     solver.array_solves += 1
     if solver.array_solves < ARRAY_COMPILE_AFTER:
         return None
-    solver.compiled_array = compile_array(solver.scene) or False
-    solver.compiled_usual = _compile_usual(solver) if solver.compiled_array else False
+    solver.compiled_array = compile_scene(solver.scene, ARRAY)
+    solver.compiled_usual = (_compile_usual(solver) if solver.compiled_array
+                             else solver.compiled_array)
     return solver.compiled_array
 
 
 def _compile_usual(solver: _Solver) -> Any:
-    """Return the scene's array path compiled for its own rates (the usual call), or False.
+    """Return the scene's array path compiled for its own rates (the usual call), or why not.
 
-    False where those rates are solved with time rescaled (:func:`_execute`),
+    Not where those rates are solved with time rescaled (:func:`_execute`),
     which the compiled function does not do. Sets ``solver.usual_floors``.
     """
     omega, alpha = solver.default_arrays
     if _rate_exponent(omega, alpha) or solver.shift:
-        return False
+        return NotCompiled("the scene's own crank rates are solved with time rescaled")
     solver.usual_floors = _crank_floors(solver.crank_length, omega, alpha)
-    return compile_array(solver.scene, solver.defaults) or False
+    return compile_scene(solver.scene, Array(solver.defaults))
 
 
 def _warn_near_singular(measures: dict[str, Any], vector: bool, valid: Any) -> None:
@@ -836,7 +798,7 @@ def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any,
         for name, kind in plan.joint_types.items():
             if kind.angular:  # a unit complex number, its angle reported
                 e, w, al = ctx.links[name][:3]
-                joints[name] = JointMotion(kind, finish(_angles(e)), finish(w),
+                joints[name] = JointMotion(kind, finish(wrapped_angles(e)), finish(w),
                                            finish(al))
             else:
                 x, v, a = ctx.sliders[name][:3]
@@ -874,7 +836,7 @@ def _state(scene: Scene, solver: _Solver, ctx: _Context, theta: Any, omega: Any,
         for name, kind in plan.joint_types.items():
             if kind.angular:  # a unit complex number, its angle reported
                 e, w, al = ctx.links[name][:3]
-                joints[name] = JointMotion(kind, _wrapped_angle(e), w, al)
+                joints[name] = JointMotion(kind, wrapped_angle(e), w, al)
             else:
                 joints[name] = JointMotion(kind, *ctx.sliders[name][:3])
         points = {name: table[name][:3] for name in plan.output_points}

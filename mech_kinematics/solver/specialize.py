@@ -14,7 +14,10 @@ kernels out for one scene instead, as the statements of one function:
   value: constants;
 - ``ctx.points[name]``, ``ctx.links[name]``, ``ctx.sliders[name]`` and
   ``ctx.measures[name]`` become local variables (:data:`TABLES`);
-- one-line helpers of the solver package are written out in place;
+- one-line helpers of the solver package are written out in place, and so
+  are the step's methods a kernel calls as ``self.<helper>(ctx, ...)`` in a
+  statement (their locals get a suffix of their own, their arguments are
+  bound in order, their final ``return`` assigns the statement's targets);
 - each step's local names get the step's number as a suffix, and the steps
   are laid out one after another in plan order.
 
@@ -67,10 +70,11 @@ which a 0-d array operand is about eight times slower than a Python number
 (0.54 against 0.06 µs) and turns ``1j * x`` from a Python complex into a
 ``np.complex128``. What the caller does with the
 statements (which values the function returns, how a failed check is
-reported) is the caller's: the node's tick (:mod:`mech_kinematics.ros.ticker`)
-and the solver's own compiled paths (:mod:`.compiled`). A step whose code uses
-something this module does not know raises :class:`Unsupported`, and the
-caller falls back to the general solver.
+reported) is the caller's: the one compiler (:mod:`.compiler`), whose targets
+are ``mk.solve``'s paths and the node's tick. A step whose code uses
+something this module does not know raises :class:`Unsupported` with the
+reason (naming the step), which the compiler returns as why it did not
+compile the scene; the caller keeps the general solver.
 """
 
 from __future__ import annotations
@@ -100,7 +104,17 @@ TABLES = {'points': 'P', 'links': 'L', 'sliders': 'S', 'measures': 'M'}
 
 
 class Unsupported(Exception):
-    """A step's code holds something the specializer does not handle."""
+    """A step's code holds something the specializer does not handle; ``reason`` says what.
+
+    The one exception the compiler turns into a reason (:class:`.compiler.NotCompiled`):
+    ``reason`` is one line, e.g. ``'step RRR C: kernel uses `for` (not in the kernel
+    subset)'`` (:func:`plan_body` names the step).
+    """
+
+    def __init__(self, reason: str) -> None:
+        """Hold ``reason``, one line."""
+        super().__init__(reason)
+        self.reason = reason
 
 
 class _Folder(ast.NodeTransformer):
@@ -181,6 +195,8 @@ class _Specializer(ast.NodeTransformer):
         self.namespace = namespace
         self.arguments = arguments      # run() argument -> tick argument
         self.locals: set[str] = set()
+        self.depth = 0                  # helpers written out around this code
+        self.inlined = 0                # helpers written out in this code so far
 
     def constant(self, value: Any) -> ast.expr:
         if value is None or isinstance(value, (bool, int, float, complex, str)):
@@ -198,7 +214,8 @@ class _Specializer(ast.NodeTransformer):
         key = node.slice
         if not (isinstance(key, ast.Attribute) and isinstance(key.value, ast.Name)
                 and key.value.id == 'self'):
-            raise Unsupported('a table read with a key that is not a step attribute')
+            raise Unsupported('a table of ctx read with a key that is not a step attribute '
+                              '(not in the kernel subset)')
         name = getattr(self.step, key.attr)
         entry = f'{TABLES[value.attr]}_{name}'
         return self.names.setdefault(entry, f'{entry}_{len(self.names)}')
@@ -228,7 +245,7 @@ class _Specializer(ast.NodeTransformer):
                     return ast.Call(ast.Name('_shown', ast.Load()),
                                     [ast.Name('theta', ast.Load()),
                                      ast.Name('turns', ast.Load())], [])
-                raise Unsupported(f'ctx.{node.attr}')
+                raise Unsupported(f'uses `ctx.{node.attr}` (not in the kernel subset)')
         return self.generic_visit(node)
 
     def visit_If(self, node: ast.If) -> Any:
@@ -257,13 +274,108 @@ class _Specializer(ast.NodeTransformer):
                 and isinstance(value.func.value, ast.Name) and value.func.value.id == 'ctx'
                 and value.func.attr in DROPPED and not self.vector):
             return ast.Pass()       # a side fact the scalar path does not report
+        helper = self.helper(value)
+        if helper is not None:
+            return self.inline(*helper, None, node)
         return self.generic_visit(node)
+
+    def visit_Assign(self, node: ast.Assign) -> Any:
+        helper = self.helper(node.value)
+        if helper is None:
+            return self.generic_visit(node)
+        if len(node.targets) != 1:
+            raise Unsupported(f'the result of helper {helper[0].__name__} assigned to '
+                              f'{len(node.targets)} targets at once')
+        target = cast(ast.expr, self.visit(node.targets[0]))
+        return self.inline(*helper, target, node)
+
+    def helper(self, value: ast.expr) -> tuple[Callable[..., Any], list[ast.expr]] | None:
+        """Return (the method, its arguments after ``ctx``) of ``self.<method>(ctx, ...)``.
+
+        ``None`` for any other expression (a call of a step's method without
+        the context is a call of a constant, the bound method).
+        """
+        if not (isinstance(value, ast.Call) and isinstance(value.func, ast.Attribute)
+                and isinstance(value.func.value, ast.Name) and value.func.value.id == 'self'
+                and value.args and isinstance(value.args[0], ast.Name)
+                and value.args[0].id == 'ctx'):
+            return None
+        name = value.func.attr
+        if value.keywords or any(isinstance(a, ast.Starred) for a in value.args):
+            raise Unsupported(f'helper {name} called with keywords or *args')
+        method = getattr(type(self.step), name, None)
+        if not inspect.isfunction(method):
+            raise Unsupported(f'self.{name}(ctx, ...) is not a method written in Python')
+        return method, value.args[1:]
+
+    def inline(self, method: Callable[..., Any], args: list[ast.expr],
+               target: ast.expr | None, call: ast.stmt) -> list[ast.stmt]:
+        """Return the statements of the helper ``method`` called on ``args``, written out.
+
+        A helper is a method of the step taking ``(self, ctx, ...)``, in the
+        kernel subset, that may end with one ``return``. Its locals get a
+        suffix of their own (a caller's names are never touched); an argument
+        that is a name is read for its parameter where the helper never binds
+        it, any other is bound to the parameter first, in order; the final
+        ``return`` value is assigned to ``target`` (the calling statement's,
+        ``call``). The same operations in the same order as the call: the
+        same bits.
+        """
+        name = method.__name__
+        if self.depth >= _HELPER_DEPTH:
+            raise Unsupported(f'helper {name} called {_HELPER_DEPTH} helpers deep')
+        definition = ast.parse(_source(method)).body[0]
+        if not isinstance(definition, ast.FunctionDef):
+            raise Unsupported(f'helper {name} is not a plain function')
+        signature = definition.args
+        if (signature.posonlyargs or signature.vararg or signature.kwonlyargs
+                or signature.kwarg or signature.defaults or len(signature.args) < 2
+                or signature.args[1].arg != 'ctx'):
+            raise Unsupported(f'helper {name} is not a function of (self, ctx, ...) without '
+                              'defaults')
+        parameters = [a.arg for a in signature.args[2:]]
+        if len(parameters) != len(args):
+            raise Unsupported(f'helper {name} takes {len(parameters)} arguments after ctx, '
+                              f'got {len(args)}')
+        body = _checked(definition, f'helper {name}', returns=True)
+        final = body[-1] if body and isinstance(body[-1], ast.Return) else None
+        if final is not None:
+            body = body[:-1]
+        suffix = f'{self.suffix}h{self.inlined}'
+        self.inlined += 1
+        stored = _stored(definition)
+        arguments: dict[str, str] = {}
+        bindings: list[ast.stmt] = []
+        for parameter, arg in zip(parameters, args, strict=True):
+            value = cast(ast.expr, self.visit(arg))
+            if isinstance(value, ast.Name) and parameter not in stored:
+                arguments[parameter] = value.id
+            else:
+                stored.add(parameter)
+                bindings.append(ast.copy_location(ast.Assign(
+                    [ast.Name(f'{parameter}{suffix}', ast.Store())], value), call))
+        inner = _Specializer(self.step, suffix, self.names, self.namespace, arguments,
+                             self.vector)
+        inner.depth = self.depth + 1
+        inner.locals = stored - {'self', 'ctx'} - set(arguments)
+        out = bindings + inner.statements(body)
+        if final is not None and final.value is not None:
+            value = cast(ast.expr, inner.visit(final.value))
+            if target is not None:
+                out.append(ast.copy_location(ast.Assign([target], value), call))
+            elif not _inert(value):
+                out.append(ast.copy_location(ast.Expr(value), call))
+        elif target is not None:
+            out.append(ast.copy_location(ast.Assign([target], ast.Constant(None)), call))
+        return out
 
     def visit_Call(self, node: ast.Call) -> ast.AST:
         func = node.func
         if any(isinstance(arg, ast.Name) and arg.id in ('ctx', 'self')
                for arg in (*node.args, *(k.value for k in node.keywords))):
-            raise Unsupported('the context or the step passed as a value')
+            called = ast.unparse(func)
+            raise Unsupported(f'the context or the step passed as a value (to {called}; a '
+                              'helper is called as a statement: `x = self.helper(ctx, ...)`)')
         inlined = _inline(func, node.args, self.namespace) if not node.keywords else None
         if inlined is not None:
             result: ast.AST = self.visit(ast.copy_location(inlined, node))
@@ -297,7 +409,7 @@ class _Specializer(ast.NodeTransformer):
         if node.id == 'ctx' and self.vector and isinstance(node.ctx, ast.Load):
             return node         # the receiver of a real context's attribute or method
         if node.id in ('ctx', 'self'):
-            raise Unsupported(f'{node.id} used as a value')
+            raise Unsupported(f'`{node.id}` used as a value (not in the kernel subset)')
         return node
 
 
@@ -330,10 +442,49 @@ def _inline(func: ast.expr, args: list[ast.expr],
     return expression
 
 
+#: How deep helpers may call helpers (:meth:`_Specializer.inline`).
+_HELPER_DEPTH = 8
+#: The statements and expressions outside the kernel subset, and their keyword.
+_OUTSIDE = {ast.Global: 'global', ast.Nonlocal: 'nonlocal', ast.Return: 'return',
+            ast.Yield: 'yield', ast.YieldFrom: 'yield from', ast.Await: 'await',
+            ast.For: 'for', ast.AsyncFor: 'async for', ast.While: 'while', ast.Try: 'try',
+            ast.With: 'with', ast.AsyncWith: 'async with', ast.FunctionDef: 'def',
+            ast.AsyncFunctionDef: 'async def', ast.ClassDef: 'class'}
+
+
 @functools.cache
 def _source(function: Callable[..., Any]) -> str:
     """Return the source of a kernel or helper, dedented (read once per process)."""
-    return textwrap.dedent(inspect.getsource(function))
+    try:
+        source = inspect.getsource(function)
+    except (OSError, TypeError) as error:   # no source file (defined at a prompt, built in)
+        name = getattr(function, '__qualname__', repr(function))
+        raise Unsupported(f'the source of {name} cannot be read ({error})') from None
+    return textwrap.dedent(source)
+
+
+def _stored(function: ast.FunctionDef) -> set[str]:
+    """Return the names ``function``'s body binds."""
+    return {n.id for n in ast.walk(function)
+            if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Store)}
+
+
+def _checked(function: ast.FunctionDef, what: str, returns: bool = False) -> list[ast.stmt]:
+    """Return ``function``'s statements after its docstring; refuse what is outside the subset.
+
+    With ``returns`` (a helper), one ``return`` is allowed, as the last statement.
+    """
+    body = [stmt for stmt in function.body
+            if not (isinstance(stmt, ast.Expr) and isinstance(stmt.value, ast.Constant))]
+    last = body[-1] if returns and body and isinstance(body[-1], ast.Return) else None
+    for n in itertools.chain.from_iterable(ast.walk(stmt) for stmt in body):
+        if isinstance(n, ast.Lambda) and (n.args.args or n.args.vararg or n.args.kwarg):
+            raise Unsupported(f'{what} uses a lambda with arguments (not in the kernel subset)')
+        if type(n) in _OUTSIDE and n is not last:
+            where = ' before its end' if isinstance(n, ast.Return) and returns else ''
+            raise Unsupported(f'{what} uses `{_OUTSIDE[type(n)]}`{where} (not in the kernel '
+                              'subset)')
+    return body
 
 
 def _body(step: Any, method: Callable[..., Any], suffix: str, names: dict[str, str],
@@ -343,29 +494,31 @@ def _body(step: Any, method: Callable[..., Any], suffix: str, names: dict[str, s
     tree = ast.parse(_source(method))
     function = tree.body[0]
     if not isinstance(function, ast.FunctionDef):
-        raise Unsupported('run is not a plain function')
+        raise Unsupported('kernel is not a plain function')
     specializer = _Specializer(step, suffix, names, namespace, arguments, vector)
     parameters = {a.arg for a in function.args.args}
-    specializer.locals = {n.id for n in ast.walk(function)
-                          if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Store)
-                          } - parameters - set(arguments)
-    for n in itertools.chain.from_iterable(ast.walk(stmt) for stmt in function.body):
-        if isinstance(n, ast.Lambda) and (n.args.args or n.args.vararg or n.args.kwarg):
-            raise Unsupported('a lambda with arguments')
-        if isinstance(n, (ast.Global, ast.Nonlocal, ast.Return, ast.Yield, ast.For,
-                          ast.While, ast.Try, ast.With, ast.FunctionDef)):
-            raise Unsupported(type(n).__name__)
-    module = ast.Module(body=[stmt for stmt in function.body if not (
-        isinstance(stmt, ast.Expr) and isinstance(stmt.value, ast.Constant))], type_ignores=[])
+    specializer.locals = _stored(function) - parameters - set(arguments)
+    module = ast.Module(body=_checked(function, 'kernel'), type_ignores=[])
     module = cast(ast.Module, fold(specializer.visit(module)))
     return [stmt for stmt in module.body if not isinstance(stmt, ast.Pass)]
+
+
+def _step_body(step: Any, method: Callable[..., Any], suffix: str, names: dict[str, str],
+               namespace: dict[str, Any], arguments: dict[str, str],
+               vector: bool) -> list[ast.stmt]:
+    """Return :func:`_body`'s statements; an :class:`Unsupported` names the step."""
+    try:
+        return _body(step, method, suffix, names, namespace, arguments, vector)
+    except Unsupported as unsupported:
+        label = getattr(step, 'label', '') or type(step).__name__
+        raise Unsupported(f'step {label}: {unsupported.reason}') from None
 
 
 def plan_body(plan: Any, names: dict[str, str], namespace: dict[str, Any],
               vector: bool = False,
               driver_values: Sequence[tuple[str, str, str]] | None = None,
               propagated: bool = True) -> list[ast.stmt]:
-    """Return the statements solving ``plan`` (a :class:`.tick.TickPlan`) in one function.
+    """Return the statements solving ``plan`` (a :class:`.compiler.ScenePlan`) in one function.
 
     The function's arguments are ``theta, omega, alpha, turns`` (and, on the
     array path, ``ctx``: a context for the checks and side facts); the
@@ -378,7 +531,8 @@ def plan_body(plan: Any, names: dict[str, str], namespace: dict[str, Any],
     statements are :func:`propagate`'d, every table entry's local kept; with
     ``propagated`` false they are not, for a caller that runs
     :func:`propagate` over the whole function it makes of them.
-    Raises :class:`Unsupported` where a kernel is outside the subset.
+    Raises :class:`Unsupported` where a kernel is outside the subset (its
+    reason names the step).
     """
     drivers = (plan.crank,) if driver_values is None else plan.drivers
     values = (('theta', 'omega', 'alpha'),) if driver_values is None else driver_values
@@ -389,24 +543,24 @@ def plan_body(plan: Any, names: dict[str, str], namespace: dict[str, Any],
                 namespace.update((k, v) for k, v in vars(home).items()
                                  if not k.startswith('__'))
     body: list[ast.stmt] = []
-    try:
-        for name, entry in plan.ground.items():
-            local = names.setdefault(f'P_{name}', f'P_{name}_{len(names)}')
-            namespace[f'_ground_{local}'] = entry
-            body.append(ast.parse(f'{local} = _ground_{local}').body[0])
-        for k, (driver, given) in enumerate(zip(drivers, values, strict=True)):
-            run = type(driver).run
-            parameters = list(inspect.signature(run).parameters)[2:]   # after self, ctx
-            arguments = dict(zip(parameters, given, strict=True))
-            body += _body(driver, run, f'_d{k}' if driver_values else '_0', names, namespace,
-                          arguments, vector)
-        for index, step in enumerate(plan.steps, 1):
-            # Step.kernels names the single-angle path; the array path is ``run`` itself.
-            kernels = (type(step).run,) if vector else step.kernels()
-            for part, kernel in enumerate(kernels):
-                body += _body(step, kernel, f'_{index}_{part}', names, namespace, {}, vector)
-    except (OSError, TypeError) as error:
-        raise Unsupported(str(error)) from error
+    for name, entry in plan.ground.items():
+        local = names.setdefault(f'P_{name}', f'P_{name}_{len(names)}')
+        namespace[f'_ground_{local}'] = entry
+        body.append(ast.parse(f'{local} = _ground_{local}').body[0])
+    for k, (driver, given) in enumerate(zip(drivers, values, strict=True)):
+        run = type(driver).run
+        parameters = list(inspect.signature(run).parameters)[2:]   # after self, ctx
+        if len(parameters) != len(given):
+            raise Unsupported(f"step {driver.label}: a driver's run takes (self, ctx, "
+                              f'position, speed, accel), got {len(parameters)} after ctx')
+        arguments = dict(zip(parameters, given, strict=True))
+        body += _step_body(driver, run, f'_d{k}' if driver_values else '_0', names, namespace,
+                           arguments, vector)
+    for index, step in enumerate(plan.steps, 1):
+        # Step.kernels names the single-angle path; the array path is ``run`` itself.
+        kernels = (type(step).run,) if vector else step.kernels()
+        for part, kernel in enumerate(kernels):
+            body += _step_body(step, kernel, f'_{index}_{part}', names, namespace, {}, vector)
     return propagate(body, namespace, set(names.values()), vector) if propagated else body
 
 

@@ -30,6 +30,7 @@ import numpy as np
 
 from .cli import positive_int, run_tool
 from .peer import available, BATCHES, measure_peer, PEER_SCENES, peer_table, PEERS
+from ..memory import keep_freed_memory
 from ..scene import load_scene, scene_names
 from ..solver import solve
 
@@ -405,8 +406,11 @@ def measure(names: list[str], angles: int, repeat: int) -> list[dict[str, Any]]:
     Each row holds ``single_us`` and ``array_us`` (per configuration) as
     ``[min, median, max]`` over ``repeat`` runs, microseconds; a row of a
     scene with a hand-written form also holds the median ratios
-    ``single_ratio`` and ``array_ratio`` to it.
+    ``single_ratio`` and ``array_ratio`` to it. The process keeps freed memory
+    for reuse (:func:`~mech_kinematics.memory.keep_freed_memory`), for ours and
+    the hand-written forms alike.
     """
+    keep_freed_memory()
     sweep = np.linspace(0.0, 2.0 * math.pi, angles, endpoint=False)
     rows = []
     for name in names:
@@ -512,7 +516,12 @@ def _handle_peer(args: argparse.Namespace) -> int:
 
 def measure_peers(repeat: int, names: Sequence[str] = PEER_SCENES,
                   batches: tuple[int, ...] = BATCHES) -> list[dict[str, Any]]:
-    """Return :func:`.peer.measure_peer`'s row of every scene timed against pylinkage."""
+    """Return :func:`.peer.measure_peer`'s row of every scene timed against pylinkage.
+
+    The process keeps freed memory for reuse, as in :func:`measure`.
+    """
+    keep_freed_memory()
+
     def forms(scene: Any) -> tuple[str, tuple[float, ...]]:
         found = geometry_of(scene)
         if found is None or found[0] not in ('RRR', 'RRP'):

@@ -17,7 +17,9 @@ a file that cannot be read or written is one line naming it (exit 2), a
 broken pipe (``solve ... | head``) exits quietly, Ctrl-C exits 130, running
 out of memory is one line saying to ask for less (exit 2), and an
 unexpected exception is one line too (never empty, never several), with its traceback only when
-``MECH_KINEMATICS_TRACEBACK=1`` is set.
+``MECH_KINEMATICS_TRACEBACK=1`` is set. It also lets the C library keep freed
+memory for reuse (:func:`mech_kinematics.memory.keep_freed_memory`): a
+command's process is its own, the library never changes a host's allocator.
 """
 
 from __future__ import annotations
@@ -32,6 +34,7 @@ import traceback
 from typing import Any
 
 from ..errors import MechKinematicsError
+from ..memory import keep_freed_memory
 from ..units import LENGTH_UNITS, rad_per_s_from_rpm, turns_from_degrees
 
 __all__ = ['ArgumentParser', 'PROG', 'add_driver_arguments', 'add_scene_argument',
@@ -124,7 +127,12 @@ def positive_int(text: str) -> int:
 
 
 def run_handler(args: argparse.Namespace) -> int:
-    """Run ``args.handler(args)``; return its exit status, turning failures into one line."""
+    """Run ``args.handler(args)``; return its exit status, turning failures into one line.
+
+    The command's process keeps freed memory for its large array solves
+    (:func:`~mech_kinematics.memory.keep_freed_memory`).
+    """
+    keep_freed_memory()
     try:
         status = int(args.handler(args) or 0)
         sys.stdout.flush()

@@ -6,14 +6,16 @@ import math
 from pathlib import Path
 import warnings
 
-from helpers import crank_scene_names, driver_scene_names, general_only, strip_scene
+from helpers import (crank_scene_names, driver_scene_names, general_tick_outcome, strip_scene,
+                     tick_outcome)
 import numpy as np
 import pytest
 import yaml
 
 import mech_kinematics as mk
-from mech_kinematics.ros.ticker import compile_tick, tick_function, values_from_state
-from mech_kinematics.solver import tick as hooks
+from mech_kinematics.ros.ticker import (compile_tick, compiled_tick, tick_function,
+                                        values_from_state)
+from mech_kinematics.solver.compiler import NotCompiled, scene_plan
 from mech_kinematics.tools.report.common import MODES
 from mech_kinematics.tools.report.cost import chain_scene
 from mech_kinematics.tools.report.extreme import extreme_cases
@@ -21,35 +23,6 @@ from mech_kinematics.tools.report.extreme import extreme_cases
 #: Crank angles over two turns and a bit, both signs.
 ANGLES = np.linspace(-7.0, 7.0, 351)
 TOLERANCES = (1e-6, 1e-12, math.inf)
-
-
-def _general(scene, theta, omega, alpha, tol, turns=0, joints=None, points=None, frames=()):
-    """Return what the general solver answers, in a tick function's terms, or its error.
-
-    The solver's own compiled path is turned off (``general_only``): the tick is
-    held to the general solve, not to code compiled the same way.
-    """
-    general_only(scene)
-    with warnings.catch_warnings():
-        warnings.simplefilter('ignore', mk.NearSingularWarning)
-        try:
-            state = mk.solve(scene, theta, omega, alpha, turns=turns, max_error=tol)
-        except mk.AssemblyError as error:
-            return type(error), str(error)
-    measures = state.singularity.values()
-    joints = scene.output_joints if joints is None else joints
-    points = scene.output_points if points is None else points
-    return (values_from_state(state, joints, points, frames),
-            min(measures) if measures else math.inf)
-
-
-def _compiled(tick, theta, omega, alpha, tol, turns=0):
-    with warnings.catch_warnings():
-        warnings.simplefilter('ignore', mk.NearSingularWarning)
-        try:
-            return tick(theta, omega, alpha, tol, turns)
-        except mk.AssemblyError as error:
-            return type(error), str(error)
 
 
 def _assert_same(scene, tick, angles, speeds=(None,), turns=(0,), **kwargs):
@@ -60,9 +33,9 @@ def _assert_same(scene, tick, angles, speeds=(None,), turns=(0,), **kwargs):
             omega = scene.input.speed if speed is None else speed
             for tol in TOLERANCES:
                 for k in turns:
-                    expected = _general(scene, float(theta), omega, scene.input.accel, tol, k,
-                                        **kwargs)
-                    got = _compiled(tick, float(theta), omega, scene.input.accel, tol, k)
+                    expected = general_tick_outcome(scene, float(theta), omega,
+                                                    scene.input.accel, tol, k, **kwargs)
+                    got = tick_outcome(tick, float(theta), omega, scene.input.accel, tol, k)
                     assert repr(got) == repr(expected), (scene.name, theta, tol, k)
                     refused += isinstance(expected[0], type)
     return refused
@@ -134,9 +107,9 @@ def test_several_driver_scenes_compile_to_the_same_bits(name):
 
 
 def test_a_step_outside_the_kernel_subset_falls_back(monkeypatch):
-    """A kernel with a loop is not compiled: the scene falls back (what the test above catches)."""
+    """A kernel with a loop is not compiled: the scene falls back, saying why in one line."""
     scene = mk.load_scene('khurmi_four_bar_ad150')
-    step = type(hooks.tick_plan(scene).steps[0])
+    step = type(scene_plan(scene).steps[0])
 
     def looping(self, ctx):
         for _ in range(1):
@@ -145,6 +118,8 @@ def test_a_step_outside_the_kernel_subset_falls_back(monkeypatch):
     assert tick_function(scene)[1]
     monkeypatch.setattr(step, 'kernels', classmethod(lambda cls: (looping,)))
     assert not tick_function(scene)[1]
+    assert compiled_tick(scene) == NotCompiled(
+        'step RRR C: kernel uses `for` (not in the kernel subset)')
 
 
 def test_the_extreme_suite_refuses_and_answers_alike():
@@ -197,6 +172,9 @@ def test_a_scene_the_solver_rescales_is_served_by_the_general_solver(tmp_path):
     """Lengths of 1e-300 m are not compiled; tick_function falls back with the same answers."""
     scene = _tiny_four_bar(tmp_path)
     assert compile_tick(scene) is None
+    assert compiled_tick(scene).reason == (
+        'scene rescaled: its size 1.5e-298 m is beyond 2**60 of 1 m (its lengths are solved '
+        'scaled by a power of two)')
     tick, compiled = tick_function(scene)
     assert not compiled
     _assert_same(scene, tick, ANGLES[::10])

@@ -3,29 +3,29 @@
 """The solver's compiled single-angle path against its general one: the same state, bit for bit.
 
 ``solve(scene, angle)`` compiles a scene it has solved at single angles often
-enough (``solver/compiled.py``, issue 19's "bounds that cost little"): its
-states, bounds, warnings and refusals must be the general path's exactly.
+enough (``solver/compiler.py``'s ``Single`` and ``Array`` targets, issue 19's
+"bounds that cost little"): its states, bounds, warnings and refusals must be
+the general path's exactly. Where a scene does not compile, the compiler says
+why (issue 30).
 """
 
 import importlib
 import math
-import sys
-import warnings
 
-from helpers import (crank_scene_names, driver_scene_names, general_only, state_facts,
-                     strip_scene)
+from helpers import (array_outcome, crank_scene_names, driver_scene_names, general_only,
+                     solve_outcome, state_facts, strip_scene)
 import numpy as np
 import pytest
 
 import mech_kinematics as mk
-from mech_kinematics.solver import compiled as compiled_module
-from mech_kinematics.solver.compiled import (ARRAY_COMPILE_AFTER, COMPILE_AFTER, compile_array,
-                                             compile_single, LARGE_BATCH)
+from mech_kinematics.solver.compiler import (ARRAY, compile_scene, COMPILE_STEPS, NotCompiled,
+                                             SINGLE, Single)
 from mech_kinematics.tools.report.common import MODES
 from mech_kinematics.tools.report.extreme import extreme_cases
 
 #: The module (``mech_kinematics.solver.solve`` is also the name of its function).
 solve_module = importlib.import_module('mech_kinematics.solver.solve')
+COMPILE_AFTER, ARRAY_COMPILE_AFTER = solve_module.COMPILE_AFTER, solve_module.ARRAY_COMPILE_AFTER
 
 #: Crank angles over two turns and a bit, both signs.
 ANGLES = np.linspace(-7.0, 7.0, 141)
@@ -35,22 +35,10 @@ TOLERANCES = (1e-6, 1e-12, math.inf)
 def _pair(scene_of):
     """Return the same scene twice: compiled now, and never compiled."""
     fast, slow = scene_of(), general_only(scene_of())
-    fast._solver.compiled_single = compile_single(fast)
-    fast._solver.compiled_array = compile_array(fast)
+    fast._solver.compiled_single = compile_scene(fast, SINGLE)
+    fast._solver.compiled_array = compile_scene(fast, ARRAY)
     fast._solver.compiled_usual = solve_module._compile_usual(fast._solver)
     return fast, slow
-
-
-def _outcome(scene, *args, **kwargs):
-    """Return the state's facts and the warnings raised, or the error's type, text and facts."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter('always')
-        try:
-            state = mk.solve(scene, *args, **kwargs)
-        except mk.AssemblyError as error:
-            return (type(error), str(error), error.dyad, repr(error.angle),
-                    getattr(error, 'facts', None), getattr(error, 'quantity', None))
-    return state_facts(state), [(w.category, str(w.message), w.filename) for w in caught]
 
 
 def _assert_same(fast, slow, angles, speeds=(None,), turns=(0,)):
@@ -60,8 +48,8 @@ def _assert_same(fast, slow, angles, speeds=(None,), turns=(0,)):
             for tol in TOLERANCES:
                 for k in turns:
                     args = (float(theta), speed)
-                    expected = _outcome(slow, *args, turns=k, max_error=tol)
-                    assert _outcome(fast, *args, turns=k, max_error=tol) == expected, (
+                    expected = solve_outcome(slow, *args, turns=k, max_error=tol)
+                    assert solve_outcome(fast, *args, turns=k, max_error=tol) == expected, (
                         fast.name, theta, speed, tol, k)
                     refused += isinstance(expected[0], type)
     return refused
@@ -71,7 +59,10 @@ def _assert_same(fast, slow, angles, speeds=(None,), turns=(0,)):
 def test_every_packaged_scene_solves_alike_compiled(name):
     """Over two turns, three speeds and three tolerances: identical states, bounds, refusals."""
     fast, slow = _pair(lambda: mk.load_scene(name))
-    if name != 'geneva':    # its state reports the lever's engagement: the general path's
+    if name == 'geneva':    # its state reports the lever's engagement: the general path's
+        assert fast._solver.compiled_single == NotCompiled(
+            "an intermittent lever's engagement is reported (wheel): the general path's")
+    else:
         assert fast._solver.compiled_single, f'{name} does not compile'
     refused = _assert_same(fast, slow, ANGLES, speeds=(None, -3.5, 1e4), turns=(0, 3))
     if name == 'four_bar_coupler_points':
@@ -87,14 +78,6 @@ def test_the_extreme_suite_refuses_and_answers_alike():
         speed = case.speed if case.speed is not None else case.scene.input.speed
         _assert_same(fast, slow, case.angles, speeds=(speed,))
     assert compiled > 0
-
-
-def _array_outcome(scene, *args, **kwargs):
-    """Return the array solve's facts and warnings."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter('always')
-        state = mk.solve(scene, *args, **kwargs)
-    return state_facts(state), [(w.category, str(w.message), w.filename) for w in caught]
 
 
 @pytest.mark.parametrize('name', crank_scene_names())
@@ -114,7 +97,7 @@ def test_every_packaged_scene_solves_arrays_alike_compiled(name):
                    for key, value in kwargs.items()}
             if 'speed' in cut and np.ndim(cut['speed']):
                 cut['speed'] = speeds[:angles.size]
-            assert _array_outcome(fast, angles, **cut) == _array_outcome(slow, angles, **cut), (
+            assert array_outcome(fast, angles, **cut) == array_outcome(slow, angles, **cut), (
                 name, angles.size, kwargs)
 
 
@@ -125,7 +108,7 @@ def test_rigid_triangles_compile_and_solve_alike():
     assert fast._solver.compiled_usual
     _assert_same(fast, slow, ANGLES, speeds=(None, -3.5), turns=(0, 3))
     for kwargs in ({}, {'speed': np.linspace(-20.0, 30.0, ANGLES.size)}, {'max_error': 1e-12}):
-        assert _array_outcome(fast, ANGLES, **kwargs) == _array_outcome(slow, ANGLES, **kwargs)
+        assert array_outcome(fast, ANGLES, **kwargs) == array_outcome(slow, ANGLES, **kwargs)
 
 
 def test_the_extreme_suite_solves_arrays_alike():
@@ -134,9 +117,9 @@ def test_the_extreme_suite_solves_arrays_alike():
         fast, slow = _pair(lambda case=case: case.scene)
         speed = case.speed if case.speed is not None else case.scene.input.speed
         angles = np.asarray(case.angles, dtype=float)
-        assert _array_outcome(fast, angles, speed) == _array_outcome(slow, angles, speed)
+        assert array_outcome(fast, angles, speed) == array_outcome(slow, angles, speed)
         if case.speed is None:      # at the scene's own rates: the usual call's compiled path
-            assert _array_outcome(fast, angles) == _array_outcome(slow, angles), case.name
+            assert array_outcome(fast, angles) == array_outcome(slow, angles), case.name
 
 
 @pytest.mark.parametrize('angle', [np.float64(1.25), np.float32(1.25), 1, np.int64(-2)])
@@ -185,7 +168,7 @@ def test_the_callers_arrays_are_never_written(compiled):
     """
     scene = mk.load_scene('four_bar_coupler_points')
     if compiled:
-        scene._solver.compiled_array = compile_array(scene)
+        scene._solver.compiled_array = compile_scene(scene, ARRAY)
     else:
         general_only(scene)
     angles, speeds = ANGLES.copy(), np.linspace(-20.0, 30.0, ANGLES.size)
@@ -199,35 +182,6 @@ def test_the_callers_arrays_are_never_written(compiled):
             one = mk.solve(scene, *(float(np.broadcast_to(x, angles.shape)[index])
                                     for x in args))
             assert state.joints['crank'].acceleration[index] == one.joints['crank'].acceleration
-
-
-def test_a_large_batch_keeps_freed_memory_once(monkeypatch):
-    """An array solve of LARGE_BATCH angles asks the C library to keep freed memory (once)."""
-    calls = []
-    monkeypatch.setattr(compiled_module, 'keep_freed_memory', lambda: calls.append(1) or True)
-    solve_module = sys.modules['mech_kinematics.solver.solve']
-    monkeypatch.setattr(solve_module, 'keep_freed_memory', compiled_module.keep_freed_memory)
-    scene = mk.load_scene('khurmi_four_bar_ad150')
-    mk.solve(scene, np.linspace(0.0, 1.0, LARGE_BATCH - 1))
-    assert not calls
-    mk.solve(scene, np.linspace(0.0, 1.0, LARGE_BATCH))
-    assert calls == [1]
-    # Several drivers too (the five-bar's array path cost 2.8x as much without it).
-    five_bar = mk.load_scene('five_bar')
-    starts = [driver.start for driver in five_bar.drivers]
-    mk.solve(five_bar, [np.full(LARGE_BATCH - 1, x) for x in starts])
-    assert calls == [1]
-    mk.solve(five_bar, [np.full(LARGE_BATCH, x) for x in starts])
-    assert calls == [1, 1]
-
-
-def test_keeping_freed_memory_is_set_once_on_glibc():
-    """On glibc the two settings are accepted, and asking again changes nothing."""
-    import platform
-
-    first = compiled_module.keep_freed_memory()
-    assert first == (platform.libc_ver()[0] == 'glibc')
-    assert compiled_module.keep_freed_memory() == first
 
 
 @pytest.mark.parametrize('args, kwargs', [((math.nan,), {}), ((math.inf,), {}),
@@ -259,15 +213,21 @@ def test_the_array_path_compiles_run_and_the_single_angle_path_the_kernels(monke
             ctx.measures[self.key] = 1.0
 
     monkeypatch.setattr(step, 'kernels', classmethod(lambda cls: (looping,)))
-    assert compile_single(scene) is None
-    assert compile_array(scene) is not None
+    assert compile_scene(scene, SINGLE) == NotCompiled(
+        'step RRR C: kernel uses `for` (not in the kernel subset)')
+    assert callable(compile_scene(scene, ARRAY))
 
 
 @pytest.mark.parametrize('name', driver_scene_names())
 def test_a_scene_of_several_drivers_keeps_the_general_path(name):
     """Several drivers or an actuator: neither path compiles, and solving often changes nothing."""
     scene = mk.load_scene(name)
-    assert compile_single(scene) is None and compile_array(scene) is None
+    names = ', '.join(driver.name for driver in scene.drivers)
+    drivers = (f'its driver {names} is not a crank' if len(scene.drivers) == 1
+               else f'{len(scene.drivers)} drivers ({names})')
+    why = NotCompiled(f"{drivers}: mk.solve compiles one crank's paths alone (the node's tick "
+                      "compiles any drivers)")
+    assert compile_scene(scene, SINGLE) == why and compile_scene(scene, ARRAY) == why
     positions = [driver.start for driver in scene.drivers]
     many = [np.full(3, x) for x in positions]
     if len(positions) == 1:     # an actuator alone: the one-driver signature, bare values
@@ -277,23 +237,8 @@ def test_a_scene_of_several_drivers_keeps_the_general_path(name):
         mk.solve(scene, positions)
         mk.solve(scene, many)
     assert state_facts(mk.solve(scene, positions)) == first
-    assert scene._solver.compiled_single in (None, False)
-    assert scene._solver.compiled_array in (None, False)
-
-
-def test_keeping_freed_memory_can_be_declined():
-    """MECH_KINEMATICS_KEEP_FREED_MEMORY=0: the process's allocator settings are left alone."""
-    import os
-    import subprocess
-
-    code = ('from mech_kinematics.solver.compiled import keep_freed_memory as k\n'
-            'import platform\n'
-            'print(k(), platform.libc_ver()[0] == "glibc")')
-    for value, kept in (('0', 'False'), ('1', None)):
-        env = {**os.environ, 'MECH_KINEMATICS_KEEP_FREED_MEMORY': value}
-        out = subprocess.run([sys.executable, '-c', code], env=env, capture_output=True,
-                             text=True, check=True).stdout.split()
-        assert out[0] == (kept if kept is not None else out[1])
+    assert scene._solver.compiled_single in (None, why)
+    assert scene._solver.compiled_array in (None, why)
 
 
 def test_bounds_summed_over_a_limit_are_still_judged_one_by_one():
@@ -331,8 +276,9 @@ def test_a_scene_of_more_steps_than_compile_steps_keeps_the_general_path():
     """A strip of COMPILE_STEPS + 1 dyads is never compiled by solve (it would take seconds)."""
     from helpers import equilateral_chain
 
-    from mech_kinematics.solver.compiled import COMPILE_STEPS
-
-    assert compile_single(equilateral_chain(COMPILE_STEPS + 1)) is None
-    assert compile_array(equilateral_chain(COMPILE_STEPS + 1)) is None
-    assert compile_single(equilateral_chain(8)) is not None
+    long = equilateral_chain(COMPILE_STEPS + 1)
+    why = NotCompiled(f'more than {COMPILE_STEPS} steps ({COMPILE_STEPS + 1}): compiling would '
+                      'cost more than the solves it speeds up')
+    assert compile_scene(long, SINGLE) == why and compile_scene(long, ARRAY) == why
+    assert callable(compile_scene(long, Single(max_steps=None)))
+    assert callable(compile_scene(equilateral_chain(8), SINGLE))

@@ -18,7 +18,8 @@ import numpy as np
 import pytest
 
 import mech_kinematics as mk
-from mech_kinematics.solver import tick as hooks
+from mech_kinematics.solver.base import Step
+from mech_kinematics.solver.compiler import scene_plan
 from mech_kinematics.solver.specialize import plan_body, propagate
 
 SETTINGS = settings(max_examples=400, deadline=None, derandomize=True)
@@ -235,7 +236,7 @@ def test_propagation_keeps_every_bit_type_and_error(vector, source):
 
 def _code(scene, vector):
     """Return the generated code of ``scene`` on one path, and its table entries' locals."""
-    plan = hooks.tick_plan(mk.load_scene(scene))
+    plan = scene_plan(mk.load_scene(scene))
     names = {}
     return ast.unparse(ast.Module(plan_body(plan, names, {}, vector=vector), [])), names
 
@@ -295,3 +296,100 @@ def test_array_operations_take_zero_d_constants_with_the_same_bits():
     for omega in (np.array(3.0), np.array(-0.0), np.float64(2.0), np.linspace(-1.0, 1.0, 5)):
         assert [_facts(v) for v in after(theta, omega)] == [
             _facts(v) for v in before(theta, omega)], omega
+
+
+# --- helpers a kernel calls, written out in place (issue 30) -----------------------------
+
+class _Tip:
+    """A driver for the helpers' tests: its tip at ``theta + 0j`` (no bounds)."""
+
+    label = 'input tip'
+    tip = 'A'
+
+    def run(self, ctx, theta, omega, alpha):
+        ctx.points[self.tip] = (theta + 0j, omega + 0j, alpha + 0j, 0.0, 0.0, 0.0)
+
+
+class _Helped(Step):
+    """A step whose kernel calls helpers: one rebinds a parameter and calls another."""
+
+    label = 'helped Q'
+    start = 'A'
+    point = 'Q'
+
+    def run(self, ctx):
+        p, v, a, ep, ev, ea = ctx.points[self.start]
+        w = v * 3.0
+        q, bound = self.shift(ctx, p * 2.0 - 1.0, w.real)
+        self.record(ctx, q)
+        ctx.points[self.point] = (q, w, a, bound, ev, ea)
+
+    def shift(self, ctx, z, bound):
+        bound = bound + 1.0
+        w = np.hypot(z.real, z.imag) if ctx.vector else abs(z)
+        scaled = self.scale(ctx, w)
+        return z + scaled, bound * scaled
+
+    def scale(self, ctx, w):
+        return w * 0.5 + 0.25
+
+    def record(self, ctx, q):
+        ctx.measures[self.point] = q.imag - q.real
+
+
+class _HelpedPlan:
+    """The plan of a tip and a :class:`_Helped` step, as the compiler's ``ScenePlan``."""
+
+    ground = {}
+    crank = _Tip()
+    drivers = (crank,)
+    steps = (_Helped(),)
+
+
+@pytest.mark.parametrize('vector', [False, True])
+def test_helpers_are_written_out_with_the_same_bits(vector):
+    """A kernel's helpers (nested, a parameter rebound, none returned) compile to run's bits."""
+    from mech_kinematics.solver.context import _Context
+
+    names, namespace = {}, {'np': np}
+    body = plan_body(_HelpedPlan, names, namespace, vector=vector)
+    code = ast.unparse(ast.Module(body, []))
+    assert not re.findall(r'self|shift\(|scale\(|record\(', code), code
+    entries = ', '.join(f'{key!r}: {local}' for key, local in names.items())
+    function = _function([*body, *ast.parse(f'out = {{{entries}}}').body], namespace,
+                         'theta, omega, alpha, turns, ctx')
+    theta = (np.array([0.0, -0.0, 0.5, 2.5, -7.0, np.nan]) if vector else 0.75)
+    ctx = _Context(theta, vector)
+    _Tip().run(ctx, theta, 1.5, -0.25)
+    _Helped().run(ctx)
+    got = function(theta, 1.5, -0.25, 0, _Context(theta, vector))
+    assert _facts(got['P_Q']) == _facts(ctx.points['Q'])
+    assert _facts(got['M_Q']) == _facts(ctx.measures['Q'])
+
+
+def test_the_two_rrr_kinds_share_one_kernel_written_out():
+    """The fixed and the actuated RRR call _meet; the compiled code calls nothing of the step."""
+    import inspect
+
+    from mech_kinematics.solver.rrr import _ActuatedRRRStep, _RRRStep
+
+    for kind in (_RRRStep, _ActuatedRRRStep):
+        assert 'self._meet(ctx, ' in inspect.getsource(kind.run), kind
+    for scene in ('khurmi_four_bar_ad150', 'excavator'):
+        code, _ = _code(scene, False)
+        assert '_meet' not in code and 'self' not in code, scene
+
+
+def test_a_helper_outside_the_kernel_subset_is_named(monkeypatch):
+    """A helper returning before its end is not compiled: the reason names the step and helper."""
+    from mech_kinematics.solver.compiler import compile_scene, NotCompiled, SINGLE
+    from mech_kinematics.solver.rrr import _RRRStep
+
+    def _meet(self, ctx, d, dist, l1, l2, lsum, inputs, lengths):
+        if ctx.vector:
+            return d, d, dist, dist, dist
+        return d, d, dist, dist, dist
+
+    monkeypatch.setattr(_RRRStep, '_meet', _meet)
+    assert compile_scene(mk.load_scene('khurmi_four_bar_ad150'), SINGLE) == NotCompiled(
+        'step RRR C: helper _meet uses `return` before its end (not in the kernel subset)')

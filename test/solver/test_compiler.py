@@ -1,0 +1,258 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The one compiler: every registered kind compiles to the bit of the general path, or says why.
+
+Only the packaged scenes were compiled before (issue 30): a new kind could
+ship with a kernel the compiler falls back on, or gets wrong, unseen. Here a
+scene is generated for every kind the registry holds (``solver/registry.py``
+``KINDS``), for both drivers (a crank, an actuator) and for the variants that
+run kernels of their own (carried points, a Geneva wheel's RPR, an actuated
+RRR), and each is compiled for every target of
+:func:`mech_kinematics.solver.compiler.compile_scene`: ``mk.solve``'s
+single-angle path, its array path (any rates, and the scene's own) and the
+node's tick. Each compiled function must answer as the general path does at
+many instants (values, bounds, warnings, refusals with the same message),
+or the compiler must give the reason this test expects. A kind with no
+generator here fails, named.
+"""
+
+import importlib
+import math
+
+from helpers import (array_outcome, general_only, general_tick_outcome, solve_outcome,
+                     tick_outcome)
+import numpy as np
+import pytest
+
+import mech_kinematics as mk
+from mech_kinematics.ros.ticker import general_tick
+from mech_kinematics.solver.compiler import (ARRAY, Array, compile_scene, NotCompiled, SINGLE,
+                                             Tick)
+from mech_kinematics.solver.registry import KINDS
+
+#: The module (``mech_kinematics.solver.solve`` is also the name of its function).
+solve_module = importlib.import_module('mech_kinematics.solver.solve')
+
+#: The drivers (not in the registry: ``inputs:`` entries are a crank unless ``actuator:``).
+DRIVERS = ('crank', 'actuator')
+#: Variants of registered kinds that run kernels of their own.
+VARIANTS = ('carried point', 'Geneva RPR', 'actuated RRR')
+
+MM_DEG = {'length': 'mm', 'angle': 'deg'}
+
+
+def _crank(length=50.0, angle=30.0, rpm=120.0, accel=-3.0, center='A', point='B'):
+    """Return a crank's scene entry (a link ``crank``)."""
+    return {'link': 'crank', 'center': center, 'point': point, 'length': length,
+            'angle': angle, 'speed_rpm': rpm, 'accel': accel}
+
+
+def _scene(name, ground, dyads=(), points=None, **drivers):
+    """Return the scene of these entries (mm and deg), as a scene file's mapping."""
+    data = {'name': name, 'units': MM_DEG, 'ground': ground, 'dyads': list(dyads), **drivers}
+    if points:
+        data['points'] = points
+    return data
+
+
+#: A scene for each kind: a mapping of a scene file, that exercises the kind's kernel over
+#: a range where it assembles and one where it refuses (most of them).
+GENERATORS = {
+    'crank': lambda: _scene(
+        'crank', {'A': [0, 0]}, input=_crank(),
+        points={'P': {'link': 'crank', 'origin': 'A', 'xaxis': 'B', 'local': [20, 10]}}),
+    # A triple rocker: the crank turns only part of the way.
+    'RRR': lambda: _scene(
+        'RRR', {'A': [0, 0], 'D': [100, 0]}, input=_crank(angle=61),
+        dyads=[{'type': 'RRR', 'point': 'C', 'links': [
+            {'name': 'coupler', 'from': 'B', 'length': 66},
+            {'name': 'rocker', 'from': 'D', 'length': 56}], 'branch': 1}]),
+    # An offset slider-crank whose rod cannot reach the guide at the bottom of the turn.
+    'RRP': lambda: _scene(
+        'RRP', {'O': [0, 0], 'E': [0, 40]}, input=_crank(150, 135, -300, 5.0, 'O'),
+        dyads=[{'type': 'RRP', 'point': 'P',
+                'link': {'name': 'rod', 'from': 'B', 'length': 160},
+                'guide': {'through': 'E', 'angle': 0}, 'slider': 'piston', 'branch': -1}]),
+    'RPR': lambda: _scene(
+        'RPR', {'O': [0, 0], 'A': [0, 400]}, input=_crank(150, 45, 120, 2.0),
+        dyads=[{'type': 'RPR', 'link': 'lever', 'center': 'O', 'through': 'B',
+                'slider': 'block'}]),
+    'RPP': lambda: _scene(
+        'RPP', {'A': [0, 0]}, input=_crank(50, 30, 300, 0.0),
+        dyads=[{'type': 'RPP', 'point': 'Y', 'through': 'B',
+                'guide': {'through': 'A', 'angle': 0}, 'slot_angle': 90, 'slider': 'yoke',
+                'slot_slider': 'pin_in_slot'}]),
+    'actuator': lambda: _scene(
+        'actuator', {'O': [0, 0], 'F': [400, -1100]},
+        inputs=[{'actuator': 'cyl', 'length': 2600, 'speed': 100, 'stroke': [2000, 3300]}],
+        dyads=[{'type': 'RRR', 'point': 'Q', 'links': [
+            {'name': 'boom', 'from': 'O', 'length': 2600},
+            {'name': 'barrel', 'from': 'F', 'actuator': 'cyl'}], 'branch': 1}]),
+    'carried point': lambda: _scene(
+        'carried', {'A': [0, 0], 'D': [100, 0]}, input=_crank(angle=61),
+        dyads=[{'type': 'RRR', 'point': 'C', 'links': [
+            {'name': 'coupler', 'from': 'B', 'length': 66},
+            {'name': 'rocker', 'from': 'D', 'length': 56}], 'branch': 1}],
+        points={'E': {'link': 'coupler', 'from': 'B', 'toward': 'C', 'distance': 40},
+                'F': {'link': 'coupler', 'origin': 'B', 'xaxis': 'C', 'local': [40, -30]}}),
+    'Geneva RPR': lambda: _scene(
+        'geneva', {'D': [0, 0], 'S': [-70.71067811865476, 0]},
+        input={'link': 'driver', 'center': 'D', 'point': 'P', 'length': 50, 'angle': 150,
+               'speed_rpm': 95.4929658551372, 'accel': 0},
+        dyads=[{'type': 'RPR', 'link': 'wheel', 'center': 'S', 'through': 'P',
+                'slider': 'pin_slot', 'slots': 4}]),
+    # A crank and a cylinder: the RRR's second link is the cylinder's.
+    'actuated RRR': lambda: _scene(
+        'actuated', {'A': [0, 0], 'F': [300, -100]},
+        inputs=[_crank(60, 40, 30, 0.0),
+                {'actuator': 'cyl', 'length': 280, 'speed': 20, 'stroke': [200, 360]}],
+        dyads=[{'type': 'RRR', 'point': 'C', 'links': [
+            {'name': 'arm', 'from': 'B', 'length': 250},
+            {'name': 'barrel', 'from': 'F', 'actuator': 'cyl'}], 'branch': 1}]),
+}
+
+#: The reasons the compiler is expected to give, per (kind, target); every other compiles.
+NOT_COMPILED = {
+    ('Geneva RPR', 'single'): "an intermittent lever's engagement is reported (wheel): "
+                              "the general path's",
+    ('Geneva RPR', 'array'): "an intermittent lever's engagement is reported (wheel): "
+                             "the general path's",
+    ('actuator', 'single'): "its driver cyl is not a crank: mk.solve compiles one crank's "
+                            "paths alone (the node's tick compiles any drivers)",
+    ('actuator', 'array'): "its driver cyl is not a crank: mk.solve compiles one crank's "
+                           "paths alone (the node's tick compiles any drivers)",
+    ('actuated RRR', 'single'): "2 drivers (crank, cyl): mk.solve compiles one crank's paths "
+                                "alone (the node's tick compiles any drivers)",
+    ('actuated RRR', 'array'): "2 drivers (crank, cyl): mk.solve compiles one crank's paths "
+                               "alone (the node's tick compiles any drivers)",
+}
+
+#: Crank angles over two turns and a bit, both signs (rad); tolerances (1e-17: every
+#: instant refused as untrusted, by the quick trust test and the full one).
+ANGLES = np.linspace(-7.0, 7.0, 61)
+TOLERANCES = (1e-6, 1e-12, 1e-17, math.inf)
+
+
+def _kinds():
+    """Return every kind to prove: the registry's, the drivers and the variants."""
+    return [*sorted(KINDS), *DRIVERS, *VARIANTS]
+
+
+def _scene_of(kind):
+    """Return the generated scene of ``kind``, or fail naming the kind that has none."""
+    generator = GENERATORS.get(kind)
+    assert generator is not None, (
+        f'no scene is generated for the kind {kind!r}: add one to GENERATORS in '
+        'test/solver/test_compiler.py (and its expected reasons to NOT_COMPILED)')
+    return mk.parse_scene(generator())
+
+
+def _expect(kind, target, compiled):
+    """Assert ``compiled`` is a function, or the reason NOT_COMPILED holds for it; say which."""
+    reason = NOT_COMPILED.get((kind, target))
+    if reason is None:
+        assert callable(compiled), f'{kind}, {target}: {compiled}'
+        return True
+    assert compiled == NotCompiled(reason), (kind, target)
+    return False
+
+
+def test_every_kind_of_the_registry_has_a_generated_scene():
+    """The registry's kinds are all generated here: a new kind fails until it is."""
+    missing = [kind for kind in _kinds() if kind not in GENERATORS]
+    assert not missing, f'kinds with no generated scene: {", ".join(missing)}'
+
+
+@pytest.mark.parametrize('kind', _kinds())
+def test_every_kind_compiles_mk_solves_paths_to_the_same_bits(kind):
+    """The single-angle and array paths, compiled: mk.solve's states, bounds and refusals."""
+    fast, slow = _scene_of(kind), general_only(_scene_of(kind))
+    single = compile_scene(fast, SINGLE)
+    array = compile_scene(fast, ARRAY)
+    compiles = _expect(kind, 'single', single) & _expect(kind, 'array', array)
+    if not compiles:
+        return
+    fast._solver.compiled_single, fast._solver.compiled_array = single, array
+    # The usual call (the scene's own rates), compiled for them as mk.solve does.
+    fast._solver.compiled_usual = solve_module._compile_usual(fast._solver)
+    assert callable(fast._solver.compiled_usual), fast._solver.compiled_usual
+    refused = 0
+    for theta in ANGLES:
+        for tol in TOLERANCES:
+            for args, turns in (((float(theta),), 0), ((float(theta), -3.5, 7.0), 3)):
+                expected = solve_outcome(slow, *args, turns=turns, max_error=tol)
+                assert solve_outcome(fast, *args, turns=turns, max_error=tol) == expected, (
+                    kind, theta, tol, args)
+                refused += isinstance(expected[0], type)
+    speeds = np.linspace(-20.0, 30.0, ANGLES.size)
+    for kwargs in ({}, {'speed': speeds}, {'speed': 3.0, 'accel': speeds},
+                   {'turns': np.arange(ANGLES.size) % 3}, {'max_error': 1e-12}):
+        assert array_outcome(fast, ANGLES, **kwargs) == array_outcome(slow, ANGLES, **kwargs), (
+            kind, kwargs)
+    assert refused > 0, f'{kind}: no instant refused, at 1e-12 or where it cannot assemble'
+
+
+@pytest.mark.parametrize('kind', _kinds())
+def test_every_kind_compiles_the_nodes_tick_to_the_same_bits(kind):
+    """The node's tick, compiled: mk.solve's values, measure, or error and its message.
+
+    The compiled function must answer some instants itself: the fallback (the
+    general solver, for the instants it hands over) is counted.
+    """
+    scene = _scene_of(kind)
+    general = general_tick(scene, None, None, ())
+    handed = []
+
+    def fallback(*args):
+        handed.append(args)
+        return general(*args)
+
+    tick = compile_scene(scene, Tick(scene.output_joints, scene.output_points, (), fallback))
+    assert _expect(kind, 'tick', tick)
+    drivers = scene.drivers
+    refused = instants = 0
+    if scene.input is not None and len(drivers) == 1:
+        for theta in ANGLES:
+            for omega, alpha, turns in ((scene.input.speed, scene.input.accel, 0),
+                                        (-3.5, 7.0, 3), (1e13, 0.0, 0)):
+                for tol in TOLERANCES:
+                    expected = general_tick_outcome(scene, float(theta), omega, alpha, tol,
+                                                    turns)
+                    got = tick_outcome(tick, float(theta), omega, alpha, tol, turns)
+                    assert repr(got) == repr(expected), (kind, theta, omega, tol)
+                    refused += isinstance(expected[0], type)
+                    instants += 1
+    else:
+        # One value per driver; one driver's bare (as mk.solve and the node give them).
+        count = len(drivers)
+        shape = (lambda values: values[0]) if count == 1 else list
+        starts = [driver.start for driver in drivers]
+        for step in np.linspace(-1.0, 1.0, 41):
+            positions = shape([x + step * (0.6 if k == 0 and count > 1 else 0.12)
+                               for k, x in enumerate(starts)])
+            for speeds, accels in ((shape([0.0] * count), shape([0.0] * count)),
+                                   (shape([0.3] * count), shape([-0.2] * count)),
+                                   (shape([1e13] * count), shape([0.0] * count))):
+                for tol in TOLERANCES:
+                    expected = general_tick_outcome(scene, positions, speeds, accels, tol)
+                    got = tick_outcome(tick, positions, speeds, accels, tol)
+                    assert repr(got) == repr(expected), (kind, positions, speeds, tol)
+                    refused += isinstance(expected[0], type)
+                    instants += 1
+    assert refused > 0, f'{kind}: no instant refused, at 1e-12 or where it cannot assemble'
+    assert len(handed) < instants, f'{kind}: the fallback served every answer'
+
+
+def test_the_reasons_a_scene_is_not_compiled_are_one_line_each():
+    """Pins to bound, more steps than allowed: the compiler's reason, not a silent None."""
+    data = GENERATORS['RRR']()
+    data['pins'] = {'C': 5}
+    scene = mk.parse_scene(data)
+    why = NotCompiled("pins to bound: the rubbing velocities at C are the general path's")
+    assert compile_scene(scene, SINGLE) == why
+    assert compile_scene(scene, Tick((), (), (), lambda *args: ([], math.inf))) == why
+    scene = mk.parse_scene(GENERATORS['RRR']())
+    assert compile_scene(scene, Array(max_steps=0)) == NotCompiled(
+        'more than 0 steps (1): compiling would cost more than the solves it speeds up')
+    for compiled in (why, compile_scene(scene, Array(max_steps=0))):
+        assert not compiled and '\n' not in compiled.reason and str(compiled) == compiled.reason
