@@ -233,6 +233,11 @@ class Forces:
         The forces' scale (N): the largest of every force computed, of every
         body's inertia force and weight and of every load; moments are judged
         on ``scale`` times the mechanism's size.
+    failures : dict of str to ndarray of bool
+        For arrays: per reason, the instants refused.
+    worst : (str, float, float) or None
+        For one instant refused: the value whose bound exceeds its limit most
+        (its name in ``as_dict()``), its bound and the limit.
     """
 
     efforts: dict[str, Any]
@@ -244,6 +249,7 @@ class Forces:
     valid: Any
     scale: Any
     failures: dict[str, Any] = field(default_factory=dict)
+    worst: tuple[str, float, float] | None = None
 
     def as_dict(self, vector: bool) -> dict[str, Any]:
         """Return ``"efforts"``, ``"reactions"`` and ``"shaking"`` as ``State.as_dict()``."""
@@ -605,8 +611,7 @@ class Dynamics:
                 d = kin.position(at) - kin.position(origin)
                 e_d = kin.position_bound(at) + kin.position_bound(origin) + U * np.abs(d)
                 A[..., row_of[(bi, 2)], column] += sign * _cross(d, unit)
-                EA[..., row_of[(bi, 2)], column] += (np.abs(d) * e_unit + e_d
-                                                      + 3 * U * np.abs(d))
+                EA[..., row_of[(bi, 2)], column] += np.abs(d) * (e_unit + 3 * U) + e_d
 
         units = {}
         for column, (i, component) in enumerate(config.columns):
@@ -688,6 +693,15 @@ class Dynamics:
         force_limit = max_error * np.fmax(scale, np.finfo(float).tiny)
         moment_limit = force_limit * size
         untrusted = np.zeros(kin.shape, dtype=bool)
+        worst: list[tuple[float, str, Any, Any]] = []
+
+        def judge(name: str, bound: Any, limit: Any) -> Any:
+            bad = ~(bound <= limit)
+            if not kin.vector and bool(bad):
+                ratio = float(bound) / float(limit) if float(limit) > 0 else math.inf
+                worst.append((ratio, name, float(bound), float(limit)))
+            return bad
+
         for joint in graph.joints:
             carried = done.get(joint.name)
             if carried is None:
@@ -697,25 +711,27 @@ class Dynamics:
                 value, bound = parts.get('effort', (np.zeros(kin.shape), np.zeros(kin.shape)))
                 efforts[joint.name], effort_bounds[joint.name] = value, bound
                 limit = force_limit if joint.line is not None else moment_limit
-                untrusted |= ~(bound <= limit)
+                untrusted |= judge(f'efforts.{joint.name}', bound, limit)
             if joint.type.table is None:    # a lock: its holding moment
                 reaction = Reaction(joint.at, joint.body, joint.on,
                                     moment=parts.get('moment', (carried.couple,))[0],
                                     moment_bound=parts.get('moment', (0, carried.couple_bound))[1])
-                untrusted |= ~(reaction.moment_bound <= moment_limit)
+                untrusted |= judge(f'reactions.{joint.name}.moment', reaction.moment_bound,
+                                   moment_limit)
             elif joint.line is None:
                 force = parts['x'][0] + 1j * parts['y'][0] if 'x' in parts else carried.force
                 bound = (np.hypot(parts['x'][1], parts['y'][1]) if 'x' in parts
                          else carried.force_bound)
                 reaction = Reaction(joint.at, joint.body, joint.on, force=force,
                                     force_bound=bound)
-                untrusted |= ~(bound <= force_limit)
+                untrusted |= judge(f'reactions.{joint.name}.force', bound, force_limit)
             else:
                 normal, e_normal = parts.get('normal', (np.zeros(kin.shape),) * 2)
                 couple, e_couple = parts.get('moment', (np.zeros(kin.shape),) * 2)
                 reaction = Reaction(joint.at, joint.body, joint.on, normal=normal,
                                     moment=couple, normal_bound=e_normal, moment_bound=e_couple)
-                untrusted |= ~(e_normal <= force_limit) | ~(e_couple <= moment_limit)
+                untrusted |= (judge(f'reactions.{joint.name}.normal', e_normal, force_limit)
+                              | judge(f'reactions.{joint.name}.moment', e_couple, moment_limit))
             reactions[joint.name] = reaction
             if joint.on == graph.ground:
                 at = kin.position(joint.at)
@@ -728,7 +744,8 @@ class Dynamics:
                                        + carried.couple_bound
                                        + 4 * U * (np.abs(at) * np.abs(carried.force)
                                                   + np.abs(moment)))
-        untrusted |= ~(e_shaking <= force_limit) | ~(e_moment <= moment_limit)
+        untrusted |= (judge('shaking.force', e_shaking, force_limit)
+                      | judge('shaking.moment', e_moment, moment_limit))
         untrusted &= valid
         if np.any(untrusted):
             failures['forces (untrusted)'] = untrusted
@@ -736,7 +753,8 @@ class Dynamics:
         if not kin.vector:
             valid = bool(valid)
         return Forces(efforts, reactions, shaking, moment, effort_bounds,
-                      (e_shaking, e_moment), valid, scale, failures)
+                      (e_shaking, e_moment), valid, scale, failures,
+                      max(worst)[1:] if worst else None)
 
 
 def _cross(a: Any, b: Any) -> Any:
