@@ -795,8 +795,8 @@ def _bounded_solve(A: Any, EA: Any, b: Any, Eb: Any) -> tuple[Any, Any, Any]:
         x = np.einsum('...ij,...j->...i', X, b)
         absA, absX = np.abs(A), np.abs(X)
         residual = b - np.einsum('...ij,...j->...i', A, x)
-        t = (np.abs(residual) + _gamma(k + 1) * (np.einsum('...ij,...j->...i', absA, np.abs(x))
-                                                  + np.abs(b))
+        products = np.einsum('...ij,...j->...i', absA, np.abs(x))
+        t = (np.abs(residual) + _gamma(k + 1) * (products + np.abs(b))
              + np.einsum('...ij,...j->...i', EA, np.abs(x)) + Eb)
         R = np.eye(k) - A @ X
         R_true = np.abs(R) + _gamma(k) * (absA @ absX) + EA @ absX
