@@ -498,28 +498,30 @@ class Dynamics:
         makes the instant invalid (``Forces.valid``, ``Forces.failures``).
         """
         kin = _Kinematics(self.graph, state)
-        shape = kin.shape
+        biggest = kin.biggest
         done: dict[str, _Carried] = {}   # joint -> what it carries, solved
-        scale = np.zeros(shape)
-        valid = np.ones(shape, dtype=bool)
+        scale: Any = 0.0
+        valid: Any = True
         failures: dict[str, Any] = {}
         inertial = {name: self._inertial(name, kin) for name in kin.frames}
         for F, _, _, _ in inertial.values():
-            scale = np.fmax(scale, np.abs(F))
+            scale = biggest(scale, abs(F))
         for load in self.loads:
             if load.force is not None:
-                scale = np.fmax(scale, abs(complex(*load.force)))
+                scale = biggest(scale, abs(complex(*load.force)))
             else:
-                scale = np.fmax(scale, abs(load.torque or 0.0) / self.size)
+                scale = biggest(scale, abs(load.torque or 0.0) / self.size)
         for group in self.groups:
             solved, ok = self._solve(group, kin, inertial, done)
-            if not np.all(ok):
-                failures[f'{group.key} (statics singular)'] = ~ok
-                valid &= ok
+            if ok is not True:
+                bad = ~np.asarray(ok, dtype=bool) if kin.vector else not ok
+                if np.any(bad):
+                    failures[f'{group.key} (statics singular)'] = bad
+                    valid = valid & ok
             done.update(solved)
         for carried in done.values():
-            scale = np.fmax(scale, np.abs(carried.force))
-            scale = np.fmax(scale, np.abs(carried.couple) / self.size)
+            scale = biggest(scale, abs(carried.force))
+            scale = biggest(scale, abs(carried.couple) / self.size)
         return self._result(done, kin, scale, valid, failures, max_error)
 
     def _inertial(self, name: str, kin: _Kinematics) -> tuple[Any, Any, Any, Any]:
@@ -529,13 +531,14 @@ class Dynamics:
         - their moments``, with ``r`` from the frame's origin to the centre of mass.
         """
         origin, theta, omega, alpha, e = kin.frames[name]
-        zero = np.zeros(kin.shape)
-        F, M, eF, eM = zero + 0j, zero, zero, zero
+        F: Any = 0j
+        M: Any = 0.0
+        eF: Any = 0.0
+        eM: Any = 0.0
         mass = self.masses.get(name)
         if mass is not None:
             m, com = mass.mass, complex(*mass.com)
-            turn = np.exp(1j * theta) if kin.vector or theta else 1.0 + 0j
-            r = com * turn
+            r = com * kin.expi(theta) if com else 0j
             a_o = kin.acceleration(origin)
             spin = 1j * alpha - omega * omega
             a_c = a_o + spin * r
@@ -543,139 +546,155 @@ class Dynamics:
             M = mass.inertia * alpha + _cross(r, F)
             e_theta, e_omega, e_alpha = e
             e_r = abs(com) * (e_theta + 4 * U)
-            e_spin = e_alpha + 2 * np.abs(omega) * e_omega + 2 * U * np.abs(spin)
-            e_ac = (kin.acceleration_bound(origin) + e_spin * abs(com)
-                    + np.abs(spin) * e_r + 4 * U * np.abs(a_c))
-            eF = m * e_ac + 2 * U * np.abs(F)
-            eM = (mass.inertia * (e_alpha + U * np.abs(alpha)) + e_r * np.abs(F)
-                  + abs(com) * eF + 4 * U * (np.abs(M) + abs(com) * np.abs(F)))
+            e_spin = e_alpha + 2 * abs(omega) * e_omega + 2 * U * abs(spin)
+            e_ac = (kin.acceleration_bound(origin) + e_spin * abs(com) + abs(spin) * e_r
+                    + 4 * U * abs(a_c))
+            eF = m * e_ac + 2 * U * abs(F)
+            eM = (mass.inertia * (e_alpha + U * abs(alpha)) + e_r * abs(F) + abs(com) * eF
+                  + 4 * U * (abs(M) + abs(com) * abs(F)))
         for load in self.point_loads.get(name, ()):
             force = complex(*load.force)  # type: ignore[misc]
-            d = kin.position(load.point) - kin.position(origin)  # type: ignore[arg-type]
+            point = load.point
+            assert point is not None
+            d = kin.position(point) - kin.position(origin)
             F = F - force
             M = M - _cross(d, force)
-            e_d = (kin.position_bound(load.point) + kin.position_bound(origin)  # type: ignore
-                   + U * np.abs(d))
-            eF = eF + U * (np.abs(F) + abs(force))
-            eM = eM + e_d * abs(force) + 3 * U * (np.abs(d) * abs(force) + np.abs(M))
+            e_d = kin.position_bound(point) + kin.position_bound(origin) + U * abs(d)
+            eF = eF + U * (abs(F) + abs(force))
+            eM = eM + e_d * abs(force) + 3 * U * (abs(d) * abs(force) + abs(M))
         for load in self.torque_loads.get(name, ()):
             M = M - float(load.torque)  # type: ignore[arg-type]
-            eM = eM + U * np.abs(M)
+            eM = eM + U * abs(M)
         return F, M, eF, eM
 
     def _solve(self, group: _Group, kin: _Kinematics,
                inertial: Mapping[str, tuple[Any, Any, Any, Any]],
                done: Mapping[str, _Carried]) -> tuple[dict[str, _Carried], Any]:
         """Return what the group's joints carry, and where it could be bounded."""
-        results: dict[tuple[bool, ...], tuple[dict[str, _Carried], Any]] = {}
-        for phase, config in group.configs.items():
-            results[phase] = self._solve_config(group, config, kin, inertial, done)
-        if len(results) == 1:
-            return next(iter(results.values()))
-        engaged = np.asarray(kin.engaged(group.levers[0]), dtype=bool)
-        (on, ok_on), (off, ok_off) = results[(True,)], results[(False,)]
+        if len(group.configs) == 1:
+            config = next(iter(group.configs.values()))
+            return self._solve_config(group, config, kin, inertial, done)
+        engaged = kin.engaged(group.levers[0])
+        if not kin.vector:     # one instant: one phase
+            return self._solve_config(group, group.configs[(bool(engaged),)], kin, inertial,
+                                      done)
+        on, ok_on = self._solve_config(group, group.configs[(True,)], kin, inertial, done)
+        off, ok_off = self._solve_config(group, group.configs[(False,)], kin, inertial, done)
+        engaged = np.asarray(engaged, dtype=bool)
         merged = {name: _Carried.where(engaged, on[name], off[name]) for name in on}
         return merged, np.where(engaged, ok_on, ok_off)
 
     def _solve_config(self, group: _Group, config: _Config, kin: _Kinematics,
                       inertial: Mapping[str, tuple[Any, Any, Any, Any]],
                       done: Mapping[str, _Carried]) -> tuple[dict[str, _Carried], Any]:
-        shape = kin.shape
         k = len(config.rows)
         row_of = {row: index for index, row in enumerate(config.rows)}
         index_of = {body: b for b, body in enumerate(group.bodies)}
-        A = np.zeros((*shape, k, k))
-        EA = np.zeros((*shape, k, k))
-        b = np.zeros((*shape, k))
-        Eb = np.zeros((*shape, k))
-        origins = {body: kin.frames[body][0] for body in group.bodies}
+        A: list[list[Any]] = [[_ZERO] * k for _ in range(k)]
+        EA: list[list[Any]] = [[0.0] * k for _ in range(k)]
+        b: list[Any] = [0.0] * k
+        Eb: list[Any] = [0.0] * k
+        arms: dict[tuple[str, str], tuple[Any, Any]] = {}
 
-        def put(body: str, column: int, unit: Any, e_unit: Any, at: str | None) -> None:
+        def arm(at: str, body: str) -> tuple[Any, Any]:
+            """Return the vector from a body's frame origin to a point, with its bound."""
+            key = (at, body)
+            if key not in arms:
+                origin = kin.frames[body][0]
+                if at == origin:
+                    arms[key] = None, 0.0
+                else:
+                    d = kin.position(at) - kin.position(origin)
+                    arms[key] = d, (kin.position_bound(at) + kin.position_bound(origin)
+                                    + U * abs(d))
+            return arms[key]
+
+        def put(body: str, sign: float, column: int, unit: Any, e_unit: Any,
+                at: str | None) -> None:
             """Add a unit force ``unit`` at point ``at`` (or a unit couple: ``at`` None)."""
-            sign = 1.0
-            if body.startswith('-'):
-                body, sign = body[1:], -1.0
-            if body not in index_of:
+            bi = index_of.get(body)
+            if bi is None:
                 return
-            bi = index_of[body]
+            moment = row_of.get((bi, 2))
             if at is None:
-                if (bi, 2) in row_of:
-                    A[..., row_of[(bi, 2)], column] += sign
+                if moment is not None:
+                    A[moment][column] += sign
                 return
-            A[..., row_of[(bi, 0)], column] += sign * np.real(unit)
-            A[..., row_of[(bi, 1)], column] += sign * np.imag(unit)
-            EA[..., row_of[(bi, 0)], column] += e_unit
-            EA[..., row_of[(bi, 1)], column] += e_unit
-            if (bi, 2) in row_of:
-                origin = origins[body]
-                d = kin.position(at) - kin.position(origin)
-                e_d = kin.position_bound(at) + kin.position_bound(origin) + U * np.abs(d)
-                A[..., row_of[(bi, 2)], column] += sign * _cross(d, unit)
-                EA[..., row_of[(bi, 2)], column] += np.abs(d) * (e_unit + 3 * U) + e_d
+            fx, fy = row_of[(bi, 0)], row_of[(bi, 1)]
+            A[fx][column] += sign * unit.real
+            A[fy][column] += sign * unit.imag
+            if e_unit is not _EXACT:
+                EA[fx][column] += e_unit
+                EA[fy][column] += e_unit
+            if moment is not None:
+                d, e_d = arm(at, body)
+                if d is not None:
+                    A[moment][column] += sign * _cross(d, unit)
+                    EA[moment][column] += abs(d) * (e_unit + 3 * U) + e_d
 
-        units = {}
+        units = []
         for column, (i, component) in enumerate(config.columns):
             joint = group.joints[i]
             unit, e_unit, at = _unit(joint, component, kin)
-            units[column] = (unit, e_unit, at)
-            put(joint.body, column, unit, e_unit, at)
-            put('-' + joint.on, column, unit, e_unit, at)
+            units.append((unit, e_unit, at))
+            put(joint.body, 1.0, column, unit, e_unit, at)
+            put(joint.on, -1.0, column, unit, e_unit, at)
         # The right-hand side: the bodies' inertia wrenches, less their loads, plus what the
         # joints already solved (later groups') put on them.
         for (bi, component), row in row_of.items():
-            body = group.bodies[bi]
-            F, M, eF, eM = inertial[body]
-            if component < 2:
-                part = np.real(F) if component == 0 else np.imag(F)
-                b[..., row] = part
-                Eb[..., row] = eF
+            F, M, eF, eM = inertial[group.bodies[bi]]
+            if component == 0:
+                b[row], Eb[row] = F.real, eF
+            elif component == 1:
+                b[row], Eb[row] = F.imag, eF
             else:
-                b[..., row] = M
-                Eb[..., row] = eM
+                b[row], Eb[row] = M, eM
         for carried in done.values():
             joint = carried.joint
-            if joint.on not in index_of:
+            bi = index_of.get(joint.on)
+            if bi is None:
                 continue
-            bi = index_of[joint.on]
-            origin = origins[joint.on]
-            b[..., row_of[(bi, 0)]] += np.real(carried.force)
-            b[..., row_of[(bi, 1)]] += np.imag(carried.force)
-            Eb[..., row_of[(bi, 0)]] += carried.force_bound + U * np.abs(carried.force)
-            Eb[..., row_of[(bi, 1)]] += carried.force_bound + U * np.abs(carried.force)
-            if (bi, 2) in row_of:
-                d = kin.position(joint.at) - kin.position(origin)
-                e_d = (kin.position_bound(joint.at) + kin.position_bound(origin)
-                       + U * np.abs(d))
-                moment = _cross(d, carried.force) + carried.couple
-                b[..., row_of[(bi, 2)]] += moment
-                Eb[..., row_of[(bi, 2)]] += (np.abs(d) * carried.force_bound
-                                             + e_d * np.abs(carried.force)
-                                             + carried.couple_bound + 4 * U * (
-                                                 np.abs(d) * np.abs(carried.force)
-                                                 + np.abs(moment)))
-        x, e_x, ok = _bounded_solve(A, EA, b, Eb)
+            force = carried.force
+            e_force = carried.force_bound + U * abs(force)
+            fx, fy = row_of[(bi, 0)], row_of[(bi, 1)]
+            b[fx] = b[fx] + force.real
+            b[fy] = b[fy] + force.imag
+            Eb[fx] = Eb[fx] + e_force
+            Eb[fy] = Eb[fy] + e_force
+            moment = row_of.get((bi, 2))
+            if moment is not None:
+                d, e_d = arm(joint.at, joint.on)
+                if d is None:
+                    d = 0j
+                turn = _cross(d, force) + carried.couple
+                b[moment] = b[moment] + turn
+                Eb[moment] = Eb[moment] + (abs(d) * carried.force_bound + e_d * abs(force)
+                                           + carried.couple_bound
+                                           + 4 * U * (abs(d) * abs(force) + abs(turn)))
+        x, e_x, ok = _bounded_solve(A, EA, b, Eb, kin.vector)
         carried_by: dict[str, _Carried] = {}
+        acting = set(config.joints)
         for i, joint in enumerate(group.joints):
-            if i not in config.joints:
-                carried_by[joint.name] = _Carried.idle(joint, shape)
+            if i not in acting:
+                carried_by[joint.name] = _Carried.idle(joint)
                 continue
-            force = np.zeros(shape) + 0j
-            e_force = np.zeros(shape)
-            couple = np.zeros(shape)
-            e_couple = np.zeros(shape)
+            force: Any = 0j
+            e_force: Any = 0.0
+            couple: Any = 0.0
+            e_couple: Any = 0.0
             parts: dict[str, tuple[Any, Any]] = {}
             for column, (j, component) in enumerate(config.columns):
                 if j != i:
                     continue
-                value, bound = x[..., column], e_x[..., column]
+                value, bound = x[column], e_x[column]
                 parts[component] = (value, bound)
                 unit, e_unit, at = units[column]
                 if at is None:
                     couple = couple + value
-                    e_couple = e_couple + bound + U * np.abs(couple)
+                    e_couple = e_couple + bound + U * abs(couple)
                 else:
                     force = force + value * unit
-                    e_force = e_force + bound + np.abs(value) * e_unit + 2 * U * np.abs(force)
+                    e_force = e_force + bound + abs(value) * e_unit + 2 * U * abs(force)
             carried_by[joint.name] = _Carried(joint, force, e_force, couple, e_couple, parts)
         return carried_by, ok
 
@@ -685,19 +704,18 @@ class Dynamics:
         efforts: dict[str, Any] = {}
         effort_bounds: dict[str, Any] = {}
         reactions: dict[str, Reaction] = {}
-        shaking = np.zeros(kin.shape) + 0j
-        e_shaking = np.zeros(kin.shape)
-        moment = np.zeros(kin.shape)
-        e_moment = np.zeros(kin.shape)
-        size = self.size
-        force_limit = max_error * np.fmax(scale, np.finfo(float).tiny)
-        moment_limit = force_limit * size
-        untrusted = np.zeros(kin.shape, dtype=bool)
-        worst: list[tuple[float, str, Any, Any]] = []
+        shaking: Any = 0j
+        e_shaking: Any = 0.0
+        moment: Any = 0.0
+        e_moment: Any = 0.0
+        force_limit = max_error * kin.biggest(scale, _TINY)
+        moment_limit = force_limit * self.size
+        untrusted: Any = False
+        worst: list[tuple[float, str, float, float]] = []
 
         def judge(name: str, bound: Any, limit: Any) -> Any:
-            bad = ~(bound <= limit)
-            if not kin.vector and bool(bad):
+            bad = np.logical_not(bound <= limit) if kin.vector else not bound <= limit
+            if not kin.vector and bad:
                 ratio = float(bound) / float(limit) if float(limit) > 0 else math.inf
                 worst.append((ratio, name, float(bound), float(limit)))
             return bad
@@ -708,106 +726,180 @@ class Dynamics:
                 continue
             parts = carried.parts
             if joint.driver:
-                value, bound = parts.get('effort', (np.zeros(kin.shape), np.zeros(kin.shape)))
+                value, bound = parts.get('effort', (0.0, 0.0))
                 efforts[joint.name], effort_bounds[joint.name] = value, bound
                 limit = force_limit if joint.line is not None else moment_limit
-                untrusted |= judge(f'efforts.{joint.name}', bound, limit)
+                untrusted = untrusted | judge(f'efforts.{joint.name}', bound, limit)
             if joint.type.table is None:    # a lock: its holding moment
-                reaction = Reaction(joint.at, joint.body, joint.on,
-                                    moment=parts.get('moment', (carried.couple,))[0],
-                                    moment_bound=parts.get('moment', (0, carried.couple_bound))[1])
-                untrusted |= judge(f'reactions.{joint.name}.moment', reaction.moment_bound,
-                                   moment_limit)
+                value, bound = parts.get('moment', (0.0, 0.0))
+                reaction = Reaction(joint.at, joint.body, joint.on, moment=value,
+                                    moment_bound=bound)
+                untrusted = untrusted | judge(f'reactions.{joint.name}.moment', bound,
+                                              moment_limit)
             elif joint.line is None:
-                force = parts['x'][0] + 1j * parts['y'][0] if 'x' in parts else carried.force
-                bound = (np.hypot(parts['x'][1], parts['y'][1]) if 'x' in parts
-                         else carried.force_bound)
-                reaction = Reaction(joint.at, joint.body, joint.on, force=force,
+                (fx, e_fx), (fy, e_fy) = parts.get('x', (0.0, 0.0)), parts.get('y', (0.0, 0.0))
+                bound = e_fx + e_fy
+                reaction = Reaction(joint.at, joint.body, joint.on, force=fx + 1j * fy,
                                     force_bound=bound)
-                untrusted |= judge(f'reactions.{joint.name}.force', bound, force_limit)
+                untrusted = untrusted | judge(f'reactions.{joint.name}.force', bound,
+                                              force_limit)
             else:
-                normal, e_normal = parts.get('normal', (np.zeros(kin.shape),) * 2)
-                couple, e_couple = parts.get('moment', (np.zeros(kin.shape),) * 2)
+                normal, e_normal = parts.get('normal', (0.0, 0.0))
+                couple, e_couple = parts.get('moment', (0.0, 0.0))
                 reaction = Reaction(joint.at, joint.body, joint.on, normal=normal,
                                     moment=couple, normal_bound=e_normal, moment_bound=e_couple)
-                untrusted |= (judge(f'reactions.{joint.name}.normal', e_normal, force_limit)
-                              | judge(f'reactions.{joint.name}.moment', e_couple, moment_limit))
+                untrusted = (untrusted
+                             | judge(f'reactions.{joint.name}.normal', e_normal, force_limit)
+                             | judge(f'reactions.{joint.name}.moment', e_couple, moment_limit))
             reactions[joint.name] = reaction
             if joint.on == graph.ground:
                 at = kin.position(joint.at)
-                shaking = shaking - carried.force
-                e_shaking = e_shaking + carried.force_bound + U * np.abs(shaking)
-                turn = _cross(at, carried.force) + carried.couple
+                force = carried.force
+                shaking = shaking - force
+                e_shaking = e_shaking + carried.force_bound + U * abs(shaking)
+                turn = _cross(at, force) + carried.couple
                 moment = moment - turn
-                e_moment = e_moment + (np.abs(at) * carried.force_bound
-                                       + kin.position_bound(joint.at) * np.abs(carried.force)
+                e_moment = e_moment + (abs(at) * carried.force_bound
+                                       + kin.position_bound(joint.at) * abs(force)
                                        + carried.couple_bound
-                                       + 4 * U * (np.abs(at) * np.abs(carried.force)
-                                                  + np.abs(moment)))
-        untrusted |= (judge('shaking.force', e_shaking, force_limit)
-                      | judge('shaking.moment', e_moment, moment_limit))
-        untrusted &= valid
-        if np.any(untrusted):
-            failures['forces (untrusted)'] = untrusted
-        valid = valid & ~untrusted
-        if not kin.vector:
-            valid = bool(valid)
+                                       + 4 * U * (abs(at) * abs(force) + abs(moment)))
+        untrusted = (untrusted | judge('shaking.force', e_shaking, force_limit)
+                     | judge('shaking.moment', e_moment, moment_limit))
+        if kin.vector:
+            untrusted = untrusted & np.asarray(valid, dtype=bool)
+            if np.any(untrusted):
+                failures['forces (untrusted)'] = untrusted
+            valid = np.asarray(valid, dtype=bool) & ~untrusted
+            shape = kin.shape
+            efforts = {n: np.broadcast_to(v, shape) for n, v in efforts.items()}
+        else:
+            valid = bool(valid) and not bool(untrusted)
         return Forces(efforts, reactions, shaking, moment, effort_bounds,
                       (e_shaking, e_moment), valid, scale, failures,
                       max(worst)[1:] if worst else None)
 
 
+#: The least scale a force is judged on (the smallest normal double), N.
+_TINY = float(np.finfo(np.float64).tiny)
+#: A unit vector known exactly (a pin's x or y direction): no bound to add.
+_EXACT = 0.0
+#: A structural zero of a statics matrix (this object, not any 0.0): skipped by the solve.
+_ZERO = float('0')
+
+
 def _cross(a: Any, b: Any) -> Any:
     """Return the z component of the cross product of two vectors given as complex numbers."""
-    return np.real(a) * np.imag(b) - np.imag(a) * np.real(b)
+    return a.real * b.imag - a.imag * b.real
 
 
 def _unit(joint: Joint, component: str, kin: _Kinematics) -> tuple[Any, Any, str | None]:
     """Return the unit force (complex, its bound, its point) of one unknown; None: a couple."""
     if component == 'x':
-        return 1.0 + 0j, 0.0, joint.at
+        return 1.0 + 0j, _EXACT, joint.at
     if component == 'y':
-        return 1j, 0.0, joint.at
+        return 1j, _EXACT, joint.at
     if component == 'moment' or (component == 'effort' and joint.line is None):
-        return 0j, 0.0, None
+        return 0j, _EXACT, None
     line = joint.line
     assert line is not None
     angle, e_angle = kin.line_angle(line)
-    u = np.exp(1j * angle)
+    u = kin.expi(angle)
     e_u = e_angle + 2 * U
     return (1j * u if component == 'normal' else u), e_u, joint.at
 
 
-def _bounded_solve(A: Any, EA: Any, b: Any, Eb: Any) -> tuple[Any, Any, Any]:
+def _bounded_solve(A: list[list[Any]], EA: list[list[Any]], b: list[Any], Eb: list[Any],
+                   vector: bool) -> tuple[list[Any], list[Any], Any]:
     """Return ``x`` solving ``A x = b``, a bound of its error, and where the bound holds.
 
-    The bound covers the rounding of the solve and the errors ``EA`` and
-    ``Eb`` of the entries (see the module): ``|X| t + |X| |R| 1 ||t|| / (1 -
-    rho)``; where ``rho`` (the norm of ``I - A X`` with its rounding and the
-    entries' errors) is not below 1/2, the system is too near singular.
+    Gauss-Jordan elimination with partial pivoting, on the entries as they
+    are (floats for one instant, arrays for many: the same operations), gives
+    ``x`` and the inverse ``X``. The bound, to first order as the kinematics'
+    are: ``|X| t`` with ``t`` the computed residual ``|b - A x|``, its
+    rounding, and the entries' errors ``EA |x| + Eb``. Where ``A`` is within
+    rounding of singular (its condition number beyond ``1 / (64 k U)``: a
+    toggle, where the statics degenerate), there is no bound.
     """
-    k = A.shape[-1]
+    k = len(b)
+    # The augmented matrix [A | I]; structural zeros stay _ZERO and are skipped.
+    M = [list(row) + [1.0 if c == r else _ZERO for c in range(k)] for r, row in enumerate(A)]
+    ok: Any = True
+    for j in range(k):
+        candidates = [M[r][j] for r in range(j, k)]
+        if vector:
+            stacked = np.abs(np.broadcast_arrays(*candidates))
+            best = np.argmax(stacked, axis=0)
+            if np.any(best):
+                rows = M[j:]
+                picked = [np.choose(best, [row[c] for row in rows]) for c in range(2 * k)]
+                for offset in range(1, k - j):
+                    mine = best == offset
+                    if np.any(mine):
+                        M[j + offset] = [np.where(mine, M[j][c], M[j + offset][c])
+                                         for c in range(2 * k)]
+                M[j] = picked
+            pivot = M[j][j]
+            ok = ok & (np.abs(pivot) > 0.0)
+        else:
+            best = max(range(k - j), key=lambda r: abs(candidates[r]))
+            if best:
+                M[j], M[j + best] = M[j + best], M[j]
+            pivot = M[j][j]
+            if pivot == 0.0:
+                return [math.nan] * k, [math.inf] * k, False
+        with np.errstate(all='ignore'):
+            inverse = 1.0 / pivot
+            row = [v if v is _ZERO else v * inverse for v in M[j]]
+            row[j] = 1.0
+            M[j] = row
+            for r in range(k):
+                factor = M[r][j]
+                if r == j or factor is _ZERO or (not vector and factor == 0.0):
+                    continue
+                target = M[r]
+                M[r] = [t if v is _ZERO else t - factor * v
+                        for t, v in zip(target, row, strict=True)]
+                M[r][j] = _ZERO
+    X = [row[k:] for row in M]
     with np.errstate(all='ignore'):
-        try:
-            X = np.linalg.inv(A)
-        except np.linalg.LinAlgError:
-            X = np.linalg.pinv(A)
-        x = np.einsum('...ij,...j->...i', X, b)
-        absA, absX = np.abs(A), np.abs(X)
-        residual = b - np.einsum('...ij,...j->...i', A, x)
-        products = np.einsum('...ij,...j->...i', absA, np.abs(x))
-        t = (np.abs(residual) + _gamma(k + 1) * (products + np.abs(b))
-             + np.einsum('...ij,...j->...i', EA, np.abs(x)) + Eb)
-        R = np.eye(k) - A @ X
-        R_true = np.abs(R) + _gamma(k) * (absA @ absX) + EA @ absX
-        rho = R_true.sum(axis=-1).max(axis=-1)
-        t_norm = t.max(axis=-1)
-        spill = np.einsum('...ij,...j->...i', absX @ R_true, np.ones(k))
-        e_x = (np.einsum('...ij,...j->...i', absX, t)
-               + spill * (t_norm / (1.0 - rho))[..., None])
-        ok = (rho < 0.5) & np.isfinite(e_x).all(axis=-1) & np.isfinite(x).all(axis=-1)
-    e_x = np.where(ok[..., None], e_x, np.inf)
+        x = [sum([v * w for v, w in zip(row, b, strict=True)]) for row in X]
+        t = []
+        a_norm: Any = 0.0
+        for r, row in enumerate(A):
+            entries = [(v, c) for c, v in enumerate(row) if v is not _ZERO]
+            products = [v * x[c] for v, c in entries]
+            residual = b[r] - sum(products)
+            size = sum([abs(p) for p in products]) + abs(b[r])
+            a_norm = _fmax(a_norm, sum([abs(v) for v, _ in entries]), vector)
+            error = sum([EA[r][c] * abs(x[c]) for _, c in entries]) + Eb[r]
+            t.append(abs(residual) + _gamma(k + 1) * size + error)
+        x_norm: Any = 0.0
+        e_x = []
+        for row in X:
+            magnitudes = [abs(v) for v in row]
+            x_norm = _fmax(x_norm, sum(magnitudes), vector)
+            e_x.append(sum([v * w for v, w in zip(magnitudes, t, strict=True)]))
+        condition = a_norm * x_norm
+        ok = ok & (condition * (64 * k * U) < 1.0)
+        # First order, as the kinematics: the inverse's own rounding scales the bound by
+        # at most 1 / (1 - k U cond), under 1 + 1/63 where it is answered.
+        grow = 1.0 / (1.0 - k * U * condition) if not vector else np.where(
+            ok, 1.0 / (1.0 - k * U * condition), np.inf)
+        e_x = [e * grow for e in e_x]
+    if not vector:
+        ok = bool(ok) and all(math.isfinite(v) for v in (*x, *e_x))
+        if not ok:
+            e_x = [math.inf] * k
+    else:
+        ok = np.asarray(ok, dtype=bool)
+        for value in (*x, *e_x):
+            ok = ok & np.isfinite(value)
+        e_x = [np.where(ok, e, np.inf) for e in e_x]
     return x, e_x, ok
+
+
+def _fmax(a: Any, b: Any, vector: bool) -> Any:
+    return np.fmax(a, b) if vector else max(a, b)
 
 
 @dataclass(frozen=True)
@@ -822,11 +914,10 @@ class _Carried:
     parts: dict[str, tuple[Any, Any]]
 
     @classmethod
-    def idle(cls, joint: Joint, shape: tuple[int, ...]) -> _Carried:
+    def idle(cls, joint: Joint) -> _Carried:
         """Return a joint that carries nothing (an intermittent joint out of action)."""
-        zero = np.zeros(shape)
-        parts = {c: (zero, zero) for c in _components(joint)}
-        return cls(joint, zero + 0j, zero, zero, zero, parts)
+        parts = {c: (0.0, 0.0) for c in _components(joint)}
+        return cls(joint, 0j, 0.0, 0.0, 0.0, parts)
 
     @classmethod
     def where(cls, mask: Any, a: _Carried, b: _Carried) -> _Carried:
@@ -840,12 +931,17 @@ class _Carried:
 
 
 class _Kinematics:
-    """What the forces read of a solved state: points, frames, lines, with their bounds."""
+    """What the forces read of a solved state: points, frames, lines, with their bounds.
+
+    Floats for one instant, arrays for many: the same arithmetic serves both.
+    """
 
     def __init__(self, graph: Graph, state: State) -> None:
         self.state = state
         self.vector = not isinstance(state.valid, (bool, np.bool_))
         self.shape: tuple[int, ...] = np.shape(state.valid) if self.vector else ()
+        self.biggest = np.fmax if self.vector else max
+        self.expi = _expi_array if self.vector else _expi
         self.points = state.complex_points
         bounds = state.error_bound
         self.point_bounds = bounds.points
@@ -856,36 +952,41 @@ class _Kinematics:
             if frame is None:
                 continue
             if frame.angle_of is None:
-                zero = np.zeros(self.shape)
-                self.frames[name] = (frame.origin, frame.angle + zero, zero, zero,
-                                     (U * abs(frame.angle) + zero, zero, zero))
+                self.frames[name] = (frame.origin, frame.angle, 0.0, 0.0,
+                                     (U * abs(frame.angle), 0.0, 0.0))
                 continue
             joint = state.joints[frame.angle_of]
             b = self.joint_bounds[frame.angle_of]
-            self.frames[name] = (frame.origin, np.asarray(joint.position) + frame.angle,
-                                 np.asarray(joint.velocity), np.asarray(joint.acceleration),
-                                 (np.asarray(b.position), np.asarray(b.velocity),
-                                  np.asarray(b.acceleration)))
+            self.frames[name] = (frame.origin, joint.position + frame.angle, joint.velocity,
+                                 joint.acceleration, (b.position, b.velocity, b.acceleration))
 
     def position(self, point: str) -> Any:
-        return np.asarray(self.points[point][0])
+        return self.points[point][0]
 
     def acceleration(self, point: str) -> Any:
-        return np.asarray(self.points[point][2])
+        return self.points[point][2]
 
     def position_bound(self, point: str) -> Any:
-        return np.asarray(self.point_bounds[point].position)
+        return self.point_bounds[point].position
 
     def acceleration_bound(self, point: str) -> Any:
-        return np.asarray(self.point_bounds[point].acceleration)
+        return self.point_bounds[point].acceleration
 
     def line_angle(self, line: Any) -> tuple[Any, Any]:
         """Return a line's direction in the ground frame and its bound, rad."""
         if line.angle_of is None:
-            return line.angle + np.zeros(self.shape), U * abs(line.angle)
+            return line.angle, U * abs(line.angle)
         joint = self.state.joints[line.angle_of]
         bound = self.joint_bounds[line.angle_of].position
-        return np.asarray(joint.position) + line.angle, np.asarray(bound) + U * abs(line.angle)
+        return joint.position + line.angle, bound + U * abs(line.angle)
 
     def engaged(self, lever: str) -> Any:
         return self.state.intermittent[lever].engaged
+
+
+def _expi(angle: float) -> complex:
+    return complex(math.cos(angle), math.sin(angle))
+
+
+def _expi_array(angle: Any) -> Any:
+    return np.cos(angle) + 1j * np.sin(angle)
