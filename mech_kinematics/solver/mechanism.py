@@ -9,7 +9,7 @@ assemble in the scene's own units.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 import math
 from typing import Any, cast
@@ -308,12 +308,27 @@ class Scene:
         object.__setattr__(self, 'loads', tuple(self.loads))
         if self.gravity is None and not self.masses and not self.loads:
             return None
-        gravity = (0.0, 0.0) if self.gravity is None else tuple(self.gravity)
-        if len(gravity) != 2 or not all(math.isfinite(g) for g in gravity):
+        for items, kind in ((self.masses, Mass), (self.loads, Load)):
+            for item in items:
+                if not isinstance(item, kind):
+                    what = 'masses' if kind is Mass else 'loads'
+                    msg = f'Expected {what} as {kind.__name__} values, got {item!r}'
+                    raise SceneError(msg, (self, what))
+        gravity = (0.0, 0.0) if self.gravity is None else self.gravity
+        if isinstance(gravity, (str, bytes)) or not isinstance(gravity, Sequence) \
+                or len(gravity) != 2 or not all(isinstance(g, (int, float)) and not
+                                                isinstance(g, bool) and math.isfinite(g)
+                                                for g in gravity):
             msg = f'Expected gravity as [gx, gy] in m/s^2, finite, got {self.gravity!r}'
             raise SceneError(msg, (self, 'gravity'))
-        object.__setattr__(self, 'gravity', (float(gravity[0]), float(gravity[1])))
-        return Dynamics(full.graph, self.masses, self.loads, self.gravity,
+        g = (float(gravity[0]), float(gravity[1]))
+        object.__setattr__(self, 'gravity', g)
+        for imu in self.imus:   # an IMU's own gravity, where given, must be the scene's
+            if tuple(imu.gravity) not in ((0.0, 0.0), g):
+                msg = (f'Expected the gravity of IMU "{imu.name}" to be the scene\'s '
+                       f'{list(g)} m/s^2 (both given must agree), got {list(imu.gravity)}')
+                raise SceneError(msg, (imu, 'gravity'))
+        return Dynamics(full.graph, self.masses, self.loads, g,
                         (*self.ground, *full.output_points), _size(self))
 
     @property
