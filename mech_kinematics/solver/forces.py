@@ -501,28 +501,36 @@ class Dynamics:
         biggest = kin.biggest
         done: dict[str, _Carried] = {}   # joint -> what it carries, solved
         scale: Any = 0.0
-        valid: Any = True
+        # Where the kinematics answered (an array's other instants are theirs to explain).
+        valid: Any = np.asarray(state.valid, dtype=bool) if kin.vector else True
         failures: dict[str, Any] = {}
-        inertial = {name: self._inertial(name, kin) for name in kin.frames}
-        for F, _, _, _ in inertial.values():
-            scale = biggest(scale, abs(F))
-        for load in self.loads:
-            if load.force is not None:
-                scale = biggest(scale, abs(complex(*load.force)))
-            else:
-                scale = biggest(scale, abs(load.torque or 0.0) / self.size)
-        for group in self.groups:
-            solved, ok = self._solve(group, kin, inertial, done)
-            if ok is not True:
-                bad = ~np.asarray(ok, dtype=bool) if kin.vector else not ok
-                if np.any(bad):
-                    failures[f'{group.key} (statics singular)'] = bad
+        with np.errstate(all='ignore'):     # an overflow is refused below, never warned
+            inertial = {name: self._inertial(name, kin) for name in kin.frames}
+            finite: Any = True
+            for F, M, _, _ in inertial.values():
+                scale = biggest(scale, abs(F))
+                finite = finite & np.isfinite(F) & np.isfinite(M)
+            for load in self.loads:
+                if load.force is not None:
+                    scale = biggest(scale, abs(complex(*load.force)))
+                else:
+                    scale = biggest(scale, abs(load.torque or 0.0) / self.size)
+            overflow = valid & ~np.asarray(finite, dtype=bool)
+            if np.any(overflow):
+                failures['forces (overflow)'] = overflow if kin.vector else True
+                valid = valid & ~overflow if kin.vector else False
+            for group in self.groups:
+                solved, ok = self._solve(group, kin, inertial, done)
+                if ok is not True:
+                    bad = valid & ~np.asarray(ok, dtype=bool) if kin.vector else not ok
+                    if np.any(bad):
+                        failures.setdefault(f'{group.key} (statics singular)', bad)
                     valid = valid & ok
-            done.update(solved)
-        for carried in done.values():
-            scale = biggest(scale, abs(carried.force))
-            scale = biggest(scale, abs(carried.couple) / self.size)
-        return self._result(done, kin, scale, valid, failures, max_error)
+                done.update(solved)
+            for carried in done.values():
+                scale = biggest(scale, abs(carried.force))
+                scale = biggest(scale, abs(carried.couple) / self.size)
+            return self._result(done, kin, scale, valid, failures, max_error)
 
     def _inertial(self, name: str, kin: _Kinematics) -> tuple[Any, Any, Any, Any]:
         """Return a body's inertia wrench less its loads, about its frame's origin, and bounds.
@@ -715,7 +723,7 @@ class Dynamics:
 
         def judge(name: str, bound: Any, limit: Any) -> Any:
             bad = np.logical_not(bound <= limit) if kin.vector else not bound <= limit
-            if not kin.vector and bad:
+            if not kin.vector and bad and valid:    # the worst of an instant otherwise sound
                 ratio = float(bound) / float(limit) if float(limit) > 0 else math.inf
                 worst.append((ratio, name, float(bound), float(limit)))
             return bad
@@ -803,6 +811,14 @@ def _unit(joint: Joint, component: str, kin: _Kinematics) -> tuple[Any, Any, str
     line = joint.line
     assert line is not None
     angle, e_angle = kin.line_angle(line)
+    if joint.copies > 1:    # evenly spaced slots (a Geneva wheel's): the one the point is in
+        step = 2 * math.pi / joint.copies
+        toward = kin.position(joint.at) - kin.position(line.through)
+        turn = step * np.round((np.angle(toward) - angle) / step)
+        if not kin.vector:
+            turn = float(turn)
+        angle = angle + turn
+        e_angle = e_angle + 2 * U * (abs(turn) + abs(angle))
     u = kin.expi(angle)
     e_u = e_angle + 2 * U
     return (1j * u if component == 'normal' else u), e_u, joint.at
