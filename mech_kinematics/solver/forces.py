@@ -438,13 +438,13 @@ class Dynamics:
                             for j in graph.joints if j not in joints)
                 if turns or later:
                     rows.append((b, 2))
-                elif self._moment_given(body):
+                elif (given := self._moment_given(body)) is not None:
                     phase = 'engaged' if engaged else 'locked'
                     msg = (f'Expected the statics of {key} to be determined, got {body}, which '
                            f'turns freely about {origin} while {phase} and has a moment to '
                            f'carry (its centre of mass off {origin}, an inertia or a load): '
                            f'give it no mass there')
-                    raise SceneError(msg)
+                    raise SceneError(msg, given)
             if len(rows) != len(columns):
                 msg = (f'Expected the joint reactions of {key} to be determined by statics, got '
                        f'{len(rows)} equations for {len(columns)} unknowns')
@@ -460,14 +460,20 @@ class Dynamics:
         return joint.line is not None or joint.type.table is None or joint.driver \
             or joint.at != origin
 
-    def _moment_given(self, body: str) -> bool:
+    def _moment_given(self, body: str) -> tuple[Any, str] | None:
+        """Return what gives ``body`` a moment about its frame's origin (the key to name)."""
         mass = self.masses.get(body)
-        if mass is not None and (mass.inertia or mass.com != (0.0, 0.0)):
-            return True
-        if self.torque_loads.get(body):
-            return True
+        if mass is not None and mass.com != (0.0, 0.0):
+            return mass, 'com'
+        if mass is not None and mass.inertia:
+            return mass, 'inertia'
+        for load in self.torque_loads.get(body, ()):
+            return load, 'link'
         origin = self.graph.bodies[body].frame.origin  # type: ignore[union-attr]
-        return any(load.point != origin for load in self.point_loads.get(body, ()))
+        for load in self.point_loads.get(body, ()):
+            if load.point != origin:
+                return load, 'point'
+        return None
 
     def needs(self) -> tuple[set[str], set[str]]:
         """Return the joints (coordinates) and points a state must hold for :meth:`forces`."""

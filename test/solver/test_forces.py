@@ -38,6 +38,7 @@ from hypothesis import strategies as st
 import mpmath
 import numpy as np
 import pytest
+import yaml
 
 import mech_kinematics as mk
 from mech_kinematics.imu import ImuSpec
@@ -966,6 +967,24 @@ def test_a_bad_v4_value_through_the_python_api_is_one_scene_error(mistake):
     assert '\n' not in str(caught.value)
 
 
+@pytest.mark.parametrize(('entry', 'key'), [
+    ({'mass': 0.1, 'com': [5, 0]}, 'masses.pin_slot.com'),
+    ({'mass': 0.1, 'inertia': 1e-6}, 'masses.pin_slot.inertia'),
+])
+def test_a_body_free_while_locked_with_a_moment_is_refused_naming_its_key(entry, key, tmp_path):
+    """A Geneva pin's block turns freely while the wheel dwells: a moment on it is refused."""
+    path = tmp_path / 'geneva.yaml'
+    path.write_text(yaml.safe_dump({**GEOMETRIES['Geneva RPR'](), 'masses': {'pin_slot': entry}}))
+    with pytest.raises(mk.SceneError) as caught:
+        mk.load_scene(path)
+    message = str(caught.value)
+    assert message.startswith(f'{path}: {key}: Expected the statics of wheel to be determined, '
+                              'got pin_slot, which turns freely about P while locked'), message
+    path.write_text(yaml.safe_dump({**GEOMETRIES['Geneva RPR'](),
+                                    'masses': {'pin_slot': {'mass': 0.1}}}))
+    assert mk.load_scene(path).dynamics is not None     # a mass at the pin is determined
+
+
 def test_an_imu_without_its_own_gravity_is_left_alone():
     """An IMU that gives no gravity (the API's default (0, 0)) may sit in a scene with one."""
     bare, _ = _loaded()
@@ -992,3 +1011,91 @@ def test_a_scene_with_none_of_the_v4_keys_computes_no_forces():
             for field in ('position', 'velocity', 'acceleration'):
                 np.testing.assert_array_equal(data['joints'][name][field],
                                               with_forces['joints'][name][field])
+
+
+# --- the packaged scenes with masses ----------------------------------------------------
+
+#: The packaged scenes with masses, gravity or loads (issue 32 asks for these four at least).
+PACKAGED = [name for name in mk.scene_names() if mk.load_scene(name).dynamics is not None]
+#: A loaded scene -> the kinematic scene it copies (the same geometry, start and speeds).
+TWINS = {'five_bar_payload': 'five_bar', 'excavator_loaded': 'excavator',
+         'shaper': 'quick_return'}
+
+
+def _bare(scene):
+    """Return ``scene`` without its masses, loads and gravity (its kinematics alone)."""
+    return dataclasses.replace(scene, gravity=None, masses=(), loads=())
+
+
+def _packaged_instants(scene):
+    """Return instants (positions, speeds, accels) of a packaged scene: its start, a sweep."""
+    drivers = scene.drivers
+    start = [d.start for d in drivers]
+    speeds = [d.speed for d in drivers]
+    accels = [d.accel for d in drivers]
+    sweep = []
+    for driver in drivers:
+        if driver.joint_type.angular:
+            sweep.append(driver.start + np.linspace(0.0, 2 * math.pi, 24, endpoint=False))
+        else:
+            low, high = driver.stroke
+            sweep.append(np.linspace(low, high, 26)[1:-1])
+    moving = [s if s else (0.1 if not d.joint_type.angular else 3.0)
+              for s, d in zip(speeds, drivers, strict=True)]
+    return [(start, speeds, accels), (sweep, speeds, accels),
+            (start, moving, [0.5 * v for v in moving]), (sweep, moving, [-v for v in moving])]
+
+
+@pytest.mark.parametrize('name', PACKAGED)
+def test_packaged_scene_with_masses_balances_power_bodies_and_frame(name):
+    """Each packaged scene with masses: power, virtual power, every body and the frame balance."""
+    scene = mk.load_scene(name)
+    bare = _bare(scene)
+    for instant in _packaged_instants(scene):
+        state = _solve(scene, *instant)
+        assert np.all(state.valid), (name, state.failures)
+        _assert_power_balance(scene, state)
+        _assert_virtual_power(scene, state, bare, instant)
+        _assert_bodies_balance(scene, state)
+        _assert_shaking(scene, state)
+
+
+@pytest.mark.parametrize('name', PACKAGED)
+def test_packaged_scene_with_masses_is_within_its_bounds_at_50_digits(name):
+    """At its start and moving, every reported bound covers a 50-digit recomputation."""
+    scene = mk.load_scene(name)
+    for positions, speeds, accels in _packaged_instants(scene)[::2]:
+        state = _solve(scene, positions, speeds, accels)
+        assert _assert_within_bounds(scene, state) >= 4
+
+
+def test_the_issues_four_scenes_have_masses():
+    """An engine, a shaper, the five-bar with a payload and the excavator carry masses."""
+    assert {'engine', 'shaper', 'five_bar_payload', 'excavator_loaded'} <= set(PACKAGED)
+    engine, shaper = mk.load_scene('engine'), mk.load_scene('shaper')
+    assert {m.body for m in engine.masses} == {'crank', 'rod', 'piston'}
+    assert all(m.inertia > 0 for m in engine.masses if m.body != 'piston')
+    assert [load.point for load in engine.loads] == ['P']
+    assert [(load.point, load.force) for load in shaper.loads] == [('D', (3000.0, 0.0))]
+    for name in ('five_bar_payload', 'excavator_loaded'):
+        assert mk.load_scene(name).gravity == (0.0, -9.81)
+    assert set(mk.load_scene('excavator_loaded').graph.drivers) == {'boom_cyl', 'stick_cyl'}
+
+
+@pytest.mark.parametrize('name', sorted(TWINS))
+def test_a_loaded_scene_moves_as_its_kinematic_twin(name):
+    """A scene with masses copied from a packaged one has its motion, bit for bit."""
+    scene, twin = mk.load_scene(name), mk.load_scene(TWINS[name])
+    assert [(d.name, d.start, d.speed, d.accel) for d in scene.drivers] == [
+        (d.name, d.start, d.speed, d.accel) for d in twin.drivers]
+    for positions, speeds, accels in _packaged_instants(twin):
+        ours, theirs = _solve(scene, positions, speeds, accels), _solve(
+            twin, positions, speeds, accels)
+        assert ours.joints.keys() == theirs.joints.keys()
+        for joint, motion in theirs.joints.items():
+            for field in ('position', 'velocity', 'acceleration'):
+                np.testing.assert_array_equal(getattr(ours.joints[joint], field),
+                                              getattr(motion, field))
+        for point, values in theirs.complex_points.items():
+            for got, want in zip(ours.complex_points[point], values, strict=True):
+                np.testing.assert_array_equal(got, want)
