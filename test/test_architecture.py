@@ -1,10 +1,13 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""The layers and their arrows: core <- geometry <- ROS layer and tools. See issue 9.
+"""The layers and their arrows: core <- geometry, verify <- ROS layer and tools. See issue 9.
 
 - the solver core (errors, units, the solver package, scene, textbook) imports only NumPy,
   PyYAML and the standard library;
 - geometry imports the core only, and never matplotlib;
+- the verification room (``verify/``: the 50-digit reference, the extreme suite) sits
+  beside geometry: it imports the core and geometry, never a tool or the ROS layer; the
+  tools (the report) import it (issue 30);
 - the ROS layer never imports a tool (drawing, report, recorder) nor matplotlib;
 - the bag writer (``bag/``) imports the core only; the tools use it;
 - building the command line for ``solve`` imports no heavy dependency.
@@ -24,8 +27,9 @@ CORE_PACKAGES = ('solver',)
 HEAVY = ('rclpy', 'matplotlib', 'mpmath', 'scipy', 'rosbags', 'tqdm')
 
 #: Layer of each subpackage (modules at the top are the core), and what each may import.
-LAYERS = {'core': set(), 'data': set(), 'geometry': {'core'}, 'ros': {'core', 'geometry'},
-          'bag': {'core'}, 'tools': {'core', 'geometry', 'ros', 'data', 'bag'}}
+LAYERS = {'core': set(), 'data': set(), 'geometry': {'core'}, 'verify': {'core', 'geometry'},
+          'ros': {'core', 'geometry'}, 'bag': {'core'},
+          'tools': {'core', 'geometry', 'ros', 'data', 'bag', 'verify'}}
 
 
 def _modules_after(code: str) -> set:
@@ -130,3 +134,23 @@ def test_each_fact_is_spelled_in_its_home_only(literal, home):
     spelled = sorted(str(p.relative_to(PACKAGE)) for p in PACKAGE.rglob('*.py')
                      if literal in p.read_text(encoding='utf-8'))
     assert spelled == [home]
+
+
+#: The step kinds and drivers: each is one module with a test file of its own.
+KIND_MODULES = ('crank', 'actuator', 'rrr', 'rrp', 'rpr', 'rpp', 'geneva', 'carried')
+
+
+def test_every_kind_module_has_its_own_test_file():
+    """Tests mirror the package: each kind's module has test/solver/test_<kind>.py."""
+    tests = Path(__file__).resolve().parent / 'solver'
+    for kind in KIND_MODULES:
+        assert (PACKAGE / 'solver' / f'{kind}.py').is_file(), kind
+        assert (tests / f'test_{kind}.py').is_file(), f'no test/solver/test_{kind}.py'
+
+
+def test_no_test_file_is_named_after_a_module_that_does_not_exist():
+    """A test/solver/test_X*.py names an existing solver module X (or the solver's solve)."""
+    modules = {path.stem for path in (PACKAGE / 'solver').glob('*.py')}
+    for path in (Path(__file__).resolve().parent / 'solver').glob('test_*.py'):
+        name = path.stem.removeprefix('test_')
+        assert any(name == m or name.startswith(m + '_') for m in modules), path.name

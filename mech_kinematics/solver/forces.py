@@ -516,6 +516,13 @@ class Dynamics:
             for F, M, _, _ in inertial.values():
                 scale = biggest(scale, abs(F))
                 finite = finite & np.isfinite(F) & np.isfinite(M)
+            # The least scale, as the kinematics' floors: every body's weight and the inertia
+            # force of its mass at the state's scale of acceleration (every force may be 0).
+            scales = state.scales
+            gravity = abs(self.gravity)
+            for mass in self.masses.values():
+                scale = biggest(scale, mass.mass * (gravity + scales['acceleration'])
+                                + mass.inertia * scales['angular acceleration'] / self.size)
             for load in self.loads:
                 if load.force is not None:
                     scale = biggest(scale, abs(complex(*load.force)))
@@ -816,17 +823,16 @@ def _unit(joint: Joint, component: str, kin: _Kinematics) -> tuple[Any, Any, str
         return 0j, _EXACT, None
     line = joint.line
     assert line is not None
-    angle, e_angle = kin.line_angle(line)
-    if joint.copies > 1:    # evenly spaced slots (a Geneva wheel's): the one the point is in
-        step = 2 * math.pi / joint.copies
-        toward = kin.position(joint.at) - kin.position(line.through)
-        turn = step * np.round((np.angle(toward) - angle) / step)
-        if not kin.vector:
-            turn = float(turn)
-        angle = angle + turn
-        e_angle = e_angle + 2 * U * (abs(turn) + abs(angle))
-    u = kin.expi(angle)
-    e_u = e_angle + 2 * U
+    if joint.copies > 1:   # one of several slots: the one its point is in, from the line's point
+        d = kin.position(joint.at) - kin.position(line.through)
+        length = abs(d)
+        u = d / length
+        e_u = (kin.position_bound(joint.at) + kin.position_bound(line.through)) * 2 / length \
+            + 4 * U
+    else:
+        angle, e_angle = kin.line_angle(line)
+        u = kin.expi(angle)
+        e_u = e_angle + 2 * U
     return (1j * u if component == 'normal' else u), e_u, joint.at
 
 
