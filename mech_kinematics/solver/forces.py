@@ -116,11 +116,13 @@ class Load:
     name : str
         Its name (the node's ``loads.NAME.*`` parameters).
     point : str or None
-        The point a force acts at (on the body it was placed on).
+        The point a force acts at.
     force : (float, float) or None
         N, in the scene's frame.
     link : str or None
-        The body a torque acts on.
+        The body a torque acts on; for a force, the body it acts on, which must
+        carry ``point`` (by default: the slider block at that point if there is
+        one, as a gas force on a piston, else the first link placed there).
     torque : float or None
         N m about z, + CCW.
     """
@@ -135,12 +137,12 @@ class Load:
         """Validate the fields: a force at a point, or a torque on a link, not both."""
         _check_name(self.name, 'a load name', (self, 'name'))
         at_point = self.point is not None or self.force is not None
-        on_link = self.link is not None or self.torque is not None
-        if at_point == on_link or (at_point and (self.point is None or self.force is None)) \
-                or (on_link and (self.link is None or self.torque is None)):
-            msg = (f'Expected load "{self.name}" to be {{point, force}} or {{link, torque}}, '
-                   f'got point={self.point!r}, force={self.force!r}, link={self.link!r}, '
-                   f'torque={self.torque!r}')
+        twist = self.torque is not None
+        if at_point == twist or (at_point and (self.point is None or self.force is None)) \
+                or (twist and self.link is None):
+            msg = (f'Expected load "{self.name}" to be {{point, force}} (optionally with the '
+                   f'link it acts on) or {{link, torque}}, got point={self.point!r}, '
+                   f'force={self.force!r}, link={self.link!r}, torque={self.torque!r}')
             raise SceneError(msg, (self, 'name'))
         if self.force is not None:
             force = tuple(self.force)
@@ -347,10 +349,12 @@ class Dynamics:
                 msg = f'Expected each body once in masses, got "{mass.body}" twice'
                 raise SceneError(msg, (mass, 'body'))
             self.masses[mass.body] = mass
-        owner = {}
+        owner: dict[str, str] = {}   # point -> the body a force there acts on by default
         for name, body in graph.bodies.items():
             for point in body.points:
-                owner.setdefault(point, name)
+                block = body.points == (point,) and body.guide is not None
+                if point not in owner or (block and owner[point] != graph.ground):
+                    owner[point] = name
         self.loads = tuple(loads)
         self.point_loads: dict[str, list[Load]] = {}
         self.torque_loads: dict[str, list[Load]] = {}
@@ -361,7 +365,13 @@ class Dynamics:
                 raise SceneError(msg, (load, 'name'))
             names.add(load.name)
             if load.point is not None:
-                body = owner.get(load.point)
+                body = owner.get(load.point) if load.link is None else load.link
+                if load.link is not None and (load.link not in graph.bodies or load.point
+                                              not in graph.bodies[load.link].points):
+                    msg = (f'Expected load "{load.name}" on a body carrying {load.point} '
+                           f'({", ".join(graph.carriers(load.point)) or "none"}), got '
+                           f'"{load.link}"')
+                    raise SceneError(msg, (load, 'link'))
                 if load.point not in points or body is None:
                     msg = f'Expected a load at a point of the scene, got unknown "{load.point}"'
                     raise SceneError(msg, (load, 'point'))

@@ -203,9 +203,14 @@ def _cross(a, b):
     return np.real(a) * np.imag(b) - np.imag(a) * np.real(b)
 
 
-def _owner(graph, point):
-    """Return the first body a point is fixed on (where a load at it acts)."""
-    return next(name for name, body in graph.bodies.items() if point in body.points)
+def _owner(graph, point, link=None):
+    """Return the body a load at a point acts on: its link, a block there, else the first."""
+    if link is not None:
+        return link
+    carriers = [(name, body) for name, body in graph.bodies.items() if point in body.points]
+    blocks = [name for name, body in carriers if body.points == (point,)
+              and body.guide is not None]
+    return blocks[-1] if blocks and carriers[0][0] != graph.ground else carriers[0][0]
 
 
 def _power_terms(scene, state):
@@ -374,7 +379,7 @@ def _applied_wrenches(scene, state):
                  -mass.inertia * motion.alpha)
     for load in scene.loads:
         if load.force is not None:
-            sums.add(_owner(graph, load.point), complex(*load.force),
+            sums.add(_owner(graph, load.point, load.link), complex(*load.force),
                      np.asarray(state.complex_points[load.point][0]))
         else:
             sums.add(load.link, couple=load.torque + 0.0 * Motion(state, graph, load.link).omega)
@@ -512,7 +517,7 @@ def _mp_forces(scene, state):
             b[rows[(mass.body, 2)]] += cross(r, inertia) + mass.inertia * alpha
         for load in scene.loads:
             if load.force is not None:
-                body, force = _owner(graph, load.point), mpc(*load.force)
+                body, force = _owner(graph, load.point, load.link), mpc(*load.force)
                 b[rows[(body, 0)]] -= force.real
                 b[rows[(body, 1)]] -= force.imag
                 origin = p[graph.bodies[body].frame.origin]
@@ -889,8 +894,8 @@ REFUSALS = {
                              'the ground'),
     'force and torque': ('{name: push, point: C, force: [10, -5]}',
                          '{name: push, point: C, force: [10, -5], link: rocker, torque: 1}',
-                         'loads[1]', 'Expected load "push" to be {point, force} or {link, '
-                         'torque}'),
+                         'loads[1]', 'Expected load "push" to be {point, force} (optionally '
+                         'with the link it acts on) or {link, torque}'),
     'gravity of three': ('gravity: [0, -9.81]', 'gravity: [0, -9.81, 0]', 'gravity',
                          'expected [x, y] in m/s^2, got [0, -9.81, 0]'),
     'gravity a number': ('gravity: [0, -9.81]', 'gravity: -9.81', 'gravity',
@@ -942,7 +947,8 @@ API_REFUSALS = {
         'Expected load "push" at a moving point, got "D", fixed on the ground'),
     'force and torque': (lambda bare: Load('push', point='C', force=(1.0, 0.0), link='rocker',
                                            torque=1.0),
-                         'Expected load "push" to be {point, force} or {link, torque}'),
+                         'Expected load "push" to be {point, force} (optionally with the link it '
+                         'acts on) or {link, torque}'),
     'gravity of three': (lambda bare: dataclasses.replace(bare, gravity=(0.0, -9.81, 0.0)),
                          'Expected gravity as [gx, gy] in m/s^2, finite, got (0.0, -9.81, 0.0)'),
     'gravity of text': (lambda bare: dataclasses.replace(bare, gravity=(0.0, 'down')),
