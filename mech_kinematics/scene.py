@@ -36,6 +36,7 @@ from .imu import ImuSpec
 from .solver import Branch, CarriedPoint, Crank, Link, Pin, Scene, SceneUnits
 from .solver.base import Driver, Item
 from .solver.crank import CrankDict
+from .solver.forces import Load, Mass
 from .solver.model import IDENTIFIER
 from .solver.registry import DRIVERS, KINDS
 from .units import (ANGLE_UNITS, LENGTH_UNITS, reduce_radians,
@@ -69,6 +70,8 @@ MAX_PINS = 10_000
 MAX_IMUS = 10_000
 #: Most drivers (``inputs:``) in a scene.
 MAX_DRIVERS = 100
+#: Most bodies with a mass (``masses:``) and most loads (``loads:``) in a scene.
+MAX_MASSES = MAX_LOADS = 10_000
 
 #: The two spellings of ``units`` every refusal of a missing or bad one shows.
 UNITS_EXAMPLES = 'units: {length: mm, angle: deg} or units: {length: m, angle: rad}'
@@ -97,6 +100,9 @@ class SceneDict(TypedDict, total=False):
     outputs: dict[str, list[str]]
     pins: dict[str, Any]
     imus: dict[str, dict[str, Any]]
+    gravity: list[float]
+    masses: dict[str, dict[str, Any]]
+    loads: list[dict[str, Any]]
 
 
 class ImuDict(TypedDict, total=False):
@@ -319,6 +325,18 @@ def parse_scene(data: Any) -> Scene:
     pins = [_pin(reader, keys, str(key), value, f'pins.{key}')
             for key, value in pins_data.items()]
     imus = _imus(reader, keys, data.get('imus', {}))
+    gravity = None
+    if 'gravity' in data:
+        gravity = _xy_pair(reader, data['gravity'], 'gravity', 'm/s^2')
+        for key, value in (data.get('imus') or {}).items():
+            if isinstance(value, dict) and 'gravity' in value:
+                given = _xy_pair(reader, value['gravity'], f'imus.{key}.gravity', 'm/s^2')
+                if given != gravity:
+                    raise SceneError(f"imus.{key}.gravity: expected the scene's gravity "
+                                     f'{list(gravity)} m/s^2 (both given must agree), got '
+                                     f'{list(given)}')
+    masses = _masses(reader, keys, data.get('masses'))
+    loads = _loads(reader, keys, data.get('loads'))
 
     outputs = data.get('outputs', {}) or {}
     if not isinstance(outputs, dict):
@@ -336,7 +354,8 @@ def parse_scene(data: Any) -> Scene:
         return Scene(name=name, ground=ground, input=crank, dyads=tuple(dyads),
                      points=tuple(points), outputs_joints=selected['joints'],
                      outputs_points=selected['points'], description=description,
-                     pins=tuple(pins), units=reader.units, imus=imus, inputs=drivers)
+                     pins=tuple(pins), units=reader.units, imus=imus, inputs=drivers,
+                     gravity=gravity, masses=masses, loads=loads)
     except SceneError as error:
         raise SceneError(f'{keys.key(error)}: {error}') from None
 
@@ -504,6 +523,66 @@ def _imus(reader: _Reader, keys: _Keys, raw: Any) -> tuple[ImuSpec, ...]:
                                 point=reader.name(value, 'point', where), gravity=(gx, gy),
                                 angle=reader.angle(value, 'angle', where, 0.0)))
     return tuple(specs)
+
+
+def _xy_pair(reader: _Reader, raw: Any, where: str, unit: str,
+             length: bool = False) -> tuple[float, float]:
+    """Return ``[x, y]`` at ``where`` as two finite numbers (lengths in m where ``length``)."""
+    if not isinstance(raw, list) or len(raw) != 2:
+        raise SceneError(f'{where}: expected [x, y] in {unit}, got {_brief(raw)}')
+    read = reader.length if length else reader.number
+    x, y = (read({f'[{i}]': v}, f'[{i}]', where, **({'positive': False} if length else {}))
+            for i, v in enumerate(raw))
+    return x, y
+
+
+def _masses(reader: _Reader, keys: _Keys, raw: Any) -> tuple[Mass, ...]:
+    """Read ``masses:``: body -> {mass (kg), com ([x, y], scene length), inertia (kg m^2)}."""
+    if raw is None:
+        return ()
+    if not isinstance(raw, dict):
+        raise SceneError(f'masses: expected a mapping of bodies to {{mass, com, inertia}}, got '
+                         f'{_kind(raw)}')
+    _check_count('masses', raw, MAX_MASSES, 'MAX_MASSES', 'bodies')
+    masses = []
+    for key, value in raw.items():
+        where = f'masses.{key}'
+        if not isinstance(value, dict):
+            raise SceneError(f'{where}: expected a mapping such as {{mass: 0.35, com: [75, 0], '
+                             f'inertia: 6.6e-4}}, got {_kind(value)} {_brief(value)}')
+        _check_keys(value, {'mass', 'com', 'inertia'}, where)
+        com = (_xy_pair(reader, value['com'], f'{where}.com', "the scene's length unit",
+                        length=True) if 'com' in value else (0.0, 0.0))
+        masses.append(keys.build(where, {'body': ''}, Mass, body=str(key),
+                                 mass=reader.number(value, 'mass', where), com=com,
+                                 inertia=reader.number(value, 'inertia', where, 0.0)))
+    return tuple(masses)
+
+
+def _loads(reader: _Reader, keys: _Keys, raw: Any) -> tuple[Load, ...]:
+    """Read ``loads:``: a list of {name, point, force ([fx, fy], N)} or {name, link, torque}."""
+    if raw is None:
+        return ()
+    if not isinstance(raw, list):
+        raise SceneError(f'loads: expected a list of loads ({{name, point, force}} or {{name, '
+                         f'link, torque}}), got {_kind(raw)}')
+    _check_count('loads', raw, MAX_LOADS, 'MAX_LOADS', 'loads')
+    loads = []
+    for index, value in enumerate(raw):
+        where = f'loads[{index}]'
+        if not isinstance(value, dict):
+            raise SceneError(f'{where}: expected {{name, point, force}} or {{name, link, '
+                             f'torque}}, got {_kind(value)} {_brief(value)}')
+        _check_keys(value, {'name', 'point', 'force', 'link', 'torque'}, where)
+        force = (_xy_pair(reader, value['force'], f'{where}.force', 'N')
+                 if 'force' in value else None)
+        loads.append(keys.build(
+            where, {}, Load, name=reader.name(value, 'name', where),
+            point=reader.name(value, 'point', where) if 'point' in value else None,
+            force=force,
+            link=reader.name(value, 'link', where) if 'link' in value else None,
+            torque=reader.number(value, 'torque', where) if 'torque' in value else None))
+    return tuple(loads)
 
 
 def scene_dirs() -> list[Path]:

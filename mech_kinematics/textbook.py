@@ -31,7 +31,18 @@ Each answer (:class:`TextbookAnswer`) has these keys in the file:
       (relative velocity), ``abs(alpha) * s`` (tangential acceleration of a
       slot point at ``s``), ``2 * abs(omega * ds/dt)`` (Coriolis).
 
-    FIELD is ``position``, ``velocity`` or ``acceleration``.
+    - ``{effort: NAME, factor: F, mode: abs | signed}``: ``F * efforts[NAME]``
+      (:class:`EffortValue`), a driver's effort scaled, e.g. ``-1`` for the
+      turning moment on a crankshaft (the effort holds the motion against it),
+      ``-1 / r`` for the tangential force on its crank pin;
+    - ``{reaction: NAME, field: force, component: x | y | norm, mode: abs |
+      signed}`` or ``{reaction: NAME, field: normal | moment, mode: ...}``:
+      a joint's reaction, ``reactions[NAME][field]``, one component of a
+      pin's force or its length (:class:`ReactionValue`).
+
+    FIELD is ``position``, ``velocity`` or ``acceleration`` (for a joint or
+    a point). The forces' accessors read a scene with masses, gravity or
+    loads (N, N m).
 ``printed``
     The printed value converted to SI (m, m/s, m/s^2, rad/s, rad/s^2), or in
     degrees where ``unit`` is ``deg`` (:meth:`TextbookAnswer.evaluate` then
@@ -76,8 +87,8 @@ import yaml
 
 from .units import degrees_from_radians
 
-__all__ = ['Accessor', 'JointValue', 'PointNorm', 'Product', 'TextbookAnswer', 'find_answer',
-           'load_answers', 'textbook_answers']
+__all__ = ['Accessor', 'EffortValue', 'JointValue', 'PointNorm', 'Product', 'ReactionValue',
+           'TextbookAnswer', 'find_answer', 'load_answers', 'textbook_answers']
 
 Field: TypeAlias = Literal['position', 'velocity', 'acceleration']
 #: The fields an accessor may read.
@@ -129,7 +140,43 @@ class Product:
         return value
 
 
-Accessor: TypeAlias = JointValue | PointNorm | Product
+@dataclass(frozen=True)
+class EffortValue:
+    """A driver's effort times ``factor``: ``factor * efforts[name]``, signed or its magnitude."""
+
+    name: str
+    factor: float
+    mode: Literal['abs', 'signed']
+
+    def value(self, state: Mapping[str, Any]) -> float:
+        """Return the value from ``state`` (a ``State.as_dict()``), SI."""
+        value = self.factor * float(state['efforts'][self.name])
+        return abs(value) if self.mode == 'abs' else value
+
+
+#: The components of a pin's force an answer may read.
+COMPONENTS = ('x', 'y', 'norm')
+
+
+@dataclass(frozen=True)
+class ReactionValue:
+    """A joint's reaction: ``reactions[name][field]``, a force's component or its length."""
+
+    name: str
+    field: Literal['force', 'normal', 'moment']
+    component: Literal['x', 'y', 'norm'] | None
+    mode: Literal['abs', 'signed']
+
+    def value(self, state: Mapping[str, Any]) -> float:
+        """Return the value from ``state`` (a ``State.as_dict()``), SI."""
+        raw = state['reactions'][self.name][self.field]
+        if self.component == 'norm':
+            return math.hypot(*raw)
+        value = float(raw[COMPONENTS.index(self.component)]) if self.component else float(raw)
+        return abs(value) if self.mode == 'abs' else value
+
+
+Accessor: TypeAlias = JointValue | PointNorm | Product | EffortValue | ReactionValue
 
 
 @dataclass(frozen=True)
@@ -214,8 +261,27 @@ class _Reader:
             if not terms:
                 where.fail('product', 'at least one [NAME, FIELD, POWER]', raw['product'])
             return Product(where.number(raw, 'factor'), tuple(terms))
-        self.fail('accessor', 'keys joint/field/mode, point/field or factor/product',
-                  sorted(raw))
+        if set(raw) == {'effort', 'factor', 'mode'}:
+            return EffortValue(where.text(raw, 'effort'), where.number(raw, 'factor'),
+                               where.mode(raw))
+        if set(raw) in ({'reaction', 'field', 'component', 'mode'}, {'reaction', 'field', 'mode'}):
+            field, component = raw['field'], raw.get('component')
+            if field == 'force' and component not in COMPONENTS:
+                where.fail('component', f'one of {", ".join(COMPONENTS)} for a force', component)
+            if field in ('normal', 'moment') and component is not None:
+                where.fail('component', f'none for a {field}', component)
+            if field not in ('force', 'normal', 'moment'):
+                where.fail('field', 'force, normal or moment', field)
+            return ReactionValue(where.text(raw, 'reaction'), field, component,
+                                 where.mode(raw))
+        self.fail('accessor', 'keys joint/field/mode, point/field, factor/product, '
+                  'effort/factor/mode or reaction/field/component/mode', sorted(raw))
+
+    def mode(self, raw: Mapping[str, Any]) -> Literal['abs', 'signed']:
+        value = raw.get('mode')
+        if value not in ('abs', 'signed'):
+            self.fail('mode', 'abs or signed', value)
+        return 'abs' if value == 'abs' else 'signed'
 
     def flag(self, raw: Mapping[str, Any], key: str) -> bool:
         value = raw.get(key, False)

@@ -139,6 +139,19 @@ points:
   T: {link: boom, origin: O, xaxis: Q, local: [5680, 550]}
 """
 
+# --- test scenes with forces (issue 32) -------------------------------------------
+# Used by geometry/test_turning.py, geometry/test_force_polygon.py and the check, plot
+# and diagram tests: the turning-moment diagram, the flywheel and the force polygon.
+#: Scenes with masses, gravity and loads written for the tests (not packaged), each
+#: with what is known of it in its description: ``test/data/forces/NAME.yaml``.
+FORCES = HERE / 'data' / 'forces'
+
+
+def forces_scene(name: str) -> Any:
+    """Return the test scene with forces ``test/data/forces/NAME.yaml``."""
+    return mk.load_scene(str(FORCES / f'{name}.yaml'))
+
+
 # --- what setup.py installs and which parameters the node declares ---------------
 # Used by test_launch.py and test_packaging.py.
 #: Parameters every rclpy node declares itself.

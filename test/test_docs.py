@@ -72,6 +72,16 @@ dyads:
 """
 #: The packaged excavator (two cylinders), whose actuators the table names wrongly twice.
 EXCAVATOR = (ROOT / 'config' / 'scenes' / 'excavator.yaml').read_text()
+#: The four-bar with gravity, masses and loads (the reference's forces example).
+LOADED = BASE + """\
+gravity: [0, -9.81]
+masses:
+  coupler: {mass: 0.5, com: [75, 10], inertia: 6.0e-4}
+  rocker: {mass: 0.3, com: [40, 0]}
+loads:
+  - {name: brake, link: rocker, torque: -2.0}
+  - {name: push, point: C, force: [10, -5]}
+"""
 #: Each mistake of the reference's error table, as the scene text that makes it.
 MISTAKES = {
     'no_units': BASE.replace('units: {length: mm, angle: deg}\n', ''),
@@ -101,6 +111,17 @@ MISTAKES = {
                                         'actuator: boom_cyl\n    length: 3.0'),
     'actuator_two_links': EXCAVATOR.replace('{name: stick_cyl_body, from: S, actuator: stick_cyl}',
                                             '{name: stick_cyl_body, from: S, actuator: boom_cyl}'),
+    'negative_mass': LOADED.replace('mass: 0.5', 'mass: -0.5'),
+    'mass_of_no_body': LOADED.replace('rocker: {mass', 'rockr: {mass'),
+    'mass_on_ground': LOADED.replace('rocker: {mass: 0.3, com: [40, 0]}', 'ground: {mass: 0.3}'),
+    'load_at_no_point': LOADED.replace('point: C, force', 'point: Q, force'),
+    'load_on_ground': LOADED.replace('point: C, force', 'point: D, force'),
+    'force_and_torque': LOADED.replace('force: [10, -5]}', 'force: [10, -5], link: rocker, '
+                                                           'torque: 1}'),
+    'gravity_shape': LOADED.replace('gravity: [0, -9.81]', 'gravity: [0, -9.81, 0]'),
+    'imu_gravity': LOADED + 'imus:\n  tip: {link: coupler, point: C, gravity: [0, -9.80665]}\n',
+    'free_block': (ROOT / 'config' / 'scenes' / 'geneva.yaml').read_text()
+    + 'masses:\n  pin_slot: {mass: 0.1, com: [5, 0]}\n',
 }
 
 
@@ -300,3 +321,56 @@ def test_readme_python_example_prints_what_its_comments_say():
             assert abs(value - float(text)) <= 0.5 * 10.0 ** -digits, line
         checked += 1
     assert checked >= 2
+
+
+def _run_commented(block: str, namespace: dict) -> int:
+    """Run a Python block; each expression whose comment starts with a number must give it.
+
+    The numbers are compared to the digits written (as README's example is);
+    statements may span lines. Returns how many values were checked.
+    """
+    import ast
+    import numpy as np
+
+    lines = block.splitlines()
+    number = r'-?\d+(?:\.\d+)?(?:e-?\d+)?'
+    checked = 0
+    for node in ast.parse(block).body:
+        code = ast.get_source_segment(block, node)
+        comment = lines[node.end_lineno - 1].partition('#')[2]
+        values = re.match(rf'\s*({number})(?=\s|$|:)', comment)
+        if values is None or not isinstance(node, ast.Expr):
+            exec(code, namespace)  # noqa: S102 - the docs' own example
+            continue
+        got = float(np.ravel(eval(code, namespace))[0])  # noqa: S307
+        text = values.group(1)
+        digits = len(text.split('.')[1]) if '.' in text else 0
+        assert abs(got - float(text)) <= 0.5 * 10.0 ** -digits, (code, got, text)
+        checked += 1
+    return checked
+
+
+def test_the_apis_forces_examples_give_what_their_comments_say():
+    """docs/api.md's forces examples run, and every value their comments give is returned."""
+    text = (ROOT / 'docs' / 'api.md').read_text(encoding='utf-8')
+    section = text.split('## Forces: efforts, reactions, shaking', 1)[1].split('\n## ', 1)[0]
+    namespace: dict = {'mk': mk, 'np': __import__('numpy')}
+    checked = sum(_run_commented(block, namespace) for block in blocks(section, 'python'))
+    assert checked >= 5
+    assert namespace['cycle'].forces.efforts['crank'].shape == (360,)
+
+
+def test_the_forces_excerpt_is_what_solve_prints(tmp_path):
+    """The reference's forces example prints the quoted efforts, reaction and shaking."""
+    text = DOC.read_text()
+    scene = next(b for b in blocks(text, 'yaml') if b.startswith('name: four_bar_loaded'))
+    path = tmp_path / 'four_bar_loaded.yaml'
+    path.write_text(scene)
+    status, out = run('solve', path)
+    assert status == 0
+    data = json.loads(out)
+    excerpt = json.loads(next(b for b in blocks(text, 'json') if '"efforts"' in b))
+    assert excerpt['efforts'] == data['efforts']
+    assert excerpt['shaking'] == data['shaking']
+    for name, reaction in excerpt['reactions'].items():
+        assert reaction == data['reactions'][name]

@@ -5,8 +5,10 @@
 The entries are package data, ``mech_kinematics/data/textbook_answers.yaml``,
 read through :mod:`mech_kinematics.textbook`, with their source, their
 tolerance (0.5 % for numbers the text computes, 5 % for values measured on a
-drawing, 10 % for squares and products of measured values) and, for known-bad
-printed numbers, the exact value beside them. The loader's own checks follow.
+drawing, 10 % for squares and products of measured values; for the forces, what
+the book's approximate piston acceleration deserves) and, for known-bad printed
+numbers and the forces' answers, the exact value beside them. The loader's own
+checks follow.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ import subprocess
 import sys
 from typing import Any
 
+import mpmath
 import pytest
 
 import mech_kinematics as mk
@@ -24,8 +27,8 @@ from mech_kinematics.textbook import TextbookAnswer
 
 #: Agreement of the solver with an entry's stored exact (50-digit) value.
 RTOL_EXACT = 1e-12
-#: How many answers the seeds print (every one is kept).
-N_ANSWERS = 60
+#: How many answers the seeds print (every one is kept), and the forces' four (issue 32).
+N_ANSWERS = 64
 
 ANSWERS = textbook.textbook_answers()
 
@@ -68,21 +71,69 @@ def test_every_seed_scene_has_answers() -> None:
     covered = {entry.scene for entry in ANSWERS}
     assert covered >= {'khurmi_four_bar_ad150', 'slider_crank_150_600', 'steam_engine_500_2000',
                        'quick_return', 'geneva', 'rocking_lever', 'piston_300',
-                       'four_bar_coupler_points'}
+                       'four_bar_coupler_points', 'khurmi_engine_15_7',
+                       'singh_petrol_engine_13_15'}
 
 
 def test_every_printed_answer_is_kept_with_its_source() -> None:
-    """All 60 printed answers load, each citing its seed and, where known, its book."""
+    """All 64 printed answers load, each citing its seed and, where known, its book."""
     assert len(ANSWERS) == N_ANSWERS
     assert len({(e.scene, e.quantity) for e in ANSWERS}) == N_ANSWERS
     for entry in ANSWERS:
         assert entry.source.startswith(('seed 00', 'not in the seed text')), entry.source
-    books = ('Khurmi & Gupta', 'Beer & Johnston', 'Dunn', 'Rattan')
+    books = ('Khurmi & Gupta', 'Beer & Johnston', 'Dunn', 'Rattan', 'V. P. Singh')
     assert all(any(book in e.source for book in books) for e in ANSWERS)
     example = textbook.find_answer('quick_return', "alpha_lever = a^t_B'O / B'O = 6.4 / 0.52")
     assert 'Example 8.10' in example.source and example.printed == 12.3
     assert example.rel_tol == 0.10 and example.kind == 'derived from measured'
     assert 'Khurmi prints' in (example.note or '')
+
+
+#: The engines of the forces' answers (issue 32): crank and rod (m), the crank's angle from
+#: the dead centre toward the piston (deg), rpm, reciprocating mass (kg), gas load toward the
+#: crank (N, as pressure x area), gravity along the stroke away from the crank (m/s^2).
+ENGINES = {
+    'khurmi_engine_15_7': ('0.3', '1.2', 60, 250, '250', ('0.35e6', '0.5'), '0'),
+    'singh_petrol_engine_13_15': ('0.1', '0.35', 30, 1800, '1.6', ('750e3', '0.15'), '-9.81'),
+}
+
+
+def _engine(r, rod, theta, rpm, mass, gas, g):
+    """Return a slider-crank's statics at 50 digits, the rod and crank massless.
+
+    (rod thrust, push along the stroke, turning moment on the crank, the crank pin's
+    tangential force), from the piston's exact acceleration (its position
+    differentiated twice) and the rod's line; none of the package's formulas.
+    """
+    with mpmath.workdps(50):
+        r, rod, mass, g = (mpmath.mpf(v) for v in (r, rod, mass, g))
+        load = mpmath.mpf(gas[0]) * mpmath.pi / 4 * mpmath.mpf(gas[1]) ** 2
+        angle, omega = mpmath.radians(theta), 2 * mpmath.pi * rpm / 60
+
+        def stroke(t):
+            return r * mpmath.cos(t) + mpmath.sqrt(rod ** 2 - (r * mpmath.sin(t)) ** 2)
+
+        accel = mpmath.diff(stroke, angle, 2) * omega ** 2
+        push = mass * accel + load - mass * g          # on the piston from the rod
+        pin = mpmath.mpc(r * mpmath.cos(angle), r * mpmath.sin(angle))
+        along = (stroke(angle) - pin) / abs(stroke(angle) - pin)
+        thrust = push / along.real
+        on_crank = -thrust * along
+        moment = pin.real * on_crank.imag - pin.imag * on_crank.real
+        return {'thrust': abs(thrust), 'push': push, 'moment': moment, 'tangential': moment / r}
+
+
+#: Each force answer's quantity (its first word) -> the closed form's value.
+CLOSED_FORM = {'F_Q,': 'thrust', 'F_T,': 'tangential', 'T,': 'moment', 'F_P,': 'push'}
+
+
+@pytest.mark.parametrize('entry', [e for e in ANSWERS if e.scene in ENGINES], ids=_id)
+def test_a_force_answers_exact_value_is_the_closed_form(entry: TextbookAnswer) -> None:
+    """The forces' stored exact values are a slider-crank's statics solved at 50 digits."""
+    want = _engine(*ENGINES[entry.scene])[CLOSED_FORM[entry.quantity.split(' ')[0]]]
+    assert entry.exact is not None
+    assert abs(entry.exact - want) <= 1e-15 * abs(want)
+    assert abs(entry.printed - float(want)) <= entry.rel_tol * abs(float(want))
 
 
 def test_degrees_answer_converts_the_radians() -> None:
@@ -153,6 +204,36 @@ def test_load_answers_refuses_a_bad_file(tmp_path, old, new, match) -> None:
     with pytest.raises(ValueError, match=match) as info:
         textbook.load_answers(path)
     assert str(info.value).startswith(str(path))
+
+
+@pytest.mark.parametrize(('accessor', 'match'), [
+    pytest.param('{effort: crank, factor: 1, mode: twice}', r'accessor\.mode: expected abs or',
+                 id='effort-mode'),
+    pytest.param('{reaction: C, field: force, component: z, mode: abs}',
+                 r'accessor\.component: expected one of x, y, norm', id='component'),
+    pytest.param('{reaction: C, field: moment, component: x, mode: abs}',
+                 r'accessor\.component: expected none for a moment', id='moment-component'),
+    pytest.param('{reaction: C, field: torque, mode: abs}', r'accessor\.field: expected force',
+                 id='field'),
+])
+def test_a_bad_force_accessor_is_named(tmp_path, accessor, match) -> None:
+    """An effort or reaction accessor with a bad mode, component or field is one line."""
+    path = tmp_path / 'answers.yaml'
+    path.write_text(_GOOD.replace('{joint: wheel, field: velocity, mode: signed}', accessor))
+    with pytest.raises(ValueError, match=match):
+        textbook.load_answers(path)
+
+
+def test_force_accessors_read_state_dicts() -> None:
+    """An effort is scaled and signed; a reaction's component, length or scalar field is read."""
+    state = {'efforts': {'crank': -2.0},
+             'reactions': {'C': {'force': [3.0, -4.0]}, 'ram': {'normal': -7.0, 'moment': 1.5}}}
+    assert textbook.EffortValue('crank', -0.5, 'signed').value(state) == 1.0
+    assert textbook.EffortValue('crank', 1.0, 'abs').value(state) == 2.0
+    assert textbook.ReactionValue('C', 'force', 'norm', 'abs').value(state) == 5.0
+    assert textbook.ReactionValue('C', 'force', 'y', 'signed').value(state) == -4.0
+    assert textbook.ReactionValue('C', 'force', 'y', 'abs').value(state) == 4.0
+    assert textbook.ReactionValue('ram', 'normal', None, 'signed').value(state) == -7.0
 
 
 def test_loader_is_pure() -> None:

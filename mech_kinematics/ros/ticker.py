@@ -23,6 +23,7 @@ the extreme suite over a cycle). Where the scene does not compile,
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import replace
 import math
 
 from .. import solver as lk
@@ -82,6 +83,11 @@ def general_tick(scene: lk.Scene, joints: Sequence[str] | None,
     joints = tuple(scene.output_joints if joints is None else joints)
     points = tuple(scene.output_points if points is None else points)
     frames = tuple(frames)
+    if scene.dynamics is not None:
+        # The tick reports the motion, as the compiled tick does: solved alone, an instant is
+        # never refused for forces it does not report (the node's forces are issue 32's).
+        scene = replace(scene, gravity=None, masses=(), loads=(),
+                        outputs_joints=scene.output_joints, outputs_points=scene.output_points)
 
     def general(theta: float, omega: float, alpha: float, tol: float,
                 turns: int = 0) -> tuple[list[float], float]:

@@ -9,7 +9,7 @@ assemble in the scene's own units.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 import math
 from typing import Any, cast
@@ -21,6 +21,7 @@ from .actuator import Actuator
 from .base import Intermittent, Item
 from .carried import CarriedPoint
 from .crank import Crank
+from .forces import Dynamics, Load, Mass
 from .graph import Graph
 from .model import _check_name, SceneUnits
 from .plan import _compile, _Plan
@@ -224,8 +225,13 @@ class Scene:
     units: SceneUnits = SceneUnits()
     imus: tuple[ImuSpec, ...] = ()
     inputs: tuple[Crank | Actuator, ...] = ()
+    gravity: tuple[float, float] | None = None
+    masses: tuple[Mass, ...] = ()
+    loads: tuple[Load, ...] = ()
     _plan: _Plan = field(init=False, repr=False, compare=False)
     _solver: _Solver = field(init=False, repr=False, compare=False)
+    #: The scene's inverse dynamics (:mod:`.forces`), ``None`` without masses, gravity, loads.
+    dynamics: Dynamics | None = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         """Validate the fields."""
@@ -278,6 +284,16 @@ class Scene:
         object.__setattr__(self, '_plan', full)  # the graph, for the IMUs' links
         joints, points = imu_outputs(self, full.joint_types, self.outputs_joints,
                                      self.outputs_points)
+        dynamics = self._dynamics_of(full)
+        object.__setattr__(self, 'dynamics', dynamics)
+        if dynamics is not None:  # what the forces read is computed and reported too
+            needed_joints, needed_points = dynamics.needs()
+            if joints is not None:
+                joints = (*joints, *(n for n in full.joint_types
+                                     if n in needed_joints and n not in joints))
+            if points is not None:
+                points = (*points, *(n for n in full.output_points
+                                     if n in needed_points and n not in points))
         if joints is None and points is None:
             plan = full
         else:
@@ -285,6 +301,35 @@ class Scene:
             solver = _Solver(self, plan)
         object.__setattr__(self, '_plan', plan)
         object.__setattr__(self, '_solver', solver)
+
+    def _dynamics_of(self, full: _Plan) -> Dynamics | None:
+        """Return the scene's inverse dynamics, or None where it has no masses, gravity, loads."""
+        object.__setattr__(self, 'masses', tuple(self.masses))
+        object.__setattr__(self, 'loads', tuple(self.loads))
+        if self.gravity is None and not self.masses and not self.loads:
+            return None
+        for items, kind in ((self.masses, Mass), (self.loads, Load)):
+            for item in items:
+                if not isinstance(item, kind):
+                    what = 'masses' if kind is Mass else 'loads'
+                    msg = f'Expected {what} as {kind.__name__} values, got {item!r}'
+                    raise SceneError(msg, (self, what))
+        gravity = (0.0, 0.0) if self.gravity is None else self.gravity
+        if isinstance(gravity, (str, bytes)) or not isinstance(gravity, Sequence) \
+                or len(gravity) != 2 or not all(isinstance(g, (int, float)) and not
+                                                isinstance(g, bool) and math.isfinite(g)
+                                                for g in gravity):
+            msg = f'Expected gravity as [gx, gy] in m/s^2, finite, got {self.gravity!r}'
+            raise SceneError(msg, (self, 'gravity'))
+        g = (float(gravity[0]), float(gravity[1]))
+        object.__setattr__(self, 'gravity', g)
+        for imu in self.imus:   # an IMU's own gravity, where given, must be the scene's
+            if tuple(imu.gravity) not in ((0.0, 0.0), g):
+                msg = (f'Expected the gravity of IMU "{imu.name}" to be the scene\'s '
+                       f'{list(g)} m/s^2 (both given must agree), got {list(imu.gravity)}')
+                raise SceneError(msg, (imu, 'gravity'))
+        return Dynamics(full.graph, self.masses, self.loads, g,
+                        (*self.ground, *full.output_points), _size(self))
 
     @property
     def drivers(self) -> tuple[Crank | Actuator, ...]:

@@ -16,6 +16,7 @@ refusals; where the scene does not compile, the solver keeps the reason
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
+from dataclasses import replace
 import math
 from typing import Any, TYPE_CHECKING
 import warnings
@@ -330,6 +331,38 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
         trusted (a bound above the tolerance, a dyad within rounding of an
         assembly limit, a value beyond the range of doubles).
     """
+    state = _kinematics(scene, angle, speed, accel, turns=turns, max_error=max_error)
+    if scene.dynamics is None:
+        return state
+    return _with_forces(scene, state, max_error)
+
+
+def _with_forces(scene: Scene, state: State, max_error: Any) -> State:
+    """Return ``state`` with its forces (:mod:`.forces`); refuse an instant they cannot bound."""
+    forces = scene.dynamics.forces(state, float(max_error))  # type: ignore[union-attr]
+    if isinstance(state.valid, np.ndarray):
+        failures = dict(state.failures)
+        failures.update(forces.failures)
+        valid = state.valid & np.asarray(forces.valid, dtype=bool)
+        return replace(state, forces=forces, valid=valid, failures=failures)
+    if not forces.valid:
+        if forces.worst is None:   # the statics degenerate: no bound at all
+            reason = next(iter(forces.failures), 'forces')
+            raise UntrustedError('forces', float(state.angle),
+                                 f'the forces cannot be bounded here ({reason})', 'forces',
+                                 math.inf, float(max_error))
+        name, bound, limit = forces.worst
+        raise UntrustedError('forces', float(state.angle),
+                             f'the error bound of {name} ({bound:.3g}) exceeds max_error '
+                             f'{float(max_error):g} of its scale ({limit / float(max_error):.6g})',
+                             name, bound, float(max_error))
+    return replace(state, forces=forces)
+
+
+def _kinematics(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None,
+                accel: npt.ArrayLike | None = None, *, turns: npt.ArrayLike = 0,
+                max_error: float = MAX_ERROR) -> State:
+    """Return the kinematic state of :func:`solve` (its arguments, its refusals)."""
     theta: Any
     omega: Any
     alpha: Any

@@ -8,7 +8,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field
 from functools import cached_property
 import math
-from typing import Any
+from typing import Any, TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
@@ -17,6 +17,9 @@ from .model import Number, Vector
 from .scaling import _LINEAR
 from ..bounds import ErrorBound
 from ..imu import imu_reading, ImuReading, ImuSpec
+
+if TYPE_CHECKING:
+    from .forces import Forces
 
 
 class JointMotion:
@@ -165,6 +168,10 @@ class State:
         its derivative.
     imu_specs : tuple of ImuSpec
         The scene's inertial sensors, whose readings :attr:`imus` gives.
+    forces : Forces or None
+        For a scene with masses, gravity or loads: every driver's effort,
+        every joint's reaction and the shaking of the frame, bounded
+        (:mod:`.forces`); ``None`` for a scene with none of them.
     """
 
     scene: str
@@ -183,6 +190,7 @@ class State:
     jumps: dict[str, Any] = field(default_factory=dict)
     drivers: dict[str, JointMotion] = field(default_factory=dict)
     imu_specs: tuple[ImuSpec, ...] = ()
+    forces: Forces | None = None
 
     @cached_property
     def imus(self) -> dict[str, ImuReading]:
@@ -282,10 +290,13 @@ class State:
                if self.jumps else {}),
             **({'imus': {name: r.as_dict(vector) for name, r in self.imus.items()}}
                if self.imu_specs else {}),
+            **(self.forces.as_dict(vector) if self.forces is not None else {}),
             'error_bound': {**self.error_bound.as_dict(vector),
                             **({'imus': {name: r.bounds_dict(vector)
                                          for name, r in self.imus.items()}}
-                               if self.imu_specs else {})},
+                               if self.imu_specs else {}),
+                            **(self.forces.bound_dict(vector)
+                               if self.forces is not None else {})},
         }
 
 

@@ -11,6 +11,13 @@ several drivers (or an actuator) gets its assembly region instead
 grid over two drivers that assembles, each driver's ranges with the others
 at their start positions, stroke limits, and on request a map of the grid
 (``--map`` as text, ``--png FILE`` as a picture).
+
+A scene with forces (``masses``, ``gravity`` or ``loads``) gets its
+turning-moment diagram too (:mod:`mech_kinematics.geometry.turning`): each
+driver's mean effort and extremes over a turn of the (first) crank, the
+fluctuation of energy, and with ``--flywheel CS`` the flywheel's moment of
+inertia for that coefficient of fluctuation of speed; each figure with its
+error. A scene without forces prints nothing more.
 """
 
 from __future__ import annotations
@@ -18,6 +25,7 @@ from __future__ import annotations
 import argparse
 from collections.abc import Sequence
 import json
+import math
 import sys
 from typing import Any
 
@@ -28,8 +36,9 @@ from ..errors import SceneError
 from ..geometry.region import GRID
 from ..solver.graph import JointType
 
-__all__ = ['add_parser', 'grid_size', 'main', 'map_text', 'region_json', 'region_text',
-           'report_json', 'report_text', 'write_region_png']
+__all__ = ['add_parser', 'coefficient', 'grid_size', 'main', 'map_text', 'region_json',
+           'region_text', 'report_json', 'report_text', 'turning_json', 'turning_text',
+           'write_region_png']
 
 #: The text map's largest size, characters.
 MAP_COLUMNS = 72
@@ -46,6 +55,19 @@ def grid_size(text: str) -> int:
         value = 0
     if not 2 <= value <= GRID_MOST:
         msg = f'expected a whole number of grid points from 2 to {GRID_MOST}, got {text!r}'
+        raise argparse.ArgumentTypeError(msg)
+    return value
+
+
+def coefficient(text: str) -> float:
+    """Parse a coefficient of fluctuation of speed (above 0, below 2), or tell argparse why not."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not 0.0 < value < 2.0:
+        msg = (f'expected a coefficient of fluctuation of speed (w_max - w_min) / w_mean above 0 '
+               f'and below 2 (e.g. 0.02), got {text!r}')
         raise argparse.ArgumentTypeError(msg)
     return value
 
@@ -85,6 +107,16 @@ A scene with several drivers (inputs:) or a linear actuator gets instead:
     up to a length no closing position can exceed);
   - with --map, the grid drawn in text (# assembles, . does not, + partly);
     with --png FILE, as a picture.
+
+A scene with forces (masses, gravity or loads) also gets its turning-moment
+diagram: the (first) crank turns once at its speed with no acceleration (any
+other driver held at its start), and check prints each driver's mean effort
+and its largest and least values and where, the fluctuation of energy (the
+largest swing of the energy given beyond the mean, J) and where the energy is
+least and most; with --flywheel CS the moment of inertia of a flywheel for the
+coefficient of fluctuation of speed CS = (w_max - w_min) / w_mean, I = dE /
+(w_mean^2 CS) (one crank only). Each figure with its error; efforts in N m (a
+crank) or N (an actuator), SI in --json too.
 """
 
 
@@ -393,14 +425,136 @@ def write_region_png(region: Any, path: str) -> None:
     figure.savefig(path, dpi=100)
 
 
+def _e(value: float) -> str:
+    """Return an error estimate to 2 significant digits."""
+    return f'{value:.2g}'
+
+
+def turning_text(study: Any, scene: Any, flywheel: Any = None) -> list[str]:
+    """Return the turning-moment lines of ``check`` (angles in the scene's unit, SI otherwise).
+
+    ``study`` is a :class:`~mech_kinematics.geometry.turning.TurningMoment`,
+    ``flywheel`` one of its :class:`~mech_kinematics.geometry.turning.Flywheel`.
+    """
+    from ..geometry.assembly import angle_text
+    from ..units import rpm_from_rad_per_s
+
+    units = scene.units
+
+    def angle(theta: float) -> str:
+        return f'{angle_text(units, theta)} {units.angle}'
+
+    kinds = {d.name: d for d in scene.drivers}
+    how = '' if study.accel == 0.0 else f', accelerating at {study.accel:.6g} rad/s^2'
+    held = ''.join(f', {name} held at {kinds[name].position_text(x, units)}'
+                   for name, x in study.held.items())
+    lines = [f'turning moment (crank "{study.crank}" turning at '
+             f'{rpm_from_rad_per_s(study.speed):.6g} rpm{how}{held}; efforts in N m for a '
+             f'crank, N for an actuator, each +- its error):']
+    for name, effort in study.drivers.items():
+        top, low = effort.maximum, effort.minimum
+        lines.append(f'  {name}: mean {effort.mean:.6g} {effort.unit} '
+                     f'(+-{_e(effort.mean_error)}), largest {top.value:.6g} at '
+                     f'{angle(top.angle)} (+-{_e(top.bound)}), least '
+                     f'{low.value:.6g} at {angle(low.angle)} (+-{_e(low.bound)})')
+    if study.energy_max is None:
+        where = 'the effort stays at its mean'
+    else:
+        count = len(study.crossings)
+        where = (f'energy least at crank {angle(study.energy_min)}, most at '
+                 f'{angle(study.energy_max)} ({count} crossing{"s" if count != 1 else ""} of '
+                 f'the mean)')
+    lines.append(f'fluctuation of energy ({study.crank}): {study.fluctuation:.6g} J '
+                 f'(+-{_e(study.fluctuation_error)}); {where}')
+    if flywheel is not None:
+        lines.append(f'flywheel for Cs = {flywheel.cs:.6g} (Cs = (w_max - w_min) / w_mean, '
+                     f'w_mean = {flywheel.speed:.6g} rad/s): I = dE / (w_mean^2 Cs) = '
+                     f'{flywheel.inertia:.6g} kg m^2 (+-{_e(flywheel.error)})')
+    return lines
+
+
+def turning_json(study: Any, flywheel: Any = None) -> dict[str, Any]:
+    """Return the ``"turning_moment"`` object of ``check --json``: SI (rad, N m, N, J)."""
+    def extreme(x: Any) -> dict[str, float]:
+        return {'value': x.value, 'angle': x.angle, 'bound': x.bound}
+
+    data: dict[str, Any] = {
+        'crank': study.crank, 'speed': study.speed, 'accel': study.accel,
+        'held': dict(study.held),
+        'efforts': {name: {'unit': e.unit, 'mean': e.mean, 'mean_error': e.mean_error,
+                           'max': extreme(e.maximum), 'min': extreme(e.minimum)}
+                    for name, e in study.drivers.items()},
+        'power': study.power,
+        'crossings': list(study.crossings),
+        'loops': [{'start': x.start, 'end': x.end, 'area': x.area, 'error': x.error}
+                  for x in study.loops],
+        'fluctuation': study.fluctuation, 'fluctuation_error': study.fluctuation_error,
+        'energy_max_angle': study.energy_max, 'energy_min_angle': study.energy_min,
+        'panels': study.panels,
+    }
+    if flywheel is not None:
+        data['flywheel'] = {'cs': flywheel.cs, 'speed': flywheel.speed,
+                            'inertia': flywheel.inertia, 'error': flywheel.error}
+    return data
+
+
+def _turning(scene: Any, cs: float | None) -> tuple[Any, Any, str]:
+    """Return the scene's turning-moment study, its flywheel for ``cs``, or why there is none.
+
+    ``(None, None, '')`` for a scene without forces. Asked for a flywheel
+    (``cs``), a scene that cannot give one is refused in one line.
+    """
+    from ..geometry.turning import turning_moment_from_scene
+
+    if scene.dynamics is None:
+        if cs is not None:
+            msg = (f'Expected a scene with masses, gravity or loads for --flywheel, got '
+                   f'{scene.name} without')
+            raise SceneError(msg)
+        return None, None, ''
+    if cs is not None and not scene.single_crank:
+        msg = (f'Expected a scene driven by one crank for --flywheel, got {scene.name}, driven '
+               f'by {", ".join(d.name for d in scene.drivers)}')
+        raise SceneError(msg)
+    try:
+        study = turning_moment_from_scene(scene)
+    except SceneError as error:
+        if cs is not None:
+            raise
+        return None, None, str(error)
+    if cs is None:
+        return study, None, ''
+    try:
+        return study, study.flywheel(cs), ''
+    except ValueError as error:
+        raise SceneError(str(error)) from None
+
+
+def _print_report(args: argparse.Namespace, scene: Any, data: dict[str, Any], text: str
+                  ) -> None:
+    """Print the report (text or JSON) with the scene's turning moment, if it has forces."""
+    study, flywheel, refused = _turning(scene, args.flywheel)
+    if args.json:
+        if study is not None:
+            data['turning_moment'] = turning_json(study, flywheel)
+        elif refused:
+            data['turning_moment'] = {'refused': refused}
+        print(json.dumps(data, indent=1, allow_nan=False))
+        return
+    lines = [text]
+    if study is not None:
+        lines.extend(turning_text(study, scene, flywheel))
+    elif refused:
+        lines.append(f'turning moment: none ({refused})')
+    print('\n'.join(lines))
+
+
 def _handle_region(args: argparse.Namespace, scene: Any) -> int:
     from ..geometry.region import region_from_scene
     pair = None if args.pair is None else [p.strip() for p in args.pair.split(',')]
     region = region_from_scene(scene, args.grid, pair)
-    if args.json:
-        print(json.dumps(region_json(region, scene, args.map), indent=1, allow_nan=False))
-    else:
-        print(region_text(region, scene, args.map))
+    _print_report(args, scene, region_json(region, scene, args.map) if args.json else {},
+                  '' if args.json else region_text(region, scene, args.map))
     if args.png is not None:
         write_region_png(region, args.png)
     return 0
@@ -420,10 +574,8 @@ def _handle(args: argparse.Namespace) -> int:
                f'got {scene.name}, driven by one crank: drop {", ".join(given)}')
         raise SceneError(msg)
     assembly = assembly_from_scene(scene)
-    if args.json:
-        print(json.dumps(report_json(assembly, scene), indent=1, allow_nan=False))
-    else:
-        print(report_text(assembly, scene))
+    _print_report(args, scene, report_json(assembly, scene) if args.json else {},
+                  '' if args.json else report_text(assembly, scene))
     return 0
 
 
@@ -446,6 +598,10 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
                         help='several drivers: draw the grid in text (also in --json)')
     parser.add_argument('--png', metavar='FILE',
                         help='several drivers: write the grid as a PNG picture')
+    parser.add_argument('--flywheel', type=coefficient, metavar='CS',
+                        help='a scene with forces and one crank: the moment of inertia of a '
+                             'flywheel for the coefficient of fluctuation of speed CS = (w_max - '
+                             'w_min) / w_mean, e.g. 0.02')
     parser.set_defaults(handler=_handle)
     return parser
 

@@ -6,7 +6,10 @@
 import matplotlib inside their functions and draw on an Agg canvas, so this
 module imports with NumPy alone. Diagrams are drawn to a true scale at the
 figure's nominal size (``1 cm = 0.1 m/s``), as in a textbook.
-``python -m mech_kinematics diagram`` is :func:`main`.
+``python -m mech_kinematics diagram`` is :func:`main`; with ``--force-polygon
+BODY`` it draws the force polygon of one body of a scene with forces instead
+(:func:`figure_from_force_polygon`, from
+:mod:`mech_kinematics.geometry.force_polygon`).
 """
 
 from __future__ import annotations
@@ -33,10 +36,11 @@ from ..geometry.diagrams import (arrows_from_state, colours_from_scene, Diagram,
 from ..geometry.instant_centres import (bodies_from_scene, BodyKind, full_scene,
                                         instant_centres_from_state)
 from ..solver import Scene, solve
-from ..units import rad_per_s_from_rpm, rpm_from_rad_per_s, turns_from_degrees
+from ..units import (rad_per_s_from_rpm, radians_from_degrees, rpm_from_rad_per_s,
+                     turns_from_degrees)
 
-__all__ = ['add_parser', 'figure_from_diagram', 'main', 'title_from_diagram', 'write_animation',
-           'write_diagram']
+__all__ = ['add_parser', 'figure_from_diagram', 'figure_from_force_polygon', 'main',
+           'title_from_diagram', 'write_animation', 'write_diagram']
 
 Array = npt.NDArray[np.float64]
 
@@ -759,6 +763,145 @@ def write_animation(scene: Scene, path: str | Path, *, frames: int = 72, fps: in
     return len(states)
 
 
+# --- the force polygon of one body -----------------------------------------
+
+#: Colours of the forces on a body, by what they are.
+FORCE_COLOURS = {'joint': '#1f4e9c', 'effort': '#1f4e9c', 'weight': '#2a7a2a',
+                 'inertia': '#c0392b', 'load': '#8e44ad'}
+#: The longest force arrow of the free body, as a fraction of the mechanism's size.
+FREE_BODY_REACH = 0.4
+
+
+def _free_body_panel(ax: Any, scene: Scene, diagram: Diagram, polygon: Any,
+                     colours: Mapping[str, str]) -> float:
+    """Draw the mechanism with the forces on the body at their points; return the scale."""
+    space = diagram.space
+    lo, hi = space.extent()
+    size = float(np.hypot(*(hi - lo))) or 1.0
+    largest = max((f.magnitude for f in polygon.forces), default=0.0)
+    k = FREE_BODY_REACH * size / largest if largest > 0.0 else 0.0     # m per N
+    arrows = [(np.asarray(f.xy, dtype=np.float64),
+               np.asarray(f.xy, dtype=np.float64) + k * np.asarray(f.force, dtype=np.float64), f)
+              for f in polygon.forces]
+    for tail, head, _ in arrows:
+        lo, hi = np.minimum(lo, np.minimum(tail, head)), np.maximum(hi, np.maximum(tail, head))
+    scale = _fit_scale(lo, hi)
+    scale = _fit_scale(lo - [0, 0.7 * scale], hi)
+    origin = _frame(ax, lo - [0, 0.7 * scale], hi, scale)
+    if k > 0.0:     # a round number of N per cm, the arrows no longer than framed
+        per_cm = nice_scale(scale / k)
+        k = scale / per_cm
+        arrows = [(tail, tail + k * np.asarray(f.force, dtype=np.float64), f)
+                  for tail, _, f in arrows]
+    _draw_mechanism(ax, scene, space, colours, scale)
+    segments = [(tail, head) for tail, head, _ in arrows]
+    segments += [(link.outline[i], link.outline[(i + 1) % len(link.outline)])
+                 for link in space.links
+                 for i in range(len(link.outline) - (len(link.outline) == 2))]
+    placer = _Placer(ax, origin, scale, (PANEL_W, PANEL_H), segments,
+                     list(space.points.values()))
+    for name, xy in space.points.items():
+        placer.place(name, xy, None, size=FONT, fontweight='bold')
+    for tail, head, force in arrows:
+        colour = FORCE_COLOURS[force.kind.value]
+        _arrow(ax, tail, head, colour, '-', 1.6, scale, zorder=7)
+        if force.magnitude > 0.0:
+            placer.place(force.label, head, head - tail, size=FONT + 0.5, color=colour)
+    _scale_bar(ax, origin, scale, 'm')
+    if k > 0.0:
+        ax.text(origin[0] + 0.5 * scale, origin[1] + 1.0 * scale,
+                f'forces: {scale_text(per_cm, "N")}', fontsize=FONT, va='center', ha='left')
+    ax.set_title(f'Free body: {polygon.body}', fontsize=FONT + 2)
+    return scale
+
+
+def _force_polygon_panel(ax: Any, polygon: Any) -> float:
+    """Draw the forces head to tail, to scale; return the scale (N per cm)."""
+    xy = polygon.vertices
+    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    scale = _fit_scale(lo, hi)
+    origin = _frame(ax, lo, hi, scale)
+    segments = list(zip(xy[:-1], xy[1:], strict=True))
+    placer = _Placer(ax, origin, scale, (PANEL_W, PANEL_H), segments, [xy[0]])
+    for force, start, end in zip(polygon.forces, xy[:-1], xy[1:], strict=True):
+        colour = FORCE_COLOURS[force.kind.value]
+        _arrow(ax, start, end, colour, '-', 1.6, scale)
+    for force, start, end in zip(polygon.forces, xy[:-1], xy[1:], strict=True):
+        if force.magnitude > 0.0:
+            d = (end - start) / force.magnitude
+            placer.place(force.label, (start + end) / 2, np.array([-d[1], d[0]]),
+                         size=FONT + 1, color=FORCE_COLOURS[force.kind.value])
+    ax.plot(0.0, 0.0, marker='o', ms=4.0, color='black', zorder=5)
+    if polygon.closure > 1e-9 * max(f.magnitude for f in polygon.forces):
+        ax.plot([xy[-1][0], 0.0], [xy[-1][1], 0.0], color='black', ls=':', lw=1.0)
+    _scale_bar(ax, origin, scale, 'N')
+    ax.set_title(f'Force polygon of {polygon.body}', fontsize=FONT + 2)
+    return scale
+
+
+def _force_tables(polygon: Any) -> tuple[Table, Table]:
+    """Return the tables of the forces (N, deg CCW from +x) and couples (N m) on the body."""
+    from ..units import degrees_from_radians
+
+    forces = Table(f'Forces on {polygon.body} (SI; directions CCW from +x)',
+                   ('', 'force', '|F| [N]', 'dir. [deg]', 'at', 'bound [N]'),
+                   tuple((f.label, f.text, fmt_value(f.magnitude),
+                          fmt_value(degrees_from_radians(f.direction)), f.at or 'G',
+                          f'{f.bound:.2g}') for f in polygon.forces))
+    couples = Table(f'Couples on {polygon.body} (+ CCW)', ('', 'couple', 'M [N m]', 'bound [N m]'),
+                    tuple((c.label, c.text, fmt_value(c.moment), f'{c.bound:.2g}')
+                          for c in polygon.couples))
+    return forces, couples
+
+
+def figure_from_force_polygon(polygon: Any, diagram: Diagram, scene: Scene) -> Any:
+    """Draw one body's forces: on the mechanism, head to tail, and in a table (Agg figure).
+
+    Parameters
+    ----------
+    polygon : ForcePolygon
+        The body's forces
+        (:func:`~mech_kinematics.geometry.force_polygon.force_polygon_from_state`).
+    diagram : Diagram
+        The mechanism at the same instant (its space diagram is drawn).
+    scene : Scene
+        The scene.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    scene = full_scene(scene)
+    colours = colours_from_scene(scene)
+    forces, couples = _force_tables(polygon)
+    rows = len(forces.rows) + 1 + (len(couples.rows) + 2 if couples.rows else 0)
+    width = 2 * MARGIN + 3 * PANEL_W + 2 * PANEL_GAP
+    height = TITLE_H + 0.5 + max(PANEL_H, rows * ROW_H + 1.0) + 0.3
+    fig = Figure(figsize=(width * CM, height * CM), dpi=DPI)
+    FigureCanvasAgg(fig)
+
+    def axes(x: float, y: float, w: float, h: float) -> Any:
+        return fig.add_axes((x / width, y / height, w / width, h / height))
+
+    panel_y = height - TITLE_H - PANEL_H
+    xs = [MARGIN + i * (PANEL_W + PANEL_GAP) for i in range(3)]
+    _free_body_panel(axes(xs[0], panel_y, PANEL_W, PANEL_H), scene, diagram, polygon, colours)
+    _force_polygon_panel(axes(xs[1], panel_y, PANEL_W, PANEL_H), polygon)
+    top = height - TITLE_H
+    n = len(forces.rows) + 1
+    _table(axes(xs[2], top - n * ROW_H, PANEL_W, n * ROW_H), forces)
+    if couples.rows:
+        m = len(couples.rows) + 1
+        _table(axes(xs[2], top - (n + m) * ROW_H - 0.9, PANEL_W, m * ROW_H), couples)
+    closes = (f'forces on {polygon.body}: they close within {polygon.closure:.2g} N (bound '
+              f'{polygon.closure_bound:.2g} N); moments about {polygon.origin} sum to '
+              f'{polygon.moment:.2g} N m (bound {polygon.moment_bound:.2g} N m); W weight, '
+              f'-ma inertia force at the centre of mass G')
+    fig.text(MARGIN / width, 1.0 - 0.5 / height, title_from_diagram(diagram),
+             fontsize=FONT + 3, va='center', ha='left')
+    fig.text(MARGIN / width, 1.0 - 1.1 / height, closes, fontsize=FONT, va='center', ha='left')
+    return fig
+
+
 # --- command line ---------------------------------------------------------
 
 DIAGRAM_HELP = """\
@@ -767,8 +910,11 @@ angle, to scale and side by side, with a table of every value drawn (SI
 units; directions in degrees CCW from +x). The output format follows the
 file name: .png, .svg or .pdf. With --animate, write an animated GIF of one
 crank turn with the velocity and acceleration of every point drawn on the
-mechanism instead. Exits with status 2 on a scene or position that cannot be
-solved.
+mechanism instead. With --force-polygon BODY (a scene with masses, gravity or
+loads), draw that body's forces at the instant instead: on the mechanism (a
+free body), head to tail (the force polygon, to scale: it closes, the body
+being in dynamic equilibrium) and in a table, with its couples. Exits with
+status 2 on a scene or position that cannot be solved.
 """
 
 
@@ -789,6 +935,9 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='write an animated GIF of one crank turn instead')
     parser.add_argument('--frames', type=positive_int, default=72, metavar='N',
                         help='frames of the animation (default 72, every 5 degrees)')
+    parser.add_argument('--force-polygon', metavar='BODY',
+                        help='a scene with forces: draw the force polygon of the moving body '
+                             'BODY (a link or slider) at the instant instead')
 
 
 def add_parser(commands: Any) -> argparse.ArgumentParser:
@@ -828,6 +977,8 @@ def _handle(args: argparse.Namespace) -> int:
     try:
         scene = load_scene(args.scene)
         drivers = scene.drivers
+        if args.force_polygon is not None:
+            return _handle_force_polygon(args, scene, output)
         if not scene.single_crank or args.input or args.speed:
             return _handle_drivers(args, scene, output)
         accel = values_by_driver(scene, '--accel', args.accel).get(drivers[0].name)
@@ -868,6 +1019,59 @@ def _handle_drivers(args: argparse.Namespace, scene: Scene, output: Path) -> int
     write_diagram(diagram, scene, output)
     if diagram.refused:
         print(f'{scene.name}: {diagram.refused}')
+    print(f'wrote {output}')
+    return 0
+
+
+def _handle_force_polygon(args: argparse.Namespace, scene: Scene, output: Path) -> int:
+    """Draw the force polygon of ``--force-polygon BODY`` at the instant the options give."""
+    from ..geometry.force_polygon import force_polygon_from_state, moving_bodies
+
+    if args.animate:
+        msg = 'Expected --force-polygon or --animate, got both: the polygon is of one instant'
+        raise ValueError(msg)
+    if scene.dynamics is None:
+        msg = (f'Expected a scene with masses, gravity or loads for --force-polygon, got '
+               f'{scene.name} without')
+        raise ValueError(msg)
+    if args.force_polygon not in moving_bodies(scene):
+        got = ('the ground' if args.force_polygon == scene.graph.ground
+               else repr(args.force_polygon))
+        msg = (f'Expected --force-polygon BODY, a moving body of {scene.name} '
+               f'({", ".join(moving_bodies(scene))}), got {got}')
+        raise ValueError(msg)
+    scene = full_scene(scene)
+    drivers = scene.drivers
+    if not scene.single_crank or args.input or args.speed:
+        positions, rates, accels, turns, _ = drive_from_args(scene, args)
+        if len(drivers) == 1:
+            positions, rates, accels, turns = [positions], [rates], [accels], [turns]
+        inputs = {d.name: float(x) + (2.0 * math.pi * int(t) if t else 0.0)
+                  for d, x, t in zip(drivers, positions, turns, strict=True)}
+        speeds = {d.name: float(v) for d, v in zip(drivers, rates, strict=True) if v is not None}
+        accel = {d.name: float(a) for d, a in zip(drivers, accels, strict=True) if a is not None}
+        diagram = diagram_from_scene(scene, inputs=inputs, speeds=speeds, accels=accel)
+        xs = [inputs.get(d.name, d.start) for d in drivers]
+        vs = [speeds.get(d.name, d.speed) for d in drivers]
+        acs = [accel.get(d.name, d.accel) for d in drivers]
+        state = (solve(scene, xs[0], vs[0], acs[0]) if len(drivers) == 1
+                 else solve(scene, xs, vs, acs))
+    else:
+        speed = None if args.speed_rpm is None else rad_per_s_from_rpm(args.speed_rpm)
+        alpha = values_by_driver(scene, '--accel', args.accel).get(drivers[0].name)
+        if args.angle_deg is None:
+            theta, turns = scene.input.angle, scene.input.turns
+        elif abs(args.angle_deg) > 360.0:
+            theta, turns = turns_from_degrees(args.angle_deg)
+        else:
+            theta, turns = radians_from_degrees(args.angle_deg), 0
+        diagram = diagram_from_scene(scene, args.angle_deg, speed, alpha, degrees=True)
+        state = solve(scene, theta, speed, alpha, turns=turns)
+    polygon = force_polygon_from_state(scene, state, args.force_polygon)
+    fig = figure_from_force_polygon(polygon, diagram, scene)
+    fig.savefig(output, dpi=DPI, format=output.suffix.lower()[1:])
+    print(f'{scene.name}: forces on {polygon.body} close within {polygon.closure:.2g} N '
+          f'(bound {polygon.closure_bound:.2g} N)')
     print(f'wrote {output}')
     return 0
 

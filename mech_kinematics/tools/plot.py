@@ -13,7 +13,11 @@ time or crank angle, in SI units:
   accelerations;
 - what the scene's IMUs read (orientation, angular velocity, the x and y of
   the linear acceleration in each sensor's frame), if it has any: from a bag,
-  its ``imu/NAME`` topics.
+  its ``imu/NAME`` topics;
+- for a scene with forces (``masses``, ``gravity`` or ``loads``), from the
+  solver: the turning-moment diagram (every driver's effort, with the
+  crank's mean over the turn, :mod:`mech_kinematics.geometry.turning`), the
+  force each joint carries and the shaking force on the frame.
 
 Figures are built with Matplotlib's object API (``Figure``, no pyplot), so no
 display or backend choice is involved: PNG goes through Agg. Matplotlib and
@@ -30,6 +34,7 @@ import os
 from pathlib import Path
 import stat
 import sys
+import textwrap
 from typing import Any
 import warnings
 
@@ -38,14 +43,14 @@ import numpy.typing as npt
 
 from .cli import finite_float, positive_float, PROG, run_tool
 from .cli import named_value, values_by_driver
-from ..errors import MechKinematicsError
+from ..errors import MechKinematicsError, SceneError
 from ..ros import topics
 from ..ros.cdr import stamp_from_cdr
 from ..solver.graph import REVOLUTE
 from ..units import NS_PER_S, rad_per_s_from_rpm, rpm_from_rad_per_s
 
 __all__ = [
-    'DEFAULT_MAX_SAMPLES', 'DEFAULT_SAMPLES', 'Motion', 'PlotError', 'add_parser',
+    'DEFAULT_MAX_SAMPLES', 'DEFAULT_SAMPLES', 'ForceSeries', 'Motion', 'PlotError', 'add_parser',
     'drivers_period', 'figure_from_motion', 'main', 'motion_from_bag', 'motion_from_scene',
     'plot_bag', 'plot_scene', '_handle', 'save_figure',
 ]
@@ -73,6 +78,9 @@ TITLES = {
     'imu_orientation': 'IMU orientations',
     'imu_angular_velocity': 'IMU angular velocities',
     'imu_acceleration': 'IMU linear accelerations (sensor frame)',
+    'effort': 'Turning moment (driver efforts)',
+    'reaction': 'Joint reactions |F|',
+    'shaking': 'Shaking force on the frame |F|',
 }
 YLABELS = {
     'joint_position': 'angle [rad]',
@@ -87,7 +95,13 @@ YLABELS = {
     'imu_orientation': 'angle [rad]',
     'imu_angular_velocity': 'angular velocity [rad/s]',
     'imu_acceleration': 'acceleration [m/s²]',
+    'effort': 'effort [N m]',
+    'reaction': 'force [N]',
+    'shaking': 'force [N]',
 }
+#: The effort panel's label where some driver is an actuator (its effort a force).
+EFFORT_LABELS = {(True,): 'effort [N m]', (False,): 'effort [N]',
+                 (False, True): 'effort [N m; N for an actuator]'}
 XLABELS = {'time': 'time [s]', 'angle': 'crank angle θ [rad]', 'path': 'x [m]'}
 #: The node's topics, by message type.
 _JOINT_STATE = topics.TYPES[topics.JOINT_STATES]
@@ -100,6 +114,37 @@ _TOPICS = {topics.TYPES[t]: t for t in (*topics.STATE_TOPICS, topics.DIAGNOSTICS
 
 class PlotError(MechKinematicsError):
     """A plot cannot be made from the given bag or scene."""
+
+
+@dataclass(frozen=True)
+class ForceSeries:
+    """The forces along a :class:`Motion`, from the solver (SI; NaN where not solved).
+
+    Attributes
+    ----------
+    efforts : dict of str to ndarray, shape (n,)
+        Every driver's effort: a crank's torque (N m), an actuator's force (N).
+    angular : dict of str to bool
+        Per driver, whether it is a crank (its effort a torque).
+    reactions : dict of str to ndarray, shape (n,)
+        The force each joint carries, N: a pin's ``|F|``, a prismatic joint's
+        ``|normal|`` (labelled ``NAME (normal)``); a joint named otherwise
+        than its point is labelled ``NAME at POINT``.
+    shaking : ndarray, shape (n,)
+        The magnitude of the shaking force on the frame, N.
+    means : dict of str to float
+        The crank's mean effort over its turn (the turning-moment diagram's
+        mean line), where the motion is one turn of one crank.
+    note : str
+        Why there is no mean line, or ''.
+    """
+
+    efforts: Mapping[str, Array]
+    angular: Mapping[str, bool]
+    reactions: Mapping[str, Array]
+    shaking: Array
+    means: Mapping[str, float] = field(default_factory=dict)
+    note: str = ''
 
 
 @dataclass(frozen=True)
@@ -134,6 +179,8 @@ class Motion:
         Per IMU of the scene: orientation (rad) and angular velocity (rad/s),
         shape (n,), linear acceleration in the sensor frame (m/s²), shape
         (n, 2); NaN where a recording has no reading.
+    forces : ForceSeries or None
+        A scene with forces, solved: efforts, reactions, shaking.
     """
 
     title: str
@@ -146,6 +193,41 @@ class Motion:
     note: str = ''
     gaps: tuple[tuple[float, float], ...] = ()
     imus: Mapping[str, tuple[Array, Array, Array]] = field(default_factory=dict)
+    forces: ForceSeries | None = None
+
+
+def _forces_from_state(scene: Any, state: Any, means: Mapping[str, float] | None = None,
+                       note: str = '') -> ForceSeries | None:
+    """Return the forces of an array ``state`` of ``scene`` (NaN where it is not valid)."""
+    forces = state.forces
+    if forces is None:
+        return None
+    valid = np.asarray(state.valid, dtype=bool)
+
+    def masked(values: Any) -> Array:
+        return np.where(valid, np.asarray(values, dtype=np.float64), np.nan)
+
+    reactions = {}
+    for name, reaction in forces.reactions.items():
+        label = name if name == reaction.at else f'{name} at {reaction.at}'
+        if reaction.force is not None:
+            reactions[label] = masked(np.abs(reaction.force))
+        elif reaction.normal is not None:
+            reactions[f'{label} (normal)'] = masked(np.abs(reaction.normal))
+    return ForceSeries({d.name: masked(forces.efforts[d.name]) for d in scene.drivers},
+                       {d.name: d.joint_type.angular for d in scene.drivers}, reactions,
+                       masked(np.abs(forces.shaking_force)), dict(means or {}), note)
+
+
+def _turn_means(scene: Any, speed: float, accel: float) -> tuple[dict[str, float], str]:
+    """Return the turning crank's mean effort over its turn, or why there is none."""
+    from ..geometry.turning import turning_moment_from_scene
+
+    try:
+        study = turning_moment_from_scene(scene, speed=speed, accel=accel)
+    except SceneError as error:
+        return {}, f'no mean line: {error}'
+    return {study.crank: study.mean}, ''
 
 
 # -- from the solver -------------------------------------------------------------
@@ -223,8 +305,11 @@ def motion_from_scene(scene: Any, *, samples: int = DEFAULT_SAMPLES,
     _, gaps = assembly_ranges(scene)
     imus = {name: (r.orientation, r.angular_velocity, r.linear_acceleration)
             for name, r in state.imus.items()}
+    forces = None
+    if scene.dynamics is not None:
+        forces = _forces_from_state(scene, state, *_turn_means(scene, speed, accel))
     return Motion(title, np.asarray(angle, dtype=np.float64), time, scene.joint_types, joints,
-                  points, jumps, summary_from_gaps(gaps, scene.units), gaps, imus)
+                  points, jumps, summary_from_gaps(gaps, scene.units), gaps, imus, forces)
 
 
 def _first_time(v: float, a: float, distance: float) -> float:
@@ -346,7 +431,8 @@ def _motion_of_drivers(scene: Any, samples: int, speed: float | None, accel: flo
         engaged = np.asarray(engagement.engaged, dtype=bool)
         jumps |= engaged[1:] != engaged[:-1]
     return Motion(title, np.asarray(positions[0], dtype=np.float64), time, scene.joint_types,
-                  joints, points, jumps, 'the path stays where it assembles')
+                  joints, points, jumps, 'the path stays where it assembles',
+                  forces=_forces_from_state(scene, state))
 
 
 # -- from a bag ------------------------------------------------------------------
@@ -756,6 +842,8 @@ def figure_from_motion(motion: Motion, *, x: str = 'time') -> Any:
         columns.append(('slider_position', 'slider_velocity', 'slider_acceleration'))
     if motion.imus:
         columns.append(('imu_orientation', 'imu_angular_velocity', 'imu_acceleration'))
+    if motion.forces is not None:
+        columns.append(('effort', 'reaction', 'shaking'))
     gaps = _gaps(motion.time, len(motion.crank_angle))
     if motion.jumps is not None:
         gaps = gaps | motion.jumps  # an acceleration's jump: no line across it
@@ -767,6 +855,8 @@ def figure_from_motion(motion: Motion, *, x: str = 'time') -> Any:
         """(label, values, values wrap at ±π) per line of a panel against ``x``."""
         if kind.startswith('imu'):
             return _imu_series(motion, kind)
+        if kind in ('effort', 'reaction', 'shaking'):
+            return _force_series(motion.forces, kind)
         if kind.startswith('joint') or kind.startswith('slider'):
             names = revolute if kind.startswith('joint') else prismatic
             k = ('position', 'velocity', 'acceleration').index(kind.split('_')[1])
@@ -785,6 +875,8 @@ def figure_from_motion(motion: Motion, *, x: str = 'time') -> Any:
             ax = grid[row, col]
             ax.set_title(TITLES[kind])
             ax.set_ylabel(YLABELS[kind])
+            if kind == 'effort' and motion.forces is not None:
+                ax.set_ylabel(EFFORT_LABELS[tuple(sorted(set(motion.forces.angular.values())))])
             ax.grid(True, alpha=0.3)
             if kind == 'point_path':
                 _draw_paths(ax, motion, gaps)
@@ -802,8 +894,13 @@ def figure_from_motion(motion: Motion, *, x: str = 'time') -> Any:
                     absent += 1
                     continue
                 px, py = _broken(xs, values, gaps, x_wraps=x == 'angle', y_wraps=wraps)
-                ax.plot(px, py, label=label, linewidth=1.0)
+                drawn_line = ax.plot(px, py, label=label, linewidth=1.0)[0]
                 drawn += 1
+                if kind == 'effort':
+                    _mean_line(ax, motion.forces, label, drawn_line.get_color())
+            if kind == 'effort' and motion.forces is not None and motion.forces.note:
+                ax.text(0.02, 0.02, textwrap.fill(motion.forces.note, 60), transform=ax.transAxes,
+                        fontsize='x-small', color='0.4', va='bottom')
             if drawn:
                 _legend(ax)
             else:
@@ -818,6 +915,28 @@ def _moves(p: Array, v: Array | None, a: Array | None) -> bool:
         known = p[np.isfinite(p).all(axis=1)]
         return bool(len(known)) and bool((known.max(axis=0) - known.min(axis=0)).max() > 0.0)
     return any(x is not None and np.nanmax(np.abs(x), initial=0.0) > 0.0 for x in (v, a))
+
+
+def _force_series(forces: ForceSeries | None, kind: str) -> list[tuple[str, Array | None, bool]]:
+    """(label, values, wraps) of a forces panel: efforts, reactions or the shaking force."""
+    if forces is None:
+        return []
+    if kind == 'effort':
+        return [(name, values, False) for name, values in forces.efforts.items()]
+    if kind == 'reaction':
+        return [(name, values, False) for name, values in forces.reactions.items()]
+    return [('shaking', forces.shaking, False)]
+
+
+def _mean_line(ax: Any, forces: ForceSeries | None, name: str, colour: str) -> None:
+    """Draw a driver's mean effort over its turn as a dashed line, if it has one."""
+    if forces is None or name not in forces.means:
+        return
+    from ..geometry.turning import effort_unit
+
+    mean = forces.means[name]
+    ax.axhline(mean, color=colour, linestyle='--', linewidth=0.9,
+               label=f'{name} mean {mean:.4g} {effort_unit(forces.angular[name])}')
 
 
 def _imu_series(motion: Motion, kind: str) -> list[tuple[str, Array | None, bool]]:

@@ -2,6 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """The compiled tick against the general solver: the same bits, the same refusals (issue 14)."""
 
+import dataclasses
 import importlib
 import math
 from pathlib import Path
@@ -25,6 +26,20 @@ ANGLES = np.linspace(-7.0, 7.0, 351)
 TOLERANCES = (1e-6, 1e-12, math.inf)
 
 
+def _motion(scene):
+    """Return the scene a tick answers for: with masses, its motion alone (issue 32).
+
+    The node's tick reports the motion, not the forces (not yet published), so
+    it is held to the solve of the same scene without masses, loads and
+    gravity: an instant is not refused for forces the tick does not report.
+    """
+    if scene.dynamics is None:
+        return scene
+    return dataclasses.replace(scene, gravity=None, masses=(), loads=(),
+                               outputs_joints=scene.output_joints,
+                               outputs_points=scene.output_points)
+
+
 def _assert_same(scene, tick, angles, speeds=(None,), turns=(0,), **kwargs):
     """Every instant: identical values (bit for bit), measure, or error and message."""
     refused = 0
@@ -33,7 +48,7 @@ def _assert_same(scene, tick, angles, speeds=(None,), turns=(0,), **kwargs):
             omega = scene.input.speed if speed is None else speed
             for tol in TOLERANCES:
                 for k in turns:
-                    expected = general_tick_outcome(scene, float(theta), omega,
+                    expected = general_tick_outcome(_motion(scene), float(theta), omega,
                                                     scene.input.accel, tol, k, **kwargs)
                     got = tick_outcome(tick, float(theta), omega, scene.input.accel, tol, k)
                     assert repr(got) == repr(expected), (scene.name, theta, tol, k)
@@ -76,7 +91,7 @@ def test_several_driver_scenes_compile_to_the_same_bits(name):
         low, high = scene.drivers[0].stroke
         grid = [(x,) for x in np.linspace(low - 0.2, high + 0.2, 13)]
         rates = [([0.0], [0.0]), ([0.1], [0.05]), ([1e13], [0.0])]
-    elif name == 'five_bar':
+    elif name in ('five_bar', 'five_bar_payload'):
         grid = [(a, b) for a in np.linspace(0.0, 2 * math.pi, 9) for b in np.linspace(0, 6, 7)]
         rates = [([0.0, 0.0], [0.0, 0.0]), ([3.0, -1.5], [2.0, 0.5]), ([1e13, 1.0], [0.0, 0.0])]
     else:
@@ -91,7 +106,7 @@ def test_several_driver_scenes_compile_to_the_same_bits(name):
                 with warnings.catch_warnings():
                     warnings.simplefilter('ignore', mk.NearSingularWarning)
                     try:
-                        state = mk.solve(scene, *drive, max_error=tol)
+                        state = mk.solve(_motion(scene), *drive, max_error=tol)
                         expected = (values_from_state(state, scene.output_joints,
                                                       scene.output_points),
                                     min(state.singularity.values()))

@@ -62,9 +62,9 @@ def test_hand_written_forms_agree(scalar, vector):
         np.testing.assert_allclose(values, [a[k] for a in arrays], rtol=1e-13, atol=1e-15)
 
 
-HAND_WRITTEN = ('four_bar_coupler_points', 'khurmi_four_bar_ad150', 'offset_slider_crank',
-                'piston_300', 'rocking_lever', 'scotch_yoke', 'slider_crank_150_600',
-                'steam_engine_500_2000')
+HAND_WRITTEN = ('four_bar_coupler_points', 'khurmi_engine_15_7', 'khurmi_four_bar_ad150',
+                'offset_slider_crank', 'piston_300', 'rocking_lever', 'scotch_yoke',
+                'slider_crank_150_600', 'steam_engine_500_2000')
 
 
 def test_which_scenes_have_hand_written_forms():

@@ -11,14 +11,17 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
+import re
 import subprocess
 import sys
 
-from helpers import BOOM_CYLINDER, FIVE_BAR_TWO_CRANKS
+from helpers import BOOM_CYLINDER, FIVE_BAR_TWO_CRANKS, FORCES
 import pytest
+import yaml
 
 import mech_kinematics as mk
 from mech_kinematics.__main__ import build_parser, main, TOOLS
+from mech_kinematics.geometry.turning import turning_moment_from_scene
 from mech_kinematics.tools import check
 
 REPO = Path(__file__).resolve().parents[2]
@@ -236,3 +239,143 @@ def test_packaged_scenes_with_several_drivers(name, capsys):
         assert [d['stroke'] for d in data['drivers']] == [[2.0, 3.3], [2.5, 3.9]]
     else:
         assert 0 < data['grid']['assembling'] < 400
+
+
+# --- forces (issue 32): the turning-moment diagram and the flywheel ---------------------
+
+#: An error estimate as printed: 2 significant digits (its last bits depend on the BLAS).
+ERROR = r'\(\+-[0-9.e+-]+\)'
+
+
+def test_turning_moment_in_text(capsys):
+    """The test four-bar with masses: its mean (the drag's 3 N m), extremes, dE, the flywheel."""
+    assert main(['check', str(FORCES / 'four_bar_masses.yaml'), '--flywheel', '0.02']) == 0
+    lines = capsys.readouterr().out.splitlines()
+    head = lines.index('turning moment (crank "crank" turning at -120 rpm; efforts in N m for a '
+                       'crank, N for an actuator, each +- its error):')
+    patterns = [
+        rf'  crank: mean 3 N m {ERROR}, largest 4\.37735 at 85\.1394 deg {ERROR}, least '
+        rf'1\.33976 at 333\.235 deg {ERROR}',
+        rf'fluctuation of energy \(crank\): 2\.70541 J {ERROR}; energy least at crank 21\.3506 '
+        r'deg, most at 202\.86 deg \(2 crossings of the mean\)',
+        r'flywheel for Cs = 0\.02 \(Cs = \(w_max - w_min\) / w_mean, w_mean = 12\.5664 rad/s\): '
+        rf'I = dE / \(w_mean\^2 Cs\) = 0\.85661 kg m\^2 {ERROR}',
+    ]
+    assert len(lines) == head + 1 + len(patterns)
+    for line, pattern in zip(lines[head + 1:], patterns, strict=True):
+        assert re.fullmatch(pattern, line), line
+
+
+def test_turning_moment_in_json_is_the_study(capsys):
+    """--json: "turning_moment" in SI, equal to the study's figures; the flywheel's formula."""
+    path = FORCES / 'scotch_yoke_mass.yaml'
+    assert main(['check', str(path), '--json', '--flywheel', '0.05']) == 0
+    data = json.loads(capsys.readouterr().out)['turning_moment']
+    study = turning_moment_from_scene(mk.load_scene(str(path)))
+    assert data['crank'] == 'crank' and data['held'] == {} and data['accel'] == 0.0
+    assert data['fluctuation'] == study.fluctuation
+    assert data['fluctuation_error'] == study.fluctuation_error
+    assert data['crossings'] == list(study.crossings)
+    effort = data['efforts']['crank']
+    assert effort['unit'] == 'N m'
+    assert effort['max']['value'] == study.drivers['crank'].maximum.value
+    assert effort['max']['angle'] == pytest.approx(math.pi / 4, abs=1e-8)
+    w = data['speed']
+    assert data['flywheel']['inertia'] == data['fluctuation'] / (w * w * 0.05)
+    assert data['flywheel']['inertia'] == pytest.approx(2.0 * 0.05 ** 2 / (2 * 0.05), rel=1e-13)
+    assert [round(loop['area'] / data['fluctuation']) for loop in data['loops']] == [1, -1, 1, -1]
+
+
+def test_several_drivers_turn_the_first_crank_and_hold_the_others(capsys):
+    """The five-bar with masses: the region, then each crank's effort, the right one held."""
+    assert main(['check', str(FORCES / 'five_bar_masses.yaml')]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    head = next(i for i, line in enumerate(lines) if line.startswith('turning moment'))
+    assert lines[head] == ('turning moment (crank "left_crank" turning at 30 rpm, right_crank '
+                           'held at 60 deg; efforts in N m for a crank, N for an actuator, each '
+                           '+- its error):')
+    assert lines[head + 1].startswith('  left_crank: mean ')
+    assert lines[head + 2].startswith('  right_crank: mean 0.195385 N m ')
+    assert lines[head + 3].startswith('fluctuation of energy (left_crank): 1.41674 J ')
+
+
+def test_an_actuator_alone_says_why_it_has_no_turning_moment(capsys):
+    """The boom with masses: one line saying there is no crank; JSON says it as "refused"."""
+    path = str(FORCES / 'boom_masses.yaml')
+    assert main(['check', path, '--grid', '5']) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == (
+        'turning moment: none (Expected a crank to turn for a turning-moment diagram, got '
+        'boom_masses, driven by lift_cyl, none a crank)')
+    assert main(['check', path, '--grid', '5', '--json']) == 0
+    assert 'none a crank' in json.loads(capsys.readouterr().out)['turning_moment']['refused']
+
+
+@pytest.mark.parametrize('name', ['khurmi_four_bar_ad150', 'geneva', 'five_bar'])
+def test_a_scene_without_forces_prints_nothing_new(name, capsys):
+    """No masses, gravity or loads: no turning-moment line, no "turning_moment" key."""
+    assert main(['check', name, '--grid', '5'] if name == 'five_bar' else ['check', name]) == 0
+    assert 'turning moment' not in capsys.readouterr().out
+    assert main(['check', name, '--json'] + (['--grid', '5'] if name == 'five_bar' else [])) == 0
+    assert 'turning_moment' not in json.loads(capsys.readouterr().out)
+
+
+@pytest.mark.parametrize('args, message', [
+    (['khurmi_four_bar_ad150', '--flywheel', '0.02'],
+     'Expected a scene with masses, gravity or loads for --flywheel, got khurmi_four_bar_ad150 '
+     'without'),
+    ([str(FORCES / 'five_bar_masses.yaml'), '--flywheel', '0.02', '--grid', '5'],
+     'Expected a scene driven by one crank for --flywheel, got five_bar_masses, driven by '
+     'left_crank, right_crank'),
+    ([str(FORCES / 'boom_masses.yaml'), '--flywheel', '0.02', '--grid', '5'],
+     'Expected a scene driven by one crank for --flywheel, got boom_masses, driven by lift_cyl'),
+])
+def test_a_flywheel_it_cannot_give_is_one_line_and_exit_2(args, message, capsys):
+    """--flywheel on a scene without forces or with several drivers: one line, status 2."""
+    assert main(['check', *args]) == 2
+    captured = capsys.readouterr()
+    assert captured.err == f'error: {message}\n' and captured.out == ''
+
+
+def test_a_flywheel_for_a_crank_that_cannot_turn_is_refused(tmp_path, capsys):
+    """A crank longer than its rocker cannot turn: --flywheel says where, in one line."""
+    data = yaml.safe_load((FORCES / 'four_bar_masses.yaml').read_text())
+    data['input']['length'] = 100
+    path = tmp_path / 'stuck.yaml'
+    path.write_text(yaml.safe_dump(data))
+    assert main(['check', str(path), '--flywheel', '0.02']) == 2
+    err = capsys.readouterr().err
+    assert err.startswith('error: Expected four_bar_masses to turn a whole turn with its forces '
+                          'bounded for a turning-moment diagram, got crank "crank" at ')
+    assert err.count('\n') == 1
+    assert main(['check', str(path)]) == 0       # without --flywheel: said, not refused
+    assert capsys.readouterr().out.splitlines()[-1].startswith(
+        'turning moment: none (Expected four_bar_masses to turn a whole turn')
+
+
+@pytest.mark.parametrize('value', ['0', '2', '-0.1', 'abc', 'nan', 'inf'])
+def test_a_bad_coefficient_is_refused(value, capsys):
+    """--flywheel takes a coefficient above 0 and below 2: argparse's one line, status 2."""
+    with pytest.raises(SystemExit) as caught:
+        main(['check', str(FORCES / 'engine.yaml'), '--flywheel', value])
+    assert caught.value.code == 2
+    err = capsys.readouterr().err.splitlines()
+    assert err[-1].endswith(f'expected a coefficient of fluctuation of speed (w_max - w_min) / '
+                            f'w_mean above 0 and below 2 (e.g. 0.02), got {value!r}')
+
+
+def test_the_commands_page_shows_what_check_prints():
+    """docs/commands.md's turning-moment example is check's output (errors masked)."""
+    text = (REPO / 'docs' / 'commands.md').read_text()
+    block = text[text.index('$ python -m mech_kinematics check test/data/forces/'):]
+    block = block[:block.index('```')].splitlines()
+    command = block[0].removeprefix('$ python -m mech_kinematics ').split()
+    result = subprocess.run([sys.executable, '-m', 'mech_kinematics', *command],
+                            capture_output=True, text=True, check=True, cwd=REPO)
+    shown = [line for line in block[1:] if line != '...']
+    printed = result.stdout.splitlines()
+    tail = printed[-len(shown):]
+
+    def masked(line):
+        return re.sub(ERROR, '(+-E)', line)
+
+    assert [masked(line) for line in tail] == [masked(line) for line in shown]

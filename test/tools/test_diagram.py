@@ -13,7 +13,7 @@ import subprocess
 import sys
 import warnings
 
-from helpers import BOOM_CYLINDER, crank_scene_names, FIVE_BAR_TWO_CRANKS
+from helpers import BOOM_CYLINDER, crank_scene_names, FIVE_BAR_TWO_CRANKS, FORCES, forces_scene
 import numpy as np
 import pytest
 import yaml
@@ -565,3 +565,73 @@ def test_cli_draws_the_packaged_five_bar_where_solve_puts_it(tmp_path, monkeypat
     np.testing.assert_allclose(diagram.velocity.letters['p'],
                                _xy(complex(state.complex_points['P'][1])), rtol=1e-12)
     assert _png_size(out)[0] >= MIN_PNG_SIZE[0]
+
+
+# --- the force polygon of one body (issue 32) -------------------------------------------
+
+
+def png_size(path):
+    """Return a PNG's (width, height) in pixels."""
+    return struct.unpack('>II', Path(path).read_bytes()[16:24])
+
+
+def test_cli_draws_the_force_polygon_of_a_body(tmp_path, capsys):
+    """--force-polygon coupler: the PNG, and a line saying how well its forces close."""
+    out = tmp_path / 'coupler.png'
+    assert dg.main([str(FORCES / 'four_bar_masses.yaml'), '--force-polygon', 'coupler',
+                    '--angle-deg', '30', '-o', str(out)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith('four_bar_masses: forces on coupler close within ')
+    assert lines[1] == f'wrote {out}'
+    width, height = png_size(out)
+    assert width >= MIN_PNG_SIZE[0] and height >= 500
+
+
+def test_force_polygon_figure_is_the_polygon_drawn_to_scale():
+    """The polygon panel's arrows run head to tail through the polygon's vertices (N)."""
+    from mech_kinematics.geometry.force_polygon import force_polygon_from_state
+
+    scene = forces_scene('engine')
+    state = mk.solve(scene, 1.0)
+    polygon = force_polygon_from_state(scene, state, 'rod')
+    diagram = geo.diagram_from_scene(scene, 1.0)
+    fig = dg.figure_from_force_polygon(polygon, diagram, scene)
+    ax = next(a for a in fig.axes if a.get_title() == 'Force polygon of rod')
+    drawn = [line.get_xydata() for line in ax.get_lines() if len(line.get_xydata()) == 2]
+    starts = np.array([xy[0] for xy in drawn[:len(polygon.forces)]])
+    np.testing.assert_allclose(starts, polygon.vertices[:-1], rtol=0, atol=1e-9)
+    titles = [a.get_title(loc='left') for a in fig.axes]
+    assert 'Forces on rod (SI; directions CCW from +x)' in titles
+    assert 'Couples on rod (+ CCW)' in titles
+
+
+def test_cli_draws_an_actuator_scene_at_given_positions(tmp_path, capsys):
+    """The boom on its cylinder, at --input, with the cylinder's force along its line."""
+    out = tmp_path / 'rod.svg'
+    assert dg.main([str(FORCES / 'boom_masses.yaml'), '--force-polygon', 'lift_cyl', '--input',
+                    'lift_cyl=2.1', '-o', str(out)]) == 0
+    assert capsys.readouterr().out.startswith('boom_masses: forces on lift_cyl close within ')
+    assert out.read_text().startswith('<?xml')
+
+
+@pytest.mark.parametrize(('args', 'message'), [
+    ([str(FORCES / 'four_bar_masses.yaml'), '--force-polygon', 'ground'],
+     'Expected --force-polygon BODY, a moving body of four_bar_masses (crank, coupler, rocker), '
+     'got the ground'),
+    ([str(FORCES / 'four_bar_masses.yaml'), '--force-polygon', 'lever'],
+     'Expected --force-polygon BODY, a moving body of four_bar_masses (crank, coupler, rocker), '
+     "got 'lever'"),
+    ([KHURMI, '--force-polygon', 'coupler'],
+     'Expected a scene with masses, gravity or loads for --force-polygon, got '
+     'khurmi_four_bar_ad150 without'),
+    ([str(FORCES / 'four_bar_masses.yaml'), '--force-polygon', 'coupler', '--animate'],
+     'Expected --force-polygon or --animate, got both: the polygon is of one instant'),
+])
+def test_force_polygon_errors_are_one_line_and_exit_2(args, message, tmp_path, capsys,
+                                                      monkeypatch):
+    """A body it cannot draw, a scene without forces, --animate: one line, status 2, no file."""
+    monkeypatch.chdir(tmp_path)
+    output = 'x.gif' if '--animate' in args else 'x.png'
+    assert dg.main([*args, '-o', output]) == 2
+    assert capsys.readouterr().err == f'error: {message}\n'
+    assert not list(tmp_path.iterdir())

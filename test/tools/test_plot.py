@@ -12,7 +12,7 @@ from pathlib import Path
 import subprocess
 import sys
 
-from helpers import BOOM_CYLINDER, FIVE_BAR_TWO_CRANKS
+from helpers import BOOM_CYLINDER, FIVE_BAR_TWO_CRANKS, forces_scene
 import numpy as np
 import pytest
 import yaml
@@ -27,7 +27,8 @@ PNG_MAGIC = b'\x89PNG\r\n\x1a\n'
 JOINT_PANELS = {'Joint angles', 'Joint angular velocities', 'Joint angular accelerations'}
 POINT_PANELS = {'Point paths', 'Point speeds |v|', 'Point accelerations |a|'}
 SLIDER_PANELS = {'Slider positions', 'Slider velocities', 'Slider accelerations'}
-UNITS = ('[rad]', '[rad/s]', '[rad/s²]', '[m]', '[m/s]', '[m/s²]', '[s]')
+UNITS = ('[rad]', '[rad/s]', '[rad/s²]', '[m]', '[m/s]', '[m/s²]', '[s]', '[N]', '[N m]',
+         '[N m; N for an actuator]')
 TYPES = {'joint_states': 'sensor_msgs/msg/JointState',
          'joint_accelerations': 'trajectory_msgs/msg/JointTrajectory',
          'point_accelerations': 'trajectory_msgs/msg/MultiDOFJointTrajectory'}
@@ -581,3 +582,71 @@ def test_a_bag_without_accelerations_plots_what_is_there_and_says_what_is_not(
     assert capsys.readouterr().err == (
         f'warning: {bag}: no {missing} in the recording (empty in every message, as a node '
         f'driven from a topic publishes them): their panels say so\n')
+
+
+# --- forces (issue 32): the turning-moment diagram and what the joints carry ------------
+
+FORCE_PANELS = {'Turning moment (driver efforts)', 'Joint reactions |F|',
+                'Shaking force on the frame |F|'}
+
+
+def test_a_scene_with_forces_gets_its_turning_moment_and_reactions(tmp_path):
+    """The engine: efforts, |F| of every pin and the shaking force are the solver's; the mean."""
+    from mech_kinematics.geometry.turning import turning_moment_from_scene
+
+    scene = forces_scene('engine')
+    fig = plot.plot_scene(scene, tmp_path / 'engine.png', samples=181)
+    assert_png(tmp_path / 'engine.png')
+    found = panels(fig)
+    assert set(found) >= FORCE_PANELS
+    assert_units_everywhere(fig)
+    angles = np.linspace(0.0, 2.0 * math.pi, 181)
+    state = mk.solve(scene, angles)
+    drawn = lines(found['Turning moment (driver efforts)'])
+    np.testing.assert_array_equal(drawn['crank'].get_ydata(), state.forces.efforts['crank'])
+    mean = turning_moment_from_scene(scene).mean
+    (label,) = [name for name in drawn if name.startswith('crank mean')]
+    assert label == f'crank mean {mean:.4g} N m'
+    np.testing.assert_array_equal(drawn[label].get_ydata(), [mean, mean])
+    reactions = lines(found['Joint reactions |F|'])
+    assert set(reactions) == {'crank at O', 'B', 'P', 'piston at P (normal)'}
+    np.testing.assert_array_equal(reactions['B'].get_ydata(),
+                                  np.abs(state.forces.reactions['B'].force))
+    np.testing.assert_array_equal(reactions['piston at P (normal)'].get_ydata(),
+                                  np.abs(state.forces.reactions['piston'].normal))
+    np.testing.assert_array_equal(lines(found['Shaking force on the frame |F|'])['shaking']
+                                  .get_ydata(), np.abs(state.forces.shaking_force))
+
+
+def test_several_drivers_plot_their_efforts_along_their_path(tmp_path):
+    """The five-bar with masses, against time: both efforts, no mean line (no one turn)."""
+    scene = forces_scene('five_bar_masses')
+    fig = plot.plot_scene(scene, tmp_path / 'five.png', samples=101)
+    drawn = lines(panels(fig)['Turning moment (driver efforts)'])
+    assert set(drawn) == {'left_crank', 'right_crank'}
+    assert panels(fig)['Turning moment (driver efforts)'].get_xlabel() == 'time [s]'
+
+
+def test_no_forces_no_forces_column(tmp_path):
+    """A scene without masses, gravity or loads draws what it drew before, nothing more."""
+    fig = plot.plot_scene(mk.load_scene('khurmi_four_bar_ad150'), tmp_path / 'k.png',
+                          samples=91)
+    assert not FORCE_PANELS & set(panels(fig))
+    assert plot.motion_from_scene(mk.load_scene('khurmi_four_bar_ad150'), samples=5).forces \
+        is None
+
+
+def test_a_crank_that_cannot_turn_has_no_mean_line_and_says_why(tmp_path):
+    """The four-bar with masses, its crank made longer than its rocker: gaps, and the reason."""
+    data = yaml.safe_load((REPO / 'test' / 'data' / 'forces' / 'four_bar_masses.yaml')
+                          .read_text())
+    data['input']['length'] = 100
+    scene = mk.parse_scene(data)
+    motion = plot.motion_from_scene(scene, samples=181)
+    assert motion.forces.means == {}
+    assert motion.forces.note.startswith('no mean line: Expected four_bar_masses to turn')
+    efforts = motion.forces.efforts['crank']
+    assert np.isnan(efforts).any() and np.isfinite(efforts).any()
+    fig = plot.figure_from_motion(motion, x='angle')
+    texts = [t.get_text() for t in panels(fig)['Turning moment (driver efforts)'].texts]
+    assert any(t.startswith('no mean line') for t in texts)
