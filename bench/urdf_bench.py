@@ -36,10 +36,10 @@ import time
 
 import numpy as np
 
+import mech_kinematics as mk
 from mech_kinematics.robot import load_robot
 from mech_kinematics.robot.description import ClosureKind
 from mech_kinematics.robot.writer import robot_urdf_from_scene
-import mech_kinematics as mk
 
 DATA = Path(__file__).resolve().parents[1] / 'test' / 'data' / 'urdf'
 TOLERANCE = 1e-5
@@ -80,15 +80,18 @@ class LevenbergMarquardt:
         return frames, axes
 
     def residual(self, q):
+        """Return the constraints' residual at ``q``: closure gaps (m), mimic rules."""
         frames, _ = self.frames(q)
         rows = []
         for c in self.closures:
-            rows.extend((frames[c.link_a] @ c.frame_a)[:3, 3] - (frames[c.link_b] @ c.frame_b)[:3, 3])
+            rows.extend((frames[c.link_a] @ c.frame_a)[:3, 3]
+                        - (frames[c.link_b] @ c.frame_b)[:3, 3])
         for i, leader, rule in self.mimics:
             rows.append(q[i] - rule.multiplier * q[leader] - rule.offset)
         return np.array(rows)
 
     def jacobian(self, q):
+        """Return the residual's geometric Jacobian at ``q``."""
         frames, axes = self.frames(q)
         rows = []
         for c in self.closures:
@@ -111,6 +114,7 @@ class LevenbergMarquardt:
         return np.array(rows)
 
     def normalize(self, q):
+        """Return ``q`` with its revolute joints wrapped to [-pi, pi)."""
         out = q.copy()
         out[self.angular] = np.remainder(out[self.angular] + math.pi, math.tau) - math.pi
         return out

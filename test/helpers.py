@@ -544,8 +544,10 @@ class UrdfFk:
         return out
 
     def gaps(self, values: dict) -> dict:
-        """Return each closure's gap (m) at ``values``: its frames' origins apart (a weld's
-        rotation too, times the loop's size)."""
+        """Return each closure's gap (m) at ``values``.
+
+        Its frames' origins apart; for a weld, its rotation too, times the loop's size.
+        """
         import numpy as np
         frames = self.transforms(values)
         out = {}
@@ -558,8 +560,11 @@ class UrdfFk:
         return out
 
     def loop_size(self, name: str) -> float:
-        """Return the size of a closure's loop at the zero pose: the largest distance between
-        the frames of the links on its path through the tree, and the closure's point."""
+        """Return the size of a closure's loop at the zero pose (m).
+
+        The largest distance between the frames of the links on its path
+        through the tree, and the closure's point.
+        """
         import numpy as np
         closure = next(c for c in self.closures if c[0] == name)
         frames = self.transforms({})

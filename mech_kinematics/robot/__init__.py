@@ -17,7 +17,7 @@ Pure: no ROS (lxml and urdf_parser_py read the XML).
 """
 
 from .description import Closure, ClosureKind, Description, read_description
-from .planar import GAP_TOLERANCE, PLANAR_TOLERANCE, Planar
+from .planar import GAP_TOLERANCE, Planar, PLANAR_TOLERANCE
 from .robot import load_robot, MIMIC_TOLERANCE, Robot, RobotState
 
 __all__ = ['Closure', 'ClosureKind', 'Description', 'GAP_TOLERANCE', 'MIMIC_TOLERANCE',

@@ -385,7 +385,7 @@ def _joints(robot: Any, source: str) -> dict[str, UrdfJoint]:
             origin = transform(xyz, rpy)
         axis: tuple[float, float, float] = (1.0, 0.0, 0.0)
         if joint.axis is not None and URDF_TYPES[kind] is not None:
-            axis = _unit(tuple(float(v) for v in joint.axis), f'{where}\'s <axis>', source,
+            axis = _unit(tuple(float(v) for v in joint.axis), f"{where}'s <axis>", source,
                          name)
         limits = None
         if joint.limit is not None and joint.limit.lower is not None \

@@ -191,8 +191,8 @@ class _Edge:
     closure: Closure | None = None
 
 
-def _bodies(description: Description, weld: list[Closure]) -> tuple[dict[str, str],
-                                                                     dict[str, Matrix]]:
+def _bodies(description: Description, weld: list[Closure]
+            ) -> tuple[dict[str, str], dict[str, Matrix]]:
     """Return link -> body (its group's link nearest the root) and each link in its body.
 
     Links joined by fixed joints, and links welded by a closure, are one body.
@@ -597,7 +597,7 @@ class _Builder:
         self._known(body, (crank_link, phi0), edge.name, tip, phi0)
 
     def _tip(self, body: str, centre_pin: str, centre: complex) -> str:
-        """Return a pin of ``body`` away from ``centre``: the crank's tip (one is added if none)."""
+        """Return a pin of ``body`` away from ``centre``: the crank's tip (added if none)."""
         m = self.m
         far = [p for p, z in m.pins[body].items()
                if p != centre_pin and abs(z - centre) > TOGGLE_TOLERANCE * m.size]
@@ -732,7 +732,7 @@ class _Builder:
         if offset > PLANAR_TOLERANCE * m.size:
             raise self.fail(
                 f'joint "{joint}": Expected a cylinder\'s line through both its pins, got '
-                f'the rod\'s pin {offset:.3g} m off the line of the barrel\'s pin', joint)
+                f"the rod's pin {offset:.3g} m off the line of the barrel's pin", joint)
         kappa = 1.0 if (u.conjugate() * line).real > 0 else -1.0
         assert edge.joint is not None
         reference = m.reference_value(edge.joint)
@@ -927,10 +927,10 @@ def _actuated_names(description: Description, actuated: Iterable[str] | None,
         how = 'the actuated joints given'
     elif description.independent is not None:
         names = description.independent
-        how = 'the sidecar\'s independent joints'
+        how = "the sidecar's independent joints"
     elif description.actuated:
         names = description.actuated
-        how = 'the URDF\'s <transmission>/<ros2_control> joints'
+        how = "the URDF's <transmission>/<ros2_control> joints"
     else:
         candidates = ', '.join(loop_joints) or 'none'
         raise UrdfError(f'{source}: Expected the actuated joints (--actuated J1,J2,... or '

@@ -31,7 +31,7 @@ from .planar import Planar
 from ..errors import UrdfError
 from ..geometry.frames import child_frame
 from ..geometry.instant_centres import full_scene
-from ..geometry.urdf import _add_visuals, _assembled, _fmt, COLOURS, visuals_from_scene, Visual
+from ..geometry.urdf import _add_visuals, _assembled, _fmt, COLOURS, Visual, visuals_from_scene
 from ..solver import Scene
 
 __all__ = ['robot_urdf_from_scene', 'scene_yaml']
@@ -44,9 +44,8 @@ def scene_yaml(planar: Planar, source: str) -> str:
              "# the change of the scene's coordinates it follows (rad or m):"]
     for item in planar.joints.values():
         if item.type.angular:
-            parts = [f'{name} - {ref!r}' for name, ref in ((item.child, item.child_ref),
-                                                         (item.parent, item.parent_ref))
-                     if name is not None]
+            ends = ((item.child, item.child_ref), (item.parent, item.parent_ref))
+            parts = [f'{name} - {ref!r}' for name, ref in ends if name is not None]
             turn = ' - '.join(f'({p})' for p in parts) or '0'
         else:
             turn = f'{item.slider} - {item.slider_ref!r}'

@@ -88,14 +88,14 @@ def joint_list(text: str) -> tuple[str, ...]:
 
 
 def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
-    """Add what a robot described in URDF takes: ``--closures``, ``--actuated``, ``--reference``."""
+    """Add what a robot in URDF takes: ``--closures``, ``--actuated`` and ``--reference``."""
     group = parser.add_argument_group('a robot described in URDF (a SCENE path ending in .urdf)')
     group.add_argument('--closures', metavar='FILE',
-                       help="a scikit-robot loop_closures.yaml beside the URDF (its <constraint> "
+                       help='a scikit-robot loop_closures.yaml beside the URDF (its <constraint> '
                             'elements and closing_NAME_1/_2 frames are read from the URDF)')
     group.add_argument('--actuated', type=joint_list, metavar='J1,J2,...',
-                       help='the actuated joints (default: the closures file\'s independent '
-                            'joints, else the URDF\'s <transmission> and <ros2_control> joints)')
+                       help="the actuated joints (default: the closures file's independent "
+                            "joints, else the URDF's <transmission> and <ros2_control> joints)")
     group.add_argument('--reference', type=named_value, action='append', metavar='J=VALUE',
                        help='a reference pose whose branches the loops keep (degrees for a '
                             'revolute joint, m for a prismatic one; repeatable; default: the '

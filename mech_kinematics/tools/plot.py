@@ -36,8 +36,8 @@ import warnings
 import numpy as np
 import numpy.typing as npt
 
-from .cli import finite_float, positive_float, PROG, run_tool
 from .cli import add_robot_arguments, load_scene_argument, named_value, values_by_driver
+from .cli import finite_float, positive_float, PROG, run_tool
 from ..errors import MechKinematicsError
 from ..ros import topics
 from ..ros.cdr import stamp_from_cdr

@@ -169,7 +169,7 @@ def _taylor_gap(fk, answer, h):
 
 @pytest.mark.parametrize('name', SCENES)
 def test_every_packaged_scene_round_trips_through_its_urdf(name):
-    """urdf --robot, read back: every body's link sits where the scene puts the body.
+    """Read back, `urdf --robot` puts every body's link where the scene puts the body.
 
     At drivers moved from their start, the URDF's forward kinematics with the
     joints we answer puts each link at its body's angle, and each of the
@@ -183,7 +183,6 @@ def test_every_packaged_scene_round_trips_through_its_urdf(name):
     robot = load_robot(text)
     fk = UrdfFk(text)
     graph = scene.graph
-    drivers = [d.name for d in scene.drivers]
 
     def solve_scene(values):
         return mk.solve(full, values[0] if len(values) == 1 else values)
