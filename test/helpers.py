@@ -583,3 +583,61 @@ class UrdfFk:
         points = [frames[link][:3, 3] for link in links]
         points.append((frames[closure[2]] @ closure[3])[:3, 3])
         return max(float(np.linalg.norm(p - q)) for p in points for q in points)
+
+
+# --- Khurmi's four-bar as a URDF -------------------------------------------------------
+# test/robot/test_robot.py and test_refusals.py: the packaged khurmi_four_bar_ad150 written
+# by hand as a robot (crank "motor", coupler "elbow", rocker "rocker_pivot" about -z),
+# closed at C in either closure form (issue 31).
+
+
+KHURMI = """<?xml version="1.0"?>
+<robot name="khurmi">
+  <link name="frame"/><link name="crank"/><link name="coupler"/><link name="rocker"/>
+  <joint name="motor" type="revolute">
+    <parent link="frame"/><child link="crank"/>
+    <origin xyz="0 0 0" rpy="0 0 1.0471975511965976"/><axis xyz="0 0 1"/>
+    <limit lower="-3.2" upper="3.2" effort="1" velocity="1"/>
+  </joint>
+  <joint name="elbow" type="revolute">
+    <parent link="crank"/><child link="coupler"/>
+    <origin xyz="0.04 0 {dz}" rpy="0 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="1" velocity="1"/>
+  </joint>
+  <joint name="rocker_pivot" type="continuous">
+    <parent link="frame"/><child link="rocker"/>
+    <origin xyz="0.15 0 0" rpy="0 0 0"/><axis xyz="0 0 -1"/>
+  </joint>
+  {closure}
+  <transmission name="t"><type>transmission_interface/SimpleTransmission</type>
+    <joint name="motor"><hardwareInterface>EffortJointInterface</hardwareInterface></joint>
+    <actuator name="m"/></transmission>
+</robot>
+"""
+
+
+def khurmi_pin():
+    """Return pin C of Khurmi's four-bar in the coupler's and the rocker's frames (m)."""
+    scene = mk.load_scene('khurmi_four_bar_ad150')
+    state = mk.solve(scene, scene.input.angle)
+    b, c = state.complex_points['B'][0], state.complex_points['C'][0]
+    on_coupler = (c - b) * complex(math.cos(-math.pi / 3), math.sin(-math.pi / 3))
+    return on_coupler, c - 0.15
+
+
+def khurmi_urdf(form='constraint', dz=0.0):
+    """Return Khurmi's four-bar (AB 40, BC 150, CD 80, AD 150 mm) in URDF, closed in ``form``."""
+    coupler, rocker = khurmi_pin()
+    if form == 'constraint':
+        closure = (f'<constraint name="pin_C" type="revolute">'
+                   f'<parent link="coupler"/><parent_origin xyz="{coupler.real!r} '
+                   f'{coupler.imag!r} {-dz!r}" rpy="0 0 0"/><parent_axis xyz="0 0 1"/>'
+                   f'<child link="rocker"/><child_origin xyz="{rocker.real!r} {rocker.imag!r} '
+                   f'0" rpy="0 0 0"/><child_axis xyz="0 0 -1"/></constraint>')
+    else:
+        closure = ''.join(
+            f'<link name="closing_C_{i}"/><joint name="closing_C_{i}_frame" type="fixed">'
+            f'<parent link="{link}"/><child link="closing_C_{i}"/>'
+            f'<origin xyz="{z.real!r} {z.imag!r} {oz!r}" rpy="0.3 0.1 0.2"/></joint>'
+            for i, link, z, oz in ((1, 'coupler', coupler, -dz), (2, 'rocker', rocker, 0.0)))
+    return KHURMI.format(closure=closure, dz=dz)
