@@ -33,6 +33,7 @@ RTOL_DIFFERENCE = 1e-6
 NO_URDF = {'geneva': 'intermittent'}
 SCENES = [name for name in mk.scene_names() if name not in NO_URDF]
 
+
 def test_the_four_bar_in_urdf_answers_the_scene_under_the_urdf_signs():
     """Khurmi's rocker pivot turns about -z: its joint is minus the rocker's absolute turn."""
     robot = load_robot(khurmi_urdf())
