@@ -226,7 +226,7 @@ def test_a_scene_of_several_drivers_keeps_the_general_path(name):
     drivers = (f'its driver {names} is not a crank' if len(scene.drivers) == 1
                else f'{len(scene.drivers)} drivers ({names})')
     why = NotCompiled(f"{drivers}: mk.solve compiles one crank's paths alone (the node's tick "
-                      "compiles any drivers)")
+                      'compiles any drivers)')
     assert compile_scene(scene, SINGLE) == why and compile_scene(scene, ARRAY) == why
     positions = [driver.start for driver in scene.drivers]
     many = [np.full(3, x) for x in positions]
