@@ -332,8 +332,12 @@ def viewer(requests: int = 100) -> dict[str, Any]:
         try:
             _wait_for(log, '(Ctrl-C stops it)', view)
             url = re.search(r'(http://\S+/)', log.read_text()).group(1)    # type: ignore
+            # /state answers the page's token only (docs/view.md, The door).
+            token = re.search(r'name="view-token" content="([^"]+)"', urllib.request.urlopen(
+                url).read().decode()).group(1)    # type: ignore
+            state = urllib.request.Request(url + 'state', headers={'X-View-Token': token})
             deadline = time.monotonic() + 30
-            while json.loads(urllib.request.urlopen(url + 'state').read())['frame'] is None:
+            while json.loads(urllib.request.urlopen(state).read())['frame'] is None:
                 if time.monotonic() > deadline:
                     raise RuntimeError('no frame from view within 30 s')
                 time.sleep(0.1)
@@ -341,7 +345,7 @@ def viewer(requests: int = 100) -> dict[str, Any]:
             times, sizes = [], []
             for _ in range(requests):
                 start = time.perf_counter()
-                sizes.append(len(urllib.request.urlopen(url + 'state').read()))
+                sizes.append(len(urllib.request.urlopen(state).read()))
                 times.append(1e3 * (time.perf_counter() - start))
         finally:
             for process in (view, node):

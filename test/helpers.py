@@ -23,7 +23,7 @@ import setuptools
 
 import mech_kinematics as mk
 from mech_kinematics.ros.parameters import PARAMETERS
-from mech_kinematics.tools.report import reference as ref
+from mech_kinematics.verify import reference as ref
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
@@ -33,7 +33,7 @@ SCENES = HERE.parent / 'config' / 'scenes'
 
 # --- the packaged scenes by their drivers ----------------------------------------------
 # Tests that sweep one crank's angle (geometry, diagrams, the reference's time
-# differences) take the scenes driven by one crank; test/solver/test_drivers.py
+# differences) take the scenes driven by one crank; test/solver/test_solve_drivers.py
 # and the several-driver tests of each tool take the others (issue 18).
 
 
@@ -55,7 +55,7 @@ def driver_scene_names() -> list[str]:
 
 
 # --- the published 50-digit reference cases ------------------------------------
-# Used by test_linkage_golden.py (the solver against them) and test_reference.py
+# Used by test_solve_golden.py (the solver against them) and test_reference.py
 # (the mpmath reference against them).
 
 #: Verbatim copies of the published golden cases (``<scene>.json``).
@@ -330,7 +330,7 @@ def first_order_spreads(scene, angle, speed=None, accel=None, exact=None):
 
 
 # --- the solver's compiled paths against its general one ----------------------
-# Used by test_compiled.py (the compiled single-angle and array solves),
+# Used by test_compiler_solve.py (the compiled single-angle and array solves),
 # test_ticker.py (the node's tick against the general solver) and
 # test_compiler.py (every registered kind, compiled for every target).
 

@@ -20,6 +20,8 @@ import sys
 import threading
 import time
 
+from lifecycle_msgs.msg import Transition
+from lifecycle_msgs.srv import ChangeState, GetState
 import pytest
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
@@ -63,6 +65,26 @@ def wait_for(predicate, timeout: float, what: str):
             return value
         time.sleep(0.01)
     pytest.fail(f'timed out after {timeout} s waiting for {what}')
+
+
+def send_until(send, predicate, timeout: float, what: str, every: float = 0.5):
+    """Call ``send``, then again every ``every`` s, until ``predicate`` is true; return it.
+
+    A message sent before the other side has matched this one is lost (each side
+    discovers the other on its own; ``get_subscription_count`` says only that
+    this side has): resend until answered. Fails naming ``what`` after ``timeout`` s.
+    """
+    deadline = time.monotonic() + timeout
+    while True:
+        send()
+        again = min(deadline, time.monotonic() + every)
+        while time.monotonic() < again:
+            value = predicate()
+            if value:
+                return value
+            time.sleep(0.01)
+        if time.monotonic() >= deadline:
+            pytest.fail(f'timed out after {timeout} s waiting for {what}')
 
 
 def exited(proc: 'NodeProcess') -> tuple[int, str]:
@@ -139,6 +161,57 @@ class Ros:
         self.node.destroy_node()
         rclpy.try_shutdown(context=self.context)
         self._thread.join(timeout=2.0)
+
+
+class Lifecycle:
+    """Clients of a managed node's lifecycle services, asking again what was not answered.
+
+    A request sent before the node has matched this client is lost, and so is
+    an answer sent before this client has matched the node: ``wait_for_service``
+    says only that this side sees the service.
+    """
+
+    #: The state each transition leads to.
+    GOALS = {Transition.TRANSITION_CONFIGURE: 'inactive',
+             Transition.TRANSITION_CLEANUP: 'unconfigured',
+             Transition.TRANSITION_ACTIVATE: 'active',
+             Transition.TRANSITION_DEACTIVATE: 'inactive',
+             Transition.TRANSITION_UNCONFIGURED_SHUTDOWN: 'finalized',
+             Transition.TRANSITION_INACTIVE_SHUTDOWN: 'finalized',
+             Transition.TRANSITION_ACTIVE_SHUTDOWN: 'finalized'}
+    #: How long an unanswered request waits before it is sent again, s.
+    AGAIN_S = 2.0
+
+    def __init__(self, ros: 'Ros', node: str) -> None:
+        self.ros = ros
+        self.change = ros.node.create_client(ChangeState, f'{node}/change_state')
+        self.get = ros.node.create_client(GetState, f'{node}/get_state')
+        assert self.change.wait_for_service(timeout_sec=STARTUP_S)
+        assert self.get.wait_for_service(timeout_sec=STARTUP_S)
+
+    def state(self) -> str:
+        """Return the node's state label (asking again until answered)."""
+        futures: list = []
+        send_until(lambda: futures.append(self.get.call_async(GetState.Request())),
+                   lambda: any(f.done() for f in futures), STARTUP_S, 'get_state',
+                   every=self.AGAIN_S)
+        return next(f for f in futures if f.done()).result().current_state.label
+
+    def transition(self, transition_id: int) -> bool:
+        """Ask for a transition; return whether it succeeded.
+
+        Unanswered after AGAIN_S, the request is sent again; a repeat of a
+        transition that was made is refused by the node, so success is any
+        answer's, or the node being in the transition's goal state.
+        """
+        request = ChangeState.Request(transition=Transition(id=transition_id))
+        futures: list = []
+        send_until(lambda: futures.append(self.change.call_async(request)),
+                   lambda: any(f.done() for f in futures), STARTUP_S,
+                   f'change_state {transition_id}', every=self.AGAIN_S)
+        if any(f.result().success for f in futures if f.done()):
+            return True
+        return len(futures) > 1 and self.state() == self.GOALS[transition_id]
 
 
 class NodeProcess:

@@ -1,12 +1,15 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""The layers and their arrows: core <- geometry <- ROS layer and tools. See issue 9.
+"""The layers and their arrows: core <- geometry, verify <- ROS layer and tools. See issue 9.
 
 - the solver core (errors, units, the solver package, scene, textbook) imports only NumPy,
   PyYAML and the standard library;
 - geometry imports the core only, and never matplotlib;
 - a robot described in URDF (``robot/``: reading it, mapping its loops onto the kinds)
   imports the core and geometry only, never rclpy; the node and the tools build on it;
+- the verification room (``verify/``: the 50-digit reference, the extreme suite) sits
+  beside geometry: it imports the core and geometry, never a tool or the ROS layer; the
+  tools (the report) import it (issue 30);
 - the ROS layer never imports a tool (drawing, report, recorder) nor matplotlib;
 - the bag writer (``bag/``) imports the core only; the tools use it;
 - building the command line for ``solve`` imports no heavy dependency.
@@ -27,8 +30,8 @@ HEAVY = ('rclpy', 'matplotlib', 'mpmath', 'scipy', 'rosbags', 'tqdm')
 
 #: Layer of each subpackage (modules at the top are the core), and what each may import.
 LAYERS = {'core': set(), 'data': set(), 'geometry': {'core'}, 'robot': {'core', 'geometry'},
-          'ros': {'core', 'geometry', 'robot'}, 'bag': {'core'},
-          'tools': {'core', 'geometry', 'robot', 'ros', 'data', 'bag'}}
+          'verify': {'core', 'geometry'}, 'ros': {'core', 'geometry', 'robot'}, 'bag': {'core'},
+          'tools': {'core', 'geometry', 'robot', 'ros', 'data', 'bag', 'verify'}}
 
 
 def _modules_after(code: str) -> set:
@@ -139,3 +142,23 @@ def test_each_fact_is_spelled_in_its_home_only(literal, home):
     spelled = sorted(str(p.relative_to(PACKAGE)) for p in PACKAGE.rglob('*.py')
                      if literal in p.read_text(encoding='utf-8'))
     assert spelled == [home]
+
+
+#: The step kinds and drivers: each is one module with a test file of its own.
+KIND_MODULES = ('crank', 'actuator', 'rrr', 'rrp', 'rpr', 'rpp', 'geneva', 'carried')
+
+
+def test_every_kind_module_has_its_own_test_file():
+    """Tests mirror the package: each kind's module has test/solver/test_<kind>.py."""
+    tests = Path(__file__).resolve().parent / 'solver'
+    for kind in KIND_MODULES:
+        assert (PACKAGE / 'solver' / f'{kind}.py').is_file(), kind
+        assert (tests / f'test_{kind}.py').is_file(), f'no test/solver/test_{kind}.py'
+
+
+def test_no_test_file_is_named_after_a_module_that_does_not_exist():
+    """A test/solver/test_X*.py names an existing solver module X (or the solver's solve)."""
+    modules = {path.stem for path in (PACKAGE / 'solver').glob('*.py')}
+    for path in (Path(__file__).resolve().parent / 'solver').glob('test_*.py'):
+        name = path.stem.removeprefix('test_')
+        assert any(name == m or name.startswith(m + '_') for m in modules), path.name

@@ -23,7 +23,7 @@ import yaml
 import mech_kinematics as mk
 from mech_kinematics.__main__ import main
 from mech_kinematics.imu import imu_reading, ImuSpec
-from mech_kinematics.tools.report import reference as ref
+from mech_kinematics.verify import reference as ref
 
 G = (0.0, -9.80665)  # m/s^2, standard gravity along -y
 SCENE = mk.load_scene('khurmi_four_bar_ad150')

@@ -69,10 +69,29 @@ class Window:
     last_sample: tuple[float, float, float] | None = None   # crank angle, speed, accel
     last_published_stamp_ns: int = 0
     totals: dict[str, int] = field(default_factory=dict)
+    # Driven from a topic (carried over windows but the count): the last input message's
+    # joints ignored and passed through, and the stamps' jumps back.
+    stamp_jumps_back: int = 0
+    last_stamp_jump_back: str = ''
+    ignored_joints: tuple[str, ...] = ()
+    passed_joints: tuple[str, ...] = ()
 
 
 _TOTALS = ('instants', 'published', 'unsolved', 'late', 'skipped', 'clock_jumps',
-           'jump_instants')
+           'jump_instants', 'stamp_jumps_back')
+#: How many joint names a diagnostics value lists before it says how many more there are.
+SHOWN_JOINTS = 20
+
+
+def _seconds(stamp_ns: int) -> str:
+    sec, nanosec = divmod(stamp_ns, NS_PER_S)
+    return f'{sec}.{nanosec:09d} s'
+
+
+def _joint_list(names: Sequence[str]) -> str:
+    shown = ', '.join(names[:SHOWN_JOINTS])
+    more = len(names) - SHOWN_JOINTS
+    return f'{shown} and {more} more' if more > 0 else shown
 
 
 class TickStats:
@@ -84,11 +103,15 @@ class TickStats:
         self._lock = threading.Lock()
         self._totals = dict.fromkeys(_TOTALS, 0)
         self._last_published_stamp_ns = 0
+        self._window = Window()
         self._reset(time.monotonic_ns())
 
     def _reset(self, now_mono_ns: int) -> None:
         self._start = now_mono_ns
-        self._window = Window()
+        last = self._window
+        self._window = Window(last_stamp_jump_back=last.last_stamp_jump_back,
+                              ignored_joints=last.ignored_joints,
+                              passed_joints=last.passed_joints)
 
     def record(self, stamp_ns: int, lateness_ns: int, late: bool, *, error: str | None = None,
                refusal: str = 'cannot assemble', measure: float = math.inf,
@@ -142,6 +165,24 @@ class TickStats:
             if jump:
                 w.jump_instants += 1
 
+    def topic_input(self, stamp_ns: int, jumped_from_ns: int | None, ignored: Sequence[str],
+                    passed: Sequence[str]) -> None:
+        """Note what a published input message (``drive: topic``) did beside its drivers.
+
+        ``jumped_from_ns``: the last published stamp, when ``stamp_ns`` jumped
+        back from it (the order reset); ``ignored`` and ``passed``: the
+        message's other joints, dropped or passed through.
+        """
+        with self._lock:
+            w = self._window
+            if jumped_from_ns is not None:
+                w.stamp_jumps_back += 1
+                w.last_stamp_jump_back = (
+                    f'from {_seconds(jumped_from_ns)} to {_seconds(stamp_ns)}, '
+                    f'{(jumped_from_ns - stamp_ns) / NS_PER_S:.9g} s back')
+            w.ignored_joints = tuple(ignored)
+            w.passed_joints = tuple(passed)
+
     def skip(self, count: int) -> None:
         """Count ``count`` grid instants dropped."""
         if count:
@@ -185,12 +226,18 @@ def lateness_p99_ns(window: Window) -> int | None:
 
 
 def solver_status(window: Window, *, name: str, hardware_id: str, near_singular: float,
-                  waiting_for: str = '', assembly: str = '') -> Status:
+                  waiting_for: str = '', assembly: str = '', extra_joints: str = '') -> Status:
     """Return the solver status of ``window``.
 
     ERROR if any instant could not be solved or was refused (with the last
-    reason), WARN if any was near-singular or the node is ``waiting_for``
-    something (e.g. ``'/clock'``), STALE if there was nothing to solve, else OK.
+    reason), WARN if an input's stamp jumped back (the order reset), if any
+    was near-singular or the node is ``waiting_for`` something (e.g.
+    ``'/clock'``), STALE if there was nothing to solve, else OK.
+    ``extra_joints``: the node's ``extra_joints`` when it is driven from a
+    topic ('' otherwise), which adds the keys ``extra_joints``,
+    ``ignored_joints`` and ``passed_joints`` (the last input's),
+    ``stamp_jumps_back``, ``stamp_jumps_back_total`` and
+    ``last_stamp_jump_back``.
     Instants at which a value jumps, published one-sided (a Geneva wheel's
     engagement instants), are counted (keys ``jump_instants``,
     ``jump_instants_total``) and do not change the level.
@@ -205,6 +252,10 @@ def solver_status(window: Window, *, name: str, hardware_id: str, near_singular:
     elif w.unsolved:
         level = ERROR
         message = f'{w.last_refusal} at {w.unsolved} of {w.instants} ticks: {w.last_error}'
+    elif w.stamp_jumps_back:
+        level = WARN
+        message = (f'input stamp jumped back {w.stamp_jumps_back} time(s) (the order reset), '
+                   f'last {w.last_stamp_jump_back}')
     elif w.near_singular:
         level, message = WARN, f'near-singular at {w.near_singular} of {w.instants} ticks'
     else:
@@ -221,6 +272,13 @@ def solver_status(window: Window, *, name: str, hardware_id: str, near_singular:
     ]
     if assembly:
         values.append(('assembly', assembly))
+    if extra_joints:
+        values += [('extra_joints', extra_joints),
+                   ('ignored_joints', _joint_list(w.ignored_joints)),
+                   ('passed_joints', _joint_list(w.passed_joints)),
+                   ('stamp_jumps_back', str(w.stamp_jumps_back)),
+                   ('stamp_jumps_back_total', str(w.totals.get('stamp_jumps_back', 0))),
+                   ('last_stamp_jump_back', w.last_stamp_jump_back)]
     if w.last_sample is not None and isinstance(w.last_sample[0], tuple):
         # Several drivers: each one's position, speed and acceleration, in scene order.
         values += [(f'driver_{key}', ', '.join(map(repr, column)))

@@ -48,12 +48,13 @@ from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
 import rclpy
 from rclpy.clock import Clock, ClockType, JumpThreshold
 from rclpy.duration import Duration
-from rclpy.executors import ExternalShutdownException
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
 from rclpy.logging import get_logger
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSDurabilityPolicy, QoSHistoryPolicy, QoSProfile, QoSReliabilityPolicy
 from rclpy.qos_overriding_options import QoSOverridingOptions, QoSPolicyKind
+from rclpy.signals import install_signal_handlers, SignalHandlerOptions
 from sensor_msgs.msg import Imu, JointState
 from std_msgs.msg import String
 from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
@@ -70,6 +71,7 @@ from .parameters import (CATCH_UP, catch_up_window_ns, driver_parameters, first_
                          joint_refusal, PARAMETERS, ParameterSpec, refusal, rpm_parameter, spec,
                          STATE_DEPTH, TOPIC)
 from .schedule import period_ns_from_rate
+from .startup import catch_stop_signals, start_refusal, stop_asked
 from .tf import static_tf_message, TfMessages
 from .ticker import compile_tick, general_tick, tick_function
 from .timebase import ActuatorTimebase, CrankSample, CrankTimebase
@@ -361,6 +363,8 @@ class KinematicsNode(LifecycleNode):
             self._tf_period_ns = self._tf_period(changes['tf_rate_hz'])
         if 'max_relative_error' in changes:
             self._max_error = float(changes['max_relative_error'])
+        if 'stamp_jump_back_s' in changes and self._topic is not None:
+            self._topic.jump_back_ns = round(changes['stamp_jump_back_s'] * NS_PER_S)
         requests: dict[str, dict[str, float]] = {}
         for name, value in changes.items():
             for drive, key in self._drive_keys.get(name, ()):
@@ -718,7 +722,7 @@ class KinematicsNode(LifecycleNode):
         names = ('scene', 'drive', 'crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm',
                  'rate_hz', 'late_ticks', 'max_catch_up_s', 'max_lateness_ms',
                  'max_relative_error', 'frame_id', 'tf_rate_hz', 'tf_prefix',
-                 'use_sim_time', 'markers', 'managed')
+                 'use_sim_time', 'markers', 'managed', 'extra_joints', 'stamp_jump_back_s')
         names += tuple(self._driver_specs)
         settings = ', '.join(f'{name}={self._value(name)!r}' for name in names[1:])
         self.get_logger().info(
@@ -942,7 +946,10 @@ class KinematicsNode(LifecycleNode):
         self._topic_messages = {
             known: TickMessages(joints, points, self.frame_id, velocities=known,
                                 accelerations=False) for known in (True, False)}
-        self._topic = TopicDrive(scene.drivers)
+        self._topic = TopicDrive(
+            scene.drivers, extra_joints=self._value('extra_joints'),
+            jump_back_ns=round(self._value('stamp_jump_back_s') * NS_PER_S),
+            published_joints=joints)
         # Subscribed at configure (its QoS overrides are declared with the others); a
         # message is published only while active.
         qos = QoSProfile(history=QoSHistoryPolicy.KEEP_LAST, depth=INPUT_DEPTH,
@@ -996,7 +1003,8 @@ class KinematicsNode(LifecycleNode):
         stamp = msg.header.stamp
         stamp_ns = stamp.sec * NS_PER_S + stamp.nanosec
         try:
-            given = topic.read(stamp.sec, stamp.nanosec, msg.name, msg.position, msg.velocity)
+            given = topic.read(stamp.sec, stamp.nanosec, msg.name, msg.position, msg.velocity,
+                               msg.effort)
             values, measure = self._solve_input(given)
         except (RefusedInput, mk.AssemblyError) as exc:
             kind = 'refused input' if isinstance(exc, RefusedInput) else \
@@ -1007,9 +1015,19 @@ class KinematicsNode(LifecycleNode):
             return
         sec, nanosec = divmod(given.stamp_ns, NS_PER_S)
         messages = self._topic_messages[given.speeds is not None]
-        for publish, data in zip(self._publish_state,
-                                 messages.render_values(values, sec, nanosec), strict=True):
+        rendered = messages.render_values(values, sec, nanosec)
+        if given.passed is not None:    # extra_joints: pass: names that change per message
+            rendered = (self._joint_state_passed(topic, given, values, sec, nanosec),
+                        *rendered[1:])
+        for publish, data in zip(self._publish_state, rendered, strict=True):
             publish(data)
+        if given.jumped_from_ns is not None:
+            self._next_tf = 0   # /tf's rate counts from the new order
+            self.get_logger().warning(
+                f'{topics.INPUT_JOINT_STATES}: the stamp jumped back '
+                f'{(given.jumped_from_ns - given.stamp_ns) / NS_PER_S:.9g} s (more than '
+                'stamp_jump_back_s): published, the order starts again from it',
+                throttle_duration_sec=1.0)
         if self._tf is not None and self._tf_period_ns is not None \
                 and given.stamp_ns >= self._next_tf:
             self._pub_tf.publish(self._tf.render_values(values, self._tf_first, sec, nanosec))
@@ -1019,6 +1037,17 @@ class KinematicsNode(LifecycleNode):
         topic.published(given.stamp_ns)
         self._stats.record(given.stamp_ns, time.monotonic_ns() - received, False,
                            measure=measure, near_singular=measure < mk.NEAR_SINGULAR)
+        self._stats.topic_input(given.stamp_ns, given.jumped_from_ns, given.ignored,
+                                given.passed.names if given.passed is not None else ())
+
+    def _joint_state_passed(self, topic: TopicDrive, given: TopicInput, values: Any, sec: int,
+                            nanosec: int) -> JointState:
+        """Return ``joint_states`` with the input's other joints after the mechanism's."""
+        name, position, velocity, effort = topic.joint_state_arrays(given, values)
+        msg = JointState(name=name, position=position, velocity=velocity, effort=effort)
+        msg.header.stamp = Time(sec=sec, nanosec=nanosec)
+        msg.header.frame_id = self.frame_id
+        return msg
 
     def _solve_input(self, given: TopicInput) -> tuple[Any, float]:
         """Return (the tick function's values, the singularity measure) for one input.
@@ -1070,7 +1099,8 @@ class KinematicsNode(LifecycleNode):
         statuses = [
             solver_status(window, name=name, hardware_id=hardware_id,
                           near_singular=mk.NEAR_SINGULAR, waiting_for=waiting,
-                          assembly=self._assembly),
+                          assembly=self._assembly,
+                          extra_joints=self._value('extra_joints') if self._topic else ''),
             timing_status(window, name=name, hardware_id=hardware_id,
                           rate_hz=self._value('rate_hz'),
                           max_lateness_ms=self._value('max_lateness_ms')),
@@ -1168,37 +1198,69 @@ class Instance:
                 '(remap the name with -r __node:=NAME or the namespace with -r __ns:=/NS)')
 
 
+class _Executor(SingleThreadedExecutor):
+    """rclpy's executor; one half built (a signal shut its context down) deletes quietly."""
+
+    # Executor.__del__ reads it: without this, an executor whose __init__ failed prints
+    # "Exception ignored ... AttributeError" when it is collected.
+    _sigint_gc = None
+
+
 def main(args: list[str] | None = None) -> int:
-    """Run the node until Ctrl-C or SIGTERM; return the exit status."""
+    """Run the node until Ctrl-C or SIGTERM; return the exit status.
+
+    0 when stopped (a SIGINT or SIGTERM at any point of the start included), 1 if
+    it cannot start, 2 if a file its arguments name may not be read
+    (:mod:`~mech_kinematics.ros.startup`).
+    """
+    catch_stop_signals()
     # The node reports near-singular poses on diagnostics and in its log.
     warnings.filterwarnings('ignore', category=mk.NearSingularWarning)
     # The tick thread must not wait long for the GIL when it wakes (default 5 ms).
     sys.setswitchinterval(SWITCH_INTERVAL_S)
     logger = get_logger(NODE_NAME)
     start_ns = time.time_ns()
+    refused = start_refusal(sys.argv if args is None else args)
+    if refused is not None:
+        logger.fatal(f'cannot start: {refused}')
+        return 2
+    if stop_asked():
+        return 0
     try:
-        rclpy.init(args=args)
+        # Until the spin a signal is only noted (startup.catch_stop_signals), and the start
+        # stops at its next step: rclpy's handler would shut the context down under the
+        # step running (a SIGINT while configuring crashed the process with SIGSEGV).
+        rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     except Exception as exc:     # noqa: BLE001 - rclpy's argument errors come in several kinds
         logger.fatal(f'cannot start: bad arguments: {_one_line(exc)}')
         return 1
     node = None
     status = 0
     try:
+        if stop_asked():
+            return 0
         node = KinematicsNode()
         logger = node.get_logger()
         Instance(node, start_ns)
-        if not node.managed:
+        if not node.managed and not stop_asked():
             node.trigger_configure()
-            if node.scene is None:
+            if node.scene is None and not stop_asked():
                 logger.fatal(f'cannot start: {node.configure_error}')
                 return 1
         node.starting = False
-        if not node.managed:
+        if not node.managed and not stop_asked():
             node.trigger_activate()
         # Everything built so far lives as long as the node: keep it out of the
         # garbage collector's full passes, which would otherwise delay ticks.
         gc.freeze()
-        rclpy.spin(node)
+        # From now on rclpy's handler ends the spin on a signal (and calls ours); a signal
+        # noted before it was installed is seen here.
+        install_signal_handlers(SignalHandlerOptions.ALL)
+        if stop_asked():
+            return 0
+        executor = _Executor()
+        executor.add_node(node)
+        executor.spin()
     except (KeyboardInterrupt, ExternalShutdownException):
         pass  # Ctrl-C or shutdown: a clean exit, status 0
     except TickThreadError:
@@ -1207,10 +1269,11 @@ def main(args: list[str] | None = None) -> int:
         logger.fatal(f'cannot start: {exc}')
         status = 1
     except StartError as exc:
-        get_logger(exc.logger_name).fatal(f'cannot start: {exc.reason}')
-        status = 1
+        if not stop_asked():
+            get_logger(exc.logger_name).fatal(f'cannot start: {exc.reason}')
+            status = 1
     except Exception as exc:     # noqa: BLE001 - a start-up failure: one line, no traceback
-        if rclpy.ok():
+        if rclpy.ok() and not stop_asked():
             logger.fatal(f'cannot start: {_one_line(exc)}')
             status = 1
         # else a signal shut the context down while the node started (rclpy's own

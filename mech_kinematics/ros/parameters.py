@@ -19,12 +19,14 @@ from typing import Any
 
 from .diagnostics import DEFAULT_MAX_LATENESS_MS
 from .markers import DEFAULT_ACCELERATION_SCALE, DEFAULT_VELOCITY_SCALE
+from .topic_drive import DEFAULT_JUMP_BACK_S, EXTRA_JOINTS, REFUSE
 from ..bounds import MAX_ERROR
 from ..scene import DEFAULT_SCENE
 from ..units import NS_PER_S, rpm_from_rad_per_s
 
-__all__ = ['CATCH_UP', 'DRIVE_MODES', 'LATE_TICKS', 'PARAMETERS', 'ParameterSpec',
-           'SHOWN_CHARS', 'SKIP', 'STATE_DEPTH', 'TIME', 'TOPIC', 'catch_up_window_ns',
+__all__ = ['CATCH_UP', 'DRIVE_MODES', 'LATE_TICKS', 'MAX_NAME_CHARS', 'MAX_PATH_CHARS',
+           'PARAMETERS', 'ParameterSpec', 'SHOWN_CHARS', 'SKIP', 'STATE_DEPTH', 'TIME', 'TOPIC',
+           'catch_up_window_ns',
            'depth_refusal', 'driver_parameters', 'first_crank_aliases', 'frame_refusal',
            'joint_refusal', 'refusal', 'rpm_parameter', 'shown', 'spec']
 
@@ -36,6 +38,10 @@ LATE_TICKS = (CATCH_UP, SKIP)
 TIME = 'time'
 TOPIC = 'topic'
 DRIVE_MODES = (TIME, TOPIC)
+#: Longest string parameter (a frame id, a prefix, a choice), characters.
+MAX_NAME_CHARS = 256
+#: Longest path parameter (``scene``), characters: Linux's PATH_MAX.
+MAX_PATH_CHARS = 4096
 
 
 @dataclass(frozen=True)
@@ -64,6 +70,9 @@ class ParameterSpec:
         A string that may be empty.
     frame : bool
         A tf2 frame id (or a prefix of frame ids): see :func:`frame_refusal`.
+    max_chars : int
+        Longest value of a string, characters (a longer one is refused before
+        anything else reads it).
     """
 
     name: str
@@ -77,12 +86,13 @@ class ParameterSpec:
     read_only: bool = False
     may_be_empty: bool = False
     frame: bool = False
+    max_chars: int = MAX_NAME_CHARS
 
 
 PARAMETERS = (
     ParameterSpec('scene', 'string', DEFAULT_SCENE,
                   'Scene YAML: a path, or the name of a scene in config/scenes/',
-                  read_only=True),
+                  read_only=True, max_chars=MAX_PATH_CHARS),
     ParameterSpec('frame_id', 'string', 'mechanism',
                   'header.frame_id of every message: the ground frame of the scene',
                   read_only=True, frame=True),
@@ -95,6 +105,16 @@ PARAMETERS = (
                   'on the rate_hz grid) or topic (the positions, and velocities if given, of '
                   'each message on input_joint_states, published with its stamp)',
                   choices=DRIVE_MODES, read_only=True),
+    ParameterSpec('extra_joints', 'string', REFUSE,
+                  "With drive: topic, what an input message's joints that are not drivers "
+                  'do: refuse the message, ignore them (the drivers are taken), or pass them '
+                  "through unchanged in joint_states after the mechanism's joints",
+                  choices=EXTRA_JOINTS, read_only=True),
+    ParameterSpec('stamp_jump_back_s', 'double', DEFAULT_JUMP_BACK_S,
+                  'With drive: topic, an input stamped earlier than the last published state '
+                  'by more than this is a jump of the clock back: it is published and the '
+                  'order starts again from it (said on diagnostics); one earlier by less is '
+                  'refused as out of order', 's', 0.0, 1e9),
     ParameterSpec('crank_speed_rpm', 'double', None,
                   'Crank speed, + CCW, from the tick at which it is applied (the crank angle '
                   "stays continuous). Defaults to the scene's input.speed_rpm",
@@ -313,6 +333,9 @@ def refusal(name: str, value: Any,
         return f'{name}: expected a string, got {_kind_of(value)} {shown(value)}'
     if p.choices and value not in p.choices:
         return f'{name}: expected one of {", ".join(p.choices)}, got {shown(value)}'
+    if len(value) > p.max_chars:
+        return (f'{name}: expected at most {p.max_chars} characters, got {len(value)}: '
+                f'{value[:SHOWN_CHARS // 2]!r}...')
     if not value and not p.may_be_empty:
         return f'{name}: expected a non-empty string, got {value!r}'
     if p.frame:

@@ -259,7 +259,7 @@ class Item(ABC):
     scaling, its part of the mechanism's graph (:meth:`fragment`: every other
     concern reads the graph), the words of its failures and what its
     near-singularity measure means. Every method is abstract: a kind that
-    leaves one out cannot be built (``test_solver_protocol`` names it).
+    leaves one out cannot be built (``test_base`` names it).
 
     ``kind`` is the scene's ``type:`` of the item (``'RRR'``, ...; ``'point'``
     for a carried point): the registry keys on it.

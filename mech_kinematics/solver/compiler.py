@@ -25,7 +25,7 @@ partial evaluation of their syntax trees (:mod:`.specialize`), for one
 
 The same operations run in the same order on the same values, so each
 function gives the bits, bounds and errors of the general path
-(``test_compiled``, ``test_ticker`` and ``test_compile_every_kind`` compare
+(``test_compiler_solve``, ``test_ticker`` and ``test_compile_every_kind`` compare
 them). Where a scene cannot be compiled for a target, :func:`compile_scene`
 returns a :class:`NotCompiled` carrying the reason, one line: its lengths are
 rescaled (a size beyond 2**60 of 1 m), it has pins to bound, a kernel is

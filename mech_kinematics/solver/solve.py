@@ -865,7 +865,7 @@ def _new_state(scene: str, angle: Any, speed: Any, accel: Any, joints: dict[str,
     A frozen dataclass's ``__init__`` sets each field through
     ``object.__setattr__``: about 1 us of a 7 us single-angle solve. The fields
     go straight into the new instance's ``__dict__`` instead (there is no
-    ``__post_init__`` to run); ``test_linkage_bounds`` checks the result equals
+    ``__post_init__`` to run); ``test_solve_bounds`` checks the result equals
     the dataclass's own construction.
     """
     state = object.__new__(State)

@@ -10,89 +10,212 @@ fixes the drawing's size in pixels): the mechanism drawn
 to scale as it moves (links, ground pivots, slider blocks and guides, the
 published points, their traces over the last turn, optional velocity and
 acceleration arrows), the solver and timing status of ``diagnostics``, and a
-control for the crank speed that sets the node's ``crank_speed_rpm``
-(``rcl_interfaces/srv/SetParameters``).
+speed control for each driver that sets the node's parameter
+(``crank_speed_rpm`` for a first driver that is a crank, else
+``inputs.NAME.speed_rpm`` or, for an actuator, ``inputs.NAME.speed``, through
+``rcl_interfaces/srv/SetParameters``).
 
 The page (:data:`PAGE`, plain HTML and a canvas) asks ``/state`` for a JSON
 frame (:func:`frame_from_state`) 20 times a second. The links are drawn from
-the scene the node publishes on ``scene``, solved at the crank angle and
-speed of the latest ``joint_states``; points, arrows and traces are the
+the scene the node publishes on ``scene``, solved at the positions of every
+driver in the latest ``joint_states``; points, arrows and traces are the
 published values. ``make run`` starts the view beside the node and prints
 its URL.
+
+The door (a control that moves a machine answers only the person at the
+page): every request must name this server in ``Host`` (``127.0.0.1:PORT``,
+``localhost:PORT`` or ``[::1]:PORT``: a DNS-rebinding name is refused), a
+request from a browser must come from the page's own origin (``Origin`` and
+``Sec-Fetch-Site``), and ``/state`` and ``/speed`` must carry this run's
+secret token (:attr:`ViewServer.token`, in the page; header
+``X-View-Token``). ``/speed`` takes only a JSON body (``Content-Type:
+application/json``), which no cross-site form can send. Anything else is
+refused with 403 and one line. Nothing from the ROS graph becomes HTML: the
+page writes every string with ``textContent``, and its Content-Security-Policy
+runs no script but its own.
 """
 
 from __future__ import annotations
 
 import argparse
+import base64
 from collections import deque
 from collections.abc import Mapping, Sequence
+import hashlib
+import hmac
 import http.server
 import json
 import math
+import re
+import secrets
+import statistics
 import sys
 import threading
 from typing import Any
-from urllib.parse import parse_qs, urlparse
+from urllib.parse import urlparse
 import warnings
 
 from .cli import run_tool
 from ..ros import topics
+from ..units import NS_PER_S, rpm_from_rad_per_s
 
-__all__ = ['DEFAULT_PORT', 'PAGE', 'ViewServer', 'add_parser', 'frame_from_state', 'main',
-           'scene_bounds']
+__all__ = ['DEFAULT_PORT', 'PAGE', 'TOKEN_HEADER', 'ViewServer', 'add_parser',
+           'frame_from_state', 'main', 'scene_bounds']
 
 #: The port tried first (not foxglove_bridge's 8765); if it is taken, any free port.
 DEFAULT_PORT = 8790
 HOST = '127.0.0.1'
-#: Trace length per point: the published positions over at most this many messages.
+#: Trace length per point: the published positions (and gaps) over at most this many messages.
 TRACE_LENGTH = 600
-#: Crank angles sampled for the drawing's fixed bounds.
+#: Crank angles sampled for the drawing's fixed bounds (one crank's turn).
 BOUNDS_SAMPLES = 144
+#: At most this many configurations sampled for the bounds of a scene with several drivers
+#: (a grid over the drivers: 144 x 144 for two).
+BOUNDS_GRID = BOUNDS_SAMPLES ** 2
+#: An actuator without stroke limits is sampled over these fractions of its start length.
+FREE_STROKE = (0.5, 1.5)
+#: A trace breaks where two published points are more than this many times the usual
+#: interval apart (the median of the last :data:`CADENCE_WINDOW` intervals): a tick
+#: that published nothing is a gap, not a chord.
+GAP_FACTOR = 1.5
+CADENCE_WINDOW = 9
 #: Seconds to wait for the node's SetParameters answer.
 SERVICE_TIMEOUT_S = 3.0
+#: The header that carries the page's token on ``/state`` and ``/speed``.
+TOKEN_HEADER = 'X-View-Token'
+#: The largest ``/speed`` body accepted, bytes.
+MAX_BODY = 1024
+#: Seconds a connection may stay silent before the server closes it.
+REQUEST_TIMEOUT_S = 10.0
+#: Refusals kept (:attr:`ViewServer.refusals`).
+REFUSALS_KEPT = 100
+#: Diagnostic levels the page colours (OK, WARN, ERROR, STALE); any other shows as STALE.
+LEVELS = (0, 1, 2, 3)
+
+
+def _finite(value: Any) -> float | None:
+    """Return ``value`` as a finite float, or None (text, NaN, infinity, anything else)."""
+    try:
+        number = float(value)
+    except (TypeError, ValueError, OverflowError):
+        return None
+    return number if math.isfinite(number) else None
+
+
+def _driver_samples(driver: Any, count: int) -> Any:
+    """Return ``count`` positions of ``driver`` to sample, with its start, rad or m.
+
+    A crank over a turn; an actuator over its stroke, or over
+    :data:`FREE_STROKE` of its start length when it has none.
+    """
+    import numpy as np
+
+    start = float(driver.start)
+    if driver.joint_type == 'revolute':
+        values = np.linspace(0.0, 2.0 * math.pi, count, endpoint=False)
+    elif driver.stroke is not None:
+        values = np.linspace(float(driver.stroke[0]), float(driver.stroke[1]), count)
+    else:
+        values = np.linspace(FREE_STROKE[0] * start, FREE_STROKE[1] * start, count)
+    return np.unique(np.append(values, start))
 
 
 def scene_bounds(scene: Any) -> tuple[float, float, float, float]:
-    """Return (x_min, y_min, x_max, y_max) of every point over a crank turn, m, padded 10 %."""
+    """Return (x_min, y_min, x_max, y_max) of every point the scene reaches, m, padded 10 %.
+
+    One crank: over its turn. Several drivers (or an actuator): over a grid
+    of the drivers' positions (each sampled by :func:`_driver_samples`, at
+    most :data:`BOUNDS_GRID` configurations in all), wherever the scene
+    assembles; the ground points and the start pose are always inside.
+    """
     import numpy as np
 
     import mech_kinematics as mk
     from ..geometry.instant_centres import full_scene
 
     full = full_scene(scene)
-    angles = np.linspace(0.0, 2.0 * math.pi, BOUNDS_SAMPLES, endpoint=False)
+    drivers = full.drivers
+    count = BOUNDS_SAMPLES
+    while count > 2 and count ** len(drivers) > BOUNDS_GRID:
+        count -= 1
+    axes = [_driver_samples(driver, count) for driver in drivers]
     with warnings.catch_warnings():
         warnings.simplefilter('ignore', mk.NearSingularWarning)
-        state = mk.solve(full, angles)
+        if len(drivers) == 1:
+            state = mk.solve(full, axes[0], 0.0, 0.0)
+        else:
+            grid = [axis.ravel() for axis in np.meshgrid(*axes, indexing='ij')]
+            zeros = [np.zeros_like(grid[0])] * len(drivers)
+            state = mk.solve(full, grid, zeros, zeros)
     xy = [complex(x, y) for x, y in scene.ground.values()]
     for position, _, _ in state.complex_points.values():
         xy += list(np.asarray(position)[state.valid])
+    return _padded(xy)
+
+
+def _padded(xy: Sequence[complex]) -> tuple[float, float, float, float]:
+    """Return the box around ``xy``, padded by 10 % of its larger side (at least 0.1 mm)."""
     xs, ys = [z.real for z in xy], [z.imag for z in xy]
     pad = 0.1 * max(max(xs) - min(xs), max(ys) - min(ys), 1e-3)
     return min(xs) - pad, min(ys) - pad, max(xs) + pad, max(ys) + pad
 
 
-def frame_from_state(scene: Any, angle: float, speed: float,
+def frame_from_state(scene: Any, position: float | Sequence[float],
+                     speed: float | Sequence[float],
                      strokes: Mapping[str, tuple[float, float]]) -> dict[str, Any]:
-    """Return the mechanism at crank ``angle`` (rad) as JSON-ready shapes, m.
+    """Return the mechanism at its drivers' positions as JSON-ready shapes, m.
 
-    ``links``: name, kind and outline (a polyline) of every moving link;
-    ``pivots``: ground pins; ``sliders``: block centre and direction;
-    ``guides``: fixed slider guides over their stroke; ``points``: every
-    named point. Raises :class:`~mech_kinematics.errors.AssemblyError` where
-    the scene cannot assemble.
+    Parameters
+    ----------
+    scene : Scene
+        The mechanism.
+    position : float or sequence of float
+        The crank angle (rad) of a one-driver scene, or one position per
+        driver in ``scene.drivers`` order (rad for a crank, m for an actuator).
+    speed : float or sequence of float
+        The driver's speed, or one per driver (rad/s, m/s).
+    strokes : mapping of str to (float, float)
+        Range of each RRP slider's coordinate, m, over which its guide is drawn.
+
+    Returns
+    -------
+    dict
+        ``angle``: the first driver's position; ``positions``: every
+        driver's; ``links``: name, kind and outline (a polyline) of every
+        moving link; ``pivots``: ground pins; ``sliders``: block centre and
+        direction; ``guides``: fixed slider guides; ``points``: every named
+        point.
+
+    Raises
+    ------
+    AssemblyError
+        Where the scene cannot assemble.
+    ValueError
+        Where the positions are not one finite value per driver.
     """
     import mech_kinematics as mk
     from ..geometry.diagrams import space_from_state
     from ..geometry.instant_centres import full_scene
 
     full = full_scene(scene)
+    count = len(full.drivers)
+    positions = [position] if isinstance(position, (int, float)) else list(position)
+    speeds = [speed] if isinstance(speed, (int, float)) else list(speed)
+    if len(positions) != count or len(speeds) != count:
+        msg = (f'Expected one position and one speed per driver ({count}), got '
+               f'{len(positions)} and {len(speeds)}')
+        raise ValueError(msg)
     with warnings.catch_warnings():
         warnings.simplefilter('ignore', mk.NearSingularWarning)
-        state = mk.solve(full, angle, speed, 0.0)
+        if count == 1:
+            state = mk.solve(full, float(positions[0]), float(speeds[0]), 0.0)
+        else:
+            state = mk.solve(full, [float(p) for p in positions], [float(v) for v in speeds],
+                             [0.0] * count)
     space = space_from_state(full, state, strokes)
     return {
-        'angle': angle,
+        'angle': float(positions[0]),
+        'positions': [float(p) for p in positions],
         'links': [{'name': link.name, 'kind': link.kind.value,
                    'outline': [[float(x), float(y)] for x, y in link.outline]}
                   for link in space.links],
@@ -105,6 +228,56 @@ def frame_from_state(scene: Any, angle: float, speed: float,
     }
 
 
+def _frame_xy(frame: Mapping[str, Any]) -> list[complex]:
+    """Return every position a frame draws (points, outlines, guides), m."""
+    xy = [complex(*p) for p in frame['points'].values()]
+    xy += [complex(*p) for link in frame['links'] for p in link['outline']]
+    xy += [complex(*p) for guide in frame['guides'] for p in guide]
+    return xy
+
+
+class _Cadence:
+    """Whether each published stamp follows the last at the stream's usual interval.
+
+    The usual interval is the median of the last :data:`CADENCE_WINDOW`
+    (one long gap does not move it; a new rate does, within a few messages).
+    A stamp more than :data:`GAP_FACTOR` usual intervals after the last, or
+    not after it (a clock set back), is a break: the traces do not join
+    across it.
+    """
+
+    def __init__(self) -> None:
+        self.last: int | None = None
+        self.intervals: deque[int] = deque(maxlen=CADENCE_WINDOW)
+
+    def broken(self, stamp_ns: int) -> bool:
+        """Take the next stamp (ns); return whether the stream broke before it."""
+        last, self.last = self.last, stamp_ns
+        if last is None:
+            return False
+        interval = stamp_ns - last
+        if interval <= 0:
+            self.intervals.clear()
+            return True
+        usual = statistics.median(self.intervals) if self.intervals else None
+        self.intervals.append(interval)
+        return usual is not None and interval > GAP_FACTOR * usual
+
+
+def _vector(items: Any, index: int, field: str) -> list[float] | None:
+    """Return ``items[index].field``'s (x, y) if it is there and finite, else None."""
+    try:
+        vector = getattr(items[index], field)
+        x, y = _finite(vector.x), _finite(vector.y)
+    except (IndexError, AttributeError, TypeError):
+        return None
+    return None if x is None or y is None else [x, y]
+
+
+def _stamp_ns(stamp: Any) -> int:
+    return int(stamp.sec) * NS_PER_S + int(stamp.nanosec)
+
+
 class _Latest:
     """What the node last published, shared by the ROS callbacks and the HTTP handlers."""
 
@@ -114,9 +287,12 @@ class _Latest:
         self.scene_error = ''
         self.bounds: tuple[float, float, float, float] | None = None
         self.strokes: dict[str, tuple[float, float]] = {}
-        self.joints: tuple[Sequence[str], Sequence[float], Sequence[float]] | None = None
-        self.points: dict[str, list[list[float]]] = {}
-        self.traces: dict[str, deque[tuple[float, float]]] = {}
+        #: joint name -> (position, velocity), each a finite float or None.
+        self.joints: dict[str, tuple[float | None, float | None]] | None = None
+        self.points: dict[str, tuple[list[float], list[float] | None, list[float] | None]] = {}
+        #: point name -> its published positions, None where the stream broke.
+        self.traces: dict[str, deque[tuple[float, float] | None]] = {}
+        self.cadence = _Cadence()
         self.statuses: list[dict[str, Any]] = []
         self.values: dict[str, str] = {}
         self.stamp = 0.0
@@ -131,6 +307,19 @@ class ViewServer:
         The node to subscribe with (spun by the caller).
     port : int
         The port to serve on (127.0.0.1); 0 or a taken port: any free one.
+
+    Attributes
+    ----------
+    token : str
+        This run's secret, in the page it serves: ``/state`` and ``/speed``
+        answer only requests that carry it in ``X-View-Token``.
+    hosts : tuple of str
+        The ``Host`` values accepted: ``127.0.0.1:PORT``, ``localhost:PORT``,
+        ``[::1]:PORT``.
+    refusals : deque of str
+        The last :data:`REFUSALS_KEPT` refused requests, one line each (what
+        was asked, and why it was refused); each is also logged as a warning,
+        at most once a second.
     """
 
     def __init__(self, node: Any, port: int = DEFAULT_PORT) -> None:
@@ -144,6 +333,8 @@ class ViewServer:
 
         self.node = node
         self.latest = _Latest()
+        self.token = secrets.token_urlsafe(32)
+        self.refusals: deque[str] = deque(maxlen=REFUSALS_KEPT)
         latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                              durability=DurabilityPolicy.TRANSIENT_LOCAL)
         node.create_subscription(String, topics.SCENE, self._on_scene, latched)
@@ -159,6 +350,7 @@ class ViewServer:
         self.httpd = _bind(port, self)
         self.port = self.httpd.server_address[1]
         self.url = f'http://{HOST}:{self.port}/'
+        self.hosts = (f'{HOST}:{self.port}', f'localhost:{self.port}', f'[::1]:{self.port}')
         self._thread = threading.Thread(target=self.httpd.serve_forever, name='view-http',
                                         daemon=True)
         self._thread.start()
@@ -167,6 +359,11 @@ class ViewServer:
         """Stop serving."""
         self.httpd.shutdown()
         self.httpd.server_close()
+
+    def refused(self, line: str) -> None:
+        """Record a refused request (one line) and log it, at most once a second."""
+        self.refusals.append(line)
+        self.node.get_logger().warning(f'view refused {line}', throttle_duration_sec=1.0)
 
     # -- ROS callbacks ---------------------------------------------------------
 
@@ -178,52 +375,71 @@ class ViewServer:
         try:
             scene = mk.parse_scene(read_scene_yaml(msg.data))
             bounds, strokes = scene_bounds(scene), strokes_from_scene(scene)
-        except mk.MechKinematicsError as error:
+        except ValueError as error:     # SceneError, or a scene the view cannot size
+            line = str(error).splitlines()[0] if str(error) else repr(error)
             with self.latest.lock:
-                self.latest.scene_error = f'the scene the node published cannot be read: {error}'
+                self.latest.scene_error = f'the scene the node published cannot be read: {line}'
             return
         with self.latest.lock:
             self.latest.scene, self.latest.bounds, self.latest.strokes = scene, bounds, strokes
             self.latest.scene_error = ''
             self.latest.traces = {}
+            self.latest.cadence = _Cadence()
 
     def _on_joints(self, msg: Any) -> None:
+        positions, velocities = list(msg.position), list(msg.velocity)
+        joints = {}
+        for i, name in enumerate(msg.name):
+            joints[str(name)] = (_finite(positions[i]) if i < len(positions) else None,
+                                 _finite(velocities[i]) if i < len(velocities) else None)
         with self.latest.lock:
-            self.latest.joints = (list(msg.name), list(msg.position), list(msg.velocity))
+            self.latest.joints = joints
             self.latest.stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
 
     def _on_points(self, msg: Any) -> None:
-        if not msg.points:
-            return
-        point = msg.points[0]
-        out = {}
-        for i, name in enumerate(msg.joint_names):
-            p, v = point.transforms[i].translation, point.velocities[i].linear
-            a = point.accelerations[i].linear
-            out[name] = [[p.x, p.y], [v.x, v.y], [a.x, a.y]]
+        out: dict[str, tuple[list[float], list[float] | None, list[float] | None]] = {}
+        for point in msg.points[:1]:
+            for i, name in enumerate(msg.joint_names):
+                xy = _vector(point.transforms, i, 'translation')
+                if xy is not None:  # a point not published, or not finite: a gap in its trace
+                    out[str(name)] = (xy, _vector(point.velocities, i, 'linear'),
+                                      _vector(point.accelerations, i, 'linear'))
+        stamp = _stamp_ns(msg.header.stamp)
         with self.latest.lock:
-            self.latest.points = out
-            ground = self.latest.scene.ground if self.latest.scene is not None else {}
+            latest = self.latest
+            latest.points = out
+            broken = latest.cadence.broken(stamp)
+            ground = latest.scene.ground if latest.scene is not None else {}
+            for name, trace in latest.traces.items():
+                if (broken or name not in out) and trace and trace[-1] is not None:
+                    trace.append(None)
             for name, (xy, _, _) in out.items():
                 if name in ground:
                     continue    # a fixed point: nothing to trace
-                self.latest.traces.setdefault(name, deque(maxlen=TRACE_LENGTH)).append(
+                latest.traces.setdefault(name, deque(maxlen=TRACE_LENGTH)).append(
                     (xy[0], xy[1]))
 
     def _on_diagnostics(self, msg: Any) -> None:
-        statuses = [{'name': s.name, 'level': int.from_bytes(s.level, 'little')
-                     if isinstance(s.level, bytes) else int(s.level), 'message': s.message}
-                    for s in msg.status]
-        values = {kv.key: kv.value for s in msg.status for kv in s.values}
+        statuses = []
+        values = {}
+        for status in msg.status:
+            level = status.level
+            level = int.from_bytes(level, 'little') if isinstance(level, bytes) else level
+            statuses.append({'name': str(status.name), 'message': str(status.message),
+                             'level': level if level in LEVELS else LEVELS[-1]})
+            values.update({str(kv.key): str(kv.value) for kv in status.values})
         with self.latest.lock:
             self.latest.statuses, self.latest.values = statuses, values
 
     # -- HTTP ------------------------------------------------------------------
 
     def state(self) -> dict[str, Any]:
-        """Return the JSON of ``/state``: the frame to draw, the points, traces and statuses."""
-        import mech_kinematics as mk
+        """Return the JSON of ``/state``: the frame to draw, the drivers, points, traces, statuses.
 
+        Whatever another node published, the answer is finite JSON: a value
+        that is not a finite number is left out (``None``), and a frame that
+        cannot be drawn says why in ``error``.
+        """
         with self.latest.lock:
             latest = self.latest
             scene, joints, strokes = latest.scene, latest.joints, dict(latest.strokes)
@@ -232,40 +448,111 @@ class ViewServer:
                 'scene_error': latest.scene_error, 'bounds': latest.bounds,
                 'stamp': latest.stamp, 'points': dict(latest.points),
                 'traces': {name: list(trace) for name, trace in latest.traces.items()},
-                'statuses': list(latest.statuses),
+                'statuses': list(latest.statuses), 'drivers': [],
                 'crank_speed_rpm': None, 'frame': None, 'error': ''}
             values = dict(latest.values)
-        if 'crank_speed' in values:
-            out['crank_speed_rpm'] = float(values['crank_speed']) * 60.0 / (2.0 * math.pi)
-        if scene is not None and joints is not None:
-            by_name = {n: (p, v) for n, p, v in zip(*joints, strict=False)}
-            crank = scene.input.link
-            if crank in by_name:
-                angle, speed = by_name[crank]
-                out['crank_speed_rpm'] = speed * 60.0 / (2.0 * math.pi)
-                try:
-                    out['frame'] = frame_from_state(scene, angle, speed, strokes)
-                except mk.AssemblyError as error:
-                    out['error'] = str(error)
+        # Before joint_states: the node's own report of its crank's speed, where it is a number.
+        reported = _finite(values.get('crank_speed'))
+        if reported is not None:
+            out['crank_speed_rpm'] = rpm_from_rad_per_s(reported)
+        if scene is None:
+            return out
+        joints = joints or {}
+        positions: list[float] = []
+        speeds: list[float] = []
+        missing = []
+        for index, driver in enumerate(scene.drivers):
+            position, speed = joints.get(driver.name, (None, None))
+            crank = driver.joint_type == 'revolute'
+            shown = None if speed is None else rpm_from_rad_per_s(speed) if crank else speed
+            out['drivers'].append({'name': driver.name, 'kind': 'crank' if crank else 'actuator',
+                                   'unit': 'rpm' if crank else 'm/s', 'position': position,
+                                   'speed': shown})
+            if index == 0 and crank and shown is not None:
+                out['crank_speed_rpm'] = shown
+            if position is None:
+                missing.append(driver.name)
+            else:
+                positions.append(position)
+            speeds.append(0.0 if speed is None else speed)
+        if joints and missing:
+            out['error'] = f'Expected a finite position of {", ".join(missing)} in joint_states'
+        elif joints:
+            try:
+                out['frame'] = frame_from_state(scene, positions, speeds, strokes)
+            except ValueError as error:     # AssemblyError too
+                out['error'] = str(error).splitlines()[0] if str(error) else repr(error)
+        if out['frame'] is not None:
+            out['bounds'] = self._grown(scene, out['bounds'], _frame_xy(out['frame']))
         return out
 
-    def set_speed(self, rpm: float) -> dict[str, Any]:
-        """Ask the node to set ``crank_speed_rpm``; return {'successful', 'reason'}."""
+    def _grown(self, scene: Any, bounds: tuple[float, float, float, float] | None,
+               xy: list[complex]) -> tuple[float, float, float, float] | None:
+        """Return ``bounds`` grown (and kept) to hold ``xy`` where a frame reaches past them."""
+        if bounds is None or not xy:
+            return bounds
+        x0, y0, x1, y1 = bounds
+        if all(x0 <= z.real <= x1 and y0 <= z.imag <= y1 for z in xy):
+            return bounds
+        grown = _padded([*xy, complex(x0, y0), complex(x1, y1)])
+        with self.latest.lock:
+            if self.latest.scene is scene:
+                self.latest.bounds = grown
+        return grown
+
+    def parameter_of(self, driver: str | None) -> tuple[str, str]:
+        """Return the node parameter that sets ``driver``'s speed, and its unit.
+
+        ``crank_speed_rpm`` for the first driver when it is a crank (also
+        ``driver=None``), ``inputs.NAME.speed_rpm`` for another crank,
+        ``inputs.NAME.speed`` (m/s) for an actuator. Raises ValueError for a
+        driver the scene does not have, or before the scene has come.
+        """
+        with self.latest.lock:
+            scene = self.latest.scene
+        if scene is None:
+            msg = "Expected the node's scene before a speed, got none yet"
+            raise ValueError(msg)
+        drivers = list(scene.drivers)
+        names = [d.name for d in drivers]
+        if driver is None:
+            driver = names[0]
+        if driver not in names:
+            msg = f'Expected a driver of the scene ({", ".join(names)}), got {driver!r}'
+            raise ValueError(msg)
+        index = names.index(driver)
+        if drivers[index].joint_type != 'revolute':
+            return f'inputs.{driver}.speed', 'm/s'
+        return ('crank_speed_rpm' if index == 0 else f'inputs.{driver}.speed_rpm'), 'rpm'
+
+    def set_speed(self, value: float, driver: str | None = None) -> dict[str, Any]:
+        """Ask the node to set a driver's speed; return {'successful', 'reason'}.
+
+        ``value`` is in rpm for a crank, m/s for an actuator; ``driver``
+        defaults to the first (:meth:`parameter_of` names the parameter).
+        """
         from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
         from rcl_interfaces.srv import SetParameters
 
+        try:
+            name, _ = self.parameter_of(driver)
+        except ValueError as error:
+            return {'successful': False, 'reason': str(error)}
         if not self._set_parameters.wait_for_service(timeout_sec=SERVICE_TIMEOUT_S):
             return {'successful': False, 'reason': 'the node does not answer set_parameters'}
         request = SetParameters.Request(parameters=[Parameter(
-            name='crank_speed_rpm', value=ParameterValue(type=ParameterType.PARAMETER_DOUBLE,
-                                                         double_value=float(rpm)))])
+            name=name, value=ParameterValue(type=ParameterType.PARAMETER_DOUBLE,
+                                            double_value=float(value)))])
         done = threading.Event()
         future = self._set_parameters.call_async(request)
         future.add_done_callback(lambda _future: done.set())
         if not done.wait(SERVICE_TIMEOUT_S):
             return {'successful': False, 'reason': 'no answer from set_parameters in time'}
-        result = future.result().results[0]
-        return {'successful': bool(result.successful), 'reason': result.reason}
+        results = future.result().results
+        if len(results) != 1:
+            return {'successful': False,
+                    'reason': f'Expected one result from set_parameters, got {len(results)}'}
+        return {'successful': bool(results[0].successful), 'reason': str(results[0].reason)}
 
 
 def _bind(port: int, view: ViewServer) -> http.server.ThreadingHTTPServer:
@@ -276,91 +563,210 @@ def _bind(port: int, view: ViewServer) -> http.server.ThreadingHTTPServer:
         return http.server.ThreadingHTTPServer((HOST, 0), handler)
 
 
+class _Refused(Exception):
+    """A request the door does not let in: its status and one line saying why."""
+
+    def __init__(self, status: int, line: str) -> None:
+        super().__init__(line)
+        self.status = status
+        self.line = line
+
+
 class _Handler(http.server.BaseHTTPRequestHandler):
     view: ViewServer
+    timeout = REQUEST_TIMEOUT_S
+    server_version = 'mech_kinematics-view'
+    sys_version = ''
 
     def log_message(self, format: str, *args: Any) -> None:  # noqa: A002 - the base's name
         """Log nothing per request (the console belongs to the live view)."""
 
-    def _send(self, body: bytes, content_type: str, status: int = 200) -> None:
+    def _send(self, body: bytes, content_type: str, status: int = 200,
+              headers: Mapping[str, str] | None = None) -> None:
         self.send_response(status)
         self.send_header('Content-Type', content_type)
         self.send_header('Content-Length', str(len(body)))
         self.send_header('Cache-Control', 'no-store')
+        self.send_header('X-Content-Type-Options', 'nosniff')
+        self.send_header('Referrer-Policy', 'no-referrer')
+        self.send_header('Cross-Origin-Resource-Policy', 'same-origin')
+        for name, value in (headers or {}).items():
+            self.send_header(name, value)
         self.end_headers()
         self.wfile.write(body)
 
     def _json(self, data: Any, status: int = 200) -> None:
         self._send(json.dumps(data, allow_nan=False).encode(), 'application/json', status)
 
+    def _refuse(self, status: int, line: str) -> None:
+        self.view.refused(f'{self.command} {urlparse(self.path).path}: {line}')
+        self._send(f'{line}\n'.encode(), 'text/plain; charset=utf-8', status)
+
+    def _door(self, api: bool) -> None:
+        """Raise :class:`_Refused` unless the request may come in.
+
+        ``Host`` must name this server; ``Origin`` and ``Sec-Fetch-Site``,
+        where a browser sends them, must say the page's own origin; ``api``
+        (``/state``, ``/speed``): the token must be in ``X-View-Token``.
+        """
+        host = self.headers.get('Host')
+        if host is None or host.lower() not in self.view.hosts:
+            line = (f'Expected Host {" or ".join(self.view.hosts)}, got '
+                    f'{"none" if host is None else repr(host)}')
+            raise _Refused(403, line)
+        origin = self.headers.get('Origin')
+        if origin is not None and origin.lower() != f'http://{host.lower()}':
+            raise _Refused(403, f'Expected a request from the page of http://{host}, got one '
+                                f'from Origin {origin!r}')
+        site = self.headers.get('Sec-Fetch-Site')
+        if api and site is not None and site != 'same-origin':
+            raise _Refused(403, f'Expected a request from the page of http://{host} '
+                                f'(Sec-Fetch-Site same-origin), got Sec-Fetch-Site {site!r}')
+        if not api:
+            return
+        given = self.headers.get(TOKEN_HEADER)
+        if given is None:
+            raise _Refused(403, f"Expected this view's token in {TOKEN_HEADER} (the page "
+                                'sends it), got none')
+        if not hmac.compare_digest(given.encode('utf-8', 'replace'), self.view.token.encode()):
+            raise _Refused(403, f"Expected this view's token in {TOKEN_HEADER}, got another "
+                                '(a page of an earlier view? reload it)')
+
+    def _answer(self, serve: Any) -> None:
+        """Run ``serve``; a refusal is its line, any failure one line, never a dropped request."""
+        try:
+            serve()
+        except _Refused as refused:
+            self._refuse(refused.status, refused.line)
+        except (BrokenPipeError, ConnectionResetError):
+            pass    # the browser went away
+        except Exception as error:  # noqa: BLE001 - the page gets one line, the server goes on
+            line = f'view: {self.command} failed: {type(error).__name__}: {error}'
+            self._json({'error': line.splitlines()[0]}, 500)
+
     def do_GET(self) -> None:
         """Serve the page and ``/state``."""
-        path = urlparse(self.path).path
-        if path == '/':
-            self._send(PAGE.encode(), 'text/html; charset=utf-8')
-        elif path == '/state':
-            self._json(self.view.state())
-        else:
-            self._json({'error': f'Expected / or /state, got {path}'}, 404)
+        self._answer(self._get)
 
     def do_POST(self) -> None:
-        """``/speed?rpm=X``: set the node's crank speed."""
-        url = urlparse(self.path)
-        if url.path != '/speed':
-            self._json({'error': f'Expected /speed, got {url.path}'}, 404)
+        """``/speed``: set a driver's speed (a JSON body ``{"driver": NAME, "value": X}``)."""
+        self._answer(self._post)
+
+    def do_OPTIONS(self) -> None:
+        """Refuse a CORS preflight: no other origin may call the view."""
+        self._answer(self._preflight)
+
+    def _preflight(self) -> None:
+        self._door(api=False)
+        raise _Refused(403, 'Expected no cross-origin request, got a CORS preflight')
+
+    def _get(self) -> None:
+        path = urlparse(self.path).path
+        if path == '/':
+            self._door(api=False)
+            self._send(_page(self.view.token).encode(), 'text/html; charset=utf-8',
+                       headers={'Content-Security-Policy': CSP, 'X-Frame-Options': 'DENY'})
+        elif path == '/state':
+            self._door(api=True)
+            self._json(self.view.state())
+        else:
+            self._door(api=False)
+            self._json({'error': f'Expected / or /state, got {path}'}, 404)
+
+    def _post(self) -> None:
+        path = urlparse(self.path).path
+        self._door(api=path == '/speed')
+        if path != '/speed':
+            self._json({'error': f'Expected /speed, got {path}'}, 404)
             return
-        text = parse_qs(url.query).get('rpm', [''])[0]
+        if self.headers.get_content_type() != 'application/json':
+            raise _Refused(415, f'Expected Content-Type application/json, got '
+                                f'{self.headers.get("Content-Type")!r}')
+        length = self.headers.get('Content-Length', '')
+        if not length.isdigit() or not 0 < int(length) <= MAX_BODY:
+            raise _Refused(400, f'Expected a body of 1 to {MAX_BODY} bytes with its '
+                                f'Content-Length, got Content-Length {length!r}')
+        text = self.rfile.read(int(length)).decode('utf-8', 'replace')
         try:
-            rpm = float(text)
+            body = json.loads(text)
         except ValueError:
-            rpm = math.nan
-        if not math.isfinite(rpm):
+            body = None
+        value = body.get('value') if isinstance(body, dict) else None
+        driver = body.get('driver') if isinstance(body, dict) else None
+        if not isinstance(value, (int, float)) or isinstance(value, bool) \
+                or not math.isfinite(value) or not isinstance(driver, (str, type(None))):
+            shown = text if len(text) <= 80 else text[:77] + '...'
             self._json({'successful': False,
-                        'reason': f'Expected a number of rpm, got {text!r}'}, 400)
+                        'reason': 'Expected {"driver": NAME, "value": a number (rpm for a crank, '
+                                  f'm/s for an actuator)}}, got {shown!r}'}, 400)
             return
-        self._json(self.view.set_speed(rpm))
+        try:
+            self.view.parameter_of(driver)
+        except ValueError as error:
+            self._json({'successful': False, 'reason': str(error)}, 400)
+            return
+        self._json(self.view.set_speed(float(value), driver))
+
+
+def _page(token: str) -> str:
+    """Return :data:`PAGE` carrying ``token`` (URL-safe characters only)."""
+    return PAGE.replace('VIEW_TOKEN', token, 1)
 
 
 PAGE = """<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>mech_kinematics view</title>
+<meta name="view-token" content="VIEW_TOKEN">
 <style>
 body { font: 14px sans-serif; margin: 0; display: flex; flex-direction: column; height: 100vh; }
 header { padding: 6px 10px; background: #eee; display: flex; gap: 16px; align-items: center;
          flex-wrap: wrap; }
-canvas { flex: 1; width: 100%; min-height: 0; background: #fff; }
+/* the canvas's box is set in pixels to its bitmap's size: one metre is as many pixels in x
+   as in y whatever the window does between two drawings */
+#frame { flex: 1; min-height: 0; position: relative; overflow: hidden; background: #fff; }
+#c { position: absolute; left: 0; top: 0; }
 /* two lines, always: a status whose text wraps differently must not move the drawing */
 #status { flex-basis: 100%; line-height: 1.2em; height: 2.4em; overflow: hidden; }
 #status span { margin-right: 12px; }
+#controls label { margin-right: 10px; }
+input.speed { width: 7em; }
 .l0 { color: #1a7f37; } .l1 { color: #b35900; } .l2 { color: #c00; } .l3 { color: #777; }
 #drawn { display: none; }
 </style></head><body>
 <header>
 <b id="scene">waiting for the node's scene...</b>
-<label>crank speed <input id="rpm" type="number" step="10" style="width: 7em"> rpm
-<button id="set">set</button></label> <span id="answer"></span>
+<span id="controls"></span>
 <label><input id="arrows" type="checkbox"> velocity and acceleration arrows</label>
-<span id="speed"></span>
 <div id="status"></div>
 </header>
-<canvas id="c"></canvas>
+<div id="frame"><canvas id="c"></canvas></div>
 <pre id="drawn"></pre>
 <script>
 'use strict';
+// Every string from the ROS graph (scene, driver, point and status names, messages) is
+// written with textContent or drawn on the canvas: none is ever parsed as HTML.
+const TOKEN = document.querySelector('meta[name="view-token"]').content;
 const COLOURS = {crank: '#d62728', link: '#1f77b4', lever: '#2ca02c'};
+const frame = document.getElementById('frame');
 const canvas = document.getElementById('c');
 const ctx = canvas.getContext('2d');
-let busy = false;
+let busy = false, last = null, controlsFor = null;
 
-// ?w=800&h=500 fixes the canvas size in pixels (default: the window's free space).
+// ?w=800&h=500 fixes the drawing's size in pixels (default: the window's free space).
 const query = new URLSearchParams(location.search);
-if (query.get('w') && query.get('h')) {
-  canvas.style.flex = 'none';
-  canvas.style.width = query.get('w') + 'px'; canvas.style.height = query.get('h') + 'px';
+const fixed = [query.get('w'), query.get('h')].map((v) => parseInt(v, 10));
+if (fixed.every((v) => v > 0 && v <= 20000)) {
+  frame.style.flex = 'none';
+  frame.style.width = fixed[0] + 'px'; frame.style.height = fixed[1] + 'px';
 }
 
 function transform(bounds) {
-  const w = canvas.clientWidth, h = canvas.clientHeight;
-  canvas.width = w; canvas.height = h;
+  // The bitmap and the canvas's box are given the same size in pixels, so the drawing is
+  // never stretched: one metre is k pixels in x and in y.
+  const w = Math.max(1, frame.clientWidth), h = Math.max(1, frame.clientHeight);
+  if (canvas.width !== w || canvas.height !== h) {
+    canvas.width = w; canvas.height = h;
+    canvas.style.width = w + 'px'; canvas.style.height = h + 'px';
+  }
   const [x0, y0, x1, y1] = bounds;
   const k = Math.min(w / (x1 - x0), h / (y1 - y0));   // pixels per metre, both axes: to scale
   const ox = (w - k * (x1 + x0)) / 2, oy = (h + k * (y1 + y0)) / 2;
@@ -376,14 +782,67 @@ function dot(t, p, r, colour) {
   ctx.fillStyle = colour; ctx.beginPath(); ctx.arc(...t.px(p), r, 0, 2 * Math.PI); ctx.fill();
 }
 
+function element(tag, text, className) {
+  const e = document.createElement(tag);
+  if (text !== undefined) e.textContent = text;
+  if (className) e.className = className;
+  return e;
+}
+
+async function setSpeed(driver, input, answer) {
+  const value = Number(input.value);
+  if (input.value.trim() === '' || !Number.isFinite(value)) {
+    answer.textContent = 'Expected a number, got ' + JSON.stringify(input.value);
+    return;
+  }
+  try {
+    const r = await fetch('/speed', {method: 'POST', body: JSON.stringify(
+      {driver: driver, value: value}), headers: {'X-View-Token': TOKEN,
+                                                 'Content-Type': 'application/json'}});
+    const text = await r.text();
+    let said = text.trim();
+    try { const j = JSON.parse(text); said = j.successful ? 'set' : j.reason || j.error; }
+    catch (e) { }
+    answer.textContent = said;
+  } catch (e) {
+    answer.textContent = 'the view does not answer: ' + e.message;
+  }
+}
+
+// One speed control per driver (rpm for a crank, m/s for an actuator), rebuilt when the
+// scene's drivers change; each shows the driver's speed in the latest joint_states.
+function controls(s) {
+  const box = document.getElementById('controls');
+  const key = JSON.stringify(s.drivers.map((d) => [d.name, d.unit]));
+  if (key !== controlsFor) {
+    controlsFor = key;
+    box.replaceChildren();
+    for (const d of s.drivers) {
+      const label = element('label', d.name + ' speed ');
+      const input = element('input', undefined, 'speed');
+      input.type = 'number'; input.step = d.unit === 'rpm' ? '10' : '0.01';
+      input.dataset.driver = d.name;
+      const button = element('button', 'set');
+      const answer = element('span', '', 'answer');
+      button.onclick = () => setSpeed(d.name, input, answer);
+      label.append(input, ' ' + d.unit + ' ', button, ' ', element('span', '', 'running'),
+                   ' ', answer);
+      box.append(label);
+    }
+  }
+  s.drivers.forEach((d, i) => {
+    box.children[i].querySelector('.running').textContent = d.speed === null ? '' :
+      '(running at ' + d.speed.toFixed(d.unit === 'rpm' ? 2 : 4) + ' ' + d.unit + ')';
+  });
+}
+
 function draw(s) {
+  last = s;
   document.getElementById('scene').textContent = s.scene ?
     s.scene + (s.error ? ': ' + s.error : '') : (s.scene_error || 'waiting for the node...');
-  document.getElementById('speed').textContent = s.crank_speed_rpm === null ? '' :
-    'running at ' + s.crank_speed_rpm.toFixed(2) + ' rpm';
-  document.getElementById('status').innerHTML = s.statuses.map(
-    (x) => '<span class="l' + x.level + '">' + x.name.split(': ').pop() + ': ' +
-           x.message.replace(/&/g, '&amp;').replace(/</g, '&lt;') + '</span>').join('');
+  controls(s);
+  document.getElementById('status').replaceChildren(...s.statuses.map(
+    (x) => element('span', x.name.split(': ').pop() + ': ' + x.message, 'l' + x.level)));
   if (!s.bounds) return;
   const t = transform(s.bounds);
   ctx.clearRect(0, 0, canvas.width, canvas.height);
@@ -391,19 +850,25 @@ function draw(s) {
   const m = canvas.width / 5 / t.k, bar = Math.pow(10, Math.floor(Math.log10(m)));
   ctx.fillStyle = '#000'; ctx.fillRect(10, canvas.height - 14, bar * t.k, 3);
   ctx.fillText(String(+(bar * 1000).toPrecision(1)) + ' mm', 10, canvas.height - 18);
-  for (const [name, trace] of Object.entries(s.traces)) {
-    if (trace.length < 2) continue;
-    ctx.strokeStyle = '#bbb'; ctx.lineWidth = 1; ctx.beginPath();
-    ctx.moveTo(...t.px(trace[0]));
-    for (const p of trace) ctx.lineTo(...t.px(p));
+  // A trace is broken where the stream was (null): no chord across what was not published.
+  ctx.strokeStyle = '#bbb'; ctx.lineWidth = 1;
+  for (const trace of Object.values(s.traces)) {
+    ctx.beginPath();
+    let pen = false;
+    for (const p of trace) {
+      if (p === null) { pen = false; continue; }
+      if (pen) ctx.lineTo(...t.px(p)); else ctx.moveTo(...t.px(p));
+      pen = true;
+    }
     ctx.stroke();
   }
   // What was drawn, in metres and as the canvas maps them to pixels (read by the tests).
   const box = canvas.getBoundingClientRect();
-  const f = s.frame, drawn = {angle: null, k: t.k, ox: t.ox, oy: t.oy, left: box.left,
-                              top: box.top, links: []};
+  const f = s.frame, drawn = {angle: null, positions: null, k: t.k, ox: t.ox, oy: t.oy,
+                              left: box.left, top: box.top, width: canvas.width,
+                              height: canvas.height, links: []};
   if (f) {
-    drawn.angle = f.angle;
+    drawn.angle = f.angle; drawn.positions = f.positions;
     for (const g of f.guides) line(t, g[0], g[1], '#888', 2);
     for (const l of f.links) {
       const o = l.outline, colour = COLOURS[l.kind] || '#1f77b4';
@@ -421,34 +886,52 @@ function draw(s) {
   }
   if (document.getElementById('arrows').checked) {
     const size = (s.bounds[2] - s.bounds[0]) / 10;
-    for (const [name, [p, v, a]] of Object.entries(s.points)) {
-      const sv = Math.hypot(...v), sa = Math.hypot(...a);
-      if (sv > 0) line(t, p, [p[0] + v[0] / sv * size, p[1] + v[1] / sv * size], '#9467bd', 2);
-      if (sa > 0) line(t, p, [p[0] + a[0] / sa * size, p[1] + a[1] / sa * size], '#8c564b', 2);
+    for (const [p, v, a] of Object.values(s.points)) {
+      for (const [u, colour] of [[v, '#9467bd'], [a, '#8c564b']]) {
+        const su = u === null ? 0 : Math.hypot(...u);
+        if (su > 0) line(t, p, [p[0] + u[0] / su * size, p[1] + u[1] / su * size], colour, 2);
+      }
     }
   }
-  for (const [name, [p]] of Object.entries(s.points)) {
-    ctx.fillStyle = '#000'; ctx.fillText(name, ...t.px(p).map((c) => c + 6));
-  }
+  ctx.fillStyle = '#000';
+  for (const [name, [p]] of Object.entries(s.points)) ctx.fillText(name, ...t.px(p).map(
+    (c) => c + 6));
   document.getElementById('drawn').textContent = JSON.stringify(drawn);
 }
 
 async function poll() {
   if (busy) return;
   busy = true;
-  try { draw(await (await fetch('/state')).json()); } catch (e) { }
+  try {
+    const r = await fetch('/state', {headers: {'X-View-Token': TOKEN}, cache: 'no-store'});
+    if (r.ok) draw(await r.json());
+    else document.getElementById('scene').textContent = (await r.text()).trim();
+  } catch (e) {
+    document.getElementById('scene').textContent = 'the view does not answer: ' + e.message;
+  }
   busy = false;
 }
 
-document.getElementById('set').onclick = async () => {
-  const rpm = document.getElementById('rpm').value;
-  const r = await (await fetch('/speed?rpm=' + encodeURIComponent(rpm), {method: 'POST'})).json();
-  document.getElementById('answer').textContent = r.successful ? 'set' : r.reason;
-};
+// A new size of the window is drawn at once, from the last state.
+new ResizeObserver(() => { if (last) draw(last); }).observe(frame);
 setInterval(poll, 50);
 poll();
 </script></body></html>
 """
+
+
+def _digest(tag: str) -> str:
+    """Return the base64 SHA-256 of the text of :data:`PAGE`'s one ``<tag>`` element."""
+    found = re.search(f'<{tag}>(.*?)</{tag}>', PAGE, re.DOTALL)
+    assert found is not None, tag
+    return base64.b64encode(hashlib.sha256(found[1].encode()).digest()).decode()
+
+
+#: The page's Content-Security-Policy: its own script and style only (by their SHA-256),
+#: requests to its own origin only, no image, form, base or frame.
+CSP = (f"default-src 'none'; script-src 'sha256-{_digest('script')}'; "
+       f"style-src 'sha256-{_digest('style')}'; connect-src 'self'; img-src 'none'; "
+       "base-uri 'none'; form-action 'none'; frame-ancestors 'none'")
 
 
 def _handle(args: argparse.Namespace) -> int:

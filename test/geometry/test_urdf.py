@@ -22,7 +22,7 @@ from mech_kinematics.geometry.urdf import urdf_from_scene
 
 #: Drawn pins against solved points, m (relative to the mechanism's size).
 RTOL_PLACE = 1e-12
-SCENES = crank_scene_names()  # several drivers: test_drivers (issue 18)
+SCENES = crank_scene_names()  # several drivers: test_solve_drivers (issue 18)
 
 
 def _links_and_joints(text):

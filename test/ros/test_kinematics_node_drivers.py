@@ -70,7 +70,7 @@ def test_the_first_cranks_two_names_are_one_value(ros, tmp_path):
         assert result.successful, result.reason
         assert node.get('crank_speed_rpm', f'inputs.{CRANK}.speed_rpm') == [-60.0, -60.0]
         count = len(node.js)
-        wait_for(lambda: len(node.js) > count + 20, 5.0, 'joint_states after the change')
+        wait_for(lambda: len(node.js) > count + 20, STARTUP_S, 'joint_states after the change')
         assert node.js[-1].velocity[0] == rad_per_s_from_rpm(-60.0)
         assert node.set(f'inputs.{CRANK}.accel', 2.5).successful
         assert node.get('crank_accel') == [2.5]
@@ -111,7 +111,7 @@ def test_five_bar_drives_each_crank_as_an_exact_function_of_time(ros, tmp_path):
         wait_for(lambda: len(node.js) > 40, STARTUP_S, 'joint_states of the five-bar')
         before = len(node.js)
         assert node.set('inputs.right_crank.speed_rpm', 10.0).successful
-        wait_for(lambda: len(node.js) > before + 60, 5.0, 'joint_states after the change')
+        wait_for(lambda: len(node.js) > before + 60, STARTUP_S, 'joint_states after the change')
     finally:
         node.stop()
     left, right = _index(node.js[0], 'left_crank'), _index(node.js[0], 'right_crank')

@@ -15,6 +15,7 @@ import time
 from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
+from rclpy.qos import QoSProfile, ReliabilityPolicy
 from ros_helpers import (NodeProcess, NS, Ros, SESSION, stamp_ns, STARTUP_S, wait_for,
                          wait_for_parameters, wrap)
 from sensor_msgs.msg import JointState
@@ -36,13 +37,19 @@ def stamps_of(raw) -> list:
     return [stamp_ns(deserialize_message(data, JointState)) for data in raw]
 
 
+#: History of this process's joint_states readers: 10 s at 1 kHz, so that a reader late on a
+#: loaded machine (the node's history is 1000) loses nothing the node published.
+READER_DEPTH = 10_000
+
+
 class Stream:
     """A node of its own and its joint_states (serialized) and diagnostics, as received here."""
 
-    def __init__(self, ros: Ros, tmp, name: str, *args: str) -> None:
+    def __init__(self, ros: Ros, tmp, name: str, *args: str, depth: int = READER_DEPTH) -> None:
         self.ros = ros
         self.ns = f'{SESSION}/{name}'
-        self.js = ros.collect_raw(JointState, f'{self.ns}/joint_states')    # decoded later
+        self.js = ros.collect_raw(JointState, f'{self.ns}/joint_states',
+                                  QoSProfile(depth=depth, reliability=ReliabilityPolicy.RELIABLE))
         self.diag = ros.collect(DiagnosticArray, f'{self.ns}/diagnostics')
         self.process = NodeProcess(tmp, '-r', f'__ns:={self.ns}', *args)
         self.params = AsyncParameterClient(ros.node, f'{self.ns}/mech_kinematics')
@@ -71,9 +78,12 @@ def test_stamps_are_an_exact_grid_without_holes(ros, tmp_path):
     """At 1 kHz every stamp is a multiple of 1 ms and none is missing over 2 s. See issue 14."""
     stream = Stream(ros, tmp_path, 'grid', '-p', 'rate_hz:=1000')
     try:
-        start = len(stream.js)
-        time.sleep(2.0)
-        stamps = stamps_of(stream.js[start:])
+        start = len(stream.js) - 1
+        # 2 s of instants as stamped (received late or not, on a loaded machine).
+        first = stamps_of(stream.js[start:start + 1])[0]
+        wait_for(lambda: stamps_of(stream.js[-1:])[0] >= first + 2 * NS, 2 + STARTUP_S,
+                 '2 s of states')
+        stamps = [t for t in stamps_of(stream.js[start:]) if t <= first + 2 * NS]
         wait_for(lambda: len(stream.diag) >= 2, STARTUP_S, 'diagnostics')
         skipped = diagnostic_value(stream.diag, 'skipped_ticks_total')
     finally:
@@ -141,17 +151,25 @@ def test_a_burst_of_drive_changes_keeps_the_angle_continuous(ros, tmp_path):
                         '-p', 'max_crank_speed_rpm:=3000.0', '-p', 'crank_speed_rpm:=300.0')
         trajectories = ros.collect_raw(JointTrajectory, f'{stream.ns}/joint_accelerations')
         try:
-            time.sleep(0.5)
+            wait_for(lambda t=trajectories: len(t) > 50, STARTUP_S, 'joint_accelerations')
             start = len(trajectories)
+            sets = []
             for k in range(60):
                 if k % 2:
-                    stream.params.set_parameters([Parameter(
-                        'crank_speed_rpm', value=rng.uniform(-3000.0, 3000.0))])
+                    sets.append(stream.params.set_parameters([Parameter(
+                        'crank_speed_rpm', value=rng.uniform(-3000.0, 3000.0))]))
                 else:
-                    stream.params.set_parameters([Parameter(
-                        'crank_accel', value=rng.choice((-1.0, 1.0)) * rng.uniform(1e2, 1e4))])
+                    sets.append(stream.params.set_parameters([Parameter(
+                        'crank_accel', value=rng.choice((-1.0, 1.0)) * rng.uniform(1e2, 1e4))]))
                 time.sleep(rng.uniform(0.0, 0.02))
-            time.sleep(0.5)
+            wait_for(lambda sets=sets: all(f.done() for f in sets), STARTUP_S,
+                     'the 60 changes answered')
+            assert all(r.successful for f in sets for r in f.result().results)
+            # Every change is applied by now: wait for the states stamped after it (the
+            # stamps are this machine's clock), however late they arrive.
+            done = time.time_ns() + NS // 10
+            wait_for(lambda t=trajectories, done=done: _crank_samples(t[-1:])[0][0] > done,
+                     STARTUP_S, 'the states after the burst')
             samples = _crank_samples(trajectories[start:])
         finally:
             stream.stop()
@@ -175,6 +193,15 @@ def _stall(stream, seconds):
     stream.process.proc.send_signal(signal.SIGCONT)
 
 
+def _states_until(raw, stamp):
+    """Wait until a state stamped after ``stamp`` (ns) is received on ``raw``.
+
+    After a stall, every state before it (the catch-up burst) has arrived then:
+    one publisher, in order. A sleep instead would be too short on a loaded machine.
+    """
+    wait_for(lambda: stamps_of(raw[-1:])[0] > stamp, STARTUP_S, 'the states after the stall')
+
+
 def test_a_stall_is_caught_up_to_the_bound_and_the_rest_counted(ros, tmp_path):
     """After a 0.5 s stall the last 0.1 s of instants are published, the rest skipped and counted.
 
@@ -192,9 +219,10 @@ def test_a_stall_is_caught_up_to_the_bound_and_the_rest_counted(ros, tmp_path):
             skipped_before = diagnostic_value(stream.diag, 'skipped_ticks_total')
             start = max(0, len(stream.js) - 20)     # from before the stall
             _stall(stream, 0.5)
-            time.sleep(1.0)
+            _states_until(stream.js, time.time_ns() + NS // 2)
             count = len(stream.diag)
-            wait_for(lambda n=count: len(stream.diag) > n + 1, 5.0, 'diagnostics after the stall')
+            wait_for(lambda n=count: len(stream.diag) > n + 1, STARTUP_S,
+                     'diagnostics after the stall')
             skipped = diagnostic_value(stream.diag, 'skipped_ticks_total') - skipped_before
             stamps = sorted(stamps_of(stream.js[start:]))
             gaps = sorted(b - a for a, b in zip(stamps, stamps[1:], strict=False) if b > a)
@@ -221,22 +249,21 @@ def test_a_long_stop_at_1_khz_is_one_burst_a_keep_last_1000_reader_gets_whole(ro
     reader gets every instant from the burst's first on, and the older ones are skipped
     and counted on diagnostics.
     """
-    from rclpy.qos import QoSProfile, ReliabilityPolicy
-
     period = 1_000_000
     stream = Stream(ros, tmp_path, 'stop_10s', '-p', 'rate_hz:=1000', '-p',
-                    'max_catch_up_s:=10.0')
-    reader = ros.collect_raw(JointState, f'{stream.ns}/joint_states',
-                             QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE))
+                    'max_catch_up_s:=10.0', depth=1000)
+    # The stream's own subscription is the reader: reliable, KEEP_LAST 1000 (a second one at
+    # 1 kHz would halve what this process keeps up with on a loaded machine).
+    reader = stream.js
     try:
         wait_for(lambda: len(reader) > 100, STARTUP_S, 'the KEEP_LAST 1000 reader')
         wait_for(lambda: len(stream.diag) >= 2, STARTUP_S, 'diagnostics')
         skipped_before = diagnostic_value(stream.diag, 'skipped_ticks_total')
         start = len(reader) - 1
         _stall(stream, 4.0)
-        time.sleep(2.0)
+        _states_until(reader, time.time_ns() + NS)
         count = len(stream.diag)
-        wait_for(lambda: len(stream.diag) > count + 1, 5.0, 'diagnostics after the stop')
+        wait_for(lambda: len(stream.diag) > count + 1, STARTUP_S, 'diagnostics after the stop')
         skipped = diagnostic_value(stream.diag, 'skipped_ticks_total') - skipped_before
         stamps = sorted(set(stamps_of(reader[start:])))
     finally:

@@ -27,8 +27,8 @@ from rcl_interfaces.msg import Parameter as ParameterMsg
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 from rclpy.qos import qos_profile_sensor_data
-from ros_helpers import (NodeProcess, NS, REPO, Ros, SESSION, stamp_ns, STARTUP_S, wait_for,
-                         wait_for_parameters, wrap)
+from ros_helpers import (NodeProcess, NS, RELIABLE, REPO, Ros, send_until, SESSION, stamp_ns,
+                         STARTUP_S, wait_for, wait_for_parameters, wrap)
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
@@ -80,21 +80,32 @@ class Running:
         return [Parameter.from_parameter_msg(ParameterMsg(name=n, value=v))
                 for n, v in zip(names, response.values, strict=True)]
 
-    def set_ok(self, **values: float) -> float:
-        """Set doubles, assert they were accepted, return the monotonic time after."""
+    def set_ok(self, **values: float) -> int:
+        """Set doubles, assert they were accepted; return the clock after, ns.
+
+        The node's stamps are this machine's clock: an instant stamped later than
+        this (and later than the catch-up window) is published with the new values.
+        """
         results = self.set(*(Parameter(k, Parameter.Type.DOUBLE, float(v))
                              for k, v in values.items()))
         assert all(r.successful for r in results), [r.reason for r in results]
-        return time.monotonic()
+        return time.time_ns()
 
-    def window(self, seconds: float, since: float | None = None):
-        """Return the messages received in the next ``seconds`` (after settling past ``since``)."""
-        if since is not None:
-            time.sleep(max(0.0, since + 0.1 - time.monotonic()))
+    def window(self, seconds: float, since_ns: int | None = None):
+        """Return the messages stamped in ``seconds`` from 0.1 s after ``since_ns`` (or now).
+
+        By stamp, not by arrival: on a loaded machine states arrive late, and a
+        window of arrival time would hold fewer, or ones from before a change
+        (0.1 s: how far back a late wake-up catches up). Each topic has one
+        publisher, in order: once a state stamped after the window is here, the
+        window is whole.
+        """
+        start = (time.time_ns() if since_ns is None else since_ns) + NS // 10
+        end = start + round(seconds * NS)
         lists = (self.joint_states, self.joint_accel, self.point_accel)
-        starts = [len(x) for x in lists]
-        time.sleep(seconds)
-        return tuple(x[s:] for x, s in zip(lists, starts, strict=True))
+        wait_for(lambda: all(x and stamp_ns(x[-1]) > end for x in lists), seconds + STARTUP_S,
+                 f'{seconds} s of states on every topic')
+        return tuple([m for m in x if start < stamp_ns(m) <= end] for x in lists)
 
 
 @pytest.fixture(scope='module')
@@ -187,7 +198,7 @@ def test_every_message_agrees_with_the_solver(node):
 def test_sensor_data_subscriber_receives_joint_states(node):
     """A best-effort SensorDataQoS subscriber gets joint_states from the reliable publisher."""
     start = len(node.sensor_joint_states)
-    wait_for(lambda: len(node.sensor_joint_states) >= start + 20, 5.0,
+    wait_for(lambda: len(node.sensor_joint_states) >= start + 20, STARTUP_S,
              'joint_states on a SensorDataQoS subscription')
 
 
@@ -205,13 +216,12 @@ def test_integers_are_accepted_for_doubles(node):
 
 def test_speed_change_keeps_the_angle_continuous(node):
     """Setting crank_speed_rpm while running changes the speed; the angle does not jump."""
-    since = node.set_ok(crank_speed_rpm=120, crank_accel=0)
-    time.sleep(max(0.0, since + 0.2 - time.monotonic()))
-    start = len(node.joint_states) - 10      # a few ticks before the change for sure
+    since = node.set_ok(crank_speed_rpm=120, crank_accel=0) + NS // 10
+    node.window(0.05, since)                # a few ticks at 120 rpm, before the change
     results = node.set(Parameter('crank_speed_rpm', Parameter.Type.INTEGER, -300))
     assert results[0].successful, results[0].reason
-    time.sleep(0.5)
-    msgs = sorted(node.joint_states[start:], key=stamp_ns)
+    node.window(0.4)                        # and after it
+    msgs = sorted((m for m in node.joint_states if stamp_ns(m) > since), key=stamp_ns)
     ci = crank_index()
     w1, w2 = 120 * math.pi / 30, -300 * math.pi / 30
     speeds = [m.velocity[ci] for m in msgs]
@@ -271,7 +281,8 @@ def test_bad_values_are_refused_and_publishing_goes_on(node):
         else:
             assert sum(result.reason in line for line in refused) >= 1, (result.reason, refused)
     start = len(node.joint_states)
-    wait_for(lambda: len(node.joint_states) >= start + 20, 5.0, 'joint_states after refusals')
+    wait_for(lambda: len(node.joint_states) >= start + 20, STARTUP_S,
+             'joint_states after refusals')
 
 
 def test_rate_change(node):
@@ -285,14 +296,12 @@ def test_rate_change(node):
 
 def test_acceleration_is_held_at_the_bound(node):
     """A positive crank_accel ramps the speed up to max_crank_speed_rpm and holds it there."""
-    since = node.set_ok(max_crank_speed_rpm=600, crank_speed_rpm=120)
-    start = len(node.joint_states)
-    node.set_ok(crank_accel=200)            # 12.6 -> 62.8 rad/s in 0.25 s
-    time.sleep(max(0.0, since + 0.7 - time.monotonic()))
-    js_list, jt_list, md_list = node.window(0.3)
+    since = node.set_ok(max_crank_speed_rpm=600, crank_speed_rpm=120) + NS // 10
+    ramping = node.set_ok(crank_accel=200)   # 12.6 -> 62.8 rad/s in 0.25 s
+    js_list, jt_list, md_list = node.window(0.3, ramping + 4 * NS // 10)
     ci = crank_index()
     w_max = 600 * math.pi / 30
-    ramp = sorted(node.joint_states[start:], key=stamp_ns)
+    ramp = sorted((m for m in node.joint_states if stamp_ns(m) > since), key=stamp_ns)
     speeds = [m.velocity[ci] for m in ramp]
     assert all(a <= b for a, b in zip(speeds, speeds[1:], strict=False)), 'the speed went down'
     assert max(speeds) == pytest.approx(w_max, rel=1e-12)
@@ -321,7 +330,7 @@ def test_acceleration_is_held_at_the_bound(node):
 def test_diagnostics_report_status_and_timing(node):
     """The diagnostics carry solver status ok, the achieved rate and the late-tick counts."""
     start = len(node.diagnostics)
-    wait_for(lambda: len(node.diagnostics) >= start + 2, 5.0, 'diagnostics')
+    wait_for(lambda: len(node.diagnostics) >= start + 2, STARTUP_S, 'diagnostics')
     msg = node.diagnostics[-1]
     status = {s.name: s for s in msg.status}
     solver = status['mech_kinematics: solver']
@@ -362,7 +371,7 @@ def test_sim_time_drives_the_angle_exactly(ros, tmp_path):
     js_list = ros.collect(JointState, f'{ns_topic}/joint_states')
     diag = ros.collect(DiagnosticArray, f'{ns_topic}/diagnostics')
     # /clock remapped too, so that no other test session can drive this node's clock.
-    clock_pub = ros.node.create_publisher(Clock, f'{ns_topic}/clock', 10)
+    clock_pub = ros.node.create_publisher(Clock, f'{ns_topic}/clock', RELIABLE)
     proc = NodeProcess(tmp_path, '-r', f'__ns:={ns_topic}', '-r', f'/clock:={ns_topic}/clock',
                        '-p', 'use_sim_time:=true',
                        '-p', f'crank_speed_rpm:={rpm}', '-p', 'rate_hz:=100')
@@ -375,6 +384,15 @@ def test_sim_time_drives_the_angle_exactly(ros, tmp_path):
         assert solver.level == DiagnosticStatus.WARN and 'waiting for /clock' in solver.message
         wait_for(lambda: clock_pub.get_subscription_count() > 0, STARTUP_S, 'the /clock match')
         t0 = 1_000 * NS + 123_456_789
+        # The first /clock until the node has it (one sent before its subscription has
+        # matched is lost): it says on diagnostics that it no longer waits for /clock.
+        seen = len(diag)
+        send_until(lambda: clock_pub.publish(Clock(clock=Time(sec=t0 // NS,
+                                                              nanosec=t0 % NS))),
+                   lambda: any('waiting for /clock' not in m.status[0].message
+                               for m in diag[seen:]), STARTUP_S, 'the node hearing /clock',
+                   every=0.2)
+        assert not js_list
         for k in range(120):
             t = t0 + k * period             # 10 ms of sim time per 5 ms of wall time
             clock_pub.publish(Clock(clock=Time(sec=t // NS, nanosec=t % NS)))
@@ -391,7 +409,7 @@ def test_sim_time_drives_the_angle_exactly(ros, tmp_path):
         count = len(js_list)
         clock_pub.publish(Clock(clock=Time(sec=big // NS, nanosec=big % NS)))
         last = big // period * period
-        wait_for(lambda: js_list and stamp_ns(js_list[-1]) == last, 5.0,
+        wait_for(lambda: js_list and stamp_ns(js_list[-1]) == last, STARTUP_S,
                  'the ticks after the 30-day jump')
         time.sleep(0.3)
         assert len(js_list) == count + 11, 'ticked without the clock moving'
@@ -448,8 +466,11 @@ def test_unsolvable_ticks_publish_nothing_and_the_node_carries_on(ros, tmp_path)
             return any(s.level == DiagnosticStatus.ERROR for m in diag for s in m.status)
         wait_for(saw_error, STARTUP_S, 'a cannot-assemble status on diagnostics')
         start = len(remapped)
-        wait_for(lambda: len(remapped) >= start + 30, 5.0, 'states after an unsolvable stretch')
-        time.sleep(0.2)
+        wait_for(lambda: len(remapped) >= start + 30, STARTUP_S,
+                 'states after an unsolvable stretch')
+        # The same ticks on the other two topics (each topic arrives on its own).
+        wait_for(lambda: len(ticks(remapped[start:], jt_list, md_list)) >= 30, STARTUP_S,
+                 'the same 30 ticks on joint_accelerations and point_accelerations')
         solver = [s for m in diag for s in m.status if s.level == DiagnosticStatus.ERROR][0]
         assert 'cannot assemble' in solver.message and 'RRR' in solver.message
         # Where it cannot, in one line (issue 11): the same as `check` finds.

@@ -13,13 +13,12 @@ import signal
 import time
 
 from lifecycle_msgs.msg import State, Transition
-from lifecycle_msgs.srv import ChangeState, GetState
 import pytest
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 from rclpy.qos import QoSProfile, ReliabilityPolicy
-from ros_helpers import (cannot_start, exited, NodeProcess, NS, Ros, SESSION, stamp_ns, STARTUP_S,
-                         wait_for, wait_for_parameters, wrap)
+from ros_helpers import (cannot_start, exited, Lifecycle, NodeProcess, NS, send_until, SESSION,
+                         stamp_ns, STARTUP_S, wait_for, wait_for_parameters, wrap)
 from sensor_msgs.msg import JointState
 
 #: Tolerance of an angle that the time base fixes exactly, rad.
@@ -61,7 +60,7 @@ def test_a_second_node_of_the_same_name_exits_1(ros, tmp_path):
         assert status == 1, output
         assert f'another node named {ns}/mech_kinematics is running' in output
         count = len(js)
-        wait_for(lambda: len(js) > count + 50, 5.0, 'the first node still publishing')
+        wait_for(lambda: len(js) > count + 50, STARTUP_S, 'the first node still publishing')
     finally:
         status, _ = first.stop(signal.SIGINT)
     assert status == 0, first.output()
@@ -84,6 +83,7 @@ def test_qos_override_makes_joint_states_best_effort(ros, tmp_path):
         offers = ros.node.get_publishers_info_by_topic(topic)
         assert [o.qos_profile.reliability for o in offers] == [ReliabilityPolicy.BEST_EFFORT]
         params = AsyncParameterClient(ros.node, f'{ns}/mech_kinematics')
+        wait_for_parameters(params)
         response = ros.call(params.get_parameters([f'qos_overrides.{topic}.publisher.depth']))
         assert response.values[0].integer_value == 3
         others = ros.node.get_publishers_info_by_topic(f'{ns}/joint_accelerations')
@@ -91,23 +91,6 @@ def test_qos_override_makes_joint_states_best_effort(ros, tmp_path):
     finally:
         status, _ = proc.stop(signal.SIGINT)
     assert status == 0, proc.output()
-
-
-class Lifecycle:
-    """Clients of a managed node's lifecycle services."""
-
-    def __init__(self, ros: Ros, node: str) -> None:
-        self.ros = ros
-        self.change = ros.node.create_client(ChangeState, f'{node}/change_state')
-        self.get = ros.node.create_client(GetState, f'{node}/get_state')
-        assert self.change.wait_for_service(timeout_sec=STARTUP_S)
-
-    def state(self) -> str:
-        return self.ros.call(self.get.call_async(GetState.Request())).current_state.label
-
-    def transition(self, transition_id: int) -> bool:
-        request = ChangeState.Request(transition=Transition(id=transition_id))
-        return self.ros.call(self.change.call_async(request)).success
 
 
 def test_managed_node_follows_the_lifecycle(ros, tmp_path):
@@ -130,17 +113,24 @@ def test_managed_node_follows_the_lifecycle(ros, tmp_path):
         assert life.transition(Transition.TRANSITION_ACTIVATE) and life.state() == 'active'
         wait_for(lambda: len(js) > 50, STARTUP_S, 'joint_states once active')
         assert life.transition(Transition.TRANSITION_DEACTIVATE) and life.state() == 'inactive'
-        time.sleep(0.3)
-        before = list(js)
+        # Stamps are the node's clock (this machine's): the tick thread has stopped once the
+        # transition is answered, so every state stamped before now was published before.
+        deactivated = time.time_ns()
         time.sleep(1.0)
-        assert len(js) == len(before), 'published while inactive'
         # While inactive the speed changes: it applies from that instant, as time goes on.
         params = AsyncParameterClient(ros.node, f'{ns}/mech_kinematics')
+        wait_for_parameters(params)
         response = ros.call(params.set_parameters([Parameter('crank_speed_rpm', value=120.0)]))
         assert response.results[0].successful
+        activated = time.time_ns()
         assert life.transition(Transition.TRANSITION_ACTIVATE)
-        wait_for(lambda: len(js) > len(before) + 20, STARTUP_S, 'joint_states again')
-        last, again = before[-1], js[len(before)]
+        wait_for(lambda: sum(stamp_ns(m) > activated for m in js) > 20, STARTUP_S,
+                 'joint_states again')
+        assert not [m for m in js if deactivated < stamp_ns(m) <= activated], \
+            'published while inactive'
+        before = [m for m in js if stamp_ns(m) <= deactivated]
+        after = [m for m in js if stamp_ns(m) > activated]
+        last, again = before[-1], after[0]
         gap = (stamp_ns(again) - stamp_ns(last)) / NS
         assert gap > 1.0
         ci = list(last.name).index('crank')
@@ -149,7 +139,7 @@ def test_managed_node_follows_the_lifecycle(ros, tmp_path):
         moved = wrap(again.position[ci] - last.position[ci])
         low, high = sorted((wrap(2 * math.pi * gap), wrap(4 * math.pi * gap)))
         assert low - ATOL_TIMEBASE <= moved <= high + ATOL_TIMEBASE or high - low > math.pi
-        for a, b in zip(js[len(before):], js[len(before) + 1:], strict=False):
+        for a, b in zip(after, after[1:], strict=False):
             dt = (stamp_ns(b) - stamp_ns(a)) / NS
             assert abs(wrap(b.position[ci] - a.position[ci] - 4 * math.pi * dt)) < ATOL_TIMEBASE
         assert life.transition(Transition.TRANSITION_DEACTIVATE)
@@ -171,7 +161,7 @@ def test_managed_node_with_a_bad_scene_fails_to_configure(ros, tmp_path):
         life = Lifecycle(ros, f'{ns}/mech_kinematics')
         assert not life.transition(Transition.TRANSITION_CONFIGURE)
         assert life.state() == 'unconfigured'
-        wait_for(lambda: 'cannot configure' in proc.output(), 5.0, 'the reason in the log')
+        wait_for(lambda: 'cannot configure' in proc.output(), STARTUP_S, 'the reason in the log')
         assert 'no_such_scene' in proc.output()
     finally:
         status, _ = proc.stop(signal.SIGINT)
@@ -196,11 +186,14 @@ def test_untrusted_ticks_publish_nothing_and_say_why(ros, tmp_path):
         response = ros.call(params.set_parameters(
             [Parameter('max_relative_error', value=1e-15)]))
         assert response.results[0].successful, response.results[0].reason
-        time.sleep(0.3)
-        count = len(js)
+        # Applied before the answer: no instant after it is published (stamps are this
+        # machine's clock, as the node's).
+        changed = time.time_ns()
         start = len(diag)
-        wait_for(lambda: len(diag) > start + 1, 5.0, 'diagnostics after the change')
-        assert len(js) <= count + 2, 'published while every tick is untrusted'
+        wait_for(lambda: len(diag) > start + 1, STARTUP_S, 'diagnostics after the change')
+        count = len(js)
+        assert not [m for m in js if stamp_ns(m) > changed], \
+            'published while every tick is untrusted'
         solver = diag[-1].status[0]
         assert solver.level == DiagnosticStatus.ERROR
         assert solver.message.startswith('not trusted at ')
@@ -209,7 +202,7 @@ def test_untrusted_ticks_publish_nothing_and_say_why(ros, tmp_path):
         response = ros.call(params.set_parameters(
             [Parameter('max_relative_error', value=1e-6)]))
         assert response.results[0].successful
-        wait_for(lambda: len(js) > count + 50, 5.0, 'joint_states again')
+        wait_for(lambda: len(js) > count + 50, STARTUP_S, 'joint_states again')
     finally:
         status, _ = proc.stop(signal.SIGINT)
     assert status == 0, proc.output()
@@ -280,15 +273,21 @@ def test_switching_to_sim_time_and_back_keeps_the_crank_where_it_was(ros, tmp_pa
         wait_for_parameters(params)
         assert ros.call(params.set_parameters(
             [Parameter('use_sim_time', value=True)])).results[0].successful
-        time.sleep(0.3)
-        wall_last = js[-1]
-        count = len(js)
-        t = 5_000 * NS
-        for _ in range(30):
-            t += 10_000_000
-            clock_pub.publish(Clock(clock=Time(sec=t // NS, nanosec=t % NS)))
-            time.sleep(0.01)
-        wait_for(lambda: len(js) > count + 10, 5.0, 'joint_states on sim time')
+        count = len(js) - 1         # a state on the wall clock, before the switch
+        clock = [5_000 * NS]
+
+        def tick():
+            # The node subscribes to /clock when use_sim_time turns true: a /clock sent
+            # before that subscription has matched is lost; the clock goes on until heard.
+            clock[0] += 10_000_000
+            clock_pub.publish(Clock(clock=Time(sec=clock[0] // NS, nanosec=clock[0] % NS)))
+
+        send_until(tick, lambda: sum(stamp_ns(m) < 100_000 * NS for m in js[count:]) > 10,
+                   STARTUP_S, 'joint_states on sim time', every=0.01)
+        # The last state on the wall clock is the one received before the first on sim time
+        # (one publisher: in the order published).
+        first_sim = next(i for i in range(count, len(js)) if stamp_ns(js[i]) < 100_000 * NS)
+        wall_last = js[first_sim - 1]
         sim = [m for m in js[count:] if stamp_ns(m) < 100_000 * NS]
         ci = list(wall_last.name).index('crank')
         assert abs(wrap(sim[0].position[ci] - wall_last.position[ci])) < ATOL_TIMEBASE
@@ -297,10 +296,10 @@ def test_switching_to_sim_time_and_back_keeps_the_crank_where_it_was(ros, tmp_pa
             assert abs(wrap(b.position[ci] - a.position[ci] - 2 * math.pi * dt)) < ATOL_TIMEBASE
         assert ros.call(params.set_parameters(
             [Parameter('use_sim_time', value=False)])).results[0].successful
-        wait_for(lambda: any(stamp_ns(m) > 100_000 * NS for m in js[count:]), 5.0,
+        wait_for(lambda: any(stamp_ns(m) > 100_000 * NS for m in js[first_sim:]), STARTUP_S,
                  'joint_states on the wall clock again')
-        last_sim = [m for m in js[count:] if stamp_ns(m) < 100_000 * NS][-1]
-        first_wall = next(m for m in js[count:] if stamp_ns(m) > 100_000 * NS)
+        last_sim = [m for m in js[first_sim:] if stamp_ns(m) < 100_000 * NS][-1]
+        first_wall = next(m for m in js[first_sim:] if stamp_ns(m) > 100_000 * NS)
         assert abs(wrap(first_wall.position[ci] - last_sim.position[ci])) < ATOL_TIMEBASE
     finally:
         status, _ = proc.stop(signal.SIGINT)

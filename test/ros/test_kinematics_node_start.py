@@ -7,6 +7,7 @@ See issue 20, item 5. Every node says its start instant and a random id on
 the older one goes on.
 """
 
+import os
 import re
 import signal
 import time
@@ -149,7 +150,7 @@ def test_the_older_node_goes_on_without_a_gap_while_newcomers_are_refused(ros, t
             _one_refusal(output, ns)
             assert first.proc.poll() is None, first.output()
         count = len(js)
-        wait_for(lambda: len(js) > count + 50, 5.0, 'the first node still publishing')
+        wait_for(lambda: len(js) > count + 50, STARTUP_S, 'the first node still publishing')
         assert first.proc.poll() is None, first.output()
     finally:
         status, _ = first.stop(signal.SIGINT)
@@ -177,7 +178,7 @@ def test_of_two_nodes_started_together_exactly_one_goes_on(ros, tmp_path):
         assert gone[0].proc.returncode == 1, gone[0].output()
         _one_refusal(gone[0].output(), ns)
         count = len(js)
-        wait_for(lambda: len(js) > count + 50, 5.0, 'the remaining node still publishing')
+        wait_for(lambda: len(js) > count + 50, STARTUP_S, 'the remaining node still publishing')
     finally:
         statuses = [p.stop(signal.SIGINT)[0] for p in procs]
     assert sorted(statuses) == [0, 1], [p.output() for p in procs]
@@ -249,7 +250,7 @@ def test_a_long_chain_is_published_while_its_tick_compiles(ros, tmp_path):
         wait_for(lambda: 'the compiled tick serves from now' in proc.output(), 60.0,
                  'the compiled tick')
         count = len(js)
-        wait_for(lambda: len(js) > count + 25, 5.0, 'states from the compiled tick')
+        wait_for(lambda: len(js) > count + 25, STARTUP_S, 'states from the compiled tick')
     finally:
         status, _ = proc.stop(signal.SIGINT)
     output = proc.output()
@@ -271,3 +272,115 @@ def test_a_long_chain_is_published_while_its_tick_compiles(ros, tmp_path):
         turn = msg.position[names.index('b99')] - msg.position[names.index('crank')]
         offsets.append(math.remainder(turn, math.tau))
     assert max(offsets) - min(offsets) < 1e-9, (min(offsets), max(offsets))
+
+
+def _params_file(path, **values) -> str:
+    path.write_text('/**:\n  ros__parameters:\n' + ''.join(
+        f'    {name}: {value}\n' for name, value in values.items()))
+    return str(path)
+
+
+@pytest.mark.parametrize('kind', ['fifo', 'directory', 'missing', 'device', 'too large'])
+def test_a_params_file_that_cannot_be_read_is_one_line_and_exit_2(tmp_path, kind):
+    """Issue 33: --params-file naming a FIFO hung before our code ran; it is looked at first.
+
+    A FIFO, a directory, a device, a missing file or one over 1 MiB is refused in one
+    line naming the file, before rcl opens it.
+    """
+    path = tmp_path / 'params.yaml'
+    if kind == 'fifo':
+        os.mkfifo(path)
+    elif kind == 'directory':
+        path.mkdir()
+    elif kind == 'device':
+        path = '/dev/zero'
+    elif kind == 'too large':
+        _params_file(path, tf_prefix='a' * (1 << 20))
+    proc = NodeProcess(tmp_path / 'node', '--params-file', str(path),
+                       '-r', f'__ns:={SESSION}/params_file')
+    status, output = exited(proc)
+    assert status == 2, output
+    assert output.count('\n') == 1 and len(cannot_start(output)) == 1, output
+    words = {'fifo': 'got a FIFO (named pipe)', 'directory': 'got a directory',
+             'missing': 'expected a readable file, got no such file or directory',
+             'device': 'got a character device', 'too large': 'at most 1048576 bytes (1 MiB)'}
+    assert f'cannot start: --params-file {path}: expected ' in output, output
+    assert words[kind] in output, output
+
+
+def test_a_long_string_parameter_is_refused_at_once(tmp_path):
+    """Issue 33: a 10 MB tf_prefix took the start over 7 s; over 256 characters is one line.
+
+    The start is refused before the prefix is used (status 1, like every refused start).
+    """
+    path = _params_file(tmp_path / 'params.yaml', tf_prefix='p' * 1_000_000)
+    proc = NodeProcess(tmp_path / 'node', '--params-file', path,
+                       '-r', f'__ns:={SESSION}/long_string')
+    status, output = exited(proc)
+    assert status == 1, output
+    [line] = cannot_start(output)
+    assert output.count('\n') == 1, output
+    assert "tf_prefix: expected at most 256 characters, got 1000000: 'ppppp" in line
+
+
+#: When the stop test signals each node: after which event of its start (rclpy loaded, the
+#: node on the graph, its start line logged), how long after (s), and with what.
+STOPS = [('rclpy', 0.0, signal.SIGTERM), ('rclpy', 0.0, signal.SIGINT),
+         ('rclpy', 0.2, signal.SIGTERM), ('graph', 0.0, signal.SIGTERM),
+         ('graph', 0.3, signal.SIGINT), ('started', 0.0, signal.SIGTERM),
+         ('started', 0.0, signal.SIGINT)]
+
+
+def _rclpy_loaded(proc: NodeProcess) -> bool:
+    try:
+        with open(f'/proc/{proc.proc.pid}/maps') as maps:
+            return '_rclpy_pybind11' in maps.read()
+    except OSError:
+        return False
+
+
+def test_a_stop_at_any_point_of_the_start_is_a_clean_exit(ros, tmp_path):
+    """Issue 33: a SIGTERM while the node started printed an AttributeError traceback.
+
+    Seven nodes on a 16-dyad strip (its tick compiles while it configures) are each
+    sent SIGTERM or SIGINT at another point of their start: once rclpy is loaded
+    (importing, rclpy.init), once the node is on the graph (configuring), once its
+    start line is logged (activating, the executor made, the spin). Each exits 0
+    with no traceback and no refusal; it was status 1 ("cannot start: Failed to
+    create publisher: rcl node's context is invalid"), or a traceback. (Before
+    rclpy is loaded, while Python imports the package, a SIGTERM ends the process
+    by its default action: not tested here.)
+    """
+    path = tmp_path / 'strip.yaml'
+    path.write_text(_strip_yaml(16))
+    spaces = [f'{SESSION}/stop{i}' for i in range(len(STOPS))]
+    procs = [NodeProcess(tmp_path / f'node{i}', '-r', f'__ns:={ns}', '-p', f'scene:={path}')
+             for i, ns in enumerate(spaces)]
+    events = {'rclpy': lambda i: _rclpy_loaded(procs[i]),
+              'graph': lambda i: spaces[i] in {ns for _, ns in
+                                               ros.node.get_node_names_and_namespaces()},
+              'started': lambda i: "scene 'strip16'" in procs[i].output()}
+    seen: list[float | None] = [None] * len(procs)      # when each one's event was seen
+    signalled = [False] * len(procs)
+    try:
+        deadline = time.monotonic() + 3 * STARTUP_S
+        while not all(signalled) and time.monotonic() < deadline:
+            now = time.monotonic()
+            for i, (proc, (event, delay, signum)) in enumerate(zip(procs, STOPS, strict=True)):
+                if seen[i] is None and events[event](i):
+                    seen[i] = now
+                if not signalled[i] and seen[i] is not None and now >= seen[i] + delay:
+                    proc.proc.send_signal(signum)
+                    signalled[i] = True
+            time.sleep(0.005)
+        results = [exited(proc) for proc in procs]
+    finally:
+        for proc in procs:
+            if proc.proc.poll() is None:
+                proc.proc.kill()
+    assert all(signalled), [p.output() for p, s in zip(procs, signalled, strict=True) if not s]
+    unclean = [(event, delay, signum.name, status, output)
+               for (status, output), (event, delay, signum) in zip(results, STOPS, strict=True)
+               if status != 0 or 'Traceback' in output or 'Exception ignored' in output
+               or cannot_start(output)]
+    assert not unclean, unclean

@@ -10,7 +10,6 @@ frame sits at its block, a slotted lever's frame carries the pin at (s, 0).
 
 import math
 import signal
-import time
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -84,8 +83,14 @@ def test_link_frames_compose_to_the_published_points(ros, tmp_path, scene_name):
         # A late subscriber still gets the static frames (transient local).
         ros.node.create_subscription(TFMessage, f'{ns}/tf_static', static.append,
                                      static_qos)
-        wait_for(lambda: static, 5.0, '/tf_static')
-        time.sleep(0.2)
+        wait_for(lambda: static, STARTUP_S, '/tf_static')
+
+        def complete():
+            # /tf messages whose tick's points and joints have arrived too (each topic
+            # arrives on its own, later on a loaded machine).
+            stamps = {stamp_ns(m) for m in points_msgs} & {stamp_ns(m) for m in joint_msgs}
+            return sum(stamp_ns(m.transforms[0]) in stamps for m in tf) >= 30
+        wait_for(complete, STARTUP_S, '30 /tf messages with the states of their ticks')
     finally:
         status, _ = proc.stop(signal.SIGINT)
     assert status == 0, proc.output()

@@ -8,6 +8,11 @@ state per accepted message on every state topic (and /tf), stamped with the
 input's stamp, positions as the solver gives them, velocities only when the
 input has them, accelerations never; each bad message is refused on
 ``diagnostics`` with its reason while the node goes on.
+
+A message sent before the node's subscription has matched this process's
+publisher is lost (the publisher may see the match first), so every node is
+first greeted (:meth:`TopicNode.handshake`): messages stamped before
+:data:`T0` are sent until one is answered; what answers them is not kept.
 """
 
 import math
@@ -15,14 +20,14 @@ import time
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from lifecycle_msgs.msg import Transition
-from lifecycle_msgs.srv import ChangeState
 import numpy as np
 import pytest
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 from rclpy.qos import QoSProfile, ReliabilityPolicy
-from ros_helpers import (cannot_start, exited, NodeProcess, NS, SESSION, stamp_ns, STARTUP_S,
-                         wait_for, wait_for_parameters)
+from ros_helpers import (cannot_start, exited, Lifecycle, NodeProcess, NS, RELIABLE,
+                         send_until, SESSION, stamp_ns, STARTUP_S, wait_for,
+                         wait_for_parameters)
 from sensor_msgs.msg import JointState
 from tf2_msgs.msg import TFMessage
 from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
@@ -38,42 +43,76 @@ INPUT_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
 ANSWER_S = 10.0
 #: The first stamp sent, ns (any positive instant: the node never reads its own clock here).
 T0 = 1_700_000_000 * NS
+#: The stamp of the first greeting (TopicNode.handshake), ns; greetings are 1 ms apart.
+HELLO = T0 - 100 * NS
 
 
 class TopicNode:
     """A node with drive: topic in a namespace of its own, and what it publishes, as received."""
 
-    def __init__(self, ros, tmp_path, name, *args, input_topic=None, wait=True,
+    def __init__(self, ros, tmp_path, name, *args, scene=SCENE, input_topic=None, wait=True,
                  input_qos=INPUT_QOS):
         self.ns = f'{SESSION}/{name}'
         self.prefix = f'{SESSION[1:]}_{name}'
-        self.js = ros.collect(JointState, f'{self.ns}/joint_states')
-        self.jt = ros.collect(JointTrajectory, f'{self.ns}/joint_accelerations')
-        self.pt = ros.collect(MultiDOFJointTrajectory, f'{self.ns}/point_accelerations')
+        self.drivers = mk.load_scene(scene).drivers
+        self.greeted = []
+        # The states answering the greetings (stamped before T0) are not kept.
+        self.js = self._collect(ros, JointState, 'joint_states')
+        self.jt = self._collect(ros, JointTrajectory, 'joint_accelerations')
+        self.pt = self._collect(ros, MultiDOFJointTrajectory, 'point_accelerations')
         self.tf = ros.collect(TFMessage, '/tf')
         self.diag = ros.collect(DiagnosticArray, f'{self.ns}/diagnostics')
         self.input = ros.node.create_publisher(
             JointState, input_topic or f'{self.ns}/input_joint_states', input_qos)
-        self.proc = NodeProcess(tmp_path, '-r', f'__ns:={self.ns}', '-p', f'scene:={SCENE}',
+        self.hello = HELLO
+        self.proc = NodeProcess(tmp_path, '-r', f'__ns:={self.ns}', '-p', f'scene:={scene}',
                                 '-p', 'drive:=topic', '-p', 'tf_rate_hz:=10000.0',
                                 '-p', f'tf_prefix:={self.prefix}', *args)
         if wait:
             self.wait_for_subscription()
+            self.handshake()
+
+    def _collect(self, ros, msg_type, topic):
+        kept = []
+
+        def keep(msg):
+            if stamp_ns(msg) >= T0:
+                kept.append(msg)
+            elif msg_type is JointState:
+                self.greeted.append(msg)
+        ros.node.create_subscription(msg_type, f'{self.ns}/{topic}', keep, RELIABLE)
+        return kept
 
     def wait_for_subscription(self):
         wait_for(lambda: self.input.get_subscription_count() > 0 or self.proc.proc.poll(),
                  STARTUP_S, 'the node subscribing to input_joint_states')
         assert self.proc.proc.poll() is None, self.proc.output()
 
-    def send(self, stamp, names, positions, velocities=()):
+    def handshake(self):
+        """Send the drivers at their start until the node answers one (it hears us from then).
+
+        The publisher may see the node's subscription before the subscription has
+        matched the publisher: a message sent then is lost. The greetings are
+        stamped 1 ms apart before T0, and their answers are not kept.
+        """
+        def greet():
+            self.send(self.hello, [d.name for d in self.drivers],
+                      [d.start for d in self.drivers])
+            self.hello += 1_000_000
+
+        send_until(greet, lambda: self.greeted or self.proc.proc.poll() is not None,
+                   STARTUP_S, 'the node answering a greeting on input_joint_states', every=0.2)
+        assert self.proc.proc.poll() is None, self.proc.output()
+
+    def send(self, stamp, names, positions, velocities=(), efforts=()):
         msg = JointState(name=list(names), position=list(positions),
-                         velocity=list(velocities))
+                         velocity=list(velocities), effort=list(efforts))
         msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(stamp, NS)
         self.input.publish(msg)
 
     def tf_stamps(self):
         return [stamp_ns(t) for m in self.tf for t in m.transforms
-                if t.child_frame_id == f'{self.prefix}/crank']
+                if t.child_frame_id == f'{self.prefix}/crank' and stamp_ns(t) >= T0]
 
     def solver_statuses(self, since=0):
         """Return the solver statuses on diagnostics from message ``since`` on, oldest first."""
@@ -141,7 +180,8 @@ def test_bad_messages_are_refused_on_diagnostics_and_the_node_goes_on(ros, tmp_p
     """Each bad message publishes nothing and says why on diagnostics; good ones go on."""
     node = TopicNode(ros, tmp_path, 'topic_refusals')
     bad = [
-        (['crank', 'wrist'], [0.1, 0.2], [], "unknown joint(s) 'wrist'"),
+        (['crank', 'wrist'], [0.1, 0.2], [],
+         "unknown joint(s) 'wrist' (extra_joints:=ignore|pass takes the drivers"),
         (['rocker'], [0.1], [], "unknown joint(s) 'rocker'"),
         ([], [], [], "got none for 'crank'"),
         (['crank'], [math.nan], [], "expected a finite position of 'crank', got nan"),
@@ -190,16 +230,17 @@ def test_bad_messages_are_refused_on_diagnostics_and_the_node_goes_on(ros, tmp_p
 def test_a_managed_node_publishes_only_while_active(ros, tmp_path):
     """managed:=true: subscribed from configure, a state per message only while active."""
     node = TopicNode(ros, tmp_path, 'topic_managed', '-p', 'managed:=true', wait=False)
-    change = ros.node.create_client(ChangeState, f'{node.ns}/mech_kinematics/change_state')
 
     def transition(transition_id):
-        request = ChangeState.Request(transition=Transition(id=transition_id))
-        assert ros.call(change.call_async(request)).success
+        assert life.transition(transition_id)
 
     try:
-        assert change.wait_for_service(timeout_sec=STARTUP_S)
+        life = Lifecycle(ros, f'{node.ns}/mech_kinematics')
         transition(Transition.TRANSITION_CONFIGURE)
         node.wait_for_subscription()
+        transition(Transition.TRANSITION_ACTIVATE)
+        node.handshake()                          # from now on every message reaches it
+        transition(Transition.TRANSITION_DEACTIVATE)
         node.send(T0 + 1, ['crank'], [0.1])       # inactive: nothing
         transition(Transition.TRANSITION_ACTIVATE)
         node.send(T0 + 2, ['crank'], [0.2])
@@ -208,8 +249,9 @@ def test_a_managed_node_publishes_only_while_active(ros, tmp_path):
         node.send(T0 + 3, ['crank'], [0.3])       # inactive again: nothing
         transition(Transition.TRANSITION_ACTIVATE)
         node.send(T0 + 4, ['crank'], [0.4])
-        wait_for(lambda: len(node.js) >= 2, ANSWER_S, 'a state once active again')
-        time.sleep(0.3)
+        # Answers come in the order sent: T0 + 1's and T0 + 3's would come before this one.
+        wait_for(lambda: any(stamp_ns(m) == T0 + 4 for m in node.js), ANSWER_S,
+                 'a state once active again')
     finally:
         node.stop()
     assert [stamp_ns(m) for m in node.js] == [T0 + 2, T0 + 4]
@@ -276,7 +318,7 @@ def test_the_input_qos_is_overridden_like_the_publishers(ros, tmp_path):
 def test_several_drivers_from_one_message(ros, tmp_path):
     """Five-bar: both cranks in one message give the whole state; one missing is refused."""
     scene = mk.load_scene('five_bar')
-    node = TopicNode(ros, tmp_path, 'topic_five_bar', '-p', 'scene:=five_bar')
+    node = TopicNode(ros, tmp_path, 'topic_five_bar', scene='five_bar')
     poses = [(1.5 + 0.01 * i, 1.0 - 0.02 * i, 0.5 * i - 2.0, 1.0) for i in range(10)]
     try:
         for i, (left, right, v_left, v_right) in enumerate(poses):
@@ -302,7 +344,7 @@ def test_several_drivers_from_one_message(ros, tmp_path):
 def test_an_actuator_length_outside_its_stroke_is_refused(ros, tmp_path):
     """Excavator: cylinder lengths in, the arm out; a length beyond the stroke is refused."""
     scene = mk.load_scene('excavator')
-    node = TopicNode(ros, tmp_path, 'topic_excavator', '-p', 'scene:=excavator')
+    node = TopicNode(ros, tmp_path, 'topic_excavator', scene='excavator')
     try:
         node.send(T0, ['boom_cyl', 'stick_cyl'], [2.8, 3.1])
         wait_for(lambda: node.js, ANSWER_S, 'the excavator state')
@@ -320,6 +362,116 @@ def test_an_actuator_length_outside_its_stroke_is_refused(ros, tmp_path):
     assert not msg.velocity
     np.testing.assert_allclose(msg.position, [state.joints[n].position for n in msg.name],
                                rtol=0, atol=ATOL)
+
+
+def values_of(status):
+    return {v.key: v.value for v in status.values}
+
+
+def test_a_far_future_stamp_does_not_end_the_stream(ros, tmp_path):
+    """Issue 33: after one message stamped 2^31 - 1 s, ordinary messages are published again.
+
+    Every later message was refused as "not after the last published one". An
+    earlier stamp by more than stamp_jump_back_s (1 s) resets the order, is
+    published (/tf too) and is said on diagnostics (WARN, counted, the jump); one
+    earlier by less is still refused.
+    """
+    node = TopicNode(ros, tmp_path, 'topic_far_future')
+    far = (2**31 - 1) * NS
+    stamps = [T0, far, T0 + NS, T0 + NS + 2_000_000]
+    try:
+        for i, (stamp, angle) in enumerate(zip(stamps[:3], (0.1, 0.2, 0.3), strict=True)):
+            seen = len(node.diag)
+            node.send(stamp, ['crank'], [angle])
+            wait_for(lambda n=i + 1: len(node.js) >= n, ANSWER_S, f'the state stamped {stamp}')
+        jump = 'from 2147483647.000000000 s to 1700000001.000000000 s, 447483646 s back'
+        status = wait_for(lambda: node.refusal(seen, 'input stamp jumped back'), ANSWER_S,
+                          'diagnostics saying the stamp jumped back')
+        assert status.level == DiagnosticStatus.WARN
+        assert status.message == ('input stamp jumped back 1 time(s) (the order reset), last '
+                                  f'{jump}')
+        node.send(stamps[3], ['crank'], [0.4])
+        wait_for(lambda: len(node.js) >= 4, ANSWER_S, 'the state after the jump')
+        seen = len(node.diag)
+        node.send(stamps[3] - 1_000_000, ['crank'], [0.5])     # 1 ms back: out of order
+        status = wait_for(lambda: node.refusal(seen, 'expected a stamp after'), ANSWER_S,
+                          'the refusal of a stamp 1 ms back')
+        assert status.level == DiagnosticStatus.ERROR
+        values = values_of(status)
+        wait_for(lambda: len(node.tf_stamps()) >= 4 and len(node.pt) >= 4, ANSWER_S,
+                 '/tf and point_accelerations after the jump')
+    finally:
+        node.stop()
+    assert [stamp_ns(m) for m in node.js] == stamps
+    assert [stamp_ns(m) for m in node.pt] == stamps
+    assert node.tf_stamps() == stamps
+    np.testing.assert_allclose([m.position[0] for m in node.js], [0.1, 0.2, 0.3, 0.4],
+                               rtol=0, atol=ATOL)
+    assert values['stamp_jumps_back_total'] == '1' and values['last_stamp_jump_back'] == jump
+    assert 'stamp_jump_back_s' in values['last_error']
+    assert any('the stamp jumped back 447483646 s' in line
+               for line in node.proc.output().splitlines())
+
+
+#: A robot's whole joint_states: the crank among joints of other parts (and the coupler,
+#: which the node computes itself).
+ROBOT = ['wrist', 'crank', 'coupler', 'gripper']
+
+
+def test_extra_joints_pass_puts_the_robots_other_joints_after_the_mechanisms(ros, tmp_path):
+    """extra_joints:=pass: the input's other joints are published unchanged after ours.
+
+    Issue 33: a real /joint_states carries every joint of the robot. The crank is
+    taken; 'wrist' and 'gripper' follow the mechanism's joints in joint_states
+    with their position, velocity and effort (effort NaN, unknown, for the
+    mechanism's); 'coupler', published by the node, is ignored, not passed twice.
+    Diagnostics say which joints were passed and ignored.
+    """
+    scene = mk.load_scene(SCENE)
+    joints = list(scene.output_joints)
+    node = TopicNode(ros, tmp_path, 'topic_pass', '-p', 'extra_joints:=pass')
+    try:
+        node.send(T0, ROBOT, [0.3, 0.2, 9.9, 0.05], [0.5, 2.0, 0.0, -0.1], [1.0, 2.0, 3.0, 4.0])
+        node.send(T0 + 1, ROBOT[::-1], [0.06, 9.9, 0.25, 0.31])
+        wait_for(lambda: len(node.js) >= 2 and len(node.jt) >= 2, ANSWER_S, 'two states')
+        seen = len(node.diag)
+        status = wait_for(lambda: node.solver_statuses(seen), ANSWER_S, 'diagnostics')[-1]
+    finally:
+        node.stop()
+    first, second = node.js
+    assert first.name == [*joints, 'wrist', 'gripper']
+    state = mk.solve(scene, 0.2, 2.0, 0.0)
+    np.testing.assert_allclose(first.position, [*(state.joints[n].position for n in joints),
+                                                0.3, 0.05], rtol=0, atol=ATOL)
+    np.testing.assert_allclose(first.velocity, [*(state.joints[n].velocity for n in joints),
+                                                0.5, -0.1], rtol=0, atol=ATOL)
+    np.testing.assert_array_equal(first.effort, [math.nan] * len(joints) + [1.0, 4.0])
+    assert second.name == [*joints, 'gripper', 'wrist']
+    assert list(second.position[-2:]) == [0.06, 0.31]
+    assert not second.velocity and not second.effort
+    assert [m.joint_names for m in node.jt] == [joints, joints]
+    values = values_of(status)
+    assert status.level == DiagnosticStatus.OK, status.message
+    assert (values['extra_joints'], values['passed_joints'], values['ignored_joints']) == \
+        ('pass', 'gripper, wrist', 'coupler')
+
+
+def test_extra_joints_ignore_takes_the_drivers_and_says_what_it_dropped(ros, tmp_path):
+    """extra_joints:=ignore: a message with other joints publishes the mechanism's state only."""
+    node = TopicNode(ros, tmp_path, 'topic_ignore', '-p', 'extra_joints:=ignore')
+    try:
+        node.send(T0, ROBOT, [0.3, 0.2, 9.9, 0.05], [0.5, 2.0, 0.0, -0.1])
+        wait_for(lambda: node.js, ANSWER_S, 'the state')
+        seen = len(node.diag)
+        status = wait_for(lambda: node.solver_statuses(seen), ANSWER_S, 'diagnostics')[-1]
+    finally:
+        node.stop()
+    [msg] = node.js
+    assert msg.name == list(mk.load_scene(SCENE).output_joints)
+    assert msg.position[0] == 0.2 and msg.velocity[0] == 2.0 and not msg.effort
+    values = values_of(status)
+    assert (values['extra_joints'], values['ignored_joints'], values['passed_joints']) == \
+        ('ignore', 'wrist, coupler, gripper', '')
 
 
 @pytest.mark.parametrize('args, words', [

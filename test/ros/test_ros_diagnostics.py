@@ -165,3 +165,44 @@ def test_several_drivers_are_listed_each_in_scene_order():
     assert solver.value('driver_speeds') == '0.5, -0.25'
     assert solver.value('driver_accels') == '0.0, 0.0'
     assert 'crank_angle' not in dict(solver.values)
+
+
+def test_a_stamp_jumping_back_warns_once_and_is_counted():
+    """Topic drive: a jump of the input's stamp back is WARN in its window, counted (issue 33).
+
+    The next window is OK again; the total and the last jump stay.
+    """
+    stats = TickStats(near_singular=1e-3)
+    far, back = (2**31 - 1) * NS, 1_700_000_000 * NS
+    for stamp, jumped_from in ((far, None), (back, far), (back + 1, None)):
+        stats.record(stamp, 5_000, False, measure=0.5)
+        stats.topic_input(stamp, jumped_from, (), ())
+    first = solver_status(stats.take_window(stats._start + NS), near_singular=1e-3,
+                          extra_joints='refuse', **NAME)
+    assert first.level == WARN
+    jump = 'from 2147483647.000000000 s to 1700000000.000000000 s, 447483647 s back'
+    assert first.message == f'input stamp jumped back 1 time(s) (the order reset), last {jump}'
+    assert first.value('stamp_jumps_back') == '1' == first.value('stamp_jumps_back_total')
+    assert first.value('last_stamp_jump_back') == jump
+    stats.record(back + 2, 5_000, False, measure=0.5)
+    stats.topic_input(back + 2, None, (), ())
+    second = solver_status(stats.take_window(stats._start + NS), near_singular=1e-3,
+                           extra_joints='refuse', **NAME)
+    assert second.level == OK and second.message == 'ok'
+    assert (second.value('stamp_jumps_back'), second.value('stamp_jumps_back_total')) == ('0', '1')
+    assert second.value('last_stamp_jump_back') == jump
+
+
+def test_the_joints_ignored_and_passed_are_said_in_topic_drive_only():
+    """The last input's joints ignored and passed are values of the status; time drive has none."""
+    stats = TickStats()
+    stats.record(1, 5_000, False, measure=0.5)
+    stats.topic_input(1, None, ('coupler',), tuple(f'j{k}' for k in range(25)))
+    window = stats.take_window(stats._start + NS)
+    solver = solver_status(window, near_singular=1e-3, extra_joints='pass', **NAME)
+    assert solver.level == OK
+    assert solver.value('extra_joints') == 'pass'
+    assert solver.value('ignored_joints') == 'coupler'
+    assert solver.value('passed_joints') == ', '.join(f'j{k}' for k in range(20)) + ' and 5 more'
+    keys = dict(solver_status(window, near_singular=1e-3, **NAME).values)
+    assert not {'extra_joints', 'passed_joints', 'stamp_jumps_back'} & set(keys)

@@ -24,10 +24,22 @@ from mech_kinematics.ros.parameters import (driver_parameters, first_crank_alias
     ('drive', 'topics', "drive: expected one of time, topic, got 'topics'"),
     ('drive', 1, 'drive: expected a string, got number 1'),
     ('max_catch_up_s', -1.0, 'max_catch_up_s: expected 0 <= value <= 10 s, got -1.0'),
+    ('extra_joints', 'keep', "extra_joints: expected one of refuse, ignore, pass, got 'keep'"),
+    ('stamp_jump_back_s', -0.5, 'stamp_jump_back_s: expected 0 <= value <= 1e+09 s, got -0.5'),
 ])
 def test_bad_values_are_refused_with_a_reason(name, value, reason):
     """Each bad value gets one line naming the parameter, what it expects and what it got."""
     assert refusal(name, value) == reason
+
+
+@pytest.mark.parametrize('name, limit', [('tf_prefix', 256), ('frame_id', 256), ('scene', 4096)])
+def test_every_string_is_bounded(name, limit):
+    """Issue 33: a 10 MB tf_prefix took the start 7 s; a name over 256, a path over 4096, no."""
+    assert refusal(name, 'a' * limit) is None
+    reason = refusal(name, 'a' * 10_000_000)
+    assert reason == (f'{name}: expected at most {limit} characters, got 10000000: '
+                      f"'{'a' * 30}'...")
+    assert all(p.max_chars in (256, 4096) for p in PARAMETERS if p.kind == 'string')
 
 
 def test_good_values_and_foreign_names_pass():

@@ -16,9 +16,8 @@ import mech_kinematics as mk
 from mech_kinematics.ros.ticker import (compile_tick, compiled_tick, tick_function,
                                         values_from_state)
 from mech_kinematics.solver.compiler import NotCompiled, scene_plan
-from mech_kinematics.tools.report.common import MODES
-from mech_kinematics.tools.report.cost import chain_scene
-from mech_kinematics.tools.report.extreme import extreme_cases
+from mech_kinematics.verify.cases import chain_scene
+from mech_kinematics.verify.extreme import extreme_cases
 
 #: Crank angles over two turns and a bit, both signs.
 ANGLES = np.linspace(-7.0, 7.0, 351)
@@ -124,7 +123,7 @@ def test_a_step_outside_the_kernel_subset_falls_back(monkeypatch):
 
 def test_the_extreme_suite_refuses_and_answers_alike():
     """Toggles, change points, grazing guides, a pin at the pivot: same answers and refusals."""
-    cases = extreme_cases(MODES['smoke'])
+    cases = extreme_cases(extra_angles=0)  # each case's own instants (the report's smoke run)
     compiled = 0
     for case in cases:
         tick, is_compiled = tick_function(case.scene)

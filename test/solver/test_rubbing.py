@@ -24,7 +24,7 @@ import pytest
 import mech_kinematics as mk
 from mech_kinematics.__main__ import main
 from mech_kinematics.geometry import diagrams as geo
-from mech_kinematics.tools.report import reference as ref
+from mech_kinematics.verify import reference as ref
 
 #: Closed-form hand values against the solver, relative.
 RTOL_HAND = 1e-12

@@ -5,15 +5,16 @@
 ``python -m mech_kinematics report -o DIR [--quick | --smoke]`` writes
 ``DIR/REPORT.md`` and its PNG figures:
 
-1. the 50-digit reference (:mod:`mech_kinematics.tools.report.reference`) and its
-   checks (:mod:`.checks`);
+1. the 50-digit reference (:mod:`mech_kinematics.verify.reference`, the
+   verification room's) and its checks (:mod:`.checks`);
 2. work-precision diagrams: our solver against Newton-Raphson, finite
    differences, ``solve_ivp`` and the textbooks' printed answers
    (:mod:`.baselines`);
 3. the error of the node's crank angle against run time, for the exact time
    base and for naive ``angle += omega * dt`` accumulation (:mod:`.clock`);
 4. stiff and extreme cases against the reference, with the solver's flags,
-   digits lost and the formula audit (:mod:`.extreme`);
+   digits lost and the formula audit (the verification room's extreme suite,
+   :mod:`mech_kinematics.verify.extreme`);
 5. cost growth with the batch size and the number of dyads (:mod:`.cost`);
 6. the solver's error bounds against the actual errors over an extreme suite,
    and the fraction of a turn refused at each tolerance (:mod:`.bounds`).
@@ -57,30 +58,28 @@ from .checks import golden_checks, golden_folder, GoldenCheck, reference_checks,
 from .clock import (clock_errors, CLOCK_TICKS, ClockRow, EPOCH_NS, naive_accumulate,
                     naive_cumsum, naive_wrapped, naive_wrapped_trace, node_clock, TICK_HZ)
 from .common import DURATIONS, EPS, ERROR_FLOOR, Mode, MODES, slug, spread_time, WP_SCENES
-from .cost import chain_scene, CHUNK, cost_growth, CostGrowth
+from .cost import CHUNK, cost_growth, CostGrowth
 from .data import (BLOCKS, check_text, collect, DATA_FILE, KEPT, lookup, read_data,
                    render_block, SPREAD_RULE, store_section, STORED, update_text, write_data)
-from .extreme import (AngleResult, BOUND_FACTOR, Case, CaseResult, digits_lost, evaluate_angle,
-                      evaluate_case, extreme_cases, formula_audit, FormulaAudit)
 from .figures import (plot_bounds, plot_clock, plot_cost, plot_extreme, plot_refused,
                       plot_work_precision)
 from .markdown import bench_text, write_report
 from ..cli import run_tool
+from ...verify.extreme import evaluate_case, extreme_cases, formula_audit
 
 __all__ = [
     'BLOCKS', 'DATA_FILE', 'EPOCH_NS', 'KEPT', 'ORDERS', 'SPREAD_RULE', 'STORED', 'by_order',
     'check_text', 'collect', 'lookup', 'node_clock', 'read_data', 'render_block', 'spread_time',
     'store_section', 'update_text', 'write_data',
-    'AngleResult', 'BOUND_FACTOR', 'BoundCase', 'BoundStats', 'BoundValue', 'CHUNK', 'CLOCK_TICKS',
-    'Case', 'CaseBounds', 'CaseResult', 'ClockRow', 'Configurations', 'CostGrowth', 'DURATIONS',
-    'EPS', 'ERROR_FLOOR', 'FormulaAudit', 'GoldenCheck', 'HAND_TIME', 'KAPPA_WELL', 'MODES',
+    'BoundCase', 'BoundStats', 'BoundValue', 'CHUNK', 'CLOCK_TICKS',
+    'CaseBounds', 'ClockRow', 'Configurations', 'CostGrowth', 'DURATIONS',
+    'EPS', 'ERROR_FLOOR', 'GoldenCheck', 'HAND_TIME', 'KAPPA_WELL', 'MODES',
     'Mode', 'NEWTON_TRACKING_STEP', 'OFFSETS', 'ReferenceCheck', 'RefusedFractions', 'TICK_HZ',
     'TOLERANCES', 'WP_PRINTED', 'WP_RANGES', 'WP_SCENES', 'WorkPoint', 'WorkPrecision',
     'add_parser', 'bench_section', 'bound_cases', 'bound_statistics', 'bound_values',
-    'chain_scene',
     'clock_errors', 'refresh_bench',
-    'configurations', 'cost_growth', 'digits_lost', 'evaluate_angle', 'evaluate_case',
-    'extreme_cases', 'formula_audit', 'golden_checks', 'golden_folder', 'headline', 'main',
+    'configurations', 'cost_growth',
+    'golden_checks', 'golden_folder', 'headline', 'main',
     'naive_accumulate', 'naive_cumsum', 'naive_wrapped', 'naive_wrapped_trace', 'newton_positions',
     'plot_bounds', 'plot_clock', 'plot_cost', 'plot_extreme', 'plot_refused',
     'plot_work_precision', 'reference_checks', 'refused_fractions', 'run', 'work_precision',
@@ -129,7 +128,7 @@ def run(outdir: str | os.PathLike[str], mode: str | Mode = 'full',
         bar.set_description('clock')
         clock, clock_check = clock_errors(mode, tick=tick)
         bar.set_description('extreme cases')
-        extreme = [evaluate_case(case) for case in extreme_cases(mode)]
+        extreme = [evaluate_case(case) for case in extreme_cases(mode.extreme_angles)]
         audit = formula_audit()
         tick()
         bar.set_description('cost growth')

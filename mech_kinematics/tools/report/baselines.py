@@ -24,6 +24,7 @@ import numpy as np
 from .common import ERROR_FLOOR, Mode, quiet_solve, spread_time, WP_SCENES
 from ...scene import load_scene
 from ...solver import JointMotion, Scene, solve
+from ...solver.graph import joint_type
 from ...textbook import find_answer, PointNorm
 from ...units import radians_from_degrees
 
@@ -93,7 +94,7 @@ class _State:
 
 
 def _coefficient(x: Any, k: int) -> Any:
-    from .reference import Jet
+    from ...verify.reference import Jet
     if isinstance(x, Jet):
         return (x.c0, x.c1, x.c2)[k]
     return x if k == 0 else 0 * x
@@ -119,7 +120,7 @@ def _linear_solve(columns: list[list[Any]], rhs: list[Any]) -> Any:
 def _float_kinematics(model: Any, q: list[Any], theta: Any, omega: Any, alpha: Any,
                       ) -> _State:
     """Velocities and accelerations from the linear systems, in double precision."""
-    from .reference import Jet
+    from ...verify.reference import Jet
     values = model.values
     columns = model.jacobian_columns(values, q, theta)
     theta_jet = Jet(theta, omega, alpha / 2)
@@ -145,9 +146,10 @@ def _float_kinematics(model: Any, q: list[Any], theta: Any, omega: Any, alpha: A
 
     joints = {}
     for name, index in model.links.items():
-        joints[name] = motion('revolute', theta_jet if index is None else jets[index])
+        joints[name] = motion(model.joint_types[name],
+                              theta_jet if index is None else jets[index])
     for name, index in model.sliders.items():
-        joints[name] = motion('prismatic', jets[index])
+        joints[name] = motion(model.joint_types[name], jets[index])
     return _State(out_points, joints)
 
 
@@ -181,7 +183,7 @@ class WorkPoint:
     angular_acc: float        # worst relative error of link angular accelerations
     note: str = ''
     #: Worst relative error per kind (position, angle, velocity, ... as
-    #: :func:`mech_kinematics.tools.report.reference.compare`), where measured.
+    #: :func:`mech_kinematics.verify.reference.compare`), where measured.
     errors: dict[str, float] = field(default_factory=dict)
     #: Min, median and max of the repeated timings, s per configuration.
     spread: tuple[float, float, float] | None = None
@@ -200,7 +202,7 @@ class WorkPrecision:
 
 def _errors(states: Sequence[tuple[Any, int | None]], refs: Sequence[Any]) -> dict[str, float]:
     """Worst relative error per kind over the configurations."""
-    from .reference import compare
+    from ...verify.reference import compare
     worst: dict[str, float] = {}
     for (state, index), ref in zip(states, refs, strict=True):
         for kind, value in compare(state, ref, index).items():
@@ -225,7 +227,7 @@ def work_precision(mechanism: str, mode: Mode,
     """Cost and error of every method on one work-precision mechanism."""
     from scipy.integrate import solve_ivp
 
-    from . import reference as ref_mod
+    from ...verify import reference as ref_mod
     scene = load_scene(WP_SCENES[mechanism])
     model = ref_mod.Model(scene)
     conf = configurations(scene, mode.wp_configs, WP_RANGES[mechanism])
@@ -288,7 +290,7 @@ def work_precision(mechanism: str, mode: Mode,
             joints = {}
             for name, joint in mid.joints.items():
                 xm, x0, xp = (s.joints[name].position for s in (minus, mid, plus))
-                if joint.type == 'revolute':
+                if joint_type(joint.type).angular:
                     lo, hi = np.remainder(x0 - xm + np.pi, 2 * np.pi) - np.pi, \
                         np.remainder(xp - x0 + np.pi, 2 * np.pi) - np.pi
                 else:
@@ -343,7 +345,7 @@ def work_precision(mechanism: str, mode: Mode,
     return result
 
 
-#: The kinds of :func:`mech_kinematics.tools.report.reference.compare` by order of derivative.
+#: The kinds of :func:`mech_kinematics.verify.reference.compare` by order of derivative.
 ORDERS = {'position': ('position', 'angle'), 'velocity': ('velocity', 'angular velocity'),
           'acceleration': ('acceleration', 'angular acceleration')}
 

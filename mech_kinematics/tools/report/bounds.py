@@ -12,7 +12,7 @@ passing through its pivot, extreme ratios, scales and speeds):
 - :func:`bound_values` solves each case with an infinite tolerance at
   :data:`OFFSETS` from every singular position, and puts every value's bound
   beside its actual error against the 50-digit reference
-  (:func:`mech_kinematics.tools.report.reference.value_errors`);
+  (:func:`mech_kinematics.verify.reference.value_errors`);
   :func:`bound_statistics` sums them up: no bound may be below its error;
 - :func:`refused_fractions` measures, for each case, the fraction of a full
   crank turn refused at each of :data:`TOLERANCES` (and the part that cannot
@@ -33,12 +33,13 @@ import warnings
 
 import numpy as np
 
-from .common import distance_angle, four_bar, Mode, MODES, slider_crank
+from .common import Mode, MODES
 from ...bounds import MAX_ERROR
 from ...errors import AssemblyError, NearSingularWarning, UntrustedError
 from ...scene import load_scene
 from ...solver import CarriedPoint, Crank, Link, RPR, RRP, Scene, solve
 from ...units import rad_per_s_from_rpm, radians_from_degrees
+from ...verify.cases import distance_angle, four_bar, slider_crank
 
 __all__ = ['BoundCase', 'BoundStats', 'BoundValue', 'CaseBounds', 'KAPPA_WELL', 'OFFSETS',
            'RefusedFractions', 'TOLERANCES', 'bound_cases', 'bound_statistics', 'bound_values',
@@ -55,7 +56,7 @@ REFINE = tuple(10.0 ** (-k / 20) for k in range(20, 301))
 #: Each edge of a refused interval is located to this crank angle, rad.
 EDGE = 1e-14
 #: An instant is well-conditioned when the reference's condition number of every kind
-#: of value is at most this (``reference.condition``; issue 10, test_linkage_bounds):
+#: of value is at most this (``reference.condition``; issue 10, test_solve_bounds):
 #: there the bound must be within 1e3 x (actual error + 1 ulp of the scale).
 KAPPA_WELL = 10.0
 #: Below this near-singularity measure kappa exceeds KAPPA_WELL anyway: not computed.
@@ -125,7 +126,7 @@ def _spaced(count: int, start: float = 0.3) -> tuple[float, ...]:
 def bound_cases(mode: Mode | None = None) -> list[BoundCase]:
     """Return the extreme suite of issue 10: every kind of singular position, ratio, scale, speed.
 
-    The mechanisms follow ``test/test_linkage_bounds.py``'s suite and the
+    The mechanisms follow ``test/solver/test_solve_bounds.py``'s suite and the
     extreme cases of section 4; every length is in m, every angle in rad.
     """
     import mpmath
@@ -233,7 +234,7 @@ def bound_values(case: BoundCase) -> CaseBounds:
     an assembly limit) counts as refused. Where the reference finds no
     assembly, the solver must refuse; an answer there is recorded in ``wrong``.
     """
-    from . import reference as ref_mod
+    from ...verify import reference as ref_mod
     model = ref_mod.Model(case.scene)
     result = CaseBounds(case)
     for angle in case.angles():

@@ -19,6 +19,7 @@ from typing import Any
 from .common import Mode, quiet_solve
 from ...errors import AssemblyError
 from ...scene import load_scene, scene_dirs
+from ...solver.graph import joint_type
 from ...units import rad_per_s_from_rpm, radians_from_degrees
 
 __all__ = ['GoldenCheck', 'ReferenceCheck', 'golden_checks', 'golden_folder',
@@ -40,11 +41,11 @@ class ReferenceCheck:
 def reference_checks(mode: Mode, tick: Callable[[], None] = lambda: None
                      ) -> list[ReferenceCheck]:
     """Check the reference on the packaged scenes: residual, second route, solver."""
-    from . import reference as ref_mod
+    from ...verify import reference as ref_mod
     from ...scene import scene_names
     rows = []
     # The packaged scenes driven by one crank (its angle swept); several drivers:
-    # test/solver/test_drivers.py checks them against the reference.
+    # test/solver/test_solve_drivers.py checks them against the reference.
     names = mode.check_scenes or tuple(name for name in scene_names()
                                        if load_scene(name).input is not None
                                        and len(load_scene(name).drivers) == 1)
@@ -107,7 +108,7 @@ def golden_checks(folder: Path | None = None) -> list[GoldenCheck]:
 
     import mpmath
 
-    from . import reference as ref_mod
+    from ...verify import reference as ref_mod
     folder = folder or golden_folder()
     rows = []
     for path in sorted(folder.glob('*.json')) if folder.is_dir() else []:
@@ -136,23 +137,30 @@ def golden_checks(folder: Path | None = None) -> list[GoldenCheck]:
     return rows
 
 
+#: The golden files' name of each kind of value's scale (``case['scales']``), by the
+#: kind a joint type's values are (:attr:`~mech_kinematics.solver.graph.JointType.quantities`).
+_GOLDEN_SCALES = {'angle': 'angle', 'angular velocity': 'angvel',
+                  'angular acceleration': 'angacc', 'position': 'length', 'velocity': 'vel',
+                  'acceleration': 'acc'}
+
+
 def _golden_values(case: dict[str, Any], decimal: dict[str, Any],
                    double: dict[str, Any]) -> Iterable[tuple[float, float, float, float]]:
     """Yield (expected, reference from decimals, reference from doubles, scale)."""
-    kinds = {'revolute': ('angle', 'angvel', 'angacc'), 'prismatic': ('length', 'vel', 'acc')}
     scales = case['scales']
     expected = case['expected']
     for name, joint in expected['joints'].items():
+        kind_of = joint_type(joint['type'])
         for quantity, kind in zip(('position', 'velocity', 'acceleration'),
-                                  kinds[joint['type']], strict=True):
+                                  kind_of.quantities, strict=True):
             a, b = decimal['joints'][name][quantity], double['joints'][name][quantity]
-            if quantity == 'position' and joint['type'] == 'revolute':
+            if quantity == 'position' and kind_of.angular:
                 a = joint[quantity] + math.remainder(a - joint[quantity], 2 * math.pi)
                 b = joint[quantity] + math.remainder(b - joint[quantity], 2 * math.pi)
-            yield joint[quantity], a, b, scales[kind]
+            yield joint[quantity], a, b, scales[_GOLDEN_SCALES[kind]]
     for name, point in expected['points'].items():
-        for quantity, kind in (('position', 'length'), ('velocity', 'vel'),
-                               ('acceleration', 'acc')):
+        for quantity in ('position', 'velocity', 'acceleration'):
+            kind = _GOLDEN_SCALES[quantity]
             for axis in range(2):
                 yield (point[quantity][axis], decimal['points'][name][quantity][axis],
                        double['points'][name][quantity][axis], scales[kind])

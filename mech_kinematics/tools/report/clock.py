@@ -168,7 +168,7 @@ def clock_errors(mode: Mode, scene_name: str = 'khurmi_four_bar_ad150',
     """
     import mpmath
 
-    from . import reference as ref_mod
+    from ...verify import reference as ref_mod
     scene = load_scene(scene_name)
     model = ref_mod.Model(scene)
     theta0 = scene.input.angle

@@ -6,9 +6,8 @@
 ``--quick``, ``--smoke``); :data:`WP_SCENES` names the work-precision
 mechanisms; :func:`spread_time` (min / median / max) and :func:`median_time`
 are the timers and :func:`quiet_solve` the solver with its near-singularity
-warning silenced. :func:`four_bar`,
-:func:`slider_crank` and :func:`distance_angle` build the mechanisms of the
-extreme sections (:mod:`.extreme`, :mod:`.bounds`).
+warning silenced. The mechanisms of the extreme sections are built by the
+verification room (:mod:`mech_kinematics.verify.cases`).
 """
 
 from __future__ import annotations
@@ -24,10 +23,10 @@ import warnings
 import numpy as np
 
 from ...errors import NearSingularWarning
-from ...solver import Branch, CarriedPoint, Crank, Link, RRP, RRR, Scene, solve
+from ...solver import Scene, solve
 
-__all__ = ['DURATIONS', 'EPS', 'ERROR_FLOOR', 'MODES', 'Mode', 'WP_SCENES', 'distance_angle',
-           'four_bar', 'median_time', 'quiet_solve', 'slider_crank', 'slug', 'spread_time']
+__all__ = ['DURATIONS', 'EPS', 'ERROR_FLOOR', 'MODES', 'Mode', 'WP_SCENES', 'median_time',
+           'quiet_solve', 'slug', 'spread_time']
 
 EPS = float(np.finfo(np.float64).eps)
 #: Relative errors below this are drawn at this floor on log axes.
@@ -122,47 +121,3 @@ def quiet_solve(scene: Scene, angle: Any, speed: Any = None, accel: Any = None) 
 def slug(text: str) -> str:
     """Return ``text`` as a file-name stem: lower case, ``_`` for anything not alphanumeric."""
     return ''.join(ch if ch.isalnum() else '_' for ch in text.lower()).strip('_')
-
-
-# --- mechanisms of the extreme sections ------------------------------------------
-
-
-def four_bar(name: str, a: float, b: float, c: float, d: float, angle: float = 0.0,
-             branch: int = 1, speed: float = -4 * math.pi, scale: float = 1.0) -> Scene:
-    """Return a four-bar: crank AB = a about A = 0, coupler BC = b, rocker DC = c, D = (d, 0).
-
-    Every length is multiplied by ``scale``; the coupler carries a point E at
-    (0.5 b, 0.3 b) in its frame. ``angle`` (rad) and ``speed`` (rad/s) are
-    the crank's.
-    """
-    links = (Link('coupler', 'B', b * scale), Link('rocker', 'D', c * scale))
-    crank = Crank('crank', 'A', 'B', a * scale, angle, speed, 0.0)
-    return Scene(name, {'A': (0.0, 0.0), 'D': (d * scale, 0.0)}, crank,
-                 (RRR('C', links, Branch(branch)),),
-                 (CarriedPoint('E', 'coupler', 'B', 'C', (0.5 * b * scale, 0.3 * b * scale)),))
-
-
-def slider_crank(name: str, crank_length: float, rod: float, offset: float = 0.0,
-                 angle: float = 0.0, speed: float = 10 * math.pi) -> Scene:
-    """Return a slider-crank: crank OB about O = 0, rod BP, piston P on the line y = ``offset``.
-
-    The guide runs along +x (branch PLUS: the piston on the +x side); the rod
-    carries its midpoint M. Lengths in m, ``angle`` in rad, ``speed`` in rad/s.
-    """
-    crank = Crank('crank', 'O', 'B', crank_length, angle, speed, 0.0)
-    dyad = RRP('P', Link('rod', 'B', rod), 'E', 0.0, 'piston', Branch.PLUS)
-    return Scene(name, {'O': (0.0, 0.0), 'E': (0.0, offset)}, crank, (dyad,),
-                 (CarriedPoint('M', 'rod', 'B', 'P', (0.5 * rod, 0.0)),))
-
-
-def distance_angle(a: float, d: float, distance: float) -> Any:
-    """Return the crank angle (mpmath, 60 digits) at which the tip is ``distance`` from (d, 0).
-
-    For a crank of length ``a`` about the origin: the position where the
-    circles of a four-bar with ``b + c`` (or ``|b - c|``) equal to
-    ``distance`` just meet, a toggle.
-    """
-    import mpmath
-    with mpmath.workdps(60):
-        a_, d_, r = (mpmath.mpf(x) for x in (a, d, distance))
-        return mpmath.acos((a_ * a_ + d_ * d_ - r * r) / (2 * a_ * d_))

@@ -4,7 +4,8 @@
 
 :func:`cost_growth` times ``solve`` over batches of 1 .. 1e7 angles (in one
 call and in calls of :data:`CHUNK` angles) and over chains of four-bar
-stages (:func:`chain_scene`), one angle and arrays, and fits the growth.
+stages (:func:`~mech_kinematics.verify.cases.chain_scene`), one angle and
+arrays, and fits the growth.
 """
 
 from __future__ import annotations
@@ -18,38 +19,13 @@ import numpy as np
 
 from .common import median_time, Mode
 from ...scene import load_scene
-from ...solver import Branch, CarriedPoint, Crank, Link, RRR, Scene, solve
-from ...units import radians_from_degrees
+from ...solver import Scene, solve
+from ...verify.cases import chain_scene
 
-__all__ = ['CHUNK', 'CostGrowth', 'chain_scene', 'cost_growth']
+__all__ = ['CHUNK', 'CostGrowth', 'cost_growth']
 
 #: Angles per call when a large batch is solved in chunks.
 CHUNK = 4096
-
-
-def chain_scene(stages: int) -> Scene:
-    """Return a chain of ``stages`` four-bar stages, each driven by the previous rocker.
-
-    Stage k is the Grashof crank-rocker of ``khurmi_four_bar_ad150`` (input
-    40, coupler 150, rocker 80, ground 150 mm): its input is the point carried
-    40 mm along the previous rocker from its pivot, so every stage assembles
-    at every crank angle, on either branch. One RRR dyad and one carried
-    point per stage.
-    """
-    if stages < 1:
-        msg = f'Expected at least 1 stage, got {stages}'
-        raise ValueError(msg)
-    a, b, c, d = 0.04, 0.15, 0.08, 0.15
-    ground = {f'G{k}': (k * d, 0.0) for k in range(stages + 1)}
-    dyads = []
-    points = []
-    for k in range(1, stages + 1):
-        dyads.append(RRR(f'C{k}', (Link(f'coupler{k}', f'P{k - 1}', b),
-                                   Link(f'rocker{k}', f'G{k}', c)), Branch.PLUS))
-        if k < stages:
-            points.append(CarriedPoint(f'P{k}', f'rocker{k}', f'G{k}', f'C{k}', (a, 0.0)))
-    crank = Crank('crank', 'G0', 'P0', a, radians_from_degrees(60.0), -4 * math.pi, 0.0)
-    return Scene(f'chain_{stages}', ground, crank, tuple(dyads), tuple(points))
 
 
 @dataclass

@@ -20,7 +20,7 @@ from .bounds import CaseBounds, RefusedFractions
 from .clock import ClockRow, TICK_HZ
 from .common import DURATIONS, EPS, ERROR_FLOOR
 from .cost import CHUNK, CostGrowth
-from .extreme import BOUND_FACTOR, CaseResult
+from ...verify.extreme import BOUND_FACTOR, CaseResult
 
 __all__ = ['plot_bounds', 'plot_clock', 'plot_cost', 'plot_extreme', 'plot_refused',
            'plot_work_precision']

@@ -26,10 +26,10 @@ from .clock import ClockRow, EPOCH_NS, TICK_HZ
 from .common import EPS, Mode, slug
 from .cost import CHUNK, CostGrowth
 from .data import render_block
-from .extreme import BOUND_FACTOR, CaseResult, digits_lost, FormulaAudit
 from ..bench import ARRAY_TARGET, SINGLE_TARGET
 from ...bounds import MAX_ERROR, ROUNDING_MARGIN
 from ...solver import NEAR_SINGULAR, SINGULAR
+from ...verify.extreme import BOUND_FACTOR, CaseResult, digits_lost, FormulaAudit
 
 __all__ = ['write_report']
 
@@ -153,7 +153,7 @@ def _reference(checks: Sequence[ReferenceCheck], golden: Sequence[GoldenCheck]) 
     w = lines.append
     w('## 1. The 50-digit reference')
     w('')
-    w('`mech_kinematics/tools/report/reference.py` writes each scene as its loop-closure '
+    w('`mech_kinematics/verify/reference.py` writes each scene as its loop-closure '
       'equations (two per dyad: RRR, the two link angles; RRP, link angle and slider coordinate; '
       'RPR, lever angle and slider coordinate; carried points as explicit functions of '
       'their frame points) and solves them in mpmath at 64 working digits, without '

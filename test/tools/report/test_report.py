@@ -19,16 +19,16 @@ import sys
 import pytest
 
 from mech_kinematics.tools import report
+from mech_kinematics.verify.extreme import extreme_cases
 
 SECTIONS = ('## 1. The 50-digit reference', '## 2. Work-precision',
             '## 3. Error against run time of the node', '## 4. Stiff and extreme cases',
             '## 5. Cost growth', '## 6. Error bounds against the truth')
 #: The modules of the report package, one per concern.
-MODULES = ('baselines', 'bounds', 'checks', 'clock', 'common', 'cost', 'data', 'extreme',
-           'figures', 'markdown')
+MODULES = ('baselines', 'bounds', 'checks', 'clock', 'common', 'cost', 'data', 'figures',
+           'markdown')
 #: What common.py shares with the section modules only (not re-exported).
-SHARED_HELPERS = {'distance_angle', 'four_bar', 'median_time', 'quiet_solve', 'slider_crank',
-                  'slug'}
+SHARED_HELPERS = {'median_time', 'quiet_solve', 'slug'}
 
 
 def test_add_parser_registers_report():
@@ -95,7 +95,7 @@ def test_quick_report_has_no_failures(quick_report):
     text = (quick_report / 'REPORT.md').read_text()
     table = text.split('## 4.')[1].split('###')[0]
     rows = [line for line in table.splitlines() if re.match(r'\| \d+ \|', line)]
-    assert len(rows) == len(report.extreme_cases(report.MODES['quick']))
+    assert len(rows) == len(extreme_cases(report.MODES['quick'].extreme_angles))
     assert all(re.search(r'\*\*(meets bound|flagged|refused \(no assembly\))\*\*', r)
                for r in rows)
     assert 'FAIL' not in text

@@ -1,6 +1,6 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""The report's stiff and extreme cases, digits lost and formula audit (issue 5, part 4).
+"""The extreme suite: stiff and extreme cases, digits lost and formula audit (issue 5, part 4).
 
 Extreme cases are asserted one by one: each either meets its error bound
 (``BOUND_FACTOR * eps * max(1, kappa)`` against the 50-digit reference) or is
@@ -10,13 +10,14 @@ flagged by the solver.
 from __future__ import annotations
 
 import math
+import subprocess
+import sys
 
 import numpy as np
 import pytest
 
 import mech_kinematics as mk
-from mech_kinematics.tools.report import extreme
-from mech_kinematics.tools.report.common import MODES
+from mech_kinematics.verify import extreme
 
 EPS = float(np.finfo(float).eps)
 #: The formula audit: the solver's product form is within this factor of the
@@ -26,7 +27,9 @@ AUDIT_FACTOR = 3.0
 #: the condition number grows as 1 / measure**2, so about 2.
 LOSS_RATIO_RANGE = (1.8, 2.3)
 
-CASES = extreme.extreme_cases(MODES['quick'])
+#: Angles added around each multi-angle case: the report's quick run's.
+EXTRA_ANGLES = 2
+CASES = extreme.extreme_cases(EXTRA_ANGLES)
 
 
 @pytest.mark.parametrize('case', CASES, ids=[c.name for c in CASES])
@@ -96,3 +99,14 @@ def test_velocities_lose_twice_the_measure_digits_near_a_toggle():
     for result, measure, lost in rows:
         ratio = lost['velocity'] / -math.log10(measure)
         assert LOSS_RATIO_RANGE[0] <= ratio <= LOSS_RATIO_RANGE[1], (result.case.name, ratio)
+
+
+def test_import_is_light():
+    """Importing the room, its cases and the extreme suite loads no mpmath, tool or ROS code."""
+    code = ('import sys, mech_kinematics.verify, mech_kinematics.verify.cases, '
+            'mech_kinematics.verify.extreme; '
+            "heavy = {'matplotlib', 'scipy', 'mpmath', 'rclpy'} & set(sys.modules); "
+            "above = [m for m in sys.modules if m.startswith(('mech_kinematics.tools', "
+            "'mech_kinematics.ros'))]; "
+            'assert not heavy and not above, (heavy, above)')
+    subprocess.run([sys.executable, '-c', code], check=True, timeout=60)

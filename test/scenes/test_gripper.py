@@ -26,7 +26,7 @@ import yaml
 import mech_kinematics as mk
 from mech_kinematics.geometry.assembly import assembly_summary
 from mech_kinematics.imu import imu_reading
-from mech_kinematics.tools.report import reference as ref
+from mech_kinematics.verify import reference as ref
 
 SCENE_FILE = Path(__file__).resolve().parents[2] / 'config' / 'scenes' / 'gripper.yaml'
 SCENE = mk.load_scene(SCENE_FILE)

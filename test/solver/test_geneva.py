@@ -6,7 +6,7 @@ See issue 11. The packaged ``geneva`` scene (Beer & Johnston's Sample Problem
 in seed 000: R = 50 mm, four slots, 10 rad/s CCW) engages from 135 to 225 deg
 of every crank turn; the wheel is locked between, and indexes a quarter turn
 clockwise per crank turn. The exact values are computed here with mpmath (and
-the 50-digit reference of ``mech_kinematics.tools.report.reference`` for the engaged
+the 50-digit reference of ``mech_kinematics.verify.reference`` for the engaged
 RPR motion), never by the solver's own formulas.
 """
 
@@ -24,7 +24,7 @@ import pytest
 import mech_kinematics as mk
 from mech_kinematics.__main__ import main
 from mech_kinematics.ros.ticker import tick_function, values_from_state
-from mech_kinematics.tools.report import reference as ref
+from mech_kinematics.verify import reference as ref
 
 SLOTS = 4
 INDEX = 2 * math.pi / SLOTS  # rad per crank turn

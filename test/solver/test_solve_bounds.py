@@ -5,7 +5,7 @@
 Every value the solver returns carries an absolute error bound
 (``State.error_bound``). These tests measure the actual error of every
 returned value against the 50-digit reference of
-``mech_kinematics.tools.report.reference`` (the exact answer for the scene's
+``mech_kinematics.verify.reference`` (the exact answer for the scene's
 doubles) and check that
 
 - the bound is never below the actual error: over an extreme suite built
@@ -48,8 +48,8 @@ import numpy as np
 import pytest
 
 import mech_kinematics as mk
-from mech_kinematics.tools.report import reference as ref
 from mech_kinematics.units import rad_per_s_from_rpm
+from mech_kinematics.verify import reference as ref
 
 pytestmark = pytest.mark.filterwarnings('ignore::mech_kinematics.NearSingularWarning')
 
@@ -471,7 +471,7 @@ NEVER_WELL_CONDITIONED = {
 }
 
 
-@pytest.mark.parametrize('name', crank_scene_names())  # several drivers: test_drivers
+@pytest.mark.parametrize('name', crank_scene_names())  # several drivers: test_solve_drivers
 def test_bound_is_tight_on_the_packaged_scenes(name):
     """Where well-conditioned, a packaged scene's bounds are within 1e3 x (error + 1 ulp)."""
     scene = mk.load_scene(name)
@@ -480,7 +480,7 @@ def test_bound_is_tight_on_the_packaged_scenes(name):
     assert any(checked) or name in NEVER_WELL_CONDITIONED
 
 
-@pytest.mark.parametrize('name', crank_scene_names())  # several drivers: test_drivers
+@pytest.mark.parametrize('name', crank_scene_names())  # several drivers: test_solve_drivers
 def test_bound_covers_the_actual_error_on_the_packaged_scenes(name):
     """At eight angles of a turn, no value of a packaged scene is off by more than its bound."""
     scene = mk.load_scene(name)
@@ -489,7 +489,7 @@ def test_bound_covers_the_actual_error_on_the_packaged_scenes(name):
         with contextlib.suppress(mk.AssemblyError):
             state = mk.solve(scene, angle, max_error=math.inf)
             if not all(e.engaged for e in state.intermittent.values()):
-                continue  # the reference has no dwell: test_intermittent checks locked wheels
+                continue  # the reference has no dwell: test_geneva checks locked wheels
         answered.append(assert_bounded(scene, angle)[0] is not None)
     assert sum(answered) >= 2, answered
 
@@ -507,7 +507,7 @@ def test_bound_is_tight_where_well_conditioned(scene, motion, angle):
 # --- the packaged scenes, both paths, the API --------------------------------------------
 
 
-@pytest.mark.parametrize('name', crank_scene_names())  # several drivers: test_drivers
+@pytest.mark.parametrize('name', crank_scene_names())  # several drivers: test_solve_drivers
 def test_packaged_scenes_are_answered_wherever_they_assemble(name):
     """Over 3600 angles every packaged scene is answered except where it cannot assemble."""
     scene = mk.load_scene(name)

@@ -1,14 +1,15 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""Section 4 of the report: stiff and extreme cases, digits lost, and the formula audit.
+"""The extreme suite: stiff and extreme cases, digits lost, and the formula audit.
 
 :func:`extreme_cases` builds the configurations of issue 5 (toggles, a
 change point, circles that just miss, extreme ratios, scales and speeds, a
 slotted-lever pin at its pivot, the edge of assembly); :func:`evaluate_case`
-judges the solver at each instant against the 50-digit reference and the
-bound ``BOUND_FACTOR * EPS * max(1, kappa)``; :func:`digits_lost` and
-:func:`formula_audit` explain the errors near a toggle. mpmath is imported
-inside the functions.
+judges the solver at each instant against the 50-digit reference
+(:mod:`.reference`) and the bound ``BOUND_FACTOR * EPS * max(1, kappa)``;
+:func:`digits_lost` and :func:`formula_audit` explain the errors near a
+toggle. The report's section 4 shows them; the tests hold them. mpmath is
+imported inside the functions.
 """
 
 from __future__ import annotations
@@ -16,22 +17,28 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 import math
+import sys
 from typing import Any
 import warnings
 
-from .common import distance_angle, EPS, four_bar, Mode, MODES, slider_crank
-from ...errors import AssemblyError, NearSingularWarning, UntrustedError
-from ...scene import load_scene
-from ...solver import CarriedPoint, Crank, RPR, Scene, solve
-from ...units import rad_per_s_from_rpm, radians_from_degrees
+from .cases import distance_angle, four_bar, slider_crank
+from ..errors import AssemblyError, NearSingularWarning, UntrustedError
+from ..scene import load_scene
+from ..solver import CarriedPoint, Crank, RPR, Scene, solve
+from ..units import rad_per_s_from_rpm, radians_from_degrees
 
-__all__ = ['AngleResult', 'BOUND_FACTOR', 'Case', 'CaseResult', 'FormulaAudit', 'digits_lost',
-           'evaluate_angle', 'evaluate_case', 'extreme_cases', 'formula_audit']
+__all__ = ['AngleResult', 'BOUND_FACTOR', 'Case', 'CaseResult', 'EXTRA_ANGLES', 'FormulaAudit',
+           'digits_lost', 'evaluate_angle', 'evaluate_case', 'extreme_cases', 'formula_audit']
+
+#: The machine epsilon of a double.
+EPS = sys.float_info.epsilon
+#: Angles added around each multi-angle case by default (the report's full run).
+EXTRA_ANGLES = 8
 
 #: An extreme case meets its bound when, for every kind of value, the error
 #: relative to that kind's largest magnitude is at most
 #: ``BOUND_FACTOR * EPS * max(1, kappa)``, kappa the problem's condition number
-#: (:func:`mech_kinematics.tools.report.reference.condition`): the error that rounding
+#: (:func:`mech_kinematics.verify.reference.condition`): the error that rounding
 #: the inputs alone would cause, with room for the few roundings per dyad.
 BOUND_FACTOR = 4.0
 
@@ -53,10 +60,14 @@ def _spread(center: float, width: float, count: int) -> tuple[float, ...]:
         if count > 1 else (center,)
 
 
-def extreme_cases(mode: Mode | None = None) -> list[Case]:
-    """Return the stiff and extreme configurations of issue 5, part 4."""
+def extreme_cases(extra_angles: int = EXTRA_ANGLES) -> list[Case]:
+    """Return the stiff and extreme configurations of issue 5, part 4.
+
+    ``extra_angles`` angles are spread around each case of several instants
+    (none: only the instants that define the case).
+    """
     import mpmath
-    extra = (mode or MODES['full']).extreme_angles
+    extra = extra_angles
     cases = []
     # A non-Grashof four-bar (seed 002 Problem 3) near its two toggle positions.
     toggle = load_scene('four_bar_coupler_points')

@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """The 50-digit reference: golden cases, its second route, and its own arithmetic.
 
-The reference (``mech_kinematics.tools.report.reference``) solves the loop-closure
+The reference (``mech_kinematics.verify.reference``) solves the loop-closure
 equations by Newton-Raphson in mpmath and differentiates them; the report's
 errors are measured against it, so it is checked here against the published
 golden files (50-digit values rounded to doubles), against finite
@@ -12,8 +12,10 @@ blocks.
 
 from __future__ import annotations
 
+import ast
 import math
 from pathlib import Path
+import re
 import subprocess
 import sys
 import warnings
@@ -24,8 +26,10 @@ import numpy as np
 import pytest
 
 import mech_kinematics as mk
-from mech_kinematics.tools.report import reference as ref
+from mech_kinematics.solver import RPP
+from mech_kinematics.solver.registry import DRIVERS, KINDS
 from mech_kinematics.units import rad_per_s_from_rpm, radians_from_degrees
+from mech_kinematics.verify import reference as ref
 
 EPS = float(np.finfo(float).eps)
 #: From the decimal inputs as written, the reference rounded to double is the
@@ -194,6 +198,118 @@ def test_decimal_values_of_scenes_with_sliding_levers(name):
         assert float(value) == pytest.approx(model.values[key], rel=4 * EPS, abs=0), key
 
 
+@pytest.mark.parametrize('name', mk.scene_names())
+def test_decimal_values_of_every_packaged_scene(name):
+    """Every kind's values are read, drivers' of ``inputs:`` and RPP's angles too; each rounds.
+
+    Which values are lengths and angles, and where each is written, the
+    kind's model says: before it, an RPP fell into the RPR's case (no value
+    read) and a scene of ``inputs:`` was not read at all. See issue 30.
+    """
+    model = ref.Model(mk.load_scene(name))
+    decimals = ref.decimal_values(SCENES / f'{name}.yaml', model)
+    assert decimals.keys() == model.values.keys()
+    for key, value in decimals.items():
+        assert float(value) == pytest.approx(model.values[key], rel=4 * EPS, abs=0), key
+
+
+YOKE = """\
+name: yoke_30
+units: {length: mm, angle: deg}
+ground:
+  A: [0, 0]
+input: {link: crank, center: A, point: B, length: 50, angle: 10, speed_rpm: 300}
+dyads:
+  - {type: RPP, point: Y, through: B, guide: {through: A, angle: 30}, slot_angle: 120,
+     slider: yoke, slot_slider: pin_in_slot}
+"""
+#: The 50-digit reference against a closed form of the same decimal inputs, m.
+ATOL_EXACT = 1e-50
+#: What reading the yoke's angles as doubles (each within 1e-16 rad) moves it by, m, at least.
+MOVED_BY_DOUBLES = 1e-20
+
+
+def test_rpp_angles_are_read_as_exact_decimals(tmp_path):
+    """An RPP's guide and slot angles (30 and 120 deg) are pi/6 and 2 pi/3, not their doubles.
+
+    The yoke's slot is square to its guide, so ``yoke = r cos(theta - 30 deg)``
+    and ``pin_in_slot = r sin(theta - 30 deg)`` for a crank of radius r: the
+    reference from the decimals meets them to 50 digits; with the two angles
+    taken as doubles it is 1e-19 away. See issue 30.
+    """
+    path = tmp_path / 'yoke_30.yaml'
+    path.write_text(YOKE)
+    model = ref.Model(mk.load_scene(path))
+    decimals = ref.decimal_values(path, model)
+    with mpmath.workdps(ref.DPS):
+        assert abs(decimals['guide.Y.angle'] - mpmath.pi / 6) <= mpmath.mpf('1e-62')
+        assert abs(decimals['slot.Y.angle'] - 2 * mpmath.pi / 3) <= mpmath.mpf('1e-62')
+        theta = radians_from_degrees(mpmath.mpf(10), mpmath.pi)
+        r, phase = mpmath.mpf('0.05'), theta - mpmath.pi / 6
+    exact = ref.reference(model, theta, values=decimals)
+    doubles = ref.reference(model, theta, values={
+        **decimals, **{key: model.values[key] for key in ('guide.Y.angle', 'slot.Y.angle')}})
+    with mpmath.workdps(ref.DPS):
+        closed = {'yoke': r * mpmath.cos(phase), 'pin_in_slot': r * mpmath.sin(phase)}
+        for name, value in closed.items():
+            assert abs(exact.joints[name][0] - value) <= ATOL_EXACT, name
+            assert abs(doubles.joints[name][0] - value) >= MOVED_BY_DOUBLES, name
+
+
+def _lacking(kinds, drivers):
+    """Return the kinds of item and of driver among these that the reference has no model for.
+
+    The items: each kind of ``kinds``, the carried point and the Geneva
+    wheel's RPR (an RPR whose graph fragment has an intermittent joint).
+    """
+    geneva = mk.RPR('wheel', 'S', 'P', 'pin_slot', slots=4)
+    items = [*kinds, mk.CarriedPoint.kind, ref.model_key(geneva.kind, geneva.fragment())]
+    return ([kind for kind in items if kind not in ref.MODELS]
+            + [kind for kind in drivers if kind not in ref.DRIVER_MODELS])
+
+
+def test_the_reference_has_equations_for_every_kind_of_the_registries():
+    """Every kind of KINDS, the carried point, the Geneva RPR and every DRIVERS has a model.
+
+    A kind added to the solver's registry alone fails here, named. See issue 30.
+    """
+    missing = _lacking(KINDS, DRIVERS)
+    assert not missing, (f'kinds the reference has no equations for: {", ".join(missing)} '
+                         '(add a model to MODELS or DRIVER_MODELS in '
+                         'mech_kinematics/verify/reference.py)')
+    assert _lacking([*KINDS, 'RRQ'], [*DRIVERS, 'motor']) == ['RRQ', 'motor']
+
+
+def test_a_kind_without_equations_is_refused_naming_it():
+    """An item or a driver of a kind with no model raises, naming it: never another kind's."""
+    scene = mk.load_scene('scotch_yoke')
+
+    class Yoke(RPP):
+        kind = 'RPX'
+
+    class Motor(mk.Crank):
+        scene_key = 'motor'
+
+    yoke = mk.Scene('yoke', scene.ground, scene.input, (Yoke(**vars(scene.dyads[0])),))
+    with pytest.raises(ref.NoReferenceModel, match=r"Expected a kind of scene item .*got 'RPX'"):
+        ref.Model(yoke)
+    motor = mk.Scene('motor', scene.ground, Motor(**vars(scene.input)), scene.dyads)
+    with pytest.raises(ref.NoReferenceModel, match=r"Expected a kind of driver .*got 'motor'"):
+        ref.Model(motor)
+
+
+def test_an_intermittent_variant_has_equations_of_its_own(monkeypatch):
+    """A Geneva wheel's RPR takes the intermittent model, never falls back on the plain RPR's."""
+    geneva = mk.load_scene('geneva')
+    key = ref.model_key(mk.RPR.kind, geneva.dyads[0].fragment())
+    assert key != mk.RPR.kind
+    assert [element.equations for element in ref.Model(geneva).elements] == [ref.MODELS[key]]
+    assert ref.MODELS[key] is not ref.MODELS[mk.RPR.kind]
+    monkeypatch.delitem(ref.MODELS, key)
+    with pytest.raises(ref.NoReferenceModel, match=re.escape(repr(key))):
+        ref.Model(geneva)
+
+
 @pytest.mark.parametrize(('name', 'case'), reference_cases())
 def test_golden_case_from_double_inputs(name, case):
     """From the scene's doubles, the published values agree to 1e-15 of (value + scale)."""
@@ -205,7 +321,7 @@ def test_golden_case_from_double_inputs(name, case):
         assert abs(value - expected) <= RTOL_GOLDEN * (abs(expected) + scale)
 
 
-@pytest.mark.parametrize('name', crank_scene_names())  # several drivers: test_drivers
+@pytest.mark.parametrize('name', crank_scene_names())  # several drivers: test_solve_drivers
 def test_second_route_agrees(name):
     """Velocities and accelerations match 64-digit differences in time to 1e-30."""
     scene = mk.load_scene(name)
@@ -226,7 +342,7 @@ def test_second_route_with_crank_acceleration():
     assert max(ref.check_by_differences(scene, exact).values()) <= RTOL_ROUTES
 
 
-@pytest.mark.parametrize('name', crank_scene_names())  # several drivers: test_drivers
+@pytest.mark.parametrize('name', crank_scene_names())  # several drivers: test_solve_drivers
 def test_newton_sets_the_digits(name):
     """Positions come from Newton-Raphson on the constraints, not from the 20-digit start."""
     scene = mk.load_scene(name)
@@ -235,7 +351,7 @@ def test_newton_sets_the_digits(name):
     assert float(exact.residual) <= ATOL_RESIDUAL
 
 
-@pytest.mark.parametrize('name', crank_scene_names())  # several drivers: test_drivers
+@pytest.mark.parametrize('name', crank_scene_names())  # several drivers: test_solve_drivers
 def test_solver_within_conditioning_on_packaged_scenes(name):
     """The solver's error per kind is within 4 eps * max(1, kappa) on every packaged scene."""
     scene = mk.load_scene(name)
@@ -283,7 +399,7 @@ def test_singular_pose_has_positions_only():
 
 def test_measures_match_the_solver():
     """The exact near-singularity measures are the solver's, to rounding."""
-    for name in crank_scene_names():  # several drivers: test_drivers
+    for name in crank_scene_names():  # several drivers: test_solve_drivers
         scene = mk.load_scene(name)
         exact = ref.reference(scene, scene.input.angle)
         with warnings.catch_warnings():
@@ -294,11 +410,27 @@ def test_measures_match_the_solver():
             assert value == pytest.approx(float(exact.measures[key]), rel=1e-12)
 
 
+#: What the reference may import from the solver: the scene, its items' and drivers'
+#: dataclasses (whose kinds key its models) and the graph's types (no step, no solve).
+SOLVER_NAMES = {'..solver': {'Actuator', 'CarriedPoint', 'Crank', 'RPP', 'RPR', 'RRP', 'RRR',
+                             'Scene'},
+                '..solver.graph': {'Fragment', 'JointType', 'joint_type'}}
+
+
 def test_reference_does_not_use_the_solver():
     """The reference module imports the solver's dataclasses only, never its steps."""
-    source = Path(ref.__file__).read_text()
-    assert 'from ...solver import Scene' in source
-    for name in ('solve', '_RRRStep', '_RRPStep', '_RPRStep', '_run'):
+    tree = ast.parse(Path(ref.__file__).read_text())
+    imported = {}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and (node.module or '').startswith('solver'):
+            module = '.' * node.level + node.module
+            imported.setdefault(module, set()).update(alias.name for alias in node.names)
+        assert not (isinstance(node, ast.Import)
+                    and any('solver' in alias.name for alias in node.names)), ast.unparse(node)
+    assert imported['..solver'] >= {'Scene'}
+    for module, names in imported.items():
+        assert names <= SOLVER_NAMES.get(module, set()), (module, names)
+    for name in ('solve', '_RRRStep', '_RRPStep', '_RPRStep', '_RPPStep', '_CarryStep', '_run'):
         assert not hasattr(ref, name)
 
 
@@ -349,6 +481,6 @@ def test_condition_number_of_a_toggle_grows_as_measure_squared():
 
 def test_import_needs_no_plotting():
     """Importing the reference pulls in mpmath but neither matplotlib nor SciPy."""
-    code = ('import sys, mech_kinematics.tools.report.reference; '
+    code = ('import sys, mech_kinematics.verify.reference; '
             "assert 'matplotlib' not in sys.modules and 'scipy' not in sys.modules")
     subprocess.run([sys.executable, '-c', code], check=True, timeout=60)

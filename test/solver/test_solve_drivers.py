@@ -19,7 +19,7 @@ import yaml
 
 import mech_kinematics as mk
 from mech_kinematics.scene import scene_text
-from mech_kinematics.tools.report import reference as ref
+from mech_kinematics.verify import reference as ref
 
 pytestmark = pytest.mark.filterwarnings('ignore::mech_kinematics.NearSingularWarning')
 

@@ -5,9 +5,10 @@
 The scene is written as its loop-closure constraints ``Phi(q, theta) = 0``,
 two real equations per dyad in two unknowns (RRR: the angles of both links;
 RRP: the link angle and the slider coordinate; RPR: the lever angle and the
-slider coordinate), with the points carried by links as explicit functions of
-the points that define their link's frame. Nothing here uses the solver's
-formulas:
+slider coordinate; RPP: the yoke's and the pin's slider coordinates), with the
+points carried by links as explicit functions of the points that define their
+link's frame, and each driver placing what its position moves (a crank's
+tip, an actuator's link lengths). Nothing here uses the solver's formulas:
 
 positions
     a textbook construction (law of cosines, circle and line) gives a start,
@@ -19,6 +20,17 @@ velocities and accelerations
     ``J qddot = -(d/dt)^2 Phi`` at ``qddot = 0``, two linear systems solved in
     mpmath; the derivatives are taken by forward-mode Taylor arithmetic
     (:class:`Jet`), not by hand.
+
+Each kind's equations are a model of their own, looked up by the kind in
+:data:`MODELS` (every kind of the solver's registry, the carried point, the
+Geneva wheel's RPR) and :data:`DRIVER_MODELS` (every driver): a scene holding
+a kind with no model is refused, naming it (:class:`NoReferenceModel`),
+never solved as another kind. Each model also says which scene values its
+equations read, lengths or angles, and where a scene file writes them
+(:class:`Parameter`), which is how :func:`decimal_values` reads every one as
+the decimal written. What is structure, not equations (the type of each
+output joint, the links an actuator drives, which items are intermittent), is
+read from the scene's graph of bodies and joints.
 
 A second route, :func:`check_by_differences`, differentiates 50-digit
 positions in time with five-point central differences and must agree with the
@@ -33,10 +45,11 @@ for its Newton-Raphson and ODE baselines.
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 import cmath
 from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 import math
 import os
 from pathlib import Path
@@ -47,14 +60,16 @@ import mpmath
 import numpy as np
 import yaml
 
-from ...errors import SceneError
-from ...scene import read_scene_yaml
-from ...solver import Scene
-from ...units import ANGLE_UNITS, LENGTH_UNITS, radians_from_degrees
+from ..errors import SceneError
+from ..scene import read_scene_yaml
+from ..solver import Actuator, CarriedPoint, Crank, RPP, RPR, RRP, RRR, Scene
+from ..solver.graph import Fragment, joint_type, JointType
+from ..units import ANGLE_UNITS, LENGTH_UNITS, radians_from_degrees
 
-__all__ = ['DIGITS', 'DPS', 'Jet', 'Model', 'NoAssembly', 'Reference', 'as_float_dict',
-           'check_by_differences', 'compare', 'condition', 'decimal_values', 'reference',
-           'value_errors']
+__all__ = ['DIGITS', 'DPS', 'DRIVER_MODELS', 'INTERMITTENT', 'Jet', 'MODELS', 'Model',
+           'NoAssembly', 'NoReferenceModel', 'Parameter', 'Reference', 'as_float_dict',
+           'check_by_differences', 'compare', 'condition', 'decimal_values', 'model_key',
+           'reference', 'value_errors']
 
 #: Digits the reference values are good to.
 DIGITS = 50
@@ -220,20 +235,111 @@ def _value(x: Any) -> Any:
 # --- the constraint model ------------------------------------------------------
 
 
+class NoReferenceModel(TypeError):
+    """A scene holds a kind of item or driver the reference has no equations for."""
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A number of the scene that a kind's equations read.
+
+    Attributes
+    ----------
+    key : str
+        Its key in :attr:`Model.values` (``link.coupler.length``,
+        ``guide.P.angle``, ``point.E.local.x``, ...).
+    value : float
+        The scene's double: m for a length, rad for an angle.
+    angle : bool
+        Whether it is an angle (written in the scene's angle unit), else a
+        length (written in its length unit).
+    paths : tuple of tuple
+        Where its number may be written in a scene file, as keys and list
+        indices (``('dyads', 0, 'links', 1, 'length')``): the first present
+        is read (a kind's model gives them within its item's entry, the
+        :class:`Model` prefixes the entry's own path).
+    default : int or None
+        Its value where none of ``paths`` is written (a guide's angle: 0);
+        ``None`` where one must be.
+    """
+
+    key: str
+    value: float
+    angle: bool
+    paths: tuple[tuple[str | int, ...], ...]
+    default: int | None = None
+
+    def within(self, entry: tuple[str | int, ...]) -> Parameter:
+        """Return it with each path prefixed by its entry's path in the scene file."""
+        return replace(self, paths=tuple((*entry, *path) for path in self.paths))
+
+
+def _length(key: str, value: float, *paths: tuple[str | int, ...],
+            default: int | None = None) -> Parameter:
+    return Parameter(key, value, False, paths, default)
+
+
+def _angle(key: str, value: float, *paths: tuple[str | int, ...],
+           default: int | None = None) -> Parameter:
+    return Parameter(key, value, True, paths, default)
+
+
+#: What marks the key of an item whose fragment has an intermittent joint (a Geneva wheel's
+#: RPR): its equations are looked up apart from its kind's (:func:`model_key`).
+INTERMITTENT = ' (intermittent)'
+
+
+def model_key(kind: str, fragment: Fragment) -> str:
+    """Return the key of an item's equations in :data:`MODELS`.
+
+    Its kind (the scene's ``type:``, ``point`` for a carried point), marked
+    :data:`INTERMITTENT` where its part of the mechanism's graph has an
+    intermittent joint: a variant that moves otherwise (a Geneva wheel's RPR,
+    or any such variant a kind may grow) is never taken for its base kind.
+    """
+    return kind + INTERMITTENT if any(joint.intermittent for joint in fragment.joints) else kind
+
+
+def _equations(key: str) -> _Equations:
+    try:
+        return MODELS[key]
+    except KeyError:
+        msg = (f'Expected a kind of scene item the reference has equations for '
+               f'({", ".join(MODELS)}), got {key!r}')
+        raise NoReferenceModel(msg) from None
+
+
+def _driver_equations(key: str) -> _DriverEquations:
+    try:
+        return DRIVER_MODELS[key]
+    except KeyError:
+        msg = (f'Expected a kind of driver the reference has equations for '
+               f'({", ".join(DRIVER_MODELS)}), got {key!r}')
+        raise NoReferenceModel(msg) from None
+
+
 @dataclass(frozen=True)
 class _Element:
-    kind: str          # the scene's type of the item: 'RRR', 'RRP', 'RPR', 'RPP' or 'point'
-    item: Any          # the scene's dyad or carried point
-    index: int = -1    # first of the element's two unknowns, -1 for a carried point
+    equations: _Equations  # its kind's (MODELS)
+    item: Any              # the scene's dyad or carried point
+    index: int = -1        # first of the element's unknowns, -1 where it has none
 
     @property
-    def equations(self) -> type[_Kind]:
-        """Return the kind's equations."""
-        return _KINDS[self.kind]
+    def label(self) -> str:
+        """Return the item as messages name it, e.g. ``'RRR C'``."""
+        return f'{self.item.kind} {self.item.key}'
 
 
 class Model:
-    """The loop-closure constraints of a scene, generic over its dyads and points.
+    """The loop-closure constraints of a scene, generic over its drivers, dyads and points.
+
+    Each driver's, dyad's and carried point's equations are its kind's model
+    (:data:`DRIVER_MODELS`, :data:`MODELS`), looked up by its kind: a kind
+    with none is refused (:class:`NoReferenceModel`), never solved as
+    another. What is structure rather than equations is read from the
+    scene's graph (:attr:`~mech_kinematics.solver.Scene.graph`): the type of
+    every output joint, the links an actuator drives, which items are
+    intermittent variants.
 
     Parameters
     ----------
@@ -246,55 +352,94 @@ class Model:
         Every numeric input of the geometry, by name (``ground.A.x``,
         ``crank.length``, ``link.coupler.length``, ``guide.P.angle``,
         ``point.E.local.x``, ...), as the scene's doubles.
+    parameters : dict of str to Parameter
+        The same, each with whether it is a length or an angle and where a
+        scene file writes it (:func:`decimal_values`).
     size : float
         The mechanism's size, m, defined as the solver defines it (the largest
         crank, link or ground distance): the RPR near-singularity measure is
         the slider coordinate over it.
+
+    Raises
+    ------
+    NoReferenceModel
+        Naming a kind of the scene that has no equations here.
     """
 
     def __init__(self, scene: Scene) -> None:
         self.scene = scene
-        values: dict[str, float] = {}
-        for name, (x, y) in scene.ground.items():
-            values[f'ground.{name}.x'] = float(x)
-            values[f'ground.{name}.y'] = float(y)
+        graph = scene.graph
+        self.graph = graph
         drivers = scene.drivers
+        items: list[Any] = [*scene.dyads, *scene.points]
+        fragments = graph.fragments[len(drivers):]
+        equations = [_equations(model_key(item.kind, fragment))
+                     for item, fragment in zip(items, fragments, strict=True)]
+        driver_equations = [_driver_equations(driver.scene_key) for driver in drivers]
         #: One crank (the v1 scene): ``theta`` is its angle; else a sequence, one per driver.
-        self.single = scene.input is not None and len(drivers) == 1
-        self.links: dict[str, Any] = {}   # link -> unknown index, or None for a crank's
-        self.sliders: dict[str, int] = {}
-        self.joint_types: dict[str, str] = {}
-        #: Per actuator, the RRR links whose length is its length.
+        self.single = scene.single_crank
+        self.values: dict[str, float] = {}
+        self.parameters: dict[str, Parameter] = {}
+        for name, (x, y) in scene.ground.items():
+            self._parameter(_length(f'ground.{name}.x', float(x), (0,)), ('ground', name))
+            self._parameter(_length(f'ground.{name}.y', float(y), (1,)), ('ground', name))
+        self.links: dict[str, Any] = {}   # angle coordinate -> unknown index, None for a crank's
+        self.sliders: dict[str, int] = {}  # length coordinate -> unknown index
+        self.joint_types: dict[str, JointType] = {}
+        #: Per actuator, the links whose length is its length.
         self.actuated: dict[str, list[str]] = {}
         known = set(scene.ground)
-        for driver in drivers:
-            self.joint_types[driver.name] = driver.joint_type
-            if driver.joint_type == 'revolute':
-                values[self.crank_key(driver.name)] = driver.length
-                self.links[driver.name] = None
-                known.add(driver.point)  # type: ignore[union-attr]
-            else:
-                self.actuated[driver.name] = []
+        self.drivers = tuple(zip(drivers, driver_equations, strict=True))
+        for k, (driver, moves) in enumerate(self.drivers):
+            entry: tuple[str | int, ...] = ('inputs', k) if scene.inputs else ('input',)
+            for parameter in moves.parameters(self, driver):
+                self._parameter(parameter, entry)
+            self.joint_types[driver.name] = graph.coordinates[driver.name]
+            moves.place(self, driver, known)
         self.unknown_names: list[str] = []
         self.unknown_is_length: list[bool] = []
-        pending: list[Any] = [*scene.dyads, *scene.points]
+        entries = [('dyads', k) for k in range(len(scene.dyads))] + [
+            ('points', point.name) for point in scene.points]
+        pending = list(zip(items, equations, entries, strict=True))
         elements: list[_Element] = []
         while pending:
-            for position, item in enumerate(pending):
-                element = self._place(item, known, values, len(self.unknown_names))
-                if element is not None:
-                    elements.append(element)
+            for position, (item, kind, entry) in enumerate(pending):
+                if kind.ready(self, item, known):
+                    elements.append(self._place(item, kind, entry, known))
                     del pending[position]
                     break
             else:
-                msg = f'Expected the scene to be solvable in order, got {pending!r}'
+                left = [entry[0] for entry in pending]
+                msg = f'Expected the scene to be solvable in order, got {left!r}'
                 raise ValueError(msg)
         self.elements = tuple(elements)
-        self.values = values
         lengths = [driver.reach for driver in drivers] + [
-            v for k, v in values.items() if k.startswith('link.') and k.endswith('.length')]
+            v for k, v in self.values.items() if k.startswith('link.') and k.endswith('.length')]
         ground = [complex(x, y) for x, y in scene.ground.values()]
         self.size = max(lengths + [abs(a - b) for a in ground for b in ground])
+
+    def _parameter(self, parameter: Parameter, entry: tuple[str | int, ...]) -> None:
+        self.values[parameter.key] = parameter.value
+        self.parameters[parameter.key] = parameter.within(entry)
+
+    def _place(self, item: Any, model: _Equations, entry: tuple[str | int, ...],
+               known: set[str]) -> _Element:
+        """Record a ready item's parameters and unknowns (their types from the graph)."""
+        for parameter in model.parameters(item):
+            self._parameter(parameter, entry)
+        index = len(self.unknown_names)
+        unknowns = model.unknowns(item)
+        for offset, name in enumerate(unknowns):
+            kind = self.graph.coordinates[name]
+            self.joint_types[name] = kind
+            if kind.angular:
+                self.links[name] = index + offset
+                self._unknowns((f'{name} angle', False))
+            else:
+                self.sliders[name] = index + offset
+                self._unknowns((name, True))
+        known.update(model.new_points(item))
+        return _Element(model, item, index if unknowns else -1)
 
     def crank_key(self, name: str) -> str:
         """Return the key of crank ``name``'s length in :attr:`values`."""
@@ -313,26 +458,14 @@ class Model:
         values = (theta,) if self.single else tuple(theta) if isinstance(
             theta, (list, tuple)) else (theta,)
         lengths: dict[str, Any] = {}
-        for driver, value in zip(scene.drivers, values, strict=True):
-            if driver.joint_type == 'revolute':
-                tip = p[self.crank_key(driver.name)] * expi(value)
-                points[driver.point] = points[driver.center] + tip  # type: ignore[union-attr]
-            else:
-                for link in self.actuated[driver.name]:
-                    lengths[f'link.{link}.length'] = value
+        for (driver, model), value in zip(self.drivers, values, strict=True):
+            model.drive(self, driver, p, value, points, lengths)
         return ({**p, **lengths} if lengths else p), points
 
     def _unknowns(self, *names: tuple[str, bool]) -> None:
         for name, is_length in names:
             self.unknown_names.append(name)
             self.unknown_is_length.append(is_length)
-
-    def _place(self, item: Any, known: set[str], values: dict[str, float],
-               index: int) -> _Element | None:
-        kind = item.kind
-        if not _KINDS[kind].place(self, item, known, values, index):
-            return None
-        return _Element(kind, item, index if kind != 'point' else -1)
 
     @property
     def n(self) -> int:
@@ -360,7 +493,8 @@ class Model:
         """Return a first estimate of the unknowns by textbook constructions (mpmath).
 
         Law of cosines for RRR, circle and line for RRP, the pin's polar
-        coordinates for RPR, the branch taken from its definition.
+        coordinates for RPR, two lines crossing for RPP, the branch taken
+        from its definition.
 
         Raises
         ------
@@ -385,69 +519,197 @@ class Model:
             columns.append([r.c1 if isinstance(r, Jet) else 0 * _value(r) for r in res])
         return columns
 
-# --- each kind's constraint equations ------------------------------------------------
+
+# --- each driver's equations -----------------------------------------------------
 
 
-class _Kind:
-    """One scene type's loop-closure equations, written here, apart from the solver's forms.
+class _DriverEquations(ABC):
+    """One kind of driver as the constraints see it: what it moves, given its position.
 
-    ``place`` records the item's parameters and unknowns in the model (or
-    returns None until what it starts from is known); ``evaluate`` appends its
-    complex residual and puts its new point; ``construct`` estimates its
-    unknowns by a textbook construction (mpmath); ``measure`` gives its
-    near-singularity measure as the solver defines it; ``branch_ok`` checks
-    the assembly branch against its definition in the scene format.
+    ``parameters`` names the scene values it reads; ``place`` records what
+    its position makes known; ``drive`` puts, for a position (number or jet),
+    the points it places and the link lengths it sets; ``floors`` gives, for
+    its speed and acceleration, the scales below which no error is measured
+    (:func:`scales`).
     """
 
     @staticmethod
-    def place(model: Model, item: Any, known: set[str], values: dict[str, float],
-              index: int) -> bool:
-        """Record ``item`` in ``model`` if what it starts from is ``known``; say if it was."""
-        msg = f'Expected an item of a known kind, got {item!r}'
-        raise TypeError(msg)
+    @abstractmethod
+    def parameters(model: Model, driver: Any) -> tuple[Parameter, ...]:
+        """Return the scene values it reads, each where its entry writes it."""
 
     @staticmethod
+    @abstractmethod
+    def place(model: Model, driver: Any, known: set[str]) -> None:
+        """Record in ``model`` what its position makes known."""
+
+    @staticmethod
+    @abstractmethod
+    def drive(model: Model, driver: Any, p: Mapping[str, Any], value: Any,
+              points: dict[str, Any], lengths: dict[str, Any]) -> None:
+        """Put the points it places and the link lengths it sets at position ``value``."""
+
+    @staticmethod
+    @abstractmethod
+    def floors(model: Model, driver: Any, p: Mapping[str, Any], speed: Any,
+               accel: Any) -> dict[str, Any]:
+        """Return, per kind of value, the least scale it sets (``|speed|``, ``|accel|``)."""
+
+
+class _Crank(_DriverEquations):
+    """A crank of fixed length turning about a ground point: its tip."""
+
+    @staticmethod
+    def parameters(model: Model, driver: Any) -> tuple[Parameter, ...]:
+        """Return its length."""
+        return (_length(model.crank_key(driver.name), driver.length, ('length',)),)
+
+    @staticmethod
+    def place(model: Model, driver: Any, known: set[str]) -> None:
+        """Its angle is given (no unknown); its tip is known."""
+        model.links[driver.name] = None
+        known.add(driver.point)
+
+    @staticmethod
+    def drive(model: Model, driver: Any, p: Mapping[str, Any], value: Any,
+              points: dict[str, Any], lengths: dict[str, Any]) -> None:
+        """Put its tip at its angle."""
+        tip = p[model.crank_key(driver.name)] * expi(value)
+        points[driver.point] = points[driver.center] + tip
+
+    @staticmethod
+    def floors(model: Model, driver: Any, p: Mapping[str, Any], speed: Any,
+               accel: Any) -> dict[str, Any]:
+        """Its length ``a`` for positions, ``a |omega|``, ``a (omega**2 + |alpha|)``, ..."""
+        a = abs(p[model.crank_key(driver.name)])
+        return {'position': a, 'velocity': a * speed, 'angular velocity': speed,
+                'acceleration': a * (speed * speed + accel),
+                'angular acceleration': speed * speed + accel}
+
+
+class _Actuator(_DriverEquations):
+    """A linear actuator: its position is the length of the links it drives."""
+
+    @staticmethod
+    def parameters(model: Model, driver: Any) -> tuple[Parameter, ...]:
+        """Return none: its length is its position."""
+        return ()
+
+    @staticmethod
+    def place(model: Model, driver: Any, known: set[str]) -> None:
+        """Record the links it drives: those its rod slides along (the graph's driven slide)."""
+        model.actuated[driver.name] = [joint.on for joint in model.graph.joints
+                                       if joint.driver and joint.line is not None
+                                       and joint.body == driver.name]
+
+    @staticmethod
+    def drive(model: Model, driver: Any, p: Mapping[str, Any], value: Any,
+              points: dict[str, Any], lengths: dict[str, Any]) -> None:
+        """Set each driven link's length to its position."""
+        for link in model.actuated[driver.name]:
+            lengths[f'link.{link}.length'] = value
+
+    @staticmethod
+    def floors(model: Model, driver: Any, p: Mapping[str, Any], speed: Any,
+               accel: Any) -> dict[str, Any]:
+        """Its rates ``|v|`` and ``|a|``."""
+        return {'velocity': speed, 'acceleration': accel}
+
+
+# --- each kind's constraint equations ------------------------------------------------
+
+
+class _Equations(ABC):
+    """One kind's loop-closure equations, written here, apart from the solver's forms.
+
+    ``parameters`` names the scene values they read (lengths and angles, and
+    where its entry writes each); ``ready`` says whether what the item starts
+    from is known; ``unknowns`` names its coordinates solved for (output
+    joints of the graph, whose types say angle or length) and
+    ``new_points`` the points it places; ``evaluate`` appends its complex
+    residual and puts its new point; ``construct`` estimates its unknowns by
+    a textbook construction (mpmath); ``measure`` gives its near-singularity
+    measure as the solver defines it; ``branch_ok`` checks the assembly
+    branch against its definition in the scene format. Every method is
+    abstract: a model that leaves one out cannot be built.
+    """
+
+    @staticmethod
+    @abstractmethod
+    def parameters(item: Any) -> tuple[Parameter, ...]:
+        """Return the scene values its equations read, each where its entry writes it."""
+
+    @staticmethod
+    @abstractmethod
+    def ready(model: Model, item: Any, known: set[str]) -> bool:
+        """Return whether what the item starts from is known (``known`` points, placed links)."""
+
+    @staticmethod
+    @abstractmethod
+    def unknowns(item: Any) -> tuple[str, ...]:
+        """Return the coordinates it solves for, in the order of its unknowns."""
+
+    @staticmethod
+    @abstractmethod
+    def new_points(item: Any) -> tuple[str, ...]:
+        """Return the points it places."""
+
+    @staticmethod
+    @abstractmethod
     def evaluate(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
                  points: dict[str, Any], residuals: list[Any]) -> None:
         """Append the item's residual (numbers, arrays or jets) and put its new point."""
 
     @staticmethod
+    @abstractmethod
     def construct(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
                   pts: dict[str, Any], tiny: Any) -> None:
         """Estimate the item's unknowns into ``q`` and put its new point (mpmath)."""
 
     @staticmethod
+    @abstractmethod
     def measure(model: Model, item: Any, i: int, p: Mapping[str, Any],
                 points: Mapping[str, Any], q: list[Any], measures: dict[str, Any]) -> None:
         """Put the item's near-singularity measure, if it has one."""
 
     @staticmethod
+    @abstractmethod
     def branch_ok(item: Any, i: int, p: Mapping[str, Any], points: Mapping[str, Any],
                   q: list[Any]) -> bool:
-        """Return whether the item is on its assembly branch (one configuration: True)."""
-        return True
+        """Return whether the item is on its assembly branch."""
 
 
-class _RRR(_Kind):
-    """Two links from known points meeting at the new pin: unknowns, the two link angles."""
+class _RRR(_Equations):
+    """Two links from known points meeting at the new pin: unknowns, the two link angles.
+
+    A link whose ``actuator`` is a driver has that driver's position as its
+    length (:meth:`Model.driven`): no length of its own.
+    """
 
     @staticmethod
-    def place(model: Model, item: Any, known: set[str], values: dict[str, float],
-              index: int) -> bool:
-        """Record both links' lengths and angles."""
+    def parameters(item: Any) -> tuple[Parameter, ...]:
+        """Return the length of each link of fixed length."""
+        return tuple(_length(f'link.{link.name}.length', link.length, ('links', k, 'length'))
+                     for k, (link, actuator) in enumerate(zip(item.links, item.actuators,
+                                                              strict=True))
+                     if actuator is None)
+
+    @staticmethod
+    def ready(model: Model, item: Any, known: set[str]) -> bool:
+        """Return whether both links' starts are known."""
         first, second = item.links
-        if first.start not in known or second.start not in known:
-            return False
-        values[f'link.{first.name}.length'] = first.length
-        values[f'link.{second.name}.length'] = second.length
-        for link, actuator in zip(item.links, item.actuators, strict=True):
-            if actuator is not None:  # its length is the actuator's (Model.driven)
-                model.actuated[actuator].append(link.name)
-        model.links[first.name], model.links[second.name] = index, index + 1
-        model.joint_types[first.name] = model.joint_types[second.name] = 'revolute'
-        model._unknowns((f'{first.name} angle', False), (f'{second.name} angle', False))
-        known.add(item.point)
-        return True
+        return first.start in known and second.start in known
+
+    @staticmethod
+    def unknowns(item: Any) -> tuple[str, ...]:
+        """Return both links (their angles)."""
+        first, second = item.links
+        return first.name, second.name
+
+    @staticmethod
+    def new_points(item: Any) -> tuple[str, ...]:
+        """Return the pin."""
+        return (item.point,)
 
     @staticmethod
     def evaluate(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
@@ -499,24 +761,30 @@ class _RRR(_Kind):
         return bool(side * int(item.branch) >= 0)
 
 
-class _RRP(_Kind):
+class _RRP(_Equations):
     """A link from a known point ending on a fixed guide: unknowns, its angle and the slider."""
 
     @staticmethod
-    def place(model: Model, item: Any, known: set[str], values: dict[str, float],
-              index: int) -> bool:
-        """Record the link's length and the guide's angle."""
-        if item.link.start not in known:
-            return False
-        values[f'link.{item.link.name}.length'] = item.link.length
-        values[f'guide.{item.point}.angle'] = item.guide_angle
-        model.links[item.link.name] = index
-        model.sliders[item.slider] = index + 1
-        model.joint_types[item.link.name] = 'revolute'
-        model.joint_types[item.slider] = 'prismatic'
-        model._unknowns((f'{item.link.name} angle', False), (f'{item.slider}', True))
-        known.add(item.point)
-        return True
+    def parameters(item: Any) -> tuple[Parameter, ...]:
+        """Return the link's length and the guide's angle (0 where not written)."""
+        return (_length(f'link.{item.link.name}.length', item.link.length, ('link', 'length')),
+                _angle(f'guide.{item.point}.angle', item.guide_angle, ('guide', 'angle'),
+                       default=0))
+
+    @staticmethod
+    def ready(model: Model, item: Any, known: set[str]) -> bool:
+        """Return whether the link's start is known."""
+        return bool(item.link.start in known)
+
+    @staticmethod
+    def unknowns(item: Any) -> tuple[str, ...]:
+        """Return the link (its angle) and the slider."""
+        return item.link.name, item.slider
+
+    @staticmethod
+    def new_points(item: Any) -> tuple[str, ...]:
+        """Return the slider's pin."""
+        return (item.point,)
 
     @staticmethod
     def evaluate(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
@@ -564,21 +832,28 @@ class _RRP(_Kind):
         return bool((q[i + 1] - along) * int(item.branch) >= 0)
 
 
-class _RPR(_Kind):
+class _RPR(_Equations):
     """A slotted lever about a ground pivot through a known pin: its angle and the slider."""
 
     @staticmethod
-    def place(model: Model, item: Any, known: set[str], values: dict[str, float],
-              index: int) -> bool:
-        """Record the lever's angle and the slider."""
-        if item.through not in known:
-            return False
-        model.links[item.link] = index
-        model.sliders[item.slider] = index + 1
-        model.joint_types[item.link] = 'revolute'
-        model.joint_types[item.slider] = 'prismatic'
-        model._unknowns((f'{item.link} angle', False), (f'{item.slider}', True))
-        return True
+    def parameters(item: Any) -> tuple[Parameter, ...]:
+        """Return none: the lever's length (pivot to pin) is an unknown."""
+        return ()
+
+    @staticmethod
+    def ready(model: Model, item: Any, known: set[str]) -> bool:
+        """Return whether the pin is known."""
+        return bool(item.through in known)
+
+    @staticmethod
+    def unknowns(item: Any) -> tuple[str, ...]:
+        """Return the lever (its angle) and the slider."""
+        return item.link, item.slider
+
+    @staticmethod
+    def new_points(item: Any) -> tuple[str, ...]:
+        """Return none: the pin was known, the pivot is on the ground."""
+        return ()
 
     @staticmethod
     def evaluate(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
@@ -606,23 +881,41 @@ class _RPR(_Kind):
         return bool(q[i + 1] >= 0)
 
 
-class _RPP(_Kind):
+class _Geneva(_RPR):
+    """An intermittent (Geneva) wheel's RPR: the engaged motion, slot 0's, at every angle.
+
+    The reference solves the wheel as the plain slotted lever through the
+    pin (its slot 0, continued beyond the engagement window): the engaged
+    values of every window follow by turning it back ``2 pi k / n``, and the
+    dwell between windows is held exactly still (the solver's closed forms,
+    checked against this in ``test/solver/test_geneva.py``).
+    """
+
+
+class _RPP(_Equations):
     """The Scotch yoke: unknowns, the yoke's coordinate on its guide and the pin's in the slot."""
 
     @staticmethod
-    def place(model: Model, item: Any, known: set[str], values: dict[str, float],
-              index: int) -> bool:
-        """Record the guide's and the slot's angles and both sliders."""
-        if item.through not in known:
-            return False
-        values[f'guide.{item.point}.angle'] = item.guide_angle
-        values[f'slot.{item.point}.angle'] = item.slot_angle
-        model.sliders[item.slider] = index
-        model.sliders[item.slot_slider] = index + 1
-        model.joint_types[item.slider] = model.joint_types[item.slot_slider] = 'prismatic'
-        model._unknowns((f'{item.slider}', True), (f'{item.slot_slider}', True))
-        known.add(item.point)
-        return True
+    def parameters(item: Any) -> tuple[Parameter, ...]:
+        """Return the guide's angle (0 where not written) and the slot's."""
+        return (_angle(f'guide.{item.point}.angle', item.guide_angle, ('guide', 'angle'),
+                       default=0),
+                _angle(f'slot.{item.point}.angle', item.slot_angle, ('slot_angle',)))
+
+    @staticmethod
+    def ready(model: Model, item: Any, known: set[str]) -> bool:
+        """Return whether the pin is known."""
+        return bool(item.through in known)
+
+    @staticmethod
+    def unknowns(item: Any) -> tuple[str, ...]:
+        """Return both sliders: the yoke on its guide, the pin in the slot."""
+        return item.slider, item.slot_slider
+
+    @staticmethod
+    def new_points(item: Any) -> tuple[str, ...]:
+        """Return the yoke's point on the guide."""
+        return (item.point,)
 
     @staticmethod
     def evaluate(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
@@ -653,20 +946,37 @@ class _RPP(_Kind):
         w = mpmath.expj(p[f'slot.{item.point}.angle'])
         measures[item.point] = abs((mpmath.conj(u) * w).imag)
 
+    @staticmethod
+    def branch_ok(item: Any, i: int, p: Mapping[str, Any], points: Mapping[str, Any],
+                  q: list[Any]) -> bool:
+        """Return True: the two lines cross once (one configuration)."""
+        return True
 
-class _Carry(_Kind):
+
+class _Carry(_Equations):
     """A point carried by a link: an explicit function of its frame's two points."""
 
     @staticmethod
-    def place(model: Model, item: Any, known: set[str], values: dict[str, float],
-              index: int) -> bool:
-        """Record its local coordinates."""
-        if item.origin not in known or item.xaxis not in known or item.link not in model.links:
-            return False
-        values[f'point.{item.name}.local.x'] = item.local[0]
-        values[f'point.{item.name}.local.y'] = item.local[1]
-        known.add(item.name)
-        return True
+    def parameters(item: Any) -> tuple[Parameter, ...]:
+        """Return its local coordinates (``local: [x, y]``, or ``distance:`` along x)."""
+        x, y = item.local
+        return (_length(f'point.{item.name}.local.x', x, ('local', 0), ('distance',)),
+                _length(f'point.{item.name}.local.y', y, ('local', 1), default=0))
+
+    @staticmethod
+    def ready(model: Model, item: Any, known: set[str]) -> bool:
+        """Return whether its frame's points are known and its link is placed."""
+        return item.origin in known and item.xaxis in known and item.link in model.links
+
+    @staticmethod
+    def unknowns(item: Any) -> tuple[str, ...]:
+        """Return none: it is an explicit function of known points."""
+        return ()
+
+    @staticmethod
+    def new_points(item: Any) -> tuple[str, ...]:
+        """Return the point."""
+        return (item.name,)
 
     @staticmethod
     def evaluate(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
@@ -686,10 +996,28 @@ class _Carry(_Kind):
         local = mpmath.mpc(p[f'point.{item.name}.local.x'], p[f'point.{item.name}.local.y'])
         pts[item.name] = origin + local * axis / abs(axis)
 
+    @staticmethod
+    def measure(model: Model, item: Any, i: int, p: Mapping[str, Any],
+                points: Mapping[str, Any], q: list[Any], measures: dict[str, Any]) -> None:
+        """Put none: a carried point is never singular (its frame's points are apart)."""
 
-#: The scene's ``type:`` of an item (``point`` for a carried point) -> its equations.
-_KINDS: dict[str, type[_Kind]] = {'RRR': _RRR, 'RRP': _RRP, 'RPR': _RPR, 'RPP': _RPP,
-                                  'point': _Carry}
+    @staticmethod
+    def branch_ok(item: Any, i: int, p: Mapping[str, Any], points: Mapping[str, Any],
+                  q: list[Any]) -> bool:
+        """Return True: it has one position."""
+        return True
+
+
+#: The equations of every kind of scene item, by :func:`model_key`: each kind of the
+#: registry (``solver/registry.py`` ``KINDS``), the carried point and the Geneva wheel's
+#: RPR. A kind missing here is refused by :class:`Model`, never solved as another.
+MODELS: dict[str, _Equations] = {
+    RRR.kind: _RRR(), RRP.kind: _RRP(), RPR.kind: _RPR(), RPP.kind: _RPP(),
+    CarriedPoint.kind: _Carry(), RPR.kind + INTERMITTENT: _Geneva()}
+
+#: The equations of every kind of driver, by its key in a scene's ``inputs:`` (``DRIVERS``).
+DRIVER_MODELS: dict[str, _DriverEquations] = {Crank.scene_key: _Crank(),
+                                              Actuator.scene_key: _Actuator()}
 
 
 def _real_vector(residuals: list[Any]) -> list[Any]:
@@ -728,11 +1056,17 @@ class Reference:
         The solver's near-singularity measures, computed exactly from the
         reference positions: RRR, ``|sin|`` of the angle between its links;
         RRP, ``|sin|`` of the rod's angle to the guide normal; RPR, the slider
-        coordinate over the mechanism's size.
+        coordinate over the mechanism's size; RPP, ``|sin|`` of the angle
+        between the slot and the guide.
+    joint_types : dict of str to JointType
+        The type of every joint of ``joints`` (the graph's), the drivers' first.
     singular : bool
         A measure is below :data:`SINGULAR_MEASURE`: velocities are undefined.
     residual : mpf
         Largest constraint residual over the mechanism's size.
+    model : Model
+        The constraints it solves (whose drivers set the least scales of
+        :func:`scales`).
     """
 
     scene: str
@@ -744,12 +1078,13 @@ class Reference:
     qddot: list[Any] | None
     points: dict[str, tuple[Any, Any, Any]]
     joints: dict[str, tuple[Any, Any, Any]]
-    joint_types: dict[str, str]
+    joint_types: dict[str, JointType]
     measures: dict[str, Any]
     singular: bool
     residual: Any
     iterations: int = 0
     inputs: dict[str, Any] = field(default_factory=dict)
+    model: Model | None = field(default=None, repr=False, compare=False)
 
     @property
     def min_measure(self) -> Any:
@@ -816,9 +1151,8 @@ def _check_branch(model: Model, p: Mapping[str, Any], points: Mapping[str, Any],
                   q: list[Any]) -> None:
     """Raise if Newton left the branch that docs/scene_format.md defines."""
     for element in model.elements:
-        item = element.item
-        if not element.equations.branch_ok(item, element.index, p, points, q):
-            msg = f'{element.kind} {item.key}: wrong branch'
+        if not element.equations.branch_ok(element.item, element.index, p, points, q):
+            msg = f'{element.label}: wrong branch'
             raise ArithmeticError(msg)
 
 
@@ -884,7 +1218,21 @@ def reference(scene: Scene | Model, theta: Any, omega: Any | None = None,
         state = _state(model, p, q, qdot, qddot, th, om, al)
         return Reference(model.scene.name, th, om, al, q, qdot, qddot, state[0], state[1],
                          dict(model.joint_types), measures, singular, residual, iterations,
-                         dict(p))
+                         dict(p), model)
+
+
+def _floors(model: Model, p: Mapping[str, Any], om: Any, al: Any) -> dict[str, Any]:
+    """Per kind of value, the largest of the least scales each driver sets (1 rad for angles).
+
+    At mpmath's working precision where called (:func:`scales`'s caller's).
+    """
+    floors: dict[str, Any] = dict.fromkeys(KINDS, mpmath.mpf(0))
+    floors['angle'] = 1
+    rates = zip((om,) if model.single else om, (al,) if model.single else al, strict=True)
+    for (driver, equations), (w, a) in zip(model.drivers, rates, strict=True):
+        mine = equations.floors(model, driver, p, abs(w), abs(a))
+        floors.update((kind, max(floors[kind], value)) for kind, value in mine.items())
+    return floors
 
 
 def _each(given: Any, n: int) -> list[Any]:
@@ -913,8 +1261,8 @@ def _state(model: Model, p: Mapping[str, Any], q: list[Any], qdot: list[Any] | N
         point_states = {name: (z, None, None) for name, z in points.items()}
         joints: dict[str, Any] = {}
         for driver, x in zip(drivers, (th,) if model.single else th, strict=True):
-            revolute = driver.joint_type == 'revolute'
-            joints[driver.name] = (_wrap(x) if revolute else x, None, None)
+            angular = model.joint_types[driver.name].angular
+            joints[driver.name] = (_wrap(x) if angular else x, None, None)
         for name, index in model.links.items():
             if index is not None:
                 joints[name] = (_wrap(q[index]), None, None)
@@ -929,7 +1277,7 @@ def _state(model: Model, p: Mapping[str, Any], q: list[Any], qdot: list[Any] | N
     joints = {}
     for driver, jet in zip(drivers, (theta_jet,) if model.single else theta_jet, strict=True):
         x, v, a = jet.derivatives()
-        joints[driver.name] = (_wrap(x) if driver.joint_type == 'revolute' else x, v, a)
+        joints[driver.name] = (_wrap(x) if model.joint_types[driver.name].angular else x, v, a)
     for name, index in model.links.items():
         if index is not None:
             x, v, a = jets[index].derivatives()
@@ -1018,15 +1366,11 @@ def _by_kind(ref: Reference) -> dict[str, dict[str, Any]]:
         out['position'][name] = x
         if v is not None:
             out['velocity'][name], out['acceleration'][name] = v, a
-    for name, (x, v, a) in ref.joints.items():
-        if ref.joint_types[name] == 'revolute':
-            out['angle'][name] = x
-            if v is not None:
-                out['angular velocity'][name], out['angular acceleration'][name] = v, a
-        else:
-            out['position'][name] = x
-            if v is not None:
-                out['velocity'][name], out['acceleration'][name] = v, a
+    for name, values in ref.joints.items():
+        position, velocity, acceleration = ref.joint_types[name].quantities
+        out[position][name] = values[0]
+        if values[1] is not None:
+            out[velocity][name], out[acceleration][name] = values[1:]
     return out
 
 
@@ -1043,9 +1387,7 @@ def _solver_by_kind(state: Any, index: int | None = None) -> dict[str, dict[str,
     for name, joint in state.joints.items():
         values = (float(pick(joint.position)), float(pick(joint.velocity)),
                   float(pick(joint.acceleration)))
-        kinds = (('angle', 'angular velocity', 'angular acceleration')
-                 if joint.type == 'revolute' else ('position', 'velocity', 'acceleration'))
-        for kind, value in zip(kinds, values, strict=True):
+        for kind, value in zip(joint_type(joint.type).quantities, values, strict=True):
             out[kind][name] = value
     return out
 
@@ -1059,28 +1401,14 @@ def scales(ref: Reference) -> dict[str, float]:
     ``omega**2 + |alpha|`` for angular ones (a parallelogram's links have no
     angular acceleration at all); 1 rad for angles; 1 if all that is zero.
     With several drivers, the largest of what each sets: each crank's as
-    above, an actuator's rate ``|v|`` and ``|a|``.
+    above, an actuator's rate ``|v|`` and ``|a|`` (each driver's model says,
+    :data:`DRIVER_MODELS`).
     """
+    if ref.model is None:
+        msg = 'Expected a reference computed by reference(), got one without its model'
+        raise ValueError(msg)
     expected = _by_kind(ref)
-    if isinstance(ref.omega, tuple):
-        floors = dict.fromkeys(KINDS, mpmath.mpf(0))
-        floors['angle'] = 1
-        drivers = list(ref.joint_types)[:len(ref.omega)]  # the drivers' joints come first
-        for name, w, al in zip(drivers, ref.omega, ref.alpha, strict=True):
-            w, al = abs(w), abs(al)
-            if ref.joint_types[name] == 'revolute':
-                a = abs(ref.inputs[f'crank.{name}.length'])
-                mine = {'position': a, 'velocity': a * w, 'angular velocity': w,
-                        'acceleration': a * (w * w + al), 'angular acceleration': w * w + al}
-            else:
-                mine = {'velocity': w, 'acceleration': al}
-            floors.update((kind, max(floors[kind], value)) for kind, value in mine.items())
-    else:
-        crank = abs(ref.inputs.get('crank.length', 0))
-        omega, alpha = abs(ref.omega), abs(ref.alpha)
-        floors = {'position': crank, 'angle': 1, 'velocity': crank * omega,
-                  'angular velocity': omega, 'acceleration': crank * (omega * omega + alpha),
-                  'angular acceleration': omega * omega + alpha}
+    floors = _floors(ref.model, ref.inputs, ref.omega, ref.alpha)
     out = {}
     for kind, values in expected.items():
         largest = max([abs(v) for v in values.values()] + [floors[kind]])
@@ -1138,15 +1466,14 @@ def value_errors(state: Any, ref: Reference) -> dict[str, tuple[str, float]]:
                     error = abs(mpmath.mpc(values[index]) - exact)
                     out[f'points.{name}.{quantity}'] = (quantity, float(error))
         for name, joint in state.joints.items():
-            revolute = joint.type == 'revolute'
-            kinds = (('angle', 'angular velocity', 'angular acceleration') if revolute
-                     else quantities)
+            kind = joint_type(joint.type)
+            kinds = kind.quantities
             for index, quantity in enumerate(quantities):
                 exact = ref.joints[name][index]
                 if exact is None:
                     continue
                 error = mpmath.mpf(getattr(joint, quantity)) - exact
-                if index == 0 and revolute:
+                if index == 0 and kind.angular:
                     error = _wrap(error)
                 out[f'joints.{name}.{quantity}'] = (kinds[index], float(abs(error)))
     return out
@@ -1251,15 +1578,18 @@ def decimal_values(path: str | os.PathLike[str], model: Model) -> dict[str, Any]
     number written as a decimal is then taken at every digit written (a
     20-digit length keeps its 20 digits), any other (``0x10``, ``!!float 3``)
     at its exact value. The units are :mod:`mech_kinematics.units`' (the
-    scene loader's).
+    scene loader's). Which values are read, whether each is a length or an
+    angle and where the file writes it, each kind's model says
+    (:attr:`Model.parameters`): every value of ``model.values``, of every
+    kind, is read so.
 
     Raises
     ------
     SceneError
         If the file cannot be read, is not a scene file the loader reads
         (naming the line and column), holds a value that is not a number where
-        a number belongs, or has a ``units.length`` or ``units.angle`` that
-        is not one a scene may use.
+        a number belongs, lacks a value of the model's scene, or has a
+        ``units.length`` or ``units.angle`` that is not one a scene may use.
     """
     try:
         text = Path(path).read_text(encoding='utf-8').removeprefix('\ufeff')
@@ -1283,9 +1613,8 @@ def decimal_values(path: str | os.PathLike[str], model: Model) -> dict[str, Any]
     out: dict[str, Any] = {}
     with _precision(DPS):
         per_metre = mpmath.mpf(LENGTH_UNITS[length_unit])
-
-        def put(key: str, value: Any, text: Any, is_angle: bool = False) -> None:
-            """Store ``value`` (the loader's number, written as ``text``) under ``key``, SI."""
+        for key, parameter in model.parameters.items():
+            value, text = _written(data, written, parameter, path)
             if type(value) is int:
                 x = mpmath.mpf(value)
             elif type(value) is float and math.isfinite(value):
@@ -1294,37 +1623,42 @@ def decimal_values(path: str | os.PathLike[str], model: Model) -> dict[str, Any]
             else:
                 msg = f'{path}: {key}: expected a number, got {value!r}'
                 raise SceneError(msg)
-            if not is_angle:
+            if not parameter.angle:
                 out[key] = x / per_metre
             else:
                 out[key] = radians_from_degrees(x, mpmath.pi) if angle_unit == 'deg' else x
-
-        for name, (x, y) in data['ground'].items():
-            tx, ty = written['ground'][name]
-            put(f'ground.{name}.x', x, tx)
-            put(f'ground.{name}.y', y, ty)
-        put('crank.length', data['input']['length'], written['input']['length'])
-        for dyad, text in zip(data.get('dyads') or [], written.get('dyads') or [], strict=True):
-            if dyad['type'] == 'RRR':
-                pairs = list(zip(dyad['links'], text['links'], strict=True))
-            elif dyad['type'] == 'RRP':
-                pairs = [(dyad['link'], text['link'])]
-            else:  # an RPR has no length of its own
-                pairs = []
-            for link, link_text in pairs:
-                put(f'link.{link["name"]}.length', link['length'], link_text['length'])
-            if dyad['type'] == 'RRP':
-                put(f'guide.{dyad["point"]}.angle', dyad['guide'].get('angle', 0),
-                    text['guide'].get('angle', '0'), is_angle=True)
-        texts = written.get('points') or {}
-        for name, point in (data.get('points') or {}).items():
-            if 'local' in point:
-                local, local_text = point['local'], texts[name]['local']
-            else:
-                local, local_text = (point['distance'], 0), (texts[name]['distance'], '0')
-            put(f'point.{name}.local.x', local[0], local_text[0])
-            put(f'point.{name}.local.y', local[1], local_text[1])
     if set(out) != set(model.values):
         msg = f'Expected the keys {sorted(model.values)}, got {sorted(out)}'
         raise ValueError(msg)
     return out
+
+
+#: A path that a scene file does not have.
+_ABSENT = object()
+
+
+def _at(tree: Any, path: tuple[str | int, ...]) -> Any:
+    """Return the value at ``path`` (keys and list indices) in a scene file's tree."""
+    for step in path:
+        if isinstance(step, int):
+            if not isinstance(tree, list) or not -len(tree) <= step < len(tree):
+                return _ABSENT
+        elif not isinstance(tree, dict) or step not in tree:
+            return _ABSENT
+        tree = tree[step]
+    return tree
+
+
+def _written(data: Any, written: Any, parameter: Parameter,
+             path: str | os.PathLike[str]) -> tuple[Any, Any]:
+    """Return a parameter's number as the loader reads it and its text as written."""
+    for where in parameter.paths:
+        value = _at(data, where)
+        if value is not _ABSENT:
+            return value, _at(written, where)
+    if parameter.default is not None:
+        return parameter.default, str(parameter.default)
+    places = ' or '.join('.'.join(str(step) for step in where) for where in parameter.paths)
+    msg = (f'{path}: {places}: expected the number of {parameter.key} (of the model), '
+           'got none')
+    raise SceneError(msg)

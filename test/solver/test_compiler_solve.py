@@ -20,8 +20,7 @@ import pytest
 import mech_kinematics as mk
 from mech_kinematics.solver.compiler import (ARRAY, compile_scene, COMPILE_STEPS, NotCompiled,
                                              SINGLE, Single)
-from mech_kinematics.tools.report.common import MODES
-from mech_kinematics.tools.report.extreme import extreme_cases
+from mech_kinematics.verify.extreme import extreme_cases
 
 #: The module (``mech_kinematics.solver.solve`` is also the name of its function).
 solve_module = importlib.import_module('mech_kinematics.solver.solve')
@@ -72,7 +71,7 @@ def test_every_packaged_scene_solves_alike_compiled(name):
 def test_the_extreme_suite_refuses_and_answers_alike():
     """Toggles, change points, grazing guides, a pin at the pivot: same states and refusals."""
     compiled = 0
-    for case in extreme_cases(MODES['smoke']):
+    for case in extreme_cases(extra_angles=0):
         fast, slow = _pair(lambda case=case: case.scene)
         compiled += bool(fast._solver.compiled_single)
         speed = case.speed if case.speed is not None else case.scene.input.speed
@@ -113,7 +112,7 @@ def test_rigid_triangles_compile_and_solve_alike():
 
 def test_the_extreme_suite_solves_arrays_alike():
     """The extreme cases over their angles as one array: same states, masks and bounds."""
-    for case in extreme_cases(MODES['smoke']):
+    for case in extreme_cases(extra_angles=0):
         fast, slow = _pair(lambda case=case: case.scene)
         speed = case.speed if case.speed is not None else case.scene.input.speed
         angles = np.asarray(case.angles, dtype=float)
