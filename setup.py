@@ -66,6 +66,7 @@ setup(
             'reindex = mech_kinematics.tools.reindex:main',
             'check = mech_kinematics.tools.check:main',
             'urdf = mech_kinematics.tools.urdf:main',
+            'urdf2scene = mech_kinematics.tools.urdf2scene:main',
             'view = mech_kinematics.tools.view:main',
         ],
     },

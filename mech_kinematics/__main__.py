@@ -8,13 +8,15 @@ import argparse
 from collections.abc import Sequence
 import sys
 
-from .tools import bench, check, diagram, plot, record, reindex, report, run, solve, urdf, view
+from .tools import (bench, check, diagram, plot, record, reindex, report, run, solve, urdf,
+                    urdf2scene, view)
 from .tools.cli import ArgumentParser, PROG, run_handler
 
 __all__ = ['TOOLS', 'build_parser', 'main']
 
 #: The subcommands, in the order ``--help`` lists them.
-TOOLS = (solve, check, run, bench, diagram, plot, record, reindex, report, urdf, view)
+TOOLS = (solve, check, run, bench, diagram, plot, record, reindex, report, urdf, urdf2scene,
+         view)
 #: The node's executable, listed after the tools: ``python -m mech_kinematics NODE ...`` is
 #: the console script ``kinematics_node ...`` (``ros2 run mech_kinematics kinematics_node``).
 NODE = 'kinematics_node'

@@ -30,6 +30,24 @@ class SceneError(MechKinematicsError):
         self.where = where
 
 
+class UrdfError(SceneError):
+    """A robot description (URDF, loop closures, actuated joints) we cannot read or solve.
+
+    One line naming the source and what is wrong: a URDF that is not one, a
+    closure or sidecar that does not fit it, a loop that is not planar, a
+    zero pose that does not close, a loop that is no chain of our kinds.
+
+    Attributes
+    ----------
+    joint : str or None
+        The URDF joint (or closure) at fault, where there is one.
+    """
+
+    def __init__(self, msg: str, *, joint: str | None = None) -> None:
+        super().__init__(msg)
+        self.joint = joint
+
+
 class AssemblyError(MechKinematicsError):
     """The mechanism cannot be solved at a given crank angle.
 

@@ -450,3 +450,207 @@ def tick_outcome(tick: Any, theta: Any, omega: Any, alpha: Any, tol: float,
             return tick(theta, omega, alpha, tol, turns)
         except mk.AssemblyError as error:
             return type(error), str(error)
+
+
+# --- an independent forward kinematics of a URDF ---------------------------------------
+# test/robot/test_robot_*.py and bench/urdf_bench.py check what mech_kinematics.robot
+# answers with the URDF's own kinematics, written here once and apart from the package:
+# xml.etree for the XML, 4x4 transforms from each joint's origin, axis and value, the
+# loop closures read again from the text (issue 31).
+
+
+def _rpy(r: float, p: float, y: float) -> Any:
+    import numpy as np
+    rx = np.array([[1, 0, 0], [0, math.cos(r), -math.sin(r)], [0, math.sin(r), math.cos(r)]])
+    ry = np.array([[math.cos(p), 0, math.sin(p)], [0, 1, 0], [-math.sin(p), 0, math.cos(p)]])
+    rz = np.array([[math.cos(y), -math.sin(y), 0], [math.sin(y), math.cos(y), 0], [0, 0, 1]])
+    return rz @ ry @ rx
+
+
+def _pose(element: Any, xyz_key: str = 'xyz', rpy_key: str = 'rpy') -> Any:
+    import numpy as np
+    out = np.eye(4)
+    if element is not None:
+        out[:3, :3] = _rpy(*(float(v) for v in element.get(rpy_key, '0 0 0').split()))
+        out[:3, 3] = [float(v) for v in element.get(xyz_key, '0 0 0').split()]
+    return out
+
+
+class UrdfFk:
+    """A URDF's forward kinematics and its loop closures, read with xml.etree.
+
+    ``joints``: name -> (type, parent, child, origin 4x4, unit axis, mimic or None).
+    ``closures``: (name, weld, link_a, frame_a 4x4, link_b, frame_b 4x4), from
+    ``<constraint>`` elements, ``closing_NAME_1/2`` frames and a scikit-robot
+    ``loop_closures.yaml`` (its point in the root frame at the zero pose).
+    """
+
+    def __init__(self, text: str, sidecar: str | os.PathLike | None = None) -> None:
+        import xml.etree.ElementTree as ET
+        import numpy as np
+        import yaml
+        root = ET.fromstring(text)
+        self.links = [link.get('name') for link in root.findall('link')]
+        self.joints = {}
+        for j in root.findall('joint'):
+            axis = j.find('axis')
+            vector = np.array([float(v) for v in (axis.get('xyz') if axis is not None
+                                                  else '1 0 0').split()])
+            mimic = j.find('mimic')
+            rule = None if mimic is None else (mimic.get('joint'),
+                                               float(mimic.get('multiplier', 1)),
+                                               float(mimic.get('offset', 0)))
+            self.joints[j.get('name')] = (j.get('type'), j.find('parent').get('link'),
+                                          j.find('child').get('link'), _pose(j.find('origin')),
+                                          vector / np.linalg.norm(vector), rule)
+        children = {j[2] for j in self.joints.values()}
+        self.root = next(link for link in self.links if link not in children)
+        self.closures = []
+        for c in root.findall('constraint'):
+            self.closures.append((c.get('name'), c.get('type') in ('link', 'fixed'),
+                                  c.find('parent').get('link'), _pose(c.find('parent_origin')),
+                                  c.find('child').get('link'), _pose(c.find('child_origin'))))
+        for link in self.links:
+            if link.startswith('closing_') and link.endswith('_1'):
+                other = link[:-1] + '2'
+                self.closures.append((link[:-2], False, link, np.eye(4), other, np.eye(4)))
+        if sidecar is not None:
+            data = yaml.safe_load(Path(sidecar).read_text())
+            zero = self.transforms({})
+            for i, c in enumerate(data['closures']):
+                point = np.eye(4)
+                point[:3, 3] = c['point']
+                self.closures.append((f'closure_{i}', False, c['link_a'],
+                                      np.linalg.inv(zero[c['link_a']]) @ point, c['link_b'],
+                                      np.linalg.inv(zero[c['link_b']]) @ point))
+
+    def transforms(self, values: dict) -> dict:
+        """Return every link's 4x4 frame in the root's at ``values`` (0 where not given)."""
+        import numpy as np
+        out = {self.root: np.eye(4)}
+        parent_of = {j[2]: (name, j) for name, j in self.joints.items()}
+
+        def value(name: str) -> float:
+            if name in values:
+                return values[name]
+            rule = self.joints[name][5]
+            return 0.0 if rule is None else rule[1] * value(rule[0]) + rule[2]
+
+        def frame(link: str) -> Any:
+            if link not in out:
+                name, (kind, parent, _, origin, axis, _) = parent_of[link]
+                motion = np.eye(4)
+                q = value(name) if kind in ('revolute', 'continuous', 'prismatic') else 0.0
+                if kind in ('revolute', 'continuous'):
+                    x, y, z = axis
+                    c, s, v = math.cos(q), math.sin(q), 1 - math.cos(q)
+                    motion[:3, :3] = [[c + x * x * v, x * y * v - z * s, x * z * v + y * s],
+                                      [y * x * v + z * s, c + y * y * v, y * z * v - x * s],
+                                      [z * x * v - y * s, z * y * v + x * s, c + z * z * v]]
+                elif kind == 'prismatic':
+                    motion[:3, 3] = axis * q
+                out[link] = frame(parent) @ origin @ motion
+            return out[link]
+
+        for link in self.links:
+            frame(link)
+        return out
+
+    def gaps(self, values: dict) -> dict:
+        """Return each closure's gap (m) at ``values``.
+
+        Its frames' origins apart; for a weld, its rotation too, times the loop's size.
+        """
+        import numpy as np
+        frames = self.transforms(values)
+        out = {}
+        for name, weld, a, fa, b, fb in self.closures:
+            ta, tb = frames[a] @ fa, frames[b] @ fb
+            gap = float(np.linalg.norm(ta[:3, 3] - tb[:3, 3]))
+            if weld:
+                gap += float(np.linalg.norm(ta[:3, :3] - tb[:3, :3])) * self.loop_size(name)
+            out[name] = gap
+        return out
+
+    def loop_size(self, name: str) -> float:
+        """Return the size of a closure's loop at the zero pose (m).
+
+        The largest distance between the frames of the links on its path
+        through the tree, and the closure's point.
+        """
+        import numpy as np
+        closure = next(c for c in self.closures if c[0] == name)
+        frames = self.transforms({})
+        parent_of = {j[2]: j[1] for j in self.joints.values()}
+
+        def up(link: str) -> list:
+            out = [link]
+            while link in parent_of:
+                link = parent_of[link]
+                out.append(link)
+            return out
+
+        path_a, path_b = up(closure[2]), up(closure[4])
+        common = next(link for link in path_a if link in path_b)
+        links = path_a[:path_a.index(common) + 1] + path_b[:path_b.index(common)]
+        points = [frames[link][:3, 3] for link in links]
+        points.append((frames[closure[2]] @ closure[3])[:3, 3])
+        return max(float(np.linalg.norm(p - q)) for p in points for q in points)
+
+
+# --- Khurmi's four-bar as a URDF -------------------------------------------------------
+# test/robot/test_robot.py and test_refusals.py: the packaged khurmi_four_bar_ad150 written
+# by hand as a robot (crank "motor", coupler "elbow", rocker "rocker_pivot" about -z),
+# closed at C in either closure form (issue 31).
+
+
+KHURMI = """<?xml version="1.0"?>
+<robot name="khurmi">
+  <link name="frame"/><link name="crank"/><link name="coupler"/><link name="rocker"/>
+  <joint name="motor" type="revolute">
+    <parent link="frame"/><child link="crank"/>
+    <origin xyz="0 0 0" rpy="0 0 1.0471975511965976"/><axis xyz="0 0 1"/>
+    <limit lower="-3.2" upper="3.2" effort="1" velocity="1"/>
+  </joint>
+  <joint name="elbow" type="revolute">
+    <parent link="crank"/><child link="coupler"/>
+    <origin xyz="0.04 0 {dz}" rpy="0 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="1" velocity="1"/>
+  </joint>
+  <joint name="rocker_pivot" type="continuous">
+    <parent link="frame"/><child link="rocker"/>
+    <origin xyz="0.15 0 0" rpy="0 0 0"/><axis xyz="0 0 -1"/>
+  </joint>
+  {closure}
+  <transmission name="t"><type>transmission_interface/SimpleTransmission</type>
+    <joint name="motor"><hardwareInterface>EffortJointInterface</hardwareInterface></joint>
+    <actuator name="m"/></transmission>
+</robot>
+"""
+
+
+def khurmi_pin():
+    """Return pin C of Khurmi's four-bar in the coupler's and the rocker's frames (m)."""
+    scene = mk.load_scene('khurmi_four_bar_ad150')
+    state = mk.solve(scene, scene.input.angle)
+    b, c = state.complex_points['B'][0], state.complex_points['C'][0]
+    on_coupler = (c - b) * complex(math.cos(-math.pi / 3), math.sin(-math.pi / 3))
+    return on_coupler, c - 0.15
+
+
+def khurmi_urdf(form='constraint', dz=0.0):
+    """Return Khurmi's four-bar (AB 40, BC 150, CD 80, AD 150 mm) in URDF, closed in ``form``."""
+    coupler, rocker = khurmi_pin()
+    if form == 'constraint':
+        closure = (f'<constraint name="pin_C" type="revolute">'
+                   f'<parent link="coupler"/><parent_origin xyz="{coupler.real!r} '
+                   f'{coupler.imag!r} {-dz!r}" rpy="0 0 0"/><parent_axis xyz="0 0 1"/>'
+                   f'<child link="rocker"/><child_origin xyz="{rocker.real!r} {rocker.imag!r} '
+                   f'0" rpy="0 0 0"/><child_axis xyz="0 0 -1"/></constraint>')
+    else:
+        closure = ''.join(
+            f'<link name="closing_C_{i}"/><joint name="closing_C_{i}_frame" type="fixed">'
+            f'<parent link="{link}"/><child link="closing_C_{i}"/>'
+            f'<origin xyz="{z.real!r} {z.imag!r} {oz!r}" rpy="0.3 0.1 0.2"/></joint>'
+            for i, link, z, oz in ((1, 'coupler', coupler, -dz), (2, 'rocker', rocker, 0.0)))
+    return KHURMI.format(closure=closure, dz=dz)

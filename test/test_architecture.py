@@ -5,6 +5,8 @@
 - the solver core (errors, units, the solver package, scene, textbook) imports only NumPy,
   PyYAML and the standard library;
 - geometry imports the core only, and never matplotlib;
+- a robot described in URDF (``robot/``: reading it, mapping its loops onto the kinds)
+  imports the core and geometry only, never rclpy; the node and the tools build on it;
 - the verification room (``verify/``: the 50-digit reference, the extreme suite) sits
   beside geometry: it imports the core and geometry, never a tool or the ROS layer; the
   tools (the report) import it (issue 30);
@@ -27,9 +29,9 @@ CORE_PACKAGES = ('solver',)
 HEAVY = ('rclpy', 'matplotlib', 'mpmath', 'scipy', 'rosbags', 'tqdm')
 
 #: Layer of each subpackage (modules at the top are the core), and what each may import.
-LAYERS = {'core': set(), 'data': set(), 'geometry': {'core'}, 'verify': {'core', 'geometry'},
-          'ros': {'core', 'geometry'}, 'bag': {'core'},
-          'tools': {'core', 'geometry', 'ros', 'data', 'bag', 'verify'}}
+LAYERS = {'core': set(), 'data': set(), 'geometry': {'core'}, 'robot': {'core', 'geometry'},
+          'verify': {'core', 'geometry'}, 'ros': {'core', 'geometry', 'robot'}, 'bag': {'core'},
+          'tools': {'core', 'geometry', 'robot', 'ros', 'data', 'bag', 'verify'}}
 
 
 def _modules_after(code: str) -> set:
@@ -50,6 +52,12 @@ def test_core_imports_only_numpy_yaml_and_the_standard_library():
     allowed = set(sys.stdlib_module_names) | {'numpy', 'cython_runtime', 'yaml', 'mech_kinematics'}
     extra = {n for n in loaded - allowed if not n.startswith('_')}
     assert not extra, extra
+
+
+def test_the_robot_layer_is_pure():
+    """Reading a URDF robot and solving it loads neither rclpy nor matplotlib nor a tool."""
+    loaded = _modules_after('import mech_kinematics.robot')
+    assert not loaded & {'rclpy', 'matplotlib'}, loaded & {'rclpy', 'matplotlib'}
 
 
 def test_the_node_imports_no_drawing_or_report_code():

@@ -58,6 +58,8 @@ ROSDEP_KEYS = {
     'rosidl_parser': 'rosidl_parser',
     'launch': 'launch',
     'launch_ros': 'launch_ros',
+    # ROS's Python URDF reader (the urdfdom_py package) reads a robot's links and joints
+    'urdf_parser_py': 'urdfdom_py',
     # Python packages (rosdistro's rosdep/python.yaml and base.yaml keys)
     'numpy': 'python3-numpy',
     'yaml': 'python3-yaml',
@@ -69,6 +71,7 @@ ROSDEP_KEYS = {
     'pytest': 'python3-pytest',
     'hypothesis': 'python3-hypothesis',
     'packaging': 'python3-packaging',
+    'lxml': 'python3-lxml',
     'setuptools': 'python3-setuptools',
     # On PyPI only: -pip keys, defined in rosdep/mech_kinematics.yaml
     'rosbags': 'python3-rosbags-pip',

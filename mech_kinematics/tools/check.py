@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from .cli import add_scene_argument, run_tool
+from .cli import add_robot_arguments, add_scene_argument, load_scene_argument, run_tool
 from ..errors import SceneError
 from ..geometry.region import GRID
 from ..solver.graph import JointType
@@ -562,9 +562,9 @@ def _handle_region(args: argparse.Namespace, scene: Any) -> int:
 
 def _handle(args: argparse.Namespace) -> int:
     from ..geometry.assembly import assembly_from_scene
-    from ..scene import load_scene
 
-    scene = load_scene(args.scene)  # a SceneError is one line, exit 2 (cli.run_handler)
+    # A scene, or a URDF's loops as a scene; a SceneError is one line, exit 2 (cli.run_handler).
+    scene = load_scene_argument(args)
     if not scene.single_crank:
         return _handle_region(args, scene)
     given = [flag for flag, value in (('--grid', args.grid != GRID), ('--pair', args.pair),
@@ -586,6 +586,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
                       'transmission angle, Grashof class', description=CHECK_HELP,
         formatter_class=argparse.RawDescriptionHelpFormatter)
     add_scene_argument(parser)
+    add_robot_arguments(parser)
     parser.add_argument('--json', action='store_true',
                         help='print one JSON object, in SI units (rad, m)')
     parser.add_argument('--grid', type=grid_size, default=GRID, metavar='N',

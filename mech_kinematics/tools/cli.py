@@ -37,9 +37,11 @@ from ..errors import MechKinematicsError
 from ..memory import keep_freed_memory
 from ..units import LENGTH_UNITS, rad_per_s_from_rpm, turns_from_degrees
 
-__all__ = ['ArgumentParser', 'PROG', 'add_driver_arguments', 'add_scene_argument',
-           'drive_from_args', 'finite_float', 'named_value', 'positive_float', 'positive_int',
-           'positive_seconds', 'run_handler', 'run_tool', 'seconds_or_zero', 'values_by_driver']
+__all__ = ['ArgumentParser', 'PROG', 'add_driver_arguments', 'add_robot_arguments',
+           'add_scene_argument', 'drive_from_args', 'finite_float', 'is_urdf', 'joint_list',
+           'load_robot_argument', 'load_scene_argument', 'named_value', 'positive_float',
+           'positive_int', 'positive_seconds', 'run_handler', 'run_tool', 'seconds_or_zero',
+           'values_by_driver']
 
 #: The program name shown in usage lines.
 PROG = 'python -m mech_kinematics'
@@ -69,6 +71,76 @@ def add_scene_argument(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('scene', metavar='SCENE',
                         help='path to a scene YAML, or the name of a packaged scene '
                              '(e.g. khurmi_four_bar_ad150)')
+
+
+def is_urdf(source: Any) -> bool:
+    """Return whether a SCENE argument names a robot description: a path ending in .urdf."""
+    return source is not None and str(source).lower().endswith('.urdf')
+
+
+def joint_list(text: str) -> tuple[str, ...]:
+    """Parse ``J1,J2,...`` (joint names), or tell argparse why not."""
+    names = tuple(name.strip() for name in text.split(','))
+    if not names or not all(names):
+        msg = f'expected joint names separated by commas, got {text!r}'
+        raise argparse.ArgumentTypeError(msg)
+    return names
+
+
+def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add what a robot in URDF takes: ``--closures``, ``--actuated`` and ``--reference``."""
+    group = parser.add_argument_group('a robot described in URDF (a SCENE path ending in .urdf)')
+    group.add_argument('--closures', metavar='FILE',
+                       help='a scikit-robot loop_closures.yaml beside the URDF (its <constraint> '
+                            'elements and closing_NAME_1/_2 frames are read from the URDF)')
+    group.add_argument('--actuated', type=joint_list, metavar='J1,J2,...',
+                       help="the actuated joints (default: the closures file's independent "
+                            "joints, else the URDF's <transmission> and <ros2_control> joints)")
+    group.add_argument('--reference', type=named_value, action='append', metavar='J=VALUE',
+                       help='a reference pose whose branches the loops keep (degrees for a '
+                            'revolute joint, m for a prismatic one; repeatable; default: the '
+                            "URDF's zero pose)")
+
+
+def load_robot_argument(args: argparse.Namespace) -> Any:
+    """Return the :class:`~mech_kinematics.robot.Robot` of a URDF SCENE and its options."""
+    from ..robot import Robot
+    from ..robot.description import read_description
+
+    description = read_description(args.scene, getattr(args, 'closures', None))
+    reference = {}
+    for name, value in getattr(args, 'reference', None) or ():
+        joint = description.joints.get(name or '')
+        if joint is None or joint.type is None:
+            from ..errors import UrdfError
+            moving = ', '.join(n for n, j in description.joints.items() if j.type is not None)
+            msg = (f'{args.scene}: Expected --reference J=VALUE with J a moving joint of the '
+                   f'robot ({moving}), got {name!r}')
+            raise UrdfError(msg)
+        reference[name] = math.radians(value) if joint.type.angular else value
+    return Robot(description, getattr(args, 'actuated', None), reference)
+
+
+def load_scene_argument(args: argparse.Namespace, source: Any = None) -> Any:
+    """Return the scene a SCENE argument names: a scene file, a packaged name or a URDF.
+
+    A URDF (a path ending in ``.urdf``) gives the scene its planar loops
+    become (``urdf2scene``'s); ``--closures``, ``--actuated`` and
+    ``--reference`` are refused for anything else.
+    """
+    from ..errors import SceneError
+    from ..scene import load_scene
+
+    source = args.scene if source is None else source
+    if is_urdf(source):
+        return load_robot_argument(args).scene
+    given = [flag for flag, key in (('--closures', 'closures'), ('--actuated', 'actuated'),
+                                    ('--reference', 'reference')) if getattr(args, key, None)]
+    if given:
+        msg = (f'Expected {", ".join(given)} with a robot described in URDF (a path ending in '
+               f'.urdf), got scene {source}')
+        raise SceneError(msg)
+    return load_scene(source)
 
 
 def finite_float(text: str) -> float:

@@ -26,7 +26,8 @@ import warnings
 import numpy as np
 import numpy.typing as npt
 
-from .cli import (add_driver_arguments, add_scene_argument, drive_from_args, finite_float,
+from .cli import (add_driver_arguments, add_robot_arguments, add_scene_argument,
+                  drive_from_args, finite_float, load_scene_argument,
                   positive_int, run_tool, values_by_driver)
 from ..errors import AssemblyError, NearSingularWarning, SceneError
 from ..geometry.diagrams import (arrows_from_state, colours_from_scene, Diagram,
@@ -928,6 +929,7 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--speed-rpm', type=finite_float, metavar='N',
                         help="signed crank speed in rpm, + CCW (default: the scene's)")
     add_driver_arguments(parser)
+    add_robot_arguments(parser)
     parser.add_argument('--instant-centres', action='store_true',
                         help='also compute the instant centres, mark them on the space '
                              'diagram and list them')
@@ -963,8 +965,6 @@ def add_parser(commands: Any) -> argparse.ArgumentParser:
 
 def _handle(args: argparse.Namespace) -> int:
     """Run the ``diagram`` command on parsed arguments; return the exit status."""
-    from ..scene import load_scene
-
     output = Path(args.output)
     suffixes = ('.gif',) if args.animate else ('.png', '.svg', '.pdf')
     if output.suffix.lower() not in suffixes:
@@ -975,7 +975,7 @@ def _handle(args: argparse.Namespace) -> int:
         return 2
     speed = None if args.speed_rpm is None else rad_per_s_from_rpm(args.speed_rpm)
     try:
-        scene = load_scene(args.scene)
+        scene = load_scene_argument(args)   # a scene, or a URDF's loops as a scene
         drivers = scene.drivers
         if args.force_polygon is not None:
             return _handle_force_polygon(args, scene, output)

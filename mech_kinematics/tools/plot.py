@@ -41,8 +41,8 @@ import warnings
 import numpy as np
 import numpy.typing as npt
 
+from .cli import add_robot_arguments, load_scene_argument, named_value, values_by_driver
 from .cli import finite_float, positive_float, PROG, run_tool
-from .cli import named_value, values_by_driver
 from ..errors import MechKinematicsError, SceneError
 from ..ros import topics
 from ..ros.cdr import stamp_from_cdr
@@ -1065,7 +1065,7 @@ def _handle(args: argparse.Namespace) -> int:
         return 2
     speed = None if args.speed_rpm is None else rad_per_s_from_rpm(args.speed_rpm)
     try:
-        scene = None if args.scene is None else mk.load_scene(args.scene)
+        scene = None if args.scene is None else load_scene_argument(args)
         if args.bag is not None:
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter('always', UserWarning)
@@ -1119,8 +1119,10 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('-o', '--output', required=True, metavar='FILE.png',
                         help='image to write (format from the suffix: png, svg, pdf)')
     parser.add_argument('--scene', metavar='SCENE',
-                        help='scene file or packaged scene name: plot the solver over one '
-                             'crank cycle, or (with BAG) name the joint types')
+                        help='scene file or packaged scene name (or a URDF, .urdf: its loops as '
+                             'a scene): plot the solver over one crank cycle, or (with BAG) name '
+                             'the joint types')
+    add_robot_arguments(parser)
     parser.add_argument('--x', choices=AXES,
                         help='horizontal axis (default: time for a bag, angle for a scene)')
     parser.add_argument('--namespace', metavar='NS',

@@ -12,13 +12,14 @@ import sys
 from typing import Any
 import warnings
 
-from .cli import (add_driver_arguments, add_scene_argument, drive_from_args, finite_float,
-                  positive_float, run_tool)
+from .cli import (add_driver_arguments, add_robot_arguments, add_scene_argument,
+                  drive_from_args, finite_float, is_urdf, load_robot_argument, positive_float,
+                  run_tool, values_by_driver)
 from ..bounds import MAX_ERROR
 from ..errors import AssemblyError, NearSingularWarning, SceneError, UntrustedError
 from ..scene import load_scene
 from ..solver import assembly_text, solve
-from ..units import turns_from_degrees
+from ..units import rad_per_s_from_rpm, turns_from_degrees
 
 __all__ = ['add_parser', 'main', 'turns_from_degrees']
 
@@ -44,11 +45,89 @@ solved, or whose answer cannot be trusted (a value's error bound above
 --max-error times its kind's scale, a dyad within rounding of an assembly
 limit, a value beyond the range of doubles, anywhere in the JSON: an IMU's
 reading too), it prints a one-line error and exits with status 2.
+A robot described in URDF (SCENE a path ending in .urdf, with --closures,
+--actuated and --reference) is driven by its actuated joints, named as in
+the URDF: --input J=VALUE in degrees (revolute) or m (prismatic), --speed
+J=VALUE in rpm or m/s, --accel J=VALUE in rad/s^2 or m/s^2, each from the
+joint's zero and positive about its axis as written. Its JSON has "robot",
+"inputs" and "joints" keyed by URDF joint names (every joint of every loop,
+the actuated ones and the mimic joints that follow them), the loops'
+"points" in their plane, "mimic" (a mimic joint a loop moves away from its
+rule) and "limits" (a joint outside its <limit>, reported, not refused).
 """
 
 
-def _handle(args: argparse.Namespace) -> int:
+def _robot_drive(robot: Any, args: argparse.Namespace
+                 ) -> tuple[dict[str, float], dict[str, float], dict[str, float], str]:
+    """Return a robot's actuated joints' values (SI) from --input, --speed and --accel J=V."""
+    from types import SimpleNamespace
+
+    names = SimpleNamespace(drivers=[SimpleNamespace(name=n) for n in robot.actuated])
+    inputs = values_by_driver(names, '--input', args.input)
+    speeds = values_by_driver(names, '--speed', args.speed)
+    accels = values_by_driver(names, '--accel', args.accel)
+    for flag, value, key, table in (('--angle-deg', args.angle_deg, '--input', inputs),
+                                    ('--speed-rpm', args.speed_rpm, '--speed', speeds)):
+        if value is None:
+            continue
+        single = len(robot.actuated) == 1 and robot.joint_type(robot.actuated[0]).angular
+        if not single or robot.actuated[0] in table:
+            msg = (f'Expected {key} J=VALUE for the actuated joints of {robot.name} '
+                   f'({", ".join(robot.actuated)}), got {flag}')
+            raise ValueError(msg)
+        table[robot.actuated[0]] = value
+    positions, rates, words = {}, {}, []
+    for name in robot.actuated:
+        angular = robot.joint_type(name).angular
+        if name in inputs:
+            positions[name] = math.radians(inputs[name]) if angular else inputs[name]
+            words.append(f'{name} = {inputs[name]:.15g} {"deg" if angular else "m"}')
+        if name in speeds:
+            rates[name] = rad_per_s_from_rpm(speeds[name]) if angular else speeds[name]
+    shown = ', '.join(words) or 'the reference pose'
+    return positions, rates, accels, shown
+
+
+def _handle_robot(args: argparse.Namespace) -> int:
+    """Solve a robot described in URDF: its joints under their URDF names."""
     try:
+        robot = load_robot_argument(args)
+        positions, speeds, accels, shown = _robot_drive(robot, args)
+    except (SceneError, ValueError) as error:
+        print(f'error: {error}', file=sys.stderr)
+        return 2
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter('always', NearSingularWarning)
+            answer = robot.solve(positions, speeds, accels, max_error=args.max_error)
+    except AssemblyError as error:
+        reason = error.reason if isinstance(error, UntrustedError) or error.facts is None \
+            else assembly_text(error, robot.scene.units)
+        print(f'error: {error.dyad} cannot be solved at {shown}: {reason}', file=sys.stderr)
+        return 2
+    for warning in caught:
+        print(f'warning: {warning.message}', file=sys.stderr)
+    result: dict[str, Any] = answer.as_dict()
+    if args.diagnostics:
+        result['singularity'] = {key: float(m) for key, m in answer.state.singularity.items()}
+        result['relative_error_bound'] = float(answer.state.relative_error_bound)
+    path, value = next(_not_finite(result), ('', 0.0))
+    if path:
+        print(f'error: Expected every value of the state at {shown} to be finite, got {path} = '
+              f'{value!r} (beyond the range of doubles)', file=sys.stderr)
+        return 2
+    print(json.dumps(result, indent=args.indent, allow_nan=False))
+    return 0
+
+
+def _handle(args: argparse.Namespace) -> int:
+    if is_urdf(args.scene):
+        return _handle_robot(args)
+    try:
+        if args.closures or args.actuated or args.reference:
+            msg = (f'Expected --closures, --actuated and --reference with a robot described '
+                   f'in URDF (a path ending in .urdf), got scene {args.scene}')
+            raise SceneError(msg)
         scene = load_scene(args.scene)
     except SceneError as error:
         print(f'error: {error}', file=sys.stderr)
@@ -114,6 +193,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     parser.add_argument('--speed-rpm', type=finite_float, metavar='N',
                         help="signed crank speed in rpm, + CCW (default: the scene's)")
     add_driver_arguments(parser)
+    add_robot_arguments(parser)
     parser.add_argument('--max-error', type=positive_float, default=MAX_ERROR, metavar='REL',
                         help="refuse (exit 2) where a value's error bound exceeds REL times "
                              "its kind's scale (the mechanism's size, its largest speed, its "

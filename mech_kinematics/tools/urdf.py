@@ -27,6 +27,14 @@ the root link FRAME_ID, a fixed link at every ground point and a floating
 link per moving link or slider (posed by /tf), each drawn as bars between
 its points, pins and slider blocks, to scale (m). --frame-id and --tf-prefix
 must match the node's parameters of the same names.
+With --robot it writes the scene as a real robot description instead: a
+tree of revolute and prismatic joints from the ground (the drivers' and the
+prismatic joints first), each loop closed by a <constraint type="revolute">
+element (ros/urdfdom#264) and a <transmission> per driver, its zero pose
+the drivers' start; `solve` and `urdf2scene` read it back as the same
+mechanism. robot_state_publisher draws it from joint_states in its joint
+names (docs/node.md says what publishes those). A Geneva wheel's
+intermittent slot has no such form: refused.
 """
 
 
@@ -36,9 +44,12 @@ def _handle(args: argparse.Namespace) -> int:
     from ..scene import load_scene
     from ..solver import assembly_text
 
+    from ..robot.writer import robot_urdf_from_scene
+
     scene = load_scene(args.scene)  # a SceneError is one line, exit 2 (cli.run_handler)
+    write = robot_urdf_from_scene if args.robot else urdf_from_scene
     try:
-        text = urdf_from_scene(scene, frame_id=args.frame_id, prefix=args.tf_prefix)
+        text = write(scene, frame_id=args.frame_id, prefix=args.tf_prefix)
     except AssemblyError as error:  # no pose to draw it in: why, in the scene's units
         crank = scene.input
         where = (f'crank angle {scene.units.angle_text(crank.shown)}, nor at any of a turn'
@@ -69,6 +80,9 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
                         help="the node's frame_id: the root link (default: %(default)s)")
     parser.add_argument('--tf-prefix', default='',
                         help="the node's tf_prefix (default: '', meaning FRAME_ID)")
+    parser.add_argument('--robot', action='store_true',
+                        help='write a robot description: a tree of joints, each loop closed by '
+                             'a <constraint> (default: the floating links posed by /tf)')
     parser.set_defaults(handler=_handle)
     return parser
 

@@ -1,0 +1,605 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""A robot as it is written: a URDF, its loop closures and its actuated joints.
+
+The URDF's links and joints are read by ``urdf_parser_py`` (ROS's own Python
+URDF reader, the ``urdfdom_py`` package), on an XML tree that lxml parses here
+with entities and the network turned off (a URDF is text from anyone). What
+no URDF library reads is read here from the same tree:
+
+- ``<constraint>`` elements, as proposed in ros/urdfdom#264 and
+  ros/urdfdom_headers#108 (``name``, ``type``; ``<parent link>``,
+  ``<parent_origin xyz rpy>``, ``<parent_axis xyz>`` and the same for the
+  child; the axis in the constraint's frame). ``revolute``, ``continuous``,
+  ``spherical`` and ``universal`` close a loop at a point (in a planar loop
+  they all act as a pin); ``link`` (or ``fixed``) welds two links; a
+  ``prismatic`` closure is refused (cut the loop at a revolute joint);
+- onshape-to-robot's closing frames: the links ``closing_NAME_1`` and
+  ``closing_NAME_2`` (frames: fixed child links) whose origins coincide;
+- ``<transmission>`` joints and ``<ros2_control>`` joints with a
+  ``<command_interface>``: the actuated joints (a joint with state
+  interfaces only is measured, not driven);
+
+and, beside the URDF, scikit-robot's ``loop_closures.yaml`` (its
+``LoopClosureSolver``): ``closures: [{link_a, link_b, point, axis}]`` with the
+point and axis in the root frame at the zero pose, ``dependent`` and
+``independent`` joint lists (``independent``: the driven joints).
+
+Every failure is one :class:`~mech_kinematics.errors.UrdfError` line naming
+the source and what is wrong. Pure: no ROS.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field
+from enum import Enum
+import math
+import os
+from pathlib import Path
+import re
+import threading
+from typing import Any
+
+import numpy as np
+
+from .transforms import Matrix, rotation_about, transform, translation
+from ..errors import SceneError, UrdfError
+from ..solver.graph import JointType, PRISMATIC, REVOLUTE
+
+__all__ = ['Closure', 'ClosureKind', 'Description', 'Mimic', 'UrdfJoint', 'read_description',
+           'URDF_TYPES']
+
+#: A URDF joint type -> the joint type of its coordinate (None: no coordinate we solve).
+URDF_TYPES: dict[str, JointType | None] = {
+    'revolute': REVOLUTE, 'continuous': REVOLUTE, 'prismatic': PRISMATIC, 'fixed': None,
+    'floating': None, 'planar': None}
+#: URDF joint types that move (a floating or planar joint moves, but with no one coordinate).
+MOVING = frozenset({'revolute', 'continuous', 'prismatic', 'floating', 'planar'})
+#: A ``<constraint>`` type -> what it closes.
+CONSTRAINT_TYPES = {'revolute': 'pin', 'continuous': 'pin', 'spherical': 'pin',
+                    'universal': 'pin', 'link': 'weld', 'fixed': 'weld'}
+#: A ``<constraint>`` type we refuse -> what to do instead.
+REFUSED_CONSTRAINTS = {'prismatic': ' (cut the loop at a revolute joint instead)'}
+#: The name of an onshape-to-robot closing frame: ``closing_NAME_1`` or ``closing_NAME_2``.
+CLOSING_FRAME = re.compile(r'closing_(.+)_([12])\Z')
+
+_PARSE_LOCK = threading.Lock()
+
+
+class ClosureKind(Enum):
+    """What a loop closure joins: a point of each link (a pin), or the two links rigidly."""
+
+    PIN = 'pin'
+    WELD = 'weld'
+
+
+@dataclass(frozen=True)
+class Closure:
+    """One cut of a loop: two links joined where the tree does not join them.
+
+    Attributes
+    ----------
+    name : str
+        Its name (a constraint's, ``closing_NAME``, ``closure_I`` of a sidecar).
+    kind : ClosureKind
+        A pin (the two frames' origins coincide) or a weld (the frames coincide).
+    link_a, link_b : str
+        The two links.
+    frame_a, frame_b : ndarray, shape (4, 4)
+        The closure's frame on each link, in that link's frame (m).
+    axis_a, axis_b : tuple of float or None
+        A pin's axis in each link's frame where it is written; ``None`` for a
+        point (closing frames) or a weld.
+    form : str
+        Where it was written: ``<constraint>``, ``closing frames`` or the sidecar.
+    """
+
+    name: str
+    kind: ClosureKind
+    link_a: str
+    frame_a: Matrix
+    link_b: str
+    frame_b: Matrix
+    axis_a: tuple[float, float, float] | None
+    axis_b: tuple[float, float, float] | None
+    form: str
+
+
+@dataclass(frozen=True)
+class Mimic:
+    """A ``<mimic>``: value = ``multiplier`` x the leader's + ``offset``."""
+
+    joint: str
+    multiplier: float = 1.0
+    offset: float = 0.0
+
+
+@dataclass(frozen=True)
+class UrdfJoint:
+    """A URDF joint as written (SI units).
+
+    Attributes
+    ----------
+    name, urdf_type, parent, child : str
+        Its name, its type as written (``revolute``, ``continuous``,
+        ``prismatic``, ``fixed``, ``floating``, ``planar``), its links.
+    type : JointType or None
+        The joint type of its coordinate (:data:`URDF_TYPES`); ``None`` for a
+        fixed joint and for a floating or planar one.
+    origin : ndarray, shape (4, 4)
+        Its ``<origin>``: the child's frame at value 0 in the parent's.
+    axis : tuple of float
+        Its unit ``<axis>`` in its own frame (default x).
+    limits : tuple of float or None
+        ``(lower, upper)`` from ``<limit>`` where ``upper > lower``.
+    mimic : Mimic or None
+        Its ``<mimic>``.
+    """
+
+    name: str
+    urdf_type: str
+    type: JointType | None
+    parent: str
+    child: str
+    origin: Matrix
+    axis: tuple[float, float, float]
+    limits: tuple[float, float] | None = None
+    mimic: Mimic | None = None
+
+    @property
+    def moving(self) -> bool:
+        """Whether it moves (every type but ``fixed``)."""
+        return self.urdf_type in MOVING
+
+    def motion(self, value: float) -> Matrix:
+        """Return the child's frame in the parent's at ``value`` (rad or m)."""
+        if self.type is None:
+            return self.origin
+        if self.type.angular:
+            return self.origin @ rotation_about(self.axis, value)
+        return self.origin @ translation(np.multiply(self.axis, value))
+
+
+@dataclass(frozen=True)
+class Description:
+    """A robot as written: its URDF's links and joints, closures and actuated joints.
+
+    Attributes
+    ----------
+    name : str
+        The ``<robot name>``.
+    source : str
+        The URDF's path, or ``<robot_description>`` for text.
+    text : str
+        The URDF's text, unchanged.
+    links : tuple of str
+        Every link, in file order.
+    joints : dict of str to UrdfJoint
+        Every joint, in file order.
+    root : str
+        The root link.
+    closures : tuple of Closure
+        The loop closures, every form together.
+    actuated : tuple of str
+        The joints the URDF says are driven (``<transmission>``,
+        ``<ros2_control>`` command interfaces), in file order.
+    independent : tuple of str or None
+        A sidecar's ``independent`` joints (``None`` without a sidecar).
+    """
+
+    name: str
+    source: str
+    text: str
+    links: tuple[str, ...]
+    joints: dict[str, UrdfJoint]
+    root: str
+    closures: tuple[Closure, ...] = ()
+    actuated: tuple[str, ...] = ()
+    independent: tuple[str, ...] | None = None
+    _parent: dict[str, UrdfJoint] = field(default_factory=dict, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        """Index each link's parent joint."""
+        self._parent.update({j.child: j for j in self.joints.values()})
+
+    def parent_joint(self, link: str) -> UrdfJoint | None:
+        """Return the joint whose child is ``link`` (``None`` for the root)."""
+        return self._parent.get(link)
+
+    def chain(self, link: str) -> list[UrdfJoint]:
+        """Return the joints from the root down to ``link``, in order."""
+        out = []
+        joint = self._parent.get(link)
+        while joint is not None:
+            out.append(joint)
+            joint = self._parent.get(joint.parent)
+        out.reverse()
+        return out
+
+    def depth(self, link: str) -> int:
+        """Return how many joints ``link`` is below the root."""
+        return len(self.chain(link))
+
+    def pose(self, values: Mapping[str, float] | None = None) -> dict[str, float]:
+        """Return every moving joint's value: ``values``, else its mimic rule, else 0.
+
+        A mimic joint not given follows its leader (value = multiplier x
+        leader + offset), as joint_state_publisher draws it.
+        """
+        values = dict(values or {})
+        out: dict[str, float] = {}
+
+        def value(name: str, seen: tuple[str, ...] = ()) -> float:
+            if name in out:
+                return out[name]
+            joint = self.joints[name]
+            if name in values:
+                out[name] = float(values[name])
+            elif joint.mimic is not None and joint.mimic.joint not in seen:
+                rule = joint.mimic
+                out[name] = rule.multiplier * value(rule.joint, (*seen, name)) + rule.offset
+            else:
+                out[name] = 0.0
+            return out[name]
+
+        for name, joint in self.joints.items():
+            if joint.type is not None:
+                value(name)
+        return out
+
+    def transforms(self, values: Mapping[str, float] | None = None) -> dict[str, Matrix]:
+        """Return every link's frame in the root's at the joint values :meth:`pose` gives."""
+        pose = self.pose(values)
+        out: dict[str, Matrix] = {self.root: np.eye(4)}
+
+        def frame(link: str) -> Matrix:
+            if link not in out:
+                joint = self._parent[link]
+                out[link] = frame(joint.parent) @ joint.motion(pose.get(joint.name, 0.0))
+            return out[link]
+
+        for link in self.links:
+            frame(link)
+        return out
+
+
+def _fail(source: str, msg: str, joint: str | None = None) -> UrdfError:
+    return UrdfError(f'{source}: {msg}', joint=joint)
+
+
+def _floats(text: str | None, count: int, what: str, source: str,
+            default: tuple[float, ...] | None = None) -> tuple[float, ...]:
+    """Return ``count`` finite numbers from an XML attribute, or refuse in one line."""
+    if text is None:
+        if default is None:
+            raise _fail(source, f'Expected {what} ({count} numbers), got none')
+        return default
+    try:
+        values = tuple(float(v) for v in text.split())
+    except ValueError:
+        values = ()
+    if len(values) != count or not all(math.isfinite(v) for v in values):
+        raise _fail(source, f'Expected {what} to be {count} finite numbers, got {text!r}')
+    return values
+
+
+def _unit(vector: tuple[float, ...], what: str, source: str, joint: str | None = None
+          ) -> tuple[float, float, float]:
+    norm = math.sqrt(sum(v * v for v in vector))
+    if not norm > 0.0 or not math.isfinite(norm):
+        raise _fail(source, f'Expected {what} to be a non-zero direction, got '
+                    f'{" ".join(f"{v:g}" for v in vector)}', joint)
+    x, y, z = (v / norm for v in vector)
+    return x, y, z
+
+
+def _origin(element: Any, what: str, source: str) -> Matrix:
+    if element is None:
+        return np.eye(4)
+    xyz = _floats(element.get('xyz'), 3, f'{what} xyz', source, (0.0, 0.0, 0.0))
+    rpy = _floats(element.get('rpy'), 3, f'{what} rpy', source, (0.0, 0.0, 0.0))
+    return transform(xyz, rpy)
+
+
+class _Collect:
+    """Collect urdf_parser_py's complaints (it prints them) instead of printing them."""
+
+    def __init__(self) -> None:
+        self.messages: list[str] = []
+
+    def __call__(self, message: str) -> None:
+        self.messages.append(message)
+
+
+def _parse_xml(text: str, source: str) -> Any:
+    """Return the root element of ``text``, parsed with no entities and no network."""
+    from lxml import etree
+    parser = etree.XMLParser(resolve_entities=False, no_network=True, huge_tree=False,
+                             remove_comments=True, remove_pis=True, load_dtd=False)
+    try:
+        root = etree.fromstring(text.encode('utf-8'), parser)
+    except etree.XMLSyntaxError as error:
+        raise _fail(source, f'Expected a URDF (XML), got text that is not XML: {error}') from None
+    if root.tag != 'robot':
+        raise _fail(source, f'Expected a URDF whose root element is <robot>, got <{root.tag}>')
+    return root
+
+
+def _read_links_and_joints(root: Any, source: str) -> Any:
+    """Return urdf_parser_py's robot for ``root``, its complaints kept, not printed."""
+    from lxml import etree
+    import urdf_parser_py.urdf as urdf
+    from urdf_parser_py.xml_reflection import core
+
+    known = {'link', 'joint', 'material', 'transmission', 'gazebo'}
+    tree = etree.ElementTree(root)
+    copy = etree.fromstring(etree.tostring(tree))
+    for child in list(copy):  # what we read ourselves, or what no URDF reader reads
+        if not isinstance(child.tag, str) or child.tag not in known:
+            copy.remove(child)
+    collect = _Collect()
+    with _PARSE_LOCK:  # urdf_parser_py reports through a module-level function
+        saved = core.on_error
+        core.on_error = collect
+        try:
+            path = core.Path(urdf.Robot.XML_REFL.tag, tree=etree.ElementTree(copy))
+            return urdf.Robot.from_xml(copy, path)
+        except Exception as error:  # noqa: BLE001 - the library raises anything: one line
+            text = ' '.join(str(error).split()) or type(error).__name__
+            raise _fail(source, f'Expected a valid URDF, got: {text}') from None
+        finally:
+            core.on_error = saved
+
+
+def _joints(robot: Any, source: str) -> dict[str, UrdfJoint]:
+    links = {link.name for link in robot.links}
+    out: dict[str, UrdfJoint] = {}
+    children: dict[str, str] = {}
+    for joint in robot.joints:
+        name = joint.name
+        where = f'joint "{name}"'
+        if name in out:
+            raise _fail(source, f'Expected every joint to have a name of its own, got "{name}" '
+                        'twice', name)
+        kind = joint.type
+        if kind not in URDF_TYPES:
+            raise _fail(source, f'{where}: Expected a type in {", ".join(URDF_TYPES)}, got '
+                        f'{kind!r}', name)
+        for end in (joint.parent, joint.child):
+            if end not in links:
+                raise _fail(source, f'{where}: Expected its parent and child to be links of '
+                            f'the robot, got unknown link "{end}"', name)
+        if joint.child in children:
+            raise _fail(source, f'{where}: Expected each link to be the child of one joint (a '
+                        f'URDF is a tree: close a loop with a <constraint>), got link '
+                        f'"{joint.child}" the child of "{children[joint.child]}" too', name)
+        children[joint.child] = name
+        origin = np.eye(4)
+        if joint.origin is not None:
+            xyz = tuple(float(v) for v in (joint.origin.xyz or (0.0, 0.0, 0.0)))
+            rpy = tuple(float(v) for v in (joint.origin.rpy or (0.0, 0.0, 0.0)))
+            if not all(math.isfinite(v) for v in xyz + rpy):
+                raise _fail(source, f'{where}: Expected a finite <origin>, got xyz '
+                            f'{xyz} rpy {rpy}', name)
+            origin = transform(xyz, rpy)
+        axis: tuple[float, float, float] = (1.0, 0.0, 0.0)
+        if joint.axis is not None and URDF_TYPES[kind] is not None:
+            axis = _unit(tuple(float(v) for v in joint.axis), f"{where}'s <axis>", source,
+                         name)
+        limits = None
+        if joint.limit is not None and joint.limit.lower is not None \
+                and joint.limit.upper is not None:
+            lower, upper = float(joint.limit.lower), float(joint.limit.upper)
+            if math.isfinite(lower) and math.isfinite(upper) and upper > lower:
+                limits = (lower, upper)
+        mimic = None
+        if joint.mimic is not None:
+            rule = joint.mimic
+            mimic = Mimic(rule.joint, 1.0 if rule.multiplier is None else float(rule.multiplier),
+                          0.0 if rule.offset is None else float(rule.offset))
+            if not (math.isfinite(mimic.multiplier) and math.isfinite(mimic.offset)):
+                raise _fail(source, f'{where}: Expected a finite <mimic> multiplier and offset, '
+                            f'got {mimic.multiplier!r} and {mimic.offset!r}', name)
+        out[name] = UrdfJoint(name, kind, URDF_TYPES[kind], joint.parent, joint.child, origin,
+                              axis, limits, mimic)
+    for joint in out.values():
+        if joint.mimic is not None and (joint.mimic.joint not in out
+                                        or out[joint.mimic.joint].type is None):
+            raise _fail(source, f'joint "{joint.name}": Expected its <mimic> to follow a '
+                        f'moving joint of the robot, got "{joint.mimic.joint}"', joint.name)
+    return out
+
+
+def _root(links: tuple[str, ...], joints: dict[str, UrdfJoint], source: str) -> str:
+    children = {j.child for j in joints.values()}
+    roots = [link for link in links if link not in children]
+    if len(roots) != 1:
+        got = ', '.join(roots[:5]) or 'none (the joints make a cycle)'
+        raise _fail(source, f'Expected one root link (a URDF is a tree), got {got}')
+    parent = {j.child: j.parent for j in joints.values()}
+    for link in links:  # a cycle among the joints leaves some link without a path up
+        seen = set()
+        while link in parent:
+            if link in seen:
+                raise _fail(source, f'Expected the joints to make a tree, got a cycle through '
+                            f'link "{link}"')
+            seen.add(link)
+            link = parent[link]
+    return roots[0]
+
+
+def _constraints(root: Any, links: set[str], source: str) -> Iterator[Closure]:
+    for element in root.findall('constraint'):
+        name = element.get('name') or ''
+        where = f'<constraint name="{name}">'
+        kind = element.get('type', '')
+        if kind not in CONSTRAINT_TYPES:
+            extra = REFUSED_CONSTRAINTS.get(kind, '')
+            raise _fail(source, f'{where}: Expected a type in {", ".join(CONSTRAINT_TYPES)}, '
+                        f'got {kind!r}{extra}')
+        ends = []
+        for end in ('parent', 'child'):
+            link = element.find(end)
+            link_name = None if link is None else link.get('link')
+            if link_name not in links:
+                raise _fail(source, f'{where}: Expected <{end} link="..."/> naming a link of the '
+                            f'robot, got {link_name!r}')
+            frame = _origin(element.find(f'{end}_origin'), f'{where} {end}_origin', source)
+            axis = element.find(f'{end}_axis')
+            direction = None if axis is None else _unit(
+                _floats(axis.get('xyz'), 3, f'{where} {end}_axis xyz', source),
+                f'{where} {end}_axis', source)
+            ends.append((link_name, frame, direction))
+        closure_kind = ClosureKind(CONSTRAINT_TYPES[kind])
+        axes = []
+        for _, frame, axis in ends:  # each axis is written in its constraint frame
+            axes.append(None if axis is None or closure_kind is ClosureKind.WELD else
+                        tuple(float(v) for v in frame[:3, :3] @ np.asarray(axis)))
+        (link_a, frame_a, _), (link_b, frame_b, _) = ends
+        yield Closure(name or f'constraint_{link_a}_{link_b}', closure_kind, str(link_a),
+                      frame_a, str(link_b), frame_b, axes[0], axes[1], '<constraint>')
+
+
+def _closing_frames(joints: dict[str, UrdfJoint], links: tuple[str, ...],
+                    source: str) -> Iterator[Closure]:
+    pairs: dict[str, dict[str, str]] = {}
+    for link in links:
+        match = CLOSING_FRAME.match(link)
+        if match:
+            pairs.setdefault(match[1], {})[match[2]] = link
+    for name, pair in pairs.items():
+        if len(pair) != 2:
+            have = next(iter(pair.values()))
+            missing = f'closing_{name}_{"2" if "1" in pair else "1"}'
+            raise _fail(source, f'Expected closing frames in pairs, got "{have}" without '
+                        f'"{missing}"')
+        yield Closure(f'closing_{name}', ClosureKind.PIN, pair['1'], np.eye(4), pair['2'],
+                      np.eye(4), None, None, 'closing frames')
+
+
+def _sidecar(path: str | os.PathLike[str], description: Description,
+             ) -> tuple[tuple[Closure, ...], tuple[str, ...] | None]:
+    """Read scikit-robot's ``loop_closures.yaml``: closures and independent joints."""
+    from ..scene import _decode, _read_bytes
+    from ..yaml12 import read_scene_yaml
+
+    where = str(path)
+    try:
+        data = read_scene_yaml(_decode(Path(path), _read_bytes(Path(path))))
+    except SceneError as error:
+        raise UrdfError(f'{where}: {error}') from None
+    if not isinstance(data, dict) or not isinstance(data.get('closures'), list) \
+            or not data['closures']:
+        raise UrdfError(f'{where}: Expected a loop_closures.yaml (closures: [{{link_a, link_b, '
+                        f'point, axis}}], dependent, independent), got no closures')
+    unknown = set(data) - {'closures', 'dependent', 'independent'}
+    if unknown:
+        raise UrdfError(f'{where}: Expected keys closures, dependent and independent, got '
+                        f'{", ".join(sorted(map(str, unknown)))}')
+    zero = description.transforms({name: 0.0 for name, j in description.joints.items()
+                                   if j.type is not None})
+    closures = []
+    for index, item in enumerate(data['closures']):
+        at = f'{where}: closures[{index}]'
+        if not isinstance(item, dict) or set(item) != {'link_a', 'link_b', 'point', 'axis'}:
+            raise UrdfError(f'{at}: Expected {{link_a, link_b, point, axis}}, got '
+                            f'{item!r:.80}')
+        ends = []
+        for key in ('link_a', 'link_b'):
+            if item[key] not in zero:
+                raise UrdfError(f'{at}.{key}: Expected a link of the robot, got '
+                                f'{item[key]!r:.80}')
+            ends.append(item[key])
+        vectors = []
+        for key in ('point', 'axis'):
+            value = item[key]
+            if not isinstance(value, list) or len(value) != 3 or not all(
+                    isinstance(v, (int, float)) and not isinstance(v, bool)
+                    and math.isfinite(v) for v in value):
+                raise UrdfError(f'{at}.{key}: Expected [x, y, z] (finite numbers, the root '
+                                f'frame at the zero pose), got {value!r:.80}')
+            vectors.append(np.asarray(value, dtype=np.float64))
+        point, axis = vectors
+        axis_unit = _unit(tuple(axis), f'{at}.axis', where)
+        frames = []
+        for link in ends:
+            inverse = np.linalg.inv(zero[link])
+            frames.append(inverse @ translation(point))
+        axes = [tuple(float(v) for v in np.linalg.inv(zero[link])[:3, :3]
+                      @ np.asarray(axis_unit)) for link in ends]
+        closures.append(Closure(f'closure_{index}', ClosureKind.PIN, ends[0], frames[0], ends[1],
+                                frames[1], axes[0], axes[1], 'loop_closures.yaml'))
+    independent = data.get('independent')
+    if independent is not None:
+        if not isinstance(independent, list) or not all(isinstance(n, str) for n in independent):
+            raise UrdfError(f'{where}: independent: Expected a list of joint names, got '
+                            f'{independent!r:.80}')
+        independent = tuple(independent)
+    return tuple(closures), independent
+
+
+def _actuated(root: Any) -> tuple[str, ...]:
+    """Return the joints of ``<transmission>`` and ``<ros2_control>`` command interfaces."""
+    names: list[str] = []
+    for element in root.findall('transmission'):
+        for joint in element.findall('joint'):
+            if joint.get('name'):
+                names.append(joint.get('name'))
+    for element in root.findall('ros2_control'):
+        for joint in element.findall('joint'):
+            if joint.get('name') and joint.findall('command_interface'):
+                names.append(joint.get('name'))
+    return tuple(dict.fromkeys(names))
+
+
+def read_description(source: str | os.PathLike[str], closures: str | os.PathLike[str] | None
+                     = None) -> Description:
+    """Read a robot: a URDF (a path, or its text) and its loop closures.
+
+    Parameters
+    ----------
+    source : str or path
+        A URDF file, or the URDF's text (a string starting with ``<``).
+    closures : str or path, optional
+        A scikit-robot ``loop_closures.yaml`` beside it.
+
+    Returns
+    -------
+    Description
+
+    Raises
+    ------
+    UrdfError
+        One line naming the source and what is wrong.
+    """
+    from ..scene import _decode, _read_bytes
+
+    text_given = isinstance(source, str) and source.lstrip().startswith('<')
+    name = '<robot_description>' if text_given else str(source)
+    if text_given:
+        text = str(source)
+    else:
+        try:
+            text = _decode(Path(source), _read_bytes(Path(source)))
+        except SceneError as error:
+            raise UrdfError(str(error)) from None
+    root = _parse_xml(text, name)
+    robot = _read_links_and_joints(root, name)
+    links = tuple(link.name for link in robot.links)
+    if len(set(links)) != len(links):
+        twice = next(link for link in links if links.count(link) > 1)
+        raise _fail(name, f'Expected every link to have a name of its own, got "{twice}" twice')
+    if not links:
+        raise _fail(name, 'Expected a URDF with at least one link, got none')
+    joints = _joints(robot, name)
+    root_link = _root(links, joints, name)
+    found = tuple(_constraints(root, set(links), name)) + tuple(
+        _closing_frames(joints, links, name))
+    description = Description(str(robot.name or 'robot'), name, text, links, joints, root_link,
+                              found, _actuated(root))
+    if closures is None:
+        return description
+    extra, independent = _sidecar(closures, description)
+    return Description(description.name, name, text, links, joints, root_link,
+                       found + extra, description.actuated, independent)

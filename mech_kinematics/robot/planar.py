@@ -1,0 +1,1058 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""A robot's planar loops as a scene: bodies, pins and slides, decomposed into our kinds.
+
+From a :class:`~.description.Description` and its actuated joints:
+
+1. **Bodies.** Links joined by fixed joints (or welded by a closure) are one
+   rigid body, in the frame of its link nearest the root. Every moving joint
+   and every pin closure joins two bodies.
+2. **Loops.** The biconnected components of that graph of bodies with more
+   than one joint are the mechanisms (a leg's five-bar, a gripper's
+   four-bar); every other joint is outside every loop and passes through.
+   A mechanism's ground is its body nearest the root.
+3. **The plane.** Every revolute axis of a mechanism (and a closure's, where
+   written) must be parallel to one normal, every prismatic axis across it,
+   within :data:`PLANAR_TOLERANCE` rad: else refused naming the joint whose
+   axis is off and by how much. The plane's frame is fixed on the ground body.
+4. **Geometry**, at the reference pose (the zero pose unless given): each
+   body's points (its pins, each closure's point on it) in the plane, each
+   from that body's own frame, so that a closure whose two points miss each
+   other by a rounding still gives each body its exact shape. A closure
+   whose points miss by more than :data:`GAP_TOLERANCE` of the loop's size
+   is refused with the gap.
+5. **Drivers and dyads.** An actuated revolute joint on the ground is a
+   crank; an actuated prismatic joint between a barrel and a rod, each
+   pinned once, is a cylinder (an actuator). Then, while bodies remain, a
+   dyad of our kinds whose attachments are known is placed (Assur groups of
+   class II): RRR (two links, or a link and a cylinder), RRP (a link and a
+   block on a guide of the ground), RPR (a lever on a ground pivot, its slot
+   through the pivot, and the block in it), RPP (a yoke on a ground guide and
+   the block in its slot). Each dyad's branch is the reference pose's. What
+   no dyad places (a class-III group such as a triad) is refused.
+
+The result is a scene mapping (what ``urdf2scene`` writes, read by
+:func:`~mech_kinematics.scene.parse_scene`) and, for every URDF joint of
+every loop, the affine map from the scene's coordinates to the joint's own
+value: a revolute joint's value is its reference value plus ``sigma`` (+1
+or -1: its axis along or against the plane's normal) times the turn of its
+child body relative to its parent body; a prismatic joint's is its
+reference value plus ``kappa`` (+1 or -1) times the change of the scene's
+slider coordinate it moves. Pure: NumPy only.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Iterator, Mapping
+from dataclasses import dataclass, field
+import math
+import re
+from typing import Any
+
+import numpy as np
+
+from .description import Closure, ClosureKind, Description, UrdfJoint
+from .transforms import Matrix
+from ..errors import UrdfError
+from ..solver.graph import JointType, PRISMATIC, REVOLUTE
+from ..solver.model import IDENTIFIER
+
+__all__ = ['DriverMap', 'GAP_TOLERANCE', 'JointMap', 'PLANAR_TOLERANCE', 'Planar',
+           'TOGGLE_TOLERANCE', 'planar_from_description']
+
+#: Largest angle (rad) between a revolute axis and the loop's normal (or a prismatic axis
+#: and the plane), and largest offset of a slot or cylinder line from its pin over the
+#: loop's size: an exact planar solution closes the URDF's own loops to about this.
+PLANAR_TOLERANCE = 1e-12
+#: Largest gap between a closure's two points at the reference pose, over the loop's size.
+GAP_TOLERANCE = 1e-6
+#: A joint's value in the model within this (relative) of its pose's is the pose's.
+SNAP = 1e-13
+#: Smallest sine of the angle at a dyad's new pin at the reference pose (its branch).
+TOGGLE_TOLERANCE = 1e-9
+
+
+@dataclass(frozen=True)
+class JointMap:
+    """How one URDF joint of a loop follows the scene's coordinates.
+
+    A revolute joint: ``value = reference + sigma * ((child - child_ref) -
+    (parent - parent_ref))`` with ``child`` and ``parent`` the scene's angle
+    coordinates its bodies turn with (``None``: a body that does not turn:
+    the ground, a block on a guide). A prismatic joint: ``value = reference +
+    sigma * (slider - slider_ref)``, ``slider`` the scene's coordinate.
+    ``center`` is the middle of the joint's limits (0 without): a revolute
+    value is reported within pi of it.
+    """
+
+    name: str
+    type: JointType
+    sigma: float
+    reference: float
+    child: str | None = None
+    child_ref: float = 0.0
+    parent: str | None = None
+    parent_ref: float = 0.0
+    slider: str | None = None
+    slider_ref: float = 0.0
+    center: float = 0.0
+    mechanism: int = 0
+
+
+@dataclass(frozen=True)
+class DriverMap:
+    """A scene driver from a URDF joint: ``scene = scene_ref + sigma * (urdf - reference)``.
+
+    ``mimic`` is the joint's mimic rule where the driver is a mimic joint
+    whose leader is an actuated joint (its value follows the leader's).
+    """
+
+    name: str
+    scene: str
+    type: JointType
+    sigma: float
+    reference: float
+    scene_ref: float
+    mimic: Any = None
+
+
+@dataclass
+class Planar:
+    """A robot's loops as a scene mapping, with the maps of its joints.
+
+    Attributes
+    ----------
+    data : dict
+        The scene mapping (``parse_scene``'s input), SI units.
+    drivers : tuple of DriverMap
+        The scene's drivers in its order, each from a URDF joint.
+    joints : dict of str to JointMap
+        Every URDF joint of every loop.
+    mechanisms : list of dict
+        Per mechanism: its ``ground`` link, ``links``, ``joints``, ``normal``
+        (in the ground link's frame), ``size`` (m) and ``gap`` (the largest
+        closure gap at the reference pose, m).
+    actuated : tuple of str
+        The actuated joints (given, the sidecar's or the URDF's).
+    names : dict of str to str
+        URDF name -> scene name, where they differ (a name that is no
+        identifier, or used twice).
+    """
+
+    data: dict[str, Any]
+    drivers: tuple[DriverMap, ...]
+    joints: dict[str, JointMap]
+    mechanisms: list[dict[str, Any]]
+    actuated: tuple[str, ...] = ()
+    names: dict[str, str] = field(default_factory=dict)
+
+
+# --- names -----------------------------------------------------------------------------
+
+
+class _Names:
+    """Scene names for URDF names: identifiers, each used once across the scene."""
+
+    def __init__(self) -> None:
+        self.used: set[str] = set()
+        self.given: dict[tuple[str, str], str] = {}
+        self.changed: dict[str, str] = {}
+
+    def __call__(self, kind: str, urdf: str) -> str:
+        key = (kind, urdf)
+        if key in self.given:
+            return self.given[key]
+        base = re.sub(r'[^A-Za-z0-9_]', '_', urdf) or '_'
+        if not IDENTIFIER.match(base):
+            base = '_' + base
+        name, count = base, 1
+        while name in self.used or name == 'ground':
+            count += 1
+            name = f'{base}_{count}'
+        self.used.add(name)
+        self.given[key] = name
+        if name != urdf:
+            self.changed[urdf] = name
+        return name
+
+
+# --- the graph of bodies ---------------------------------------------------------------
+
+
+@dataclass
+class _Edge:
+    """A joint between two bodies: a tree joint (revolute, prismatic, free) or a pin closure."""
+
+    name: str
+    a: str                      # the parent side's body (a closure's link_a)
+    b: str                      # the child side's body
+    kind: str                   # 'pin', 'slide' or 'free'
+    joint: UrdfJoint | None = None
+    closure: Closure | None = None
+
+
+def _bodies(description: Description, weld: list[Closure]
+            ) -> tuple[dict[str, str], dict[str, Matrix]]:
+    """Return link -> body (its group's link nearest the root) and each link in its body.
+
+    Links joined by fixed joints, and links welded by a closure, are one body.
+    """
+    parent = {link: link for link in description.links}
+
+    def find(x: str) -> str:
+        while parent[x] != x:
+            parent[x] = parent[parent[x]]
+            x = parent[x]
+        return x
+
+    rigid: list[tuple[str, str, Matrix]] = []
+    for joint in description.joints.values():
+        if not joint.moving:
+            rigid.append((joint.parent, joint.child, joint.origin))
+    for closure in weld:
+        rigid.append((closure.link_a, closure.link_b,
+                      closure.frame_a @ np.linalg.inv(closure.frame_b)))
+    for a, b, _ in rigid:
+        parent[find(a)] = find(b)
+    groups: dict[str, list[str]] = {}
+    for link in description.links:
+        groups.setdefault(find(link), []).append(link)
+    depth = {link: description.depth(link) for link in description.links}
+    body_of: dict[str, str] = {}
+    in_body: dict[str, Matrix] = {}
+    neighbours: dict[str, list[tuple[str, Matrix]]] = {}
+    for a, b, t in rigid:
+        neighbours.setdefault(a, []).append((b, t))
+        neighbours.setdefault(b, []).append((a, np.linalg.inv(t)))
+    for members in groups.values():
+        top = min(members, key=lambda link: (depth[link], description.links.index(link)))
+        in_body[top] = np.eye(4)
+        stack = [top]
+        while stack:
+            link = stack.pop()
+            body_of[link] = top
+            for other, t in neighbours.get(link, ()):
+                if other not in in_body:
+                    in_body[other] = in_body[link] @ t
+                    stack.append(other)
+    return body_of, in_body
+
+
+def _components(bodies: list[str], edges: list[_Edge]) -> list[list[int]]:
+    """Return the biconnected components (lists of edge indices) of a multigraph."""
+    adjacency: dict[str, list[tuple[str, int]]] = {b: [] for b in bodies}
+    for index, edge in enumerate(edges):
+        adjacency[edge.a].append((edge.b, index))
+        adjacency[edge.b].append((edge.a, index))
+    order: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[int] = []
+    out: list[list[int]] = []
+    counter = 0
+    for start in bodies:
+        if start in order:
+            continue
+        order[start] = low[start] = counter
+        counter += 1
+        work: list[tuple[str, int, Iterator[tuple[str, int]]]] = [
+            (start, -1, iter(adjacency[start]))]
+        while work:
+            node, via, neighbours = work[-1]
+            advanced = False
+            for other, index in neighbours:
+                if index == via:
+                    continue
+                if other not in order:
+                    stack.append(index)
+                    order[other] = low[other] = counter
+                    counter += 1
+                    work.append((other, index, iter(adjacency[other])))
+                    advanced = True
+                    break
+                if order[other] < order[node]:
+                    stack.append(index)
+                    low[node] = min(low[node], order[other])
+            if advanced:
+                continue
+            work.pop()
+            if work:
+                parent_node = work[-1][0]
+                low[parent_node] = min(low[parent_node], low[node])
+                if low[node] >= order[parent_node]:
+                    component = []
+                    while stack:
+                        index = stack.pop()
+                        component.append(index)
+                        if index == via:
+                            break
+                    out.append(component)
+    return out
+
+
+# --- geometry helpers ------------------------------------------------------------------
+
+
+def _rotation_angle(rotation: Matrix, axis: Iterable[float]) -> float:
+    """Return the angle of ``rotation`` about the unit ``axis`` (rad)."""
+    a = np.asarray(tuple(axis), dtype=np.float64)
+    vee = np.array([rotation[2, 1] - rotation[1, 2], rotation[0, 2] - rotation[2, 0],
+                    rotation[1, 0] - rotation[0, 1]])
+    # A rotation by q about a: R - R^T = 2 sin q [a]x and trace R = 1 + 2 cos q.
+    return math.atan2(0.5 * float(a @ vee), 0.5 * (float(np.trace(rotation)) - 1.0))
+
+
+def _angle(v: complex) -> float:
+    return math.atan2(v.imag, v.real)
+
+
+def _fmt(vector: Iterable[float]) -> str:
+    return '[' + ', '.join(f'{v:.6g}' for v in vector) + ']'
+
+
+# --- one mechanism ---------------------------------------------------------------------
+
+
+class _Mechanism:
+    """One loop component: its bodies, pins and slides in its plane, and its dyads."""
+
+    def __init__(self, index: int, edges: list[_Edge], model: dict[str, Matrix],
+                 in_body: dict[str, Matrix], body_of: dict[str, str], description: Description,
+                 ground: str, pose: Mapping[str, float]) -> None:
+        self.index = index
+        self.edges = edges
+        self.description = description
+        self.ground = ground
+        self.bodies = sorted({e.a for e in edges} | {e.b for e in edges},
+                             key=description.links.index)
+        self.source = description.source
+        to_ground = np.linalg.inv(model[ground])
+        # Each link's frame in the ground's frame, by its body's geometry (the model).
+        self.frame = {link: to_ground @ model[body_of[link]] @ in_body[link]
+                      for link in description.links if body_of[link] in self.bodies}
+        self.body_of = body_of
+        self.pose = pose
+        self._plane()
+        self._points()
+
+    def fail(self, msg: str, joint: str | None = None) -> UrdfError:
+        return UrdfError(f'{self.source}: {msg}', joint=joint)
+
+    # The plane: its normal from the revolute axes, every axis checked.
+    def _axis(self, edge: _Edge) -> list[tuple[str, np.ndarray]]:
+        if edge.joint is not None:
+            joint = edge.joint
+            frame = self.frame[joint.parent] @ joint.origin
+            return [(joint.name, frame[:3, :3] @ np.asarray(joint.axis))]
+        closure = edge.closure
+        assert closure is not None
+        out = []
+        for link, axis in ((closure.link_a, closure.axis_a), (closure.link_b, closure.axis_b)):
+            if axis is not None:
+                out.append((closure.name, self.frame[link][:3, :3] @ np.asarray(axis)))
+        return out
+
+    def _plane(self) -> None:
+        turning = [(name, axis) for e in self.edges if e.kind == 'pin' for name, axis
+                   in self._axis(e)]
+        if not turning:
+            raise self.fail(f'joint "{self.edges[0].name}": Expected a loop with a revolute '
+                            f'joint, got one of prismatic joints only', self.edges[0].name)
+        first, normal = turning[0]
+        normal = normal / np.linalg.norm(normal)
+        worst = (0.0, '', '')
+        for edge in self.edges:
+            if edge.kind == 'free':
+                raise self.fail(f'joint "{edge.name}": Expected the joints of a loop to be '
+                                f'revolute, continuous or prismatic, got '
+                                f'{edge.joint.urdf_type if edge.joint else "?"}', edge.name)
+            for name, axis in self._axis(edge):
+                axis = axis / np.linalg.norm(axis)
+                if edge.kind == 'pin':
+                    off = math.atan2(float(np.linalg.norm(np.cross(axis, normal))),
+                                     abs(float(axis @ normal)))
+                    what = 'parallel to'
+                else:
+                    off = math.asin(min(1.0, abs(float(axis @ normal))))
+                    what = 'across'
+                if off > worst[0]:
+                    worst = (off, name, what)
+        if worst[0] > PLANAR_TOLERANCE:
+            off, name, what = worst
+            links = ', '.join(self.bodies[:6]) + (', ...' if len(self.bodies) > 6 else '')
+            raise self.fail(
+                f'joint "{name}": Expected every joint of the loop through {links} to turn '
+                f'about an axis parallel to its normal {_fmt(normal)} (in link '
+                f'"{self.ground}", from joint "{first}") or slide across it, got an axis '
+                f'{worst[2].replace("parallel to", "off it").replace("across", "off the plane")}'
+                f' by {off:.3g} rad (more than {PLANAR_TOLERANCE:g}): the loop is not planar',
+                name)
+        # The normal's sign: along the ground's z, else y, else x; the plane's x from the
+        # ground's x (or y).
+        for basis in np.eye(3)[::-1]:
+            if abs(float(normal @ basis)) > 1e-6:
+                if normal @ basis < 0:
+                    normal = -normal
+                break
+        x = np.eye(3)[0] if np.linalg.norm(np.cross(np.eye(3)[0], normal)) > 0.5 \
+            else np.eye(3)[1]
+        e1 = x - (x @ normal) * normal
+        e1 /= np.linalg.norm(e1)
+        self.normal, self.e1, self.e2 = normal, e1, np.cross(normal, e1)
+        self.first = first
+
+    def flat(self, point: np.ndarray) -> complex:
+        """Return a point of the ground's frame (3 or 4 components) in the plane."""
+        p = np.asarray(point)[:3]
+        return complex(float(p @ self.e1), float(p @ self.e2))
+
+    def sign(self, edge: _Edge) -> float:
+        """Return +1 where a joint's axis points along the normal, -1 against."""
+        assert edge.joint is not None
+        frame = self.frame[edge.joint.parent] @ edge.joint.origin
+        return 1.0 if float(frame[:3, :3] @ np.asarray(edge.joint.axis) @ self.normal) > 0 \
+            else -1.0
+
+    def _points(self) -> None:
+        """Each body's points (its pins) in the plane, each from that body's own frame."""
+        self.pins: dict[str, dict[str, complex]] = {b: {} for b in self.bodies}
+        self.pin_ends: dict[str, tuple[str, str]] = {}
+        self.slides: dict[str, _Edge] = {}
+        self.edges_of: dict[str, list[_Edge]] = {b: [] for b in self.bodies}
+        self.gaps: list[tuple[float, str]] = []
+        for edge in self.edges:
+            self.edges_of[edge.a].append(edge)
+            self.edges_of[edge.b].append(edge)
+            if edge.kind == 'slide':
+                self.slides[edge.name] = edge
+                continue
+            if edge.joint is not None:
+                joint = edge.joint
+                on_a = self.frame[joint.parent] @ joint.origin
+                on_b = self.frame[joint.child]
+            else:
+                closure = edge.closure
+                assert closure is not None
+                on_a = self.frame[closure.link_a] @ closure.frame_a
+                on_b = self.frame[closure.link_b] @ closure.frame_b
+                self.gaps.append((float(np.linalg.norm(on_a[:3, 3] - on_b[:3, 3])), edge.name))
+            self.pins[edge.a][edge.name] = self.flat(on_a[:, 3])
+            self.pins[edge.b][edge.name] = self.flat(on_b[:, 3])
+            self.pin_ends[edge.name] = (edge.a, edge.b)
+        points = [p for pins in self.pins.values() for p in pins.values()]
+        self.size = max((abs(p - q) for p in points for q in points), default=0.0) or 1.0
+        for gap, name in self.gaps:
+            if gap > GAP_TOLERANCE * self.size:
+                raise self.fail(
+                    f'closure "{name}": Expected the reference pose to close the loop within '
+                    f'{GAP_TOLERANCE:g} of its size ({self.size:.6g} m), got its two points '
+                    f'{gap:.3g} m apart', name)
+
+    def slide_direction(self, edge: _Edge, block: str) -> complex:
+        """Return the unit direction ``block`` moves relative to the other body per +1 m."""
+        assert edge.joint is not None
+        frame = self.frame[edge.joint.parent] @ edge.joint.origin
+        u = self.flat(frame[:3, :3] @ np.asarray(edge.joint.axis))
+        u /= abs(u)
+        return u if block == edge.b else -u
+
+    def reference_value(self, joint: UrdfJoint) -> float:
+        """Return a joint's value in the model's geometry (its pose's, to the closures' gaps)."""
+        relative = np.linalg.inv(self.frame[joint.parent] @ joint.origin) \
+            @ self.frame[joint.child]
+        given = self.pose.get(joint.name, 0.0)
+        assert joint.type is not None
+        if joint.type.angular:
+            angle = _rotation_angle(relative[:3, :3], joint.axis)
+            value = given + math.remainder(angle - given, math.tau)
+            # Through the tree alone the model is the pose: keep its value to the bit.
+            return given if abs(value - given) <= SNAP * math.pi else value
+        value = float(np.asarray(joint.axis) @ relative[:3, 3])
+        return given if abs(value - given) <= SNAP * self.size else value
+
+
+# --- the decomposition -----------------------------------------------------------------
+
+
+class _Builder:
+    """Places every mechanism's bodies by drivers and dyads: the scene mapping and the maps."""
+
+    def __init__(self, description: Description, actuated: tuple[str, ...],
+                 pose: Mapping[str, float]) -> None:
+        self.description = description
+        self.source = description.source
+        self.actuated = actuated
+        self.pose = pose
+        self.names = _Names()
+        self.ground: dict[str, list[float]] = {}
+        self.inputs: list[dict[str, Any]] = []
+        self.dyads: list[dict[str, Any]] = []
+        self.points: dict[str, dict[str, Any]] = {}
+        self.drivers: list[DriverMap] = []
+        self.joint_maps: dict[str, JointMap] = {}
+        self.offset = 0.0
+
+    def fail(self, msg: str, joint: str | None = None) -> UrdfError:
+        return UrdfError(f'{self.source}: {msg}', joint=joint)
+
+    # Names in the scene.
+    def point(self, pin: str) -> str:
+        return self.names('point', pin)
+
+    def link(self, body: str) -> str:
+        return self.names('link', body)
+
+    def slider(self, joint: str) -> str:
+        return self.names('slider', joint)
+
+    def build(self, m: _Mechanism) -> None:
+        self.m = m
+        # Lay the mechanisms side by side in the scene's plane (each is solved in its own).
+        xs = [p.real for pins in m.pins.values() for p in pins.values()]
+        shift = self.offset - min(xs)
+        self.shift = complex(shift, 0.0)
+        self.offset = shift + max(xs) + 0.5 * m.size
+        self.known: set[str] = {m.ground}
+        self.placed: set[str] = set()
+        # A body's angle: the scene coordinate it turns with and that coordinate's value in
+        # the reference pose; (None, 0) for a body that does not turn.
+        self.turns: dict[str, tuple[str | None, float]] = {m.ground: (None, 0.0)}
+        for pin, z in m.pins[m.ground].items():
+            self.ground[self.point(pin)] = self.xy(z)
+            self.placed.add(pin)
+        self.cylinders = self._cylinders()
+        self._drivers()
+        while len(self.known) < len(m.bodies):
+            if not self._dyad():
+                left = [b for b in m.bodies if b not in self.known]
+                joint = next(e.name for b in left for e in m.edges_of[b])
+                raise self.fail(
+                    f'joint "{joint}": Expected the loop through {", ".join(m.bodies[:6])} to '
+                    f'decompose into dyads of our kinds (RRR, RRP, RPR, RPP, a cylinder), got '
+                    f'links {", ".join(left)} that no dyad places: a group of higher class '
+                    '(such as a triad), a slider on a moving guide, a slot off its pivot or an '
+                    'actuated joint our kinds do not drive', joint)
+        self._joint_maps()
+
+    def xy(self, z: complex) -> list[float]:
+        w = z + self.shift
+        return [w.real, w.imag]
+
+    # --- drivers ---------------------------------------------------------------------------
+    def _cylinders(self) -> dict[str, tuple[str, str, str, str]]:
+        """Return actuated slide -> (barrel, rod, barrel's pin, rod's pin)."""
+        m = self.m
+        out = {}
+        for name, edge in m.slides.items():
+            if name not in self.drivers_here:
+                continue
+            ends = []
+            for body in (edge.a, edge.b):
+                others = [e for e in m.edges_of[body] if e is not edge]
+                pins = [e for e in others if e.kind == 'pin']
+                if len(others) != 1 or len(pins) != 1 or body == m.ground:
+                    raise self.fail(
+                        f'joint "{name}": Expected an actuated prismatic joint to be a cylinder '
+                        f'(a barrel and a rod, each pinned once to the mechanism), got link '
+                        f'"{body}" with {len(others)} other joints'
+                        + (' (the ground: our kinds drive no slider on a guide)'
+                           if body == m.ground else ''), name)
+                ends.append(pins[0].name)
+            out[name] = (edge.a, edge.b, ends[0], ends[1])
+        return out
+
+    def _drivers(self) -> None:
+        m = self.m
+        for name in self.drivers_here:
+            edge = next(e for e in m.edges if e.name == name)
+            joint = edge.joint
+            assert joint is not None and joint.type is not None
+            mimic = self.mimics.get(name)
+            if joint.type.angular:
+                if m.ground not in (edge.a, edge.b):
+                    raise self.fail(
+                        f'joint "{name}": Expected an actuated revolute joint to turn a link '
+                        f'about the ground of its loop (link "{m.ground}": a crank), got one '
+                        f'between links "{edge.a}" and "{edge.b}", both moving: our kinds drive '
+                        'no relative angle', name)
+                self._crank(edge, mimic)
+            # A cylinder is placed with the dyad that uses it.
+
+    def _crank(self, edge: _Edge, mimic: Any) -> None:
+        m = self.m
+        body = edge.b if edge.a == m.ground else edge.a
+        centre = m.pins[body][edge.name]
+        tip = self._tip(body, edge.name, centre)
+        crank_link = self.link(body)
+        phi0 = _angle(m.pins[body][tip] - centre)
+        assert edge.joint is not None
+        sigma = m.sign(edge) * (1.0 if body == edge.b else -1.0)
+        reference = m.reference_value(edge.joint)
+        start = self.pose.get(edge.name, 0.0)
+        self.inputs.append({'link': crank_link, 'center': self.point(edge.name),
+                            'point': self.point(tip), 'length': abs(m.pins[body][tip] - centre),
+                            'angle': phi0 + sigma * (start - reference), 'speed': 0.0})
+        self.placed.add(tip)
+        self.drivers.append(DriverMap(edge.name, crank_link, REVOLUTE, sigma, reference, phi0,
+                                      mimic))
+        self._known(body, (crank_link, phi0), edge.name, tip, phi0)
+
+    def _tip(self, body: str, centre_pin: str, centre: complex) -> str:
+        """Return a pin of ``body`` away from ``centre``: the crank's tip (added if none)."""
+        m = self.m
+        far = [p for p, z in m.pins[body].items()
+               if p != centre_pin and abs(z - centre) > TOGGLE_TOLERANCE * m.size]
+        if far:
+            return far[0]
+        tip = f'{body}_tip'
+        m.pins[body][tip] = centre + 0.1 * m.size
+        return tip
+
+    # --- known bodies and carried points ---------------------------------------------------
+    def _known(self, body: str, turns: tuple[str | None, float], origin: str | None,
+               xaxis: str | None, direction: float) -> None:
+        """Mark ``body`` placed; carry its other pins on it from (origin, x toward xaxis)."""
+        m = self.m
+        self.known.add(body)
+        self.turns[body] = turns
+        for pin, z in m.pins[body].items():
+            if pin in self.placed:
+                continue
+            if origin is None or xaxis is None:
+                raise self.fail(f'joint "{pin}": Expected a block that only slides to carry '
+                                f'its one pin, got link "{body}" carrying another', pin)
+            local = (z - m.pins[body][origin]) * complex(math.cos(direction),
+                                                         -math.sin(direction))
+            self.points[self.point(pin)] = {'link': turns[0], 'origin': self.point(origin),
+                                            'xaxis': self.point(xaxis),
+                                            'local': [local.real, local.imag]}
+            self.placed.add(pin)
+
+    def _known_pin(self, body: str) -> list[_Edge]:
+        """Return ``body``'s pins to placed bodies."""
+        return [e for e in self.m.edges_of[body] if e.kind == 'pin'
+                and (e.b if e.a == body else e.a) in self.known]
+
+    def _branch(self, p1: complex, p2: complex, c: complex, what: str, joint: str) -> int:
+        cross = ((p2 - p1).conjugate() * (c - p1)).imag
+        scale = abs(p2 - p1) * abs(c - p1) or 1.0
+        if abs(cross) <= TOGGLE_TOLERANCE * scale:
+            raise self.fail(
+                f'joint "{joint}": Expected the reference pose to show the branch of {what}, '
+                f'got its pins in line (a toggle or dead centre): give a reference pose '
+                f'away from it', joint)
+        return 1 if cross > 0 else -1
+
+    # --- dyads -----------------------------------------------------------------------------
+    def _dyad(self) -> bool:
+        return self._rrr() or self._rrp() or self._rpr() or self._rpp()
+
+    def _unit(self, body: str) -> tuple[str, str] | None:
+        """Return (kind, key): ``body`` as an RRR element: a link, or a cylinder's barrel."""
+        for name, (barrel, rod, _, _) in self.cylinders.items():
+            if body in (barrel, rod):
+                return 'cylinder', name
+        if any(e.kind == 'slide' for e in self.m.edges_of[body]):
+            return None
+        return 'link', body
+
+    def _rrr(self) -> bool:
+        m = self.m
+        for pin, (a, b) in m.pin_ends.items():
+            if a in self.known or b in self.known:
+                continue
+            sides = []
+            for body in (a, b):
+                unit = self._unit(body)
+                if unit is None:
+                    break
+                if unit[0] == 'cylinder':
+                    barrel, rod, pa, pb = self.cylinders[unit[1]]
+                    if pin not in (pa, pb):
+                        break
+                    start = pb if pin == pa else pa
+                    if start not in self.placed:
+                        break
+                    sides.append(('cylinder', unit[1], start))
+                    continue
+                known = [e for e in self._known_pin(body) if e.name != pin]
+                if not known:
+                    break
+                sides.append(('link', body, known[0].name))
+            else:
+                self._place_rrr(pin, (a, b), sides)
+                return True
+        return False
+
+    def _place_rrr(self, pin: str, bodies: tuple[str, str], sides: list[tuple[str, str, str]]
+                   ) -> None:
+        m = self.m
+        links = []
+        ends = []
+        for body, (kind, key, start) in zip(bodies, sides, strict=True):
+            if kind == 'cylinder':
+                barrel, rod, pa, pb = self.cylinders[key]
+                on_start = m.pins[barrel if start == pa else rod][start]
+                on_end = m.pins[rod if start == pa else barrel][pin]
+                name = self.link(barrel)
+                links.append({'name': name, 'from': self.point(start),
+                              'actuator': self.slider(key)})
+                self._actuator(key, on_start, on_end, start == pa)
+            else:
+                on_start, on_end = m.pins[body][start], m.pins[body][pin]
+                name = self.link(body)
+                links.append({'name': name, 'from': self.point(start),
+                              'length': abs(on_end - on_start)})
+            ends.append((on_start, on_end, name, start))
+        (p1, c1, _, _), (p2, c2, _, _) = ends
+        branch = self._branch(p1, p2, c1, f'RRR {pin}', pin)
+        self.dyads.append({'type': 'RRR', 'point': self.point(pin), 'links': links,
+                           'branch': branch})
+        self.placed.add(pin)
+        for body, (kind, key, start), (on_start, on_end, name, _) in zip(
+                bodies, sides, ends, strict=True):
+            phi0 = _angle(on_end - on_start)
+            if kind == 'cylinder':
+                barrel, rod, _, _ = self.cylinders[key]
+                for part in (barrel, rod):
+                    self._known(part, (name, phi0), None, None, phi0)
+            else:
+                self._known(body, (name, phi0), start, pin, phi0)
+
+    def _actuator(self, joint: str, on_start: complex, on_end: complex, from_barrel: bool
+                  ) -> None:
+        """Add the cylinder ``joint`` as an actuator: length = |rod's pin - barrel's pin|."""
+        m = self.m
+        edge = m.slides[joint]
+        barrel, rod, pa, pb = self.cylinders[joint]
+        pa_z = m.pins[barrel][pa]
+        pb_z = m.pins[rod][pb]
+        u = m.slide_direction(edge, rod)
+        line = pb_z - pa_z
+        offset = abs((u.conjugate() * line).imag)
+        if offset > PLANAR_TOLERANCE * m.size:
+            raise self.fail(
+                f'joint "{joint}": Expected a cylinder\'s line through both its pins, got '
+                f"the rod's pin {offset:.3g} m off the line of the barrel's pin", joint)
+        kappa = 1.0 if (u.conjugate() * line).real > 0 else -1.0
+        assert edge.joint is not None
+        reference = m.reference_value(edge.joint)
+        length0 = abs(line)
+        mimic = self.mimics.get(joint)
+        start = self.pose.get(joint, 0.0)
+        self.inputs.append({'actuator': self.slider(joint),
+                            'length': length0 + kappa * (start - reference), 'speed': 0.0})
+        self.drivers.append(DriverMap(joint, self.slider(joint), PRISMATIC, kappa, reference,
+                                      length0, mimic))
+        self.slider_of[joint] = (self.slider(joint), kappa, length0)
+
+    def _block(self, body: str) -> list[_Edge] | None:
+        """Return a block's (slide, pin) where ``body`` has exactly those two joints."""
+        edges = self.m.edges_of[body]
+        if len(edges) != 2 or body == self.m.ground:
+            return None
+        slides = [e for e in edges if e.kind == 'slide']
+        pins = [e for e in edges if e.kind == 'pin']
+        if len(slides) != 1 or len(pins) != 1 or slides[0].name in self.cylinders:
+            return None
+        return [slides[0], pins[0]]
+
+    def _rrp(self) -> bool:
+        m = self.m
+        for body in m.bodies:
+            if body in self.known:
+                continue
+            block = self._block(body)
+            if block is None:
+                continue
+            slide, pin = block
+            guide = slide.a if slide.b == body else slide.b
+            if guide != m.ground:
+                continue
+            link = pin.a if pin.b == body else pin.b
+            if link in self.known or self._unit(link) != ('link', link):
+                continue
+            known = [e for e in self._known_pin(link) if e.name != pin.name]
+            if not known:
+                continue
+            self._place_rrp(body, slide, pin, link, known[0].name)
+            return True
+        return False
+
+    def _place_rrp(self, block: str, slide: _Edge, pin: _Edge, link: str, start: str) -> None:
+        m = self.m
+        c_block = m.pins[block][pin.name]
+        g = m.slide_direction(slide, block)
+        through = self.point(f'{slide.name}_guide')
+        self.ground[through] = self.xy(c_block)
+        p1, c1 = m.pins[link][start], m.pins[link][pin.name]
+        foot = ((p1 - c_block) * g.conjugate()).real      # the solutions' midpoint along g
+        if abs(foot) <= TOGGLE_TOLERANCE * m.size:
+            raise self.fail(
+                f'joint "{pin.name}": Expected the reference pose to show the branch of RRP '
+                f'{pin.name}, got its link square to the guide (a dead centre): give a '
+                f'reference pose away from it', pin.name)
+        name = self.link(link)
+        self.dyads.append({'type': 'RRP', 'point': self.point(pin.name),
+                           'link': {'name': name, 'from': self.point(start),
+                                    'length': abs(c1 - p1)},
+                           'guide': {'through': through, 'angle': _angle(g)},
+                           'slider': self.slider(slide.name), 'branch': 1 if foot < 0 else -1})
+        self.placed.add(pin.name)
+        self.slider_of[slide.name] = (self.slider(slide.name), 1.0, 0.0)
+        self._known(block, (None, 0.0), None, None, 0.0)
+        phi0 = _angle(c1 - p1)
+        self._known(link, (name, phi0), start, pin.name, phi0)
+
+    def _rpr(self) -> bool:
+        m = self.m
+        for body in m.bodies:
+            if body in self.known:
+                continue
+            block = self._block(body)
+            if block is None:
+                continue
+            slide, pin = block
+            if (pin.a if pin.b == body else pin.b) not in self.known:
+                continue
+            lever = slide.a if slide.b == body else slide.b
+            if lever in self.known or lever == m.ground:
+                continue
+            pivots = [e for e in m.edges_of[lever] if e.kind == 'pin'
+                      and m.ground in (e.a, e.b)]
+            if not pivots:
+                continue
+            self._place_rpr(lever, body, slide, pin, pivots[0].name)
+            return True
+        return False
+
+    def _place_rpr(self, lever: str, block: str, slide: _Edge, pin: _Edge, pivot: str) -> None:
+        m = self.m
+        o = m.pins[lever][pivot]
+        b = m.pins[block][pin.name]
+        u = m.slide_direction(slide, block)
+        offset = abs((u.conjugate() * (b - o)).imag)
+        if offset > PLANAR_TOLERANCE * m.size:
+            raise self.fail(
+                f'joint "{slide.name}": Expected a slot through its lever\'s pivot '
+                f'"{pivot}" (an RPR), got it {offset:.3g} m off the pivot', slide.name)
+        along = (u.conjugate() * (b - o)).real
+        if abs(along) <= TOGGLE_TOLERANCE * m.size:
+            raise self.fail(f'joint "{slide.name}": Expected the reference pose to have the '
+                            f'pin "{pin.name}" off its lever\'s pivot, got it on the pivot',
+                            slide.name)
+        kappa = 1.0 if along > 0 else -1.0
+        name = self.link(lever)
+        self.dyads.append({'type': 'RPR', 'link': name, 'center': self.point(pivot),
+                           'through': self.point(pin.name), 'slider': self.slider(slide.name)})
+        self.slider_of[slide.name] = (self.slider(slide.name), kappa, abs(along))
+        phi0 = _angle(kappa * u)
+        self._known(block, (name, phi0), None, None, phi0)
+        # The lever's frame: its pivot, x along its slot toward the pin.
+        self.m.pins[lever].setdefault(pin.name, o + kappa * u * abs(along))
+        self.placed.add(pin.name)
+        self._known(lever, (name, phi0), pivot, pin.name, phi0)
+
+    def _rpp(self) -> bool:
+        m = self.m
+        for body in m.bodies:
+            if body in self.known:
+                continue
+            block = self._block(body)
+            if block is None:
+                continue
+            slot, pin = block
+            if (pin.a if pin.b == body else pin.b) not in self.known:
+                continue
+            yoke = slot.a if slot.b == body else slot.b
+            if yoke in self.known or yoke == m.ground:
+                continue
+            edges = m.edges_of[yoke]
+            guides = [e for e in edges if e.kind == 'slide' and e is not slot
+                      and m.ground in (e.a, e.b)]
+            if len(edges) != 2 or len(guides) != 1:
+                continue
+            self._place_rpp(yoke, body, guides[0], slot, pin)
+            return True
+        return False
+
+    def _place_rpp(self, yoke: str, block: str, guide: _Edge, slot: _Edge, pin: _Edge) -> None:
+        m = self.m
+        b = m.pins[block][pin.name]
+        g = m.slide_direction(guide, yoke)
+        w = m.slide_direction(slot, block)
+        if abs((g.conjugate() * w).imag) <= TOGGLE_TOLERANCE:
+            raise self.fail(f'joint "{slot.name}": Expected a yoke\'s slot to cross its guide '
+                            f'"{guide.name}", got them parallel', slot.name)
+        through = self.point(f'{guide.name}_guide')
+        self.ground[through] = self.xy(b)
+        new = f'{slot.name}_crossing'
+        self.dyads.append({'type': 'RPP', 'point': self.point(new),
+                           'through': self.point(pin.name),
+                           'guide': {'through': through, 'angle': _angle(g)},
+                           'slot_angle': _angle(w), 'slider': self.slider(guide.name),
+                           'slot_slider': self.slider(slot.name)})
+        self.slider_of[guide.name] = (self.slider(guide.name), 1.0, 0.0)
+        self.slider_of[slot.name] = (self.slider(slot.name), 1.0, 0.0)
+        self._known(yoke, (None, 0.0), None, None, 0.0)
+        self._known(block, (None, 0.0), None, None, 0.0)
+
+    # --- the URDF joints -------------------------------------------------------------------
+    def _joint_maps(self) -> None:
+        m = self.m
+        for edge in m.edges:
+            joint = edge.joint
+            if joint is None or joint.type is None:
+                continue
+            reference = m.reference_value(joint)
+            if joint.type.angular:
+                child, child_ref = self.turns[edge.b]
+                parent, parent_ref = self.turns[edge.a]
+                centre = 0.0 if joint.limits is None else 0.5 * sum(joint.limits)
+                self.joint_maps[joint.name] = JointMap(
+                    joint.name, REVOLUTE, m.sign(edge), reference, child, child_ref, parent,
+                    parent_ref, center=centre, mechanism=m.index)
+            else:
+                slider, kappa, slider_ref = self.slider_of[joint.name]
+                self.joint_maps[joint.name] = JointMap(
+                    joint.name, PRISMATIC, kappa, reference, slider=slider,
+                    slider_ref=slider_ref, mechanism=m.index)
+
+
+def _actuated_names(description: Description, actuated: Iterable[str] | None,
+                    loop_joints: list[str]) -> tuple[str, ...]:
+    """Return the actuated joints: given, else the sidecar's, else the URDF's; else refuse."""
+    source = description.source
+    if actuated is not None:
+        names = tuple(actuated)
+        how = 'the actuated joints given'
+    elif description.independent is not None:
+        names = description.independent
+        how = "the sidecar's independent joints"
+    elif description.actuated:
+        names = description.actuated
+        how = "the URDF's <transmission>/<ros2_control> joints"
+    else:
+        candidates = ', '.join(loop_joints) or 'none'
+        raise UrdfError(f'{source}: Expected the actuated joints (--actuated J1,J2,... or '
+                        f'<transmission>/<ros2_control> joints in the URDF), got none: the '
+                        f'joints of its loops are {candidates}')
+    for name in names:
+        joint = description.joints.get(name)
+        if joint is None or joint.type is None:
+            candidates = ', '.join(loop_joints) or 'none'
+            got = 'no joint of the robot' if joint is None else f'a {joint.urdf_type} joint'
+            raise UrdfError(f'{source}: Expected {how} to be revolute, continuous or prismatic '
+                            f'joints of the robot (those of its loops: {candidates}), got '
+                            f'"{name}", {got}', joint=name)
+    return tuple(dict.fromkeys(names))
+
+
+def planar_from_description(description: Description, actuated: Iterable[str] | None = None,
+                            reference: Mapping[str, float] | None = None) -> Planar:
+    """Return the scene of a robot's planar loops and the maps of its joints.
+
+    Parameters
+    ----------
+    description : Description
+        The robot as read.
+    actuated : iterable of str, optional
+        The driven joints; default the sidecar's independent joints, else the
+        URDF's transmissions and ros2_control command interfaces.
+    reference : mapping of str to float, optional
+        A reference pose (joint -> rad or m) whose branches the loops keep;
+        default the zero pose (a mimic joint not given follows its rule).
+
+    Raises
+    ------
+    UrdfError
+        One line naming the joint and why (see the module's docstring).
+    """
+    source = description.source
+    for name in reference or {}:
+        if name not in description.joints or description.joints[name].type is None:
+            raise UrdfError(f'{source}: Expected the reference pose to name moving joints of '
+                            f'the robot, got "{name}"', joint=name)
+    pose = description.pose(reference)
+    weld = [c for c in description.closures if c.kind is ClosureKind.WELD]
+    body_of, in_body = _bodies(description, weld)
+    edges: list[_Edge] = []
+    for joint in description.joints.values():
+        if not joint.moving:
+            continue
+        a, b = body_of[joint.parent], body_of[joint.child]
+        kind = 'free' if joint.type is None else 'pin' if joint.type.angular else 'slide'
+        if a == b:
+            raise UrdfError(f'{source}: joint "{joint.name}": Expected a joint of a loop to '
+                            f'move, got its links "{joint.parent}" and "{joint.child}" welded '
+                            f'by a closure', joint=joint.name)
+        edges.append(_Edge(joint.name, a, b, kind, joint=joint))
+    for closure in description.closures:
+        if closure.kind is not ClosureKind.PIN:
+            continue
+        a, b = body_of[closure.link_a], body_of[closure.link_b]
+        if a == b:
+            raise UrdfError(f'{source}: closure "{closure.name}": Expected it to join two '
+                            f'moving parts, got links "{closure.link_a}" and '
+                            f'"{closure.link_b}" of one rigid body', joint=closure.name)
+        edges.append(_Edge(closure.name, a, b, 'pin', closure=closure))
+    bodies = sorted(set(body_of.values()), key=description.links.index)
+    components = [sorted(c) for c in _components(bodies, edges) if len(c) > 1]
+    components.sort(key=lambda c: c[0])
+    loop_joints = [edges[i].name for c in components for i in c if edges[i].joint is not None]
+    if not components:
+        raise UrdfError(f'{source}: Expected a robot with a closed loop (a <constraint>, '
+                        f'closing frames or a loop_closures.yaml), got a tree with no loop')
+    actuated_names = _actuated_names(description, actuated, loop_joints)
+    # Every link's frame at the reference pose, by the tree.
+    tree = description.transforms(pose)
+    model = {body: tree[body] for body in bodies}
+    builder = _Builder(description, actuated_names, pose)
+    mechanisms = []
+    claimed: set[str] = set()
+    for index, component in enumerate(components):
+        part = [edges[i] for i in component]
+        members = {e.a for e in part} | {e.b for e in part}
+        ground = min(members, key=lambda b: (description.depth(b), description.links.index(b)))
+        m = _Mechanism(index, part, model, in_body, body_of, description, ground, pose)
+        names = {e.name for e in part}
+        here = [n for n in actuated_names if n in names]
+        mimics = {}
+        dof = 3 * (len(m.bodies) - 1) - 2 * len(part)
+        for edge in part:  # a mimic whose leader is actuated drives the loop it is in
+            joint = edge.joint
+            if len(here) >= dof or joint is None or joint.mimic is None or edge.name in here:
+                continue
+            leader = joint.mimic.joint
+            if leader in actuated_names and leader not in names:
+                here.append(edge.name)
+                mimics[edge.name] = joint.mimic
+        if dof <= 0 or len(here) != dof:
+            links = ', '.join(m.bodies[:6]) + (', ...' if len(m.bodies) > 6 else '')
+            candidates = ', '.join(e.name for e in part if e.joint is not None)
+            what = ('rigid (it cannot move)' if dof <= 0 else
+                    f'{dof} degree{"s" if dof != 1 else ""} of freedom')
+            got = ', '.join(here) or 'none'
+            raise UrdfError(f'{source}: joint "{part[0].name}": Expected the loop through '
+                            f'{links} to have as many actuated joints as degrees of freedom, '
+                            f'got a loop that is {what} with actuated joints: {got} (its joints: '
+                            f'{candidates})', joint=part[0].name)
+        claimed.update(here)
+        builder.drivers_here = here
+        builder.mimics = mimics
+        builder.slider_of = {}
+        builder.build(m)
+        mechanisms.append({'ground': ground, 'links': list(m.bodies),
+                           'joints': [e.name for e in part],
+                           'normal': [float(v) for v in m.normal],
+                           'size': m.size, 'gap': max((g for g, _ in m.gaps), default=0.0)})
+    data: dict[str, Any] = {
+        'name': builder.names('robot', description.name),
+        'description': f'The planar loops of the URDF robot "{description.name}".',
+        'units': {'length': 'm', 'angle': 'rad'},
+        'ground': builder.ground, 'inputs': builder.inputs}
+    if builder.dyads:
+        data['dyads'] = builder.dyads
+    if builder.points:
+        data['points'] = builder.points
+    return Planar(data, tuple(builder.drivers), builder.joint_maps, mechanisms, actuated_names,
+                  dict(builder.names.changed))
