@@ -43,13 +43,13 @@ from .diagnostics import solver_status, TickStats, timing_status, waiting_for
 from .drive import check_start
 from .driver import TickDriver
 from .node_parameters import NodeParameters
-from .parameters import CATCH_UP, spec, TOPIC
+from .parameters import CATCH_UP, extra_joints_default, spec, TOPIC
 from .publishing import diagnostic_array, Markers, Publishing, qos_options, tf_period_ns
+from .robot_mode import load_source
 from .schedule import period_ns_from_rate
 from .solver_path import SolverPath
 from .tick_thread import TickThread, TickThreadError
 from .topic_input import InputSubscription
-from ..scene import load_scene
 from ..solver.context import NEAR_SINGULAR
 from ..units import NS_PER_S
 
@@ -97,6 +97,7 @@ class KinematicsNode(LifecycleNode):
 
     def _declare(self) -> None:
         self.scene: Any = None
+        self.extra_joints = ''
         self.configure_error = ''
         self._stats = TickStats(NEAR_SINGULAR)
         # The clock as a pure driver, at the parameters' defaults until they are declared.
@@ -165,7 +166,12 @@ class KinematicsNode(LifecycleNode):
 
     def _configure(self) -> None:
         assert self.params is not None
-        scene = load_scene(self._value('scene'))
+        # A scene, or a robot described in URDF (URDF mode: robot_mode.py).
+        source = load_source(self._value('scene'), self._value('robot_description'),
+                             self._value('loop_closures'), self._value('actuated_joints'))
+        scene = source.scene
+        self.extra_joints = self._value('extra_joints') or \
+            extra_joints_default(source.robot is not None)
         starts = self.params.declare_drivers(scene)
         # What `solve` refuses at the start, the node refuses to start with.
         check_start(scene, starts, self._solver.max_error)
@@ -173,7 +179,8 @@ class KinematicsNode(LifecycleNode):
             self._driver.add_drive(d.name, start.kind, **start.start)
         self._publishing = publishing = Publishing(
             self, scene, frame_id=self.frame_id, tf_prefix=self._value('tf_prefix'),
-            tf_rate_hz=self._value('tf_rate_hz'), scene_path=self._value('scene'))
+            tf_rate_hz=self._value('tf_rate_hz'), scene_path=self._value('scene'),
+            source=source)
         compile_later = self._solver.setup(
             publishing.tick_scene, scene, [(f.origin, f.angle_of, f.angle)
                                            for f in publishing.frames],
@@ -184,11 +191,14 @@ class KinematicsNode(LifecycleNode):
         if self._value('drive') == TOPIC:
             self._input = InputSubscription(
                 self, scene, self._solver, publishing, self._stats, frame_id=self.frame_id,
-                extra_joints=self._value('extra_joints'),
-                jump_back_s=self._value('stamp_jump_back_s'))
+                extra_joints=self.extra_joints, jump_back_s=self._value('stamp_jump_back_s'),
+                robot=publishing.robot_values)
+        elif publishing.robot_values is not None and publishing.robot_values.clock_note:
+            self.get_logger().warning(publishing.robot_values.clock_note)
         self.scene = scene
         self.params.loaded = True
-        self.get_logger().info(self.params.start_line(scene))
+        self.get_logger().info(self.params.start_line(
+            scene, {'extra_joints': self.extra_joints}, source.robot))
         if compile_later is not None:
             # Started once the rest of the set-up is done: a thread holding the GIL slows
             # every release and re-acquisition of it by this one (the assembly sweep's NumPy).
@@ -268,7 +278,7 @@ class KinematicsNode(LifecycleNode):
             solver_status(window, name=name, hardware_id=hardware_id,
                           near_singular=NEAR_SINGULAR, waiting_for=waiting,
                           assembly=self._solver.assembly,
-                          extra_joints=self._value('extra_joints') if self._input else '',
+                          extra_joints=self.extra_joints if self._input else '',
                           solver_path=self._solver.path),
             timing_status(window, name=name, hardware_id=hardware_id,
                           rate_hz=self._value('rate_hz'),

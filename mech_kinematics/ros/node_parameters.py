@@ -54,7 +54,8 @@ JOINT_RULES = (*DRIVE, 'drive', 'markers')
 DOUBLES = frozenset(p.name for p in PARAMETERS if p.kind == 'double')
 READ_ONLY = frozenset(p.name for p in PARAMETERS if p.read_only)
 #: The parameters of the start's log line, in order (the scene's own first), before the drivers'.
-START_LOGGED = ('scene', 'drive', 'crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm',
+START_LOGGED = ('scene', 'loop_closures', 'actuated_joints', 'drive', 'crank_speed_rpm',
+                'crank_accel', 'max_crank_speed_rpm',
                 'rate_hz', 'late_ticks', 'max_catch_up_s', 'max_lateness_ms',
                 'max_relative_error', 'frame_id', 'tf_rate_hz', 'tf_prefix', 'use_sim_time',
                 'markers', 'managed', 'extra_joints', 'stamp_jump_back_s')
@@ -283,10 +284,24 @@ class NodeParameters:
         values[MAX_SPEED_KEY] = self.declared(DRIVE[2], DEFAULT_MAX_CRANK_SPEED_RPM)
         return values
 
-    def start_line(self, scene: Scene) -> str:
-        """Return the start's log line: the scene, its outputs and the effective parameters."""
+    def start_line(self, scene: Scene, effective: Mapping[str, Any] | None = None,
+                   robot: Any = None) -> str:
+        """Return the start's log line: the scene, its outputs and the effective parameters.
+
+        ``effective``: values the node resolved for parameters left unset
+        (``extra_joints``); ``robot``: in URDF mode, the robot (its joints
+        are the ones published).
+        """
         names = (*START_LOGGED, *self.drivers.specs)
-        settings = ', '.join(f'{name}={self.value(name)!r}' for name in names[1:])
+        effective = effective or {}
+        settings = ', '.join(f'{name}={effective.get(name, self.value(name))!r}'
+                             for name in names[1:])
+        if robot is not None:
+            origin = 'robot_description' if self.value('robot_description') else \
+                self.value('scene')
+            return (f'robot {robot.name!r} ({origin}; its loops: scene {scene.name!r}): '
+                    f'joints {list(robot.joint_names)}, actuated {list(robot.actuated)}; '
+                    f'{settings}')
         return (f'scene {scene.name!r} ({self.value("scene")}): joints '
                 f'{list(scene.output_joints)}, points {list(scene.output_points)}; {settings}')
 

@@ -18,9 +18,9 @@ from typing import Any, TYPE_CHECKING
 
 from .diagnostics import DEFAULT_MAX_LATENESS_MS
 from .markers import DEFAULT_ACCELERATION_SCALE, DEFAULT_VELOCITY_SCALE
-from .topic_drive import DEFAULT_JUMP_BACK_S, EXTRA_JOINTS, REFUSE
+from .topic_drive import DEFAULT_JUMP_BACK_S, EXTRA_JOINTS, PASS, REFUSE
 from ..bounds import MAX_ERROR
-from ..scene import DEFAULT_SCENE
+from ..scene import DEFAULT_SCENE, MAX_FILE_BYTES
 from ..units import NS_PER_S, rate_from_si, si_from_rate
 
 if TYPE_CHECKING:
@@ -29,8 +29,9 @@ if TYPE_CHECKING:
 __all__ = ['CATCH_UP', 'DRIVE_MODES', 'DRIVER_RATES', 'DriverRates', 'LATE_TICKS',
            'MAX_NAME_CHARS', 'MAX_PATH_CHARS', 'PARAMETERS', 'ParameterSpec', 'SHOWN_CHARS',
            'SKIP', 'STATE_DEPTH', 'TIME', 'TOPIC', 'bounded_by_max_crank_speed',
-           'catch_up_window_ns', 'depth_refusal', 'driver_parameters', 'first_crank_aliases',
-           'frame_refusal', 'joint_refusal', 'rate_default', 'refusal', 'shown', 'spec']
+           'catch_up_window_ns', 'depth_refusal', 'driver_parameters', 'extra_joints_default',
+           'first_crank_aliases', 'frame_refusal', 'joint_refusal', 'rate_default', 'refusal',
+           'shown', 'spec']
 
 #: ``late_ticks`` values: publish every missed grid instant, or only the latest.
 CATCH_UP = 'catch_up'
@@ -54,7 +55,7 @@ class ParameterSpec:
     ----------
     name : str
         The ROS parameter name.
-    kind : {'double', 'string', 'bool'}
+    kind : {'double', 'string', 'bool', 'string_array'}
         Its type; an integer is accepted for a double (``-p rate_hz:=500``).
     default : float, str, bool or None
         The default; ``None`` where the scene (or another parameter) gives it.
@@ -93,8 +94,21 @@ class ParameterSpec:
 
 PARAMETERS = (
     ParameterSpec('scene', 'string', DEFAULT_SCENE,
-                  'Scene YAML: a path, or the name of a scene in config/scenes/',
+                  'Scene YAML: a path, or the name of a scene in config/scenes/; or a robot '
+                  'described in URDF: a path ending in .urdf (URDF mode)',
                   read_only=True, max_chars=MAX_PATH_CHARS),
+    ParameterSpec('robot_description', 'string', '',
+                  "A robot's URDF text, as robot_state_publisher takes it (URDF mode, with "
+                  'scene left at its default); published unchanged on robot_description',
+                  read_only=True, may_be_empty=True, max_chars=MAX_FILE_BYTES),
+    ParameterSpec('loop_closures', 'string', '',
+                  "URDF mode: a scikit-robot loop_closures.yaml closing the robot's loops "
+                  '(<constraint> elements and closing_NAME_1/_2 frames are read from the URDF)',
+                  read_only=True, may_be_empty=True, max_chars=MAX_PATH_CHARS),
+    ParameterSpec('actuated_joints', 'string_array', None,
+                  "URDF mode: the actuated joints. Defaults to the loop_closures' independent "
+                  "joints, else the URDF's <transmission> and <ros2_control> joints",
+                  read_only=True),
     ParameterSpec('frame_id', 'string', 'mechanism',
                   'header.frame_id of every message: the ground frame of the scene',
                   read_only=True, frame=True),
@@ -107,10 +121,11 @@ PARAMETERS = (
                   'on the rate_hz grid) or topic (the positions, and velocities if given, of '
                   'each message on input_joint_states, published with its stamp)',
                   choices=DRIVE_MODES, read_only=True),
-    ParameterSpec('extra_joints', 'string', REFUSE,
+    ParameterSpec('extra_joints', 'string', None,
                   "With drive: topic, what an input message's joints that are not drivers "
                   'do: refuse the message, ignore them (the drivers are taken), or pass them '
-                  "through unchanged in joint_states after the mechanism's joints",
+                  "through unchanged in joint_states after the mechanism's joints. Defaults "
+                  'to refuse, and to pass in URDF mode',
                   choices=EXTRA_JOINTS, read_only=True),
     ParameterSpec('stamp_jump_back_s', 'double', DEFAULT_JUMP_BACK_S,
                   'With drive: topic, an input stamped earlier than the last published state '
@@ -379,6 +394,8 @@ def refusal(name: str, value: Any,
         if not isinstance(value, bool):
             return f'{name}: expected true or false, got {_kind_of(value)} {shown(value)}'
         return None
+    if p.kind == 'string_array':
+        return _names_refusal(name, value)
     if not isinstance(value, str):
         return f'{name}: expected a string, got {_kind_of(value)} {shown(value)}'
     if p.choices and value not in p.choices:
@@ -391,6 +408,23 @@ def refusal(name: str, value: Any,
     if p.frame:
         return frame_refusal(name, value)
     return None
+
+
+def _names_refusal(name: str, value: Any) -> str | None:
+    """Return why ``value`` is not a list of distinct non-empty names, or ``None``."""
+    if isinstance(value, str) or not isinstance(value, (list, tuple)) \
+            or not all(isinstance(v, str) for v in value):
+        return (f"{name}: expected a list of joint names (e.g. ['j1', 'j2']), got "
+                f'{_kind_of(value)} {shown(value)}')
+    if not value or not all(value) or len(set(value)) != len(value):
+        return (f'{name}: expected one or more distinct non-empty joint names, got '
+                f'{shown(list(value))}')
+    return None
+
+
+def extra_joints_default(urdf: bool) -> str:
+    """Return ``extra_joints``' default: ``pass`` in URDF mode, else ``refuse``."""
+    return PASS if urdf else REFUSE
 
 
 def joint_refusal(values: Mapping[str, Any]) -> str | None:

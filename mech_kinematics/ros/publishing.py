@@ -44,6 +44,7 @@ from .imus import ImuFrames, ImuMessages
 from .markers import marker_array_from_state, marker_size_from_space, MarkerThrottle
 from .messages import TickMessages
 from .parameters import STATE_DEPTH
+from .robot_mode import RobotValues, Source
 from .schedule import period_ns_from_rate
 from .tf import static_tf_message, TfMessages
 from ..errors import AssemblyError
@@ -128,6 +129,14 @@ class Publishing:
         The rate of ``/tf`` (0: off).
     scene_path : str
         The ``scene`` parameter: its file's text is published on ``scene``.
+    source : Source, optional
+        What the node loaded (:func:`~mech_kinematics.ros.robot_mode.load_source`):
+        its text is published on ``scene``; in URDF mode (``source.robot``)
+        the state topics name the URDF's joints (:attr:`robot_values`), the
+        URDF is published unchanged on ``robot_description``, and nothing on
+        ``/tf``: robot_state_publisher draws the robot from ``joint_states``
+        and the URDF (our link frames, a second copy of the loops in the
+        scene's plane, would stand beside its tree unconnected).
 
     Attributes
     ----------
@@ -144,15 +153,21 @@ class Publishing:
         ``tf_rate_hz`` changes.
     next_tf : int
         The first stamp at which ``/tf`` is published again, ns.
+    robot_values : RobotValues or None
+        In URDF mode, the URDF's joints of a tick's values.
     """
 
     def __init__(self, node: Any, scene: Any, *, frame_id: str, tf_prefix: str,
-                 tf_rate_hz: float, scene_path: str) -> None:
+                 tf_rate_hz: float, scene_path: str, source: Source | None = None) -> None:
         self.node = node
         self.frame_id = frame_id
         self.prefix = tf_prefix or frame_id
         self.publishers: list[Any] = []
-        self.messages = TickMessages(scene.output_joints, scene.output_points, frame_id)
+        robot = source.robot if source is not None else None
+        self.robot_values = None if robot is None else \
+            RobotValues(robot, scene.output_joints, scene.output_points)
+        self.messages = TickMessages(scene.output_joints if robot is None else robot.joint_names,
+                                     scene.output_points, frame_id)
         self.tf: TfMessages | None = None
         self.frames: tuple[Any, ...] = ()
         self.imus: ImuMessages | None = None
@@ -163,9 +178,9 @@ class Publishing:
                 in ((JointState, topics.JOINT_STATES),
                     (JointTrajectory, topics.JOINT_ACCELERATIONS),
                     (MultiDOFJointTrajectory, topics.POINT_ACCELERATIONS)))
-            self.tick_scene = self._setup_tf(scene)
+            self.tick_scene = self._setup_tf(scene) if robot is None else scene
             self._setup_imus(scene)
-            self._publish_descriptions(scene, scene_path, tf_prefix)
+            self._publish_descriptions(scene, scene_path, tf_prefix, source)
         except BaseException:
             self.close()    # a QoS override refused, a sensor beyond doubles: none left behind
             raise
@@ -235,14 +250,19 @@ class Publishing:
             if transforms:
                 self.imu_frames = ImuFrames(transforms)
 
-    def _publish_descriptions(self, scene: Any, scene_path: str, tf_prefix: str) -> None:
+    def _publish_descriptions(self, scene: Any, scene_path: str, tf_prefix: str,
+                              source: Source | None = None) -> None:
         """Publish the URDF on ``robot_description`` and the scene's text on ``scene``, latched.
 
-        Transient local, depth 1: a late subscriber (RViz, the recorder) gets them.
+        Transient local, depth 1: a late subscriber (RViz, robot_state_publisher,
+        the recorder) gets them. In URDF mode the URDF is the user's, unchanged.
         """
         description = self._publisher(String, topics.ROBOT_DESCRIPTION, tf_qos(True), False)
         text = self._publisher(String, topics.SCENE, tf_qos(True), False)
-        text.publish(String(data=scene_text(scene_path)))
+        text.publish(String(data=scene_text(scene_path) if source is None else source.text))
+        if source is not None and source.robot is not None:
+            description.publish(String(data=source.robot.description.text))
+            return
         try:
             urdf = urdf_from_scene(scene, self.frame_id, tf_prefix)
         except AssemblyError as error:
@@ -254,6 +274,8 @@ class Publishing:
 
     def tick(self, values: Sequence[float], stamp: int, sec: int, nanosec: int) -> None:
         """Publish a tick's state at ``stamp`` (``sec``, ``nanosec``): every topic, /tf by rate."""
+        if self.robot_values is not None:
+            values = self.robot_values.values(values)
         joint_states, joint_accel, point_accel = self.messages.render_values(
             values, sec, nanosec)
         publish_js, publish_jt, publish_pt = self.publish_state

@@ -41,6 +41,7 @@ from ..units import NS_PER_S
 if TYPE_CHECKING:
     from .diagnostics import TickStats
     from .publishing import Publishing
+    from .robot_mode import RobotValues
     from .solver_path import SolverPath
 
 __all__ = ['INPUT_BURST', 'INPUT_DEPTH', 'InputSubscription']
@@ -72,6 +73,10 @@ class InputSubscription:
         ``ignore``, ``pass``).
     jump_back_s : float
         ``stamp_jump_back_s``: an earlier stamp by more than this resets the order.
+    robot : RobotValues, optional
+        In URDF mode: the input names the actuated joints (URDF names and
+        values), turned into the scene's drivers; ``joint_states`` names the
+        URDF's joints (the actuated ones echoed as given).
 
     Attributes
     ----------
@@ -83,14 +88,18 @@ class InputSubscription:
 
     def __init__(self, node: Any, scene: Any, solver: SolverPath, publishing: Publishing,
                  stats: TickStats, *, frame_id: str, extra_joints: str,
-                 jump_back_s: float) -> None:
+                 jump_back_s: float, robot: RobotValues | None = None) -> None:
         self.node, self.solver, self.publishing, self.stats = node, solver, publishing, stats
         self.frame_id = frame_id
+        self.robot = robot
         joints, points = scene.output_joints, scene.output_points
+        drivers = scene.drivers
+        if robot is not None:
+            joints, drivers = robot.names, robot.drivers
         # What the input determines: positions always, velocities when a message has them.
         self.messages = {known: TickMessages(joints, points, frame_id, velocities=known,
                                              accelerations=False) for known in (True, False)}
-        self.topic = TopicDrive(scene.drivers, extra_joints=extra_joints,
+        self.topic = TopicDrive(drivers, extra_joints=extra_joints,
                                 jump_back_ns=round(jump_back_s * NS_PER_S),
                                 published_joints=joints)
         self.active = False
@@ -134,6 +143,8 @@ class InputSubscription:
             given = topic.read(stamp.sec, stamp.nanosec, msg.name, msg.position, msg.velocity,
                                msg.effort)
             values, measure = self._solve(given)
+            if self.robot is not None:
+                values = self.robot.values(values, (given.positions, given.speeds))
         except (RefusedInput, AssemblyError) as exc:
             kind = 'refused input' if isinstance(exc, RefusedInput) else \
                 'not trusted' if isinstance(exc, UntrustedError) else 'cannot assemble'
@@ -187,9 +198,13 @@ class InputSubscription:
         Unknown velocities are solved as zero and left out of what is published;
         the accelerations are never published.
         """
-        solver, n = self.solver, len(given.positions)
-        speeds = (0.0,) * n if given.speeds is None else given.speeds
+        solver = self.solver
+        positions, speeds = given.positions, given.speeds
+        if self.robot is not None:
+            positions, speeds = self.robot.scene_inputs(positions, speeds)
+        n = len(positions)
+        speeds = (0.0,) * n if speeds is None else speeds
         assert solver.solve is not None
         if n == 1:
-            return solver.solve(given.positions[0], speeds[0], 0.0, solver.max_error, 0)
-        return solver.solve(given.positions, speeds, (0.0,) * n, solver.max_error, (0,) * n)
+            return solver.solve(positions[0], speeds[0], 0.0, solver.max_error, 0)
+        return solver.solve(positions, speeds, (0.0,) * n, solver.max_error, (0,) * n)

@@ -1,0 +1,296 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The node in URDF mode: what it loads from its parameters, and the URDF's joints of a tick.
+
+The node's ``scene`` parameter names a scene (YAML) or, in *URDF mode*, a
+robot: a path ending in ``.urdf``, or the URDF's text given as the parameter
+``robot_description`` (as robot_state_publisher takes it), with
+``loop_closures`` (a scikit-robot ``loop_closures.yaml``) and
+``actuated_joints`` (default: the URDF's ``<transmission>`` and
+``<ros2_control>`` joints). :func:`load_source` reads what the parameters
+name, or refuses in one line (:class:`~mech_kinematics.errors.SceneError`,
+the one ``solve`` prints); the robot's loops become a scene
+(:class:`~mech_kinematics.robot.Robot`), which the node solves as any other,
+compiled tick included.
+
+:class:`RobotValues` turns a tick's values (the scene's coordinates, in the
+order of :func:`~mech_kinematics.ros.ticker.values_from_state`) into the
+URDF's joints in the same layout (positions, velocities, accelerations of
+:attr:`Robot.joint_names <mech_kinematics.robot.Robot.joint_names>`, then the
+scene's points), so that the node's message templates publish them
+unchanged: relative to each joint's zero, positive about its axis as
+written, exactly as :meth:`Robot.joints_from_state
+<mech_kinematics.robot.Robot.joints_from_state>` answers them (``test/ros/
+test_robot_mode.py`` checks the two agree). In topic drive the input names
+the actuated joints by their URDF names and values (:attr:`RobotValues.drivers`
+for :class:`~mech_kinematics.ros.topic_drive.TopicDrive`), turned into the
+scene's drivers by :meth:`RobotValues.scene_inputs`; the actuated joints are
+echoed as given. On the clock (``drive: time``) the scene's drivers move
+each on its own, every joint of a loop follows the scene's coordinates, and
+an actuated joint outside every loop stays at its reference value, at rest.
+
+Pure: no ROS.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+import math
+from typing import Any
+
+from ..errors import SceneError
+from ..scene import DEFAULT_SCENE, load_scene, scene_text
+from ..solver.mechanism import Scene
+
+__all__ = ['RobotDriver', 'RobotValues', 'Source', 'URDF_SUFFIX', 'is_urdf', 'load_source']
+
+#: A ``scene`` parameter ending so names a robot described in URDF.
+URDF_SUFFIX = '.urdf'
+
+
+def is_urdf(scene: str) -> bool:
+    """Return whether the ``scene`` parameter names a robot described in URDF."""
+    return scene.lower().endswith(URDF_SUFFIX)
+
+
+@dataclass(frozen=True)
+class Source:
+    """What the node loads from ``scene`` (or ``robot_description``).
+
+    Attributes
+    ----------
+    scene : Scene
+        The scene the node solves (a robot's: its loops, outputting every
+        coordinate :class:`RobotValues` reads).
+    text : str
+        Published on ``scene``: the scene file's text, or the scene a robot's
+        loops become (``urdf2scene``'s YAML).
+    robot : Robot or None
+        The robot, in URDF mode.
+    origin : str
+        Where it came from, for the start's log line (a path, or
+        ``robot_description``).
+    """
+
+    scene: Scene
+    text: str
+    robot: Any = None
+    origin: str = ''
+
+
+def load_source(scene: str, robot_description: str = '', loop_closures: str = '',
+                actuated_joints: Sequence[str] | None = None) -> Source:
+    """Load the scene or robot the node's parameters name.
+
+    Parameters
+    ----------
+    scene : str
+        The ``scene`` parameter: a scene path or packaged name, or a path
+        ending in ``.urdf``.
+    robot_description : str
+        The URDF's text ('' for none); then ``scene`` must be left at its
+        default.
+    loop_closures : str
+        A ``loop_closures.yaml`` beside the URDF ('' for none).
+    actuated_joints : sequence of str or None
+        The actuated joints (None: the URDF's).
+
+    Raises
+    ------
+    SceneError
+        One line: a scene that cannot be loaded, a robot refused
+        (:class:`~mech_kinematics.errors.UrdfError`, naming the joint), or
+        parameters that do not go together.
+    """
+    urdf = robot_description or (scene if is_urdf(scene) else '')
+    if robot_description and scene != DEFAULT_SCENE:
+        msg = ('Expected the robot in one parameter, scene:=ROBOT.urdf or robot_description, '
+               f'got both (scene {scene})')
+        raise SceneError(msg)
+    if not urdf:
+        given = [name for name, value in (('loop_closures', loop_closures),
+                                          ('actuated_joints', actuated_joints)) if value]
+        if given:
+            msg = (f'Expected {", ".join(given)} with a robot described in URDF (scene:=PATH.urdf '
+                   f'or robot_description), got scene {scene}')
+            raise SceneError(msg)
+        return Source(load_scene(scene), scene_text(scene), origin=scene)
+    from ..robot import load_robot
+    from ..robot.writer import scene_yaml
+
+    origin = 'robot_description' if robot_description else scene
+    robot = load_robot(urdf, loop_closures or None, actuated_joints or None)
+    needed = RobotValues.coordinates(robot)
+    built = robot.scene
+    missing = tuple(n for n in needed if n not in built.output_joints)
+    if missing:
+        built = replace(built, outputs_joints=(*built.output_joints, *missing))
+    return Source(built, scene_yaml(robot.planar, origin), robot, origin)
+
+
+@dataclass(frozen=True)
+class RobotDriver:
+    """An actuated joint as :class:`~mech_kinematics.ros.topic_drive.TopicDrive` reads it.
+
+    ``stroke``: a prismatic joint's limits in its own values (m, inclusive)
+    where it moves a cylinder of a stroke, else None.
+    """
+
+    name: str
+    stroke: tuple[float, float] | None = None
+
+
+def _wrap(value: float, centre: float) -> float:
+    return centre + math.remainder(value - centre, math.tau)
+
+
+class RobotValues:
+    """The URDF's joints of a tick's values, and the scene's drivers of the actuated joints.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot.
+    joints, points : sequence of str
+        The scene's output joints and points, in the tick's order.
+
+    Attributes
+    ----------
+    names : tuple of str
+        The joints published (:attr:`Robot.joint_names`), in order.
+    drivers : tuple of RobotDriver
+        The actuated joints, in :attr:`Robot.actuated`'s order.
+    clock_note : str
+        With ``drive: time``, the warning the node logs where a mimic joint
+        drives a loop ('' for none).
+    """
+
+    def __init__(self, robot: Any, joints: Sequence[str], points: Sequence[str]) -> None:
+        self.names = tuple(robot.joint_names)
+        self._n = len(joints)
+        self._points = 6 * len(points)
+        index = {name: i for i, name in enumerate(joints)}
+        actuated = {name: k for k, name in enumerate(robot.actuated)}
+        position = {name: k for k, name in enumerate(self.names)}
+        scene_drivers = {d.name: d for d in robot.scene.drivers}
+        # The scene's drivers from the actuated joints: (joint, multiplier, offset, sigma,
+        # reference, scene_ref) each, scene = scene_ref + sigma * (m * urdf + o - reference).
+        self._inputs = []
+        strokes: dict[str, tuple[float, float]] = {}
+        for d in robot.planar.drivers:
+            rule = d.mimic
+            leader, m, o = (d.name, 1.0, 0.0) if rule is None else \
+                (rule.joint, rule.multiplier, rule.offset)
+            self._inputs.append((actuated[leader], m, o, d.sigma, d.reference, d.scene_ref))
+            stroke = scene_drivers[d.scene].stroke
+            if rule is None and stroke is not None:
+                ends = sorted(d.reference + (s - d.scene_ref) / d.sigma for s in stroke)
+                strokes[d.name] = (ends[0], ends[1])
+        self.drivers = tuple(RobotDriver(name, strokes.get(name)) for name in robot.actuated)
+        mimics = [f'{d.scene} ({d.name} mimics {d.mimic.joint})' for d in robot.planar.drivers
+                  if d.mimic is not None]
+        #: What ``drive: time`` does not do as the URDF says ('' where it does all of it).
+        self.clock_note = '' if not mimics else (
+            'URDF mode with drive: time: the scene drivers ' + ', '.join(mimics) + ' move on '
+            'their own (inputs.NAME.*), so a mimic rule holds while their speeds keep it; '
+            'drive: topic takes the actuated joints by their URDF names')
+        by_urdf = {d.name: d for d in robot.planar.drivers}
+        maps = robot.planar.joints
+        # Per joint, in order, how the clock's tick gives it and how an input's does.
+        self._time: list[tuple[Any, ...]] = []
+        self._topic: list[tuple[Any, ...]] = []
+        for name in self.names:
+            item = maps.get(name)
+            driver = by_urdf.get(name)
+            if item is not None:
+                recipe: tuple[Any, ...] = self._map(item, index)
+            elif driver is not None:
+                recipe = ('driver', index[driver.scene], driver.scene_ref, driver.sigma,
+                          driver.reference)
+            elif name in actuated:    # outside every loop: on the clock, at its reference
+                recipe = ('rest', robot.start(name))
+            else:
+                rule = robot.description.joints[name].mimic
+                recipe = ('mimic', position[rule.joint], rule.multiplier, rule.offset)
+            self._time.append(recipe)
+            if name in actuated:
+                self._topic.append(('given', actuated[name]))
+            elif driver is not None and driver.mimic is not None:
+                rule = driver.mimic
+                self._topic.append(('mimic', position[rule.joint], rule.multiplier,
+                                    rule.offset))
+            else:
+                self._topic.append(recipe)
+
+    @staticmethod
+    def coordinates(robot: Any) -> tuple[str, ...]:
+        """Return the scene's coordinates the robot's joints follow (the tick must output them)."""
+        out: list[str] = []
+        for item in robot.planar.joints.values():
+            out += [c for c in (item.child, item.parent, item.slider) if c is not None]
+        out += [d.scene for d in robot.planar.drivers]
+        return tuple(dict.fromkeys(out))
+
+    @staticmethod
+    def _map(item: Any, index: dict[str, int]) -> tuple[Any, ...]:
+        if item.type.angular:
+            terms = tuple((sign, index[c], ref) for sign, c, ref in
+                          ((1.0, item.child, item.child_ref), (-1.0, item.parent, item.parent_ref))
+                          if c is not None)
+            return ('map', terms, item.reference, item.sigma, item.center)
+        return ('map', ((1.0, index[item.slider], item.slider_ref),), item.reference,
+                item.sigma, None)
+
+    def scene_inputs(self, positions: Sequence[float], speeds: Sequence[float] | None
+                     ) -> tuple[list[float], list[float] | None]:
+        """Return the scene's drivers' positions and speeds of the actuated joints' (in order)."""
+        p_out = [scene_ref + sigma * (m * positions[k] + o - reference)
+                 for k, m, o, sigma, reference, scene_ref in self._inputs]
+        if speeds is None:
+            return p_out, None
+        return p_out, [sigma * m * speeds[k] for k, m, _o, sigma, _r, _s in self._inputs]
+
+    def values(self, values: Sequence[float], given: tuple[Sequence[float],
+                                                           Sequence[float] | None] | None = None
+               ) -> list[float]:
+        """Return the URDF joints' values of a tick's ``values``, then the scene's points'.
+
+        ``given``: the actuated joints' (positions, speeds or None) of an
+        input message, echoed as given (None: the clock's tick, every joint
+        from the scene's coordinates).
+        """
+        n = self._n
+        count = len(self.names)
+        p = [0.0] * count
+        v = [0.0] * count
+        a = [0.0] * count
+        recipes = self._time if given is None else self._topic
+        for j, recipe in enumerate(recipes):
+            kind = recipe[0]
+            if kind == 'map':
+                _kind, terms, reference, sigma, centre = recipe
+                dp = dv = da = 0.0
+                for sign, i, ref in terms:
+                    dp += sign * (values[i] - ref)
+                    dv += sign * values[n + i]
+                    da += sign * values[2 * n + i]
+                value = reference + sigma * dp
+                p[j] = value if centre is None else _wrap(value, centre)
+                v[j], a[j] = sigma * dv, sigma * da
+            elif kind == 'given':
+                assert given is not None
+                k = recipe[1]
+                p[j] = float(given[0][k])
+                speeds = given[1]
+                v[j] = float(speeds[k]) if speeds is not None else 0.0
+            elif kind == 'driver':
+                _kind, i, scene_ref, sigma, reference = recipe
+                p[j] = reference + (values[i] - scene_ref) / sigma
+                v[j], a[j] = values[n + i] / sigma, values[2 * n + i] / sigma
+            elif kind == 'rest':
+                p[j] = recipe[1]
+            else:
+                _kind, leader, m, o = recipe
+                p[j], v[j], a[j] = m * p[leader] + o, m * v[leader], m * a[leader]
+        return [*p, *v, *a, *values[3 * n:3 * n + self._points]]
