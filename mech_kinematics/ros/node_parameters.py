@@ -54,8 +54,7 @@ JOINT_RULES = (*DRIVE, 'drive', 'markers')
 DOUBLES = frozenset(p.name for p in PARAMETERS if p.kind == 'double')
 READ_ONLY = frozenset(p.name for p in PARAMETERS if p.read_only)
 #: The parameters of the start's log line, in order (the scene's own first), before the drivers'.
-START_LOGGED = ('scene', 'loop_closures', 'actuated_joints', 'drive', 'crank_speed_rpm',
-                'crank_accel', 'max_crank_speed_rpm',
+START_LOGGED = ('scene', 'drive', 'crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm',
                 'rate_hz', 'late_ticks', 'max_catch_up_s', 'max_lateness_ms',
                 'max_relative_error', 'frame_id', 'tf_rate_hz', 'tf_prefix', 'use_sim_time',
                 'markers', 'managed', 'extra_joints', 'stamp_jump_back_s')
@@ -301,7 +300,7 @@ class NodeParameters:
                 self.value('scene')
             return (f'robot {robot.name!r} ({origin}; its loops: scene {scene.name!r}): '
                     f'joints {list(robot.joint_names)}, actuated {list(robot.actuated)}; '
-                    f'{settings}')
+                    f'loop_closures={self.value("loop_closures")!r}, {settings}')
         return (f'scene {scene.name!r} ({self.value("scene")}): joints '
                 f'{list(scene.output_joints)}, points {list(scene.output_points)}; {settings}')
 

@@ -7,8 +7,10 @@ import math
 import pytest
 
 from mech_kinematics.ros.parameters import (bounded_by_max_crank_speed, driver_parameters,
-                                            first_crank_aliases, joint_refusal, PARAMETERS,
-                                            rate_default, refusal, spec)
+                                            extra_joints_default, first_crank_aliases,
+                                            joint_refusal, PARAMETERS, rate_default, refusal,
+                                            spec)
+from mech_kinematics.scene import MAX_FILE_BYTES
 from mech_kinematics.solver.actuator import Actuator
 from mech_kinematics.solver.crank import Crank
 from mech_kinematics.units import rad_per_s_from_rpm
@@ -29,20 +31,43 @@ from mech_kinematics.units import rad_per_s_from_rpm
     ('max_catch_up_s', -1.0, 'max_catch_up_s: expected 0 <= value <= 10 s, got -1.0'),
     ('extra_joints', 'keep', "extra_joints: expected one of refuse, ignore, pass, got 'keep'"),
     ('stamp_jump_back_s', -0.5, 'stamp_jump_back_s: expected 0 <= value <= 1e+09 s, got -0.5'),
+    ('actuated_joints', 3,
+     "actuated_joints: expected a list of joint names (e.g. ['j1', 'j2']), got number 3"),
+    ('actuated_joints', 'finger_joint', 'actuated_joints: expected a list of joint names '
+     "(e.g. ['j1', 'j2']), got string 'finger_joint'"),
+    ('actuated_joints', ['a', 'a'],
+     "actuated_joints: expected one or more distinct non-empty joint names, got ['a', 'a']"),
+    ('actuated_joints', ['a', ''],
+     "actuated_joints: expected one or more distinct non-empty joint names, got ['a', '']"),
+    ('loop_closures', 7, 'loop_closures: expected a string, got number 7'),
 ])
 def test_bad_values_are_refused_with_a_reason(name, value, reason):
     """Each bad value gets one line naming the parameter, what it expects and what it got."""
     assert refusal(name, value) == reason
 
 
-@pytest.mark.parametrize('name, limit', [('tf_prefix', 256), ('frame_id', 256), ('scene', 4096)])
+@pytest.mark.parametrize('name, limit', [('tf_prefix', 256), ('frame_id', 256), ('scene', 4096),
+                                         ('loop_closures', 4096),
+                                         ('robot_description', MAX_FILE_BYTES)])
 def test_every_string_is_bounded(name, limit):
-    """Issue 33: a 10 MB tf_prefix took the start 7 s; a name over 256, a path over 4096, no."""
+    """Issue 33: a 10 MB tf_prefix took the start 7 s; a name over 256, a path over 4096, no.
+
+    A URDF's text (``robot_description``) is bounded as a scene file is (8 MiB).
+    """
     assert refusal(name, 'a' * limit) is None
     reason = refusal(name, 'a' * 10_000_000)
     assert reason == (f'{name}: expected at most {limit} characters, got 10000000: '
                       f"'{'a' * 30}'...")
-    assert all(p.max_chars in (256, 4096) for p in PARAMETERS if p.kind == 'string')
+    assert all(p.max_chars in (256, 4096, MAX_FILE_BYTES) for p in PARAMETERS
+               if p.kind == 'string')
+
+
+def test_urdf_mode_passes_the_robots_other_joints_by_default():
+    """extra_joints is unset unless given: refuse for a scene, pass in URDF mode (issue 31)."""
+    assert spec('extra_joints').default is None
+    assert (extra_joints_default(False), extra_joints_default(True)) == ('refuse', 'pass')
+    assert refusal('actuated_joints', ['finger_joint', 'wrist']) is None
+    assert refusal('robot_description', '') is None and refusal('loop_closures', '') is None
 
 
 def test_good_values_and_foreign_names_pass():
@@ -72,7 +97,7 @@ def test_markers_are_refused_with_drive_topic():
 def test_every_parameter_is_described():
     """Every parameter has a type, a description, and a range for every double."""
     for p in PARAMETERS:
-        assert p.kind in ('double', 'string', 'bool') and p.description
+        assert p.kind in ('double', 'string', 'bool', 'string_array') and p.description
         if p.kind == 'double':
             assert p.low is not None and p.high is not None and p.unit
     assert spec('rate_hz').default == 100.0

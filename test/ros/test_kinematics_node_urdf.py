@@ -1,0 +1,203 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The node in URDF mode over real DDS: between the motors' joint_states and robot_state_publisher.
+
+See issue 31. A motor publisher in this process sends the actuated joints
+(and a joint the robot does not have) at 200 Hz to a node started with
+``scene:=ROBOT.urdf`` and ``drive:=topic``; every message must be answered
+with complete joint states under the URDF's names (the actuated joints as
+given, every joint of every loop, the other joint passed through unchanged),
+and every answered state must close every loop of the URDF in the
+independent 4x4 forward kinematics of test/helpers.py (``UrdfFk``) within
+1e-12 of the loop's size. The node publishes the user's URDF on
+``robot_description``, latched, byte for byte, and none of its own frames on
+``/tf``.
+
+Every node is first greeted: messages stamped before :data:`T0` are sent
+until one is answered (a message sent before the subscription matched is
+lost); their answers are not kept.
+"""
+
+from pathlib import Path
+import time
+
+from helpers import UrdfFk
+import numpy as np
+import pytest
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from ros_helpers import (cannot_start, exited, NodeProcess, NS, RELIABLE, send_until, SESSION,
+                         stamp_ns, STARTUP_S, wait_for)
+from sensor_msgs.msg import JointState
+from std_msgs.msg import String
+from tf2_msgs.msg import TFMessage
+from trajectory_msgs.msg import JointTrajectory
+
+from mech_kinematics.robot import load_robot
+
+DATA = Path(__file__).resolve().parents[1] / 'data' / 'urdf'
+#: The motors' rate, Hz, and how long they send, s.
+MOTOR_HZ = 200
+MOTOR_S = 2.0
+#: A loop closes within this, over its size (the contract's exactness).
+RTOL_CLOSURE = 1e-12
+#: Published joints against Robot.solve at the same input (rad, m, /s): the same bits.
+ATOL = 0.0
+#: Deadline for the answers to arrive once the motors stop, s.
+ANSWER_S = 20.0
+T0 = 1_700_000_000 * NS
+HELLO = T0 - 100 * NS
+#: A joint of the input that the robot does not have (a wrist before the gripper).
+OTHER = 'wrist_3_joint'
+LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                     durability=DurabilityPolicy.TRANSIENT_LOCAL)
+
+
+class UrdfNode:
+    """A node in URDF mode with drive: topic in a namespace of its own, and what it publishes."""
+
+    def __init__(self, ros, tmp_path, name, robot, *args):
+        self.ns = f'{SESSION}/{name}'
+        self.urdf = DATA / f'{robot}.urdf'
+        self.closures = DATA / f'{robot}.loop_closures.yaml'
+        self.robot = load_robot(self.urdf, self.closures)
+        self.greeted = []
+        self.js = []
+        self.jt_all = ros.collect(JointTrajectory, f'{self.ns}/joint_accelerations')
+        self.description = ros.collect(String, f'{self.ns}/robot_description', LATCHED)
+        self.tf = ros.collect(TFMessage, '/tf')
+        self.tf_static = ros.collect(TFMessage, '/tf_static', LATCHED)
+
+        def keep(msg):
+            (self.js if stamp_ns(msg) >= T0 else self.greeted).append(msg)
+        ros.node.create_subscription(JointState, f'{self.ns}/joint_states', keep, RELIABLE)
+        self.input = ros.node.create_publisher(JointState, f'{self.ns}/input_joint_states',
+                                               RELIABLE)
+        self.proc = NodeProcess(tmp_path, '-r', f'__ns:={self.ns}', '-p', 'drive:=topic',
+                                *args)
+
+    @property
+    def jt(self):
+        return [msg for msg in self.jt_all if stamp_ns(msg) >= T0]
+
+    def start(self):
+        wait_for(lambda: self.input.get_subscription_count() > 0 or self.proc.proc.poll(),
+                 STARTUP_S, 'the node subscribing to input_joint_states')
+        assert self.proc.proc.poll() is None, self.proc.output()
+        hello = [HELLO]
+
+        def greet():
+            self.send(hello[0], [self.robot.start(n) for n in self.robot.actuated], None)
+            hello[0] += 1_000_000
+        send_until(greet, lambda: self.greeted or self.proc.proc.poll() is not None,
+                   STARTUP_S, 'the node answering a greeting', every=0.2)
+        assert self.proc.proc.poll() is None, self.proc.output()
+
+    def send(self, stamp, positions, speeds, other=(0.25, -1.5)):
+        msg = JointState(name=[*self.robot.actuated, OTHER], position=[*positions, other[0]],
+                         velocity=[] if speeds is None else [*speeds, other[1]])
+        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(stamp, NS)
+        self.input.publish(msg)
+
+    def motors(self, count):
+        """Send ``count`` messages at MOTOR_HZ on a deadline; return what was sent."""
+        rng = np.random.default_rng(31)
+        sent = []
+        period = 1.0 / MOTOR_HZ
+        start = time.monotonic()
+        for i in range(count):
+            t = i * period
+            positions = [self.robot.start(n) + 0.3 * np.sin(2.0 * t + k)
+                         for k, n in enumerate(self.robot.actuated)]
+            speeds = [0.6 * np.cos(2.0 * t + k) for k in range(len(positions))]
+            other = (float(rng.uniform(-3, 3)), float(rng.uniform(-3, 3)))
+            stamp = T0 + round(t * NS)
+            self.send(stamp, positions, speeds, other)
+            sent.append((stamp, positions, speeds, other))
+            delay = start + (i + 1) * period - time.monotonic()
+            if delay > 0:
+                time.sleep(delay)
+        return sent
+
+    def stop(self):
+        status, _ = self.proc.stop()
+        assert status == 0, self.proc.output()
+
+
+@pytest.mark.parametrize('robot', ['robotiq_2f_85', 'abb_irb2400_12_155'])
+def test_motors_at_200_hz_get_every_joint_of_the_urdf_closing_every_loop(ros, tmp_path, robot):
+    """Each motor message: one joint_states, URDF names, loops closed to 1e-12, others passed."""
+    node = UrdfNode(ros, tmp_path, f'urdf_{robot}', robot, '-p',
+                    f'scene:={DATA / f"{robot}.urdf"}', '-p',
+                    f'loop_closures:={DATA / f"{robot}.loop_closures.yaml"}')
+    try:
+        node.start()
+        sent = node.motors(round(MOTOR_HZ * MOTOR_S))
+        wait_for(lambda: len(node.js) >= len(sent) and len(node.jt) >= len(sent)
+                 or node.proc.proc.poll() is not None, ANSWER_S, 'every motor message answered')
+        wait_for(lambda: node.description, STARTUP_S, 'robot_description')
+    finally:
+        node.stop()
+    robot_ = node.robot
+    names = [*robot_.joint_names, OTHER]
+    fk = UrdfFk(node.urdf.read_text(), node.closures)
+    m = len(robot_.joint_names)
+    assert [stamp_ns(msg) for msg in node.js] == [s[0] for s in sent]
+    assert [stamp_ns(msg) for msg in node.jt] == [s[0] for s in sent]
+    worst = 0.0
+    for msg, jt, (_, positions, speeds, other) in zip(node.js, node.jt, sent, strict=True):
+        assert msg.name == names
+        assert (msg.position[m], msg.velocity[m]) == other      # passed through unchanged
+        assert list(msg.position[:len(positions)]) == [float(p) for p in positions]
+        answer = robot_.solve(dict(zip(robot_.actuated, positions, strict=True)),
+                              dict(zip(robot_.actuated, speeds, strict=True)))
+        np.testing.assert_allclose(msg.position[:m], [answer.joints[n].position
+                                                      for n in robot_.joint_names],
+                                   rtol=0, atol=ATOL)
+        np.testing.assert_allclose(msg.velocity[:m], [answer.joints[n].velocity
+                                                      for n in robot_.joint_names],
+                                   rtol=0, atol=ATOL)
+        assert jt.joint_names == list(robot_.joint_names) and not jt.points[0].accelerations
+        gaps = fk.gaps(dict(zip(names, msg.position, strict=True)))
+        worst = max(worst, *(gap / fk.loop_size(c) for c, gap in gaps.items()))
+    assert worst <= RTOL_CLOSURE
+    assert node.description[0].data == node.urdf.read_text()
+    assert not node.tf and not node.tf_static      # robot_state_publisher draws the links
+
+
+def test_the_urdf_text_as_robot_description_and_a_velocity_left_out(ros, tmp_path):
+    """robot_description:=TEXT (a params file) runs the same robot; no velocity in, none out."""
+    urdf = DATA / 'robotiq_2f_85.urdf'
+    params = tmp_path / 'params.yaml'
+    literal = '\n'.join('      ' + line for line in urdf.read_text().splitlines())
+    params.write_text(f'/**:\n  ros__parameters:\n    robot_description: |-\n{literal}\n'
+                      f'    loop_closures: {DATA / "robotiq_2f_85.loop_closures.yaml"}\n'
+                      '    extra_joints: ignore\n')
+    node = UrdfNode(ros, tmp_path, 'urdf_text', 'robotiq_2f_85', '--params-file', str(params))
+    try:
+        node.start()
+        node.send(T0, [0.2], None)
+        wait_for(lambda: node.js and node.description, ANSWER_S, 'the state and the URDF')
+    finally:
+        node.stop()
+    msg = node.js[0]
+    assert msg.name == list(node.robot.joint_names)     # extra_joints: ignore drops the wrist
+    answer = node.robot.solve({'finger_joint': 0.2})
+    assert list(msg.position) == [answer.joints[n].position for n in node.robot.joint_names]
+    assert not msg.velocity
+    assert node.description[0].data == urdf.read_text().rstrip('\n')
+
+
+@pytest.mark.parametrize('args, line', [
+    (('-p', 'loop_closures:=x.yaml'), 'cannot start: Expected loop_closures with a robot '
+     'described in URDF (scene:=PATH.urdf or robot_description), got scene'),
+    (('-p', f'scene:={DATA / "robotiq_2f_85.urdf"}', '-p', 'actuated_joints:=[finger_joint]'),
+     'Expected a robot with a closed loop'),
+    (('-p', 'actuated_joints:=[a, a]'), 'cannot start: actuated_joints: expected one or more '
+     "distinct non-empty joint names, got ['a', 'a']"),
+])
+def test_a_robot_the_node_cannot_take_is_refused_in_one_line(tmp_path, args, line):
+    """A URDF parameter that does not fit: the node does not start and says why in one line."""
+    proc = NodeProcess(tmp_path, *args)
+    status, output = exited(proc)
+    lines = cannot_start(output)
+    assert status != 0 and len(lines) == 1 and line in lines[0], output
