@@ -160,6 +160,8 @@ def test_motors_at_200_hz_get_every_joint_of_the_urdf_closing_every_loop(ros, tm
         gaps = fk.gaps(dict(zip(names, msg.position, strict=True)))
         worst = max(worst, *(gap / fk.loop_size(c) for c, gap in gaps.items()))
     assert worst <= RTOL_CLOSURE
+    # robot_state_publisher needs a value for every moving joint of the URDF: here all.
+    assert {n for n, j in fk.joints.items() if j[0] != 'fixed'} <= set(names)
     assert node.description[0].data == node.urdf.read_text()
     assert not node.tf and not node.tf_static      # robot_state_publisher draws the links
 
