@@ -141,10 +141,6 @@ class RobotDriver:
     stroke: tuple[float, float] | None = None
 
 
-def _wrap(value: float, centre: float) -> float:
-    return centre + math.remainder(value - centre, math.tau)
-
-
 class RobotValues:
     """The URDF's joints of a tick's values, and the scene's drivers of the actuated joints.
 
@@ -222,6 +218,8 @@ class RobotValues:
                                     rule.offset))
             else:
                 self._topic.append(recipe)
+        self._on_clock = self._compile(self._time, 'on_clock')
+        self._on_input = self._compile(self._topic, 'on_input')
 
     @staticmethod
     def coordinates(robot: Any) -> tuple[str, ...]:
@@ -260,37 +258,53 @@ class RobotValues:
         input message, echoed as given (None: the clock's tick, every joint
         from the scene's coordinates).
         """
+        if given is None:
+            return self._on_clock(values, None, None)
+        return self._on_input(values, given[0], given[1])
+
+    def _compile(self, recipes: Sequence[tuple[Any, ...]], what: str) -> Any:
+        """Return the recipes written out as one function ``f(values, positions, speeds)``.
+
+        Straight-line code, as the node's message templates are (a message of
+        the motors at kilohertz rates pays for every loop and lookup); the
+        same operations in the same order as :meth:`Robot.joints_from_state
+        <mech_kinematics.robot.Robot.joints_from_state>`, so the same bits
+        (``test_robot_mode``).
+        """
         n = self._n
-        count = len(self.names)
-        p = [0.0] * count
-        v = [0.0] * count
-        a = [0.0] * count
-        recipes = self._time if given is None else self._topic
+        lines = [f'def {what}(x, gp, gs):']
         for j, recipe in enumerate(recipes):
             kind = recipe[0]
             if kind == 'map':
                 _kind, terms, reference, sigma, centre = recipe
-                dp = dv = da = 0.0
-                for sign, i, ref in terms:
-                    dp += sign * (values[i] - ref)
-                    dv += sign * values[n + i]
-                    da += sign * values[2 * n + i]
-                value = reference + sigma * dp
-                p[j] = value if centre is None else _wrap(value, centre)
-                v[j], a[j] = sigma * dv, sigma * da
+                dp = ' + '.join(['0.0', *(f'{sign!r} * (x[{i}] - {ref!r})'
+                                          for sign, i, ref in terms)])
+                dv = ' + '.join(['0.0', *(f'{sign!r} * x[{n + i}]' for sign, i, _ in terms)])
+                da = ' + '.join(['0.0', *(f'{sign!r} * x[{2 * n + i}]'
+                                          for sign, i, _ in terms)])
+                value = f'{reference!r} + {sigma!r} * ({dp})'
+                if centre is not None:
+                    value = f'{centre!r} + _remainder(({value}) - {centre!r}, _TAU)'
+                lines += [f'    p{j} = {value}', f'    v{j} = {sigma!r} * ({dv})',
+                          f'    a{j} = {sigma!r} * ({da})']
             elif kind == 'given':
-                assert given is not None
                 k = recipe[1]
-                p[j] = float(given[0][k])
-                speeds = given[1]
-                v[j] = float(speeds[k]) if speeds is not None else 0.0
+                lines += [f'    p{j} = float(gp[{k}])',
+                          f'    v{j} = 0.0 if gs is None else float(gs[{k}])', f'    a{j} = 0.0']
             elif kind == 'driver':
                 _kind, i, scene_ref, sigma, reference = recipe
-                p[j] = reference + (values[i] - scene_ref) / sigma
-                v[j], a[j] = values[n + i] / sigma, values[2 * n + i] / sigma
+                lines += [f'    p{j} = {reference!r} + (x[{i}] - {scene_ref!r}) / {sigma!r}',
+                          f'    v{j} = x[{n + i}] / {sigma!r}',
+                          f'    a{j} = x[{2 * n + i}] / {sigma!r}']
             elif kind == 'rest':
-                p[j] = recipe[1]
+                lines += [f'    p{j} = {recipe[1]!r}', f'    v{j} = 0.0', f'    a{j} = 0.0']
             else:
                 _kind, leader, m, o = recipe
-                p[j], v[j], a[j] = m * p[leader] + o, m * v[leader], m * a[leader]
-        return [*p, *v, *a, *values[3 * n:3 * n + self._points]]
+                lines += [f'    p{j} = {m!r} * p{leader} + {o!r}', f'    v{j} = {m!r} * v{leader}',
+                          f'    a{j} = {m!r} * a{leader}']
+        joints = ', '.join(f'{q}{j}' for q in 'pva' for j in range(len(recipes)))
+        lines.append(f'    return [{joints}, *x[{3 * n}:{3 * n + self._points}]]')
+        namespace: dict[str, Any] = {'_remainder': math.remainder, '_TAU': math.tau}
+        exec(compile('\n'.join(lines) + '\n', f'<URDF joints {what}>', 'exec'),  # noqa: S102
+             namespace)
+        return namespace[what]

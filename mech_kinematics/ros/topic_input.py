@@ -31,6 +31,7 @@ from rclpy.qos import QoSDurabilityPolicy, QoSHistoryPolicy, QoSProfile, QoSReli
 from sensor_msgs.msg import JointState
 
 from . import topics
+from .cdr import marker, MessageTemplate, STAMP_MARKER
 from .messages import TickMessages
 from .publishing import qos_options, RCLError
 from .topic_drive import RefusedInput, TopicDrive, TopicInput
@@ -44,13 +45,15 @@ if TYPE_CHECKING:
     from .robot_mode import RobotValues
     from .solver_path import SolverPath
 
-__all__ = ['INPUT_BURST', 'INPUT_DEPTH', 'InputSubscription']
+__all__ = ['INPUT_BURST', 'INPUT_DEPTH', 'InputSubscription', 'PASSED_TEMPLATES']
 
 #: History depth of the input_joint_states subscription (a second of input at 1 kHz, as the
 #: state publishers keep: a stall of the executor loses no message).
 INPUT_DEPTH = 1000
 #: Input messages one call of the subscription's callback takes from its queue at most.
 INPUT_BURST = 100
+#: ``joint_states`` templates kept for the sets of passed joints seen (all dropped past it).
+PASSED_TEMPLATES = 16
 
 
 class InputSubscription:
@@ -103,6 +106,8 @@ class InputSubscription:
                                 jump_back_ns=round(jump_back_s * NS_PER_S),
                                 published_joints=joints)
         self.active = False
+        #: joint_states templates with the passed joints, by (names, velocities, efforts).
+        self._passed: dict[tuple[tuple[str, ...], bool, bool], MessageTemplate | None] = {}
         qos = QoSProfile(history=QoSHistoryPolicy.KEEP_LAST, depth=INPUT_DEPTH,
                          reliability=QoSReliabilityPolicy.RELIABLE,
                          durability=QoSDurabilityPolicy.VOLATILE)
@@ -184,13 +189,44 @@ class InputSubscription:
                           given.passed.names if given.passed is not None else ())
 
     def _joint_state_passed(self, given: TopicInput, values: Any, sec: int,
-                            nanosec: int) -> JointState:
-        """Return ``joint_states`` with the input's other joints after the mechanism's."""
+                            nanosec: int) -> JointState | bytes:
+        """Return ``joint_states`` with the input's other joints after the mechanism's.
+
+        Rendered from a template of its names (:data:`PASSED_TEMPLATES` kept:
+        a robot's motors name the same joints in every message), so that a
+        message of the motors costs a pack, not a Python message; a template
+        that cannot be made (a name whose bytes hold a slot's marker) gives
+        the message itself.
+        """
         name, position, velocity, effort = self.topic.joint_state_arrays(given, values)
+        key = (tuple(name), bool(velocity), bool(effort))
+        template = self._passed.get(key)
+        if template is None and key not in self._passed:
+            if len(self._passed) >= PASSED_TEMPLATES:
+                self._passed.clear()
+            self._passed[key] = template = self._passed_template(*key)
+        if template is not None:
+            return template.render(sec, nanosec, [*position, *velocity, *effort])
         msg = JointState(name=name, position=position, velocity=velocity, effort=effort)
         msg.header.stamp = Time(sec=sec, nanosec=nanosec)
         msg.header.frame_id = self.frame_id
         return msg
+
+    def _passed_template(self, names: tuple[str, ...], velocities: bool,
+                         efforts: bool) -> MessageTemplate | None:
+        """Return the template of ``joint_states`` naming ``names``, or None if it cannot be."""
+        n = len(names)
+        counts = (n, n * velocities, n * efforts)
+        slots = [[marker(sum(counts[:k]) + i) for i in range(count)]
+                 for k, count in enumerate(counts)]
+        msg = JointState(name=list(names), position=slots[0], velocity=slots[1],
+                         effort=slots[2])
+        msg.header.stamp = Time(sec=STAMP_MARKER[0], nanosec=STAMP_MARKER[1])
+        msg.header.frame_id = self.frame_id
+        try:
+            return MessageTemplate(msg, sum(counts))
+        except ValueError:
+            return None
 
     def _solve(self, given: TopicInput) -> tuple[Any, float]:
         """Return (the tick function's values, the singularity measure) for one input.
