@@ -64,6 +64,8 @@ __all__ = ['DEFAULT_JUMP_BACK_S', 'EXTRA_JOINTS', 'IGNORE', 'PASS', 'PassedJoint
 
 #: How many names a reason lists before it says how many more there are.
 SHOWN_NAMES = 5
+#: Sets of names whose checks are kept (a robot's motors send one; all dropped past it).
+LAYOUTS = 16
 #: ``extra_joints`` values: what a message's joints that are not drivers do.
 REFUSE = 'refuse'
 IGNORE = 'ignore'
@@ -184,6 +186,8 @@ class TopicDrive:
         self.published_joints = tuple(published_joints)
         self._published = frozenset(self.published_joints)
         self.last_stamp_ns: int | None = None
+        #: Per set of names accepted: (driver order, other joints, passed ones, ignored names).
+        self._layouts: dict[tuple[str, ...], tuple[Any, ...]] = {}
 
     def read(self, sec: int, nanosec: int, names: Sequence[str], positions: Sequence[float],
              velocities: Sequence[float], efforts: Sequence[float] = ()) -> TopicInput:
@@ -207,7 +211,14 @@ class TopicDrive:
         """
         stamp_ns = sec * NS_PER_S + nanosec
         jumped_from = self._check_stamp(stamp_ns)
-        order, extras = self._order(names)
+        key = tuple(names)
+        layout = self._layouts.get(key)
+        if layout is None:      # a new set of names: checked once, then looked up
+            order, extras = self._order(names)
+            if len(self._layouts) >= LAYOUTS:
+                self._layouts.clear()
+            layout = self._layouts[key] = (order, extras, *self._split(names, extras))
+        order, extras = layout[0], layout[1]
         if len(positions) != len(names):
             self._refuse(f'expected one position per name ({len(names)}), got '
                          f'{len(positions)}')
@@ -226,7 +237,8 @@ class TopicDrive:
             self._check_finite('velocity', speeds)
         if not extras:
             return TopicInput(stamp_ns, ordered, speeds, jumped_from)
-        passed, ignored = self._extras(names, extras, positions, velocities, efforts)
+        passed, ignored = self._extras(names, layout[2], layout[3], positions, velocities,
+                                       efforts)
         return TopicInput(stamp_ns, ordered, speeds, jumped_from, ignored, passed)
 
     def joint_state_arrays(self, given: TopicInput, values: Sequence[float]) -> tuple[
@@ -305,17 +317,23 @@ class TopicDrive:
                          f'{_listed(missing)}')
         return [where[n] for n in self.names], extras
 
-    def _extras(self, names: Sequence[str], extras: list[int], positions: Sequence[float],
-                velocities: Sequence[float], efforts: Sequence[float]) -> tuple[
-                    PassedJoints | None, tuple[str, ...]]:
-        """Return the joints ``extras`` (indices into ``names``) passed, and those ignored."""
+    def _split(self, names: Sequence[str], extras: list[int]) -> tuple[
+            tuple[int, ...], tuple[str, ...]]:
+        """Return which of ``extras`` (indices into ``names``) pass, and the names ignored."""
         if self.extra_joints == IGNORE:
-            return None, tuple(names[i] for i in extras)
+            return (), tuple(names[i] for i in extras)
+        return (tuple(i for i in extras if names[i] not in self._published),
+                tuple(names[i] for i in extras if names[i] in self._published))
+
+    def _extras(self, names: Sequence[str], kept: tuple[int, ...], ignored: tuple[str, ...],
+                positions: Sequence[float], velocities: Sequence[float],
+                efforts: Sequence[float]) -> tuple[PassedJoints | None, tuple[str, ...]]:
+        """Return the joints ``kept`` (indices into ``names``) passed, and those ignored."""
+        if self.extra_joints == IGNORE:
+            return None, ignored
         if len(efforts) and len(efforts) != len(names):
             self._refuse(f'expected no effort or one per name ({len(names)}), got '
                          f'{len(efforts)} (extra_joints: pass passes them through)')
-        ignored = tuple(names[i] for i in extras if names[i] in self._published)
-        kept = [i for i in extras if names[i] not in self._published]
         if not kept:
             return None, ignored
         return PassedJoints(
