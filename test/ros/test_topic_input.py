@@ -10,6 +10,8 @@ stamp's jump back said, and nothing while inactive. The node driven over DDS
 is ``test_kinematics_node_topic.py``'s.
 """
 
+import math
+
 from builtin_interfaces.msg import Time
 from rclpy.qos import QoSReliabilityPolicy
 from rclpy.serialization import deserialize_message
@@ -177,6 +179,30 @@ def test_other_joints_pass_through_after_the_mechanisms():
     assert (state.position[-1], state.velocity[-1]) == (0.25, 0.5)
     assert list(state.effort) == []         # the message has none
     assert stats.take_window().passed_joints == ('gripper',)
+
+
+def test_passed_joints_are_rendered_from_a_template_of_their_names():
+    """Issue 31: joint_states with passed joints is CDR from a template per set of names.
+
+    Efforts: NaN for the mechanism's joints, the input's for the passed ones; a
+    message naming other joints gets its own template, and both are exact.
+    """
+    node, subscription, _ = _input('five_bar', extra_joints='pass')
+    first = _message(5, ['left_crank', 'gripper', 'right_crank'], [1.5, 0.25, 1.0],
+                     [0.0, 0.5, 0.0])
+    first.effort = [9.0, -2.5, 7.0]
+    subscription.message(first)
+    subscription.message(_message(6, ['wrist', 'right_crank', 'left_crank', 'gripper'],
+                                  [-0.75, 1.0, 1.5, 0.125]))
+    assert all(isinstance(m, bytes) for m in node.publishers['joint_states'].sent)
+    one, two = _decoded(node, 'joint_states')
+    assert list(one.name)[-1] == 'gripper' and one.header.stamp.nanosec == 5
+    assert (one.position[-1], one.velocity[-1], one.effort[-1]) == (0.25, 0.5, -2.5)
+    assert all(math.isnan(e) for e in one.effort[:-1])
+    assert list(two.name)[-2:] == ['wrist', 'gripper'] and list(two.position)[-2:] == [-0.75,
+                                                                                       0.125]
+    assert list(two.velocity) == [] and list(two.effort) == []
+    assert list(one.position)[:-1] == list(two.position)[:-2]     # the same drivers
 
 
 def test_an_inactive_node_publishes_nothing():
