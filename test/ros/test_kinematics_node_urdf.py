@@ -203,3 +203,30 @@ def test_a_robot_the_node_cannot_take_is_refused_in_one_line(tmp_path, args, lin
     status, output = exited(proc)
     lines = cannot_start(output)
     assert status != 0 and len(lines) == 1 and line in lines[0], output
+
+
+def test_on_the_clock_a_robots_loops_move_with_the_scenes_drivers(ros, tmp_path):
+    """drive: time (make run): URDF joints on the grid, loops closed, the mimic driver warned."""
+    urdf, closures = DATA / 'robotiq_2f_85.urdf', DATA / 'robotiq_2f_85.loop_closures.yaml'
+    robot = load_robot(urdf, closures)
+    ns = f'{SESSION}/urdf_clock'
+    received = ros.collect(JointState, f'{ns}/joint_states')
+    proc = NodeProcess(tmp_path, '-r', f'__ns:={ns}', '-p', f'scene:={urdf}', '-p',
+                       f'loop_closures:={closures}', '-p', 'rate_hz:=50.0', '-p',
+                       'inputs.left_outer_knuckle.speed_rpm:=0.5')
+    try:
+        wait_for(lambda: len(received) >= 10 or proc.proc.poll() is not None, STARTUP_S,
+                 'ten states on the clock')
+    finally:
+        status, _ = proc.stop()
+    assert status == 0, proc.output()
+    fk = UrdfFk(urdf.read_text(), closures)
+    m = len(robot.joint_names)
+    for msg in received[:10]:
+        assert msg.name == list(robot.joint_names) and len(msg.velocity) == m
+        gaps = fk.gaps(dict(zip(msg.name, msg.position, strict=True)))
+        assert max(gap / fk.loop_size(c) for c, gap in gaps.items()) <= RTOL_CLOSURE
+    # The left finger turns at 0.5 rpm about -z of its scene link (finger_joint's sigma -1).
+    assert received[0].velocity[0] == -0.5 * 2 * np.pi / 60
+    assert 'right_outer_knuckle (right_outer_knuckle_joint mimics finger_joint) move on ' \
+        'their own' in proc.output()
