@@ -29,7 +29,7 @@ LAUNCH_XML = ROOT / 'launch' / 'kinematics.launch.xml'
 #: The five-line example of docs/node.md: a node driven by the motors' joint_states (issue 18).
 CLOSED_CHAIN = ROOT / 'launch' / 'closed_chain.launch.py'
 RVIZ = ROOT / 'config' / 'mech_kinematics.rviz'
-NODE_SOURCE = ROOT / 'mech_kinematics' / 'ros' / 'node.py'
+PUBLISHING_SOURCE = ROOT / 'mech_kinematics' / 'ros' / 'publishing.py'
 PACKAGE = 'mech_kinematics'
 #: Launch arguments -> the node parameter each sets ('namespace' sets the namespace,
 #: 'params_file' the parameters file, 'rviz' starts RViz).
@@ -236,7 +236,7 @@ def test_rviz_config_shows_the_nodes_frame_tf_and_markers():
     # Relative names, as the node publishes them: RViz in the node's namespace sees its
     # topics (issue 20); nothing hard-codes /markers.
     assert markers['Topic']['Value'] == 'markers'
-    source = NODE_SOURCE.read_text(encoding='utf-8')
+    source = PUBLISHING_SOURCE.read_text(encoding='utf-8')
     assert topics.MARKERS == 'markers'
     assert 'create_publisher(MarkerArray, topics.MARKERS' in source
     model = displays['rviz_default_plugins/RobotModel']
@@ -244,7 +244,7 @@ def test_rviz_config_shows_the_nodes_frame_tf_and_markers():
     assert model['Description Topic']['Value'] == 'robot_description'
     assert model['Description Topic']['Durability Policy'] == 'Transient Local'
     assert topics.ROBOT_DESCRIPTION == 'robot_description'
-    assert 'create_publisher(String, topics.ROBOT_DESCRIPTION' in source
+    assert '_publisher(String, topics.ROBOT_DESCRIPTION' in source
     assert 'Value: /' not in RVIZ.read_text(encoding='utf-8')     # no absolute topic
 
 

@@ -136,8 +136,8 @@ def _locking(stat: os.stat_result) -> list[int]:
                 # "1: FLOCK  ADVISORY  WRITE 4242 fe:00:2146330 0 EOF"
                 if len(fields) >= 6 and fields[5] == device and fields[4].isdigit():
                     pids.append(int(fields[4]))
-    except OSError:
-        pass
+    except OSError:     # /proc/locks unreadable: the holders read so far
+        return pids
     return pids
 
 
@@ -169,8 +169,8 @@ def _maps(pid: int, stat: os.stat_result, resolved: str) -> bool:
                 if (len(fields) == 6 and fields[4] == str(stat.st_ino)
                         and fields[5].rstrip('\n') == resolved):
                     return True
-    except OSError:
-        pass
+    except OSError:     # the process ended, or is another user's: it maps nothing we see
+        return False
     return False
 
 

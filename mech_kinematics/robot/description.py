@@ -47,8 +47,8 @@ from .transforms import Matrix, rotation_about, transform, translation
 from ..errors import SceneError, UrdfError
 from ..solver.graph import JointType, PRISMATIC, REVOLUTE
 
-__all__ = ['Closure', 'ClosureKind', 'Description', 'Mimic', 'UrdfJoint', 'read_description',
-           'URDF_TYPES']
+__all__ = ['Closure', 'ClosureKind', 'Description', 'Inertial', 'Mimic', 'UrdfJoint',
+           'read_description', 'URDF_TYPES']
 
 #: A URDF joint type -> the joint type of its coordinate (None: no coordinate we solve).
 URDF_TYPES: dict[str, JointType | None] = {
@@ -162,6 +162,20 @@ class UrdfJoint:
 
 
 @dataclass(frozen=True)
+class Inertial:
+    """A link's ``<inertial>``: its mass (kg), its frame (the centre of mass) and inertia.
+
+    ``origin`` is the inertial frame in the link's (4x4: the centre of mass at
+    its origin), ``inertia`` the 3x3 tensor about the centre of mass in that
+    frame's axes (kg m^2), both as the URDF writes them.
+    """
+
+    mass: float
+    origin: Matrix
+    inertia: Matrix
+
+
+@dataclass(frozen=True)
 class Description:
     """A robot as written: its URDF's links and joints, closures and actuated joints.
 
@@ -186,6 +200,9 @@ class Description:
         ``<ros2_control>`` command interfaces), in file order.
     independent : tuple of str or None
         A sidecar's ``independent`` joints (``None`` without a sidecar).
+    inertials : dict of str to Inertial
+        Each link's ``<inertial>`` with a mass above 0 (a link without one,
+        or of mass 0, is massless).
     """
 
     name: str
@@ -197,6 +214,7 @@ class Description:
     closures: tuple[Closure, ...] = ()
     actuated: tuple[str, ...] = ()
     independent: tuple[str, ...] | None = None
+    inertials: dict[str, Inertial] = field(default_factory=dict)
     _parent: dict[str, UrdfJoint] = field(default_factory=dict, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -350,6 +368,41 @@ def _read_links_and_joints(root: Any, source: str) -> Any:
             raise _fail(source, f'Expected a valid URDF, got: {text}') from None
         finally:
             core.on_error = saved
+
+
+def _inertials(robot: Any, source: str) -> dict[str, Inertial]:
+    """Return each link's ``<inertial>`` of mass above 0, checked (one line naming the link)."""
+    out: dict[str, Inertial] = {}
+    for link in robot.links:
+        inertial = getattr(link, 'inertial', None)
+        if inertial is None:
+            continue
+        mass = float(inertial.mass if inertial.mass is not None else 0.0)
+        if not math.isfinite(mass) or mass < 0.0:
+            raise _fail(source, f'link "{link.name}": Expected its <inertial> mass to be a '
+                                f'finite number >= 0 kg, got {mass!r}')
+        if mass == 0.0:
+            continue
+        origin = inertial.origin
+        xyz = tuple(float(v) for v in (origin.xyz if origin is not None and origin.xyz
+                                       is not None else (0.0, 0.0, 0.0)))
+        rpy = tuple(float(v) for v in (origin.rpy if origin is not None and origin.rpy
+                                       is not None else (0.0, 0.0, 0.0)))
+        i = inertial.inertia
+        names = ('ixx', 'ixy', 'ixz', 'iyy', 'iyz', 'izz')
+        values = [float(getattr(i, k, 0.0) or 0.0) if i is not None else 0.0 for k in names]
+        if not all(math.isfinite(v) for v in (*xyz, *rpy, *values)):
+            raise _fail(source, f'link "{link.name}": Expected its <inertial> origin and '
+                                f'inertia to be finite, got xyz {xyz} rpy {rpy} inertia '
+                                f'{dict(zip(names, values, strict=True))}')
+        ixx, ixy, ixz, iyy, iyz, izz = values
+        tensor = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+        if float(np.linalg.eigvalsh(tensor)[0]) < -1e-12 * max(1.0, abs(tensor).max()):
+            given = dict(zip(names, values, strict=True))
+            raise _fail(source, f'link "{link.name}": Expected its <inertial> inertia to be '
+                                f'positive semi-definite, got {given}')
+        out[link.name] = Inertial(mass, transform(xyz, rpy), tensor)
+    return out
 
 
 def _joints(robot: Any, source: str) -> dict[str, UrdfJoint]:
@@ -596,10 +649,11 @@ def read_description(source: str | os.PathLike[str], closures: str | os.PathLike
     root_link = _root(links, joints, name)
     found = tuple(_constraints(root, set(links), name)) + tuple(
         _closing_frames(joints, links, name))
+    inertials = _inertials(robot, name)
     description = Description(str(robot.name or 'robot'), name, text, links, joints, root_link,
-                              found, _actuated(root))
+                              found, _actuated(root), inertials=inertials)
     if closures is None:
         return description
     extra, independent = _sidecar(closures, description)
     return Description(description.name, name, text, links, joints, root_link,
-                       found + extra, description.actuated, independent)
+                       found + extra, description.actuated, independent, inertials)

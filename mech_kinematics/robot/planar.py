@@ -43,6 +43,7 @@ slider coordinate it moves. Pure: NumPy only.
 
 from __future__ import annotations
 
+import cmath
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 import math
@@ -130,13 +131,18 @@ class Planar:
         Every URDF joint of every loop.
     mechanisms : list of dict
         Per mechanism: its ``ground`` link, ``links``, ``joints``, ``normal``
-        (in the ground link's frame), ``size`` (m) and ``gap`` (the largest
-        closure gap at the reference pose, m).
+        and the scene plane's axes ``x`` and ``y`` (in the ground link's
+        frame), ``size`` (m) and ``gap`` (the largest closure gap at the
+        reference pose, m).
     actuated : tuple of str
         The actuated joints (given, the sidecar's or the URDF's).
     names : dict of str to str
         URDF name -> scene name, where they differ (a name that is no
         identifier, or used twice).
+    masses : dict of str to dict
+        The scene's ``masses:`` from the ``<inertial>`` of the links each
+        moving body holds (``urdf2scene`` writes them; ``data`` leaves them
+        out, so that solving a robot's joints computes no forces).
     """
 
     data: dict[str, Any]
@@ -145,6 +151,7 @@ class Planar:
     mechanisms: list[dict[str, Any]]
     actuated: tuple[str, ...] = ()
     names: dict[str, str] = field(default_factory=dict)
+    masses: dict[str, dict[str, Any]] = field(default_factory=dict)
 
 
 # --- names -----------------------------------------------------------------------------
@@ -490,6 +497,11 @@ class _Builder:
         self.drivers: list[DriverMap] = []
         self.joint_maps: dict[str, JointMap] = {}
         self.offset = 0.0
+        #: URDF body (its link nearest the root) -> the scene body it became.
+        self.body_names: dict[str, str] = {}
+        #: Scene body -> (mass kg, centre of mass in the scene's plane, inertia kg m^2 about
+        #: it and the plane's normal), from the <inertial> of the URDF links it holds.
+        self.mass_props: dict[str, tuple[float, complex, float]] = {}
 
     def fail(self, msg: str, joint: str | None = None) -> UrdfError:
         return UrdfError(f'{self.source}: {msg}', joint=joint)
@@ -532,6 +544,35 @@ class _Builder:
                     '(such as a triad), a slider on a moving guide, a slot off its pivot or an '
                     'actuated joint our kinds do not drive', joint)
         self._joint_maps()
+        self._masses()
+
+    def _masses(self) -> None:
+        """Gather each moving body's <inertial>s: mass, centre of mass, inertia about the normal.
+
+        Links welded into one body add up (the parallel-axis theorem about their
+        common centre of mass, distances measured in the plane).
+        """
+        m = self.m
+        n = m.normal
+        for body in m.bodies:
+            if body == m.ground:
+                continue
+            parts = []
+            for link in self.description.links:
+                inertial = self.description.inertials.get(link)
+                if inertial is None or m.body_of.get(link) != body:
+                    continue
+                frame = m.frame[link] @ inertial.origin
+                rotation = frame[:3, :3]
+                tensor = rotation @ inertial.inertia @ rotation.T
+                parts.append((inertial.mass, m.flat(frame[:3, 3]) + self.shift,
+                              float(n @ tensor @ n)))
+            if not parts:
+                continue
+            total = math.fsum(p[0] for p in parts)
+            com = sum((p[0] * p[1] for p in parts), 0j) / total
+            inertia = math.fsum(i + mass * abs(c - com) ** 2 for mass, c, i in parts)
+            self.mass_props[self.body_names[body]] = (total, com, inertia)
 
     def xy(self, z: complex) -> list[float]:
         w = z + self.shift
@@ -583,6 +624,7 @@ class _Builder:
         centre = m.pins[body][edge.name]
         tip = self._tip(body, edge.name, centre)
         crank_link = self.link(body)
+        self.body_names[body] = crank_link
         phi0 = _angle(m.pins[body][tip] - centre)
         assert edge.joint is not None
         sigma = m.sign(edge) * (1.0 if body == edge.b else -1.0)
@@ -694,12 +736,14 @@ class _Builder:
                 on_start = m.pins[barrel if start == pa else rod][start]
                 on_end = m.pins[rod if start == pa else barrel][pin]
                 name = self.link(barrel)
+                self.body_names[barrel], self.body_names[rod] = name, self.slider(key)
                 links.append({'name': name, 'from': self.point(start),
                               'actuator': self.slider(key)})
                 self._actuator(key, on_start, on_end, start == pa)
             else:
                 on_start, on_end = m.pins[body][start], m.pins[body][pin]
                 name = self.link(body)
+                self.body_names[body] = name
                 links.append({'name': name, 'from': self.point(start),
                               'length': abs(on_end - on_start)})
             ends.append((on_start, on_end, name, start))
@@ -792,6 +836,7 @@ class _Builder:
                 f'{pin.name}, got its link square to the guide (a dead centre): give a '
                 f'reference pose away from it', pin.name)
         name = self.link(link)
+        self.body_names[link], self.body_names[block] = name, self.slider(slide.name)
         self.dyads.append({'type': 'RRP', 'point': self.point(pin.name),
                            'link': {'name': name, 'from': self.point(start),
                                     'length': abs(c1 - p1)},
@@ -842,6 +887,7 @@ class _Builder:
                             slide.name)
         kappa = 1.0 if along > 0 else -1.0
         name = self.link(lever)
+        self.body_names[lever], self.body_names[block] = name, self.slider(slide.name)
         self.dyads.append({'type': 'RPR', 'link': name, 'center': self.point(pivot),
                            'through': self.point(pin.name), 'slider': self.slider(slide.name)})
         self.slider_of[slide.name] = (self.slider(slide.name), kappa, abs(along))
@@ -886,6 +932,8 @@ class _Builder:
         through = self.point(f'{guide.name}_guide')
         self.ground[through] = self.xy(b)
         new = f'{slot.name}_crossing'
+        self.body_names[yoke] = self.slider(guide.name)
+        self.body_names[block] = self.slider(slot.name)
         self.dyads.append({'type': 'RPP', 'point': self.point(new),
                            'through': self.point(pin.name),
                            'guide': {'through': through, 'angle': _angle(g)},
@@ -1044,6 +1092,7 @@ def planar_from_description(description: Description, actuated: Iterable[str] | 
         mechanisms.append({'ground': ground, 'links': list(m.bodies),
                            'joints': [e.name for e in part],
                            'normal': [float(v) for v in m.normal],
+                           'x': [float(v) for v in m.e1], 'y': [float(v) for v in m.e2],
                            'size': m.size, 'gap': max((g for g, _ in m.gaps), default=0.0)})
     data: dict[str, Any] = {
         'name': builder.names('robot', description.name),
@@ -1055,4 +1104,28 @@ def planar_from_description(description: Description, actuated: Iterable[str] | 
     if builder.points:
         data['points'] = builder.points
     return Planar(data, tuple(builder.drivers), builder.joint_maps, mechanisms, actuated_names,
-                  dict(builder.names.changed))
+                  dict(builder.names.changed), _scene_masses(data, builder.mass_props))
+
+
+def _scene_masses(data: dict[str, Any], props: Mapping[str, tuple[float, complex, float]]
+                  ) -> dict[str, dict[str, Any]]:
+    """Return the scene's ``masses:``: each body's centre of mass in its own /tf frame.
+
+    The frames are the scene's at its drivers' start (the reference pose the
+    centres of mass were taken in).
+    """
+    if not props:
+        return {}
+    from ..geometry.frames import frames_from_scene, poses_from_state
+    from ..geometry.urdf import _assembled
+    from ..scene import parse_scene
+
+    scene = parse_scene(data)
+    state = _assembled(scene)
+    frames = frames_from_scene(scene, list(props))
+    out: dict[str, dict[str, Any]] = {}
+    for pose in poses_from_state(frames, state):
+        mass, com, inertia = props[pose.joint]
+        local = (com - complex(pose.x, pose.y)) * cmath.exp(-1j * pose.angle)
+        out[pose.joint] = {'mass': mass, 'com': [local.real, local.imag], 'inertia': inertia}
+    return out

@@ -58,10 +58,22 @@ def scene_yaml(planar: Planar, source: str) -> str:
     if planar.names:
         lines.append('# Scene names of URDF names: '
                      + ', '.join(f'{k} -> {v}' for k, v in planar.names.items()))
-    lines.append('# Masses from <inertial> are not written: this version of the scene format '
-                 'has no masses.')
-    body = yaml.safe_dump(planar.data, sort_keys=False, default_flow_style=None, width=99)
+    data = dict(planar.data)
+    if planar.masses:
+        lines.append("# masses: from each link's <inertial> (welded links added up); the URDF has "
+                     'no gravity: add')
+        lines.append('# gravity: [gx, gy] in the scene frame, whose x and y are, in the ground '
+                     "link's frame:")
+        for mechanism in planar.mechanisms:
+            lines.append(f"#   {mechanism['ground']}: x {_vector(mechanism['x'])}, "
+                         f"y {_vector(mechanism['y'])}")
+        data['masses'] = planar.masses
+    body = yaml.safe_dump(data, sort_keys=False, default_flow_style=None, width=99)
     return '\n'.join(lines) + '\n' + body
+
+
+def _vector(values: Any) -> str:
+    return '[' + ', '.join(f'{float(v):.12g}' for v in values) + ']'
 
 
 def _priority(joint: Any) -> int:

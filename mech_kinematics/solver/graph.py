@@ -54,7 +54,7 @@ THE_GROUND = '<ground>'
 class JointType(str):
     """A kind of joint, and what its coordinate means: a string, e.g. ``'revolute'``.
 
-    A ``JointType`` equals its name (``REVOLUTE == 'revolute'``), prints and
+    A ``JointType`` is equal to its name (``REVOLUTE`` and ``'revolute'``), prints and
     serializes as it, and carries the facts the rest of the package asks of
     it instead of comparing names:
 

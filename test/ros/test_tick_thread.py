@@ -202,7 +202,7 @@ class RefusingPublishing(Publishing):
 
 
 def test_a_publish_the_middleware_refuses_loses_that_state_not_the_node():
-    """RCLError on a publish: counted and said, the next instants published, no failure.
+    """A publish the middleware refuses (RCLError): counted, said, the next ones published.
 
     A reliable subscriber too slow for 5 kHz made Fast DDS refuse a publish in
     one CI run, and the node stopped (the tick thread's fatal error).

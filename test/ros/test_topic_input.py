@@ -214,7 +214,7 @@ def test_an_inactive_node_publishes_nothing():
 
 
 def test_a_publish_the_middleware_refuses_is_counted_and_the_next_message_published():
-    """RCLError on a publish (a reliable reader too slow): counted, said, the node goes on."""
+    """A publish refused (RCLError: a slow reliable reader): counted, said, the next one sent."""
     node, subscription, stats = _input('five_bar')
     publishing = subscription.publishing
     sent, refuse = [], [True]
