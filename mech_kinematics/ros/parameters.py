@@ -26,9 +26,10 @@ from ..units import NS_PER_S, rate_from_si, si_from_rate
 if TYPE_CHECKING:
     from ..solver.base import Driver
 
-__all__ = ['CATCH_UP', 'DRIVE_MODES', 'DRIVER_RATES', 'DriverRates', 'LATE_TICKS',
+__all__ = ['CATCH_UP', 'DRIVE_MODES', 'DRIVER_RATES', 'DriverRates', 'DYNAMIC', 'EFFORT_MODES',
+           'LATE_TICKS',
            'MAX_NAME_CHARS', 'MAX_PATH_CHARS', 'PARAMETERS', 'ParameterSpec', 'SHOWN_CHARS',
-           'SKIP', 'STATE_DEPTH', 'TIME', 'TOPIC', 'bounded_by_max_crank_speed',
+           'SKIP', 'STATE_DEPTH', 'STATIC', 'TIME', 'TOPIC', 'bounded_by_max_crank_speed',
            'catch_up_window_ns', 'depth_refusal', 'driver_parameters', 'first_crank_aliases',
            'frame_refusal', 'joint_refusal', 'rate_default', 'refusal', 'shown', 'spec']
 
@@ -40,6 +41,12 @@ LATE_TICKS = (CATCH_UP, SKIP)
 TIME = 'time'
 TOPIC = 'topic'
 DRIVE_MODES = (TIME, TOPIC)
+#: ``effort`` values: the forces of the motion the drive determines (inertia, gravity and
+#: loads; left out where the drive gives no accelerations: ``drive: topic``), or the statics
+#: (gravity and loads only, inertia neglected: velocities and accelerations taken as zero).
+DYNAMIC = 'dynamic'
+STATIC = 'static'
+EFFORT_MODES = (DYNAMIC, STATIC)
 #: Longest string parameter (a frame id, a prefix, a choice), characters.
 MAX_NAME_CHARS = 256
 #: Longest path parameter (``scene``), characters: Linux's PATH_MAX.
@@ -54,8 +61,9 @@ class ParameterSpec:
     ----------
     name : str
         The ROS parameter name.
-    kind : {'double', 'string', 'bool'}
+    kind : {'double', 'xy', 'string', 'bool'}
         Its type; an integer is accepted for a double (``-p rate_hz:=500``).
+        ``xy``: a double array of two finite numbers ``[x, y]`` (integers accepted).
     default : float, str, bool or None
         The default; ``None`` where the scene (or another parameter) gives it.
     description : str
@@ -112,6 +120,12 @@ PARAMETERS = (
                   'do: refuse the message, ignore them (the drivers are taken), or pass them '
                   "through unchanged in joint_states after the mechanism's joints",
                   choices=EXTRA_JOINTS, read_only=True),
+    ParameterSpec('effort', 'string', DYNAMIC,
+                  'For a scene with masses, gravity or loads, what joint_states.effort, '
+                  'reactions/* and shaking carry: dynamic (the forces of the motion: with '
+                  'drive: topic, whose input gives no accelerations, they are left out) or '
+                  'static (gravity and loads only, inertia neglected: every velocity and '
+                  'acceleration taken as zero)', choices=EFFORT_MODES, read_only=True),
     ParameterSpec('stamp_jump_back_s', 'double', DEFAULT_JUMP_BACK_S,
                   'With drive: topic, an input stamped earlier than the last published state '
                   'by more than this is a jump of the clock back: it is published and the '
@@ -375,6 +389,8 @@ def refusal(name: str, value: Any,
             return (f'{name}: expected {p.low:g} <= value <= {p.high:g} {p.unit}, got '
                     f'{number!r}').rstrip()
         return None
+    if p.kind == 'xy':
+        return _xy_refusal(name, value, p.unit)
     if p.kind == 'bool':
         if not isinstance(value, bool):
             return f'{name}: expected true or false, got {_kind_of(value)} {shown(value)}'
@@ -390,6 +406,20 @@ def refusal(name: str, value: Any,
         return f'{name}: expected a non-empty string, got {value!r}'
     if p.frame:
         return frame_refusal(name, value)
+    return None
+
+
+def _xy_refusal(name: str, value: Any, unit: str) -> str | None:
+    """Return why ``value`` is not ``[x, y]``, two finite numbers, or ``None``."""
+    if isinstance(value, (str, bytes)) or not isinstance(value, Sequence) and \
+            type(value).__name__ != 'array':
+        return (f'{name}: expected [x, y] ({unit}), got {_kind_of(value)} {shown(value)}')
+    items = list(value)
+    if len(items) != 2 or any(isinstance(v, bool) or not isinstance(v, (int, float))
+                              for v in items):
+        return f'{name}: expected [x, y], two numbers ({unit}), got {shown(items)}'
+    if not all(math.isfinite(float(v)) for v in items):
+        return f'{name}: expected two finite numbers ({unit}), got {shown(items)}'
     return None
 
 

@@ -8,7 +8,9 @@ QoS of the node's contract and the standard overrides) and publishes a tick's va
 from pre-serialized templates (:mod:`~mech_kinematics.ros.messages`,
 :mod:`~mech_kinematics.ros.tf`, :mod:`~mech_kinematics.ros.imus`): the three
 state messages every tick, the sensors' ``imu/NAME``, and ``/tf`` at
-``tf_rate_hz`` by stamp. At set-up it latches ``/tf_static``,
+``tf_rate_hz`` by stamp; on a scene whose forces it publishes
+(:meth:`Publishing.add_forces`), ``joint_states.effort``, ``reactions/JOINT``
+and ``shaking`` (:mod:`~mech_kinematics.ros.wrenches`). At set-up it latches ``/tf_static``,
 ``robot_description`` and ``scene``. :class:`Markers` builds the RViz
 markers in the executor's thread from the samples the tick thread hands over
 (at most 30 a second), so that the tick thread keeps its deadlines.
@@ -29,9 +31,12 @@ from typing import Any
 
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from geometry_msgs.msg import WrenchStamped
+from rclpy.exceptions import InvalidTopicNameException
 from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.qos import QoSDurabilityPolicy, QoSHistoryPolicy, QoSProfile, QoSReliabilityPolicy
 from rclpy.qos_overriding_options import QoSOverridingOptions, QoSPolicyKind
+from rclpy.validate_topic_name import validate_topic_name
 from sensor_msgs.msg import Imu, JointState
 from std_msgs.msg import String
 from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
@@ -46,6 +51,7 @@ from .messages import TickMessages
 from .parameters import STATE_DEPTH
 from .schedule import period_ns_from_rate
 from .tf import static_tf_message, TfMessages
+from .wrenches import ForceMessages, ForcesTick
 from ..errors import AssemblyError
 from ..geometry.diagrams import space_from_state, strokes_from_scene
 from ..geometry.frames import angle_joints, frames_from_scene, origin_points, sensor_offsets
@@ -173,6 +179,53 @@ class Publishing:
         self.tf_first = 3 * len(scene.output_joints) + 6 * len(scene.output_points)
         self.tf_period_ns = tf_period_ns(tf_rate_hz)
         self.next_tf = 0
+        #: The forces tick whose values carry the forces (None: no forces published).
+        self.forces: ForcesTick | None = None
+        self.efforts_first: int | None = None
+
+    def add_forces(self, forces: ForcesTick) -> None:
+        """Publish the forces of ``forces``' values: efforts, ``reactions/JOINT``, ``shaking``.
+
+        A joint whose name makes no valid ROS topic name (a URDF's ``a-b``) has
+        no reaction topic: said at set-up, one warning naming the joints.
+        """
+        joints, points = self.messages.joints, self.messages.points
+        self.efforts_first = forces.forces_first
+        self.messages = TickMessages(joints, points, self.frame_id,
+                                     efforts_first=forces.forces_first)
+        self.force_messages = ForceMessages(self.frame_id, len(joints), len(forces.reactions))
+        publish: list[Any] = []
+        invalid = []
+        for joint in forces.reactions:
+            topic = topics.reaction_topic(joint.name)
+            try:
+                validate_topic_name(topic)
+            except InvalidTopicNameException:
+                invalid.append(joint.name)
+                publish.append(None)
+                continue
+            publish.append(self._publisher(WrenchStamped, topic, state_qos()).publish)
+        publish.append(self._publisher(WrenchStamped, topics.SHAKING, state_qos()).publish)
+        self.publish_forces_to = tuple(publish)
+        if invalid:
+            self.node.get_logger().warning(
+                f'no reactions/JOINT topic for {", ".join(invalid)}: not valid in a ROS topic '
+                'name (letters, digits and _, not starting with a digit)')
+        self.forces = forces
+
+    def publish_forces(self, values: Sequence[float], sec: int, nanosec: int) -> None:
+        """Publish a tick's reactions and shaking, or say why its forces are left out."""
+        first = self.efforts_first
+        assert self.forces is not None and first is not None
+        if len(values) <= first:
+            self.node.get_logger().warning(f'forces not published: {self.forces.refusal}',
+                                           throttle_duration_sec=1.0)
+            return
+        for publish, data in zip(self.publish_forces_to,
+                                 self.force_messages.render(values, first, sec, nanosec),
+                                 strict=True):
+            if publish is not None:
+                publish(data)
 
     def close(self) -> None:
         """Destroy every publisher created."""
@@ -260,6 +313,8 @@ class Publishing:
         publish_js(joint_states)
         publish_jt(joint_accel)
         publish_pt(point_accel)
+        if self.forces is not None:
+            self.publish_forces(values, sec, nanosec)
         if self.imus is not None:
             self._publish_imus(values, sec, nanosec)
         if stamp >= self.next_tf:
