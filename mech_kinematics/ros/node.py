@@ -193,7 +193,8 @@ class KinematicsNode(LifecycleNode):
                                            self.get_logger().info, forces)
         if self._value('markers'):
             self._markers = Markers(self, scene, self.frame_id, lambda: (
-                self._value('marker_velocity_scale'), self._value('marker_acceleration_scale')))
+                self._value('marker_velocity_scale'), self._value('marker_acceleration_scale'),
+                self._value('marker_force_scale')), forces)
         if self._value('drive') == TOPIC:
             self._input = InputSubscription(
                 self, scene, self._solver, publishing, self._stats, frame_id=self.frame_id,

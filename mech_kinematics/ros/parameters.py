@@ -176,6 +176,10 @@ PARAMETERS = (
     ParameterSpec('marker_acceleration_scale', 'double', DEFAULT_ACCELERATION_SCALE,
                   'Length of the acceleration arrows on markers per unit acceleration',
                   'm per m/s^2', 0.0, 1000.0),
+    ParameterSpec('marker_force_scale', 'double', 0.0,
+                  'Length of the reaction arrows on markers per newton (a scene with masses, '
+                  "gravity or loads); 0: the largest drawn at 0.3 of the mechanism's size",
+                  'm per N', 0.0, 1000.0),
 )
 
 _BY_NAME = {p.name: p for p in PARAMETERS}

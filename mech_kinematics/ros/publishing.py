@@ -51,7 +51,7 @@ from .messages import TickMessages
 from .parameters import STATE_DEPTH
 from .schedule import period_ns_from_rate
 from .tf import static_tf_message, TfMessages
-from .wrenches import ForceMessages, ForcesTick
+from .wrenches import ForceMessages, ForcesTick, reaction_wrench
 from ..errors import AssemblyError
 from ..geometry.diagrams import space_from_state, strokes_from_scene
 from ..geometry.frames import angle_joints, frames_from_scene, origin_points, sensor_offsets
@@ -365,17 +365,25 @@ class Markers:
     frame_id : str
         The frame of the markers.
     scales : callable
-        ``scales()`` returns (velocity scale, acceleration scale) now (the
-        parameters ``marker_velocity_scale``, ``marker_acceleration_scale``).
+        ``scales()`` returns (velocity scale, acceleration scale, force scale)
+        now (the parameters ``marker_velocity_scale``,
+        ``marker_acceleration_scale``, ``marker_force_scale``).
+    forces : ForcesTick or None
+        On a scene whose forces the node publishes, its forces tick: the
+        reactions are drawn as arrows, solved with its current ``dynamics``
+        (``effort: static``: at rest).
     """
 
     def __init__(self, node: Any, scene: Any, frame_id: str,
-                 scales: Callable[[], tuple[float, float]]) -> None:
+                 scales: Callable[[], tuple[float, float, float]],
+                 forces: ForcesTick | None = None) -> None:
         self.node = node
         self.frame_id = frame_id
         self.scales = scales
         self.points = scene.output_points
-        self.scene = full_scene(scene)
+        self.forces = forces
+        # The motion alone (the forces, with the parameters' values, are the forces tick's).
+        self.scene = full_scene(scene if forces is None else forces.kinematics)
         self.strokes = strokes_from_scene(self.scene)
         try:
             self.size: float | None = marker_size_from_space(space_from_state(
@@ -412,10 +420,30 @@ class Markers:
         sec, nanosec, angle, speed, accel = request
         try:
             state = solve(self.scene, angle, speed, accel)
+            reactions = self._reactions(state, angle)
         except AssemblyError:
             return      # a part beyond the outputs cannot assemble: no markers this time
-        velocity_scale, acceleration_scale = self.scales()
+        velocity_scale, acceleration_scale, force_scale = self.scales()
         self.publisher.publish(marker_array_from_state(
             self.scene, state, frame_id=self.frame_id, stamp=Time(sec=sec, nanosec=nanosec),
             velocity_scale=velocity_scale, acceleration_scale=acceleration_scale,
-            points=self.points, size=self.size, strokes=self.strokes))
+            points=self.points, size=self.size, strokes=self.strokes, reactions=reactions,
+            force_scale=force_scale))
+
+    def _reactions(self, state: Any, angle: Any) -> list[tuple[complex, complex]]:
+        """Return each joint's point and the force on its body at ``state`` (none: no forces)."""
+        forces = self.forces
+        if forces is None:
+            return []
+        at = state
+        if forces.static:
+            rest = 0.0 if forces.drivers == 1 else (0.0,) * forces.drivers
+            at = solve(self.scene, angle, rest, rest)
+        solved = forces.dynamics.forces(at, math.inf)
+        if not solved.valid:    # the statics degenerate here: no arrows, never a guess
+            return []
+        out = []
+        for joint in forces.reactions:
+            fx, fy, _ = reaction_wrench(joint, solved, at)
+            out.append((complex(at.complex_points[joint.at][0]), complex(fx, fy)))
+        return out
