@@ -14,7 +14,7 @@ sides in the same run, alternating, medians of ``--repeat`` runs:
 - ``array``: ``mk.solve`` over a turn of 360 crank angles (or each driver's
   start with the positions swept) with the forces against the same scene's
   motion alone; goal within 2x;
-- ``node`` (``--node``): the node on a scene with forces at 1 kHz against
+- ``node`` (``--node``): the node on a scene with forces at 1 kHz (``--rate``) against
   the rclpy floor of ``node_bench.py`` publishing the same messages (the
   three state messages and one WrenchStamped per reaction and the shaking),
   CPU of the publishing process; goal within 1.3x.
@@ -223,8 +223,8 @@ def floor(namespace: str, rate: float, scene_name: str) -> None:
 
 def measure(kind: str, scene: str, args: argparse.Namespace, env: dict[str, str],
             tmp: Path) -> dict[str, float]:
-    """Run the node or the floor at 1 kHz on ``scene`` with a subscriber; return CPU, delivered."""
-    rate = 1000.0
+    """Run the node or the floor at ``--rate`` on ``scene`` with a subscriber; CPU, delivered."""
+    rate = args.rate
     namespace = f'/fbench_{os.getpid()}_{kind}_{random.randrange(10 ** 6)}'
     out = tmp / f'{namespace[1:]}.json'
     listen = args.warmup + args.seconds + 2.0
@@ -264,6 +264,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument('--profile', action='store_true', help="profile engine's forces tick")
     parser.add_argument('--node', action='store_true', help='the node at 1 kHz vs the floor')
     parser.add_argument('--scene', default='engine', help='the scene of --node')
+    parser.add_argument('--rate', type=float, default=1000.0, help='--node: rate_hz')
     parser.add_argument('--seconds', type=float, default=20.0, help='--node: time per run')
     parser.add_argument('--warmup', type=float, default=5.0, help='--node: settling time')
     parser.add_argument('--floor', nargs=3, help=argparse.SUPPRESS)
@@ -291,8 +292,8 @@ def main(argv: list[str] | None = None) -> int:
         f_cpu = [r['cpu'] for r in rows if r['kind'] == 'floor']
         n_cpu = [r['cpu'] for r in rows if r['kind'] == 'node']
         print(f'node on {args.scene} (forces) vs the floor publishing the same messages, '
-              f'1 kHz, {args.seconds:g} s per run; load average {os.getloadavg()[0]:.1f} at '
-              'the end\n')
+              f'{args.rate:g} Hz, {args.seconds:g} s per run; load average '
+              f'{os.getloadavg()[0]:.1f} at the end\n')
         print('| floor CPU % (runs) | node CPU % (runs) | node / floor (medians) | '
               'delivered floor / node (worst) |\n|---:|---:|---:|---:|')
         print(f'| {" / ".join(f"{c:.1f}" for c in f_cpu)} | '
