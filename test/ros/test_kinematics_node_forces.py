@@ -9,6 +9,7 @@ with their reason, good ones in effect from an instant on); with ``drive:
 topic`` no effort unless ``effort: static``, which diagnostics say.
 """
 
+from dataclasses import replace
 import math
 
 from diagnostic_msgs.msg import DiagnosticArray
@@ -21,7 +22,7 @@ from sensor_msgs.msg import JointState
 
 import mech_kinematics as mk
 from mech_kinematics.ros import topics
-from mech_kinematics.ros.wrenches import dynamics_with, ForcesTick
+from mech_kinematics.ros.wrenches import forces_values, reaction_joints
 
 SCENE = 'engine'
 #: The node's forces against mk.solve's at the position it published: the same doubles in,
@@ -31,14 +32,12 @@ RTOL_FORCES = 1e-12
 T0 = 1_700_000_000 * NS
 
 
-def _forces(scene, msg, dynamics=None):
+def _forces(scene, msg):
     """Return the forces' values mk.solve gives at a joint_states message's crank state."""
     crank = msg.name.index('crank')
-    tick = ForcesTick(scene, scene.output_joints, scene.output_points, (), static=False)
-    if dynamics is not None:
-        tick.dynamics = dynamics
-    values, _ = tick(msg.position[crank], msg.velocity[crank], 0.0, 1e-6, 0)
-    return values[tick.forces_first:], tick
+    state = mk.solve(scene, msg.position[crank], msg.velocity[crank], 0.0)
+    return forces_values(state.forces, state, scene.output_joints,
+                         reaction_joints(scene.dynamics))
 
 
 def _close(a, b):
@@ -56,10 +55,9 @@ class ForcesNode:
         self.ros = ros
         self.ns = f'{SESSION}/{name}'
         self.js = ros.collect(JointState, f'{self.ns}/joint_states')
-        tick = ForcesTick(mk.load_scene(SCENE), (), (), (), static=False)
         self.reactions = {j.name: ros.collect(WrenchStamped,
                                               f'{self.ns}/{topics.reaction_topic(j.name)}')
-                          for j in tick.reactions}
+                          for j in reaction_joints(mk.load_scene(SCENE).dynamics)}
         self.shaking = ros.collect(WrenchStamped, f'{self.ns}/{topics.SHAKING}')
         self.diag = ros.collect(DiagnosticArray, f'{self.ns}/diagnostics')
         self.proc = NodeProcess(tmp_path, '-r', f'__ns:={self.ns}', '-p', f'scene:={SCENE}',
@@ -114,7 +112,7 @@ def test_efforts_reactions_and_shaking_are_solves_at_the_same_instant(ros, tmp_p
     assert node.effort_status()[-1] == 'dynamic: inertia, gravity and loads'
     checked = 0
     for msg in node.js[:20]:
-        expected, _ = _forces(scene, msg)
+        expected = _forces(scene, msg)
         assert list(msg.effort[1:]) == [0.0, 0.0]     # the rod's and the piston's: passive
         assert msg.effort[0] != 0.0
         got = node.published(msg)
@@ -139,13 +137,13 @@ def test_gravity_and_loads_change_while_running(ros, tmp_path):
         assert node.set('gravity', [0, 0]).successful      # integers, as -p gives them
         assert node.set('loads.gas.force', [0.0, -1000.0]).successful
         assert node.get('gravity') == [0.0, 0.0]
-        changed = dynamics_with(scene.dynamics, {'gravity': [0.0, 0.0],
-                                                 'loads.gas.force': [0.0, -1000.0]})
+        [gas] = scene.loads
+        changed = replace(scene, gravity=(0.0, 0.0), loads=(replace(gas, force=(0.0, -1000.0)),))
         count = len(node.js)
 
         def new_forces():
             return [m for m in node.js[count:]
-                    if _close(node.published(m), _forces(scene, m, changed)[0])]
+                    if _close(node.published(m), _forces(changed, m))]
         wait_for(lambda: len(node.js) > count + 10 and new_forces(), STARTUP_S,
                  'a state with the new gravity and load')
     finally:
@@ -156,9 +154,9 @@ def test_gravity_and_loads_change_while_running(ros, tmp_path):
     later = [m for m in node.js if stamp_ns(m) > first and node.published(m) is not None]
     assert len(later) >= 10
     for m in later:
-        assert _close(node.published(m), _forces(scene, m, changed)[0])
+        assert _close(node.published(m), _forces(changed, m))
     for m in node.js[:5]:
-        assert _close(node.published(m), _forces(scene, m)[0])
+        assert _close(node.published(m), _forces(scene, m))
 
 
 def _topic_node(ros, tmp_path, name, *args):
@@ -201,9 +199,14 @@ def test_topic_drive_with_static_effort_publishes_the_statics(ros, tmp_path):
         wait_for(node.effort_status, STARTUP_S, 'diagnostics')
     finally:
         node.stop()
-    tick = ForcesTick(scene, scene.output_joints, scene.output_points, (), static=True)
+    reactions = reaction_joints(scene.dynamics)
     for msg in node.js[:3]:
-        values, _ = tick(msg.position[0], 50.0, 0.0, 1e-6, 0)
-        assert list(msg.velocity) == [float(v) for v in values[3:6]]
-        assert node.published(msg) == values[tick.forces_first:]
+        moving = mk.solve(scene, msg.position[0], 50.0, 0.0)
+        rest = mk.solve(scene, msg.position[0], 0.0, 0.0)
+        assert list(msg.velocity) == [float(moving.joints[j].velocity)
+                                      for j in scene.output_joints]
+        assert node.published(msg) == forces_values(rest.forces, rest, scene.output_joints,
+                                                    reactions)
+        inertia = forces_values(moving.forces, moving, scene.output_joints, reactions)
+        assert node.published(msg) != inertia
     assert node.effort_status()[-1] == 'static: gravity and loads only, inertia neglected'
