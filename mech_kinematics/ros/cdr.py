@@ -294,6 +294,12 @@ class MessageTemplate:
         ``marker(n_slots - 1)``; every other field holds its final value.
     n_slots : int
         Number of float64 slots.
+    where : sequence of int, optional
+        For each slot, the index of its value in the ``values`` of a render
+        (before ``first`` is added); by default slot ``i`` takes index ``i``. A
+        message whose values are not one run of a tick's values (a
+        ``JointState`` with positions, velocities and the efforts kept after
+        the frames) reads them where they are, without a copy.
 
     Raises
     ------
@@ -301,7 +307,10 @@ class MessageTemplate:
         If a marker is not found exactly once in the serialized bytes.
     """
 
-    def __init__(self, msg: Any, n_slots: int) -> None:
+    def __init__(self, msg: Any, n_slots: int, where: Sequence[int] | None = None) -> None:
+        if where is not None and len(where) != n_slots:
+            text = f'Expected one index per slot ({n_slots}), got {len(where)}'
+            raise ValueError(text)
         data = cdr_from_message(msg)
         self._stamp = struct.Struct('<iI')
         # One stamp, or several (a TFMessage has one per transform), all patched alike.
@@ -331,7 +340,7 @@ class MessageTemplate:
                 self._arguments += ['sec', 'nanosec']
             else:
                 fmt += 'd'
-                self._arguments.append(index)
+                self._arguments.append(index if where is None else int(where[index]))
             at = offset + 8
         if at < len(buffer):
             fmt += f'{len(buffer) - at}s'
@@ -342,6 +351,6 @@ class MessageTemplate:
     def render(self, sec: int, nanosec: int, values: Sequence[float], first: int = 0) -> bytes:
         """Return the serialized message with this stamp and slot values.
 
-        Slot ``i`` takes ``values[first + i]``.
+        Slot ``i`` takes ``values[first + i]`` (``values[first + where[i]]`` given ``where``).
         """
         return self._render(sec, nanosec, values, first)

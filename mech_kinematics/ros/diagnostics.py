@@ -254,7 +254,8 @@ def waiting_for(*, configured: bool, publishing: bool, managed: bool, clock: boo
 
 def solver_status(window: Window, *, name: str, hardware_id: str, near_singular: float,
                   waiting_for: str = '', assembly: str = '', extra_joints: str = '',
-                  solver_path: str = '') -> Status:
+                  solver_path: str = '',
+                  forces: Sequence[tuple[str, str]] = ()) -> Status:
     """Return the solver status of ``window``.
 
     ERROR if any instant could not be solved or was refused (with the last
@@ -272,7 +273,10 @@ def solver_status(window: Window, *, name: str, hardware_id: str, near_singular:
     ``assembly`` says in one line where the scene cannot assemble (key
     ``assembly``). ``solver_path`` says which function solves the ticks (key
     ``solver_path``): ``compiled``, or ``general: REASON`` where the tick
-    does not compile (:mod:`~mech_kinematics.ros.solver_path`).
+    does not compile (:mod:`~mech_kinematics.ros.solver_path`). ``forces``:
+    the keys of a scene with forces (``effort``: what the efforts are, and
+    how many instants' forces were left out, ``forces_left_out_total``, and
+    why the last was, ``last_forces_left_out``), added as they are.
     """
     w = window
     if waiting_for:
@@ -304,6 +308,7 @@ def solver_status(window: Window, *, name: str, hardware_id: str, near_singular:
         values.append(('solver_path', solver_path))
     if assembly:
         values.append(('assembly', assembly))
+    values += forces
     if extra_joints:
         values += [('extra_joints', extra_joints),
                    ('ignored_joints', _joint_list(w.ignored_joints)),

@@ -21,7 +21,11 @@ The array holds, in this order (``ns``, ``id``):
 - ``joints``, 0: one ``SPHERE_LIST`` of every named point, ground points dark;
 - ``velocity``, 0 .. m-1: one ``ARROW`` per arrow point, from the point to
   point + ``velocity_scale`` * v;
-- ``acceleration``, 0 .. m-1: the same with ``acceleration_scale`` * a.
+- ``acceleration``, 0 .. m-1: the same with ``acceleration_scale`` * a;
+- ``reactions``, 0 .. r-1: on a scene whose forces the node publishes, one
+  ``ARROW`` per joint from its point to point + ``force_scale`` * F, F the
+  force its reaction puts on the joint's body (:mod:`~mech_kinematics.ros.wrenches`;
+  a lock's, a moment only, is an arrow of no length).
 
 The count and the ids depend only on the scene, so every array replaces the
 previous one in RViz.
@@ -50,7 +54,9 @@ DEFAULT_ACCELERATION_SCALE = 0.01
 MAX_RATE_HZ = 30.0
 #: Marker namespaces, in the order of the array.
 NAMESPACES = ('links', 'guides', 'sliders', 'actuators', 'joints', 'velocity',
-              'acceleration')
+              'acceleration', 'reactions')
+#: The longest reaction arrow with ``force_scale`` 0 (automatic), a fraction of the size.
+AUTO_FORCE_LENGTH = 0.3
 
 # Sizes as fractions of the mechanism's size (marker_size_from_space).
 LINE_WIDTH = 0.012
@@ -69,6 +75,7 @@ SLIDER_RGBA = (0.55, 0.55, 0.6, 0.9)
 ACTUATOR_RGBA = (0.9, 0.75, 0.1, 0.9)
 VELOCITY_RGBA = (0.0, 0.6, 0.2, 1.0)
 ACCELERATION_RGBA = (0.85, 0.1, 0.1, 1.0)
+REACTION_RGBA = (0.75, 0.2, 0.85, 1.0)
 
 
 def _rgba(colour: str) -> tuple[float, float, float, float]:
@@ -89,7 +96,9 @@ def marker_array_from_state(scene: Scene, state: State, *, frame_id: str = 'mech
                             velocity_scale: float = DEFAULT_VELOCITY_SCALE,
                             acceleration_scale: float = DEFAULT_ACCELERATION_SCALE,
                             points: Sequence[str] | None = None, size: float | None = None,
-                            strokes: Mapping[str, tuple[float, float]] | None = None) -> Any:
+                            strokes: Mapping[str, tuple[float, float]] | None = None,
+                            reactions: Sequence[tuple[complex, complex]] = (),
+                            force_scale: float = 0.0) -> Any:
     """Return the mechanism of ``scene`` in ``state`` as a ``visualization_msgs/MarkerArray``.
 
     Parameters
@@ -116,6 +125,12 @@ def marker_array_from_state(scene: Scene, state: State, *, frame_id: str = 'mech
     strokes : mapping of str to (float, float), optional
         Range of each RRP slider's coordinate, m, over which its guide is drawn
         (:func:`~mech_kinematics.diagram.strokes_from_scene`).
+    reactions : sequence of (complex, complex)
+        Each joint's point and the force on its body (x + iy, m and N), drawn
+        as the ``reactions`` arrows.
+    force_scale : float
+        Arrow length per unit force, m per N, >= 0; 0 draws the largest
+        force :data:`AUTO_FORCE_LENGTH` of the mechanism's size long.
 
     Returns
     -------
@@ -132,7 +147,8 @@ def marker_array_from_state(scene: Scene, state: State, *, frame_id: str = 'mech
     from visualization_msgs.msg import Marker, MarkerArray
 
     for name, value in (('velocity_scale', velocity_scale),
-                        ('acceleration_scale', acceleration_scale)):
+                        ('acceleration_scale', acceleration_scale),
+                        ('force_scale', force_scale)):
         if not (math.isfinite(value) and value >= 0.0):
             msg = f'Expected `{name}` to be a finite number >= 0, got {value!r}'
             raise ValueError(msg)
@@ -202,6 +218,15 @@ def marker_array_from_state(scene: Scene, state: State, *, frame_id: str = 'mech
         for i, arrow in enumerate(arrows[first::2]):
             m = marker(ns, i, Marker.ARROW, rgba, shaft)
             m.points = [point(arrow.start), point(arrow.end)]
+    if reactions:
+        per_newton = force_scale
+        if per_newton == 0.0:
+            largest = max(abs(force) for _, force in reactions)
+            per_newton = AUTO_FORCE_LENGTH * unit / largest if largest > 0.0 else 0.0
+        for i, (at, force) in enumerate(reactions):
+            m = marker('reactions', i, Marker.ARROW, REACTION_RGBA, shaft)
+            end = at + per_newton * force
+            m.points = [point((at.real, at.imag)), point((end.real, end.imag))]
     return MarkerArray(markers=markers)
 
 

@@ -32,8 +32,10 @@ def _stamp(sec: int, nanosec: int) -> Time:
 
 
 def _joint_state(names: Sequence[str], frame_id: str, stamp: Time,
-                 position: list[float], velocity: list[float]) -> JointState:
-    msg = JointState(name=list(names), position=position, velocity=velocity)
+                 position: list[float], velocity: list[float],
+                 effort: list[float] | None = None) -> JointState:
+    msg = JointState(name=list(names), position=position, velocity=velocity,
+                     effort=effort or [])
     msg.header.stamp = stamp
     msg.header.frame_id = frame_id
     return msg
@@ -93,10 +95,19 @@ def _point_values(state: Any, names: Sequence[str]) -> tuple[list[float], ...]:
 
 
 def joint_state_from_state(state: Any, names: Sequence[str], frame_id: str,
-                           sec: int, nanosec: int) -> JointState:
-    """Return ``sensor_msgs/JointState``: name, position and velocity of the joints ``names``."""
+                           sec: int, nanosec: int, *, efforts: bool = False) -> JointState:
+    """Return ``sensor_msgs/JointState``: name, position and velocity of the joints ``names``.
+
+    With ``efforts``, ``effort`` holds each driver's effort from ``state.forces``
+    (N m for a crank, N for an actuator) and 0 for every other joint
+    (frictionless); without, it is empty.
+    """
     position, velocity, _ = _joint_values(state, names)
-    return _joint_state(names, frame_id, _stamp(sec, nanosec), position, velocity)
+    effort = None
+    if efforts:
+        given = state.forces.efforts
+        effort = [float(given[n]) if n in given else 0.0 for n in names]
+    return _joint_state(names, frame_id, _stamp(sec, nanosec), position, velocity, effort)
 
 
 def joint_trajectory_from_state(state: Any, names: Sequence[str], frame_id: str,
@@ -122,6 +133,12 @@ class TickMessages:
         Point names, in publish order.
     frame_id : str
         ``header.frame_id`` of every message.
+    efforts_first : int or None, keyword-only
+        Where each joint's effort sits in the values of a tick function that
+        solves forces (:class:`~mech_kinematics.ros.wrenches.ForcesTick`: one
+        per joint after the frames' poses); ``joint_states`` then carries them
+        in ``effort``. The values of an instant whose forces were left out end
+        before that index: its ``effort`` is empty. ``None``: never efforts.
     velocities, accelerations : bool, keyword-only
         Whether the messages carry the velocities, the accelerations. A
         quantity left out is an empty array (``velocity`` of a JointState,
@@ -137,7 +154,8 @@ class TickMessages:
     """
 
     def __init__(self, joints: Sequence[str], points: Sequence[str], frame_id: str, *,
-                 velocities: bool = True, accelerations: bool = True) -> None:
+                 velocities: bool = True, accelerations: bool = True,
+                 efforts_first: int | None = None) -> None:
         if accelerations and not velocities:
             msg = 'Expected velocities with accelerations (a template keeps a prefix of slots)'
             raise ValueError(msg)
@@ -155,6 +173,16 @@ class TickMessages:
                        slots(4 * npt, 2 * npt, a))
         self._joint_state = MessageTemplate(
             _joint_state(self.joints, frame_id, stamp, *joint_slots[:2]), (1 + v) * nj)
+        self.efforts_first = efforts_first
+        self._joint_state_efforts = None
+        if efforts_first is not None and nj:
+            # The efforts' slots follow the velocities' in the template and read the values
+            # where the forces tick puts them (MessageTemplate's ``where``).
+            n = (1 + v) * nj
+            self._joint_state_efforts = MessageTemplate(
+                _joint_state(self.joints, frame_id, stamp, *joint_slots[:2],
+                             slots(n, nj)), n + nj,
+                where=[*range(n), *range(efforts_first, efforts_first + nj)])
         self._joint_trajectory = MessageTemplate(_joint_trajectory(
             self.joints, frame_id, stamp, joint_slots), sum(map(len, joint_slots)))
         self._points = MessageTemplate(_multi_dof(self.points, frame_id, stamp, point_slots),
@@ -173,6 +201,9 @@ class TickMessages:
         (joints' positions, velocities, accelerations, then the points' positions,
         velocities, accelerations as x, y), which is the order of the slots.
         """
-        return (self._joint_state.render(sec, nanosec, values),
+        joint_state = self._joint_state
+        if self._joint_state_efforts is not None and len(values) > self.efforts_first:
+            joint_state = self._joint_state_efforts
+        return (joint_state.render(sec, nanosec, values),
                 self._joint_trajectory.render(sec, nanosec, values),
                 self._points.render(sec, nanosec, values, 3 * len(self.joints)))

@@ -13,7 +13,8 @@ module of its own, and :class:`KinematicsNode` wires them to one
 - the function that solves a tick (:mod:`~mech_kinematics.ros.solver_path`:
   compiled, or the general solver and why);
 - what it publishes (:mod:`~mech_kinematics.ros.publishing`: the state topics,
-  ``/tf``, the IMUs, markers, the descriptions);
+  ``/tf``, the IMUs, markers, the descriptions; on a scene with masses, gravity
+  or loads the forces, :mod:`~mech_kinematics.ros.wrenches`);
 - the tick thread (:mod:`~mech_kinematics.ros.tick_thread`) with ``drive:
   time``, or the input subscription (:mod:`~mech_kinematics.ros.topic_input`)
   with ``drive: topic``;
@@ -50,6 +51,7 @@ from .schedule import period_ns_from_rate
 from .solver_path import SolverPath
 from .tick_thread import TickThread, TickThreadError
 from .topic_input import InputSubscription
+from .wrenches import dynamics_with, effort_status, forces_tick, ForcesTick
 from ..solver.context import NEAR_SINGULAR
 from ..units import NS_PER_S
 
@@ -108,6 +110,7 @@ class KinematicsNode(LifecycleNode):
         self._publishing: Publishing | None = None
         self._markers: Markers | None = None
         self._input: InputSubscription | None = None
+        self._forces: ForcesTick | None = None
         failure = self.create_guard_condition(self._on_failure)
         self._ticks = TickThread(self.get_clock(), self._driver, self._stats, self.get_logger(),
                                  failure.trigger, lambda: not self.context.ok())
@@ -141,6 +144,10 @@ class KinematicsNode(LifecycleNode):
             self._solver.max_error = float(changes['max_relative_error'])
         if 'stamp_jump_back_s' in changes and self._input is not None:
             self._input.topic.jump_back_ns = round(changes['stamp_jump_back_s'] * NS_PER_S)
+        forces = self.params.force_changes(changes) if self.params is not None else {}
+        if forces and self._forces is not None:
+            # A new Dynamics over the same graph, read by the tick at its next instant.
+            self._forces.dynamics = dynamics_with(self._forces.dynamics, forces)
         if requested and not self._ticks.running:
             self._apply_now()   # not ticking: from the current instant
 
@@ -181,13 +188,20 @@ class KinematicsNode(LifecycleNode):
             self, scene, frame_id=self.frame_id, tf_prefix=self._value('tf_prefix'),
             tf_rate_hz=self._value('tf_rate_hz'), scene_path=self._value('scene'),
             source=source)
-        compile_later = self._solver.setup(
-            publishing.tick_scene, scene, [(f.origin, f.angle_of, f.angle)
-                                           for f in publishing.frames],
-            self.get_logger().info)
+        frames = [(f.origin, f.angle_of, f.angle) for f in publishing.frames]
+        self._forces = forces = forces_tick(scene, publishing.tick_scene, frames,
+                                            drive=self._value('drive'),
+                                            effort=self._value('effort'))
+        if forces is not None:
+            values = self.params.declare_forces(forces.dynamics)
+            forces.dynamics = dynamics_with(forces.dynamics, values)
+            publishing.add_forces(forces)
+        compile_later = self._solver.setup(publishing.tick_scene, scene, frames,
+                                           self.get_logger().info, forces)
         if self._value('markers'):
             self._markers = Markers(self, scene, self.frame_id, lambda: (
-                self._value('marker_velocity_scale'), self._value('marker_acceleration_scale')))
+                self._value('marker_velocity_scale'), self._value('marker_acceleration_scale'),
+                self._value('marker_force_scale')), forces)
         if self._value('drive') == TOPIC:
             self._input = InputSubscription(
                 self, scene, self._solver, publishing, self._stats, frame_id=self.frame_id,
@@ -229,7 +243,7 @@ class KinematicsNode(LifecycleNode):
         for part in (self._publishing, self._markers, self._input):
             if part is not None:
                 part.close()
-        self._publishing = self._markers = self._input = None
+        self._publishing = self._markers = self._input = self._forces = None
         self._solver.drop()      # a compile still running is not installed
         self.scene = None
         if self.params is not None:
@@ -267,6 +281,18 @@ class KinematicsNode(LifecycleNode):
 
     # -- diagnostics ----------------------------------------------------------
 
+    def _forces_status(self) -> list[tuple[str, str]]:
+        """Return the forces' keys of the solver status (none for a scene without forces)."""
+        if self.scene is None:
+            return []
+        effort = effort_status(self.scene, self._value('drive'), self._value('effort'))
+        if not effort:
+            return []
+        forces = self._forces
+        return [('effort', effort),
+                ('forces_left_out_total', str(forces.refused if forces else 0)),
+                ('last_forces_left_out', forces.refusal if forces else '')]
+
     def _publish_diagnostics(self) -> None:
         window = self._stats.take_window()
         name = self.get_name()
@@ -279,7 +305,7 @@ class KinematicsNode(LifecycleNode):
                           near_singular=NEAR_SINGULAR, waiting_for=waiting,
                           assembly=self._solver.assembly,
                           extra_joints=self.extra_joints if self._input else '',
-                          solver_path=self._solver.path),
+                          solver_path=self._solver.path, forces=self._forces_status()),
             timing_status(window, name=name, hardware_id=hardware_id,
                           rate_hz=self._value('rate_hz'),
                           max_lateness_ms=self._value('max_lateness_ms')),

@@ -34,6 +34,7 @@ from .drive import (DEFAULT_MAX_CRANK_SPEED_RPM, drive_start, DriveStart,
 from .parameters import (CATCH_UP, catch_up_window_ns, driver_parameters, first_crank_aliases,
                          joint_refusal, PARAMETERS, ParameterSpec, rate_default, refusal, spec)
 from .schedule import period_ns_from_rate
+from .wrenches import force_parameters
 from ..errors import SceneError
 
 if TYPE_CHECKING:
@@ -41,6 +42,7 @@ if TYPE_CHECKING:
 
     from .driver import TickDriver
     from ..solver.base import Driver
+    from ..solver.forces import Dynamics
     from ..solver.mechanism import Scene
 
 __all__ = ['DOUBLES', 'DRIVE', 'DriverParameters', 'JOINT_RULES', 'NodeParameters', 'READ_ONLY',
@@ -57,7 +59,7 @@ READ_ONLY = frozenset(p.name for p in PARAMETERS if p.read_only)
 START_LOGGED = ('scene', 'drive', 'crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm',
                 'rate_hz', 'late_ticks', 'max_catch_up_s', 'max_lateness_ms',
                 'max_relative_error', 'frame_id', 'tf_rate_hz', 'tf_prefix', 'use_sim_time',
-                'markers', 'managed', 'extra_joints', 'stamp_jump_back_s')
+                'markers', 'managed', 'extra_joints', 'effort', 'stamp_jump_back_s')
 
 
 def description(p: ParameterSpec) -> str:
@@ -183,6 +185,8 @@ class NodeParameters:
         #: Whether a scene is loaded (a set is logged then).
         self.loaded = False
         self.drivers = DriverParameters()
+        #: A scene's forces' parameters (``gravity``, ``loads.NAME.*``) by name, once declared.
+        self.forces: dict[str, ParameterSpec] = {}
         self._own: dict[str, bool] = {}
         self._declaring = False
         node.add_pre_set_parameters_callback(self._pre_set)
@@ -271,6 +275,38 @@ class NodeParameters:
             self._declaring = False
         return [drive_start(d, self.driver_values(d), self._own[d.name]) for d in drivers]
 
+    # -- a scene's forces ------------------------------------------------------
+
+    def declare_forces(self, dynamics: Dynamics) -> dict[str, Any]:
+        """Declare ``gravity`` and each load's ``loads.NAME.*``; return their values.
+
+        The defaults are the scene's; a value given at start is checked like
+        one set later (refused: the node does not start).
+        """
+        self.forces = {p.name: p for p in force_parameters(dynamics)}
+        self._declaring = True
+        try:
+            for p in self.forces.values():
+                if not self.node.has_parameter(p.name):
+                    descriptor = ParameterDescriptor(description=description(p),
+                                                     dynamic_typing=True)
+                    self.node.declare_parameter(p.name, p.default, descriptor)
+                value = self.value(p.name)
+                if p.kind == 'xy' and not isinstance(value, str) and \
+                        any(type(v) is int for v in value):
+                    self.node.set_parameters([Parameter(
+                        p.name, Parameter.Type.DOUBLE_ARRAY, [float(v) for v in value])])
+                elif type(value) is int:
+                    self.node.set_parameters(
+                        [Parameter(p.name, Parameter.Type.DOUBLE, float(value))])
+        finally:
+            self._declaring = False
+        return {name: self.value(name) for name in self.forces}
+
+    def force_changes(self, changes: Mapping[str, Any]) -> dict[str, Any]:
+        """Return the accepted ``changes`` that are the forces' parameters."""
+        return {name: value for name, value in changes.items() if name in self.forces}
+
     def _set_atomically(self, scene: Scene, parameters: list[Parameter]) -> None:
         result = self.node.set_parameters_atomically(parameters)
         if not result.successful:
@@ -291,7 +327,7 @@ class NodeParameters:
         (``extra_joints``); ``robot``: in URDF mode, the robot (its joints
         are the ones published).
         """
-        names = (*START_LOGGED, *self.drivers.specs)
+        names = (*START_LOGGED, *self.drivers.specs, *self.forces)
         effective = effective or {}
         settings = ', '.join(f'{name}={effective.get(name, self.value(name))!r}'
                              for name in names[1:])
@@ -307,7 +343,8 @@ class NodeParameters:
     # -- rclpy's callbacks ----------------------------------------------------
 
     def _is_double(self, name: str) -> bool:
-        return name in DOUBLES or name in self.drivers.specs
+        return name in DOUBLES or name in self.drivers.specs or (
+            name in self.forces and self.forces[name].kind == 'double')
 
     def _pre_set(self, parameters: list[Parameter]) -> list[Parameter]:
         """Turn an integer given for a double into a double (rclcpp#979); log read-only sets.
@@ -320,8 +357,10 @@ class NodeParameters:
                 self.node.get_logger().warning(
                     f'parameter refused: {p.name}: read-only (set it at start), got {p.value!r}')
         parameters = [Parameter(p.name, Parameter.Type.DOUBLE, float(p.value))
-                      if self._is_double(p.name) and p.type_ == Parameter.Type.INTEGER else p
-                      for p in parameters]
+                      if self._is_double(p.name) and p.type_ == Parameter.Type.INTEGER else
+                      Parameter(p.name, Parameter.Type.DOUBLE_ARRAY, [float(v) for v in p.value])
+                      if p.name in self.forces and p.type_ == Parameter.Type.INTEGER_ARRAY
+                      else p for p in parameters]
         if self._declaring:
             return parameters
         return self.drivers.with_aliases(parameters)
@@ -330,11 +369,12 @@ class NodeParameters:
         """Refuse a value of the wrong type or out of range, or one that breaks a joint rule."""
         reason = None
         specs = self.drivers.specs
+        known = {**specs, **self.forces} if self.forces else specs
         for p in parameters:
             if p.type_ == Parameter.Type.NOT_SET and not self.node.has_parameter(p.name) \
                     and spec_default_is_none(p.name):
                 continue    # declared unset: the scene gives it at configure
-            reason = refusal(p.name, p.value, specs or None)
+            reason = refusal(p.name, p.value, known or None)
             if reason is not None:
                 break
         if reason is None:

@@ -26,9 +26,10 @@ from ..units import NS_PER_S, rate_from_si, si_from_rate
 if TYPE_CHECKING:
     from ..solver.base import Driver
 
-__all__ = ['CATCH_UP', 'DRIVE_MODES', 'DRIVER_RATES', 'DriverRates', 'LATE_TICKS',
+__all__ = ['CATCH_UP', 'DRIVE_MODES', 'DRIVER_RATES', 'DriverRates', 'DYNAMIC', 'EFFORT_MODES',
+           'LATE_TICKS',
            'MAX_NAME_CHARS', 'MAX_PATH_CHARS', 'PARAMETERS', 'ParameterSpec', 'SHOWN_CHARS',
-           'SKIP', 'STATE_DEPTH', 'TIME', 'TOPIC', 'bounded_by_max_crank_speed',
+           'SKIP', 'STATE_DEPTH', 'STATIC', 'TIME', 'TOPIC', 'bounded_by_max_crank_speed',
            'catch_up_window_ns', 'depth_refusal', 'driver_parameters', 'extra_joints_default',
            'first_crank_aliases', 'frame_refusal', 'joint_refusal', 'rate_default', 'refusal',
            'shown', 'spec']
@@ -41,6 +42,12 @@ LATE_TICKS = (CATCH_UP, SKIP)
 TIME = 'time'
 TOPIC = 'topic'
 DRIVE_MODES = (TIME, TOPIC)
+#: ``effort`` values: the forces of the motion the drive determines (inertia, gravity and
+#: loads; left out where the drive gives no accelerations: ``drive: topic``), or the statics
+#: (gravity and loads only, inertia neglected: velocities and accelerations taken as zero).
+DYNAMIC = 'dynamic'
+STATIC = 'static'
+EFFORT_MODES = (DYNAMIC, STATIC)
 #: Longest string parameter (a frame id, a prefix, a choice), characters.
 MAX_NAME_CHARS = 256
 #: Longest path parameter (``scene``), characters: Linux's PATH_MAX.
@@ -55,8 +62,9 @@ class ParameterSpec:
     ----------
     name : str
         The ROS parameter name.
-    kind : {'double', 'string', 'bool', 'string_array'}
+    kind : {'double', 'xy', 'string', 'bool', 'string_array'}
         Its type; an integer is accepted for a double (``-p rate_hz:=500``).
+        ``xy``: a double array of two finite numbers ``[x, y]`` (integers accepted).
     default : float, str, bool or None
         The default; ``None`` where the scene (or another parameter) gives it.
     description : str
@@ -127,6 +135,12 @@ PARAMETERS = (
                   "through unchanged in joint_states after the mechanism's joints. Defaults "
                   'to refuse, and to pass in URDF mode',
                   choices=EXTRA_JOINTS, read_only=True),
+    ParameterSpec('effort', 'string', DYNAMIC,
+                  'For a scene with masses, gravity or loads, what joint_states.effort, '
+                  'reactions/* and shaking carry: dynamic (the forces of the motion: with '
+                  'drive: topic, whose input gives no accelerations, they are left out) or '
+                  'static (gravity and loads only, inertia neglected: every velocity and '
+                  'acceleration taken as zero)', choices=EFFORT_MODES, read_only=True),
     ParameterSpec('stamp_jump_back_s', 'double', DEFAULT_JUMP_BACK_S,
                   'With drive: topic, an input stamped earlier than the last published state '
                   'by more than this is a jump of the clock back: it is published and the '
@@ -177,6 +191,10 @@ PARAMETERS = (
     ParameterSpec('marker_acceleration_scale', 'double', DEFAULT_ACCELERATION_SCALE,
                   'Length of the acceleration arrows on markers per unit acceleration',
                   'm per m/s^2', 0.0, 1000.0),
+    ParameterSpec('marker_force_scale', 'double', 0.0,
+                  'Length of the reaction arrows on markers per newton (a scene with masses, '
+                  "gravity or loads); 0: the largest drawn at 0.3 of the mechanism's size",
+                  'm per N', 0.0, 1000.0),
 )
 
 _BY_NAME = {p.name: p for p in PARAMETERS}
@@ -390,6 +408,8 @@ def refusal(name: str, value: Any,
             return (f'{name}: expected {p.low:g} <= value <= {p.high:g} {p.unit}, got '
                     f'{number!r}').rstrip()
         return None
+    if p.kind == 'xy':
+        return _xy_refusal(name, value, p.unit)
     if p.kind == 'bool':
         if not isinstance(value, bool):
             return f'{name}: expected true or false, got {_kind_of(value)} {shown(value)}'
@@ -425,6 +445,20 @@ def _names_refusal(name: str, value: Any) -> str | None:
 def extra_joints_default(urdf: bool) -> str:
     """Return ``extra_joints``' default: ``pass`` in URDF mode, else ``refuse``."""
     return PASS if urdf else REFUSE
+
+
+def _xy_refusal(name: str, value: Any, unit: str) -> str | None:
+    """Return why ``value`` is not ``[x, y]``, two finite numbers, or ``None``."""
+    if isinstance(value, (str, bytes)) or not isinstance(value, Sequence) and \
+            type(value).__name__ != 'array':
+        return (f'{name}: expected [x, y] ({unit}), got {_kind_of(value)} {shown(value)}')
+    items = list(value)
+    if len(items) != 2 or any(isinstance(v, bool) or not isinstance(v, (int, float))
+                              for v in items):
+        return f'{name}: expected [x, y], two numbers ({unit}), got {shown(items)}'
+    if not all(math.isfinite(float(v)) for v in items):
+        return f'{name}: expected two finite numbers ({unit}), got {shown(items)}'
+    return None
 
 
 def joint_refusal(values: Mapping[str, Any]) -> str | None:

@@ -8,7 +8,9 @@ QoS of the node's contract and the standard overrides) and publishes a tick's va
 from pre-serialized templates (:mod:`~mech_kinematics.ros.messages`,
 :mod:`~mech_kinematics.ros.tf`, :mod:`~mech_kinematics.ros.imus`): the three
 state messages every tick, the sensors' ``imu/NAME``, and ``/tf`` at
-``tf_rate_hz`` by stamp. At set-up it latches ``/tf_static``,
+``tf_rate_hz`` by stamp; on a scene whose forces it publishes
+(:meth:`Publishing.add_forces`), ``joint_states.effort``, ``reactions/JOINT``
+and ``shaking`` (:mod:`~mech_kinematics.ros.wrenches`). At set-up it latches ``/tf_static``,
 ``robot_description`` and ``scene``. :class:`Markers` builds the RViz
 markers in the executor's thread from the samples the tick thread hands over
 (at most 30 a second), so that the tick thread keeps its deadlines.
@@ -29,9 +31,12 @@ from typing import Any
 
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from geometry_msgs.msg import WrenchStamped
+from rclpy.exceptions import InvalidTopicNameException
 from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.qos import QoSDurabilityPolicy, QoSHistoryPolicy, QoSProfile, QoSReliabilityPolicy
 from rclpy.qos_overriding_options import QoSOverridingOptions, QoSPolicyKind
+from rclpy.validate_topic_name import validate_topic_name
 from sensor_msgs.msg import Imu, JointState
 from std_msgs.msg import String
 from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
@@ -47,6 +52,7 @@ from .parameters import STATE_DEPTH
 from .robot_mode import RobotValues, Source
 from .schedule import period_ns_from_rate
 from .tf import static_tf_message, TfMessages
+from .wrenches import ForceMessages, ForcesTick, reaction_wrench
 from ..errors import AssemblyError
 from ..geometry.diagrams import space_from_state, strokes_from_scene
 from ..geometry.frames import angle_joints, frames_from_scene, origin_points, sensor_offsets
@@ -188,6 +194,53 @@ class Publishing:
         self.tf_first = 3 * len(scene.output_joints) + 6 * len(scene.output_points)
         self.tf_period_ns = tf_period_ns(tf_rate_hz)
         self.next_tf = 0
+        #: The forces tick whose values carry the forces (None: no forces published).
+        self.forces: ForcesTick | None = None
+        self.efforts_first: int | None = None
+
+    def add_forces(self, forces: ForcesTick) -> None:
+        """Publish the forces of ``forces``' values: efforts, ``reactions/JOINT``, ``shaking``.
+
+        A joint whose name makes no valid ROS topic name (a URDF's ``a-b``) has
+        no reaction topic: said at set-up, one warning naming the joints.
+        """
+        joints, points = self.messages.joints, self.messages.points
+        self.efforts_first = forces.forces_first
+        self.messages = TickMessages(joints, points, self.frame_id,
+                                     efforts_first=forces.forces_first)
+        self.force_messages = ForceMessages(self.frame_id, len(joints), len(forces.reactions))
+        publish: list[Any] = []
+        invalid = []
+        for joint in forces.reactions:
+            topic = topics.reaction_topic(joint.name)
+            try:
+                validate_topic_name(topic)
+            except InvalidTopicNameException:
+                invalid.append(joint.name)
+                publish.append(None)
+                continue
+            publish.append(self._publisher(WrenchStamped, topic, state_qos()).publish)
+        publish.append(self._publisher(WrenchStamped, topics.SHAKING, state_qos()).publish)
+        self.publish_forces_to = tuple(publish)
+        if invalid:
+            self.node.get_logger().warning(
+                f'no reactions/JOINT topic for {", ".join(invalid)}: not valid in a ROS topic '
+                'name (letters, digits and _, not starting with a digit)')
+        self.forces = forces
+
+    def publish_forces(self, values: Sequence[float], sec: int, nanosec: int) -> None:
+        """Publish a tick's reactions and shaking, or say why its forces are left out."""
+        first = self.efforts_first
+        assert self.forces is not None and first is not None
+        if len(values) <= first:
+            self.node.get_logger().warning(f'forces not published: {self.forces.refusal}',
+                                           throttle_duration_sec=1.0)
+            return
+        for publish, data in zip(self.publish_forces_to,
+                                 self.force_messages.render(values, first, sec, nanosec),
+                                 strict=True):
+            if publish is not None:
+                publish(data)
 
     def close(self) -> None:
         """Destroy every publisher created."""
@@ -282,6 +335,8 @@ class Publishing:
         publish_js(joint_states)
         publish_jt(joint_accel)
         publish_pt(point_accel)
+        if self.forces is not None:
+            self.publish_forces(values, sec, nanosec)
         if self.imus is not None:
             self._publish_imus(values, sec, nanosec)
         if stamp >= self.next_tf:
@@ -332,17 +387,25 @@ class Markers:
     frame_id : str
         The frame of the markers.
     scales : callable
-        ``scales()`` returns (velocity scale, acceleration scale) now (the
-        parameters ``marker_velocity_scale``, ``marker_acceleration_scale``).
+        ``scales()`` returns (velocity scale, acceleration scale, force scale)
+        now (the parameters ``marker_velocity_scale``,
+        ``marker_acceleration_scale``, ``marker_force_scale``).
+    forces : ForcesTick or None
+        On a scene whose forces the node publishes, its forces tick: the
+        reactions are drawn as arrows, solved with its current ``dynamics``
+        (``effort: static``: at rest).
     """
 
     def __init__(self, node: Any, scene: Any, frame_id: str,
-                 scales: Callable[[], tuple[float, float]]) -> None:
+                 scales: Callable[[], tuple[float, float, float]],
+                 forces: ForcesTick | None = None) -> None:
         self.node = node
         self.frame_id = frame_id
         self.scales = scales
         self.points = scene.output_points
-        self.scene = full_scene(scene)
+        self.forces = forces
+        # The motion alone (the forces, with the parameters' values, are the forces tick's).
+        self.scene = full_scene(scene if forces is None else forces.kinematics)
         self.strokes = strokes_from_scene(self.scene)
         try:
             self.size: float | None = marker_size_from_space(space_from_state(
@@ -379,10 +442,30 @@ class Markers:
         sec, nanosec, angle, speed, accel = request
         try:
             state = solve(self.scene, angle, speed, accel)
+            reactions = self._reactions(state, angle)
         except AssemblyError:
             return      # a part beyond the outputs cannot assemble: no markers this time
-        velocity_scale, acceleration_scale = self.scales()
+        velocity_scale, acceleration_scale, force_scale = self.scales()
         self.publisher.publish(marker_array_from_state(
             self.scene, state, frame_id=self.frame_id, stamp=Time(sec=sec, nanosec=nanosec),
             velocity_scale=velocity_scale, acceleration_scale=acceleration_scale,
-            points=self.points, size=self.size, strokes=self.strokes))
+            points=self.points, size=self.size, strokes=self.strokes, reactions=reactions,
+            force_scale=force_scale))
+
+    def _reactions(self, state: Any, angle: Any) -> list[tuple[complex, complex]]:
+        """Return each joint's point and the force on its body at ``state`` (none: no forces)."""
+        forces = self.forces
+        if forces is None:
+            return []
+        at = state
+        if forces.static:
+            rest = 0.0 if forces.drivers == 1 else (0.0,) * forces.drivers
+            at = solve(self.scene, angle, rest, rest)
+        solved = forces.dynamics.forces(at, math.inf)
+        if not solved.valid:    # the statics degenerate here: no arrows, never a guess
+            return []
+        out = []
+        for joint in forces.reactions:
+            fx, fy, _ = reaction_wrench(joint, solved, at)
+            out.append((complex(at.complex_points[joint.at][0]), complex(fx, fy)))
+        return out

@@ -20,6 +20,11 @@ its set-up is done); the compiled function takes over the next tick after it
 is made, so a long chain is published from the start instead of after
 minutes.
 
+On a scene whose forces the node publishes (a :class:`~mech_kinematics.ros.wrenches.ForcesTick`
+handed to :meth:`SolverPath.setup`), the forces tick serves: the forces are
+solved at a solved state, which the compiled tick does not make, so the path
+is ``general: `` and :data:`FORCES`.
+
 No ROS: the node hands over its logger's ``info``. Tested in
 ``test/ros/test_solver_path.py``.
 """
@@ -40,7 +45,7 @@ if TYPE_CHECKING:
     from ..solver.compiler import FrameSpec, TickFunction
     from ..solver.mechanism import Scene
 
-__all__ = ['BACKGROUND_STEPS', 'COMPILED', 'COMPILING', 'GENERAL', 'SolverPath']
+__all__ = ['BACKGROUND_STEPS', 'COMPILED', 'COMPILING', 'FORCES', 'GENERAL', 'SolverPath']
 
 #: A scene of more dyads and points than this compiles its tick in the background.
 BACKGROUND_STEPS = 16
@@ -50,6 +55,9 @@ COMPILED = 'compiled'
 GENERAL = 'solved by the general solver'
 #: The general path's reason while the tick compiles in the background.
 COMPILING = 'its tick compiles in the background'
+#: The general path's reason where the node publishes forces.
+FORCES = ('the forces are solved at a solved state (solver/forces.py), which the compiled '
+          'tick does not make')
 
 
 class SolverPath:
@@ -85,12 +93,14 @@ class SolverPath:
         self._token: object | None = None
 
     def setup(self, tick_scene: Scene, scene: Scene, frames: Sequence[FrameSpec],
-              log: Callable[[str], None]) -> threading.Thread | None:
+              log: Callable[[str], None],
+              forces: TickFunction | None = None) -> threading.Thread | None:
         """Set the tick function of ``tick_scene``; return a thread to start, or ``None``.
 
         ``tick_scene`` is ``scene`` outputting what ``frames`` (origin, angle
         joint, fixed angle) need too; the function returns the values of
         ``scene``'s outputs and of the frames. ``log`` takes the info lines.
+        ``forces``: the forces tick, which then serves (nothing is compiled).
         The thread (not started: started once the rest of the set-up is done,
         as a thread holding the GIL slows every release and re-acquisition of
         it by the node's) sweeps and compiles a long scene in the background.
@@ -101,6 +111,13 @@ class SolverPath:
         self._token = token = object()     # a later set-up or drop() makes this one stale
         self.jumps_at = tick_scene.jumps_at if tick_scene.intermittent else None
         self.assembly = ''
+        if forces is not None:
+            if sweep and steps <= BACKGROUND_STEPS:
+                self.assembly = assembly_summary(scene)
+            self.solve = forces
+            self.path = f'general: {FORCES}'
+            log(f'{GENERAL}: {FORCES}')
+            return None
         if steps <= BACKGROUND_STEPS:
             if sweep:
                 self.assembly = assembly_summary(scene)

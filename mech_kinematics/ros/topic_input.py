@@ -23,6 +23,7 @@ Thread use: the executor's thread only.
 
 from __future__ import annotations
 
+import math
 import time
 from typing import Any, TYPE_CHECKING
 
@@ -100,8 +101,11 @@ class InputSubscription:
         if robot is not None:
             joints, drivers = robot.names, robot.drivers
         # What the input determines: positions always, velocities when a message has them.
+        # With effort: static (publishing.forces), each joint's effort too.
         self.messages = {known: TickMessages(joints, points, frame_id, velocities=known,
-                                             accelerations=False) for known in (True, False)}
+                                             accelerations=False,
+                                             efforts_first=publishing.efforts_first)
+                         for known in (True, False)}
         self.topic = TopicDrive(drivers, extra_joints=extra_joints,
                                 jump_back_ns=round(jump_back_s * NS_PER_S),
                                 published_joints=joints)
@@ -165,6 +169,8 @@ class InputSubscription:
         try:
             for publish, data in zip(publishing.publish_state, rendered, strict=True):
                 publish(data)
+            if publishing.forces is not None:
+                publishing.publish_forces(values, sec, nanosec)
         except RCLError as exc:    # the middleware refused: this input's state is lost
             reason = str(exc).split(',', 1)[0]
             stats.publish_failed(given.stamp_ns, time.monotonic_ns() - received, False, reason)
@@ -199,6 +205,11 @@ class InputSubscription:
         the message itself.
         """
         name, position, velocity, effort = self.topic.joint_state_arrays(given, values)
+        first = self.publishing.efforts_first
+        if first is not None and len(values) > first:   # effort: static: the mechanism's
+            n = len(self.topic.published_joints)
+            effort = [*values[first:first + n],
+                      *(effort[n:] if effort else [math.nan] * (len(name) - n))]
         key = (tuple(name), bool(velocity), bool(effort))
         template = self._passed.get(key)
         if template is None and key not in self._passed:

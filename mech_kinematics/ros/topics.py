@@ -10,8 +10,9 @@ from __future__ import annotations
 
 __all__ = ['DIAGNOSTICS', 'IMU', 'IMU_TYPE', 'INPUT_JOINT_STATES', 'JOINT_ACCELERATIONS',
            'JOINT_STATES', 'MARKERS',
-           'POINT_ACCELERATIONS', 'ROBOT_DESCRIPTION', 'SCENE', 'STATE_TOPICS', 'TF',
-           'TF_STATIC', 'TYPES', 'imu_topic']
+           'POINT_ACCELERATIONS', 'REACTIONS', 'ROBOT_DESCRIPTION', 'SCENE', 'SHAKING',
+           'STATE_TOPICS', 'TF', 'TF_STATIC', 'TYPES', 'WRENCH_TYPE', 'imu_topic',
+           'reaction_topic']
 
 JOINT_STATES = 'joint_states'
 JOINT_ACCELERATIONS = 'joint_accelerations'
@@ -32,6 +33,13 @@ INPUT_JOINT_STATES = 'input_joint_states'
 IMU = 'imu'
 IMU_TYPE = 'sensor_msgs/msg/Imu'
 
+#: The namespace of the joints' reactions: ``reactions/JOINT``, one per joint of the
+#: mechanism's graph (a scene with masses, gravity or loads), each of type :data:`WRENCH_TYPE`.
+REACTIONS = 'reactions'
+#: The shaking force and moment the mechanism puts on its frame, of type :data:`WRENCH_TYPE`.
+SHAKING = 'shaking'
+WRENCH_TYPE = 'geometry_msgs/msg/WrenchStamped'
+
 #: The topics of the kinematic state, published together at every instant.
 STATE_TOPICS = (JOINT_STATES, JOINT_ACCELERATIONS, POINT_ACCELERATIONS)
 
@@ -47,9 +55,19 @@ TYPES = {
     ROBOT_DESCRIPTION: 'std_msgs/msg/String',
     SCENE: 'std_msgs/msg/String',
     INPUT_JOINT_STATES: 'sensor_msgs/msg/JointState',
+    SHAKING: WRENCH_TYPE,
 }
 
 
 def imu_topic(name: str) -> str:
     """Return the topic of the scene's sensor ``name``: ``imu/NAME`` (relative)."""
     return f'{IMU}/{name}'
+
+
+def reaction_topic(joint: str) -> str:
+    """Return the topic of the reaction at the graph's joint ``joint``: ``reactions/JOINT``.
+
+    A joint named ``POINT/BODY`` (several pins at one point) makes a
+    sub-namespace, which ROS names allow.
+    """
+    return f'{REACTIONS}/{joint}'

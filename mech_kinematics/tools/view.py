@@ -9,9 +9,11 @@ namespaces and remaps apply) and serves one page on ``http://127.0.0.1:PORT/``
 fixes the drawing's size in pixels): the mechanism drawn
 to scale as it moves (links, ground pivots, slider blocks and guides, the
 published points, their traces over the last turn, optional velocity and
-acceleration arrows), the solver and timing status of ``diagnostics``, and a
-speed control for each driver that sets the node's parameter
-(``crank_speed_rpm`` for a first driver that is a crank, else
+acceleration arrows and, for a scene with masses, gravity or loads, optional
+arrows of the reactions the node publishes on ``reactions/JOINT``, at the
+joints, scaled so that the largest is a fifth of the drawing), the solver
+and timing status of ``diagnostics``, and a speed control for each driver
+that sets the node's parameter (``crank_speed_rpm`` for a first driver that is a crank, else
 ``inputs.NAME.speed_rpm`` or, for an actuator, ``inputs.NAME.speed``, through
 ``rcl_interfaces/srv/SetParameters``).
 
@@ -41,6 +43,7 @@ import argparse
 import base64
 from collections import deque
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 import hashlib
 import hmac
 import http.server
@@ -199,6 +202,8 @@ def frame_from_state(scene: Any, position: float | Sequence[float],
     from ..geometry.instant_centres import full_scene
 
     full = full_scene(scene)
+    if full.dynamics is not None:   # the motion alone: the forces drawn are the node's
+        full = replace(full, gravity=None, masses=(), loads=())
     count = len(full.drivers)
     positions = [position] if isinstance(position, (int, float)) else list(position)
     speeds = [speed] if isinstance(speed, (int, float)) else list(speed)
@@ -297,6 +302,8 @@ class _Latest:
         self.statuses: list[dict[str, Any]] = []
         self.values: dict[str, str] = {}
         self.stamp = 0.0
+        #: joint name -> (its point, [fx, fy] N) as last published on reactions/JOINT.
+        self.reactions: dict[str, tuple[str, list[float]]] = {}
 
 
 class ViewServer:
@@ -334,6 +341,7 @@ class ViewServer:
 
         self.node = node
         self.latest = _Latest()
+        self._reaction_subscriptions: list[Any] = []
         self.token = secrets.token_urlsafe(32)
         self.refusals: deque[str] = deque(maxlen=REFUSALS_KEPT)
         latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
@@ -386,6 +394,40 @@ class ViewServer:
             self.latest.scene_error = ''
             self.latest.traces = {}
             self.latest.cadence = _Cadence()
+            self.latest.reactions = {}
+        self._subscribe_reactions(scene)
+
+    def _subscribe_reactions(self, scene: Any) -> None:
+        """Subscribe ``reactions/JOINT`` of each joint of a scene with forces (none else)."""
+        from geometry_msgs.msg import WrenchStamped
+        from rclpy.exceptions import InvalidTopicNameException
+        from rclpy.qos import qos_profile_sensor_data
+        from rclpy.validate_topic_name import validate_topic_name
+
+        old, self._reaction_subscriptions = self._reaction_subscriptions, []
+        for subscription in old:
+            if subscription is not None:
+                self.node.destroy_subscription(subscription)
+        if scene.dynamics is None:
+            return
+        for joint in scene.dynamics.graph.joints:
+            topic = topics.reaction_topic(joint.name)
+            try:
+                validate_topic_name(topic)
+            except InvalidTopicNameException:
+                continue    # no topic of that name (the node warns at its start)
+            self._reaction_subscriptions.append(self.node.create_subscription(
+                WrenchStamped, topic,
+                lambda msg, name=joint.name, at=joint.at: self._on_reaction(name, at, msg),
+                qos_profile_sensor_data))
+
+    def _on_reaction(self, name: str, at: str, msg: Any) -> None:
+        fx, fy = _finite(msg.wrench.force.x), _finite(msg.wrench.force.y)
+        with self.latest.lock:
+            if fx is None or fy is None:
+                self.latest.reactions.pop(name, None)   # not finite: not drawn
+            else:
+                self.latest.reactions[name] = (at, [fx, fy])
 
     def _on_joints(self, msg: Any) -> None:
         positions, velocities = list(msg.position), list(msg.velocity)
@@ -450,8 +492,9 @@ class ViewServer:
                 'stamp': latest.stamp, 'points': dict(latest.points),
                 'traces': {name: list(trace) for name, trace in latest.traces.items()},
                 'statuses': list(latest.statuses), 'drivers': [],
-                'crank_speed_rpm': None, 'frame': None, 'error': ''}
+                'crank_speed_rpm': None, 'frame': None, 'error': '', 'reactions': []}
             values = dict(latest.values)
+            reactions = dict(latest.reactions)
         # Before joint_states: the node's own report of its crank's speed, where it is a number.
         reported = _finite(values.get('crank_speed'))
         if reported is not None:
@@ -486,6 +529,9 @@ class ViewServer:
                 out['error'] = str(error).splitlines()[0] if str(error) else repr(error)
         if out['frame'] is not None:
             out['bounds'] = self._grown(scene, out['bounds'], _frame_xy(out['frame']))
+            where = out['frame']['points']
+            out['reactions'] = [{'name': name, 'at': where[at], 'force': force}
+                                for name, (at, force) in reactions.items() if at in where]
         return out
 
     def _grown(self, scene: Any, bounds: tuple[float, float, float, float] | None,
@@ -739,6 +785,7 @@ input.speed { width: 7em; }
 <b id="scene">waiting for the node's scene...</b>
 <span id="controls"></span>
 <label><input id="arrows" type="checkbox"> velocity and acceleration arrows</label>
+<label><input id="forces" type="checkbox"> reactions</label>
 <div id="status"></div>
 </header>
 <div id="frame"><canvas id="c"></canvas></div>
@@ -894,6 +941,16 @@ function draw(s) {
         const su = u === null ? 0 : Math.hypot(...u);
         if (su > 0) line(t, p, [p[0] + u[0] / su * size, p[1] + u[1] / su * size], colour, 2);
       }
+    }
+  }
+  drawn.reactions = [];
+  if (document.getElementById('forces').checked && s.reactions.length) {
+    const big = Math.max(...s.reactions.map((r) => Math.hypot(...r.force)));
+    const k = big > 0 ? (s.bounds[2] - s.bounds[0]) / 5 / big : 0;
+    for (const r of s.reactions) {
+      const e = [r.at[0] + r.force[0] * k, r.at[1] + r.force[1] * k];
+      line(t, r.at, e, '#e377c2', 3);
+      drawn.reactions.push({name: r.name, from: r.at, to: e});
     }
   }
   ctx.fillStyle = '#000';

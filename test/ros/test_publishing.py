@@ -8,6 +8,8 @@ bytes published. The node's topics seen from a subscriber are the
 ``test_kinematics_node_*`` files'.
 """
 
+import math
+
 from builtin_interfaces.msg import Time
 import pytest
 from rclpy.qos import QoSDurabilityPolicy, QoSReliabilityPolicy
@@ -22,6 +24,7 @@ from mech_kinematics.ros.diagnostics import Status, WARN
 from mech_kinematics.ros.publishing import (diagnostic_array, Markers, Publishing, TF_DEPTH,
                                             tf_period_ns)
 from mech_kinematics.ros.ticker import general_tick
+from mech_kinematics.ros.wrenches import ForcesTick, reaction_wrench
 from mech_kinematics.units import NS_PER_S
 
 #: The stamp of the first tick here, ns.
@@ -206,7 +209,7 @@ def test_markers_are_built_from_the_samples_handed_over_at_most_30_a_second():
     """The tick hands a sample over (the guard fires); the executor's call publishes it."""
     scene = mk.load_scene('khurmi_four_bar_ad150')
     node = Node()
-    markers = Markers(node, scene, 'mechanism', lambda: (0.1, 0.01))
+    markers = Markers(node, scene, 'mechanism', lambda: (0.1, 0.01, 0.0))
     period = NS_PER_S // 1000
     for _ in range(10):     # 10 ticks at 1 kHz: the first is due, the next 9 are not
         markers.request(period, 7, 8, 0.5, -4.0, 0.0)
@@ -233,3 +236,62 @@ def test_the_diagnostics_message_holds_every_status():
         b'\x01', 'n: solver', 'near-singular', 'scene')
     assert [(kv.key, kv.value) for kv in status.values] == [('solver_path', 'compiled')]
     assert (msg.header.stamp.sec, msg.header.frame_id) == (3, 'mechanism')
+
+
+def _forces_publishing(name):
+    scene = mk.load_scene(name)
+    node, publishing = _publishing(scene)
+    frames = [(f.origin, f.angle_of, f.angle) for f in publishing.frames]
+    forces = ForcesTick(publishing.tick_scene, scene.output_joints, scene.output_points, frames,
+                        static=False)
+    publishing.add_forces(forces)
+    return scene, node, publishing, forces
+
+
+def test_a_tick_publishes_efforts_reactions_and_shaking():
+    """A forces tick's values: effort in joint_states, a WrenchStamped per joint and shaking."""
+    scene, node, publishing, forces = _forces_publishing('engine')
+    crank = scene.drivers[0]
+    values, _ = forces(0.7, crank.speed, 0.0, 1e-6)
+    publishing.tick(values, STAMP, *divmod(STAMP, NS_PER_S))
+    state = mk.solve(scene, 0.7, crank.speed, 0.0)
+    [js] = node.topic('joint_states').decoded()
+    assert list(js.effort) == [state.forces.efforts['crank'], 0.0, 0.0]
+    for joint in forces.reactions:
+        [wrench] = node.topic(f'reactions/{joint.name}').decoded()
+        assert (wrench.wrench.force.x, wrench.wrench.force.y, wrench.wrench.torque.z) == \
+            reaction_wrench(joint, state.forces, state)
+        assert (wrench.header.stamp.sec, wrench.header.frame_id) == (STAMP // NS_PER_S,
+                                                                     'mechanism')
+    [shaking] = node.topic('shaking').decoded()
+    assert (shaking.wrench.force.x, shaking.wrench.force.y, shaking.wrench.torque.z) == (
+        state.forces.shaking_force.real, state.forces.shaking_force.imag,
+        state.forces.shaking_moment)
+    # Forces left out: the motion is published with an empty effort, no wrench, a warning.
+    forces.refusal = 'the forces cannot be bounded here (rod (statics singular))'
+    publishing.tick(values[:forces.forces_first], STAMP + 1, *divmod(STAMP + 1, NS_PER_S))
+    assert list(node.topic('joint_states').decoded()[-1].effort) == []
+    assert len(node.topic('shaking').sent) == 1
+    assert node.logger.lines[-1] == f'forces not published: {forces.refusal}'
+
+
+def test_reaction_arrows_start_at_the_joints_along_the_forces():
+    """Markers draw each joint's reaction from its point, the largest 0.3 of the size long."""
+    scene, node, publishing, forces = _forces_publishing('shaper')
+    markers = Markers(node, scene, 'mechanism', lambda: (0.1, 0.01, 0.0), forces)
+    markers.request(NS_PER_S // 100, 7, 8, 0.5, scene.drivers[0].speed, 0.0)
+    markers.publish()
+    [array] = node.topic('markers').sent
+    arrows = [m for m in array.markers if m.ns == 'reactions']
+    assert [m.id for m in arrows] == list(range(len(forces.reactions)))
+    state = mk.solve(scene, 0.5, scene.drivers[0].speed, 0.0)
+    lengths = []
+    for joint, arrow in zip(forces.reactions, arrows, strict=True):
+        start, end = arrow.points
+        at = state.complex_points[joint.at][0]
+        assert (start.x, start.y) == (at.real, at.imag)
+        fx, fy, _ = reaction_wrench(joint, state.forces, state)
+        length = math.hypot(end.x - start.x, end.y - start.y)
+        lengths.append(length)
+        assert (end.x - start.x) * fy == pytest.approx((end.y - start.y) * fx, abs=1e-9 * length)
+    assert max(lengths) == pytest.approx(0.3 * markers.size, rel=1e-12)

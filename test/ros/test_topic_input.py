@@ -19,9 +19,11 @@ from sensor_msgs.msg import JointState
 
 import mech_kinematics as mk
 from mech_kinematics.ros.diagnostics import TickStats
+from mech_kinematics.ros.parameters import STATIC, TOPIC
 from mech_kinematics.ros.publishing import Publishing, RCLError
 from mech_kinematics.ros.solver_path import SolverPath
 from mech_kinematics.ros.topic_input import INPUT_DEPTH, InputSubscription
+from mech_kinematics.ros.wrenches import forces_tick
 
 #: A stamp of an input, s.
 SEC = 1_700_000_000
@@ -203,6 +205,45 @@ def test_passed_joints_are_rendered_from_a_template_of_their_names():
                                                                                        0.125]
     assert list(two.velocity) == [] and list(two.effort) == []
     assert list(one.position)[:-1] == list(two.position)[:-2]     # the same drivers
+
+
+def _static_input(scene_name, extra_joints):
+    """Return (the node, an active subscription with effort: static, the scene)."""
+    scene, node, stats = mk.load_scene(scene_name), Node(), TickStats(mk.NEAR_SINGULAR)
+    publishing = Publishing(node, scene, frame_id='mechanism', tf_prefix='',
+                            tf_rate_hz=100.0, scene_path=scene_name)
+    frames = [(f.origin, f.angle_of, f.angle) for f in publishing.frames]
+    forces = forces_tick(scene, publishing.tick_scene, frames, drive=TOPIC, effort=STATIC)
+    publishing.add_forces(forces)
+    solver = SolverPath(1e-6)
+    solver.setup(publishing.tick_scene, scene, frames, node.logger.info, forces)
+    subscription = InputSubscription(node, scene, solver, publishing, stats,
+                                     frame_id='mechanism', extra_joints=extra_joints,
+                                     jump_back_s=1.0)
+    subscription.active = True
+    return node, subscription, scene
+
+
+def test_static_efforts_with_the_passed_joints():
+    """effort: static: the mechanism's efforts at rest, then the passed joints' (NaN if none)."""
+    node, subscription, scene = _static_input('five_bar_payload', 'pass')
+    names = ['left_crank', 'gripper', 'right_crank']
+    subscription.message(_message(5, names, [2.0, 0.25, 1.0], [0.3, 0.5, -0.2]))
+    rest = mk.solve(scene, [2.0, 1.0], [0.0, 0.0], [0.0, 0.0])
+    expected = [float(rest.forces.efforts.get(j, 0.0)) for j in scene.output_joints]
+    assert any(expected)
+    msg = _message(6, names, [2.0, 0.25, 1.0], [0.3, 0.5, -0.2])
+    msg.effort = [1.0, 7.5, 2.0]
+    subscription.message(msg)
+    first, second = _decoded(node, 'joint_states')
+    assert list(first.effort[:-1]) == expected and math.isnan(first.effort[-1])
+    assert list(second.effort) == [*expected, 7.5]
+    assert len(_decoded(node, 'shaking')) == 2
+    # Without passed joints, the template's efforts: the same values.
+    node, subscription, _ = _static_input('five_bar_payload', 'refuse')
+    subscription.message(_message(5, ['left_crank', 'right_crank'], [2.0, 1.0]))
+    [state] = _decoded(node, 'joint_states')
+    assert list(state.effort) == expected and list(state.velocity) == []
 
 
 def test_an_inactive_node_publishes_nothing():

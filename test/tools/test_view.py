@@ -571,6 +571,48 @@ def test_state_answers_whatever_the_graph_publishes(fake):
                                  'position': 0.5, 'speed': None}]
 
 
+def _reactions(server, scene, angle):
+    """Publish, as the node does, each joint's reaction at ``angle``; return mk.solve's forces."""
+    from geometry_msgs.msg import WrenchStamped
+
+    from mech_kinematics.ros.wrenches import reaction_wrench
+
+    state = mk.solve(scene, angle, scene.drivers[0].speed, 0.0)
+    for joint in scene.dynamics.graph.joints:
+        fx, fy, tz = reaction_wrench(joint, state.forces, state)
+        msg = WrenchStamped()
+        msg.wrench.force.x, msg.wrench.force.y, msg.wrench.torque.z = fx, fy, tz
+        server._on_reaction(joint.name, joint.at, msg)
+    return state
+
+
+def test_state_has_the_published_reactions_at_their_joints(fake):
+    """A scene with forces: /state gives each published reaction at its joint's drawn point."""
+    from geometry_msgs.msg import WrenchStamped
+
+    scene = _scene(fake, 'engine')
+    _joints(fake, ['crank'], [0.5], [1.0])
+    state = _reactions(fake, scene, 0.5)
+    answer = _state(fake)
+    joints = {j.name: j for j in scene.dynamics.graph.joints}
+    assert {r['name'] for r in answer['reactions']} == set(joints)
+    for r in answer['reactions']:
+        assert r['at'] == answer['frame']['points'][joints[r['name']].at]
+        assert r['at'] == pytest.approx(list(_xy_of(state, joints[r['name']].at)), abs=1e-12)
+    bad = WrenchStamped()
+    bad.wrench.force.x = math.nan
+    fake._on_reaction('C', 'C', bad)      # not finite: not drawn
+    assert 'C' not in {r['name'] for r in _state(fake)['reactions']}
+    _scene(fake, 'khurmi_four_bar_ad150')     # a scene without forces: none
+    _joints(fake, ['crank'], [0.5], [1.0])
+    assert _state(fake)['reactions'] == []
+
+
+def _xy_of(state, point):
+    z = state.complex_points[point][0]
+    return z.real, z.imag
+
+
 def test_a_frame_past_the_bounds_grows_them(fake):
     """Bounds grow to hold a frame that reaches past them: nothing is drawn off the canvas."""
     scene = _scene(fake, 'khurmi_four_bar_ad150')
@@ -688,6 +730,33 @@ def test_chromium_draws_every_packaged_scene(fake, browser):
         _assert_links_drawn(_link_pixels(image, drawn, [np.array(s['xy'])
                                                         for s in frame['sliders']]), name)
         assert controls == [d.name for d in drivers], name
+
+
+def test_chromium_draws_the_reactions_scaled_at_their_joints(fake, browser):
+    """With "reactions" ticked, an arrow per joint along its force, the largest 1/5 of the view."""
+    scene = _scene(fake, 'shaper')
+    _joints(fake, ['crank'], [0.5], [1.0])
+    _reactions(fake, scene, 0.5)
+    answer = _state(fake)
+    target, session = browser.open(fake.url)
+    try:
+        _drawn(browser, session, 'shaper drawn')
+        browser.evaluate(session, "document.getElementById('forces').click()")
+        text = browser.wait(session, '(() => { const d = JSON.parse(document.getElementById('
+                                     '"drawn").textContent); return d.reactions.length && '
+                                     'JSON.stringify(d.reactions); })()', 'reactions drawn')
+    finally:
+        browser.close_tab(target)
+    drawn = {r['name']: r for r in json.loads(text)}
+    published = {r['name']: r for r in answer['reactions']}
+    assert set(drawn) == set(published)
+    width = answer['bounds'][2] - answer['bounds'][0]
+    largest = max(math.hypot(*r['force']) for r in published.values())
+    for name, r in published.items():
+        start, end = np.array(drawn[name]['from']), np.array(drawn[name]['to'])
+        assert list(start) == r['at']
+        np.testing.assert_allclose(end - start, np.array(r['force']) * width / 5 / largest,
+                                   rtol=1e-9, atol=1e-12)
 
 
 def test_chromium_shows_html_from_the_graph_as_text(fake, browser):

@@ -1,0 +1,301 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""What the node publishes of the forces through the loop: efforts, reactions, shaking.
+
+A scene with ``masses``, ``gravity`` or ``loads`` has a
+:class:`~mech_kinematics.solver.forces.Dynamics`. On such a scene the node's
+tick is a :class:`ForcesTick`: the kinematics solved as the general tick
+solves them (the same bits), then the forces at that state
+(:meth:`Dynamics.forces <mech_kinematics.solver.forces.Dynamics.forces>`,
+bounded like every value), appended to the tick's values in the order of
+:func:`forces_values`: each published joint's effort (a driver's; 0 for a
+passive joint, frictionless), each reaction's ``(fx, fy, tz)``, the shaking
+``(fx, fy, mz)``. An instant whose forces cannot be bounded keeps its
+kinematics and leaves the forces out (its ``effort`` empty, no reaction or
+shaking message), never a guess: :attr:`ForcesTick.refusal` says why.
+
+Each reaction is a ``geometry_msgs/msg/WrenchStamped`` (:class:`ForceMessages`,
+rendered from pre-serialized templates like the state's): the force on the
+joint's child body (``Joint.body``, the body its kind adds) from its parent
+(``Joint.on``), in ``frame_id``'s axes, applied at the joint's point; a pin
+carries no moment (``torque`` 0), a prismatic joint's normal force is the
+vector ``normal * n`` (``n`` its line's direction turned +90 deg) with the
+moment the line exerts about the point as ``torque.z``, a Geneva lock only its
+holding moment. ``shaking`` is the resultant force the joints put on the
+frame and its moment about the scene's origin (``frame_id``'s origin).
+
+``gravity`` and the loads are the node's parameters; :func:`dynamics_with`
+makes the Dynamics of new values over the same graph and masses (the scene
+is not rebuilt), which the tick reads at its next instant.
+
+No rclpy here except the message classes; tested in ``test/ros/test_wrenches.py``.
+"""
+
+from __future__ import annotations
+
+import cmath
+from collections.abc import Mapping, Sequence
+from dataclasses import replace
+import math
+from typing import Any, TYPE_CHECKING
+
+from geometry_msgs.msg import WrenchStamped
+
+from .cdr import marker, MessageTemplate, STAMP_MARKER
+from .parameters import DYNAMIC, ParameterSpec, STATIC, TOPIC
+from .ticker import NOT_IN_THE_TICK, values_from_state
+from .. import solver as lk
+from ..solver.compiler import NotCompiled
+from ..solver.forces import Dynamics
+
+if TYPE_CHECKING:
+    from ..solver.compiler import FrameSpec
+    from ..solver.forces import Forces
+    from ..solver.graph import Joint
+    from ..solver.mechanism import Scene
+
+__all__ = ['ForceMessages', 'ForcesTick', 'dynamics_with', 'effort_status',
+           'force_parameters', 'forces_tick', 'forces_values', 'gravity_of', 'reaction_joints',
+           'reaction_wrench', 'wrench_stamped']
+
+
+def reaction_joints(dynamics: Dynamics) -> tuple[Joint, ...]:
+    """Return the joints whose reactions are published, in the graph's order (all of them)."""
+    return tuple(dynamics.graph.joints)
+
+
+def _normal(joint: Joint, state: Any) -> complex:
+    """Return the unit normal of a prismatic joint's line at ``state`` (direction + 90 deg)."""
+    line = joint.line
+    assert line is not None
+    if joint.copies > 1:     # one of several slots: the one its point is in
+        d = state.complex_points[joint.at][0] - state.complex_points[line.through][0]
+        return 1j * d / abs(d)
+    angle = line.angle if line.angle_of is None else \
+        float(state.joints[line.angle_of].position) + line.angle
+    return 1j * cmath.exp(1j * angle)
+
+
+def reaction_wrench(joint: Joint, forces: Forces, state: Any) -> tuple[float, float, float]:
+    """Return ``(fx, fy, tz)`` of the reaction at ``joint``: N, N, N m (see the module)."""
+    r = forces.reactions[joint.name]
+    if r.force is not None:
+        return float(r.force.real), float(r.force.imag), 0.0
+    moment = float(r.moment) if r.moment is not None else 0.0
+    if r.normal is None:     # a lock: its holding moment
+        return 0.0, 0.0, moment
+    f = float(r.normal) * _normal(joint, state)
+    return f.real, f.imag, moment
+
+
+def forces_values(forces: Forces, state: Any, joints: Sequence[str],
+                  reactions: Sequence[Joint]) -> list[float]:
+    """Return the forces of a state in the order the node's templates read them.
+
+    Each of ``joints``' effort (a driver's; 0 for another joint), then
+    ``(fx, fy, tz)`` of each reaction (:func:`reaction_wrench`), then the
+    shaking force and moment ``(fx, fy, mz)``.
+    """
+    efforts = forces.efforts
+    values = [float(efforts[n]) if n in efforts else 0.0 for n in joints]
+    for joint in reactions:
+        values += reaction_wrench(joint, forces, state)
+    shaking = forces.shaking_force
+    values += (float(shaking.real), float(shaking.imag), float(forces.shaking_moment))
+    return values
+
+
+def _refusal(forces: Forces, max_error: float) -> str:
+    """Return why an instant's forces were not bounded, one line."""
+    if forces.worst is None:
+        return f'the forces cannot be bounded here ({next(iter(forces.failures), "forces")})'
+    name, bound, limit = forces.worst
+    return (f'the error bound of {name} ({bound:.3g}) exceeds max_relative_error '
+            f'{max_error:g} of its scale ({limit / max_error:.6g})')
+
+
+class ForcesTick:
+    """The node's tick on a scene with forces: its kinematics' values, then its forces'.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene the ticks solve (with its :attr:`~Scene.dynamics`).
+    joints, points : sequence of str
+        The joints and points whose values the tick returns (the state topics').
+    frames : sequence of FrameSpec
+        The frames whose poses follow them (``/tf``).
+    static : bool, keyword-only
+        ``effort: static``: the forces of gravity and the loads alone, solved
+        at the same positions with every velocity and acceleration zero.
+
+    Attributes
+    ----------
+    dynamics : Dynamics
+        What the forces are solved with; replaced whole when ``gravity`` or a
+        load changes (:func:`dynamics_with`), read once per instant.
+    reactions : tuple of Joint
+        The joints whose reactions follow the efforts, in order.
+    forces_first : int
+        Where the forces start in the values (after the frames' poses).
+    refusal : str
+        Why the forces of the last instant left out were (``''`` until one is).
+    refused : int
+        How many instants' forces were left out.
+    """
+
+    def __init__(self, scene: Scene, joints: Sequence[str], points: Sequence[str],
+                 frames: Sequence[FrameSpec], *, static: bool) -> None:
+        assert scene.dynamics is not None
+        self.dynamics: Dynamics = scene.dynamics
+        # The motion alone (the forces' own bounds are judged below, where a refusal leaves
+        # the kinematics published): the same bits as the dynamics scene's motion.
+        self.kinematics = replace(scene, gravity=None, masses=(), loads=(),
+                                  outputs_joints=scene.output_joints,
+                                  outputs_points=scene.output_points)
+        if self.kinematics._solver.compiled_single is None:
+            self.kinematics._solver.compiled_single = NotCompiled(NOT_IN_THE_TICK)
+        self.joints, self.points, self.frames = tuple(joints), tuple(points), tuple(frames)
+        self.static = static
+        self.drivers = len(scene.drivers)
+        self.reactions = reaction_joints(self.dynamics)
+        self.forces_first = 3 * len(self.joints) + 6 * len(self.points) + 3 * len(self.frames)
+        self.refusal = ''
+        self.refused = 0
+
+    def __call__(self, theta: Any, omega: Any, alpha: Any, tol: float,
+                 turns: Any = 0) -> tuple[list[float], float]:
+        """Return ``(values, measure)`` as a tick function does, the forces after the motion."""
+        kinematics = self.kinematics
+        state = lk.solve(kinematics, theta, omega, alpha, turns=turns, max_error=tol)
+        values = values_from_state(state, self.joints, self.points, self.frames)
+        measures = state.singularity.values()
+        measure = float(min(measures)) if measures else math.inf
+        at = state
+        if self.static:
+            rest = 0.0 if self.drivers == 1 else (0.0,) * self.drivers
+            at = lk.solve(kinematics, theta, rest, rest, turns=turns, max_error=tol)
+        forces = self.dynamics.forces(at, tol)
+        if forces.valid:
+            values += forces_values(forces, at, self.joints, self.reactions)
+        else:
+            self.refusal = _refusal(forces, tol)
+            self.refused += 1
+        return values, measure
+
+
+def forces_tick(scene: Scene, tick_scene: Scene, frames: Sequence[FrameSpec], *, drive: str,
+                effort: str) -> ForcesTick | None:
+    """Return the forces tick of ``scene`` on the node, or ``None`` where none is published.
+
+    None for a scene without masses, gravity or loads (it computes nothing
+    new), and with ``drive: topic`` unless ``effort: static``: the input gives
+    no accelerations, so the efforts of the motion are not determined.
+    """
+    if scene.dynamics is None or (drive == TOPIC and effort == DYNAMIC):
+        return None
+    return ForcesTick(tick_scene, scene.output_joints, scene.output_points, frames,
+                      static=effort == STATIC)
+
+
+def effort_status(scene: Scene, drive: str, effort: str) -> str:
+    """Return what the node's efforts are, for ``diagnostics`` ('' for a scene without forces)."""
+    if scene.dynamics is None:
+        return ''
+    if effort == STATIC:
+        return 'static: gravity and loads only, inertia neglected'
+    if drive == TOPIC:
+        return ('left out: the input gives no accelerations (effort: static publishes the '
+                'statics)')
+    return 'dynamic: inertia, gravity and loads'
+
+
+def wrench_stamped(force: tuple[float, float, float], frame_id: str, sec: int,
+                   nanosec: int) -> WrenchStamped:
+    """Return ``geometry_msgs/WrenchStamped`` of ``(fx, fy, tz)`` in ``frame_id``."""
+    msg = WrenchStamped()
+    msg.header.stamp.sec, msg.header.stamp.nanosec = sec, nanosec
+    msg.header.frame_id = frame_id
+    msg.wrench.force.x, msg.wrench.force.y = force[0], force[1]
+    msg.wrench.torque.z = force[2]
+    return msg
+
+
+class ForceMessages:
+    """Each reaction's and the shaking's ``WrenchStamped``, rendered from one template.
+
+    Parameters
+    ----------
+    frame_id : str
+        ``header.frame_id``.
+    joints : int
+        How many efforts precede the reactions in the forces' values.
+    reactions : int
+        How many reactions follow them (the shaking after those).
+    """
+
+    def __init__(self, frame_id: str, joints: int, reactions: int) -> None:
+        self._template = MessageTemplate(
+            wrench_stamped((marker(0), marker(1), marker(2)), frame_id, *STAMP_MARKER), 3)
+        self.joints, self.reactions = joints, reactions
+
+    def render(self, values: Sequence[float], first: int, sec: int,
+               nanosec: int) -> list[bytes]:
+        """Return the reactions' messages, then the shaking's, of the forces at ``first``."""
+        render = self._template.render
+        start = first + self.joints
+        return [render(sec, nanosec, values, start + 3 * k) for k in range(self.reactions + 1)]
+
+
+def gravity_of(dynamics: Dynamics) -> list[float]:
+    """Return the gravity of ``dynamics`` as ``[gx, gy]``, m/s^2."""
+    return [dynamics.gravity.real, dynamics.gravity.imag]
+
+
+def force_parameters(dynamics: Dynamics) -> tuple[ParameterSpec, ...]:
+    """Return the parameters of a scene's forces, defaulting to the scene's values.
+
+    ``gravity`` ([gx, gy], m/s^2), and for each load NAME ``loads.NAME.force``
+    ([fx, fy], N, scene frame) or ``loads.NAME.torque`` (N m, + CCW): each
+    changeable while the node runs.
+    """
+    specs = [ParameterSpec('gravity', 'xy', gravity_of(dynamics),
+                           "Gravity [gx, gy] in the scene's frame, from the next instant "
+                           "published. Defaults to the scene's", 'm/s^2')]
+    for load in dynamics.loads:
+        if load.force is not None:
+            specs.append(ParameterSpec(
+                f'loads.{load.name}.force', 'xy', list(load.force),
+                f'Force [fx, fy] of load {load.name} at {load.point}, scene frame, from the '
+                "next instant published. Defaults to the scene's", 'N'))
+        else:
+            specs.append(ParameterSpec(
+                f'loads.{load.name}.torque', 'double', float(load.torque or 0.0),
+                f'Torque of load {load.name} on {load.link}, + CCW, from the next instant '
+                "published. Defaults to the scene's", 'N m'))
+    return tuple(specs)
+
+
+def dynamics_with(dynamics: Dynamics, changes: Mapping[str, Any]) -> Dynamics:
+    """Return ``dynamics`` with accepted parameter values (:func:`force_parameters`' names).
+
+    The graph and the masses are kept; only the gravity and the loads' values
+    change, so nothing of the scene is rebuilt.
+    """
+    gravity = changes.get('gravity')
+    g = dynamics.gravity if gravity is None else complex(float(gravity[0]),
+                                                         float(gravity[1]))
+    loads = []
+    for load in dynamics.loads:
+        force = changes.get(f'loads.{load.name}.force')
+        torque = changes.get(f'loads.{load.name}.torque')
+        if force is not None:
+            load = replace(load, force=(float(force[0]), float(force[1])))
+        if torque is not None:
+            load = replace(load, torque=float(torque))
+        loads.append(load)
+    graph = dynamics.graph
+    points = {p for body in graph.bodies.values() for p in body.points}
+    points.update(load.point for load in loads if load.point is not None)
+    return Dynamics(graph, tuple(dynamics.masses.values()), loads, (g.real, g.imag),
+                    tuple(points), dynamics.size)
