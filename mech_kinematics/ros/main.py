@@ -97,13 +97,16 @@ def main(args: list[str] | None = None) -> int:
         # Everything built so far lives as long as the node: keep it out of the
         # garbage collector's full passes, which would otherwise delay ticks.
         gc.freeze()
+        # The executor is made before rclpy's handler is installed: a signal that shut the
+        # context down while it was made left its guard condition half built, whose
+        # deletion printed "Exception ignored ... AttributeError" (one run in 7 stops).
+        executor = _Executor()
+        executor.add_node(node)
         # From now on rclpy's handler ends the spin on a signal (and calls ours); a signal
         # noted before it was installed is seen here.
         install_signal_handlers(SignalHandlerOptions.ALL)
         if stop_asked():
             return 0
-        executor = _Executor()
-        executor.add_node(node)
         executor.spin()
     except (KeyboardInterrupt, ExternalShutdownException):
         pass  # Ctrl-C or shutdown: a clean exit, status 0
