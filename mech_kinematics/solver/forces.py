@@ -42,10 +42,12 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 import math
-from typing import Any, TYPE_CHECKING
+from typing import Any, cast, TYPE_CHECKING
 
 import numpy as np
 
+from .compiler import NotCompiled
+from .forces_compiled import compile_single, SingleForces
 from .graph import Graph, Joint
 from .model import _check_finite, _check_name
 from ..bounds import U
@@ -55,6 +57,12 @@ if TYPE_CHECKING:
     from .state import State
 
 __all__ = ['Dynamics', 'Forces', 'Load', 'Mass', 'Reaction']
+
+#: Single instants of one scene on the general path before its forces are written out
+#: (:mod:`.forces_compiled`): writing them out costs what a few general instants do.
+COMPILE_AFTER = 8
+#: Pivot sequences written out per scene at most (a turn of the packaged scenes meets 1 to 3).
+MAX_SEQUENCES = 8
 
 #: Rounding of one correctly rounded operation, as a multiple of |result| (NumPy's
 #: products and sums of a few terms: gamma_k = k U / (1 - k U) for k operations).
@@ -388,6 +396,11 @@ class Dynamics:
                     raise SceneError(msg, (load, 'link'))
                 self.torque_loads.setdefault(load.link, []).append(load)
         self.groups = self._groups()
+        #: Why one instant's forces are not written out (:mod:`.forces_compiled`), or None.
+        self.compiled_single: NotCompiled | None = None
+        self._fast: list[SingleForces] = []     # one per pivot sequence, the last used first
+        self._sequences: set[Any] = set()
+        self._general = 0               # single instants on the general path
 
     # --- structure -------------------------------------------------------------------
 
@@ -512,7 +525,44 @@ class Dynamics:
         ``max_error`` is the tolerance: a value whose bound exceeds it times
         the force scale (moments: times the scale and the mechanism's size)
         makes the instant invalid (``Forces.valid``, ``Forces.failures``).
+
+        One instant runs written out (:mod:`.forces_compiled`) once the scene
+        has had :data:`COMPILE_AFTER` instants on the general path: one
+        function per pivot sequence met (at most :data:`MAX_SEQUENCES`), the
+        general path's bits and bounds; an instant none of them settles (a
+        refusal, another pivot sequence) takes the general path.
+        ``compiled_single`` says why a scene is not written out.
         """
+        if state.valid.__class__ is bool:
+            fast = self._fast
+            for index, function in enumerate(fast):
+                answer = function(state, max_error)
+                if answer is False:     # another pivot sequence: try the next
+                    continue
+                if answer is not None:
+                    if index:
+                        fast.insert(0, fast.pop(index))
+                    return cast(Forces, answer)
+                break
+            self._general += 1
+            if self._general > COMPILE_AFTER and self.compiled_single is None \
+                    and len(fast) < MAX_SEQUENCES:
+                pivots: dict[str, list[int]] = {}
+                forces = self._forces(state, max_error, pivots)
+                key = tuple((name, tuple(p)) for name, p in pivots.items())
+                if forces.valid is True and key not in self._sequences:
+                    self._sequences.add(key)
+                    written = compile_single(self, pivots, Forces, Reaction, _TINY)
+                    if isinstance(written, NotCompiled):
+                        self.compiled_single = written
+                    else:
+                        fast.insert(0, written)
+                return forces
+        return self._forces(state, max_error)
+
+    def _forces(self, state: State, max_error: float,
+                pivots: dict[str, list[int]] | None = None) -> Forces:
+        """Return :meth:`forces` on the general path; record each group's pivots in ``pivots``."""
         kin = _Kinematics(self.graph, state)
         biggest = kin.biggest
         done: dict[str, _Carried] = {}   # joint -> what it carries, solved
@@ -543,7 +593,8 @@ class Dynamics:
                 failures['forces (overflow)'] = overflow if kin.vector else True
                 valid = valid & ~overflow if kin.vector else False
             for group in self.groups:
-                solved, ok = self._solve(group, kin, inertial, done)
+                solved, ok = self._solve(group, kin, inertial, done, None if pivots is None
+                                         else pivots.setdefault(group.key, []))
                 if ok is not True:
                     bad = valid & ~np.asarray(ok, dtype=bool) if kin.vector else not ok
                     if np.any(bad):
@@ -600,15 +651,16 @@ class Dynamics:
 
     def _solve(self, group: _Group, kin: _Kinematics,
                inertial: Mapping[str, tuple[Any, Any, Any, Any]],
-               done: Mapping[str, _Carried]) -> tuple[dict[str, _Carried], Any]:
+               done: Mapping[str, _Carried],
+               pivots: list[int] | None = None) -> tuple[dict[str, _Carried], Any]:
         """Return what the group's joints carry, and where it could be bounded."""
         if len(group.configs) == 1:
             config = next(iter(group.configs.values()))
-            return self._solve_config(group, config, kin, inertial, done)
+            return self._solve_config(group, config, kin, inertial, done, pivots)
         engaged = kin.engaged(group.levers[0])
         if not kin.vector:     # one instant: one phase
             return self._solve_config(group, group.configs[(bool(engaged),)], kin, inertial,
-                                      done)
+                                      done, pivots)
         on, ok_on = self._solve_config(group, group.configs[(True,)], kin, inertial, done)
         off, ok_off = self._solve_config(group, group.configs[(False,)], kin, inertial, done)
         engaged = np.asarray(engaged, dtype=bool)
@@ -617,7 +669,8 @@ class Dynamics:
 
     def _solve_config(self, group: _Group, config: _Config, kin: _Kinematics,
                       inertial: Mapping[str, tuple[Any, Any, Any, Any]],
-                      done: Mapping[str, _Carried]) -> tuple[dict[str, _Carried], Any]:
+                      done: Mapping[str, _Carried],
+                      pivots: list[int] | None = None) -> tuple[dict[str, _Carried], Any]:
         k = len(config.rows)
         row_of = {row: index for index, row in enumerate(config.rows)}
         index_of = {body: b for b, body in enumerate(group.bodies)}
@@ -702,7 +755,7 @@ class Dynamics:
                 Eb[moment] = Eb[moment] + (abs(d) * carried.force_bound + e_d * abs(force)
                                            + carried.couple_bound
                                            + 4 * U * (abs(d) * abs(force) + abs(turn)))
-        x, e_x, ok = _bounded_solve(A, EA, b, Eb, kin.vector)
+        x, e_x, ok = _bounded_solve(A, EA, b, Eb, kin.vector, pivots)
         carried_by: dict[str, _Carried] = {}
         acting = set(config.joints)
         for i, joint in enumerate(group.joints):
@@ -847,7 +900,8 @@ def _unit(joint: Joint, component: str, kin: _Kinematics) -> tuple[Any, Any, str
 
 
 def _bounded_solve(A: list[list[Any]], EA: list[list[Any]], b: list[Any], Eb: list[Any],
-                   vector: bool) -> tuple[list[Any], list[Any], Any]:
+                   vector: bool, pivots: list[int] | None = None
+                   ) -> tuple[list[Any], list[Any], Any]:
     """Return ``x`` solving ``A x = b``, a bound of its error, and where the bound holds.
 
     Gauss-Jordan elimination with partial pivoting, on the entries as they
@@ -856,7 +910,9 @@ def _bounded_solve(A: list[list[Any]], EA: list[list[Any]], b: list[Any], Eb: li
     are: ``|X| t`` with ``t`` the computed residual ``|b - A x|``, its
     rounding, and the entries' errors ``EA |x| + Eb``. Where ``A`` is within
     rounding of singular (its condition number beyond ``1 / (64 k U)``: a
-    toggle, where the statics degenerate), there is no bound.
+    toggle, where the statics degenerate), there is no bound. For one
+    instant, ``pivots`` (a list) receives the row offset picked at each step
+    (:mod:`.forces_compiled` writes the elimination out for that sequence).
     """
     k = len(b)
     # The augmented matrix [A | I]; structural zeros stay _ZERO and are skipped.
@@ -880,6 +936,8 @@ def _bounded_solve(A: list[list[Any]], EA: list[list[Any]], b: list[Any], Eb: li
             ok = ok & (np.abs(pivot) > 0.0)
         else:
             best = max(range(k - j), key=lambda r: abs(candidates[r]))
+            if pivots is not None:
+                pivots.append(best)
             if best:
                 M[j], M[j + best] = M[j + best], M[j]
             pivot = M[j][j]
