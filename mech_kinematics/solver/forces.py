@@ -42,6 +42,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 import math
+from types import SimpleNamespace
 from typing import Any, cast, TYPE_CHECKING
 
 import numpy as np
@@ -61,6 +62,8 @@ __all__ = ['Dynamics', 'Forces', 'Load', 'Mass', 'Reaction']
 #: Single instants of one scene on the general path before its forces are written out
 #: (:mod:`.forces_compiled`): writing them out costs what a few general instants do.
 COMPILE_AFTER = 8
+#: Array calls of one scene on the general path before its forces are written out.
+ARRAY_COMPILE_AFTER = 2
 #: Pivot sequences written out per scene at most (a turn of the packaged scenes meets 1 to 3).
 MAX_SEQUENCES = 8
 
@@ -401,6 +404,11 @@ class Dynamics:
         self._fast: list[SingleForces] = []     # one per pivot sequence, the last used first
         self._sequences: set[Any] = set()
         self._general = 0               # single instants on the general path
+        #: Why arrays' forces are not written out, or None.
+        self.compiled_array: NotCompiled | None = None
+        self._fast_array: list[Any] = []    # one per pivot sequence, in the order met
+        self._array_sequences: set[Any] = set()
+        self._arrays = 0                # array calls
 
     # --- structure -------------------------------------------------------------------
 
@@ -558,7 +566,48 @@ class Dynamics:
                     else:
                         fast.insert(0, written)
                 return forces
-        return self._forces(state, max_error)
+            return self._forces(state, max_error)
+        self._arrays += 1
+        if self._arrays <= ARRAY_COMPILE_AFTER or self.compiled_array is not None:
+            return self._forces(state, max_error)
+        with np.errstate(all='ignore'):
+            return self._array_forces(state, max_error, 0)
+
+    def _array_forces(self, state: Any, max_error: float, start: int) -> Forces:
+        """Return the forces of an array from the written-out functions from ``start`` on.
+
+        Each function settles the instants of its pivot sequence; the others go
+        to the next (written from the first of them, up to MAX_SEQUENCES), the
+        last to the general path; the answers are put back in place.
+        """
+        fast = self._fast_array
+        valid = np.asarray(state.valid, dtype=bool)
+        if start == len(fast):
+            written: Any = None
+            first = np.flatnonzero(valid)
+            if len(fast) < MAX_SEQUENCES and first.size:
+                pivots: dict[str, list[int]] = {}
+                one = self._forces(cast('State', _Subset(state, int(first[0]))), max_error,
+                                   pivots)
+                key = tuple((name, tuple(p)) for name, p in pivots.items())
+                if one.valid is True and key not in self._array_sequences:
+                    self._array_sequences.add(key)
+                    written = compile_single(self, pivots, Forces, Reaction, _TINY,
+                                             vector=True)
+                    if isinstance(written, NotCompiled):
+                        self.compiled_array = written
+                    else:
+                        fast.append(written)
+            if not callable(written):
+                return self._forces(state, max_error)
+        forces, ok = fast[start](state, max_error)
+        settled = np.broadcast_to(ok, valid.shape)
+        redo = valid & ~settled
+        object.__setattr__(forces, 'valid', valid & settled)
+        if not redo.any():
+            return cast(Forces, forces)
+        part = self._array_forces(_Subset(state, redo), max_error, start + 1)
+        return _merge(forces, redo, part)
 
     def _forces(self, state: State, max_error: float,
                 pivots: dict[str, list[int]] | None = None) -> Forces:
@@ -992,6 +1041,68 @@ def _bounded_solve(A: list[list[Any]], EA: list[list[Any]], b: list[Any], Eb: li
             ok = ok & np.isfinite(value)
         e_x = [np.where(ok, e, np.inf) for e in e_x]
     return x, e_x, ok
+
+
+class _Subset:
+    """The instants ``index`` of an array state: what the forces read of it (one or an array)."""
+
+    def __init__(self, state: Any, index: Any) -> None:
+        size = np.shape(state.valid)
+
+        def take(value: Any) -> Any:
+            if isinstance(value, np.ndarray) and value.shape == size:
+                return value[index]
+            return value
+
+        def motion(m: Any) -> SimpleNamespace:
+            return SimpleNamespace(position=take(m.position), velocity=take(m.velocity),
+                                   acceleration=take(m.acceleration))
+
+        valid = take(np.asarray(state.valid, dtype=bool))
+        self.valid = bool(valid) if np.ndim(valid) == 0 else valid
+        self.complex_points = {name: tuple(take(v) for v in values)
+                               for name, values in state.complex_points.items()}
+        bounds = state.error_bound
+        self.error_bound = SimpleNamespace(
+            points={name: motion(b) for name, b in bounds.points.items()},
+            joints={name: motion(b) for name, b in bounds.joints.items()})
+        self.joints = {name: motion(m) for name, m in state.joints.items()}
+        self.scales = {name: take(v) for name, v in state.scales.items()}
+        self.intermittent = {name: SimpleNamespace(engaged=take(e.engaged))
+                             for name, e in state.intermittent.items()}
+
+
+def _merge(forces: Forces, redo: Any, part: Forces) -> Forces:
+    """Return ``forces`` with the instants ``redo`` replaced by ``part``'s (arrays)."""
+    shape = redo.shape
+
+    def put(whole: Any, some: Any) -> Any:
+        if whole is None:
+            return None
+        out = np.array(np.broadcast_to(whole, shape), dtype=np.result_type(whole, some))
+        out[redo] = some
+        return out
+
+    reactions = {}
+    for name, r in forces.reactions.items():
+        p = part.reactions[name]
+        reactions[name] = Reaction(r.at, r.on, r.by, put(r.force, p.force),
+                                   put(r.normal, p.normal), put(r.moment, p.moment),
+                                   put(r.force_bound, p.force_bound),
+                                   put(r.normal_bound, p.normal_bound),
+                                   put(r.moment_bound, p.moment_bound))
+    failures = dict(forces.failures)
+    for reason, mask in part.failures.items():
+        full = np.zeros(shape, dtype=bool)
+        full[redo] = mask
+        failures[reason] = failures[reason] | full if reason in failures else full
+    return Forces({n: put(v, part.efforts[n]) for n, v in forces.efforts.items()}, reactions,
+                  put(forces.shaking_force, part.shaking_force),
+                  put(forces.shaking_moment, part.shaking_moment),
+                  {n: put(v, part.effort_bounds[n]) for n, v in forces.effort_bounds.items()},
+                  (put(forces.shaking_bounds[0], part.shaking_bounds[0]),
+                   put(forces.shaking_bounds[1], part.shaking_bounds[1])),
+                  put(forces.valid, part.valid), put(forces.scale, part.scale), failures)
 
 
 def _fmax(a: Any, b: Any, vector: bool) -> Any:

@@ -43,6 +43,8 @@ from collections.abc import Callable, Mapping, Sequence
 import math
 from typing import Any, cast, TYPE_CHECKING
 
+import numpy as np
+
 from .compiler import NotCompiled
 from ..bounds import U
 
@@ -62,11 +64,16 @@ def _gamma(k: int) -> float:
 class _Writer:
     """The statements of one function, its temporaries and its constants."""
 
-    def __init__(self) -> None:
+    def __init__(self, vector: bool) -> None:
+        self.vector = vector
         self.lines: list[str] = []
         self.namespace: dict[str, Any] = {}
         self.count = 0
         self.memo: dict[Any, str] = {}
+        # The functions of the target's own path: math on floats, NumPy on arrays (the
+        # general path's _expi and _expi_array), constants folded with them.
+        self.functions = ({'cos': np.cos, 'sin': np.sin, 'fmax': np.fmax} if vector
+                          else {'cos': math.cos, 'sin': math.sin})
 
     def const(self, value: Any) -> str:
         """Return the name of a constant bound in the function's globals."""
@@ -81,7 +88,7 @@ class _Writer:
         """Return the value of ``expr`` if it reads constants only (the same operations, now)."""
         try:
             return eval(expr, {'__builtins__': {}, 'abs': abs, 'complex': complex,  # noqa: S307
-                               'cos': math.cos, 'sin': math.sin, **self.namespace})
+                               **self.functions, **self.namespace})
         except NameError:   # it reads a value of the instant
             return _RUNTIME
         except ArithmeticError:     # left to the instant (a refusal guards it)
@@ -136,6 +143,12 @@ class _Writer:
         """
         values = [self.fold(term) for term in terms]
         constants = [v for v in values if v is not _RUNTIME]
+        if self.vector:     # np.fmax, in the same order
+            if start is not None:
+                self.emit(f'{var} = {self.const(start)}')
+            for term in terms:
+                self.emit(f'{var} = fmax({var}, {term})')
+            return
         if start is not None:
             self.emit(f'{var} = {self.const(max([start, *constants]))}')
         elif constants:
@@ -149,10 +162,18 @@ class _Writer:
                 self.emit(f'if {term} > {var}: {var} = {term}')
 
     def refuse_unless(self, conditions: Sequence[str], answer: str = 'None') -> None:
-        """Emit a return of ``answer`` unless every condition holds."""
+        """Emit a return of ``answer`` unless every condition holds (arrays: mask ``ok``)."""
         conditions = [c for c in conditions if self.fold(c) is not True]
-        if conditions:
+        if conditions and self.vector:
+            self.emit(f'ok = ok & {" & ".join(f"({c})" for c in conditions)}')
+        elif conditions:
             self.emit(f'if not ({" and ".join(conditions)}): return {answer}')
+
+    def expi(self, angle: str) -> str:
+        """Return a temporary holding the unit complex number at ``angle`` (rad)."""
+        if self.vector:
+            return self.let(f'cos({angle}) + 1j * sin({angle})')
+        return self.let(f'complex(cos({angle}), sin({angle}))')
 
 
 #: What :meth:`_Writer.fold` returns for an expression that reads the instant.
@@ -177,8 +198,8 @@ def _sum(terms: Sequence[str]) -> str:
 
 
 def compile_single(dynamics: Dynamics, pivots: Mapping[str, Sequence[int]],
-                   forces_type: type, reaction_type: type,
-                   tiny: float) -> SingleForces | NotCompiled:
+                   forces_type: type, reaction_type: type, tiny: float,
+                   vector: bool = False) -> SingleForces | NotCompiled:
     """Return one instant's forces of ``dynamics`` as one function, or why not.
 
     Parameters
@@ -193,6 +214,11 @@ def compile_single(dynamics: Dynamics, pivots: Mapping[str, Sequence[int]],
         function builds (passed in: :mod:`.forces` imports this module).
     tiny : float
         The least force scale (``forces._TINY``), N.
+    vector : bool
+        Write the array path instead: the same statements on arrays (every
+        instant computed), returning ``(forces, ok)`` with ``ok`` the mask of
+        the instants it settles (where a pivot differs or a test fails, the
+        caller asks the general path); ``Forces.valid`` is left to the caller.
 
     Returns
     -------
@@ -206,7 +232,7 @@ def compile_single(dynamics: Dynamics, pivots: Mapping[str, Sequence[int]],
         if group.key not in pivots:
             return NotCompiled(f'{group.key}: no pivot sequence recorded')
     graph = dynamics.graph
-    w = _Writer()
+    w = _Writer(vector)
     ab = w.abs
     size = dynamics.size
     K_U = w.const(U)
@@ -257,7 +283,7 @@ def compile_single(dynamics: Dynamics, pivots: Mapping[str, Sequence[int]],
         if mass is not None:
             m, com = w.const(mass.mass), complex(*mass.com)
             K_com, K_abs_com = w.const(com), w.const(abs(com))
-            r = w.let(f'{K_com} * complex(cos({theta}), sin({theta}))') if com else '0j'
+            r = w.let(f'{K_com} * {w.expi(theta)}') if com else '0j'
             spin = w.let(f'1j * {alpha} - {omega} * {omega}')
             a_c = w.let(f'{acc(origin)} + {spin} * {r}')
             F = w.let(f'{m} * ({a_c} - {gravity})')
@@ -352,7 +378,7 @@ def compile_single(dynamics: Dynamics, pivots: Mapping[str, Sequence[int]],
                                           f'{w.const(line.angle)}')
                             e_angle = w.let(f'{joint_bound(line.angle_of, "position")} + '
                                             f'{w.const(U * abs(line.angle))}')
-                        u = w.let(f'complex(cos({angle}), sin({angle}))')
+                        u = w.expi(angle)
                         e_u = w.let(f'{e_angle} + {K_2U}')
                     lines[joint.name] = u, e_u
                 u, e_u = lines[joint.name]
@@ -436,7 +462,8 @@ def compile_single(dynamics: Dynamics, pivots: Mapping[str, Sequence[int]],
                     e_force = w.let(f'{bound} + {K_2U} * {ab(value)}')
                     force = value
                 elif component == 'y':
-                    force = w.let(f'complex({force}, {value})')
+                    force = w.let(f'{force} + 1j * {value}' if w.vector
+                                  else f'complex({force}, {value})')
                     e_force = w.let(f'{e_force} + {bound} + {K_2U} * {ab(force)}')
                 else:
                     force = w.let(_plus(force, f'{value} * {unit}'))
@@ -446,7 +473,8 @@ def compile_single(dynamics: Dynamics, pivots: Mapping[str, Sequence[int]],
     w.maximum('scale', [term for _, force, _, couple, _, _ in done
                         for term in (ab(force), f'{ab(couple)} / {w.const(size)}')])
     # --- the result (Dynamics._result) ----------------------------------------------
-    w.emit(f'force_limit = max_error * max(scale, {w.const(tiny)})')
+    w.emit(f'force_limit = max_error * {"fmax" if w.vector else "max"}(scale, '
+           f'{w.const(tiny)})')
     w.emit(f'moment_limit = force_limit * {w.const(size)}')
     checks: list[str] = []
     efforts: list[str] = []
@@ -497,27 +525,33 @@ def compile_single(dynamics: Dynamics, pivots: Mapping[str, Sequence[int]],
             e_turning = w.let(_plus(e_turning, e_turn))
     checks += [f'{e_shaking} <= force_limit', f'{e_turning} <= moment_limit']
     w.refuse_unless(checks)
+    if w.vector:
+        efforts = [f'{e.split(": ")[0]}: broadcast_to({e.split(": ")[1]}, shape)'
+                   for e in efforts]
     w.emit('result = new(Forces)')
     w.emit(f'result.__dict__.update(efforts={{{", ".join(efforts)}}}, reactions={{'
            f'{", ".join(reactions)}}}, shaking_force={shaking}, shaking_moment={turning}, '
            f'effort_bounds={{{", ".join(effort_bounds)}}}, shaking_bounds=({e_shaking}, '
            f'{e_turning}), valid=True, scale=scale, failures={{}}, worst=None)')
-    w.emit('return result')
-    head = ['def forces(state, max_error):',
-            f'    if state.valid is not True or state.joints[{first!r}].position.__class__ '
-            f'is not float: return None',
+    w.emit('return (result, ok)' if w.vector else 'return result')
+    head = ['def forces(state, max_error):']
+    if w.vector:
+        head += ['    ok = True', '    shape = state.valid.shape']
+    else:
+        head += [f'    if state.valid is not True or state.joints[{first!r}].position.__class__ '
+                 f'is not float: return None']
+    head += [
             '    S_a = state.scales["acceleration"]',
             '    S_alpha = state.scales["angular acceleration"]',
             '    P = state.complex_points',
             '    B = state.error_bound',
             '    PB = B.points',
             '    JB = B.joints',
-            '    J = state.joints',
-            ]
+            '    J = state.joints']
     source = '\n'.join(head + ['    ' + line for line in w.lines]) + '\n'
     namespace = dict(w.namespace)
-    namespace.update(new=object.__new__, Reaction=reaction_type, Forces=forces_type, cos=math.cos,
-                     sin=math.sin)
+    namespace.update(w.functions, new=object.__new__, Reaction=reaction_type,
+                     Forces=forces_type, broadcast_to=np.broadcast_to)
     exec(compile(source, f'<forces of {graph.ground}>', 'exec'), namespace)  # noqa: S102
     function = namespace['forces']
     function.source = source

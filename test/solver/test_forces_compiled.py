@@ -218,3 +218,84 @@ def test_an_intermittent_drive_is_not_written_out_and_says_why():
         mk.solve(scene, math.radians(160.0) + f)
     assert isinstance(scene.dynamics.compiled_single, NotCompiled)
     assert not scene.dynamics._fast
+
+
+# --- arrays ---------------------------------------------------------------------------
+
+def _sweep(scene, n, moving=False):
+    """Return an array state of ``scene``: ``n`` configurations over each driver's range."""
+    fractions = np.linspace(0.0, 1.0, n, endpoint=False)
+    angle = _angle(scene, [fractions] * len(scene.drivers))
+    if not moving:
+        return mk.solve(scene, angle)
+    k = len(scene.drivers)
+    speed, accel = 2.0 + np.sin(7 * fractions), -3.0 * np.cos(5 * fractions)
+    return mk.solve(scene, angle, speed if k == 1 else [speed] * k,
+                    accel if k == 1 else [accel] * k)
+
+
+def _warm_arrays(scene):
+    """Solve ``scene`` at arrays until its arrays' forces run written out; return its dynamics."""
+    for _ in range(forces_module.ARRAY_COMPILE_AFTER + 1):
+        state = _sweep(scene, 40)
+    scene.dynamics.forces(state, MAX_ERROR)
+    assert scene.dynamics._fast_array, scene.dynamics.compiled_array
+    return scene.dynamics
+
+
+def _assert_same_arrays(got, want):
+    """Assert two array Forces agree: valid, failures, and every value and bound where valid."""
+    valid = np.asarray(want.valid, dtype=bool)
+    np.testing.assert_array_equal(got.valid, valid)
+    assert got.failures.keys() == want.failures.keys()
+    for reason, mask in want.failures.items():
+        np.testing.assert_array_equal(got.failures[reason], mask)
+
+    def same(a, b):
+        a, b = np.broadcast_to(a, valid.shape), np.broadcast_to(b, valid.shape)
+        np.testing.assert_array_equal(a[valid], b[valid])
+
+    for name, value in want.efforts.items():
+        same(got.efforts[name], value)
+        same(got.effort_bounds[name], want.effort_bounds[name])
+    for name, reaction in want.reactions.items():
+        for field in dataclasses.fields(reaction):
+            mine, theirs = getattr(got.reactions[name], field.name), getattr(reaction, field.name)
+            if isinstance(theirs, str) or theirs is None:
+                assert mine == theirs
+            else:
+                same(mine, theirs)
+    same(got.shaking_force, want.shaking_force)
+    same(got.shaking_moment, want.shaking_moment)
+    same(got.shaking_bounds[0], want.shaking_bounds[0])
+    same(got.shaking_bounds[1], want.shaking_bounds[1])
+    same(got.scale, want.scale)
+
+
+@pytest.mark.parametrize('name', PACKAGED)
+@pytest.mark.parametrize('moving', [False, True])
+def test_arrays_written_out_are_the_general_paths(name, moving):
+    """An array's forces written out (one function a pivot sequence) are the general path's."""
+    scene = mk.load_scene(name)
+    dynamics = _warm_arrays(scene)
+    state = _sweep(scene, 720, moving)
+    _assert_same_arrays(state.forces, dynamics._forces(state, MAX_ERROR))
+    assert 1 <= len(dynamics._fast_array) <= forces_module.MAX_SEQUENCES
+
+
+def test_an_arrays_refused_instants_are_refused_with_the_general_paths_reasons():
+    """Instants beyond the tolerance and singular ones keep the general path's failures."""
+    scene = mk.load_scene('engine')
+    dynamics = _warm_arrays(scene)
+    state = _sweep(scene, 90)
+    points = dict(state.complex_points)
+    singular = np.arange(90) % 7 == 3
+    points['C'] = (np.where(singular, points['P'][0], points['C'][0]), *points['C'][1:])
+    tampered = dataclasses.replace(state, complex_points=points)
+    want = dynamics._forces(tampered, MAX_ERROR)
+    assert 'P (statics singular)' in want.failures
+    _assert_same_arrays(dynamics.forces(tampered, MAX_ERROR), want)
+    strict = 6.5e-15   # between the bounds of the instants (46 of 90 beyond it)
+    want = dynamics._forces(state, strict)
+    assert 0 < np.count_nonzero(want.failures['forces (untrusted)']) < 90
+    _assert_same_arrays(dynamics.forces(state, strict), want)
