@@ -8,9 +8,11 @@ both meet the same machine:
 - **single**: ``mk.solve``'s kinematics alone at one instant (``_kinematics``,
   the path ``mk.solve`` takes: compiled where the scene compiles, warmed past
   ``COMPILE_AFTER``), the forces alone at that state
-  (``scene.dynamics.forces``) and the whole ``mk.solve`` (both and the
-  refusal checks), in microseconds per instant, over a turn of instants (each
-  driver swept over its range);
+  (``scene.dynamics.forces``: written out once warmed, :mod:`.forces_compiled`),
+  the general path's forces (``Dynamics._forces``, the dense solve every
+  instant took before) and the whole ``mk.solve`` (kinematics, forces and the
+  state rebuilt with them), in microseconds per instant, over a turn of
+  instants (each driver swept over its range);
 - **array**: the same for arrays of 360 and 100,000 configurations (the array
   path, warmed past ``ARRAY_COMPILE_AFTER``), in microseconds per
   configuration.
@@ -37,6 +39,7 @@ import numpy as np
 
 import mech_kinematics as mk
 from mech_kinematics.bounds import MAX_ERROR
+from mech_kinematics.solver.forces import ARRAY_COMPILE_AFTER
 from mech_kinematics.solver.solve import _kinematics
 
 SIZES = (360, 100_000)
@@ -75,20 +78,39 @@ def _per_call(fn, calls):
 
 
 def single(scene, repeat, calls=360):
-    """Return median us per instant: kinematics, forces alone, the whole ``mk.solve``."""
+    """Return median us per instant: kinematics, forces, general forces, the whole ``mk.solve``.
+
+    The forces are timed at a state fresh from the kinematics (as ``mk.solve``
+    and the node meet it): they include building the kinematic bounds and
+    scales the state builds on first use, which the kinematics alone never ask.
+    """
     columns = _sweep(scene, calls)
     angles = [_args(scene, columns, i) for i in range(calls)]
-    states = []
     for _ in range(2):      # past COMPILE_AFTER: the compiled tick where the scene compiles
-        states = [_kinematics(scene, a) for a in angles]
+        for a in angles:
+            _kinematics(scene, a)
     dynamics = scene.dynamics
-    for i in range(calls):
-        mk.solve(scene, angles[i])
-    runs = {'kinematics': [], 'forces': [], 'solve': []}
+    for a in angles:
+        mk.solve(scene, a)
+    clock = time.perf_counter_ns
+    runs = {'kinematics': [], 'forces': [], 'general': [], 'solve': []}
     for _ in range(repeat):
-        runs['kinematics'].append(_per_call(lambda i: _kinematics(scene, angles[i]), calls))
-        runs['forces'].append(_per_call(lambda i: dynamics.forces(states[i], MAX_ERROR),
-                                        calls))
+        spent = {'kinematics': 0, 'forces': 0, 'general': 0}
+        for a in angles:
+            start = clock()
+            state = _kinematics(scene, a)
+            middle = clock()
+            dynamics.forces(state, MAX_ERROR)
+            end = clock()
+            spent['kinematics'] += middle - start
+            spent['forces'] += end - middle
+        for a in angles:
+            state = _kinematics(scene, a)
+            start = clock()
+            dynamics._forces(state, MAX_ERROR)
+            spent['general'] += clock() - start
+        for key, ns in spent.items():
+            runs[key].append(ns / calls / 1e3)
         runs['solve'].append(_per_call(lambda i: mk.solve(scene, angles[i]), calls))
     return {k: statistics.median(v) for k, v in runs.items()}
 
@@ -99,13 +121,16 @@ def array(scene, n, repeat):
     for _ in range(20):     # past ARRAY_COMPILE_AFTER
         state = _kinematics(scene, angle)
     dynamics = scene.dynamics
-    mk.solve(scene, angle)
-    runs = {'kinematics': [], 'forces': [], 'solve': []}
+    for _ in range(ARRAY_COMPILE_AFTER + 2):    # written out
+        dynamics.forces(state, MAX_ERROR)
+    runs = {'kinematics': [], 'forces': [], 'general': [], 'solve': []}
     calls = max(1, 3600 // n)
     for _ in range(repeat):
         runs['kinematics'].append(_per_call(lambda i: _kinematics(scene, angle), calls) / n)
         runs['forces'].append(_per_call(lambda i: dynamics.forces(state, MAX_ERROR),
                                         calls) / n)
+        runs['general'].append(_per_call(lambda i: dynamics._forces(state, MAX_ERROR),
+                                         calls) / n)
         runs['solve'].append(_per_call(lambda i: mk.solve(scene, angle), calls) / n)
     return {k: statistics.median(v) for k, v in runs.items()}
 
@@ -121,6 +146,9 @@ def profile(scene, calls=2000):
         dynamics.forces(state, MAX_ERROR)
     profiler.disable()
     pstats.Stats(profiler).sort_stats('tottime').print_stats(18)
+    if dynamics._fast:
+        print(f'written out: {len(dynamics._fast)} function(s), the first '
+              f'{dynamics._fast[0].source.count(chr(10))} lines')
 
 
 def main(argv=None):
@@ -150,12 +178,13 @@ def main(argv=None):
         return
     print(f'load average {load:.1f} before, {results["load"][1]:.1f} after; medians of '
           f'{args.repeat} runs; us per instant (arrays: per configuration)')
-    print(f'{"scene":28s} {"path":10s} {"kinematics":>10s} {"forces":>8s} {"ratio":>6s} '
-          f'{"solve":>8s}')
+    print(f'{"scene":26s} {"path":12s} {"kinematics":>10s} {"forces":>8s} {"ratio":>6s} '
+          f'{"general":>8s} {"ratio":>6s} {"solve":>8s}')
     for name in names:
         for path, r in results[name].items():
-            print(f'{name:28s} {path:10s} {r["kinematics"]:10.2f} {r["forces"]:8.2f} '
-                  f'{r["forces"] / r["kinematics"]:6.2f} {r["solve"]:8.2f}')
+            print(f'{name:26s} {path:12s} {r["kinematics"]:10.2f} {r["forces"]:8.2f} '
+                  f'{r["forces"] / r["kinematics"]:6.2f} {r["general"]:8.2f} '
+                  f'{r["general"] / r["kinematics"]:6.2f} {r["solve"]:8.2f}')
 
 
 if __name__ == '__main__':

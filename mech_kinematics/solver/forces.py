@@ -535,11 +535,14 @@ class Dynamics:
         makes the instant invalid (``Forces.valid``, ``Forces.failures``).
 
         One instant runs written out (:mod:`.forces_compiled`) once the scene
-        has had :data:`COMPILE_AFTER` instants on the general path: one
-        function per pivot sequence met (at most :data:`MAX_SEQUENCES`), the
-        general path's bits and bounds; an instant none of them settles (a
-        refusal, another pivot sequence) takes the general path.
-        ``compiled_single`` says why a scene is not written out.
+        has had :data:`COMPILE_AFTER` instants on the general path, an array
+        once it has had :data:`ARRAY_COMPILE_AFTER` arrays: one function per
+        pivot sequence met (at most :data:`MAX_SEQUENCES` each), the general
+        path's bits and bounds; an instant none of them settles (a refusal,
+        another pivot sequence) takes the general path. ``compiled_single``
+        and ``compiled_array`` say why a scene is not written out. The lists
+        of functions are replaced, never changed in place: a thread reading
+        one while another writes a function sees the old list or the new.
         """
         if state.valid.__class__ is bool:
             fast = self._fast
@@ -548,8 +551,8 @@ class Dynamics:
                 if answer is False:     # another pivot sequence: try the next
                     continue
                 if answer is not None:
-                    if index:
-                        fast.insert(0, fast.pop(index))
+                    if index:   # the last used first (a new list: another thread may read)
+                        self._fast = [function, *(f for f in fast if f is not function)]
                     return cast(Forces, answer)
                 break
             self._general += 1
@@ -564,7 +567,7 @@ class Dynamics:
                     if isinstance(written, NotCompiled):
                         self.compiled_single = written
                     else:
-                        fast.insert(0, written)
+                        self._fast = [written, *self._fast]
                 return forces
             return self._forces(state, max_error)
         self._arrays += 1
@@ -597,7 +600,7 @@ class Dynamics:
                     if isinstance(written, NotCompiled):
                         self.compiled_array = written
                     else:
-                        fast.append(written)
+                        fast = self._fast_array = [*fast, written]
             if not callable(written):
                 return self._forces(state, max_error)
         forces, ok = fast[start](state, max_error)
