@@ -64,6 +64,10 @@ __all__ = ['Dynamics', 'Forces', 'Load', 'Mass', 'Reaction']
 COMPILE_AFTER = 8
 #: Array calls of one scene on the general path before its forces are written out.
 ARRAY_COMPILE_AFTER = 2
+#: Pivot sequences written out for a scene's arrays at most: one with more (the excavator
+#: meets 6) keeps the general path for its arrays, which a chain of functions, each run over
+#: the instants the last left, was slower than (bench/forces_bench.py).
+ARRAY_SEQUENCES = 2
 #: Pivot sequences written out per scene at most (a turn of the packaged scenes meets 1 to 3).
 MAX_SEQUENCES = 8
 
@@ -537,7 +541,8 @@ class Dynamics:
         One instant runs written out (:mod:`.forces_compiled`) once the scene
         has had :data:`COMPILE_AFTER` instants on the general path, an array
         once it has had :data:`ARRAY_COMPILE_AFTER` arrays: one function per
-        pivot sequence met (at most :data:`MAX_SEQUENCES` each), the general
+        pivot sequence met (at most :data:`MAX_SEQUENCES`; for arrays
+        :data:`ARRAY_SEQUENCES`, beyond which they take the general path), the general
         path's bits and bounds; an instant none of them settles (a refusal,
         another pivot sequence) takes the general path. ``compiled_single``
         and ``compiled_array`` say why a scene is not written out. The lists
@@ -574,26 +579,35 @@ class Dynamics:
         if self._arrays <= ARRAY_COMPILE_AFTER or self.compiled_array is not None:
             return self._forces(state, max_error)
         with np.errstate(all='ignore'):
-            return self._array_forces(state, max_error, 0)
+            answer = self._array_forces(state, max_error, 0)
+        return self._forces(state, max_error) if answer is None else answer
 
-    def _array_forces(self, state: Any, max_error: float, start: int) -> Forces:
+    def _array_forces(self, state: Any, max_error: float, start: int) -> Forces | None:
         """Return the forces of an array from the written-out functions from ``start`` on.
 
         Each function settles the instants of its pivot sequence; the others go
-        to the next (written from the first of them, up to MAX_SEQUENCES), the
-        last to the general path; the answers are put back in place.
+        to the next (written from the first of them), the last to the general
+        path; the answers are put back in place. None: the scene meets more
+        than :data:`ARRAY_SEQUENCES` sequences, its arrays go to the general
+        path from now on (each function costs, on an array, what the general
+        path does on a few times fewer instants).
         """
         fast = self._fast_array
         valid = np.asarray(state.valid, dtype=bool)
         if start == len(fast):
             written: Any = None
             first = np.flatnonzero(valid)
-            if len(fast) < MAX_SEQUENCES and first.size:
+            if first.size:
                 pivots: dict[str, list[int]] = {}
                 one = self._forces(cast('State', _Subset(state, int(first[0]))), max_error,
                                    pivots)
                 key = tuple((name, tuple(p)) for name, p in pivots.items())
                 if one.valid is True and key not in self._array_sequences:
+                    if len(fast) == ARRAY_SEQUENCES:
+                        self.compiled_array = NotCompiled(
+                            f'more than {ARRAY_SEQUENCES} pivot sequences over its arrays (a '
+                            f'function each costs more than the general path)')
+                        return None
                     self._array_sequences.add(key)
                     written = compile_single(self, pivots, Forces, Reaction, _TINY,
                                              vector=True)
@@ -610,7 +624,7 @@ class Dynamics:
         if not redo.any():
             return cast(Forces, forces)
         part = self._array_forces(_Subset(state, redo), max_error, start + 1)
-        return _merge(forces, redo, part)
+        return None if part is None else _merge(forces, redo, part)
 
     def _forces(self, state: State, max_error: float,
                 pivots: dict[str, list[int]] | None = None) -> Forces:
