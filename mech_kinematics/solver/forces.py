@@ -68,6 +68,9 @@ ARRAY_COMPILE_AFTER = 2
 #: meets 6) keeps the general path for its arrays, which a chain of functions, each run over
 #: the instants the last left, was slower than (bench/forces_bench.py).
 ARRAY_SEQUENCES = 2
+#: Instants a written-out function runs at once over a longer array (its temporaries stay
+#: in the cache: twice as fast over 100,000 instants as all at once, bench/forces_bench.py).
+ARRAY_CHUNK = 8192
 #: Pivot sequences written out per scene at most (a turn of the packaged scenes meets 1 to 3).
 MAX_SEQUENCES = 8
 
@@ -579,7 +582,14 @@ class Dynamics:
         if self._arrays <= ARRAY_COMPILE_AFTER or self.compiled_array is not None:
             return self._forces(state, max_error)
         with np.errstate(all='ignore'):
-            answer = self._array_forces(state, max_error, 0)
+            size = int(np.size(state.valid))
+            if size <= ARRAY_CHUNK:
+                answer = self._array_forces(state, max_error, 0)
+            else:   # in blocks whose temporaries stay in the cache: the same operations
+                parts = [self._array_forces(_Subset(state, slice(i, i + ARRAY_CHUNK)),
+                                            max_error, 0) for i in range(0, size, ARRAY_CHUNK)]
+                answer = None if any(p is None for p in parts) else _concatenate(
+                    cast('list[Forces]', parts))
         return self._forces(state, max_error) if answer is None else answer
 
     def _array_forces(self, state: Any, max_error: float, start: int) -> Forces | None:
@@ -1120,6 +1130,37 @@ def _merge(forces: Forces, redo: Any, part: Forces) -> Forces:
                   (put(forces.shaking_bounds[0], part.shaking_bounds[0]),
                    put(forces.shaking_bounds[1], part.shaking_bounds[1])),
                   put(forces.valid, part.valid), put(forces.scale, part.scale), failures)
+
+
+def _concatenate(parts: list[Forces]) -> Forces:
+    """Return the forces of consecutive blocks of instants as those of the whole array."""
+    def join(values: list[Any], shapes: list[Any]) -> Any:
+        if values[0] is None:
+            return None
+        pairs = zip(values, shapes, strict=True)
+        return np.concatenate([np.broadcast_to(v, s) for v, s in pairs])
+
+    shapes = [np.shape(p.valid) for p in parts]
+    first = parts[0]
+    reactions = {}
+    for name, r in first.reactions.items():
+        fields = {f: join([getattr(p.reactions[name], f) for p in parts], shapes)
+                  for f in ('force', 'normal', 'moment', 'force_bound', 'normal_bound',
+                            'moment_bound')}
+        reactions[name] = Reaction(r.at, r.on, r.by, **fields)
+    failures = {}
+    for reason in dict.fromkeys(k for p in parts for k in p.failures):
+        failures[reason] = join([p.failures.get(reason, np.zeros(s, dtype=bool))
+                                 for p, s in zip(parts, shapes, strict=True)], shapes)
+    return Forces({n: join([p.efforts[n] for p in parts], shapes) for n in first.efforts},
+                  reactions, join([p.shaking_force for p in parts], shapes),
+                  join([p.shaking_moment for p in parts], shapes),
+                  {n: join([p.effort_bounds[n] for p in parts], shapes)
+                   for n in first.effort_bounds},
+                  (join([p.shaking_bounds[0] for p in parts], shapes),
+                   join([p.shaking_bounds[1] for p in parts], shapes)),
+                  join([p.valid for p in parts], shapes), join([p.scale for p in parts], shapes),
+                  failures)
 
 
 def _fmax(a: Any, b: Any, vector: bool) -> Any:

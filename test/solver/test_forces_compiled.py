@@ -317,3 +317,19 @@ def test_refused_instants_beyond_the_last_sequence_leave_the_arrays_written_out(
     assert 0 < np.count_nonzero(want.failures['forces (untrusted)']) < 90
     _assert_same_arrays(dynamics.forces(state, strict), want)
     assert dynamics.compiled_array is None
+
+
+def test_a_long_array_runs_in_blocks_with_the_general_paths_answer(monkeypatch):
+    """An array longer than ARRAY_CHUNK runs block by block; put together, the general path's."""
+    scene = mk.load_scene('engine')
+    dynamics = _warm_arrays(scene)
+    monkeypatch.setattr(forces_module, 'ARRAY_CHUNK', 17)
+    state = _sweep(scene, 90)
+    points = dict(state.complex_points)
+    singular = np.arange(90) % 11 == 5
+    points['C'] = (np.where(singular, points['P'][0], points['C'][0]), *points['C'][1:])
+    tampered = dataclasses.replace(state, complex_points=points)
+    for strict in (MAX_ERROR, 6.5e-15):
+        want = dynamics._forces(tampered, strict)
+        assert want.failures and not want.valid.all()
+        _assert_same_arrays(dynamics.forces(tampered, strict), want)
