@@ -41,6 +41,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 import math
+import re
 from typing import Any, cast, TYPE_CHECKING
 
 import numpy as np
@@ -86,6 +87,8 @@ class _Writer:
 
     def fold(self, expr: str) -> Any:
         """Return the value of ``expr`` if it reads constants only (the same operations, now)."""
+        if _READS_INSTANT.search(expr):     # a temporary or the state: not worth an eval
+            return _RUNTIME
         try:
             return eval(expr, {'__builtins__': {}, 'abs': abs, 'complex': complex,  # noqa: S307
                                **self.functions, **self.namespace})
@@ -178,6 +181,9 @@ class _Writer:
 
 #: What :meth:`_Writer.fold` returns for an expression that reads the instant.
 _RUNTIME = object()
+#: A name only the instant defines: a temporary, the state's tables, the running maxima.
+_READS_INSTANT = re.compile(r'\b(t\d+|P|PB|J|JB|S_a|S_alpha|scale|a_norm|x_norm|condition|'
+                            r'force_limit|moment_limit|max_error)\b')
 
 
 def _neg(expr: str) -> str:
