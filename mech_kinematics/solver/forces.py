@@ -42,10 +42,13 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 import math
-from typing import Any, TYPE_CHECKING
+from types import SimpleNamespace
+from typing import Any, cast, TYPE_CHECKING
 
 import numpy as np
 
+from .compiler import NotCompiled
+from .forces_compiled import compile_single, SingleForces
 from .graph import Graph, Joint
 from .model import _check_finite, _check_name
 from ..bounds import U
@@ -55,6 +58,21 @@ if TYPE_CHECKING:
     from .state import State
 
 __all__ = ['Dynamics', 'Forces', 'Load', 'Mass', 'Reaction']
+
+#: Single instants of one scene on the general path before its forces are written out
+#: (:mod:`.forces_compiled`): writing them out costs what a few general instants do.
+COMPILE_AFTER = 8
+#: Array calls of one scene on the general path before its forces are written out.
+ARRAY_COMPILE_AFTER = 2
+#: Pivot sequences written out for a scene's arrays at most: one with more (the excavator
+#: meets 6) keeps the general path for its arrays, which a chain of functions, each run over
+#: the instants the last left, was slower than (bench/forces_bench.py).
+ARRAY_SEQUENCES = 2
+#: Instants a written-out function runs at once over a longer array (its temporaries stay
+#: in the cache: twice as fast over 100,000 instants as all at once, bench/forces_bench.py).
+ARRAY_CHUNK = 8192
+#: Pivot sequences written out per scene at most (a turn of the packaged scenes meets 1 to 3).
+MAX_SEQUENCES = 8
 
 #: Rounding of one correctly rounded operation, as a multiple of |result| (NumPy's
 #: products and sums of a few terms: gamma_k = k U / (1 - k U) for k operations).
@@ -388,6 +406,16 @@ class Dynamics:
                     raise SceneError(msg, (load, 'link'))
                 self.torque_loads.setdefault(load.link, []).append(load)
         self.groups = self._groups()
+        #: Why one instant's forces are not written out (:mod:`.forces_compiled`), or None.
+        self.compiled_single: NotCompiled | None = None
+        self._fast: list[SingleForces] = []     # one per pivot sequence, the last used first
+        self._sequences: set[Any] = set()
+        self._general = 0               # single instants on the general path
+        #: Why arrays' forces are not written out, or None.
+        self.compiled_array: NotCompiled | None = None
+        self._fast_array: list[Any] = []    # one per pivot sequence, in the order met
+        self._array_sequences: set[Any] = set()
+        self._arrays = 0                # array calls
 
     # --- structure -------------------------------------------------------------------
 
@@ -512,7 +540,105 @@ class Dynamics:
         ``max_error`` is the tolerance: a value whose bound exceeds it times
         the force scale (moments: times the scale and the mechanism's size)
         makes the instant invalid (``Forces.valid``, ``Forces.failures``).
+
+        One instant runs written out (:mod:`.forces_compiled`) once the scene
+        has had :data:`COMPILE_AFTER` instants on the general path, an array
+        once it has had :data:`ARRAY_COMPILE_AFTER` arrays: one function per
+        pivot sequence met (at most :data:`MAX_SEQUENCES`; for arrays
+        :data:`ARRAY_SEQUENCES`, beyond which they take the general path), the general
+        path's bits and bounds; an instant none of them settles (a refusal,
+        another pivot sequence) takes the general path. ``compiled_single``
+        and ``compiled_array`` say why a scene is not written out. The lists
+        of functions are replaced, never changed in place: a thread reading
+        one while another writes a function sees the old list or the new.
         """
+        if state.valid.__class__ is bool:
+            fast = self._fast
+            for index, function in enumerate(fast):
+                answer = function(state, max_error)
+                if answer is False:     # another pivot sequence: try the next
+                    continue
+                if answer is not None:
+                    if index:   # the last used first (a new list: another thread may read)
+                        self._fast = [function, *(f for f in fast if f is not function)]
+                    return cast(Forces, answer)
+                break
+            self._general += 1
+            if self._general > COMPILE_AFTER and self.compiled_single is None \
+                    and len(fast) < MAX_SEQUENCES:
+                pivots: dict[str, list[int]] = {}
+                forces = self._forces(state, max_error, pivots)
+                key = tuple((name, tuple(p)) for name, p in pivots.items())
+                if forces.valid is True and key not in self._sequences:
+                    self._sequences.add(key)
+                    written = compile_single(self, pivots, Forces, Reaction, _TINY)
+                    if isinstance(written, NotCompiled):
+                        self.compiled_single = written
+                    else:
+                        self._fast = [written, *self._fast]
+                return forces
+            return self._forces(state, max_error)
+        self._arrays += 1
+        if self._arrays <= ARRAY_COMPILE_AFTER or self.compiled_array is not None:
+            return self._forces(state, max_error)
+        with np.errstate(all='ignore'):
+            size = int(np.size(state.valid))
+            if size <= ARRAY_CHUNK:
+                answer = self._array_forces(state, max_error, 0)
+            else:   # in blocks whose temporaries stay in the cache: the same operations
+                parts = [self._array_forces(_Subset(state, slice(i, i + ARRAY_CHUNK)),
+                                            max_error, 0) for i in range(0, size, ARRAY_CHUNK)]
+                answer = None if any(p is None for p in parts) else _concatenate(
+                    cast('list[Forces]', parts))
+        return self._forces(state, max_error) if answer is None else answer
+
+    def _array_forces(self, state: Any, max_error: float, start: int) -> Forces | None:
+        """Return the forces of an array from the written-out functions from ``start`` on.
+
+        Each function settles the instants of its pivot sequence; the others go
+        to the next (written from the first of them), the last to the general
+        path; the answers are put back in place. None: the scene meets more
+        than :data:`ARRAY_SEQUENCES` sequences, its arrays go to the general
+        path from now on (each function costs, on an array, what the general
+        path does on a few times fewer instants).
+        """
+        fast = self._fast_array
+        valid = np.asarray(state.valid, dtype=bool)
+        if start == len(fast):
+            written: Any = None
+            first = np.flatnonzero(valid)
+            if first.size:
+                pivots: dict[str, list[int]] = {}
+                one = self._forces(cast('State', _Subset(state, int(first[0]))), max_error,
+                                   pivots)
+                key = tuple((name, tuple(p)) for name, p in pivots.items())
+                if one.valid is True and key not in self._array_sequences:
+                    if len(fast) == ARRAY_SEQUENCES:
+                        self.compiled_array = NotCompiled(
+                            f'more than {ARRAY_SEQUENCES} pivot sequences over its arrays (a '
+                            f'function each costs more than the general path)')
+                        return None
+                    self._array_sequences.add(key)
+                    written = compile_single(self, pivots, Forces, Reaction, _TINY,
+                                             vector=True)
+                    if isinstance(written, NotCompiled):
+                        self.compiled_array = written
+                    else:
+                        fast = self._fast_array = [*fast, written]
+            if not callable(written):
+                return self._forces(state, max_error)
+        forces, ok = fast[start](state, max_error)
+        settled = np.broadcast_to(ok, valid.shape)
+        redo = valid & ~settled
+        object.__setattr__(forces, 'valid', valid & settled)
+        if not redo.any():
+            return cast(Forces, forces)
+        part = self._array_forces(_Subset(state, redo), max_error, start + 1)
+        return None if part is None else _merge(forces, redo, part)
+
+    def _forces(self, state: State, max_error: float,
+                pivots: dict[str, list[int]] | None = None) -> Forces:
+        """Return :meth:`forces` on the general path; record each group's pivots in ``pivots``."""
         kin = _Kinematics(self.graph, state)
         biggest = kin.biggest
         done: dict[str, _Carried] = {}   # joint -> what it carries, solved
@@ -543,7 +669,8 @@ class Dynamics:
                 failures['forces (overflow)'] = overflow if kin.vector else True
                 valid = valid & ~overflow if kin.vector else False
             for group in self.groups:
-                solved, ok = self._solve(group, kin, inertial, done)
+                solved, ok = self._solve(group, kin, inertial, done, None if pivots is None
+                                         else pivots.setdefault(group.key, []))
                 if ok is not True:
                     bad = valid & ~np.asarray(ok, dtype=bool) if kin.vector else not ok
                     if np.any(bad):
@@ -600,15 +727,16 @@ class Dynamics:
 
     def _solve(self, group: _Group, kin: _Kinematics,
                inertial: Mapping[str, tuple[Any, Any, Any, Any]],
-               done: Mapping[str, _Carried]) -> tuple[dict[str, _Carried], Any]:
+               done: Mapping[str, _Carried],
+               pivots: list[int] | None = None) -> tuple[dict[str, _Carried], Any]:
         """Return what the group's joints carry, and where it could be bounded."""
         if len(group.configs) == 1:
             config = next(iter(group.configs.values()))
-            return self._solve_config(group, config, kin, inertial, done)
+            return self._solve_config(group, config, kin, inertial, done, pivots)
         engaged = kin.engaged(group.levers[0])
         if not kin.vector:     # one instant: one phase
             return self._solve_config(group, group.configs[(bool(engaged),)], kin, inertial,
-                                      done)
+                                      done, pivots)
         on, ok_on = self._solve_config(group, group.configs[(True,)], kin, inertial, done)
         off, ok_off = self._solve_config(group, group.configs[(False,)], kin, inertial, done)
         engaged = np.asarray(engaged, dtype=bool)
@@ -617,7 +745,8 @@ class Dynamics:
 
     def _solve_config(self, group: _Group, config: _Config, kin: _Kinematics,
                       inertial: Mapping[str, tuple[Any, Any, Any, Any]],
-                      done: Mapping[str, _Carried]) -> tuple[dict[str, _Carried], Any]:
+                      done: Mapping[str, _Carried],
+                      pivots: list[int] | None = None) -> tuple[dict[str, _Carried], Any]:
         k = len(config.rows)
         row_of = {row: index for index, row in enumerate(config.rows)}
         index_of = {body: b for b, body in enumerate(group.bodies)}
@@ -702,7 +831,7 @@ class Dynamics:
                 Eb[moment] = Eb[moment] + (abs(d) * carried.force_bound + e_d * abs(force)
                                            + carried.couple_bound
                                            + 4 * U * (abs(d) * abs(force) + abs(turn)))
-        x, e_x, ok = _bounded_solve(A, EA, b, Eb, kin.vector)
+        x, e_x, ok = _bounded_solve(A, EA, b, Eb, kin.vector, pivots)
         carried_by: dict[str, _Carried] = {}
         acting = set(config.joints)
         for i, joint in enumerate(group.joints):
@@ -847,7 +976,8 @@ def _unit(joint: Joint, component: str, kin: _Kinematics) -> tuple[Any, Any, str
 
 
 def _bounded_solve(A: list[list[Any]], EA: list[list[Any]], b: list[Any], Eb: list[Any],
-                   vector: bool) -> tuple[list[Any], list[Any], Any]:
+                   vector: bool, pivots: list[int] | None = None
+                   ) -> tuple[list[Any], list[Any], Any]:
     """Return ``x`` solving ``A x = b``, a bound of its error, and where the bound holds.
 
     Gauss-Jordan elimination with partial pivoting, on the entries as they
@@ -856,7 +986,9 @@ def _bounded_solve(A: list[list[Any]], EA: list[list[Any]], b: list[Any], Eb: li
     are: ``|X| t`` with ``t`` the computed residual ``|b - A x|``, its
     rounding, and the entries' errors ``EA |x| + Eb``. Where ``A`` is within
     rounding of singular (its condition number beyond ``1 / (64 k U)``: a
-    toggle, where the statics degenerate), there is no bound.
+    toggle, where the statics degenerate), there is no bound. For one
+    instant, ``pivots`` (a list) receives the row offset picked at each step
+    (:mod:`.forces_compiled` writes the elimination out for that sequence).
     """
     k = len(b)
     # The augmented matrix [A | I]; structural zeros stay _ZERO and are skipped.
@@ -880,6 +1012,8 @@ def _bounded_solve(A: list[list[Any]], EA: list[list[Any]], b: list[Any], Eb: li
             ok = ok & (np.abs(pivot) > 0.0)
         else:
             best = max(range(k - j), key=lambda r: abs(candidates[r]))
+            if pivots is not None:
+                pivots.append(best)
             if best:
                 M[j], M[j + best] = M[j + best], M[j]
             pivot = M[j][j]
@@ -934,6 +1068,99 @@ def _bounded_solve(A: list[list[Any]], EA: list[list[Any]], b: list[Any], Eb: li
             ok = ok & np.isfinite(value)
         e_x = [np.where(ok, e, np.inf) for e in e_x]
     return x, e_x, ok
+
+
+class _Subset:
+    """The instants ``index`` of an array state: what the forces read of it (one or an array)."""
+
+    def __init__(self, state: Any, index: Any) -> None:
+        size = np.shape(state.valid)
+
+        def take(value: Any) -> Any:
+            if isinstance(value, np.ndarray) and value.shape == size:
+                return value[index]
+            return value
+
+        def motion(m: Any) -> SimpleNamespace:
+            return SimpleNamespace(position=take(m.position), velocity=take(m.velocity),
+                                   acceleration=take(m.acceleration))
+
+        valid = take(np.asarray(state.valid, dtype=bool))
+        self.valid = bool(valid) if np.ndim(valid) == 0 else valid
+        self.complex_points = {name: tuple(take(v) for v in values)
+                               for name, values in state.complex_points.items()}
+        bounds = state.error_bound
+        self.error_bound = SimpleNamespace(
+            points={name: motion(b) for name, b in bounds.points.items()},
+            joints={name: motion(b) for name, b in bounds.joints.items()})
+        self.joints = {name: motion(m) for name, m in state.joints.items()}
+        self.scales = {name: take(v) for name, v in state.scales.items()}
+        self.intermittent = {name: SimpleNamespace(engaged=take(e.engaged))
+                             for name, e in state.intermittent.items()}
+
+
+def _merge(forces: Forces, redo: Any, part: Forces) -> Forces:
+    """Return ``forces`` with the instants ``redo`` replaced by ``part``'s (arrays)."""
+    shape = redo.shape
+
+    def put(whole: Any, some: Any) -> Any:
+        if whole is None:
+            return None
+        out = np.array(np.broadcast_to(whole, shape), dtype=np.result_type(whole, some))
+        out[redo] = some
+        return out
+
+    reactions = {}
+    for name, r in forces.reactions.items():
+        p = part.reactions[name]
+        reactions[name] = Reaction(r.at, r.on, r.by, put(r.force, p.force),
+                                   put(r.normal, p.normal), put(r.moment, p.moment),
+                                   put(r.force_bound, p.force_bound),
+                                   put(r.normal_bound, p.normal_bound),
+                                   put(r.moment_bound, p.moment_bound))
+    failures = dict(forces.failures)
+    for reason, mask in part.failures.items():
+        full = np.zeros(shape, dtype=bool)
+        full[redo] = mask
+        failures[reason] = failures[reason] | full if reason in failures else full
+    return Forces({n: put(v, part.efforts[n]) for n, v in forces.efforts.items()}, reactions,
+                  put(forces.shaking_force, part.shaking_force),
+                  put(forces.shaking_moment, part.shaking_moment),
+                  {n: put(v, part.effort_bounds[n]) for n, v in forces.effort_bounds.items()},
+                  (put(forces.shaking_bounds[0], part.shaking_bounds[0]),
+                   put(forces.shaking_bounds[1], part.shaking_bounds[1])),
+                  put(forces.valid, part.valid), put(forces.scale, part.scale), failures)
+
+
+def _concatenate(parts: list[Forces]) -> Forces:
+    """Return the forces of consecutive blocks of instants as those of the whole array."""
+    def join(values: list[Any], shapes: list[Any]) -> Any:
+        if values[0] is None:
+            return None
+        pairs = zip(values, shapes, strict=True)
+        return np.concatenate([np.broadcast_to(v, s) for v, s in pairs])
+
+    shapes = [np.shape(p.valid) for p in parts]
+    first = parts[0]
+    reactions = {}
+    for name, r in first.reactions.items():
+        fields = {f: join([getattr(p.reactions[name], f) for p in parts], shapes)
+                  for f in ('force', 'normal', 'moment', 'force_bound', 'normal_bound',
+                            'moment_bound')}
+        reactions[name] = Reaction(r.at, r.on, r.by, **fields)
+    failures = {}
+    for reason in dict.fromkeys(k for p in parts for k in p.failures):
+        failures[reason] = join([p.failures.get(reason, np.zeros(s, dtype=bool))
+                                 for p, s in zip(parts, shapes, strict=True)], shapes)
+    return Forces({n: join([p.efforts[n] for p in parts], shapes) for n in first.efforts},
+                  reactions, join([p.shaking_force for p in parts], shapes),
+                  join([p.shaking_moment for p in parts], shapes),
+                  {n: join([p.effort_bounds[n] for p in parts], shapes)
+                   for n in first.effort_bounds},
+                  (join([p.shaking_bounds[0] for p in parts], shapes),
+                   join([p.shaking_bounds[1] for p in parts], shapes)),
+                  join([p.valid for p in parts], shapes), join([p.scale for p in parts], shapes),
+                  failures)
 
 
 def _fmax(a: Any, b: Any, vector: bool) -> Any:
