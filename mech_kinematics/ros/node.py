@@ -146,8 +146,10 @@ class KinematicsNode(LifecycleNode):
             self._input.topic.jump_back_ns = round(changes['stamp_jump_back_s'] * NS_PER_S)
         forces = self.params.force_changes(changes) if self.params is not None else {}
         if forces and self._forces is not None:
-            # A new Dynamics over the same graph, read by the tick at its next instant.
-            self._forces.dynamics = dynamics_with(self._forces.dynamics, forces)
+            # A new Dynamics over the same graph, its code written out here, read by the
+            # tick at its next instant.
+            self._forces.dynamics = self._forces.warm(
+                dynamics_with(self._forces.dynamics, forces))
         if requested and not self._ticks.running:
             self._apply_now()   # not ticking: from the current instant
 
@@ -194,7 +196,7 @@ class KinematicsNode(LifecycleNode):
                                             effort=self._value('effort'))
         if forces is not None:
             values = self.params.declare_forces(forces.dynamics)
-            forces.dynamics = dynamics_with(forces.dynamics, values)
+            forces.dynamics = forces.warm(dynamics_with(forces.dynamics, values))
             publishing.add_forces(forces)
         compile_later = self._solver.setup(publishing.tick_scene, scene, frames,
                                            self.get_logger().info, forces)

@@ -45,6 +45,7 @@ from .cdr import marker, MessageTemplate, STAMP_MARKER
 from .parameters import DYNAMIC, ParameterSpec, STATIC, TOPIC
 from .ticker import NOT_IN_THE_TICK, values_from_state
 from .. import solver as lk
+from ..errors import AssemblyError
 from ..solver.compiler import NotCompiled
 from ..solver.forces import Dynamics
 
@@ -114,6 +115,10 @@ def _refusal(forces: Forces, max_error: float) -> str:
             f'{max_error:g} of its scale ({limit / max_error:.6g})')
 
 
+#: Positions over a crank's turn at which the forces are solved before the ticks.
+WARM_SAMPLES = 64
+
+
 class ForcesTick:
     """The node's tick on a scene with forces: its kinematics' values, then its forces'.
 
@@ -162,6 +167,41 @@ class ForcesTick:
         self.forces_first = 3 * len(self.joints) + 6 * len(self.points) + 3 * len(self.frames)
         self.refusal = ''
         self.refused = 0
+        self._samples: list[Any] | None = None
+
+    def warm(self, dynamics: Dynamics | None = None) -> Dynamics:
+        """Solve ``dynamics`` (the tick's by default) at positions the drivers take; return it.
+
+        The forces of one instant are written out as straight-line code per
+        pivot sequence once a scene has had a few instants on the general path
+        (:mod:`~mech_kinematics.solver.forces_compiled`), 5 to 13 ms each: done
+        here, before the ticks (and before a changed ``gravity`` or load takes
+        effect), no instant waits for it. The pivots follow the positions
+        alone: one crank is sampled over a turn, several drivers at their start.
+        """
+        dynamics = self.dynamics if dynamics is None else dynamics
+        if self._samples is None:
+            self._samples = self._sample_states()
+        for state in self._samples:
+            dynamics.forces(state, math.inf)
+        return dynamics
+
+    def _sample_states(self) -> list[Any]:
+        drivers = self.kinematics.drivers
+        starts = [d.start for d in drivers]
+        if len(drivers) == 1 and self.kinematics.input is not None:
+            positions = [starts[0] + math.tau * k / WARM_SAMPLES for k in range(WARM_SAMPLES)]
+            rest: Any = 0.0
+        else:
+            positions = [starts[0] if len(starts) == 1 else starts] * (WARM_SAMPLES // 4)
+            rest = 0.0 if len(starts) == 1 else (0.0,) * len(starts)
+        states = []
+        for position in positions:
+            try:
+                states.append(lk.solve(self.kinematics, position, rest, rest))
+            except AssemblyError:
+                continue        # a position where it does not assemble: nothing to warm
+        return states
 
     def __call__(self, theta: Any, omega: Any, alpha: Any, tol: float,
                  turns: Any = 0) -> tuple[list[float], float]:

@@ -227,3 +227,28 @@ def test_which_scenes_and_drives_publish_forces():
     assert effort_status(loaded, TOPIC, DYNAMIC).startswith('left out')
     assert forces_tick(loaded, loaded, (), drive=TOPIC, effort=STATIC).static
     assert not forces_tick(loaded, loaded, (), drive=TIME, effort=DYNAMIC).static
+
+
+@pytest.mark.parametrize('name', LOADED)
+def test_warming_writes_the_forces_out_before_any_tick_and_changes_no_value(name):
+    """warm(): the written-out forces exist before the first tick; ticks write nothing more.
+
+    Writing one pivot sequence's function takes milliseconds: a tick thread at
+    1 kHz that wrote them would stall. The values are the cold tick's, bit for bit.
+    """
+    scene = mk.load_scene(name)
+    args = _start(scene)
+    cold = _tick(mk.load_scene(name))     # a Dynamics of its own, on the general path
+    warm = _tick(scene)
+    assert cold.dynamics is not warm.dynamics
+    dynamics = warm.warm()
+    assert dynamics is warm.dynamics and dynamics._fast, dynamics.compiled_single
+    written = list(dynamics._fast)
+    one = len(scene.drivers) == 1
+    for k in range(16):
+        at = (args[0] + 0.37 * k if one else args[0], *args[1:])
+        try:
+            assert warm(*at, TOL, 0) == cold(*at, TOL, 0)
+        except mk.AssemblyError:
+            continue
+    assert set(dynamics._fast) == set(written)
