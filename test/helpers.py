@@ -654,3 +654,21 @@ def khurmi_urdf(form='constraint', dz=0.0):
             f'<origin xyz="{z.real!r} {z.imag!r} {oz!r}" rpy="0.3 0.1 0.2"/></joint>'
             for i, link, z, oz in ((1, 'coupler', coupler, -dz), (2, 'rocker', rocker, 0.0)))
     return KHURMI.format(closure=closure, dz=dz)
+
+
+#: The units of the generated scenes (test_compiler, test_forces).
+MM_DEG = {'length': 'mm', 'angle': 'deg'}
+
+
+def crank_entry(length=50.0, angle=30.0, rpm=120.0, accel=-3.0, center='A', point='B'):
+    """Return a crank's scene entry (a link ``crank``)."""
+    return {'link': 'crank', 'center': center, 'point': point, 'length': length,
+            'angle': angle, 'speed_rpm': rpm, 'accel': accel}
+
+
+def scene_mapping(name, ground, dyads=(), points=None, **drivers):
+    """Return the scene of these entries (mm and deg), as a scene file's mapping."""
+    data = {'name': name, 'units': MM_DEG, 'ground': ground, 'dyads': list(dyads), **drivers}
+    if points:
+        data['points'] = points
+    return data

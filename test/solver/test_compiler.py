@@ -19,8 +19,8 @@ generator here fails, named.
 import importlib
 import math
 
-from helpers import (array_outcome, equilateral_chain, general_only, general_tick_outcome,
-                     solve_outcome, tick_outcome)
+from helpers import (array_outcome, crank_entry, equilateral_chain, general_only,
+                     general_tick_outcome, scene_mapping, solve_outcome, tick_outcome)
 import numpy as np
 import pytest
 
@@ -39,73 +39,57 @@ DRIVERS = ('crank', 'actuator')
 #: Variants of registered kinds that run kernels of their own.
 VARIANTS = ('carried point', 'Geneva RPR', 'actuated RRR')
 
-MM_DEG = {'length': 'mm', 'angle': 'deg'}
-
-
-def _crank(length=50.0, angle=30.0, rpm=120.0, accel=-3.0, center='A', point='B'):
-    """Return a crank's scene entry (a link ``crank``)."""
-    return {'link': 'crank', 'center': center, 'point': point, 'length': length,
-            'angle': angle, 'speed_rpm': rpm, 'accel': accel}
-
-
-def _scene(name, ground, dyads=(), points=None, **drivers):
-    """Return the scene of these entries (mm and deg), as a scene file's mapping."""
-    data = {'name': name, 'units': MM_DEG, 'ground': ground, 'dyads': list(dyads), **drivers}
-    if points:
-        data['points'] = points
-    return data
-
 
 #: A scene for each kind: a mapping of a scene file, that exercises the kind's kernel over
 #: a range where it assembles and one where it refuses (most of them).
 GENERATORS = {
-    'crank': lambda: _scene(
-        'crank', {'A': [0, 0]}, input=_crank(),
+    'crank': lambda: scene_mapping(
+        'crank', {'A': [0, 0]}, input=crank_entry(),
         points={'P': {'link': 'crank', 'origin': 'A', 'xaxis': 'B', 'local': [20, 10]}}),
     # A triple rocker: the crank turns only part of the way.
-    'RRR': lambda: _scene(
-        'RRR', {'A': [0, 0], 'D': [100, 0]}, input=_crank(angle=61),
+    'RRR': lambda: scene_mapping(
+        'RRR', {'A': [0, 0], 'D': [100, 0]}, input=crank_entry(angle=61),
         dyads=[{'type': 'RRR', 'point': 'C', 'links': [
             {'name': 'coupler', 'from': 'B', 'length': 66},
             {'name': 'rocker', 'from': 'D', 'length': 56}], 'branch': 1}]),
     # An offset slider-crank whose rod cannot reach the guide at the bottom of the turn.
-    'RRP': lambda: _scene(
-        'RRP', {'O': [0, 0], 'E': [0, 40]}, input=_crank(150, 135, -300, 5.0, 'O'),
+    'RRP': lambda: scene_mapping(
+        'RRP', {'O': [0, 0], 'E': [0, 40]}, input=crank_entry(150, 135, -300, 5.0, 'O'),
         dyads=[{'type': 'RRP', 'point': 'P',
                 'link': {'name': 'rod', 'from': 'B', 'length': 160},
                 'guide': {'through': 'E', 'angle': 0}, 'slider': 'piston', 'branch': -1}]),
-    'RPR': lambda: _scene(
-        'RPR', {'O': [0, 0], 'A': [0, 400]}, input=_crank(150, 45, 120, 2.0),
+    'RPR': lambda: scene_mapping(
+        'RPR', {'O': [0, 0], 'A': [0, 400]}, input=crank_entry(150, 45, 120, 2.0),
         dyads=[{'type': 'RPR', 'link': 'lever', 'center': 'O', 'through': 'B',
                 'slider': 'block'}]),
-    'RPP': lambda: _scene(
-        'RPP', {'A': [0, 0]}, input=_crank(50, 30, 300, 0.0),
+    'RPP': lambda: scene_mapping(
+        'RPP', {'A': [0, 0]}, input=crank_entry(50, 30, 300, 0.0),
         dyads=[{'type': 'RPP', 'point': 'Y', 'through': 'B',
                 'guide': {'through': 'A', 'angle': 0}, 'slot_angle': 90, 'slider': 'yoke',
                 'slot_slider': 'pin_in_slot'}]),
-    'actuator': lambda: _scene(
+    'actuator': lambda: scene_mapping(
         'actuator', {'O': [0, 0], 'F': [400, -1100]},
         inputs=[{'actuator': 'cyl', 'length': 2600, 'speed': 100, 'stroke': [2000, 3300]}],
         dyads=[{'type': 'RRR', 'point': 'Q', 'links': [
             {'name': 'boom', 'from': 'O', 'length': 2600},
             {'name': 'barrel', 'from': 'F', 'actuator': 'cyl'}], 'branch': 1}]),
-    'carried point': lambda: _scene(
-        'carried', {'A': [0, 0], 'D': [100, 0]}, input=_crank(angle=61),
+    'carried point': lambda: scene_mapping(
+        'carried', {'A': [0, 0], 'D': [100, 0]}, input=crank_entry(angle=61),
         dyads=[{'type': 'RRR', 'point': 'C', 'links': [
             {'name': 'coupler', 'from': 'B', 'length': 66},
             {'name': 'rocker', 'from': 'D', 'length': 56}], 'branch': 1}],
         points={'E': {'link': 'coupler', 'from': 'B', 'toward': 'C', 'distance': 40},
                 'F': {'link': 'coupler', 'origin': 'B', 'xaxis': 'C', 'local': [40, -30]}}),
-    'Geneva RPR': lambda: _scene(
+    'Geneva RPR': lambda: scene_mapping(
         'geneva', {'D': [0, 0], 'S': [-70.71067811865476, 0]},
         input={'link': 'driver', 'center': 'D', 'point': 'P', 'length': 50, 'angle': 150,
                'speed_rpm': 95.4929658551372, 'accel': 0},
         dyads=[{'type': 'RPR', 'link': 'wheel', 'center': 'S', 'through': 'P',
                 'slider': 'pin_slot', 'slots': 4}]),
     # A crank and a cylinder: the RRR's second link is the cylinder's.
-    'actuated RRR': lambda: _scene(
+    'actuated RRR': lambda: scene_mapping(
         'actuated', {'A': [0, 0], 'F': [300, -100]},
-        inputs=[_crank(60, 40, 30, 0.0),
+        inputs=[crank_entry(60, 40, 30, 0.0),
                 {'actuator': 'cyl', 'length': 280, 'speed': 20, 'stroke': [200, 360]}],
         dyads=[{'type': 'RRR', 'point': 'C', 'links': [
             {'name': 'arm', 'from': 'B', 'length': 250},

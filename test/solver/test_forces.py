@@ -33,6 +33,7 @@ import functools
 import math
 import warnings
 
+from helpers import crank_entry, MM_DEG, scene_mapping
 from hypothesis import assume, given, HealthCheck, settings
 from hypothesis import strategies as st
 import mpmath
@@ -60,72 +61,55 @@ TINY = 1e-280
 #: Digits of the mpmath recomputation.
 MP_DIGITS = 50
 
-MM_DEG = {'length': 'mm', 'angle': 'deg'}
-
-
 # --- generated scenes, one per kind ------------------------------------------------
-
-def _crank(length=50.0, angle=30.0, rpm=120.0, accel=-3.0, center='A', point='B'):
-    """Return a crank's scene entry (a link ``crank``)."""
-    return {'link': 'crank', 'center': center, 'point': point, 'length': length,
-            'angle': angle, 'speed_rpm': rpm, 'accel': accel}
-
-
-def _scene(name, ground, dyads=(), points=None, **drivers):
-    """Return the scene of these entries (mm and deg), as a scene file's mapping."""
-    data = {'name': name, 'units': MM_DEG, 'ground': ground, 'dyads': list(dyads), **drivers}
-    if points:
-        data['points'] = points
-    return data
-
 
 #: For each kind, the mapping of a scene file using it.
 GEOMETRIES = {
-    'crank': lambda: _scene(
-        'crank', {'A': [0, 0]}, input=_crank(),
+    'crank': lambda: scene_mapping(
+        'crank', {'A': [0, 0]}, input=crank_entry(),
         points={'P': {'link': 'crank', 'origin': 'A', 'xaxis': 'B', 'local': [20, 10]}}),
-    'RRR': lambda: _scene(
-        'RRR', {'A': [0, 0], 'D': [150, 0]}, input=_crank(40, 60, -120),
+    'RRR': lambda: scene_mapping(
+        'RRR', {'A': [0, 0], 'D': [150, 0]}, input=crank_entry(40, 60, -120),
         dyads=[{'type': 'RRR', 'point': 'C', 'links': [
             {'name': 'coupler', 'from': 'B', 'length': 150},
             {'name': 'rocker', 'from': 'D', 'length': 80}], 'branch': 1}]),
-    'RRP': lambda: _scene(
-        'RRP', {'O': [0, 0], 'E': [0, 40]}, input=_crank(150, 135, -300, 5.0, 'O'),
+    'RRP': lambda: scene_mapping(
+        'RRP', {'O': [0, 0], 'E': [0, 40]}, input=crank_entry(150, 135, -300, 5.0, 'O'),
         dyads=[{'type': 'RRP', 'point': 'P',
                 'link': {'name': 'rod', 'from': 'B', 'length': 600},
                 'guide': {'through': 'E', 'angle': 0}, 'slider': 'piston', 'branch': -1}]),
-    'RPR': lambda: _scene(
-        'RPR', {'O': [0, 0], 'A': [0, 400]}, input=_crank(150, 45, 120, 2.0),
+    'RPR': lambda: scene_mapping(
+        'RPR', {'O': [0, 0], 'A': [0, 400]}, input=crank_entry(150, 45, 120, 2.0),
         dyads=[{'type': 'RPR', 'link': 'lever', 'center': 'O', 'through': 'B',
                 'slider': 'block'}]),
-    'RPP': lambda: _scene(
-        'RPP', {'A': [0, 0]}, input=_crank(50, 30, 300, 0.0),
+    'RPP': lambda: scene_mapping(
+        'RPP', {'A': [0, 0]}, input=crank_entry(50, 30, 300, 0.0),
         dyads=[{'type': 'RPP', 'point': 'Y', 'through': 'B',
                 'guide': {'through': 'A', 'angle': 0}, 'slot_angle': 70, 'slider': 'yoke',
                 'slot_slider': 'pin_in_slot'}]),
-    'actuator': lambda: _scene(
+    'actuator': lambda: scene_mapping(
         'actuator', {'O': [0, 0], 'F': [400, -1100]},
         inputs=[{'actuator': 'cyl', 'length': 2600, 'speed': 100, 'stroke': [2000, 3300]}],
         dyads=[{'type': 'RRR', 'point': 'Q', 'links': [
             {'name': 'boom', 'from': 'O', 'length': 2600},
             {'name': 'barrel', 'from': 'F', 'actuator': 'cyl'}], 'branch': 1}]),
-    'carried point': lambda: _scene(
-        'carried', {'A': [0, 0], 'D': [150, 0]}, input=_crank(40, 60, -120),
+    'carried point': lambda: scene_mapping(
+        'carried', {'A': [0, 0], 'D': [150, 0]}, input=crank_entry(40, 60, -120),
         dyads=[{'type': 'RRR', 'point': 'C', 'links': [
             {'name': 'coupler', 'from': 'B', 'length': 150},
             {'name': 'rocker', 'from': 'D', 'length': 80}], 'branch': 1}],
         points={'E': {'link': 'coupler', 'from': 'B', 'toward': 'C', 'distance': 40},
                 'F': {'link': 'coupler', 'origin': 'B', 'xaxis': 'C', 'local': [40, -30]},
                 'G': {'link': 'rocker', 'origin': 'D', 'xaxis': 'C', 'local': [30, 25]}}),
-    'Geneva RPR': lambda: _scene(
+    'Geneva RPR': lambda: scene_mapping(
         'geneva', {'D': [0, 0], 'S': [-70.71067811865476, 0]},
         input={'link': 'driver', 'center': 'D', 'point': 'P', 'length': 50, 'angle': 150,
                'speed_rpm': 95.4929658551372, 'accel': 0},
         dyads=[{'type': 'RPR', 'link': 'wheel', 'center': 'S', 'through': 'P',
                 'slider': 'pin_slot', 'slots': 4}]),
-    'actuated RRR': lambda: _scene(
+    'actuated RRR': lambda: scene_mapping(
         'actuated', {'A': [0, 0], 'F': [300, -100]},
-        inputs=[_crank(60, 40, 30, 0.0),
+        inputs=[crank_entry(60, 40, 30, 0.0),
                 {'actuator': 'cyl', 'length': 280, 'speed': 20, 'stroke': [200, 360]}],
         dyads=[{'type': 'RRR', 'point': 'C', 'links': [
             {'name': 'arm', 'from': 'B', 'length': 250},
@@ -815,7 +799,7 @@ def test_one_instants_forces_are_python_numbers():
 #: A triple rocker (crank 50, coupler 66, rocker 56, ground 100 mm) that stops where the
 #: coupler and rocker come in line: its toggle, at |B - D| = 66 + 56 mm.
 TOGGLE = {'name': 'toggle', 'units': MM_DEG, 'ground': {'A': [0, 0], 'D': [100, 0]},
-          'input': _crank(50, 61, 120, -3.0),
+          'input': crank_entry(50, 61, 120, -3.0),
           'dyads': [{'type': 'RRR', 'point': 'C', 'links': [
               {'name': 'coupler', 'from': 'B', 'length': 66},
               {'name': 'rocker', 'from': 'D', 'length': 56}], 'branch': 1}]}
