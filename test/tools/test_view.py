@@ -59,6 +59,9 @@ ATOL_FRAME = 1e-12
 BLOCK_HALF_DIAGONAL_PX = 22.0
 #: A link (6 px wide) drawn over another hides it this far from its centre line, plus a margin.
 LINK_COVER_PX = 6.0
+#: A point's dot and its name (drawn 6 px right of and below it, over the links) hide a link
+#: this far from the point, px.
+POINT_COVER_PX = 20.0
 #: A circle drawn to scale is as wide as it is tall, to the pixel grid and the line's width.
 ATOL_ROUND_PX = 2.0
 #: A pixel is background where every channel is at least this (a 1 px #bbb line is darker).
@@ -669,13 +672,15 @@ def _distance(xy, a, b):
     return np.hypot(*(xy - (a + f * span)))
 
 
-def _link_pixels(image, drawn, sliders=()):
+def _link_pixels(image, drawn, sliders=(), dots=()):
     """Return each link's (name, pixels sampled along its edges' middles, how many match).
 
     A pixel matches when it has the link's colour. Samples under something
     drawn over the link are left out: within a slider block's half-diagonal
-    of its centre, or within :data:`LINK_COVER_PX` of a link drawn after it
-    (a crank that lies along its slotted lever at that instant).
+    of its centre, within :data:`LINK_COVER_PX` of a link drawn after it
+    (a crank that lies along its slotted lever at that instant), or within
+    :data:`POINT_COVER_PX` of a point ``dots`` (its dot and name: quick
+    return's E on its link CD).
     """
     k, ox, oy, top, left = (drawn[key] for key in ('k', 'ox', 'oy', 'top', 'left'))
     found = []
@@ -688,7 +693,8 @@ def _link_pixels(image, drawn, sliders=()):
             for f in np.linspace(0.35, 0.65, 7):
                 xy = a + f * (b - a)
                 if any(k * np.hypot(*(xy - s)) <= BLOCK_HALF_DIAGONAL_PX for s in sliders) or \
-                        any(k * _distance(xy, *edge) <= LINK_COVER_PX for edge in over):
+                        any(k * _distance(xy, *edge) <= LINK_COVER_PX for edge in over) or \
+                        any(k * np.hypot(*(xy - d)) <= POINT_COVER_PX for d in dots):
                     continue
                 pixel = image[round(top + oy - k * xy[1]), round(left + ox + k * xy[0])]
                 count += 1
@@ -1091,4 +1097,5 @@ def test_chromium_draws_the_links_where_the_solver_puts_them(running):
     # block, so samples within a block's half-diagonal of its centre are not counted.
     frame = frame_from_state(scene, drawn['angle'], 0.0, strokes_from_scene(scene))
     _assert_links_drawn(_link_pixels(_image(shot.read_bytes()), drawn,
-                                     [np.array(s['xy']) for s in frame['sliders']]), shot)
+                                     [np.array(s['xy']) for s in frame['sliders']],
+                                     list(points.values())), shot)
