@@ -57,7 +57,7 @@ RTOL = 1e-12
 RATE_HZ = 500.0
 DURATION_S = 4.0        # of the --duration recorders, from their first subscription
 STARTUP_S = 30.0        # deadline for processes to come up
-DIAGNOSTICS_WINDOW_S = 2.5  # on /diagnostics (1 Hz) long enough to hold two messages
+DIAGNOSTICS_WINDOW_S = 4.5  # on /diagnostics (1 Hz) long enough to hold three messages
 SCENE = mk.load_scene(mk.DEFAULT_SCENE)
 STATE_TOPICS = {'/joint_states': 'sensor_msgs/msg/JointState',
                 '/joint_accelerations': 'trajectory_msgs/msg/JointTrajectory',
@@ -211,11 +211,11 @@ def _wait_for_a_written_message(path: Path, recorder: Process) -> None:
 
 
 def _wait_for_two_diagnostics(recorder: Process) -> None:
-    """Wait until ``recorder`` has been subscribed to /diagnostics (1 Hz) for 2.5 s.
+    """Wait until ``recorder`` has been subscribed to /diagnostics (1 Hz) for 4.5 s.
 
     Topics are discovered one after another, so a recorder stopped by a signal
     right after the --duration ones may have joined /diagnostics too late to hold
-    the two messages that bound the window of ``test_nothing_..._is_lost``.
+    the three messages the window of ``test_nothing_..._is_lost`` needs.
     """
     recorder.wait_for_output('subscribed to /diagnostics', STARTUP_S)
     line = next(line for line in recorder.output().splitlines()
@@ -331,8 +331,12 @@ def test_nothing_the_node_published_is_lost(contents, name):
     # first that counts a message.
     windows = [w for w in windows if w[1] > 0]
     assert len(windows) >= 2, 'expected two diagnostics messages to bound a window'
+    # Where there are three, the window ends a diagnostics message before the last: the
+    # states stamped up to the last one may still be on their way (their own subscription)
+    # when the recorder is stopped, not lost (one run beside two CPU hogs: 1,997 of 1,998
+    # at the last one). The recorders stopped by a signal record three or more.
     (start, published_start, owed_start), (end, published_end, owed_end) = \
-        windows[0], windows[-1]
+        windows[0], windows[-2 if len(windows) >= 3 else -1]
     published = published_end - published_start
     assert published > 0, windows
     # The node ran: each grid instant of the window was published, refused or skipped, and
