@@ -43,6 +43,8 @@ def stamps_of(raw) -> list:
 READER_DEPTH = 10_000
 #: The node's state history (docs/robustness.md): a catch-up burst is at most this many.
 HISTORY = 1000
+#: How long after SIGSTOP is sent the node may still publish (every thread stopped), ns.
+SIGNAL_SLACK_NS = 10_000_000
 
 
 class Stream:
@@ -290,8 +292,8 @@ def test_a_stall_is_caught_up_to_the_bound_and_the_rest_counted(ros, tmp_path):
     assert next_gap == period, results
     # Every instant but those of the stall older than 0.1 s arrived, and those are counted.
     # (The last state before the stall is stamped before SIGSTOP was sent, 0.5 s before
-    # `resumed`, up to the microseconds the signal takes: one period of slack.)
-    assert stall_gap > 0.5 * NS - window - 2 * period, results
+    # `resumed`, up to the time the signal takes to stop the node: SIGNAL_SLACK_NS.)
+    assert stall_gap > 0.5 * NS - window - SIGNAL_SLACK_NS, results
     assert holes == stall_gap // period - 1 <= skipped, results
     # Skip mode: only the latest instant owed at the wake-up (woke - period < first <= woke):
     # the stall leaves a hole of its whole length, counted too.
@@ -345,8 +347,9 @@ def test_a_long_stop_at_1_khz_is_one_burst_that_fits_a_keep_last_1000_history(ro
     # ... and all of those (the whole history's worth, caught up).
     assert arrived - first >= (HISTORY - 1) * period, (arrived - first, stop_gap)
     # The older instants of the stop were skipped, and counted. (The last state before the
-    # stop is stamped before SIGSTOP was sent, up to the microseconds the signal takes.)
-    assert stop_gap > 4 * NS - HISTORY * period - period, stop_gap
+    # stop is stamped before SIGSTOP was sent, up to the time the signal takes to stop
+    # every thread: 1 to 2 ms beside two CPU hogs, where one period of slack failed.)
+    assert stop_gap > 4 * NS - HISTORY * period - SIGNAL_SLACK_NS, stop_gap
     assert stop_gap // period - 1 <= skipped
     after = stamps[at + 1:]
     assert len(after) >= HISTORY + 500
