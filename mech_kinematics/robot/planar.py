@@ -981,8 +981,9 @@ def _actuated_names(description: Description, actuated: Iterable[str] | None,
         how = "the URDF's <transmission>/<ros2_control> joints"
     else:
         candidates = ', '.join(loop_joints) or 'none'
-        raise UrdfError(f'{source}: Expected the actuated joints (--actuated J1,J2,... or '
-                        f'<transmission>/<ros2_control> joints in the URDF), got none: the '
+        raise UrdfError(f'{source}: Expected the actuated joints (--actuated J1,J2,... to a '
+                        f'command, actuated_joints:=[J1, J2, ...] to the node, actuated= to the '
+                        f'API, or <transmission>/<ros2_control> joints in the URDF), got none: the '
                         f'joints of its loops are {candidates}')
     for name in names:
         joint = description.joints.get(name)

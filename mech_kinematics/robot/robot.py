@@ -32,7 +32,7 @@ import numpy as np
 from .description import Description, read_description
 from .planar import DriverMap, JointMap, Planar, planar_from_description
 from ..bounds import MAX_ERROR
-from ..errors import SceneError, UrdfError
+from ..errors import AssemblyError, SceneError, UrdfError
 from ..solver import Scene, solve, State
 from ..solver.graph import JointType
 from ..solver.state import JointMotion
@@ -254,17 +254,38 @@ class Robot:
         Raises
         ------
         AssemblyError
-            Where the loops cannot close (the scene's refusal, its names).
+            Where the loops cannot close: the scene's dyad and reason, at the
+            actuated joints' values under the URDF's names
+            (``at finger_joint = 0.9 rad: ...``, :meth:`where`).
         ValueError
             A joint that is not actuated.
         """
         inputs = self._inputs(positions, speeds, accels)
         p, v, a = self.scene_inputs(inputs)
-        if len(p) == 1:  # one driver: solve's one-driver signature takes bare values
-            state = solve(self.scene, p[0], v[0], a[0], max_error=max_error)
-        else:
-            state = solve(self.scene, p, v, a, max_error=max_error)
+        try:
+            if len(p) == 1:  # one driver: solve's one-driver signature takes bare values
+                state = solve(self.scene, p[0], v[0], a[0], max_error=max_error)
+            else:
+                state = solve(self.scene, p, v, a, max_error=max_error)
+        except AssemblyError as error:  # one instant (arrays mask what they refuse)
+            raise error.located(self.where({n: x[0] for n, x in inputs.items()})) from None
         return self.joints_from_state(state, inputs)
+
+    def where(self, positions: Mapping[str, Any] | Iterable[Any]) -> str:
+        """Return where the loops' actuated joints stand, for a message: ``j3 = 0.5 rad``.
+
+        ``positions``: by actuated joint, or one per actuated joint in
+        :attr:`actuated`'s order. Each joint that drives a loop (a mimic's
+        leader for a mimic that does) once, under the URDF's name: a refusal
+        names these, not the scene's drivers they were mapped to, nor the
+        joints outside every loop.
+        """
+        given = positions if isinstance(positions, Mapping) else \
+            dict(zip(self.actuated, positions, strict=True))
+        names = dict.fromkeys(d.name if d.mimic is None else d.mimic.joint
+                              for d in self.planar.drivers)
+        return ', '.join(f'{name} = {float(given[name]):.6g} {self.joint_type(name).units[0]}'
+                         for name in names)
 
     def joints_from_state(self, state: State, inputs: Mapping[str, tuple[Any, Any, Any]]
                           ) -> RobotState:

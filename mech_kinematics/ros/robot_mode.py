@@ -164,6 +164,9 @@ class RobotValues:
 
     def __init__(self, robot: Any, joints: Sequence[str], points: Sequence[str]) -> None:
         self.names = tuple(robot.joint_names)
+        #: Where the actuated joints stand, for a refusal (:meth:`Robot.where
+        #: <mech_kinematics.robot.Robot.where>`): the URDF's names, not the scene's drivers.
+        self.where = robot.where
         self._n = len(joints)
         self._points = 6 * len(points)
         index = {name: i for i, name in enumerate(joints)}

@@ -148,6 +148,7 @@ class InputSubscription:
         topic, stats, publishing = self.topic, self.stats, self.publishing
         stamp = msg.header.stamp
         stamp_ns = stamp.sec * NS_PER_S + stamp.nanosec
+        given = None
         try:
             given = topic.read(stamp.sec, stamp.nanosec, msg.name, msg.position, msg.velocity,
                                msg.effort)
@@ -155,6 +156,8 @@ class InputSubscription:
             if self.robot is not None:
                 values = self.robot.values(values, (given.positions, given.speeds))
         except (RefusedInput, AssemblyError) as exc:
+            if isinstance(exc, AssemblyError) and self.robot is not None and given is not None:
+                exc = exc.located(self.robot.where(given.positions))  # the URDF's joints
             kind = 'refused input' if isinstance(exc, RefusedInput) else \
                 'not trusted' if isinstance(exc, UntrustedError) else 'cannot assemble'
             stats.record(stamp_ns, time.monotonic_ns() - received, False, error=str(exc),

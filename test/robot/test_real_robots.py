@@ -218,6 +218,8 @@ def test_the_fanucs_joint_3_limit_reaches_past_its_parallelograms_change_point()
         robot.solve({'joint_3': 1.570796}, {'joint_3': 1.0})
     message = str(caught.value)
     assert '\n' not in message and 'closure_0' in message and 'cannot be trusted' in message
+    # Where: the URDF's actuated joint and its value, not the scene's driver it maps to.
+    assert ' at joint_3 = 1.5708 rad: ' in message and 'crank angle' not in message
     answer = robot.solve({'joint_3': -1.8})
     values = {n: j.position for n, j in answer.joints.items()}
     assert fk.gaps(values)['closure_0'] <= RTOL_CLOSURE * fk.loop_size('closure_0')

@@ -109,3 +109,22 @@ def test_a_tree_without_a_closure_is_refused():
     start, end = text.index('<constraint'), text.index('</constraint>') + len('</constraint>')
     error = _refused(text[:start] + text[end:])
     assert 'no loop' in str(error)
+
+
+def test_a_robot_without_actuated_joints_is_refused_saying_where_each_door_gives_them():
+    """No --actuated, no sidecar's, no <transmission>: one line, the loop's joints listed.
+
+    The line names how each door takes them (a command's flag, the node's
+    parameter, the API's argument, the URDF's transmissions), so the node's
+    user is not sent to a command-line flag the node has not got.
+    """
+    text = khurmi_urdf()
+    start, end = text.index('<transmission'), text.index('</transmission>') + 15
+    error = str(_refused(text[:start] + text[end:]))
+    assert error.split(': ', 1)[1].startswith(
+        'Expected the actuated joints (--actuated J1,J2,... to a command, '
+        'actuated_joints:=[J1, J2, ...] to the node, actuated= to the API, or '
+        '<transmission>/<ros2_control> joints in the URDF), got none: the joints of its loops '
+        'are ')
+    for joint in ('motor', 'rocker_pivot', 'elbow'):
+        assert joint in error.split('the joints of its loops are ')[1]

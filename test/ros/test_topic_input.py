@@ -11,6 +11,7 @@ is ``test_kinematics_node_topic.py``'s.
 """
 
 import math
+from pathlib import Path
 
 from builtin_interfaces.msg import Time
 from rclpy.qos import QoSReliabilityPolicy
@@ -21,10 +22,13 @@ import mech_kinematics as mk
 from mech_kinematics.ros.diagnostics import TickStats
 from mech_kinematics.ros.parameters import STATIC, TOPIC
 from mech_kinematics.ros.publishing import Publishing, RCLError
+from mech_kinematics.ros.robot_mode import load_source
 from mech_kinematics.ros.solver_path import SolverPath
 from mech_kinematics.ros.topic_input import INPUT_DEPTH, InputSubscription
 from mech_kinematics.ros.wrenches import forces_tick
 
+#: The real robots' URDFs.
+URDF = Path(__file__).resolve().parents[1] / 'data' / 'urdf'
 #: A stamp of an input, s.
 SEC = 1_700_000_000
 
@@ -83,17 +87,18 @@ class Node:
         return Clock()
 
 
-def _input(scene_name, extra_joints='refuse', tf_rate_hz=100.0):
-    """Return (the node, an active InputSubscription on the scene, its stats)."""
-    scene, node, stats = mk.load_scene(scene_name), Node(), TickStats(mk.NEAR_SINGULAR)
+def _input(scene_name, extra_joints='refuse', tf_rate_hz=100.0, source=None):
+    """Return (the node, an active InputSubscription on the scene or robot, its stats)."""
+    scene = mk.load_scene(scene_name) if source is None else source.scene
+    node, stats = Node(), TickStats(mk.NEAR_SINGULAR)
     publishing = Publishing(node, scene, frame_id='mechanism', tf_prefix='',
-                            tf_rate_hz=tf_rate_hz, scene_path=scene_name)
+                            tf_rate_hz=tf_rate_hz, scene_path=scene_name, source=source)
     solver = SolverPath(1e-6)
     solver.setup(publishing.tick_scene, scene, [(f.origin, f.angle_of, f.angle)
                                                 for f in publishing.frames], node.logger.info)
     subscription = InputSubscription(node, scene, solver, publishing, stats,
                                      frame_id='mechanism', extra_joints=extra_joints,
-                                     jump_back_s=1.0)
+                                     jump_back_s=1.0, robot=publishing.robot_values)
     subscription.active = True
     return node, subscription, stats
 
@@ -155,6 +160,32 @@ def test_a_refused_message_publishes_nothing_and_is_counted_with_its_reason():
     assert (window.unsolved, window.last_refusal) == (1, 'refused input')
     assert 'right_crank' in window.last_error
     assert node.logger.lines[-1] == f'no state published: {window.last_error}'
+
+
+def test_a_robots_refusal_names_its_urdf_joint_where_the_scenes_driver_stood():
+    """URDF mode: the refusal says where the actuated joint stands, under the URDF's name.
+
+    The FANUC's joint_3 at its upper limit, 3.3e-7 rad from its parallelogram's
+    fold, moving at 1 rad/s: refused (its rates cannot be trusted) at
+    ``joint_3 = 1.5708 rad``, never at the scene's crank angle the joint maps to.
+    """
+    source = load_source(str(URDF / 'fanuc_m900ia260l.urdf'),
+                         loop_closures=str(URDF / 'fanuc_m900ia260l.loop_closures.yaml'))
+    node, subscription, stats = _input('fanuc', extra_joints='pass', source=source)
+    names = list(source.robot.actuated)    # joint_1 to joint_6: joint_3 drives the loop
+    at = [0.0] * len(names)
+    at[names.index('joint_3')] = 1.570796
+    subscription.message(_message(5, names, at, [1.0] * len(names)))
+    assert node.publishers['joint_states'].sent == []
+    window = stats.take_window()
+    assert (window.unsolved, window.last_refusal) == (1, 'not trusted')
+    assert ' at joint_3 = 1.5708 rad: ' in window.last_error    # the loop's joint alone
+    assert 'crank angle' not in window.last_error and '\n' not in window.last_error
+    assert node.logger.lines[-1] == f'no state published: {window.last_error}'
+    at[names.index('joint_3')] = -1.8    # past the fold: solved
+    subscription.message(_message(6, names, at, [1.0] * len(names)))
+    [state] = _decoded(node, 'joint_states')
+    assert list(state.name) == list(source.robot.joint_names)
 
 
 def test_tf_follows_the_inputs_time_and_starts_again_after_a_jump_back():
@@ -219,7 +250,7 @@ def _static_input(scene_name, extra_joints):
     solver.setup(publishing.tick_scene, scene, frames, node.logger.info, forces)
     subscription = InputSubscription(node, scene, solver, publishing, stats,
                                      frame_id='mechanism', extra_joints=extra_joints,
-                                     jump_back_s=1.0)
+                                     jump_back_s=1.0, robot=publishing.robot_values)
     subscription.active = True
     return node, subscription, scene
 
