@@ -800,19 +800,28 @@ class _Builder:
             return None
         return [slides[0], pins[0]]
 
-    def _rrp(self) -> bool:
-        m = self.m
-        for body in m.bodies:
+    def _blocks(self) -> Iterator[tuple[str, _Edge, _Edge, str, str]]:
+        """Yield each block not yet placed: (body, slide, pin, slid on, pinned to).
+
+        A block: a moving body with exactly one slide and one pin (not a
+        cylinder's); ``slid on`` is the body across its slide, ``pinned to``
+        the one across its pin. The RRP, RPR and RPP each take one.
+        """
+        for body in self.m.bodies:
             if body in self.known:
                 continue
             block = self._block(body)
             if block is None:
                 continue
             slide, pin = block
-            guide = slide.a if slide.b == body else slide.b
+            yield (body, slide, pin, slide.a if slide.b == body else slide.b,
+                   pin.a if pin.b == body else pin.b)
+
+    def _rrp(self) -> bool:
+        m = self.m
+        for body, slide, pin, guide, link in self._blocks():
             if guide != m.ground:
                 continue
-            link = pin.a if pin.b == body else pin.b
             if link in self.known or self._unit(link) != ('link', link):
                 continue
             known = [e for e in self._known_pin(link) if e.name != pin.name]
@@ -850,17 +859,8 @@ class _Builder:
 
     def _rpr(self) -> bool:
         m = self.m
-        for body in m.bodies:
-            if body in self.known:
-                continue
-            block = self._block(body)
-            if block is None:
-                continue
-            slide, pin = block
-            if (pin.a if pin.b == body else pin.b) not in self.known:
-                continue
-            lever = slide.a if slide.b == body else slide.b
-            if lever in self.known or lever == m.ground:
+        for body, slide, pin, lever, pinned in self._blocks():
+            if pinned not in self.known or lever in self.known or lever == m.ground:
                 continue
             pivots = [e for e in m.edges_of[lever] if e.kind == 'pin'
                       and m.ground in (e.a, e.b)]
@@ -900,17 +900,8 @@ class _Builder:
 
     def _rpp(self) -> bool:
         m = self.m
-        for body in m.bodies:
-            if body in self.known:
-                continue
-            block = self._block(body)
-            if block is None:
-                continue
-            slot, pin = block
-            if (pin.a if pin.b == body else pin.b) not in self.known:
-                continue
-            yoke = slot.a if slot.b == body else slot.b
-            if yoke in self.known or yoke == m.ground:
+        for body, slot, pin, yoke, pinned in self._blocks():
+            if pinned not in self.known or yoke in self.known or yoke == m.ground:
                 continue
             edges = m.edges_of[yoke]
             guides = [e for e in edges if e.kind == 'slide' and e is not slot
