@@ -205,14 +205,18 @@ def imu_outputs(scene: Any, joint_types: dict[str, str], joints: Sequence[str] |
     return joints, points
 
 
-def imu_values(theta: float, omega: float, ax: float, ay: float,
-               spec: ImuSpec) -> tuple[float, float, float, float]:
+def imu_values(theta: float, omega: float, ax: float, ay: float, spec: ImuSpec,
+               gravity: tuple[float, float] | None = None
+               ) -> tuple[float, float, float, float]:
     """Return one instant's (orientation, angular velocity, x, y acceleration) of a sensor.
 
     ``theta`` (rad) and ``omega`` (rad/s) are its link's angle and angular
     velocity, ``ax, ay`` (m/s^2) its point's acceleration in the ground frame:
     the readings of :func:`imu_reading` for plain floats, without bounds (the
-    node's tick). The same formulas, in :mod:`math`.
+    node's tick). The same formulas, in :mod:`math`. ``gravity`` (m/s^2):
+    the gravity taken off, when not the sensor's own (the node's ``gravity``
+    parameter, which a sensor of the scene's gravity follows); a reading it
+    makes overflow is ``inf``, which the caller refuses.
     """
     phi = theta + spec.angle
     if phi > math.pi:
@@ -220,6 +224,6 @@ def imu_values(theta: float, omega: float, ax: float, ay: float,
     elif phi <= -math.pi:
         phi += 2 * math.pi
     c, s = math.cos(phi), math.sin(phi)
-    gx, gy = spec.gravity
+    gx, gy = spec.gravity if gravity is None else gravity
     x, y = ax - gx, ay - gy
     return phi, omega, c * x + s * y, c * y - s * x

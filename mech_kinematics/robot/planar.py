@@ -974,8 +974,8 @@ def _actuated_names(description: Description, actuated: Iterable[str] | None,
         candidates = ', '.join(loop_joints) or 'none'
         raise UrdfError(f'{source}: Expected the actuated joints (--actuated J1,J2,... to a '
                         f'command, actuated_joints:=[J1, J2, ...] to the node, actuated= to the '
-                        f'API, or <transmission>/<ros2_control> joints in the URDF), got none: the '
-                        f'joints of its loops are {candidates}')
+                        f'API, or <transmission>/<ros2_control> joints in the URDF), got '
+                        f'none: the joints of its loops are {candidates}')
     for name in names:
         joint = description.joints.get(name)
         if joint is None or joint.type is None:

@@ -62,9 +62,10 @@ def _imu(frame_id: str, stamp: Any, values: Sequence[float]) -> Imu:
     return msg
 
 
-def _slots(theta: float, omega: float, ax: float, ay: float,
-           spec: ImuSpec) -> tuple[float, float, float, float, float]:
-    phi, omega, x, y = imu_values(theta, omega, ax, ay, spec)
+def _slots(theta: float, omega: float, ax: float, ay: float, spec: ImuSpec,
+           gravity: tuple[float, float] | None = None
+           ) -> tuple[float, float, float, float, float]:
+    phi, omega, x, y = imu_values(theta, omega, ax, ay, spec, gravity)
     half = 0.5 * phi
     return math.sin(half), math.cos(half), omega, x, y
 
@@ -89,11 +90,20 @@ class ImuMessages:
         hold every sensor's link and point.
     prefix : str
         Prefix of the frame names (the node's ``tf_prefix`` or ``frame_id``).
+    scene_gravity : (float, float) or None, optional
+        The scene's top-level ``gravity`` (None: not given). A sensor whose
+        own ``gravity`` equals it follows the node's ``gravity`` parameter
+        (:meth:`follow_gravity`); any other keeps its own (the v3 meaning).
     """
 
     def __init__(self, specs: Sequence[ImuSpec], joints: Sequence[str], points: Sequence[str],
-                 prefix: str) -> None:
+                 prefix: str, scene_gravity: tuple[float, float] | None = None) -> None:
         self.specs = tuple(specs)
+        #: The sensors that follow the ``gravity`` parameter: their gravity is the scene's.
+        self.following = tuple(s.name for s in self.specs if scene_gravity is not None
+                               and tuple(s.gravity) == tuple(scene_gravity))
+        #: Per sensor, the gravity its readings take off, m/s^2 (replaced whole).
+        self.gravity = tuple(tuple(s.gravity) for s in self.specs)
         self.frames = tuple(imu_frame(spec, prefix) for spec in self.specs)
         nj, npt = len(joints), len(points)
         accel = 3 * nj + 4 * npt
@@ -114,12 +124,23 @@ class ImuMessages:
         point's acceleration less its gravity overflows): never an ``inf``.
         """
         out: list[bytes | None] = []
-        for template, spec, (i, j, k, m) in zip(self._templates, self.specs, self.indices,
-                                                strict=True):
-            slots = _slots(values[i], values[j], values[k], values[m], spec)
+        for template, spec, (i, j, k, m), g in zip(self._templates, self.specs, self.indices,
+                                                   self.gravity, strict=True):
+            slots = _slots(values[i], values[j], values[k], values[m], spec, g)
             out.append(template.render(sec, nanosec, slots)
                        if all(map(math.isfinite, slots)) else None)
         return out
+
+    def follow_gravity(self, gravity: Sequence[float]) -> None:
+        """Take ``gravity`` ([gx, gy], m/s^2) off the readings of the sensors that follow it.
+
+        The node's ``gravity`` parameter: from the next instant published,
+        as the forces take it. A reading it makes overflow is not published
+        (:meth:`render_values`).
+        """
+        g = (float(gravity[0]), float(gravity[1]))
+        self.gravity = tuple(g if spec.name in self.following else own
+                             for spec, own in zip(self.specs, self.gravity, strict=True))
 
     def frame_transforms(self, local: dict[str, tuple[float, float]]) -> list[Any]:
         """Return the ``TransformStamped`` of every sensor with a frame of its own (stamp unset).

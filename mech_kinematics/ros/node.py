@@ -150,6 +150,9 @@ class KinematicsNode(LifecycleNode):
             # tick at its next instant.
             self._forces.dynamics = self._forces.warm(
                 dynamics_with(self._forces.dynamics, forces))
+            imus = self._publishing.imus if self._publishing is not None else None
+            if 'gravity' in forces and imus is not None:
+                imus.follow_gravity(forces['gravity'])    # the sensors of the scene's gravity
         if requested and not self._ticks.running:
             self._apply_now()   # not ticking: from the current instant
 
@@ -197,6 +200,8 @@ class KinematicsNode(LifecycleNode):
         if forces is not None:
             values = self.params.declare_forces(forces.dynamics)
             forces.dynamics = forces.warm(dynamics_with(forces.dynamics, values))
+            if publishing.imus is not None:    # a params file's gravity, from the start
+                publishing.imus.follow_gravity(values['gravity'])
             publishing.add_forces(forces)
         compile_later = self._solver.setup(publishing.tick_scene, scene, frames,
                                            self.get_logger().info, forces)

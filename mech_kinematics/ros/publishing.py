@@ -287,7 +287,7 @@ class Publishing:
         if not scene.imus:
             return
         self.imus = ImuMessages(scene.imus, scene.output_joints, scene.output_points,
-                                self.prefix)
+                                self.prefix, scene.gravity)
         self._publish_imu = tuple(
             self._publisher(Imu, topics.imu_topic(spec.name), state_qos()).publish
             for spec in scene.imus)
