@@ -6,7 +6,9 @@
   (:class:`BagInfo`) and its ``metadata.yaml``;
 - :mod:`.storage_mcap`, :mod:`.storage_sqlite3`: the two storage files, each
   flushed a chunk or a transaction at a time, and recovered after a crash;
-- :mod:`.writer`: :class:`BagWriter` and :func:`reindex`.
+- :mod:`.writer`: :class:`BagWriter` and :func:`reindex`;
+- :mod:`.queued`: :class:`QueuedWriter`, a writer written by a thread of its
+  own, so that receiving never waits on the disk.
 
 The files are those rosbag2 and rosbags write (MCAP ``ros2`` profile, sqlite3
 schema version 4): rosbags, ``ros2 bag`` and Foxglove read them. Only the
@@ -15,8 +17,10 @@ type-hash helpers, inside the functions that use it.
 """
 
 from .metadata import BAG_VERSIONS, BagError, BagInfo, Topic
+from .queued import QueuedWriter
 from .writer import (BagWriter, check_new_bag, check_options, DEFAULT_VERSION, FLUSH_INTERVAL_S,
                      reindex, STORAGES)
 
 __all__ = ['BAG_VERSIONS', 'BagError', 'BagInfo', 'BagWriter', 'DEFAULT_VERSION',
-           'FLUSH_INTERVAL_S', 'STORAGES', 'Topic', 'check_new_bag', 'check_options', 'reindex']
+           'FLUSH_INTERVAL_S', 'QueuedWriter', 'STORAGES', 'Topic', 'check_new_bag',
+           'check_options', 'reindex']

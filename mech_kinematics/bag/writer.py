@@ -119,8 +119,9 @@ class BagWriter:
 
     Notes
     -----
-    Not thread safe: call every method from one thread (the recorder calls
-    them from its executor's thread). From :meth:`open` to :meth:`close` the
+    Not thread safe: call its methods from one thread at a time (the
+    recorder's :class:`~.queued.QueuedWriter` orders them with a lock, so
+    that receiving never waits on a flush). From :meth:`open` to :meth:`close` the
     storage file is locked (:func:`.lock.hold`): ``reindex`` refuses it.
     """
 
@@ -135,6 +136,7 @@ class BagWriter:
         self.flush_bytes = flush_bytes
         self.file = self.path / f'{self.path.name}{STORAGES[storage]}'
         self.topics: list[Topic] = []
+        self._ids = 0
         self.failure: str | None = None
         self._storage: Any = None
         self._lock: int | None = None
@@ -182,15 +184,26 @@ class BagWriter:
         qos : sequence of rosbags.interfaces.Qos
             Offered QoS profiles of the publishers.
         """
+        topic = self.new_topic(name, type_name, definition=definition, encoding=encoding,
+                               type_hash=type_hash, qos=qos)
+        self.add(topic)
+        return topic
+
+    def new_topic(self, name: str, type_name: str, *, definition: str, encoding: str,
+                  type_hash: str, qos: Sequence[Any] = ()) -> Topic:
+        """Return a topic of the next id, for :meth:`add` (nothing written yet)."""
         self._check()
-        topic = Topic(len(self.topics) + 1, name, type_name, definition, encoding, type_hash,
-                      tuple(qos))
+        self._ids += 1
+        return Topic(self._ids, name, type_name, definition, encoding, type_hash, tuple(qos))
+
+    def add(self, topic: Topic) -> None:
+        """Write a topic of :meth:`new_topic` to the storage; its messages may follow."""
+        self._check()
         try:
-            self._storage.add_topic(topic, qos_text(qos, self.version))
+            self._storage.add_topic(topic, qos_text(topic.qos, self.version))
         except _WRITE_ERRORS as error:
             self._fail(error)
         self.topics.append(topic)
-        return topic
 
     def write(self, topic: Topic, timestamp: int, data: bytes) -> None:
         """Write one serialized message of ``topic`` received at ``timestamp`` ns.
@@ -210,11 +223,13 @@ class BagWriter:
     def flush(self) -> None:
         """Write what is pending to the storage file and sync it."""
         self._check()
-        self._due = time.monotonic() + self.flush_interval
         try:
             self._storage.flush()
         except _WRITE_ERRORS as error:
             self._fail(error)
+        # From the end of this flush: a sync slower than the interval (a loaded disk) must
+        # not make every following write a flush of its own.
+        self._due = time.monotonic() + self.flush_interval
 
     def flush_if_due(self) -> None:
         """:meth:`flush` if the oldest pending message has waited ``flush_interval`` s."""

@@ -404,7 +404,7 @@ class BagRecorder:
         import rclpy
         from rclpy.signals import SignalHandlerOptions
 
-        from ..bag import BagError, BagWriter
+        from ..bag import BagError, BagWriter, QueuedWriter
 
         self._context = rclpy.Context()
         # The recorder handles SIGINT and SIGTERM itself (a flag, see run()), so that a
@@ -429,7 +429,9 @@ class BagRecorder:
                 writer.open()
             except BagError as error:
                 raise RecorderError(str(error)) from None
-            self._writer = writer
+            # Written by a thread of its own: a flush's fsync, seconds on a loaded disk, never
+            # holds up the executor while the middleware's queues fill and drop messages.
+            self._writer = QueuedWriter(writer)
             self._node.create_timer(POLL_INTERVAL_S, self._housekeeping)
         except BaseException:
             if self._writer is not None:
