@@ -25,7 +25,9 @@ A second set of recorders meets a node at 1 kHz for the crash-safety tests
 is stopped normally, tells which messages they had received; two run with a
 file size limit (``RLIMIT_FSIZE``, so that writes fail with ``EFBIG``) and
 must end with one ``error:`` line and a bag whose metadata tells the truth;
-one, in a namespace where nothing publishes, must say what it waits for.
+one, in a namespace where nothing publishes, must say what it waits for; and
+one whose every ``fsync`` is 1.5 s slower (a loaded disk) must hold the same
+states as the witness.
 """
 
 import contextlib
