@@ -7,8 +7,7 @@ writer flushes and syncs the storage file every half second, and on a
 loaded machine one ``fsync`` can take seconds. While the executor waits on
 it, the middleware's queue of each subscription (``QUEUE_DEPTH``, 2 s of a
 500 Hz topic) fills and drops the oldest messages: the bag loses what was
-published. (Seen beside two CPU hogs: ~0.3 s of every state topic missing
-from two of four bags, in the middle of the recording.)
+published (``test_a_slow_disk_delays_the_bag_and_loses_nothing``).
 
 :class:`QueuedWriter` takes the same calls. :meth:`QueuedWriter.add_topic`
 and :meth:`QueuedWriter.write` only append to a queue in memory (a topic's
@@ -17,8 +16,7 @@ thread of its own writes the queue to the :class:`BagWriter` and flushes it
 when due, so the writer is used by one thread. :meth:`QueuedWriter.close`
 writes everything queued before it closes the bag: what was received is
 written, however slow the disk. The queue has no bound: a disk stalled for
-a minute holds a minute of messages in memory (a recording of the node at
-1 kHz: about 0.5 MB/s).
+a minute holds a minute of messages in memory.
 """
 
 from __future__ import annotations
@@ -65,9 +63,7 @@ class QueuedWriter:
 
     def write(self, topic: Topic, timestamp: int, data: bytes) -> None:
         """Queue one message; raise :class:`BagError` if writing has failed."""
-        failure = self.writer.failure
-        if failure is not None:
-            raise BagError(failure)
+        self.flush_if_due()
         self._queue.append((topic, timestamp, data))
 
     def flush_if_due(self) -> None:
@@ -95,16 +91,14 @@ class QueuedWriter:
     def _drain(self) -> None:
         """Write every queued topic and message (after a failure, drop them: close() says)."""
         queue, writer = self._queue, self.writer
-        while queue:
-            if writer.failure is not None:
-                queue.clear()
-                return
-            item = queue.popleft()
-            try:
+        try:
+            while queue and writer.failure is None:
+                item = queue.popleft()
                 if len(item) == 1:
                     writer.add(item[0])
                 else:
                     writer.write(*item)
-            except BagError:
-                queue.clear()
-                return
+        except BagError:
+            pass            # kept in writer.failure
+        if writer.failure is not None:
+            queue.clear()

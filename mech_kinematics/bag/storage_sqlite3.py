@@ -69,7 +69,7 @@ _INSERT_MESSAGE = 'INSERT INTO messages (topic_id, timestamp, data) VALUES (?, ?
 
 def _connect(path: Path) -> sqlite3.Connection:
     # Autocommit: transactions are opened and committed explicitly, one per flush. Used by
-    # one thread at a time, not always the one that opened it (QueuedWriter's lock orders them).
+    # one thread at a time, not always the one that opened it (QueuedWriter's writing thread).
     conn = sqlite3.connect(path, isolation_level=None, check_same_thread=False)
     conn.execute('PRAGMA journal_mode=DELETE')
     conn.execute('PRAGMA synchronous=NORMAL')

@@ -120,8 +120,8 @@ class BagWriter:
     Notes
     -----
     Not thread safe: call its methods from one thread at a time (the
-    recorder's :class:`~.queued.QueuedWriter` orders them with a lock, so
-    that receiving never waits on a flush). From :meth:`open` to :meth:`close` the
+    recorder's :class:`~.queued.QueuedWriter` writes from a thread of its
+    own, so that receiving never waits on a flush). From :meth:`open` to :meth:`close` the
     storage file is locked (:func:`.lock.hold`): ``reindex`` refuses it.
     """
 
