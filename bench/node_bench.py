@@ -48,18 +48,13 @@ import statistics
 import subprocess
 import sys
 import tempfile
-import threading
 import time
 
-NS = 1_000_000_000
+from ros_runs import cpu_seconds, NS, publish_on_grid, qos, ros_env
+
 STATE_TOPICS = ('joint_states', 'joint_accelerations', 'point_accelerations')
 SCENE = 'khurmi_four_bar_ad150'
 CHAIN_SIZES = (1, 4, 16, 64)
-
-
-def _cpu_seconds(pid: int) -> float:
-    fields = Path(f'/proc/{pid}/stat').read_text().rsplit(')', 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
 
 
 def shaft_scene(dyads: int) -> str:
@@ -87,62 +82,18 @@ def shaft_scene(dyads: int) -> str:
 
 def floor(namespace: str, rate: float, scene_name: str) -> None:
     """Publish the three state messages of ``scene_name``, pre-serialized, on an exact grid."""
-    import struct
-
-    import rclpy
-    from rclpy.executors import ExternalShutdownException
-    from rclpy.qos import QoSProfile, ReliabilityPolicy
     from sensor_msgs.msg import JointState
     from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
 
     import mech_kinematics as mk
     from mech_kinematics.ros.messages import TickMessages
-    from mech_kinematics.ros.schedule import period_ns_from_rate, TickGrid
 
     scene = mk.load_scene(scene_name)
     state = mk.solve(scene, scene.input.angle)
-    payloads = [bytearray(b) for b in TickMessages(
-        scene.output_joints, scene.output_points, 'mechanism').render(state, 0, 0)]
-    rclpy.init()
-    node = rclpy.create_node('floor_publisher', namespace=namespace)
-    qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
-    publishers = [node.create_publisher(t, topic, qos) for t, topic in zip(
-        (JointState, JointTrajectory, MultiDOFJointTrajectory), STATE_TOPICS, strict=True)]
-    stamp = struct.Struct('<iI')
-    period = period_ns_from_rate(rate)
-    stop = threading.Event()
-
-    def loop() -> None:
-        grid = TickGrid.aligned(time.time_ns(), period)
-        while not stop.is_set():
-            now = time.time_ns()
-            if now < grid.next_ns:
-                time.sleep(min(grid.next_ns - now, 50_000_000) / NS)
-                continue
-            for t in grid.take(now, NS // 10).instants:
-                sec, nanosec = divmod(t, NS)
-                for publisher, payload in zip(publishers, payloads, strict=True):
-                    stamp.pack_into(payload, 4, sec, nanosec)
-                    try:
-                        publisher.publish(bytes(payload))
-                    except Exception:       # noqa: BLE001 - the context ends under a publish
-                        if stop.is_set() or not rclpy.ok():
-                            return
-                        raise
-
-    sys.setswitchinterval(0.0005)
-    thread = threading.Thread(target=loop, daemon=True)
-    thread.start()
-    signal.signal(signal.SIGTERM, lambda *_: stop.set())
-    try:
-        while not stop.is_set():
-            rclpy.spin_once(node, timeout_sec=0.1)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    stop.set()
-    thread.join(timeout=1.0)
-    node.destroy_node()
-    rclpy.try_shutdown()
+    payloads = TickMessages(scene.output_joints, scene.output_points, 'mechanism').render(
+        state, 0, 0)
+    types = (JointState, JointTrajectory, MultiDOFJointTrajectory)
+    publish_on_grid(namespace, rate, list(zip(types, STATE_TOPICS, strict=True)), payloads)
 
 
 # -- the subscriber -------------------------------------------------------------------
@@ -152,7 +103,6 @@ def subscribe(namespace: str, seconds: float, out: str) -> None:
     """Record the stamps of every state message and the diagnostics, then write them out."""
     import rclpy
     from diagnostic_msgs.msg import DiagnosticArray
-    from rclpy.qos import QoSProfile, ReliabilityPolicy
     from sensor_msgs.msg import JointState
     from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
 
@@ -160,14 +110,13 @@ def subscribe(namespace: str, seconds: float, out: str) -> None:
 
     rclpy.init()
     node = rclpy.create_node('node_bench_subscriber', namespace=namespace)
-    qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
     received: dict[str, list[bytes]] = {t: [] for t in STATE_TOPICS}
     for topic, msg_type in zip(STATE_TOPICS,
                                (JointState, JointTrajectory, MultiDOFJointTrajectory),
                                strict=True):
         sink = received[topic]
         node.create_subscription(msg_type, topic, lambda data, sink=sink: sink.append(data[:12]),
-                                 qos, raw=True)
+                                 qos(), raw=True)
     diagnostics: list[dict[str, str]] = []
 
     def on_diagnostics(msg: DiagnosticArray) -> None:
@@ -193,27 +142,26 @@ def _delivered(stamps: dict[str, list[int]], period: int, lo: int, hi: int) -> f
     return min(len({s for s in v if lo <= s <= hi}) / owed for v in stamps.values())
 
 
-def measure(kind: str, rate: float, scene: str, args: argparse.Namespace,
-            env: dict[str, str], tmp: Path) -> dict[str, float]:
-    """Run the node or the floor at ``rate`` with a subscriber; return the row of the table."""
-    namespace = f'/bench_{os.getpid()}_{kind}_{int(rate)}_{random.randrange(10 ** 6)}'
+def run_publisher(command: list[str], namespace: str, rate: float, args: argparse.Namespace,
+                  env: dict[str, str], tmp: Path) -> dict[str, float]:
+    """Run ``command`` (the node or a floor) publishing in ``namespace`` at ``rate``, measured.
+
+    A subscriber in another process records every state message's stamp and
+    the diagnostics. Returns the publisher's ``cpu`` (% of a core over
+    ``args.seconds`` after ``args.warmup``), the ``delivered`` fraction of
+    grid instants and, from the node's diagnostics, ``skipped`` instants.
+    """
     out = tmp / f'{namespace[1:]}.json'
     listen = args.warmup + args.seconds + 2.0
     sub = subprocess.Popen([sys.executable, __file__, '--subscribe', namespace, str(listen),
                             str(out)], env=env)
     time.sleep(1.0)     # the subscriber is there before the first message
-    if kind == 'node':
-        command = [sys.executable, '-m', 'mech_kinematics.kinematics_node', '--ros-args',
-                   '-r', f'__ns:={namespace}', '-p', f'scene:={scene}',
-                   '-p', f'rate_hz:={rate}', '--log-level', 'warn']
-    else:
-        command = [sys.executable, __file__, '--floor', namespace, str(rate), scene]
     publisher = subprocess.Popen(command, env=env)
     try:
         time.sleep(args.warmup)
-        cpu0, wall0, stamp0 = _cpu_seconds(publisher.pid), time.monotonic(), time.time_ns()
+        cpu0, wall0, stamp0 = cpu_seconds(publisher.pid), time.monotonic(), time.time_ns()
         time.sleep(args.seconds)
-        cpu1, wall1, stamp1 = _cpu_seconds(publisher.pid), time.monotonic(), time.time_ns()
+        cpu1, wall1, stamp1 = cpu_seconds(publisher.pid), time.monotonic(), time.time_ns()
     finally:
         publisher.send_signal(signal.SIGINT)
         publisher.wait(timeout=10)
@@ -222,12 +170,29 @@ def measure(kind: str, rate: float, scene: str, args: argparse.Namespace,
     period = round(NS / rate)
     lo = -(-stamp0 // period) * period
     hi = stamp1 // period * period
-    row = {'kind': kind, 'rate': rate, 'cpu': 100 * (cpu1 - cpu0) / (wall1 - wall0),
+    row = {'cpu': 100 * (cpu1 - cpu0) / (wall1 - wall0),
            'delivered': _delivered(data['stamps'], period, lo, hi)}
     if data['diagnostics']:
         last = data['diagnostics'][-1]
         row['skipped'] = int(last.get('skipped_ticks_total', 0))
     return row
+
+
+def node_command(namespace: str, scene: str, rate: float) -> list[str]:
+    """Return the command of the node on ``scene`` at ``rate`` in ``namespace``."""
+    return [sys.executable, '-m', 'mech_kinematics.kinematics_node', '--ros-args',
+            '-r', f'__ns:={namespace}', '-p', f'scene:={scene}', '-p', f'rate_hz:={rate}',
+            '--log-level', 'warn']
+
+
+def measure(kind: str, rate: float, scene: str, args: argparse.Namespace,
+            env: dict[str, str], tmp: Path) -> dict[str, float]:
+    """Run the node or the floor at ``rate`` with a subscriber; return the row of the table."""
+    namespace = f'/bench_{os.getpid()}_{kind}_{int(rate)}_{random.randrange(10 ** 6)}'
+    command = (node_command(namespace, scene, rate) if kind == 'node' else
+               [sys.executable, __file__, '--floor', namespace, str(rate), scene])
+    return {'kind': kind, 'rate': rate,
+            **run_publisher(command, namespace, rate, args, env, tmp)}
 
 
 def _table(rows: list[dict[str, float]], key: str) -> list[str]:
@@ -312,11 +277,7 @@ def main(argv: list[str] | None = None) -> int:
         namespace, rate, scene = args.floor
         floor(namespace, float(rate), scene)
         return 0
-    env = dict(os.environ)
-    env.setdefault('ROS_DOMAIN_ID', str(random.SystemRandom().randint(101, 200)))
-    env['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-    repo = str(Path(__file__).resolve().parents[1])
-    env['PYTHONPATH'] = os.pathsep.join(filter(None, [repo, env.get('PYTHONPATH')]))
+    env = ros_env()
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         if args.chains:

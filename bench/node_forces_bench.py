@@ -36,23 +36,20 @@ import os
 from pathlib import Path
 import pstats
 import random
-import signal
 import statistics
-import subprocess
 import sys
 import tempfile
-import threading
 import time
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import node_bench  # noqa: E402
 import numpy as np  # noqa: E402
+from ros_runs import publish_on_grid, ros_env  # noqa: E402
 
 import mech_kinematics as mk  # noqa: E402
 from mech_kinematics.ros.ticker import compiled_tick, general_tick  # noqa: E402
 from mech_kinematics.ros.wrenches import ForcesTick  # noqa: E402
 
-NS = 1_000_000_000
 #: The packaged scenes with masses, gravity or loads.
 LOADED = ('engine', 'shaper', 'five_bar_payload', 'excavator_loaded', 'khurmi_engine_15_7',
           'singh_petrol_engine_13_15')
@@ -154,106 +151,37 @@ def profile(name: str, count: int) -> str:
 
 def floor(namespace: str, rate: float, scene_name: str) -> None:
     """Publish a forces tick's messages of ``scene_name``, pre-serialized, on an exact grid."""
-    import struct
-
     from geometry_msgs.msg import WrenchStamped
-    import rclpy
-    from rclpy.executors import ExternalShutdownException
-    from rclpy.qos import QoSProfile, ReliabilityPolicy
     from sensor_msgs.msg import JointState
     from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
 
     from mech_kinematics.ros import topics
     from mech_kinematics.ros.messages import TickMessages
-    from mech_kinematics.ros.schedule import period_ns_from_rate, TickGrid
     from mech_kinematics.ros.wrenches import ForceMessages
 
     scene = mk.load_scene(scene_name)
     joints, points = scene.output_joints, scene.output_points
     tick = ForcesTick(scene, joints, points, (), static=False)
     values, _ = tick(*_drivers(scene), TOL, 0)
-    payloads = [bytearray(b) for b in TickMessages(
-        joints, points, 'mechanism', efforts_first=tick.forces_first).render_values(values, 0, 0)]
-    payloads += [bytearray(b) for b in ForceMessages(
-        'mechanism', len(joints), len(tick.reactions)).render(values, tick.forces_first, 0, 0)]
-    rclpy.init()
-    node = rclpy.create_node('floor_publisher', namespace=namespace)
-    qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+    payloads = [*TickMessages(joints, points, 'mechanism',
+                              efforts_first=tick.forces_first).render_values(values, 0, 0),
+                *ForceMessages('mechanism', len(joints), len(tick.reactions)).render(
+                    values, tick.forces_first, 0, 0)]
     types = [(JointState, topics.JOINT_STATES), (JointTrajectory, topics.JOINT_ACCELERATIONS),
              (MultiDOFJointTrajectory, topics.POINT_ACCELERATIONS)]
     types += [(WrenchStamped, topics.reaction_topic(j.name)) for j in tick.reactions]
     types.append((WrenchStamped, topics.SHAKING))
-    publishers = [node.create_publisher(t, topic, qos) for t, topic in types]
-    stamp = struct.Struct('<iI')
-    period = period_ns_from_rate(rate)
-    stop = threading.Event()
-
-    def loop() -> None:
-        grid = TickGrid.aligned(time.time_ns(), period)
-        while not stop.is_set():
-            now = time.time_ns()
-            if now < grid.next_ns:
-                time.sleep(min(grid.next_ns - now, 50_000_000) / NS)
-                continue
-            for t in grid.take(now, NS // 10).instants:
-                sec, nanosec = divmod(t, NS)
-                for publisher, payload in zip(publishers, payloads, strict=True):
-                    stamp.pack_into(payload, 4, sec, nanosec)
-                    try:
-                        publisher.publish(bytes(payload))
-                    except Exception:       # noqa: BLE001 - the context ends under a publish
-                        if stop.is_set() or not rclpy.ok():
-                            return
-                        raise
-
-    sys.setswitchinterval(0.0005)
-    thread = threading.Thread(target=loop, daemon=True)
-    thread.start()
-    signal.signal(signal.SIGTERM, lambda *_: stop.set())
-    try:
-        while not stop.is_set():
-            rclpy.spin_once(node, timeout_sec=0.1)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    stop.set()
-    thread.join(timeout=1.0)
-    node.destroy_node()
-    rclpy.try_shutdown()
+    publish_on_grid(namespace, rate, types, payloads)
 
 
 def measure(kind: str, scene: str, args: argparse.Namespace, env: dict[str, str],
             tmp: Path) -> dict[str, float]:
     """Run the node or the floor at ``--rate`` on ``scene`` with a subscriber; CPU, delivered."""
-    rate = args.rate
     namespace = f'/fbench_{os.getpid()}_{kind}_{random.randrange(10 ** 6)}'
-    out = tmp / f'{namespace[1:]}.json'
-    listen = args.warmup + args.seconds + 2.0
-    sub = subprocess.Popen([sys.executable, node_bench.__file__, '--subscribe', namespace,
-                            str(listen), str(out)], env=env)
-    time.sleep(1.0)
-    if kind == 'node':
-        command = [sys.executable, '-m', 'mech_kinematics.kinematics_node', '--ros-args',
-                   '-r', f'__ns:={namespace}', '-p', f'scene:={scene}',
-                   '-p', f'rate_hz:={rate}', '--log-level', 'warn']
-    else:
-        command = [sys.executable, __file__, '--floor', namespace, str(rate), scene]
-    publisher = subprocess.Popen(command, env=env)
-    try:
-        time.sleep(args.warmup)
-        cpu0, wall0, stamp0 = (node_bench._cpu_seconds(publisher.pid), time.monotonic(),
-                               time.time_ns())
-        time.sleep(args.seconds)
-        cpu1, wall1, stamp1 = (node_bench._cpu_seconds(publisher.pid), time.monotonic(),
-                               time.time_ns())
-    finally:
-        publisher.send_signal(signal.SIGINT)
-        publisher.wait(timeout=10)
-        sub.wait(timeout=60)
-    data = node_bench.json.loads(out.read_text())
-    period = round(NS / rate)
-    lo, hi = -(-stamp0 // period) * period, stamp1 // period * period
-    return {'kind': kind, 'cpu': 100 * (cpu1 - cpu0) / (wall1 - wall0),
-            'delivered': node_bench._delivered(data['stamps'], period, lo, hi)}
+    command = (node_bench.node_command(namespace, scene, args.rate) if kind == 'node' else
+               [sys.executable, __file__, '--floor', namespace, str(args.rate), scene])
+    return {'kind': kind, **node_bench.run_publisher(command, namespace, args.rate, args, env,
+                                                     tmp)}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -276,11 +204,7 @@ def main(argv: list[str] | None = None) -> int:
     load = os.getloadavg()[0]
     print(f'{os.cpu_count()} cores, load average {load:.1f} at the start\n')
     if args.node:
-        env = dict(os.environ)
-        env.setdefault('ROS_DOMAIN_ID', str(random.SystemRandom().randint(101, 200)))
-        env['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-        repo = str(Path(__file__).resolve().parents[1])
-        env['PYTHONPATH'] = os.pathsep.join(filter(None, [repo, env.get('PYTHONPATH')]))
+        env = ros_env()
         rows = []
         with tempfile.TemporaryDirectory() as tmp:
             for _ in range(args.repeat):

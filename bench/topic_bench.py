@@ -42,30 +42,17 @@ import math
 import os
 from pathlib import Path
 import random
-import signal
 import statistics
-import subprocess
 import sys
 import tempfile
-import threading
-import time
 
-NS = 1_000_000_000
+import ros_runs
+from ros_runs import NS, quantile, relay_floor, relay_run, ros_env
+
 STATE_TOPICS = ('joint_states', 'joint_accelerations', 'point_accelerations')
-INPUT = 'input_joint_states'
 SCENE = 'khurmi_four_bar_ad150'
 #: The crank's speed in the input messages, rad/s (the scene's -120 rpm).
 SPEED = -4 * math.pi
-
-
-def _cpu_seconds(pid: int) -> float:
-    fields = Path(f'/proc/{pid}/stat').read_text().rsplit(')', 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
-
-
-def _qos(depth: int = 1000):
-    from rclpy.qos import QoSProfile, ReliabilityPolicy
-    return QoSProfile(depth=depth, reliability=ReliabilityPolicy.RELIABLE)
 
 
 # -- the floor: a bare relay ------------------------------------------------------------
@@ -73,8 +60,6 @@ def _qos(depth: int = 1000):
 
 def floor(namespace: str, scene_name: str) -> None:
     """Publish three pre-serialized state messages with each input message's stamp."""
-    import rclpy
-    from rclpy.executors import ExternalShutdownException
     from sensor_msgs.msg import JointState
     from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
 
@@ -83,29 +68,10 @@ def floor(namespace: str, scene_name: str) -> None:
 
     scene = mk.load_scene(scene_name)
     state = mk.solve(scene, scene.input.angle)
-    payloads = [bytearray(b) for b in TickMessages(
-        scene.output_joints, scene.output_points, 'mechanism', velocities=True,
-        accelerations=False).render(state, 0, 0)]
-    rclpy.init()
-    node = rclpy.create_node('floor_relay', namespace=namespace)
-    publishers = [node.create_publisher(t, topic, _qos()) for t, topic in zip(
-        (JointState, JointTrajectory, MultiDOFJointTrajectory), STATE_TOPICS, strict=True)]
-
-    def relay(data: bytes) -> None:
-        stamp = data[4:12]
-        for publisher, payload in zip(publishers, payloads, strict=True):
-            payload[4:12] = stamp
-            publisher.publish(bytes(payload))
-
-    node.create_subscription(JointState, INPUT, relay, _qos(100), raw=True)
-    signal.signal(signal.SIGTERM, lambda *_: rclpy.try_shutdown())
-    try:
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
+    payloads = TickMessages(scene.output_joints, scene.output_points, 'mechanism',
+                            velocities=True, accelerations=False).render(state, 0, 0)
+    types = (JointState, JointTrajectory, MultiDOFJointTrajectory)
+    relay_floor(namespace, list(zip(types, STATE_TOPICS, strict=True)), payloads)
 
 
 # -- the driver: inputs out, states in, one clock ----------------------------------------
@@ -113,65 +79,24 @@ def floor(namespace: str, scene_name: str) -> None:
 
 def drive(namespace: str, rate: float, seconds: float, out: str) -> None:
     """Publish inputs at ``rate`` for ``seconds``; note send and arrival times; write them."""
-    import rclpy
-    from rclpy.executors import SingleThreadedExecutor
     from sensor_msgs.msg import JointState
     from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
 
-    from mech_kinematics.ros.cdr import marker, MessageTemplate, STAMP_MARKER, stamp_from_cdr
-    from mech_kinematics.ros.schedule import period_ns_from_rate, TickGrid
+    from mech_kinematics.ros.cdr import marker, MessageTemplate, STAMP_MARKER
 
     msg = JointState(name=['crank'], position=[marker(0)], velocity=[marker(1)])
     msg.header.stamp.sec, msg.header.stamp.nanosec = STAMP_MARKER
     template = MessageTemplate(msg, 2)
-    rclpy.init()
-    node = rclpy.create_node('topic_bench_driver', namespace=namespace)
-    publisher = node.create_publisher(JointState, INPUT, _qos(100))
-    arrivals: dict[str, list[tuple[int, int]]] = {t: [] for t in STATE_TOPICS}
-    for topic, msg_type in zip(STATE_TOPICS,
-                               (JointState, JointTrajectory, MultiDOFJointTrajectory),
-                               strict=True):
-        sink = arrivals[topic].append
-        node.create_subscription(
-            msg_type, topic,
-            lambda data, sink=sink: sink((stamp_from_cdr(data), time.monotonic_ns())),
-            _qos(), raw=True)
-    executor = SingleThreadedExecutor()
-    executor.add_node(node)
-    spinner = threading.Thread(target=executor.spin, daemon=True)
-    spinner.start()
-    deadline = time.monotonic() + 30.0
-    while publisher.get_subscription_count() == 0 and time.monotonic() < deadline:
-        time.sleep(0.05)
-    Path(f'{out}.started').touch()     # the relay's CPU is measured from now on
-    sent: list[tuple[int, int]] = []
-    period = period_ns_from_rate(rate)
-    grid = TickGrid.aligned(time.time_ns(), period)
-    end = time.monotonic() + seconds
-    sys.setswitchinterval(0.0005)
-    while time.monotonic() < end:
-        now = time.time_ns()
-        if now < grid.next_ns:
-            time.sleep(min(grid.next_ns - now, 50_000_000) / NS)
-            continue
-        for t in grid.take(now, NS // 10, catch_up=False).instants:
-            angle = SPEED * (t % (10 * NS)) / NS
-            data = template.render(*divmod(t, NS), (angle, SPEED))
-            sent.append((t, time.monotonic_ns()))
-            publisher.publish(data)
-    time.sleep(1.0)     # the last answers arrive
-    executor.shutdown(timeout_sec=1.0)
-    node.destroy_node()
-    rclpy.try_shutdown()
-    Path(out).write_text(json.dumps({'sent': sent, 'arrivals': arrivals}))
+
+    def render(t: int) -> bytes:
+        return template.render(*divmod(t, NS), (SPEED * (t % (10 * NS)) / NS, SPEED))
+
+    types = (JointState, JointTrajectory, MultiDOFJointTrajectory)
+    ros_runs.drive(namespace, 'topic_bench_driver', rate, seconds, out, render,
+                   list(zip(types, STATE_TOPICS, strict=True)))
 
 
 # -- one run, and the table ---------------------------------------------------------------
-
-
-def _quantile(values: list[float], q: float) -> float:
-    ordered = sorted(values)
-    return ordered[min(len(ordered) - 1, int(q * len(ordered)))]
 
 
 def measure(kind: str, rate: float, args: argparse.Namespace, env: dict[str, str],
@@ -185,26 +110,12 @@ def measure(kind: str, rate: float, args: argparse.Namespace, env: dict[str, str
                    '--log-level', 'warn']
     else:
         command = [sys.executable, __file__, '--floor', namespace, SCENE]
-    relay = subprocess.Popen(command, env=env)
-    time.sleep(2.0)     # the relay is up before the driver starts sending
-    total = args.warmup + args.seconds
-    driver = subprocess.Popen([sys.executable, __file__, '--drive', namespace, str(rate),
-                               str(total), str(out)], env=env)
-    try:
-        started = Path(f'{out}.started')
-        while not started.exists() and driver.poll() is None:
-            time.sleep(0.05)
-        time.sleep(args.warmup)
-        cpu0, wall0 = _cpu_seconds(relay.pid), time.monotonic()
-        time.sleep(args.seconds - 0.5)
-        cpu1, wall1 = _cpu_seconds(relay.pid), time.monotonic()
-        driver.wait(timeout=total + 60)
-    finally:
-        relay.send_signal(signal.SIGINT)
-        relay.wait(timeout=10)
+    driver = [sys.executable, __file__, '--drive', namespace, str(rate),
+              str(args.warmup + args.seconds), str(out)]
+    cpu, wall0, wall1 = relay_run(command, driver, out, args.warmup, args.seconds, env)
     data = json.loads(out.read_text())
     sent = data['sent']
-    measured = sent[int(len(sent) * args.warmup / total):]
+    measured = sent[int(len(sent) * args.warmup / (args.warmup + args.seconds)):]
     arrived: dict[int, int] = {}
     counts: dict[int, int] = {}
     for topic in STATE_TOPICS:
@@ -213,9 +124,9 @@ def measure(kind: str, rate: float, args: argparse.Namespace, env: dict[str, str
             counts[stamp] = counts.get(stamp, 0) + 1
     latencies = [(arrived[t] - at) / 1e3 for t, at in measured
                  if counts.get(t) == len(STATE_TOPICS)]
-    return {'kind': kind, 'rate': rate, 'cpu_pct': 100 * (cpu1 - cpu0) / (wall1 - wall0),
+    return {'kind': kind, 'rate': rate, 'cpu_pct': 100 * cpu / (wall1 - wall0),
             'latency_median_us': statistics.median(latencies),
-            'latency_p99_us': _quantile(latencies, 0.99),
+            'latency_p99_us': quantile(latencies, 0.99),
             'answered': len(latencies) / len(measured), 'inputs': len(measured)}
 
 
@@ -261,11 +172,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.floor:
         floor(*args.floor)
         return 0
-    env = dict(os.environ)
-    env.setdefault('ROS_DOMAIN_ID', str(random.SystemRandom().randint(101, 200)))
-    env['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-    repo = str(Path(__file__).resolve().parents[1])
-    env['PYTHONPATH'] = os.pathsep.join(filter(None, [repo, env.get('PYTHONPATH')]))
+    env = ros_env()
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for rate in args.rates:

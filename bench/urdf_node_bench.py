@@ -45,20 +45,15 @@ import math
 import os
 from pathlib import Path
 import random
-import signal
 import statistics
-import subprocess
 import sys
 import tempfile
-import threading
-import time
 
-from topic_bench import _cpu_seconds, _qos, _quantile
+import ros_runs
+from ros_runs import NS, quantile, relay_floor, relay_run, ros_env
 
-NS = 1_000_000_000
 DATA = Path(__file__).resolve().parents[1] / 'test' / 'data' / 'urdf'
 ROBOT = 'robotiq_2f_85'
-INPUT = 'input_joint_states'
 #: A joint of the motors' message that the robot does not have (passed through).
 OTHER = 'wrist_3_joint'
 
@@ -67,100 +62,49 @@ def _paths(robot: str) -> tuple[Path, Path]:
     return DATA / f'{robot}.urdf', DATA / f'{robot}.loop_closures.yaml'
 
 
-def floor(namespace: str, robot: str) -> None:
-    """Publish one pre-serialized joint_states of the node's size per input, its stamp patched."""
-    import rclpy
-    from rclpy.executors import ExternalShutdownException
+def _template(names: list[str]) -> object:
+    """Return a JointState template of ``names``' positions and velocities."""
     from sensor_msgs.msg import JointState
 
-    from mech_kinematics.robot import load_robot
     from mech_kinematics.ros.cdr import marker, MessageTemplate, STAMP_MARKER
 
-    model = load_robot(*_paths(robot))
-    names = [*model.joint_names, OTHER]
     n = len(names)
     msg = JointState(name=names, position=[marker(i) for i in range(n)],
                      velocity=[marker(n + i) for i in range(n)])
     msg.header.stamp.sec, msg.header.stamp.nanosec = STAMP_MARKER
     msg.header.frame_id = 'mechanism'
-    payload = bytearray(MessageTemplate(msg, 2 * n).render(0, 0, [0.1] * (2 * n)))
-    rclpy.init()
-    node = rclpy.create_node('floor_relay', namespace=namespace)
-    publisher = node.create_publisher(JointState, 'joint_states', _qos())
+    return MessageTemplate(msg, 2 * n)
 
-    def relay(data: bytes) -> None:
-        payload[4:12] = data[4:12]
-        publisher.publish(bytes(payload))
 
-    # The node's input depth (ros.topic_input.INPUT_DEPTH): behind by a burst, neither loses one.
-    node.create_subscription(JointState, INPUT, relay, _qos(1000), raw=True)
-    signal.signal(signal.SIGTERM, lambda *_: rclpy.try_shutdown())
-    try:
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
+def floor(namespace: str, robot: str) -> None:
+    """Publish one pre-serialized joint_states of the node's size per input, its stamp patched."""
+    from sensor_msgs.msg import JointState
+
+    from mech_kinematics.robot import load_robot
+
+    names = [*load_robot(*_paths(robot)).joint_names, OTHER]
+    payload = _template(names).render(0, 0, [0.1] * (2 * len(names)))
+    relay_floor(namespace, [(JointState, 'joint_states')], [payload])
 
 
 def drive(namespace: str, robot: str, rate: float, seconds: float, out: str) -> None:
     """Publish the motors at ``rate`` for ``seconds``; note send and arrival times; write them."""
-    import rclpy
-    from rclpy.executors import SingleThreadedExecutor
     from sensor_msgs.msg import JointState
 
     from mech_kinematics.robot import load_robot
-    from mech_kinematics.ros.cdr import marker, MessageTemplate, STAMP_MARKER, stamp_from_cdr
-    from mech_kinematics.ros.schedule import period_ns_from_rate, TickGrid
 
     model = load_robot(*_paths(robot))
-    names = [*model.actuated, OTHER]
-    n = len(names)
-    msg = JointState(name=names, position=[marker(i) for i in range(n)],
-                     velocity=[marker(n + i) for i in range(n)])
-    msg.header.stamp.sec, msg.header.stamp.nanosec = STAMP_MARKER
-    template = MessageTemplate(msg, 2 * n)
+    template = _template([*model.actuated, OTHER])
     starts = [model.start(name) for name in model.actuated]
-    rclpy.init()
-    node = rclpy.create_node('urdf_bench_driver', namespace=namespace)
-    publisher = node.create_publisher(JointState, INPUT, _qos(100))
-    arrivals: list[tuple[int, int]] = []
-    node.create_subscription(
-        JointState, 'joint_states',
-        lambda data: arrivals.append((stamp_from_cdr(data), time.monotonic_ns())), _qos(),
-        raw=True)
-    executor = SingleThreadedExecutor()
-    executor.add_node(node)
-    spinner = threading.Thread(target=executor.spin, daemon=True)
-    spinner.start()
-    deadline = time.monotonic() + 30.0
-    while publisher.get_subscription_count() == 0 and time.monotonic() < deadline:
-        time.sleep(0.05)
-    time.sleep(1.0)     # the relay's subscription has matched this publisher too
-    Path(f'{out}.started').touch()     # the relay's CPU is measured from now on
-    sent: list[tuple[int, int]] = []
-    period = period_ns_from_rate(rate)
-    grid = TickGrid.aligned(time.time_ns(), period)
-    end = time.monotonic() + seconds
-    sys.setswitchinterval(0.0005)
-    while time.monotonic() < end:
-        now = time.time_ns()
-        if now < grid.next_ns:
-            time.sleep(min(grid.next_ns - now, 50_000_000) / NS)
-            continue
-        for t in grid.take(now, NS // 10, catch_up=False).instants:
-            phase = 2.0 * (t % (10 * NS)) / NS
-            positions = [s + 0.3 * math.sin(phase) for s in starts]
-            speeds = [0.6 * math.cos(phase) for _ in starts]
-            data = template.render(*divmod(t, NS), (*positions, 0.25, *speeds, -1.5))
-            sent.append((t, time.monotonic_ns()))
-            publisher.publish(data)
-    time.sleep(1.0)     # the last answers arrive
-    executor.shutdown(timeout_sec=1.0)
-    node.destroy_node()
-    rclpy.try_shutdown()
-    Path(out).write_text(json.dumps({'sent': sent, 'arrivals': arrivals}))
+
+    def render(t: int) -> bytes:
+        phase = 2.0 * (t % (10 * NS)) / NS
+        positions = [s + 0.3 * math.sin(phase) for s in starts]
+        speeds = [0.6 * math.cos(phase) for _ in starts]
+        return template.render(*divmod(t, NS), (*positions, 0.25, *speeds, -1.5))
+
+    ros_runs.drive(namespace, 'urdf_bench_driver', rate, seconds, out, render,
+                   [(JointState, 'joint_states')])
 
 
 def measure(kind: str, args: argparse.Namespace, env: dict[str, str],
@@ -175,34 +119,21 @@ def measure(kind: str, args: argparse.Namespace, env: dict[str, str],
                    f'loop_closures:={closures}', '-p', 'drive:=topic', '--log-level', 'warn']
     else:
         command = [sys.executable, __file__, '--floor', namespace, args.robot]
-    relay = subprocess.Popen(command, env=env)
-    time.sleep(2.0)     # the relay is up before the driver starts sending
     total = args.warmup + args.seconds
-    driver = subprocess.Popen([sys.executable, __file__, '--drive', namespace, args.robot,
-                               str(args.rate), str(total), str(out)], env=env)
-    try:
-        started = Path(f'{out}.started')
-        while not started.exists() and driver.poll() is None:
-            time.sleep(0.05)
-        time.sleep(args.warmup)
-        cpu0, wall0 = _cpu_seconds(relay.pid), time.monotonic()
-        time.sleep(args.seconds - 0.5)
-        cpu1, wall1 = _cpu_seconds(relay.pid), time.monotonic()
-        driver.wait(timeout=total + 60)
-    finally:
-        relay.send_signal(signal.SIGINT)
-        relay.wait(timeout=10)
+    driver = [sys.executable, __file__, '--drive', namespace, args.robot, str(args.rate),
+              str(total), str(out)]
+    cpu, wall0, wall1 = relay_run(command, driver, out, args.warmup, args.seconds, env)
     data = json.loads(out.read_text())
     sent = data['sent']
     measured = sent[int(len(sent) * args.warmup / total):]
-    arrived = dict(data['arrivals'])
+    arrived = dict(data['arrivals']['joint_states'])
     latencies = [(arrived[t] - at) / 1e3 for t, at in measured if t in arrived]
     # The inputs sent while the CPU was measured (one monotonic clock for all processes).
     within = sum(1 for _, at in sent if wall0 * NS <= at <= wall1 * NS)
-    return {'kind': kind, 'cpu_pct': 100 * (cpu1 - cpu0) / (wall1 - wall0),
-            'cpu_us_per_input': 1e6 * (cpu1 - cpu0) / max(within, 1),
+    return {'kind': kind, 'cpu_pct': 100 * cpu / (wall1 - wall0),
+            'cpu_us_per_input': 1e6 * cpu / max(within, 1),
             'latency_median_us': statistics.median(latencies) if latencies else math.nan,
-            'latency_p99_us': _quantile(latencies, 0.99) if latencies else math.nan,
+            'latency_p99_us': quantile(latencies, 0.99) if latencies else math.nan,
             'answered': len(latencies) / len(measured), 'inputs': len(measured)}
 
 
@@ -225,11 +156,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.floor:
         floor(*args.floor)
         return 0
-    env = dict(os.environ)
-    env.setdefault('ROS_DOMAIN_ID', str(random.SystemRandom().randint(101, 200)))
-    env['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-    repo = str(Path(__file__).resolve().parents[1])
-    env['PYTHONPATH'] = os.pathsep.join(filter(None, [repo, env.get('PYTHONPATH')]))
+    env = ros_env()
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for _ in range(args.repeat):

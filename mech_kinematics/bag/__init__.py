@@ -8,7 +8,8 @@
   flushed a chunk or a transaction at a time, and recovered after a crash;
 - :mod:`.writer`: :class:`BagWriter` and :func:`reindex`;
 - :mod:`.queued`: :class:`QueuedWriter`, a writer written by a thread of its
-  own, so that receiving never waits on the disk.
+  own, so that receiving never waits on the disk (its queue bounded:
+  what overflows it is dropped and counted).
 
 The files are those rosbag2 and rosbags write (MCAP ``ros2`` profile, sqlite3
 schema version 4): rosbags, ``ros2 bag`` and Foxglove read them. Only the
@@ -17,10 +18,10 @@ type-hash helpers, inside the functions that use it.
 """
 
 from .metadata import BAG_VERSIONS, BagError, BagInfo, Topic
-from .queued import QueuedWriter
+from .queued import MAX_QUEUE_BYTES, QueuedWriter
 from .writer import (BagWriter, check_new_bag, check_options, DEFAULT_VERSION, FLUSH_INTERVAL_S,
                      reindex, STORAGES)
 
 __all__ = ['BAG_VERSIONS', 'BagError', 'BagInfo', 'BagWriter', 'DEFAULT_VERSION',
-           'FLUSH_INTERVAL_S', 'QueuedWriter', 'STORAGES', 'Topic', 'check_new_bag',
-           'check_options', 'reindex']
+           'FLUSH_INTERVAL_S', 'MAX_QUEUE_BYTES', 'QueuedWriter', 'STORAGES', 'Topic',
+           'check_new_bag', 'check_options', 'reindex']

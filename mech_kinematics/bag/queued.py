@@ -15,8 +15,15 @@ id is given at once, its record written in order before its messages); a
 thread of its own writes the queue to the :class:`BagWriter` and flushes it
 when due, so the writer is used by one thread. :meth:`QueuedWriter.close`
 writes everything queued before it closes the bag: what was received is
-written, however slow the disk. The queue has no bound: a disk stalled for
-a minute holds a minute of messages in memory.
+written, however slow the disk.
+
+The queue is bounded: while the messages waiting in it hold ``max_bytes``
+(their serialized bytes; :data:`MAX_QUEUE_BYTES` by default, 100 MiB as
+``ros2 bag record``'s ``--max-cache-size``), a message that would pass the
+bound is dropped and counted per topic in :attr:`QueuedWriter.dropped`, as
+rosbag2's cache drops and counts what overflows it. A disk stalled for a
+minute can no longer fill the memory with a minute of messages; the bag
+keeps what came before the stall and what came once the disk caught up.
 """
 
 from __future__ import annotations
@@ -28,10 +35,13 @@ from typing import Any
 from .metadata import BagError, BagInfo, Topic
 from .writer import BagWriter
 
-__all__ = ['QueuedWriter', 'WRITE_POLL_S']
+__all__ = ['MAX_QUEUE_BYTES', 'QueuedWriter', 'WRITE_POLL_S']
 
 #: Longest wait of a received message before the writing thread takes it, s.
 WRITE_POLL_S = 0.02
+#: Default bound of the messages waiting for the writing thread, bytes (rosbag2's default
+#: ``max_cache_size``): over a minute of everything the node publishes at 1 kHz.
+MAX_QUEUE_BYTES = 100 * 1024 * 1024
 
 
 class QueuedWriter:
@@ -41,11 +51,29 @@ class QueuedWriter:
     ----------
     writer : BagWriter
         Open. From now on used only through this object.
+    max_bytes : int
+        Most bytes of messages waiting to be written; a message that would
+        pass it is dropped (:attr:`dropped`).
+
+    Attributes
+    ----------
+    dropped : dict of str to int
+        Messages dropped because the queue was full, by topic name (only
+        topics that lost one). Written by the thread that calls :meth:`write`.
     """
 
-    def __init__(self, writer: BagWriter) -> None:
+    def __init__(self, writer: BagWriter, max_bytes: int = MAX_QUEUE_BYTES) -> None:
+        if isinstance(max_bytes, bool) or not (isinstance(max_bytes, int) and max_bytes > 0):
+            msg = f'Expected a positive number of bytes for the queue, got {max_bytes!r}'
+            raise BagError(msg)
         self.writer = writer
+        self.max_bytes = max_bytes
+        self.dropped: dict[str, int] = {}
         self._queue: deque[tuple[Any, ...]] = deque()
+        # Bytes queued and bytes taken, each counted by one thread only: their difference is
+        # what waits, without a lock.
+        self._queued_bytes = 0
+        self._taken_bytes = 0
         self._closing = threading.Event()
         self._thread = threading.Thread(target=self._run, name='bag writer', daemon=True)
         self._thread.start()
@@ -61,10 +89,27 @@ class QueuedWriter:
         self._queue.append((topic,))
         return topic
 
-    def write(self, topic: Topic, timestamp: int, data: bytes) -> None:
-        """Queue one message; raise :class:`BagError` if writing has failed."""
+    @property
+    def dropped_total(self) -> int:
+        """Return the messages dropped so far because the queue was full."""
+        return sum(self.dropped.values())
+
+    def write(self, topic: Topic, timestamp: int, data: bytes) -> bool:
+        """Queue one message; return False if it was dropped (the queue full).
+
+        Raises
+        ------
+        BagError
+            If writing has failed.
+        """
         self.flush_if_due()
+        size = len(data)
+        if self._queued_bytes - self._taken_bytes + size > self.max_bytes:
+            self.dropped[topic.name] = self.dropped.get(topic.name, 0) + 1
+            return False
+        self._queued_bytes += size
         self._queue.append((topic, timestamp, data))
+        return True
 
     def flush_if_due(self) -> None:
         """Raise :class:`BagError` if writing has failed (the thread flushes when due)."""
@@ -97,6 +142,7 @@ class QueuedWriter:
                 if len(item) == 1:
                     writer.add(item[0])
                 else:
+                    self._taken_bytes += len(item[2])
                     writer.write(*item)
         except BagError:
             pass            # kept in writer.failure

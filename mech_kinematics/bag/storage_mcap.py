@@ -257,6 +257,8 @@ class McapStorage:
         self.path = path
         self._file: BinaryIO = open(path, 'xb')   # noqa: SIM115 - closed by close()/abort()
         self._offset = 0
+        #: ``_offset`` at the last sync.
+        self._synced = -1
         self.schemas: dict[int, Schema] = {}
         self.channels: dict[int, Channel] = {}
         self._schema_ids: dict[str, int] = {}
@@ -318,10 +320,15 @@ class McapStorage:
         chunk += data
 
     def flush(self) -> None:
-        """Write the pending chunk and its message indexes; flush and sync the file."""
+        """Write the pending chunk and its message indexes; flush and sync the file.
+
+        Nothing is synced when nothing was written since the last sync (an idle topic's
+        flushes cost no disk time).
+        """
         if self._chunk:
             self._write_chunk()
-        self._sync()
+        if self._offset != self._synced:
+            self._sync()
 
     def close(self, version: int, metadata: str) -> None:
         """Flush, write the metadata record, the summary and the footer; close the file.
@@ -348,6 +355,7 @@ class McapStorage:
     def _sync(self) -> None:
         self._file.flush()
         os.fsync(self._file.fileno())
+        self._synced = self._offset
 
     def _write_chunk(self) -> None:
         records, entries = self._chunk, self._entries

@@ -28,6 +28,11 @@ rebuilds ``metadata.yaml`` after ``kill -9``. A write error (a full disk) stops
 the recording: the bag is closed with what it holds, its metadata counting
 exactly that, and the command prints one ``error:`` line and exits with 1.
 
+A slow disk delays the bag (its writing thread, :class:`~mech_kinematics.bag.QueuedWriter`)
+while messages wait in memory, up to ``--max-queue-bytes``; beyond it, a message is
+dropped and counted (a log line while recording says how many, a ``warning:`` line at
+the end names them per topic, and the command exits with 3).
+
 While no topic has a publisher, a log line says which topics it waits for
 (every :data:`WAIT_REPORT_INTERVAL_S`); while recording, a line every
 ``--progress`` seconds gives the messages per topic and per second.
@@ -53,7 +58,7 @@ import threading
 import time
 from typing import Any
 
-from .cli import positive_seconds, run_tool, seconds_or_zero
+from .cli import positive_int, positive_seconds, run_tool, seconds_or_zero
 from .. import bag
 from ..errors import MechKinematicsError
 from ..ros import topics
@@ -62,7 +67,7 @@ from ..units import NS_PER_S
 __all__ = [
     'BAG_VERSIONS', 'BagRecorder', 'DEFAULT_BAG_VERSION', 'DEFAULT_EXECUTOR',
     'DEFAULT_NAMESPACES', 'DEFAULT_PROGRESS_S', 'DEFAULT_STORAGE', 'DEFAULT_TOPICS',
-    'EXECUTORS', 'RecorderError',
+    'EXECUTORS', 'MAX_QUEUE_BYTES', 'RecorderError',
     'STORAGES', 'TopicStats', 'WAIT_REPORT_INTERVAL_S', 'add_parser', 'main',
     'message_definition', 'record', '_handle',
 ]
@@ -83,6 +88,10 @@ STORAGES = tuple(bag.STORAGES)
 DEFAULT_STORAGE = 'mcap'
 BAG_VERSIONS = bag.BAG_VERSIONS
 DEFAULT_BAG_VERSION = bag.DEFAULT_VERSION
+#: Most bytes of received messages waiting for the disk (``--max-queue-bytes``).
+MAX_QUEUE_BYTES = bag.MAX_QUEUE_BYTES
+#: Exit status of a recording that ended normally but dropped messages (the queue full).
+DROPPED_STATUS = 3
 NODE_NAME = 'mech_kinematics_recorder'
 #: How often the graph is searched for topics not subscribed yet, and pending messages
 #: are checked for a flush, s (rosbag2 searches every 100 ms).
@@ -297,6 +306,8 @@ class TopicStats:
     type: str = ''
     received: int = 0
     written: int = 0
+    #: Received but dropped, the queue for the disk full (``max_queue_bytes``).
+    dropped: int = 0
     error: str = ''
 
 
@@ -331,6 +342,9 @@ class BagRecorder:
         which is also used where this rclpy has no ``EventsExecutor``.
     progress : float
         Seconds between progress lines while recording; 0 for none.
+    max_queue_bytes : int
+        Most bytes of received messages waiting for the disk; a message that
+        would pass it is dropped and counted (:attr:`TopicStats.dropped`).
     namespaces : sequence of str, optional
         Namespaces whose every topic is recorded too, as it appears (relative
         names resolved like ``topics``). Default: :data:`DEFAULT_NAMESPACES`
@@ -353,7 +367,7 @@ class BagRecorder:
     def __init__(self, output: str | os.PathLike[str], topics: Sequence[str] = DEFAULT_TOPICS,
                  *, storage: str = DEFAULT_STORAGE, version: int = DEFAULT_BAG_VERSION,
                  args: list[str] | None = None, executor: str = DEFAULT_EXECUTOR,
-                 progress: float = DEFAULT_PROGRESS_S,
+                 progress: float = DEFAULT_PROGRESS_S, max_queue_bytes: int = MAX_QUEUE_BYTES,
                  namespaces: Sequence[str] | None = None) -> None:
         self.output = Path(output)
         try:
@@ -370,6 +384,12 @@ class BagRecorder:
         if not (math.isfinite(progress) and progress >= 0):
             msg = f'Expected a progress interval of 0 s or more, got {progress!r}'
             raise RecorderError(msg)
+        if isinstance(max_queue_bytes, bool) or not (
+                isinstance(max_queue_bytes, int) and max_queue_bytes > 0):
+            msg = (f'Expected a positive number of bytes for max_queue_bytes, got '
+                   f'{max_queue_bytes!r}')
+            raise RecorderError(msg)
+        self.max_queue_bytes = max_queue_bytes
         self.storage = storage
         self.version = version
         self.executor = executor
@@ -396,6 +416,9 @@ class BagRecorder:
         self._next_wait_report = 0.0
         self._next_progress = math.inf
         self._last_progress = 0.0
+        #: Messages dropped (the queue full) at the last report of drops, and when it was.
+        self._dropped_reported = 0
+        self._next_drop_report = 0.0
 
     # -- life cycle ---------------------------------------------------------------
 
@@ -431,7 +454,7 @@ class BagRecorder:
                 raise RecorderError(str(error)) from None
             # Written by a thread of its own: a flush's fsync, seconds on a loaded disk, never
             # holds up the executor while the middleware's queues fill and drop messages.
-            self._writer = QueuedWriter(writer)
+            self._writer = QueuedWriter(writer, self.max_queue_bytes)
             self._node.create_timer(POLL_INTERVAL_S, self._housekeeping)
         except BaseException:
             if self._writer is not None:
@@ -493,6 +516,8 @@ class BagRecorder:
                         topic.subscription = None
             if self._writer is not None:
                 writer, self._writer = self._writer, None
+                for topic in self._topics.values():
+                    topic.stats.dropped = writer.dropped.get(topic.stats.name, 0)
                 try:
                     self.bag = writer.close()
                 except BagError as error:
@@ -543,6 +568,8 @@ class BagRecorder:
             return
         self._discover()
         now = time.monotonic()
+        if now >= self._next_drop_report:
+            self._report_drops(now)
         if self.recording_since is None:
             if now >= self._next_wait_report:
                 self._report_waiting(now)
@@ -563,6 +590,18 @@ class BagRecorder:
             self._node.get_logger().info(
                 f'waiting for publishers on {", ".join(pending)} (is the node running, in this '
                 f'ROS_DOMAIN_ID and namespace?)')
+
+    def _report_drops(self, now: float) -> None:
+        """Warn, at most every WAIT_REPORT_INTERVAL_S, while messages are being dropped."""
+        dropped = self._writer.dropped
+        total = sum(dropped.values())
+        if total == self._dropped_reported:
+            return
+        self._dropped_reported = total
+        self._next_drop_report = now + WAIT_REPORT_INTERVAL_S
+        self._node.get_logger().warning(
+            f'the disk is behind by more than --max-queue-bytes ({self.max_queue_bytes} bytes '
+            f'of messages): {total} messages dropped so far: {_per_topic(dropped)}')
 
     def _report_progress(self, now: float) -> None:
         """Log the messages received so far, per topic and per second, in one line."""
@@ -672,13 +711,18 @@ class BagRecorder:
         return on_message
 
 
+def _per_topic(counts: dict[str, int]) -> str:
+    return ', '.join(f'{name} {n}' for name, n in counts.items() if n)
+
+
 # -- command line ----------------------------------------------------------------
 
 
 def record(output: str | os.PathLike[str], topics: Sequence[str] = DEFAULT_TOPICS, *,
            duration: float | None = None, storage: str = DEFAULT_STORAGE,
            version: int = DEFAULT_BAG_VERSION, args: list[str] | None = None,
-           executor: str = DEFAULT_EXECUTOR, progress: float = DEFAULT_PROGRESS_S) -> BagRecorder:
+           executor: str = DEFAULT_EXECUTOR, progress: float = DEFAULT_PROGRESS_S,
+           max_queue_bytes: int = MAX_QUEUE_BYTES) -> BagRecorder:
     """Record ``topics`` to the new bag ``output`` until Ctrl-C, SIGTERM or ``duration`` s.
 
     ``duration`` counts from the first subscription (see :meth:`BagRecorder.run`).
@@ -697,7 +741,8 @@ def record(output: str | os.PathLike[str], topics: Sequence[str] = DEFAULT_TOPIC
         msg = f'Expected a positive duration in seconds, got {duration!r}'
         raise RecorderError(msg)
     recorder = BagRecorder(output, topics, storage=storage, version=version, args=args,
-                           executor=executor, progress=progress)
+                           executor=executor, progress=progress,
+                           max_queue_bytes=max_queue_bytes)
     previous: dict[signal.Signals, Any] = {}
     if threading.current_thread() is threading.main_thread():
         for sig in (signal.SIGINT, signal.SIGTERM):
@@ -738,22 +783,30 @@ def _handle(args: argparse.Namespace) -> int:
 
     0 after a normal stop, 1 after a write error (the bag holds what was
     written before it; one ``error:`` line says what happened), 2 if the
-    recording could not start.
+    recording could not start, 3 after a normal stop that dropped messages
+    because the disk fell ``--max-queue-bytes`` behind (one ``warning:``
+    line names them per topic; the bag is whole and holds the rest).
     """
     output = Path(args.output)
     rclpy_args = ['record', '--ros-args', *args.ros_args] if args.ros_args else ['record']
     try:
         recorder = record(output, args.topics, duration=args.duration, storage=args.storage,
                           version=args.bag_version, args=rclpy_args, executor=args.executor,
-                          progress=args.progress)
+                          progress=args.progress, max_queue_bytes=args.max_queue_bytes)
     except RecorderError as error:
         print(f'error: {error}', file=sys.stderr)
         return 2
     _print_summary(recorder)
+    dropped = {s.name: s.dropped for s in recorder.stats}
+    if any(dropped.values()):
+        received = sum(s.received for s in recorder.stats)
+        print(f'warning: dropped {sum(dropped.values())} of the {received} messages received, '
+              f'the disk behind by more than --max-queue-bytes ({recorder.max_queue_bytes} '
+              f'bytes): {_per_topic(dropped)}', file=sys.stderr)
     if recorder.error:
         print(f'error: {recorder.error}', file=sys.stderr)
         return 1
-    return 0
+    return DROPPED_STATUS if any(dropped.values()) else 0
 
 
 RECORD_HELP = """\
@@ -778,6 +831,12 @@ killed, `python -m mech_kinematics reindex DIR` makes the bag readable again
 with everything but the last half second. A write error (a full disk) ends
 the recording with one `error:` line and exit status 1; the bag is closed
 with what was written and its metadata counts exactly that.
+
+A slow disk delays the bag, not the recording: received messages wait in
+memory for the disk, up to --max-queue-bytes. A message that would pass it
+is dropped and counted: a log line says so while recording, one `warning:`
+line at the end names the dropped messages per topic, and the exit status
+is 3 (the bag is whole and holds every other message).
 """
 
 
@@ -810,6 +869,11 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         metavar='S', help='log the messages per topic and per second every S '
                                           'seconds while recording; 0: never '
                                           '(default: %(default)s)')
+    parser.add_argument('--max-queue-bytes', type=positive_int, default=MAX_QUEUE_BYTES,
+                        metavar='N', help='most bytes of received messages waiting for a slow '
+                                          'disk; beyond, messages are dropped, counted and '
+                                          'the exit status is 3 (default: %(default)s, 100 MiB '
+                                          "as ros2 bag record's --max-cache-size)")
     parser.add_argument('--executor', choices=EXECUTORS, default=DEFAULT_EXECUTOR,
                         help='rclpy executor: events (EventsExecutor, the lighter) or single '
                              '(SingleThreadedExecutor, used anyway where rclpy has no '

@@ -21,13 +21,15 @@ import signal
 import struct
 import subprocess
 import sys
+import threading
 
 from hypothesis import given, settings, strategies as st
 import numpy as np
 import pytest
 import yaml
 
-from mech_kinematics.bag import BagError, BagWriter, reindex, storage_mcap, storage_sqlite3
+from mech_kinematics.bag import (BagError, BagWriter, QueuedWriter, reindex, storage_mcap,
+                                 storage_sqlite3)
 from mech_kinematics.bag.metadata import type_hash_from_definition
 from mech_kinematics.bag.writer import RESERVE_FILE
 from mech_kinematics.tools import record
@@ -234,6 +236,69 @@ def test_flushes_happen_by_time_and_by_size(tmp_path, storage):
     flushed = reindex(snapshot(writer, tmp_path / 'b')).count('/js')
     assert 25 - 10 < flushed < 25      # never 10 messages' bytes pending, never none
     assert_prefix(tmp_path / 'b', flushed)
+    writer.close()
+
+
+def test_an_mcap_flush_with_nothing_new_syncs_nothing(tmp_path, monkeypatch):
+    """A flush syncs the file only when something was written since the last sync."""
+    syncs = []
+    fsync = os.fsync
+    monkeypatch.setattr(storage_mcap.os, 'fsync', lambda fd: (syncs.append(fd), fsync(fd)))
+    writer, topic = open_writer(tmp_path / 'bag', 'mcap', flush_interval=3600.0)
+    opened = len(syncs)             # the header's, the reserve file's
+    writer.flush()                  # the topics' records, written but not synced yet
+    assert len(syncs) == opened + 1
+    writer.flush()
+    writer.flush()
+    assert len(syncs) == opened + 1     # before: one sync a flush
+    write(writer, topic, range(5))
+    writer.flush()
+    assert len(syncs) == opened + 2
+    writer.close()
+    assert_prefix(tmp_path / 'bag', 5)
+
+
+@pytest.mark.parametrize('storage', STORAGES)
+def test_a_full_queue_drops_what_overflows_and_counts_it(tmp_path, storage):
+    """QueuedWriter: while the disk holds its thread, 10 messages' bytes wait, the rest drop.
+
+    The thread takes message 0 and flushes it (flush_bytes=1); the flush is
+    held. Of the 100 messages written meanwhile the first 10 fit the bound
+    and wait; 90 are dropped and counted. Once the disk answers, the bag
+    holds messages 0 to 10 and nothing else.
+    """
+    writer, topic = open_writer(tmp_path / 'bag', storage, flush_interval=3600.0, flush_bytes=1)
+    entered, release = threading.Event(), threading.Event()
+    held = writer._storage
+    flush = held.flush
+
+    def slow_flush() -> None:
+        entered.set()
+        release.wait(60)
+        flush()
+
+    held.flush = slow_flush
+    size = len(payload(0))
+    queued = QueuedWriter(writer, max_bytes=10 * size)
+    try:
+        assert queued.write(topic, T0, payload(0))
+        assert entered.wait(60)
+        kept = [queued.write(topic, T0 + i * DT, payload(i)) for i in range(1, 101)]
+    finally:
+        release.set()
+    assert kept == [True] * 10 + [False] * 90
+    assert queued.dropped == {'/js': 90}
+    assert queued.dropped_total == 90
+    info = queued.close()
+    assert info.count('/js') == 11
+    assert_prefix(tmp_path / 'bag', 11)
+
+
+@pytest.mark.parametrize('bound', [0, -1, 1.5, True])
+def test_a_queue_bound_must_be_a_positive_whole_number_of_bytes(tmp_path, bound):
+    writer, _ = open_writer(tmp_path / 'bag', 'mcap')
+    with pytest.raises(BagError, match=r'^Expected a positive number of bytes for the queue'):
+        QueuedWriter(writer, max_bytes=bound)
     writer.close()
 
 

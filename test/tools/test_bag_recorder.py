@@ -632,6 +632,8 @@ CRASH_RECORD_S = 4.0
 RECOVERY_S = 1.0
 #: Storage file size limit of the recorders that meet a write error, bytes.
 FILE_LIMIT = 1_500_000
+#: The small_queue recorder's --max-queue-bytes.
+SMALL_QUEUE_BYTES = 20_000
 #: A namespace of its own for the recorder that waits: nothing publishes there.
 IDLE_NS = f'/idle_{os.getpid()}_{random.SystemRandom().randrange(16 ** 6):06x}'
 CRASH_RECORDERS = {
@@ -644,7 +646,12 @@ CRASH_RECORDERS = {
     'idle': ['--ros-args', '-r', f'__ns:={IDLE_NS}', '-r', f'/tf:={IDLE_NS}/tf',
              '-r', f'/tf_static:={IDLE_NS}/tf_static'],
     'slow_disk': ['--storage', 'mcap'],
+    # As slow, with room for 20 kB of messages: a stalled sync overflows it (1 kHz states).
+    'small_queue': ['--storage', 'mcap', '--topics', 'joint_states', '--max-queue-bytes',
+                    str(SMALL_QUEUE_BYTES)],
 }
+#: The recorders whose every fsync is SLOW_FSYNC_S slower.
+SLOW_DISKS = ('slow_disk', 'small_queue')
 #: The slow_disk recorder's every fsync takes this long more, s: a loaded disk (one stalled
 #: 2 to 3 s beside two CPU hogs and four recorders, and two bags lost 0.3 s of states).
 SLOW_FSYNC_S = 1.5
@@ -693,7 +700,7 @@ def crashes(tmp_path_factory):
     try:
         for name, extra in CRASH_RECORDERS.items():
             popen = {'preexec_fn': _limit_file_size} if name.startswith('full') else {}
-            how = ('-c', SLOW_DISK) if name == 'slow_disk' else ('-m', 'mech_kinematics')
+            how = ('-c', SLOW_DISK) if name in SLOW_DISKS else ('-m', 'mech_kinematics')
             recorders[name] = Process(name, tmp, *how, 'record', '-o', str(tmp / name),
                                       *extra, **popen)
         for recorder in recorders.values():
@@ -705,6 +712,7 @@ def crashes(tmp_path_factory):
                 statuses[name] = recorders[name].stop(timeout=STARTUP_S + 10)
             for name in ('kill_mcap', 'kill_sqlite3'):
                 recorders[name].wait_for_output('subscribed to /diagnostics', STARTUP_S)
+            recorders['small_queue'].wait_for_output('subscribed to /joint_states', STARTUP_S)
             time.sleep(CRASH_RECORD_S)
             kill_ns = time.time_ns()
             for name in ('kill_mcap', 'kill_sqlite3'):
@@ -712,9 +720,11 @@ def crashes(tmp_path_factory):
             for name in ('kill_mcap', 'kill_sqlite3'):
                 statuses[name] = recorders[name].proc.wait(timeout=10)
             time.sleep(0.2)     # the witness gets what was on the way at the kill
-            recorders['slow_disk'].proc.send_signal(signal.SIGINT)
+            for name in SLOW_DISKS:
+                recorders[name].proc.send_signal(signal.SIGINT)
             statuses['witness'] = recorders['witness'].stop(signal.SIGINT)
-            statuses['slow_disk'] = recorders['slow_disk'].stop(timeout=30 * SLOW_FSYNC_S)
+            for name in SLOW_DISKS:
+                statuses[name] = recorders[name].stop(timeout=30 * SLOW_FSYNC_S)
             deadline = time.monotonic() + 10
             while recorders['idle'].output().count('waiting for publishers') < 2:
                 assert time.monotonic() < deadline, recorders['idle'].output()
@@ -759,6 +769,36 @@ def test_a_slow_disk_delays_the_bag_and_loses_nothing(crashes):
         both = [x for x in a if low <= x <= high]
         assert both == [x for x in b if low <= x <= high], topic
         assert len(both) == len(set(both))
+
+
+def test_a_disk_too_slow_for_the_queue_drops_counts_and_says_so(crashes):
+    """20 kB of room for a disk 1.5 s slower: what overflows is dropped, counted and said.
+
+    Exit status 3; a warning while recording and one ``warning:`` line at
+    the end, whose count is exactly what was received and not written; the
+    bag is whole and holds the rest, the states the witness recorded.
+    """
+    output = crashes.outputs['small_queue']
+    assert crashes.statuses['small_queue'] == 3, output
+    assert re.search(r'\[WARN\] .*: the disk is behind by more than --max-queue-bytes '
+                     r'\(20000 bytes of messages\): \d+ messages dropped so far: '
+                     r'/joint_states \d+$', output, re.MULTILINE), output
+    warning = re.findall(r'^warning: .*$', output, re.MULTILINE)
+    assert len(warning) == 1, output
+    match = re.fullmatch(r'warning: dropped (\d+) of the (\d+) messages received, the disk '
+                         r'behind by more than --max-queue-bytes \(20000 bytes\): '
+                         r'/joint_states (\d+)', warning[0])
+    assert match, warning
+    dropped = int(match[3])
+    assert int(match[1]) == dropped > 0
+    summary = {m[1]: (int(m[3]), int(m[4])) for m in SUMMARY_LINE.finditer(output)}
+    received, written = summary['/joint_states']
+    assert int(match[2]) == received == written + dropped
+    assert readable_counts(crashes.path('small_queue')) == {'/joint_states': written}
+    kept = [stamp_ns(m) for _, m in decoded(crashes.path('small_queue'))['/joint_states']]
+    assert kept == sorted(set(kept))
+    witness = sorted(stamp_ns(m) for _, m in decoded(crashes.path('witness'))['/joint_states'])
+    assert {s for s in kept if witness[0] <= s <= witness[-1]} <= set(witness)
 
 
 @pytest.mark.parametrize('storage', ['mcap', 'sqlite3'])

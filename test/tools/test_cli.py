@@ -94,6 +94,10 @@ def test_number_types_refuse_with_one_reason(parse, text, message):
      ["--duration: expected a positive number of seconds, got '0'"]),
     (['record', '-o', 'x', '--progress', '-1'],
      ["--progress: expected a number of seconds >= 0, got '-1'"]),
+    (['record', '-o', 'x', '--max-queue-bytes', '0'],
+     ["--max-queue-bytes: expected a positive integer, got '0'"]),
+    (['record', '-o', 'x', '--max-queue-bytes', '1e6'],
+     ["--max-queue-bytes: expected a positive integer, got '1e6'"]),
 ])
 def test_solve_and_record_use_the_shared_number_types(argv, words):
     """The number options of solve and record refuse with the shared types' reasons."""
