@@ -21,6 +21,7 @@ Every script imports this module from its own folder (``sys.path[0]``).
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+import json
 import os
 from pathlib import Path
 import random
@@ -206,8 +207,6 @@ def drive(namespace: str, node_name: str, rate: float, seconds: float, out: str,
     time, on one monotonic clock. Writes ``{'sent': [(stamp, ns)],
     'arrivals': {topic: [(stamp, ns)]}}`` as JSON to ``out``.
     """
-    import json
-
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
     from sensor_msgs.msg import JointState

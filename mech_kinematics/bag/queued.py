@@ -40,7 +40,7 @@ __all__ = ['MAX_QUEUE_BYTES', 'QueuedWriter', 'WRITE_POLL_S']
 #: Longest wait of a received message before the writing thread takes it, s.
 WRITE_POLL_S = 0.02
 #: Default bound of the messages waiting for the writing thread, bytes (rosbag2's default
-#: ``max_cache_size``): over a minute of everything the node publishes at 1 kHz.
+#: ``max_cache_size``).
 MAX_QUEUE_BYTES = 100 * 1024 * 1024
 
 

@@ -100,6 +100,8 @@ POLL_INTERVAL_S = 0.1
 #: the first time FIRST_WAIT_REPORT_S after start.
 WAIT_REPORT_INTERVAL_S = 5.0
 FIRST_WAIT_REPORT_S = 1.0
+#: How often, at most, a warning says messages are being dropped (the queue for the disk full), s.
+DROP_REPORT_INTERVAL_S = 5.0
 #: Default interval of the progress lines (messages per topic and per second), s.
 DEFAULT_PROGRESS_S = 5.0
 #: Depth of each subscription's queue: 1 s of a 1 kHz topic.
@@ -592,13 +594,13 @@ class BagRecorder:
                 f'ROS_DOMAIN_ID and namespace?)')
 
     def _report_drops(self, now: float) -> None:
-        """Warn, at most every WAIT_REPORT_INTERVAL_S, while messages are being dropped."""
+        """Warn, at most every DROP_REPORT_INTERVAL_S, while messages are being dropped."""
         dropped = self._writer.dropped
         total = sum(dropped.values())
         if total == self._dropped_reported:
             return
         self._dropped_reported = total
-        self._next_drop_report = now + WAIT_REPORT_INTERVAL_S
+        self._next_drop_report = now + DROP_REPORT_INTERVAL_S
         self._node.get_logger().warning(
             f'the disk is behind by more than --max-queue-bytes ({self.max_queue_bytes} bytes '
             f'of messages): {total} messages dropped so far: {_per_topic(dropped)}')

@@ -434,8 +434,13 @@ def test_extra_joints_pass_puts_the_robots_other_joints_after_the_mechanisms(ros
         node.send(T0, ROBOT, [0.3, 0.2, 9.9, 0.05], [0.5, 2.0, 0.0, -0.1], [1.0, 2.0, 3.0, 4.0])
         node.send(T0 + 1, ROBOT[::-1], [0.06, 9.9, 0.25, 0.31])
         wait_for(lambda: len(node.js) >= 2 and len(node.jt) >= 2, ANSWER_S, 'two states')
-        seen = len(node.diag)
-        status = wait_for(lambda: node.solver_statuses(seen), ANSWER_S, 'diagnostics')[-1]
+        # The solver status of the first diagnostics whose last published stamp is the
+        # second message's: its window holds that tick (a later one says 'no ticks').
+        status = wait_for(lambda: [s for msg in node.diag
+                                   if any(values_of(t).get('last_published_stamp_ns')
+                                          == str(T0 + 1) for t in msg.status)
+                                   for s in msg.status if s.name.endswith(': solver')],
+                          ANSWER_S, 'diagnostics of the second state')[0]
     finally:
         node.stop()
     first, second = node.js
