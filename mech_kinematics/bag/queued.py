@@ -12,10 +12,13 @@ published (``test_a_slow_disk_delays_the_bag_and_loses_nothing``).
 :class:`QueuedWriter` takes the same calls. :meth:`QueuedWriter.add_topic`
 and :meth:`QueuedWriter.write` only append to a queue in memory (a topic's
 id is given at once, its record written in order before its messages); a
-thread of its own writes the queue to the :class:`BagWriter` and flushes it
-when due, so the writer is used by one thread. :meth:`QueuedWriter.close`
-writes everything queued before it closes the bag: what was received is
-written, however slow the disk.
+thread of its own writes the queue to the :class:`BagWriter` and flushes
+it, so the writer is used by one thread. It flushes an interval after the
+start of the last flush (at once if that flush took longer), each time after
+writing everything queued: a message reaches the file within an interval and
+two flushes, and a slow sync never makes each message a flush of its own.
+:meth:`QueuedWriter.close` writes everything queued before it closes the
+bag: what was received is written, however slow the disk.
 
 The queue is bounded: while the messages waiting in it hold ``max_bytes``
 (their serialized bytes; :data:`MAX_QUEUE_BYTES` by default, 100 MiB as
@@ -30,6 +33,7 @@ from __future__ import annotations
 
 from collections import deque
 import threading
+import time
 from typing import Any
 
 from .metadata import BagError, BagInfo, Topic
@@ -74,6 +78,8 @@ class QueuedWriter:
         # what waits, without a lock.
         self._queued_bytes = 0
         self._taken_bytes = 0
+        #: When the thread flushes next: an interval after the start of the last flush.
+        self._next_flush = time.monotonic() + writer.flush_interval
         self._closing = threading.Event()
         self._thread = threading.Thread(target=self._run, name='bag writer', daemon=True)
         self._thread.start()
@@ -125,11 +131,19 @@ class QueuedWriter:
         return self.writer.close()
 
     def _run(self) -> None:
+        writer = self.writer
         while not self._closing.wait(WRITE_POLL_S):
             self._drain()
-            if self.writer.failure is None:
+            if writer.failure is not None:
+                continue
+            now = time.monotonic()
+            if now >= self._next_flush or writer.pending_bytes >= writer.flush_bytes:
+                # Every interval from the start of a flush, each flush taking all that was
+                # queued: a message waits at most an interval and two flushes, however slow
+                # the disk, and a slow sync never makes each message a flush of its own.
+                self._next_flush = now + writer.flush_interval
                 try:
-                    self.writer.flush_if_due()
+                    writer.flush()
                 except BagError:
                     pass        # kept in writer.failure: the next write() raises it
 
@@ -143,7 +157,7 @@ class QueuedWriter:
                     writer.add(item[0])
                 else:
                     self._taken_bytes += len(item[2])
-                    writer.write(*item)
+                    writer.append(*item)
         except BagError:
             pass            # kept in writer.failure
         if writer.failure is not None:

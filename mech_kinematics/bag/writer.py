@@ -213,12 +213,20 @@ class BagWriter:
         BagError
             If writing has failed (now or before): see :attr:`failure`.
         """
+        self.append(topic, timestamp, data)
+        if self._storage.pending_bytes >= self.flush_bytes or time.monotonic() >= self._due:
+            self.flush()
+
+    def append(self, topic: Topic, timestamp: int, data: bytes) -> None:
+        """Add one message to what is pending, never flushing (the caller flushes)."""
         if self.failure is not None:
             raise BagError(self.failure)
-        storage = self._storage
-        storage.write(topic.id, timestamp, data)
-        if storage.pending_bytes >= self.flush_bytes or time.monotonic() >= self._due:
-            self.flush()
+        self._storage.write(topic.id, timestamp, data)
+
+    @property
+    def pending_bytes(self) -> int:
+        """Bytes of messages waiting for the next flush."""
+        return self._storage.pending_bytes
 
     def flush(self) -> None:
         """Write what is pending to the storage file and sync it."""

@@ -22,6 +22,7 @@ import struct
 import subprocess
 import sys
 import threading
+import types
 
 from hypothesis import given, settings, strategies as st
 import numpy as np
@@ -292,6 +293,50 @@ def test_a_full_queue_drops_what_overflows_and_counts_it(tmp_path, storage):
     info = queued.close()
     assert info.count('/js') == 11
     assert_prefix(tmp_path / 'bag', 11)
+
+
+def test_the_queued_writer_flushes_an_interval_after_each_flush_starts(tmp_path, monkeypatch):
+    """A flush slower than the interval is followed at once by the next, holding all queued.
+
+    On the thread's own clock, faked: the first flush starts at 100 s (the
+    interval) and is held while the clock reaches 300 s and a message
+    arrives; once it ends, the next flush takes that message with the clock
+    still at 300 s. Before, the interval counted from a flush's end (the
+    next at 400 s on the real clock, never in this test): beside two CPU
+    hogs an sqlite3 recorder went 1.03 s without a commit, and kill -9 lost
+    26 states received more than a second before it.
+    """
+    from mech_kinematics.bag import queued
+
+    clock = [0.0]
+    monkeypatch.setattr(queued, 'time', types.SimpleNamespace(monotonic=lambda: clock[0]))
+    writer, topic = open_writer(tmp_path / 'bag', 'sqlite3', flush_interval=100.0)
+    held = writer._storage
+    flush = held.flush
+    starts, entered, release = [], threading.Event(), threading.Event()
+
+    def slow_flush() -> None:
+        starts.append((clock[0], held.pending_bytes))
+        entered.set()
+        if len(starts) == 1:
+            release.wait(60)
+        flush()
+
+    held.flush = slow_flush
+    queued_writer = QueuedWriter(writer)
+    try:
+        assert queued_writer.write(topic, T0, payload(0))
+        clock[0] = 100.0
+        assert entered.wait(60)
+        clock[0] = 300.0
+        entered.clear()
+        assert queued_writer.write(topic, T0 + DT, payload(1))
+    finally:
+        release.set()
+    assert entered.wait(60)
+    assert starts == [(100.0, len(payload(0))), (300.0, len(payload(1)))]
+    queued_writer.close()
+    assert_prefix(tmp_path / 'bag', 2)
 
 
 @pytest.mark.parametrize('bound', [0, -1, 1.5, True])
