@@ -296,10 +296,11 @@ def test_a_stall_is_caught_up_to_the_bound_and_the_rest_counted(ros, tmp_path):
     assert stall_gap > 0.5 * NS - window - SIGNAL_SLACK_NS, results
     assert holes == stall_gap // period - 1 <= skipped, results
     # Skip mode: only the latest instant owed at the wake-up (woke - period < first <= woke):
-    # the stall leaves a hole of its whole length, counted too.
+    # the stall leaves a hole of its whole length, counted too (less, as above, the time
+    # SIGSTOP takes to stop the node: beside two CPU hogs a state came 3.4 ms after it).
     skipped, holes, stall_gap, _, after_resumed, _ = results['skip']
     assert after_resumed > -period, results
-    assert stall_gap > 0.5 * NS - 2 * period, results
+    assert stall_gap > 0.5 * NS - 2 * period - SIGNAL_SLACK_NS, results
     assert skipped >= stall_gap // period - 1, results
 
 
