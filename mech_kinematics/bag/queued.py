@@ -108,7 +108,7 @@ class QueuedWriter:
         BagError
             If writing has failed.
         """
-        self.flush_if_due()
+        self.check()
         size = len(data)
         if self._queued_bytes - self._taken_bytes + size > self.max_bytes:
             self.dropped[topic.name] = self.dropped.get(topic.name, 0) + 1
@@ -117,8 +117,8 @@ class QueuedWriter:
         self._queue.append((topic, timestamp, data))
         return True
 
-    def flush_if_due(self) -> None:
-        """Raise :class:`BagError` if writing has failed (the thread flushes when due)."""
+    def check(self) -> None:
+        """Raise :class:`BagError` if writing has failed (the thread writes and flushes)."""
         failure = self.writer.failure
         if failure is not None:
             raise BagError(failure)

@@ -239,11 +239,6 @@ class BagWriter:
         # not make every following write a flush of its own.
         self._due = time.monotonic() + self.flush_interval
 
-    def flush_if_due(self) -> None:
-        """:meth:`flush` if the oldest pending message has waited ``flush_interval`` s."""
-        if time.monotonic() >= self._due:
-            self.flush()
-
     def close(self) -> BagInfo:
         """Close the storage and write ``metadata.yaml``; return what the bag holds.
 

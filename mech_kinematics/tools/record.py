@@ -555,16 +555,16 @@ class BagRecorder:
             rclpy.try_shutdown(context=self._context)
             self._context = None
 
-    # -- housekeeping: discovery, flushes, reports -----------------------------------
+    # -- housekeeping: failures, discovery, reports -----------------------------------
 
     def _housekeeping(self) -> None:
-        """Poll the graph, flush the bag if due, and log waiting or progress lines."""
+        """Stop on a failed write, poll the graph, and log drops, waiting or progress lines."""
         from ..bag import BagError
 
         if self._writer is None:
             return
         try:
-            self._writer.flush_if_due()
+            self._writer.check()
         except BagError:
             self.request_stop()
             return
@@ -872,10 +872,11 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                                           'seconds while recording; 0: never '
                                           '(default: %(default)s)')
     parser.add_argument('--max-queue-bytes', type=positive_int, default=MAX_QUEUE_BYTES,
-                        metavar='N', help='most bytes of received messages waiting for a slow '
-                                          'disk; beyond, messages are dropped, counted and '
-                                          'the exit status is 3 (default: %(default)s, 100 MiB '
-                                          "as ros2 bag record's --max-cache-size)")
+                        metavar='N', help='most serialized bytes of received messages waiting '
+                                          'for a slow disk; beyond, messages are dropped, '
+                                          'counted and the exit status is 3 (default: '
+                                          "%(default)s, 100 MiB as ros2 bag record's "
+                                          '--max-cache-size)')
     parser.add_argument('--executor', choices=EXECUTORS, default=DEFAULT_EXECUTOR,
                         help='rclpy executor: events (EventsExecutor, the lighter) or single '
                              '(SingleThreadedExecutor, used anyway where rclpy has no '
