@@ -12,6 +12,7 @@ rosbags (strictly: type hashes checked, every message deserialized) and MCAP
 with Foxglove's reader too. See issue 12.
 """
 
+import contextlib
 import errno
 import functools
 import os
@@ -260,16 +261,9 @@ def test_an_mcap_flush_with_nothing_new_syncs_nothing(tmp_path, monkeypatch):
     assert_prefix(tmp_path / 'bag', 5)
 
 
-@pytest.mark.parametrize('storage', STORAGES)
-def test_a_full_queue_drops_what_overflows_and_counts_it(tmp_path, storage):
-    """QueuedWriter: while the disk holds its thread, 10 messages' bytes wait, the rest drop.
-
-    The thread takes message 0 and flushes it (flush_bytes=1); the flush is
-    held. Of the 100 messages written meanwhile the first 10 fit the bound
-    and wait; 90 are dropped and counted. Once the disk answers, the bag
-    holds messages 0 to 10 and nothing else.
-    """
-    writer, topic = open_writer(tmp_path / 'bag', storage, flush_interval=3600.0, flush_bytes=1)
+@contextlib.contextmanager
+def held_queue(writer, topic, **options):
+    """Yield a QueuedWriter whose thread took message 0 and is held in its flush until exit."""
     entered, release = threading.Event(), threading.Event()
     held = writer._storage
     flush = held.flush
@@ -280,14 +274,27 @@ def test_a_full_queue_drops_what_overflows_and_counts_it(tmp_path, storage):
         flush()
 
     held.flush = slow_flush
-    size = len(payload(0))
-    queued = QueuedWriter(writer, max_bytes=10 * size)
+    queued = QueuedWriter(writer, **options)
     try:
         assert queued.write(topic, T0, payload(0))
         assert entered.wait(60)
-        kept = [queued.write(topic, T0 + i * DT, payload(i)) for i in range(1, 101)]
+        yield queued
     finally:
         release.set()
+
+
+@pytest.mark.parametrize('storage', STORAGES)
+def test_a_full_queue_drops_what_overflows_and_counts_it(tmp_path, storage):
+    """QueuedWriter: while the disk holds its thread, 10 messages' bytes wait, the rest drop.
+
+    The thread takes message 0 and flushes it (flush_bytes=1); the flush is
+    held. Of the 100 messages written meanwhile the first 10 fit the bound
+    and wait; 90 are dropped and counted. Once the disk answers, the bag
+    holds messages 0 to 10 and nothing else.
+    """
+    writer, topic = open_writer(tmp_path / 'bag', storage, flush_interval=3600.0, flush_bytes=1)
+    with held_queue(writer, topic, max_bytes=10 * len(payload(0))) as queued:
+        kept = [queued.write(topic, T0 + i * DT, payload(i)) for i in range(1, 101)]
     assert kept == [True] * 10 + [False] * 90
     assert queued.dropped == {'/js': 90}
     assert queued.dropped_total == 90
@@ -312,21 +319,8 @@ def test_a_waiting_message_costs_its_bytes_and_the_overhead_docs_bags_states(tmp
                        (REPO / 'docs' / 'bags.md').read_text())
     assert stated, 'docs/bags.md states the memory of a waiting message'
     writer, topic = open_writer(tmp_path / 'bag', 'mcap', flush_interval=3600.0, flush_bytes=1)
-    entered, release = threading.Event(), threading.Event()
-    held = writer._storage
-    flush = held.flush
-
-    def slow_flush() -> None:
-        entered.set()
-        release.wait(60)
-        flush()
-
-    held.flush = slow_flush
-    queued = QueuedWriter(writer)
     count = 20_000
-    try:
-        assert queued.write(topic, T0, payload(0))
-        assert entered.wait(60)
+    with held_queue(writer, topic) as queued:
         datas = [payload(i) for i in range(1, count + 1)]
         serialized = sum(map(len, datas))
         tracemalloc.start()
@@ -337,8 +331,6 @@ def test_a_waiting_message_costs_its_bytes_and_the_overhead_docs_bags_states(tmp
             after = tracemalloc.get_traced_memory()[0]
         finally:
             tracemalloc.stop()
-    finally:
-        release.set()
     overhead = (after - before - serialized) / count
     assert 0 < overhead <= int(stated.group(1)), overhead
     assert overhead > int(stated.group(1)) - 16, f'docs/bags.md overstates it: {overhead:.1f}'
