@@ -13,10 +13,10 @@ published (``test_a_slow_disk_delays_the_bag_and_loses_nothing``).
 and :meth:`QueuedWriter.write` only append to a queue in memory (a topic's
 id is given at once, its record written in order before its messages); a
 thread of its own writes the queue to the :class:`BagWriter` and flushes
-it, so the writer is used by one thread. It flushes an interval after the
-start of the last flush (at once if that flush took longer), each time after
-writing everything queued: a message reaches the file within an interval and
-two flushes, and a slow sync never makes each message a flush of its own.
+it when the writer says a flush is due (:meth:`BagWriter.flush_due`), each
+time after writing everything queued, so the writer is used by one thread and
+a message reaches the file within an interval and two flushes
+(:attr:`last_flush` says what the last one wrote, and how long it took).
 :meth:`QueuedWriter.close` writes everything queued before it closes the
 bag: what was received is written, however slow the disk.
 
@@ -33,11 +33,10 @@ from __future__ import annotations
 
 from collections import deque
 import threading
-import time
 from typing import Any
 
 from .metadata import BagError, BagInfo, Topic
-from .writer import BagWriter
+from .writer import BagWriter, Flush
 
 __all__ = ['MAX_QUEUE_BYTES', 'QueuedWriter', 'WRITE_POLL_S']
 
@@ -78,8 +77,6 @@ class QueuedWriter:
         # what waits, without a lock.
         self._queued_bytes = 0
         self._taken_bytes = 0
-        #: When the thread flushes next: an interval after the start of the last flush.
-        self._next_flush = time.monotonic() + writer.flush_interval
         self._closing = threading.Event()
         self._thread = threading.Thread(target=self._run, name='bag writer', daemon=True)
         self._thread.start()
@@ -88,6 +85,11 @@ class QueuedWriter:
     def failure(self) -> str | None:
         """Return the writer's failure (None while writing goes well)."""
         return self.writer.failure
+
+    @property
+    def last_flush(self) -> Flush | None:
+        """Return the writer's last flush that wrote messages (:attr:`BagWriter.last_flush`)."""
+        return self.writer.last_flush
 
     def add_topic(self, name: str, type_name: str, **kwargs: Any) -> Topic:
         """As :meth:`BagWriter.add_topic`; its record is written by the thread, in order."""
@@ -134,14 +136,7 @@ class QueuedWriter:
         writer = self.writer
         while not self._closing.wait(WRITE_POLL_S):
             self._drain()
-            if writer.failure is not None:
-                continue
-            now = time.monotonic()
-            if now >= self._next_flush or writer.pending_bytes >= writer.flush_bytes:
-                # Every interval from the start of a flush, each flush taking all that was
-                # queued: a message waits at most an interval and two flushes, however slow
-                # the disk, and a slow sync never makes each message a flush of its own.
-                self._next_flush = now + writer.flush_interval
+            if writer.failure is None and writer.flush_due():
                 try:
                     writer.flush()
                 except BagError:

@@ -35,6 +35,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Sequence
 import contextlib
+from dataclasses import dataclass
 import os
 from pathlib import Path
 import sqlite3
@@ -49,8 +50,9 @@ from .metadata import (bag_version_of_qos, BAG_VERSIONS, BagError, BagInfo, META
 from .storage_mcap import McapStorage, RecoveredMcap
 from .storage_sqlite3 import RecoveredSqlite3, Sqlite3Storage
 
-__all__ = ['BagWriter', 'DEFAULT_VERSION', 'FLUSH_BYTES', 'FLUSH_INTERVAL_S', 'RESERVE_BYTES',
-           'RESERVE_FILE', 'STORAGES', 'check_new_bag', 'check_options', 'reindex']
+__all__ = ['BagWriter', 'DEFAULT_VERSION', 'FLUSH_BYTES', 'FLUSH_INTERVAL_S', 'Flush',
+           'RESERVE_BYTES', 'RESERVE_FILE', 'STORAGES', 'check_new_bag', 'check_options',
+           'reindex']
 
 #: rosbag2 storage identifiers, and the suffix of their files.
 STORAGES = {'mcap': '.mcap', 'sqlite3': '.db3'}
@@ -94,8 +96,30 @@ def check_new_bag(path: Path) -> None:
         raise BagError(msg)
 
 
+@dataclass(frozen=True)
+class Flush:
+    """One flush of a :class:`BagWriter` that wrote messages: what reached the file, how fast."""
+
+    #: 1 for the first flush that wrote messages, then 2, 3...
+    number: int
+    #: Messages it wrote to the file.
+    messages: int
+    #: Messages in the file after it (every flush's).
+    written: int
+    #: Receive time of the newest of them, ns: every message written before it is in the file.
+    newest_ns: int
+    #: How long it took (writing and syncing), s.
+    seconds: float
+
+
 class BagWriter:
-    """Write a new rosbag2 bag directory, flushed at least every ``flush_interval`` s.
+    """Write a new rosbag2 bag directory, flushed about every ``flush_interval`` s.
+
+    A flush is due an interval after the previous one started, or, if that
+    one took longer than the interval (a slow disk), an interval after it
+    ended; and whenever ``flush_bytes`` are pending (:meth:`flush_due`). A
+    message therefore reaches the file within an interval and two flushes
+    of being written, and a slow disk is never synced back to back.
 
     Parameters
     ----------
@@ -116,6 +140,8 @@ class BagWriter:
         The topics added, in id order.
     failure : str or None
         Why writing stopped (a write error), None while all is well.
+    last_flush : Flush or None
+        The last flush that wrote messages (None before the first).
 
     Notes
     -----
@@ -140,7 +166,11 @@ class BagWriter:
         self.failure: str | None = None
         self._storage: Any = None
         self._lock: int | None = None
+        self.last_flush: Flush | None = None
+        #: When the next flush is due (time.monotonic()), and what waits for it.
         self._due = 0.0
+        self._waiting = 0
+        self._newest_ns = 0
 
     def open(self) -> None:
         """Create the directory and the storage file (a valid, empty bag file at once)."""
@@ -214,7 +244,7 @@ class BagWriter:
             If writing has failed (now or before): see :attr:`failure`.
         """
         self.append(topic, timestamp, data)
-        if self._storage.pending_bytes >= self.flush_bytes or time.monotonic() >= self._due:
+        if self.flush_due():
             self.flush()
 
     def append(self, topic: Topic, timestamp: int, data: bytes) -> None:
@@ -222,22 +252,36 @@ class BagWriter:
         if self.failure is not None:
             raise BagError(self.failure)
         self._storage.write(topic.id, timestamp, data)
+        self._waiting += 1
+        self._newest_ns = max(self._newest_ns, timestamp)
 
     @property
     def pending_bytes(self) -> int:
         """Bytes of messages waiting for the next flush."""
         return self._storage.pending_bytes
 
+    def flush_due(self) -> bool:
+        """Return whether a flush is due: the interval has passed, or ``flush_bytes`` wait."""
+        return self._storage.pending_bytes >= self.flush_bytes or time.monotonic() >= self._due
+
     def flush(self) -> None:
-        """Write what is pending to the storage file and sync it."""
+        """Write what is pending to the storage file and sync it (:attr:`last_flush`)."""
         self._check()
+        start = time.monotonic()
         try:
             self._storage.flush()
         except _WRITE_ERRORS as error:
             self._fail(error)
-        # From the end of this flush: a sync slower than the interval (a loaded disk) must
-        # not make every following write a flush of its own.
-        self._due = time.monotonic() + self.flush_interval
+        end = time.monotonic()
+        # An interval after this flush started; after it ended if it took longer (a slow
+        # disk): never synced back to back, nor, for a caller that writes and flushes in
+        # one thread, a flush at every write.
+        self._due = (end if end - start > self.flush_interval else start) + self.flush_interval
+        if self._waiting:
+            last = self.last_flush or Flush(0, 0, 0, 0, 0.0)
+            self.last_flush = Flush(last.number + 1, self._waiting, last.written + self._waiting,
+                                    self._newest_ns, end - start)
+            self._waiting = 0
 
     def close(self) -> BagInfo:
         """Close the storage and write ``metadata.yaml``; return what the bag holds.

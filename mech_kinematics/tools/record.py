@@ -22,8 +22,9 @@ the subscriptions are destroyed and the bag is closed: every message received
 is in it.
 
 Nothing is lost if the recorder itself dies: messages reach the storage file
-at least every :data:`~mech_kinematics.bag.FLUSH_INTERVAL_S` (an MCAP chunk closed and synced,
-an sqlite3 transaction committed), and ``python -m mech_kinematics reindex``
+every :data:`~mech_kinematics.bag.FLUSH_INTERVAL_S` (an MCAP chunk closed and synced,
+an sqlite3 transaction committed; a flush that takes longer is warned of, and
+each is logged at debug level), and ``python -m mech_kinematics reindex``
 rebuilds ``metadata.yaml`` after ``kill -9``. A write error (a full disk) stops
 the recording: the bag is closed with what it holds, its metadata counting
 exactly that, and the command prints one ``error:`` line and exits with 1.
@@ -100,8 +101,9 @@ POLL_INTERVAL_S = 0.1
 #: the first time FIRST_WAIT_REPORT_S after start.
 WAIT_REPORT_INTERVAL_S = 5.0
 FIRST_WAIT_REPORT_S = 1.0
-#: How often, at most, a warning says messages are being dropped (the queue for the disk full), s.
-DROP_REPORT_INTERVAL_S = 5.0
+#: How often, at most, a warning is repeated while its cause lasts (messages dropped because
+#: the queue for the disk is full; flushes slower than their interval), s.
+WARNING_INTERVAL_S = 5.0
 #: Default interval of the progress lines (messages per topic and per second), s.
 DEFAULT_PROGRESS_S = 5.0
 #: Depth of each subscription's queue: 1 s of a 1 kHz topic.
@@ -421,6 +423,10 @@ class BagRecorder:
         #: Messages dropped (the queue full) at the last report of drops, and when it was.
         self._dropped_reported = 0
         self._next_drop_report = 0.0
+        #: The last flush logged, and when a slow one may be warned of again (and how slow).
+        self._flush_reported = 0
+        self._next_slow_report = 0.0
+        self._slow_reported = 0.0
 
     # -- life cycle ---------------------------------------------------------------
 
@@ -570,6 +576,7 @@ class BagRecorder:
             return
         self._discover()
         now = time.monotonic()
+        self._report_flush(now)
         if now >= self._next_drop_report:
             self._report_drops(now)
         if self.recording_since is None:
@@ -593,14 +600,38 @@ class BagRecorder:
                 f'waiting for publishers on {", ".join(pending)} (is the node running, in this '
                 f'ROS_DOMAIN_ID and namespace?)')
 
+    def _report_flush(self, now: float) -> None:
+        """Log each new flush (debug); warn of one slower than the interval (a slow disk).
+
+        The warning is repeated at most every WARNING_INTERVAL_S, or sooner
+        for a flush slower than the last one warned of.
+        """
+        flush = self._writer.last_flush
+        if flush is None or flush.number == self._flush_reported:
+            return
+        self._flush_reported = flush.number
+        logger = self._node.get_logger()
+        logger.debug(f'flush {flush.number}: {flush.messages} messages in {flush.seconds:.3f} s '
+                     f'({flush.written} in the file), the newest received at {flush.newest_ns} ns')
+        interval = self._writer.writer.flush_interval
+        if flush.seconds <= interval or (now < self._next_slow_report
+                                         and flush.seconds <= self._slow_reported):
+            return
+        self._next_slow_report = now + WARNING_INTERVAL_S
+        self._slow_reported = flush.seconds
+        logger.warning(
+            f'the disk is slow: a flush of the bag took {flush.seconds:.2f} s, more than the '
+            f'{interval:g} s interval; messages now reach the file up to '
+            f'{interval + 2 * flush.seconds:.1f} s after they are received (a crash loses them)')
+
     def _report_drops(self, now: float) -> None:
-        """Warn, at most every DROP_REPORT_INTERVAL_S, while messages are being dropped."""
+        """Warn, at most every WARNING_INTERVAL_S, while messages are being dropped."""
         dropped = self._writer.dropped
         total = sum(dropped.values())
         if total == self._dropped_reported:
             return
         self._dropped_reported = total
-        self._next_drop_report = now + DROP_REPORT_INTERVAL_S
+        self._next_drop_report = now + WARNING_INTERVAL_S
         self._node.get_logger().warning(
             f'the disk is behind by more than --max-queue-bytes ({self.max_queue_bytes} bytes '
             f'of messages): {total} messages dropped so far: {_per_topic(dropped)}')
@@ -827,10 +858,13 @@ the messages per topic and per second. Ctrl-C, SIGTERM or the end of
 the bag; a per-topic summary (received and written counts) is printed. An
 existing output directory is refused.
 
-Crash safety: messages reach the file at least every 0.5 s (an MCAP chunk
-closed and synced, an sqlite3 transaction committed). If the recorder is
+Crash safety: messages reach the file every 0.5 s (an MCAP chunk closed and
+synced, an sqlite3 transaction committed); a flush that takes longer (a slow
+disk) is warned of, with what a crash would now lose. If the recorder is
 killed, `python -m mech_kinematics reindex DIR` makes the bag readable again
-with everything but the last half second. A write error (a full disk) ends
+with everything but the last half second (and the flush under way). Every
+flush is logged at debug level (--ros-args --log-level
+mech_kinematics_recorder:=debug). A write error (a full disk) ends
 the recording with one `error:` line and exit status 1; the bag is closed
 with what was written and its metadata counts exactly that.
 

@@ -6,7 +6,8 @@ The counterpart of ``ros2 bag reindex`` for the bags of ``record`` (and of
 rosbags and rosbag2: one ``.mcap`` or ``.db3`` file). After the recorder was
 killed, its bag has no ``metadata.yaml`` and rosbags and ``ros2 bag`` refuse
 it; this makes it readable, with every message that reached the file (all
-but the last half second of the recording), by
+but those not flushed yet: the last half second of the recording, more on a
+slow disk), by
 :func:`mech_kinematics.bag.reindex`:
 
 - MCAP: the file is scanned and every intact chunk kept, also those after a

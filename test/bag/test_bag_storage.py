@@ -24,7 +24,6 @@ import struct
 import subprocess
 import sys
 import threading
-import types
 
 from hypothesis import given, settings, strategies as st
 import numpy as np
@@ -34,7 +33,7 @@ import yaml
 from mech_kinematics.bag import (BagError, BagWriter, QueuedWriter, reindex, storage_mcap,
                                  storage_sqlite3)
 from mech_kinematics.bag.metadata import type_hash_from_definition
-from mech_kinematics.bag.writer import RESERVE_FILE
+from mech_kinematics.bag.writer import Flush, RESERVE_FILE
 from mech_kinematics.tools import record
 
 REPO = Path(__file__).resolve().parents[2]
@@ -337,28 +336,90 @@ def test_a_waiting_message_costs_its_bytes_and_the_overhead_docs_bags_states(tmp
     assert queued.close().count('/js') == count + 1
 
 
-def test_the_queued_writer_flushes_an_interval_after_each_flush_starts(tmp_path, monkeypatch):
-    """A flush slower than the interval is followed at once by the next, holding all queued.
+class FakeClock:
+    """``time`` of the writer module, at ``now`` s; notifies whoever waits on reads of it."""
 
-    On the thread's own clock, faked: the first flush starts at 100 s (the
-    interval) and is held while the clock reaches 300 s and a message
-    arrives; once it ends, the next flush takes that message with the clock
-    still at 300 s. Before, the interval counted from a flush's end (the
-    next at 400 s on the real clock, never in this test): beside two CPU
-    hogs an sqlite3 recorder went 1.03 s without a commit, and kill -9 lost
-    26 states received more than a second before it.
+    def __init__(self) -> None:
+        self.now = 0.0
+        self.reads = 0
+        self.changed = threading.Condition()
+
+    def monotonic(self) -> float:
+        with self.changed:
+            self.reads += 1
+            self.changed.notify_all()
+            return self.now
+
+    def wait_for(self, predicate, timeout: float = 60.0) -> None:
+        with self.changed:
+            assert self.changed.wait_for(predicate, timeout)
+
+
+@pytest.fixture
+def clock(monkeypatch):
+    from mech_kinematics.bag import writer as writer_module
+
+    fake = FakeClock()
+    monkeypatch.setattr(writer_module, 'time', fake)
+    return fake
+
+
+@pytest.mark.parametrize('storage', STORAGES)
+def test_a_flush_is_due_an_interval_after_the_last_started_or_after_it_ended_when_slower(
+        tmp_path, storage, clock):
+    """BagWriter.write flushes when due: an interval after the last flush started, or ended.
+
+    On a faked clock with an interval of 100 s: the first flush at 100 s
+    takes 30 s, and the next is due at 200 s (an interval after the first
+    started, not after it ended); that one takes 150 s, longer than the
+    interval, and the next is due at 450 s, an interval after it ended --
+    not at once (a slow disk synced back to back, and a writer that writes
+    and flushes in one thread flushing at every write). Each flush says
+    what it wrote and how long it took.
     """
-    from mech_kinematics.bag import queued
+    writer, topic = open_writer(tmp_path / 'bag', storage, flush_interval=100.0)
+    held = writer._storage
+    flush = held.flush
+    took = [30.0]
 
-    clock = [0.0]
-    monkeypatch.setattr(queued, 'time', types.SimpleNamespace(monotonic=lambda: clock[0]))
+    def timed_flush() -> None:
+        flush()
+        clock.now += took[0]
+
+    held.flush = timed_flush
+    flushes = []
+    for i, now in enumerate([0.0, 99.0, 100.0, 199.0, 200.0, None, 449.0, 450.0]):
+        if now is not None:
+            clock.now = now
+        if i == 4:
+            took[0] = 150.0         # the flush at 200 s ends at 350 s, when message 5 comes
+        write(writer, topic, [i])
+        if writer.last_flush is not None and writer.last_flush not in flushes:
+            flushes.append(writer.last_flush)
+    assert flushes == [Flush(1, 3, 3, T0 + 2 * DT, 30.0), Flush(2, 2, 5, T0 + 4 * DT, 150.0),
+                       Flush(3, 3, 8, T0 + 7 * DT, 150.0)]
+    writer.close()
+    assert_prefix(tmp_path / 'bag', 8)
+
+
+def test_the_queued_writer_flushes_when_the_writer_says_after_writing_all_queued(
+        tmp_path, clock):
+    """The writing thread writes everything queued, then flushes if the writer says it is due.
+
+    On the writer's clock, faked, interval 100 s: the first flush starts at
+    100 s and is held while the clock reaches 300 s and a message arrives.
+    Once it ends (200 s long), the thread asks again and again with the
+    clock at 300 s and does not flush; at 400 s, an interval after that
+    flush ended, it flushes the message. Before, the thread kept a rule of
+    its own (an interval after a flush started, at once after a slow one).
+    """
     writer, topic = open_writer(tmp_path / 'bag', 'sqlite3', flush_interval=100.0)
     held = writer._storage
     flush = held.flush
     starts, entered, release = [], threading.Event(), threading.Event()
 
     def slow_flush() -> None:
-        starts.append((clock[0], held.pending_bytes))
+        starts.append((clock.now, held.pending_bytes))
         entered.set()
         if len(starts) == 1:
             release.wait(60)
@@ -368,15 +429,21 @@ def test_the_queued_writer_flushes_an_interval_after_each_flush_starts(tmp_path,
     queued_writer = QueuedWriter(writer)
     try:
         assert queued_writer.write(topic, T0, payload(0))
-        clock[0] = 100.0
+        clock.now = 100.0
         assert entered.wait(60)
-        clock[0] = 300.0
+        clock.now = 300.0
         entered.clear()
         assert queued_writer.write(topic, T0 + DT, payload(1))
     finally:
         release.set()
+    clock.wait_for(lambda: queued_writer.last_flush is not None)
+    asked = clock.reads
+    clock.wait_for(lambda: clock.reads >= asked + 5)     # the thread asked, at 300 s
+    assert len(starts) == 1
+    clock.now = 400.0
     assert entered.wait(60)
-    assert starts == [(100.0, len(payload(0))), (300.0, len(payload(1)))]
+    assert starts == [(100.0, len(payload(0))), (400.0, len(payload(1)))]
+    assert queued_writer.last_flush == Flush(1, 1, 1, T0, 200.0)
     queued_writer.close()
     assert_prefix(tmp_path / 'bag', 2)
 
