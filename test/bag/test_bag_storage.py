@@ -437,14 +437,15 @@ def test_the_queued_writer_flushes_when_the_writer_says_after_writing_all_queued
     finally:
         release.set()
     clock.wait_for(lambda: queued_writer.last_flush is not None)
+    assert queued_writer.last_flush == Flush(1, 1, 1, T0, 200.0)
     asked = clock.reads
     clock.wait_for(lambda: clock.reads >= asked + 5)     # the thread asked, at 300 s
     assert len(starts) == 1
     clock.now = 400.0
     assert entered.wait(60)
     assert starts == [(100.0, len(payload(0))), (400.0, len(payload(1)))]
-    assert queued_writer.last_flush == Flush(1, 1, 1, T0, 200.0)
     queued_writer.close()
+    assert queued_writer.last_flush == Flush(2, 1, 2, T0 + DT, 0.0)
     assert_prefix(tmp_path / 'bag', 2)
 
 
