@@ -423,10 +423,11 @@ class BagRecorder:
         #: Messages dropped (the queue full) at the last report of drops, and when it was.
         self._dropped_reported = 0
         self._next_drop_report = 0.0
-        #: The last flush logged, and when a slow one may be warned of again (and how slow).
+        #: The last flush logged; when a slow one may be warned of again, and the slowest
+        #: flush longer than the interval since the last warning (0 if none).
         self._flush_reported = 0
         self._next_slow_report = 0.0
-        self._slow_reported = 0.0
+        self._slowest = 0.0
 
     # -- life cycle ---------------------------------------------------------------
 
@@ -603,8 +604,8 @@ class BagRecorder:
     def _report_flush(self, now: float) -> None:
         """Log each new flush (debug); warn of one slower than the interval (a slow disk).
 
-        The warning is repeated at most every WARNING_INTERVAL_S, or sooner
-        for a flush slower than the last one warned of.
+        The warning is repeated at most every WARNING_INTERVAL_S, with the
+        slowest flush since the last one.
         """
         flush = self._writer.last_flush
         if flush is None or flush.number == self._flush_reported:
@@ -614,15 +615,16 @@ class BagRecorder:
         logger.debug(f'flush {flush.number}: {flush.messages} messages in {flush.seconds:.3f} s '
                      f'({flush.written} in the file), the newest received at {flush.newest_ns} ns')
         interval = self._writer.writer.flush_interval
-        if flush.seconds <= interval or (now < self._next_slow_report
-                                         and flush.seconds <= self._slow_reported):
+        if flush.seconds > interval:
+            self._slowest = max(self._slowest, flush.seconds)
+        if not self._slowest or now < self._next_slow_report:
             return
+        slowest, self._slowest = self._slowest, 0.0
         self._next_slow_report = now + WARNING_INTERVAL_S
-        self._slow_reported = flush.seconds
         logger.warning(
-            f'the disk is slow: a flush of the bag took {flush.seconds:.2f} s, more than the '
+            f'the disk is slow: a flush of the bag took {slowest:.2f} s, more than the '
             f'{interval:g} s interval; messages now reach the file up to '
-            f'{interval + 2 * flush.seconds:.1f} s after they are received (a crash loses them)')
+            f'{interval + 2 * slowest:.1f} s after they are received (a crash loses them)')
 
     def _report_drops(self, now: float) -> None:
         """Warn, at most every WARNING_INTERVAL_S, while messages are being dropped."""
