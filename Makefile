@@ -33,6 +33,14 @@ STAMP := $(VENV)/.mech_kinematics-installed-$(PKG_STATE)
 TF2_STAMP := $(VENV)/.tf2_msgs-built
 DEV_STAMP := $(VENV)/.mech_kinematics-dev-installed
 
+# Build in this clone, never through a link: a `.venv` that is a symlink (to another
+# checkout's virtualenv, say) is refused by every target but help and clean.
+ifneq ($(filter-out help clean,$(or $(MAKECMDGOALS),help)),)
+ifneq ($(shell test -L $(VENV) && echo link),)
+$(error $(VENV) is a symlink (to $(shell readlink $(VENV))): remove it (rm $(VENV)) and make creates this clone's own)
+endif
+endif
+
 # Keep DDS discovery on the loopback interface (no multicast onto the LAN);
 # override with e.g. `make run ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET`.
 ROS_AUTOMATIC_DISCOVERY_RANGE ?= LOCALHOST
