@@ -37,13 +37,14 @@ ulp could make it unassemblable or flip its branch) is refused too.
 from __future__ import annotations
 
 from collections.abc import Callable
+import math
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 __all__ = ['Bounds', 'ErrorBound', 'KINDS', 'LARGEST', 'MAX_ERROR', 'ROUNDING_MARGIN', 'U',
-           'limit']
+           'limit', 'magnitude']
 
 #: Unit roundoff of IEEE doubles, 2**-53: the largest relative rounding error of one
 #: correctly rounded operation.
@@ -100,6 +101,20 @@ def limit(max_error: Any, scale: Any) -> Any:
         return np.fmin(lim, LARGEST)
     lim = max_error * max(scale, SMALLEST_NORMAL)
     return lim if lim <= LARGEST else LARGEST
+
+
+def magnitude(z: Any) -> Any:
+    """Return ``abs(z)``, or ``inf`` where the modulus of a finite complex overflows a double.
+
+    Python's ``abs`` of such a complex raises ``OverflowError`` ("absolute value
+    too large": ``abs(1.5e308 + 1.5e308j)``) where NumPy's gives ``inf``: the
+    same bits otherwise, so a value that overflows is refused as non-finite
+    (``forces (overflow)``) by the code that reads it, never raised.
+    """
+    try:
+        return abs(z)
+    except OverflowError:
+        return math.inf
 
 
 class Bounds:

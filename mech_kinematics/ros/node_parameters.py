@@ -34,7 +34,7 @@ from .drive import (DEFAULT_MAX_CRANK_SPEED_RPM, drive_start, DriveStart,
 from .parameters import (CATCH_UP, catch_up_window_ns, driver_parameters, first_crank_aliases,
                          joint_refusal, PARAMETERS, ParameterSpec, rate_default, refusal, spec)
 from .schedule import period_ns_from_rate
-from .wrenches import force_parameters
+from .wrenches import force_parameters, forces_refusal
 from ..errors import SceneError
 
 if TYPE_CHECKING:
@@ -187,6 +187,8 @@ class NodeParameters:
         self.drivers = DriverParameters()
         #: A scene's forces' parameters (``gravity``, ``loads.NAME.*``) by name, once declared.
         self.forces: dict[str, ParameterSpec] = {}
+        #: The scene's forces as loaded (the forces' parameters are checked against its masses).
+        self._dynamics: Dynamics | None = None
         self._own: dict[str, bool] = {}
         self._declaring = False
         node.add_pre_set_parameters_callback(self._pre_set)
@@ -284,6 +286,7 @@ class NodeParameters:
         one set later (refused: the node does not start).
         """
         self.forces = {p.name: p for p in force_parameters(dynamics)}
+        self._dynamics = dynamics
         self._declaring = True
         try:
             for p in self.forces.values():
@@ -387,6 +390,8 @@ class NodeParameters:
         if reason is None:
             reason = self._stroke_refusal(parameters)
         if reason is None:
+            reason = self._forces_refusal(parameters)
+        if reason is None:
             return SetParametersResult(successful=True)
         # Every refusal is logged once, with its reason, besides the service's answer
         # (at start, main() says it in its one line).
@@ -395,6 +400,16 @@ class NodeParameters:
         else:
             self.node.get_logger().warning(f'parameter refused: {reason}')
         return SetParametersResult(successful=False, reason=reason)
+
+    def _forces_refusal(self, parameters: list[Parameter]) -> str | None:
+        """Return why a new ``gravity`` or load gives forces beyond the doubles, or None."""
+        changes = {p.name: p.value for p in parameters if p.name in self.forces}
+        if not changes or self._dynamics is None:
+            return None
+        values = {name: self.value(name) if self.node.has_parameter(name) else spec.default
+                  for name, spec in self.forces.items()}
+        values.update(changes)
+        return forces_refusal(self._dynamics, values)
 
     def _stroke_refusal(self, parameters: list[Parameter]) -> str | None:
         """Return why an actuator's drive change is refused (:func:`.drive.stroke_refusal`)."""

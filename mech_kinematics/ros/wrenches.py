@@ -47,7 +47,7 @@ from .ticker import NOT_IN_THE_TICK, values_from_state
 from .. import solver as lk
 from ..errors import AssemblyError
 from ..solver.compiler import NotCompiled
-from ..solver.forces import Dynamics
+from ..solver.forces import Dynamics, given_forces_refusal, Load
 
 if TYPE_CHECKING:
     from ..solver.compiler import FrameSpec
@@ -56,8 +56,8 @@ if TYPE_CHECKING:
     from ..solver.mechanism import Scene
 
 __all__ = ['ForceMessages', 'ForcesTick', 'dynamics_with', 'effort_status',
-           'force_parameters', 'forces_tick', 'forces_values', 'gravity_of', 'reaction_joints',
-           'reaction_wrench', 'wrench_stamped']
+           'force_parameters', 'forces_refusal', 'forces_tick', 'forces_values', 'gravity_of',
+           'reaction_joints', 'reaction_wrench', 'wrench_stamped']
 
 
 def reaction_joints(dynamics: Dynamics) -> tuple[Joint, ...]:
@@ -316,15 +316,12 @@ def force_parameters(dynamics: Dynamics) -> tuple[ParameterSpec, ...]:
     return tuple(specs)
 
 
-def dynamics_with(dynamics: Dynamics, changes: Mapping[str, Any]) -> Dynamics:
-    """Return ``dynamics`` with accepted parameter values (:func:`force_parameters`' names).
-
-    The graph and the masses are kept; only the gravity and the loads' values
-    change, so nothing of the scene is rebuilt.
-    """
+def _given(dynamics: Dynamics, changes: Mapping[str, Any]) -> tuple[tuple[float, float],
+                                                                    list[Load]]:
+    """Return the gravity and the loads of ``dynamics`` with accepted parameter values."""
     gravity = changes.get('gravity')
-    g = dynamics.gravity if gravity is None else complex(float(gravity[0]),
-                                                         float(gravity[1]))
+    g = (dynamics.gravity.real, dynamics.gravity.imag) if gravity is None else (
+        float(gravity[0]), float(gravity[1]))
     loads = []
     for load in dynamics.loads:
         force = changes.get(f'loads.{load.name}.force')
@@ -334,8 +331,36 @@ def dynamics_with(dynamics: Dynamics, changes: Mapping[str, Any]) -> Dynamics:
         if torque is not None:
             load = replace(load, torque=float(torque))
         loads.append(load)
+    return g, loads
+
+
+def forces_refusal(dynamics: Dynamics, values: Mapping[str, Any]) -> str | None:
+    """Return why ``values`` of :func:`force_parameters` give forces beyond the doubles, or None.
+
+    ``values``: the parameters' values as they would be (each already a pair
+    or a number of finite doubles). The rule is the scene's
+    (:func:`~mech_kinematics.solver.forces.given_forces_refusal`): the weights
+    and the loads' forces, each and in all, finite; the reason names the
+    parameter at fault (``gravity`` or ``loads.NAME.force``).
+    """
+    gravity, loads = _given(dynamics, values)
+    refused = given_forces_refusal(tuple(dynamics.masses.values()), loads, gravity)
+    if refused is None:
+        return None
+    element, _, reason = refused
+    name = f'loads.{element.name}.force' if isinstance(element, Load) else 'gravity'
+    return f'{name}: {reason}'
+
+
+def dynamics_with(dynamics: Dynamics, changes: Mapping[str, Any]) -> Dynamics:
+    """Return ``dynamics`` with accepted parameter values (:func:`force_parameters`' names).
+
+    The graph and the masses are kept; only the gravity and the loads' values
+    change, so nothing of the scene is rebuilt.
+    """
+    gravity, loads = _given(dynamics, changes)
     graph = dynamics.graph
     points = {p for body in graph.bodies.values() for p in body.points}
     points.update(load.point for load in loads if load.point is not None)
-    return Dynamics(graph, tuple(dynamics.masses.values()), loads, (g.real, g.imag),
+    return Dynamics(graph, tuple(dynamics.masses.values()), loads, gravity,
                     tuple(points), dynamics.size)

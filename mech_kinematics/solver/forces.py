@@ -51,13 +51,13 @@ from .compiler import NotCompiled
 from .forces_compiled import compile_single, SingleForces
 from .graph import Graph, Joint
 from .model import _check_finite, _check_name
-from ..bounds import U
+from ..bounds import LARGEST, magnitude, U
 from ..errors import SceneError
 
 if TYPE_CHECKING:
     from .state import State
 
-__all__ = ['Dynamics', 'Forces', 'Load', 'Mass', 'Reaction']
+__all__ = ['Dynamics', 'Forces', 'Load', 'Mass', 'Reaction', 'given_forces_refusal']
 
 #: Single instants of one scene on the general path before its forces are written out
 #: (:mod:`.forces_compiled`): writing them out costs what a few general instants do.
@@ -172,6 +172,43 @@ class Load:
             object.__setattr__(self, 'force', (float(force[0]), float(force[1])))
         if self.torque is not None:
             _check_finite(self.torque, f'the torque of load "{self.name}"', (self, 'torque'))
+
+
+def given_forces_refusal(masses: Sequence[Mass], loads: Sequence[Load],
+                         gravity: tuple[float, float]) -> tuple[Any, str, str] | None:
+    """Return why the forces a scene gives overflow a double, or None where they do not.
+
+    The forces given are the weights of the moving bodies (their total mass
+    times ``|g|``) and the loads' forces: each, and their sum, must be finite
+    doubles (at most :data:`~mech_kinematics.bounds.LARGEST`, 1.8e308 N), or
+    the forces at an instant, which add them, cannot be either. Returns
+    ``(element, field, reason)``: the mass whose total overflows, gravity
+    (``element`` None) whose weight does, or the first load that makes the
+    sum overflow; ``reason`` starts with "expected" (the caller puts the key
+    before it).
+    """
+    mass = 0.0
+    for m in masses:
+        mass += m.mass
+        if not math.isfinite(mass):
+            return m, 'mass', (f"expected the moving bodies' masses to add up to a finite "
+                               f'mass, got {m.mass!r} kg')
+    g = magnitude(complex(*gravity))
+    weight = mass * g
+    if not (math.isfinite(g) and math.isfinite(weight)):
+        return None, 'gravity', (f'expected [gx, gy] whose weight on the moving bodies '
+                                 f'({mass:.6g} kg) is a finite force (at most {LARGEST:.4g} '
+                                 f'N), got {list(gravity)} m/s^2')
+    total = weight
+    for load in loads:
+        if load.force is None:
+            continue
+        total += magnitude(complex(*load.force))
+        if not math.isfinite(total):
+            return load, 'force', (f"expected the loads' forces and the weights "
+                                   f'({weight:.4g} N) to add up to a finite force (at most '
+                                   f'{LARGEST:.4g} N), got {list(load.force)} N')
+    return None
 
 
 @dataclass(frozen=True)
@@ -405,6 +442,10 @@ class Dynamics:
                         'the ground' if load.link == graph.ground else f'unknown "{load.link}"')
                     raise SceneError(msg, (load, 'link'))
                 self.torque_loads.setdefault(load.link, []).append(load)
+        refused = given_forces_refusal(tuple(self.masses.values()), self.loads, gravity)
+        if refused is not None:
+            element, key, reason = refused
+            raise SceneError(reason, (element, key))
         self.groups = self._groups()
         #: Why one instant's forces are not written out (:mod:`.forces_compiled`), or None.
         self.compiled_single: NotCompiled | None = None
@@ -555,7 +596,10 @@ class Dynamics:
         if state.valid.__class__ is bool:
             fast = self._fast
             for index, function in enumerate(fast):
-                answer = function(state, max_error)
+                try:
+                    answer = function(state, max_error)
+                except OverflowError:   # abs() of a complex beyond the doubles: refused below
+                    answer = None
                 if answer is False:     # another pivot sequence: try the next
                     continue
                 if answer is not None:
@@ -650,18 +694,18 @@ class Dynamics:
             inertial = {name: self._inertial(name, kin) for name in kin.frames}
             finite: Any = True
             for F, M, _, _ in inertial.values():
-                scale = biggest(scale, abs(F))
+                scale = biggest(scale, magnitude(F))
                 finite = finite & np.isfinite(F) & np.isfinite(M)
             # The least scale, as the kinematics' floors: every body's weight and the inertia
             # force of its mass at the state's scale of acceleration (every force may be 0).
             scales = state.scales
-            gravity = abs(self.gravity)
+            gravity = magnitude(self.gravity)
             for mass in self.masses.values():
                 scale = biggest(scale, mass.mass * (gravity + scales['acceleration'])
                                 + mass.inertia * scales['angular acceleration'] / self.size)
             for load in self.loads:
                 if load.force is not None:
-                    scale = biggest(scale, abs(complex(*load.force)))
+                    scale = biggest(scale, magnitude(complex(*load.force)))
                 else:
                     scale = biggest(scale, abs(load.torque or 0.0) / self.size)
             overflow = valid & ~np.asarray(finite, dtype=bool)
@@ -678,7 +722,7 @@ class Dynamics:
                     valid = valid & ok
                 done.update(solved)
             for carried in done.values():
-                scale = biggest(scale, abs(carried.force))
+                scale = biggest(scale, magnitude(carried.force))
                 scale = biggest(scale, abs(carried.couple) / self.size)
             return self._result(done, kin, scale, valid, failures, max_error)
 
@@ -703,13 +747,15 @@ class Dynamics:
             F = m * (a_c - self.gravity)
             M = mass.inertia * alpha + _cross(r, F)
             e_theta, e_omega, e_alpha = e
-            e_r = abs(com) * (e_theta + 4 * U)
-            e_spin = e_alpha + 2 * abs(omega) * e_omega + 2 * U * abs(spin)
-            e_ac = (kin.acceleration_bound(origin) + e_spin * abs(com) + abs(spin) * e_r
-                    + 4 * U * abs(a_c))
-            eF = m * e_ac + 2 * U * abs(F)
-            eM = (mass.inertia * (e_alpha + U * abs(alpha)) + e_r * abs(F) + abs(com) * eF
-                  + 4 * U * (abs(M) + abs(com) * abs(F)))
+            a_com, a_spin = magnitude(com), magnitude(spin)
+            e_r = a_com * (e_theta + 4 * U)
+            e_spin = e_alpha + 2 * abs(omega) * e_omega + 2 * U * a_spin
+            e_ac = (kin.acceleration_bound(origin) + e_spin * a_com + a_spin * e_r
+                    + 4 * U * magnitude(a_c))
+            a_F = magnitude(F)
+            eF = m * e_ac + 2 * U * a_F
+            eM = (mass.inertia * (e_alpha + U * abs(alpha)) + e_r * a_F + a_com * eF
+                  + 4 * U * (abs(M) + a_com * a_F))
         for load in self.point_loads.get(name, ()):
             force = complex(*load.force)  # type: ignore[misc]
             point = load.point
@@ -717,9 +763,10 @@ class Dynamics:
             d = kin.position(point) - kin.position(origin)
             F = F - force
             M = M - _cross(d, force)
-            e_d = kin.position_bound(point) + kin.position_bound(origin) + U * abs(d)
-            eF = eF + U * (abs(F) + abs(force))
-            eM = eM + e_d * abs(force) + 3 * U * (abs(d) * abs(force) + abs(M))
+            a_d, a_force = magnitude(d), magnitude(force)
+            e_d = kin.position_bound(point) + kin.position_bound(origin) + U * a_d
+            eF = eF + U * (magnitude(F) + a_force)
+            eM = eM + e_d * a_force + 3 * U * (a_d * a_force + abs(M))
         for load in self.torque_loads.get(name, ()):
             M = M - float(load.torque)  # type: ignore[arg-type]
             eM = eM + U * abs(M)
@@ -766,7 +813,7 @@ class Dynamics:
                 else:
                     d = kin.position(at) - kin.position(origin)
                     arms[key] = d, (kin.position_bound(at) + kin.position_bound(origin)
-                                    + U * abs(d))
+                                    + U * magnitude(d))
             return arms[key]
 
         def put(body: str, sign: float, column: int, unit: Any, e_unit: Any,
@@ -790,7 +837,7 @@ class Dynamics:
                 d, e_d = arm(at, body)
                 if d is not None:
                     A[moment][column] += sign * _cross(d, unit)
-                    EA[moment][column] += abs(d) * (e_unit + 3 * U) + e_d
+                    EA[moment][column] += magnitude(d) * (e_unit + 3 * U) + e_d
 
         units = []
         for column, (i, component) in enumerate(config.columns):
@@ -815,7 +862,8 @@ class Dynamics:
             if bi is None:
                 continue
             force = carried.force
-            e_force = carried.force_bound + U * abs(force)
+            a_force = magnitude(force)
+            e_force = carried.force_bound + U * a_force
             fx, fy = row_of[(bi, 0)], row_of[(bi, 1)]
             b[fx] = b[fx] + force.real
             b[fy] = b[fy] + force.imag
@@ -828,9 +876,10 @@ class Dynamics:
                     d = 0j
                 turn = _cross(d, force) + carried.couple
                 b[moment] = b[moment] + turn
-                Eb[moment] = Eb[moment] + (abs(d) * carried.force_bound + e_d * abs(force)
+                a_d = magnitude(d)
+                Eb[moment] = Eb[moment] + (a_d * carried.force_bound + e_d * a_force
                                            + carried.couple_bound
-                                           + 4 * U * (abs(d) * abs(force) + abs(turn)))
+                                           + 4 * U * (a_d * a_force + abs(turn)))
         x, e_x, ok = _bounded_solve(A, EA, b, Eb, kin.vector, pivots)
         carried_by: dict[str, _Carried] = {}
         acting = set(config.joints)
@@ -854,7 +903,7 @@ class Dynamics:
                     e_couple = e_couple + bound + U * abs(couple)
                 else:
                     force = force + value * unit
-                    e_force = e_force + bound + abs(value) * e_unit + 2 * U * abs(force)
+                    e_force = e_force + bound + abs(value) * e_unit + 2 * U * magnitude(force)
             carried_by[joint.name] = _Carried(joint, force, e_force, couple, e_couple, parts)
         return carried_by, ok
 
@@ -916,13 +965,14 @@ class Dynamics:
                 at = kin.position(joint.at)
                 force = carried.force
                 shaking = shaking - force
-                e_shaking = e_shaking + carried.force_bound + U * abs(shaking)
+                e_shaking = e_shaking + carried.force_bound + U * magnitude(shaking)
                 turn = _cross(at, force) + carried.couple
                 moment = moment - turn
-                e_moment = e_moment + (abs(at) * carried.force_bound
-                                       + kin.position_bound(joint.at) * abs(force)
+                a_at, a_force = magnitude(at), magnitude(force)
+                e_moment = e_moment + (a_at * carried.force_bound
+                                       + kin.position_bound(joint.at) * a_force
                                        + carried.couple_bound
-                                       + 4 * U * (abs(at) * abs(force) + abs(moment)))
+                                       + 4 * U * (a_at * a_force + abs(moment)))
         untrusted = (untrusted | judge('shaking.force', e_shaking, force_limit)
                      | judge('shaking.moment', e_moment, moment_limit))
         if kin.vector:
@@ -964,7 +1014,7 @@ def _unit(joint: Joint, component: str, kin: _Kinematics) -> tuple[Any, Any, str
     assert line is not None
     if joint.copies > 1:   # one of several slots: the one its point is in, from the line's point
         d = kin.position(joint.at) - kin.position(line.through)
-        length = abs(d)
+        length = magnitude(d)
         u = d / length
         e_u = (kin.position_bound(joint.at) + kin.position_bound(line.through)) * 2 / length \
             + 4 * U

@@ -47,7 +47,7 @@ from typing import Any, cast, TYPE_CHECKING
 import numpy as np
 
 from .compiler import NotCompiled
-from ..bounds import U
+from ..bounds import magnitude, U
 
 if TYPE_CHECKING:
     from .forces import _Group, Dynamics
@@ -288,7 +288,7 @@ def compile_single(dynamics: Dynamics, pivots: Mapping[str, Sequence[int]],
         mass = dynamics.masses.get(name)
         if mass is not None:
             m, com = w.const(mass.mass), complex(*mass.com)
-            K_com, K_abs_com = w.const(com), w.const(abs(com))
+            K_com, K_abs_com = w.const(com), w.const(magnitude(com))
             r = w.let(f'{K_com} * {w.expi(theta)}') if com else '0j'
             spin = w.let(f'1j * {alpha} - {omega} * {omega}')
             a_c = w.let(f'{acc(origin)} + {spin} * {r}')
@@ -308,7 +308,7 @@ def compile_single(dynamics: Dynamics, pivots: Mapping[str, Sequence[int]],
                        f'{K_abs_com} * {aF}))')
         for load in dynamics.point_loads.get(name, ()):
             load_force = complex(*load.force)  # type: ignore[misc]
-            K_f, K_af = w.const(load_force), w.const(abs(load_force))
+            K_f, K_af = w.const(load_force), w.const(magnitude(load_force))
             point = load.point
             assert point is not None
             d = w.let(f'{pos(point)} - {pos(origin)}')
@@ -325,12 +325,12 @@ def compile_single(dynamics: Dynamics, pivots: Mapping[str, Sequence[int]],
     w.maximum('scale', [ab(F) for F, _, _, _ in inertial.values()], 0.0)
     w.refuse_unless([c for F, M, _, _ in inertial.values()
                      for c in (f'{F} - {F} == 0', f'{M} - {M} == 0.0')])
-    gravity_size = abs(dynamics.gravity)
+    gravity_size = magnitude(dynamics.gravity)
     w.maximum('scale', [f'{w.const(mass.mass)} * ({w.const(gravity_size)} + S_a) + '
                         f'{w.const(mass.inertia)} * S_alpha / {w.const(size)}'
                         for mass in dynamics.masses.values()]
-              + [repr(abs(complex(*load.force))) if load.force is not None
-                 else repr(abs(load.torque or 0.0) / size) for load in dynamics.loads])
+              + [w.const(magnitude(complex(*load.force))) if load.force is not None
+                 else w.const(abs(load.torque or 0.0) / size) for load in dynamics.loads])
     # --- the groups (Dynamics._solve_config, _bounded_solve) ------------------------
     arms: dict[tuple[str, str], tuple[str, str] | None] = {}
 

@@ -16,8 +16,8 @@ from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import WrenchStamped
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
-from ros_helpers import (NodeProcess, NS, RELIABLE, send_until, SESSION, stamp_ns, STARTUP_S,
-                         wait_for, wait_for_parameters)
+from ros_helpers import (cannot_start, exited, NodeProcess, NS, RELIABLE, send_until, SESSION,
+                         stamp_ns, STARTUP_S, wait_for, wait_for_parameters)
 from sensor_msgs.msg import JointState
 
 import mech_kinematics as mk
@@ -218,3 +218,45 @@ def test_topic_drive_with_static_effort_publishes_the_statics(ros, tmp_path):
         inertia = forces_values(moving.forces, moving, scene.output_joints, reactions)
         assert node.published(msg) != inertia
     assert node.effort_status()[-1] == 'static: gravity and loads only, inertia neglected'
+
+
+#: Finite values whose forces overflow a double (issue 42, item 1): the engine's moving
+#: bodies weigh 24 kg, so |g| x 24 kg overflows; a load whose |F| does (abs() of the complex
+#: 1.5e308 + 1.5e308j raised OverflowError, which killed the node: status 1, no answer).
+OVERFLOWING = (('loads.gas.force', [1.5e308, 1.5e308], "loads.gas.force: expected the loads' "
+                'forces and the weights (235.4 N) to add up to a finite force'),
+               ('gravity', [1.5e308, 1.5e308], 'gravity: expected [gx, gy] whose weight on the '
+                'moving bodies (24 kg) is a finite force'),
+               ('gravity', [1.7e308, -1.7e308], 'gravity: expected [gx, gy] whose weight'),
+               ('gravity', [1e308, 1e308], 'gravity: expected [gx, gy] whose weight'))
+
+
+def test_values_whose_forces_overflow_are_refused_and_the_node_goes_on(ros, tmp_path):
+    """Each is refused with its reason through the service; the node keeps publishing forces."""
+    node = ForcesNode(ros, tmp_path, 'forces_overflow', '-p', 'rate_hz:=100')
+    try:
+        wait_for(lambda: len(node.shaking) >= 5, STARTUP_S, 'the first forces')
+        for name, value, reason in OVERFLOWING:
+            result = node.set(name, value)
+            assert not result.successful, (name, value, node.proc.output())
+            assert result.reason.startswith(reason), result.reason
+        assert node.get('gravity') == [0.0, -9.81]
+        assert node.get('loads.gas.force') == [0.0, -17892.35190989812]
+        count = len(node.shaking)
+        wait_for(lambda: len(node.shaking) >= count + 5, STARTUP_S,
+                 'forces published after the refusals')
+        assert node.proc.proc.poll() is None, node.proc.output()
+    finally:
+        node.stop()
+
+
+def test_a_value_whose_forces_overflow_given_at_start_is_one_line(tmp_path):
+    """-p gravity:=[1.5e308, 1.5e308]: exit 1 with one line naming the parameter."""
+    for name, value, reason in OVERFLOWING[:2]:
+        proc = NodeProcess(tmp_path / name, '-r', f'__ns:={SESSION}/forces_overflow_start',
+                           '-p', f'scene:={SCENE}', '-p', f'{name}:={value}')
+        status, output = exited(proc)
+        assert status == 1, output
+        [line] = cannot_start(output)
+        assert output.count('\n') == 1, output
+        assert f'cannot start: {reason}' in line, line
