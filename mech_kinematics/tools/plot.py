@@ -63,6 +63,10 @@ DEFAULT_SAMPLES = 721
 DEFAULT_MAX_SAMPLES = 20_000
 #: Most crank angles per cycle for ``--samples`` (memory stays bounded; no figure shows more).
 MAX_SAMPLES = 100_000
+#: The largest magnitude a panel draws: matplotlib's axis margins and ticks overflow on values
+#: near the largest double (gravity [1.2e308, 1.2e308] on a light scene: forces of 1.7e308 N
+#: gave eight RuntimeWarnings and "arange: cannot compute length"); beyond it, one line.
+MAX_DRAWN = 1e300
 AXES = ('time', 'angle')
 #: Panel titles, by column; tests and readers rely on them.
 TITLES = {
@@ -785,6 +789,16 @@ def _gaps(time: Array | None, n: int) -> Any:
     return steps > GAP_FACTOR * typical if typical > 0 else np.zeros(len(steps), dtype=bool)
 
 
+def _check_drawable(title: str, label: str, values: Array) -> None:
+    """Refuse, in one line, a series with a value beyond :data:`MAX_DRAWN` in magnitude."""
+    finite = np.abs(values[np.isfinite(values)])
+    if finite.size and float(finite.max()) > MAX_DRAWN:
+        msg = (f'Expected values a plot can draw (at most {MAX_DRAWN:g} in magnitude), got '
+               f'{float(finite.max()):.4g} in {title!r}, {label} (smaller forces or speeds '
+               f'plot)')
+        raise PlotError(msg)
+
+
 def _broken(x: Array, y: Array, gaps: Any, *, x_wraps: bool,
             y_wraps: bool) -> tuple[Array, Array]:
     """Insert NaN at ``gaps`` and where ``x`` or ``y`` jumps by more than π (an angle wrap).
@@ -893,6 +907,7 @@ def figure_from_motion(motion: Motion, *, x: str = 'time') -> Any:
                 if values is None:
                     absent += 1
                     continue
+                _check_drawable(TITLES[kind], label, values)
                 px, py = _broken(xs, values, gaps, x_wraps=x == 'angle', y_wraps=wraps)
                 drawn_line = ax.plot(px, py, label=label, linewidth=1.0)[0]
                 drawn += 1

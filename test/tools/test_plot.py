@@ -12,7 +12,7 @@ from pathlib import Path
 import subprocess
 import sys
 
-from helpers import BOOM_CYLINDER, FIVE_BAR_TWO_CRANKS, forces_scene
+from helpers import BOOM_CYLINDER, FIVE_BAR_TWO_CRANKS, forces_scene, SCENES
 import numpy as np
 import pytest
 import yaml
@@ -650,3 +650,43 @@ def test_a_crank_that_cannot_turn_has_no_mean_line_and_says_why(tmp_path):
     fig = plot.figure_from_motion(motion, x='angle')
     texts = [t.get_text() for t in panels(fig)['Turning moment (driver efforts)'].texts]
     assert any(t.startswith('no mean line') for t in texts)
+
+
+def _engine(tmp_path, gravity, masses=None):
+    """The packaged engine with ``gravity`` (and ``masses``, kg by body, if given)."""
+    data = yaml.safe_load((SCENES / 'engine.yaml').read_text())
+    data['gravity'] = gravity
+    for body, mass in (masses or {}).items():
+        data['masses'][body]['mass'] = mass
+    path = tmp_path / 'engine.yaml'
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def test_gravity_whose_forces_overflow_is_one_line(tmp_path, capsys):
+    """Issue 42: gravity [1e308, 1e308] was "unexpected OverflowError"; now the scene's line."""
+    path = _engine(tmp_path, [1e308, 1e308])
+    out = tmp_path / 'e.png'
+    assert plot.main(['--scene', str(path), '-o', str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err == (f'error: {path}: gravity: expected [gx, gy] whose weight on the moving '
+                   'bodies (24 kg) is a finite force (at most 1.798e+308 N), got [1e+308, '
+                   '1e+308] m/s^2\n')
+    assert not out.exists()
+
+
+def test_forces_too_large_to_draw_are_one_line_without_warnings(tmp_path, capsys):
+    """Finite forces of 1e306 N and more: one line, exit 2, no matplotlib warnings.
+
+    The engine with 0.6 kg in all under gravity [1.2e308, 1.2e308]: the weights (1e308 N)
+    are finite, the forces answered; matplotlib's ticks overflowed on them (eight
+    RuntimeWarnings, then "unexpected ValueError: arange: cannot compute length").
+    """
+    path = _engine(tmp_path, [1.2e308, 1.2e308], {'crank': 0.2, 'rod': 0.16, 'piston': 0.24})
+    out = tmp_path / 'e.png'
+    assert plot.main(['--scene', str(path), '-o', str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith('error: Expected values a plot can draw (at most 1e+300 in '
+                          'magnitude), got '), err
+    assert err.rstrip().endswith('(smaller forces or speeds plot)'), err
+    assert err.count('\n') == 1 and not out.exists()

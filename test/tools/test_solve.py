@@ -18,6 +18,8 @@ import mech_kinematics as mk
 from mech_kinematics.__main__ import main
 from mech_kinematics.units import rad_per_s_from_rpm
 
+from helpers import SCENES
+
 
 def run(*args):
     """Return (status, stdout, stderr) of ``python -m mech_kinematics solve ARGS``."""
@@ -180,3 +182,29 @@ def test_a_value_beyond_the_range_of_doubles_is_refused_in_one_line(tmp_path):
     status, out, err = run(str(path), '--speed-rpm', '1e150')   # slower: answered
     assert (status, err) == (0, '')
     assert all(math.isfinite(x) for x in json.loads(out)['imus']['tip']['linear_acceleration'])
+
+
+@pytest.mark.parametrize(('old', 'new', 'message'), [
+    ('gravity: [0, -9.81]', 'gravity: [1.5e308, 1.5e308]',
+     'gravity: expected [gx, gy] whose weight on the moving bodies (24 kg) is a finite force '
+     '(at most 1.798e+308 N), got [1.5e+308, 1.5e+308] m/s^2'),
+    ('gravity: [0, -9.81]', 'gravity: [1e308, 1e308]',
+     'gravity: expected [gx, gy] whose weight on the moving bodies (24 kg) is a finite force '
+     '(at most 1.798e+308 N), got [1e+308, 1e+308] m/s^2'),
+    ('force: [0, -17892.35190989812]', 'force: [1.7e308, -1.7e308]',
+     "loads[0].force: expected the loads' forces and the weights (235.4 N) to add up to a "
+     'finite force (at most 1.798e+308 N), got [1.7e+308, -1.7e+308] N'),
+])
+def test_gravity_or_a_load_whose_forces_overflow_is_one_line(tmp_path, old, new, message):
+    """Issue 42: finite numbers whose forces overflow name the key, exit 2 (was OverflowError).
+
+    ``solve`` printed "unexpected OverflowError: absolute value too large" (abs() of the
+    complex gravity or force) and exited 1.
+    """
+    text = (SCENES / 'engine.yaml').read_text()
+    assert old in text
+    path = tmp_path / 'engine.yaml'
+    path.write_text(text.replace(old, new))
+    status, out, err = run(str(path))
+    assert (status, out) == (2, '')
+    assert err == f'error: {path}: {message}\n'
