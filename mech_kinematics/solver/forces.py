@@ -383,8 +383,9 @@ class Dynamics:
     ------
     SceneError
         Naming the key: a mass on a body the graph lacks (or the ground), a load
-        on an unknown point or body, or a part of the mechanism whose joint
-        reactions statics cannot determine.
+        on an unknown point or body, a part of the mechanism whose joint
+        reactions statics cannot determine, or gravity or a load whose forces
+        overflow a double (:func:`given_forces_refusal`).
     """
 
     def __init__(self, graph: Graph, masses: Sequence[Mass], loads: Sequence[Load],

@@ -28,8 +28,10 @@ bounds (``test_forces_compiled``). A function returns:
 - the :class:`.forces.Forces` of a valid instant;
 - ``False`` where a pivot differs (the caller tries another sequence);
 - ``None`` where the general path must decide: a singular or unbounded
-  group, a value beyond the doubles, a bound beyond the tolerance (the
-  general path refuses with its reason), or NumPy scalars in the state.
+  group, a value beyond the doubles (also where ``abs()`` of a complex
+  raises ``OverflowError``, which the caller takes as None), a bound beyond
+  the tolerance (the general path refuses with its reason), or NumPy
+  scalars in the state.
 
 Where a scene cannot be written out, :func:`compile_single` returns a
 :class:`.compiler.NotCompiled` with the reason, one line: an intermittent

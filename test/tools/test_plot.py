@@ -653,7 +653,7 @@ def test_a_crank_that_cannot_turn_has_no_mean_line_and_says_why(tmp_path):
 
 
 def _engine(tmp_path, gravity, masses=None):
-    """The packaged engine with ``gravity`` (and ``masses``, kg by body, if given)."""
+    """Return the packaged engine with ``gravity`` (and ``masses``, kg by body, if given)."""
     data = yaml.safe_load((SCENES / 'engine.yaml').read_text())
     data['gravity'] = gravity
     for body, mass in (masses or {}).items():

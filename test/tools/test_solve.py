@@ -12,13 +12,12 @@ import io
 import json
 import math
 
+from helpers import SCENES
 import pytest
 
 import mech_kinematics as mk
 from mech_kinematics.__main__ import main
 from mech_kinematics.units import rad_per_s_from_rpm
-
-from helpers import SCENES
 
 
 def run(*args):
