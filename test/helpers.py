@@ -468,10 +468,16 @@ def _rpy(r: float, p: float, y: float) -> Any:
 
 
 def _pose(element: Any, xyz_key: str = 'xyz', rpy_key: str = 'rpy') -> Any:
+    """Return an ``<origin>``'s 4x4: ``rpy``, or URDF 1.1's ``quat_xyzw`` (through SciPy)."""
     import numpy as np
     out = np.eye(4)
     if element is not None:
-        out[:3, :3] = _rpy(*(float(v) for v in element.get(rpy_key, '0 0 0').split()))
+        quat = element.get('quat_xyzw')
+        if quat is None:
+            out[:3, :3] = _rpy(*(float(v) for v in element.get(rpy_key, '0 0 0').split()))
+        else:
+            from scipy.spatial.transform import Rotation
+            out[:3, :3] = Rotation.from_quat([float(v) for v in quat.split()]).as_matrix()
         out[:3, 3] = [float(v) for v in element.get(xyz_key, '0 0 0').split()]
     return out
 

@@ -4,8 +4,11 @@
 
 The URDF's links and joints are read by ``urdf_parser_py`` (ROS's own Python
 URDF reader, the ``urdfdom_py`` package), on an XML tree that lxml parses here
-with entities and the network turned off (a URDF is text from anyone). What
-no URDF library reads is read here from the same tree:
+with entities and the network turned off (a URDF is text from anyone). The
+``<robot version>`` gate is ours (urdf_parser_py knows 1.0 only): 1.0, 1.1 and
+1.2 are read (:data:`URDF_VERSIONS`), and an ``<origin quat_xyzw>`` (1.1) of a
+joint, an inertial or a constraint is read here, exactly. What no URDF library
+reads is read here from the same tree:
 
 - ``<constraint>`` elements, as proposed in ros/urdfdom#264 and
   ros/urdfdom_headers#108 (``name``, ``type``; ``<parent link>``,
@@ -48,7 +51,13 @@ from ..errors import SceneError, UrdfError
 from ..solver.graph import JointType, PRISMATIC, REVOLUTE
 
 __all__ = ['Closure', 'ClosureKind', 'Description', 'Inertial', 'Mimic', 'UrdfJoint',
-           'read_description', 'URDF_TYPES']
+           'read_description', 'URDF_TYPES', 'URDF_VERSIONS']
+
+#: The ``<robot version>`` values read (none given: 1.0), as urdfdom 6 writes them:
+#: 1.1 adds ``quat_xyzw`` to ``<origin>`` (read) and capsule geometry, 1.2 a
+#: ``<limit>``'s acceleration, deceleration and jerk (neither used by a loop:
+#: ignored, never refused).
+URDF_VERSIONS = ('1.0', '1.1', '1.2')
 
 #: A URDF joint type -> the joint type of its coordinate (None: no coordinate we solve).
 URDF_TYPES: dict[str, JointType | None] = {
@@ -312,12 +321,58 @@ def _unit(vector: tuple[float, ...], what: str, source: str, joint: str | None =
     return x, y, z
 
 
-def _origin(element: Any, what: str, source: str) -> Matrix:
+def _origin(element: Any, what: str, source: str, version: str = '1.0') -> Matrix:
+    """Return the transform of an ``<origin xyz rpy>`` or ``<origin xyz quat_xyzw>`` (1.1)."""
     if element is None:
         return np.eye(4)
     xyz = _floats(element.get('xyz'), 3, f'{what} xyz', source, (0.0, 0.0, 0.0))
-    rpy = _floats(element.get('rpy'), 3, f'{what} rpy', source, (0.0, 0.0, 0.0))
-    return transform(xyz, rpy)
+    quat = element.get('quat_xyzw')
+    if quat is None:
+        rpy = _floats(element.get('rpy'), 3, f'{what} rpy', source, (0.0, 0.0, 0.0))
+        return transform(xyz, rpy)
+    if version == '1.0':
+        raise _fail(source, f'{what}: Expected quat_xyzw only in a URDF of version 1.1 or '
+                            'later (<robot version="1.1">), got it in version 1.0')
+    if element.get('rpy') is not None:
+        raise _fail(source, f'{what}: Expected rpy or quat_xyzw, got both')
+    q = _floats(quat, 4, f'{what} quat_xyzw', source)
+    try:
+        return transform(xyz, quat_xyzw=q)
+    except ValueError:
+        raise _fail(source, f'Expected {what} quat_xyzw to be a non-zero quaternion, got '
+                            f'{quat!r}') from None
+
+
+def _version(root: Any, source: str) -> str:
+    """Return the URDF's ``<robot version>`` (1.0 when none is given), or refuse in one line."""
+    text = root.get('version')
+    if text is None:
+        return '1.0'
+    match = re.fullmatch(r'\s*(\d+)\.(\d+)\s*', text)
+    version = None if match is None else f'{int(match[1])}.{int(match[2])}'
+    if version not in URDF_VERSIONS:
+        form = '' if match is not None else ' (the form MAJOR.MINOR)'
+        raise _fail(source, f'Expected <robot version> {", ".join(URDF_VERSIONS)}{form}, '
+                            f'got {text!r}')
+    return str(version)
+
+
+def _quaternion_origins(root: Any, version: str, source: str) -> dict[tuple[str, str], Matrix]:
+    """Return the ``<origin quat_xyzw>`` transforms of joints and inertials, read exactly.
+
+    urdf_parser_py reads ``rpy`` only; these replace its origins (keys ``('joint',
+    NAME)`` and ``('inertial', LINK)``).
+    """
+    out: dict[tuple[str, str], Matrix] = {}
+    for kind, parent_tag, path in (('joint', 'joint', 'origin'),
+                                   ('inertial', 'link', 'inertial/origin')):
+        for parent in root.findall(parent_tag):
+            origin = parent.find(path)
+            if origin is not None and origin.get('quat_xyzw') is not None:
+                name = parent.get('name') or ''
+                out[kind, name] = _origin(origin, f'{parent_tag} "{name}" <{path}>', source,
+                                          version)
+    return out
 
 
 class _Collect:
@@ -356,6 +411,10 @@ def _read_links_and_joints(root: Any, source: str) -> Any:
     for child in list(copy):  # what we read ourselves, or what no URDF reader reads
         if not isinstance(child.tag, str) or child.tag not in known:
             copy.remove(child)
+    copy.attrib.pop('version', None)  # our gate (_version): urdf_parser_py knows only 1.0
+    for link in copy.iter('link'):  # shapes no loop uses (1.1's capsule is not theirs)
+        for shape in [*link.findall('visual'), *link.findall('collision')]:
+            link.remove(shape)
     collect = _Collect()
     with _PARSE_LOCK:  # urdf_parser_py reports through a module-level function
         saved = core.on_error
@@ -370,7 +429,8 @@ def _read_links_and_joints(root: Any, source: str) -> Any:
             core.on_error = saved
 
 
-def _inertials(robot: Any, source: str) -> dict[str, Inertial]:
+def _inertials(robot: Any, source: str, quaternions: Mapping[tuple[str, str], Matrix]
+               ) -> dict[str, Inertial]:
     """Return each link's ``<inertial>`` of mass above 0, checked (one line naming the link)."""
     out: dict[str, Inertial] = {}
     for link in robot.links:
@@ -401,11 +461,13 @@ def _inertials(robot: Any, source: str) -> dict[str, Inertial]:
             given = dict(zip(names, values, strict=True))
             raise _fail(source, f'link "{link.name}": Expected its <inertial> inertia to be '
                                 f'positive semi-definite, got {given}')
-        out[link.name] = Inertial(mass, transform(xyz, rpy), tensor)
+        frame = quaternions.get(('inertial', link.name))
+        out[link.name] = Inertial(mass, transform(xyz, rpy) if frame is None else frame, tensor)
     return out
 
 
-def _joints(robot: Any, source: str) -> dict[str, UrdfJoint]:
+def _joints(robot: Any, source: str, quaternions: Mapping[tuple[str, str], Matrix]
+            ) -> dict[str, UrdfJoint]:
     links = {link.name for link in robot.links}
     out: dict[str, UrdfJoint] = {}
     children: dict[str, str] = {}
@@ -436,6 +498,7 @@ def _joints(robot: Any, source: str) -> dict[str, UrdfJoint]:
                 raise _fail(source, f'{where}: Expected a finite <origin>, got xyz '
                             f'{xyz} rpy {rpy}', name)
             origin = transform(xyz, rpy)
+        origin = quaternions.get(('joint', name), origin)
         axis: tuple[float, float, float] = (1.0, 0.0, 0.0)
         if joint.axis is not None and URDF_TYPES[kind] is not None:
             axis = _unit(tuple(float(v) for v in joint.axis), f"{where}'s <axis>", source,
@@ -482,7 +545,8 @@ def _root(links: tuple[str, ...], joints: dict[str, UrdfJoint], source: str) -> 
     return roots[0]
 
 
-def _constraints(root: Any, links: set[str], source: str) -> Iterator[Closure]:
+def _constraints(root: Any, links: set[str], source: str, version: str
+                 ) -> Iterator[Closure]:
     for element in root.findall('constraint'):
         name = element.get('name') or ''
         where = f'<constraint name="{name}">'
@@ -498,7 +562,8 @@ def _constraints(root: Any, links: set[str], source: str) -> Iterator[Closure]:
             if link_name not in links:
                 raise _fail(source, f'{where}: Expected <{end} link="..."/> naming a link of the '
                             f'robot, got {link_name!r}')
-            frame = _origin(element.find(f'{end}_origin'), f'{where} {end}_origin', source)
+            frame = _origin(element.find(f'{end}_origin'), f'{where} {end}_origin', source,
+                            version)
             axis = element.find(f'{end}_axis')
             direction = None if axis is None else _unit(
                 _floats(axis.get('xyz'), 3, f'{where} {end}_axis xyz', source),
@@ -638,6 +703,8 @@ def read_description(source: str | os.PathLike[str], closures: str | os.PathLike
         except SceneError as error:
             raise UrdfError(str(error)) from None
     root = _parse_xml(text, name)
+    version = _version(root, name)
+    quaternions = _quaternion_origins(root, version, name)
     robot = _read_links_and_joints(root, name)
     links = tuple(link.name for link in robot.links)
     if len(set(links)) != len(links):
@@ -645,11 +712,11 @@ def read_description(source: str | os.PathLike[str], closures: str | os.PathLike
         raise _fail(name, f'Expected every link to have a name of its own, got "{twice}" twice')
     if not links:
         raise _fail(name, 'Expected a URDF with at least one link, got none')
-    joints = _joints(robot, name)
+    joints = _joints(robot, name, quaternions)
     root_link = _root(links, joints, name)
-    found = tuple(_constraints(root, set(links), name)) + tuple(
+    found = tuple(_constraints(root, set(links), name, version)) + tuple(
         _closing_frames(joints, links, name))
-    inertials = _inertials(robot, name)
+    inertials = _inertials(robot, name, quaternions)
     description = Description(str(robot.name or 'robot'), name, text, links, joints, root_link,
                               found, _actuated(root), inertials=inertials)
     if closures is None:
