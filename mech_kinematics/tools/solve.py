@@ -52,17 +52,17 @@ J=VALUE in rpm or m/s, --accel J=VALUE in rad/s^2 or m/s^2, each from the
 joint's zero and positive about its axis as written. Its JSON has "robot",
 "inputs" and "joints" keyed by URDF joint names (every joint of every loop,
 the actuated ones and the mimic joints that follow them), the loops'
-"points" in their plane, "mimic" (a mimic joint a loop moves away from its
-rule) and "limits" (a joint outside its <limit>, reported, not refused).
+"points" in their plane, "mimic" (every joint whose value strays from its
+<mimic> rule: a loop's joint, an actuated one) and "limits" (a joint outside
+its <limit>, reported, not refused). A revolute joint given beyond a turn
+is reduced exactly, as a scene's crank angle is.
 """
 
 
 def _robot_drive(robot: Any, args: argparse.Namespace
                  ) -> tuple[dict[str, float], dict[str, float], dict[str, float], str]:
     """Return a robot's actuated joints' values (SI) from --input, --speed and --accel J=V."""
-    from types import SimpleNamespace
-
-    names = SimpleNamespace(drivers=[SimpleNamespace(name=n) for n in robot.actuated])
+    names = _named(robot)
     inputs = values_by_driver(names, '--input', args.input)
     speeds = values_by_driver(names, '--speed', args.speed)
     accels = values_by_driver(names, '--accel', args.accel)
@@ -88,6 +88,31 @@ def _robot_drive(robot: Any, args: argparse.Namespace
     return positions, rates, accels, shown
 
 
+def _within_a_turn(robot: Any, args: argparse.Namespace) -> dict[str, float]:
+    """Return the actuated revolute joints given beyond a turn, each reduced exactly (rad).
+
+    As a scene's crank (``turns_from_degrees``): ``--input J=1e17`` turns the
+    loops as ``J=-80`` does, to the bit, where ``math.radians(1e17)`` is a
+    double 1.7e15 rad whose direction is lost. A joint a ``<mimic>`` rule
+    involves (it leads one, or has one) is left as given: its rule is applied
+    to its value, not to its direction.
+    """
+    joints = robot.description.joints
+    ruled = {n for n in robot.joint_names if joints[n].mimic is not None}
+    ruled |= {joints[n].mimic.joint for n in ruled}
+    given = dict(values_by_driver(_named(robot), '--input', args.input))
+    if args.angle_deg is not None and len(robot.actuated) == 1:
+        given.setdefault(robot.actuated[0], args.angle_deg)
+    return {name: turns_from_degrees(degrees)[0] for name, degrees in given.items()
+            if abs(degrees) > 360.0 and name not in ruled and robot.joint_type(name).angular}
+
+
+def _named(robot: Any) -> Any:
+    """Return the robot's actuated joints as the drivers ``values_by_driver`` names."""
+    from types import SimpleNamespace
+    return SimpleNamespace(drivers=[SimpleNamespace(name=n) for n in robot.actuated])
+
+
 def _handle_robot(args: argparse.Namespace) -> int:
     """Solve a robot described in URDF: its joints under their URDF names."""
     try:
@@ -96,10 +121,16 @@ def _handle_robot(args: argparse.Namespace) -> int:
     except (SceneError, ValueError) as error:
         print(f'error: {error}', file=sys.stderr)
         return 2
+    exact = _within_a_turn(robot, args)
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter('always', NearSingularWarning)
-            answer = robot.solve(positions, speeds, accels, max_error=args.max_error)
+            answer = robot.solve({**positions, **exact}, speeds, accels,
+                                 max_error=args.max_error)
+        if exact:  # the loops at the exact direction; the joints echoed as given
+            answer = robot.joints_from_state(answer.state, {
+                name: (positions.get(name, motion.position), motion.velocity,
+                       motion.acceleration) for name, motion in answer.inputs.items()})
     except AssemblyError as error:
         reason = error.reason if isinstance(error, UntrustedError) or error.facts is None \
             else assembly_text(error, robot.scene.units)
