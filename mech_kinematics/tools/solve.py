@@ -13,8 +13,8 @@ from typing import Any
 import warnings
 
 from .cli import (add_driver_arguments, add_robot_arguments, add_scene_argument,
-                  drive_from_args, finite_float, is_urdf, load_robot_argument, positive_float,
-                  run_tool, values_by_driver)
+                  drive_from_args, finite_float, is_urdf, load_robot_argument, mimic_ruled,
+                  positive_float, run_tool, values_by_driver)
 from ..bounds import MAX_ERROR
 from ..errors import AssemblyError, NearSingularWarning, SceneError, UntrustedError
 from ..scene import load_scene
@@ -59,10 +59,19 @@ is reduced exactly, as a scene's crank angle is.
 """
 
 
-def _robot_drive(robot: Any, args: argparse.Namespace
-                 ) -> tuple[dict[str, float], dict[str, float], dict[str, float], str]:
-    """Return a robot's actuated joints' values (SI) from --input, --speed and --accel J=V."""
-    names = _named(robot)
+def _robot_drive(robot: Any, args: argparse.Namespace) -> tuple[
+        dict[str, float], dict[str, float], dict[str, float], str, dict[str, float]]:
+    """Return a robot's actuated joints' values (SI) from --input, --speed and --accel J=V.
+
+    And, last, the revolute joints given beyond a turn, each reduced exactly
+    to its direction in rad, as a scene's crank (``turns_from_degrees``):
+    ``--input J=1e17`` turns the loops as ``J=-80`` does, to the bit, where
+    ``math.radians(1e17)`` is a double of 1.7e15 rad whose direction is lost.
+    A joint a ``<mimic>`` rule involves is taken as given (:func:`mimic_ruled`).
+    """
+    from types import SimpleNamespace
+
+    names = SimpleNamespace(drivers=[SimpleNamespace(name=n) for n in robot.actuated])
     inputs = values_by_driver(names, '--input', args.input)
     speeds = values_by_driver(names, '--speed', args.speed)
     accels = values_by_driver(names, '--accel', args.accel)
@@ -76,52 +85,29 @@ def _robot_drive(robot: Any, args: argparse.Namespace
                    f'({", ".join(robot.actuated)}), got {flag}')
             raise ValueError(msg)
         table[robot.actuated[0]] = value
-    positions, rates, words = {}, {}, []
+    positions, rates, words, exact = {}, {}, [], {}
+    ruled = mimic_ruled(robot.description)
     for name in robot.actuated:
         angular = robot.joint_type(name).angular
         if name in inputs:
             positions[name] = math.radians(inputs[name]) if angular else inputs[name]
+            if angular and abs(inputs[name]) > 360.0 and name not in ruled:
+                exact[name] = turns_from_degrees(inputs[name])[0]
             words.append(f'{name} = {inputs[name]:.15g} {"deg" if angular else "m"}')
         if name in speeds:
             rates[name] = rad_per_s_from_rpm(speeds[name]) if angular else speeds[name]
     shown = ', '.join(words) or 'the reference pose'
-    return positions, rates, accels, shown
-
-
-def _within_a_turn(robot: Any, args: argparse.Namespace) -> dict[str, float]:
-    """Return the actuated revolute joints given beyond a turn, each reduced exactly (rad).
-
-    As a scene's crank (``turns_from_degrees``): ``--input J=1e17`` turns the
-    loops as ``J=-80`` does, to the bit, where ``math.radians(1e17)`` is a
-    double 1.7e15 rad whose direction is lost. A joint a ``<mimic>`` rule
-    involves (it leads one, or has one) is left as given: its rule is applied
-    to its value, not to its direction.
-    """
-    joints = robot.description.joints
-    ruled = {n for n in robot.joint_names if joints[n].mimic is not None}
-    ruled |= {joints[n].mimic.joint for n in ruled}
-    given = dict(values_by_driver(_named(robot), '--input', args.input))
-    if args.angle_deg is not None and len(robot.actuated) == 1:
-        given.setdefault(robot.actuated[0], args.angle_deg)
-    return {name: turns_from_degrees(degrees)[0] for name, degrees in given.items()
-            if abs(degrees) > 360.0 and name not in ruled and robot.joint_type(name).angular}
-
-
-def _named(robot: Any) -> Any:
-    """Return the robot's actuated joints as the drivers ``values_by_driver`` names."""
-    from types import SimpleNamespace
-    return SimpleNamespace(drivers=[SimpleNamespace(name=n) for n in robot.actuated])
+    return positions, rates, accels, shown, exact
 
 
 def _handle_robot(args: argparse.Namespace) -> int:
     """Solve a robot described in URDF: its joints under their URDF names."""
     try:
         robot = load_robot_argument(args)
-        positions, speeds, accels, shown = _robot_drive(robot, args)
+        positions, speeds, accels, shown, exact = _robot_drive(robot, args)
     except (SceneError, ValueError) as error:
         print(f'error: {error}', file=sys.stderr)
         return 2
-    exact = _within_a_turn(robot, args)
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter('always', NearSingularWarning)

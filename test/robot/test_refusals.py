@@ -252,3 +252,29 @@ def test_a_crank_given_beyond_a_turn_is_reduced_exactly(tmp_path, capsys, flag):
     for name in ('elbow', 'rocker_pivot'):
         assert got['joints'][name] == within['joints'][name]
     assert got['points'] == within['points']
+
+
+@pytest.mark.parametrize('turns', [3 * 10 ** 9, 2 ** 52])
+def test_a_reference_beyond_a_turn_is_reduced_exactly(tmp_path, capsys, turns):
+    """--reference motor=360*N (deg) is the zero pose to the bit (was refused: a gap)."""
+    import json
+    answers = []
+    for degrees in (360.0 * turns, 0.0):
+        status, out, err = solve_urdf_text(tmp_path, capsys, khurmi_urdf(), '--input',
+                                           'motor=30', '--reference', f'motor={degrees!r}')
+        assert (status, err) == (0, '')
+        answers.append(json.loads(out))
+    assert answers[0]['joints'] == answers[1]['joints']
+    assert answers[0]['points'] == answers[1]['points']
+
+
+def test_a_joint_a_mimic_rule_involves_is_taken_as_given(tmp_path, capsys):
+    """The crank leads a <mimic>: 1e17 deg is its value (the rule's), not reduced to -80."""
+    import json
+    text = khurmi_urdf().replace('</robot>', """<link name="e1"/>
+      <joint name="w1" type="revolute"><parent link="frame"/><child link="e1"/>
+        <axis xyz="1 0 0"/><mimic joint="motor" multiplier="0.5"/></joint></robot>""")
+    status, out, _ = solve_urdf_text(tmp_path, capsys, text, '--input', 'motor=400')
+    assert status == 0
+    import math
+    assert json.loads(out)['joints']['w1']['position'] == 0.5 * math.radians(400)
