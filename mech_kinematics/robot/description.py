@@ -307,7 +307,7 @@ def _unit(vector: tuple[float, ...], what: str, source: str, joint: str | None =
     # Scaled by its largest component first, so that 0 0 1e-300 (whose squares underflow)
     # and 0 0 1e200 (whose squares overflow) are the directions they are.
     largest = max((abs(v) for v in vector), default=0.0)
-    if not largest > 0.0 or not math.isfinite(largest):
+    if not largest > 0.0 or not all(math.isfinite(v) for v in vector):
         raise _fail(source, f'Expected {what} to be a non-zero direction, got '
                     f'{" ".join(f"{v:g}" for v in vector)}', joint)
     scaled = [v / largest for v in vector]

@@ -1024,7 +1024,8 @@ def _pinned_once(description: Description, edges: list[_Edge], tree: Mapping[str
         why = ('at the same point: one pin written twice' if apart <= GAP_TOLERANCE * scale
                else f'{apart:.3g} m apart, they weld them: join them by a fixed joint or a '
                f'<constraint type="link">')
-        raise UrdfError(f'{source}: closure "{late.name}": Expected two bodies to be pinned '
+        who = 'closure' if late.closure is not None else 'joint'
+        raise UrdfError(f'{source}: {who} "{late.name}": Expected two bodies to be pinned '
                         f'together once, got links "{_ends(late)[0]}" and "{_ends(late)[1]}" '
                         f'pinned by "{early.name}" too ({why})', joint=late.name)
 

@@ -278,3 +278,10 @@ def test_a_joint_a_mimic_rule_involves_is_taken_as_given(tmp_path, capsys):
     assert status == 0
     import math
     assert json.loads(out)['joints']['w1']['position'] == 0.5 * math.radians(400)
+
+
+@pytest.mark.parametrize('xyz', ['nan 0 1', '0 nan -1', '0 inf 1', '0 0 -inf'])
+def test_an_axis_that_is_not_finite_is_refused(xyz):
+    """Scaled by its largest component, a NaN beside a 1 must still be refused."""
+    error = _refused(khurmi_urdf().replace('<axis xyz="0 0 -1"/>', f'<axis xyz="{xyz}"/>', 1))
+    assert error.joint == 'rocker_pivot' and 'non-zero direction' in str(error)
