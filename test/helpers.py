@@ -635,6 +635,16 @@ KHURMI = """<?xml version="1.0"?>
 """
 
 
+def solve_urdf_text(tmp_path, capsys, text, *args):
+    """Return ``solve ROBOT.urdf ARGS``'s (status, stdout, stderr) for a URDF's ``text``."""
+    from mech_kinematics.__main__ import main as cli_main
+    path = tmp_path / 'robot.urdf'
+    path.write_text(text)
+    status = cli_main(['solve', str(path), *args])
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
 def khurmi_pin():
     """Return pin C of Khurmi's four-bar in the coupler's and the rocker's frames (m)."""
     scene = mk.load_scene('khurmi_four_bar_ad150')

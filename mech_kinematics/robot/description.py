@@ -313,11 +313,15 @@ def _floats(text: str | None, count: int, what: str, source: str,
 
 def _unit(vector: tuple[float, ...], what: str, source: str, joint: str | None = None
           ) -> tuple[float, float, float]:
-    norm = math.sqrt(sum(v * v for v in vector))
-    if not norm > 0.0 or not math.isfinite(norm):
+    # Scaled by its largest component first, so that 0 0 1e-300 (whose squares underflow)
+    # and 0 0 1e200 (whose squares overflow) are the directions they are.
+    largest = max((abs(v) for v in vector), default=0.0)
+    if not largest > 0.0 or not all(math.isfinite(v) for v in vector):
         raise _fail(source, f'Expected {what} to be a non-zero direction, got '
                     f'{" ".join(f"{v:g}" for v in vector)}', joint)
-    x, y, z = (v / norm for v in vector)
+    scaled = [v / largest for v in vector]
+    norm = math.sqrt(sum(v * v for v in scaled))
+    x, y, z = (v / norm for v in scaled)
     return x, y, z
 
 
@@ -393,7 +397,8 @@ def _parse_xml(text: str, source: str) -> Any:
     try:
         root = etree.fromstring(text.encode('utf-8'), parser)
     except etree.XMLSyntaxError as error:
-        raise _fail(source, f'Expected a URDF (XML), got text that is not XML: {error}') from None
+        text = ' '.join(str(error).split())  # lxml's message may hold a newline (a NUL's)
+        raise _fail(source, f'Expected a URDF (XML), got text that is not XML: {text}') from None
     if root.tag != 'robot':
         raise _fail(source, f'Expected a URDF whose root element is <robot>, got <{root.tag}>')
     return root
@@ -524,7 +529,26 @@ def _joints(robot: Any, source: str, quaternions: Mapping[tuple[str, str], Matri
                                         or out[joint.mimic.joint].type is None):
             raise _fail(source, f'joint "{joint.name}": Expected its <mimic> to follow a '
                         f'moving joint of the robot, got "{joint.mimic.joint}"', joint.name)
+    _mimic_chains(out, source)
     return out
+
+
+def _mimic_chains(joints: Mapping[str, UrdfJoint], source: str) -> None:
+    """Refuse a cycle of ``<mimic>`` rules (a joint that mimics itself, w1 -> w2 -> w1)."""
+    done: set[str] = set()
+    for name in joints:
+        chain: list[str] = []
+        joint: str | None = name
+        while joint is not None and joint not in done:
+            if joint in chain:
+                cycle = chain[chain.index(joint):] + [joint]
+                raise _fail(source, f'joint "{joint}": Expected its <mimic> rule to lead to a '
+                            f'joint that mimics none, got a cycle: '
+                            f'{" mimics ".join(cycle)}', joint)
+            chain.append(joint)
+            rule = joints[joint].mimic
+            joint = None if rule is None else rule.joint
+        done.update(chain)
 
 
 def _root(links: tuple[str, ...], joints: dict[str, UrdfJoint], source: str) -> str:

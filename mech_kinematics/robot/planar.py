@@ -441,7 +441,10 @@ class _Mechanism:
                 assert closure is not None
                 on_a = self.frame[closure.link_a] @ closure.frame_a
                 on_b = self.frame[closure.link_b] @ closure.frame_b
-                self.gaps.append((float(np.linalg.norm(on_a[:3, 3] - on_b[:3, 3])), edge.name))
+                # hypot, not a norm of squares: points 1e308 m apart are that far, not inf.
+                gap = math.hypot(*(float(a) - float(b) for a, b in zip(on_a[:3, 3], on_b[:3, 3],
+                                                                       strict=True)))
+                self.gaps.append((gap, edge.name))
             self.pins[edge.a][edge.name] = self.flat(on_a[:, 3])
             self.pins[edge.b][edge.name] = self.flat(on_b[:, 3])
             self.pin_ends[edge.name] = (edge.a, edge.b)
@@ -987,6 +990,62 @@ def _actuated_names(description: Description, actuated: Iterable[str] | None,
     return tuple(dict.fromkeys(names))
 
 
+def _pinned_once(description: Description, edges: list[_Edge], tree: Mapping[str, Matrix]
+                 ) -> None:
+    """Refuse a closure named as another closure or a joint, or a second pin of two bodies.
+
+    A closure's name is its scene point's, so two of one name would be one
+    point; two pins between the same two bodies are a closure written twice
+    (at one point) or a weld (at two), never a loop that moves.
+    """
+    source = description.source
+    names = {e.name: e for e in edges if e.joint is not None}
+    pins: dict[frozenset[str], _Edge] = {}
+    for edge in edges:
+        closure = edge.closure
+        if closure is not None:
+            other = names.setdefault(edge.name, edge)
+            if other is not edge:
+                what = 'closure' if other.closure is not None else 'joint'
+                raise UrdfError(f'{source}: closure "{edge.name}": Expected every closure to '
+                                f'have a name of its own, got "{edge.name}" twice (the other '
+                                f'{what} joins links "{_ends(other)[0]}" and '
+                                f'"{_ends(other)[1]}")', joint=edge.name)
+        if edge.kind != 'pin':
+            continue
+        first = pins.setdefault(frozenset((edge.a, edge.b)), edge)
+        if first is edge:
+            continue
+        late = edge if edge.closure is not None else first
+        early = first if late is edge else edge
+        p, q = (_pin_point(e, tree) for e in (early, late))
+        apart = math.hypot(*(float(a) - float(b) for a, b in zip(p, q, strict=True)))
+        scale = max(math.hypot(*map(float, p)), math.hypot(*map(float, q)))
+        why = ('at the same point: one pin written twice' if apart <= GAP_TOLERANCE * scale
+               else f'{apart:.3g} m apart, they weld them: join them by a fixed joint or a '
+               f'<constraint type="link">')
+        who = 'closure' if late.closure is not None else 'joint'
+        raise UrdfError(f'{source}: {who} "{late.name}": Expected two bodies to be pinned '
+                        f'together once, got links "{_ends(late)[0]}" and "{_ends(late)[1]}" '
+                        f'pinned by "{early.name}" too ({why})', joint=late.name)
+
+
+def _ends(edge: _Edge) -> tuple[str, str]:
+    """Return the URDF links an edge joins (a joint's parent and child, a closure's links)."""
+    if edge.joint is not None:
+        return edge.joint.parent, edge.joint.child
+    assert edge.closure is not None
+    return edge.closure.link_a, edge.closure.link_b
+
+
+def _pin_point(edge: _Edge, tree: Mapping[str, Matrix]) -> Any:
+    """Return a pin's point in the root frame at the reference pose."""
+    if edge.joint is not None:
+        return (tree[edge.joint.parent] @ edge.joint.origin)[:3, 3]
+    assert edge.closure is not None
+    return (tree[edge.closure.link_a] @ edge.closure.frame_a)[:3, 3]
+
+
 def planar_from_description(description: Description, actuated: Iterable[str] | None = None,
                             reference: Mapping[str, float] | None = None) -> Planar:
     """Return the scene of a robot's planar loops and the maps of its joints.
@@ -1045,6 +1104,7 @@ def planar_from_description(description: Description, actuated: Iterable[str] | 
     actuated_names = _actuated_names(description, actuated, loop_joints)
     # Every link's frame at the reference pose, by the tree.
     tree = description.transforms(pose)
+    _pinned_once(description, edges, tree)
     model = {body: tree[body] for body in bodies}
     builder = _Builder(description, actuated_names, pose)
     mechanisms = []

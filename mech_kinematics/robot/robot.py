@@ -39,7 +39,7 @@ from ..solver.state import JointMotion
 
 __all__ = ['MIMIC_TOLERANCE', 'Robot', 'RobotState', 'load_robot']
 
-#: A mimic joint inside a loop strays from its rule when they differ by more (rad or m).
+#: A joint strays from its ``<mimic>`` rule when they differ by more (rad or m).
 MIMIC_TOLERANCE = 1e-9
 _EPS = float(np.finfo(np.float64).eps)
 
@@ -69,8 +69,10 @@ class RobotState:
     state : State
         The scene's state (points in the loops' plane).
     mimic : dict of str to dict
-        A mimic joint inside a loop whose value strays from its rule by more
-        than :data:`MIMIC_TOLERANCE`: ``{'leader', 'rule', 'stray'}``.
+        Every answered joint with a ``<mimic>`` whose leader is answered (a
+        loop's joint, an actuated one) whose value strays from its rule by
+        more than :data:`MIMIC_TOLERANCE`: ``{'leader', 'rule', 'stray'}``
+        (the rule's value, the joint's minus it).
     limits : dict of str to dict
         A joint outside its ``<limit>``: ``{'position', 'lower', 'upper'}``.
     """
@@ -151,7 +153,6 @@ class Robot:
                             f'actuated joints start, got: {error}') from None
         self.reference = description.pose(reference)
         maps = self.planar.joints
-        drivers = {d.name for d in self.planar.drivers}
         self.actuated = self.planar.actuated
         self._driven = {d.name: d for d in self.planar.drivers}
         names = list(self.actuated)
@@ -170,9 +171,10 @@ class Robot:
                     changed = True
         self.joint_names = tuple(names)
         self._maps: dict[str, JointMap] = maps
-        self._loop_mimics = {n: description.joints[n].mimic for n in maps
-                             if description.joints[n].mimic is not None and n not in drivers}
-        del drivers
+        # Every answered joint's <mimic> whose leader is answered: a loop's joint, an actuated
+        # one (given, so free to break it), and those that follow it (0 stray: checked alike).
+        self._rules = {n: rule for n in names if (rule := description.joints[n].mimic)
+                       is not None and rule.joint in known}
 
     @classmethod
     def from_urdf(cls, source: str | os.PathLike[str], closures: str | os.PathLike[str] | None
@@ -357,11 +359,9 @@ class Robot:
         return motion, (bp + rounding, bv + 4 * _EPS * np.abs(v), ba + 4 * _EPS * np.abs(a))
 
     def _strays(self, joints: Mapping[str, JointMotion]) -> dict[str, dict[str, Any]]:
-        """Return the mimic joints inside loops that stray from their rule."""
+        """Return the answered joints that stray from their ``<mimic>`` rule (every one)."""
         out = {}
-        for name, rule in self._loop_mimics.items():
-            if rule.joint not in joints:
-                continue
+        for name, rule in self._rules.items():
             expected = rule.multiplier * joints[rule.joint].position + rule.offset
             stray = joints[name].position - expected
             if self.joint_type(name).angular:

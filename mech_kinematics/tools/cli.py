@@ -39,9 +39,9 @@ from ..units import LENGTH_UNITS, rad_per_s_from_rpm, turns_from_degrees
 
 __all__ = ['ArgumentParser', 'PROG', 'add_driver_arguments', 'add_robot_arguments',
            'add_scene_argument', 'drive_from_args', 'finite_float', 'is_urdf', 'joint_list',
-           'load_robot_argument', 'load_scene_argument', 'named_value', 'positive_float',
-           'positive_int', 'positive_seconds', 'run_handler', 'run_tool', 'seconds_or_zero',
-           'values_by_driver']
+           'load_robot_argument', 'load_scene_argument', 'mimic_ruled', 'named_value',
+           'positive_float', 'positive_int', 'positive_seconds', 'run_handler', 'run_tool',
+           'seconds_or_zero', 'values_by_driver']
 
 #: The program name shown in usage lines.
 PROG = 'python -m mech_kinematics'
@@ -117,8 +117,25 @@ def load_robot_argument(args: argparse.Namespace) -> Any:
             msg = (f'{args.scene}: Expected --reference J=VALUE with J a moving joint of the '
                    f'robot ({moving}), got {name!r}')
             raise UrdfError(msg)
-        reference[name] = math.radians(value) if joint.type.angular else value
+        if not joint.type.angular:
+            reference[name] = value
+        elif abs(value) > 360.0 and name not in mimic_ruled(description):
+            reference[name] = turns_from_degrees(value)[0]  # its direction, exactly
+        else:
+            reference[name] = math.radians(value)
     return Robot(description, getattr(args, 'actuated', None), reference)
+
+
+def mimic_ruled(description: Any) -> set[str]:
+    """Return the joints a ``<mimic>`` rule involves (they have one, or lead one).
+
+    A revolute joint given beyond a turn is reduced exactly to its direction
+    (``turns_from_degrees``), as a scene's crank angle is, except these: a
+    rule applies to a joint's value, not to its direction.
+    """
+    rules = [j.mimic for j in description.joints.values() if j.mimic is not None]
+    return {j.name for j in description.joints.values() if j.mimic is not None} | {
+        rule.joint for rule in rules}
 
 
 def load_scene_argument(args: argparse.Namespace, source: Any = None) -> Any:

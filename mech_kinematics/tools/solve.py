@@ -13,8 +13,8 @@ from typing import Any
 import warnings
 
 from .cli import (add_driver_arguments, add_robot_arguments, add_scene_argument,
-                  drive_from_args, finite_float, is_urdf, load_robot_argument, positive_float,
-                  run_tool, values_by_driver)
+                  drive_from_args, finite_float, is_urdf, load_robot_argument, mimic_ruled,
+                  positive_float, run_tool, values_by_driver)
 from ..bounds import MAX_ERROR
 from ..errors import AssemblyError, NearSingularWarning, SceneError, UntrustedError
 from ..scene import load_scene
@@ -52,14 +52,23 @@ J=VALUE in rpm or m/s, --accel J=VALUE in rad/s^2 or m/s^2, each from the
 joint's zero and positive about its axis as written. Its JSON has "robot",
 "inputs" and "joints" keyed by URDF joint names (every joint of every loop,
 the actuated ones and the mimic joints that follow them), the loops'
-"points" in their plane, "mimic" (a mimic joint a loop moves away from its
-rule) and "limits" (a joint outside its <limit>, reported, not refused).
+"points" in their plane, "mimic" (every joint whose value strays from its
+<mimic> rule: a loop's joint, an actuated one) and "limits" (a joint outside
+its <limit>, reported, not refused). A revolute joint given beyond a turn
+is reduced exactly, as a scene's crank angle is.
 """
 
 
-def _robot_drive(robot: Any, args: argparse.Namespace
-                 ) -> tuple[dict[str, float], dict[str, float], dict[str, float], str]:
-    """Return a robot's actuated joints' values (SI) from --input, --speed and --accel J=V."""
+def _robot_drive(robot: Any, args: argparse.Namespace) -> tuple[
+        dict[str, float], dict[str, float], dict[str, float], str, dict[str, float]]:
+    """Return a robot's actuated joints' values (SI) from --input, --speed and --accel J=V.
+
+    And, last, the revolute joints given beyond a turn, each reduced exactly
+    to its direction in rad, as a scene's crank (``turns_from_degrees``):
+    ``--input J=1e17`` turns the loops as ``J=-80`` does, to the bit, where
+    ``math.radians(1e17)`` is a double of 1.7e15 rad whose direction is lost.
+    A joint a ``<mimic>`` rule involves is taken as given (:func:`mimic_ruled`).
+    """
     from types import SimpleNamespace
 
     names = SimpleNamespace(drivers=[SimpleNamespace(name=n) for n in robot.actuated])
@@ -76,30 +85,38 @@ def _robot_drive(robot: Any, args: argparse.Namespace
                    f'({", ".join(robot.actuated)}), got {flag}')
             raise ValueError(msg)
         table[robot.actuated[0]] = value
-    positions, rates, words = {}, {}, []
+    positions, rates, words, exact = {}, {}, [], {}
+    ruled = mimic_ruled(robot.description)
     for name in robot.actuated:
         angular = robot.joint_type(name).angular
         if name in inputs:
             positions[name] = math.radians(inputs[name]) if angular else inputs[name]
+            if angular and abs(inputs[name]) > 360.0 and name not in ruled:
+                exact[name] = turns_from_degrees(inputs[name])[0]
             words.append(f'{name} = {inputs[name]:.15g} {"deg" if angular else "m"}')
         if name in speeds:
             rates[name] = rad_per_s_from_rpm(speeds[name]) if angular else speeds[name]
     shown = ', '.join(words) or 'the reference pose'
-    return positions, rates, accels, shown
+    return positions, rates, accels, shown, exact
 
 
 def _handle_robot(args: argparse.Namespace) -> int:
     """Solve a robot described in URDF: its joints under their URDF names."""
     try:
         robot = load_robot_argument(args)
-        positions, speeds, accels, shown = _robot_drive(robot, args)
+        positions, speeds, accels, shown, exact = _robot_drive(robot, args)
     except (SceneError, ValueError) as error:
         print(f'error: {error}', file=sys.stderr)
         return 2
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter('always', NearSingularWarning)
-            answer = robot.solve(positions, speeds, accels, max_error=args.max_error)
+            answer = robot.solve({**positions, **exact}, speeds, accels,
+                                 max_error=args.max_error)
+        if exact:  # the loops at the exact direction; the joints echoed as given
+            answer = robot.joints_from_state(answer.state, {
+                name: (positions.get(name, motion.position), motion.velocity,
+                       motion.acceleration) for name, motion in answer.inputs.items()})
     except AssemblyError as error:
         reason = error.reason if isinstance(error, UntrustedError) or error.facts is None \
             else assembly_text(error, robot.scene.units)

@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """What a robot in URDF is refused for: one line naming the joint and why. See issue 31."""
 
-from helpers import khurmi_pin, khurmi_urdf, UrdfFk
+from helpers import khurmi_pin, khurmi_urdf, solve_urdf_text, UrdfFk
 import pytest
 
 import mech_kinematics as mk
@@ -128,3 +128,160 @@ def test_a_robot_without_actuated_joints_is_refused_saying_where_each_door_gives
         'are ')
     for joint in ('motor', 'rocker_pivot', 'elbow'):
         assert joint in error.split('the joints of its loops are ')[1]
+
+
+# --- issue 42: errors in one line, naming the right cause ----------------------------------
+
+
+@pytest.mark.parametrize('where', ['<link name="frame"/>', '</robot>'])
+def test_a_nul_in_a_urdf_is_one_line(tmp_path, capsys, where):
+    """A NUL gave two lines (lxml's message holds a newline)."""
+    text = khurmi_urdf().replace(where, where.replace('/>', '/>\x00').replace('</', '</\x00'),
+                                 1)
+    assert '\x00' in text
+    status, out, err = solve_urdf_text(tmp_path, capsys, text)
+    assert (status, out) == (2, '')
+    assert len(err.splitlines()) == 1
+    assert 'Expected a URDF (XML), got text that is not XML: Invalid character: Char 0x0' in err
+
+
+def test_a_closure_point_at_1e308_is_refused_with_its_gap_and_no_warning(tmp_path, capsys):
+    """The gap of a pin at 1e308 m: 1e+308 m, no numpy overflow warning (was inf, warned)."""
+    coupler, _ = khurmi_pin()
+    text = khurmi_urdf().replace(f'<parent_origin xyz="{coupler.real!r} {coupler.imag!r} ',
+                                 '<parent_origin xyz="1e308 0 ', 1)
+    assert '1e308' in text
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        error = _refused(text)
+    assert error.joint == 'pin_C' and 'got its two points 1e+308 m apart' in str(error)
+    status, _, err = solve_urdf_text(tmp_path, capsys, text)
+    assert status == 2 and len(err.splitlines()) == 1 and 'inf' not in err
+
+
+@pytest.mark.parametrize('z', ['-1e-300', '-1e200', '-5e-324', '-1.7e308'])
+def test_a_tiny_or_huge_axis_is_the_direction_it_is(z):
+    """<axis xyz="0 0 -1e-300"> and "0 0 -1e200" were refused as no non-zero direction."""
+    text = khurmi_urdf()
+    given = text.replace('<axis xyz="0 0 -1"/>', f'<axis xyz="0 0 {z}"/>', 1)
+    assert given != text
+    robot = load_robot(given)
+    assert robot.description.joints['rocker_pivot'].axis == (0.0, 0.0, -1.0)
+    expected = load_robot(text).solve({'motor': 0.7}).joints
+    got = load_robot(given).solve({'motor': 0.7}).joints
+    assert {n: j.position for n, j in got.items()} == {n: j.position for n, j in expected.items()}
+
+
+def test_a_zero_axis_is_still_refused():
+    """0 0 0 is no direction: refused naming the joint."""
+    error = _refused(khurmi_urdf().replace('<axis xyz="0 0 -1"/>', '<axis xyz="0 0 0"/>', 1))
+    assert error.joint == 'rocker_pivot' and 'non-zero direction, got 0 0 0' in str(error)
+
+
+def _constraint(text):
+    start, end = text.index('<constraint'), text.index('</constraint>') + len('</constraint>')
+    return text[start:end], end
+
+
+def test_a_closure_written_twice_is_refused_as_such(tmp_path, capsys):
+    """The <constraint> copied: refused as a name twice (was "a loop that is rigid")."""
+    text = khurmi_urdf()
+    closure, end = _constraint(text)
+    error = _refused(text[:end] + closure + text[end:])
+    assert error.joint == 'pin_C'
+    assert str(error).endswith('closure "pin_C": Expected every closure to have a name of its '
+                               'own, got "pin_C" twice (the other closure joins links "coupler" '
+                               'and "rocker")')
+    status, out, err = solve_urdf_text(tmp_path, capsys, text[:end] + closure + text[end:])
+    assert (status, out) == (2, '') and len(err.splitlines()) == 1 and 'rigid' not in err
+
+
+def test_a_second_pin_of_two_links_is_refused_naming_both():
+    """The same pin under another name: one pin written twice; elsewhere: a weld."""
+    text = khurmi_urdf()
+    closure, end = _constraint(text)
+    error = _refused(text[:end] + closure.replace('pin_C', 'pin_C2') + text[end:])
+    assert error.joint == 'pin_C2'
+    assert str(error).endswith('closure "pin_C2": Expected two bodies to be pinned together '
+                               'once, got links "coupler" and "rocker" pinned by "pin_C" too (at '
+                               'the same point: one pin written twice)')
+    import numpy as np
+    frames = load_robot(text).description.transforms()
+    b = frames['coupler'][:, 3]                       # the elbow, on the coupler's origin
+    on_rocker = np.linalg.inv(frames['rocker']) @ b
+    xyz = ' '.join(repr(float(v)) for v in on_rocker[:3])
+    second = (f'<constraint name="pin_B" type="revolute"><parent link="coupler"/>'
+              f'<parent_origin xyz="0 0 0"/><child link="rocker"/><child_origin '
+              f'xyz="{xyz}"/></constraint>')
+    error = _refused(text[:end] + second + text[end:])
+    assert error.joint == 'pin_B'
+    assert str(error).endswith('got links "coupler" and "rocker" pinned by "pin_C" too (0.15 m '
+                               'apart, they weld them: join them by a fixed joint or a '
+                               '<constraint type="link">)')
+
+
+def test_a_closure_named_as_a_joint_is_refused():
+    """A closure named "elbow" would be the elbow's scene point too."""
+    text = khurmi_urdf().replace('name="pin_C"', 'name="elbow"')
+    error = _refused(text)
+    assert error.joint == 'elbow' and 'got "elbow" twice (the other joint joins links ' \
+        '"crank" and "coupler")' in str(error)
+
+
+@pytest.mark.parametrize('flag', [['--input', 'motor=1e17'], ['--angle-deg', '1e17'],
+                                  ['--input', 'motor=36000280']])
+def test_a_crank_given_beyond_a_turn_is_reduced_exactly(tmp_path, capsys, flag):
+    """--input motor=1e17 (deg) turns the loop as -80 does (was refused as within rounding).
+
+    The joint is echoed as given (math.radians of it, as a scene's crank is),
+    and listed outside its limits; the loop's joints are those of -80 deg to
+    the bit, as a scene's --angle-deg 1e17 is.
+    """
+    import math
+    status, out, err = solve_urdf_text(tmp_path, capsys, khurmi_urdf(), *flag)
+    assert (status, err) == (0, '')
+    import json
+    got = json.loads(out)
+    degrees = float(flag[1].split('=')[-1])
+    assert got['inputs']['motor']['position'] == math.radians(degrees)
+    assert got['limits']['motor']['position'] == math.radians(degrees)
+    within_a_turn = f'motor={math.remainder(degrees, 360.0)!r}'
+    status, out, _ = solve_urdf_text(tmp_path, capsys, khurmi_urdf(), '--input', within_a_turn)
+    within = json.loads(out)
+    for name in ('elbow', 'rocker_pivot'):
+        assert got['joints'][name] == within['joints'][name]
+    assert got['points'] == within['points']
+
+
+@pytest.mark.parametrize('turns', [3 * 10 ** 9, 2 ** 52])
+def test_a_reference_beyond_a_turn_is_reduced_exactly(tmp_path, capsys, turns):
+    """--reference motor=360*N (deg) is the zero pose to the bit (was refused: a gap)."""
+    import json
+    answers = []
+    for degrees in (360.0 * turns, 0.0):
+        status, out, err = solve_urdf_text(tmp_path, capsys, khurmi_urdf(), '--input',
+                                           'motor=30', '--reference', f'motor={degrees!r}')
+        assert (status, err) == (0, '')
+        answers.append(json.loads(out))
+    assert answers[0]['joints'] == answers[1]['joints']
+    assert answers[0]['points'] == answers[1]['points']
+
+
+def test_a_joint_a_mimic_rule_involves_is_taken_as_given(tmp_path, capsys):
+    """The crank leads a <mimic>: 1e17 deg is its value (the rule's), not reduced to -80."""
+    import json
+    text = khurmi_urdf().replace('</robot>', """<link name="e1"/>
+      <joint name="w1" type="revolute"><parent link="frame"/><child link="e1"/>
+        <axis xyz="1 0 0"/><mimic joint="motor" multiplier="0.5"/></joint></robot>""")
+    status, out, _ = solve_urdf_text(tmp_path, capsys, text, '--input', 'motor=400')
+    assert status == 0
+    import math
+    assert json.loads(out)['joints']['w1']['position'] == 0.5 * math.radians(400)
+
+
+@pytest.mark.parametrize('xyz', ['nan 0 1', '0 nan -1', '0 inf 1', '0 0 -inf'])
+def test_an_axis_that_is_not_finite_is_refused(xyz):
+    """Scaled by its largest component, a NaN beside a 1 must still be refused."""
+    error = _refused(khurmi_urdf().replace('<axis xyz="0 0 -1"/>', f'<axis xyz="{xyz}"/>', 1))
+    assert error.joint == 'rocker_pivot' and 'non-zero direction' in str(error)
