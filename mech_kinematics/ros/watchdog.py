@@ -10,10 +10,11 @@ docs/robustness.md). The node then publishes nothing and, as rclpy's
 alive: :class:`PublishWatchdog` ends it, so that launch's ``respawn`` or
 systemd's ``Restart=`` starts it again.
 
-The publishing threads pay two stores and a clock read per publish, no
-handoff to another thread: :meth:`PublishWatch.wrap` returns a publish that
-stamps its :class:`Slot` with ``time.monotonic_ns()`` and the topic before
-calling the publisher, and clears the stamp after. A daemon thread looks at
+The publishing threads pay a Python call, a clock read and three stores
+per publish (0.55 us at load 10), no handoff to another thread:
+:meth:`PublishWatch.wrap` returns a publish that stamps its :class:`Slot`
+with ``time.monotonic_ns()`` and the topic before calling the publisher,
+and clears the stamp after. A daemon thread looks at
 the slots a few times per bound. It sees a publish stuck beyond the bound:
 
 - while the stuck thread has released the GIL, the watchdog's thread logs
