@@ -28,6 +28,7 @@ Usage (with the package importable, e.g. ``make``'s .venv)::
 
     python bench/node_bench.py [--rates 1000 5000] [--seconds 60] [--repeat 3]
     python bench/node_bench.py --chains [--seconds 20]
+    python bench/node_bench.py --udp --rates 1000   # the node on UDPv4 against its default
 
 ``--data docs/report/data.json`` stores the figures in the report's data file
 (under ``node_rates``, or ``node_chains`` with ``--chains``; the report keeps
@@ -143,20 +144,22 @@ def _delivered(stamps: dict[str, list[int]], period: int, lo: int, hi: int) -> f
 
 
 def run_publisher(command: list[str], namespace: str, rate: float, args: argparse.Namespace,
-                  env: dict[str, str], tmp: Path) -> dict[str, float]:
+                  env: dict[str, str], tmp: Path,
+                  publisher_env: dict[str, str] | None = None) -> dict[str, float]:
     """Run ``command`` (the node or a floor) publishing in ``namespace`` at ``rate``, measured.
 
     A subscriber in another process records every state message's stamp and
     the diagnostics. Returns the publisher's ``cpu`` (% of a core over
     ``args.seconds`` after ``args.warmup``), the ``delivered`` fraction of
     grid instants and, from the node's diagnostics, ``skipped`` instants.
+    ``publisher_env``: the publisher's own environment (default ``env``).
     """
     out = tmp / f'{namespace[1:]}.json'
     listen = args.warmup + args.seconds + 2.0
     sub = subprocess.Popen([sys.executable, __file__, '--subscribe', namespace, str(listen),
                             str(out)], env=env)
     time.sleep(1.0)     # the subscriber is there before the first message
-    publisher = subprocess.Popen(command, env=env)
+    publisher = subprocess.Popen(command, env=env if publisher_env is None else publisher_env)
     try:
         time.sleep(args.warmup)
         cpu0, wall0, stamp0 = cpu_seconds(publisher.pid), time.monotonic(), time.time_ns()
@@ -189,10 +192,12 @@ def measure(kind: str, rate: float, scene: str, args: argparse.Namespace,
             env: dict[str, str], tmp: Path) -> dict[str, float]:
     """Run the node or the floor at ``rate`` with a subscriber; return the row of the table."""
     namespace = f'/bench_{os.getpid()}_{kind}_{int(rate)}_{random.randrange(10 ** 6)}'
-    command = (node_command(namespace, scene, rate) if kind == 'node' else
+    command = (node_command(namespace, scene, rate) if kind.startswith('node') else
                [sys.executable, __file__, '--floor', namespace, str(rate), scene])
+    # 'node_udp': the node alone on Fast DDS's UDPv4 transport (no shared memory).
+    publisher_env = {**env, 'FASTDDS_BUILTIN_TRANSPORTS': 'UDPv4'} if kind == 'node_udp' else None
     return {'kind': kind, 'rate': rate,
-            **run_publisher(command, namespace, rate, args, env, tmp)}
+            **run_publisher(command, namespace, rate, args, env, tmp, publisher_env)}
 
 
 def _table(rows: list[dict[str, float]], key: str) -> list[str]:
@@ -209,6 +214,21 @@ def _table(rows: list[dict[str, float]], key: str) -> list[str]:
             f'{" / ".join(f"{c:.1f}" for c in n_cpu)} | {ratio:.2f} | '
             f'{100 * min(r["delivered"] for r in floor):.3f} % / '
             f'{100 * min(r["delivered"] for r in node):.3f} % |')
+    return lines
+
+
+def _udp_table(rows: list[dict[str, float]]) -> list[str]:
+    lines = ['| rate Hz | node CPU % default (runs) | node CPU % UDPv4 (runs) | UDPv4 / default '
+             '(medians) | delivered default / UDPv4 (worst run) |', '|---:|---:|---:|---:|---:|']
+    for rate in dict.fromkeys(r['rate'] for r in rows):
+        shm = [r for r in rows if r['rate'] == rate and r['kind'] == 'node']
+        udp = [r for r in rows if r['rate'] == rate and r['kind'] == 'node_udp']
+        ratio = statistics.median(r['cpu'] for r in udp) / statistics.median(r['cpu'] for r in shm)
+        runs = [' / '.join(f'{r["cpu"]:.1f}' for r in side) for side in (shm, udp)]
+        lines.append(
+            f'| {rate:g} | {runs[0]} | {runs[1]} | {ratio:.2f} | '
+            f'{100 * min(r["delivered"] for r in shm):.3f} % / '
+            f'{100 * min(r["delivered"] for r in udp):.3f} % |')
     return lines
 
 
@@ -262,6 +282,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument('--repeat', type=int, default=3, help='runs of each, alternating')
     parser.add_argument('--chains', action='store_true',
                         help=f'scenes of {", ".join(map(str, CHAIN_SIZES))} dyads at 1 kHz')
+    parser.add_argument('--udp', action='store_true',
+                        help='the node on its default transports against the node with '
+                             'FASTDDS_BUILTIN_TRANSPORTS=UDPv4 (no floor), alternating')
     parser.add_argument('--json', action='store_true', help='also print the rows as JSON')
     parser.add_argument('--data', metavar='FILE',
                         help='store the figures in this data file (docs/report/data.json) '
@@ -269,6 +292,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument('--subscribe', nargs=3, help=argparse.SUPPRESS)
     parser.add_argument('--floor', nargs=3, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
+    if args.udp and (args.chains or args.data):
+        parser.error('--udp compares the node with itself: without --chains and --data')
     if args.subscribe:
         namespace, seconds, out = args.subscribe
         subscribe(namespace, float(seconds), out)
@@ -293,18 +318,23 @@ def main(argv: list[str] | None = None) -> int:
                               flush=True)
             key = 'dyads'
         else:
+            kinds = ('node', 'node_udp') if args.udp else ('floor', 'node')
             for rate in args.rates:
                 for _ in range(args.repeat):
-                    for kind in ('floor', 'node'):
+                    for kind in kinds:
                         row = measure(kind, rate, SCENE, args, env, Path(tmp))
                         rows.append(row)
                         print(f'{kind} {rate:g} Hz: {row["cpu"]:.1f} %, delivered '
                               f'{100 * row["delivered"]:.3f} %', file=sys.stderr, flush=True)
             key = 'rate'
-    print(f'kinematics_node vs the rclpy floor, {args.seconds:g} s per run, '
+    against = 'itself on UDPv4 only' if args.udp else 'the rclpy floor'
+    print(f'kinematics_node vs {against}, {args.seconds:g} s per run, '
           f'{args.repeat} runs each, alternating; {os.cpu_count()} cores, load average '
           f'{os.getloadavg()[0]:.1f}\n')
-    print('\n'.join(_table(rows, key)))
+    if args.udp:
+        print('\n'.join(_udp_table(rows)))
+    else:
+        print('\n'.join(_table(rows, key)))
     if args.json:
         print(json.dumps(rows, indent=1))
     if args.data:

@@ -123,6 +123,7 @@ class TickDriver:
         self.last_stamp: int | None = None
         self.sim: bool | None = None
         self._offset = 0            # system clock minus monotonic clock, ns
+        self._known = (0, 0)        # ... known to lie in this range (its reading's bracket), ns
         self._rebase_from: int | None = None
         self._lock = threading.Lock()
 
@@ -170,7 +171,8 @@ class TickDriver:
         """Start a new grid at the next step: the instants while nothing ticked are not owed."""
         self.grid = None
 
-    def step(self, now_ns: int, sim: bool = False, monotonic_ns: int | None = None) -> Wake:
+    def step(self, now_ns: int, sim: bool = False, monotonic_ns: int | None = None,
+             monotonic_after_ns: int | None = None) -> Wake:
         """Return the instants owed at ``now_ns`` and mark them taken.
 
         Parameters
@@ -182,8 +184,16 @@ class TickDriver:
             ``/clock``). A change of time source starts a new grid, and the
             drivers go on from where they were at the next instant.
         monotonic_ns : int, optional
-            A monotonic clock read with ``now_ns`` (system time): a change of
-            ``now_ns - monotonic_ns`` beyond ``CLOCK_JUMP_NS`` is a jump.
+            A monotonic clock read just before ``now_ns`` (system time): a
+            change of ``now_ns - monotonic_ns`` beyond ``CLOCK_JUMP_NS`` is a jump.
+        monotonic_after_ns : int, optional
+            The monotonic clock read again just after ``now_ns`` (default:
+            ``monotonic_ns``). A thread descheduled between its reads (a
+            loaded machine, another thread holding the GIL) cannot tell when
+            in the bracket it read the system clock: the offset is then only
+            known to within ``monotonic_after_ns - monotonic_ns``, and only a
+            change beyond ``CLOCK_JUMP_NS`` plus the brackets of both readings
+            is a jump.
         """
         if sim != self.sim:
             if self.sim is not None and self.last_stamp is not None:
@@ -193,7 +203,9 @@ class TickDriver:
             self.grid = None
         if sim:
             return self._step_sim(now_ns)
-        return self._step_system(now_ns, now_ns if monotonic_ns is None else monotonic_ns)
+        before = now_ns if monotonic_ns is None else monotonic_ns
+        return self._step_system(now_ns, before,
+                                 before if monotonic_after_ns is None else monotonic_after_ns)
 
     def _step_sim(self, now_ns: int) -> Wake:
         if now_ns <= 0:
@@ -208,14 +220,20 @@ class TickDriver:
         due = grid.take(now_ns, self.max_behind_ns, self.catch_up)
         return Wake(due.instants, due.skipped, jump)
 
-    def _step_system(self, now_ns: int, monotonic_ns: int) -> Wake:
-        offset = now_ns - monotonic_ns
+    def _step_system(self, now_ns: int, before_ns: int, after_ns: int) -> Wake:
+        # The offset (system minus monotonic) is somewhere in [now - after, now - before]:
+        # a jump is a change beyond the bound that the brackets of the readings cannot explain.
+        low, high = now_ns - max(after_ns, before_ns), now_ns - before_ns
         grid, jump = self.grid, None
-        if grid is None or abs(offset - self._offset) > CLOCK_JUMP_NS:
+        known_low, known_high = self._known
+        if grid is None or max(low - known_high, known_low - high) > CLOCK_JUMP_NS:
             if grid is not None:
-                jump = offset - self._offset
-            self._offset = offset
+                jump = (low + high) // 2 - self._offset
+            self._known = low, high
             grid = self.grid = TickGrid.aligned(now_ns, self.period_ns)
+        elif high - low < known_high - known_low:
+            self._known = low, high         # a sharper reading of the same offset
+        self._offset = sum(self._known) // 2
         grid.set_period(self.period_ns)
         remaining = grid.next_ns - now_ns
         if remaining > 0:

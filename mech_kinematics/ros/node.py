@@ -51,6 +51,7 @@ from .schedule import period_ns_from_rate
 from .solver_path import SolverPath
 from .tick_thread import TickThread, TickThreadError
 from .topic_input import InputSubscription
+from .watchdog import PublishWatch, PublishWatchdog
 from .wrenches import dynamics_with, effort_status, forces_tick, ForcesTick
 from ..solver.context import NEAR_SINGULAR
 from ..units import NS_PER_S
@@ -119,8 +120,14 @@ class KinematicsNode(LifecycleNode):
         self._solver.max_error = float(self._value('max_relative_error'))
         self.managed = bool(self._value('managed'))
         self.frame_id = self._value('frame_id')
-        self._pub_diagnostics = self.create_publisher(
+        # A publish that never returns (Fast DDS's shared-memory hang) ends the process.
+        self._watch = PublishWatch()
+        self._watchdog = PublishWatchdog(self._watch, float(self._value('publish_timeout_s')),
+                                         self.get_logger().fatal)
+        pub_diagnostics = self.create_publisher(
             DiagnosticArray, topics.DIAGNOSTICS, 10, qos_overriding_options=qos_options())
+        self._publish_diagnostic_array = self._watch.wrap(
+            self._watch.slot(), topics.DIAGNOSTICS, pub_diagnostics.publish)
         self._diagnostics_timer = self.create_timer(
             1.0, self._publish_diagnostics, clock=Clock(clock_type=ClockType.STEADY_TIME))
         self._jump_handle = self.get_clock().create_jump_callback(
@@ -192,7 +199,7 @@ class KinematicsNode(LifecycleNode):
         self._publishing = publishing = Publishing(
             self, scene, frame_id=self.frame_id, tf_prefix=self._value('tf_prefix'),
             tf_rate_hz=self._value('tf_rate_hz'), scene_path=self._value('scene'),
-            source=source)
+            source=source, watch=self._watch)
         frames = [(f.origin, f.angle_of, f.angle) for f in publishing.frames]
         self._forces = forces = forces_tick(scene, publishing.tick_scene, frames,
                                             drive=self._value('drive'),
@@ -260,6 +267,7 @@ class KinematicsNode(LifecycleNode):
 
     def start(self) -> None:
         """Start the tick thread (with ``drive: topic``, the input subscription instead)."""
+        self._watchdog.start()
         if self._input is not None:
             self._input.active = True     # a state for each message from now on
             return
@@ -271,6 +279,7 @@ class KinematicsNode(LifecycleNode):
         if self._input is not None:
             self._input.active = False
         self._ticks.stop()
+        self._watchdog.stop()
         self._apply_now()
 
     def destroy_node(self) -> None:
@@ -317,5 +326,5 @@ class KinematicsNode(LifecycleNode):
                           rate_hz=self._value('rate_hz'),
                           max_lateness_ms=self._value('max_lateness_ms')),
         ]
-        self._pub_diagnostics.publish(diagnostic_array(
+        self._publish_diagnostic_array(diagnostic_array(
             statuses, self.get_clock().now().to_msg(), self.frame_id))

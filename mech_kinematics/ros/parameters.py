@@ -168,6 +168,11 @@ PARAMETERS = (
                   'How far behind a late wake-up still publishes missed instants; older '
                   'ones are skipped and counted. Capped so that a burst is at most 1000 '
                   'messages (the history depth): (1000 - 1) / rate_hz', 's', 0.0, 10.0),
+    ParameterSpec('publish_timeout_s', 'double', 2.0,
+                  'A publish that has not returned after this long (Fast DDS shared memory '
+                  'blocked on a killed reader) ends the node, naming the topic, with exit '
+                  'status 1, for a supervisor (launch respawn, systemd) to restart it; '
+                  '0: off', 's', 0.0, 3600.0, read_only=True),
     ParameterSpec('max_lateness_ms', 'double', DEFAULT_MAX_LATENESS_MS,
                   'Timing on diagnostics turns WARN when the p99 lateness of a second of '
                   'ticks exceeds this (or when an instant is skipped); caught-up late ticks '

@@ -52,6 +52,7 @@ from .parameters import STATE_DEPTH
 from .robot_mode import RobotValues, Source
 from .schedule import period_ns_from_rate
 from .tf import static_tf_message, TfMessages
+from .watchdog import PublishWatch
 from .wrenches import ForceMessages, ForcesTick, reaction_wrench
 from ..errors import AssemblyError
 from ..geometry.diagrams import space_from_state, strokes_from_scene
@@ -143,6 +144,10 @@ class Publishing:
         ``/tf``: robot_state_publisher draws the robot from ``joint_states``
         and the URDF (our link frames, a second copy of the loops in the
         scene's plane, would stand beside its tree unconnected).
+    watch : PublishWatch, optional
+        Every publish of a tick (state, forces, IMUs, ``/tf``) stamps a slot
+        of it while it runs, for the node's watchdog
+        (:mod:`~mech_kinematics.ros.watchdog`).
 
     Attributes
     ----------
@@ -164,8 +169,10 @@ class Publishing:
     """
 
     def __init__(self, node: Any, scene: Any, *, frame_id: str, tf_prefix: str,
-                 tf_rate_hz: float, scene_path: str, source: Source | None = None) -> None:
+                 tf_rate_hz: float, scene_path: str, source: Source | None = None,
+                 watch: PublishWatch | None = None) -> None:
         self.node = node
+        self.watch, self.slot = watch, None if watch is None else watch.slot()
         self.frame_id = frame_id
         self.prefix = tf_prefix or frame_id
         self.publishers: list[Any] = []
@@ -180,7 +187,7 @@ class Publishing:
         self.imu_frames: ImuFrames | None = None
         try:
             self.publish_state = tuple(
-                self._publisher(kind, topic, state_qos()).publish for kind, topic
+                self._watched(topic, self._publisher(kind, topic, state_qos())) for kind, topic
                 in ((JointState, topics.JOINT_STATES),
                     (JointTrajectory, topics.JOINT_ACCELERATIONS),
                     (MultiDOFJointTrajectory, topics.POINT_ACCELERATIONS)))
@@ -219,8 +226,10 @@ class Publishing:
                 invalid.append(joint.name)
                 publish.append(None)
                 continue
-            publish.append(self._publisher(WrenchStamped, topic, state_qos()).publish)
-        publish.append(self._publisher(WrenchStamped, topics.SHAKING, state_qos()).publish)
+            publish.append(self._watched(topic, self._publisher(WrenchStamped, topic,
+                                                                state_qos())))
+        publish.append(self._watched(topics.SHAKING, self._publisher(WrenchStamped,
+                                                                     topics.SHAKING, state_qos())))
         self.publish_forces_to = tuple(publish)
         if invalid:
             self.node.get_logger().warning(
@@ -248,6 +257,12 @@ class Publishing:
         for publisher in publishers:
             self.node.destroy_publisher(publisher)
 
+    def _watched(self, topic: str, publisher: Any) -> Callable[[Any], None]:
+        """Return ``publisher``'s publish, stamping the watch's slot while it runs."""
+        if self.watch is None or self.slot is None:
+            return publisher.publish  # type: ignore[no-any-return]
+        return self.watch.wrap(self.slot, topic, publisher.publish)
+
     def _publisher(self, msg_type: Any, topic: str, qos: QoSProfile,
                    overrides: bool = True) -> Any:
         publisher = self.node.create_publisher(
@@ -268,6 +283,7 @@ class Publishing:
         self.tf = TfMessages(frames, self.frame_id, self.prefix)
         self.frames = frames
         self._pub_tf = self._publisher(TFMessage, topics.TF, tf_qos(False))
+        self._publish_tf = self._watched(topics.TF, self._pub_tf)
         tf_static = self._publisher(TFMessage, topics.TF_STATIC, tf_qos(True))
         tf_static.publish(static_tf_message(scene.ground, self.frame_id, self.prefix,
                                             self.node.get_clock().now().to_msg()))
@@ -289,7 +305,8 @@ class Publishing:
         self.imus = ImuMessages(scene.imus, scene.output_joints, scene.output_points,
                                 self.prefix, scene.gravity)
         self._publish_imu = tuple(
-            self._publisher(Imu, topics.imu_topic(spec.name), state_qos()).publish
+            self._watched(topics.imu_topic(spec.name),
+                          self._publisher(Imu, topics.imu_topic(spec.name), state_qos()))
             for spec in scene.imus)
         if self.tf is not None:
             # The sensors' offsets on their links, from any pose: the drivers' starts.
@@ -350,9 +367,9 @@ class Publishing:
     def tf_frames(self, values: Sequence[float], sec: int, nanosec: int) -> None:
         """Publish the frames on ``/tf`` (the links', then the sensors' own) of a tick's values."""
         assert self.tf is not None
-        self._pub_tf.publish(self.tf.render_values(values, self.tf_first, sec, nanosec))
+        self._publish_tf(self.tf.render_values(values, self.tf_first, sec, nanosec))
         if self.imu_frames is not None:    # a sensor's frame is a position: known here
-            self._pub_tf.publish(self.imu_frames.render(sec, nanosec))
+            self._publish_tf(self.imu_frames.render(sec, nanosec))
 
     def tf_due(self, stamp: int) -> bool:
         """Return whether ``/tf`` is on and due at ``stamp`` (an input's); if so, count it."""

@@ -26,7 +26,8 @@ its URL.
 
 The door (a control that moves a machine answers only the person at the
 page): every request must name this server in ``Host`` (``127.0.0.1:PORT``,
-``localhost:PORT`` or ``[::1]:PORT``: a DNS-rebinding name is refused), a
+``localhost:PORT`` or ``[::1]:PORT``, served where the machine has IPv6's
+loopback: a DNS-rebinding name is refused), a
 request from a browser must come from the page's own origin (``Origin`` and
 ``Sec-Fetch-Site``), and ``/state`` and ``/speed`` must carry this run's
 secret token (:attr:`ViewServer.token`, in the page; header
@@ -51,6 +52,7 @@ import json
 import math
 import re
 import secrets
+import socket
 import statistics
 import sys
 import threading
@@ -69,6 +71,8 @@ __all__ = ['DEFAULT_PORT', 'PAGE', 'TOKEN_HEADER', 'ViewServer', 'add_parser',
 #: The port tried first (not foxglove_bridge's 8765); if it is taken, any free port.
 DEFAULT_PORT = 8790
 HOST = '127.0.0.1'
+#: IPv6's loopback, served at the same port where the machine has it.
+HOST6 = '::1'
 #: Trace length per point: the published positions (and gaps) over at most this many messages.
 TRACE_LENGTH = 600
 #: Crank angles sampled for the drawing's fixed bounds (one crank's turn).
@@ -104,6 +108,17 @@ def _finite(value: Any) -> float | None:
     except (TypeError, ValueError, OverflowError):
         return None
     return number if math.isfinite(number) else None
+
+
+def _shown(rate: float) -> float:
+    """Return a speed converted for display (rpm from rad/s) to 15 significant digits.
+
+    The default -120 rpm is published as -12.566370614359172 rad/s, which
+    converts back to -119.99999999999999 rpm: the conversion's last bit, not
+    the node's speed. 15 digits drop it (at most 5e-16 relative) and nothing
+    a double holds of a real speed. Only the display: a speed set is sent as given.
+    """
+    return float(f'{rate:.15g}')
 
 
 def _driver_samples(driver: Any, count: int) -> Any:
@@ -302,8 +317,9 @@ class _Latest:
         self.statuses: list[dict[str, Any]] = []
         self.values: dict[str, str] = {}
         self.stamp = 0.0
-        #: joint name -> (its point, [fx, fy] N) as last published on reactions/JOINT.
-        self.reactions: dict[str, tuple[str, list[float]]] = {}
+        #: joint name -> (its point, [fx, fy] N) as last published on reactions/JOINT
+        #: (None: not finite, not drawn).
+        self.reactions: dict[str, tuple[str, list[float] | None]] = {}
 
 
 class ViewServer:
@@ -323,7 +339,7 @@ class ViewServer:
         answer only requests that carry it in ``X-View-Token``.
     hosts : tuple of str
         The ``Host`` values accepted: ``127.0.0.1:PORT``, ``localhost:PORT``,
-        ``[::1]:PORT``.
+        and ``[::1]:PORT`` where it listens on IPv6's loopback too (``httpd6``).
     refusals : deque of str
         The last :data:`REFUSALS_KEPT` refused requests, one line each (what
         was asked, and why it was refused); each is also logged as a warning,
@@ -359,15 +375,23 @@ class ViewServer:
         self.httpd = _bind(port, self)
         self.port = self.httpd.server_address[1]
         self.url = f'http://{HOST}:{self.port}/'
-        self.hosts = (f'{HOST}:{self.port}', f'localhost:{self.port}', f'[::1]:{self.port}')
-        self._thread = threading.Thread(target=self.httpd.serve_forever, name='view-http',
-                                        daemon=True)
-        self._thread.start()
+        # IPv6's loopback too, at the same port, where the machine has one (a browser may
+        # try localhost there first); its Host name is let in only where it is served.
+        self.httpd6 = _bind6(self.port, self)
+        self.hosts: tuple[str, ...] = (f'{HOST}:{self.port}', f'localhost:{self.port}')
+        if self.httpd6 is not None:
+            self.hosts += (f'[{HOST6}]:{self.port}',)
+        for server in self._servers():
+            threading.Thread(target=server.serve_forever, name='view-http', daemon=True).start()
+
+    def _servers(self) -> list[http.server.ThreadingHTTPServer]:
+        return [self.httpd] + ([] if self.httpd6 is None else [self.httpd6])
 
     def close(self) -> None:
         """Stop serving."""
-        self.httpd.shutdown()
-        self.httpd.server_close()
+        for server in self._servers():
+            server.shutdown()
+            server.server_close()
 
     def refused(self, line: str) -> None:
         """Record a refused request (one line) and log it, at most once a second."""
@@ -424,10 +448,8 @@ class ViewServer:
     def _on_reaction(self, name: str, at: str, msg: Any) -> None:
         fx, fy = _finite(msg.wrench.force.x), _finite(msg.wrench.force.y)
         with self.latest.lock:
-            if fx is None or fy is None:
-                self.latest.reactions.pop(name, None)   # not finite: not drawn
-            else:
-                self.latest.reactions[name] = (at, [fx, fy])
+            # Not finite: None, not drawn, and the page says so.
+            self.latest.reactions[name] = (at, None if fx is None or fy is None else [fx, fy])
 
     def _on_joints(self, msg: Any) -> None:
         positions, velocities = list(msg.position), list(msg.velocity)
@@ -498,7 +520,7 @@ class ViewServer:
         # Before joint_states: the node's own report of its crank's speed, where it is a number.
         reported = _finite(values.get('crank_speed'))
         if reported is not None:
-            out['crank_speed_rpm'] = rate_from_si(reported, 'rpm')
+            out['crank_speed_rpm'] = _shown(rate_from_si(reported, 'rpm'))
         if scene is None:
             return out
         joints = joints or {}
@@ -510,7 +532,7 @@ class ViewServer:
             position, speed = joints.get(driver.name, (None, None))
             # The speed in the unit the node's parameter sets it in (rpm, m/s).
             unit = driver.rate_parameter.unit
-            shown = None if speed is None else rate_from_si(speed, unit)
+            shown = None if speed is None else _shown(rate_from_si(speed, unit))
             out['drivers'].append({'name': driver.name, 'kind': type(driver).__name__.lower(),
                                    'unit': unit, 'position': position, 'speed': shown})
             if index == 0 and first_crank and shown is not None:
@@ -610,6 +632,19 @@ def _bind(port: int, view: ViewServer) -> http.server.ThreadingHTTPServer:
         return http.server.ThreadingHTTPServer((HOST, port), handler)
     except OSError:
         return http.server.ThreadingHTTPServer((HOST, 0), handler)
+
+
+class _Server6(http.server.ThreadingHTTPServer):
+    address_family = socket.AF_INET6
+
+
+def _bind6(port: int, view: ViewServer) -> http.server.ThreadingHTTPServer | None:
+    """Return a server on ``[::1]:port``, or None without an IPv6 loopback (or it is taken)."""
+    handler = type('Handler', (_Handler,), {'view': view})
+    try:
+        return _Server6((HOST6, port), handler)
+    except OSError:
+        return None
 
 
 class _Refused(Exception):
@@ -882,7 +917,7 @@ function controls(s) {
   }
   s.drivers.forEach((d, i) => {
     box.children[i].querySelector('.running').textContent = d.speed === null ? '' :
-      '(running at ' + d.speed.toFixed(d.unit === 'rpm' ? 2 : 4) + ' ' + d.unit + ')';
+      '(running at ' + d.speed + ' ' + d.unit + ')';
   });
 }
 
@@ -916,7 +951,7 @@ function draw(s) {
   const box = canvas.getBoundingClientRect();
   const f = s.frame, drawn = {angle: null, positions: null, k: t.k, ox: t.ox, oy: t.oy,
                               left: box.left, top: box.top, width: canvas.width,
-                              height: canvas.height, links: []};
+                              height: canvas.height, links: [], arrows: [], reactions: []};
   if (f) {
     drawn.angle = f.angle; drawn.positions = f.positions;
     for (const g of f.guides) line(t, g[0], g[1], '#888', 2);
@@ -934,25 +969,30 @@ function draw(s) {
     for (const p of f.pivots) dot(t, p, 7, '#444');
     for (const p of Object.values(f.points)) dot(t, p, 3, '#000');
   }
+  // u / m first (m = max |u[i]|): Math.hypot(2e308, 0) is Infinity.
+  const big = (u) => Math.max(Math.abs(u[0]), Math.abs(u[1])), no = [];
+  const w = s.bounds[2] - s.bounds[0], arrow = (p, u, m, k, c, lw) => {
+    const e = m ? [p[0] + u[0] / m * k, p[1] + u[1] / m * k] : p;
+    line(t, p, e, c, lw); return {from: p, to: e};
+  };
   if (document.getElementById('arrows').checked) {
-    const size = (s.bounds[2] - s.bounds[0]) / 10;
-    for (const [p, v, a] of Object.values(s.points)) {
-      for (const [u, colour] of [[v, '#9467bd'], [a, '#8c564b']]) {
-        const su = u === null ? 0 : Math.hypot(...u);
-        if (su > 0) line(t, p, [p[0] + u[0] / su * size, p[1] + u[1] / su * size], colour, 2);
-      }
+    for (const [n, [p, ...va]] of Object.entries(s.points)) va.forEach((u, i) => {
+      const m = u && big(u), what = ['velocity', 'acceleration'][i];
+      if (!u) no.push(what + ' of ' + n);
+      else if (m) drawn.arrows.push({name: n, what: what, ...arrow(
+        p, u, m, w / 10 / Math.hypot(u[0] / m, u[1] / m), i ? '#8c564b' : '#9467bd', 2)});
+    });
+  }
+  if (document.getElementById('forces').checked) {
+    const fs = s.reactions.filter((r) => r.force || !no.push('reaction at ' + r.name));
+    const m = Math.max(0, ...fs.map((r) => big(r.force)));
+    const h = Math.max(...fs.map((r) => m && Math.hypot(r.force[0] / m, r.force[1] / m)));
+    for (const r of fs) {
+      drawn.reactions.push({name: r.name, ...arrow(r.at, r.force, m, w / 5 / h, '#e377c2', 3)});
     }
   }
-  drawn.reactions = [];
-  if (document.getElementById('forces').checked && s.reactions.length) {
-    const big = Math.max(...s.reactions.map((r) => Math.hypot(...r.force)));
-    const k = big > 0 ? (s.bounds[2] - s.bounds[0]) / 5 / big : 0;
-    for (const r of s.reactions) {
-      const e = [r.at[0] + r.force[0] * k, r.at[1] + r.force[1] * k];
-      line(t, r.at, e, '#e377c2', 3);
-      drawn.reactions.push({name: r.name, from: r.at, to: e});
-    }
-  }
+  drawn.undrawn = no.length ? 'not drawn (not finite): ' + no.join(', ') : '';
+  ctx.fillStyle = '#c00'; ctx.fillText(drawn.undrawn, 10, 14);
   ctx.fillStyle = '#000';
   for (const [name, [p]] of Object.entries(s.points)) ctx.fillText(name, ...t.px(p).map(
     (c) => c + 6));

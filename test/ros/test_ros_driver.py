@@ -120,6 +120,38 @@ def test_a_small_clock_adjustment_is_not_a_jump():
     assert list(wake.instants) == [k * MS for k in range(1, 12)]
 
 
+def test_a_deschedule_between_the_clock_reads_is_not_a_jump():
+    """A thread away between its clock reads sees no jump; a real one is seen through the bracket.
+
+    The node warned "the system clock jumped by +0.010 s" about every 2 s
+    under load (issue 42): it read the system clock, was descheduled, then
+    read the monotonic clock, and took the time away for a change of offset.
+    """
+    driver = crank_driver(period_ns=MS)
+    publish(driver, driver.step(0, monotonic_ns=0, monotonic_after_ns=0))
+    # The system clock read at 5 ms, then 15 ms away before the monotonic clock's second read.
+    wake = driver.step(5 * MS, monotonic_ns=5 * MS, monotonic_after_ns=20 * MS)
+    assert wake.jump_ns is None
+    assert list(wake.instants) == [k * MS for k in range(1, 6)]
+    assert driver.step(21 * MS, monotonic_ns=21 * MS).jump_ns is None
+    # Set 30 ms ahead, read with the same 15 ms away: 15 ms at least, a jump.
+    wake = driver.step(52 * MS, monotonic_ns=22 * MS, monotonic_after_ns=37 * MS)
+    assert wake.jump_ns == 52 * MS - (22 * MS + 37 * MS) // 2
+    # Only the bracket can hide a change: the same 15 ms away read the other way is no jump.
+    driver = crank_driver(period_ns=MS)
+    driver.step(0, monotonic_ns=0, monotonic_after_ns=15 * MS)
+    assert driver.step(16 * MS, monotonic_ns=16 * MS).jump_ns is None
+
+
+def test_the_sharpest_reading_of_the_offset_is_kept():
+    """A wide first reading gives way to a sharp one: the bracket does not hide jumps for ever."""
+    driver = crank_driver(period_ns=MS)
+    driver.step(0, monotonic_ns=0, monotonic_after_ns=40 * MS)
+    assert driver.step(41 * MS, monotonic_ns=41 * MS).jump_ns is None
+    wake = driver.step(42 * MS + CLOCK_JUMP_NS + MS, monotonic_ns=42 * MS)
+    assert wake.jump_ns == CLOCK_JUMP_NS + MS
+
+
 def test_sim_time_waits_for_a_clock_then_follows_it():
     """Simulated time: nothing before the first /clock; then the instants up to each reading."""
     driver = crank_driver(period_ns=10 * MS)

@@ -17,7 +17,8 @@ import mech_kinematics as mk
 from mech_kinematics.ros.diagnostics import TickStats, timing_status, WARN
 from mech_kinematics.ros.driver import TickDriver
 from mech_kinematics.ros.publishing import RCLError
-from mech_kinematics.ros.tick_thread import LATE_NS, TickThread
+from mech_kinematics.ros.tick_thread import (CLOCK_READ_NS, LATE_NS, read_system_clock,
+                                             TickThread)
 from mech_kinematics.ros.timebase import CrankTimebase
 from mech_kinematics.units import NS_PER_S, rad_per_s_from_rpm
 
@@ -155,6 +156,65 @@ def test_the_thread_ticks_on_the_system_clock_until_stopped():
     assert stamps[0] % MS == 0
     time.sleep(0.01)
     assert len(publishing.ticks) == count
+
+
+class Descheduling:
+    """System and monotonic clocks of one virtual time, the thread away between their reads.
+
+    Virtual time is the real monotonic clock plus ``away``; every ``every``-th
+    read of the system clock is followed by ``gap_ns`` away (both clocks move
+    on, as when the thread is descheduled), and ``jump_ns`` once sets the
+    system clock alone ahead (a real jump).
+    """
+
+    def __init__(self, every, gap_ns):
+        self.every, self.gap_ns, self.reads, self.away = every, gap_ns, 0, 0
+        self.epoch, self.jump_ns = 1_780_000_000 * NS_PER_S, 0
+
+    def monotonic_ns(self):
+        return time.monotonic_ns() + self.away
+
+    def time_ns(self):
+        self.reads += 1
+        now = self.monotonic_ns() + self.epoch + self.jump_ns
+        if self.reads % self.every == 0:
+            self.away += self.gap_ns
+        return now
+
+
+@pytest.mark.parametrize('jump_ns', [0, 50 * MS])
+def test_a_thread_descheduled_between_its_clock_reads_sees_no_jump(jump_ns):
+    """15 ms away between the reads of system and monotonic clocks, 20 times: no jump counted.
+
+    The same loop still counts a real jump of the system clock (50 ms).
+    """
+    ticks, stats, logger, _ = _thread()
+    clocks = Descheduling(every=7, gap_ns=15 * MS)
+    ticks.time_ns, ticks.monotonic_ns = clocks.time_ns, clocks.monotonic_ns
+    ticks.start(ticks.solver, ticks.publishing, None)
+    _wait(lambda: clocks.reads >= 70, 'ten deschedules')
+    clocks.jump_ns = jump_ns
+    _wait(lambda: clocks.reads >= 140, 'ten more')
+    ticks.stop()
+    jumps = stats.take_window().totals['clock_jumps']
+    warned = [text for _, text in logger.lines if 'jumped' in text]
+    if jump_ns:
+        assert jumps == 1 and warned == ['the system clock jumped by +0.050 s: the tick grid '
+                                         'starts again']
+    else:
+        assert (jumps, warned) == (0, [])
+
+
+def test_the_clocks_are_read_again_while_the_bracket_is_wide():
+    """The narrowest of the tries: a read away 15 ms is read again, the sharp one is taken."""
+    clocks = Descheduling(every=1, gap_ns=15 * MS)
+    _, before, after = read_system_clock(clocks.time_ns, clocks.monotonic_ns)
+    assert after - before >= 15 * MS        # away after every read: no sharp one to be had
+    clocks.every = 2
+    clocks.reads = 1        # the next read of the system clock is followed by time away
+    now, before, after = read_system_clock(clocks.time_ns, clocks.monotonic_ns)
+    assert after - before <= CLOCK_READ_NS and clocks.reads == 3
+    assert before <= now - clocks.epoch <= after
 
 
 def test_a_simulated_clock_before_its_first_message_waits_and_says_so_once():

@@ -32,6 +32,7 @@ import re
 import select
 import shutil
 import signal
+import socket
 import subprocess
 import sys
 import tempfile
@@ -47,6 +48,7 @@ from mech_kinematics.geometry.diagrams import strokes_from_scene
 from mech_kinematics.geometry.instant_centres import full_scene
 from mech_kinematics.tools.view import (frame_from_state, PAGE, scene_bounds, TOKEN_HEADER,
                                         ViewServer)
+from mech_kinematics.units import rad_per_s_from_rpm, rpm_from_rad_per_s
 
 REPO = Path(__file__).resolve().parents[2]
 SCENES = sorted(path.stem for path in (REPO / 'config' / 'scenes').glob('*.yaml'))
@@ -424,12 +426,13 @@ def _diagnostics(server, *statuses):
         for name, level, message, values in statuses]))
 
 
-def _request(server, method, path, headers=None, body=None):
+def _request(server, method, path, headers=None, body=None, address='127.0.0.1'):
     """Return (status, headers, body text) of a raw request; Host is the server's own."""
-    connection = http.client.HTTPConnection('127.0.0.1', server.port, timeout=10)
+    connection = http.client.HTTPConnection(address, server.port, timeout=10)
+    host = f'[{address}]' if ':' in address else address
     try:
         connection.request(method, path, body=body, headers={
-            'Host': f'127.0.0.1:{server.port}', **(headers or {})})
+            'Host': f'{host}:{server.port}', **(headers or {})})
         response = connection.getresponse()
         return response.status, dict(response.getheaders()), response.read().decode()
     finally:
@@ -467,6 +470,39 @@ def test_a_foreign_host_is_refused_with_one_line(fake, host):
         assert fake.token not in text
     assert fake.node.parameters.requests == []
     assert len(fake.refusals) == 3
+
+
+def _has_ipv6_loopback():
+    try:
+        with socket.socket(socket.AF_INET6) as probe:
+            probe.bind(('::1', 0))
+    except OSError:
+        return False
+    return True
+
+
+def test_the_view_answers_on_ipv6s_loopback_too(fake):
+    """The docs let `Host: [::1]:PORT` in: something listens there (nothing did, issue 42)."""
+    if not _has_ipv6_loopback():
+        assert f'[::1]:{fake.port}' not in fake.hosts    # not let in where it is not served
+        pytest.skip('no IPv6 loopback on this machine')
+    _scene(fake, 'khurmi_four_bar_ad150')
+    status, _, page = _request(fake, 'GET', '/', address='::1')
+    assert status == 200 and f'content="{fake.token}"' in page
+    status, _, body = _request(fake, 'GET', '/state', {TOKEN_HEADER: fake.token}, address='::1')
+    assert status == 200 and json.loads(body)['scene'] == 'khurmi_four_bar_ad150'
+
+
+def test_a_speed_is_shown_without_the_conversions_last_bit(fake):
+    """The default -120 rpm, published as rad/s, is shown as -120 rpm (not -119.99999999999999)."""
+    _scene(fake, 'khurmi_four_bar_ad150')
+    speed = rad_per_s_from_rpm(-120.0)
+    assert rpm_from_rad_per_s(speed) == -119.99999999999999     # the conversion's last bit
+    _joints(fake, ['crank'], [0.5], [speed])
+    state = _state(fake)
+    assert state['crank_speed_rpm'] == -120.0 and state['drivers'][0]['speed'] == -120.0
+    _joints(fake, ['crank'], [0.5], [rad_per_s_from_rpm(1e-160)])
+    assert _state(fake)['crank_speed_rpm'] == pytest.approx(1e-160, rel=1e-15)
 
 
 @pytest.mark.parametrize('host', ['127.0.0.1:{port}', 'LOCALHOST:{port}', '[::1]:{port}'])
@@ -604,8 +640,9 @@ def test_state_has_the_published_reactions_at_their_joints(fake):
         assert r['at'] == pytest.approx(list(_xy_of(state, joints[r['name']].at)), abs=1e-12)
     bad = WrenchStamped()
     bad.wrench.force.x = math.nan
-    fake._on_reaction('C', 'C', bad)      # not finite: not drawn
-    assert 'C' not in {r['name'] for r in _state(fake)['reactions']}
+    fake._on_reaction('C', 'C', bad)      # not finite: not drawn, and the page says so
+    [c] = [r for r in _state(fake)['reactions'] if r['name'] == 'C']
+    assert c['force'] is None
     _scene(fake, 'khurmi_four_bar_ad150')     # a scene without forces: none
     _joints(fake, ['crank'], [0.5], [1.0])
     assert _state(fake)['reactions'] == []
@@ -763,6 +800,81 @@ def test_chromium_draws_the_reactions_scaled_at_their_joints(fake, browser):
         assert list(start) == r['at']
         np.testing.assert_allclose(end - start, np.array(r['force']) * width / 5 / largest,
                                    rtol=1e-9, atol=1e-12)
+
+
+def _huge_points(server, stamp_ns, points):
+    """Publish points ({name: ((x, y), velocity or None, acceleration)}) as the node does."""
+    from geometry_msgs.msg import Transform, Twist, Vector3
+    from trajectory_msgs.msg import MultiDOFJointTrajectory, MultiDOFJointTrajectoryPoint
+
+    def twist(v):
+        return Twist(linear=Vector3(x=math.nan, y=0.0) if v is None else
+                     Vector3(x=float(v[0]), y=float(v[1])))
+
+    msg = MultiDOFJointTrajectory(joint_names=list(points), points=[MultiDOFJointTrajectoryPoint(
+        transforms=[Transform(translation=Vector3(x=float(p[0][0]), y=float(p[0][1])))
+                    for p in points.values()],
+        velocities=[twist(p[1]) for p in points.values()],
+        accelerations=[twist(p[2]) for p in points.values()])])
+    msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(stamp_ns, 1_000_000_000)
+    server._on_points(msg)
+
+
+def test_chromium_draws_huge_forces_and_velocities_to_scale_and_says_what_it_cannot(fake,
+                                                                                     browser):
+    """Reactions of 1.5e308 N draw to scale; a value not finite is named on the drawing.
+
+    Math.hypot of [1.5e308, 1.5e308] is Infinity: every reaction arrow was drawn
+    0 long, and a velocity that large too, with no word (issue 42).
+    """
+    from geometry_msgs.msg import WrenchStamped
+
+    scene = _scene(fake, 'shaper')
+    _joints(fake, ['crank'], [0.5], [1.0])
+    forces = {}
+    for joint, force in zip(scene.dynamics.graph.joints,
+                            [(1.5e308, 1.5e308), (-1e308, 0.0), (3.0, -4.0), (math.inf, 0.0)],
+                            strict=False):
+        msg = WrenchStamped()
+        msg.wrench.force.x, msg.wrench.force.y = force
+        fake._on_reaction(joint.name, joint.at, msg)
+        forces[joint.name] = force
+    points = {name: (xy, [1.5e308, -1.5e308], None) for name, xy in
+              ((n, _xy_of(mk.solve(scene, 0.5), n)) for n in scene.output_points)}
+    _huge_points(fake, 1, points)
+    answer = _state(fake)
+    target, session = browser.open(fake.url)
+    try:
+        _drawn(browser, session, 'shaper drawn')
+        browser.evaluate(session, "document.getElementById('forces').click()")
+        browser.evaluate(session, "document.getElementById('arrows').click()")
+        text = browser.wait(session, '(() => { const d = JSON.parse(document.getElementById('
+                                     '"drawn").textContent); return d.reactions.length && '
+                                     'd.arrows.length && JSON.stringify(d); })()', 'arrows drawn')
+    finally:
+        browser.close_tab(target)
+    drawn = json.loads(text)
+    width = answer['bounds'][2] - answer['bounds'][0]
+    reactions = {r['name']: r for r in drawn['reactions']}
+    finite = {name: f for name, f in forces.items() if math.isfinite(f[0])}
+    assert set(reactions) == set(finite)
+    # One scale: the largest, |[1.5e308, 1.5e308]| = 2.1e308 (beyond doubles), a fifth wide.
+    largest = math.sqrt(2) * (1.5e308 / 1e300)
+    for name, force in finite.items():
+        r = reactions[name]
+        expected = np.array(force) / 1e300 * width / 5 / largest
+        np.testing.assert_allclose(np.array(r['to']) - np.array(r['from']), expected,
+                                   rtol=1e-9, atol=1e-300)
+    # Each velocity a tenth of the drawing wide along [1, -1]; no acceleration (not finite).
+    velocities = [a for a in drawn['arrows'] if a['what'] == 'velocity']
+    assert len(velocities) == len(points) and all(a['what'] == 'velocity' for a in drawn['arrows'])
+    for a in velocities:
+        np.testing.assert_allclose(np.array(a['to']) - np.array(a['from']),
+                                   np.array([1.0, -1.0]) / math.sqrt(2) * width / 10, rtol=1e-9)
+    [infinite] = [name for name, f in forces.items() if not math.isfinite(f[0])]
+    assert drawn['undrawn'].startswith('not drawn (not finite): ')
+    assert f'reaction at {infinite}' in drawn['undrawn']
+    assert all(f'acceleration of {name}' in drawn['undrawn'] for name in points)
 
 
 def test_chromium_shows_html_from_the_graph_as_text(fake, browser):
