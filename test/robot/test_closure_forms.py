@@ -184,3 +184,51 @@ def test_a_malformed_loop_element_in_a_urdf_is_refused_in_one_line(tag, body, ex
     with pytest.raises(UrdfError, match=expected) as error:
         read_description(text)
     assert '<robot_description>' in str(error.value) and '\n' not in str(error.value)
+
+
+def _slides_in_urdf(tag):
+    """Return the fusion2URDF gripper's URDF with its two slides written as ``tag`` elements.
+
+    Each slide's frame on its child at the zero pose comes from ``UrdfFk``
+    (our own forward kinematics), its rpy from SciPy.
+    """
+    from scipy.spatial.transform import Rotation
+
+    text = (DATA / 'fusion2urdf_assem1_exact.urdf').read_text()
+    fk = UrdfFk(text, DATA / 'fusion2urdf_assem1_exact.robot_data.yaml')
+
+    def attributes(frame):
+        xyz = ' '.join(repr(float(v)) for v in frame[:3, 3])
+        rpy = ' '.join(repr(float(v)) for v in Rotation.from_matrix(frame[:3, :3]).as_euler('xyz'))
+        return f'xyz="{xyz}" rpy="{rpy}"'
+
+    elements = []
+    for name, _, a, fa, b, fb in fk.closures:
+        axis = ' '.join(repr(float(v)) for v in fk.slides[name])
+        if tag == 'constraint':
+            elements.append(
+                f'<constraint name="{name}" type="prismatic"><parent link="{a}"/>'
+                f'<parent_origin {attributes(fa)}/><parent_axis xyz="{axis}"/>'
+                f'<child link="{b}"/><child_origin {attributes(fb)}/>'
+                f'<child_axis xyz="{axis}"/></constraint>')
+        else:
+            elements.append(f'<loop_joint name="{name}" type="prismatic"><link1 link="{a}" '
+                            f'{attributes(fa)}/><link2 link="{b}" {attributes(fb)}/>'
+                            f'<axis xyz="{axis}"/></loop_joint>')
+    return text.replace('</robot>', '\n'.join(elements) + '\n</robot>')
+
+
+@pytest.mark.parametrize('tag', ['constraint', 'loop_joint'])
+def test_a_prismatic_constraint_or_loop_joint_in_the_urdf_is_a_slide_closing_its_loop(tag):
+    """The gripper's fingers slide on its base: <constraint type="prismatic"> (once refused)."""
+    text = _slides_in_urdf(tag)
+    robot = load_robot(text, actuated=['servo_joint'])
+    fk = UrdfFk(text)
+    assert {c.kind.value for c in robot.description.closures} == {'slide'}
+    assert len(fk.slides) == 2
+    worst = 0.0
+    for servo in np.linspace(-0.95, -0.05, 7):
+        answer = robot.solve({'servo_joint': float(servo)})
+        gaps = fk.gaps({n: j.position for n, j in answer.joints.items()})
+        worst = max(worst, *(gap / fk.loop_size(name) for name, gap in gaps.items()))
+    assert worst <= RTOL_CLOSURE
