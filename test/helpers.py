@@ -537,9 +537,11 @@ class UrdfFk:
         elif sidecar is not None:
             data = yaml.safe_load(Path(sidecar).read_text())
             zero = self.transforms({})
-            for a, b in data.get('closed_loop', []):     # Extended URDF: Pinocchio frames
-                self.closures.append((f'{a}C{b}', True, self._frame_link(a), np.eye(4),
-                                      self._frame_link(b), np.eye(4)))
+            for (a, b), kind in zip(data.get('closed_loop', []),   # Extended URDF
+                                    data.get('type', ['6d'] * len(data.get('closed_loop', []))),
+                                    strict=True):
+                self.closures.append((f'{a}C{b}', kind.lower() == '6d', self._frame_link(a),
+                                      np.eye(4), self._frame_link(b), np.eye(4)))
             for c in data.get('closing_joints', []):     # fusion2URDF
                 frame = np.eye(4)
                 frame[:3, :3] = _rpy(*c['origin_rpy_rad'])

@@ -20,7 +20,11 @@ From a :class:`~.description.Description` and its actuated joints:
    from that body's own frame, so that a closure whose two points miss each
    other by a rounding still gives each body its exact shape. A closure
    whose points miss by more than :data:`GAP_TOLERANCE` of the loop's size
-   is refused with the gap.
+   is refused with the gap (a weld: its two frames' distance and turn; a
+   slide closure, which is one more prismatic joint of the loop: its origins
+   off its line, and its turn). A body with two coaxial pins and nothing else
+   (idle: it could spin between them) turns with its first revolute joint,
+   held at its reference value.
 5. **Drivers and dyads.** An actuated revolute joint on the ground is a
    crank; an actuated prismatic joint between a barrel and a rod, each
    pinned once, is a cylinder (an actuator). Then, while bodies remain, a
@@ -255,11 +259,12 @@ def _idle_joints(description: Description, body_of: dict[str, str],
                  ) -> dict[str, Matrix]:
     """Return the joints to lock (name -> its child's frame in its parent's at the pose).
 
-    An idle body has two revolute joints and nothing else, coaxial (the same
-    point, parallel axes): it could spin between them without moving the
-    loop (Extended URDF's ``6d`` closure of two joint frames makes one). It
-    turns with the body of its first joint in file order: that joint is
-    locked at its pose's value, the other answers the turn.
+    An idle body has two pins and nothing else, coaxial (the same point,
+    parallel axes where written), at least one a revolute joint: it could spin
+    between them without moving the loop (Extended URDF's ``6d`` closure of
+    two joint frames makes one, its ``3d`` closure two). It turns with the body
+    of its first revolute joint in file order: that joint is locked at its
+    pose's value, the other pin answers the turn.
     """
     touching: dict[str, list[_Edge]] = {}
     for edge in edges:
@@ -269,26 +274,40 @@ def _idle_joints(description: Description, body_of: dict[str, str],
     order = list(description.joints)
     out: dict[str, Matrix] = {}
     for body, mine in touching.items():
-        if body == root or len(mine) != 2 or any(e.joint is None or e.kind != 'pin'
-                                                 for e in mine):
+        if body == root or len(mine) != 2 or any(e.kind != 'pin' for e in mine) \
+                or all(e.joint is None for e in mine):
             continue
         ends = []
         for edge in mine:
-            joint = edge.joint
-            assert joint is not None
-            frame = in_body[joint.child] if body_of[joint.child] == body \
-                else in_body[joint.parent] @ joint.origin
-            ends.append((frame[:3, 3], frame[:3, :3] @ np.asarray(joint.axis)))
+            ends.append(_pin_on(edge, body, body_of, in_body))
         (p, u), (q, v) = ends
         scale = max(1.0, float(np.linalg.norm(p)), float(np.linalg.norm(q)))
-        if float(np.linalg.norm(p - q)) > PLANAR_TOLERANCE * scale \
-                or float(np.linalg.norm(np.cross(u, v))) > PLANAR_TOLERANCE:
+        if float(np.linalg.norm(p - q)) > PLANAR_TOLERANCE * scale or (
+                u is not None and v is not None
+                and float(np.linalg.norm(np.cross(u, v))) > PLANAR_TOLERANCE):
             continue
         first = min((e.joint for e in mine if e.joint is not None),
                     key=lambda j: order.index(j.name))
         if first.name not in out:
             out[first.name] = first.motion(pose.get(first.name, 0.0))
     return out
+
+
+def _pin_on(edge: _Edge, body: str, body_of: dict[str, str], in_body: dict[str, Matrix]
+            ) -> tuple[np.ndarray, np.ndarray | None]:
+    """Return a pin's point and axis (None: not written) in the frame of ``body``, one end."""
+    if edge.joint is not None:
+        joint = edge.joint
+        frame = in_body[joint.child] if body_of[joint.child] == body \
+            else in_body[joint.parent] @ joint.origin
+        return frame[:3, 3], frame[:3, :3] @ np.asarray(joint.axis)
+    closure = edge.closure
+    assert closure is not None
+    link, on, axis = ((closure.link_a, closure.frame_a, closure.axis_a)
+                      if body_of[closure.link_a] == body else
+                      (closure.link_b, closure.frame_b, closure.axis_b))
+    frame = in_body[link] @ on
+    return frame[:3, 3], None if axis is None else in_body[link][:3, :3] @ np.asarray(axis)
 
 
 def _components(bodies: list[str], edges: list[_Edge]) -> list[list[int]]:
@@ -1065,6 +1084,33 @@ def _edges(description: Description, weld: list[Closure], locked: Mapping[str, M
     return body_of, in_body, edges
 
 
+def _check_welds(m: _Mechanism, weld: list[Closure], tree: Mapping[str, Matrix]) -> None:
+    """Refuse a weld closure of ``m`` that the reference pose does not close.
+
+    Its two frames, each where the tree puts its link, must coincide within
+    :data:`GAP_TOLERANCE` of the loop's size (their origins' distance plus
+    their turn times the size), as a pin's two points must.
+    """
+    for closure in weld:
+        if m.body_of[closure.link_a] not in m.bodies:
+            continue
+        on_a = tree[closure.link_a] @ closure.frame_a
+        on_b = tree[closure.link_b] @ closure.frame_b
+        apart = float(np.linalg.norm(on_a[:3, 3] - on_b[:3, 3]))
+        turn = math.acos(max(-1.0, min(1.0, 0.5 * (float(np.trace(on_a[:3, :3].T
+                                                                  @ on_b[:3, :3])) - 1.0))))
+        if apart + turn * m.size > GAP_TOLERANCE * m.size:
+            raise m.fail(
+                f'closure "{closure.name}": Expected the reference pose to close the loop '
+                f'within {GAP_TOLERANCE:g} of its size ({m.size:.6g} m), got its two frames '
+                f'{apart:.3g} m apart and turned {turn:.3g} rad (give a reference pose that '
+                'closes it)', closure.name)
+    m.gaps.extend(
+        (float(np.linalg.norm((tree[c.link_a] @ c.frame_a)[:3, 3]
+                              - (tree[c.link_b] @ c.frame_b)[:3, 3])), c.name)
+        for c in weld if m.body_of[c.link_a] in m.bodies)
+
+
 def _actuated_names(description: Description, actuated: Iterable[str] | None,
                     loop_joints: list[str]) -> tuple[str, ...]:
     """Return the actuated joints: given, else the sidecar's, else the URDF's; else refuse."""
@@ -1148,6 +1194,7 @@ def planar_from_description(description: Description, actuated: Iterable[str] | 
         members = {e.a for e in part} | {e.b for e in part}
         ground = min(members, key=lambda b: (description.depth(b), description.links.index(b)))
         m = _Mechanism(index, part, model, in_body, body_of, description, ground, pose)
+        _check_welds(m, weld, tree)
         names = {e.name for e in part}
         here = [n for n in actuated_names if n in names]
         mimics = {}

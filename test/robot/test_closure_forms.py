@@ -56,10 +56,33 @@ FORMS = {
 }
 
 
-def _robot(form):
-    urdf, closures, actuated, _, _, _ = FORMS[form]
-    closure_path = None if closures is None else DATA / closures
-    return (load_robot(DATA / urdf, closure_path, actuated),
+def _five_bar_reference(closures=DATA / 'gepetto_5bar_linkage.robot.yaml'):
+    """Return a pose of Gepetto's five-bar that closes it (its zero pose is 0.3 m open).
+
+    The motors at 0 and closedloop1_A at 0; free1, closedloop1_B and free2 by
+    SciPy's least squares on ``UrdfFk``'s 6d gap (our own kinematics).
+    """
+    from scipy.optimize import least_squares
+
+    fk = UrdfFk((DATA / 'gepetto_5bar_linkage.urdf').read_text(), closures)
+    _, _, a, fa, b, fb = fk.closures[0]
+    names = ('free1', 'closedloop1_B', 'free2')
+
+    def residual(x):
+        frames = fk.transforms(dict(zip(names, x, strict=True)))
+        ta, tb = frames[a] @ fa, frames[b] @ fb
+        return np.concatenate([ta[:3, 3] - tb[:3, 3], (ta[:3, :3] - tb[:3, :3]).ravel()])
+
+    fit = least_squares(residual, [0.5, 0.5, -0.5], xtol=1e-15, ftol=1e-15, gtol=1e-15)
+    assert np.abs(fit.fun).max() <= 1e-15
+    return {'mot1': 0.0, 'mot2': 0.0, **dict(zip(names, map(float, fit.x), strict=True))}
+
+
+def _robot(form, closures=None):
+    urdf, name, actuated, _, _, _ = FORMS[form]
+    closure_path = closures or (None if name is None else DATA / name)
+    reference = _five_bar_reference() if form.startswith('robot.yaml') else None
+    return (load_robot(DATA / urdf, closure_path, actuated, reference),
             UrdfFk((DATA / urdf).read_text(), closure_path))
 
 
@@ -88,6 +111,32 @@ def test_each_form_is_read_and_its_loops_close_in_the_tests_own_kinematics(form)
         h = 1e-6
         moved = {n: j.position + h * j.velocity for n, j in answer.joints.items()}
         assert max(fk.gaps(moved).values()) <= 1e-9 * max(fk.loop_size(c) for c in gaps)
+    assert worst <= RTOL_CLOSURE
+
+
+def test_the_five_bars_open_zero_pose_is_refused_naming_the_weld():
+    """Exported 0.3 m open: a weld the reference pose does not close is refused, as a pin is."""
+    with pytest.raises(UrdfError, match=r'closure "closedloop1_ACclosedloop1_B": Expected the '
+                       r'reference pose to close the loop within 1e-06 of its size '
+                       r'\(0\.967678 m\), got its two frames 0\.3 m apart and turned 1\.57 rad'):
+        load_robot(DATA / 'gepetto_5bar_linkage.urdf', DATA / 'gepetto_5bar_linkage.robot.yaml')
+
+
+def test_the_five_bar_closed_by_a_3d_point_is_solved(tmp_path):
+    """The same robot.yaml with type ['3d']: the two spheres joined at a point, both idle."""
+    closures = tmp_path / 'robot.yaml'
+    closures.write_text((DATA / 'gepetto_5bar_linkage.robot.yaml').read_text().replace(
+        "['6d']", "['3d']"))
+    robot, fk = _robot('robot.yaml 6d', closures)
+    assert [c.kind.value for c in robot.description.closures] == ['pin']
+    reference = _five_bar_reference(closures)
+    worst = 0.0
+    for t in np.linspace(-0.3, 0.3, 7):
+        answer = robot.solve({'mot1': t, 'mot2': -0.5 * t})
+        values = {n: j.position for n, j in answer.joints.items()}
+        assert values['closedloop1_B'] == reference['closedloop1_B']   # held: idle
+        for name, gap in fk.gaps(values).items():
+            worst = max(worst, gap / fk.loop_size(name))
     assert worst <= RTOL_CLOSURE
 
 
@@ -123,7 +172,7 @@ def test_a_closure_file_is_told_by_its_content_not_its_name(tmp_path):
         urdf, closures, actuated, sweep, written, _ = FORMS[form]
         renamed = tmp_path / f'closures_{len(written)}.txt'
         shutil.copy(DATA / closures, renamed)
-        robot = load_robot(DATA / urdf, renamed, actuated)
+        robot, _ = _robot(form, renamed)
         assert {c.form for c in robot.description.closures} == {written}
 
 
@@ -232,3 +281,19 @@ def test_a_prismatic_constraint_or_loop_joint_in_the_urdf_is_a_slide_closing_its
         gaps = fk.gaps({n: j.position for n, j in answer.joints.items()})
         worst = max(worst, *(gap / fk.loop_size(name) for name, gap in gaps.items()))
     assert worst <= RTOL_CLOSURE
+
+
+def test_the_nodes_loop_closures_takes_every_form():
+    """What the node loads from scene:=ROBOT.urdf and loop_closures:=FILE (no DDS needed)."""
+    from mech_kinematics.ros.robot_mode import load_source
+
+    for form in ('constraint file', 'robot_data.yaml prismatic'):
+        urdf, closures, actuated, sweep, written, _ = FORMS[form]
+        source = load_source(str(DATA / urdf), loop_closures=str(DATA / closures),
+                             actuated_joints=actuated)
+        assert {c.form for c in source.robot.description.closures} == {written}
+        assert set(source.robot.actuated) == set(sweep)
+    # The node has no reference pose yet (issue 43, item 4): the open five-bar is refused.
+    urdf, closures, _, _, _, _ = FORMS['robot.yaml 6d']
+    with pytest.raises(UrdfError, match='give a reference pose that closes it'):
+        load_source(str(DATA / urdf), loop_closures=str(DATA / closures))
