@@ -297,3 +297,32 @@ def test_the_nodes_loop_closures_takes_every_form():
     urdf, closures, _, _, _, _ = FORMS['robot.yaml 6d']
     with pytest.raises(UrdfError, match='give a reference pose that closes it'):
         load_source(str(DATA / urdf), loop_closures=str(DATA / closures))
+
+
+def test_revolute_closing_joints_of_a_robot_data_yaml_close_their_loops(tmp_path):
+    """fusion2URDF's closing_joints with type revolute: the 2F-85's finger loops, pins."""
+    import xml.etree.ElementTree as ET
+
+    items = []
+    for c in ET.parse(DATA / 'robotiq_2f_85.constraints.xml').getroot():
+        xyz = ', '.join(c.find('parent_origin').get('xyz').split())
+        axis = ', '.join(c.find('parent_axis').get('xyz').split())
+        items.append(f'  - name: {c.get("name")}\n    type: revolute\n'
+                     f'    parent: {c.find("parent").get("link")}\n'
+                     f'    child: {c.find("child").get("link")}\n'
+                     f'    origin_xyz_m: [{xyz}]\n    origin_rpy_rad: [0.0, 0.0, 0.0]\n'
+                     f'    axis: [{axis}]\n')
+    closures = tmp_path / 'robot_data.yaml'
+    closures.write_text('metadata:\n  design_name: gripper\nclosing_joints:\n' + ''.join(items)
+                        + 'rigid_groups: {}\n')
+    urdf = DATA / 'robotiq_2f_85.urdf'
+    robot = load_robot(urdf, closures)
+    fk = UrdfFk(urdf.read_text(), closures)
+    assert [c.kind.value for c in robot.description.closures] == ['pin', 'pin']
+    worst = 0.0
+    for q in np.linspace(0.0, 0.7, 8):
+        answer = robot.solve({'finger_joint': float(q)})
+        gaps = fk.gaps({n: j.position for n, j in answer.joints.items()})
+        assert len(gaps) == 2
+        worst = max(worst, *(gap / fk.loop_size(name) for name, gap in gaps.items()))
+    assert worst <= RTOL_CLOSURE
