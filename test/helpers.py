@@ -487,8 +487,14 @@ class UrdfFk:
 
     ``joints``: name -> (type, parent, child, origin 4x4, unit axis, mimic or None).
     ``closures``: (name, weld, link_a, frame_a 4x4, link_b, frame_b 4x4), from
-    ``<constraint>`` elements, ``closing_NAME_1/2`` frames and a scikit-robot
-    ``loop_closures.yaml`` (its point in the root frame at the zero pose).
+    ``<constraint>`` elements, Isaac Sim's ``<loop_joint>`` and URDF+'s
+    ``<loop>``, ``closing_NAME_1/2`` frames and a sidecar: a scikit-robot
+    ``loop_closures.yaml`` (its point in the root frame at the zero pose), a
+    file of ``<constraint>`` elements, an Extended-URDF ``robot.yaml`` (a
+    frame: a link, or a joint's child link; ``6d`` a weld) or a fusion2URDF
+    ``robot_data.yaml`` (the closing joint's frame in its parent, met by its
+    child at the zero pose). ``slides``: closure name -> its axis in frame_a
+    (a prismatic closure: the frames parallel, their origins on that line).
     """
 
     def __init__(self, text: str, sidecar: str | os.PathLike | None = None) -> None:
@@ -508,27 +514,66 @@ class UrdfFk:
                                                float(mimic.get('offset', 0)))
             self.joints[j.get('name')] = (j.get('type'), j.find('parent').get('link'),
                                           j.find('child').get('link'), _pose(j.find('origin')),
-                                          vector / np.linalg.norm(vector), rule)
+                                          vector / (np.linalg.norm(vector) or 1.0), rule)
         children = {j[2] for j in self.joints.values()}
         self.root = next(link for link in self.links if link not in children)
         self.closures = []
-        for c in root.findall('constraint'):
-            self.closures.append((c.get('name'), c.get('type') in ('link', 'fixed'),
-                                  c.find('parent').get('link'), _pose(c.find('parent_origin')),
-                                  c.find('child').get('link'), _pose(c.find('child_origin'))))
+        self.slides = {}
+        self._constraints(root)
+        for tag, one, two in (('loop_joint', 'link1', 'link2'),
+                              ('loop', 'predecessor', 'successor')):
+            for c in root.findall(tag):
+                ends = [c.find(one), c.find(two)]
+                frames = [_pose(e) if e.get('xyz') is not None else _pose(e.find('origin'))
+                          for e in ends]
+                self._add(c.get('name'), c.get('type'), ends[0].get('link'), frames[0],
+                          ends[1].get('link'), frames[1], c.find('axis'))
         for link in self.links:
             if link.startswith('closing_') and link.endswith('_1'):
                 other = link[:-1] + '2'
                 self.closures.append((link[:-2], False, link, np.eye(4), other, np.eye(4)))
-        if sidecar is not None:
+        if sidecar is not None and Path(sidecar).read_text().lstrip().startswith('<'):
+            self._constraints(ET.fromstring(Path(sidecar).read_text()))
+        elif sidecar is not None:
             data = yaml.safe_load(Path(sidecar).read_text())
             zero = self.transforms({})
-            for i, c in enumerate(data['closures']):
+            for (a, b), kind in zip(data.get('closed_loop', []),   # Extended URDF
+                                    data.get('type', ['6d'] * len(data.get('closed_loop', []))),
+                                    strict=True):
+                self.closures.append((f'{a}C{b}', kind.lower() == '6d', self._frame_link(a),
+                                      np.eye(4), self._frame_link(b), np.eye(4)))
+            for c in data.get('closing_joints', []):     # fusion2URDF
+                frame = np.eye(4)
+                frame[:3, :3] = _rpy(*c['origin_rpy_rad'])
+                frame[:3, 3] = c['origin_xyz_m']
+                on_child = np.linalg.inv(zero[c['child']]) @ zero[c['parent']] @ frame
+                self.closures.append((c['name'], c['type'] == 'fixed', c['parent'], frame,
+                                      c['child'], on_child))
+                if c['type'] == 'prismatic':
+                    self.slides[c['name']] = np.array(c['axis'], dtype=float)
+            for i, c in enumerate(data.get('closures', [])):
                 point = np.eye(4)
                 point[:3, 3] = c['point']
                 self.closures.append((f'closure_{i}', False, c['link_a'],
                                       np.linalg.inv(zero[c['link_a']]) @ point, c['link_b'],
                                       np.linalg.inv(zero[c['link_b']]) @ point))
+
+    def _constraints(self, root: Any) -> None:
+        for c in root.findall('constraint'):
+            self._add(c.get('name'), c.get('type'), c.find('parent').get('link'),
+                      _pose(c.find('parent_origin')), c.find('child').get('link'),
+                      _pose(c.find('child_origin')), c.find('parent_axis'))
+
+    def _add(self, name: str, kind: str, a: str, fa: Any, b: str, fb: Any, axis: Any) -> None:
+        import numpy as np
+        self.closures.append((name, kind in ('link', 'fixed'), a, fa, b, fb))
+        if kind == 'prismatic':
+            self.slides[name] = np.array([float(v) for v in (
+                axis.get('xyz') if axis is not None else '1 0 0').split()])
+
+    def _frame_link(self, name: str) -> str:
+        """Return the link of a Pinocchio frame name: a joint's child, or the link."""
+        return self.joints[name][2] if name in self.joints else name
 
     def transforms(self, values: dict) -> dict:
         """Return every link's 4x4 frame in the root's at ``values`` (0 where not given)."""
@@ -572,7 +617,13 @@ class UrdfFk:
         out = {}
         for name, weld, a, fa, b, fb in self.closures:
             ta, tb = frames[a] @ fa, frames[b] @ fb
-            gap = float(np.linalg.norm(ta[:3, 3] - tb[:3, 3]))
+            d = tb[:3, 3] - ta[:3, 3]
+            if name in self.slides:     # off the slide's line, and turned
+                u = ta[:3, :3] @ self.slides[name]
+                u = u / np.linalg.norm(u)
+                d = d - (d @ u) * u
+                weld = True
+            gap = float(np.linalg.norm(d))
             if weld:
                 gap += float(np.linalg.norm(ta[:3, :3] - tb[:3, :3])) * self.loop_size(name)
             out[name] = gap

@@ -16,17 +16,22 @@ reads is read here from the same tree:
   child; the axis in the constraint's frame). ``revolute``, ``continuous``,
   ``spherical`` and ``universal`` close a loop at a point (in a planar loop
   they all act as a pin); ``link`` (or ``fixed``) welds two links; a
-  ``prismatic`` closure is refused (cut the loop at a revolute joint);
+  ``prismatic`` one is a slide (the frames parallel, their origins on one line
+  along its axis);
 - onshape-to-robot's closing frames: the links ``closing_NAME_1`` and
   ``closing_NAME_2`` (frames: fixed child links) whose origins coincide;
 - ``<transmission>`` joints and ``<ros2_control>`` joints with a
   ``<command_interface>``: the actuated joints (a joint with state
   interfaces only is measured, not driven);
 
+- Isaac Sim's ``<loop_joint>`` and URDF+'s ``<loop>`` (:func:`urdf_loops`);
+
 and, beside the URDF, scikit-robot's ``loop_closures.yaml`` (its
 ``LoopClosureSolver``): ``closures: [{link_a, link_b, point, axis}]`` with the
 point and axis in the root frame at the zero pose, ``dependent`` and
-``independent`` joint lists (``independent``: the driven joints).
+``independent`` joint lists (``independent``: the driven joints), or any other
+form :func:`read_closure_file` recognises by content (a file of ``<constraint>``
+elements, an Extended-URDF ``robot.yaml``, a fusion2URDF ``robot_data.yaml``).
 
 Every failure is one :class:`~mech_kinematics.errors.UrdfError` line naming
 the source and what is wrong. Pure: no ROS.
@@ -50,8 +55,8 @@ from .transforms import Matrix, rotation_about, transform, translation
 from ..errors import SceneError, UrdfError
 from ..solver.graph import JointType, PRISMATIC, REVOLUTE
 
-__all__ = ['Closure', 'ClosureKind', 'Description', 'Inertial', 'Mimic', 'UrdfJoint',
-           'read_description', 'URDF_TYPES', 'URDF_VERSIONS']
+__all__ = ['Closure', 'ClosureKind', 'Description', 'FORMS', 'Inertial', 'Mimic', 'UrdfJoint',
+           'read_closure_file', 'read_description', 'URDF_TYPES', 'URDF_VERSIONS', 'urdf_loops']
 
 #: The ``<robot version>`` values read (none given: 1.0), as urdfdom 6 writes them:
 #: 1.1 adds ``quat_xyzw`` to ``<origin>`` (read) and capsule geometry, 1.2 a
@@ -67,9 +72,9 @@ URDF_TYPES: dict[str, JointType | None] = {
 MOVING = frozenset({'revolute', 'continuous', 'prismatic', 'floating', 'planar'})
 #: A ``<constraint>`` type -> what it closes.
 CONSTRAINT_TYPES = {'revolute': 'pin', 'continuous': 'pin', 'spherical': 'pin',
-                    'universal': 'pin', 'link': 'weld', 'fixed': 'weld'}
-#: A ``<constraint>`` type we refuse -> what to do instead.
-REFUSED_CONSTRAINTS = {'prismatic': ' (cut the loop at a revolute joint instead)'}
+                    'universal': 'pin', 'link': 'weld', 'fixed': 'weld', 'prismatic': 'slide'}
+#: A ``<constraint>`` type we refuse -> what to do instead (none: every type is read).
+REFUSED_CONSTRAINTS: dict[str, str] = {}
 #: The name of an onshape-to-robot closing frame: ``closing_NAME_1`` or ``closing_NAME_2``.
 CLOSING_FRAME = re.compile(r'closing_(.+)_([12])\Z')
 
@@ -81,6 +86,7 @@ class ClosureKind(Enum):
 
     PIN = 'pin'
     WELD = 'weld'
+    SLIDE = 'slide'
 
 
 @dataclass(frozen=True)
@@ -620,17 +626,292 @@ def _closing_frames(joints: dict[str, UrdfJoint], links: tuple[str, ...],
                       np.eye(4), None, None, 'closing frames')
 
 
-def _sidecar(path: str | os.PathLike[str], description: Description,
-             ) -> tuple[tuple[Closure, ...], tuple[str, ...] | None]:
-    """Read scikit-robot's ``loop_closures.yaml``: closures and independent joints."""
+# --- the closure forms beside the URDF (--closures FILE), told by content -------------
+#
+# Beside the URDF, one of: scikit-robot's loop_closures.yaml (a mapping with
+# ``closures``, :func:`_loop_closures_yaml`); a file of ``<constraint>``
+# elements (XML: urdfdom#264's element outside the URDF, under any root element,
+# or one ``<constraint>`` as the root); an Extended-URDF ``robot.yaml`` (Gepetto's
+# example-parallel-robots, read by Pinocchio: ``closed_loop: [[FRAME_A, FRAME_B],
+# ...]``, ``type: ['6d'|'3d', ...]``, ``name_mot``; a frame is a link, or a joint:
+# its child link's frame, as Pinocchio's joint frames; ``6d`` welds the two
+# frames, ``3d`` joins their origins); a fusion2URDF ``robot_data.yaml`` (a
+# mapping with ``closing_joints``: each ``{name, type, parent, child,
+# origin_xyz_m, origin_rpy_rad, axis}``, the joint's frame in the parent link as
+# a URDF joint's ``<origin>``, met by the child link at the zero pose). And
+# inside the URDF: Isaac Sim's ``<loop_joint>`` and URDF+'s ``<loop>``
+# (:func:`urdf_loops`).
+
+
+#: The forms ``--closures FILE`` takes, as the refusal of anything else lists them.
+FORMS = ('a loop_closures.yaml (closures:)', 'a file of <constraint> elements',
+         'an Extended-URDF robot.yaml (closed_loop:)',
+         'a fusion2URDF robot_data.yaml (closing_joints:)')
+#: A joint type (of a closing joint, a loop joint or a loop) -> what it closes.
+JOINT_CLOSURES = {'revolute': ClosureKind.PIN, 'continuous': ClosureKind.PIN,
+                  'spherical': ClosureKind.PIN, 'prismatic': ClosureKind.SLIDE,
+                  'fixed': ClosureKind.WELD}
+#: An Extended-URDF constraint type -> what it closes.
+EXTENDED_TYPES = {'6d': ClosureKind.WELD, '3d': ClosureKind.PIN}
+
+
+def read_closure_file(path: str | os.PathLike[str], description: Description
+                      ) -> tuple[tuple[Closure, ...], tuple[str, ...] | None]:
+    """Read the closures beside a URDF in any form of :data:`FORMS`, told by content.
+
+    Returns the closures and the driven joints the file names (``None``
+    where it names none).
+    """
     from ..scene import _decode, _read_bytes
-    from ..yaml12 import read_scene_yaml
 
     where = str(path)
     try:
-        data = read_scene_yaml(_decode(Path(path), _read_bytes(Path(path))))
+        text = _decode(Path(path), _read_bytes(Path(path)))
     except SceneError as error:
         raise UrdfError(f'{where}: {error}') from None
+    if text.lstrip().startswith('<'):
+        return _constraint_file(text, where, description), None
+    from ..yaml12 import read_scene_yaml
+    section = _closing_joints_section(text)
+    try:
+        data = read_scene_yaml(text if section is None else section)
+    except SceneError as error:
+        raise UrdfError(f'{where}: {error}') from None
+    if isinstance(data, dict) and 'closed_loop' in data:
+        return _extended_urdf(data, where, description)
+    if isinstance(data, dict) and 'closing_joints' in data:
+        return _fusion2urdf(data, where, description), None
+    if isinstance(data, dict) and 'closures' in data:
+        return _loop_closures_yaml(data, where, description)
+    got = (f'a mapping with keys {", ".join(sorted(map(str, data))[:6])}'
+           if isinstance(data, dict) else f'{type(data).__name__}')
+    raise UrdfError(f'{where}: Expected {", ".join(FORMS[:-1])} or {FORMS[-1]}, got {got}')
+
+
+def _closing_joints_section(text: str) -> str | None:
+    """Return a robot_data.yaml's top-level ``closing_joints:`` block alone (None: none).
+
+    fusion2URDF writes links, joints, inertias and more before it: only this
+    block is parsed (the rest is not read), which keeps the reading as fast
+    as a loop_closures.yaml's.
+    """
+    match = re.search(r'^closing_joints\s*:', text, re.M)
+    if match is None:
+        return None
+    end = re.compile(r'^[^\s#-]', re.M).search(text, match.end())
+    return text[match.start():len(text) if end is None else end.start()]
+
+
+# --- a file of <constraint> elements ---------------------------------------------------
+
+
+def _constraint_file(text: str, where: str, description: Description) -> tuple[Closure, ...]:
+    from lxml import etree
+    parser = etree.XMLParser(resolve_entities=False, no_network=True, huge_tree=False,
+                             remove_comments=True, remove_pis=True, load_dtd=False)
+    form = 'a file of <constraint> elements'
+    try:
+        root = etree.fromstring(text.encode('utf-8'), parser)
+    except etree.XMLSyntaxError as error:
+        raise UrdfError(f'{where}: Expected {form} (XML), got text that is not XML: '
+                        f'{error}') from None
+    if root.tag == 'constraint':
+        wrapper = etree.Element('constraints')
+        wrapper.append(root)
+        root = wrapper
+    version = _version(root, where) if root.get('version') is not None else '1.2'
+    found = tuple(_constraints(root, set(description.links), where, version))
+    if not found:
+        raise UrdfError(f'{where}: Expected {form}, got <{root.tag}> with no <constraint> '
+                        'child')
+    return found
+
+
+# --- Extended URDF: robot.yaml ---------------------------------------------------------
+
+
+def _frame_of(name: Any, description: Description) -> str | None:
+    """Return the link whose frame a Pinocchio frame name is (a joint: its child)."""
+    if not isinstance(name, str):
+        return None
+    joint = description.joints.get(name)
+    if joint is not None:
+        return joint.child
+    return name if name in description.links else None
+
+
+def _names(data: dict[str, Any], key: str, at: str) -> list[str]:
+    value = data[key]
+    if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+        raise UrdfError(f'{at}{key}: Expected a list of names, got {value!r:.80}')
+    return value
+
+
+def _extended_urdf(data: dict[str, Any], where: str, description: Description
+                   ) -> tuple[tuple[Closure, ...], tuple[str, ...] | None]:
+    at = f'{where}: robot.yaml (Extended URDF): '
+    known = {'closed_loop', 'type', 'name_mot', 'joint_name', 'joint_type'}
+    unknown = set(data) - known
+    if unknown:
+        raise UrdfError(f'{at}Expected keys {", ".join(sorted(known))}, got '
+                        f'{", ".join(sorted(map(str, unknown)))}')
+    loops = data['closed_loop']
+    if not isinstance(loops, list) or not loops:
+        raise UrdfError(f'{at}closed_loop: Expected [[FRAME_A, FRAME_B], ...], got '
+                        f'{loops!r:.80}')
+    types = data.get('type', ['6d'] * len(loops))
+    if not isinstance(types, list) or len(types) != len(loops):
+        raise UrdfError(f'{at}type: Expected one of {", ".join(EXTENDED_TYPES)} per closed_loop '
+                        f'pair ({len(loops)}), got {types!r:.80}')
+    for index, kind in enumerate(data.get('joint_type') or []):
+        if kind != 'SPHERICAL':   # a ball joint in a planar loop turns about the normal only
+            names = data.get('joint_name') or []
+            joint = names[index] if isinstance(names, list) and index < len(names) else '?'
+            raise UrdfError(f'{at}joint_type[{index}]: Expected SPHERICAL (read as the URDF '
+                            f'joint "{joint}" itself), got {kind!r:.40}: a joint turned into '
+                            f'{kind!r:.20} is not read')
+    closures = []
+    for index, (pair, kind) in enumerate(zip(loops, types, strict=True)):
+        here = f'{at}closed_loop[{index}]'
+        if not isinstance(pair, list) or len(pair) != 2:
+            raise UrdfError(f'{here}: Expected [FRAME_A, FRAME_B], got {pair!r:.80}')
+        links = [_frame_of(name, description) for name in pair]
+        for name, link in zip(pair, links, strict=True):
+            if link is None:
+                raise UrdfError(f'{here}: Expected a link or joint of the robot (a Pinocchio '
+                                f'frame), got {name!r:.80}')
+        closure_kind = EXTENDED_TYPES.get(str(kind).lower())
+        if closure_kind is None:
+            raise UrdfError(f'{at}type[{index}]: Expected {" or ".join(EXTENDED_TYPES)}, got '
+                            f'{kind!r:.40}')
+        a, b = links
+        closures.append(Closure(f'{pair[0]}C{pair[1]}', closure_kind, str(a), np.eye(4), str(b),
+                                np.eye(4), None, None, 'robot.yaml'))
+    independent = None
+    if 'name_mot' in data:
+        independent = tuple(_names(data, 'name_mot', at))
+    return tuple(closures), independent
+
+
+# --- fusion2URDF: robot_data.yaml ------------------------------------------------------
+
+
+def _vector(item: dict[str, Any], key: str, here: str, default: tuple[float, ...] | None
+            ) -> tuple[float, float, float]:
+    value = item.get(key, default)
+    if not isinstance(value, (list, tuple)) or len(value) != 3 or not all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+            for v in value):
+        raise UrdfError(f'{here}.{key}: Expected [x, y, z] (finite numbers), got '
+                        f'{value!r:.80}')
+    x, y, z = (float(v) for v in value)
+    return x, y, z
+
+
+def _fusion2urdf(data: dict[str, Any], where: str, description: Description
+                 ) -> tuple[Closure, ...]:
+    at = f'{where}: robot_data.yaml (fusion2URDF): closing_joints'
+    items = data['closing_joints']
+    if not isinstance(items, list) or not items:
+        raise UrdfError(f'{at}: Expected a list of closing joints ({{name, type, parent, child, '
+                        f'origin_xyz_m, origin_rpy_rad, axis}}), got {items!r:.80}')
+    zero = description.transforms({name: 0.0 for name, j in description.joints.items()
+                                   if j.type is not None})
+    closures = []
+    for index, item in enumerate(items):
+        here = f'{at}[{index}]'
+        if not isinstance(item, dict):
+            raise UrdfError(f'{here}: Expected {{name, type, parent, child, origin_xyz_m, '
+                            f'origin_rpy_rad, axis}}, got {item!r:.80}')
+        name = str(item.get('name', f'closing_{index}'))
+        here = f'{at}[{index}] "{name}"'
+        kind = JOINT_CLOSURES.get(str(item.get('type')))
+        if kind is None:
+            raise UrdfError(f'{here}.type: Expected {", ".join(JOINT_CLOSURES)}, got '
+                            f'{item.get("type")!r:.40}')
+        ends = []
+        for key in ('parent', 'child'):
+            if item.get(key) not in zero:
+                raise UrdfError(f'{here}.{key}: Expected a link of the robot, got '
+                                f'{item.get(key)!r:.80}')
+            ends.append(str(item[key]))
+        frame = transform(_vector(item, 'origin_xyz_m', here, (0.0, 0.0, 0.0)),
+                          _vector(item, 'origin_rpy_rad', here, (0.0, 0.0, 0.0)))
+        axis = _unit(_vector(item, 'axis', here, (1.0, 0.0, 0.0)), f'{here}.axis', where)
+        parent, child = ends
+        on_child = np.linalg.inv(zero[child]) @ zero[parent] @ frame
+        closures.append(_closure(name, kind, parent, frame, child, on_child, axis,
+                                 'robot_data.yaml'))
+    return tuple(closures)
+
+
+def _closure(name: str, kind: ClosureKind, link_a: str, frame_a: Matrix, link_b: str,
+             frame_b: Matrix, axis: tuple[float, float, float] | None, form: str) -> Closure:
+    """Return a closure whose axis (in ``frame_a``'s axes, as a joint's) is on both links."""
+    if kind is ClosureKind.WELD or axis is None:
+        return Closure(name, kind, link_a, frame_a, link_b, frame_b, None, None, form)
+    direction = np.asarray(axis)
+    ax, ay, az = (float(v) for v in frame_a[:3, :3] @ direction)
+    bx, by, bz = (float(v) for v in frame_b[:3, :3] @ direction)
+    return Closure(name, kind, link_a, frame_a, link_b, frame_b, (ax, ay, az), (bx, by, bz),
+                   form)
+
+
+# --- inside the URDF: <loop_joint> (Isaac Sim) and <loop> (URDF+) ----------------------
+
+
+def urdf_loops(root: Any, links: set[str], source: str, version: str) -> Iterator[Closure]:
+    """Yield the closures of a URDF's ``<loop_joint>`` and ``<loop>`` elements."""
+    for tag, ends in (('loop_joint', ('link1', 'link2')),
+                      ('loop', ('predecessor', 'successor'))):
+        for element in root.findall(tag):
+            name = element.get('name') or ''
+            where = f'<{tag} name="{name}">'
+            kind = JOINT_CLOSURES.get(element.get('type', ''))
+            if kind is None:
+                raise UrdfError(f'{source}: {where}: Expected a type in '
+                                f'{", ".join(JOINT_CLOSURES)}, got {element.get("type")!r}')
+            sides = []
+            for end in ends:
+                part = element.find(end)
+                link = None if part is None else part.get('link')
+                if link not in links:
+                    raise UrdfError(f'{source}: {where}: Expected <{end} link="..."/> naming a '
+                                    f'link of the robot, got {link!r}')
+                sides.append((str(link), _end_frame(element, part, end, where, source,
+                                                    version)))
+            axis_element = element.find('axis')
+            axis = None
+            if axis_element is not None or kind is ClosureKind.SLIDE:
+                text = None if axis_element is None else axis_element.get('xyz')
+                axis = _unit(_floats(text, 3, f'{where} <axis> xyz', source, (1.0, 0.0, 0.0)),
+                             f'{where} <axis>', source)
+            (link_a, frame_a), (link_b, frame_b) = sides
+            yield _closure(name or f'{tag}_{link_a}_{link_b}', kind, link_a, frame_a, link_b,
+                           frame_b, axis, f'<{tag}>')
+
+
+def _end_frame(element: Any, part: Any, end: str, where: str, source: str, version: str
+               ) -> Matrix:
+    """Return one end's frame: xyz/rpy on the end, an ``<origin>`` in it, or ``<END_origin>``."""
+    if part.get('xyz') is not None or part.get('rpy') is not None \
+            or part.get('quat_xyzw') is not None:
+        return _origin(part, f'{where} <{end}>', source, version)
+    inner = part.find('origin')
+    if inner is None:
+        inner = element.find(f'{end}_origin')
+    return _origin(inner, f'{where} <{end}> origin', source, version)
+
+
+def _sidecar(path: str | os.PathLike[str], description: Description,
+             ) -> tuple[tuple[Closure, ...], tuple[str, ...] | None]:
+    """Read the closures beside the URDF: any form :func:`read_closure_file` tells by content."""
+    return read_closure_file(path, description)
+
+
+def _loop_closures_yaml(data: Any, where: str, description: Description,
+                        ) -> tuple[tuple[Closure, ...], tuple[str, ...] | None]:
+    """Read scikit-robot's ``loop_closures.yaml`` (parsed): closures and independent joints."""
     if not isinstance(data, dict) or not isinstance(data.get('closures'), list) \
             or not data['closures']:
         raise UrdfError(f'{where}: Expected a loop_closures.yaml (closures: [{{link_a, link_b, '
@@ -704,7 +985,7 @@ def read_description(source: str | os.PathLike[str], closures: str | os.PathLike
     source : str or path
         A URDF file, or the URDF's text (a string starting with ``<``).
     closures : str or path, optional
-        A scikit-robot ``loop_closures.yaml`` beside it.
+        The closures beside it, in any form of :data:`FORMS`.
 
     Returns
     -------
@@ -739,7 +1020,7 @@ def read_description(source: str | os.PathLike[str], closures: str | os.PathLike
     joints = _joints(robot, name, quaternions)
     root_link = _root(links, joints, name)
     found = tuple(_constraints(root, set(links), name, version)) + tuple(
-        _closing_frames(joints, links, name))
+        _closing_frames(joints, links, name)) + tuple(urdf_loops(root, set(links), name, version))
     inertials = _inertials(robot, name, quaternions)
     description = Description(str(robot.name or 'robot'), name, text, links, joints, root_link,
                               found, _actuated(root), inertials=inertials)

@@ -20,7 +20,11 @@ From a :class:`~.description.Description` and its actuated joints:
    from that body's own frame, so that a closure whose two points miss each
    other by a rounding still gives each body its exact shape. A closure
    whose points miss by more than :data:`GAP_TOLERANCE` of the loop's size
-   is refused with the gap.
+   is refused with the gap (a weld: its two frames' distance and turn; a
+   slide closure, which is one more prismatic joint of the loop: its origins
+   off its line, and its turn). A body with two coaxial pins and nothing else
+   (idle: it could spin between them) turns with its first revolute joint,
+   held at its reference value.
 5. **Drivers and dyads.** An actuated revolute joint on the ground is a
    crank; an actuated prismatic joint between a barrel and a rod, each
    pinned once, is a cylinder (an actuator). Then, while bodies remain, a
@@ -198,11 +202,13 @@ class _Edge:
     closure: Closure | None = None
 
 
-def _bodies(description: Description, weld: list[Closure]
+def _bodies(description: Description, weld: list[Closure],
+            locked: Mapping[str, Matrix] | None = None
             ) -> tuple[dict[str, str], dict[str, Matrix]]:
     """Return link -> body (its group's link nearest the root) and each link in its body.
 
-    Links joined by fixed joints, and links welded by a closure, are one body.
+    Links joined by fixed joints, links welded by a closure, and the links of a
+    ``locked`` joint (name -> its child's frame in its parent's), are one body.
     """
     parent = {link: link for link in description.links}
 
@@ -219,6 +225,9 @@ def _bodies(description: Description, weld: list[Closure]
     for closure in weld:
         rigid.append((closure.link_a, closure.link_b,
                       closure.frame_a @ np.linalg.inv(closure.frame_b)))
+    for name, motion in (locked or {}).items():
+        joint = description.joints[name]
+        rigid.append((joint.parent, joint.child, motion))
     for a, b, _ in rigid:
         parent[find(a)] = find(b)
     groups: dict[str, list[str]] = {}
@@ -243,6 +252,62 @@ def _bodies(description: Description, weld: list[Closure]
                     in_body[other] = in_body[link] @ t
                     stack.append(other)
     return body_of, in_body
+
+
+def _idle_joints(description: Description, body_of: dict[str, str],
+                 in_body: dict[str, Matrix], edges: list[_Edge], pose: Mapping[str, float]
+                 ) -> dict[str, Matrix]:
+    """Return the joints to lock (name -> its child's frame in its parent's at the pose).
+
+    An idle body has two pins and nothing else, coaxial (the same point,
+    parallel axes where written), at least one a revolute joint: it could spin
+    between them without moving the loop (Extended URDF's ``6d`` closure of
+    two joint frames makes one, its ``3d`` closure two). It turns with the body
+    of its first revolute joint in file order: that joint is locked at its
+    pose's value, the other pin answers the turn.
+    """
+    touching: dict[str, list[_Edge]] = {}
+    for edge in edges:
+        touching.setdefault(edge.a, []).append(edge)
+        touching.setdefault(edge.b, []).append(edge)
+    root = body_of[description.root]
+    order = list(description.joints)
+    out: dict[str, Matrix] = {}
+    for body, mine in touching.items():
+        if body == root or len(mine) != 2 or any(e.kind != 'pin' for e in mine) \
+                or all(e.joint is None for e in mine):
+            continue
+        ends = []
+        for edge in mine:
+            ends.append(_pin_on(edge, body, body_of, in_body))
+        (p, u), (q, v) = ends
+        scale = max(1.0, float(np.linalg.norm(p)), float(np.linalg.norm(q)))
+        if float(np.linalg.norm(p - q)) > PLANAR_TOLERANCE * scale or (
+                u is not None and v is not None
+                and float(np.linalg.norm(np.cross(u, v))) > PLANAR_TOLERANCE):
+            continue
+        first = min((e.joint for e in mine if e.joint is not None),
+                    key=lambda j: order.index(j.name))
+        if first.name not in out:
+            out[first.name] = first.motion(pose.get(first.name, 0.0))
+    return out
+
+
+def _pin_on(edge: _Edge, body: str, body_of: dict[str, str], in_body: dict[str, Matrix]
+            ) -> tuple[np.ndarray, np.ndarray | None]:
+    """Return a pin's point and axis (None: not written) in the frame of ``body``, one end."""
+    if edge.joint is not None:
+        joint = edge.joint
+        frame = in_body[joint.child] if body_of[joint.child] == body \
+            else in_body[joint.parent] @ joint.origin
+        return frame[:3, 3], frame[:3, :3] @ np.asarray(joint.axis)
+    closure = edge.closure
+    assert closure is not None
+    link, on, axis = ((closure.link_a, closure.frame_a, closure.axis_a)
+                      if body_of[closure.link_a] == body else
+                      (closure.link_b, closure.frame_b, closure.axis_b))
+    frame = in_body[link] @ on
+    return frame[:3, 3], None if axis is None else in_body[link][:3, :3] @ np.asarray(axis)
 
 
 def _components(bodies: list[str], edges: list[_Edge]) -> list[list[int]]:
@@ -426,11 +491,14 @@ class _Mechanism:
         self.slides: dict[str, _Edge] = {}
         self.edges_of: dict[str, list[_Edge]] = {b: [] for b in self.bodies}
         self.gaps: list[tuple[float, str]] = []
+        slide_closures: list[_Edge] = []
         for edge in self.edges:
             self.edges_of[edge.a].append(edge)
             self.edges_of[edge.b].append(edge)
             if edge.kind == 'slide':
                 self.slides[edge.name] = edge
+                if edge.closure is not None:
+                    slide_closures.append(edge)
                 continue
             if edge.joint is not None:
                 joint = edge.joint
@@ -450,6 +518,9 @@ class _Mechanism:
             self.pin_ends[edge.name] = (edge.a, edge.b)
         points = [p for pins in self.pins.values() for p in pins.values()]
         self.size = max((abs(p - q) for p in points for q in points), default=0.0) or 1.0
+        for edge in slide_closures:
+            off, turn = self._slide_gap(edge)
+            self.gaps.append((off + turn * self.size, edge.name))
         for gap, name in self.gaps:
             if gap > GAP_TOLERANCE * self.size:
                 raise self.fail(
@@ -459,11 +530,35 @@ class _Mechanism:
 
     def slide_direction(self, edge: _Edge, block: str) -> complex:
         """Return the unit direction ``block`` moves relative to the other body per +1 m."""
-        assert edge.joint is not None
-        frame = self.frame[edge.joint.parent] @ edge.joint.origin
-        u = self.flat(frame[:3, :3] @ np.asarray(edge.joint.axis))
+        u = self.flat(self._slide_axis(edge))
         u /= abs(u)
         return u if block == edge.b else -u
+
+    def _slide_axis(self, edge: _Edge) -> np.ndarray:
+        """Return a slide's axis in the ground's frame: a joint's, or a closure's on link_a."""
+        if edge.joint is not None:
+            frame = self.frame[edge.joint.parent] @ edge.joint.origin
+            return frame[:3, :3] @ np.asarray(edge.joint.axis)
+        closure = edge.closure
+        assert closure is not None and closure.axis_a is not None
+        return self.frame[closure.link_a][:3, :3] @ np.asarray(closure.axis_a)
+
+    def _slide_gap(self, edge: _Edge) -> tuple[float, float]:
+        """Return a slide closure's miss at the reference pose: off its line (m), turned (rad).
+
+        A prismatic closure holds its two frames parallel and their origins on
+        one line along its axis.
+        """
+        closure = edge.closure
+        assert closure is not None
+        on_a = self.frame[closure.link_a] @ closure.frame_a
+        on_b = self.frame[closure.link_b] @ closure.frame_b
+        axis = self._slide_axis(edge)
+        axis = axis / np.linalg.norm(axis)
+        d = on_b[:3, 3] - on_a[:3, 3]
+        off = float(np.linalg.norm(d - (d @ axis) * axis))
+        turn = abs(_rotation_angle(on_a[:3, :3].T @ on_b[:3, :3], on_a[:3, :3].T @ self.normal))
+        return off, turn
 
     def reference_value(self, joint: UrdfJoint) -> float:
         """Return a joint's value in the model's geometry (its pose's, to the closures' gaps)."""
@@ -960,6 +1055,65 @@ class _Builder:
                     slider_ref=slider_ref, mechanism=m.index)
 
 
+def _edges(description: Description, weld: list[Closure], locked: Mapping[str, Matrix]
+           ) -> tuple[dict[str, str], dict[str, Matrix], list[_Edge]]:
+    """Return the bodies (:func:`_bodies`) and the joints and closures between them."""
+    source = description.source
+    body_of, in_body = _bodies(description, weld, locked)
+    edges: list[_Edge] = []
+    for joint in description.joints.values():
+        if not joint.moving or joint.name in locked:
+            continue
+        a, b = body_of[joint.parent], body_of[joint.child]
+        kind = 'free' if joint.type is None else 'pin' if joint.type.angular else 'slide'
+        if a == b:
+            raise UrdfError(f'{source}: joint "{joint.name}": Expected a joint of a loop to '
+                            f'move, got its links "{joint.parent}" and "{joint.child}" welded '
+                            f'by a closure', joint=joint.name)
+        edges.append(_Edge(joint.name, a, b, kind, joint=joint))
+    for closure in description.closures:
+        if closure.kind is ClosureKind.WELD:
+            continue
+        kind = 'pin' if closure.kind is ClosureKind.PIN else 'slide'
+        if kind == 'slide' and (closure.axis_a is None or closure.axis_b is None):
+            raise UrdfError(f'{source}: closure "{closure.name}": Expected a prismatic closure '
+                            f'to give its axis, got none', joint=closure.name)
+        a, b = body_of[closure.link_a], body_of[closure.link_b]
+        if a == b:
+            raise UrdfError(f'{source}: closure "{closure.name}": Expected it to join two '
+                            f'moving parts, got links "{closure.link_a}" and '
+                            f'"{closure.link_b}" of one rigid body', joint=closure.name)
+        edges.append(_Edge(closure.name, a, b, kind, closure=closure))
+    return body_of, in_body, edges
+
+
+def _check_welds(m: _Mechanism, weld: list[Closure], tree: Mapping[str, Matrix]) -> None:
+    """Refuse a weld closure of ``m`` that the reference pose does not close.
+
+    Its two frames, each where the tree puts its link, must coincide within
+    :data:`GAP_TOLERANCE` of the loop's size (their origins' distance plus
+    their turn times the size), as a pin's two points must.
+    """
+    for closure in weld:
+        if m.body_of[closure.link_a] not in m.bodies:
+            continue
+        on_a = tree[closure.link_a] @ closure.frame_a
+        on_b = tree[closure.link_b] @ closure.frame_b
+        apart = float(np.linalg.norm(on_a[:3, 3] - on_b[:3, 3]))
+        turn = math.acos(max(-1.0, min(1.0, 0.5 * (float(np.trace(on_a[:3, :3].T
+                                                                  @ on_b[:3, :3])) - 1.0))))
+        if apart + turn * m.size > GAP_TOLERANCE * m.size:
+            raise m.fail(
+                f'closure "{closure.name}": Expected the reference pose to close the loop '
+                f'within {GAP_TOLERANCE:g} of its size ({m.size:.6g} m), got its two frames '
+                f'{apart:.3g} m apart and turned {turn:.3g} rad (give a reference pose that '
+                'closes it)', closure.name)
+    m.gaps.extend(
+        (float(np.linalg.norm((tree[c.link_a] @ c.frame_a)[:3, 3]
+                              - (tree[c.link_b] @ c.frame_b)[:3, 3])), c.name)
+        for c in weld if m.body_of[c.link_a] in m.bodies)
+
+
 def _actuated_names(description: Description, actuated: Iterable[str] | None,
                     loop_joints: list[str]) -> tuple[str, ...]:
     """Return the actuated joints: given, else the sidecar's, else the URDF's; else refuse."""
@@ -1073,27 +1227,13 @@ def planar_from_description(description: Description, actuated: Iterable[str] | 
                             f'the robot, got "{name}"', joint=name)
     pose = description.pose(reference)
     weld = [c for c in description.closures if c.kind is ClosureKind.WELD]
-    body_of, in_body = _bodies(description, weld)
-    edges: list[_Edge] = []
-    for joint in description.joints.values():
-        if not joint.moving:
-            continue
-        a, b = body_of[joint.parent], body_of[joint.child]
-        kind = 'free' if joint.type is None else 'pin' if joint.type.angular else 'slide'
-        if a == b:
-            raise UrdfError(f'{source}: joint "{joint.name}": Expected a joint of a loop to '
-                            f'move, got its links "{joint.parent}" and "{joint.child}" welded '
-                            f'by a closure', joint=joint.name)
-        edges.append(_Edge(joint.name, a, b, kind, joint=joint))
-    for closure in description.closures:
-        if closure.kind is not ClosureKind.PIN:
-            continue
-        a, b = body_of[closure.link_a], body_of[closure.link_b]
-        if a == b:
-            raise UrdfError(f'{source}: closure "{closure.name}": Expected it to join two '
-                            f'moving parts, got links "{closure.link_a}" and '
-                            f'"{closure.link_b}" of one rigid body', joint=closure.name)
-        edges.append(_Edge(closure.name, a, b, 'pin', closure=closure))
+    locked: dict[str, Matrix] = {}
+    while True:
+        body_of, in_body, edges = _edges(description, weld, locked)
+        idle = _idle_joints(description, body_of, in_body, edges, pose)
+        if not idle:
+            break
+        locked.update(idle)
     bodies = sorted(set(body_of.values()), key=description.links.index)
     components = [sorted(c) for c in _components(bodies, edges) if len(c) > 1]
     components.sort(key=lambda c: c[0])
@@ -1114,6 +1254,7 @@ def planar_from_description(description: Description, actuated: Iterable[str] | 
         members = {e.a for e in part} | {e.b for e in part}
         ground = min(members, key=lambda b: (description.depth(b), description.links.index(b)))
         m = _Mechanism(index, part, model, in_body, body_of, description, ground, pose)
+        _check_welds(m, weld, tree)
         names = {e.name for e in part}
         here = [n for n in actuated_names if n in names]
         mimics = {}
@@ -1141,6 +1282,15 @@ def planar_from_description(description: Description, actuated: Iterable[str] | 
         builder.mimics = mimics
         builder.slider_of = {}
         builder.build(m)
+        for name in locked:   # an idle body's first joint: held at its reference value
+            joint = description.joints[name]
+            body = body_of[joint.child]
+            if body in m.bodies:
+                turn, turn_ref = builder.turns[body]
+                centre = 0.0 if joint.limits is None else 0.5 * sum(joint.limits)
+                builder.joint_maps[name] = JointMap(
+                    name, REVOLUTE, 1.0, pose.get(name, 0.0), turn, turn_ref, turn, turn_ref,
+                    center=centre, mechanism=index)
         mechanisms.append({'ground': ground, 'links': list(m.bodies),
                            'joints': [e.name for e in part],
                            'normal': [float(v) for v in m.normal],

@@ -394,8 +394,10 @@ def load_robot(source: str | os.PathLike[str], closures: str | os.PathLike[str] 
     source : str or path
         A URDF file, or its text (``robot_description``).
     closures : str or path, optional
-        A scikit-robot ``loop_closures.yaml`` (the other two forms of loop
-        closures are inside the URDF).
+        The closures beside the URDF: a scikit-robot ``loop_closures.yaml``, a
+        file of ``<constraint>`` elements, an Extended-URDF ``robot.yaml`` or a
+        fusion2URDF ``robot_data.yaml``, told by content (the other forms are
+        inside the URDF).
     actuated : iterable of str, optional
         The actuated joints; default: the sidecar's ``independent`` joints,
         else the URDF's ``<transmission>`` and ``<ros2_control>`` joints.

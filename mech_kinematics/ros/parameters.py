@@ -110,8 +110,10 @@ PARAMETERS = (
                   'scene left at its default); published unchanged on robot_description',
                   read_only=True, may_be_empty=True, max_chars=MAX_FILE_BYTES),
     ParameterSpec('loop_closures', 'string', '',
-                  "URDF mode: a scikit-robot loop_closures.yaml closing the robot's loops "
-                  '(<constraint> elements and closing_NAME_1/_2 frames are read from the URDF)',
+                  "URDF mode: a file closing the robot's loops, told by content: a "
+                  'loop_closures.yaml, a file of <constraint> elements, an Extended-URDF '
+                  'robot.yaml or a fusion2URDF robot_data.yaml (<constraint>, <loop_joint>, '
+                  '<loop> and closing_NAME_1/_2 frames are read from the URDF)',
                   read_only=True, may_be_empty=True, max_chars=MAX_PATH_CHARS),
     ParameterSpec('actuated_joints', 'string_array', None,
                   "URDF mode: the actuated joints. Defaults to the loop_closures' independent "

@@ -5,7 +5,7 @@
 The node's ``scene`` parameter names a scene (YAML) or, in *URDF mode*, a
 robot: a path ending in ``.urdf``, or the URDF's text given as the parameter
 ``robot_description`` (as robot_state_publisher takes it), with
-``loop_closures`` (a scikit-robot ``loop_closures.yaml``) and
+``loop_closures`` (a closures file in any form ``read_closure_file`` reads) and
 ``actuated_joints`` (default: the URDF's ``<transmission>`` and
 ``<ros2_control>`` joints). :func:`load_source` reads what the parameters
 name, or refuses in one line (:class:`~mech_kinematics.errors.SceneError`,
@@ -92,7 +92,8 @@ def load_source(scene: str, robot_description: str = '', loop_closures: str = ''
         The URDF's text ('' for none); then ``scene`` must be left at its
         default.
     loop_closures : str
-        A ``loop_closures.yaml`` beside the URDF ('' for none).
+        A closures file beside the URDF, in any form ``read_closure_file`` reads ('' for
+        none).
     actuated_joints : sequence of str or None
         The actuated joints (None: the URDF's).
 

@@ -91,8 +91,10 @@ def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
     """Add what a robot in URDF takes: ``--closures``, ``--actuated`` and ``--reference``."""
     group = parser.add_argument_group('a robot described in URDF (a SCENE path ending in .urdf)')
     group.add_argument('--closures', metavar='FILE',
-                       help='a scikit-robot loop_closures.yaml beside the URDF (its <constraint> '
-                            'elements and closing_NAME_1/_2 frames are read from the URDF)')
+                       help='the closures beside the URDF, told by content: a loop_closures.yaml, '
+                            'a file of <constraint> elements, an Extended-URDF robot.yaml or a '
+                            'fusion2URDF robot_data.yaml (its <constraint>, <loop_joint>, <loop> '
+                            'and closing_NAME_1/_2 frames are read from the URDF)')
     group.add_argument('--actuated', type=joint_list, metavar='J1,J2,...',
                        help="the actuated joints (default: the closures file's independent "
                             "joints, else the URDF's <transmission> and <ros2_control> joints)")

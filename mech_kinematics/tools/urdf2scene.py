@@ -24,8 +24,10 @@ __all__ = ['add_parser', 'main']
 
 URDF2SCENE_HELP = """\
 Write the scene a robot described in URDF becomes: its planar loops (closed
-by <constraint> elements, onshape-to-robot closing_NAME_1/_2 frames or a
-scikit-robot loop_closures.yaml given with --closures) as drivers (each
+by <constraint>, <loop_joint> or <loop> elements, onshape-to-robot
+closing_NAME_1/_2 frames or a closures file given with --closures: a
+loop_closures.yaml, a file of <constraint> elements, an Extended-URDF
+robot.yaml or a fusion2URDF robot_data.yaml) as drivers (each
 actuated revolute joint on a loop's ground a crank, each actuated cylinder
 an actuator), dyads (RRR, RRP, RPR, RPP, each on the branch of the URDF's
 zero pose or of --reference) and carried points, named after the URDF's
