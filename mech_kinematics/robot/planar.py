@@ -281,8 +281,10 @@ def _idle_joints(description: Description, body_of: dict[str, str],
         for edge in mine:
             ends.append(_pin_on(edge, body, body_of, in_body))
         (p, u), (q, v) = ends
-        scale = max(1.0, float(np.linalg.norm(p)), float(np.linalg.norm(q)))
-        if float(np.linalg.norm(p - q)) > PLANAR_TOLERANCE * scale or (
+        # math.hypot in floats: a point at 1e308 m overflows no square (no numpy warning)
+        scale = max(1.0, math.hypot(*map(float, p)), math.hypot(*map(float, q)))
+        gap = math.hypot(*(float(a) - float(b) for a, b in zip(p, q, strict=True)))
+        if gap > PLANAR_TOLERANCE * scale or (
                 u is not None and v is not None
                 and float(np.linalg.norm(np.cross(u, v))) > PLANAR_TOLERANCE):
             continue
