@@ -739,3 +739,29 @@ def scene_mapping(name, ground, dyads=(), points=None, **drivers):
     if points:
         data['points'] = points
     return data
+
+
+def gepetto_five_bar_reference(closures: Any = None) -> dict:
+    """Return a pose of Gepetto's five-bar that closes it (its zero pose is 0.3 m open).
+
+    The motors at 0 and closedloop1_A at 0; free1, closedloop1_B and free2 by
+    SciPy's least squares on ``UrdfFk``'s 6d gap (our own kinematics).
+    """
+    import numpy as np
+    from scipy.optimize import least_squares
+
+    data = Path(__file__).resolve().parent / 'data' / 'urdf'
+    closures = closures or data / 'gepetto_5bar_linkage.robot.yaml'
+
+    fk = UrdfFk((data / 'gepetto_5bar_linkage.urdf').read_text(), closures)
+    _, _, a, fa, b, fb = fk.closures[0]
+    names = ('free1', 'closedloop1_B', 'free2')
+
+    def residual(x):
+        frames = fk.transforms(dict(zip(names, x, strict=True)))
+        ta, tb = frames[a] @ fa, frames[b] @ fb
+        return np.concatenate([ta[:3, 3] - tb[:3, 3], (ta[:3, :3] - tb[:3, :3]).ravel()])
+
+    fit = least_squares(residual, [0.5, 0.5, -0.5], xtol=1e-15, ftol=1e-15, gtol=1e-15)
+    assert np.abs(fit.fun).max() <= 1e-15
+    return {'mot1': 0.0, 'mot2': 0.0, **dict(zip(names, map(float, fit.x), strict=True))}

@@ -112,6 +112,7 @@ class KinematicsNode(LifecycleNode):
         self._markers: Markers | None = None
         self._input: InputSubscription | None = None
         self._forces: ForcesTick | None = None
+        self._watchdog: PublishWatchdog | None = None    # once the parameters are declared
         failure = self.create_guard_condition(self._on_failure)
         self._ticks = TickThread(self.get_clock(), self._driver, self._stats, self.get_logger(),
                                  failure.trigger, lambda: not self.context.ok())
@@ -187,7 +188,8 @@ class KinematicsNode(LifecycleNode):
         assert self.params is not None
         # A scene, or a robot described in URDF (URDF mode: robot_mode.py).
         source = load_source(self._value('scene'), self._value('robot_description'),
-                             self._value('loop_closures'), self._value('actuated_joints'))
+                             self._value('loop_closures'), self._value('actuated_joints'),
+                             self._value('reference_pose'))
         scene = source.scene
         self.extra_joints = self._value('extra_joints') or \
             extra_joints_default(source.robot is not None)
@@ -267,6 +269,7 @@ class KinematicsNode(LifecycleNode):
 
     def start(self) -> None:
         """Start the tick thread (with ``drive: topic``, the input subscription instead)."""
+        assert self._watchdog is not None
         self._watchdog.start()
         if self._input is not None:
             self._input.active = True     # a state for each message from now on
@@ -279,7 +282,8 @@ class KinematicsNode(LifecycleNode):
         if self._input is not None:
             self._input.active = False
         self._ticks.stop()
-        self._watchdog.stop()
+        if self._watchdog is not None:     # None: a parameter refused while declaring
+            self._watchdog.stop()
         self._apply_now()
 
     def destroy_node(self) -> None:

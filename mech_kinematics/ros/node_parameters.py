@@ -339,7 +339,8 @@ class NodeParameters:
                 self.value('scene')
             return (f'robot {robot.name!r} ({origin}; its loops: scene {scene.name!r}): '
                     f'joints {list(robot.joint_names)}, actuated {list(robot.actuated)}; '
-                    f'loop_closures={self.value("loop_closures")!r}, {settings}')
+                    f'loop_closures={self.value("loop_closures")!r}, '
+                    f'reference_pose={list(self.value("reference_pose") or [])!r}, {settings}')
         return (f'scene {scene.name!r} ({self.value("scene")}): joints '
                 f'{list(scene.output_joints)}, points {list(scene.output_points)}; {settings}')
 

@@ -119,6 +119,11 @@ PARAMETERS = (
                   "URDF mode: the actuated joints. Defaults to the loop_closures' independent "
                   "joints, else the URDF's <transmission> and <ros2_control> joints",
                   read_only=True),
+    ParameterSpec('reference_pose', 'string_array', None,
+                  'URDF mode: a reference pose whose branches the loops keep, JOINT=VALUE '
+                  "each (rad for a revolute joint, m for a prismatic one; default: the URDF's "
+                  'zero pose), as the commands take --reference (there in degrees)',
+                  read_only=True),
     ParameterSpec('frame_id', 'string', 'mechanism',
                   'header.frame_id of every message: the ground frame of the scene',
                   read_only=True, frame=True),

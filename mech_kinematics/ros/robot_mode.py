@@ -7,7 +7,9 @@ robot: a path ending in ``.urdf``, or the URDF's text given as the parameter
 ``robot_description`` (as robot_state_publisher takes it), with
 ``loop_closures`` (a closures file in any form ``read_closure_file`` reads) and
 ``actuated_joints`` (default: the URDF's ``<transmission>`` and
-``<ros2_control>`` joints). :func:`load_source` reads what the parameters
+``<ros2_control>`` joints) and ``reference_pose`` (``JOINT=VALUE`` each, rad or
+m: the pose whose branches the loops keep, for a URDF exported open at its
+zero pose; default the zero pose). :func:`load_source` reads what the parameters
 name, or refuses in one line (:class:`~mech_kinematics.errors.SceneError`,
 the one ``solve`` prints); the robot's loops become a scene
 (:class:`~mech_kinematics.robot.Robot`), which the node solves as any other,
@@ -43,7 +45,8 @@ from ..errors import SceneError
 from ..scene import DEFAULT_SCENE, load_scene, scene_text
 from ..solver.mechanism import Scene
 
-__all__ = ['RobotDriver', 'RobotValues', 'Source', 'URDF_SUFFIX', 'is_urdf', 'load_source']
+__all__ = ['RobotDriver', 'RobotValues', 'Source', 'URDF_SUFFIX', 'is_urdf', 'load_source',
+           'reference_from_parameter']
 
 #: A ``scene`` parameter ending so names a robot described in URDF.
 URDF_SUFFIX = '.urdf'
@@ -80,7 +83,8 @@ class Source:
 
 
 def load_source(scene: str, robot_description: str = '', loop_closures: str = '',
-                actuated_joints: Sequence[str] | None = None) -> Source:
+                actuated_joints: Sequence[str] | None = None,
+                reference_pose: Sequence[str] | None = None) -> Source:
     """Load the scene or robot the node's parameters name.
 
     Parameters
@@ -96,6 +100,9 @@ def load_source(scene: str, robot_description: str = '', loop_closures: str = ''
         none).
     actuated_joints : sequence of str or None
         The actuated joints (None: the URDF's).
+    reference_pose : sequence of str or None
+        ``JOINT=VALUE`` each (rad or m): the pose whose branches the loops keep
+        (None: the URDF's zero pose); :func:`reference_from_parameter`.
 
     Raises
     ------
@@ -111,23 +118,61 @@ def load_source(scene: str, robot_description: str = '', loop_closures: str = ''
         raise SceneError(msg)
     if not urdf:
         given = [name for name, value in (('loop_closures', loop_closures),
-                                          ('actuated_joints', actuated_joints)) if value]
+                                          ('actuated_joints', actuated_joints),
+                                          ('reference_pose', reference_pose)) if value]
         if given:
             msg = (f'Expected {", ".join(given)} with a robot described in URDF (scene:=PATH.urdf '
                    f'or robot_description), got scene {scene}')
             raise SceneError(msg)
         return Source(load_scene(scene), scene_text(scene), origin=scene)
-    from ..robot import load_robot
+    from ..robot import Robot
+    from ..robot.description import read_description
     from ..robot.writer import scene_yaml
 
     origin = 'robot_description' if robot_description else scene
-    robot = load_robot(urdf, loop_closures or None, actuated_joints or None)
+    description = read_description(urdf, loop_closures or None)
+    robot = Robot(description, actuated_joints or None,
+                  reference_from_parameter(description, reference_pose or ()))
     needed = RobotValues.coordinates(robot)
     built = robot.scene
     missing = tuple(n for n in needed if n not in built.output_joints)
     if missing:
         built = replace(built, outputs_joints=(*built.output_joints, *missing))
     return Source(built, scene_yaml(robot.planar, origin), robot, origin)
+
+
+def reference_from_parameter(description: Any, entries: Sequence[str]) -> dict[str, float]:
+    """Return the ``reference_pose`` parameter's pose: ``JOINT=VALUE`` each, rad or m.
+
+    Raises
+    ------
+    UrdfError
+        One line naming the parameter: an entry not ``JOINT=VALUE``, a joint that
+        is not a moving joint of the robot, a value that is not a finite number.
+    """
+    from ..errors import UrdfError
+
+    out: dict[str, float] = {}
+    for entry in entries:
+        name, sep, text = entry.partition('=')
+        name = name.strip()
+        joint = description.joints.get(name)
+        if not sep or joint is None or joint.type is None:
+            moving = ', '.join(n for n, j in description.joints.items() if j.type is not None)
+            msg = (f'reference_pose: Expected JOINT=VALUE with JOINT a moving joint of the '
+                   f'robot ({moving}), got {entry!r}')
+            raise UrdfError(msg)
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not math.isfinite(value):
+            unit = 'rad' if joint.type.angular else 'm'
+            msg = (f'reference_pose: Expected {name}=VALUE a finite number ({unit}), got '
+                   f'{entry!r}')
+            raise UrdfError(msg)
+        out[name] = value
+    return out
 
 
 @dataclass(frozen=True)

@@ -26,7 +26,7 @@ again with xml.etree and PyYAML and closes it with 4x4 transforms.
 from pathlib import Path
 import shutil
 
-from helpers import UrdfFk
+from helpers import gepetto_five_bar_reference, UrdfFk
 import numpy as np
 import pytest
 
@@ -56,32 +56,10 @@ FORMS = {
 }
 
 
-def _five_bar_reference(closures=DATA / 'gepetto_5bar_linkage.robot.yaml'):
-    """Return a pose of Gepetto's five-bar that closes it (its zero pose is 0.3 m open).
-
-    The motors at 0 and closedloop1_A at 0; free1, closedloop1_B and free2 by
-    SciPy's least squares on ``UrdfFk``'s 6d gap (our own kinematics).
-    """
-    from scipy.optimize import least_squares
-
-    fk = UrdfFk((DATA / 'gepetto_5bar_linkage.urdf').read_text(), closures)
-    _, _, a, fa, b, fb = fk.closures[0]
-    names = ('free1', 'closedloop1_B', 'free2')
-
-    def residual(x):
-        frames = fk.transforms(dict(zip(names, x, strict=True)))
-        ta, tb = frames[a] @ fa, frames[b] @ fb
-        return np.concatenate([ta[:3, 3] - tb[:3, 3], (ta[:3, :3] - tb[:3, :3]).ravel()])
-
-    fit = least_squares(residual, [0.5, 0.5, -0.5], xtol=1e-15, ftol=1e-15, gtol=1e-15)
-    assert np.abs(fit.fun).max() <= 1e-15
-    return {'mot1': 0.0, 'mot2': 0.0, **dict(zip(names, map(float, fit.x), strict=True))}
-
-
 def _robot(form, closures=None):
     urdf, name, actuated, _, _, _ = FORMS[form]
     closure_path = closures or (None if name is None else DATA / name)
-    reference = _five_bar_reference() if form.startswith('robot.yaml') else None
+    reference = gepetto_five_bar_reference() if form.startswith('robot.yaml') else None
     return (load_robot(DATA / urdf, closure_path, actuated, reference),
             UrdfFk((DATA / urdf).read_text(), closure_path))
 
@@ -129,7 +107,7 @@ def test_the_five_bar_closed_by_a_3d_point_is_solved(tmp_path):
         "['6d']", "['3d']"))
     robot, fk = _robot('robot.yaml 6d', closures)
     assert [c.kind.value for c in robot.description.closures] == ['pin']
-    reference = _five_bar_reference(closures)
+    reference = gepetto_five_bar_reference(closures)
     worst = 0.0
     for t in np.linspace(-0.3, 0.3, 7):
         answer = robot.solve({'mot1': t, 'mot2': -0.5 * t})
@@ -293,10 +271,46 @@ def test_the_nodes_loop_closures_takes_every_form():
                              actuated_joints=actuated)
         assert {c.form for c in source.robot.description.closures} == {written}
         assert set(source.robot.actuated) == set(sweep)
-    # The node has no reference pose yet (issue 43, item 4): the open five-bar is refused.
+    # The open five-bar: refused from its zero pose, solved from reference_pose (rad),
+    # the joints of Robot.solve from the same reference, to the bit (issue 43, item 4).
     urdf, closures, _, _, _, _ = FORMS['robot.yaml 6d']
     with pytest.raises(UrdfError, match='give a reference pose that closes it'):
         load_source(str(DATA / urdf), loop_closures=str(DATA / closures))
+    reference = gepetto_five_bar_reference()
+    source = load_source(str(DATA / urdf), loop_closures=str(DATA / closures),
+                         reference_pose=[f'{n}={v!r}' for n, v in reference.items()])
+    robot = load_robot(DATA / urdf, DATA / closures, None, reference)
+    given = {n: robot.start(n) + 0.05 for n in robot.actuated}
+    got, expected = source.robot.solve(given).joints, robot.solve(given).joints
+    assert {n: (j.position, j.velocity, j.acceleration) for n, j in got.items()} == {
+        n: (j.position, j.velocity, j.acceleration) for n, j in expected.items()}
+
+
+@pytest.mark.parametrize('entry, said', [
+    ('mot1', "reference_pose: Expected JOINT=VALUE with JOINT a moving joint of the robot ("),
+    ('nothing=0.1', "reference_pose: Expected JOINT=VALUE with JOINT a moving joint of "),
+    ('mot1=fast', "reference_pose: Expected mot1=VALUE a finite number (rad), got 'mot1=fast'"),
+    ('mot1=nan', "reference_pose: Expected mot1=VALUE a finite number (rad), got 'mot1=nan'"),
+])
+def test_a_bad_reference_pose_parameter_is_one_line_naming_it(entry, said):
+    """Not JOINT=VALUE, not a moving joint, not a finite number: one line."""
+    from mech_kinematics.ros.robot_mode import load_source
+
+    urdf, closures, _, _, _, _ = FORMS['robot.yaml 6d']
+    with pytest.raises(UrdfError) as caught:
+        load_source(str(DATA / urdf), loop_closures=str(DATA / closures),
+                    reference_pose=[entry])
+    assert '\n' not in str(caught.value) and str(caught.value).startswith(said)
+
+
+def test_a_reference_pose_parameter_needs_a_robot():
+    """A scene has its own pose: reference_pose with a scene is refused in one line."""
+    from mech_kinematics.errors import SceneError
+    from mech_kinematics.ros.robot_mode import load_source
+
+    with pytest.raises(SceneError, match=r'Expected reference_pose with a robot described in '
+                                         r'URDF'):
+        load_source('khurmi_four_bar_ad150', reference_pose=['crank=0.1'])
 
 
 def test_revolute_closing_joints_of_a_robot_data_yaml_close_their_loops(tmp_path):

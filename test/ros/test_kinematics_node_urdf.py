@@ -21,7 +21,7 @@ lost); their answers are not kept.
 from pathlib import Path
 import time
 
-from helpers import UrdfFk
+from helpers import gepetto_five_bar_reference, UrdfFk
 import numpy as np
 import pytest
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
@@ -55,11 +55,11 @@ LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
 class UrdfNode:
     """A node in URDF mode with drive: topic in a namespace of its own, and what it publishes."""
 
-    def __init__(self, ros, tmp_path, name, robot, *args):
+    def __init__(self, ros, tmp_path, name, robot, *args, closures=None, reference=None):
         self.ns = f'{SESSION}/{name}'
         self.urdf = DATA / f'{robot}.urdf'
-        self.closures = DATA / f'{robot}.loop_closures.yaml'
-        self.robot = load_robot(self.urdf, self.closures)
+        self.closures = closures or DATA / f'{robot}.loop_closures.yaml'
+        self.robot = load_robot(self.urdf, self.closures, None, reference)
         self.greeted = []
         self.js = []
         self.jt_all = ros.collect(JointTrajectory, f'{self.ns}/joint_accelerations')
@@ -187,6 +187,49 @@ def test_the_urdf_text_as_robot_description_and_a_velocity_left_out(ros, tmp_pat
     assert list(msg.position) == [answer.joints[n].position for n in node.robot.joint_names]
     assert not msg.velocity
     assert node.description[0].data == urdf.read_text().rstrip('\n')
+
+
+def test_a_urdf_exported_open_runs_from_its_reference_pose(ros, tmp_path):
+    """Gepetto's five-bar, 0.3 m open at zero: reference_pose (rad) runs it as solve does.
+
+    Issue 43, item 4: without it the node refuses the open pose in one line; with
+    it, every motor message is answered with the joints of ``Robot.solve`` from the
+    same reference, to the bit, closing the 6d closure in the test's own kinematics.
+    """
+    urdf = DATA / 'gepetto_5bar_linkage.urdf'
+    closures = DATA / 'gepetto_5bar_linkage.robot.yaml'
+    refused = NodeProcess(tmp_path / 'open', '-p', f'scene:={urdf}', '-p',
+                          f'loop_closures:={closures}')
+    status, output = exited(refused)
+    lines = cannot_start(output)
+    assert status != 0 and len(lines) == 1 and 'give a reference pose that closes it' in \
+        lines[0], output
+    reference = gepetto_five_bar_reference()
+    pose = '[' + ', '.join(f'{n}={v!r}' for n, v in reference.items()) + ']'
+    node = UrdfNode(ros, tmp_path, 'urdf_reference', 'gepetto_5bar_linkage', '-p',
+                    f'scene:={urdf}', '-p', f'loop_closures:={closures}', '-p',
+                    f'reference_pose:={pose}', '-p', 'extra_joints:=ignore',
+                    closures=closures, reference=reference)
+    robot = node.robot
+    sent = [[0.1, -0.2], [0.3, -0.1], [-0.2, 0.25]]
+    try:
+        node.start()
+        for i, positions in enumerate(sent):
+            node.send(T0 + i * NS, [robot.start(n) + p for n, p in
+                                    zip(robot.actuated, positions, strict=True)], None)
+        wait_for(lambda: len(node.js) >= len(sent) or node.proc.proc.poll() is not None,
+                 ANSWER_S, 'every motor message answered')
+    finally:
+        node.stop()
+    assert 'reference_pose=' in node.proc.output()     # the start line says it
+    fk = UrdfFk(urdf.read_text(), closures)
+    for msg, positions in zip(node.js, sent, strict=True):
+        given = {n: robot.start(n) + p for n, p in zip(robot.actuated, positions, strict=True)}
+        answer = robot.solve(given)
+        assert msg.name == list(robot.joint_names)
+        assert list(msg.position) == [answer.joints[n].position for n in robot.joint_names]
+        gaps = fk.gaps(dict(zip(msg.name, msg.position, strict=True)))
+        assert max(gap / fk.loop_size(c) for c, gap in gaps.items()) <= RTOL_CLOSURE
 
 
 @pytest.mark.parametrize('args, line', [
