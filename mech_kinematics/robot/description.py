@@ -397,10 +397,16 @@ def _inertials(robot: Any, source: str) -> dict[str, Inertial]:
                                 f'{dict(zip(names, values, strict=True))}')
         ixx, ixy, ixz, iyy, iyz, izz = values
         tensor = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
-        if float(np.linalg.eigvalsh(tensor)[0]) < -1e-12 * max(1.0, abs(tensor).max()):
+        # A rigid body's: positive semi-definite, each principal moment at most the sum of
+        # the other two (a 1e-9 kg exporter's dummy, or a point mass of inertia 0, is one).
+        low, middle, high = (float(v) for v in np.linalg.eigvalsh(tensor))
+        slack = 1e-12 * max(abs(tensor).max(), 1e-300)
+        if low < -slack or low + middle < high - slack:
             given = dict(zip(names, values, strict=True))
+            what = ('positive semi-definite' if low < -slack else
+                    "a rigid body's (each principal moment at most the sum of the other two)")
             raise _fail(source, f'link "{link.name}": Expected its <inertial> inertia to be '
-                                f'positive semi-definite, got {given}')
+                                f'{what}, got {given}')
         out[link.name] = Inertial(mass, transform(xyz, rpy), tensor)
     return out
 

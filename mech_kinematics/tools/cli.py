@@ -37,8 +37,9 @@ from ..errors import MechKinematicsError
 from ..memory import keep_freed_memory
 from ..units import LENGTH_UNITS, rad_per_s_from_rpm, turns_from_degrees
 
-__all__ = ['ArgumentParser', 'PROG', 'add_driver_arguments', 'add_robot_arguments',
-           'add_scene_argument', 'drive_from_args', 'finite_float', 'is_urdf', 'joint_list',
+__all__ = ['ArgumentParser', 'PROG', 'add_driver_arguments', 'add_gravity_argument',
+           'add_robot_arguments', 'add_scene_argument', 'drive_from_args', 'finite_float',
+           'gravity_of', 'is_urdf', 'joint_list',
            'load_robot_argument', 'load_scene_argument', 'named_value', 'positive_float',
            'positive_int', 'positive_seconds', 'run_handler', 'run_tool', 'seconds_or_zero',
            'values_by_driver']
@@ -100,6 +101,34 @@ def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
                        help='a reference pose whose branches the loops keep (degrees for a '
                             'revolute joint, m for a prismatic one; repeatable; default: the '
                             "URDF's zero pose)")
+
+
+def add_gravity_argument(parser: argparse.ArgumentParser) -> None:
+    """Add ``--gravity GX,GY,GZ``: a robot's gravity in its URDF's root frame."""
+    parser.add_argument('--gravity', metavar='GX,GY,GZ',
+                        help="for a robot described in URDF: gravity in the URDF's root frame, "
+                             'm/s^2 (default 0,0,-9.80665: REP 103, z up; 0,0,0 for none); the '
+                             "part along a loop's pivots is carried by its bearings")
+
+
+def gravity_of(args: argparse.Namespace) -> tuple[float, float, float] | None:
+    """Return ``--gravity`` as three numbers (``None`` if not given), or a one-line ValueError."""
+    from ..robot.forces import check_gravity
+
+    text = getattr(args, 'gravity', None)
+    if text is None:
+        return None
+    try:
+        values = [float(v) for v in text.split(',')]
+    except ValueError:
+        values = []
+    if len(values) != 3:
+        msg = f'--gravity: Expected GX,GY,GZ (three numbers, m/s^2), got {text!r}'
+        raise ValueError(msg)
+    try:
+        return check_gravity(values)
+    except ValueError as error:
+        raise ValueError(f'--gravity: {error}') from None
 
 
 def load_robot_argument(args: argparse.Namespace) -> Any:

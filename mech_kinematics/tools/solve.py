@@ -12,9 +12,9 @@ import sys
 from typing import Any
 import warnings
 
-from .cli import (add_driver_arguments, add_robot_arguments, add_scene_argument,
-                  drive_from_args, finite_float, is_urdf, load_robot_argument, positive_float,
-                  run_tool, values_by_driver)
+from .cli import (add_driver_arguments, add_gravity_argument, add_robot_arguments,
+                  add_scene_argument, drive_from_args, finite_float, gravity_of, is_urdf,
+                  load_robot_argument, positive_float, run_tool, values_by_driver)
 from ..bounds import MAX_ERROR
 from ..errors import AssemblyError, NearSingularWarning, SceneError, UntrustedError
 from ..scene import load_scene
@@ -54,6 +54,13 @@ joint's zero and positive about its axis as written. Its JSON has "robot",
 the actuated ones and the mimic joints that follow them), the loops'
 "points" in their plane, "mimic" (a mimic joint a loop moves away from its
 rule) and "limits" (a joint outside its <limit>, reported, not refused).
+Where the URDF's links carry <inertial>: "gravity" (m/s^2 in the root frame,
+--gravity GX,GY,GZ, default 0,0,-9.80665) and "efforts": each actuated joint
+that drives a loop (a mimic follower's load on its leader), N m or N,
+positive along its <axis> (sum of effort x velocity is the power put in),
+the forces of the motion given (static with no --speed and --accel), their
+bounds under "error_bound"."efforts"; or "forces_left_out" saying why not
+(docs/urdf.md, "Forces").
 """
 
 
@@ -91,6 +98,7 @@ def _robot_drive(robot: Any, args: argparse.Namespace
 def _handle_robot(args: argparse.Namespace) -> int:
     """Solve a robot described in URDF: its joints under their URDF names."""
     try:
+        gravity = gravity_of(args)
         robot = load_robot_argument(args)
         positions, speeds, accels, shown = _robot_drive(robot, args)
     except (SceneError, ValueError) as error:
@@ -99,7 +107,8 @@ def _handle_robot(args: argparse.Namespace) -> int:
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter('always', NearSingularWarning)
-            answer = robot.solve(positions, speeds, accels, max_error=args.max_error)
+            answer = robot.solve(positions, speeds, accels, max_error=args.max_error,
+                                 gravity=gravity)
     except AssemblyError as error:
         reason = error.reason if isinstance(error, UntrustedError) or error.facts is None \
             else assembly_text(error, robot.scene.units)
@@ -124,9 +133,10 @@ def _handle(args: argparse.Namespace) -> int:
     if is_urdf(args.scene):
         return _handle_robot(args)
     try:
-        if args.closures or args.actuated or args.reference:
-            msg = (f'Expected --closures, --actuated and --reference with a robot described '
-                   f'in URDF (a path ending in .urdf), got scene {args.scene}')
+        if args.closures or args.actuated or args.reference or args.gravity is not None:
+            msg = (f'Expected --closures, --actuated, --reference and --gravity with a robot '
+                   f"described in URDF (a path ending in .urdf; a scene's gravity is its "
+                   f'gravity: key), got scene {args.scene}')
             raise SceneError(msg)
         scene = load_scene(args.scene)
     except SceneError as error:
@@ -194,6 +204,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
                         help="signed crank speed in rpm, + CCW (default: the scene's)")
     add_driver_arguments(parser)
     add_robot_arguments(parser)
+    add_gravity_argument(parser)
     parser.add_argument('--max-error', type=positive_float, default=MAX_ERROR, metavar='REL',
                         help="refuse (exit 2) where a value's error bound exceeds REL times "
                              "its kind's scale (the mechanism's size, its largest speed, its "

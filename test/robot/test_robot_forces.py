@@ -1,0 +1,328 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""Forces of a robot described in URDF (issue 44, INTERFACE v5): efforts under the URDF's names.
+
+The values are not checked against our formulas:
+
+- a hand check of the lift arm (test/data/urdf/lift_arm.urdf, a parallelogram):
+  its lower and upper arms turn by the motor's angle q and its platform (with
+  the payload welded to it) translates with the lower arm's tip, so the
+  potential energy is ``g (m1 r1 + M L + m3 r3) sin q`` above its value at
+  q = 0, and the static motor torque is ``g cos q (m1 r1 + M L + m3 r3)``:
+  one link's ``m g r cos q`` for each arm, the platform's at the arm's length;
+- static efforts against central differences of the potential energy that the
+  test's own 4x4 forward kinematics (``UrdfFk``, test/helpers.py, written
+  apart from the package) computes from the URDF, the passive joints taken
+  from our answer (the loop closed, as checked in test_real_robots.py);
+- power balance (hypothesis) at random states of the packaged robots given
+  inertials here: sum of effort x velocity = d(KE + PE)/dt, the kinetic
+  energy from the joint velocities we answer, through the test's own twists
+  of the URDF's joints, the derivative by central differences along the
+  motion.
+"""
+
+import json
+import math
+from pathlib import Path
+
+from helpers import UrdfFk
+from hypothesis import given, HealthCheck, settings, strategies as st
+import numpy as np
+import pytest
+
+from mech_kinematics.__main__ import main as cli_main
+from mech_kinematics.errors import UrdfError
+from mech_kinematics.robot import load_robot
+from mech_kinematics.robot.forces import GRAVITY
+
+DATA = Path(__file__).resolve().parents[1] / 'data' / 'urdf'
+LIFT = DATA / 'lift_arm.urdf'
+G = 9.80665
+#: The lift arm's masses (kg) and lengths (m), as its URDF writes them.
+M_LOWER, R_LOWER = 2.0, 0.25
+M_UPPER, R_UPPER = 1.2, 0.25
+M_PLATFORM = 0.8 + 3.0 + 1e-9      # the platform, the payload and the dummy tool frame
+L_ARM = 0.5
+
+
+def _hand_torque(q, g=G):
+    """Return the lift arm's static motor torque by hand: ``g cos q (m1 r1 + M L + m3 r3)``."""
+    return g * math.cos(q) * (M_LOWER * R_LOWER + M_PLATFORM * L_ARM + M_UPPER * R_UPPER)
+
+
+def test_the_lift_arms_static_motor_torque_is_the_hand_check():
+    """lift_joint's effort is g cos q (m1 r1 + M L + m3 r3), positive along its axis."""
+    robot = load_robot(LIFT)
+    for q in (-1.0, -0.4, 0.0, 0.3, 0.9):
+        answer = robot.solve({'lift_joint': q})
+        effort = answer.efforts.efforts['lift_joint']
+        assert effort == pytest.approx(_hand_torque(q), rel=1e-13)
+        assert answer.efforts.bounds['lift_joint'] < 1e-9 * abs(effort)
+    # Gravity along +x of the root instead: PE = -g (m1 r1 + M L + m3 r3) cos q, so the
+    # torque is g sin q times the same sum.
+    answer = robot.solve({'lift_joint': 0.4}, gravity=(G, 0.0, 0.0))
+    assert answer.efforts.efforts['lift_joint'] == pytest.approx(
+        _hand_torque(0.4) * math.tan(0.4), rel=1e-12)
+    # Out of the plane (along the pivots' axes): carried by the bearings, no effort.
+    answer = robot.solve({'lift_joint': 0.4}, gravity=(0.0, -G, 0.0))
+    assert abs(answer.efforts.efforts['lift_joint']) <= 1e-12 * _hand_torque(0.0)
+
+
+def test_solve_prints_the_lift_arms_efforts_keyed_by_the_urdf_joint(capsys):
+    """``solve ROBOT.urdf``: "efforts" and "error_bound.efforts" under lift_joint; --gravity."""
+    assert cli_main(['solve', str(LIFT), '--input', 'lift_joint=30']) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out['gravity'] == list(GRAVITY)
+    assert out['efforts']['lift_joint'] == pytest.approx(_hand_torque(math.radians(30)),
+                                                         rel=1e-13)
+    assert 0 < out['error_bound']['efforts']['lift_joint'] < 1e-9
+    assert cli_main(['solve', str(LIFT), '--input', 'lift_joint=30',
+                     '--gravity', '0,0,-1.62']) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out['gravity'] == [0.0, 0.0, -1.62]
+    assert out['efforts']['lift_joint'] == pytest.approx(
+        _hand_torque(math.radians(30), 1.62), rel=1e-13)
+
+
+@pytest.mark.parametrize('text', ['nan,0,-9.8', '0,0,1e308', '0,-9.8', 'x,0,0'])
+def test_a_gravity_that_is_no_gravity_is_refused_in_one_line(capsys, text):
+    """NaN, 1e308, two components, a word: one line naming --gravity, exit 2."""
+    assert cli_main(['solve', str(LIFT), f'--gravity={text}']) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert '--gravity' in err
+    robot = load_robot(LIFT)
+    if text.count(',') == 2 and 'x' not in text:
+        with pytest.raises(ValueError, match='Expected gravity'):
+            robot.solve({'lift_joint': 0.1}, gravity=[float(v) for v in text.split(',')])
+
+
+def _with_inertial(text, link, mass, xyz=(0.0, 0.0, 0.0)):
+    inertial = (f'<inertial><mass value="{mass!r}"/><origin xyz="{" ".join(map(repr, xyz))}"/>'
+                '<inertia ixx="1e-3" ixy="0" ixz="0" iyy="1e-3" iyz="0" izz="1e-3"/></inertial>')
+    return text.replace(f'<link name="{link}"/>', f'<link name="{link}">{inertial}</link>')
+
+
+def test_a_mass_hanging_from_a_loop_outside_every_loop_leaves_the_efforts_out():
+    """The ABB's wrist (link_4, beyond joint_4 on link_3): efforts left out, with the reason."""
+    urdf = DATA / 'abb_irb2400_12_155.urdf'
+    closures = DATA / 'abb_irb2400_12_155.loop_closures.yaml'
+    text = _with_inertial(_with_inertial(urdf.read_text(), 'link_3', 10.0, (0.3, 0.0, 0.0)),
+                          'link_4', 5.0, (0.2, 0.0, 0.0))
+    answer = load_robot(text, closures).solve({'joint_3': 0.2})
+    assert answer.efforts is None
+    assert answer.forces_left_out.startswith('link "link_4": Expected masses on the links')
+    assert 'joint "joint_4"' in answer.forces_left_out
+    assert answer.as_dict()['forces_left_out'] == answer.forces_left_out
+    # On link_2 (the loop's ground) a mass loads only joint_2: the efforts are given.
+    text = _with_inertial(_with_inertial(urdf.read_text(), 'link_3', 10.0, (0.3, 0.0, 0.0)),
+                          'link_2', 5.0, (0.2, 0.0, 0.0))
+    answer = load_robot(text, closures).solve({'joint_3': 0.2})
+    assert set(answer.efforts.efforts) == {'joint_3'}
+    # A ground that moves: left out, saying which joint moves it.
+    answer = load_robot(text, closures).solve({'joint_3': 0.2}, {'joint_2': 0.5})
+    assert answer.efforts is None and 'joint "joint_2"' in answer.forces_left_out
+
+
+@pytest.mark.parametrize('mass, inertia, what', [
+    ('-1', ('1e-3', '1e-3', '1e-3'), 'mass'), ('nan', ('1e-3', '1e-3', '1e-3'), 'mass'),
+    ('1', ('-1e-3', '1e-3', '1e-3'), 'inertia'), ('1', ('1e-3', '1e-3', '5e-3'), 'inertia')])
+def test_an_inertial_that_is_no_body_is_refused_in_one_line_naming_the_link(mass, inertia,
+                                                                            what):
+    """A negative or NaN mass, an inertia not positive semi-definite or no rigid body's."""
+    ixx, iyy, izz = inertia
+    text = LIFT.read_text().replace(
+        '<inertial><mass value="1.2"/><origin xyz="0.25 0 0"/>\n      <inertia ixx="0.0006" '
+        'ixy="0" ixz="0" iyy="0.025" iyz="0" izz="0.025"/></inertial>',
+        f'<inertial><mass value="{mass}"/><inertia ixx="{ixx}" ixy="0" ixz="0" iyy="{iyy}" '
+        f'iyz="0" izz="{izz}"/></inertial>')
+    assert text != LIFT.read_text()
+    with pytest.raises(UrdfError) as caught:
+        load_robot(text)
+    message = str(caught.value)
+    assert len(message.splitlines()) == 1
+    assert 'link "upper_arm"' in message and f'<inertial> {what}' in message
+
+
+# --- the test's own mechanics of a URDF ------------------------------------------------------
+
+
+def _rpy(r, p, y):
+    cr, sr, cp, sp, cy, sy = (math.cos(r), math.sin(r), math.cos(p), math.sin(p),
+                              math.cos(y), math.sin(y))
+    return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+                     [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+                     [-sp, cp * sr, cp * cr]])
+
+
+def _inertials(text):
+    """Return link -> (mass, centre of mass in the link, inertia tensor in the link's axes)."""
+    import xml.etree.ElementTree as ET
+    out = {}
+    for link in ET.fromstring(text).findall('link'):
+        inertial = link.find('inertial')
+        if inertial is None:
+            continue
+        origin = inertial.find('origin')
+        xyz = np.array([float(v) for v in (origin.get('xyz', '0 0 0') if origin is not None
+                                           else '0 0 0').split()])
+        rpy = [float(v) for v in (origin.get('rpy', '0 0 0') if origin is not None
+                                  else '0 0 0').split()]
+        i = inertial.find('inertia').attrib
+        tensor = np.array([[float(i['ixx']), float(i['ixy']), float(i['ixz'])],
+                           [float(i['ixy']), float(i['iyy']), float(i['iyz'])],
+                           [float(i['ixz']), float(i['iyz']), float(i['izz'])]])
+        rotation = _rpy(*rpy)
+        out[link.get('name')] = (float(inertial.find('mass').get('value')), xyz,
+                                 rotation @ tensor @ rotation.T)
+    return out
+
+
+def _values(answer):
+    return {n: float(j.position) for n, j in answer.joints.items()}
+
+
+def _energy(fk, inertials, answer, gravity=GRAVITY):
+    """Return (KE, PE) of a state: twists of the URDF's joints at our joint values and rates."""
+    positions = _values(answer)
+    rates = {n: float(j.velocity) for n, j in answer.joints.items()}
+    frames = fk.transforms(positions)
+    parent_of = {j[2]: name for name, j in fk.joints.items()}
+    kinetic = potential = 0.0
+    g = np.asarray(gravity)
+    for link, (mass, com, tensor) in inertials.items():
+        frame = frames[link]
+        c = frame[:3, :3] @ com + frame[:3, 3]
+        omega, velocity = np.zeros(3), np.zeros(3)
+        up = link
+        while up in parent_of:
+            name = parent_of[up]
+            kind, parent, _, origin, axis, _ = fk.joints[name]
+            rate = rates.get(name, 0.0)
+            joint_frame = frames[parent] @ origin
+            a = joint_frame[:3, :3] @ axis
+            if kind in ('revolute', 'continuous'):
+                omega += rate * a
+                velocity += rate * np.cross(a, c - joint_frame[:3, 3])
+            elif kind == 'prismatic':
+                velocity += rate * a
+            up = parent
+        inertia = frame[:3, :3] @ tensor @ frame[:3, :3].T
+        kinetic += 0.5 * mass * velocity @ velocity + 0.5 * omega @ inertia @ omega
+        potential -= mass * g @ c
+    return kinetic, potential
+
+
+#: Inertials given here to the packaged robots' loop links: mass, centre of mass (off the
+#: loop's plane too: it carries no planar force) and a full inertia tensor.
+def _give_inertials(text, links, seed):
+    rng = np.random.default_rng(seed)
+    for link in links:
+        mass = float(rng.uniform(0.2, 3.0))
+        xyz = [float(v) for v in rng.uniform(-0.05, 0.05, 3)]
+        rpy = [float(v) for v in rng.uniform(-1.0, 1.0, 3)]
+        a, b = (float(v) for v in rng.uniform(1e-4, 1e-3, 2))
+        principal = [a, b, float(rng.uniform(abs(a - b), a + b))]   # a rigid body's
+        inertial = (f'<inertial><mass value="{mass!r}"/><origin xyz="{" ".join(map(repr, xyz))}" '
+                    f'rpy="{" ".join(map(repr, rpy))}"/><inertia ixx="{principal[0]!r}" ixy="0" '
+                    f'ixz="0" iyy="{principal[1]!r}" iyz="0" izz="{principal[2]!r}"/></inertial>')
+        assert f'<link name="{link}"/>' in text
+        text = text.replace(f'<link name="{link}"/>', f'<link name="{link}">{inertial}</link>')
+    return text
+
+
+GRIPPER_LINKS = ['left_outer_knuckle', 'left_outer_finger', 'left_inner_finger',
+                 'left_inner_finger_pad', 'left_inner_knuckle', 'right_outer_knuckle',
+                 'right_outer_finger', 'right_inner_finger', 'right_inner_finger_pad',
+                 'right_inner_knuckle', 'robotiq_arg2f_base_link']
+#: Per robot: the links given masses, the joint that drives its loops, its range (rad), and
+#: the joints that carry the loop's ground (held still, at random positions).
+ROBOTS = {
+    'robotiq_2f_85': (GRIPPER_LINKS, 'finger_joint', 0.0, 0.7, ()),
+    'robotiq_2f_140': (GRIPPER_LINKS, 'finger_joint', 0.0, 0.7, ()),
+    'abb_irb2400_12_155': (['link_2', 'link_3', 'link_lever_a', 'link_lever_b'], 'joint_3',
+                           -1.0, 1.1, ('joint_1', 'joint_2')),
+    'fanuc_m900ia260l': (['link_2', 'link_3', 'plink_1', 'plink_2'], 'joint_3', -1.4, 1.4,
+                         ('joint_1', 'joint_2')),
+}
+
+
+def _robot(name):
+    links, *_ = ROBOTS[name]
+    urdf, closures = DATA / f'{name}.urdf', DATA / f'{name}.loop_closures.yaml'
+    text = _give_inertials(urdf.read_text(), links, seed=len(name))
+    return load_robot(text, closures), UrdfFk(text, closures), _inertials(text)
+
+
+def _lift():
+    text = LIFT.read_text()
+    return load_robot(LIFT), UrdfFk(text), _inertials(text)
+
+
+def _potential(robot, fk, inertials, positions):
+    return _energy(fk, inertials, robot.solve(positions))[1]
+
+
+@pytest.mark.parametrize('name', ['lift_arm', *ROBOTS])
+def test_static_efforts_are_central_differences_of_the_potential_energy(name):
+    """Each effort is dPE/dq (h = 1e-5 rad), PE from the test's own forward kinematics."""
+    robot, fk, inertials = _lift() if name == 'lift_arm' else _robot(name)
+    if name == 'lift_arm':
+        joint, low, high, carriers = 'lift_joint', -1.0, 1.0, ()
+    else:
+        _, joint, low, high, carriers = ROBOTS[name]
+    rng = np.random.default_rng(44)
+    h = 1e-5
+    checked = 0
+    for q in np.linspace(low, high, 7):
+        positions = {n: float(rng.uniform(-1.0, 1.0)) for n in carriers}
+        positions[joint] = float(q)
+        answer = robot.solve(positions)
+        assert robot.forces.carriers == [list(carriers)] * len(robot.planar.mechanisms)
+        effort = answer.efforts.efforts[joint]
+        up = _potential(robot, fk, inertials, {**positions, joint: q + h})
+        down = _potential(robot, fk, inertials, {**positions, joint: q - h})
+        scale = sum(m for m, _, _ in inertials.values()) * G * fk.loop_size(
+            fk.closures[0][0])
+        assert effort == pytest.approx((up - down) / (2 * h), abs=1e-7 * scale)
+        assert set(answer.efforts.efforts) == {joint}   # a mimic's load is its leader's
+        checked += 1
+    assert checked == 7
+
+
+@pytest.mark.parametrize('name', ['lift_arm', *ROBOTS])
+@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(data=st.data())
+def test_power_in_is_the_rate_of_kinetic_and_potential_energy(name, data):
+    """Effort x velocity = d(KE + PE)/dt at random states (central differences, h = 1e-4 s)."""
+    if name not in _LOADED:
+        _LOADED[name] = _lift() if name == 'lift_arm' else _robot(name)
+    robot, fk, inertials = _LOADED[name]
+    if name == 'lift_arm':
+        joint, low, high, carriers = 'lift_joint', -1.0, 1.0, ()
+    else:
+        _, joint, low, high, carriers = ROBOTS[name]
+    floats = st.floats
+    q = data.draw(floats(low, high))
+    v = data.draw(floats(-3.0, 3.0))
+    a = data.draw(floats(-10.0, 10.0))
+    held = {n: data.draw(floats(-1.0, 1.0)) for n in carriers}
+    g = data.draw(st.sampled_from([GRAVITY, (3.0, -2.0, -9.0), (0.0, 0.0, 0.0)]))
+    h = 1e-4
+
+    def at(t):
+        return robot.solve({**held, joint: q + v * t + 0.5 * a * t * t}, {joint: v + a * t},
+                           {joint: a}, gravity=g)
+
+    now = at(0.0)
+    power = now.efforts.efforts[joint] * v
+    before, after = (sum(_energy(fk, inertials, at(t), g)) for t in (-h, h))
+    rate = (after - before) / (2 * h)
+    kinetic, potential = _energy(fk, inertials, now, g)
+    mass = sum(m for m, _, _ in inertials.values())
+    size = fk.loop_size(fk.closures[0][0])
+    scale = mass * size * (1.0 + abs(v)) * (size * (v * v + abs(a)) + np.linalg.norm(g))
+    assert power == pytest.approx(rate, abs=1e-6 * scale + 1e-9 * abs(kinetic + potential))
+
+
+_LOADED: dict = {}
