@@ -326,3 +326,24 @@ def test_power_in_is_the_rate_of_kinetic_and_potential_energy(name, data):
 
 
 _LOADED: dict = {}
+
+
+def test_the_docs_worked_example_is_what_solve_prints(capsys):
+    """docs/urdf.md, "Forces": the excerpt of the lift arm's JSON, static and moving."""
+    doc = (DATA.parents[2] / 'docs' / 'urdf.md').read_text()
+    section = doc[doc.index('## Forces'):]
+    excerpt = section[section.index('```json\n') + 8:]
+    excerpt = json.loads('{' + excerpt[:excerpt.index('```')].strip() + '}')
+    assert cli_main(['solve', str(LIFT), '--input', 'lift_joint=30']) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out['gravity'] == excerpt['gravity']
+    assert out['efforts'] == excerpt['efforts']
+    assert out['error_bound']['efforts'] == excerpt['error_bound']['efforts']
+    assert cli_main(['solve', str(LIFT), '--input', 'lift_joint=30', '--speed', 'lift_joint=10',
+                     '--accel', 'lift_joint=-4']) == 0
+    moving = json.loads(capsys.readouterr().out)['efforts']['lift_joint']
+    assert f'it is {moving:.6g} N m' in ' '.join(section.split())
+    # 4.868 N m less: the arm's inertia about the motor, 1.217 kg m^2, times -4 rad/s^2.
+    inertia = M_LOWER * R_LOWER ** 2 + 0.042 + M_UPPER * R_UPPER ** 2 + 0.025 \
+        + M_PLATFORM * L_ARM ** 2
+    assert moving == pytest.approx(out['efforts']['lift_joint'] - 4 * inertia, rel=1e-12)
