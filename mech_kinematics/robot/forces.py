@@ -31,7 +31,7 @@ whose efforts are not computed here. Pure: NumPy only.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 import math
 from typing import Any, TYPE_CHECKING
 
@@ -92,12 +92,19 @@ class RobotEfforts:
         The gravity used, m/s^2 in the root frame.
     forces : list of Forces
         The scene's forces, one per group of loops solved together.
+    valid : bool or ndarray of bool
+        Where every group's forces could be bounded (arrays: the instants
+        whose efforts stand; one instant not bounded is refused instead).
+    failures : dict of str to ndarray of bool
+        For arrays: per reason, the instants refused.
     """
 
     efforts: dict[str, Any]
     bounds: dict[str, Any]
     gravity: tuple[float, float, float]
     forces: list[Forces]
+    valid: Any = True
+    failures: dict[str, Any] = field(default_factory=dict)
 
 
 class RobotForces:
@@ -242,11 +249,18 @@ class RobotForces:
         efforts: dict[str, Any] = {}
         bounds: dict[str, Any] = {}
         answers = []
+        valid: Any = True
+        failures: dict[str, Any] = {}
         for g, members in groups.items():
             forces = self._dynamics(tuple(members), g).forces(state, float(max_error))
             if not vector and not forces.valid:
                 refuse_forces(state, forces, max_error)
             answers.append(forces)
+            if vector:
+                valid = valid & np.asarray(forces.valid, dtype=bool)
+                for reason, where in forces.failures.items():
+                    failures[reason] = failures[reason] | where if reason in failures \
+                        else where
             for index in members:
                 for driver in self.robot.planar.drivers:
                     if driver.name not in self.mechanisms[index]['drivers']:
@@ -261,7 +275,7 @@ class RobotForces:
                     efforts[leader], bounds[leader] = value, bound
         ordered = [name for name in self.robot.actuated if name in efforts]
         return RobotEfforts({n: efforts[n] for n in ordered}, {n: bounds[n] for n in ordered},
-                            gravity, answers)
+                            gravity, answers, valid, failures)
 
 
 def robot_forces(robot: Robot) -> RobotForces | None:

@@ -317,6 +317,10 @@ class Robot:
             return replace(answer, forces_left_out=str(why))
         except AssemblyError as error:
             raise error.located(self.where({n: x[0] for n, x in inputs.items()})) from None
+        if isinstance(state.valid, np.ndarray):   # an instant whose efforts are not bounded
+            failures = {**state.failures, **efforts.failures}
+            state = replace(state, valid=state.valid & efforts.valid, failures=failures)
+            answer = replace(answer, state=state)
         return replace(answer, efforts=efforts)
 
     def where(self, positions: Mapping[str, Any] | Iterable[Any]) -> str:

@@ -347,3 +347,19 @@ def test_the_docs_worked_example_is_what_solve_prints(capsys):
     inertia = M_LOWER * R_LOWER ** 2 + 0.042 + M_UPPER * R_UPPER ** 2 + 0.025 \
         + M_PLATFORM * L_ARM ** 2
     assert moving == pytest.approx(out['efforts']['lift_joint'] - 4 * inertia, rel=1e-12)
+
+
+def test_arrays_give_each_instants_efforts_and_mask_what_one_instant_refuses():
+    """The FANUC over joint_3 through its fold: valid instants as alone, the fold masked."""
+    robot, _, _ = _robot('fanuc_m900ia260l')
+    q = np.array([0.2, math.pi / 2, -0.9, 1.0])
+    speeds = np.array([0.5, 0.0, -1.0, 2.0])
+    answer = robot.solve({'joint_3': q}, {'joint_3': speeds})
+    assert answer.state.valid.tolist() == [True, False, True, True]
+    for i in (0, 2, 3):
+        alone = robot.solve({'joint_3': float(q[i])}, {'joint_3': float(speeds[i])})
+        assert answer.efforts.efforts['joint_3'][i] == pytest.approx(
+            alone.efforts.efforts['joint_3'], rel=1e-12)
+        assert answer.efforts.bounds['joint_3'][i] >= 0.0
+    with pytest.raises(Exception, match='joint_3 = 1.5708 rad'):
+        robot.solve({'joint_3': float(q[1])})
