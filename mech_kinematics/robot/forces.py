@@ -45,8 +45,8 @@ if TYPE_CHECKING:
     from .robot import Robot
     from ..solver import State
 
-__all__ = ['ForcesLeftOut', 'GRAVITY', 'MAX_GRAVITY', 'RobotForces', 'RobotEfforts',
-           'check_gravity']
+__all__ = ['ForcesLeftOut', 'GRAVITY', 'JointReaction', 'MAX_GRAVITY', 'RobotEfforts',
+           'RobotForces', 'check_gravity', 'robot_forces']
 
 #: Gravity in the URDF's root frame by default, m/s^2 (REP 103: z up; standard gravity).
 GRAVITY = (0.0, 0.0, -9.80665)
@@ -105,6 +105,31 @@ class RobotEfforts:
     forces: list[Forces]
     valid: Any = True
     failures: dict[str, Any] = field(default_factory=dict)
+    groups: tuple[tuple[int, ...], ...] = ()
+
+
+@dataclass(frozen=True)
+class JointReaction:
+    """The load a loop joint's parent puts on its child, in the child link's frame.
+
+    At the joint's origin (a closure's: its ``<child_origin>``), in the axes
+    of ``frame`` (the child link; a closure's child frame). ``force`` holds
+    the loop's plane's part (N): the part along the pivots' axis, and the
+    bending moments, are not determined by a planar loop's statics (with
+    parallel pins it is overconstrained in space: the bearings share them by
+    their stiffness) and are not in it. ``torque`` (N m) is the actuator's
+    about the joint's axis (its effort; 0 for a passive joint).
+    """
+
+    frame: str
+    force: tuple[float, float, float]
+    torque: tuple[float, float, float]
+    force_bound: float
+    torque_bound: float
+
+    def as_dict(self) -> dict[str, Any]:
+        """Return ``{"frame", "force", "torque"}``."""
+        return {'frame': self.frame, 'force': list(self.force), 'torque': list(self.torque)}
 
 
 class RobotForces:
@@ -275,7 +300,68 @@ class RobotForces:
                     efforts[leader], bounds[leader] = value, bound
         ordered = [name for name in self.robot.actuated if name in efforts]
         return RobotEfforts({n: efforts[n] for n in ordered}, {n: bounds[n] for n in ordered},
-                            gravity, answers, valid, failures)
+                            gravity, answers, valid, failures,
+                            tuple(tuple(members) for members in groups.values()))
+
+    def reactions(self, efforts: RobotEfforts, positions: Mapping[str, float],
+                  bounds: Mapping[str, float]) -> dict[str, JointReaction]:
+        """Return each loop's revolute joints' and pins' reactions at one instant.
+
+        ``positions``: every joint's value (the answer's), ``bounds`` their
+        position bounds. A prismatic joint of a loop is not given.
+        """
+        robot = self.robot
+        description = robot.description
+        frames = description.transforms(positions)
+        body_of = self._body_of()
+        closures = {c.name: c for c in description.closures}
+        drivers = {d.name: d for d in robot.planar.drivers}
+        spread = math.fsum(abs(float(b)) for b in bounds.values())
+        out: dict[str, JointReaction] = {}
+        for forces, members in zip(efforts.forces, efforts.groups, strict=True):
+            by_at: dict[tuple[str, frozenset[str]], Any] = {}
+            for name, reaction in forces.reactions.items():
+                if reaction.force is not None:
+                    by_at[(reaction.at, frozenset((reaction.on, reaction.by)))] = (name, reaction)
+            for index in members:
+                m = self.mechanisms[index]
+                scene_body = {**m['body_names'], m['ground']: robot.scene.graph.ground}
+                ground = frames[m['ground']]
+                for name in m['joints']:
+                    joint = description.joints.get(name)
+                    if joint is not None:
+                        if joint.type is None or not joint.type.angular:
+                            continue
+                        parent, child, local = joint.parent, joint.child, np.eye(4)
+                        axis = np.asarray(joint.axis, dtype=np.float64)
+                    else:
+                        closure = closures[name]
+                        parent, child, local = closure.link_a, closure.link_b, closure.frame_b
+                        axis = None
+                    a, b = scene_body.get(body_of[parent]), scene_body.get(body_of[child])
+                    point = robot.planar.names.get(name, name)
+                    found = by_at.get((point, frozenset((a, b))))
+                    if a is None or b is None or found is None:
+                        continue
+                    _, reaction = found
+                    f = complex(reaction.force)
+                    if reaction.on != b:
+                        f = -f
+                    planar = f.real * np.asarray(m['x']) + f.imag * np.asarray(m['y'])
+                    frame = np.linalg.solve(ground, frames[child] @ local)
+                    force = frame[:3, :3].T @ planar
+                    torque = np.zeros(3)
+                    torque_bound = 0.0
+                    driver = drivers.get(name)
+                    if driver is not None and axis is not None:
+                        tau = driver.sigma * forces.efforts[driver.scene]
+                        torque = tau * axis
+                        torque_bound = float(forces.effort_bounds[driver.scene])
+                    f_bound = float(reaction.force_bound) + abs(f) * (spread + 16 * _U)
+                    out[name] = JointReaction(child, tuple(float(v) for v in force),
+                                              tuple(float(v) for v in torque), f_bound,
+                                              torque_bound)
+        return out
 
 
 def robot_forces(robot: Robot) -> RobotForces | None:

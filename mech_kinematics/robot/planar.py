@@ -145,8 +145,9 @@ class Planar:
         Per mechanism: its ``ground`` link, ``links``, ``joints``, ``normal``
         and the scene plane's axes ``x`` and ``y`` (in the ground link's
         frame), ``size`` (m), ``gap`` (the largest closure gap at the
-        reference pose, m), ``bodies`` (the scene's bodies it became) and
-        ``drivers`` (the URDF joints that drive it, a mimic among them).
+        reference pose, m), ``bodies`` (the scene's bodies it became),
+        ``body_names`` (each moving URDF body's scene body) and ``drivers``
+        (the URDF joints that drive it, a mimic among them).
     actuated : tuple of str
         The actuated joints (given, the sidecar's or the URDF's).
     names : dict of str to str
@@ -1099,6 +1100,8 @@ def planar_from_description(description: Description, actuated: Iterable[str] | 
                            'joints': [e.name for e in part],
                            'bodies': [n for n in dict.fromkeys(builder.body_names.values())
                                       if n not in before],
+                           'body_names': {b: builder.body_names[b] for b in m.bodies
+                                          if b in builder.body_names},
                            'drivers': list(here),
                            'normal': [float(v) for v in m.normal],
                            'x': [float(v) for v in m.e1], 'y': [float(v) for v in m.e2],

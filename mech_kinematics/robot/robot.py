@@ -30,7 +30,8 @@ from typing import Any
 import numpy as np
 
 from .description import Description, read_description
-from .forces import check_gravity, ForcesLeftOut, GRAVITY, robot_forces, RobotEfforts
+from .forces import (check_gravity, ForcesLeftOut, GRAVITY, JointReaction, robot_forces,
+                     RobotEfforts)
 from .planar import DriverMap, JointMap, Planar, planar_from_description
 from ..bounds import MAX_ERROR
 from ..errors import AssemblyError, SceneError, UrdfError
@@ -81,6 +82,10 @@ class RobotState:
     forces_left_out : str or None
         Why the efforts are left out (a mass the loops do not carry, a
         moving ground), or ``None``.
+    reactions : dict of str to JointReaction
+        With the efforts, at one instant: each revolute joint and pin of
+        every loop, the load its parent puts on its child in the child
+        link's frame (:class:`~.forces.JointReaction`).
     """
 
     robot: str
@@ -92,6 +97,7 @@ class RobotState:
     limits: dict[str, dict[str, Any]] = field(default_factory=dict)
     efforts: RobotEfforts | None = None
     forces_left_out: str | None = None
+    reactions: dict[str, JointReaction] = field(default_factory=dict)
 
     def as_dict(self) -> dict[str, Any]:
         """Return what ``solve ROBOT.urdf`` prints: the URDF's joints, the scene's points."""
@@ -119,6 +125,8 @@ class RobotState:
         if self.efforts is not None:
             out['gravity'] = list(self.efforts.gravity)
             out['efforts'] = {name: value(x) for name, x in self.efforts.efforts.items()}
+        if self.reactions:
+            out['reactions'] = {name: r.as_dict() for name, r in self.reactions.items()}
         if self.forces_left_out is not None:
             out['forces_left_out'] = self.forces_left_out
         out['error_bound'] = {
@@ -128,6 +136,10 @@ class RobotState:
         if self.efforts is not None:
             out['error_bound']['efforts'] = {name: value(b)
                                              for name, b in self.efforts.bounds.items()}
+        if self.reactions:
+            out['error_bound']['reactions'] = {
+                name: {'force': r.force_bound, 'torque': r.torque_bound}
+                for name, r in self.reactions.items()}
         return out
 
 
@@ -321,7 +333,11 @@ class Robot:
             failures = {**state.failures, **efforts.failures}
             state = replace(state, valid=state.valid & efforts.valid, failures=failures)
             answer = replace(answer, state=state)
-        return replace(answer, efforts=efforts)
+            return replace(answer, efforts=efforts)
+        reactions = self.forces.reactions(
+            efforts, {n: float(j.position) for n, j in answer.joints.items()},
+            {n: float(b[0]) for n, b in answer.bounds.items()})
+        return replace(answer, efforts=efforts, reactions=reactions)
 
     def where(self, positions: Mapping[str, Any] | Iterable[Any]) -> str:
         """Return where the loops' actuated joints stand, for a message: ``j3 = 0.5 rad``.

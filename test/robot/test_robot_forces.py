@@ -363,3 +363,37 @@ def test_arrays_give_each_instants_efforts_and_mask_what_one_instant_refuses():
         assert answer.efforts.bounds['joint_3'][i] >= 0.0
     with pytest.raises(Exception, match='joint_3 = 1.5708 rad'):
         robot.solve({'joint_3': float(q[1])})
+
+
+def test_the_lift_arms_reactions_balance_every_weight_in_the_child_links_frames():
+    """Static: the ground pins hold the whole weight; the platform's pins hold its weight.
+
+    Each reaction is turned from its child link's frame to the root's by the
+    test's own forward kinematics; the actuated joint's torque is its effort
+    about its axis, a passive pin's is 0.
+    """
+    robot, fk, _ = _lift()
+    total = M_LOWER + M_UPPER + M_PLATFORM
+    for q in (-0.8, 0.0, 0.5):
+        answer = robot.solve({'lift_joint': q})
+        frames = fk.transforms(_values(answer))
+        reactions = answer.reactions
+        assert {n: r.frame for n, r in reactions.items()} == {
+            'lift_joint': 'lower_arm', 'upper_pivot': 'upper_arm', 'elbow': 'platform',
+            'pin_C': 'upper_arm'}
+
+        def root(name, frames=frames, reactions=reactions):
+            return frames[reactions[name].frame][:3, :3] @ np.asarray(reactions[name].force)
+
+        weight = np.array([0.0, 0.0, G])
+        assert root('lift_joint') + root('upper_pivot') == pytest.approx(total * weight,
+                                                                         abs=1e-12 * G)
+        # The platform: the elbow's load on it, and pin_C's on the upper arm, reversed.
+        assert root('elbow') - root('pin_C') == pytest.approx(M_PLATFORM * weight,
+                                                              abs=1e-12 * G)
+        assert reactions['lift_joint'].torque == pytest.approx(
+            (0.0, -answer.efforts.efforts['lift_joint'], 0.0), rel=1e-15)
+        assert reactions['elbow'].torque == (0.0, 0.0, 0.0)
+    out = answer.as_dict()
+    assert out['reactions']['pin_C']['frame'] == 'upper_arm'
+    assert out['error_bound']['reactions']['pin_C']['force'] > 0
