@@ -203,6 +203,11 @@ class Description:
     inertials : dict of str to Inertial
         Each link's ``<inertial>`` with a mass above 0 (a link without one,
         or of mass 0, is massless).
+    reductions : dict of str to (str, float)
+        A joint of a ``<transmission>`` with one ``<actuator>`` whose
+        ``<mechanicalReduction>`` is written: (the actuator's name, the
+        reduction: joint effort = reduction x actuator effort, as ros_control's
+        SimpleTransmission).
     """
 
     name: str
@@ -215,6 +220,7 @@ class Description:
     actuated: tuple[str, ...] = ()
     independent: tuple[str, ...] | None = None
     inertials: dict[str, Inertial] = field(default_factory=dict)
+    reductions: dict[str, tuple[str, float]] = field(default_factory=dict)
     _parent: dict[str, UrdfJoint] = field(default_factory=dict, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -612,6 +618,31 @@ def _actuated(root: Any) -> tuple[str, ...]:
     return tuple(dict.fromkeys(names))
 
 
+def _reductions(root: Any, source: str) -> dict[str, tuple[str, float]]:
+    """Return joint -> (actuator, mechanicalReduction) of each one-joint ``<transmission>``."""
+    out: dict[str, tuple[str, float]] = {}
+    for element in root.findall('transmission'):
+        joints, actuators = element.findall('joint'), element.findall('actuator')
+        if len(joints) != 1 or len(actuators) != 1 or not joints[0].get('name'):
+            continue
+        text = actuators[0].findtext('mechanicalReduction')
+        if text is None:
+            text = joints[0].findtext('mechanicalReduction')
+        if text is None:
+            continue
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        name = joints[0].get('name')
+        if not math.isfinite(value) or value == 0.0:
+            raise _fail(source, f'joint "{name}": Expected its <transmission>\'s '
+                        f'<mechanicalReduction> to be a finite number other than 0, got '
+                        f'{text.strip()!r}', name)
+        out[name] = (actuators[0].get('name') or f'{name}_actuator', value)
+    return out
+
+
 def read_description(source: str | os.PathLike[str], closures: str | os.PathLike[str] | None
                      = None) -> Description:
     """Read a robot: a URDF (a path, or its text) and its loop closures.
@@ -656,10 +687,13 @@ def read_description(source: str | os.PathLike[str], closures: str | os.PathLike
     found = tuple(_constraints(root, set(links), name)) + tuple(
         _closing_frames(joints, links, name))
     inertials = _inertials(robot, name)
+    reductions = _reductions(root, name)
     description = Description(str(robot.name or 'robot'), name, text, links, joints, root_link,
-                              found, _actuated(root), inertials=inertials)
+                              found, _actuated(root), inertials=inertials,
+                              reductions=reductions)
     if closures is None:
         return description
     extra, independent = _sidecar(closures, description)
     return Description(description.name, name, text, links, joints, root_link,
-                       found + extra, description.actuated, independent, inertials)
+                       found + extra, description.actuated, independent, inertials,
+                       reductions=reductions)

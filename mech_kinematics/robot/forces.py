@@ -97,6 +97,13 @@ class RobotEfforts:
         whose efforts stand; one instant not bounded is refused instead).
     failures : dict of str to ndarray of bool
         For arrays: per reason, the instants refused.
+    groups : tuple of tuple of int
+        The mechanisms each of ``forces`` solved.
+    actuators : dict of str to (str, value, bound)
+        Per ``<transmission>`` actuator with a ``<mechanicalReduction>`` of
+        one of those joints: its joint and its effort (the joint's divided by
+        the reduction: the same power at the actuator's speed, reduction
+        times the joint's), with its bound.
     """
 
     efforts: dict[str, Any]
@@ -106,6 +113,7 @@ class RobotEfforts:
     valid: Any = True
     failures: dict[str, Any] = field(default_factory=dict)
     groups: tuple[tuple[int, ...], ...] = ()
+    actuators: dict[str, tuple[str, Any, Any]] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -299,9 +307,16 @@ class RobotForces:
                         value = total
                     efforts[leader], bounds[leader] = value, bound
         ordered = [name for name in self.robot.actuated if name in efforts]
+        actuators = {}
+        for name in ordered:
+            if name in self.robot.description.reductions:
+                actuator, reduction = self.robot.description.reductions[name]
+                value = efforts[name] / reduction
+                actuators[actuator] = (name, value,
+                                       bounds[name] / abs(reduction) + _U * np.abs(value))
         return RobotEfforts({n: efforts[n] for n in ordered}, {n: bounds[n] for n in ordered},
                             gravity, answers, valid, failures,
-                            tuple(tuple(members) for members in groups.values()))
+                            tuple(tuple(members) for members in groups.values()), actuators)
 
     def reactions(self, efforts: RobotEfforts, positions: Mapping[str, float],
                   bounds: Mapping[str, float]) -> dict[str, JointReaction]:

@@ -125,6 +125,10 @@ class RobotState:
         if self.efforts is not None:
             out['gravity'] = list(self.efforts.gravity)
             out['efforts'] = {name: value(x) for name, x in self.efforts.efforts.items()}
+            if self.efforts.actuators:
+                out['actuator_efforts'] = {
+                    name: {'joint': joint, 'effort': value(x)}
+                    for name, (joint, x, _) in self.efforts.actuators.items()}
         if self.reactions:
             out['reactions'] = {name: r.as_dict() for name, r in self.reactions.items()}
         if self.forces_left_out is not None:
@@ -136,6 +140,9 @@ class RobotState:
         if self.efforts is not None:
             out['error_bound']['efforts'] = {name: value(b)
                                              for name, b in self.efforts.bounds.items()}
+            if self.efforts.actuators:
+                out['error_bound']['actuator_efforts'] = {
+                    name: value(b) for name, (_, _, b) in self.efforts.actuators.items()}
         if self.reactions:
             out['error_bound']['reactions'] = {
                 name: {'force': r.force_bound, 'torque': r.torque_bound}

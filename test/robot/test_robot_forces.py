@@ -397,3 +397,22 @@ def test_the_lift_arms_reactions_balance_every_weight_in_the_child_links_frames(
     out = answer.as_dict()
     assert out['reactions']['pin_C']['frame'] == 'upper_arm'
     assert out['error_bound']['reactions']['pin_C']['force'] > 0
+
+
+def test_a_transmissions_reduction_gives_the_motor_side_effort():
+    """<mechanicalReduction> 50: the motor turns 50 times faster and pushes 50 times less."""
+    text = LIFT.read_text()
+    assert '<mechanicalReduction>1</mechanicalReduction>' in text
+    geared = text.replace('<mechanicalReduction>1</mechanicalReduction>',
+                          '<mechanicalReduction>50</mechanicalReduction>')
+    answer = load_robot(geared).solve({'lift_joint': 0.3}, {'lift_joint': 0.7},
+                                      {'lift_joint': -2.0})
+    joint = answer.efforts.efforts['lift_joint']
+    name, motor, bound = answer.efforts.actuators['lift_motor']
+    assert name == 'lift_joint'
+    assert motor * (50 * 0.7) == pytest.approx(joint * 0.7, rel=1e-15)   # the same power
+    assert 0 < bound < 1e-9 * abs(motor)
+    out = answer.as_dict()
+    assert out['actuator_efforts'] == {'lift_motor': {'joint': 'lift_joint', 'effort': motor}}
+    with pytest.raises(UrdfError, match='joint "lift_joint": Expected its <transmission>'):
+        load_robot(text.replace('<mechanicalReduction>1<', '<mechanicalReduction>0<'))
