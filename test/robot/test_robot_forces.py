@@ -416,3 +416,24 @@ def test_a_transmissions_reduction_gives_the_motor_side_effort():
     assert out['actuator_efforts'] == {'lift_motor': {'joint': 'lift_joint', 'effort': motor}}
     with pytest.raises(UrdfError, match='joint "lift_joint": Expected its <transmission>'):
         load_robot(text.replace('<mechanicalReduction>1<', '<mechanicalReduction>0<'))
+
+
+def test_a_ground_carried_by_a_joint_not_actuated_leaves_the_efforts_out_under_gravity():
+    """The ABB driven by joint_3 alone: link_2's pose is unknown, so is gravity in its plane."""
+    robot, _, _ = _robot('abb_irb2400_12_155')
+    urdf = DATA / 'abb_irb2400_12_155.urdf'
+    text = _give_inertials(urdf.read_text(), ROBOTS['abb_irb2400_12_155'][0], seed=18)
+    alone = load_robot(text, DATA / 'abb_irb2400_12_155.loop_closures.yaml',
+                       actuated=['joint_3'])
+    answer = alone.solve({'joint_3': 0.4})
+    assert answer.efforts is None
+    assert 'carried by joint "joint_1", which is not actuated' in answer.forces_left_out
+    # Without gravity the pose does not matter: the inertia of the motion alone, as with all
+    # six axes actuated and the arm's other joints at rest.
+    moving = alone.solve({'joint_3': 0.4}, {'joint_3': 1.5}, {'joint_3': -3.0},
+                         gravity=(0.0, 0.0, 0.0))
+    full = robot.solve({'joint_3': 0.4}, {'joint_3': 1.5}, {'joint_3': -3.0},
+                       gravity=(0.0, 0.0, 0.0))
+    assert moving.efforts.efforts['joint_3'] == pytest.approx(full.efforts.efforts['joint_3'],
+                                                              rel=1e-13)
+    assert abs(moving.efforts.efforts['joint_3']) > 0.01
