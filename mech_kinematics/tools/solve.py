@@ -103,6 +103,10 @@ def _handle_robot(args: argparse.Namespace) -> int:
     try:
         gravity = gravity_of(args)
         robot = load_robot_argument(args)
+        if gravity is not None and robot.forces is None:
+            msg = (f'--gravity: Expected a robot whose links carry <inertial> (their masses), '
+                   f'got none in {args.scene}: gravity would move nothing')
+            raise ValueError(msg)
         positions, speeds, accels, shown = _robot_drive(robot, args)
     except (SceneError, ValueError) as error:
         print(f'error: {error}', file=sys.stderr)

@@ -437,3 +437,16 @@ def test_a_ground_carried_by_a_joint_not_actuated_leaves_the_efforts_out_under_g
     assert moving.efforts.efforts['joint_3'] == pytest.approx(full.efforts.efforts['joint_3'],
                                                               rel=1e-13)
     assert abs(moving.efforts.efforts['joint_3']) > 0.01
+
+
+def test_gravity_for_a_robot_without_masses_is_refused_not_ignored(capsys):
+    """--gravity on a URDF with no <inertial>: one line, exit 2 (it would move nothing)."""
+    urdf = DATA / 'robotiq_2f_85.urdf'
+    closures = DATA / 'robotiq_2f_85.loop_closures.yaml'
+    assert cli_main(['solve', str(urdf), '--closures', str(closures)]) == 0
+    assert 'efforts' not in json.loads(capsys.readouterr().out)
+    assert cli_main(['solve', str(urdf), '--closures', str(closures),
+                     '--gravity', '0,0,-9.8']) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith('error: --gravity: Expected a robot whose links carry <inertial>')
+    assert len(err.splitlines()) == 1
