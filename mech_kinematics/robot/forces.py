@@ -37,16 +37,18 @@ from typing import Any, TYPE_CHECKING
 
 import numpy as np
 
+from ..errors import UrdfError
 from ..solver.forces import Dynamics, Forces, Mass
 from ..solver.scaling import _size
 from ..solver.solve import refuse_forces
 
 if TYPE_CHECKING:
+    from .description import Description
     from .robot import Robot
     from ..solver import State
 
 __all__ = ['ForcesLeftOut', 'GRAVITY', 'JointReaction', 'MAX_GRAVITY', 'RobotEfforts',
-           'RobotForces', 'check_gravity', 'robot_forces']
+           'RobotForces', 'check_gravity', 'robot_forces', 'with_payloads']
 
 #: Gravity in the URDF's root frame by default, m/s^2 (REP 103: z up; standard gravity).
 GRAVITY = (0.0, 0.0, -9.80665)
@@ -377,6 +379,54 @@ class RobotForces:
                                               tuple(float(v) for v in torque), f_bound,
                                               torque_bound)
         return out
+
+
+def with_payloads(description: Description,
+                  payloads: Mapping[str, tuple[float, Sequence[float]]]) -> Description:
+    """Return ``description`` with point masses added to links: ``{LINK: (kg, (x, y, z))}``.
+
+    A payload (a part in a gripper, a tool) is a point mass at a point of a
+    link, in the link's frame (m): it is welded to the link, added to its
+    ``<inertial>`` (the total mass, the common centre of mass, the inertia
+    about it by the parallel-axis theorem). Refused in one line
+    (``UrdfError``) naming the link: a link the robot lacks, a mass not
+    finite and above 0, a point not three finite numbers.
+    """
+    from dataclasses import replace
+
+    from .description import Inertial
+    from .transforms import translation
+
+    inertials = dict(description.inertials)
+    for link, (mass, point) in payloads.items():
+        where = f'{description.source}: payload on link "{link}"'
+        if link not in description.links:
+            more = ', ...' if len(description.links) > 8 else ''
+            known = ', '.join(description.links[:8]) + more
+            raise UrdfError(f'{where}: Expected a link of the robot ({known}), got none of '
+                            'that name')
+        try:
+            m = float(mass)
+            p = np.array([float(v) for v in point], dtype=np.float64)
+        except (TypeError, ValueError):
+            m, p = math.nan, np.zeros(0)
+        if not (math.isfinite(m) and m > 0.0) or p.shape != (3,) or not np.all(np.isfinite(p)):
+            raise UrdfError(f'{where}: Expected a mass above 0 kg at a point [x, y, z] of the '
+                            f'link (m, finite), got {mass!r} kg at {point!r}')
+        old = inertials.get(link)
+        if old is None:
+            inertials[link] = Inertial(m, translation(p), np.zeros((3, 3)))
+            continue
+        c_old = old.origin[:3, 3]
+        rotation = old.origin[:3, :3]
+        total = old.mass + m
+        com = (old.mass * c_old + m * p) / total
+        tensor = rotation @ old.inertia @ rotation.T      # in the link's axes
+        for part, at in ((old.mass, c_old), (m, p)):
+            d = at - com
+            tensor = tensor + part * (float(d @ d) * np.eye(3) - np.outer(d, d))
+        inertials[link] = Inertial(total, translation(com), tensor)
+    return replace(description, inertials=inertials)
 
 
 def robot_forces(robot: Robot) -> RobotForces | None:

@@ -31,7 +31,7 @@ import numpy as np
 
 from .description import Description, read_description
 from .forces import (check_gravity, ForcesLeftOut, GRAVITY, JointReaction, robot_forces,
-                     RobotEfforts)
+                     RobotEfforts, with_payloads)
 from .planar import DriverMap, JointMap, Planar, planar_from_description
 from ..bounds import MAX_ERROR
 from ..errors import AssemblyError, SceneError, UrdfError
@@ -222,9 +222,13 @@ class Robot:
     @classmethod
     def from_urdf(cls, source: str | os.PathLike[str], closures: str | os.PathLike[str] | None
                   = None, actuated: Iterable[str] | None = None,
-                  reference: Mapping[str, float] | None = None) -> Robot:
+                  reference: Mapping[str, float] | None = None,
+                  payloads: Mapping[str, tuple[float, Any]] | None = None) -> Robot:
         """Read a URDF (path or text) and its closures; see :func:`load_robot`."""
-        return cls(read_description(source, closures), actuated, reference)
+        description = read_description(source, closures)
+        if payloads:
+            description = with_payloads(description, payloads)
+        return cls(description, actuated, reference)
 
     def knows(self, joint: str) -> bool:
         """Return whether :meth:`solve` answers ``joint`` (else a node passes it through)."""
@@ -461,7 +465,8 @@ class Robot:
 
 def load_robot(source: str | os.PathLike[str], closures: str | os.PathLike[str] | None = None,
                actuated: Iterable[str] | None = None,
-               reference: Mapping[str, float] | None = None) -> Robot:
+               reference: Mapping[str, float] | None = None,
+               payloads: Mapping[str, tuple[float, Any]] | None = None) -> Robot:
     """Read a robot described in URDF and make the scene of its planar loops.
 
     Parameters
@@ -477,6 +482,9 @@ def load_robot(source: str | os.PathLike[str], closures: str | os.PathLike[str] 
     reference : mapping of str to float, optional
         A reference pose (rad or m per joint) whose branches the loops keep;
         default the URDF's zero pose.
+    payloads : mapping of str to (float, (float, float, float)), optional
+        Point masses on links, ``{LINK: (kg, (x, y, z))}`` in the link's
+        frame: welded to it (:func:`~.forces.with_payloads`).
 
     Returns
     -------
@@ -487,4 +495,4 @@ def load_robot(source: str | os.PathLike[str], closures: str | os.PathLike[str] 
     UrdfError
         One line naming the source, the joint and why.
     """
-    return Robot.from_urdf(source, closures, actuated, reference)
+    return Robot.from_urdf(source, closures, actuated, reference, payloads)

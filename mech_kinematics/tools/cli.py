@@ -39,7 +39,7 @@ from ..units import LENGTH_UNITS, rad_per_s_from_rpm, turns_from_degrees
 
 __all__ = ['ArgumentParser', 'PROG', 'add_driver_arguments', 'add_gravity_argument',
            'add_robot_arguments', 'add_scene_argument', 'drive_from_args', 'finite_float',
-           'gravity_of', 'is_urdf', 'joint_list',
+           'gravity_of', 'is_urdf', 'joint_list', 'payloads_of',
            'load_robot_argument', 'load_scene_argument', 'named_value', 'positive_float',
            'positive_int', 'positive_seconds', 'run_handler', 'run_tool', 'seconds_or_zero',
            'values_by_driver']
@@ -109,6 +109,31 @@ def add_gravity_argument(parser: argparse.ArgumentParser) -> None:
                         help="for a robot described in URDF: gravity in the URDF's root frame, "
                              'm/s^2 (default 0,0,-9.80665: REP 103, z up; 0,0,0 for none); the '
                              "part along a loop's pivots is carried by its bearings")
+    parser.add_argument('--payload', action='append', metavar='LINK=KG[@X,Y,Z]',
+                        help='for a robot described in URDF: a point mass welded to a link, '
+                             "at a point of the link's frame (m; default its origin), e.g. "
+                             'platform=2.5@0.1,0,0.05 (repeatable)')
+
+
+def payloads_of(args: argparse.Namespace) -> dict[str, tuple[float, tuple[float, ...]]]:
+    """Return ``--payload LINK=KG[@X,Y,Z]`` as ``{LINK: (kg, (x, y, z))}``, or a ValueError."""
+    out: dict[str, tuple[float, tuple[float, ...]]] = {}
+    for text in getattr(args, 'payload', None) or ():
+        link, sep, rest = text.partition('=')
+        mass, at, point = rest.partition('@')
+        try:
+            values = (float(mass), tuple(float(v) for v in point.split(',')) if at
+                      else (0.0, 0.0, 0.0))
+        except ValueError:
+            values = None
+        if not sep or not link or values is None or len(values[1]) != 3:
+            msg = f'--payload: Expected LINK=KG or LINK=KG@X,Y,Z, got {text!r}'
+            raise ValueError(msg)
+        if link in out:
+            msg = f'--payload: Expected each link once, got "{link}" twice'
+            raise ValueError(msg)
+        out[link] = values
+    return out
 
 
 def gravity_of(args: argparse.Namespace) -> tuple[float, float, float] | None:
@@ -147,6 +172,10 @@ def load_robot_argument(args: argparse.Namespace) -> Any:
                    f'robot ({moving}), got {name!r}')
             raise UrdfError(msg)
         reference[name] = math.radians(value) if joint.type.angular else value
+    payloads = payloads_of(args)
+    if payloads:
+        from ..robot.forces import with_payloads
+        description = with_payloads(description, payloads)
     return Robot(description, getattr(args, 'actuated', None), reference)
 
 

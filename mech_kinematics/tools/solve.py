@@ -140,10 +140,11 @@ def _handle(args: argparse.Namespace) -> int:
     if is_urdf(args.scene):
         return _handle_robot(args)
     try:
-        if args.closures or args.actuated or args.reference or args.gravity is not None:
-            msg = (f'Expected --closures, --actuated, --reference and --gravity with a robot '
-                   f"described in URDF (a path ending in .urdf; a scene's gravity is its "
-                   f'gravity: key), got scene {args.scene}')
+        if args.closures or args.actuated or args.reference or args.gravity is not None \
+                or args.payload:
+            msg = (f'Expected --closures, --actuated, --reference, --gravity and --payload '
+                   f"with a robot described in URDF (a path ending in .urdf; a scene's gravity "
+                   f'and masses are its gravity: and masses: keys), got scene {args.scene}')
             raise SceneError(msg)
         scene = load_scene(args.scene)
     except SceneError as error:

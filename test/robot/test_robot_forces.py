@@ -472,3 +472,40 @@ def test_gravity_for_a_robot_without_masses_is_refused_not_ignored(capsys):
     err = capsys.readouterr().err.strip()
     assert err.startswith('error: --gravity: Expected a robot whose links carry <inertial>')
     assert len(err.splitlines()) == 1
+
+
+def test_a_payload_is_a_point_mass_welded_to_its_link():
+    """--payload / payloads=: by hand statically; moving, as the same mass on a welded link.
+
+    2 kg on the upper arm at (0.4, 0.02, 0.01) in its frame: the arm turns by q about -y,
+    so the point rises by 0.4 sin q + 0.01 cos q (the 0.02 along the pivots moves nothing).
+    """
+    q, m = 0.35, 2.0
+    point = (0.4, 0.02, 0.01)
+    loaded = load_robot(LIFT, payloads={'upper_arm': (m, point)})
+    static = loaded.solve({'lift_joint': q}).efforts.efforts['lift_joint']
+    assert static == pytest.approx(
+        _hand_torque(q) + m * G * (0.4 * math.cos(q) - 0.01 * math.sin(q)), rel=1e-13)
+    welded = LIFT.read_text().replace('</robot>', (
+        f'<link name="extra"><inertial><mass value="{m}"/><inertia ixx="0" ixy="0" ixz="0" '
+        'iyy="0" iyz="0" izz="0"/></inertial></link><joint name="extra_mount" type="fixed">'
+        f'<parent link="upper_arm"/><child link="extra"/><origin xyz="{" ".join(map(str, point))}"'
+        '/></joint></robot>'))
+    motion = ({'lift_joint': q}, {'lift_joint': 1.3}, {'lift_joint': -6.0})
+    assert loaded.solve(*motion).efforts.efforts['lift_joint'] == pytest.approx(
+        load_robot(welded).solve(*motion).efforts.efforts['lift_joint'], rel=1e-13)
+
+
+def test_solve_takes_payloads_and_refuses_a_bad_one_in_one_line(capsys):
+    """A solve takes --payload LINK=KG@X,Y,Z; an unknown link, a mass of 0, no number: exit 2."""
+    assert cli_main(['solve', str(LIFT), '--input', 'lift_joint=0',
+                     '--payload', 'platform=2@0.1,0,0']) == 0
+    out = json.loads(capsys.readouterr().out)   # the platform translates: + M g L
+    assert out['efforts']['lift_joint'] == pytest.approx(_hand_torque(0.0) + 2.0 * G * L_ARM,
+                                                         rel=1e-13)
+    for bad, says in (('gripper=1', 'payload on link "gripper": Expected a link of the robot'),
+                      ('platform=0', 'payload on link "platform": Expected a mass above 0'),
+                      ('platform=1@0,0', '--payload: Expected LINK=KG or LINK=KG@X,Y,Z')):
+        assert cli_main(['solve', str(LIFT), '--payload', bad]) == 2
+        err = capsys.readouterr().err.strip()
+        assert says in err and len(err.splitlines()) == 1
