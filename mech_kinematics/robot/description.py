@@ -218,6 +218,11 @@ class Description:
     inertials : dict of str to Inertial
         Each link's ``<inertial>`` with a mass above 0 (a link without one,
         or of mass 0, is massless).
+    reductions : dict of str to (str, float)
+        A joint of a ``<transmission>`` with one ``<actuator>`` whose
+        ``<mechanicalReduction>`` is written: (the actuator's name, the
+        reduction: joint effort = reduction x actuator effort, as ros_control's
+        SimpleTransmission).
     """
 
     name: str
@@ -230,6 +235,7 @@ class Description:
     actuated: tuple[str, ...] = ()
     independent: tuple[str, ...] | None = None
     inertials: dict[str, Inertial] = field(default_factory=dict)
+    reductions: dict[str, tuple[str, float]] = field(default_factory=dict)
     _parent: dict[str, UrdfJoint] = field(default_factory=dict, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -468,10 +474,16 @@ def _inertials(robot: Any, source: str, quaternions: Mapping[tuple[str, str], Ma
                                 f'{dict(zip(names, values, strict=True))}')
         ixx, ixy, ixz, iyy, iyz, izz = values
         tensor = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
-        if float(np.linalg.eigvalsh(tensor)[0]) < -1e-12 * max(1.0, abs(tensor).max()):
+        # A rigid body's: positive semi-definite, each principal moment at most the sum of
+        # the other two (a 1e-9 kg exporter's dummy, or a point mass of inertia 0, is one).
+        low, middle, high = (float(v) for v in np.linalg.eigvalsh(tensor))
+        slack = 1e-12 * max(abs(tensor).max(), 1e-300)
+        if low < -slack or low + middle < high - slack:
             given = dict(zip(names, values, strict=True))
+            what = ('positive semi-definite' if low < -slack else
+                    "a rigid body's (each principal moment at most the sum of the other two)")
             raise _fail(source, f'link "{link.name}": Expected its <inertial> inertia to be '
-                                f'positive semi-definite, got {given}')
+                                f'{what}, got {given}')
         frame = quaternions.get(('inertial', link.name))
         out[link.name] = Inertial(mass, transform(xyz, rpy) if frame is None else frame, tensor)
     return out
@@ -976,6 +988,31 @@ def _actuated(root: Any) -> tuple[str, ...]:
     return tuple(dict.fromkeys(names))
 
 
+def _reductions(root: Any, source: str) -> dict[str, tuple[str, float]]:
+    """Return joint -> (actuator, mechanicalReduction) of each one-joint ``<transmission>``."""
+    out: dict[str, tuple[str, float]] = {}
+    for element in root.findall('transmission'):
+        joints, actuators = element.findall('joint'), element.findall('actuator')
+        if len(joints) != 1 or len(actuators) != 1 or not joints[0].get('name'):
+            continue
+        text = actuators[0].findtext('mechanicalReduction')
+        if text is None:
+            text = joints[0].findtext('mechanicalReduction')
+        if text is None:
+            continue
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        name = joints[0].get('name')
+        if not math.isfinite(value) or value == 0.0:
+            raise _fail(source, f'joint "{name}": Expected its <transmission>\'s '
+                        f'<mechanicalReduction> to be a finite number other than 0, got '
+                        f'{text.strip()!r}', name)
+        out[name] = (actuators[0].get('name') or f'{name}_actuator', value)
+    return out
+
+
 def read_description(source: str | os.PathLike[str], closures: str | os.PathLike[str] | None
                      = None) -> Description:
     """Read a robot: a URDF (a path, or its text) and its loop closures.
@@ -1022,10 +1059,13 @@ def read_description(source: str | os.PathLike[str], closures: str | os.PathLike
     found = tuple(_constraints(root, set(links), name, version)) + tuple(
         _closing_frames(joints, links, name)) + tuple(urdf_loops(root, set(links), name, version))
     inertials = _inertials(robot, name, quaternions)
+    reductions = _reductions(root, name)
     description = Description(str(robot.name or 'robot'), name, text, links, joints, root_link,
-                              found, _actuated(root), inertials=inertials)
+                              found, _actuated(root), inertials=inertials,
+                              reductions=reductions)
     if closures is None:
         return description
     extra, independent = _sidecar(closures, description)
     return Description(description.name, name, text, links, joints, root_link,
-                       found + extra, description.actuated, independent, inertials)
+                       found + extra, description.actuated, independent, inertials,
+                       reductions=reductions)

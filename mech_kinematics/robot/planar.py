@@ -120,6 +120,18 @@ class DriverMap:
     scene_ref: float
     mimic: Any = None
 
+    @property
+    def gain(self) -> tuple[str, float]:
+        """Return the joint that moves this driver and d(scene value) / d(its value).
+
+        The actuated joint itself (``sigma``), or a mimic's leader (``sigma``
+        times the multiplier): the driver's scene effort times the gain is the
+        generalised force on that joint (the same power).
+        """
+        if self.mimic is None:
+            return self.name, self.sigma
+        return self.mimic.joint, self.sigma * self.mimic.multiplier
+
 
 @dataclass
 class Planar:
@@ -136,8 +148,10 @@ class Planar:
     mechanisms : list of dict
         Per mechanism: its ``ground`` link, ``links``, ``joints``, ``normal``
         and the scene plane's axes ``x`` and ``y`` (in the ground link's
-        frame), ``size`` (m) and ``gap`` (the largest closure gap at the
-        reference pose, m).
+        frame), ``size`` (m), ``gap`` (the largest closure gap at the
+        reference pose, m), ``bodies`` (the scene's bodies it became),
+        ``body_names`` (each moving URDF body's scene body) and ``drivers``
+        (the URDF joints that drive it, a mimic among them).
     actuated : tuple of str
         The actuated joints (given, the sidecar's or the URDF's).
     names : dict of str to str
@@ -1283,6 +1297,7 @@ def planar_from_description(description: Description, actuated: Iterable[str] | 
         builder.drivers_here = here
         builder.mimics = mimics
         builder.slider_of = {}
+        before = set(builder.body_names.values())
         builder.build(m)
         for name in locked:   # an idle body's first joint: held at its reference value
             joint = description.joints[name]
@@ -1295,6 +1310,11 @@ def planar_from_description(description: Description, actuated: Iterable[str] | 
                     center=centre, mechanism=index)
         mechanisms.append({'ground': ground, 'links': list(m.bodies),
                            'joints': [e.name for e in part],
+                           'bodies': [n for n in dict.fromkeys(builder.body_names.values())
+                                      if n not in before],
+                           'body_names': {b: builder.body_names[b] for b in m.bodies
+                                          if b in builder.body_names},
+                           'drivers': list(here),
                            'normal': [float(v) for v in m.normal],
                            'x': [float(v) for v in m.e1], 'y': [float(v) for v in m.e2],
                            'size': m.size, 'gap': max((g for g, _ in m.gaps), default=0.0)})

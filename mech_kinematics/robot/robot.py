@@ -22,7 +22,7 @@ the scene can serve a robot. Pure: no ROS.
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 import math
 import os
 from typing import Any
@@ -30,6 +30,8 @@ from typing import Any
 import numpy as np
 
 from .description import Description, read_description
+from .forces import (check_gravity, ForcesLeftOut, GRAVITY, JointReaction, robot_forces,
+                     RobotEfforts, with_payloads)
 from .planar import DriverMap, JointMap, Planar, planar_from_description
 from ..bounds import MAX_ERROR
 from ..errors import AssemblyError, SceneError, UrdfError
@@ -75,6 +77,17 @@ class RobotState:
         (the rule's value, the joint's minus it).
     limits : dict of str to dict
         A joint outside its ``<limit>``: ``{'position', 'lower', 'upper'}``.
+    efforts : RobotEfforts or None
+        For a URDF with ``<inertial>``: the efforts of the actuated joints
+        that drive its loops, with their bounds and the gravity used
+        (:mod:`.forces`); ``None`` without, or where they are left out.
+    forces_left_out : str or None
+        Why the efforts are left out (a mass the loops do not carry, a
+        moving ground), or ``None``.
+    reactions : dict of str to JointReaction
+        With the efforts, at one instant: each revolute joint and pin of
+        every loop, the load its parent puts on its child in the child
+        link's frame (:class:`~.forces.JointReaction`).
     """
 
     robot: str
@@ -84,6 +97,9 @@ class RobotState:
     state: State
     mimic: dict[str, dict[str, Any]] = field(default_factory=dict)
     limits: dict[str, dict[str, Any]] = field(default_factory=dict)
+    efforts: RobotEfforts | None = None
+    forces_left_out: str | None = None
+    reactions: dict[str, JointReaction] = field(default_factory=dict)
 
     def as_dict(self) -> dict[str, Any]:
         """Return what ``solve ROBOT.urdf`` prints: the URDF's joints, the scene's points."""
@@ -108,10 +124,31 @@ class RobotState:
         if self.limits:
             out['limits'] = {name: {k: value(v) for k, v in item.items()}
                              for name, item in self.limits.items()}
+        if self.efforts is not None:
+            out['gravity'] = list(self.efforts.gravity)
+            out['efforts'] = {name: value(x) for name, x in self.efforts.efforts.items()}
+            if self.efforts.actuators:
+                out['actuator_efforts'] = {
+                    name: {'joint': joint, 'effort': value(x)}
+                    for name, (joint, x, _) in self.efforts.actuators.items()}
+        if self.reactions:
+            out['reactions'] = {name: r.as_dict() for name, r in self.reactions.items()}
+        if self.forces_left_out is not None:
+            out['forces_left_out'] = self.forces_left_out
         out['error_bound'] = {
             'joints': {name: {'position': value(b[0]), 'velocity': value(b[1]),
                               'acceleration': value(b[2])} for name, b in self.bounds.items()},
             'points': scene['error_bound']['points']}
+        if self.efforts is not None:
+            out['error_bound']['efforts'] = {name: value(b)
+                                             for name, b in self.efforts.bounds.items()}
+            if self.efforts.actuators:
+                out['error_bound']['actuator_efforts'] = {
+                    name: value(b) for name, (_, _, b) in self.efforts.actuators.items()}
+        if self.reactions:
+            out['error_bound']['reactions'] = {
+                name: {'force': r.force_bound, 'torque': r.torque_bound}
+                for name, r in self.reactions.items()}
         return out
 
 
@@ -138,6 +175,12 @@ class Robot:
         whose leader is among them.
     reference : dict of str to float
         Every moving joint's value in the reference pose (rad or m).
+    gravity : tuple of float
+        Gravity in the URDF's root frame, m/s^2 (default
+        :data:`~.forces.GRAVITY`); :meth:`solve` takes another.
+    forces : RobotForces or None
+        Its masses over its loops (:mod:`.forces`); ``None`` for a URDF
+        without ``<inertial>``.
     """
 
     def __init__(self, description: Description, actuated: Iterable[str] | None = None,
@@ -175,13 +218,19 @@ class Robot:
         # one (given, so free to break it), and those that follow it (0 stray: checked alike).
         self._rules = {n: rule for n in names if (rule := description.joints[n].mimic)
                        is not None and rule.joint in known}
+        self.gravity: tuple[float, float, float] = GRAVITY
+        self.forces = robot_forces(self)
 
     @classmethod
     def from_urdf(cls, source: str | os.PathLike[str], closures: str | os.PathLike[str] | None
                   = None, actuated: Iterable[str] | None = None,
-                  reference: Mapping[str, float] | None = None) -> Robot:
+                  reference: Mapping[str, float] | None = None,
+                  payloads: Mapping[str, tuple[float, Any]] | None = None) -> Robot:
         """Read a URDF (path or text) and its closures; see :func:`load_robot`."""
-        return cls(read_description(source, closures), actuated, reference)
+        description = read_description(source, closures)
+        if payloads:
+            description = with_payloads(description, payloads)
+        return cls(description, actuated, reference)
 
     def knows(self, joint: str) -> bool:
         """Return whether :meth:`solve` answers ``joint`` (else a node passes it through)."""
@@ -241,7 +290,8 @@ class Robot:
 
     def solve(self, positions: Mapping[str, Any] | None = None,
               speeds: Mapping[str, Any] | None = None, accels: Mapping[str, Any] | None = None,
-              *, max_error: float = MAX_ERROR) -> RobotState:
+              *, max_error: float = MAX_ERROR, gravity: Iterable[float] | None = None
+              ) -> RobotState:
         """Solve the robot where its actuated joints stand.
 
         Parameters
@@ -252,16 +302,28 @@ class Robot:
             rates to 0. Arrays (all of one shape) solve many instants.
         max_error : float, optional
             As :func:`mech_kinematics.solve`'s.
+        gravity : (float, float, float), optional
+            m/s^2 in the URDF's root frame; default :attr:`gravity`.
+
+        Returns
+        -------
+        RobotState
+            With the efforts of the actuated joints that drive the loops
+            (``efforts``) where the URDF has ``<inertial>``: the forces of the
+            motion given (with rates left at 0: static, gravity alone).
 
         Raises
         ------
         AssemblyError
             Where the loops cannot close: the scene's dyad and reason, at the
             actuated joints' values under the URDF's names
-            (``at finger_joint = 0.9 rad: ...``, :meth:`where`).
+            (``at finger_joint = 0.9 rad: ...``, :meth:`where`); its subclass
+            UntrustedError where the efforts of one instant cannot be bounded.
         ValueError
-            A joint that is not actuated.
+            A joint that is not actuated; gravity not finite or above
+            :data:`~.forces.MAX_GRAVITY`.
         """
+        g = self.gravity if gravity is None else check_gravity(tuple(gravity))
         inputs = self._inputs(positions, speeds, accels)
         p, v, a = self.scene_inputs(inputs)
         try:
@@ -271,7 +333,24 @@ class Robot:
                 state = solve(self.scene, p, v, a, max_error=max_error)
         except AssemblyError as error:  # one instant (arrays mask what they refuse)
             raise error.located(self.where({n: x[0] for n, x in inputs.items()})) from None
-        return self.joints_from_state(state, inputs)
+        answer = self.joints_from_state(state, inputs)
+        if self.forces is None:
+            return answer
+        try:
+            efforts = self.forces.efforts(state, inputs, g, max_error)
+        except ForcesLeftOut as why:
+            return replace(answer, forces_left_out=str(why))
+        except AssemblyError as error:
+            raise error.located(self.where({n: x[0] for n, x in inputs.items()})) from None
+        if isinstance(state.valid, np.ndarray):   # an instant whose efforts are not bounded
+            failures = {**state.failures, **efforts.failures}
+            state = replace(state, valid=state.valid & efforts.valid, failures=failures)
+            answer = replace(answer, state=state)
+            return replace(answer, efforts=efforts)
+        reactions = self.forces.reactions(
+            efforts, {n: float(j.position) for n, j in answer.joints.items()},
+            {n: float(b[0]) for n, b in answer.bounds.items()})
+        return replace(answer, efforts=efforts, reactions=reactions)
 
     def where(self, positions: Mapping[str, Any] | Iterable[Any]) -> str:
         """Return where the loops' actuated joints stand, for a message: ``j3 = 0.5 rad``.
@@ -386,7 +465,8 @@ class Robot:
 
 def load_robot(source: str | os.PathLike[str], closures: str | os.PathLike[str] | None = None,
                actuated: Iterable[str] | None = None,
-               reference: Mapping[str, float] | None = None) -> Robot:
+               reference: Mapping[str, float] | None = None,
+               payloads: Mapping[str, tuple[float, Any]] | None = None) -> Robot:
     """Read a robot described in URDF and make the scene of its planar loops.
 
     Parameters
@@ -404,6 +484,9 @@ def load_robot(source: str | os.PathLike[str], closures: str | os.PathLike[str] 
     reference : mapping of str to float, optional
         A reference pose (rad or m per joint) whose branches the loops keep;
         default the URDF's zero pose.
+    payloads : mapping of str to (float, (float, float, float)), optional
+        Point masses on links, ``{LINK: (kg, (x, y, z))}`` in the link's
+        frame: welded to it (:func:`~.forces.with_payloads`).
 
     Returns
     -------
@@ -414,4 +497,4 @@ def load_robot(source: str | os.PathLike[str], closures: str | os.PathLike[str] 
     UrdfError
         One line naming the source, the joint and why.
     """
-    return Robot.from_urdf(source, closures, actuated, reference)
+    return Robot.from_urdf(source, closures, actuated, reference, payloads)

@@ -46,13 +46,14 @@ from .driver import TickDriver
 from .node_parameters import NodeParameters
 from .parameters import CATCH_UP, extra_joints_default, spec, TOPIC
 from .publishing import diagnostic_array, Markers, Publishing, qos_options, tf_period_ns
-from .robot_mode import load_source
+from .robot_mode import load_source, robot_forces_refusal
 from .schedule import period_ns_from_rate
 from .solver_path import SolverPath
 from .tick_thread import TickThread, TickThreadError
 from .topic_input import InputSubscription
 from .watchdog import PublishWatch, PublishWatchdog
 from .wrenches import dynamics_with, effort_status, forces_tick, ForcesTick
+from ..errors import SceneError
 from ..solver.context import NEAR_SINGULAR
 from ..units import NS_PER_S
 
@@ -191,6 +192,11 @@ class KinematicsNode(LifecycleNode):
                              self._value('loop_closures'), self._value('actuated_joints'),
                              self._value('reference_pose'))
         scene = source.scene
+        if source.robot is not None:     # what would be accepted and ignored is refused
+            refusal = robot_forces_refusal(self._value('effort'), spec('effort').default,
+                                           list(self._parameter_overrides))
+            if refusal is not None:
+                raise SceneError(refusal)
         self.extra_joints = self._value('extra_joints') or \
             extra_joints_default(source.robot is not None)
         starts = self.params.declare_drivers(scene)

@@ -46,10 +46,28 @@ from ..scene import DEFAULT_SCENE, load_scene, scene_text
 from ..solver.mechanism import Scene
 
 __all__ = ['RobotDriver', 'RobotValues', 'Source', 'URDF_SUFFIX', 'is_urdf', 'load_source',
-           'reference_from_parameter']
+           'reference_from_parameter', 'robot_forces_refusal']
 
 #: A ``scene`` parameter ending so names a robot described in URDF.
 URDF_SUFFIX = '.urdf'
+
+
+def robot_forces_refusal(effort: str, default_effort: str, given: Sequence[str]) -> str | None:
+    """Return why a forces parameter given to the node in URDF mode is refused, or None.
+
+    The node publishes no forces of a robot yet (``solve ROBOT.urdf`` and
+    ``Robot.solve`` give them): ``effort`` other than its default, and
+    ``gravity`` or ``loads.*`` given at start, would be accepted and do
+    nothing; they are refused in one line instead.
+    """
+    named = [name for name in given if name == 'gravity' or name.startswith('loads.')]
+    if effort != default_effort:
+        named.insert(0, f'effort:={effort}')
+    if not named:
+        return None
+    return (f'Expected no forces parameters in URDF mode (the node publishes no efforts or '
+            f'reactions of a robot yet: solve ROBOT.urdf and Robot.solve give them, '
+            f'docs/urdf.md#forces), got {", ".join(named)}')
 
 
 def is_urdf(scene: str) -> bool:

@@ -346,17 +346,22 @@ def _with_forces(scene: Scene, state: State, max_error: Any) -> State:
         valid = state.valid & np.asarray(forces.valid, dtype=bool)
         return replace(state, forces=forces, valid=valid, failures=failures)
     if not forces.valid:
-        if forces.worst is None:   # the statics degenerate: no bound at all
-            reason = next(iter(forces.failures), 'forces')
-            raise UntrustedError('forces', float(state.angle),
-                                 f'the forces cannot be bounded here ({reason})', 'forces',
-                                 math.inf, float(max_error))
-        name, bound, limit = forces.worst
-        raise UntrustedError('forces', float(state.angle),
-                             f'the error bound of {name} ({bound:.3g}) exceeds max_error '
-                             f'{float(max_error):g} of its scale ({limit / float(max_error):.6g})',
-                             name, bound, float(max_error))
+        refuse_forces(state, forces, max_error)
     return replace(state, forces=forces)
+
+
+def refuse_forces(state: State, forces: Any, max_error: Any) -> None:
+    """Raise the UntrustedError of one instant whose forces (``Forces``) are not valid."""
+    if forces.worst is None:   # the statics degenerate: no bound at all
+        reason = next(iter(forces.failures), 'forces')
+        raise UntrustedError('forces', float(state.angle),
+                             f'the forces cannot be bounded here ({reason})', 'forces',
+                             math.inf, float(max_error))
+    name, bound, limit = forces.worst
+    raise UntrustedError('forces', float(state.angle),
+                         f'the error bound of {name} ({bound:.3g}) exceeds max_error '
+                         f'{float(max_error):g} of its scale ({limit / float(max_error):.6g})',
+                         name, bound, float(max_error))
 
 
 def _kinematics(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None,

@@ -37,11 +37,11 @@ from ..errors import MechKinematicsError
 from ..memory import keep_freed_memory
 from ..units import LENGTH_UNITS, rad_per_s_from_rpm, turns_from_degrees
 
-__all__ = ['ArgumentParser', 'PROG', 'add_driver_arguments', 'add_robot_arguments',
-           'add_scene_argument', 'drive_from_args', 'finite_float', 'is_urdf', 'joint_list',
-           'load_robot_argument', 'load_scene_argument', 'mimic_ruled', 'named_value',
-           'positive_float', 'positive_int', 'positive_seconds', 'run_handler', 'run_tool',
-           'seconds_or_zero', 'values_by_driver']
+__all__ = ['ArgumentParser', 'PROG', 'add_driver_arguments', 'add_gravity_argument',
+           'add_robot_arguments', 'add_scene_argument', 'drive_from_args', 'finite_float',
+           'gravity_of', 'is_urdf', 'joint_list', 'load_robot_argument', 'load_scene_argument',
+           'mimic_ruled', 'named_value', 'payloads_of', 'positive_float', 'positive_int',
+           'positive_seconds', 'run_handler', 'run_tool', 'seconds_or_zero', 'values_by_driver']
 
 #: The program name shown in usage lines.
 PROG = 'python -m mech_kinematics'
@@ -104,6 +104,59 @@ def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
                             "URDF's zero pose)")
 
 
+def add_gravity_argument(parser: argparse.ArgumentParser) -> None:
+    """Add ``--gravity GX,GY,GZ``: a robot's gravity in its URDF's root frame."""
+    parser.add_argument('--gravity', metavar='GX,GY,GZ',
+                        help="for a robot described in URDF: gravity in the URDF's root frame, "
+                             'm/s^2 (default 0,0,-9.80665: REP 103, z up; 0,0,0 for none); the '
+                             "part along a loop's pivots is carried by its bearings")
+    parser.add_argument('--payload', action='append', metavar='LINK=KG[@X,Y,Z]',
+                        help='for a robot described in URDF: a point mass welded to a link, '
+                             "at a point of the link's frame (m; default its origin), e.g. "
+                             'platform=2.5@0.1,0,0.05 (repeatable)')
+
+
+def payloads_of(args: argparse.Namespace) -> dict[str, tuple[float, tuple[float, ...]]]:
+    """Return ``--payload LINK=KG[@X,Y,Z]`` as ``{LINK: (kg, (x, y, z))}``, or a ValueError."""
+    out: dict[str, tuple[float, tuple[float, ...]]] = {}
+    for text in getattr(args, 'payload', None) or ():
+        link, sep, rest = text.partition('=')
+        mass, at, point = rest.partition('@')
+        try:
+            values = (float(mass), tuple(float(v) for v in point.split(',')) if at
+                      else (0.0, 0.0, 0.0))
+        except ValueError:
+            values = None
+        if not sep or not link or values is None or len(values[1]) != 3:
+            msg = f'--payload: Expected LINK=KG or LINK=KG@X,Y,Z, got {text!r}'
+            raise ValueError(msg)
+        if link in out:
+            msg = f'--payload: Expected each link once, got "{link}" twice'
+            raise ValueError(msg)
+        out[link] = values
+    return out
+
+
+def gravity_of(args: argparse.Namespace) -> tuple[float, float, float] | None:
+    """Return ``--gravity`` as three numbers (``None`` if not given), or a one-line ValueError."""
+    from ..robot.forces import check_gravity
+
+    text = getattr(args, 'gravity', None)
+    if text is None:
+        return None
+    try:
+        values = [float(v) for v in text.split(',')]
+    except ValueError:
+        values = []
+    if len(values) != 3:
+        msg = f'--gravity: Expected GX,GY,GZ (three numbers, m/s^2), got {text!r}'
+        raise ValueError(msg)
+    try:
+        return check_gravity(values)
+    except ValueError as error:
+        raise ValueError(f'--gravity: {error}') from None
+
+
 def load_robot_argument(args: argparse.Namespace) -> Any:
     """Return the :class:`~mech_kinematics.robot.Robot` of a URDF SCENE and its options."""
     from ..robot import Robot
@@ -125,6 +178,10 @@ def load_robot_argument(args: argparse.Namespace) -> Any:
             reference[name] = turns_from_degrees(value)[0]  # its direction, exactly
         else:
             reference[name] = math.radians(value)
+    payloads = payloads_of(args)
+    if payloads:
+        from ..robot.forces import with_payloads
+        description = with_payloads(description, payloads)
     return Robot(description, getattr(args, 'actuated', None), reference)
 
 

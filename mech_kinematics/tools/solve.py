@@ -6,15 +6,16 @@ from __future__ import annotations
 
 import argparse
 from collections.abc import Iterator, Sequence
+from dataclasses import replace
 import json
 import math
 import sys
 from typing import Any
 import warnings
 
-from .cli import (add_driver_arguments, add_robot_arguments, add_scene_argument,
-                  drive_from_args, finite_float, is_urdf, load_robot_argument, mimic_ruled,
-                  positive_float, run_tool, values_by_driver)
+from .cli import (add_driver_arguments, add_gravity_argument, add_robot_arguments,
+                  add_scene_argument, drive_from_args, finite_float, gravity_of, is_urdf,
+                  load_robot_argument, mimic_ruled, positive_float, run_tool, values_by_driver)
 from ..bounds import MAX_ERROR
 from ..errors import AssemblyError, NearSingularWarning, SceneError, UntrustedError
 from ..scene import load_scene
@@ -56,6 +57,16 @@ the actuated ones and the mimic joints that follow them), the loops'
 <mimic> rule: a loop's joint, an actuated one) and "limits" (a joint outside
 its <limit>, reported, not refused). A revolute joint given beyond a turn
 is reduced exactly, as a scene's crank angle is.
+Where the URDF's links carry <inertial>: "gravity" (m/s^2 in the root frame,
+--gravity GX,GY,GZ, default 0,0,-9.80665) and "efforts": each actuated joint
+that drives a loop (a mimic follower's load on its leader), N m or N,
+positive along its <axis> (sum of effort x velocity is the power put in),
+the forces of the motion given (static with no --speed and --accel), their
+bounds under "error_bound"."efforts"; "reactions": each revolute joint and
+pin of every loop, the load its parent puts on its child at its origin in
+the child link's frame (the force in the loop's plane, N; the actuator's
+torque about its axis, N m); or "forces_left_out" saying why not
+(docs/urdf.md, "Forces").
 """
 
 
@@ -103,7 +114,12 @@ def _robot_drive(robot: Any, args: argparse.Namespace) -> tuple[
 def _handle_robot(args: argparse.Namespace) -> int:
     """Solve a robot described in URDF: its joints under their URDF names."""
     try:
+        gravity = gravity_of(args)
         robot = load_robot_argument(args)
+        if gravity is not None and robot.forces is None:
+            msg = (f'--gravity: Expected a robot whose links carry <inertial> (their masses), '
+                   f'got none in {args.scene}: gravity would move nothing')
+            raise ValueError(msg)
         positions, speeds, accels, shown, exact = _robot_drive(robot, args)
     except (SceneError, ValueError) as error:
         print(f'error: {error}', file=sys.stderr)
@@ -112,11 +128,13 @@ def _handle_robot(args: argparse.Namespace) -> int:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter('always', NearSingularWarning)
             answer = robot.solve({**positions, **exact}, speeds, accels,
-                                 max_error=args.max_error)
+                                 max_error=args.max_error, gravity=gravity)
         if exact:  # the loops at the exact direction; the joints echoed as given
-            answer = robot.joints_from_state(answer.state, {
+            echoed = robot.joints_from_state(answer.state, {
                 name: (positions.get(name, motion.position), motion.velocity,
                        motion.acceleration) for name, motion in answer.inputs.items()})
+            answer = replace(answer, inputs=echoed.inputs, joints=echoed.joints,
+                             bounds=echoed.bounds, mimic=echoed.mimic, limits=echoed.limits)
     except AssemblyError as error:
         reason = error.reason if isinstance(error, UntrustedError) or error.facts is None \
             else assembly_text(error, robot.scene.units)
@@ -141,9 +159,11 @@ def _handle(args: argparse.Namespace) -> int:
     if is_urdf(args.scene):
         return _handle_robot(args)
     try:
-        if args.closures or args.actuated or args.reference:
-            msg = (f'Expected --closures, --actuated and --reference with a robot described '
-                   f'in URDF (a path ending in .urdf), got scene {args.scene}')
+        if args.closures or args.actuated or args.reference or args.gravity is not None \
+                or args.payload:
+            msg = (f'Expected --closures, --actuated, --reference, --gravity and --payload '
+                   f"with a robot described in URDF (a path ending in .urdf; a scene's gravity "
+                   f'and masses are its gravity: and masses: keys), got scene {args.scene}')
             raise SceneError(msg)
         scene = load_scene(args.scene)
     except SceneError as error:
@@ -211,6 +231,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
                         help="signed crank speed in rpm, + CCW (default: the scene's)")
     add_driver_arguments(parser)
     add_robot_arguments(parser)
+    add_gravity_argument(parser)
     parser.add_argument('--max-error', type=positive_float, default=MAX_ERROR, metavar='REL',
                         help="refuse (exit 2) where a value's error bound exceeds REL times "
                              "its kind's scale (the mechanism's size, its largest speed, its "

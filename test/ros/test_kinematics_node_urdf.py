@@ -239,6 +239,15 @@ def test_a_urdf_exported_open_runs_from_its_reference_pose(ros, tmp_path):
      'Expected a robot with a closed loop'),
     (('-p', 'actuated_joints:=[a, a]'), 'cannot start: actuated_joints: expected one or more '
      "distinct non-empty joint names, got ['a', 'a']"),
+    # Issue 44: forces parameters the node would accept and ignore in URDF mode.
+    (('-p', f'scene:={DATA / "lift_arm.urdf"}', '-p', 'effort:=static'),
+     'cannot start: Expected no forces parameters in URDF mode (the node publishes no efforts '
+     'or reactions of a robot yet: solve ROBOT.urdf and Robot.solve give them, '
+     'docs/urdf.md#forces), got effort:=static'),
+    (('-p', f'scene:={DATA / "lift_arm.urdf"}', '-p', 'gravity:=[0.0, 9.81]'),
+     'cannot start: Expected no forces parameters in URDF mode', ),
+    (('-p', f'scene:={DATA / "lift_arm.urdf"}', '-p', 'loads.tool.force:=[1.0, 0.0]'),
+     'got loads.tool.force'),
 ])
 def test_a_robot_the_node_cannot_take_is_refused_in_one_line(tmp_path, args, line):
     """A URDF parameter that does not fit: the node does not start and says why in one line."""

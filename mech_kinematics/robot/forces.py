@@ -1,0 +1,434 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""Forces of a robot described in URDF: its actuated joints' efforts with its own masses.
+
+A URDF's ``<inertial>`` elements give the scene its loops become its
+``masses`` (:func:`~.planar.planar_from_description`: each moving body's mass,
+centre of mass and inertia about the loop's normal, welded links added up).
+Gravity is given in the URDF's root frame (default :data:`GRAVITY`, REP 103:
+z up) and projected exactly into each loop's plane through the pose of the
+loop's ground (the part along the loop's normal is carried by the bearings:
+it loads no actuator). Each group of loops that sees one gravity in the
+scene's frame is solved by one :class:`~mech_kinematics.solver.forces.Dynamics`
+(the scene's own inverse dynamics, with its error bounds); a loop's drivers'
+efforts come back to the URDF joints through the drivers' map
+(:attr:`.planar.DriverMap.gain`): a crank's torque times ``sigma`` (+1 where
+the joint's axis is the loop's normal), a cylinder's force times ``kappa``,
+a mimic driver's times its multiplier too, on its leader. So each effort is
+the generalised force the joint's actuator applies, positive along its
+``<axis>``: the sum of effort times joint velocity is the power put in.
+
+What the planar forces cannot carry is left out with the reason
+(:class:`ForcesLeftOut`), never guessed: a mass on a link that hangs from a
+loop's moving body through a joint outside every loop (its weight loads the
+loop's actuators through a motion the loops do not solve), a loop whose
+ground moves (its carrying joints given a speed or an acceleration), or whose
+ground's pose depends on a joint that is not actuated. Masses on a loop's
+ground, or on links nearer the root, load only joints outside every loop,
+whose efforts are not computed here. Pure: NumPy only.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+import math
+from typing import Any, TYPE_CHECKING
+
+import numpy as np
+
+from ..errors import UrdfError
+from ..solver.forces import Dynamics, Forces, Mass
+from ..solver.scaling import _size
+from ..solver.solve import refuse_forces
+
+if TYPE_CHECKING:
+    from .description import Description
+    from .robot import Robot
+    from ..solver import State
+
+__all__ = ['ForcesLeftOut', 'GRAVITY', 'JointReaction', 'MAX_GRAVITY', 'RobotEfforts',
+           'RobotForces', 'check_gravity', 'robot_forces', 'with_payloads']
+
+#: Gravity in the URDF's root frame by default, m/s^2 (REP 103: z up; standard gravity).
+GRAVITY = (0.0, 0.0, -9.80665)
+#: The largest gravity accepted, m/s^2 (1e5 g: beyond it the forces overflow sooner than
+#: any machine's loads make sense).
+MAX_GRAVITY = 1e6
+#: Dynamics kept per robot (one per group of loops and gravity in their plane).
+_CACHE = 16
+_U = float(np.finfo(np.float64).eps) / 2
+
+
+class ForcesLeftOut(Exception):  # noqa: N818 - a reason, not an error of the caller's
+    """Why a robot's efforts are left out at a state (one line); never raised to a user."""
+
+
+def check_gravity(gravity: Sequence[float], what: str = 'gravity') -> tuple[float, float, float]:
+    """Return gravity as three floats, or refuse in one line (``ValueError``) naming ``what``."""
+    try:
+        values = tuple(float(g) for g in gravity)
+    except (TypeError, ValueError):
+        values = ()
+    if len(values) != 3 or not all(math.isfinite(g) for g in values) \
+            or math.hypot(*values) > MAX_GRAVITY:
+        msg = (f"Expected {what} as [gx, gy, gz] in the URDF's root frame, m/s^2, finite and "
+               f'at most {MAX_GRAVITY:g} in size, got {list(gravity)!r}')
+        raise ValueError(msg)
+    x, y, z = values
+    return x, y, z
+
+
+@dataclass(frozen=True)
+class RobotEfforts:
+    """The efforts of a robot's actuated joints at a state, with their bounds.
+
+    Attributes
+    ----------
+    efforts : dict of str to float or ndarray
+        Per actuated joint that drives a loop (or leads a mimic that does):
+        N m (revolute) or N (prismatic), positive along its ``<axis>``.
+    bounds : dict of str to float or ndarray
+        Their absolute error bounds.
+    gravity : tuple of float
+        The gravity used, m/s^2 in the root frame.
+    forces : list of Forces
+        The scene's forces, one per group of loops solved together.
+    valid : bool or ndarray of bool
+        Where every group's forces could be bounded (arrays: the instants
+        whose efforts stand; one instant not bounded is refused instead).
+    failures : dict of str to ndarray of bool
+        For arrays: per reason, the instants refused.
+    groups : tuple of tuple of int
+        The mechanisms each of ``forces`` solved.
+    actuators : dict of str to (str, value, bound)
+        Per ``<transmission>`` actuator with a ``<mechanicalReduction>`` of
+        one of those joints: its joint and its effort (the joint's divided by
+        the reduction: the same power at the actuator's speed, reduction
+        times the joint's), with its bound.
+    """
+
+    efforts: dict[str, Any]
+    bounds: dict[str, Any]
+    gravity: tuple[float, float, float]
+    forces: list[Forces]
+    valid: Any = True
+    failures: dict[str, Any] = field(default_factory=dict)
+    groups: tuple[tuple[int, ...], ...] = ()
+    actuators: dict[str, tuple[str, Any, Any]] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class JointReaction:
+    """The load a loop joint's parent puts on its child, in the child link's frame.
+
+    At the joint's origin (a closure's: its ``<child_origin>``), in the axes
+    of ``frame`` (the child link; a closure's child frame). ``force`` holds
+    the loop's plane's part (N): the part along the pivots' axis, and the
+    bending moments, are not determined by a planar loop's statics (with
+    parallel pins it is overconstrained in space: the bearings share them by
+    their stiffness) and are not in it. ``torque`` (N m) is the actuator's
+    about the joint's axis (its effort; 0 for a passive joint).
+    """
+
+    frame: str
+    force: tuple[float, float, float]
+    torque: tuple[float, float, float]
+    force_bound: float
+    torque_bound: float
+
+    def as_dict(self) -> dict[str, Any]:
+        """Return ``{"frame", "force", "torque"}``."""
+        return {'frame': self.frame, 'force': list(self.force), 'torque': list(self.torque)}
+
+
+class RobotForces:
+    """A robot's masses over its loops: :meth:`efforts` at a solved scene state.
+
+    Build it with ``RobotForces(robot)``; ``None`` from :func:`robot_forces`
+    for a robot whose URDF has no ``<inertial>``.
+    """
+
+    def __init__(self, robot: Robot) -> None:
+        self.robot = robot
+        planar = robot.planar
+        description = robot.description
+        self.mechanisms = planar.mechanisms
+        self.size = _size(robot.scene)
+        self._cache: dict[tuple[Any, ...], Dynamics] = {}
+        masses = planar.masses
+        self.masses = [tuple(Mass(body, item['mass'], tuple(item['com']), item['inertia'])
+                             for body, item in masses.items() if body in m['bodies'])
+                       for m in self.mechanisms]
+        moving: dict[str, int] = {}      # URDF link of a loop's moving body -> its mechanism
+        for index, m in enumerate(self.mechanisms):
+            for link in m['links']:
+                if link != m['ground']:
+                    moving[link] = index
+        self.moving_links = moving
+        #: Why no forces can be given at all (a mass the loops do not carry), or None.
+        self.refused: str | None = self._hanging(moving)
+        #: Per mechanism: the moving joints from the root down to its ground.
+        self.carriers = [[j.name for j in description.chain(m['ground']) if j.type is not None]
+                         for m in self.mechanisms]
+
+    def _hanging(self, moving: Mapping[str, int]) -> str | None:
+        """Return why a mass hangs from a loop's moving body outside every loop, or None."""
+        description = self.robot.description
+        body_of = self._body_of()
+        loop_joints = {j for m in self.mechanisms for j in m['joints']}
+        for link in description.links:
+            if link not in description.inertials:
+                continue
+            for joint in reversed(description.chain(link)):
+                parent = body_of[joint.parent]
+                if joint.moving and joint.name not in loop_joints and parent in moving:
+                    return (f'link "{link}": Expected masses on the links the loops move (or '
+                            f'on their grounds and nearer the root), got a mass that hangs '
+                            f'from "{parent}" (a moving link of a loop) through joint '
+                            f'"{joint.name}", outside every loop: its weight loads that loop\'s '
+                            'actuators through a motion the loops do not solve')
+        return None
+
+    def _body_of(self) -> dict[str, str]:
+        """Return each URDF link's body: itself, or the loop link it is welded to."""
+        description = self.robot.description
+        out: dict[str, str] = {}
+        for link in description.links:
+            up = link
+            while True:
+                joint = description.parent_joint(up)
+                if joint is None or joint.moving:
+                    break
+                up = joint.parent
+            out[link] = up
+        return out
+
+    # --- gravity in each loop's plane ----------------------------------------------------
+
+    def _plane_gravity(self, index: int, gravity: tuple[float, float, float],
+                       inputs: Mapping[str, tuple[Any, Any, Any]]) -> tuple[float, float]:
+        """Return gravity in mechanism ``index``'s scene frame at the ground's pose (m/s^2)."""
+        robot = self.robot
+        description = robot.description
+        m = self.mechanisms[index]
+        values: dict[str, float] = {}
+        for name in self.carriers[index]:
+            joint = description.joints[name]
+            source, gain = name, 1.0
+            if name not in inputs and joint.mimic is not None and joint.mimic.joint in inputs:
+                source, gain = joint.mimic.joint, joint.mimic.multiplier
+            if source not in inputs:
+                if not any(gravity):
+                    continue
+                raise ForcesLeftOut(
+                    f'the ground of the loop through {", ".join(m["links"][:4])} ("{m["ground"]}")'
+                    f' is carried by joint "{name}", which is not actuated: its pose, and so '
+                    f"gravity in the loop's plane, is not known")
+            p, v, a = inputs[source]
+            if np.any(np.asarray(v) != 0) or np.any(np.asarray(a) != 0):
+                raise ForcesLeftOut(
+                    f'the ground of the loop through {", ".join(m["links"][:4])} ("{m["ground"]}")'
+                    f' moves (joint "{name}" is given a speed or an acceleration): the planar '
+                    'forces hold with the ground at rest; give its carrying joints no speed '
+                    'and no acceleration')
+            p = np.asarray(p, dtype=np.float64)
+            if p.ndim and not np.all(p == p.flat[0]):
+                raise ForcesLeftOut(
+                    f'joint "{name}" carries the ground of the loop through '
+                    f'{", ".join(m["links"][:4])} and takes several positions over the array: '
+                    'solve each pose of the ground on its own')
+            value = float(p.flat[0]) if p.ndim else float(p)
+            if joint.mimic is not None and source != name:
+                value = gain * value + joint.mimic.offset
+            values[name] = value
+        frames = description.transforms(values)
+        rotation = frames[m['ground']][:3, :3]
+        local = rotation.T @ np.asarray(gravity, dtype=np.float64)
+        return (float(local @ np.asarray(m['x'])), float(local @ np.asarray(m['y'])))
+
+    def _dynamics(self, members: tuple[int, ...], g: tuple[float, float]) -> Dynamics:
+        key = (members, g)
+        dynamics = self._cache.get(key)
+        if dynamics is None:
+            if len(self._cache) >= _CACHE:
+                self._cache.pop(next(iter(self._cache)))
+            masses = [mass for i in members for mass in self.masses[i]]
+            dynamics = Dynamics(self.robot.scene.graph, masses, (), g, (), self.size)
+            self._cache[key] = dynamics
+        return dynamics
+
+    # --- at a state ---------------------------------------------------------------------
+
+    def efforts(self, state: State, inputs: Mapping[str, tuple[Any, Any, Any]],
+                gravity: tuple[float, float, float], max_error: float) -> RobotEfforts:
+        """Return the efforts of the loops' actuated joints at a solved scene state.
+
+        ``inputs``: every actuated joint's (position, speed, accel) the state
+        was solved for (:meth:`.Robot.solve`'s).
+
+        Raises
+        ------
+        ForcesLeftOut
+            What the planar forces cannot carry (see the module's docstring).
+        UntrustedError
+            One instant whose efforts cannot be bounded within ``max_error``
+            (a toggle, where the statics degenerate).
+        """
+        if self.refused is not None:
+            raise ForcesLeftOut(self.refused)
+        groups: dict[tuple[float, float], list[int]] = {}
+        for index in range(len(self.mechanisms)):
+            groups.setdefault(self._plane_gravity(index, gravity, inputs), []).append(index)
+        vector = not isinstance(state.valid, bool)
+        efforts: dict[str, Any] = {}
+        bounds: dict[str, Any] = {}
+        answers = []
+        valid: Any = True
+        failures: dict[str, Any] = {}
+        for g, members in groups.items():
+            forces = self._dynamics(tuple(members), g).forces(state, float(max_error))
+            if not vector and not forces.valid:
+                refuse_forces(state, forces, max_error)
+            answers.append(forces)
+            if vector:
+                valid = valid & np.asarray(forces.valid, dtype=bool)
+                for reason, where in forces.failures.items():
+                    failures[reason] = failures[reason] | where if reason in failures \
+                        else where
+            for index in members:
+                for driver in self.robot.planar.drivers:
+                    if driver.name not in self.mechanisms[index]['drivers']:
+                        continue
+                    leader, gain = driver.gain
+                    value = gain * forces.efforts[driver.scene]
+                    bound = abs(gain) * forces.effort_bounds[driver.scene]
+                    if leader in efforts:
+                        total = efforts[leader] + value
+                        bound = bounds[leader] + bound + _U * np.abs(total)
+                        value = total
+                    efforts[leader], bounds[leader] = value, bound
+        ordered = [name for name in self.robot.actuated if name in efforts]
+        actuators = {}
+        for name in ordered:
+            if name in self.robot.description.reductions:
+                actuator, reduction = self.robot.description.reductions[name]
+                value = efforts[name] / reduction
+                actuators[actuator] = (name, value,
+                                       bounds[name] / abs(reduction) + _U * np.abs(value))
+        return RobotEfforts({n: efforts[n] for n in ordered}, {n: bounds[n] for n in ordered},
+                            gravity, answers, valid, failures,
+                            tuple(tuple(members) for members in groups.values()), actuators)
+
+    def reactions(self, efforts: RobotEfforts, positions: Mapping[str, float],
+                  bounds: Mapping[str, float]) -> dict[str, JointReaction]:
+        """Return each loop's revolute joints' and pins' reactions at one instant.
+
+        ``positions``: every joint's value (the answer's), ``bounds`` their
+        position bounds. A prismatic joint of a loop is not given.
+        """
+        robot = self.robot
+        description = robot.description
+        frames = description.transforms(positions)
+        body_of = self._body_of()
+        closures = {c.name: c for c in description.closures}
+        drivers = {d.name: d for d in robot.planar.drivers}
+        spread = math.fsum(abs(float(b)) for b in bounds.values())
+        out: dict[str, JointReaction] = {}
+        for forces, members in zip(efforts.forces, efforts.groups, strict=True):
+            by_at: dict[tuple[str, frozenset[str]], Any] = {}
+            for name, reaction in forces.reactions.items():
+                if reaction.force is not None:
+                    by_at[(reaction.at, frozenset((reaction.on, reaction.by)))] = (name, reaction)
+            for index in members:
+                m = self.mechanisms[index]
+                scene_body = {**m['body_names'], m['ground']: robot.scene.graph.ground}
+                ground = frames[m['ground']]
+                for name in m['joints']:
+                    joint = description.joints.get(name)
+                    if joint is not None:
+                        if joint.type is None or not joint.type.angular:
+                            continue
+                        parent, child, local = joint.parent, joint.child, np.eye(4)
+                        axis = np.asarray(joint.axis, dtype=np.float64)
+                    else:
+                        closure = closures[name]
+                        parent, child, local = closure.link_a, closure.link_b, closure.frame_b
+                        axis = None
+                    a, b = scene_body.get(body_of[parent]), scene_body.get(body_of[child])
+                    point = robot.planar.names.get(name, name)
+                    found = by_at.get((point, frozenset((a, b))))
+                    if a is None or b is None or found is None:
+                        continue
+                    _, reaction = found
+                    f = complex(reaction.force)
+                    if reaction.on != b:
+                        f = -f
+                    planar = f.real * np.asarray(m['x']) + f.imag * np.asarray(m['y'])
+                    frame = np.linalg.solve(ground, frames[child] @ local)
+                    force = frame[:3, :3].T @ planar
+                    torque = np.zeros(3)
+                    torque_bound = 0.0
+                    driver = drivers.get(name)
+                    if driver is not None and axis is not None:
+                        tau = driver.sigma * forces.efforts[driver.scene]
+                        torque = tau * axis
+                        torque_bound = float(forces.effort_bounds[driver.scene])
+                    f_bound = float(reaction.force_bound) + abs(f) * (spread + 16 * _U)
+                    out[name] = JointReaction(child, tuple(float(v) for v in force),
+                                              tuple(float(v) for v in torque), f_bound,
+                                              torque_bound)
+        return out
+
+
+def with_payloads(description: Description,
+                  payloads: Mapping[str, tuple[float, Sequence[float]]]) -> Description:
+    """Return ``description`` with point masses added to links: ``{LINK: (kg, (x, y, z))}``.
+
+    A payload (a part in a gripper, a tool) is a point mass at a point of a
+    link, in the link's frame (m): it is welded to the link, added to its
+    ``<inertial>`` (the total mass, the common centre of mass, the inertia
+    about it by the parallel-axis theorem). Refused in one line
+    (``UrdfError``) naming the link: a link the robot lacks, a mass not
+    finite and above 0, a point not three finite numbers.
+    """
+    from dataclasses import replace
+
+    from .description import Inertial
+    from .transforms import translation
+
+    inertials = dict(description.inertials)
+    for link, (mass, point) in payloads.items():
+        where = f'{description.source}: payload on link "{link}"'
+        if link not in description.links:
+            more = ', ...' if len(description.links) > 8 else ''
+            known = ', '.join(description.links[:8]) + more
+            raise UrdfError(f'{where}: Expected a link of the robot ({known}), got none of '
+                            'that name')
+        try:
+            m = float(mass)
+            p = np.array([float(v) for v in point], dtype=np.float64)
+        except (TypeError, ValueError):
+            m, p = math.nan, np.zeros(0)
+        if not (math.isfinite(m) and m > 0.0) or p.shape != (3,) or not np.all(np.isfinite(p)):
+            raise UrdfError(f'{where}: Expected a mass above 0 kg at a point [x, y, z] of the '
+                            f'link (m, finite), got {mass!r} kg at {point!r}')
+        old = inertials.get(link)
+        if old is None:
+            inertials[link] = Inertial(m, translation(p), np.zeros((3, 3)))
+            continue
+        c_old = old.origin[:3, 3]
+        rotation = old.origin[:3, :3]
+        total = old.mass + m
+        com = (old.mass * c_old + m * p) / total
+        tensor = rotation @ old.inertia @ rotation.T      # in the link's axes
+        for part, at in ((old.mass, c_old), (m, p)):
+            d = at - com
+            tensor = tensor + part * (float(d @ d) * np.eye(3) - np.outer(d, d))
+        inertials[link] = Inertial(total, translation(com), tensor)
+    return replace(description, inertials=inertials)
+
+
+def robot_forces(robot: Robot) -> RobotForces | None:
+    """Return a robot's forces, or None where its URDF has no ``<inertial>`` with a mass."""
+    return RobotForces(robot) if robot.description.inertials else None
