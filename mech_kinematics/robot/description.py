@@ -65,6 +65,8 @@ REFUSED_CONSTRAINTS = {'prismatic': ' (cut the loop at a revolute joint instead)
 CLOSING_FRAME = re.compile(r'closing_(.+)_([12])\Z')
 
 _PARSE_LOCK = threading.Lock()
+#: The XML is parsed this many bytes at a time.
+_FEED_BYTES = 1 << 16
 
 
 class ClosureKind(Enum):
@@ -347,10 +349,19 @@ def _parse_xml(text: str, source: str) -> Any:
     from lxml import etree
     parser = etree.XMLParser(resolve_entities=False, no_network=True, huge_tree=False,
                              remove_comments=True, remove_pis=True, load_dtd=False)
+    data = text.encode('utf-8')
     try:
-        root = etree.fromstring(text.encode('utf-8'), parser)
+        # Fed in pieces: between two a signal's handler runs (the node's start ends at once
+        # on a stop, ros/startup.py); one call on 6 MB held it for 4 s on a loaded machine.
+        for start in range(0, max(len(data), 1), _FEED_BYTES):
+            parser.feed(data[start:start + _FEED_BYTES])
+        root = parser.close()
     except etree.XMLSyntaxError as error:
-        raise _fail(source, f'Expected a URDF (XML), got text that is not XML: {error}') from None
+        # The feeding parser's own line can be vaguer ("no element found") than the
+        # error libxml2 logged last ("Entity 'xx' not defined"): that one is said.
+        last = error.error_log.last_error if error.error_log else None
+        said = f'{last.message}, line {last.line}, column {last.column}' if last else error
+        raise _fail(source, f'Expected a URDF (XML), got text that is not XML: {said}') from None
     if root.tag != 'robot':
         raise _fail(source, f'Expected a URDF whose root element is <robot>, got <{root.tag}>')
     return root
