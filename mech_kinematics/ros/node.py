@@ -181,6 +181,7 @@ class KinematicsNode(LifecycleNode):
     def _configure(self) -> None:
         assert self.params is not None
         # A scene, or a robot described in URDF (URDF mode: robot_mode.py).
+        self.get_logger().debug('reading the scene or robot')
         # At the start (the spin not begun) a signal ends the read at once (startup.py).
         with stop_raises() if self.params.starting and not self.managed else nullcontext():
             source = load_source(self._value('scene'), self._value('robot_description'),

@@ -200,7 +200,6 @@ def test_a_robot_description_over_1_mib_is_taken_from_a_params_file(ros, tmp_pat
     one (a double-quoted YAML string): the node starts and publishes the text unchanged.
     The largest robot_description fits in the largest params file.
     """
-    assert MAX_ARGUMENT_FILE_BYTES >= 2 * MAX_FILE_BYTES
     urdf = DATA / 'robotiq_2f_85.urdf'
     text = urdf.read_text().replace('<robot ', f'<!-- {"x" * (4 << 20)} -->\n<robot ', 1)
     assert 1 << 20 < len(text.encode()) < MAX_FILE_BYTES
@@ -220,24 +219,27 @@ def test_a_robot_description_over_1_mib_is_taken_from_a_params_file(ros, tmp_pat
     assert list(node.js[0].position)[:len(node.robot.joint_names)] == \
         [answer.joints[n].position for n in node.robot.joint_names]
     assert node.description[0].data == text
+    assert MAX_ARGUMENT_FILE_BYTES >= 2 * MAX_FILE_BYTES
 
 
 def test_a_stop_while_the_start_reads_a_large_urdf_ends_it_at_once(ros, tmp_path):
     """Issue 42: SIGTERM while a 40,000-joint URDF was read took 19-26 s to end the node.
 
-    The node is signalled once it is on the graph, reading (its start line not yet
-    logged); it ends with status 0, no traceback, in less time than it took to come up
-    to the read (Python, rclpy, the node: seconds) where it used to finish the read first.
+    The node is signalled once it logs (at debug) that it reads; it ends with status 0,
+    no traceback, its start line never logged, in less time than it took to come up to
+    the read (Python, rclpy, the node: seconds), where it used to finish the read first.
     """
     path = tmp_path / 'chain.urdf'
     path.write_text(khurmi_chain_urdf(40_000))
     assert path.stat().st_size < MAX_FILE_BYTES
     ns = f'{SESSION}/urdf_stop'
+    logger = f'{ns.strip("/").replace("/", ".")}.mech_kinematics'
     started = time.monotonic()
-    proc = NodeProcess(tmp_path / 'node', '-r', f'__ns:={ns}', '-p', f'scene:={path}')
+    proc = NodeProcess(tmp_path / 'node', '-r', f'__ns:={ns}', '-p', f'scene:={path}',
+                       '--log-level', f'{logger}:=debug')
     try:
-        wait_for(lambda: ns in {n for _, n in ros.node.get_node_names_and_namespaces()}
-                 or proc.proc.poll() is not None, STARTUP_S, 'the node on the graph')
+        wait_for(lambda: 'reading the scene or robot' in proc.output()
+                 or proc.proc.poll() is not None, STARTUP_S, 'the node reading')
         up_s = time.monotonic() - started
         assert proc.proc.poll() is None, proc.output()
         status, took_s = proc.stop(signal.SIGTERM, timeout=120.0)
