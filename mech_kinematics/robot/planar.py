@@ -586,14 +586,17 @@ class _Builder:
         """
         m = self.m
         n = m.normal
+        inertials = self.description.inertials
+        held: dict[str, list[str]] = {}     # body -> its links with an <inertial>, file order
+        for link in self.description.links:
+            if link in inertials:
+                held.setdefault(m.body_of[link], []).append(link)
         for body in m.bodies:
             if body == m.ground:
                 continue
             parts = []
-            for link in self.description.links:
-                inertial = self.description.inertials.get(link)
-                if inertial is None or m.body_of.get(link) != body:
-                    continue
+            for link in held.get(body, ()):
+                inertial = inertials[link]
                 frame = m.frame[link] @ inertial.origin
                 rotation = frame[:3, :3]
                 tensor = rotation @ inertial.inertia @ rotation.T
