@@ -723,6 +723,35 @@ def khurmi_urdf(form='constraint', dz=0.0):
     return KHURMI.format(closure=closure, dz=dz)
 
 
+def khurmi_chain_urdf(count):
+    """Return Khurmi's four-bar with a chain of ``count`` fixed links hanging from its frame.
+
+    Issue 42: a URDF of 40,000 fixed joints (5.8 MB) read in quadratic time; each link is
+    ``c<i>``, 1 mm from the one before.
+    """
+    links = ''.join(f'<link name="c{i}"/><joint name="f{i}" type="fixed"><parent link='
+                    f'"{"frame" if i == 0 else f"c{i - 1}"}"/><child link="c{i}"/><origin '
+                    f'xyz="0.001 0 0" rpy="0 0 0"/></joint>\n' for i in range(count))
+    return khurmi_urdf().replace('</robot>', links + '</robot>')
+
+
+def khurmi_closures_yaml(count):
+    """Return a loop_closures.yaml closing Khurmi's open four-bar (no closure in its URDF) at C.
+
+    ``count`` times over (issue 42: 5000 closures read in quadratic time); ``independent``:
+    the motor.
+    """
+    _, rocker = khurmi_pin()
+    c = rocker + 0.15
+    line = (f'- {{link_a: coupler, link_b: rocker, point: [{c.real!r}, {c.imag!r}, 0.0], '
+            f'axis: [0, 0, 1]}}\n')
+    return 'closures:\n' + line * count + 'independent: [motor]\n'
+
+
+#: Khurmi's four-bar with no closure (a loop_closures.yaml closes it).
+KHURMI_OPEN = KHURMI.format(closure='', dz=0.0)
+
+
 #: The units of the generated scenes (test_compiler, test_forces).
 MM_DEG = {'length': 'mm', 'angle': 'deg'}
 

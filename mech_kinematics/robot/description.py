@@ -79,6 +79,8 @@ REFUSED_CONSTRAINTS: dict[str, str] = {}
 CLOSING_FRAME = re.compile(r'closing_(.+)_([12])\Z')
 
 _PARSE_LOCK = threading.Lock()
+#: The XML is parsed this many bytes at a time.
+_FEED_BYTES = 1 << 16
 
 
 class ClosureKind(Enum):
@@ -237,14 +239,31 @@ class Description:
     inertials: dict[str, Inertial] = field(default_factory=dict)
     reductions: dict[str, tuple[str, float]] = field(default_factory=dict)
     _parent: dict[str, UrdfJoint] = field(default_factory=dict, repr=False, compare=False)
+    _order: dict[str, int] = field(default_factory=dict, repr=False, compare=False)
+    _depth: dict[str, int] = field(default_factory=dict, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        """Index each link's parent joint."""
+        """Index each link's parent joint, place in the file and depth (linear in the links)."""
         self._parent.update({j.child: j for j in self.joints.values()})
+        self._order.update({link: i for i, link in enumerate(self.links)})
+        for link in self.links:  # each link's depth once: up to the first link whose is known
+            path: list[str] = []
+            while link not in self._depth and link in self._parent \
+                    and len(path) <= len(self.links):  # a cycle ends the walk (refused later)
+                path.append(link)
+                link = self._parent[link].parent
+            depth = self._depth.get(link, 0)
+            for below in reversed(path):
+                depth += 1
+                self._depth[below] = depth
 
     def parent_joint(self, link: str) -> UrdfJoint | None:
         """Return the joint whose child is ``link`` (``None`` for the root)."""
         return self._parent.get(link)
+
+    def order(self, link: str) -> int:
+        """Return ``link``'s place in :attr:`links` (file order), a sort key."""
+        return self._order[link]
 
     def chain(self, link: str) -> list[UrdfJoint]:
         """Return the joints from the root down to ``link``, in order."""
@@ -258,7 +277,7 @@ class Description:
 
     def depth(self, link: str) -> int:
         """Return how many joints ``link`` is below the root."""
-        return len(self.chain(link))
+        return self._depth.get(link, 0)
 
     def pose(self, values: Mapping[str, float] | None = None) -> dict[str, float]:
         """Return every moving joint's value: ``values``, else its mimic rule, else 0.
@@ -291,15 +310,10 @@ class Description:
         """Return every link's frame in the root's at the joint values :meth:`pose` gives."""
         pose = self.pose(values)
         out: dict[str, Matrix] = {self.root: np.eye(4)}
-
-        def frame(link: str) -> Matrix:
+        for link in sorted(self.links, key=lambda link: self._depth.get(link, 0)):  # parents 1st
             if link not in out:
                 joint = self._parent[link]
-                out[link] = frame(joint.parent) @ joint.motion(pose.get(joint.name, 0.0))
-            return out[link]
-
-        for link in self.links:
-            frame(link)
+                out[link] = out[joint.parent] @ joint.motion(pose.get(joint.name, 0.0))
         return out
 
 
@@ -406,11 +420,21 @@ def _parse_xml(text: str, source: str) -> Any:
     from lxml import etree
     parser = etree.XMLParser(resolve_entities=False, no_network=True, huge_tree=False,
                              remove_comments=True, remove_pis=True, load_dtd=False)
+    data = text.encode('utf-8')
     try:
-        root = etree.fromstring(text.encode('utf-8'), parser)
+        # Fed in pieces: between two a signal's handler runs (the node's start ends at once
+        # on a stop, ros/startup.py); one call on 6 MB held it for 4 s on a loaded machine.
+        for start in range(0, max(len(data), 1), _FEED_BYTES):
+            parser.feed(data[start:start + _FEED_BYTES])
+        root = parser.close()
     except etree.XMLSyntaxError as error:
-        text = ' '.join(str(error).split())  # lxml's message may hold a newline (a NUL's)
-        raise _fail(source, f'Expected a URDF (XML), got text that is not XML: {text}') from None
+        # The feeding parser's own line can be vaguer ("no element found") than the
+        # error libxml2 logged last ("Entity 'xx' not defined"): that one is said, on one
+        # line (lxml's message may hold a newline: a NUL's).
+        last = error.error_log.last_error if error.error_log else None
+        said = f'{last.message}, line {last.line}, column {last.column}' if last else error
+        said = ' '.join(str(said).split())
+        raise _fail(source, f'Expected a URDF (XML), got text that is not XML: {said}') from None
     if root.tag != 'robot':
         raise _fail(source, f'Expected a URDF whose root element is <robot>, got <{root.tag}>')
     return root
@@ -423,27 +447,46 @@ def _read_links_and_joints(root: Any, source: str) -> Any:
     from urdf_parser_py.xml_reflection import core
 
     known = {'link', 'joint', 'material', 'transmission', 'gazebo'}
-    tree = etree.ElementTree(root)
-    copy = etree.fromstring(etree.tostring(tree))
-    for child in list(copy):  # what we read ourselves, or what no URDF reader reads
-        if not isinstance(child.tag, str) or child.tag not in known:
-            copy.remove(child)
-    copy.attrib.pop('version', None)  # our gate (_version): urdf_parser_py knows only 1.0
-    for link in copy.iter('link'):  # shapes no loop uses (1.1's capsule is not theirs)
-        for shape in [*link.findall('visual'), *link.findall('collision')]:
-            link.remove(shape)
+    # urdf_parser_py reads <robot> in time quadratic in its children (it removes each one
+    # read from the front of a list of them): the robot is read from its attributes alone,
+    # then each child as urdf_parser_py would, in order, with the same path for its errors.
+    # What we read ourselves, or what no URDF reader reads, is left out; so is the version,
+    # our gate (_version: urdf_parser_py knows only 1.0).
+    attributes = {k: v for k, v in root.attrib.items() if k != 'version'}
+    shell = etree.Element(root.tag, attributes)
+    refl = urdf.Robot.XML_REFL
     collect = _Collect()
     with _PARSE_LOCK:  # urdf_parser_py reports through a module-level function
         saved = core.on_error
         core.on_error = collect
         try:
-            path = core.Path(urdf.Robot.XML_REFL.tag, tree=etree.ElementTree(copy))
-            return urdf.Robot.from_xml(copy, path)
+            path = core.Path(refl.tag, tree=etree.ElementTree(shell))
+            robot = urdf.Robot.from_xml(shell, path)
+            for child in root:
+                if not isinstance(child.tag, str) or child.tag not in known:
+                    continue
+                if child.tag == 'link' and (child.find('visual') is not None
+                                            or child.find('collision') is not None):
+                    child = _without_shapes(child)   # no loop uses them (1.1's capsule)
+                index = 1 + len(robot.get_aggregate_list(child.tag))  # 1-based, as XPath
+                refl.element_map[child.tag].add_from_xml(
+                    robot, child, core.Path(child.tag, parent=path, suffix=f'[{index}]'))
+            return robot
         except Exception as error:  # noqa: BLE001 - the library raises anything: one line
             text = ' '.join(str(error).split()) or type(error).__name__
             raise _fail(source, f'Expected a valid URDF, got: {text}') from None
         finally:
             core.on_error = saved
+
+
+def _without_shapes(link: Any) -> Any:
+    """Return a copy of a ``<link>`` without its ``<visual>`` and ``<collision>``."""
+    import copy
+
+    out = copy.copy(link)   # lxml: a deep copy of this element alone, not of its tree
+    for shape in [*out.findall('visual'), *out.findall('collision')]:
+        out.remove(shape)
+    return out
 
 
 def _inertials(robot: Any, source: str, quaternions: Mapping[tuple[str, str], Matrix]
@@ -576,14 +619,18 @@ def _root(links: tuple[str, ...], joints: dict[str, UrdfJoint], source: str) -> 
         got = ', '.join(roots[:5]) or 'none (the joints make a cycle)'
         raise _fail(source, f'Expected one root link (a URDF is a tree), got {got}')
     parent = {j.child: j.parent for j in joints.values()}
+    up: set[str] = {roots[0]}  # links whose path up reaches the root
     for link in links:  # a cycle among the joints leaves some link without a path up
-        seen = set()
-        while link in parent:
+        path: list[str] = []
+        seen: set[str] = set()
+        while link not in up and link in parent:  # each link walked once: linear
             if link in seen:
                 raise _fail(source, f'Expected the joints to make a tree, got a cycle through '
                             f'link "{link}"')
             seen.add(link)
+            path.append(link)
             link = parent[link]
+        up.update(path)
     return roots[0]
 
 

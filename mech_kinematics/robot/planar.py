@@ -247,7 +247,6 @@ def _bodies(description: Description, weld: list[Closure],
     groups: dict[str, list[str]] = {}
     for link in description.links:
         groups.setdefault(find(link), []).append(link)
-    depth = {link: description.depth(link) for link in description.links}
     body_of: dict[str, str] = {}
     in_body: dict[str, Matrix] = {}
     neighbours: dict[str, list[tuple[str, Matrix]]] = {}
@@ -255,7 +254,7 @@ def _bodies(description: Description, weld: list[Closure],
         neighbours.setdefault(a, []).append((b, t))
         neighbours.setdefault(b, []).append((a, np.linalg.inv(t)))
     for members in groups.values():
-        top = min(members, key=lambda link: (depth[link], description.links.index(link)))
+        top = min(members, key=lambda link: (description.depth(link), description.order(link)))
         in_body[top] = np.eye(4)
         stack = [top]
         while stack:
@@ -393,6 +392,39 @@ def _angle(v: complex) -> float:
     return math.atan2(v.imag, v.real)
 
 
+def _diameter(points: Iterable[complex]) -> float:
+    """Return the largest distance between two of ``points`` (0 for fewer than two).
+
+    The farthest two points are corners of the convex hull: the hull (Andrew's
+    monotone chain, n log n) of the distinct points, then every pair of what
+    it keeps. A point is dropped only where it turns clearly inward (by more
+    than 1e-9 of the turn's size, far above rounding), so every corner is kept
+    and the answer is the distance of every pair, to the bit. Points on a
+    circle (a hull of them all) cost the pairs of the hull.
+    """
+    unique = sorted({(z.real, z.imag) for z in points})
+    if len(unique) < 3:
+        return abs(complex(*unique[0]) - complex(*unique[-1])) if unique else 0.0
+
+    def inward(o: tuple[float, float], a: tuple[float, float], b: tuple[float, float]) -> bool:
+        ax, ay, bx, by = a[0] - o[0], a[1] - o[1], b[0] - o[0], b[1] - o[1]
+        return ax * by - ay * bx < -1e-9 * math.hypot(ax, ay) * math.hypot(bx, by)
+
+    hull: list[tuple[float, float]] = []
+    for chain in (unique, unique[::-1]):  # the lower half, then the upper
+        start = len(hull)
+        for p in chain:
+            while len(hull) >= start + 2 and inward(hull[-2], hull[-1], p):
+                hull.pop()
+            hull.append(p)
+    corners = np.array([complex(x, y) for x, y in dict.fromkeys(hull)])
+    best = 0.0
+    for i in range(len(corners) - 1):
+        d = corners[i + 1:] - corners[i]
+        best = max(best, float(np.hypot(d.real, d.imag).max()))  # abs(complex) is hypot
+    return best
+
+
 def _fmt(vector: Iterable[float]) -> str:
     return '[' + ', '.join(f'{v:.6g}' for v in vector) + ']'
 
@@ -411,12 +443,13 @@ class _Mechanism:
         self.description = description
         self.ground = ground
         self.bodies = sorted({e.a for e in edges} | {e.b for e in edges},
-                             key=description.links.index)
+                             key=description.order)
         self.source = description.source
         to_ground = np.linalg.inv(model[ground])
         # Each link's frame in the ground's frame, by its body's geometry (the model).
+        bodies = set(self.bodies)
         self.frame = {link: to_ground @ model[body_of[link]] @ in_body[link]
-                      for link in description.links if body_of[link] in self.bodies}
+                      for link in description.links if body_of[link] in bodies}
         self.body_of = body_of
         self.pose = pose
         self._plane()
@@ -532,8 +565,7 @@ class _Mechanism:
             self.pins[edge.a][edge.name] = self.flat(on_a[:, 3])
             self.pins[edge.b][edge.name] = self.flat(on_b[:, 3])
             self.pin_ends[edge.name] = (edge.a, edge.b)
-        points = [p for pins in self.pins.values() for p in pins.values()]
-        self.size = max((abs(p - q) for p in points for q in points), default=0.0) or 1.0
+        self.size = _diameter(p for pins in self.pins.values() for p in pins.values()) or 1.0
         for edge in slide_closures:
             off, turn = self._slide_gap(edge)
             self.gaps.append((off + turn * self.size, edge.name))
@@ -668,14 +700,17 @@ class _Builder:
         """
         m = self.m
         n = m.normal
+        inertials = self.description.inertials
+        held: dict[str, list[str]] = {}     # body -> its links with an <inertial>, file order
+        for link in self.description.links:
+            if link in inertials:
+                held.setdefault(m.body_of[link], []).append(link)
         for body in m.bodies:
             if body == m.ground:
                 continue
             parts = []
-            for link in self.description.links:
-                inertial = self.description.inertials.get(link)
-                if inertial is None or m.body_of.get(link) != body:
-                    continue
+            for link in held.get(body, ()):
+                inertial = inertials[link]
                 frame = m.frame[link] @ inertial.origin
                 rotation = frame[:3, :3]
                 tensor = rotation @ inertial.inertia @ rotation.T
@@ -1250,7 +1285,7 @@ def planar_from_description(description: Description, actuated: Iterable[str] | 
         if not idle:
             break
         locked.update(idle)
-    bodies = sorted(set(body_of.values()), key=description.links.index)
+    bodies = sorted(set(body_of.values()), key=description.order)
     components = [sorted(c) for c in _components(bodies, edges) if len(c) > 1]
     components.sort(key=lambda c: c[0])
     loop_joints = [edges[i].name for c in components for i in c if edges[i].joint is not None]
@@ -1268,7 +1303,7 @@ def planar_from_description(description: Description, actuated: Iterable[str] | 
     for index, component in enumerate(components):
         part = [edges[i] for i in component]
         members = {e.a for e in part} | {e.b for e in part}
-        ground = min(members, key=lambda b: (description.depth(b), description.links.index(b)))
+        ground = min(members, key=lambda b: (description.depth(b), description.order(b)))
         m = _Mechanism(index, part, model, in_body, body_of, description, ground, pose)
         _check_welds(m, weld, tree)
         names = {e.name for e in part}

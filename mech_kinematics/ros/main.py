@@ -31,7 +31,7 @@ from rclpy.signals import install_signal_handlers, SignalHandlerOptions
 
 from .instance import DuplicateNodeError, Instance
 from .node import KinematicsNode, NODE_NAME, one_line, StartError
-from .startup import catch_stop_signals, start_refusal, stop_asked
+from .startup import catch_stop_signals, start_refusal, stop_asked, StopRequested
 from .tick_thread import TickThreadError
 from ..errors import NearSingularWarning
 
@@ -110,6 +110,11 @@ def main(args: list[str] | None = None) -> int:
         executor.spin()
     except (KeyboardInterrupt, ExternalShutdownException):
         pass  # Ctrl-C or shutdown: a clean exit, status 0
+    except StopRequested:
+        # A stop while the start read the scene or robot: a clean exit, status 0. What the
+        # read left is kept out of the collector's passes at exit (as gc.freeze() keeps a
+        # started node's): they took 1.9 s after a 20,000-joint URDF, 0.5 s frozen.
+        gc.freeze()
     except TickThreadError:
         status = 1
     except DuplicateNodeError as exc:

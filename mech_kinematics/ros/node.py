@@ -32,6 +32,7 @@ Run it with ``ros2 run mech_kinematics kinematics_node`` or
 
 from __future__ import annotations
 
+from contextlib import nullcontext
 from typing import Any
 
 from diagnostic_msgs.msg import DiagnosticArray
@@ -49,6 +50,7 @@ from .publishing import diagnostic_array, Markers, Publishing, qos_options, tf_p
 from .robot_mode import load_source, robot_forces_refusal
 from .schedule import period_ns_from_rate
 from .solver_path import SolverPath
+from .startup import stop_raises
 from .tick_thread import TickThread, TickThreadError
 from .topic_input import InputSubscription
 from .watchdog import PublishWatch, PublishWatchdog
@@ -188,9 +190,12 @@ class KinematicsNode(LifecycleNode):
     def _configure(self) -> None:
         assert self.params is not None
         # A scene, or a robot described in URDF (URDF mode: robot_mode.py).
-        source = load_source(self._value('scene'), self._value('robot_description'),
-                             self._value('loop_closures'), self._value('actuated_joints'),
-                             self._value('reference_pose'))
+        self.get_logger().debug('reading the scene or robot')
+        # At the start (the spin not begun) a signal ends the read at once (startup.py).
+        with stop_raises() if self.params.starting and not self.managed else nullcontext():
+            source = load_source(self._value('scene'), self._value('robot_description'),
+                                 self._value('loop_closures'), self._value('actuated_joints'),
+                                 self._value('reference_pose'))
         scene = source.scene
         if source.robot is not None:     # what would be accepted and ignored is refused
             refusal = robot_forces_refusal(self._value('effort'), spec('effort').default,

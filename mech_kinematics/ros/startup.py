@@ -22,7 +22,13 @@ which shuts the context down from another thread, is installed only when the
 node is about to spin: shutting the context down under a step of the start
 made that step fail ("cannot start"), leave a half-built executor (a
 traceback), or crash the process (SIGSEGV). rclpy's handler calls the one it
-replaced, this one, so the note stays true once a stop is asked. Before
+replaced, this one, so the note stays true once a stop is asked. A step
+that may run long in our own code, reading the scene or the robot (a URDF
+of 40,000 joints reads for tens of seconds), runs within
+:func:`stop_raises`: there a signal raises :class:`StopRequested` at once,
+ending the step, and the start ends with status 0 (a step of rclpy's never
+runs within it: raising under rclpy's calls is what left half-built objects
+behind). Before
 :func:`catch_stop_signals` runs (Python importing the package, NumPy among
 it), a SIGTERM ends the process by its default action (killed by the signal,
 no output).
@@ -33,22 +39,28 @@ Thread use: the main thread only (signal handlers run there).
 from __future__ import annotations
 
 from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 import os
 import signal
 import stat
 from types import FrameType
 
-__all__ = ['FILE_OPTIONS', 'MAX_ARGUMENT_FILE_BYTES', 'argument_files', 'catch_stop_signals',
-           'file_refusal', 'start_refusal', 'stop_asked']
+from ..scene import MAX_FILE_BYTES
+
+__all__ = ['FILE_OPTIONS', 'MAX_ARGUMENT_FILE_BYTES', 'StopRequested', 'argument_files',
+           'catch_stop_signals', 'file_refusal', 'start_refusal', 'stop_asked', 'stop_raises']
 
 #: The ROS arguments that name a file rcl reads at ``rclpy.init``.
 FILE_OPTIONS = ('--params-file', '--log-config-file')
 #: ROS arguments followed by a value (the value is not an option even if it looks like one).
 _WITH_VALUE = (*FILE_OPTIONS, '-p', '--param', '-r', '--remap', '-e', '--enclave',
                '--log-level', '--log-file-name')
-#: Largest file an argument may name, bytes: 1 MiB (a parameters file is a few kB; 10 MB took
-#: rcl seconds to parse).
-MAX_ARGUMENT_FILE_BYTES = 1 << 20
+#: Largest file an argument may name, bytes: twice :data:`~mech_kinematics.scene.MAX_FILE_BYTES`
+#: (16 MiB), room for a parameters file holding the largest ``robot_description`` (8 MiB) in
+#: YAML, its quotes escaped and its lines indented (``yaml.safe_dump`` wrote a 5.8 MB URDF in
+#: 6.4 MB). rcl reads it in C, which no signal interrupts: 2.5 s for those 6.4 MB on a
+#: loaded machine.
+MAX_ARGUMENT_FILE_BYTES = 2 * MAX_FILE_BYTES
 
 _FILE_KINDS = ((stat.S_ISDIR, 'a directory'), (stat.S_ISFIFO, 'a FIFO (named pipe)'),
                (stat.S_ISCHR, 'a character device'), (stat.S_ISBLK, 'a block device'),
@@ -56,6 +68,15 @@ _FILE_KINDS = ((stat.S_ISDIR, 'a directory'), (stat.S_ISFIFO, 'a FIFO (named pip
 
 _STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 _asked: list[int] = []
+_raising: list[bool] = []   # non-empty within stop_raises()
+
+
+class StopRequested(BaseException):
+    """A SIGINT or SIGTERM within :func:`stop_raises`: the start ends, status 0.
+
+    A ``BaseException``, as ``KeyboardInterrupt`` is: a step's ``except
+    Exception`` (a refusal in one line) does not take it for a failure.
+    """
 
 
 def argument_files(argv: Sequence[str]) -> Iterator[tuple[str, str]]:
@@ -99,7 +120,7 @@ def file_refusal(option: str, path: str) -> str | None:
         return f'{option} {path}: expected a regular file, got {kind}'
     if info.st_size > MAX_ARGUMENT_FILE_BYTES:
         return (f'{option} {path}: expected a file of at most {MAX_ARGUMENT_FILE_BYTES} bytes '
-                f'(1 MiB), got {info.st_size} bytes')
+                f'({MAX_ARGUMENT_FILE_BYTES >> 20} MiB), got {info.st_size} bytes')
     if not os.access(path, os.R_OK):
         return f'{option} {path}: expected a readable file, got permission denied'
     return None
@@ -121,6 +142,30 @@ def start_refusal(argv: Sequence[str]) -> str | None:
 
 def _note(signum: int, frame: FrameType | None) -> None:
     _asked.append(signum)
+    if _raising:
+        _raising.clear()    # once: the step's own clean-up runs undisturbed
+        raise StopRequested(signal.Signals(signum).name)
+
+
+@contextmanager
+def stop_raises() -> Iterator[None]:
+    """Run a step of the start that a SIGINT or SIGTERM ends at once (:class:`StopRequested`).
+
+    For our own code only (reading a scene or a robot): no rclpy call may run
+    within it. A stop already asked raises on entry.
+
+    Raises
+    ------
+    StopRequested
+        A stop asked for before or during the step.
+    """
+    if _asked:
+        raise StopRequested(signal.Signals(_asked[0]).name)
+    _raising.append(True)
+    try:
+        yield
+    finally:
+        _raising.clear()
 
 
 def catch_stop_signals() -> None:

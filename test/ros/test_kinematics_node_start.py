@@ -20,6 +20,8 @@ from ros_helpers import (cannot_start, exited, first_message_s, NodeProcess, NS,
                          stamp_ns, STARTUP_S, wait_for)
 from sensor_msgs.msg import JointState
 
+from mech_kinematics.ros.startup import MAX_ARGUMENT_FILE_BYTES
+
 #: Bound on the time from the process's start to its first published state, in multiples of
 #: the floor: what a minimal rclpy publisher process takes to stamp its first message on the
 #: same machine, measured once just before the node and twice just after (the largest, as
@@ -270,8 +272,8 @@ def _params_file(path, **values) -> str:
 def test_a_params_file_that_cannot_be_read_is_one_line_and_exit_2(tmp_path, kind):
     """Issue 33: --params-file naming a FIFO hung before our code ran; it is looked at first.
 
-    A FIFO, a directory, a device, a missing file or one over 1 MiB is refused in one
-    line naming the file, before rcl opens it.
+    A FIFO, a directory, a device, a missing file or one over MAX_ARGUMENT_FILE_BYTES
+    (16 MiB) is refused in one line naming the file, before rcl opens it.
     """
     path = tmp_path / 'params.yaml'
     if kind == 'fifo':
@@ -281,7 +283,7 @@ def test_a_params_file_that_cannot_be_read_is_one_line_and_exit_2(tmp_path, kind
     elif kind == 'device':
         path = '/dev/zero'
     elif kind == 'too large':
-        _params_file(path, tf_prefix='a' * (1 << 20))
+        _params_file(path, tf_prefix='a' * MAX_ARGUMENT_FILE_BYTES)
     proc = NodeProcess(tmp_path / 'node', '--params-file', str(path),
                        '-r', f'__ns:={SESSION}/params_file')
     status, output = exited(proc)
@@ -289,7 +291,7 @@ def test_a_params_file_that_cannot_be_read_is_one_line_and_exit_2(tmp_path, kind
     assert output.count('\n') == 1 and len(cannot_start(output)) == 1, output
     words = {'fifo': 'got a FIFO (named pipe)', 'directory': 'got a directory',
              'missing': 'expected a readable file, got no such file or directory',
-             'device': 'got a character device', 'too large': 'at most 1048576 bytes (1 MiB)'}
+             'device': 'got a character device', 'too large': 'at most 16777216 bytes (16 MiB)'}
     assert f'cannot start: --params-file {path}: expected ' in output, output
     assert words[kind] in output, output
 

@@ -19,9 +19,10 @@ lost); their answers are not kept.
 """
 
 from pathlib import Path
+import signal
 import time
 
-from helpers import gepetto_five_bar_reference, UrdfFk
+from helpers import gepetto_five_bar_reference, khurmi_chain_urdf, UrdfFk
 import numpy as np
 import pytest
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
@@ -31,8 +32,11 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import String
 from tf2_msgs.msg import TFMessage
 from trajectory_msgs.msg import JointTrajectory
+import yaml
 
 from mech_kinematics.robot import load_robot
+from mech_kinematics.ros.startup import MAX_ARGUMENT_FILE_BYTES
+from mech_kinematics.scene import MAX_FILE_BYTES
 
 DATA = Path(__file__).resolve().parents[1] / 'data' / 'urdf'
 #: The motors' rate, Hz, and how long they send, s.
@@ -230,6 +234,65 @@ def test_a_urdf_exported_open_runs_from_its_reference_pose(ros, tmp_path):
         assert list(msg.position) == [answer.joints[n].position for n in robot.joint_names]
         gaps = fk.gaps(dict(zip(msg.name, msg.position, strict=True)))
         assert max(gap / fk.loop_size(c) for c, gap in gaps.items()) <= RTOL_CLOSURE
+
+
+def test_a_robot_description_over_1_mib_is_taken_from_a_params_file(ros, tmp_path):
+    """Issue 42: a params file over 1 MiB was refused, though robot_description may be 8 MiB.
+
+    The gripper's URDF padded by a comment to 4 MiB, in a params file as launch_ros writes
+    one (a double-quoted YAML string): the node starts and publishes the text unchanged.
+    The largest robot_description fits in the largest params file.
+    """
+    urdf = DATA / 'robotiq_2f_85.urdf'
+    text = urdf.read_text().replace('<robot ', f'<!-- {"x" * (4 << 20)} -->\n<robot ', 1)
+    assert 1 << 20 < len(text.encode()) < MAX_FILE_BYTES
+    params = tmp_path / 'params.yaml'
+    params.write_text(yaml.safe_dump({'/**': {'ros__parameters': {
+        'robot_description': text,
+        'loop_closures': str(DATA / 'robotiq_2f_85.loop_closures.yaml')}}}, width=1 << 30))
+    assert params.stat().st_size > 1 << 20
+    node = UrdfNode(ros, tmp_path, 'urdf_4mib', 'robotiq_2f_85', '--params-file', str(params))
+    try:
+        node.start()
+        node.send(T0, [0.2], None)
+        wait_for(lambda: node.js and node.description, ANSWER_S, 'the state and the URDF')
+    finally:
+        node.stop()
+    answer = node.robot.solve({'finger_joint': 0.2})
+    assert list(node.js[0].position)[:len(node.robot.joint_names)] == \
+        [answer.joints[n].position for n in node.robot.joint_names]
+    assert node.description[0].data == text
+    assert MAX_ARGUMENT_FILE_BYTES >= 2 * MAX_FILE_BYTES
+
+
+def test_a_stop_while_the_start_reads_a_large_urdf_ends_it_at_once(ros, tmp_path):
+    """Issue 42: SIGTERM while a 40,000-joint URDF was read took 19-26 s to end the node.
+
+    The node is signalled once it logs (at debug) that it reads; it ends with status 0,
+    no traceback, its start line never logged, in less time than it took to come up to
+    the read (Python, rclpy, the node: seconds), where it used to finish the read first.
+    """
+    path = tmp_path / 'chain.urdf'
+    path.write_text(khurmi_chain_urdf(40_000))
+    assert path.stat().st_size < MAX_FILE_BYTES
+    ns = f'{SESSION}/urdf_stop'
+    logger = f'{ns.strip("/").replace("/", ".")}.mech_kinematics'
+    started = time.monotonic()
+    proc = NodeProcess(tmp_path / 'node', '-r', f'__ns:={ns}', '-p', f'scene:={path}',
+                       '--log-level', f'{logger}:=debug')
+    try:
+        wait_for(lambda: 'reading the scene or robot' in proc.output()
+                 or proc.proc.poll() is not None, STARTUP_S, 'the node reading')
+        up_s = time.monotonic() - started
+        assert proc.proc.poll() is None, proc.output()
+        status, took_s = proc.stop(signal.SIGTERM, timeout=120.0)
+    finally:
+        if proc.proc.poll() is None:
+            proc.proc.kill()
+    output = proc.output()
+    assert "robot 'khurmi'" not in output, output        # stopped within the read
+    assert status == 0 and 'Traceback' not in output and not cannot_start(output), output
+    assert took_s < up_s, (took_s, up_s)
 
 
 @pytest.mark.parametrize('args, line', [

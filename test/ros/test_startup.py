@@ -48,7 +48,8 @@ def test_what_may_not_be_read_is_refused_naming_the_file(tmp_path):
         f'--params-file {tmp_path}/none.yaml: expected a readable file, got no such file or ' \
         'directory'
     assert file_refusal(option, str(big)) == \
-        f'--params-file {big}: expected a file of at most 1048576 bytes (1 MiB), got 1048577 bytes'
+        f'--params-file {big}: expected a file of at most 16777216 bytes (16 MiB), got ' \
+        '16777217 bytes'
     assert file_refusal(option, str(ok)) is None
     assert file_refusal(option, 'a\0b') == \
         "--params-file 'a\\x00b': expected a file path, got embedded null byte"
