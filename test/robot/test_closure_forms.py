@@ -287,8 +287,8 @@ def test_the_nodes_loop_closures_takes_every_form():
 
 
 @pytest.mark.parametrize('entry, said', [
-    ('mot1', "reference_pose: Expected JOINT=VALUE with JOINT a moving joint of the robot ("),
-    ('nothing=0.1', "reference_pose: Expected JOINT=VALUE with JOINT a moving joint of "),
+    ('mot1', 'reference_pose: Expected JOINT=VALUE with JOINT a moving joint of the robot ('),
+    ('nothing=0.1', 'reference_pose: Expected JOINT=VALUE with JOINT a moving joint of '),
     ('mot1=fast', "reference_pose: Expected mot1=VALUE a finite number (rad), got 'mot1=fast'"),
     ('mot1=nan', "reference_pose: Expected mot1=VALUE a finite number (rad), got 'mot1=nan'"),
 ])

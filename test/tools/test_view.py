@@ -820,8 +820,8 @@ def _huge_points(server, stamp_ns, points):
     server._on_points(msg)
 
 
-def test_chromium_draws_huge_forces_and_velocities_to_scale_and_says_what_it_cannot(fake,
-                                                                                     browser):
+def test_chromium_draws_huge_forces_and_velocities_to_scale_and_says_what_it_cannot(
+        fake, browser):
     """Reactions of 1.5e308 N draw to scale; a value not finite is named on the drawing.
 
     Math.hypot of [1.5e308, 1.5e308] is Infinity: every reaction arrow was drawn
