@@ -685,10 +685,10 @@ class _Builder:
                 joint = next(e.name for b in left for e in m.edges_of[b])
                 raise self.fail(
                     f'joint "{joint}": Expected the loop through {", ".join(m.bodies[:6])} to '
-                    f'decompose into dyads of our kinds (RRR, RRP, RPR, RPP, a cylinder), got '
-                    f'links {", ".join(left)} that no dyad places: a group of higher class '
-                    '(such as a triad), a slider on a moving guide, a slot off its pivot or an '
-                    'actuated joint our kinds do not drive', joint)
+                    f'decompose into dyads of our kinds (RRR, RRP, RPR, RPP, a cylinder) or '
+                    f'triads, got links {", ".join(left)} that none places: a group of higher '
+                    'class, a slider on a moving guide, a slot off its pivot or an actuated '
+                    'joint our kinds do not drive', joint)
         self._joint_maps()
         self._masses()
 
@@ -835,7 +835,7 @@ class _Builder:
 
     # --- dyads -----------------------------------------------------------------------------
     def _dyad(self) -> bool:
-        return self._rrr() or self._rrp() or self._rpr() or self._rpp()
+        return self._rrr() or self._rrp() or self._rpr() or self._rpp() or self._triad()
 
     def _unit(self, body: str) -> tuple[str, str] | None:
         """Return (kind, key): ``body`` as an RRR element: a link, or a cylinder's barrel."""
@@ -910,6 +910,52 @@ class _Builder:
                     self._known(part, (name, phi0), None, None, phi0)
             else:
                 self._known(body, (name, phi0), start, pin, phi0)
+
+    def _triad(self) -> bool:
+        """Place a ternary link held by three links from placed pins (a class-III group)."""
+        m = self.m
+        for body in m.bodies:
+            if body in self.known or self._unit(body) != ('link', body) or self._known_pin(body):
+                continue
+            arms = []
+            for edge in m.edges_of[body]:
+                other = edge.b if edge.a == body else edge.a
+                if edge.kind != 'pin' or other in self.known or self._unit(other) != (
+                        'link', other) or any(arm[0] == other for arm in arms):
+                    continue
+                starts = [e for e in self._known_pin(other) if e.name != edge.name]
+                if starts:
+                    arms.append((other, edge.name, starts[0].name))
+            if len(arms) == 3:
+                self._place_triad(body, arms)
+                return True
+        return False
+
+    def _place_triad(self, body: str, arms: list[tuple[str, str, str]]) -> None:
+        m = self.m
+        ends = [m.pins[body][pin] for _, pin, _ in arms]
+        base = abs(ends[1] - ends[0])
+        if base <= TOGGLE_TOLERANCE * m.size:
+            raise self.fail(f'joint "{arms[0][1]}": Expected the pins of ternary link '
+                            f'"{body}" apart, got two at one place', arms[0][1])
+        angle = _angle(ends[1] - ends[0])
+        local = (ends[2] - ends[0]) * complex(math.cos(angle), -math.sin(angle))
+        links = []
+        for other, pin, start in arms:
+            name = self.link(other)
+            self.body_names[other] = name
+            links.append({'name': name, 'from': self.point(start),
+                          'length': abs(m.pins[other][pin] - m.pins[other][start])})
+        name = self.link(body)
+        self.body_names[body] = name
+        self.dyads.append({'type': 'triad', 'link': {
+            'name': name, 'pins': [self.point(pin) for _, pin, _ in arms], 'length': base,
+            'local': [local.real, local.imag]}, 'links': links, 'angle': angle})
+        self.placed.update(pin for _, pin, _ in arms)
+        for (other, pin, start), link in zip(arms, links, strict=True):
+            phi0 = _angle(m.pins[other][pin] - m.pins[other][start])
+            self._known(other, (link['name'], phi0), start, pin, phi0)
+        self._known(body, (name, angle), arms[0][1], arms[1][1], angle)
 
     def _actuator(self, joint: str, on_start: complex, on_end: complex, from_barrel: bool
                   ) -> None:

@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Analytic position, velocity and acceleration of planar linkages.
 
-A mechanism is a driving crank followed by dyads (RRR, RRP, RPR, RPP) and points
+A mechanism is a driving crank followed by dyads (RRR, RRP, RPR, RPP), triads and points
 carried rigidly by links, solved one after another in closed form: no
 iteration anywhere. Points are complex numbers ``x + iy`` internally, so a
 rigid rotation is a product and every formula is the same for one crank angle
@@ -52,10 +52,11 @@ from .rrr import RRR
 from .rubbing import Pin
 from .solve import assembly_margins, solve
 from .state import Engagement, JointMotion, PointState, State
+from .triad import Triad
 
 __all__ = [
     'Actuator', 'Branch', 'CarriedPoint', 'Crank', 'Engagement', 'JointMotion', 'Link',
     'MAX_SLOTS',
     'NEAR_SINGULAR', 'Pin', 'PointState', 'RPP', 'RPR', 'RRP', 'RRR', 'SINGULAR', 'Scene', 'State',
-    'SceneUnits', 'TANGENCY_TOLERANCE', 'assembly_margins', 'assembly_text', 'solve',
+    'SceneUnits', 'Triad', 'TANGENCY_TOLERANCE', 'assembly_margins', 'assembly_text', 'solve',
 ]

@@ -186,7 +186,9 @@ class Placing(Protocol):
     size, m; ``scene`` the scene; ``intermittent(placing, item)`` the step of
     an RPR whose lever has slots (a Geneva wheel's, :mod:`.geneva`, which
     builds on :mod:`.rpr`: lent here so that the base kind imports none of its
-    variants).
+    variants); ``trace(positions)`` the context of the steps placed so far run on an
+    array of the first driver's positions at unit speed (what a triad follows its
+    branch along, :mod:`.triad`).
     """
 
     ground: Mapping[str, complex]
@@ -199,6 +201,10 @@ class Placing(Protocol):
     @property
     def intermittent(self) -> Callable[[Placing, Any], Step]:
         """Return the function building an RPR's step whose lever has slots."""
+
+    @property
+    def trace(self) -> Callable[[Any], _Context] | None:
+        """Return the function running the steps placed so far on an array of positions."""
 
 
 class Reading(Protocol):

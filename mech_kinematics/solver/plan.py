@@ -14,11 +14,15 @@ import heapq
 import math
 from typing import Any, TYPE_CHECKING
 
+import numpy as np
+
 from .base import Item, Step
+from .context import _Context
 from .geneva import _index_step
 from .graph import build_graph, Graph
 from .model import _check_finite, _check_name, _names, Where
 from .rubbing import _rub_steps, _RubStep
+from ..bounds import U
 from ..errors import SceneError
 
 if TYPE_CHECKING:
@@ -134,6 +138,9 @@ class _Placing:
     scene: Any
     carriers: Mapping[str, list[str]]       # the _Local's
     intermittent: Callable[[Any, Any], Step] = _index_step
+    #: The steps placed so far run on an array of the first driver's positions (at unit
+    #: speed): what a step that follows its branch along the crank's turn reads (a triad's).
+    trace: Callable[[Any], Any] | None = None
 
 
 def _compile(scene: Scene, joints: tuple[str, ...] | None,
@@ -177,9 +184,18 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
     local = _Local()
     for driver in drivers:
         local.update(driver.local(ground))
-    placing = _Placing(ground, local, {}, size, scene, local.carriers)
-    names = _Names(kinds, ground)
     steps: list[Step] = []
+
+    def trace(positions: Any) -> _Context:
+        ctx = _Context(positions, True)
+        ctx.points.update({name: (z, 0j, 0j, U * abs(z), 0.0, 0.0) for name, z in ground.items()})
+        driver_steps[0].run(ctx, positions, np.float64(1.0), np.float64(0.0))
+        for step in steps:
+            step.run(ctx)
+        return ctx
+
+    placing = _Placing(ground, local, {}, size, scene, local.carriers, trace=trace)
+    names = _Names(kinds, ground)
     owners: list[Item] = []  # the item of each step
     produces: dict[str, int] = {}  # point, link or slider -> index of its step
 

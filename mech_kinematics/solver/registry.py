@@ -18,9 +18,11 @@ from .rpp import RPP
 from .rpr import RPR
 from .rrp import RRP
 from .rrr import RRR
+from .triad import Triad
 
+_ITEMS: tuple[type[Item], ...] = (RRR, RRP, RPR, RPP, Triad)
 #: The scene's ``type:`` of a dyad -> its item class.
-KINDS: dict[str, type[Item]] = {kind.kind: kind for kind in (RRR, RRP, RPR, RPP)}
+KINDS: dict[str, type[Item]] = {kind.kind: kind for kind in _ITEMS}
 
 #: The key that names a driver in the scene's ``inputs:`` -> its kind.
 DRIVERS: dict[str, type[Driver]] = {kind.scene_key: kind for kind in (Crank, Actuator)}

@@ -62,7 +62,7 @@ import yaml
 
 from ..errors import SceneError
 from ..scene import read_scene_yaml
-from ..solver import Actuator, CarriedPoint, Crank, RPP, RPR, RRP, RRR, Scene
+from ..solver import Actuator, CarriedPoint, Crank, RPP, RPR, RRP, RRR, Scene, Triad
 from ..solver.graph import Fragment, joint_type, JointType
 from ..units import ANGLE_UNITS, LENGTH_UNITS, radians_from_degrees
 
@@ -398,6 +398,8 @@ class Model:
             moves.place(self, driver, known)
         self.unknown_names: list[str] = []
         self.unknown_is_length: list[bool] = []
+        #: The points of the last :meth:`construct` stopped before an element (``upto``).
+        self.partial: dict[str, Any] = {}
         entries = [('dyads', k) for k in range(len(scene.dyads))] + [
             ('points', point.name) for point in scene.points]
         pending = list(zip(items, equations, entries, strict=True))
@@ -489,7 +491,7 @@ class Model:
             element.equations.evaluate(element.item, element.index, p, q, points, residuals)
         return points, residuals
 
-    def construct(self, p: Mapping[str, Any], theta: Any) -> list[Any]:
+    def construct(self, p: Mapping[str, Any], theta: Any, upto: int | None = None) -> list[Any]:
         """Return a first estimate of the unknowns by textbook constructions (mpmath).
 
         Law of cosines for RRR, circle and line for RRP, the pin's polar
@@ -505,8 +507,11 @@ class Model:
         pts = {name: mpmath.mpc(z) for name, z in pts.items()}
         q: list[Any] = [None] * self.n
         tiny = mpmath.mpf(10) ** (-(mpmath.mp.dps - 8))
-        for element in self.elements:
+        for element in self.elements[:upto]:
+            element.equations.prepare(self, element.item, theta, pts)
             element.equations.construct(element.item, element.index, p, q, pts, tiny)
+        if upto is not None:
+            self.partial = pts
         return q
 
     def jacobian_columns(self, p: Mapping[str, Any], q: list[Any], theta: Any) -> list[list[Any]]:
@@ -674,6 +679,11 @@ class _Equations(ABC):
 
     @staticmethod
     @abstractmethod
+    def prepare(model: Model, item: Any, theta: Any, pts: dict[str, Any]) -> None:
+        """Put in ``pts`` what its construction reads of the whole model (most: nothing)."""
+
+    @staticmethod
+    @abstractmethod
     def branch_ok(item: Any, i: int, p: Mapping[str, Any], points: Mapping[str, Any],
                   q: list[Any]) -> bool:
         """Return whether the item is on its assembly branch."""
@@ -752,6 +762,10 @@ class _RRR(_Equations):
                                              * p[f'link.{second.name}.length'])
 
     @staticmethod
+    def prepare(model: Model, item: Any, theta: Any, pts: dict[str, Any]) -> None:
+        """Put nothing: its construction reads only its own starts."""
+
+    @staticmethod
     def branch_ok(item: Any, i: int, p: Mapping[str, Any], points: Mapping[str, Any],
                   q: list[Any]) -> bool:
         """Check the pin is on the side of the line between the starts the branch names."""
@@ -824,6 +838,10 @@ class _RRP(_Equations):
             f'link.{item.link.name}.length']
 
     @staticmethod
+    def prepare(model: Model, item: Any, theta: Any, pts: dict[str, Any]) -> None:
+        """Put nothing: its construction reads only its own starts."""
+
+    @staticmethod
     def branch_ok(item: Any, i: int, p: Mapping[str, Any], points: Mapping[str, Any],
                   q: list[Any]) -> bool:
         """Check the slider is beyond (branch +1) or before (-1) the foot of the start."""
@@ -873,6 +891,10 @@ class _RPR(_Equations):
                 points: Mapping[str, Any], q: list[Any], measures: dict[str, Any]) -> None:
         """Put the slider coordinate over the mechanism's size."""
         measures[item.link] = abs(q[i + 1]) / model.size
+
+    @staticmethod
+    def prepare(model: Model, item: Any, theta: Any, pts: dict[str, Any]) -> None:
+        """Put nothing: its construction reads only its own starts."""
 
     @staticmethod
     def branch_ok(item: Any, i: int, p: Mapping[str, Any], points: Mapping[str, Any],
@@ -947,9 +969,233 @@ class _RPP(_Equations):
         measures[item.point] = abs((mpmath.conj(u) * w).imag)
 
     @staticmethod
+    def prepare(model: Model, item: Any, theta: Any, pts: dict[str, Any]) -> None:
+        """Put nothing: its construction reads only its own starts."""
+
+    @staticmethod
     def branch_ok(item: Any, i: int, p: Mapping[str, Any], points: Mapping[str, Any],
                   q: list[Any]) -> bool:
         """Return True: the two lines cross once (one configuration)."""
+        return True
+
+
+class _Triad(_Equations):
+    """A ternary link held by three binary links: unknowns, the three links' and its angle.
+
+    Each binary link's end ``Pi + li exp(i thi)`` is the ternary's pin
+    ``E1 + exp(i phi) di``: two complex residuals (``E2 - E1`` and ``E3 - E1``
+    against the ternary's sides) in the four angles. The start is found here,
+    apart from the solver's polynomial: for each ternary angle on a grid, the
+    first two links close as a law-of-cosines dyad on both branches, and the
+    third link's gap changes sign at an assembly; each sign change is
+    refined by bisection. Which assembly is the branch is the solver's
+    definition, continuity from the drawn pose along the crank's turn,
+    followed here by its own continuation (:meth:`prepare`).
+    """
+
+    @staticmethod
+    def parameters(item: Any) -> tuple[Parameter, ...]:
+        """Return the binary links' lengths and the ternary's side and third pin."""
+        links = tuple(_length(f'link.{link.name}.length', link.length, ('links', k, 'length'))
+                      for k, link in enumerate(item.links))
+        name = item.link
+        return (*links, _length(f'triad.{name}.length', item.local[1].real, ('link', 'length')),
+                _length(f'triad.{name}.local.x', item.local[2].real, ('link', 'local', 0)),
+                _length(f'triad.{name}.local.y', item.local[2].imag, ('link', 'local', 1)))
+
+    @staticmethod
+    def ready(model: Model, item: Any, known: set[str]) -> bool:
+        """Return whether the three links' starts are known."""
+        return all(link.start in known for link in item.links)
+
+    @staticmethod
+    def unknowns(item: Any) -> tuple[str, ...]:
+        """Return the three binary links and the ternary (their angles)."""
+        return (*(link.name for link in item.links), item.link)
+
+    @staticmethod
+    def new_points(item: Any) -> tuple[str, ...]:
+        """Return its three pins."""
+        return tuple(item.pins)
+
+    @staticmethod
+    def _sides(item: Any, p: Mapping[str, Any]) -> tuple[Any, Any]:
+        name = item.link
+        return (p[f'triad.{name}.length'],
+                p[f'triad.{name}.local.x'] + 1j * p[f'triad.{name}.local.y'])
+
+    @staticmethod
+    def evaluate(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
+                 points: dict[str, Any], residuals: list[Any]) -> None:
+        """Each link's end is its pin on the ternary: two residuals."""
+        ends = [points[link.start] + p[f'link.{link.name}.length'] * expi(q[i + k])
+                for k, link in enumerate(item.links)]
+        d2, d3 = _Triad._sides(item, p)
+        turn = expi(q[i + 3])
+        residuals.append(ends[1] - ends[0] - turn * d2)
+        residuals.append(ends[2] - ends[0] - turn * d3)
+        for name, end in zip(item.pins, ends, strict=True):
+            points[name] = end
+
+    @staticmethod
+    def prepare(model: Model, item: Any, theta: Any, pts: dict[str, Any]) -> None:
+        """Put the ternary angle on its branch, followed here from the drawn pose to ``theta``.
+
+        The branch is the assembly nearest the written ``angle`` at the
+        crank's start, continued along the crank (within half a turn of the
+        start either way, as the solver): steps of 0.01 rad, each a Newton
+        solve (floats) of the four closure equations from the last, the
+        triad's starts at each step from this model's own construction.
+        """
+        index = next(k for k, e in enumerate(model.elements) if e.item is item)
+        p = model.mp_values()
+        start = model.scene.drivers[0].start  # (a triad's scene has one crank)
+        target = start + math.remainder(float(_value(theta)) - start, math.tau)
+        links = item.links
+        lengths = [float(p[f'link.{link.name}.length']) for link in links]
+        d2, d3 = (complex(x) for x in _Triad._sides(item, p))
+
+        def starts(t: float) -> list[complex]:
+            with _precision(20):
+                model.construct(p, mpmath.mpf(t), upto=index)
+                return [complex(model.partial[link.start]) for link in links]
+
+        first = starts(start)
+        with _precision(20):
+            found = _Triad._scan(item, p, [mpmath.mpc(z) for z in first])
+        if not found:
+            pts[f'{item.link}/followed'] = math.nan
+            return
+        phi, sign = min(found, key=lambda f: abs(math.remainder(float(f[0]) - item.angle,
+                                                                math.tau)))
+        q = _Triad._closed(item, p, [mpmath.mpc(z) for z in first], phi, sign)
+        x = np.array([float(v) for v in q])
+        steps = max(1, math.ceil(abs(target - start) / 0.01))
+        for k in range(1, steps + 1):
+            at = starts(start + (target - start) * k / steps)
+            for _ in range(30):
+                e = np.exp(1j * x)
+                ends = [at[j] + lengths[j] * e[j] for j in range(3)]
+                res = [ends[1] - ends[0] - e[3] * d2, ends[2] - ends[0] - e[3] * d3]
+                jac = np.zeros((4, 4))
+                cols = [(-1j * lengths[0] * e[0], -1j * lengths[0] * e[0]),
+                        (1j * lengths[1] * e[1], 0j), (0j, 1j * lengths[2] * e[2]),
+                        (-1j * e[3] * d2, -1j * e[3] * d3)]
+                for c, (r1, r2) in enumerate(cols):
+                    jac[:, c] = (r1.real, r1.imag, r2.real, r2.imag)
+                rhs = np.array([res[0].real, res[0].imag, res[1].real, res[1].imag])
+                dx = np.linalg.solve(jac, -rhs)
+                x = x + dx
+                if np.abs(dx).max() < 1e-13:
+                    break
+            else:
+                pts[f'{item.link}/followed'] = math.nan
+                return
+        pts[f'{item.link}/followed'] = float(x[3])
+
+    @staticmethod
+    def _scan(item: Any, p: Mapping[str, Any], starts: list[Any]) -> list[tuple[Any, int]]:
+        """Return (ternary angle, branch sign of E1) of every assembly (mpmath)."""
+        la, lb, lc = (p[f'link.{link.name}.length'] for link in item.links)
+        d2, d3 = _Triad._sides(item, p)
+        pa, pb, pc = starts
+
+        def gap(phi: Any, sign: int) -> Any:
+            # E1 on the circle about pa (la) and on the circle about pb - R d2 (lb).
+            centre = pb - mpmath.expj(phi) * d2
+            d = centre - pa
+            dist = abs(d)
+            cos_g = (la * la + dist * dist - lb * lb) / (2 * la * dist)
+            if abs(cos_g) > 1:
+                return None
+            e1 = pa + la * mpmath.expj(mpmath.arg(d) + sign * mpmath.acos(cos_g))
+            return abs(e1 + mpmath.expj(phi) * d3 - pc) - lc
+
+        found = []
+        grid = [2 * mpmath.pi * k / 2048 for k in range(2049)]
+        for sign in (1, -1):
+            values = [gap(phi, sign) for phi in grid]
+            for k in range(2048):
+                g0, g1 = values[k], values[k + 1]
+                if g0 is None or g1 is None or (g0 > 0) == (g1 > 0):
+                    continue
+                lo, hi = grid[k], grid[k + 1]
+                for _ in range(60):
+                    mid = (lo + hi) / 2
+                    gm = gap(mid, sign)
+                    if gm is None:
+                        break
+                    if (gm > 0) == (g0 > 0):
+                        lo = mid
+                    else:
+                        hi = mid
+                found.append(((lo + hi) / 2, sign))
+        return found
+
+    @staticmethod
+    def _closed(item: Any, p: Mapping[str, Any], starts: list[Any], phi: Any,
+                sign: int) -> list[Any]:
+        """Return the four angles of the assembly at ternary angle ``phi`` (mpmath)."""
+        la, lb = (p[f'link.{link.name}.length'] for link in item.links[:2])
+        d2, d3 = _Triad._sides(item, p)
+        pa, pb, pc = starts
+        centre = pb - mpmath.expj(phi) * d2
+        dd = centre - pa
+        cos_g = (la * la + abs(dd) ** 2 - lb * lb) / (2 * la * abs(dd))
+        first = mpmath.arg(dd) + sign * mpmath.acos(max(-1, min(1, cos_g)))
+        e1 = pa + la * mpmath.expj(first)
+        turn = mpmath.expj(phi)
+        return [first, mpmath.arg(e1 + turn * d2 - pb), mpmath.arg(e1 + turn * d3 - pc), phi]
+
+    @staticmethod
+    def construct(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
+                  pts: dict[str, Any], tiny: Any) -> None:
+        """Scan the ternary's angle for assemblies; take the one nearest the followed branch."""
+        followed = pts[f'{item.link}/followed']
+        if not math.isfinite(followed):
+            msg = f'triad {item.link}: its branch does not reach this crank angle'
+            raise NoAssembly(msg)
+        starts = [pts[link.start] for link in item.links]
+        with _precision(20):
+            found = _Triad._scan(item, p, starts)
+        if not found:
+            msg = f'triad {item.link}: its links cannot reach its pins'
+            raise NoAssembly(msg)
+        phi, sign = min(found, key=lambda f: abs(math.remainder(float(f[0]) - followed,
+                                                                math.tau)))
+        angles = _Triad._closed(item, p, starts, mpmath.mpf(phi), sign)
+        angles[3] = angles[3] + 2 * mpmath.pi * round((followed - float(phi)) / math.tau)
+        q[i:i + 4] = angles
+        d2, d3 = _Triad._sides(item, p)
+        e1 = starts[0] + p[f'link.{item.links[0].name}.length'] * mpmath.expj(angles[0])
+        turn = mpmath.expj(angles[3])
+        for name, end in zip(item.pins, (e1, e1 + turn * d2, e1 + turn * d3), strict=True):
+            pts[name] = end
+
+    @staticmethod
+    def measure(model: Model, item: Any, i: int, p: Mapping[str, Any],
+                points: Mapping[str, Any], q: list[Any], measures: dict[str, Any]) -> None:
+        """Put |det M| over its rows' norms (the solver's definition, docs/scene_format.md)."""
+        d2, d3 = _Triad._sides(item, p)
+        turn = mpmath.expj(q[i + 3])
+        ds = (0, d2, d3)
+        size = max(abs(d2), abs(d3))
+        rows = []
+        for k, link in enumerate(item.links):
+            u = points[item.pins[k]] - points[link.start]
+            t = 1j * turn * ds[k]
+            rows.append((u.real, u.imag, u.real * t.real + u.imag * t.imag,
+                         p[f'link.{link.name}.length']))
+        det = mpmath.det(mpmath.matrix([row[:3] for row in rows]))
+        scale = size
+        for x, y, z, length in rows:
+            scale *= mpmath.sqrt(x * x + y * y) * mpmath.sqrt(1 + (z / (length * size)) ** 2)
+        measures[item.link] = abs(det) / scale
+
+    @staticmethod
+    def branch_ok(item: Any, i: int, p: Mapping[str, Any], points: Mapping[str, Any],
+                  q: list[Any]) -> bool:
+        """Return True: the branch was taken by its definition when constructed."""
         return True
 
 
@@ -1002,6 +1248,10 @@ class _Carry(_Equations):
         """Put none: a carried point is never singular (its frame's points are apart)."""
 
     @staticmethod
+    def prepare(model: Model, item: Any, theta: Any, pts: dict[str, Any]) -> None:
+        """Put nothing: its construction reads only its own starts."""
+
+    @staticmethod
     def branch_ok(item: Any, i: int, p: Mapping[str, Any], points: Mapping[str, Any],
                   q: list[Any]) -> bool:
         """Return True: it has one position."""
@@ -1013,7 +1263,7 @@ class _Carry(_Equations):
 #: RPR. A kind missing here is refused by :class:`Model`, never solved as another.
 MODELS: dict[str, _Equations] = {
     RRR.kind: _RRR(), RRP.kind: _RRP(), RPR.kind: _RPR(), RPP.kind: _RPP(),
-    CarriedPoint.kind: _Carry(), RPR.kind + INTERMITTENT: _Geneva()}
+    Triad.kind: _Triad(), CarriedPoint.kind: _Carry(), RPR.kind + INTERMITTENT: _Geneva()}
 
 #: The equations of every kind of driver, by its key in a scene's ``inputs:`` (``DRIVERS``).
 DRIVER_MODELS: dict[str, _DriverEquations] = {Crank.scene_key: _Crank(),

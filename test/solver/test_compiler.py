@@ -67,6 +67,14 @@ GENERATORS = {
         dyads=[{'type': 'RPP', 'point': 'Y', 'through': 'B',
                 'guide': {'through': 'A', 'angle': 0}, 'slot_angle': 90, 'slider': 'yoke',
                 'slot_slider': 'pin_in_slot'}]),
+    'triad': lambda: scene_mapping(
+        'triad', {'A': [0, 0], 'D': [81, 27]}, input=crank_entry(25, 30, 60, 0.0),
+        points={'C': {'link': 'crank', 'origin': 'A', 'xaxis': 'B', 'local': [25, -43]}},
+        dyads=[{'type': 'triad', 'link': {'name': 'coupler', 'pins': ['E', 'F', 'G'],
+                                          'length': 74, 'local': [41, 32]},
+                'links': [{'name': 'link_e', 'from': 'B', 'length': 75},
+                          {'name': 'link_f', 'from': 'C', 'length': 92},
+                          {'name': 'rocker', 'from': 'D', 'length': 82}], 'angle': -111}]),
     'actuator': lambda: scene_mapping(
         'actuator', {'O': [0, 0], 'F': [400, -1100]},
         inputs=[{'actuator': 'cyl', 'length': 2600, 'speed': 100, 'stroke': [2000, 3300]}],
@@ -98,6 +106,10 @@ GENERATORS = {
 
 #: The reasons the compiler is expected to give, per (kind, target); every other compiles.
 NOT_COMPILED = {
+    # The triad's kernel loops over its polynomial's roots and Newton's steps.
+    ('triad', 'single'): 'step triad coupler: kernel uses `try` (not in the kernel subset)',
+    ('triad', 'array'): 'step triad coupler: kernel uses `try` (not in the kernel subset)',
+    ('triad', 'tick'): 'step triad coupler: kernel uses `try` (not in the kernel subset)',
     ('Geneva RPR', 'single'): "an intermittent lever's engagement is reported (wheel): "
                               "the general path's",
     ('Geneva RPR', 'array'): "an intermittent lever's engagement is reported (wheel): "
@@ -193,7 +205,8 @@ def test_every_kind_compiles_the_nodes_tick_to_the_same_bits(kind):
         return general(*args)
 
     tick = compile_scene(scene, Tick(scene.output_joints, scene.output_points, (), fallback))
-    assert _expect(kind, 'tick', tick)
+    if not _expect(kind, 'tick', tick):
+        return  # its reason, as NOT_COMPILED expects: the node serves the general tick
     drivers = scene.drivers
     refused = instants = 0
     if scene.input is not None and len(drivers) == 1:

@@ -61,6 +61,9 @@ def test_every_packaged_scene_solves_alike_compiled(name):
     if name == 'geneva':    # its state reports the lever's engagement: the general path's
         assert fast._solver.compiled_single == NotCompiled(
             "an intermittent lever's engagement is reported (wheel): the general path's")
+    elif name == 'stephenson_iii':  # a triad's kernel loops over its roots: the general path's
+        assert fast._solver.compiled_single == NotCompiled(
+            'step triad coupler: kernel uses `try` (not in the kernel subset)')
     else:
         assert fast._solver.compiled_single, f'{name} does not compile'
     refused = _assert_same(fast, slow, ANGLES, speeds=(None, -3.5, 1e4), turns=(0, 3))
@@ -83,7 +86,10 @@ def test_the_extreme_suite_refuses_and_answers_alike():
 def test_every_packaged_scene_solves_arrays_alike_compiled(name):
     """Arrays of angles, speeds and turns, three tolerances: identical states, masks, bounds."""
     fast, slow = _pair(lambda: mk.load_scene(name))
-    if name != 'geneva':
+    if name == 'stephenson_iii':  # a triad's kernel loops over its roots: the general path's
+        assert fast._solver.compiled_array == NotCompiled(
+            'step triad coupler: kernel uses `try` (not in the kernel subset)')
+    elif name != 'geneva':
         assert fast._solver.compiled_array, f'{name} does not compile'
         # ({} below: the usual call, at the scene's own rates, compiled for them)
         assert fast._solver.compiled_usual, f'{name} has no compiled usual call'
