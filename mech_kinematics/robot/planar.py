@@ -32,8 +32,10 @@ From a :class:`~.description.Description` and its actuated joints:
    class II): RRR (two links, or a link and a cylinder), RRP (a link and a
    block on a guide of the ground), RPR (a lever on a ground pivot, its slot
    through the pivot, and the block in it), RPP (a yoke on a ground guide and
-   the block in its slot). Each dyad's branch is the reference pose's. What
-   no dyad places (a class-III group such as a triad) is refused.
+   the block in its slot). Where no dyad is ready, a triad (class III: a
+   link with three pins to three unplaced links, each pinned to a placed
+   body). Each group's branch is the reference pose's. What neither places
+   (a group of a higher class) is refused.
 
 The result is a scene mapping (what ``urdf2scene`` writes, read by
 :func:`~mech_kinematics.scene.parse_scene`) and, for every URDF joint of
