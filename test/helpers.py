@@ -770,6 +770,18 @@ def scene_mapping(name, ground, dyads=(), points=None, **drivers):
     return data
 
 
+def triad_scene():
+    """Return a scene with one triad (class III): a crank, a ternary coupler, three arms."""
+    return scene_mapping(
+        'triad', {'A': [0, 0], 'D': [81, 27]}, input=crank_entry(25, 30, 60, 0.0),
+        points={'C': {'link': 'crank', 'origin': 'A', 'xaxis': 'B', 'local': [25, -43]}},
+        dyads=[{'type': 'triad', 'link': {'name': 'coupler', 'pins': ['E', 'F', 'G'],
+                                          'length': 74, 'local': [41, 32]},
+                'links': [{'name': 'link_e', 'from': 'B', 'length': 75},
+                          {'name': 'link_f', 'from': 'C', 'length': 92},
+                          {'name': 'rocker', 'from': 'D', 'length': 82}], 'angle': -111}])
+
+
 def gepetto_five_bar_reference(closures: Any = None) -> dict:
     """Return a pose of Gepetto's five-bar that closes it (its zero pose is 0.3 m open).
 

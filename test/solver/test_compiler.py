@@ -20,7 +20,8 @@ import importlib
 import math
 
 from helpers import (array_outcome, crank_entry, equilateral_chain, general_only,
-                     general_tick_outcome, scene_mapping, solve_outcome, tick_outcome)
+                     general_tick_outcome, scene_mapping, solve_outcome, tick_outcome,
+                     triad_scene)
 import numpy as np
 import pytest
 
@@ -67,14 +68,7 @@ GENERATORS = {
         dyads=[{'type': 'RPP', 'point': 'Y', 'through': 'B',
                 'guide': {'through': 'A', 'angle': 0}, 'slot_angle': 90, 'slider': 'yoke',
                 'slot_slider': 'pin_in_slot'}]),
-    'triad': lambda: scene_mapping(
-        'triad', {'A': [0, 0], 'D': [81, 27]}, input=crank_entry(25, 30, 60, 0.0),
-        points={'C': {'link': 'crank', 'origin': 'A', 'xaxis': 'B', 'local': [25, -43]}},
-        dyads=[{'type': 'triad', 'link': {'name': 'coupler', 'pins': ['E', 'F', 'G'],
-                                          'length': 74, 'local': [41, 32]},
-                'links': [{'name': 'link_e', 'from': 'B', 'length': 75},
-                          {'name': 'link_f', 'from': 'C', 'length': 92},
-                          {'name': 'rocker', 'from': 'D', 'length': 82}], 'angle': -111}]),
+    'triad': triad_scene,
     'actuator': lambda: scene_mapping(
         'actuator', {'O': [0, 0], 'F': [400, -1100]},
         inputs=[{'actuator': 'cyl', 'length': 2600, 'speed': 100, 'stroke': [2000, 3300]}],

@@ -33,7 +33,7 @@ import functools
 import math
 import warnings
 
-from helpers import crank_entry, MM_DEG, scene_mapping
+from helpers import crank_entry, MM_DEG, scene_mapping, triad_scene
 from hypothesis import assume, given, HealthCheck, settings
 from hypothesis import strategies as st
 import mpmath
@@ -101,14 +101,7 @@ GEOMETRIES = {
         points={'E': {'link': 'coupler', 'from': 'B', 'toward': 'C', 'distance': 40},
                 'F': {'link': 'coupler', 'origin': 'B', 'xaxis': 'C', 'local': [40, -30]},
                 'G': {'link': 'rocker', 'origin': 'D', 'xaxis': 'C', 'local': [30, 25]}}),
-    'triad': lambda: scene_mapping(
-        'triad', {'A': [0, 0], 'D': [81, 27]}, input=crank_entry(25, 30, 60, 0.0),
-        points={'C': {'link': 'crank', 'origin': 'A', 'xaxis': 'B', 'local': [25, -43]}},
-        dyads=[{'type': 'triad', 'link': {'name': 'coupler', 'pins': ['E', 'F', 'G'],
-                                          'length': 74, 'local': [41, 32]},
-                'links': [{'name': 'link_e', 'from': 'B', 'length': 75},
-                          {'name': 'link_f', 'from': 'C', 'length': 92},
-                          {'name': 'rocker', 'from': 'D', 'length': 82}], 'angle': -111}]),
+    'triad': triad_scene,
     'Geneva RPR': lambda: scene_mapping(
         'geneva', {'D': [0, 0], 'S': [-70.71067811865476, 0]},
         input={'link': 'driver', 'center': 'D', 'point': 'P', 'length': 50, 'angle': 150,
