@@ -420,6 +420,11 @@ def _parse_xml(text: str, source: str) -> Any:
     from lxml import etree
     parser = etree.XMLParser(resolve_entities=False, no_network=True, huge_tree=False,
                              remove_comments=True, remove_pis=True, load_dtd=False)
+    nul = text.find('\x00')
+    if nul >= 0:  # named here: libxml2 may report it as the tag it cut short
+        line, column = text.count('\n', 0, nul) + 1, nul - text.rfind('\n', 0, nul)
+        raise _fail(source, f'Expected a URDF (XML), got text that is not XML: a NUL character '
+                            f'(U+0000), line {line}, column {column}')
     data = text.encode('utf-8')
     try:
         # Fed in pieces: between two a signal's handler runs (the node's start ends at once
