@@ -153,8 +153,9 @@ def test_a_nul_in_a_urdf_is_one_line(tmp_path, capsys, where):
     status, out, err = solve_urdf_text(tmp_path, capsys, text)
     assert (status, out) == (2, '')
     assert len(err.splitlines()) == 1
-    assert err.rstrip('\n').endswith('Expected a URDF (XML), got text that is not XML: a NUL '
-                                      f'character (U+0000), line {line}, column {column}')
+    said = ('Expected a URDF (XML), got text that is not XML: a NUL character (U+0000), '
+            f'line {line}, column {column}')
+    assert err.rstrip('\n').endswith(said), err
 
 
 def test_a_closure_point_at_1e308_is_refused_with_its_gap_and_no_warning(tmp_path, capsys):
