@@ -597,9 +597,9 @@ class _TriadStep(Step):
                                      for col in columns[k]) for k in range(6)]
             try:
                 values[j] = self.solve_one(float(angles[j]), *args)
-                ok[j] = True
             except _Refused:
-                pass
+                continue        # not ok: masked under this step's label below
+            ok[j] = True
         ctx.mask(ok.reshape(shape), self.label)
         nan = complex(math.nan, math.nan)
         blank = ([(nan, nan, nan, math.nan, math.nan, math.nan)] * 3,
