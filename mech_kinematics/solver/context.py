@@ -55,7 +55,8 @@ class _Context:
         self.valid: Any = True
         self.failures: dict[str, Any] = {}
         # Filled by the steps that have them (shared empty until then: never mutated).
-        self.engagement: dict[str, tuple[Any, Any]] = _NOTHING  # lever -> (engaged, window)
+        # lever -> (engaged, window, driven): see Engagement.
+        self.engagement: dict[str, tuple[Any, Any, Any]] = _NOTHING
         self.rubbing: dict[str, tuple[Any, Any]] = _NOTHING  # pin -> (value, bound)
         self.notes: dict[str, str] = _NOTHING  # label -> why a bound is large (scalar path)
         # At a jump (an engagement instant) the steps answer the side after it; with
@@ -76,11 +77,16 @@ class _Context:
             self.jumps = {}
         self.jumps[lever] = where
 
-    def engage(self, lever: str, engaged: Any, window: Any) -> None:
-        """Record where an intermittent lever is in its cycle (the tick drops it)."""
+    def engage(self, lever: str, engaged: Any, window: Any, driven: Any) -> None:
+        """Record where an intermittent lever is in its cycle (the tick drops it).
+
+        ``engaged``: its pin is in a slot (a mouth included); ``driven``: the
+        values answer the side where the pin drives it (else a lock holds it),
+        ``engaged`` but at a jump, where it is the side answered.
+        """
         if self.engagement is _NOTHING:
             self.engagement = {}
-        self.engagement[lever] = (engaged, window)
+        self.engagement[lever] = (engaged, window, driven)
 
     def note(self, label: str, why: Any) -> None:
         """Record why a dyad's bound is large, for a refusal's message (the tick drops it).

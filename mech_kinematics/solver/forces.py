@@ -17,6 +17,10 @@ acceleration, and its inertia times its angular acceleration plus the
 moment of that), every joint brings its unknowns (a pin its two force
 components, a prismatic joint the force normal to its line and the moment
 the line exerts, a driver its effort, a Geneva lock its holding moment).
+An intermittent joint acts on the side the kinematics answer
+(``Engagement.driven``: at a mouth, the side after the jump): its slot or
+its lock; :func:`~.solve.solve` solves the other side's forces too
+(``State.jumps['forces']``).
 The equations split by the kinds that added the bodies (each kind's part of
 the graph is an Assur group, statically determinate on its own, or a driver
 with its link): solved from the last group placed back to the drivers, each
@@ -317,6 +321,30 @@ class Forces:
                 'reactions': {name: r.as_dict(vector) for name, r in self.reactions.items()},
                 'shaking': {'force': _pair(self.shaking_force, vector),
                             'moment': value(self.shaking_moment)}}
+
+    def spread(self, at: Any, shape: tuple[int, ...]) -> Forces:
+        """Return these forces of the instants ``at`` (indices) in arrays of ``shape``.
+
+        NaN (a force: NaN + NaN i) at the other instants, ``valid`` False
+        there: the shape of ``State.jumps``' values.
+        """
+        def put(some: Any) -> Any:
+            if some is None:
+                return None
+            some = np.asarray(some)
+            out = np.full(shape, False if some.dtype == bool else np.nan, dtype=some.dtype)
+            out[at] = some
+            return out
+
+        reactions = {name: Reaction(r.at, r.on, r.by, put(r.force), put(r.normal),
+                                    put(r.moment), put(r.force_bound), put(r.normal_bound),
+                                    put(r.moment_bound)) for name, r in self.reactions.items()}
+        return Forces({n: put(v) for n, v in self.efforts.items()}, reactions,
+                      put(self.shaking_force), put(self.shaking_moment),
+                      {n: put(v) for n, v in self.effort_bounds.items()},
+                      (put(self.shaking_bounds[0]), put(self.shaking_bounds[1])),
+                      put(self.valid), put(self.scale),
+                      {reason: put(mask) for reason, mask in self.failures.items()})
 
     def bound_dict(self, vector: bool) -> dict[str, Any]:
         """Return the bounds, shaped like :meth:`as_dict`'s (a force's bound is one norm)."""
@@ -1146,7 +1174,7 @@ class _Subset:
             joints={name: motion(b) for name, b in bounds.joints.items()})
         self.joints = {name: motion(m) for name, m in state.joints.items()}
         self.scales = {name: take(v) for name, v in state.scales.items()}
-        self.intermittent = {name: SimpleNamespace(engaged=take(e.engaged))
+        self.intermittent = {name: SimpleNamespace(driven=take(e.driven))
                              for name, e in state.intermittent.items()}
 
 
@@ -1297,7 +1325,12 @@ class _Kinematics:
         return joint.position + line.angle, bound + U * abs(line.angle)
 
     def engaged(self, lever: str) -> Any:
-        return self.state.intermittent[lever].engaged
+        """Return whether an intermittent drive acts (else its lock), on the side answered.
+
+        ``Engagement.driven``: at an engagement instant the side the kinematics
+        answer (the lock holds at a mouth the pin leaves turning forward).
+        """
+        return self.state.intermittent[lever].driven
 
 
 def _expi(angle: float) -> complex:

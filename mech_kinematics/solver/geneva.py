@@ -49,7 +49,11 @@ class _IndexStep(_RPRStep):
     velocity, continuous there, keep bounds that cover both sides. The
     instant is recorded (``ctx.jump``); a context with ``flip`` set
     answers the side before the jump instead (how :func:`~.solve.solve`
-    finds the other side of every value that jumps).
+    finds the other side of every value that jumps). Which side is
+    answered is recorded too (``ctx.engage``'s ``driven``,
+    ``Engagement.driven``): the forces read it to let the slot carry the
+    wheel or the lock hold it, so at the exit turning forward the lock
+    holds, as the wheel is at rest.
     """
 
     intermittent = True
@@ -130,7 +134,6 @@ class _IndexStep(_RPRStep):
         engaged, window, r, er = self.window(ctx.angle, ctx.turns, ctx.vector)
         near = self.mouth(r, er)
         e, w, al, ee, ew, eal = ctx.links[self.link]
-        ctx.engage(self.link, engaged | near, window)
         m = np.mod(window, n)
         side = np.mod(2 * window + np.where(r > 0.0, 1, -1), 2 * n)
         t = self.turn_array[m]
@@ -157,7 +160,9 @@ class _IndexStep(_RPRStep):
                 np.where(near, ew + abs(w), np.where(inside, ew, 0.0)),
                 np.where(inside, np.where(near, self.e_jump * jump, eal), 0.0))
             ctx.jump(self.link, near)
+            ctx.engage(self.link, engaged | near, window, inside)
         else:
+            ctx.engage(self.link, engaged, window, engaged)
             entry = (
                 np.where(engaged, turned, held), np.where(engaged, w, 0.0),
                 np.where(engaged, al, 0.0), np.where(engaged, ee + e_turn, e_held),
@@ -177,12 +182,16 @@ class _IndexStep(_RPRStep):
         _, r, er = self.offset(angle, turns)
         return bool(self.mouth(r, er))
 
+    def jumps_over(self, angle: Any, turns: Any) -> Any:
+        """Return where an array of crank angles are engagement instants (``ctx.jump``'s mask)."""
+        _, _, r, er = self.window(angle, turns, True)
+        return self.mouth(r, er)
+
     def run_one(self, ctx: _Context) -> None:
         """Do :meth:`run_array` for one crank angle: the same operations, only those it needs."""
         window, r, er = self.offset(ctx.angle, ctx.turns)
         engaged = abs(r) <= self.half
         near = self.mouth(r, er)
-        ctx.engage(self.link, engaged or near, window)
         n = self.slots
         e, w, al, ee, ew, eal = ctx.links[self.link]
         if near:
@@ -191,6 +200,9 @@ class _IndexStep(_RPRStep):
             engaged = ((r < 0.0) == (crank >= 0.0)) != ctx.flip
             jump = crank * crank * self.tan
             ctx.jump(self.link, True)
+        # In the slot (its mouth included), and whether the pin drives the wheel on the
+        # side answered (else the lock holds it): what the forces act on.
+        ctx.engage(self.link, engaged or near, window, engaged)
         if engaged or near:
             m = window % n
             t = self.turn[m]
@@ -214,7 +226,7 @@ class _IndexStep(_RPRStep):
 
     def engagement(self, ctx: _Context, omega: Any, finish: Any) -> Engagement:
         """Return where the lever is in its cycle (see :class:`Engagement`)."""
-        engaged, window = ctx.engagement[self.link]
+        engaged, window, driven = ctx.engagement[self.link]
         centre = self.phase0 + (window.astype(np.float64) if ctx.vector
                                 else float(window)) * math.tau
         entry, exit_ = centre - self.half, centre + self.half
@@ -223,10 +235,12 @@ class _IndexStep(_RPRStep):
         if finish is not None:
             entry, exit_, jump, zero = finish(entry), finish(exit_), finish(jump), finish(zero)
             engaged = np.broadcast_to(engaged, np.shape(entry))
+            driven = np.broadcast_to(driven, np.shape(entry))
         # The fields go straight in, as in _new_state: a frozen dataclass's __init__ costs 1 us.
         record = object.__new__(Engagement)
         record.__dict__.update(engaged=engaged, window=window, entry=entry, exit=exit_,
-                               entry_acceleration=(zero, -jump), exit_acceleration=(jump, zero))
+                               entry_acceleration=(zero, -jump), exit_acceleration=(jump, zero),
+                               driven=driven)
         return record
 
 

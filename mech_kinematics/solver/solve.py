@@ -338,16 +338,74 @@ def solve(scene: Scene, angle: npt.ArrayLike, speed: npt.ArrayLike | None = None
 
 
 def _with_forces(scene: Scene, state: State, max_error: Any) -> State:
-    """Return ``state`` with its forces (:mod:`.forces`); refuse an instant they cannot bound."""
-    forces = scene.dynamics.forces(state, float(max_error))  # type: ignore[union-attr]
+    """Return ``state`` with its forces (:mod:`.forces`); refuse an instant they cannot bound.
+
+    The forces answer the side the kinematics answer (``Engagement.driven``
+    picks what acts: a Geneva slot or its lock); where a value jumps, the
+    other side's forces go to ``jumps['forces']`` (:func:`_other_side`), an
+    instant whose other side they cannot bound refused as its own would be.
+    """
+    dynamics = scene.dynamics
+    assert dynamics is not None
+    forces = dynamics.forces(state, float(max_error))
+    other = _other_side(scene, state) if state.jumps else None
     if isinstance(state.valid, np.ndarray):
         failures = dict(state.failures)
         failures.update(forces.failures)
         valid = state.valid & np.asarray(forces.valid, dtype=bool)
-        return replace(state, forces=forces, valid=valid, failures=failures)
+        if other is None:
+            return replace(state, forces=forces, valid=valid, failures=failures)
+        before, at = other
+        part = dynamics.forces(before, float(max_error))
+        for reason, mask in part.failures.items():
+            full = np.zeros(valid.shape, dtype=bool)
+            full[at] = mask
+            failures[reason] = failures[reason] | full if reason in failures else full
+        valid[at] &= np.asarray(part.valid, dtype=bool)
+        jumps = {**state.jumps, 'forces': part.spread(at, valid.shape)}
+        return replace(state, forces=forces, valid=valid, failures=failures, jumps=jumps)
     if not forces.valid:
         refuse_forces(state, forces, max_error)
-    return replace(state, forces=forces)
+    if other is None:
+        return replace(state, forces=forces)
+    part = dynamics.forces(other[0], float(max_error))
+    if not part.valid:
+        refuse_forces(other[0], part, max_error)
+    return replace(state, forces=forces, jumps={**state.jumps, 'forces': part})
+
+
+def _other_side(scene: Scene, state: State) -> tuple[State, Any] | None:
+    """Return the kinematic state on the other side of ``state``'s jumps, and its instants.
+
+    Solved with ``flip`` as :func:`_jumps` solves the other side of the
+    values: for one instant, that instant (``at`` None); for an array, the
+    instants where a value jumps (``at``, their indices), None where none
+    does. Its forces are the other side's (:func:`_with_forces`).
+    """
+    solver = scene._solver
+    theta, omega, alpha, turns = state.angle, state.speed, state.accel, state.turns
+    if not isinstance(state.valid, np.ndarray):
+        ctx = _execute(solver, theta, omega, alpha, turns, flip=True)
+        return _state(scene, solver, ctx, theta, omega, alpha, True, turns, {},
+                      state.drivers), None
+    shape = state.valid.shape
+    near = np.zeros(shape, dtype=bool)
+    for lever in solver.levers.values():
+        near |= lever.jumps_over(theta, turns)
+    at = np.flatnonzero(near & state.valid)
+    if not at.size:
+        return None
+
+    def subset(x: Any) -> Any:
+        return np.broadcast_to(x, shape)[at]
+
+    theta, omega, alpha, turns = subset(theta), subset(omega), subset(alpha), subset(turns)
+    with np.errstate(all='ignore'):
+        ctx = _execute(solver, theta, omega, alpha, turns, flip=True)
+    valid = np.broadcast_to(np.asarray(ctx.valid, dtype=bool), at.shape).copy()
+    drivers = {name: JointMotion(j.type, subset(j.position), subset(j.velocity),
+                                 subset(j.acceleration)) for name, j in state.drivers.items()}
+    return _state(scene, solver, ctx, theta, omega, alpha, valid, turns, {}, drivers), at
 
 
 def refuse_forces(state: State, forces: Any, max_error: Any) -> None:

@@ -85,6 +85,13 @@ class Engagement:
         crank speed omega: ``(0, -omega^2 tan(pi / n))`` and
         ``(omega^2 tan(pi / n), 0)``. The angular velocity is 0 at both ends
         (the pin enters and leaves tangentially); the acceleration jumps.
+    driven : bool or ndarray of bool
+        Whether the values answer the side where the pin drives the lever
+        (False: the side where its lock holds it): ``engaged`` everywhere
+        but at an engagement instant (an entry or exit, in ``State.jumps``),
+        where it is the side answered, after the jump in the crank's sense
+        of motion. The forces follow it (:mod:`.forces`: the slot carries
+        the lever, or the lock does); the other side's are in ``jumps``.
     """
 
     engaged: bool | npt.NDArray[np.bool_]
@@ -93,6 +100,7 @@ class Engagement:
     exit: Number
     entry_acceleration: tuple[Number, Number]
     exit_acceleration: tuple[Number, Number]
+    driven: bool | npt.NDArray[np.bool_]
 
     def as_dict(self, vector: bool) -> dict[str, Any]:
         """Return the structure of ``State.as_dict()['intermittent'][LEVER]``."""
@@ -159,7 +167,14 @@ class State:
         whatever is carried on it or solved from it):
         ``{'joints': {name: {'acceleration': x}}, 'points': {name:
         {'acceleration': ndarray, shape (2,)}}}``. For arrays, shapes (n,) and
-        (n, 2), NaN at the angles where nothing jumps.
+        (n, 2), NaN at the angles where nothing jumps. A scene with forces
+        adds ``'forces'``: the other side's :class:`~.forces.Forces`, whole
+        (every effort, reaction and the shaking, with their bounds; the
+        state's ``forces`` answer the side the kinematics do: at a Geneva
+        wheel's mouth, the pin's slot carrying it or the lock holding it,
+        ``Engagement.driven``); for arrays NaN where nothing jumps. In
+        :meth:`as_dict`, its ``"efforts"``, ``"reactions"`` and ``"shaking"``
+        sit in ``"jumps"`` beside ``"joints"`` and ``"points"``.
     drivers : dict of str to JointMotion
         Every driver's own motion, in scene order, as given to the solve
         (whether or not the scene's outputs report its joint): a crank's angle
@@ -286,7 +301,9 @@ class State:
             **({'jumps': {'joints': {name: {'acceleration': value(x['acceleration'])}
                                      for name, x in self.jumps['joints'].items()},
                           'points': {name: {'acceleration': pair(x['acceleration'])}
-                                     for name, x in self.jumps['points'].items()}}}
+                                     for name, x in self.jumps['points'].items()},
+                          **(self.jumps['forces'].as_dict(vector)
+                             if 'forces' in self.jumps else {})}}
                if self.jumps else {}),
             **({'imus': {name: r.as_dict(vector) for name, r in self.imus.items()}}
                if self.imu_specs else {}),

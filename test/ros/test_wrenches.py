@@ -24,6 +24,7 @@ from mech_kinematics.ros.ticker import compiled_tick
 from mech_kinematics.ros.wrenches import (dynamics_with, effort_status, force_parameters,
                                           ForceMessages, forces_tick, forces_values,
                                           ForcesTick, reaction_wrench, wrench_stamped)
+from mech_kinematics.solver import forces as mk_forces
 from mech_kinematics.solver.forces import Forces
 
 #: The packaged scenes with masses, gravity or loads.
@@ -252,3 +253,27 @@ def test_warming_writes_the_forces_out_before_any_tick_and_changes_no_value(name
         except mk.AssemblyError:
             continue
     assert set(dynamics._fast) == set(written)
+
+
+@pytest.mark.parametrize('speed', [10.0, -10.0])
+@pytest.mark.parametrize('degrees', [135.0, 225.0])
+def test_the_tick_publishes_a_geneva_mouths_forces_on_the_kinematics_side(degrees, speed):
+    """At the pin's entry and exit the tick's forces are mk.solve's: the lock where it holds.
+
+    Issue 43: the pin was published pushing where the wheel was at rest and
+    locked (the exit turning CCW, the entry turning CW).
+    """
+    scene = replace(mk.load_scene('geneva'), masses=(mk_forces.Mass('wheel', 2.0, inertia=0.01),),
+                    loads=(mk_forces.Load('brake', link='wheel', torque=0.3),))
+    tick = _tick(scene)
+    theta = math.radians(degrees)
+    values, _ = tick(theta, speed, 0.0, TOL, 0)
+    state = mk.solve(scene, theta, speed, 0.0, max_error=TOL)
+    assert values[tick.forces_first:] == forces_values(state.forces, state, scene.output_joints,
+                                                       tick.reactions)
+    lock = [j.name for j in tick.reactions].index('wheel/lock')
+    start = tick.forces_first + len(scene.output_joints) + 3 * lock
+    holds = (degrees == 225.0) == (speed > 0.0)     # the wheel at rest after the mouth
+    assert values[start:start + 3] == ([0.0, 0.0, pytest.approx(-0.3, rel=1e-14)] if holds
+                                       else [0.0, 0.0, 0.0])
+    assert (state.joints['wheel'].acceleration == 0.0) is holds
