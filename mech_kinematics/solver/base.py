@@ -159,6 +159,9 @@ class Intermittent(Protocol):
     def jumps_at(self, angle: float, turns: int) -> bool:
         """Return whether one crank angle (plus whole turns) is within rounding of a jump."""
 
+    def jumps_over(self, angle: Any, turns: Any) -> Any:
+        """Return where an array of crank angles (plus whole turns) are within rounding of one."""
+
 
 class Names(Protocol):
     """What the plan compiler lets an item check its references against."""
