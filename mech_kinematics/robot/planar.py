@@ -58,6 +58,7 @@ from typing import Any
 
 import numpy as np
 
+from .assembly import revolute_centre
 from .description import Closure, ClosureKind, Description, UrdfJoint
 from .transforms import Matrix
 from ..errors import UrdfError
@@ -1143,7 +1144,7 @@ class _Builder:
             if joint.type.angular:
                 child, child_ref = self.turns[edge.b]
                 parent, parent_ref = self.turns[edge.a]
-                centre = 0.0 if joint.limits is None else 0.5 * sum(joint.limits)
+                centre = revolute_centre(joint)
                 self.joint_maps[joint.name] = JointMap(
                     joint.name, REVOLUTE, m.sign(edge), reference, child, child_ref, parent,
                     parent_ref, center=centre, mechanism=m.index)
@@ -1387,7 +1388,7 @@ def planar_from_description(description: Description, actuated: Iterable[str] | 
             body = body_of[joint.child]
             if body in m.bodies:
                 turn, turn_ref = builder.turns[body]
-                centre = 0.0 if joint.limits is None else 0.5 * sum(joint.limits)
+                centre = revolute_centre(joint)
                 builder.joint_maps[name] = JointMap(
                     name, REVOLUTE, 1.0, pose.get(name, 0.0), turn, turn_ref, turn, turn_ref,
                     center=centre, mechanism=index)

@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from .assembly import Assemblies, pick, wrap_revolute
 from .description import Description, read_description
 from .forces import (check_gravity, ForcesLeftOut, GRAVITY, JointReaction, robot_forces,
                      RobotEfforts, with_payloads)
@@ -44,13 +45,6 @@ __all__ = ['MIMIC_TOLERANCE', 'Robot', 'RobotState', 'load_robot']
 #: A joint strays from its ``<mimic>`` rule when they differ by more (rad or m).
 MIMIC_TOLERANCE = 1e-9
 _EPS = float(np.finfo(np.float64).eps)
-
-
-def _wrap(value: Any, centre: float) -> Any:
-    """Return an angle within pi of ``centre`` (a float for a float, an array for an array)."""
-    if isinstance(value, np.ndarray):
-        return centre + np.remainder(value - centre + math.pi, math.tau) - math.pi
-    return centre + math.remainder(value - centre, math.tau)
 
 
 @dataclass(frozen=True)
@@ -220,6 +214,8 @@ class Robot:
                        is not None and rule.joint in known}
         self.gravity: tuple[float, float, float] = GRAVITY
         self.forces = robot_forces(self)
+        #: The loops whose ``<mimic>`` rules pick their assembly (:mod:`.assembly`).
+        self.assemblies = Assemblies(self, MIMIC_TOLERANCE)
 
     @classmethod
     def from_urdf(cls, source: str | os.PathLike[str], closures: str | os.PathLike[str] | None
@@ -327,10 +323,7 @@ class Robot:
         inputs = self._inputs(positions, speeds, accels)
         p, v, a = self.scene_inputs(inputs)
         try:
-            if len(p) == 1:  # one driver: solve's one-driver signature takes bare values
-                state = solve(self.scene, p[0], v[0], a[0], max_error=max_error)
-            else:
-                state = solve(self.scene, p, v, a, max_error=max_error)
+            state = self._assembled(p, v, a, inputs, max_error)
         except AssemblyError as error:  # one instant (arrays mask what they refuse)
             raise error.located(self.where({n: x[0] for n, x in inputs.items()})) from None
         answer = self.joints_from_state(state, inputs)
@@ -351,6 +344,44 @@ class Robot:
             efforts, {n: float(j.position) for n, j in answer.joints.items()},
             {n: float(b[0]) for n, b in answer.bounds.items()})
         return replace(answer, efforts=efforts, reactions=reactions)
+
+    def _assembled(self, p: list[Any], v: list[Any], a: list[Any],
+                   inputs: Mapping[str, tuple[Any, Any, Any]], max_error: float) -> State:
+        """Return the scene's state in the assembly answered (:mod:`.assembly`).
+
+        The reference pose's branches, unless a loop's ``<mimic>`` rules pick
+        another: then the scene in that assembly, solved (for arrays, each
+        instant in its own, merged).
+        """
+        def one(scene: Scene) -> State:
+            if len(p) == 1:  # one driver: solve's one-driver signature takes bare values
+                return solve(scene, p[0], v[0], a[0], max_error=max_error)
+            return solve(scene, p, v, a, max_error=max_error)
+
+        assemblies = self.assemblies
+        if not assemblies:
+            return one(self.scene)
+        states: dict[tuple[int, ...], State] = {}
+
+        def at(combo: tuple[int, ...]) -> dict[str, Any] | None:
+            if combo not in states:
+                try:
+                    states[combo] = one(assemblies.scene(combo, self.scene))
+                except AssemblyError:
+                    if combo == assemblies.zero:
+                        raise
+                    return None
+            answer = self.joints_from_state(states[combo], inputs)
+            return {n: j.position for n, j in answer.joints.items()}
+
+        chosen = {combo: mask for combo, mask in assemblies.choose(at).items()
+                  if at(combo) is not None}   # (one that does not assemble: the reference's)
+        if len(chosen) <= 1:
+            return states[next(iter(chosen), assemblies.zero)]
+        merged = states[assemblies.zero]
+        for combo, mask in chosen.items():
+            merged = pick(mask, states[combo], merged)
+        return merged
 
     def where(self, positions: Mapping[str, Any] | Iterable[Any]) -> str:
         """Return where the loops' actuated joints stand, for a message: ``j3 = 0.5 rad``.
@@ -431,7 +462,7 @@ class Robot:
             size += abs(ref) + math.pi
         value = item.reference + item.sigma * p
         if item.type.angular:
-            value = _wrap(value, item.center)
+            value = wrap_revolute(value, item.center)
         # The sums above and the wrap round each once or twice more.
         rounding = 8 * _EPS * (size + abs(item.reference) + np.abs(value))
         motion = JointMotion(item.type, value, item.sigma * v, item.sigma * a)
@@ -444,7 +475,7 @@ class Robot:
             expected = rule.multiplier * joints[rule.joint].position + rule.offset
             stray = joints[name].position - expected
             if self.joint_type(name).angular:
-                stray = _wrap(stray, 0.0)
+                stray = wrap_revolute(stray)
             if np.any(np.abs(stray) > MIMIC_TOLERANCE):
                 out[name] = {'leader': rule.joint, 'rule': expected, 'stray': stray}
         return out

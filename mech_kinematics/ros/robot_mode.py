@@ -41,7 +41,8 @@ from dataclasses import dataclass, replace
 import math
 from typing import Any
 
-from ..errors import SceneError
+from ..errors import AssemblyError, SceneError
+from ..robot.assembly import wrap_revolute
 from ..scene import DEFAULT_SCENE, load_scene, scene_text
 from ..solver.mechanism import Scene
 
@@ -287,6 +288,7 @@ class RobotValues:
                 self._topic.append(recipe)
         self._on_clock = self._compile(self._time, 'on_clock')
         self._on_input = self._compile(self._topic, 'on_input')
+        self.assemblies = robot.assemblies
 
     @staticmethod
     def coordinates(robot: Any) -> tuple[str, ...]:
@@ -329,6 +331,36 @@ class RobotValues:
             return self._on_clock(values, None, None)
         return self._on_input(values, given[0], given[1])
 
+    def answer(self, first: tuple[Sequence[float], float],
+               given: tuple[Sequence[float], Sequence[float] | None],
+               solve: Any) -> tuple[list[float], float]:
+        """Return an input's URDF joints (:meth:`values`) and measure, in the assembly answered.
+
+        ``first``: the tick's (values, measure) in the reference assembly;
+        ``solve(combo)`` those of the scene in assembly ``combo``
+        (:class:`~mech_kinematics.robot.assembly.Assemblies`, the rule
+        :meth:`Robot.solve <mech_kinematics.robot.Robot.solve>` applies to
+        the same bits: the node answers what it answers).
+        """
+        assemblies = self.assemblies
+        out = self.values(first[0], given)
+        if not assemblies:
+            return out, first[1]
+        m = len(self.names)
+        answers = {assemblies.zero: (out, first[1])}
+
+        def at(combo: tuple[int, ...]) -> dict[str, float] | None:
+            if combo not in answers:
+                try:
+                    values, measure = solve(combo)
+                except AssemblyError:
+                    return None
+                answers[combo] = (self.values(values, given), measure)
+            return dict(zip(self.names, answers[combo][0][:m], strict=True))
+
+        (combo,) = assemblies.choose(at)
+        return answers[combo] if at(combo) is not None else answers[assemblies.zero]
+
     def _compile(self, recipes: Sequence[tuple[Any, ...]], what: str) -> Any:
         """Return the recipes written out as one function ``f(values, positions, speeds)``.
 
@@ -351,7 +383,7 @@ class RobotValues:
                                           for sign, i, _ in terms)])
                 value = f'{reference!r} + {sigma!r} * ({dp})'
                 if centre is not None:
-                    value = f'{centre!r} + _remainder(({value}) - {centre!r}, _TAU)'
+                    value = f'_wrap({value}, {centre!r})'
                 lines += [f'    p{j} = {value}', f'    v{j} = {sigma!r} * ({dv})',
                           f'    a{j} = {sigma!r} * ({da})']
             elif kind == 'given':
@@ -371,7 +403,7 @@ class RobotValues:
                           f'    a{j} = {m!r} * a{leader}']
         joints = ', '.join(f'{q}{j}' for q in 'pva' for j in range(len(recipes)))
         lines.append(f'    return [{joints}, *x[{3 * n}:{3 * n + self._points}]]')
-        namespace: dict[str, Any] = {'_remainder': math.remainder, '_TAU': math.tau}
+        namespace: dict[str, Any] = {'_wrap': wrap_revolute}   # Robot.solve's, the one wrap
         exec(compile('\n'.join(lines) + '\n', f'<URDF joints {what}>', 'exec'),  # noqa: S102
              namespace)
         return namespace[what]

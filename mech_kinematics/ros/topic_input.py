@@ -35,6 +35,7 @@ from . import topics
 from .cdr import marker, MessageTemplate, STAMP_MARKER
 from .messages import TickMessages
 from .publishing import qos_options, RCLError
+from .ticker import general_tick
 from .topic_drive import RefusedInput, TopicDrive, TopicInput
 from ..errors import AssemblyError, UntrustedError
 from ..solver.context import NEAR_SINGULAR
@@ -96,6 +97,8 @@ class InputSubscription:
         self.node, self.solver, self.publishing, self.stats = node, solver, publishing, stats
         self.frame_id = frame_id
         self.robot = robot
+        self.scene = scene
+        self._assembly_ticks: dict[tuple[int, ...], Any] = {}
         joints, points = scene.output_joints, scene.output_points
         drivers = scene.drivers
         if robot is not None:
@@ -153,8 +156,10 @@ class InputSubscription:
             given = topic.read(stamp.sec, stamp.nanosec, msg.name, msg.position, msg.velocity,
                                msg.effort)
             values, measure = self._solve(given)
-            if self.robot is not None:
-                values = self.robot.values(values, (given.positions, given.speeds))
+            if self.robot is not None:   # in the assembly Robot.solve answers (robot/assembly.py)
+                values, measure = self.robot.answer(
+                    (values, measure), (given.positions, given.speeds),
+                    lambda combo: self._solve(given, self._assembly_tick(combo)))
         except (RefusedInput, AssemblyError) as exc:
             if isinstance(exc, AssemblyError) and self.robot is not None and given is not None:
                 exc = exc.located(self.robot.where(given.positions))  # the URDF's joints
@@ -242,11 +247,23 @@ class InputSubscription:
         except ValueError:
             return None
 
-    def _solve(self, given: TopicInput) -> tuple[Any, float]:
+    def _assembly_tick(self, combo: tuple[int, ...]) -> Any:
+        """Return the tick of the robot's scene in another assembly (the general solver's)."""
+        tick = self._assembly_ticks.get(combo)
+        if tick is None:
+            frames = [(f.origin, f.angle_of, f.angle) for f in self.publishing.frames]
+            scene = self.robot.assemblies.scene(combo, self.scene)
+            tick = general_tick(scene, self.scene.output_joints, self.scene.output_points,
+                                frames)
+            self._assembly_ticks[combo] = tick
+        return tick
+
+    def _solve(self, given: TopicInput, tick: Any = None) -> tuple[Any, float]:
         """Return (the tick function's values, the singularity measure) for one input.
 
         Unknown velocities are solved as zero and left out of what is published;
-        the accelerations are never published.
+        the accelerations are never published. ``tick``: another tick function
+        than the solver's (the robot's scene in another assembly).
         """
         solver = self.solver
         positions, speeds = given.positions, given.speeds
@@ -254,7 +271,8 @@ class InputSubscription:
             positions, speeds = self.robot.scene_inputs(positions, speeds)
         n = len(positions)
         speeds = (0.0,) * n if speeds is None else speeds
-        assert solver.solve is not None
+        solve = solver.solve if tick is None else tick
+        assert solve is not None
         if n == 1:
-            return solver.solve(positions[0], speeds[0], 0.0, solver.max_error, 0)
-        return solver.solve(positions, speeds, (0.0,) * n, solver.max_error, (0,) * n)
+            return solve(positions[0], speeds[0], 0.0, solver.max_error, 0)
+        return solve(positions, speeds, (0.0,) * n, solver.max_error, (0,) * n)

@@ -34,6 +34,7 @@ from tf2_msgs.msg import TFMessage
 from trajectory_msgs.msg import JointTrajectory
 import yaml
 
+import mech_kinematics as mk
 from mech_kinematics.robot import load_robot
 from mech_kinematics.ros.startup import MAX_ARGUMENT_FILE_BYTES
 from mech_kinematics.scene import MAX_FILE_BYTES
@@ -234,6 +235,55 @@ def test_a_urdf_exported_open_runs_from_its_reference_pose(ros, tmp_path):
         assert list(msg.position) == [answer.joints[n].position for n in robot.joint_names]
         gaps = fk.gaps(dict(zip(msg.name, msg.position, strict=True)))
         assert max(gap / fk.loop_size(c) for c, gap in gaps.items()) <= RTOL_CLOSURE
+
+
+#: Motor states (finger_joint rad, rad/s) sent to the gripper: through both change points of
+#: its parallelograms (near 1.94 and 5.08 rad), a jump of more than pi, 40 rad, back.
+ONE_ANSWER = [(0.3, 0.5), (1.0, -1.0), (2.5, 2.0), (-1.5, 0.0), (3.6, 1.5), (5.5, -0.7),
+              (40.0, 3.0), (-3.0, 0.1), (12.0, -2.0), (0.2, 0.0)]
+
+
+def test_the_node_answers_what_robot_solve_answers_to_the_bit(ros, tmp_path):
+    """Issue 43, item 5: every published joint == Robot.solve's for the same motor state.
+
+    The Robotiq 2F-85 in topic drive, its <mimic> rules picking the parallel
+    assembly wherever the reference branch alone answered the crossed one;
+    each state, whatever the one before (a jump of 3.7 rad, 40 rad after
+    5.5), is answered as Robot.solve answers it: positions and velocities
+    equal (==), no mimic stray, loops closed in the test's own kinematics.
+    """
+    robot = 'robotiq_2f_85'
+    node = UrdfNode(ros, tmp_path, 'urdf_one_answer', robot, '-p',
+                    f'scene:={DATA / f"{robot}.urdf"}', '-p',
+                    f'loop_closures:={DATA / f"{robot}.loop_closures.yaml"}', '-p',
+                    'extra_joints:=ignore')
+    try:
+        node.start()
+        for i, (q, w) in enumerate(ONE_ANSWER):
+            node.send(T0 + i * NS, [q], [w])
+        wait_for(lambda: len(node.js) >= len(ONE_ANSWER) or node.proc.proc.poll() is not None,
+                 ANSWER_S, 'every motor state answered')
+    finally:
+        node.stop()
+    robot_ = node.robot
+    fk = UrdfFk(node.urdf.read_text(), node.closures)
+    assert [stamp_ns(msg) for msg in node.js] == [T0 + i * NS for i in range(len(ONE_ANSWER))]
+    crossed = []
+    for i, (msg, (q, w)) in enumerate(zip(node.js, ONE_ANSWER, strict=True)):
+        answer = robot_.solve({'finger_joint': q}, {'finger_joint': w})
+        assert answer.mimic == {}
+        assert msg.name == list(robot_.joint_names)
+        assert list(msg.position) == [answer.joints[n].position for n in robot_.joint_names]
+        assert list(msg.velocity) == [answer.joints[n].velocity for n in robot_.joint_names]
+        gaps = fk.gaps(dict(zip(msg.name, msg.position, strict=True)))
+        assert max(gap / fk.loop_size(c) for c, gap in gaps.items()) <= RTOL_CLOSURE
+        # The zero pose's branches alone (robot.scene) answer the crossed assembly here.
+        inputs = {'finger_joint': (q, w, 0.0)}
+        p, v, a = robot_.scene_inputs(inputs)
+        alone = robot_.joints_from_state(mk.solve(robot_.scene, p, v, a), inputs)
+        if alone.mimic:
+            crossed.append(i)
+    assert crossed == [2, 3, 4, 6, 7]     # 2.5, 4.78 less a turn, 3.6, 40 and 3.28 less a turn
 
 
 def test_a_robot_description_over_1_mib_is_taken_from_a_params_file(ros, tmp_path):
