@@ -47,6 +47,7 @@ from .driver import TickDriver
 from .node_parameters import NodeParameters
 from .parameters import CATCH_UP, extra_joints_default, spec, TOPIC
 from .publishing import diagnostic_array, Markers, Publishing, qos_options, tf_period_ns
+from .robot_forces import robot_forces_note, robot_forces_tick
 from .robot_mode import load_source, robot_forces_refusal
 from .schedule import period_ns_from_rate
 from .solver_path import SolverPath
@@ -54,7 +55,7 @@ from .startup import stop_raises
 from .tick_thread import TickThread, TickThreadError
 from .topic_input import InputSubscription
 from .watchdog import PublishWatch, PublishWatchdog
-from .wrenches import dynamics_with, effort_status, forces_tick, ForcesTick
+from .wrenches import effort_status, forces_tick, ForcesTick
 from ..errors import SceneError
 from ..solver.context import NEAR_SINGULAR
 from ..units import NS_PER_S
@@ -115,6 +116,7 @@ class KinematicsNode(LifecycleNode):
         self._markers: Markers | None = None
         self._input: InputSubscription | None = None
         self._forces: ForcesTick | None = None
+        self._has_forces = False
         self._watchdog: PublishWatchdog | None = None    # once the parameters are declared
         failure = self.create_guard_condition(self._on_failure)
         self._ticks = TickThread(self.get_clock(), self._driver, self._stats, self.get_logger(),
@@ -157,10 +159,9 @@ class KinematicsNode(LifecycleNode):
             self._input.topic.jump_back_ns = round(changes['stamp_jump_back_s'] * NS_PER_S)
         forces = self.params.force_changes(changes) if self.params is not None else {}
         if forces and self._forces is not None:
-            # A new Dynamics over the same graph, its code written out here, read by the
-            # tick at its next instant.
-            self._forces.dynamics = self._forces.warm(
-                dynamics_with(self._forces.dynamics, forces))
+            # The forces' new model, its code written out here, read by the tick at its next
+            # instant.
+            self._forces.apply(forces)
             imus = self._publishing.imus if self._publishing is not None else None
             if 'gravity' in forces and imus is not None:
                 imus.follow_gravity(forces['gravity'])    # the sensors of the scene's gravity
@@ -195,13 +196,17 @@ class KinematicsNode(LifecycleNode):
         with stop_raises() if self.params.starting and not self.managed else nullcontext():
             source = load_source(self._value('scene'), self._value('robot_description'),
                                  self._value('loop_closures'), self._value('actuated_joints'),
-                                 self._value('reference_pose'))
+                                 self._value('reference_pose'), self._value('payloads'))
         scene = source.scene
         if source.robot is not None:     # what would be accepted and ignored is refused
-            refusal = robot_forces_refusal(self._value('effort'), spec('effort').default,
+            note = robot_forces_note(source.robot)
+            refusal = robot_forces_refusal(note, self._value('drive'), self._value('effort'),
+                                           spec('effort').default,
                                            list(self._parameter_overrides))
             if refusal is not None:
                 raise SceneError(refusal)
+            if note:
+                self.get_logger().warning(f'no efforts or reactions of the robot: {note}')
         self.extra_joints = self._value('extra_joints') or \
             extra_joints_default(source.robot is not None)
         starts = self.params.declare_drivers(scene)
@@ -214,12 +219,15 @@ class KinematicsNode(LifecycleNode):
             tf_rate_hz=self._value('tf_rate_hz'), scene_path=self._value('scene'),
             source=source, watch=self._watch)
         frames = [(f.origin, f.angle_of, f.angle) for f in publishing.frames]
-        self._forces = forces = forces_tick(scene, publishing.tick_scene, frames,
-                                            drive=self._value('drive'),
-                                            effort=self._value('effort'))
+        drive, effort = self._value('drive'), self._value('effort')
+        self._forces = forces = forces_tick(scene, publishing.tick_scene, frames, drive=drive,
+                                            effort=effort) if source.robot is None else \
+            robot_forces_tick(source.robot, scene, drive=drive, effort=effort)
+        self._has_forces = scene.dynamics is not None or (
+            source.robot is not None and robot_forces_note(source.robot) is None)
         if forces is not None:
-            values = self.params.declare_forces(forces.dynamics)
-            forces.dynamics = forces.warm(dynamics_with(forces.dynamics, values))
+            values = self.params.declare_forces(forces)
+            forces.apply(values)
             if publishing.imus is not None:    # a params file's gravity, from the start
                 publishing.imus.follow_gravity(values['gravity'])
             publishing.add_forces(forces)
@@ -316,11 +324,12 @@ class KinematicsNode(LifecycleNode):
         """Return the forces' keys of the solver status (none for a scene without forces)."""
         if self.scene is None:
             return []
-        effort = effort_status(self.scene, self._value('drive'), self._value('effort'))
+        effort = effort_status(self._has_forces, self._value('drive'), self._value('effort'))
         if not effort:
             return []
         forces = self._forces
-        return [('effort', effort),
+        gravity = [('gravity', repr(forces.gravity()))] if forces is not None else []
+        return [('effort', effort), *gravity,
                 ('forces_left_out_total', str(forces.refused if forces else 0)),
                 ('last_forces_left_out', forces.refusal if forces else '')]
 

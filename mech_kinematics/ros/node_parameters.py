@@ -34,15 +34,14 @@ from .drive import (DEFAULT_MAX_CRANK_SPEED_RPM, drive_start, DriveStart,
 from .parameters import (CATCH_UP, catch_up_window_ns, driver_parameters, first_crank_aliases,
                          joint_refusal, PARAMETERS, ParameterSpec, rate_default, refusal, spec)
 from .schedule import period_ns_from_rate
-from .wrenches import force_parameters, forces_refusal
 from ..errors import SceneError
 
 if TYPE_CHECKING:
     from rclpy.node import Node
 
     from .driver import TickDriver
+    from .wrenches import ForcesTick
     from ..solver.base import Driver
-    from ..solver.forces import Dynamics
     from ..solver.mechanism import Scene
 
 __all__ = ['DOUBLES', 'DRIVE', 'DriverParameters', 'JOINT_RULES', 'NodeParameters', 'READ_ONLY',
@@ -187,8 +186,8 @@ class NodeParameters:
         self.drivers = DriverParameters()
         #: A scene's forces' parameters (``gravity``, ``loads.NAME.*``) by name, once declared.
         self.forces: dict[str, ParameterSpec] = {}
-        #: The scene's forces as loaded (the forces' parameters are checked against its masses).
-        self._dynamics: Dynamics | None = None
+        #: The forces tick (the forces' parameters are checked against its masses).
+        self._forces_tick: ForcesTick | None = None
         self._own: dict[str, bool] = {}
         self._declaring = False
         node.add_pre_set_parameters_callback(self._pre_set)
@@ -279,14 +278,16 @@ class NodeParameters:
 
     # -- a scene's forces ------------------------------------------------------
 
-    def declare_forces(self, dynamics: Dynamics) -> dict[str, Any]:
-        """Declare ``gravity`` and each load's ``loads.NAME.*``; return their values.
+    def declare_forces(self, forces: ForcesTick) -> dict[str, Any]:
+        """Declare the forces' parameters (``gravity``, each load's ``loads.NAME.*``); return them.
 
-        The defaults are the scene's; a value given at start is checked like
-        one set later (refused: the node does not start).
+        The parameters are the forces tick's (:meth:`ForcesTick.parameters
+        <mech_kinematics.ros.wrenches.ForcesTick.parameters>`: a scene's, or a
+        robot's three-component ``gravity``), with its defaults; a value given
+        at start is checked like one set later (refused: the node does not start).
         """
-        self.forces = {p.name: p for p in force_parameters(dynamics)}
-        self._dynamics = dynamics
+        self.forces = {p.name: p for p in forces.parameters()}
+        self._forces_tick = forces
         self._declaring = True
         try:
             for p in self.forces.values():
@@ -295,7 +296,7 @@ class NodeParameters:
                                                      dynamic_typing=True)
                     self.node.declare_parameter(p.name, p.default, descriptor)
                 value = self.value(p.name)
-                if p.kind == 'xy' and not isinstance(value, str) and \
+                if p.kind in ('xy', 'xyz') and not isinstance(value, str) and \
                         any(type(v) is int for v in value):
                     self.node.set_parameters([Parameter(
                         p.name, Parameter.Type.DOUBLE_ARRAY, [float(v) for v in value])])
@@ -340,7 +341,8 @@ class NodeParameters:
             return (f'robot {robot.name!r} ({origin}; its loops: scene {scene.name!r}): '
                     f'joints {list(robot.joint_names)}, actuated {list(robot.actuated)}; '
                     f'loop_closures={self.value("loop_closures")!r}, '
-                    f'reference_pose={list(self.value("reference_pose") or [])!r}, {settings}')
+                    f'reference_pose={list(self.value("reference_pose") or [])!r}, '
+                    f'payloads={list(self.value("payloads") or [])!r}, {settings}')
         return (f'scene {scene.name!r} ({self.value("scene")}): joints '
                 f'{list(scene.output_joints)}, points {list(scene.output_points)}; {settings}')
 
@@ -405,12 +407,12 @@ class NodeParameters:
     def _forces_refusal(self, parameters: list[Parameter]) -> str | None:
         """Return why a new ``gravity`` or load gives forces beyond the doubles, or None."""
         changes = {p.name: p.value for p in parameters if p.name in self.forces}
-        if not changes or self._dynamics is None:
+        if not changes or self._forces_tick is None:
             return None
         values = {name: self.value(name) if self.node.has_parameter(name) else spec.default
                   for name, spec in self.forces.items()}
         values.update(changes)
-        return forces_refusal(self._dynamics, values)
+        return self._forces_tick.parameters_refusal(values)
 
     def _stroke_refusal(self, parameters: list[Parameter]) -> str | None:
         """Return why an actuator's drive change is refused (:func:`.drive.stroke_refusal`)."""

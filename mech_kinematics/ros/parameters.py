@@ -62,9 +62,10 @@ class ParameterSpec:
     ----------
     name : str
         The ROS parameter name.
-    kind : {'double', 'xy', 'string', 'bool', 'string_array'}
+    kind : {'double', 'xy', 'xyz', 'string', 'bool', 'string_array'}
         Its type; an integer is accepted for a double (``-p rate_hz:=500``).
-        ``xy``: a double array of two finite numbers ``[x, y]`` (integers accepted).
+        ``xy``: a double array of two finite numbers ``[x, y]`` (integers accepted);
+        ``xyz`` of three.
     default : float, str, bool or None
         The default; ``None`` where the scene (or another parameter) gives it.
     description : str
@@ -124,6 +125,10 @@ PARAMETERS = (
                   "each (rad for a revolute joint, m for a prismatic one; default: the URDF's "
                   'zero pose), as the commands take --reference (there in degrees)',
                   read_only=True),
+    ParameterSpec('payloads', 'string_array', None,
+                  'URDF mode: point masses welded to links, LINK=KG or LINK=KG@X,Y,Z each '
+                  "(kg, and m in the link's frame; default its origin), as the commands take "
+                  '--payload', read_only=True),
     ParameterSpec('frame_id', 'string', 'mechanism',
                   'header.frame_id of every message: the ground frame of the scene',
                   read_only=True, frame=True),
@@ -143,7 +148,8 @@ PARAMETERS = (
                   'to refuse, and to pass in URDF mode',
                   choices=EXTRA_JOINTS, read_only=True),
     ParameterSpec('effort', 'string', DYNAMIC,
-                  'For a scene with masses, gravity or loads, what joint_states.effort, '
+                  'For a scene with masses, gravity or loads (a URDF with <inertial>s), what '
+                  'joint_states.effort, '
                   'reactions/* and shaking carry: dynamic (the forces of the motion: with '
                   'drive: topic, whose input gives no accelerations, they are left out) or '
                   'static (gravity and loads only, inertia neglected: every velocity and '
@@ -420,8 +426,8 @@ def refusal(name: str, value: Any,
             return (f'{name}: expected {p.low:g} <= value <= {p.high:g} {p.unit}, got '
                     f'{number!r}').rstrip()
         return None
-    if p.kind == 'xy':
-        return _xy_refusal(name, value, p.unit)
+    if p.kind in ('xy', 'xyz'):
+        return _xy_refusal(name, value, p.unit, len(p.kind))
     if p.kind == 'bool':
         if not isinstance(value, bool):
             return f'{name}: expected true or false, got {_kind_of(value)} {shown(value)}'
@@ -459,17 +465,18 @@ def extra_joints_default(urdf: bool) -> str:
     return PASS if urdf else REFUSE
 
 
-def _xy_refusal(name: str, value: Any, unit: str) -> str | None:
-    """Return why ``value`` is not ``[x, y]``, two finite numbers, or ``None``."""
+def _xy_refusal(name: str, value: Any, unit: str, count: int = 2) -> str | None:
+    """Return why ``value`` is not ``[x, y]`` (``count`` 3: ``[x, y, z]``) of finite numbers."""
+    form, words = ('[x, y]', 'two') if count == 2 else ('[x, y, z]', 'three')
     if isinstance(value, (str, bytes)) or not isinstance(value, Sequence) and \
             type(value).__name__ != 'array':
-        return (f'{name}: expected [x, y] ({unit}), got {_kind_of(value)} {shown(value)}')
+        return (f'{name}: expected {form} ({unit}), got {_kind_of(value)} {shown(value)}')
     items = list(value)
-    if len(items) != 2 or any(isinstance(v, bool) or not isinstance(v, (int, float))
-                              for v in items):
-        return f'{name}: expected [x, y], two numbers ({unit}), got {shown(items)}'
+    if len(items) != count or any(isinstance(v, bool) or not isinstance(v, (int, float))
+                                  for v in items):
+        return f'{name}: expected {form}, {words} numbers ({unit}), got {shown(items)}'
     if not all(math.isfinite(float(v)) for v in items):
-        return f'{name}: expected two finite numbers ({unit}), got {shown(items)}'
+        return f'{name}: expected {words} finite numbers ({unit}), got {shown(items)}'
     return None
 
 

@@ -53,7 +53,7 @@ from .robot_mode import RobotValues, Source
 from .schedule import period_ns_from_rate
 from .tf import static_tf_message, TfMessages
 from .watchdog import PublishWatch
-from .wrenches import ForceMessages, ForcesTick, reaction_wrench
+from .wrenches import ForcesTick, reaction_wrench
 from ..errors import AssemblyError
 from ..geometry.diagrams import space_from_state, strokes_from_scene
 from ..geometry.frames import angle_joints, frames_from_scene, origin_points, sensor_offsets
@@ -174,6 +174,7 @@ class Publishing:
         self.node = node
         self.watch, self.slot = watch, None if watch is None else watch.slot()
         self.frame_id = frame_id
+        self.tf_prefix = tf_prefix
         self.prefix = tf_prefix or frame_id
         self.publishers: list[Any] = []
         robot = source.robot if source is not None else None
@@ -208,28 +209,28 @@ class Publishing:
     def add_forces(self, forces: ForcesTick) -> None:
         """Publish the forces of ``forces``' values: efforts, ``reactions/JOINT``, ``shaking``.
 
-        A joint whose name makes no valid ROS topic name (a URDF's ``a-b``) has
-        no reaction topic: said at set-up, one warning naming the joints.
+        The wrenches' topics and messages are the forces tick's
+        (:meth:`ForcesTick.topics`, :meth:`ForcesTick.messages`: a scene's in
+        ``frame_id``, a robot's in each child link's frame). A joint whose
+        name makes no valid ROS topic name (a URDF's ``a-b``) has no reaction
+        topic: said at set-up, one warning naming the joints.
         """
         joints, points = self.messages.joints, self.messages.points
         self.efforts_first = forces.forces_first
         self.messages = TickMessages(joints, points, self.frame_id,
                                      efforts_first=forces.forces_first)
-        self.force_messages = ForceMessages(self.frame_id, len(joints), len(forces.reactions))
+        self.force_messages = forces.messages(self.frame_id, self.tf_prefix)
         publish: list[Any] = []
         invalid = []
-        for joint in forces.reactions:
-            topic = topics.reaction_topic(joint.name)
+        for topic in forces.topics():
             try:
                 validate_topic_name(topic)
             except InvalidTopicNameException:
-                invalid.append(joint.name)
+                invalid.append(topic.partition('/')[2])
                 publish.append(None)
                 continue
             publish.append(self._watched(topic, self._publisher(WrenchStamped, topic,
                                                                 state_qos())))
-        publish.append(self._watched(topics.SHAKING, self._publisher(WrenchStamped,
-                                                                     topics.SHAKING, state_qos())))
         self.publish_forces_to = tuple(publish)
         if invalid:
             self.node.get_logger().warning(
@@ -420,7 +421,8 @@ class Markers:
         self.frame_id = frame_id
         self.scales = scales
         self.points = scene.output_points
-        self.forces = forces
+        # A robot's reactions are in its links' frames, not drawn in the scene's (URDF mode).
+        self.forces = forces if forces is not None and forces.scene_reactions else None
         # The motion alone (the forces, with the parameters' values, are the forces tick's).
         self.scene = full_scene(scene if forces is None else forces.kinematics)
         self.strokes = strokes_from_scene(self.scene)

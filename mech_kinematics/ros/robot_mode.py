@@ -9,7 +9,8 @@ robot: a path ending in ``.urdf``, or the URDF's text given as the parameter
 ``actuated_joints`` (default: the URDF's ``<transmission>`` and
 ``<ros2_control>`` joints) and ``reference_pose`` (``JOINT=VALUE`` each, rad or
 m: the pose whose branches the loops keep, for a URDF exported open at its
-zero pose; default the zero pose). :func:`load_source` reads what the parameters
+zero pose; default the zero pose) and ``payloads`` (``LINK=KG[@X,Y,Z]`` each, welded to the links:
+:func:`payloads_from_parameter`). :func:`load_source` reads what the parameters
 name, or refuses in one line (:class:`~mech_kinematics.errors.SceneError`,
 the one ``solve`` prints); the robot's loops become a scene
 (:class:`~mech_kinematics.robot.Robot`), which the node solves as any other,
@@ -47,28 +48,80 @@ from ..scene import DEFAULT_SCENE, load_scene, scene_text
 from ..solver.mechanism import Scene
 
 __all__ = ['RobotDriver', 'RobotValues', 'Source', 'URDF_SUFFIX', 'is_urdf', 'load_source',
-           'reference_from_parameter', 'robot_forces_refusal']
+           'payloads_from_parameter', 'reference_from_parameter', 'robot_forces_refusal']
 
 #: A ``scene`` parameter ending so names a robot described in URDF.
 URDF_SUFFIX = '.urdf'
 
 
-def robot_forces_refusal(effort: str, default_effort: str, given: Sequence[str]) -> str | None:
+def robot_forces_refusal(note: str | None, drive: str, effort: str, default_effort: str,
+                         given: Sequence[str]) -> str | None:
     """Return why a forces parameter given to the node in URDF mode is refused, or None.
 
-    The node publishes no forces of a robot yet (``solve ROBOT.urdf`` and
-    ``Robot.solve`` give them): ``effort`` other than its default, and
-    ``gravity`` or ``loads.*`` given at start, would be accepted and do
-    nothing; they are refused in one line instead.
+    ``note``: why the robot has no forces to publish ('' for a URDF without
+    ``<inertial>``, a reason for masses its loops do not carry), or None where
+    it has (:func:`~mech_kinematics.ros.robot_forces.robot_forces_note`).
+    ``given``: the parameters given at start. Refused in one line, rather than
+    accepted and ignored: ``loads.*`` always (a robot's loads are its
+    ``payloads``; a force at a point of a link is not taken yet); ``effort``
+    other than its default, ``gravity`` and ``payloads`` where the robot has
+    no forces to publish; ``gravity`` and ``payloads`` where its efforts are
+    left out (``drive: topic`` without ``effort: static``).
     """
-    named = [name for name in given if name == 'gravity' or name.startswith('loads.')]
-    if effort != default_effort:
-        named.insert(0, f'effort:={effort}')
-    if not named:
-        return None
-    return (f'Expected no forces parameters in URDF mode (the node publishes no efforts or '
-            f'reactions of a robot yet: solve ROBOT.urdf and Robot.solve give them, '
-            f'docs/urdf.md#forces), got {", ".join(named)}')
+    loads = [name for name in given if name.startswith('loads.')]
+    if loads:
+        return (f"Expected no loads.* in URDF mode (a robot's loads are point masses on its "
+                f'links, payloads:=["LINK=KG@X,Y,Z"]; a force at a point of a link is not '
+                f'taken yet), got {", ".join(loads)}')
+    named = [name for name in given if name in ('gravity', 'payloads')]
+    if note is not None:
+        if effort != default_effort:
+            named.insert(0, f'effort:={effort}')
+        if not named:
+            return None
+        why = note or "the URDF's links carry no <inertial>: there are no forces to publish"
+        return f'Expected no forces parameters for this robot ({why}), got {", ".join(named)}'
+    from .parameters import TOPIC
+
+    if named and drive == TOPIC and effort == default_effort:
+        return (f'Expected effort:=static with drive: topic for {", ".join(named)} (the input '
+                f'gives no accelerations: the efforts are left out), got effort:={effort}')
+    return None
+
+
+def payloads_from_parameter(entries: Sequence[str]) -> dict[str, tuple[float, tuple[float, ...]]]:
+    """Return the ``payloads`` parameter as ``{LINK: (kg, (x, y, z))}`` (the commands' form).
+
+    ``LINK=KG`` or ``LINK=KG@X,Y,Z`` each (kg; m in the link's frame, default
+    its origin), as ``--payload`` takes them.
+
+    Raises
+    ------
+    UrdfError
+        One line naming the parameter: an entry not in that form, a link given
+        twice. (A link the robot lacks, or a mass not above 0, is refused by
+        :func:`~mech_kinematics.robot.forces.with_payloads`, naming the link.)
+    """
+    from ..errors import UrdfError
+
+    out: dict[str, tuple[float, tuple[float, ...]]] = {}
+    for entry in entries:
+        link, sep, rest = entry.partition('=')
+        mass, at, point = rest.partition('@')
+        link = link.strip()
+        try:
+            value = (float(mass), tuple(float(v) for v in point.split(',')) if at
+                     else (0.0, 0.0, 0.0))
+        except ValueError:
+            value = None
+        if not sep or not link or value is None or len(value[1]) != 3:
+            msg = f'payloads: Expected LINK=KG or LINK=KG@X,Y,Z, got {entry!r}'
+            raise UrdfError(msg)
+        if link in out:
+            msg = f'payloads: Expected each link once, got "{link}" twice'
+            raise UrdfError(msg)
+        out[link] = value
+    return out
 
 
 def is_urdf(scene: str) -> bool:
@@ -103,7 +156,8 @@ class Source:
 
 def load_source(scene: str, robot_description: str = '', loop_closures: str = '',
                 actuated_joints: Sequence[str] | None = None,
-                reference_pose: Sequence[str] | None = None) -> Source:
+                reference_pose: Sequence[str] | None = None,
+                payloads: Sequence[str] | None = None) -> Source:
     """Load the scene or robot the node's parameters name.
 
     Parameters
@@ -122,6 +176,9 @@ def load_source(scene: str, robot_description: str = '', loop_closures: str = ''
     reference_pose : sequence of str or None
         ``JOINT=VALUE`` each (rad or m): the pose whose branches the loops keep
         (None: the URDF's zero pose); :func:`reference_from_parameter`.
+    payloads : sequence of str or None
+        ``LINK=KG[@X,Y,Z]`` each: point masses welded to links
+        (:func:`payloads_from_parameter`).
 
     Raises
     ------
@@ -138,7 +195,8 @@ def load_source(scene: str, robot_description: str = '', loop_closures: str = ''
     if not urdf:
         given = [name for name, value in (('loop_closures', loop_closures),
                                           ('actuated_joints', actuated_joints),
-                                          ('reference_pose', reference_pose)) if value]
+                                          ('reference_pose', reference_pose),
+                                          ('payloads', payloads)) if value]
         if given:
             msg = (f'Expected {", ".join(given)} with a robot described in URDF (scene:=PATH.urdf '
                    f'or robot_description), got scene {scene}')
@@ -150,6 +208,9 @@ def load_source(scene: str, robot_description: str = '', loop_closures: str = ''
 
     origin = 'robot_description' if robot_description else scene
     description = read_description(urdf, loop_closures or None)
+    if payloads:
+        from ..robot.forces import with_payloads
+        description = with_payloads(description, payloads_from_parameter(payloads))
     robot = Robot(description, actuated_joints or None,
                   reference_from_parameter(description, reference_pose or ()))
     needed = RobotValues.coordinates(robot)
@@ -233,7 +294,6 @@ class RobotValues:
         #: <mech_kinematics.robot.Robot.where>`): the URDF's names, not the scene's drivers.
         self.where = robot.where
         self._n = len(joints)
-        self._points = 6 * len(points)
         index = {name: i for i, name in enumerate(joints)}
         actuated = {name: k for k, name in enumerate(robot.actuated)}
         position = {name: k for k, name in enumerate(self.names)}
@@ -323,6 +383,9 @@ class RobotValues:
                ) -> list[float]:
         """Return the URDF joints' values of a tick's ``values``, then the scene's points'.
 
+        Then the rest of ``values`` unchanged: the forces a forces tick appends
+        (:class:`~mech_kinematics.ros.robot_forces.RobotForcesTick`).
+
         ``given``: the actuated joints' (positions, speeds or None) of an
         input message, echoed as given (None: the clock's tick, every joint
         from the scene's coordinates).
@@ -402,7 +465,8 @@ class RobotValues:
                 lines += [f'    p{j} = {m!r} * p{leader} + {o!r}', f'    v{j} = {m!r} * v{leader}',
                           f'    a{j} = {m!r} * a{leader}']
         joints = ', '.join(f'{q}{j}' for q in 'pva' for j in range(len(recipes)))
-        lines.append(f'    return [{joints}, *x[{3 * n}:{3 * n + self._points}]]')
+        # The scene's points, and what a forces tick appends after them (robot_forces.py).
+        lines.append(f'    return [{joints}, *x[{3 * n}:]]')
         namespace: dict[str, Any] = {'_wrap': wrap_revolute}   # Robot.solve's, the one wrap
         exec(compile('\n'.join(lines) + '\n', f'<URDF joints {what}>', 'exec'),  # noqa: S102
              namespace)

@@ -268,6 +268,9 @@ class InputSubscription:
         solver = self.solver
         positions, speeds = given.positions, given.speeds
         if self.robot is not None:
+            forces = self.publishing.forces
+            if forces is not None:    # a robot's forces read the actuated joints as given
+                forces.inputs = (positions, speeds)
             positions, speeds = self.robot.scene_inputs(positions, speeds)
         n = len(positions)
         speeds = (0.0,) * n if speeds is None else speeds

@@ -44,6 +44,7 @@ from geometry_msgs.msg import WrenchStamped
 from .cdr import marker, MessageTemplate, STAMP_MARKER
 from .parameters import DYNAMIC, ParameterSpec, STATIC, TOPIC
 from .ticker import NOT_IN_THE_TICK, values_from_state
+from .topics import reaction_topic, SHAKING
 from .. import solver as lk
 from ..errors import AssemblyError
 from ..solver.compiler import NotCompiled
@@ -169,6 +170,39 @@ class ForcesTick:
         self.refused = 0
         self._samples: list[Any] | None = None
 
+    #: Whether the reactions are the scene's graph joints in ``frame_id`` (drawn as markers).
+    scene_reactions = True
+    #: With ``drive: topic``, the input's drivers as given, set before each solve (a
+    #: robot's forces read its actuated joints there; a scene's need nothing more).
+    inputs: Any = None
+
+    def parameters(self) -> tuple[ParameterSpec, ...]:
+        """Return the forces' parameters (:func:`force_parameters`), the scene's defaults."""
+        return force_parameters(self.dynamics)
+
+    def parameters_refusal(self, values: Mapping[str, Any]) -> str | None:
+        """Return why the forces' parameters' ``values`` are refused, or None (forces_refusal).
+
+        ``values``: every one of :meth:`parameters` as it would be.
+        """
+        return forces_refusal(self.dynamics, values)
+
+    def apply(self, values: Mapping[str, Any]) -> None:
+        """Solve the next instants with accepted parameter values (written out first, warm)."""
+        self.dynamics = self.warm(dynamics_with(self.dynamics, values))
+
+    def gravity(self) -> list[float]:
+        """Return the gravity the forces are solved with, for ``diagnostics`` (m/s^2)."""
+        return gravity_of(self.dynamics)
+
+    def topics(self) -> list[str]:
+        """Return the topics of the wrenches, in the order :meth:`messages` renders them."""
+        return [*(reaction_topic(joint.name) for joint in self.reactions), SHAKING]
+
+    def messages(self, frame_id: str, tf_prefix: str) -> ForceMessages:
+        """Return the wrenches' messages: each reaction's, then the shaking's, in ``frame_id``."""
+        return ForceMessages(frame_id, len(self.joints), len(self.reactions))
+
     def warm(self, dynamics: Dynamics | None = None) -> Dynamics:
         """Solve ``dynamics`` (the tick's by default) at positions the drivers take; return it.
 
@@ -238,9 +272,13 @@ def forces_tick(scene: Scene, tick_scene: Scene, frames: Sequence[FrameSpec], *,
                       static=effort == STATIC)
 
 
-def effort_status(scene: Scene, drive: str, effort: str) -> str:
-    """Return what the node's efforts are, for ``diagnostics`` ('' for a scene without forces)."""
-    if scene.dynamics is None:
+def effort_status(scene: Scene | bool, drive: str, effort: str) -> str:
+    """Return what the node's efforts are, for ``diagnostics`` ('' for a scene without forces).
+
+    ``scene``: the scene, or whether what the node loaded has forces (a robot
+    whose URDF has ``<inertial>``s).
+    """
+    if not (scene if isinstance(scene, bool) else scene.dynamics is not None):
         return ''
     if effort == STATIC:
         return 'static: gravity and loads only, inertia neglected'
@@ -250,41 +288,66 @@ def effort_status(scene: Scene, drive: str, effort: str) -> str:
     return 'dynamic: inertia, gravity and loads'
 
 
-def wrench_stamped(force: tuple[float, float, float], frame_id: str, sec: int,
+def wrench_stamped(force: Sequence[float], frame_id: str, sec: int,
                    nanosec: int) -> WrenchStamped:
-    """Return ``geometry_msgs/WrenchStamped`` of ``(fx, fy, tz)`` in ``frame_id``."""
+    """Return ``geometry_msgs/WrenchStamped`` of ``(fx, fy, tz)`` in ``frame_id``.
+
+    Six values are the whole wrench, ``(fx, fy, fz, tx, ty, tz)``.
+    """
     msg = WrenchStamped()
     msg.header.stamp.sec, msg.header.stamp.nanosec = sec, nanosec
     msg.header.frame_id = frame_id
+    if len(force) == 6:
+        w = msg.wrench
+        w.force.x, w.force.y, w.force.z, w.torque.x, w.torque.y, w.torque.z = force
+        return msg
     msg.wrench.force.x, msg.wrench.force.y = force[0], force[1]
     msg.wrench.torque.z = force[2]
     return msg
 
 
 class ForceMessages:
-    """Each reaction's and the shaking's ``WrenchStamped``, rendered from one template.
+    """Each reaction's (and the shaking's) ``WrenchStamped``, rendered from templates.
 
     Parameters
     ----------
-    frame_id : str
-        ``header.frame_id``.
+    frame_id : str or sequence of str
+        ``header.frame_id`` of every message, or of each in order (a robot's
+        reactions: each in its child link's frame).
     joints : int
         How many efforts precede the reactions in the forces' values.
     reactions : int
-        How many reactions follow them (the shaking after those).
+        How many reactions follow them.
+    width : int, keyword-only
+        The values of each: 3, ``(fx, fy, tz)`` in the scene's plane, or 6,
+        ``(fx, fy, fz, tx, ty, tz)``.
+    shaking : bool, keyword-only
+        Whether the shaking's ``(fx, fy, mz)`` follows the reactions.
     """
 
-    def __init__(self, frame_id: str, joints: int, reactions: int) -> None:
-        self._template = MessageTemplate(
-            wrench_stamped((marker(0), marker(1), marker(2)), frame_id, *STAMP_MARKER), 3)
-        self.joints, self.reactions = joints, reactions
+    def __init__(self, frame_id: str | Sequence[str], joints: int, reactions: int, *,
+                 width: int = 3, shaking: bool = True) -> None:
+        count = reactions + shaking
+        frames = [frame_id] * count if isinstance(frame_id, str) else list(frame_id)
+        assert len(frames) == count
+        templates: dict[str, MessageTemplate] = {}
+        for frame in frames:
+            if frame not in templates:
+                templates[frame] = MessageTemplate(wrench_stamped(
+                    [marker(i) for i in range(width)], frame, *STAMP_MARKER), width)
+        self._renders = [templates[frame].render for frame in frames]
+        self.joints, self.reactions, self.width = joints, reactions, width
+        self._widths = [width] * reactions + [3] * shaking
 
     def render(self, values: Sequence[float], first: int, sec: int,
                nanosec: int) -> list[bytes]:
         """Return the reactions' messages, then the shaking's, of the forces at ``first``."""
-        render = self._template.render
         start = first + self.joints
-        return [render(sec, nanosec, values, start + 3 * k) for k in range(self.reactions + 1)]
+        out = []
+        for render, width in zip(self._renders, self._widths, strict=True):
+            out.append(render(sec, nanosec, values, start))
+            start += width
+        return out
 
 
 def gravity_of(dynamics: Dynamics) -> list[float]:

@@ -352,15 +352,22 @@ def test_a_stop_while_the_start_reads_a_large_urdf_ends_it_at_once(ros, tmp_path
      'Expected a robot with a closed loop'),
     (('-p', 'actuated_joints:=[a, a]'), 'cannot start: actuated_joints: expected one or more '
      "distinct non-empty joint names, got ['a', 'a']"),
-    # Issue 44: forces parameters the node would accept and ignore in URDF mode.
-    (('-p', f'scene:={DATA / "lift_arm.urdf"}', '-p', 'effort:=static'),
-     'cannot start: Expected no forces parameters in URDF mode (the node publishes no efforts '
-     'or reactions of a robot yet: solve ROBOT.urdf and Robot.solve give them, '
-     'docs/urdf.md#forces), got effort:=static'),
-    (('-p', f'scene:={DATA / "lift_arm.urdf"}', '-p', 'gravity:=[0.0, 9.81]'),
-     'cannot start: Expected no forces parameters in URDF mode', ),
+    # Issue 44: forces parameters that do not apply in URDF mode, and bad ones.
     (('-p', f'scene:={DATA / "lift_arm.urdf"}', '-p', 'loads.tool.force:=[1.0, 0.0]'),
+     "cannot start: Expected no loads.* in URDF mode (a robot's loads are point masses on "
+     'its links, payloads:=["LINK=KG@X,Y,Z"]; a force at a point of a link is not taken yet), '
      'got loads.tool.force'),
+    (('-p', f'scene:={DATA / "lift_arm.urdf"}', '-p', "payloads:=['wing=1.5@0,0,0.1']"),
+     'payload on link "wing": Expected a link of the robot (base_link, lower_arm'),
+    (('-p', f'scene:={DATA / "lift_arm.urdf"}', '-p', 'gravity:=[0.0, 0.0, 1e308]'),
+     "cannot start: gravity: Expected gravity as [gx, gy, gz] in the URDF's root frame"),
+    (('-p', f'scene:={DATA / "lift_arm.urdf"}', '-p', 'drive:=topic', '-p',
+      'gravity:=[0.0, 0.0, -1.62]'),
+     'cannot start: Expected effort:=static with drive: topic for gravity'),
+    (('-p', f'scene:={DATA / "robotiq_2f_85.urdf"}', '-p',
+      f'loop_closures:={DATA / "robotiq_2f_85.loop_closures.yaml"}', '-p', 'effort:=static'),
+     "cannot start: Expected no forces parameters for this robot (the URDF's links carry no "
+     '<inertial>: there are no forces to publish), got effort:=static'),
 ])
 def test_a_robot_the_node_cannot_take_is_refused_in_one_line(tmp_path, args, line):
     """A URDF parameter that does not fit: the node does not start and says why in one line."""

@@ -1,0 +1,281 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The node's forces in URDF mode: the actuated joints' efforts and each loop pin's reaction.
+
+A robot whose URDF's links carry ``<inertial>`` has its forces
+(:class:`~mech_kinematics.robot.forces.RobotForces`, what ``Robot.solve``
+answers). :class:`RobotForcesTick` is the node's tick on such a robot, the
+URDF mode's :class:`~mech_kinematics.ros.wrenches.ForcesTick`: the loops'
+kinematics solved as the scene's forces tick solves them, then at that state
+(``effort: static``: at the same positions at rest) the efforts and the
+reactions of :class:`RobotForces` with the ``gravity`` parameter (three
+components in the URDF's root frame), appended to the tick's values in the
+layout of the URDF's joints (after :class:`~mech_kinematics.ros.robot_mode.RobotValues`
+has mapped the scene's coordinates onto them):
+
+- one effort per published joint (:attr:`Robot.joint_names
+  <mech_kinematics.robot.Robot.joint_names>`): an actuated joint's, positive
+  along its ``<axis>``; 0 for a passive joint of a loop (frictionless); NaN
+  (unknown, as ros2_control marks it) for an actuated joint outside every
+  loop and for a mimic joint outside the loops, whose efforts the loops do
+  not give;
+- per revolute joint and pin of a loop, its reaction ``(fx, fy, fz, tx, ty,
+  tz)``: the load the parent puts on the child, in the child link's axes,
+  at the joint's origin (:class:`~mech_kinematics.robot.forces.JointReaction`:
+  the part along the pins' axis and the bending moments are not in it).
+
+An instant whose forces cannot be bounded, or that the planar forces cannot
+carry (:class:`~mech_kinematics.robot.forces.ForcesLeftOut`), keeps its
+kinematics and leaves the forces out, with the reason, as in scene mode.
+
+No rclpy here but the message classes :mod:`~mech_kinematics.ros.wrenches`
+imports; tested in ``test/ros/test_robot_forces.py``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import replace
+import math
+from typing import Any
+
+import numpy as np
+
+from .parameters import DYNAMIC, ParameterSpec, STATIC, TOPIC
+from .robot_mode import RobotValues
+from .ticker import NOT_IN_THE_TICK, values_from_state
+from .topics import reaction_topic
+from .wrenches import ForceMessages, ForcesTick
+from .. import solver as lk
+from ..errors import AssemblyError
+from ..geometry.frames import child_frame
+from ..robot.description import ClosureKind
+from ..robot.forces import check_gravity, ForcesLeftOut, GRAVITY
+from ..solver.compiler import NotCompiled
+
+__all__ = ['RobotForcesTick', 'reaction_names', 'robot_forces_note', 'robot_forces_tick']
+
+
+def robot_forces_note(robot: Any) -> str | None:
+    """Return why a robot has no forces to publish ('' for none to say), or None if it has.
+
+    ``''``: its URDF has no ``<inertial>`` (nothing to say: a robot described
+    for its kinematics); a reason: its masses are not carried by its loops
+    (:attr:`RobotForces.refused <mech_kinematics.robot.forces.RobotForces.refused>`).
+    """
+    model = robot.forces
+    if model is None:
+        return ''
+    return model.refused
+
+
+def reaction_names(robot: Any) -> tuple[tuple[str, str, Any], ...]:
+    """Return each loop's revolute joints and pins: ``(name, child link, rotation or None)``.
+
+    In the mechanisms' order, as :meth:`RobotForces.reactions
+    <mech_kinematics.robot.forces.RobotForces.reactions>` answers them; the
+    rotation turns a closure's child frame's axes into its child link's
+    (None where they are the link's: a URDF joint, a closure whose frame is
+    not turned on its link).
+    """
+    description = robot.description
+    closures = {c.name: c for c in description.closures}
+    out = []
+    for m in robot.planar.mechanisms:
+        for name in m['joints']:
+            joint = description.joints.get(name)
+            if joint is not None:
+                if joint.type is not None and joint.type.angular:
+                    out.append((name, joint.child, None))
+                continue
+            closure = closures.get(name)
+            if closure is not None and closure.kind is ClosureKind.PIN:
+                rotation = np.asarray(closure.frame_b, dtype=np.float64)[:3, :3]
+                out.append((closure.name, closure.link_b,
+                            None if np.array_equal(rotation, np.eye(3)) else rotation))
+    return tuple(dict((item[0], item) for item in out).values())
+
+
+class RobotForcesTick(ForcesTick):
+    """The node's tick on a robot with masses: its kinematics' values, then its forces'.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot (with :attr:`~mech_kinematics.robot.Robot.forces`).
+    scene : Scene
+        The scene the ticks solve (the robot's loops, outputting what
+        :class:`RobotValues` reads).
+    static : bool, keyword-only
+        ``effort: static``: gravity alone, solved at the same positions at rest.
+    gravity : (float, float, float), keyword-only
+        m/s^2 in the URDF's root frame until the parameter says otherwise.
+
+    Attributes
+    ----------
+    names : tuple of str
+        The URDF's joints published, whose efforts lead the forces' values.
+    reactions : tuple of str
+        The joints whose reactions follow the efforts, in order.
+    links : tuple of str
+        Each reaction's child link (its message's frame, with ``tf_prefix``).
+    forces_first : int
+        Where the forces start in the values as published (the URDF's joints'
+        positions, velocities, accelerations, then the scene's points).
+    g : tuple of float
+        The gravity the next instant is solved with (replaced whole, read
+        once per instant).
+    """
+
+    scene_reactions = False
+
+    def __init__(self, robot: Any, scene: Any, *, static: bool,
+                 gravity: Sequence[float] = GRAVITY) -> None:
+        self.robot = robot
+        self.model = robot.forces
+        self.kinematics = replace(scene, gravity=None, masses=(), loads=(),
+                                  outputs_joints=scene.output_joints,
+                                  outputs_points=scene.output_points)
+        if self.kinematics._solver.compiled_single is None:
+            self.kinematics._solver.compiled_single = NotCompiled(NOT_IN_THE_TICK)
+        self.joints, self.points, self.frames = scene.output_joints, scene.output_points, ()
+        self.static = static
+        self.drivers = len(scene.drivers)
+        self.values = RobotValues(robot, self.joints, self.points)
+        self.names = tuple(robot.joint_names)
+        found = reaction_names(robot)
+        self.reactions = tuple(name for name, _, _ in found)
+        self.links = tuple(link for _, link, _ in found)
+        self._turns = tuple(rotation for _, _, rotation in found)
+        self.forces_first = 3 * len(self.names) + 6 * len(self.points)
+        self.g = check_gravity(gravity)
+        self.refusal = ''
+        self.refused = 0
+        self._samples: list[Any] | None = None
+        index = {name: k for k, name in enumerate(self.names)}
+        self._actuated = tuple((name, index[name]) for name in robot.actuated)
+        drivers = {d.name for d in robot.planar.drivers}
+        actuated = set(robot.actuated)
+        # Per published joint: its effort from the answer ('effort'), 0 (a passive joint of a
+        # loop, frictionless) or NaN (not given by the loops).
+        self._fill = tuple('effort' if name in actuated else
+                           0.0 if name in robot.planar.joints and name not in drivers else
+                           math.nan for name in self.names)
+
+    # -- the parameters -----------------------------------------------------------------
+
+    def parameters(self) -> tuple[ParameterSpec, ...]:
+        """Return ``gravity``: three components in the URDF's root frame (m/s^2)."""
+        return (ParameterSpec(
+            'gravity', 'xyz', list(self.g),
+            "Gravity [gx, gy, gz] in the URDF's root frame, from the next instant published "
+            "([0, 0, 0]: none; the part along a loop's pivots is carried by its bearings). "
+            'Defaults to [0, 0, -9.80665] (REP 103: z up)', 'm/s^2'),)
+
+    def parameters_refusal(self, values: Mapping[str, Any]) -> str | None:
+        """Return why ``values['gravity']`` is refused (beyond :data:`MAX_GRAVITY`), or None."""
+        try:
+            check_gravity(values['gravity'])
+        except ValueError as error:
+            return f'gravity: {error}'
+        return None
+
+    def apply(self, values: Mapping[str, Any]) -> None:
+        """Solve the next instants with the new gravity (its forces written out first)."""
+        g = check_gravity(values['gravity'])
+        self.warm(g)
+        self.g = g
+
+    def gravity(self) -> list[float]:
+        """Return the gravity the forces are solved with, m/s^2 in the URDF's root frame."""
+        return list(self.g)
+
+    def topics(self) -> list[str]:
+        """Return ``reactions/JOINT`` of each reaction, in order (no ``shaking``)."""
+        return [reaction_topic(name) for name in self.reactions]
+
+    def messages(self, frame_id: str, tf_prefix: str) -> ForceMessages:
+        """Return the reactions' messages, each in its child link's frame (with ``tf_prefix``)."""
+        return ForceMessages([child_frame(tf_prefix, link) for link in self.links],
+                             len(self.names), len(self.reactions), width=6, shaking=False)
+
+    # -- the tick -----------------------------------------------------------------------
+
+    def warm(self, dynamics: Any = None) -> Any:
+        """Solve the forces where the drivers go, with gravity ``dynamics`` (or the tick's).
+
+        As the scene's forces tick does (:meth:`ForcesTick.warm`): the forces'
+        straight-line code of each group of loops is written here, before the
+        ticks and before a new gravity takes effect.
+        """
+        g = self.g if dynamics is None else dynamics
+        if self._samples is None:
+            self._samples = self._sample_states()
+        for state in self._samples:
+            values = values_from_state(state, self.joints, self.points, ())
+            try:
+                self._forces(values, state, math.inf, g, None)
+            except (ForcesLeftOut, AssemblyError):
+                continue
+        return g
+
+    def __call__(self, theta: Any, omega: Any, alpha: Any, tol: float,
+                 turns: Any = 0) -> tuple[list[float], float]:
+        """Return ``(values, measure)`` as a tick function does, the forces after the motion."""
+        kinematics = self.kinematics
+        state = lk.solve(kinematics, theta, omega, alpha, turns=turns, max_error=tol)
+        values = values_from_state(state, self.joints, self.points, ())
+        measures = state.singularity.values()
+        measure = float(min(measures)) if measures else math.inf
+        at = state
+        if self.static:
+            rest = 0.0 if self.drivers == 1 else (0.0,) * self.drivers
+            at = lk.solve(kinematics, theta, rest, rest, turns=turns, max_error=tol)
+        given = self.inputs
+        try:
+            forces = self._forces(values, at, tol, self.g, given)
+        except (ForcesLeftOut, AssemblyError) as why:
+            urdf = self.values.values(values, given)
+            where = self.robot.where([urdf[k] for _, k in self._actuated])
+            self.refusal = f'at {where}: {why}'
+            self.refused += 1
+            return values, measure
+        return values + forces, measure
+
+    def _forces(self, values: list[float], at: Any, tol: float, g: tuple[float, float, float],
+                given: Any) -> list[float]:
+        """Return the forces' values at ``at`` (``values``: the scene's, of the same positions)."""
+        urdf = self.values.values(values, given)
+        n = len(self.names)
+        if self.static:
+            inputs = {name: (urdf[k], 0.0, 0.0) for name, k in self._actuated}
+        else:
+            inputs = {name: (urdf[k], urdf[n + k], urdf[2 * n + k])
+                      for name, k in self._actuated}
+        efforts = self.model.efforts(at, inputs, g, tol)
+        reactions = self.model.reactions(efforts, dict(zip(self.names, urdf[:n])), {})
+        given_efforts = efforts.efforts
+        out = [(float(given_efforts[name]) if name in given_efforts else math.nan)
+               if fill == 'effort' else fill for name, fill in zip(self.names, self._fill)]
+        for name, turn in zip(self.reactions, self._turns, strict=True):
+            reaction = reactions.get(name)
+            if reaction is None:
+                raise ForcesLeftOut(f'no reaction of {name} at this instant')
+            force, torque = reaction.force, reaction.torque
+            if turn is not None:
+                force, torque = turn @ np.asarray(force), turn @ np.asarray(torque)
+            out += (*(float(v) for v in force), *(float(v) for v in torque))
+        return out
+
+
+def robot_forces_tick(robot: Any, scene: Any, *, drive: str, effort: str
+                      ) -> RobotForcesTick | None:
+    """Return the forces tick of a robot on the node, or ``None`` where none is published.
+
+    None for a robot without forces (:func:`robot_forces_note`), and with
+    ``drive: topic`` unless ``effort: static`` (the input gives no
+    accelerations), as for a scene (:func:`~mech_kinematics.ros.wrenches.forces_tick`).
+    """
+    if robot_forces_note(robot) is not None or (drive == TOPIC and effort == DYNAMIC):
+        return None
+    return RobotForcesTick(robot, scene, static=effort == STATIC)
