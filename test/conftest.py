@@ -13,10 +13,18 @@ import pytest
 _HERE = Path(__file__).resolve().parent
 #: Test files outside test/ros/ that run the node or a browser against the clock.
 SERIAL_FILES = ('tools/test_bag_recorder.py', 'tools/test_view.py')
+#: Files in test/ros/ that start no node, open no DDS participant and time nothing (the
+#: compiled tick, the messages, the node's pure parts): they run on the workers.
+PURE_ROS_FILES = frozenset(f'ros/test_{name}.py' for name in (
+    'drive', 'instance', 'node', 'publishing', 'robot_forces', 'robot_mode', 'ros_diagnostics',
+    'ros_parameters', 'ros_schedule', 'solver_path', 'ticker', 'timebase', 'topic_drive',
+    'topic_input', 'wrenches'))
 
 
 def pytest_collection_modifyitems(config, items):
     """Mark the tests that time the node (test/ros/, the recorder, the browser) ``serial``.
+
+    The pure files of test/ros/ (:data:`PURE_ROS_FILES`) are not marked.
 
     ``make test`` runs the other tests on two workers, then these alone in one
     process: a node publishing at 1 kHz beside a worker's CPU-bound tests on a
@@ -28,5 +36,6 @@ def pytest_collection_modifyitems(config, items):
             relative = path.relative_to(_HERE).as_posix()
         except ValueError:
             continue
-        if relative.startswith('ros/') or relative in SERIAL_FILES:
+        if (relative.startswith('ros/') and relative not in PURE_ROS_FILES
+                or relative in SERIAL_FILES):
             item.add_marker(pytest.mark.serial)

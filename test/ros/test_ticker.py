@@ -60,16 +60,21 @@ def _assert_same(scene, tick, angles, speeds=(None,), turns=(0,), **kwargs):
 def test_every_packaged_scene_compiles_to_the_same_bits(name):
     """Over two turns, at three tolerances, the compiled tick answers as mk.solve does.
 
-    Every packaged scene compiles: a step whose kernels leave the subset the
-    tick understands (``solver/base.py``) would fall back to the general
-    solver and fail here (issue 17). The Geneva wheel's crank turns are passed on.
+    Each of 351 angles at the scene's speed, and every fifth angle at two other
+    speeds (-3.5 rad/s, 1e4 rad/s) and 3 and -40 turns away. Every packaged
+    scene compiles: a step whose kernels leave the subset the tick understands
+    (``solver/base.py``) would fall back to the general solver and fail here
+    (issue 17). The Geneva wheel's crank turns are passed on.
     """
     scene = mk.load_scene(name)
     tick, compiled = tick_function(scene)
     # A triad's kernel loops over its roots (solver/triad.py): its scene's tick is the
     # general one, which must answer alike all the same.
     assert compiled == (name != 'stephenson_iii'), f'{name}: a step falls back to the general path'
-    refused = _assert_same(scene, tick, ANGLES, speeds=(None, -3.5, 1e4), turns=(0, 3, -40))
+    # Every angle at the scene's speed; every fifth at the other speeds and turns.
+    refused = _assert_same(scene, tick, ANGLES)
+    refused += _assert_same(scene, tick, ANGLES[::5], speeds=(-3.5, 1e4), turns=(0, 3, -40))
+    refused += _assert_same(scene, tick, ANGLES[::5], turns=(3, -40))
     if name == 'four_bar_coupler_points':
         assert refused > 0      # the triple rocker's unassemblable angles, refused alike
 
@@ -168,7 +173,9 @@ def test_a_strip_of_rigid_triangles_compiles_to_the_same_bits():
     scene = strip_scene()
     tick, compiled = tick_function(scene)
     assert compiled, 'a rigid triangle falls back to the general solver'
-    _assert_same(scene, tick, ANGLES, speeds=(None, -3.5), turns=(0, 3))
+    _assert_same(scene, tick, ANGLES)
+    _assert_same(scene, tick, ANGLES[::5], speeds=(None, -3.5), turns=(3,))
+    _assert_same(scene, tick, ANGLES[::5], speeds=(-3.5,))
 
 
 def _tiny_four_bar(tmp_path):
