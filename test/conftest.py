@@ -16,9 +16,9 @@ SERIAL_FILES = ('tools/test_bag_recorder.py', 'tools/test_view.py')
 #: Files in test/ros/ that start no node, open no DDS participant and time nothing (the
 #: compiled tick, the messages, the node's pure parts): they run on the workers.
 PURE_ROS_FILES = frozenset(f'ros/test_{name}.py' for name in (
-    'drive', 'instance', 'node', 'publishing', 'robot_forces', 'robot_mode', 'ros_diagnostics',
-    'ros_parameters', 'ros_schedule', 'solver_path', 'ticker', 'timebase', 'topic_drive',
-    'topic_input', 'wrenches'))
+    'drive', 'instance', 'node', 'publishing', 'robot_mode', 'ros_diagnostics',
+    'robot_forces_tick', 'ros_parameters', 'ros_schedule', 'solver_path', 'ticker', 'timebase',
+    'topic_drive', 'topic_input', 'wrenches'))
 
 
 def pytest_collection_modifyitems(config, items):

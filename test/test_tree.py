@@ -143,3 +143,16 @@ def test_make_refuses_a_linked_venv(tmp_path):
         assert '.venv is a symlink (to ' in result.stderr, result.stderr
         assert len(result.stderr.splitlines()) == 1, result.stderr
     assert not (tmp_path / 'other-checkout').exists()
+
+
+def test_no_two_test_modules_share_a_name():
+    """Two test files of one name in two folders stop the whole run at collection.
+
+    The test folders have no ``__init__.py`` (pytest's rootdir-relative import
+    mode): ``test/ros/test_x.py`` beside ``test/robot/test_x.py`` is "import
+    file mismatch" when both are collected, though each passes alone.
+    """
+    by_name: dict[str, list[str]] = {}
+    for path in sorted((REPO / 'test').rglob('test_*.py')):
+        by_name.setdefault(path.name, []).append(path.relative_to(REPO).as_posix())
+    assert {name: paths for name, paths in by_name.items() if len(paths) > 1} == {}

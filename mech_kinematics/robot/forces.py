@@ -123,7 +123,8 @@ class JointReaction:
     """The load a loop joint's parent puts on its child, in the child link's frame.
 
     At the joint's origin (a closure's: its ``<child_origin>``), in the axes
-    of ``frame`` (the child link; a closure's child frame). ``force`` holds
+    of ``frame``, the child link (a closure's too, whatever the rotation of its
+    ``<child_origin>``). ``force`` holds
     the loop's plane's part (N): the part along the pivots' axis, and the
     bending moments, are not determined by a planar loop's statics (with
     parallel pins it is overconstrained in space: the bearings share them by
@@ -349,11 +350,11 @@ class RobotForces:
                     if joint is not None:
                         if joint.type is None or not joint.type.angular:
                             continue
-                        parent, child, local = joint.parent, joint.child, np.eye(4)
+                        parent, child = joint.parent, joint.child
                         axis = np.asarray(joint.axis, dtype=np.float64)
                     else:
                         closure = closures[name]
-                        parent, child, local = closure.link_a, closure.link_b, closure.frame_b
+                        parent, child = closure.link_a, closure.link_b
                         axis = None
                     a, b = scene_body.get(body_of[parent]), scene_body.get(body_of[child])
                     point = robot.planar.names.get(name, name)
@@ -365,7 +366,9 @@ class RobotForces:
                     if reaction.on != b:
                         f = -f
                     planar = f.real * np.asarray(m['x']) + f.imag * np.asarray(m['y'])
-                    frame = np.linalg.solve(ground, frames[child] @ local)
+                    # In the child link's axes (a closure's too: its <child_origin>
+                    # places the point, its rotation does not turn the answer).
+                    frame = np.linalg.solve(ground, frames[child])
                     force = frame[:3, :3].T @ planar
                     torque = np.zeros(3)
                     torque_bound = 0.0

@@ -39,7 +39,6 @@ from dataclasses import replace
 import math
 from typing import Any
 
-import numpy as np
 
 from .parameters import DYNAMIC, ParameterSpec, STATIC, TOPIC
 from .robot_mode import RobotValues
@@ -69,14 +68,12 @@ def robot_forces_note(robot: Any) -> str | None:
     return model.refused
 
 
-def reaction_names(robot: Any) -> tuple[tuple[str, str, Any], ...]:
-    """Return each loop's revolute joints and pins: ``(name, child link, rotation or None)``.
+def reaction_names(robot: Any) -> tuple[tuple[str, str], ...]:
+    """Return each loop's revolute joints and pins: ``(name, child link)``.
 
     In the mechanisms' order, as :meth:`RobotForces.reactions
-    <mech_kinematics.robot.forces.RobotForces.reactions>` answers them; the
-    rotation turns a closure's child frame's axes into its child link's
-    (None where they are the link's: a URDF joint, a closure whose frame is
-    not turned on its link).
+    <mech_kinematics.robot.forces.RobotForces.reactions>` answers them, in
+    the child link's axes.
     """
     description = robot.description
     closures = {c.name: c for c in description.closures}
@@ -86,13 +83,11 @@ def reaction_names(robot: Any) -> tuple[tuple[str, str, Any], ...]:
             joint = description.joints.get(name)
             if joint is not None:
                 if joint.type is not None and joint.type.angular:
-                    out.append((name, joint.child, None))
+                    out.append((name, joint.child))
                 continue
             closure = closures.get(name)
             if closure is not None and closure.kind is ClosureKind.PIN:
-                rotation = np.asarray(closure.frame_b, dtype=np.float64)[:3, :3]
-                out.append((closure.name, closure.link_b,
-                            None if np.array_equal(rotation, np.eye(3)) else rotation))
+                out.append((closure.name, closure.link_b))
     return tuple(dict((item[0], item) for item in out).values())
 
 
@@ -144,9 +139,8 @@ class RobotForcesTick(ForcesTick):
         self.values = RobotValues(robot, self.joints, self.points)
         self.names = tuple(robot.joint_names)
         found = reaction_names(robot)
-        self.reactions = tuple(name for name, _, _ in found)
-        self.links = tuple(link for _, link, _ in found)
-        self._turns = tuple(rotation for _, _, rotation in found)
+        self.reactions = tuple(name for name, _ in found)
+        self.links = tuple(link for _, link in found)
         self.forces_first = 3 * len(self.names) + 6 * len(self.points)
         self.g = check_gravity(gravity)
         self.refusal = ''
@@ -257,14 +251,11 @@ class RobotForcesTick(ForcesTick):
         given_efforts = efforts.efforts
         out = [(float(given_efforts[name]) if name in given_efforts else math.nan)
                if fill == 'effort' else fill for name, fill in zip(self.names, self._fill)]
-        for name, turn in zip(self.reactions, self._turns, strict=True):
+        for name in self.reactions:
             reaction = reactions.get(name)
             if reaction is None:
                 raise ForcesLeftOut(f'no reaction of {name} at this instant')
-            force, torque = reaction.force, reaction.torque
-            if turn is not None:
-                force, torque = turn @ np.asarray(force), turn @ np.asarray(torque)
-            out += (*(float(v) for v in force), *(float(v) for v in torque))
+            out += (*reaction.force, *reaction.torque)
         return out
 
 
