@@ -54,7 +54,8 @@ class _RubStep:
     A body is ``('link', name)`` (a link's angular velocity), ``('still', name)``
     (the ground or an RRP slider block: omega 0) or ``('block', lever)`` (an
     RPR block, turning with its lever; an intermittent lever's block touches
-    the pin only while engaged, so the rubbing is 0 in a dwell).
+    the pin only while engaged, so the rubbing is 0 in a dwell, and at a mouth
+    on the side the kinematics answer: ``driven``; the other in ``State.jumps``).
     """
 
     def __init__(self, pin: Pin, bodies: tuple[tuple[str, str], tuple[str, str]],
@@ -73,7 +74,8 @@ class _RubStep:
         bound = (ea + eb) * r + _U4 * value
         for kind, name in self.bodies:
             if kind == 'block' and name in ctx.engagement:  # an intermittent lever
-                engaged = ctx.engagement[name][0]
+                # The side the kinematics answer (at a mouth, after the jump).
+                engaged = ctx.engagement[name][2]
                 if ctx.vector:
                     value, bound = np.where(engaged, value, 0.0), np.where(engaged, bound, 0.0)
                 elif not engaged:

@@ -663,7 +663,9 @@ def _jumps(solver: _Solver, ctx: _Context, theta: Any, omega: Any, alpha: Any, t
                 joints[name] = {'acceleration': table[name][2]}
             for name in carried:
                 points[name] = {'acceleration': _xy(other.points[name][2])}
-        return {'joints': joints, 'points': points}
+        rubbing = {name: value for name, (value, _) in other.rubbing.items()
+                   if value != ctx.rubbing[name][0]}
+        return {'joints': joints, 'points': points, **({'rubbing': rubbing} if rubbing else {})}
     shape = valid.shape
     where = {lever: np.broadcast_to(near, shape) & valid for lever, near in ctx.jumps.items()}
     at = np.flatnonzero(np.logical_or.reduce(list(where.values())))
@@ -686,7 +688,14 @@ def _jumps(solver: _Solver, ctx: _Context, theta: Any, omega: Any, alpha: Any, t
             value = points.setdefault(name, {'acceleration': np.full((*shape, 2), np.nan)})
             a = np.broadcast_to(other.points[name][2], at.shape)[mine]
             value['acceleration'][at[mine]] = np.stack((a.real, a.imag), axis=-1)
-    return {'joints': joints, 'points': points}
+    rubbing = {}
+    for name, (value, _) in other.rubbing.items():
+        mine = np.broadcast_to(value, at.shape)
+        differs = mine != np.broadcast_to(ctx.rubbing[name][0], shape)[at]
+        if differs.any():
+            rubbing[name] = np.full(shape, np.nan)
+            rubbing[name][at[differs]] = mine[differs]
+    return {'joints': joints, 'points': points, **({'rubbing': rubbing} if rubbing else {})}
 
 
 def assembly_margins(scene: Scene) -> Callable[..., list[tuple[str, Any, Any]]]:

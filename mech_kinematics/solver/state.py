@@ -174,7 +174,10 @@ class State:
         wheel's mouth, the pin's slot carrying it or the lock holding it,
         ``Engagement.driven``); for arrays NaN where nothing jumps. In
         :meth:`as_dict`, its ``"efforts"``, ``"reactions"`` and ``"shaking"``
-        sit in ``"jumps"`` beside ``"joints"`` and ``"points"``.
+        sit in ``"jumps"`` beside ``"joints"`` and ``"points"``. A pin whose
+        rubbing velocity changes side (a Geneva pin leaving or entering its
+        slot: 0 in the dwell) adds ``'rubbing'``: pin -> the other side's value
+        (for arrays NaN where it does not jump).
     drivers : dict of str to JointMotion
         Every driver's own motion, in scene order, as given to the solve
         (whether or not the scene's outputs report its joint): a crank's angle
@@ -302,6 +305,9 @@ class State:
                                      for name, x in self.jumps['joints'].items()},
                           'points': {name: {'acceleration': pair(x['acceleration'])}
                                      for name, x in self.jumps['points'].items()},
+                          **({'rubbing': {name: value(x) for name, x
+                                          in self.jumps['rubbing'].items()}}
+                             if 'rubbing' in self.jumps else {}),
                           **(self.jumps['forces'].as_dict(vector)
                              if 'forces' in self.jumps else {})}}
                if self.jumps else {}),

@@ -146,6 +146,34 @@ def test_geneva_pin_rubs_only_while_in_a_slot():
     assert locked.rubbing['P'] == 0.0 and locked.error_bound.rubbing['P'] == 0.0
 
 
+def test_geneva_pin_rubs_at_a_mouth_on_the_side_the_kinematics_answer():
+    """At 135 and 225 deg, both senses: the rubbing follows ``driven``, the other side in jumps.
+
+    At a mouth the wheel is at rest on both sides, so the pin rubs at
+    ``|w_driver| r`` where it is in the slot and 0 where the lock holds; the
+    side answered is the kinematics' (``intermittent['wheel'].driven``).
+    """
+    base = mk.load_scene('geneva')
+    scene = dataclasses.replace(base, pins=(mk.Pin('P', 0.004),))
+    seen = set()
+    for degrees in (135.0, 225.0):
+        for omega in (10.0, -10.0):
+            state = mk.solve(scene, math.radians(degrees), omega)
+            driven = bool(state.intermittent['wheel'].driven)
+            seen.add(driven)
+            in_slot = abs(omega) * 0.004
+            assert state.rubbing['P'] == pytest.approx(in_slot if driven else 0.0, abs=1e-15)
+            assert state.jumps['rubbing']['P'] == pytest.approx(0.0 if driven else in_slot,
+                                                                abs=1e-15)
+            assert state.as_dict()['jumps']['rubbing']['P'] == state.jumps['rubbing']['P']
+            angles = np.radians([degrees, 150.0, degrees])
+            array = mk.solve(scene, angles, omega)
+            assert array.rubbing['P'][0] == state.rubbing['P']
+            assert array.jumps['rubbing']['P'][2] == state.jumps['rubbing']['P']
+            assert math.isnan(array.jumps['rubbing']['P'][1])
+    assert seen == {True, False}
+
+
 def test_diagram_table_lists_the_pins(tmp_path):
     """The space table has a row per pin: bodies, radius, relative angular speed, rubbing."""
     scene = load(tmp_path, PISTON)
