@@ -55,7 +55,7 @@ from .startup import stop_raises
 from .tick_thread import TickThread, TickThreadError
 from .topic_input import InputSubscription
 from .watchdog import PublishWatch, PublishWatchdog
-from .wrenches import effort_status, forces_tick, ForcesTick
+from .wrenches import effort_status, forces_tick, ForcesTick, scene_forces_refusal
 from ..errors import SceneError
 from ..solver.context import NEAR_SINGULAR
 from ..units import NS_PER_S
@@ -207,6 +207,12 @@ class KinematicsNode(LifecycleNode):
                 raise SceneError(refusal)
             if note:
                 self.get_logger().warning(f'no efforts or reactions of the robot: {note}')
+        else:
+            refusal = scene_forces_refusal(scene.dynamics is not None, self._value('drive'),
+                                           self._value('effort'),
+                                           list(self._parameter_overrides), bool(scene.imus))
+            if refusal is not None:
+                raise SceneError(refusal)
         self.extra_joints = self._value('extra_joints') or \
             extra_joints_default(source.robot is not None)
         starts = self.params.declare_drivers(scene)

@@ -58,7 +58,7 @@ if TYPE_CHECKING:
 
 __all__ = ['ForceMessages', 'ForcesTick', 'dynamics_with', 'effort_status',
            'force_parameters', 'forces_refusal', 'forces_tick', 'forces_values', 'gravity_of',
-           'reaction_joints', 'reaction_wrench', 'wrench_stamped']
+           'reaction_joints', 'reaction_wrench', 'scene_forces_refusal', 'wrench_stamped']
 
 
 def reaction_joints(dynamics: Dynamics) -> tuple[Joint, ...]:
@@ -270,6 +270,35 @@ def forces_tick(scene: Scene, tick_scene: Scene, frames: Sequence[FrameSpec], *,
         return None
     return ForcesTick(tick_scene, scene.output_joints, scene.output_points, frames,
                       static=effort == STATIC)
+
+
+def scene_forces_refusal(has_forces: bool, drive: str, effort: str, given: Sequence[str],
+                         sensors: bool = False) -> str | None:
+    """Return why a forces parameter given to the node with a scene is refused, or None.
+
+    ``has_forces``: the scene has masses, gravity or loads; ``given``: the
+    parameters given at start. Refused in one line rather than accepted and
+    ignored (as in URDF mode, :func:`~.robot_mode.robot_forces_refusal`):
+    ``effort`` other than ``dynamic``, ``gravity`` and ``loads.*`` on a scene
+    with nothing to weigh; ``gravity`` and ``loads.*`` where the efforts are
+    left out (``drive: topic`` without ``effort: static``), but ``gravity``
+    on a scene with inertial sensors (``sensors``: those of the scene's
+    gravity follow it).
+    """
+    named = [name for name in given if name == 'gravity' or name.startswith('loads.')]
+    if not has_forces:
+        if effort != DYNAMIC:
+            named.insert(0, f'effort:={effort}')
+        if not named:
+            return None
+        return ('Expected no forces parameters for this scene (it has no masses, gravity or '
+                f'loads: there are no forces to publish), got {", ".join(named)}')
+    if sensors:
+        named = [name for name in named if name != 'gravity']
+    if named and drive == TOPIC and effort == DYNAMIC:
+        return (f'Expected effort:=static with drive: topic for {", ".join(named)} (the input '
+                f'gives no accelerations: the efforts are left out), got effort:={effort}')
+    return None
 
 
 def effort_status(scene: Scene | bool, drive: str, effort: str) -> str:

@@ -277,3 +277,24 @@ def test_the_tick_publishes_a_geneva_mouths_forces_on_the_kinematics_side(degree
     assert values[start:start + 3] == ([0.0, 0.0, pytest.approx(-0.3, rel=1e-14)] if holds
                                        else [0.0, 0.0, 0.0])
     assert (state.joints['wheel'].acceleration == 0.0) is holds
+
+
+def test_a_forces_parameter_that_does_nothing_is_refused_at_start():
+    """On a scene without masses, or in topic drive without effort: static: one line."""
+    from mech_kinematics.ros.wrenches import scene_forces_refusal
+    assert scene_forces_refusal(False, 'time', 'dynamic', ['speed_rpm']) is None
+    assert scene_forces_refusal(False, 'time', 'static', []) == (
+        'Expected no forces parameters for this scene (it has no masses, gravity or loads: '
+        'there are no forces to publish), got effort:=static')
+    assert scene_forces_refusal(False, 'time', 'dynamic', ['gravity', 'loads.push.force']) \
+        .endswith('got gravity, loads.push.force')
+    assert scene_forces_refusal(True, 'time', 'dynamic', ['gravity']) is None
+    assert scene_forces_refusal(True, 'topic', 'static', ['gravity']) is None
+    assert scene_forces_refusal(True, 'topic', 'dynamic', ['gravity']) == (
+        'Expected effort:=static with drive: topic for gravity (the input gives no '
+        'accelerations: the efforts are left out), got effort:=dynamic')
+    # On a scene with inertial sensors, gravity moves the sensors of the scene's gravity.
+    assert scene_forces_refusal(True, 'topic', 'dynamic', ['gravity'], sensors=True) is None
+    assert scene_forces_refusal(True, 'topic', 'dynamic', ['gravity', 'loads.p.force'],
+                                sensors=True).startswith(
+        'Expected effort:=static with drive: topic for loads.p.force (')
