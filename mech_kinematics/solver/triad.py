@@ -48,6 +48,11 @@ Bounds and singular points
     is refused in one line, as where the followed branch has no root or the
     nearest two roots are within rounding of each other.
 
+One text (:meth:`_TriadStep._close`) serves one solve (floats) and an array
+of angles (NumPy arrays, every entry at once: one batched eigenvalue solve,
+Newton's steps masked where converged), with complex values as pairs
+multiplied as Python multiplies complex numbers and the C library's special
+functions in both: the array path gives the single-angle path's bits.
 The kernel loops over roots and Newton's steps, outside the compiler's
 kernel subset: the compiled paths fall back to the general solver with the
 reason (:mod:`.compiler`).
@@ -55,9 +60,9 @@ reason (:mod:`.compiler`).
 
 from __future__ import annotations
 
-import cmath
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, replace
+import functools
 import math
 from typing import Any
 
@@ -223,6 +228,135 @@ class _Refused(Exception):
     """A triad that does not close or is singular at one solve (the reason, one line)."""
 
 
+# --- arithmetic shared by one solve (floats) and an array's (NumPy arrays) ---------------
+# Complex values are pairs (re, im) of floats or arrays, multiplied as Python multiplies
+# complex numbers (NumPy's complex product may fuse its steps: other bits); every other
+# operation is an IEEE operation on floats, the same bits in Python and NumPy. Special
+# functions go through the C library's (math's cos, sin, atan2, remainder; hypot as
+# Python's complex abs and NumPy's hypot do), the same in both paths.
+
+def _cmul(a: Any, b: Any) -> tuple[Any, Any]:
+    """Return the product of two pairs, as Python multiplies complex numbers."""
+    return a[0] * b[0] - a[1] * b[1], a[0] * b[1] + a[1] * b[0]
+
+
+def _cadd(a: Any, b: Any) -> tuple[Any, Any]:
+    return a[0] + b[0], a[1] + b[1]
+
+
+def _csub(a: Any, b: Any) -> tuple[Any, Any]:
+    return a[0] - b[0], a[1] - b[1]
+
+
+def _pair(z: complex) -> tuple[float, float]:
+    return z.real, z.imag
+
+
+class _One:
+    """The special functions and masks of one solve (floats: refusals raise)."""
+
+    vector = False
+
+    @staticmethod
+    def hypot(x: float, y: float) -> float:
+        return abs(complex(x, y))
+
+    cos = staticmethod(math.cos)
+    sin = staticmethod(math.sin)
+    isfinite = staticmethod(math.isfinite)
+
+    @staticmethod
+    def where(mask: bool, x: Any, y: Any) -> Any:
+        return x if mask else y
+
+    @staticmethod
+    def refuse(mask: bool, reason: Callable[[], str]) -> None:
+        if mask:
+            raise _Refused(reason())
+
+    @staticmethod
+    def any(mask: bool) -> bool:
+        return mask
+
+    @staticmethod
+    def not_(mask: bool) -> bool:
+        return not mask
+
+    @staticmethod
+    def safe(x: float, bad: bool) -> float:
+        return x
+
+    @staticmethod
+    def square_norm(x: float, y: float) -> float:
+        return abs(complex(x, y)) ** 2
+
+
+class _Many:
+    """The special functions and masks of an array's solve (refusals clear ``ok``)."""
+
+    vector = True
+
+    def __init__(self, n: int) -> None:
+        self.ok = np.ones(n, dtype=bool)
+
+    hypot = staticmethod(np.hypot)
+    isfinite = staticmethod(np.isfinite)
+
+    @staticmethod
+    def cos(x: Any) -> Any:
+        return np.array([math.cos(t) for t in x.tolist()])
+
+    @staticmethod
+    def sin(x: Any) -> Any:
+        return np.array([math.sin(t) for t in x.tolist()])
+
+    @staticmethod
+    def where(mask: Any, x: Any, y: Any) -> Any:
+        return np.where(mask, x, y)
+
+    def refuse(self, mask: Any, reason: Callable[[], str]) -> None:
+        self.ok &= ~mask
+
+    @staticmethod
+    def any(mask: Any) -> bool:
+        return bool(mask.any())
+
+    @staticmethod
+    def not_(mask: Any) -> Any:
+        return ~mask
+
+    @staticmethod
+    def safe(x: Any, bad: Any) -> Any:
+        return np.where(bad, 1.0, x)
+
+    @staticmethod
+    def square_norm(x: Any, y: Any) -> Any:
+        return np.array([h ** 2 for h in np.hypot(x, y).tolist()])
+
+
+def _remainders(x: Any) -> Any:
+    """Return ``math.remainder(x, tau)`` of each entry (IEEE's, which NumPy has not)."""
+    return np.array([math.remainder(t, math.tau) for t in x.tolist()])
+
+
+def _det(m: Any) -> Any:
+    (a, b, c), (d, e, f), (g, h, i) = m
+    return a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
+
+
+def _adjugate(m: Any, k: Any) -> Any:
+    """Return the inverse of a 3x3 matrix by its adjugate, ``k`` its determinant's inverse."""
+    (a, b, c), (d, e, f), (g, h, i) = m
+    return [[(e * i - f * h) * k, (c * h - b * i) * k, (b * f - c * e) * k],
+            [(f * g - d * i) * k, (a * i - c * g) * k, (c * d - a * f) * k],
+            [(d * h - e * g) * k, (b * g - a * h) * k, (a * e - b * d) * k]]
+
+
+def _times(m: Any, x: Any) -> tuple[Any, Any, Any]:
+    """Return ``m x`` for a 3x3 matrix and a 3-vector (sums left to right)."""
+    return tuple(row[0] * x[0] + row[1] * x[1] + row[2] * x[2] for row in m)
+
+
 def _g_samples(p2: complex, p3: complex, d2: complex, d3: complex, l1: float, l2: float,
                l3: float, z: Any) -> Any:
     """Return ``G(phi)`` at ``z = exp(i phi)`` (arrays): zero where the three circles meet.
@@ -277,48 +411,51 @@ def _root_angles(p2: Any, p3: Any, d2: complex, d3: complex, l1: float, l2: floa
     return np.where(near, np.angle(roots), np.nan)
 
 
-def _mul(a: list[complex], b: list[complex]) -> list[complex]:
-    """Return the product of two Laurent polynomials centred on their middle entries."""
-    out = [0j] * (len(a) + len(b) - 1)
+def _mul(a: list[Any], b: list[Any]) -> list[Any]:
+    """Return the product of two Laurent polynomials of pairs centred on their middle entries."""
+    out: list[Any] = [None] * (len(a) + len(b) - 1)
     for i, x in enumerate(a):
         for j, y in enumerate(b):
-            out[i + j] += x * y
+            term = _cmul(x, y)
+            out[i + j] = term if out[i + j] is None else _cadd(out[i + j], term)
     return out
 
 
-def _add(*terms: list[complex]) -> list[complex]:
-    """Return the sum of Laurent polynomials of one length (centred)."""
-    return [sum(column) for column in zip(*terms, strict=True)]
-
-
-def _coefficients(p2: complex, p3: complex, d2: complex, d3: complex, l1: float, l2: float,
-                  l3: float) -> list[complex]:
-    """Return G's coefficients of ``z**k``, k = 4 .. -4, exactly as its formula multiplies out.
+def _coefficients(ops: Any, p2: Any, p3: Any, d2: complex, d3: complex, l1: float,
+                  l2: float, l3: float) -> list[Any]:
+    """Return G's coefficients of ``z**k``, k = 4 .. -4 (pairs), as its formula multiplies out.
 
     ``G`` of :func:`_g_samples` with ``conj(z) = 1 / z``: each centre's parts and
     its ``k`` are Laurent polynomials of degree 1, the numerators and the
-    determinant of degree 2 (pure Python: one solve's coefficients without
-    NumPy's per-call cost).
+    determinant of degree 2. ``p2``, ``p3``: pairs of floats (one solve) or
+    of arrays (every row at once: the same bits per row).
     """
-    def parts(a: complex, b: complex) -> tuple[list[complex], list[complex]]:
+    def parts(a: Any, b: complex) -> tuple[list[Any], list[Any]]:
         # q = a + b z: its real and imaginary parts on the unit circle (z^-1, z^0, z^1).
-        ca, cb = a.conjugate(), b.conjugate()
-        real = [0.5 * cb, 0.5 * (a + ca), 0.5 * b]
-        imag = [0.5j * cb, -0.5j * (a - ca), -0.5j * b]
+        cb = b.conjugate()
+        real = [_pair(0.5 * cb), (0.5 * (a[0] + a[0]), 0.5 * (a[1] - a[1])), _pair(0.5 * b)]
+        imag = [_pair(0.5j * cb), (0.5 * (a[1] + a[1]), -0.5 * (a[0] - a[0])), _pair(-0.5j * b)]
         return real, imag
 
-    def k_of(a: complex, b: complex, c: float) -> list[complex]:
-        return [a * b.conjugate(), abs(a) ** 2 + abs(b) ** 2 + c + 0j, b * a.conjugate()]
+    def k_of(a: Any, b: complex, c: float) -> list[Any]:
+        middle = ops.square_norm(a[0], a[1]) + abs(b) ** 2 + c
+        return [_cmul(a, _pair(b.conjugate())), (middle, 0.0 * middle),
+                _cmul(_pair(b), (a[0], -a[1]))]
+
+    def minus(x: list[Any], y: list[Any]) -> list[Any]:
+        return [_csub(s, t) for s, t in zip(x, y, strict=True)]
 
     q2r, q2i = parts(p2, -d2)
     q3r, q3i = parts(p3, -d3)
     k2 = k_of(p2, -d2, l1 * l1 - l2 * l2)
     k3 = k_of(p3, -d3, l1 * l1 - l3 * l3)
-    nx = _add(_mul(k2, q3i), [-x for x in _mul(k3, q2i)])
-    ny = _add(_mul(q2r, k3), [-x for x in _mul(q3r, k2)])
-    det = _add(_mul(q2r, q3i), [-x for x in _mul(q3r, q2i)])
+    nx = minus(_mul(k2, q3i), _mul(k3, q2i))
+    ny = minus(_mul(q2r, k3), _mul(q3r, k2))
+    det = minus(_mul(q2r, q3i), _mul(q3r, q2i))
     dd = _mul(det, det)
-    g = _add(_mul(nx, nx), _mul(ny, ny), [-4.0 * l1 * l1 * x for x in dd])
+    f = -4.0 * l1 * l1
+    g = [_cadd(_cadd(x, y), (f * z[0], f * z[1]))
+         for x, y, z in zip(_mul(nx, nx), _mul(ny, ny), dd, strict=True)]
     return g[::-1]
 
 
@@ -327,9 +464,10 @@ def _angles(p2: complex, p3: complex, d2: complex, d3: complex, l1: float, l2: f
     """Return the ternary's angles where the group closes, for one row of starts.
 
     As :func:`_root_angles` for one row, its coefficients multiplied out in
-    floats (:func:`_coefficients`) rather than sampled.
+    floats (:func:`_coefficients`) rather than sampled; :func:`_angles_many`
+    gives the same bits for every row of an array.
     """
-    g = _coefficients(p2, p3, d2, d3, l1, l2, l3)
+    g = [complex(*x) for x in _coefficients(_One, _pair(p2), _pair(p3), d2, d3, l1, l2, l3)]
     scale = max(abs(x) for x in g)
     top = max(abs(g[0]), abs(g[-1]))
     lead = g[1]
@@ -340,6 +478,47 @@ def _angles(p2: complex, p3: complex, d2: complex, d3: complex, l1: float, l2: f
     companion[_BELOW] = 1.0
     roots = np.linalg.eigvals(companion).tolist()
     return [math.atan2(r.imag, r.real) for r in roots if abs(abs(r) - 1.0) < _NEAR_CIRCLE]
+
+
+def _quotient(a: Any, b: Any) -> tuple[Any, Any]:
+    """Return ``a / b`` of pairs of arrays as Python divides complex numbers (``b`` not 0)."""
+    by_real = abs(b[0]) >= abs(b[1])
+    ratio = np.where(by_real, b[1] / b[0], b[0] / b[1])
+    denom = np.where(by_real, b[0] + b[1] * ratio, b[0] * ratio + b[1])
+    re = np.where(by_real, a[0] + a[1] * ratio, a[0] * ratio + a[1]) / denom
+    im = np.where(by_real, a[1] - a[0] * ratio, a[1] * ratio - a[0]) / denom
+    return re, im
+
+
+def _angles_many(p2: Any, p3: Any, d2: complex, d3: complex, l1: float, l2: float,
+                 l3: float) -> Any:
+    """Return :func:`_angles` of every row as an array (n, 6), NaN where a root is not kept.
+
+    One companion matrix per row, one eigenvalue solve for all (each
+    matrix's roots the same bits as alone); a row whose polynomial fails
+    :func:`_angles`'s checks has NaN only.
+    """
+    g = _coefficients(_Many, _pair(p2), _pair(p3), d2, d3, l1, l2, l3)
+    sizes = [np.hypot(*x) for x in g]
+    scale = functools.reduce(np.maximum, sizes)
+    top = np.maximum(sizes[0], sizes[-1])
+    lead = g[1]
+    good = np.isfinite(scale) & (top <= 64 * U * scale) & (sizes[1] > 64 * U * scale)
+    safe = (np.where(good, lead[0], 1.0), np.where(good, lead[1], 0.0))
+    n = p2.shape[0]
+    companion = np.zeros((n, 6, 6), dtype=np.complex128)
+    for j, x in enumerate(g[2:-1]):
+        re, im = _quotient((-x[0], -x[1]), safe)
+        companion[:, 0, j].real = re
+        companion[:, 0, j].imag = im
+    companion[:, _BELOW[0], _BELOW[1]] = 1.0
+    companion[~good] = np.eye(6)
+    roots = np.linalg.eigvals(companion)
+    near = (np.abs(np.hypot(roots.real, roots.imag) - 1.0) < _NEAR_CIRCLE) & good[:, None]
+    out = np.full(near.shape, np.nan)
+    out[near] = [math.atan2(y, x) for x, y in zip(roots.real[near].tolist(),
+                                                  roots.imag[near].tolist(), strict=True)]
+    return out
 
 
 _BELOW = (np.arange(1, 6), np.arange(5))
@@ -435,6 +614,15 @@ class _TriadStep(Step):
         a, b = table[k], table[k + 1]
         return float(a + f * (b - a))
 
+    def _followed_many(self, angles: Any) -> Any:
+        """Return :meth:`followed` at every crank angle of an array (the same bits)."""
+        start, h, table = self.table
+        t = (_remainders(angles - start) + math.pi) / h
+        k = np.minimum(t.astype(np.int64), len(table) - 2)
+        f = t - k
+        a, b = table[k], table[k + 1]
+        return a + f * (b - a)
+
     # --- one solve -------------------------------------------------------------------
 
     def solve_one(self, angle: float, p: tuple[complex, ...], v: tuple[complex, ...],
@@ -456,62 +644,103 @@ class _TriadStep(Step):
         if len(gaps) > 1 and gaps[1][0] - gaps[0][0] < 1e-9:
             raise _Refused(f'two assemblies are within rounding of each other at ternary angle '
                            f'{phi:.6g} rad (a singular point: two branches meet)')
-        # Newton on the closure |E1 + R di - Pi|^2 = li^2, unknowns E1 (x, y) and phi.
-        r = cmath.exp(1j * phi)
-        e1 = self._start_point(p, r)
+        points, ternary, links, measure = self._close(
+            _One, phi, [_pair(z) for z in p], [_pair(z) for z in v], [_pair(z) for z in a],
+            ep, ev, ea)
+        points = [(complex(*x), complex(*y), complex(*z), *rest) for x, y, z, *rest in points]
+        links = [(complex(*x), *rest) for x, *rest in links]
+        return points, (complex(*ternary[0]), *ternary[1:]), links, measure
+
+    def solve_many(self, angles: Any, p: list[Any], v: list[Any], a: list[Any], ep: list[Any],
+                   ev: list[Any], ea: list[Any]) -> tuple[Any, ...]:
+        """Return :meth:`solve_one` at every entry of arrays (n,) at once: ``ok`` and pairs.
+
+        The same operations entry by entry, so the same bits; where ``ok`` is
+        false the entry is refused (its values are not answers).
+        """
+        ops = _Many(angles.shape[0])
+        guess = self._followed_many(angles)
+        ops.refuse(~np.isfinite(guess), str)
+        every = _angles_many(p[1] - p[0], p[2] - p[0], self.d[1], self.d[2], *self.lengths)
+        gaps = np.abs(_remainders((every - guess[:, None]).ravel())).reshape(every.shape)
+        gaps[np.isnan(gaps)] = np.inf
+        count = np.isfinite(every).sum(axis=1)
+        ops.refuse(count == 0, str)
+        nearest = np.sort(gaps, axis=1)
+        ops.refuse((count > 1) & (nearest[:, 1] - nearest[:, 0] < 1e-9), str)
+        phi = every[np.arange(every.shape[0]), np.argmin(gaps, axis=1)]
+        phi = np.where(ops.ok, phi, 0.0)
+        out = self._close(ops, phi, [_pair(z) for z in p], [_pair(z) for z in v],
+                          [_pair(z) for z in a], ep, ev, ea)
+        return ops.ok, out
+
+    def _close(self, ops: Any, phi: Any, p: list[Any], v: list[Any], a: list[Any],
+               ep: Any, ev: Any, ea: Any) -> tuple[Any, ...]:
+        """Return the pose polished from ``phi``, its rates and bounds (pairs), or refuse.
+
+        ``ops``: :class:`_One` (floats) or :class:`_Many` (arrays, refusals in
+        its ``ok``): one text for both paths, so the same bits.
+        """
+        d = [_pair(z) for z in self.d]
         lens = self.lengths
-        minv: Any = None
+        size = self.size
+        # Newton on the closure |E1 + R di - Pi|^2 = li^2, unknowns E1 (x, y) and phi.
+        r = (ops.cos(phi), ops.sin(phi))
+        e1 = self._start_point(ops, p, r)
+        active = ops.ok.copy() if ops.vector else True
+        i_r = (0.0, 1.0)
         for _ in range(_NEWTON):
-            u = [e1 + r * d[i] - p[i] for i in range(3)]
-            t = [1j * r * d[i] for i in range(3)]
-            f = [0.5 * (u[i].real * u[i].real + u[i].imag * u[i].imag - lens[i] * lens[i])
+            u = [_csub(_cadd(e1, _cmul(r, d[i])), p[i]) for i in range(3)]
+            t = [_cmul(_cmul(i_r, r), d[i]) for i in range(3)]
+            f = [0.5 * (u[i][0] * u[i][0] + u[i][1] * u[i][1] - lens[i] * lens[i])
                  for i in range(3)]
-            m = [(u[i].real, u[i].imag, u[i].real * t[i].real + u[i].imag * t[i].imag)
-                 for i in range(3)]
-            minv = _inverse(m)
-            if minv is None:
-                raise _Refused("its links are concurrent or parallel with the ternary's "
-                               'motion (singular: its Jacobian is not invertible)')
-            dx = -sum(minv[0][j] * f[j] for j in range(3))
-            dy = -sum(minv[1][j] * f[j] for j in range(3))
-            dphi = -sum(minv[2][j] * f[j] for j in range(3))
-            e1 = e1 + complex(dx, dy)
-            phi = phi + dphi
-            r = cmath.exp(1j * phi)
-            tiny = 4 * U * (abs(e1.real) + abs(e1.imag) + self.size)
-            if abs(dx) + abs(dy) + abs(dphi) * self.size <= tiny:
+            m = [(u[i][0], u[i][1], u[i][0] * t[i][0] + u[i][1] * t[i][1]) for i in range(3)]
+            det = _det(m)
+            bad = (det == 0.0) | ops.not_(ops.isfinite(det))
+            ops.refuse(active & bad, lambda: 'its links are concurrent or parallel with the '
+                       "ternary's motion (singular: its Jacobian is not invertible)")
+            active = active & ops.not_(bad)
+            dx, dy, dphi = (-x for x in _times(_adjugate(m, 1.0 / ops.safe(det, bad)), f))
+            e1 = (ops.where(active, e1[0] + dx, e1[0]), ops.where(active, e1[1] + dy, e1[1]))
+            phi = ops.where(active, phi + dphi, phi)
+            r = (ops.cos(phi), ops.sin(phi))
+            tiny = 4 * U * (abs(e1[0]) + abs(e1[1]) + size)
+            active = active & ops.not_(abs(dx) + abs(dy) + abs(dphi) * size <= tiny)
+            if not ops.any(active):
                 break
-        pins = [e1 + r * d[i] for i in range(3)]
-        u = [pins[i] - p[i] for i in range(3)]
-        t = [1j * r * d[i] for i in range(3)]
-        m = [(u[i].real, u[i].imag, u[i].real * t[i].real + u[i].imag * t[i].imag)
-             for i in range(3)]
-        minv = _inverse(m)
+        pins = [_cadd(e1, _cmul(r, d[i])) for i in range(3)]
+        u = [_csub(pins[i], p[i]) for i in range(3)]
+        t = [_cmul(_cmul(i_r, r), d[i]) for i in range(3)]
+        m = [(u[i][0], u[i][1], u[i][0] * t[i][0] + u[i][1] * t[i][1]) for i in range(3)]
         # The measure: |det M| over the rows' norms, each row scaled to its link and the
         # ternary's size (Hadamard's ratio: 1 at best, 0 at a singular point).
-        rows = [math.hypot(m[i][0], m[i][1]) * math.hypot(1.0, m[i][2] / (lens[i] * self.size))
+        rows = [ops.hypot(m[i][0], m[i][1]) * ops.hypot(1.0, m[i][2] / (lens[i] * size))
                 for i in range(3)]
-        det = _det(m) / (self.size * rows[0] * rows[1] * rows[2])
-        measure = abs(det)
-        if minv is None or not measure > SINGULAR:
-            raise _Refused(f"its links are concurrent or parallel with the ternary's motion "
-                           f'(singular): expected its conditioning measure > {SINGULAR:g}, got '
-                           f'{measure:.3g}')
+        det = _det(m)
+        measure = abs(det / (size * rows[0] * rows[1] * rows[2]))
+        bad = (det == 0.0) | ops.not_(ops.isfinite(det)) | ops.not_(measure > SINGULAR)
+        ops.refuse(bad, lambda: f"its links are concurrent or parallel with the ternary's "
+                   f'motion (singular): expected its conditioning measure > {SINGULAR:g}, '
+                   f'got {measure:.3g}')
+        minv = _adjugate(m, 1.0 / ops.safe(det, bad))
         # Velocities: M (vE1, omega) = (ui . vPi); accelerations likewise (see module).
-        b = [u[i].real * v[i].real + u[i].imag * v[i].imag for i in range(3)]
-        vx, vy, om = (sum(minv[k][j] * b[j] for j in range(3)) for k in range(3))
-        vpins = [complex(vx, vy) + om * t[i] for i in range(3)]
-        rel = [vpins[i] - v[i] for i in range(3)]
-        c = [u[i].real * a[i].real + u[i].imag * a[i].imag
-             - (rel[i].real * rel[i].real + rel[i].imag * rel[i].imag)
-             + om * om * (u[i].real * (r * d[i]).real + u[i].imag * (r * d[i]).imag)
+        b = [u[i][0] * v[i][0] + u[i][1] * v[i][1] for i in range(3)]
+        vx, vy, om = _times(minv, b)
+        vpins = [(vx + om * t[i][0], vy + om * t[i][1]) for i in range(3)]
+        rel = [_csub(vpins[i], v[i]) for i in range(3)]
+        rd = [_cmul(r, d[i]) for i in range(3)]
+        c = [u[i][0] * a[i][0] + u[i][1] * a[i][1]
+             - (rel[i][0] * rel[i][0] + rel[i][1] * rel[i][1])
+             + om * om * (u[i][0] * rd[i][0] + u[i][1] * rd[i][1])
              for i in range(3)]
-        ax, ay, al = (sum(minv[k][j] * c[j] for j in range(3)) for k in range(3))
-        apins = [complex(ax, ay) + al * t[i] - om * om * r * d[i] for i in range(3)]
-        w = [(u[i].real * rel[i].imag - u[i].imag * rel[i].real) / (lens[i] * lens[i])
+        ax, ay, al = _times(minv, c)
+        spun = [_cmul((om * om * r[0], om * om * r[1]), d[i]) for i in range(3)]
+        apins = [(ax + al * t[i][0] - spun[i][0], ay + al * t[i][1] - spun[i][1])
+                 for i in range(3)]
+        w = [(u[i][0] * rel[i][1] - u[i][1] * rel[i][0]) / (lens[i] * lens[i])
              for i in range(3)]
-        arel = [apins[i] - a[i] for i in range(3)]
-        alpha = [(u[i].real * arel[i].imag - u[i].imag * arel[i].real) / (lens[i] * lens[i])
+        arel = [_csub(apins[i], a[i]) for i in range(3)]
+        alpha = [(u[i][0] * arel[i][1] - u[i][1] * arel[i][0]) / (lens[i] * lens[i])
                  for i in range(3)]
         # Bounds, first order: the closure's right sides move by li (ep_i + U li) and the
         # rounding; (E1, phi) by |M^-1| times that. Velocities and accelerations: the
@@ -520,35 +749,35 @@ class _TriadStep(Step):
         amin = [[abs(x) for x in row] for row in minv]
         # The closure's residual at the polished pose, measured (a posteriori), with its
         # own rounding: (E1, phi) is within M^-1 of it and of the starts' bounds.
-        dpos = [lens[i] * ep[i] + abs(0.5 * (u[i].real * u[i].real + u[i].imag * u[i].imag
+        dpos = [lens[i] * ep[i] + abs(0.5 * (u[i][0] * u[i][0] + u[i][1] * u[i][1]
                                              - lens[i] * lens[i]))
                 + _U4 * lens[i] * lens[i] for i in range(3)]
-        ex, ey, ephi = (sum(amin[k][j] * dpos[j] for j in range(3)) for k in range(3))
-        # Norms by math.hypot (the scalar path serves arrays too: the same bits).
-        ad = [abs(d[i]) for i in range(3)]
-        epin = [math.hypot(ex, ey) + ephi * ad[i] + U * abs(pins[i]) + _U4 * ad[i]
+        ex, ey, ephi = _times(amin, dpos)
+        # Norms by the C library's hypot (Python's complex abs, NumPy's hypot: the same bits).
+        ad = [abs(z) for z in self.d]
+        epin = [ops.hypot(ex, ey) + ephi * ad[i] + U * ops.hypot(*pins[i]) + _U4 * ad[i]
                 for i in range(3)]
         eu = [epin[i] + ep[i] for i in range(3)]
         # The velocity system's rows move by |du| (and u . t by |du| |d| + l |d| dphi), its
         # right sides u . vP by |du| |vP| + l |dvP|: through |M^-1| with the solution.
         aom = abs(om)
-        speed = math.hypot(vx, vy)
-        grow_v = [abs(v[i]) + speed + aom * ad[i] for i in range(3)]
+        speed = ops.hypot(vx, vy)
+        grow_v = [ops.hypot(*v[i]) + speed + aom * ad[i] for i in range(3)]
         dvel = [lens[i] * ev[i] + eu[i] * grow_v[i] + lens[i] * ad[i] * aom * ephi
                 + _U7 * lens[i] * grow_v[i] for i in range(3)]
-        evx, evy, eom = (sum(amin[k][j] * dvel[j] for j in range(3)) for k in range(3))
-        evpin = [math.hypot(evx, evy) + eom * ad[i] + aom * ad[i] * ephi for i in range(3)]
+        evx, evy, eom = _times(amin, dvel)
+        evpin = [ops.hypot(evx, evy) + eom * ad[i] + aom * ad[i] * ephi for i in range(3)]
         # Likewise the acceleration system, whose right side also holds -|vE - vP|^2 and
         # omega^2 u . (R d).
-        accel = math.hypot(ax, ay)
+        accel = ops.hypot(ax, ay)
         aal = abs(al)
-        grow_a = [abs(a[i]) + accel + (aal + om * om) * ad[i] for i in range(3)]
-        relv = [abs(rel[i]) for i in range(3)]
+        grow_a = [ops.hypot(*a[i]) + accel + (aal + om * om) * ad[i] for i in range(3)]
+        relv = [ops.hypot(*rel[i]) for i in range(3)]
         dacc = [lens[i] * ea[i] + eu[i] * grow_a[i] + lens[i] * ad[i] * (aal + om * om) * ephi
                 + 2.0 * relv[i] * (evpin[i] + ev[i]) + 2.0 * aom * eom * lens[i] * ad[i]
                 + _U7 * (lens[i] * grow_a[i] + relv[i] * relv[i]) for i in range(3)]
-        eax, eay, eal = (sum(amin[k][j] * dacc[j] for j in range(3)) for k in range(3))
-        eapin = [math.hypot(eax, eay) + (eal + 2.0 * aom * eom) * ad[i]
+        eax, eay, eal = _times(amin, dacc)
+        eapin = [ops.hypot(eax, eay) + (eal + 2.0 * aom * eom) * ad[i]
                  + (aal + om * om) * ad[i] * ephi for i in range(3)]
         links = []
         for i in range(3):
@@ -556,23 +785,27 @@ class _TriadStep(Step):
             e_dir = eu[i] / lens[i] + _U7
             e_w = (evpin[i] + ev[i]) / lens[i] + abs(w[i]) * e_dir + _U4 * abs(w[i])
             e_al = (eapin[i] + ea[i]) / lens[i] + abs(alpha[i]) * e_dir + _U4 * abs(alpha[i])
-            links.append((u[i] * inv_l, w[i], alpha[i], e_dir, e_w, e_al))
+            links.append(((u[i][0] * inv_l, u[i][1] * inv_l), w[i], alpha[i], e_dir, e_w, e_al))
         ternary = (r, om, al, ephi + _U4, eom, eal)
         points = [(pins[i], vpins[i], apins[i], epin[i], evpin[i], eapin[i]) for i in range(3)]
         return points, ternary, links, measure
 
-    def _start_point(self, p: tuple[complex, ...], r: complex) -> complex:
+    def _start_point(self, ops: Any, p: list[Any], r: Any) -> tuple[Any, Any]:
         """Return ``E1`` from the two linear equations of the circles at ``R = r`` (Cramer)."""
         l1, l2, l3 = self.lengths
         p1 = p[0]
-        q2, q3 = p[1] - p1 - r * self.d[1], p[2] - p1 - r * self.d[2]
-        k2 = abs(q2) ** 2 - l2 * l2 + l1 * l1
-        k3 = abs(q3) ** 2 - l3 * l3 + l1 * l1
-        det = 2.0 * (q2.real * q3.imag - q3.real * q2.imag)
-        if det == 0.0:
-            return p1 + l1
-        return p1 + complex((k2 * q3.imag - k3 * q2.imag) / det,
-                            (q2.real * k3 - q3.real * k2) / det)
+        q2 = _csub(_csub(p[1], p1), _cmul(r, _pair(self.d[1])))
+        q3 = _csub(_csub(p[2], p1), _cmul(r, _pair(self.d[2])))
+        k2 = ops.square_norm(*q2) - l2 * l2 + l1 * l1
+        k3 = ops.square_norm(*q3) - l3 * l3 + l1 * l1
+        det = 2.0 * (q2[0] * q3[1] - q3[0] * q2[1])
+        flat = det == 0.0
+        if not ops.vector and flat:
+            return p1[0] + l1, p1[1]
+        det = ops.safe(det, flat)
+        x = p1[0] + (k2 * q3[1] - k3 * q2[1]) / det
+        y = p1[1] + (q2[0] * k3 - q3[0] * k2) / det
+        return ops.where(flat, p1[0] + l1, x), ops.where(flat, p1[1], y)
 
     def run(self, ctx: _Context) -> None:
         starts = [ctx.points[name] for name in self.starts]
@@ -586,40 +819,30 @@ class _TriadStep(Step):
             self._put(ctx, *out)
             return
         shape = np.shape(ctx.angle)
-        angles = np.broadcast_to(ctx.angle, shape).ravel()
-        columns = [[np.broadcast_to(np.asarray(s[k]), shape).ravel() for s in starts]
-                   for k in range(6)]
-        size = angles.size
-        ok = np.zeros(size, dtype=bool)
-        values: list[Any] = [None] * size
-        for j in range(size):
-            args: list[Any] = [tuple(complex(col[j]) if k < 3 else float(col[j])
-                                     for col in columns[k]) for k in range(6)]
-            try:
-                values[j] = self.solve_one(float(angles[j]), *args)
-            except _Refused:
-                continue        # not ok: masked under this step's label below
-            ok[j] = True
+        angles = np.asarray(np.broadcast_to(ctx.angle, shape), dtype=np.float64).ravel()
+        columns = [[np.asarray(np.broadcast_to(s[k], shape),
+                               dtype=np.complex128 if k < 3 else np.float64).ravel()
+                    for s in starts] for k in range(6)]
+        with np.errstate(all='ignore'):
+            ok, (points, ternary, links, measure) = self.solve_many(angles, *columns)
         ctx.mask(ok.reshape(shape), self.label)
-        nan = complex(math.nan, math.nan)
-        blank = ([(nan, nan, nan, math.nan, math.nan, math.nan)] * 3,
-                 (nan, math.nan, math.nan, math.nan, math.nan, math.nan),
-                 [(nan, math.nan, math.nan, math.nan, math.nan, math.nan)] * 3, math.nan)
-        filled = [value if value is not None else blank for value in values]
 
-        def stack(entries: list[Any], k: int, complex_kind: bool) -> Any:
-            kind = np.complex128 if complex_kind else np.float64
-            return np.array([entry[k] for entry in entries], dtype=kind).reshape(shape)
+        def complexes(x: Any) -> Any:
+            z = np.empty(shape, dtype=np.complex128)
+            z.real = np.where(ok, x[0], math.nan).reshape(shape)
+            z.imag = np.where(ok, x[1], math.nan).reshape(shape)
+            return z
 
-        for i, name in enumerate(self.pins):
-            entries = [value[0][i] for value in filled]
-            ctx.points[name] = tuple(stack(entries, k, k < 3) for k in range(6))
-        for i, name in enumerate(self.names):
-            entries = [value[2][i] for value in filled]
-            ctx.links[name] = tuple(stack(entries, k, k == 0) for k in range(6))
-        entries = [value[1] for value in filled]
-        ctx.links[self.link] = tuple(stack(entries, k, k == 0) for k in range(6))
-        ctx.measures[self.key] = np.array([value[3] for value in filled]).reshape(shape)
+        def floats(x: Any) -> Any:
+            return np.where(ok, x, math.nan).reshape(shape)
+
+        for name, value in zip(self.pins, points, strict=True):
+            ctx.points[name] = (*(complexes(x) for x in value[:3]),
+                                *(floats(x) for x in value[3:]))
+        for name, value in zip(self.names, links, strict=True):
+            ctx.links[name] = (complexes(value[0]), *(floats(x) for x in value[1:]))
+        ctx.links[self.link] = (complexes(ternary[0]), *(floats(x) for x in ternary[1:]))
+        ctx.measures[self.key] = floats(measure)
 
     def _put(self, ctx: _Context, points: Any, ternary: Any, links: Any, measure: float) -> None:
         for name, value in zip(self.pins, points, strict=True):
@@ -628,20 +851,3 @@ class _TriadStep(Step):
             ctx.links[name] = value
         ctx.links[self.link] = ternary
         ctx.measures[self.key] = measure
-
-
-def _det(m: list[tuple[float, float, float]]) -> float:
-    (a, b, c), (d, e, f), (g, h, i) = m
-    return a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
-
-
-def _inverse(m: list[tuple[float, float, float]]) -> list[list[float]] | None:
-    """Return the inverse of a 3x3 matrix by its adjugate, or None where it is singular."""
-    (a, b, c), (d, e, f), (g, h, i) = m
-    det = _det(m)
-    if det == 0.0 or not math.isfinite(det):
-        return None
-    k = 1.0 / det
-    return [[(e * i - f * h) * k, (c * h - b * i) * k, (b * f - c * e) * k],
-            [(f * g - d * i) * k, (a * i - c * g) * k, (c * d - a * f) * k],
-            [(d * h - e * g) * k, (b * g - a * h) * k, (a * e - b * d) * k]]
