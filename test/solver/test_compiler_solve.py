@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 
 import mech_kinematics as mk
-from mech_kinematics.solver.compiler import (ARRAY, compile_scene, COMPILE_STEPS, NotCompiled,
-                                             SINGLE, Single)
+from mech_kinematics.solver.compiler import (ARRAY, Array, compile_scene, COMPILE_STEPS,
+                                             NotCompiled, SINGLE, Single)
 from mech_kinematics.verify.extreme import extreme_cases
 
 #: The module (``mech_kinematics.solver.solve`` is also the name of its function).
@@ -28,6 +28,9 @@ COMPILE_AFTER, ARRAY_COMPILE_AFTER = solve_module.COMPILE_AFTER, solve_module.AR
 
 #: Crank angles over two turns and a bit, both signs.
 ANGLES = np.linspace(-7.0, 7.0, 141)
+#: Every other one (0.2 rad apart, both ends) for the packaged scenes' single-angle solves,
+#: each at three speeds, three tolerances and two turn counts (18 solves a path an angle).
+SINGLE_ANGLES = ANGLES[::2]
 TOLERANCES = (1e-6, 1e-12, math.inf)
 
 
@@ -38,6 +41,18 @@ def _pair(scene_of):
     fast._solver.compiled_array = compile_scene(fast, ARRAY)
     fast._solver.compiled_usual = solve_module._compile_usual(fast._solver)
     return fast, slow
+
+
+#: The pairs compiled so far, by scene name: a test of the single-angle path and one of
+#: the array path share one compile of a scene (solving neither scene changes it).
+_PAIRS = {}
+
+
+def _shared_pair(name, scene_of):
+    """Return :func:`_pair` of ``scene_of``, compiled once for every test here asking ``name``."""
+    if name not in _PAIRS:
+        _PAIRS[name] = _pair(scene_of)
+    return _PAIRS[name]
 
 
 def _assert_same(fast, slow, angles, speeds=(None,), turns=(0,)):
@@ -56,8 +71,8 @@ def _assert_same(fast, slow, angles, speeds=(None,), turns=(0,)):
 
 @pytest.mark.parametrize('name', crank_scene_names())
 def test_every_packaged_scene_solves_alike_compiled(name):
-    """Over two turns, three speeds and three tolerances: identical states, bounds, refusals."""
-    fast, slow = _pair(lambda: mk.load_scene(name))
+    """Over two turns (71 angles), three speeds, three tolerances: the same states and refusals."""
+    fast, slow = _shared_pair(name, lambda: mk.load_scene(name))
     if name == 'geneva':    # its state reports the lever's engagement: the general path's
         assert fast._solver.compiled_single == NotCompiled(
             "an intermittent lever's engagement is reported (wheel): the general path's")
@@ -66,7 +81,7 @@ def test_every_packaged_scene_solves_alike_compiled(name):
             'step triad coupler: kernel uses `try` (not in the kernel subset)')
     else:
         assert fast._solver.compiled_single, f'{name} does not compile'
-    refused = _assert_same(fast, slow, ANGLES, speeds=(None, -3.5, 1e4), turns=(0, 3))
+    refused = _assert_same(fast, slow, SINGLE_ANGLES, speeds=(None, -3.5, 1e4), turns=(0, 3))
     if name == 'four_bar_coupler_points':
         assert refused > 0      # the triple rocker's unassemblable angles, refused alike
 
@@ -75,7 +90,7 @@ def test_the_extreme_suite_refuses_and_answers_alike():
     """Toggles, change points, grazing guides, a pin at the pivot: same states and refusals."""
     compiled = 0
     for case in extreme_cases(extra_angles=0):
-        fast, slow = _pair(lambda case=case: case.scene)
+        fast, slow = _shared_pair(f'extreme {case.name}', lambda case=case: case.scene)
         compiled += bool(fast._solver.compiled_single)
         speed = case.speed if case.speed is not None else case.scene.input.speed
         _assert_same(fast, slow, case.angles, speeds=(speed,))
@@ -85,7 +100,7 @@ def test_the_extreme_suite_refuses_and_answers_alike():
 @pytest.mark.parametrize('name', crank_scene_names())
 def test_every_packaged_scene_solves_arrays_alike_compiled(name):
     """Arrays of angles, speeds and turns, three tolerances: identical states, masks, bounds."""
-    fast, slow = _pair(lambda: mk.load_scene(name))
+    fast, slow = _shared_pair(name, lambda: mk.load_scene(name))
     if name == 'stephenson_iii':  # a triad's kernel loops over its roots: the general path's
         assert fast._solver.compiled_array == NotCompiled(
             'step triad coupler: kernel uses `try` (not in the kernel subset)')
@@ -119,7 +134,7 @@ def test_rigid_triangles_compile_and_solve_alike():
 def test_the_extreme_suite_solves_arrays_alike():
     """The extreme cases over their angles as one array: same states, masks and bounds."""
     for case in extreme_cases(extra_angles=0):
-        fast, slow = _pair(lambda case=case: case.scene)
+        fast, slow = _shared_pair(f'extreme {case.name}', lambda case=case: case.scene)
         speed = case.speed if case.speed is not None else case.scene.input.speed
         angles = np.asarray(case.angles, dtype=float)
         assert array_outcome(fast, angles, speed) == array_outcome(slow, angles, speed)
@@ -278,12 +293,23 @@ def test_a_constant_speed_keeps_its_sign_of_zero_in_an_array_state():
 
 
 def test_a_scene_of_more_steps_than_compile_steps_keeps_the_general_path():
-    """A strip of COMPILE_STEPS + 1 dyads is never compiled by solve (it would take seconds)."""
+    """A strip of COMPILE_STEPS + 1 dyads is never compiled by solve (it would take seconds).
+
+    The refusal is the step count's alone: a strip of 3 dyads (3 steps) is
+    refused alike on both paths under a limit of 2, and compiles under a limit
+    of 3, none, or the default (compiling the 129-dyad strip itself took 30 s).
+    """
     from helpers import equilateral_chain
 
     long = equilateral_chain(COMPILE_STEPS + 1)
     why = NotCompiled(f'more than {COMPILE_STEPS} steps ({COMPILE_STEPS + 1}): compiling would '
                       'cost more than the solves it speeds up')
     assert compile_scene(long, SINGLE) == why and compile_scene(long, ARRAY) == why
-    assert callable(compile_scene(long, Single(max_steps=None)))
-    assert callable(compile_scene(equilateral_chain(8), SINGLE))
+    short = equilateral_chain(3)
+    why = NotCompiled('more than 2 steps (3): compiling would cost more than the solves it '
+                      'speeds up')
+    assert compile_scene(short, Single(max_steps=2)) == why
+    assert compile_scene(short, Array(max_steps=2)) == why
+    assert callable(compile_scene(short, Array(max_steps=3)))
+    assert callable(compile_scene(short, Single(max_steps=None)))
+    assert callable(compile_scene(short, SINGLE))

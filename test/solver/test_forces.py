@@ -663,7 +663,10 @@ def _solved(data, kind, n=None, draw=None):
     return scene, state, instant
 
 
-HYPOTHESIS = settings(max_examples=150, deadline=None,
+#: 75 random loaded scenes a property (every registered kind, random masses, loads and
+#: instants; a new sample every run); the packaged scenes with masses are checked on the
+#: same balances every run below. 150 took the five properties 42 s under load.
+HYPOTHESIS = settings(max_examples=75, deadline=None,
                       suppress_health_check=[HealthCheck.too_slow])
 
 
