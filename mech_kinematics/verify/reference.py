@@ -987,8 +987,8 @@ class _Triad(_Equations):
     against the ternary's sides) in the four angles. The start is found here,
     apart from the solver's polynomial: for each ternary angle on a grid, the
     first two links close as a law-of-cosines dyad on both branches, and the
-    third link's gap changes sign at an assembly; each sign change is
-    refined by bisection. Which assembly is the branch is the solver's
+    third link's gap changes sign at an assembly (the grid's 2 x 2049 signs
+    in doubles); each sign change is refined by bisection (in mpmath). Which assembly is the branch is the solver's
     definition, continuity from the drawn pose along the crank's turn,
     followed here by its own continuation (:meth:`prepare`).
     """
@@ -1111,13 +1111,27 @@ class _Triad(_Equations):
             e1 = pa + la * mpmath.expj(mpmath.arg(d) + sign * mpmath.acos(cos_g))
             return abs(e1 + mpmath.expj(phi) * d3 - pc) - lc
 
+        # The grid's signs in doubles (a sign change within rounding of a grid point is
+        # no assembly a drawing could tell), each bracket then bisected in mpmath.
+        la_f, lb_f, lc_f = float(la), float(lb), float(lc)
+        d2_f, d3_f = complex(d2), complex(d3)
+        pa_f, pb_f, pc_f = complex(pa), complex(pb), complex(pc)
+        grid_f = np.arange(2049) * (2 * math.pi / 2048)
+        turn_f = np.exp(1j * grid_f)
+        d_f = pb_f - turn_f * d2_f - pa_f
+        dist_f = np.abs(d_f)
+        with np.errstate(all='ignore'):
+            cos_f = (la_f * la_f + dist_f * dist_f - lb_f * lb_f) / (2 * la_f * dist_f)
+            reach = np.abs(cos_f) <= 1
+            spread = np.arccos(np.clip(cos_f, -1.0, 1.0))
         found = []
         grid = [2 * mpmath.pi * k / 2048 for k in range(2049)]
         for sign in (1, -1):
-            values = [gap(phi, sign) for phi in grid]
+            e1_f = pa_f + la_f * np.exp(1j * (np.angle(d_f) + sign * spread))
+            values = np.where(reach, np.abs(e1_f + turn_f * d3_f - pc_f) - lc_f, np.nan)
             for k in range(2048):
                 g0, g1 = values[k], values[k + 1]
-                if g0 is None or g1 is None or (g0 > 0) == (g1 > 0):
+                if not (math.isfinite(g0) and math.isfinite(g1)) or (g0 > 0) == (g1 > 0):
                     continue
                 lo, hi = grid[k], grid[k + 1]
                 for _ in range(60):
