@@ -477,12 +477,18 @@ def cut_bag(tmp: Path, name: str, data: bytes) -> Path:
     return bag
 
 
+@pytest.fixture(scope='module')
+def unclosed(tmp_path_factory) -> tuple[bytes, list]:
+    """One :func:`unclosed_mcap` for every example of the cut (it is the same file each time)."""
+    return unclosed_mcap(tmp_path_factory.mktemp('unclosed'))
+
+
 @settings(max_examples=40, deadline=None)
 @given(fraction=st.floats(0.0, 1.0))
-def test_mcap_cut_anywhere_keeps_every_chunk_before_the_cut(tmp_path_factory, fraction):
+def test_mcap_cut_anywhere_keeps_every_chunk_before_the_cut(tmp_path_factory, unclosed,
+                                                            fraction):
     """An MCAP file cut at any byte: reindex keeps each chunk whose record is whole."""
-    tmp = tmp_path_factory.getbasetemp()
-    data, chunks = unclosed_mcap(tmp)
+    data, chunks = unclosed
     header = 8 + 9 + int.from_bytes(data[9:17], 'little')
     cut = header + round(fraction * (len(data) - header))
     bag = cut_bag(tmp_path_factory.mktemp('cut'), 'bag', data[:cut])

@@ -20,7 +20,24 @@ def run(*args: str, **kwargs) -> subprocess.CompletedProcess:
                           capture_output=True, timeout=TIMEOUT, **kwargs)
 
 
-@pytest.mark.parametrize('args, words', [
+def in_process(capsys, *args: str) -> subprocess.CompletedProcess:
+    """Run ``python -m mech_kinematics ARGS`` as its ``main`` in this process: status, output.
+
+    For the questions after each command's one end-to-end call (``run``): an
+    argparse refusal's SystemExit is its status.
+    """
+    from mech_kinematics.__main__ import main
+
+    try:
+        status = main(list(args))
+    except SystemExit as exit_:
+        status = exit_.code
+    out, err = capsys.readouterr()
+    return subprocess.CompletedProcess(list(args), status, out, err)
+
+
+#: One failing call per command, each run end to end (a subprocess).
+FAILING = [
     (['solve', 'no_such_scene'], ['no_such_scene', 'packaged scene name']),
     (['diagram', 'no_such_scene', '-o', 'x.png'], ['no_such_scene']),
     (['plot', '--scene', 'no_such_scene', '-o', 'x.png'], ['no_such_scene']),
@@ -28,10 +45,21 @@ def run(*args: str, **kwargs) -> subprocess.CompletedProcess:
     (['record', '-o', '/proc/no/bag', '--duration', '1'], ['/proc/no/bag']),
     (['report', '-o', '/proc/no/report', '--smoke', '--no-progress'], ['/proc/no']),
     (['solve', '/dev/null'], ['/dev/null']),
-])
-def test_a_failing_command_says_one_line(tmp_path, args, words):
-    """A missing scene, bag or output folder: one `error:` line naming it, status 2."""
-    result = run(*args, cwd=tmp_path)
+]
+
+
+@pytest.mark.parametrize('args, words', FAILING)
+def test_a_failing_command_says_one_line(tmp_path, capsys, monkeypatch, args, words):
+    """A missing scene, bag or output folder: one `error:` line naming it, status 2.
+
+    The first call of each command runs in a subprocess; a command's further
+    calls (solve's second) in this process, as its ``main``.
+    """
+    if [a for a, _ in FAILING].index(args) == [a[0] for a, _ in FAILING].index(args[0]):
+        result = run(*args, cwd=tmp_path)
+    else:
+        monkeypatch.chdir(tmp_path)
+        result = in_process(capsys, *args)
     assert result.returncode == 2, result.stderr
     assert 'Traceback' not in result.stderr
     lines = result.stderr.strip().splitlines()
@@ -40,10 +68,10 @@ def test_a_failing_command_says_one_line(tmp_path, args, words):
         assert word in lines[0]
 
 
-def test_a_negative_number_in_exponent_form_is_a_value():
+def test_a_negative_number_in_exponent_form_is_a_value(capsys):
     """`--speed-rpm -1e3` and `--angle-deg -.5e1` are numbers, not options (issue 12)."""
-    result = run('solve', 'khurmi_four_bar_ad150', '--speed-rpm', '-1e3', '--angle-deg',
-                 '-.5e1', '--indent', '0')
+    result = in_process(capsys, 'solve', 'khurmi_four_bar_ad150', '--speed-rpm', '-1e3',
+                        '--angle-deg', '-.5e1', '--indent', '0')
     assert result.returncode == 0, result.stderr
     assert '"speed": -104.7197551196597' in result.stdout
 
@@ -99,9 +127,12 @@ def test_number_types_refuse_with_one_reason(parse, text, message):
     (['record', '-o', 'x', '--max-queue-bytes', '1e6'],
      ["--max-queue-bytes: expected a positive integer, got '1e6'"]),
 ])
-def test_solve_and_record_use_the_shared_number_types(argv, words):
-    """The number options of solve and record refuse with the shared types' reasons."""
-    result = run(*argv)
+def test_solve_and_record_use_the_shared_number_types(capsys, argv, words):
+    """The number options of solve and record refuse with the shared types' reasons.
+
+    In this process (``main``): each command's end-to-end call is above.
+    """
+    result = in_process(capsys, *argv)
     assert result.returncode == 2
     for word in words:
         assert word in result.stderr

@@ -51,6 +51,17 @@ def assert_units_everywhere(fig) -> None:
             assert label.endswith(UNITS), f'{ax.get_title()!r}: axis label {label!r} has no unit'
 
 
+def bag_figure(bag, *, scene=None, x='time'):
+    """Return the Figure ``plot_bag`` draws, unsaved (PNGs are checked where they matter)."""
+    return plot.figure_from_motion(plot.motion_from_bag(bag, scene=scene), x=x)
+
+
+def scene_figure(scene, *, samples=plot.DEFAULT_SAMPLES, x=None):
+    """Return the Figure ``plot_scene`` draws, unsaved (PNGs are checked where they matter)."""
+    x = x or ('angle' if scene.single_crank else 'time')
+    return plot.figure_from_motion(plot.motion_from_scene(scene, samples=samples, x=x), x=x)
+
+
 def lines(ax) -> dict:
     return {line.get_label(): line for line in ax.get_lines()
             if not line.get_label().startswith('_')}
@@ -136,7 +147,7 @@ def test_scene_plot_has_every_panel_with_units(tmp_path):
 def test_scene_plot_values_are_the_solver_values(tmp_path):
     """The lines drawn are mk.solve over 0..2π: angular velocities and point speeds."""
     scene = mk.load_scene('khurmi_four_bar_ad150')
-    fig = plot.plot_scene(scene, tmp_path / 'p.png', samples=181)
+    fig = scene_figure(scene, samples=181)
     angle = np.linspace(0.0, 2 * math.pi, 181)
     state = mk.solve(scene, angle)
     rocker = lines(panels(fig)['Joint angular velocities'])['rocker']
@@ -150,7 +161,7 @@ def test_scene_plot_values_are_the_solver_values(tmp_path):
 
 def test_scene_with_sliders_adds_the_slider_column(tmp_path):
     """A mechanism with prismatic joints gets slider panels in metres."""
-    fig = plot.plot_scene(mk.load_scene('quick_return'), tmp_path / 'qr.png', x='time')
+    fig = scene_figure(mk.load_scene('quick_return'), x='time')
     assert set(panels(fig)) == JOINT_PANELS | POINT_PANELS | SLIDER_PANELS
     assert_units_everywhere(fig)
     assert set(lines(panels(fig)['Slider positions'])) == {'block', 'ram'}
@@ -161,7 +172,7 @@ def test_scene_with_sliders_adds_the_slider_column(tmp_path):
 def test_scene_that_does_not_assemble_everywhere_leaves_gaps(tmp_path):
     """A triple rocker: angles that cannot be assembled are gaps (NaN), never made-up values."""
     scene = mk.load_scene('four_bar_coupler_points')
-    fig = plot.plot_scene(scene, tmp_path / 'fb.png', samples=361)
+    fig = scene_figure(scene, samples=361)
     ydata = lines(panels(fig)['Joint angular velocities'])['rocker'].get_ydata()
     state = mk.solve(scene, np.linspace(0, 2 * math.pi, 361))
     assert np.isnan(ydata).sum() == (~state.valid).sum() > 0
@@ -207,7 +218,7 @@ def test_bag_plot_shows_the_recorded_values(tmp_path, storage):
     out = tmp_path / 'bag.png'
     assert plot.main([str(bag), '-o', str(out), '--scene', scene.name]) == 0
     assert_png(out)
-    fig = plot.plot_bag(bag, tmp_path / 'again.png', scene=scene)
+    fig = bag_figure(bag, scene=scene)
     assert set(panels(fig)) == JOINT_PANELS | POINT_PANELS
     assert_units_everywhere(fig)
     accel = lines(panels(fig)['Joint angular accelerations'])['coupler']
@@ -255,7 +266,7 @@ def test_ticks_missing_from_a_bag_leave_a_gap_not_a_line(tmp_path):
     scene = mk.load_scene('khurmi_four_bar_ad150')
     angles = scene.input.angle + scene.input.speed * 0.002 * np.arange(300)
     bag = write_bag(tmp_path / 'gap', scene, angles, skip=range(100, 140))
-    fig = plot.plot_bag(bag, tmp_path / 'gap.png', scene=scene)
+    fig = bag_figure(bag, scene=scene)
     for title in ('Joint angular velocities', 'Point paths'):
         for line in lines(panels(fig)[title]).values():
             y = np.asarray(line.get_ydata(), dtype=float)
@@ -266,7 +277,7 @@ def test_bag_with_joint_states_only_has_no_acceleration_lines(tmp_path):
     """A bag with only joint_states plots angles and velocities, and says 'no data' for α."""
     scene = mk.load_scene('khurmi_four_bar_ad150')
     bag = write_bag(tmp_path / 'js', scene, np.linspace(0, 1, 20), topics=('joint_states',))
-    fig = plot.plot_bag(bag, tmp_path / 'js.png', scene=scene, x='angle')
+    fig = bag_figure(bag, scene=scene, x='angle')
     assert set(lines(panels(fig)['Joint angular velocities'])) == {'crank', 'coupler', 'rocker'}
     assert not lines(panels(fig)['Joint angular accelerations'])
     assert not lines(panels(fig)['Point speeds |v|'])
@@ -561,7 +572,7 @@ def test_a_bag_without_accelerations_plots_what_is_there_and_says_what_is_not(
     lengths = 1.9 + 0.004 * np.arange(60)
     bag = topic_driven_bag(tmp_path / 'topic', scene, lengths, velocities=velocities)
     with pytest.warns(UserWarning) as caught:
-        fig = plot.plot_bag(bag, tmp_path / 'topic.png', scene=scene)
+        fig = bag_figure(bag, scene=scene)
     missing = 'velocities or accelerations' if not velocities else 'accelerations'
     assert [str(w.message) for w in caught] == [
         f'{bag}: no {missing} in the recording (empty in every message, as a node driven from a '
@@ -628,7 +639,7 @@ def test_a_scene_with_forces_gets_its_turning_moment_and_reactions(tmp_path):
 def test_several_drivers_plot_their_efforts_along_their_path(tmp_path):
     """The five-bar with masses, against time: both efforts, no mean line (no one turn)."""
     scene = forces_scene('five_bar_masses')
-    fig = plot.plot_scene(scene, tmp_path / 'five.png', samples=101)
+    fig = scene_figure(scene, samples=101)
     drawn = lines(panels(fig)['Turning moment (driver efforts)'])
     assert set(drawn) == {'left_crank', 'right_crank'}
     assert panels(fig)['Turning moment (driver efforts)'].get_xlabel() == 'time [s]'
@@ -636,8 +647,7 @@ def test_several_drivers_plot_their_efforts_along_their_path(tmp_path):
 
 def test_no_forces_no_forces_column(tmp_path):
     """A scene without masses, gravity or loads draws what it drew before, nothing more."""
-    fig = plot.plot_scene(mk.load_scene('khurmi_four_bar_ad150'), tmp_path / 'k.png',
-                          samples=91)
+    fig = scene_figure(mk.load_scene('khurmi_four_bar_ad150'), samples=91)
     assert not FORCE_PANELS & set(panels(fig))
     assert plot.motion_from_scene(mk.load_scene('khurmi_four_bar_ad150'), samples=5).forces \
         is None

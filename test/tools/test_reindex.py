@@ -9,6 +9,7 @@ what it does with a bag that another process holds or that it cannot write.
 """
 
 import ctypes
+import inspect
 import os
 from pathlib import Path
 import resource
@@ -28,11 +29,13 @@ from mech_kinematics.tools import reindex
 REPO = Path(__file__).resolve().parents[2]
 
 #: A bag written by a BagWriter in another process, flushed, then held open until killed.
+#: (``unclosed_bag`` and ``_string_hash`` are pasted in: importing this module would
+#: load every command, as ``mech_kinematics.__main__`` does.)
 WRITER = """
 import sys
 from pathlib import Path
-sys.path.insert(0, {here!r})
-from test_reindex import unclosed_bag
+from mech_kinematics.bag import BagWriter
+{functions}
 writer = unclosed_bag(Path(sys.argv[1]), sys.argv[2], int(sys.argv[3]))
 print('holding', flush=True)
 sys.stdin.read()
@@ -91,6 +94,18 @@ def storage_file(path: Path, storage: str) -> Path:
 def run_reindex(path: Path, **popen) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, '-m', 'mech_kinematics', 'reindex', str(path)],
                           cwd=REPO, capture_output=True, text=True, **popen)
+
+
+def reindex_here(path: Path, capsys) -> subprocess.CompletedProcess:
+    """Run ``reindex PATH`` as its ``main`` in this process: its status and output.
+
+    For every question but the command's own end-to-end calls (``run_reindex``:
+    a bag this process holds, a reindex that cannot write, a missing bag).
+    """
+    capsys.readouterr()
+    status = reindex.main([str(path)])
+    out, err = capsys.readouterr()
+    return subprocess.CompletedProcess(['reindex', str(path)], status, out, err)
 
 
 def assert_one_error_line(result: subprocess.CompletedProcess, *parts: str) -> None:
@@ -172,16 +187,18 @@ def hold(argv: list, tmp: Path) -> subprocess.Popen:
 
 
 @pytest.mark.parametrize('how', ['writer', 'open', 'mapped', 'sqlite3'])
-def test_a_bag_another_process_holds_is_refused_until_it_ends(tmp_path, how):
+def test_a_bag_another_process_holds_is_refused_until_it_ends(tmp_path, capsys, how):
     """Locked, open or mapped by another process: exit 2 naming it; once it is killed, reindexed.
 
     ``writer``: our BagWriter in another process (its lock); ``open`` and
     ``mapped``: a reader that takes no lock; ``sqlite3``: an idle connection.
+    The reindex runs in this process (the holder is the other one).
     """
     storage = 'sqlite3' if how == 'sqlite3' else 'mcap'
     bag = tmp_path / 'bag'
     if how == 'writer':
-        code = WRITER.format(here=str(Path(__file__).parent))
+        functions = '\n'.join(inspect.getsource(f) for f in (unclosed_bag, _string_hash))
+        code = WRITER.format(functions=functions)
         holder = hold([code, str(bag), storage, '30'], tmp_path)
         file = storage_file(bag, storage)
         said = 'has it locked and open'
@@ -191,7 +208,7 @@ def test_a_bag_another_process_holds_is_refused_until_it_ends(tmp_path, how):
         said = 'has it mapped' if how == 'mapped' else 'has it open'
     try:
         before = file.read_bytes()
-        result = run_reindex(bag)
+        result = reindex_here(bag, capsys)
         assert_one_error_line(result, f'got "{bag}": its storage file {file.name} ',
                               f'process {holder.pid} ({Path(sys.executable).name} -c ', said)
         assert file.read_bytes() == before
@@ -200,7 +217,7 @@ def test_a_bag_another_process_holds_is_refused_until_it_ends(tmp_path, how):
         holder.kill()
         holder.communicate()
     assert holder.returncode == -signal.SIGKILL
-    result = run_reindex(bag)
+    result = reindex_here(bag, capsys)
     assert result.returncode == 0, result.stderr
     assert result.stdout.startswith(f'reindexed {bag} ({storage}, bag version 8): 30 messages')
 
@@ -209,12 +226,12 @@ def test_a_bag_another_process_holds_is_refused_until_it_ends(tmp_path, how):
 
 
 @pytest.mark.parametrize('storage', ['mcap', 'sqlite3'])
-def test_reindex_twice_changes_nothing_the_second_time(tmp_path, storage):
+def test_reindex_twice_changes_nothing_the_second_time(tmp_path, capsys, storage):
     """The second reindex of a killed recording: the same messages, not a byte written."""
     bag = killed_bag(tmp_path / 'bag', storage, 500)
-    assert run_reindex(bag).returncode == 0
+    assert reindex_here(bag, capsys).returncode == 0
     files = {p.name: p.read_bytes() for p in bag.iterdir()}
-    result = run_reindex(bag)
+    result = reindex_here(bag, capsys)
     assert result.returncode == 0, result.stderr
     assert result.stdout.startswith(f'reindexed {bag} ({storage}, bag version 8): 500 messages')
     assert {p.name: p.read_bytes() for p in bag.iterdir()} == files
@@ -287,11 +304,13 @@ def bad_bags(tmp: Path) -> dict:
 
 @pytest.mark.parametrize('name', ['missing', 'file', 'empty', 'two', 'not_mcap', 'empty_mcap',
                                   'not_db'])
-def test_what_is_not_a_bag_is_one_error_line(tmp_path, name):
-    """Not a bag directory, no or two storage files, not a storage: exit 2, one error: line."""
+def test_what_is_not_a_bag_is_one_error_line(tmp_path, capsys, name):
+    """Not a bag directory, no or two storage files, not a storage: exit 2, one error: line.
+
+    ``missing`` runs the command end to end (a subprocess); the others in this process.
+    """
     path, expected = bad_bags(tmp_path)[name]
-    result = subprocess.run([sys.executable, '-m', 'mech_kinematics', 'reindex', str(path)],
-                            cwd=REPO, capture_output=True, text=True)
+    result = run_reindex(path) if name == 'missing' else reindex_here(path, capsys)
     assert result.returncode == 2
     assert result.stdout == ''
     assert result.stderr.count('\n') == 1 and result.stderr.startswith('error: ')
