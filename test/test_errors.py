@@ -10,6 +10,7 @@ here and bound to its class's signature.
 """
 
 import ast
+import functools
 import inspect
 from pathlib import Path
 
@@ -24,8 +25,13 @@ CLASSES = {name: cls for name, cls in vars(errors).items()
            and cls.__module__ == errors.__name__}
 
 
+@functools.lru_cache(maxsize=None)
 def constructions():
-    """Yield (file:line, class name, call) of every call of an error class in the package."""
+    """Return (file:line, class name, call) of every call of an error class in the package.
+
+    The package is read once for the module's tests and their ids.
+    """
+    found = []
     for path in sorted(PACKAGE.rglob('*.py')):
         tree = ast.parse(path.read_text(encoding='utf-8'))
         for node in ast.walk(tree):
@@ -34,7 +40,9 @@ def constructions():
                 name = func.id if isinstance(func, ast.Name) else \
                     func.attr if isinstance(func, ast.Attribute) else None
                 if name in CLASSES:
-                    yield f'{path.relative_to(PACKAGE.parent)}:{node.lineno}', name, node
+                    found.append((f'{path.relative_to(PACKAGE.parent)}:{node.lineno}', name,
+                                  node))
+    return tuple(found)
 
 
 def test_the_package_builds_its_errors():

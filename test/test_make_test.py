@@ -27,10 +27,16 @@ def make_test(pytest_args: str) -> subprocess.CompletedProcess:
 
 @pytest.mark.parametrize('pytest_args, status', [
     (f'{SERIAL_ONLY} -k nothing_is_named_this', 2),     # neither phase: make's error status
-    (SERIAL_ONLY, 0),                                   # the serial phase only
+    (f'-n 0 {SERIAL_ONLY}', 0),                         # the serial phase only
 ])
 def test_make_test_fails_when_no_test_ran_in_either_phase(pytest_args, status):
-    """No test selected in either phase fails with one line; in one phase only, it passes."""
+    """No test selected in either phase fails with one line; in one phase only, it passes.
+
+    The first case runs the first phase on its two workers as ``make test`` does (their
+    pytest must say status 5 too); the second, whose first phase selects nothing as the
+    first case's does, runs it without workers (``-n 0`` after ``-n 2``: two Pythons
+    fewer to start).
+    """
     result = make_test(pytest_args)
     output = result.stdout + result.stderr
     assert result.returncode == status, output

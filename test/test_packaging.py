@@ -15,6 +15,7 @@ See issue 13.
 
 import ast
 import configparser
+import functools
 from importlib import metadata
 from pathlib import Path
 import re
@@ -89,6 +90,23 @@ DEV_TOOLS = {'pytest', 'hypothesis', 'mcap', 'mcap-ros2-support', 'flake8', 'fla
              'types-pyyaml'}
 
 
+@functools.lru_cache(maxsize=None)
+def _import_statements(path: Path) -> tuple:
+    """Return ``(names, level, top_level)`` of each import statement of the file, in order.
+
+    Each file is parsed once for all the tests of this module.
+    """
+    tree = ast.parse(path.read_text(encoding='utf-8'))
+    top = {id(node) for node in tree.body}
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            found.append((tuple(alias.name for alias in node.names), 0, id(node) in top))
+        elif isinstance(node, ast.ImportFrom):
+            found.append(((node.module,), node.level, id(node) in top))
+    return tuple(found)
+
+
 def _imports(folder: Path, peers: bool = False) -> dict:
     """Return {top-level module: first file importing it} for absolute imports under ``folder``.
 
@@ -97,12 +115,8 @@ def _imports(folder: Path, peers: bool = False) -> dict:
     local = {path.stem for path in folder.glob('*.py')}     # test/ imports its own helpers
     found: dict = {}
     for path in sorted(folder.rglob('*.py')):
-        for node in ast.walk(ast.parse(path.read_text(encoding='utf-8'))):
-            if isinstance(node, ast.Import):
-                names = [alias.name for alias in node.names]
-            elif isinstance(node, ast.ImportFrom) and node.level == 0:
-                names = [node.module]
-            else:
+        for names, level, _ in _import_statements(path):
+            if level != 0:
                 continue
             for name in names:
                 top = name.split('.')[0]
@@ -189,12 +203,9 @@ def test_dev_peers_are_pinned_for_development_and_imported_only_inside_functions
     found = _imports(ROOT / 'mech_kinematics', peers=True)
     assert set(DEV_PEERS) <= set(found), 'a peer no longer imported: drop it from DEV_PEERS'
     for path in sorted((ROOT / 'mech_kinematics').rglob('*.py')):
-        tree = ast.parse(path.read_text(encoding='utf-8'))
-        for node in tree.body:      # top-level statements only: imports run on import
-            names = ([alias.name for alias in node.names] if isinstance(node, ast.Import)
-                     else [node.module] if isinstance(node, ast.ImportFrom) and node.module
-                     else [])
-            assert not {name.split('.')[0] for name in names} & set(DEV_PEERS), path
+        for names, _, top_level in _import_statements(path):
+            if top_level:       # top-level statements only: imports run on import
+                assert not {name.split('.')[0] for name in names if name} & set(DEV_PEERS), path
 
 
 def test_requirements_txt_holds_no_test_or_lint_tool():

@@ -489,22 +489,35 @@ def test_solve_command_prints_the_api_state(tmp_path):
     assert_same(json.loads(result.stdout), expected.as_dict())
 
 
-def test_solve_command_defaults_to_the_scene(tmp_path):
-    """Without options `solve` uses the scene's angle, speed and acceleration."""
+def run_in_process(capsys, *args):
+    """Return (status, stdout, stderr) of ``main(ARGS)``: the command, called here."""
+    capsys.readouterr()
+    try:
+        status = main([str(arg) for arg in args])
+    except SystemExit as exit_:     # --help
+        status = exit_.code
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+def test_solve_command_defaults_to_the_scene(tmp_path, capsys):
+    """Without options `solve` uses the scene's angle, speed and acceleration (called here)."""
     path = write(tmp_path, BASE)
-    result = run_command('solve', path)
-    assert result.returncode == 0, result.stderr
+    status, out, err = run_in_process(capsys, 'solve', path)
+    assert status == 0, err
     scene = mk.load_scene(path)
-    got = json.loads(result.stdout)
+    got = json.loads(out)
     assert_same(got, mk.solve(scene, scene.input.angle).as_dict())
     assert math.isclose(got['input']['speed'], -4 * math.pi, rel_tol=1e-15)
 
 
-def test_solve_help_mentions_every_option():
-    """`solve --help` explains SCENE and every option, with units."""
-    result = run_command('solve', '--help')
-    assert result.returncode == 0
-    text = result.stdout
+def test_solve_help_mentions_every_option(capsys):
+    """`solve --help` explains SCENE and every option, with units.
+
+    Called here: test_packaging.py runs the `solve` console script's --help.
+    """
+    status, text, _ = run_in_process(capsys, 'solve', '--help')
+    assert status == 0
     for word in ('SCENE', '--angle-deg', '--speed-rpm', '--accel', 'degrees', 'rpm',
                  'rad/s^2', 'status 2'):
         assert word in text, word
@@ -536,13 +549,16 @@ def test_solve_command_exits_2_on_an_unsolvable_angle(tmp_path):
     assert 'RRR C' in lines[0] and 'Traceback' not in result.stderr
 
 
-def test_solve_command_rejects_a_bad_scene_in_one_line(tmp_path):
-    """A bad scene file makes `solve` print one line naming the file and fail."""
+def test_solve_command_rejects_a_bad_scene_in_one_line(tmp_path, capsys):
+    """A bad scene file makes `solve` print one line naming the file and fail.
+
+    Called here: test_scene_loader.py runs `solve` on hostile files as a command.
+    """
     path = write(tmp_path, edit(setitem([*LINK1, 'length'], -80)))
-    result = run_command('solve', path)
-    assert result.returncode != 0
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and str(path) in lines[0], result.stderr
+    status, _, err = run_in_process(capsys, 'solve', path)
+    assert status != 0
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and str(path) in lines[0], err
 
 
 # --- the edges of the format (issue 33) -----------------------------------------------

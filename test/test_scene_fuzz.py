@@ -39,7 +39,12 @@ MAX_PEAK_BYTES = 32 * 2**20
 
 
 def fuzz_settings(examples):
-    """Return the settings of one fuzz test (the module runs in about 20 s in all)."""
+    """Return the settings of one fuzz test (the module: 61 s at load 7 to 8 on 2 cores).
+
+    The examples are fixed (``derandomize``): 400 documents, 600 texts and 400
+    mutated scenes (1,000, 1,500 and 1,200 until 2026-12-02: 158 s at that load, 63 s in
+    a suite run); test_scene_loader.py holds each limit and hostile file on its own.
+    """
     return settings(max_examples=examples, deadline=None, derandomize=True,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 
@@ -192,21 +197,21 @@ def check_load(folder, content):
     assert peak < MAX_PEAK_BYTES, (peak, content)
 
 
-@fuzz_settings(1000)
+@fuzz_settings(400)
 @given(document=yaml_documents())
 def test_random_yaml_documents(folder, document):
     """Random YAML documents give a Scene or one clean SceneError, in bounded time and memory."""
     check_load(folder, document)
 
 
-@fuzz_settings(1500)
+@fuzz_settings(600)
 @given(text=texts)
 def test_random_text(folder, text):
     """Random text and bytes give a Scene or one clean SceneError, in bounded time and memory."""
     check_load(folder, text)
 
 
-@fuzz_settings(1200)
+@fuzz_settings(400)
 @given(document=mutated_scenes())
 def test_mutated_packaged_scenes(folder, document):
     """Mutated packaged scenes give a Scene or one clean SceneError, in bounded time and memory."""

@@ -20,6 +20,7 @@ import socket
 import stat
 import subprocess
 import sys
+import warnings
 
 from helpers import BASE_SCENE as BASE
 import pytest
@@ -28,6 +29,7 @@ import yaml
 import mech_kinematics as mk
 from mech_kinematics import scene as scene_module
 from mech_kinematics import yaml12
+from mech_kinematics.__main__ import main
 from mech_kinematics.scene import (MAX_CARRIED_POINTS, MAX_DEPTH, MAX_DYADS, MAX_FILE_BYTES,
                                    MAX_GROUND_POINTS, MAX_INTEGER_DIGITS, MAX_MESSAGE,
                                    MAX_YAML_NODES, SceneLoader)
@@ -69,28 +71,49 @@ def refusal(path):
     return message
 
 
-def load_in_subprocess(path):
-    """Load ``path`` in a fresh interpreter; return its outcome, message, time and peak memory."""
+def load_in_subprocess(*paths, solve_point=None):
+    """Load each of ``paths`` in a fresh interpreter; return its outcome, message, time and peak.
+
+    One interpreter loads the paths in turn, :mod:`tracemalloc` started anew
+    around each load (a peak counts that load alone). A dict per path, or the
+    one dict of a single path; with ``solve_point``, a loaded scene is then
+    solved at its start (tracing stopped) and the point's x given as ``x``.
+    """
     code = (
         'import json, sys, time, tracemalloc\n'
         'import mech_kinematics as mk\n'
-        'tracemalloc.start()\n'
-        'start = time.perf_counter()\n'
-        'try:\n'
-        '    mk.load_scene(sys.argv[1])\n'
-        "    outcome, message = 'Scene', ''\n"
-        'except mk.SceneError as error:\n'
-        "    outcome, message = 'SceneError', str(error)\n"
-        'except BaseException as error:\n'
-        '    outcome, message = type(error).__name__, str(error)[:500]\n'
-        'seconds = time.perf_counter() - start\n'
-        "print(json.dumps({'outcome': outcome, 'message': message, 'seconds': seconds,\n"
-        "                  'peak': tracemalloc.get_traced_memory()[1]}))\n")
+        'solve_point, results = sys.argv[1], []\n'
+        'for path in sys.argv[2:]:\n'
+        '    scene = None\n'
+        '    tracemalloc.start()\n'
+        '    start = time.perf_counter()\n'
+        '    try:\n'
+        '        scene = mk.load_scene(path)\n'
+        "        outcome, message = 'Scene', ''\n"
+        '    except mk.SceneError as error:\n'
+        "        outcome, message = 'SceneError', str(error)\n"
+        '    except BaseException as error:\n'
+        '        outcome, message = type(error).__name__, str(error)[:500]\n'
+        '    seconds = time.perf_counter() - start\n'
+        '    peak = tracemalloc.get_traced_memory()[1]\n'
+        '    tracemalloc.stop()\n'
+        "    result = {'outcome': outcome, 'message': message, 'seconds': seconds,\n"
+        "              'peak': peak}\n"
+        '    if scene is not None:\n'
+        "        result['counts'] = [len(scene.ground), len(scene.dyads), len(scene.points)]\n"
+        '        if solve_point:\n'
+        '            state = mk.solve(scene, scene.input.angle)\n'
+        "            result['x'] = float(state.points[solve_point].position[0])\n"
+        '    results.append(result)\n'
+        'print(json.dumps(results))\n')
     env = dict(os.environ, PYTHONPATH=str(ROOT))
-    result = subprocess.run([sys.executable, '-c', code, str(path)], env=env,
-                            capture_output=True, text=True, timeout=TIMEOUT, check=False)
+    result = subprocess.run([sys.executable, '-c', code, solve_point or '', *map(str, paths)],
+                            env=env, capture_output=True, text=True, timeout=TIMEOUT,
+                            check=False)
     assert result.returncode == 0, result.stderr
-    return json.loads(result.stdout)
+    results = json.loads(result.stdout)
+    assert len(results) == len(paths), result.stdout
+    return results[0] if len(paths) == 1 else results
 
 
 def solve_command(path):
@@ -311,11 +334,27 @@ def test_both_parsers_read_packaged_scenes_as_yaml_safe_load(path):
 # --- files ------------------------------------------------------------------------------------
 
 
-def test_a_fifo_is_refused_without_waiting(tmp_path):
+@pytest.fixture(scope='module')
+def small_loads(tmp_path_factory):
+    """Return {name: load_in_subprocess's result} of the FIFO, hostile and 10,000-point files.
+
+    One interpreter loads them all, each traced on its own.
+    """
+    folder = tmp_path_factory.mktemp('loads')
+    files = {name: write(folder, text, f'{name}.yaml') for name, text in HOSTILE.items()}
+    files['ten_thousand_ground_points'] = write(folder, chain(2, MAX_GROUND_POINTS),
+                                                'ground.yaml')
+    files['fifo'] = folder / 'scene.yaml'
+    os.mkfifo(files['fifo'])
+    results = load_in_subprocess(*files.values())
+    return {name: dict(result, path=str(files[name]))
+            for name, result in zip(files, results, strict=True)}
+
+
+def test_a_fifo_is_refused_without_waiting(small_loads):
     """A FIFO as the scene is refused at once (it used to hang forever). See issue 12."""
-    fifo = tmp_path / 'scene.yaml'
-    os.mkfifo(fifo)
-    result = load_in_subprocess(fifo)
+    result = small_loads['fifo']
+    fifo = result['path']
     assert result['outcome'] == 'SceneError'
     assert result['message'] == f'{fifo}: expected a regular file, got a FIFO (named pipe)'
 
@@ -446,23 +485,22 @@ def chain(n_dyads, n_ground=1, n_points=0, reverse=True):
 def test_the_largest_accepted_scene_loads_in_bounded_memory(tmp_path):
     """A scene at every count limit loads: within MAX_FILE_BYTES, MAX_YAML_NODES and memory.
 
-    Measured here: 2.5 MB, 370,000 nodes, 0.9 s (median of 5) and a 50 MiB peak.
+    Measured here: 2.5 MB, 370,000 nodes, 0.9 s (median of 5) and a 50 MiB peak. The
+    subprocess that measures the load also counts the scene and solves it (once, after
+    tracing stops).
     """
     path = write(tmp_path, chain(MAX_DYADS, MAX_GROUND_POINTS, MAX_CARRIED_POINTS))
     assert path.stat().st_size < MAX_FILE_BYTES
-    result = load_in_subprocess(path)
+    result = load_in_subprocess(path, solve_point=f'P{MAX_DYADS}')
     assert result['outcome'] == 'Scene', result['message']
     assert result['peak'] < MAX_PEAK_BYTES
     print(f'largest accepted scene: {path.stat().st_size / 1e6:.2f} MB, '
           f'{result["seconds"]:.2f} s, peak {result["peak"] / 2**20:.0f} MiB')
-    scene = mk.load_scene(path)
-    assert len(scene.ground) == MAX_GROUND_POINTS and len(scene.dyads) == MAX_DYADS
-    assert len(scene.points) == MAX_CARRIED_POINTS
-    state = mk.solve(scene, scene.input.angle)
+    assert result['counts'] == [MAX_GROUND_POINTS, MAX_DYADS, MAX_CARRIED_POINTS]
     b = 0.01 * complex(math.cos(math.pi / 3), math.sin(math.pi / 3))
     first = b.real + math.sqrt(0.02**2 - b.imag**2)
     expected = first + 0.02 * (MAX_DYADS - 1)  # then 20 mm along the axis each
-    assert math.isclose(state.points[f'P{MAX_DYADS}'].position[0], expected, rel_tol=1e-12)
+    assert math.isclose(result['x'], expected, rel_tol=1e-12)
 
 
 @pytest.mark.parametrize(('what', 'text', 'limit', 'name'), [
@@ -488,9 +526,9 @@ def test_node_count_is_bounded_without_aliases(tmp_path):
 # --- hostile files: bounded memory, one line from the command ------------------------------
 
 
-def test_ten_thousand_ground_points_load_in_bounded_memory(tmp_path):
+def test_ten_thousand_ground_points_load_in_bounded_memory(small_loads):
     """10,000 ground points took 4.75 GB (the size over all pairs); now well under 200 MiB."""
-    result = load_in_subprocess(write(tmp_path, chain(2, MAX_GROUND_POINTS)))
+    result = small_loads['ten_thousand_ground_points']
     assert result['outcome'] == 'Scene', result['message']
     assert result['peak'] < MAX_PEAK_BYTES / 4
 
@@ -511,16 +549,25 @@ HOSTILE = {
 
 
 @pytest.mark.parametrize('name', sorted(HOSTILE))
-def test_hostile_files_are_refused_quickly_in_bounded_memory(tmp_path, name):
+def test_hostile_files_are_refused_quickly_in_bounded_memory(small_loads, name):
     """Each hostile file of issue 12 gives one SceneError within the memory bound."""
-    result = load_in_subprocess(write(tmp_path, HOSTILE[name]))
+    result = small_loads[name]
     assert result['outcome'] == 'SceneError', result
     assert result['peak'] < MAX_PEAK_BYTES / 10, result
 
 
+#: The inputs `solve` reads in a process of its own; the other hostile files, in this one.
+SOLVED_IN_A_SUBPROCESS = ('billion_laughs', '/dev/zero', 'fifo', 'directory')
+
+
 @pytest.mark.parametrize('name', [*sorted(HOSTILE), '/dev/zero', 'fifo', 'directory'])
-def test_solve_prints_one_line_and_exits_2_on_hostile_input(tmp_path, name):
-    """`solve` on any hostile input prints one `error:` line naming it, exit 2. See issue 12."""
+def test_solve_prints_one_line_and_exits_2_on_hostile_input(tmp_path, capsys, name):
+    """`solve` on any hostile input prints one `error:` line naming it, exit 2. See issue 12.
+
+    `python -m mech_kinematics solve` runs in a subprocess for a device, a FIFO,
+    a directory and the billion laughs; the rest call the same ``main`` here,
+    where a warning would be an error.
+    """
     if name in HOSTILE:
         path = write(tmp_path, HOSTILE[name])
     elif name == 'fifo':
@@ -530,8 +577,16 @@ def test_solve_prints_one_line_and_exits_2_on_hostile_input(tmp_path, name):
         path = tmp_path
     else:
         path = Path(name)
-    result = solve_command(path)
-    assert result.returncode == 2, result.stderr
-    assert result.stdout == ''
-    lines = result.stderr.splitlines()
-    assert len(lines) == 1 and lines[0].startswith(f'error: {path}: '), result.stderr
+    if name in SOLVED_IN_A_SUBPROCESS:
+        result = solve_command(path)
+        status, stdout, stderr = result.returncode, result.stdout, result.stderr
+    else:
+        capsys.readouterr()
+        with warnings.catch_warnings():
+            warnings.simplefilter('error')  # a warning would be a second line on stderr
+            status = main(['solve', str(path)])
+        stdout, stderr = capsys.readouterr()
+    assert status == 2, stderr
+    assert stdout == ''
+    lines = stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f'error: {path}: '), stderr

@@ -24,6 +24,7 @@ import mpmath
 import pytest
 
 import mech_kinematics as mk
+from mech_kinematics.__main__ import main
 from mech_kinematics.ros.timebase import CrankTimebase
 from mech_kinematics.units import reduce_radians, turns_from_degrees
 
@@ -48,25 +49,40 @@ def _scene(tmp_path: Path, name: str, angle: str, unit: str = 'deg') -> Path:
     return path
 
 
-def _solve(*args: object) -> dict:
+def _command(*args: object) -> dict:
+    """Return the JSON that `python -m mech_kinematics ARGS` prints, run in a subprocess."""
     env = dict(os.environ, PYTHONPATH=str(ROOT))
-    result = subprocess.run([sys.executable, '-m', 'mech_kinematics', 'solve',
-                             *map(str, args)], cwd=ROOT, env=env, capture_output=True,
-                            text=True, timeout=TIMEOUT, check=False)
+    result = subprocess.run([sys.executable, '-m', 'mech_kinematics', *map(str, args)],
+                            cwd=ROOT, env=env, capture_output=True, text=True,
+                            timeout=TIMEOUT, check=False)
     assert result.returncode == 0, result.stderr
     return json.loads(result.stdout)
 
 
+def _in_process(capsys: pytest.CaptureFixture[str], *args: object) -> dict:
+    """Return the JSON that the same command prints, called here (its ``main``)."""
+    capsys.readouterr()
+    status = main([str(arg) for arg in args])
+    out, err = capsys.readouterr()
+    assert status == 0, err
+    return json.loads(out)
+
+
 @pytest.mark.parametrize('name, degrees', [('khurmi_four_bar_ad150', 1e308),
                                            ('geneva', 1e17), ('geneva', -1e300)])
-def test_a_scene_started_far_out_answers_what_solve_angle_deg_answers(tmp_path, name, degrees):
-    """The scene loads, and `solve SCENE` prints what `solve --angle-deg X` prints."""
+def test_a_scene_started_far_out_answers_what_solve_angle_deg_answers(tmp_path, capsys, name,
+                                                                      degrees):
+    """The scene loads, and `solve SCENE` prints what `solve --angle-deg X` prints.
+
+    `solve SCENE` runs as a command; `solve --angle-deg` is called in this process.
+    """
     path = _scene(tmp_path, name, repr(degrees))
     scene = mk.load_scene(path)
     angle, turns = turns_from_degrees(degrees)
     assert (scene.input.angle, scene.input.turns) == (angle, turns)
     assert Fraction(degrees) == 360 * turns + Fraction(math.remainder(degrees, 360.0))
-    assert _solve(path) == _solve(SCENES / f'{name}.yaml', '--angle-deg', repr(degrees))
+    assert _command('solve', path) == _in_process(capsys, 'solve', SCENES / f'{name}.yaml',
+                                                  '--angle-deg', repr(degrees))
 
 
 def test_a_geneva_wheel_started_far_out_has_its_index_right(tmp_path):
@@ -134,15 +150,10 @@ def test_the_time_base_starts_at_the_whole_turns():
     assert (turns, sample.angle) == (GENEVA_TURNS, -1.0)
 
 
-def test_check_answers_a_scene_started_far_out(tmp_path):
-    """`check` reports the scene started at 1e17 deg as it does the packaged one."""
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
+def test_check_answers_a_scene_started_far_out(tmp_path, capsys):
+    """`check` reports the scene started at 1e17 deg as it does the packaged one.
 
-    def check(path: Path) -> dict:
-        result = subprocess.run([sys.executable, '-m', 'mech_kinematics', 'check', '--json',
-                                 str(path)], cwd=ROOT, env=env, capture_output=True, text=True,
-                                timeout=TIMEOUT, check=False)
-        assert result.returncode == 0, result.stderr
-        return json.loads(result.stdout)
-
-    assert check(_scene(tmp_path, 'geneva', '1e17')) == check(SCENES / 'geneva.yaml')
+    `check` runs as a command on the scene started far out, in this process on the other.
+    """
+    far = _command('check', '--json', _scene(tmp_path, 'geneva', '1e17'))
+    assert far == _in_process(capsys, 'check', '--json', SCENES / 'geneva.yaml')

@@ -27,16 +27,20 @@ def _cpu_s(read):
     return time.process_time() - start, result
 
 
-def test_a_chain_of_40000_fixed_joints_reads_in_linear_time(tmp_path):
-    """40,000 fixed joints (5.8 MB, under the 8 MiB cap) against 5,000 (483 s and 2 s before)."""
+def test_a_chain_of_16000_fixed_joints_reads_in_linear_time(tmp_path):
+    """16,000 fixed joints (2.3 MB) against 2,000: eight times as many, as 40,000 against 5,000.
+
+    40,000 and 5,000 took 483 s and 2 s before issue 42 was fixed; docs/urdf.md gives
+    the times at every size up to 40,000 (5.8 MB, under the 8 MiB cap).
+    """
     times = {}
-    for count in (5_000, 40_000):
+    for count in (2_000, 16_000):
         path = tmp_path / f'chain_{count}.urdf'
         path.write_text(khurmi_chain_urdf(count))
         times[count], robot = _cpu_s(lambda path=path: load_robot(path))
         assert len(robot.description.joints) == count + 3
         assert robot.description.depth(f'c{count - 1}') == count
-    assert times[40_000] < RATIO * times[5_000], times
+    assert times[16_000] < RATIO * times[2_000], times
 
 
 def test_a_sidecar_of_8000_closures_reads_in_linear_time(tmp_path):
