@@ -298,3 +298,39 @@ class NodeProcess:
             self.proc.wait()
             pytest.fail(f'node did not exit within {timeout} s of {sig!r}:\n{self.output()}')
         return status, time.monotonic() - start
+
+
+#: How many starts refused_starts runs at once (each CPU-bound: Python, rclpy, NumPy, a scene).
+AT_ONCE = 3
+
+
+def refused_starts(tmp, starts) -> list:
+    """Run the node with each argument list of ``starts``; return each (status, output).
+
+    At most AT_ONCE at a time, so that the starts, each one process that exits
+    alone, wait on each other's imports rather than one by one; each in a
+    namespace of its own (names are taken by age: two starts of one name must
+    not meet). One still running 2 x STARTUP_S after its start (it shares the
+    machine with AT_ONCE - 1 others) is killed: its status is then -9.
+    """
+    results: list = [None] * len(starts)
+    running: dict = {}
+    pending = list(enumerate(starts))
+    try:
+        while pending or running:
+            while pending and len(running) < AT_ONCE:
+                i, args = pending.pop(0)
+                running[i] = (NodeProcess(tmp / str(i), *args), time.monotonic())
+            for i, (proc, started) in list(running.items()):
+                if proc.proc.poll() is None and time.monotonic() > started + 2 * STARTUP_S:
+                    proc.proc.kill()
+                    proc.proc.wait()
+                if proc.proc.poll() is not None:
+                    results[i] = (proc.proc.returncode, proc.output())
+                    del running[i]
+            time.sleep(0.01)    # polling the processes, as wait_for does
+    finally:
+        for proc, _ in running.values():
+            proc.proc.kill()
+            proc.proc.wait()
+    return results

@@ -17,15 +17,17 @@ import pytest
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 from rclpy.qos import QoSProfile, ReliabilityPolicy
-from ros_helpers import (cannot_start, exited, Lifecycle, NodeProcess, NS, send_until, SESSION,
-                         stamp_ns, STARTUP_S, wait_for, wait_for_parameters, wrap)
+from ros_helpers import (cannot_start, exited, Lifecycle, NodeProcess, NS, refused_starts,
+                         send_until, SESSION, stamp_ns, STARTUP_S, wait_for,
+                         wait_for_parameters, wrap)
 from sensor_msgs.msg import JointState
 
 #: Tolerance of an angle that the time base fixes exactly, rad.
 ATOL_TIMEBASE = 1e-9
 
 
-@pytest.mark.parametrize('args, words', [
+#: Bad -p at start: (arguments, words of the one line that refuses them).
+BAD_PARAMETERS = [
     (['-p', 'scene:=123'], ['scene: expected a string, got number 123']),
     (['-p', 'frame_id:=5'], ['frame_id: expected a string, got number 5']),
     (['-p', 'scene:='], ["Couldn't parse parameter override rule: '-p scene:='"]),
@@ -35,12 +37,28 @@ ATOL_TIMEBASE = 1e-9
     (['-p', 'managed:=3'], ['managed: expected true or false']),
     (['-p', 'qos_overrides./x/joint_states.publisher.reliability:=sometimes'],
      ['reliability', 'sometimes']),
-])
-def test_bad_start_parameters_are_one_line_and_exit_1(tmp_path, args, words):
-    """Any bad -p at start stops the node with status 1 and one line naming it. See issue 12."""
-    ns = f'{SESSION}/bad_start'
-    args = [a.replace('/x/', f'{ns}/') for a in args]
-    status, output = exited(NodeProcess(tmp_path, '-r', f'__ns:={ns}', *args))
+]
+
+
+@pytest.fixture(scope='module')
+def bad_parameters(tmp_path_factory):
+    """(status, output) of each start of BAD_PARAMETERS, by its arguments."""
+    starts = []
+    for i, (args, _) in enumerate(BAD_PARAMETERS):
+        ns = f'{SESSION}/bad_start{i}'
+        starts.append(['-r', f'__ns:={ns}', *(a.replace('/x/', f'{ns}/') for a in args)])
+    results = refused_starts(tmp_path_factory.mktemp('bad_start'), starts)
+    return {tuple(args): result
+            for (args, _), result in zip(BAD_PARAMETERS, results, strict=True)}
+
+
+@pytest.mark.parametrize('args, words', BAD_PARAMETERS)
+def test_bad_start_parameters_are_one_line_and_exit_1(bad_parameters, args, words):
+    """Any bad -p at start stops the node with status 1 and one line naming it. See issue 12.
+
+    The starts run a few at once (:func:`refused_starts`).
+    """
+    status, output = bad_parameters[tuple(args)]
     assert status == 1, output
     assert 'Traceback' not in output
     fatal = cannot_start(output)
@@ -307,7 +325,8 @@ def test_switching_to_sim_time_and_back_keeps_the_crank_where_it_was(ros, tmp_pa
     assert status == 0, proc.output()
 
 
-@pytest.mark.parametrize('args, reason', [
+#: Refused starts: (arguments, the reason the one line gives, /x/ the namespace).
+REFUSED = [
     (['-p', 'frame_id:=/'], "frame_id: expected a tf2 frame id (no leading '/', no empty, '.' "
                             "or '..' part between '/', no space), got '/'"),
     (['-p', 'tf_prefix:=../..'], 'tf_prefix: expected a tf2 frame id'),
@@ -319,18 +338,32 @@ def test_switching_to_sim_time_and_back_keeps_the_crank_where_it_was(ros, tmp_pa
     (['-p', 'qos_overrides./x/joint_states.publisher.depth:=-1'],
      'qos_overrides./x/joint_states.publisher.depth: expected a whole number of messages from 0 '
      'to 2147483647, got number -1'),
-])
-def test_a_bad_start_is_one_line_with_the_nodes_own_name(tmp_path, args, reason):
+]
+
+
+@pytest.fixture(scope='module')
+def refused(tmp_path_factory):
+    """(namespace, status, output) of each start of REFUSED (-r __node:=renamed), by arguments."""
+    starts, spaces = [], []
+    for i, (args, _) in enumerate(REFUSED):
+        ns = f'{SESSION}/one_line{i}'
+        spaces.append(ns)
+        starts.append(['-r', f'__ns:={ns}', '-r', '__node:=renamed',
+                       *(a.replace('/x/', f'{ns}/') for a in args)])
+    results = refused_starts(tmp_path_factory.mktemp('one_line'), starts)
+    return {tuple(args): (ns, *result) for (args, _), ns, result in zip(
+        REFUSED, spaces, results, strict=True)}
+
+
+@pytest.mark.parametrize('args, reason', REFUSED)
+def test_a_bad_start_is_one_line_with_the_nodes_own_name(refused, args, reason):
     """Every refused start is exactly one FATAL line, naming the node as renamed (issue 21).
 
     It was 2-3 lines (a WARN or ERROR, then FATAL with the same text, or rmw's
     text with a build path) and named [mech_kinematics] after -r __node:=NAME.
     """
-    ns = f'{SESSION}/one_line'
-    args = [a.replace('/x/', f'{ns}/') for a in args]
+    ns, status, output = refused[tuple(args)]
     reason = reason.replace('/x/', f'{ns}/')
-    status, output = exited(NodeProcess(tmp_path, '-r', f'__ns:={ns}', '-r', '__node:=renamed',
-                                        *args))
     assert status == 1, output
     lines = output.strip().splitlines()
     assert len(lines) == 1, output

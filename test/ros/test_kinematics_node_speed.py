@@ -6,6 +6,8 @@ A scene's speed is kept in the unit it was given from the scene to the time
 base; before, the packaged Geneva's 10 rad/s came out as 9.999999999996104.
 """
 
+import contextlib
+import io
 import json
 import signal
 import subprocess
@@ -16,21 +18,32 @@ from ros_helpers import NodeProcess, REPO, SESSION, STARTUP_S, wait_for
 from sensor_msgs.msg import JointState
 
 
-def solve_speed(*args: str) -> float:
-    """Return the crank speed of `python -m mech_kinematics solve ARGS` (its JSON)."""
-    out = subprocess.run([sys.executable, '-m', 'mech_kinematics', 'solve', *args],
-                         cwd=REPO, check=True, capture_output=True, text=True).stdout
+def solve_speed(*args: str, cli: bool = False) -> float:
+    """Return the crank speed that `python -m mech_kinematics solve ARGS` prints (its JSON).
+
+    In this process (the command's own ``main``), or with ``cli`` as a command.
+    """
+    if cli:
+        out = subprocess.run([sys.executable, '-m', 'mech_kinematics', 'solve', *args],
+                             cwd=REPO, check=True, capture_output=True, text=True).stdout
+    else:
+        from mech_kinematics.tools import solve
+
+        with contextlib.redirect_stdout(io.StringIO()) as stdout:
+            assert solve.main(list(args)) == 0
+        out = stdout.getvalue()
     return json.loads(out)['input']['speed']
 
 
+# khurmi_four_bar_ad150 at its scene's speed (-120 rpm): test_a_tiny_speed_set_at_run_time_...
+# judges its node's states before it sets a speed.
 @pytest.mark.parametrize('scene, crank, rpm', [
     ('geneva', 'driver', None),                  # 10 rad/s, given as 95.4929658551372 rpm
-    ('khurmi_four_bar_ad150', 'crank', None),    # -120 rpm
     ('geneva', 'driver', '600.0'),               # a speed set on the node, in rpm
 ])
 def test_the_crank_speed_on_joint_states_is_what_solve_prints(ros, tmp_path, scene, crank, rpm):
     """joint_states' crank velocity == `solve`'s JSON speed, exactly, at every instant."""
-    expected = solve_speed(scene, *(['--speed-rpm', rpm] if rpm else []))
+    expected = solve_speed(scene, *(['--speed-rpm', rpm] if rpm else []), cli=rpm is None)
     ns = f'{SESSION}/speed_{scene}_{rpm or "scene"}'.replace('.', '_')
     js = ros.collect(JointState, f'{ns}/joint_states')
     proc = NodeProcess(tmp_path, '-r', f'__ns:={ns}', '-p', f'scene:={scene}',
@@ -51,7 +64,8 @@ def test_a_tiny_speed_set_at_run_time_is_published(ros, tmp_path):
 
     They used to be accepted and then nothing was published ("at most 1e-06 x 0
     m/s^2 ... got 9.88e-324"): each is now answered, its crank velocity what
-    `solve --speed-rpm` prints.
+    `solve --speed-rpm` prints. Before, every state is at the scene's speed
+    (-120 rpm), what `solve` prints, to the bit.
     """
     from rclpy.parameter import Parameter
     from rclpy.parameter_client import AsyncParameterClient
@@ -61,9 +75,12 @@ def test_a_tiny_speed_set_at_run_time_is_published(ros, tmp_path):
     js = ros.collect(JointState, f'{ns}/joint_states')
     proc = NodeProcess(tmp_path, '-r', f'__ns:={ns}', '-p', 'scene:=khurmi_four_bar_ad150')
     try:
-        wait_for(lambda: js, STARTUP_S, 'joint_states')
+        wait_for(lambda: len(js) > 20, STARTUP_S, 'joint_states')
         params = AsyncParameterClient(ros.node, f'{ns}/mech_kinematics')
         wait_for_parameters(params)
+        before = len(js)
+        speeds = {m.velocity[list(m.name).index('crank')] for m in js[:before]}
+        assert speeds == {solve_speed('khurmi_four_bar_ad150')}, speeds
         for rpm in ('1e-160', '1e-300'):
             expected = solve_speed('khurmi_four_bar_ad150', '--speed-rpm', rpm)
             assert 0.0 < expected < 1e-158

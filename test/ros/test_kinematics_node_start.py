@@ -16,8 +16,8 @@ import time
 from diagnostic_msgs.msg import DiagnosticArray
 import pytest
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-from ros_helpers import (cannot_start, exited, first_message_s, NodeProcess, NS, REPO, SESSION,
-                         stamp_ns, STARTUP_S, wait_for)
+from ros_helpers import (cannot_start, exited, first_message_s, NodeProcess, NS, refused_starts,
+                         REPO, SESSION, stamp_ns, STARTUP_S, wait_for)
 from sensor_msgs.msg import JointState
 
 from mech_kinematics.ros.startup import MAX_ARGUMENT_FILE_BYTES
@@ -90,14 +90,16 @@ def test_the_first_state_is_published_at_once(ros, tmp_path):
 
 
 def test_the_older_node_goes_on_without_a_gap_while_newcomers_are_refused(ros, tmp_path):
-    """Three newcomers each exit 1 with one line; the first never stops nor exits."""
+    """Three newcomers (started at once) each exit 1 with one line; the first goes on."""
     ns = f'{SESSION}/older'
     js = ros.collect(JointState, f'{ns}/joint_states', LATCHED)
     first = _node(tmp_path / 'first', ns)
     try:
         wait_for(lambda: js, STARTUP_S, 'the first node publishing')
-        for k in range(3):
-            status, output = exited(_node(tmp_path / f'second{k}', ns))
+        # Started together: each hears the first (and the others), and each is younger.
+        newcomers = [_node(tmp_path / f'second{k}', ns) for k in range(3)]
+        for newcomer in newcomers:
+            status, output = exited(newcomer)
             assert status == 1, output
             _one_refusal(output, ns)
             assert first.proc.poll() is None, first.output()
@@ -124,13 +126,13 @@ def test_of_two_nodes_started_together_exactly_one_goes_on(ros, tmp_path):
             for p in procs:
                 p.proc.send_signal(signal.SIGINT)
             pytest.fail(f'neither node exited: {[p.output() for p in procs]}')
-        time.sleep(1.0)
+        # The other one still runs after a second of states more (50 at 50 Hz).
+        count = len(js)
+        wait_for(lambda: len(js) > count + 50, STARTUP_S, 'the remaining node still publishing')
         gone = [p for p in procs if p.proc.poll() is not None]
         assert len(gone) == 1, [p.output() for p in procs]
         assert gone[0].proc.returncode == 1, gone[0].output()
         _one_refusal(gone[0].output(), ns)
-        count = len(js)
-        wait_for(lambda: len(js) > count + 50, STARTUP_S, 'the remaining node still publishing')
     finally:
         statuses = [p.stop(signal.SIGINT)[0] for p in procs]
     assert sorted(statuses) == [0, 1], [p.output() for p in procs]
@@ -268,25 +270,46 @@ def _params_file(path, **values) -> str:
     return str(path)
 
 
-@pytest.mark.parametrize('kind', ['fifo', 'directory', 'missing', 'device', 'too large'])
-def test_a_params_file_that_cannot_be_read_is_one_line_and_exit_2(tmp_path, kind):
+#: The params files that cannot be read (test_a_params_file_that_cannot_be_read_...).
+UNREADABLE = ['fifo', 'directory', 'missing', 'device', 'too large']
+
+
+@pytest.fixture(scope='module')
+def params_refusals(tmp_path_factory):
+    """Kind -> (params file, status, output) of each refused start below, run a few at once.
+
+    The kinds of UNREADABLE, and 'long string' (a 1 MB tf_prefix); each start
+    is one process that is refused alone, so :func:`refused_starts` runs them
+    side by side.
+    """
+    tmp = tmp_path_factory.mktemp('params_files')
+    paths, starts = {}, []
+    for i, kind in enumerate([*UNREADABLE, 'long string']):
+        path = tmp / f'params{i}.yaml'
+        if kind == 'fifo':
+            os.mkfifo(path)
+        elif kind == 'directory':
+            path.mkdir()
+        elif kind == 'device':
+            path = '/dev/zero'
+        elif kind == 'too large':
+            _params_file(path, tf_prefix='a' * MAX_ARGUMENT_FILE_BYTES)
+        elif kind == 'long string':
+            _params_file(path, tf_prefix='p' * 1_000_000)
+        paths[kind] = path
+        starts.append(['--params-file', str(path), '-r', f'__ns:={SESSION}/params_file{i}'])
+    results = refused_starts(tmp / 'nodes', starts)
+    return {kind: (paths[kind], *result) for kind, result in zip(paths, results, strict=True)}
+
+
+@pytest.mark.parametrize('kind', UNREADABLE)
+def test_a_params_file_that_cannot_be_read_is_one_line_and_exit_2(params_refusals, kind):
     """Issue 33: --params-file naming a FIFO hung before our code ran; it is looked at first.
 
     A FIFO, a directory, a device, a missing file or one over MAX_ARGUMENT_FILE_BYTES
     (16 MiB) is refused in one line naming the file, before rcl opens it.
     """
-    path = tmp_path / 'params.yaml'
-    if kind == 'fifo':
-        os.mkfifo(path)
-    elif kind == 'directory':
-        path.mkdir()
-    elif kind == 'device':
-        path = '/dev/zero'
-    elif kind == 'too large':
-        _params_file(path, tf_prefix='a' * MAX_ARGUMENT_FILE_BYTES)
-    proc = NodeProcess(tmp_path / 'node', '--params-file', str(path),
-                       '-r', f'__ns:={SESSION}/params_file')
-    status, output = exited(proc)
+    path, status, output = params_refusals[kind]
     assert status == 2, output
     assert output.count('\n') == 1 and len(cannot_start(output)) == 1, output
     words = {'fifo': 'got a FIFO (named pipe)', 'directory': 'got a directory',
@@ -296,15 +319,12 @@ def test_a_params_file_that_cannot_be_read_is_one_line_and_exit_2(tmp_path, kind
     assert words[kind] in output, output
 
 
-def test_a_long_string_parameter_is_refused_at_once(tmp_path):
+def test_a_long_string_parameter_is_refused_at_once(params_refusals):
     """Issue 33: a 10 MB tf_prefix took the start over 7 s; over 256 characters is one line.
 
     The start is refused before the prefix is used (status 1, like every refused start).
     """
-    path = _params_file(tmp_path / 'params.yaml', tf_prefix='p' * 1_000_000)
-    proc = NodeProcess(tmp_path / 'node', '--params-file', path,
-                       '-r', f'__ns:={SESSION}/long_string')
-    status, output = exited(proc)
+    _, status, output = params_refusals['long string']
     assert status == 1, output
     [line] = cannot_start(output)
     assert output.count('\n') == 1, output

@@ -25,7 +25,7 @@ import pytest
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 from rclpy.qos import QoSProfile, ReliabilityPolicy
-from ros_helpers import (cannot_start, exited, Lifecycle, NodeProcess, NS, RELIABLE,
+from ros_helpers import (cannot_start, Lifecycle, NodeProcess, NS, refused_starts, RELIABLE,
                          send_until, SESSION, stamp_ns, STARTUP_S, wait_for,
                          wait_for_parameters)
 from sensor_msgs.msg import JointState
@@ -479,14 +479,26 @@ def test_extra_joints_ignore_takes_the_drivers_and_says_what_it_dropped(ros, tmp
         ('ignore', 'wrist, coupler, gripper', '')
 
 
-@pytest.mark.parametrize('args, words', [
+#: Bad drives at start: (arguments, words of the one line that refuses them).
+BAD_DRIVES = [
     (['-p', 'drive:=topic', '-p', 'markers:=true'], ['markers: expected false with drive: topic']),
     (['-p', 'drive:=stream'], ["drive: expected one of time, topic, got 'stream'"]),
-])
-def test_a_bad_drive_at_start_is_one_line_and_exit_1(tmp_path, args, words):
+]
+
+
+@pytest.fixture(scope='module')
+def bad_drives(tmp_path_factory):
+    """(status, output) of each start of BAD_DRIVES, by its arguments (run side by side)."""
+    results = refused_starts(tmp_path_factory.mktemp('topic_bad_start'), [
+        ['-r', f'__ns:={SESSION}/topic_bad_start{i}', *args]
+        for i, (args, _) in enumerate(BAD_DRIVES)])
+    return {tuple(args): result for (args, _), result in zip(BAD_DRIVES, results, strict=True)}
+
+
+@pytest.mark.parametrize('args, words', BAD_DRIVES)
+def test_a_bad_drive_at_start_is_one_line_and_exit_1(bad_drives, args, words):
     """``drive`` takes time or topic; markers (velocity arrows) are refused with topic."""
-    proc = NodeProcess(tmp_path, '-r', f'__ns:={SESSION}/topic_bad_start', *args)
-    status, output = exited(proc)
+    status, output = bad_drives[tuple(args)]
     assert status == 1, output
     fatal = cannot_start(output)
     assert len(fatal) == 1, output

@@ -32,6 +32,7 @@ states as the witness.
 
 import contextlib
 from dataclasses import dataclass
+import functools
 import os
 from pathlib import Path
 import random
@@ -227,12 +228,16 @@ def _wait_for_two_diagnostics(recorder: Process) -> None:
     time.sleep(max(0.0, subscribed + DIAGNOSTICS_WINDOW_S - time.time()))
 
 
+@functools.cache
 def decoded(path: Path) -> dict:
     """Topic -> list of (receive time ns, message), decoded strictly with rosbags.
 
     ``Typestore.deserialize_cdr`` refuses a payload whose length does not match
     the message (it allows the final alignment padding only): the node publishes
     canonical CDR, and the recorder stores the bytes exactly as received.
+    Decoded once per bag (the module's bags are final once their fixture has
+    made them): the witness of the crash tests serves four tests. Not to be
+    changed by its callers.
     """
     from rosbags.highlevel import AnyReader
 
@@ -747,13 +752,18 @@ def crashes(tmp_path_factory):
         assert node_status == 0, node.output()
     finally:
         _kill_left_over(recorders.values())
-    reindexed = {}
+    # Both reindexed by the command at once (each bag its own copy and process).
+    running = {}
     for name in KILLED:
         copy = tmp / f'{name}_reindexed'
         shutil.copytree(tmp / name, copy)
-        result = subprocess.run([sys.executable, '-m', 'mech_kinematics', 'reindex', str(copy)],
-                                env=ros_env(), capture_output=True, text=True, cwd=tmp)
-        reindexed[name] = (copy, result.returncode, result.stdout + result.stderr)
+        running[name] = (copy, subprocess.Popen(
+            [sys.executable, '-m', 'mech_kinematics', 'reindex', str(copy)], env=ros_env(),
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp))
+    reindexed = {}
+    for name, (copy, proc) in running.items():
+        out, err = proc.communicate(timeout=120)
+        reindexed[name] = (copy, proc.returncode, out + err)
     return Crashes(tmp, {n: r.output() for n, r in recorders.items()}, statuses, kill_ns,
                    reindexed)
 

@@ -4,7 +4,7 @@
 
 Two kinds of server are tested. A *real* one: a node and a ``view`` process
 (quick_return, and five_bar for several drivers), reached over HTTP and in
-Debian's chromium headless (``--dump-dom``, ``--screenshot``): the drawn
+Debian's chromium headless (its page read and shot over DevTools): the drawn
 links lie where the solver puts them at the node's crank angle, in the
 links' colours, and each driver's speed control sets the node's parameter.
 A *fake* one: :class:`~mech_kinematics.tools.view.ViewServer` on a stand-in
@@ -312,7 +312,7 @@ class _Chromium:
 
 @pytest.fixture(scope='module')
 def browser(tmp_path_factory):
-    """One headless chromium for the module's fake-server pages."""
+    """One headless chromium for the module's pages (the fake server's and the real view's)."""
     chromium = _Chromium(_chromium(), tmp_path_factory.mktemp('chromium'))
     try:
         yield chromium
@@ -1169,31 +1169,25 @@ def test_speed_control_sets_each_driver_of_a_running_five_bar(tmp_path):
             'both cranks at their new speeds')
 
 
-def test_chromium_draws_the_links_where_the_solver_puts_them(running):
+def test_chromium_draws_the_links_where_the_solver_puts_them(running, browser):
     """In headless chromium the page draws each link, to scale, at the solver's positions."""
-    chromium = _chromium()
     url, scene = running
     assert _post(url, {'value': 0}) == {'successful': True, 'reason': ''}
-    deadline = time.monotonic() + 10
-    while _get(url)['crank_speed_rpm'] != 0.0:
-        assert time.monotonic() < deadline
-        time.sleep(0.1)
-    time.sleep(0.3)
-    page = url + '?w=800&h=480'       # the same canvas in both loads
-    shot = Path(tempfile.mkdtemp()) / 'view.png'
-    # The DOM and the screenshot come from two loads of the page: they show one
-    # instant when the drawn angle is the same before and after the screenshot
-    # (on a loaded machine the node may still be taking the speed change).
-    for _ in range(5):
-        dom = _browse(chromium, page, '--dump-dom')
-        drawn = json.loads(re.search(r'<pre id="drawn">(.*?)</pre>', dom, re.DOTALL)[1])
-        assert drawn['angle'] is not None, dom
-        _browse(chromium, page, f'--screenshot={shot}')
-        after = _browse(chromium, page, '--dump-dom')
-        if json.loads(re.search(r'<pre id="drawn">(.*?)</pre>', after, re.DOTALL)[1])[
-                'angle'] == drawn['angle']:
-            break
-        time.sleep(0.5)
+    _until(lambda: _get(url)['crank_speed_rpm'] == 0.0, 10, 'the crank stopped')
+    # The page's record of what it drew and the screenshot show one instant when the drawn
+    # angle is the same before and after the screenshot (on a loaded machine the node may
+    # still be taking the speed change, and the page draws each state it polls).
+    target, session = browser.open(url + '?w=800&h=480')
+    try:
+        def one_instant():
+            drawn = _drawn(browser, session, 'quick_return drawn')
+            image = browser.screenshot(session)
+            return (drawn, image) if _drawn(browser, session, 'quick_return drawn')[
+                'angle'] == drawn['angle'] else None
+
+        drawn, image = _until(one_instant, PAGE_S, 'one instant drawn and shot')
+    finally:
+        browser.close_tab(target)
     state = mk.solve(full_scene(scene), drawn['angle'])
     points = {n: np.array([p.real, p.imag]) for n, (p, _, _) in state.complex_points.items()}
     # The page's transform is to scale: one k (px/m) for both axes.
@@ -1208,6 +1202,6 @@ def test_chromium_draws_the_links_where_the_solver_puts_them(running):
     # Slider blocks (32 x 18 px) are drawn over the links: a sample under one shows the
     # block, so samples within a block's half-diagonal of its centre are not counted.
     frame = frame_from_state(scene, drawn['angle'], 0.0, strokes_from_scene(scene))
-    _assert_links_drawn(_link_pixels(_image(shot.read_bytes()), drawn,
+    _assert_links_drawn(_link_pixels(image, drawn,
                                      [np.array(s['xy']) for s in frame['sliders']],
-                                     list(points.values())), shot)
+                                     list(points.values())), 'quick_return')
