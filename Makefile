@@ -81,8 +81,12 @@ run: $(TF2_STAMP)
 # The tests that time the node (marked serial: test/conftest.py) run alone, after the
 # rest on two workers. One phase selecting nothing (pytest's status 5: PYTEST_ARGS='-k
 # scene' may match tests of one phase only) is no failure; neither phase running a test is.
+# The package's bytecode is written (in the clone's __pycache__, ignored by git) even
+# where the environment says PYTHONDONTWRITEBYTECODE: the suite starts some hundreds
+# of Pythons (nodes, commands), each 0.4-0.6 s slower compiling the package afresh.
 test: $(TF2_STAMP) $(DEV_STAMP)
-	@$(VPY) -m pytest -q -n 2 --dist loadfile -m 'not serial' --durations=10 $(PYTEST_ARGS); \
+	@export PYTHONDONTWRITEBYTECODE=; \
+	$(VPY) -m pytest -q -n 2 --dist loadfile -m 'not serial' --durations=10 $(PYTEST_ARGS); \
 	first=$$?; \
 	$(VPY) -m pytest -q -m serial --durations=10 $(PYTEST_ARGS); \
 	second=$$?; \
