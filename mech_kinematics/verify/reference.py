@@ -988,9 +988,10 @@ class _Triad(_Equations):
     apart from the solver's polynomial: for each ternary angle on a grid, the
     first two links close as a law-of-cosines dyad on both branches, and the
     third link's gap changes sign at an assembly (the grid's 2 x 2049 signs
-    in doubles); each sign change is refined by bisection (in mpmath). Which assembly is the branch is the solver's
-    definition, continuity from the drawn pose along the crank's turn,
-    followed here by its own continuation (:meth:`prepare`).
+    in doubles); each sign change is refined by bisection (in mpmath).
+    Which assembly is the branch is the solver's definition, continuity from
+    the drawn pose along the crank's turn, followed here by its own
+    continuation (:meth:`prepare`).
     """
 
     @staticmethod
