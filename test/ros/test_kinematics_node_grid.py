@@ -2,11 +2,9 @@
 # SPDX-License-Identifier: Apache-2.0
 """The node's stream over real DDS: an exact grid, catch-up, phase continuity (issues 12, 14).
 
-Each node (``python -m mech_kinematics.kinematics_node``) runs in a namespace
-of this session, watched from a subscriber in this process, as
-launch_testing would. The grid, the stall and the long stop share one node
-at 1 kHz (:func:`khz`): each sets the late-tick parameters it needs and
-judges only the states and counts from its own start on.
+Each test starts its own node (``python -m mech_kinematics.kinematics_node``)
+in a namespace of this session and watches it from a subscriber in this
+process, as launch_testing would.
 """
 
 import math
@@ -15,7 +13,6 @@ import signal
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray
-import pytest
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 from rclpy.qos import qos_profile_parameters, QoSProfile, ReliabilityPolicy
@@ -109,46 +106,20 @@ def _holes(stamps, period):
     return sum((b - a) // period - 1 for a, b in zip(stamps, stamps[1:], strict=False))
 
 
-@pytest.fixture(scope='module')
-def khz(ros, tmp_path_factory):
-    """One node at 1 kHz for the tests of the grid, a stall and a long stop.
-
-    Started as the long stop needs it (publish_timeout_s is read only): a whole
-    process stopped 4 s is no stuck publish, but faulthandler's timer of the
-    publish watchdog cannot tell (docs/robustness.md): its bound is above the
-    stop. Each test sets late_ticks and max_catch_up_s itself.
-    """
-    stream = Stream(ros, tmp_path_factory.mktemp('khz'), 'khz', '-p', 'rate_hz:=1000',
-                    '-p', 'publish_timeout_s:=30.0')
-    yield stream
-    stream.stop()
-
-
-def _fresh_diagnostics(stream, after: int = 0) -> None:
-    """Wait for ``after`` + 1 diagnostics messages more than there are now.
-
-    A diagnostics window (1 s) is counted when it is published: the counts of
-    the second message on are those of ticks made after this call.
-    """
-    count = len(stream.diag)
-    wait_for(lambda: len(stream.diag) > count + after, STARTUP_S, 'fresh diagnostics')
-
-
-def test_stamps_are_an_exact_grid_without_holes(khz):
+def test_stamps_are_an_exact_grid_without_holes(ros, tmp_path):
     """At 1 kHz every stamp is a multiple of 1 ms and none is missing over 2 s. See issue 14."""
-    stream = khz
-    stream.set(late_ticks='catch_up', max_catch_up_s=0.1)     # the defaults
-    _fresh_diagnostics(stream)
-    skipped_before = diagnostic_value(stream.diag, 'skipped_ticks_total')
-    start = len(stream.js) - 1
-    # 2 s of instants as stamped (received late or not, on a loaded machine).
-    first = stamps_of(stream.js[start:start + 1])[0]
-    wait_for(lambda: stamps_of(stream.js[-1:])[0] >= first + 2 * NS, 2 + STARTUP_S,
-             '2 s of states')
-    stamps = [t for t in stamps_of(stream.js[start:]) if t <= first + 2 * NS]
-    _fresh_diagnostics(stream, 1)
-    skipped = diagnostic_value(stream.diag, 'skipped_ticks_total') - skipped_before
-    assert stream.process.proc.poll() is None, stream.process.output()
+    stream = Stream(ros, tmp_path, 'grid', '-p', 'rate_hz:=1000')
+    try:
+        start = len(stream.js) - 1
+        # 2 s of instants as stamped (received late or not, on a loaded machine).
+        first = stamps_of(stream.js[start:start + 1])[0]
+        wait_for(lambda: stamps_of(stream.js[-1:])[0] >= first + 2 * NS, 2 + STARTUP_S,
+                 '2 s of states')
+        stamps = [t for t in stamps_of(stream.js[start:]) if t <= first + 2 * NS]
+        wait_for(lambda: len(stream.diag) >= 2, STARTUP_S, 'diagnostics')
+        skipped = diagnostic_value(stream.diag, 'skipped_ticks_total')
+    finally:
+        stream.stop()
     assert len(stamps) >= 1500
     assert all(s % 1_000_000 == 0 for s in stamps)
     assert stamps == sorted(set(stamps))
@@ -277,7 +248,7 @@ def _states_until(raw, stamp):
     wait_for(lambda: stamps_of(raw[-1:])[0] > stamp, STARTUP_S, 'the states after the stall')
 
 
-def test_a_stall_is_caught_up_to_the_bound_and_the_rest_counted(khz):
+def test_a_stall_is_caught_up_to_the_bound_and_the_rest_counted(ros, tmp_path):
     """After a 0.5 s stall the last 0.1 s of instants are published, the rest skipped and counted.
 
     With late_ticks: skip, only the latest instant is published. See issue 14.
@@ -288,23 +259,29 @@ def test_a_stall_is_caught_up_to_the_bound_and_the_rest_counted(khz):
     """
     period = 1_000_000
     window = NS // 10       # max_catch_up_s
-    stream = khz
-    results = {}
-    for mode in ('catch_up', 'skip'):
-        stream.set(late_ticks=mode, max_catch_up_s=0.1)
-        _fresh_diagnostics(stream)
-        skipped_before = diagnostic_value(stream.diag, 'skipped_ticks_total')
-        start = max(0, len(stream.js) - 20)     # from before the stall
-        resumed = _stall(stream, 0.5)
-        _states_until(stream.js, time.time_ns() + NS // 2)
-        _fresh_diagnostics(stream, 1)
-        skipped = diagnostic_value(stream.diag, 'skipped_ticks_total') - skipped_before
-        stamps = sorted(stamps_of(stream.js[start:]))
-        gaps = sorted((b - a, b) for a, b in zip(stamps, stamps[1:], strict=False) if b > a)
-        (stall_gap, first), (next_gap, _) = gaps[-1], gaps[-2]
-        results[mode] = (skipped, _holes(stamps, period), stall_gap, next_gap,
-                         first - resumed, stream.arrival(first) - first)
-    assert stream.process.proc.poll() is None, stream.process.output()
+    stream = Stream(ros, tmp_path, 'stall', '-p', 'rate_hz:=1000', '-p', 'max_catch_up_s:=0.1')
+    try:
+        results = {}
+        for mode in ('catch_up', 'skip'):
+            stream.set(late_ticks=mode)
+            time.sleep(1.0)
+            count = len(stream.diag)
+            wait_for(lambda n=count: len(stream.diag) > n, 3.0, 'fresh diagnostics')
+            skipped_before = diagnostic_value(stream.diag, 'skipped_ticks_total')
+            start = max(0, len(stream.js) - 20)     # from before the stall
+            resumed = _stall(stream, 0.5)
+            _states_until(stream.js, time.time_ns() + NS // 2)
+            count = len(stream.diag)
+            wait_for(lambda n=count: len(stream.diag) > n + 1, STARTUP_S,
+                     'diagnostics after the stall')
+            skipped = diagnostic_value(stream.diag, 'skipped_ticks_total') - skipped_before
+            stamps = sorted(stamps_of(stream.js[start:]))
+            gaps = sorted((b - a, b) for a, b in zip(stamps, stamps[1:], strict=False) if b > a)
+            (stall_gap, first), (next_gap, _) = gaps[-1], gaps[-2]
+            results[mode] = (skipped, _holes(stamps, period), stall_gap, next_gap,
+                             first - resumed, stream.arrival(first) - first)
+    finally:
+        stream.stop()
     # The first state after the stall: the node woke at `woke`, between `resumed` and the
     # state's arrival here, and published from the oldest instant its window holds.
     skipped, holes, stall_gap, next_gap, after_resumed, arrived_after = results['catch_up']
@@ -327,7 +304,7 @@ def test_a_stall_is_caught_up_to_the_bound_and_the_rest_counted(khz):
     assert skipped >= stall_gap // period - 1, results
 
 
-def test_a_long_stop_at_1_khz_is_one_burst_that_fits_a_keep_last_1000_history(khz):
+def test_a_long_stop_at_1_khz_is_one_burst_that_fits_a_keep_last_1000_history(ros, tmp_path):
     """Issue 21, item 7, with a real SIGSTOP: 4 s at 1 kHz with max_catch_up_s:=10.
 
     A 10 s stop made a burst of 10,001 instants and a KEEP_LAST 1000 reader lost 1,712
@@ -344,23 +321,28 @@ def test_a_long_stop_at_1_khz_is_one_burst_that_fits_a_keep_last_1000_history(kh
     own loss, where a deeper reader beside it lost none.
     """
     period = 1_000_000
-    # The node's publish_timeout_s is above the stop (khz).
-    stream = khz
+    # A whole process stopped 4 s is no stuck publish, but faulthandler's timer of the
+    # publish watchdog cannot tell (docs/robustness.md): its bound is above the stop here.
+    stream = Stream(ros, tmp_path, 'stop_10s', '-p', 'rate_hz:=1000', '-p',
+                    'max_catch_up_s:=10.0', '-p', 'publish_timeout_s:=30.0')
     reader = stream.js
-    stream.set(late_ticks='catch_up', max_catch_up_s=10.0)
-    _fresh_diagnostics(stream)
-    skipped_before = diagnostic_value(stream.diag, 'skipped_ticks_total')
-    start = len(reader) - 1
-    resumed = _stall(stream, 4.0)
-    _states_until(reader, time.time_ns() + NS)
-    _fresh_diagnostics(stream, 1)
-    skipped = diagnostic_value(stream.diag, 'skipped_ticks_total') - skipped_before
-    stamps = sorted(set(stamps_of(reader[start:])))
-    gaps = [(b - a, i) for i, (a, b) in enumerate(zip(stamps, stamps[1:], strict=False))]
-    stop_gap, at = max(gaps)
-    first = stamps[at + 1]
-    arrived = stream.arrival(first)
-    assert stream.process.proc.poll() is None, stream.process.output()
+    try:
+        wait_for(lambda: len(reader) > 100, STARTUP_S, 'the reader')
+        wait_for(lambda: len(stream.diag) >= 2, STARTUP_S, 'diagnostics')
+        skipped_before = diagnostic_value(stream.diag, 'skipped_ticks_total')
+        start = len(reader) - 1
+        resumed = _stall(stream, 4.0)
+        _states_until(reader, time.time_ns() + NS)
+        count = len(stream.diag)
+        wait_for(lambda: len(stream.diag) > count + 1, STARTUP_S, 'diagnostics after the stop')
+        skipped = diagnostic_value(stream.diag, 'skipped_ticks_total') - skipped_before
+        stamps = sorted(set(stamps_of(reader[start:])))
+        gaps = [(b - a, i) for i, (a, b) in enumerate(zip(stamps, stamps[1:], strict=False))]
+        stop_gap, at = max(gaps)
+        first = stamps[at + 1]
+        arrived = stream.arrival(first)
+    finally:
+        stream.stop()
     # The burst: the node woke at `woke`, between `resumed` and the first state's arrival
     # here, and published the instants in (woke - HISTORY periods, woke], HISTORY of them:
     # no older one (uncapped, it published all 4,000 owed, and left no gap at all)...

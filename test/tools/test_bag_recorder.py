@@ -409,7 +409,12 @@ def test_values_agree_with_the_solver(contents, name):
                                         (2, point.accelerations[k].linear, p.acceleration)):
                 add(('point', label, kind), (vector.x, vector.y, vector.z),
                     (value[0], value[1], 0.0))
-    assert matched >= 0.99 * len(contents[name]['/point_accelerations']) > 0
+    # Over the stamps both topics span: subscribed one after the other, their ends differ
+    # (beside two CPU hogs 79 of 1,352 point messages, 0.16 s at 500 Hz, came before the
+    # first joint_states recorded or after the last).
+    first, last = min(solved), max(solved)
+    both = sum(first <= stamp_ns(m) <= last for _, m in contents[name]['/point_accelerations'])
+    assert matched >= 0.99 * both > 0, (matched, both)
     scales = {'joint': joint_scale, 'point': point_scale}
     assert {key[:2] for key in got} == {(group, n) for group in scales for n in scales[group]}
     for (group, element, kind), values in got.items():
