@@ -654,8 +654,8 @@ CRASH_RECORDERS = {
     'witness': ['--storage', 'mcap'],
     'kill_mcap': ['--storage', 'mcap', *FLUSH_LOG],
     'kill_sqlite3': ['--storage', 'sqlite3', *FLUSH_LOG],
-    'full_mcap': ['--storage', 'mcap'],
-    'full_sqlite3': ['--storage', 'sqlite3'],
+    'full_mcap': ['--storage', 'mcap', *FLUSH_LOG],
+    'full_sqlite3': ['--storage', 'sqlite3', *FLUSH_LOG],
     # /tf and /tf_static are absolute: remapped into the namespace, where nothing publishes.
     'idle': ['--ros-args', '-r', f'__ns:={IDLE_NS}', '-r', f'/tf:={IDLE_NS}/tf',
              '-r', f'/tf_static:={IDLE_NS}/tf_static'],
@@ -919,7 +919,10 @@ def test_reindexed_bag_metadata_tells_the_truth(crashes, storage):
 
 @pytest.mark.parametrize('storage', ['mcap', 'sqlite3'])
 def test_write_error_ends_with_one_line_and_a_truthful_bag(crashes, storage):
-    """Writes refused (file size limit): exit 1, one error: line, metadata = what is readable."""
+    """Writes refused (file size limit): exit 1, one error: line, metadata = what is readable.
+
+    Every message a flush logged (debug) as in the file is readable.
+    """
     name = f'full_{storage}'
     output = crashes.outputs[name]
     assert crashes.statuses[name] == 1, output
@@ -938,7 +941,11 @@ def test_write_error_ends_with_one_line_and_a_truthful_bag(crashes, storage):
     assert {topic: written for topic, (_, _, written) in summary.items()} == readable
     assert all(received >= written for _, received, written in summary.values())
     assert sum(received - written for _, received, written in summary.values()) > 0
-    assert sum(readable.values()) > 0
+    # What a flush put in the file before the error is readable; beside CPU hogs the first
+    # flush can meet the limit (sqlite3's transaction then holds nothing): an empty bag.
+    flushes = FLUSH_LINE.findall(output)
+    assert sum(readable.values()) >= (int(flushes[-1][3]) if flushes else 0)
+    assert sum(readable.values()) > 0 or not flushes
     assert storage_file.stat().st_size <= FILE_LIMIT
     assert sorted(p.name for p in path.iterdir()) == sorted([storage_file.name,
                                                              'metadata.yaml'])
