@@ -384,6 +384,33 @@ class RobotForces:
         return out
 
 
+def parse_payloads(entries: Sequence[str],
+                   what: str) -> dict[str, tuple[float, tuple[float, ...]]]:
+    """Return ``LINK=KG`` or ``LINK=KG@X,Y,Z`` entries as ``{LINK: (kg, (x, y, z))}``.
+
+    The commands' ``--payload`` and the node's ``payloads`` alike; ``what``
+    names them in the ValueError (an entry not in that form, a link twice).
+    """
+    out: dict[str, tuple[float, tuple[float, ...]]] = {}
+    for entry in entries:
+        link, sep, rest = entry.partition('=')
+        mass, at, point = rest.partition('@')
+        link = link.strip()
+        try:
+            value = (float(mass), tuple(float(v) for v in point.split(',')) if at
+                     else (0.0, 0.0, 0.0))
+        except ValueError:
+            value = None
+        if not sep or not link or value is None or len(value[1]) != 3:
+            msg = f'{what}: Expected LINK=KG or LINK=KG@X,Y,Z, got {entry!r}'
+            raise ValueError(msg)
+        if link in out:
+            msg = f'{what}: Expected each link once, got "{link}" twice'
+            raise ValueError(msg)
+        out[link] = value
+    return out
+
+
 def with_payloads(description: Description,
                   payloads: Mapping[str, tuple[float, Sequence[float]]]) -> Description:
     """Return ``description`` with point masses added to links: ``{LINK: (kg, (x, y, z))}``.

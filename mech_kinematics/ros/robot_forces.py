@@ -45,7 +45,6 @@ from .robot_mode import RobotValues
 from .ticker import NOT_IN_THE_TICK, values_from_state
 from .topics import reaction_topic
 from .wrenches import ForceMessages, ForcesTick
-from .. import solver as lk
 from ..errors import AssemblyError
 from ..geometry.frames import child_frame
 from ..robot.description import ClosureKind
@@ -216,15 +215,7 @@ class RobotForcesTick(ForcesTick):
     def __call__(self, theta: Any, omega: Any, alpha: Any, tol: float,
                  turns: Any = 0) -> tuple[list[float], float]:
         """Return ``(values, measure)`` as a tick function does, the forces after the motion."""
-        kinematics = self.kinematics
-        state = lk.solve(kinematics, theta, omega, alpha, turns=turns, max_error=tol)
-        values = values_from_state(state, self.joints, self.points, ())
-        measures = state.singularity.values()
-        measure = float(min(measures)) if measures else math.inf
-        at = state
-        if self.static:
-            rest = 0.0 if self.drivers == 1 else (0.0,) * self.drivers
-            at = lk.solve(kinematics, theta, rest, rest, turns=turns, max_error=tol)
+        values, measure, at = self._motion(theta, omega, alpha, tol, turns)
         given = self.inputs
         try:
             forces = self._forces(values, at, tol, self.g, given)

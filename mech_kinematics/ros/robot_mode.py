@@ -103,25 +103,12 @@ def payloads_from_parameter(entries: Sequence[str]) -> dict[str, tuple[float, tu
         :func:`~mech_kinematics.robot.forces.with_payloads`, naming the link.)
     """
     from ..errors import UrdfError
+    from ..robot.forces import parse_payloads
 
-    out: dict[str, tuple[float, tuple[float, ...]]] = {}
-    for entry in entries:
-        link, sep, rest = entry.partition('=')
-        mass, at, point = rest.partition('@')
-        link = link.strip()
-        try:
-            value = (float(mass), tuple(float(v) for v in point.split(',')) if at
-                     else (0.0, 0.0, 0.0))
-        except ValueError:
-            value = None
-        if not sep or not link or value is None or len(value[1]) != 3:
-            msg = f'payloads: Expected LINK=KG or LINK=KG@X,Y,Z, got {entry!r}'
-            raise UrdfError(msg)
-        if link in out:
-            msg = f'payloads: Expected each link once, got "{link}" twice'
-            raise UrdfError(msg)
-        out[link] = value
-    return out
+    try:
+        return parse_payloads(entries, 'payloads')
+    except ValueError as error:
+        raise UrdfError(str(error)) from None
 
 
 def is_urdf(scene: str) -> bool:

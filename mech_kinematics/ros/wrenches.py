@@ -237,9 +237,13 @@ class ForcesTick:
                 continue        # a position where it does not assemble: nothing to warm
         return states
 
-    def __call__(self, theta: Any, omega: Any, alpha: Any, tol: float,
-                 turns: Any = 0) -> tuple[list[float], float]:
-        """Return ``(values, measure)`` as a tick function does, the forces after the motion."""
+    def _motion(self, theta: Any, omega: Any, alpha: Any, tol: float,
+                turns: Any) -> tuple[list[float], float, Any]:
+        """Return the motion's values and measure, and the state the forces are solved at.
+
+        That state is the motion's, or with ``effort: static`` the same
+        positions at rest.
+        """
         kinematics = self.kinematics
         state = lk.solve(kinematics, theta, omega, alpha, turns=turns, max_error=tol)
         values = values_from_state(state, self.joints, self.points, self.frames)
@@ -249,6 +253,12 @@ class ForcesTick:
         if self.static:
             rest = 0.0 if self.drivers == 1 else (0.0,) * self.drivers
             at = lk.solve(kinematics, theta, rest, rest, turns=turns, max_error=tol)
+        return values, measure, at
+
+    def __call__(self, theta: Any, omega: Any, alpha: Any, tol: float,
+                 turns: Any = 0) -> tuple[list[float], float]:
+        """Return ``(values, measure)`` as a tick function does, the forces after the motion."""
+        values, measure, at = self._motion(theta, omega, alpha, tol, turns)
         forces = self.dynamics.forces(at, tol)
         if forces.valid:
             values += forces_values(forces, at, self.joints, self.reactions)

@@ -118,23 +118,9 @@ def add_gravity_argument(parser: argparse.ArgumentParser) -> None:
 
 def payloads_of(args: argparse.Namespace) -> dict[str, tuple[float, tuple[float, ...]]]:
     """Return ``--payload LINK=KG[@X,Y,Z]`` as ``{LINK: (kg, (x, y, z))}``, or a ValueError."""
-    out: dict[str, tuple[float, tuple[float, ...]]] = {}
-    for text in getattr(args, 'payload', None) or ():
-        link, sep, rest = text.partition('=')
-        mass, at, point = rest.partition('@')
-        try:
-            values = (float(mass), tuple(float(v) for v in point.split(',')) if at
-                      else (0.0, 0.0, 0.0))
-        except ValueError:
-            values = None
-        if not sep or not link or values is None or len(values[1]) != 3:
-            msg = f'--payload: Expected LINK=KG or LINK=KG@X,Y,Z, got {text!r}'
-            raise ValueError(msg)
-        if link in out:
-            msg = f'--payload: Expected each link once, got "{link}" twice'
-            raise ValueError(msg)
-        out[link] = values
-    return out
+    from ..robot.forces import parse_payloads
+
+    return parse_payloads(getattr(args, 'payload', None) or (), '--payload')
 
 
 def gravity_of(args: argparse.Namespace) -> tuple[float, float, float] | None:
