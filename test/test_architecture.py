@@ -124,6 +124,56 @@ def test_arrows_run_one_way(path):
             f'{path.relative_to(PACKAGE)}:{line} ({layer}) imports from {target}'
 
 
+#: Private names a layer may use of objects it did not define: the standard library's.
+STANDARD_PRIVATE = {'_exit'}
+
+
+def _private_names_defined(paths) -> set:
+    """Return the private names (``_x``) that ``paths`` define: functions, classes, attributes."""
+    names = set()
+    for path in paths:
+        for node in ast.walk(ast.parse(path.read_text(encoding='utf-8'))):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+                names.add(node.name)
+            elif isinstance(node, ast.Attribute) and isinstance(node.ctx, ast.Store):
+                names.add(node.attr)
+            elif isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store):
+                names.add(node.id)
+            elif isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name):
+                names.add(node.target.id)
+    return {name for name in names if name.startswith('_') and not name.startswith('__')}
+
+
+def _layer_paths(layer: str) -> list:
+    if layer == 'core':
+        return sorted(p for p in PACKAGE.rglob('*.py') if _layer(p) == 'core')
+    return sorted((PACKAGE / layer).rglob('*.py'))
+
+
+@pytest.mark.parametrize('layer', sorted(set(LAYERS) - {'core', 'data'}))
+def test_a_layer_reads_and_writes_no_private_field_of_another(layer):
+    """Above the core, a layer asks the layers below through public calls (issue 45).
+
+    An attribute ``X._name`` on anything but ``self`` or ``cls`` names a private
+    field: it must be one its own module defines, or one its layer defines and no
+    layer below it does (the ROS layer once wrote ``scene._solver.compiled_single``,
+    the core's; it now calls ``solver.keep_general_path``).
+    """
+    paths = _layer_paths(layer)
+    below = set().union(*(_private_names_defined(_layer_paths(other)) for other in LAYERS[layer]))
+    layer_own = _private_names_defined(paths) - below
+    foreign = []
+    for path in paths:
+        own = _private_names_defined([path]) | layer_own | STANDARD_PRIVATE
+        for node in ast.walk(ast.parse(path.read_text(encoding='utf-8'))):
+            mine = isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) \
+                and node.value.id in ('self', 'cls')
+            if isinstance(node, ast.Attribute) and node.attr.startswith('_') and not mine \
+                    and not node.attr.startswith('__') and node.attr not in own:
+                foreign.append(f'{path.relative_to(PACKAGE)}:{node.lineno}: {ast.unparse(node)}')
+    assert foreign == []
+
+
 #: Facts with one home each: the literal, and the module that may spell it.
 ONE_HOME = {
     '1_000_000_000': 'units.py',

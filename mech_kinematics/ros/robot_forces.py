@@ -45,11 +45,11 @@ from .robot_mode import RobotValues
 from .ticker import NOT_IN_THE_TICK, values_from_state
 from .topics import reaction_topic
 from .wrenches import ForceMessages, ForcesTick
+from .. import solver as lk
 from ..errors import AssemblyError
 from ..geometry.frames import child_frame
 from ..robot.description import ClosureKind
 from ..robot.forces import check_gravity, ForcesLeftOut, GRAVITY
-from ..solver.compiler import NotCompiled
 
 __all__ = ['RobotForcesTick', 'reaction_names', 'robot_forces_note', 'robot_forces_tick']
 
@@ -130,8 +130,7 @@ class RobotForcesTick(ForcesTick):
         self.kinematics = replace(scene, gravity=None, masses=(), loads=(),
                                   outputs_joints=scene.output_joints,
                                   outputs_points=scene.output_points)
-        if self.kinematics._solver.compiled_single is None:
-            self.kinematics._solver.compiled_single = NotCompiled(NOT_IN_THE_TICK)
+        lk.keep_general_path(self.kinematics, NOT_IN_THE_TICK)
         self.joints, self.points, self.frames = scene.output_joints, scene.output_points, ()
         self.static = static
         self.drivers = len(scene.drivers)

@@ -78,8 +78,7 @@ def general_tick(scene: lk.Scene, joints: Sequence[str] | None,
     it already is; ``mk.solve`` then answers ``scene`` by its general path, the
     same bits (``test_compiler_solve``).
     """
-    if scene._solver.compiled_single is None:
-        scene._solver.compiled_single = NotCompiled(NOT_IN_THE_TICK)
+    lk.keep_general_path(scene, NOT_IN_THE_TICK)
     joints = tuple(scene.output_joints if joints is None else joints)
     points = tuple(scene.output_points if points is None else points)
     frames = tuple(frames)

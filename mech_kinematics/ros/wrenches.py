@@ -47,7 +47,6 @@ from .ticker import NOT_IN_THE_TICK, values_from_state
 from .topics import reaction_topic, SHAKING
 from .. import solver as lk
 from ..errors import AssemblyError
-from ..solver.compiler import NotCompiled
 from ..solver.forces import Dynamics, given_forces_refusal, Load
 
 if TYPE_CHECKING:
@@ -159,8 +158,7 @@ class ForcesTick:
         self.kinematics = replace(scene, gravity=None, masses=(), loads=(),
                                   outputs_joints=scene.output_joints,
                                   outputs_points=scene.output_points)
-        if self.kinematics._solver.compiled_single is None:
-            self.kinematics._solver.compiled_single = NotCompiled(NOT_IN_THE_TICK)
+        lk.keep_general_path(self.kinematics, NOT_IN_THE_TICK)
         self.joints, self.points, self.frames = tuple(joints), tuple(points), tuple(frames)
         self.static = static
         self.drivers = len(scene.drivers)

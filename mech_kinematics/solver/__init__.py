@@ -50,7 +50,7 @@ from .rpr import MAX_SLOTS, RPR
 from .rrp import RRP
 from .rrr import RRR
 from .rubbing import Pin
-from .solve import assembly_margins, solve
+from .solve import assembly_margins, keep_general_path, solve
 from .state import Engagement, JointMotion, PointState, State
 from .triad import Triad
 
@@ -58,5 +58,6 @@ __all__ = [
     'Actuator', 'Branch', 'CarriedPoint', 'Crank', 'Engagement', 'JointMotion', 'Link',
     'MAX_SLOTS',
     'NEAR_SINGULAR', 'Pin', 'PointState', 'RPP', 'RPR', 'RRP', 'RRR', 'SINGULAR', 'Scene', 'State',
-    'SceneUnits', 'Triad', 'TANGENCY_TOLERANCE', 'assembly_margins', 'assembly_text', 'solve',
+    'SceneUnits', 'Triad', 'TANGENCY_TOLERANCE', 'assembly_margins', 'assembly_text',
+    'keep_general_path', 'solve',
 ]

@@ -10,7 +10,9 @@ A scene solved often runs compiled: after :data:`COMPILE_AFTER` single-angle
 solves (:data:`ARRAY_COMPILE_AFTER` array solves) its kernels are compiled for
 that path (:func:`.compiler.compile_scene`), with the same bits, bounds and
 refusals; where the scene does not compile, the solver keeps the reason
-(``scene._solver.compiled_single.reason``) and the general path.
+(``scene._solver.compiled_single.reason``) and the general path. A caller
+that must never stall for a compile settles the general path first
+(:func:`keep_general_path`).
 """
 
 from __future__ import annotations
@@ -810,6 +812,23 @@ def _compiled_state(scene: Scene, solver: _Solver, theta: float, omega: float, a
     if scene.imus:  # read from the state when asked (State.imus), as _state does
         state.__dict__['imu_specs'] = scene.imus
     return state
+
+
+def keep_general_path(scene: Scene, reason: str) -> None:
+    """Keep :func:`solve` from compiling ``scene``'s single-angle path in its caller's thread.
+
+    Unless that path is compiled already, it is settled as not compiled, with
+    ``reason`` as why (a :class:`.compiler.NotCompiled`): :func:`solve` then
+    answers ``scene`` by its general path, the same bits, and never stalls its
+    caller for a compile (seconds on a large scene). For a caller whose thread
+    must not stall, such as the node's tick, which compiles elsewhere.
+    """
+    if not reason:
+        msg = 'Expected the reason the general path serves, got an empty string'
+        raise ValueError(msg)
+    solver = scene._solver
+    if solver.compiled_single is None:
+        solver.compiled_single = NotCompiled(reason)
 
 
 def _compiled(scene: Scene, solver: _Solver) -> Any:

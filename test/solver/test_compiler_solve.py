@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 
 import mech_kinematics as mk
+from mech_kinematics import solver as lk
 from mech_kinematics.solver.compiler import (ARRAY, Array, compile_scene, COMPILE_STEPS,
                                              NotCompiled, SINGLE, Single)
 from mech_kinematics.verify.extreme import extreme_cases
@@ -166,6 +167,29 @@ def test_a_scene_is_compiled_after_its_first_single_angle_solves():
         assert scene._solver.compiled_array is None
     mk.solve(scene, np.linspace(0.0, 1.0, 5))
     assert callable(scene._solver.compiled_array)
+
+
+def test_a_scene_kept_on_the_general_path_never_compiles_and_answers_alike():
+    """``keep_general_path``: the public call a thread that must not stall makes (the node's tick).
+
+    After it, solves past COMPILE_AFTER keep the general path, with the reason
+    given, and answer the bits of a scene that compiled; a scene compiled
+    already stays compiled; an empty reason is refused.
+    """
+    kept = mk.load_scene('slider_crank_150_600')
+    lk.keep_general_path(kept, 'a reason of the caller')
+    fast, _ = _pair(lambda: mk.load_scene('slider_crank_150_600'))
+    for angle in np.linspace(0.0, 6.0, COMPILE_AFTER + 3):
+        assert state_facts(mk.solve(kept, float(angle))) == \
+            state_facts(mk.solve(fast, float(angle)))
+    path = kept._solver.compiled_single
+    assert not path and path.reason == 'a reason of the caller'
+    compiled = fast._solver.compiled_single
+    assert callable(compiled)
+    lk.keep_general_path(fast, 'too late')
+    assert fast._solver.compiled_single is compiled
+    with pytest.raises(ValueError, match='the reason the general path serves'):
+        lk.keep_general_path(mk.load_scene('slider_crank_150_600'), '')
 
 
 def test_a_held_state_is_not_changed_by_later_solves():
