@@ -9,6 +9,7 @@ comment naming the modules that use it.
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -340,6 +341,56 @@ def first_order_spreads(scene, angle, speed=None, accel=None, exact=None):
                     diff = ref._wrap(diff)
                 totals[path] += abs(diff) / eta
         return {path: float(total) * unit for path, total in totals.items()}
+
+
+# --- an array solve against single-angle solves -------------------------------
+# Used by test_triad.py and test_one_answer.py.
+
+@functools.cache
+def numpy_is_libm() -> bool:
+    """Whether NumPy's array ``arctan2`` and ``hypot`` give the C library's bits on this machine.
+
+    The single-angle path calls the C library (``math.atan2``, ``abs`` of a
+    complex), the array path NumPy. Where NumPy dispatches its own AVX-512 loop
+    for ``arctan2`` (NumPy 2.4 on an AVX-512 Xeon, 2026-12-02: 318 of these
+    4096 random pairs one ulp off ``math.atan2``; none with
+    ``NPY_DISABLE_CPU_FEATURES="X86_V4 AVX512_ICL AVX512_SPR"``), the two paths
+    agree within their error bounds, not to the bit.
+    """
+    import numpy as np
+    x, y = np.random.default_rng(0).uniform(-4.0, 4.0, (2, 4096))
+    pairs = list(zip(x.tolist(), y.tolist(), strict=True))
+    return bool(np.array_equal(np.arctan2(y, x), [math.atan2(b, a) for a, b in pairs])
+                and np.array_equal(np.hypot(x, y), [abs(complex(a, b)) for a, b in pairs]))
+
+
+def assert_entry_is_the_single_answer(single: mk.State, many: mk.State, index: int) -> None:
+    """Assert that entry ``index`` of the array state ``many`` is the single-angle ``single``.
+
+    Bit for bit, values and bounds, where :func:`numpy_is_libm`; elsewhere every
+    value within the sum of the two states' error bounds of the other (both bound
+    the error against the exact value) and every bound within 1e-6 of the other,
+    relative.
+    """
+    import numpy as np
+    pairs = [(single.joints, many.joints, single.error_bound.joints, many.error_bound.joints),
+             (single.points, many.points, single.error_bound.points, many.error_bound.points)]
+    for one, other, one_bound, other_bound in pairs:
+        assert one.keys() == other.keys()
+        for name in one:
+            for quantity in ('position', 'velocity', 'acceleration'):
+                a = np.asarray(getattr(one[name], quantity), dtype=float)
+                b = np.asarray(getattr(other[name], quantity), dtype=float)
+                b = np.broadcast_to(b, (len(many.valid), *a.shape))[index]
+                ea = float(getattr(one_bound[name], quantity))
+                eb = float(np.broadcast_to(getattr(other_bound[name], quantity),
+                                           many.valid.shape)[index])
+                where = f'{name} {quantity}'
+                if numpy_is_libm():
+                    assert a.tolist() == b.tolist() and ea == eb, where
+                else:
+                    assert float(np.linalg.norm(a - b)) <= ea + eb, (where, a, b, ea, eb)
+                    assert abs(ea - eb) <= 1e-6 * max(ea, eb), (where, ea, eb)
 
 
 # --- the solver's compiled paths against its general one ----------------------

@@ -15,7 +15,7 @@ answered the crossed assembly (strays of 0.34 and 1.06 rad).
 import math
 from pathlib import Path
 
-from helpers import UrdfFk
+from helpers import assert_entry_is_the_single_answer, numpy_is_libm, UrdfFk
 import numpy as np
 import pytest
 
@@ -75,20 +75,31 @@ def test_the_grippers_parallelograms_keep_their_rules_through_the_change_points_
 
 
 def test_an_array_answers_each_instant_in_its_own_assembly_to_the_bit():
-    """A sweep across both change points as one array: every value the single solve's."""
+    """A sweep across both change points as one array: every value the single solve's.
+
+    To the bit where NumPy's ``arctan2`` and ``hypot`` are the C library's;
+    where NumPy runs its own AVX-512 loops, each value within the two solves'
+    error bounds (``helpers.assert_entry_is_the_single_answer``), in the same
+    assembly.
+    """
     robot, _ = _gripper()
     q = np.array([0.3, 1.0, 2.5, 3.6, 4.9, 5.5, 40.0, -3.0])
     many = robot.solve({'finger_joint': q}, {'finger_joint': np.full(q.shape, 0.7)})
     assert bool(np.all(many.state.valid)) and many.mimic == {}
     for i, x in enumerate(q):
         one = robot.solve({'finger_joint': float(x)}, {'finger_joint': 0.7})
+        assert_entry_is_the_single_answer(one.state, many.state, i)
         for name in robot.joint_names:
             got, want = many.joints[name], one.joints[name]
-            assert np.broadcast_to(got.position, q.shape)[i] == want.position
-            assert np.broadcast_to(got.velocity, q.shape)[i] == want.velocity
-            assert np.broadcast_to(many.bounds[name][0], q.shape)[i] == one.bounds[name][0]
-        for point, value in one.state.complex_points.items():
-            assert many.state.complex_points[point][0][i] == value[0]
+            for k, quantity in enumerate(('position', 'velocity')):
+                a = float(np.broadcast_to(getattr(got, quantity), q.shape)[i])
+                b = getattr(want, quantity)
+                bound_a = float(np.broadcast_to(many.bounds[name][k], q.shape)[i])
+                bound_b = one.bounds[name][k]
+                if numpy_is_libm():
+                    assert (a, bound_a) == (b, bound_b), (name, quantity)
+                else:
+                    assert abs(a - b) <= bound_a + bound_b, (name, quantity, a, b)
 
 
 def test_a_loop_without_rules_keeps_the_reference_branch():
