@@ -31,7 +31,8 @@ from typing import Any
 
 import numpy as np
 
-from .cli import add_robot_arguments, add_scene_argument, load_scene_argument, run_tool
+from .cli import (add_robot_arguments, add_scene_argument, add_units_argument,
+                  load_scene_argument, run_tool)
 from ..errors import SceneError
 from ..geometry.region import GRID
 from ..solver.graph import JointType
@@ -587,6 +588,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter)
     add_scene_argument(parser)
     add_robot_arguments(parser)
+    add_units_argument(parser)
     parser.add_argument('--json', action='store_true',
                         help='print one JSON object, in SI units (rad, m)')
     parser.add_argument('--grid', type=grid_size, default=GRID, metavar='N',

@@ -35,14 +35,19 @@ from typing import Any
 
 from ..errors import MechKinematicsError
 from ..memory import keep_freed_memory
-from ..units import LENGTH_UNITS, rad_per_s_from_rpm, turns_from_degrees
+from ..units import LENGTH_UNITS, rad_per_s_from_rpm, reduce_radians, turns_from_degrees
 
-__all__ = ['ArgumentParser', 'PROG', 'add_driver_arguments', 'add_gravity_argument',
-           'add_robot_arguments', 'add_scene_argument', 'drive_from_args', 'finite_float',
+__all__ = ['ArgumentParser', 'PROG', 'UNIT_SYSTEMS', 'add_driver_arguments',
+           'add_gravity_argument', 'add_robot_arguments', 'add_scene_argument',
+           'add_units_argument', 'angle_given', 'angle_unit', 'angular_rate_given',
+           'drive_from_args', 'finite_float',
            'gravity_of', 'is_urdf', 'joint_list', 'load_robot_argument', 'load_scene_argument',
            'mimic_ruled', 'named_value', 'payloads_of', 'positive_float', 'positive_int',
            'positive_seconds', 'run_handler', 'run_tool', 'seconds_or_zero', 'values_by_driver']
 
+#: What ``--units`` takes: ``deg`` (the default: a revolute joint's or a crank's
+#: values in degrees and rpm) or ``si`` (rad and rad/s; an actuator's length in m).
+UNIT_SYSTEMS = ('deg', 'si')
 #: The program name shown in usage lines.
 PROG = 'python -m mech_kinematics'
 #: Exit status of a command whose output pipe was closed (128 + SIGPIPE), as `yes | head`.
@@ -100,8 +105,42 @@ def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
                             "joints, else the URDF's <transmission> and <ros2_control> joints)")
     group.add_argument('--reference', type=named_value, action='append', metavar='J=VALUE',
                        help='a reference pose whose branches the loops keep (degrees for a '
-                            'revolute joint, m for a prismatic one; repeatable; default: the '
-                            "URDF's zero pose)")
+                            'revolute joint, rad with --units si; m for a prismatic one; '
+                            "repeatable; default: the URDF's zero pose)")
+
+
+def add_units_argument(parser: argparse.ArgumentParser) -> None:
+    """Add ``--units deg|si``: the units of ``--input``, ``--speed`` and ``--reference`` values."""
+    parser.add_argument('--units', choices=UNIT_SYSTEMS, default=None,
+                        help='the units of the values of --input, --speed and --reference: deg '
+                             '(the default: degrees and rpm for a crank or a revolute joint, '
+                             "the scene's length unit for an actuator, m and m/s for a "
+                             'prismatic joint) or si (rad and rad/s; m and m/s). --angle-deg '
+                             'and --speed-rpm are degrees and rpm, and --accel rad/s^2 or '
+                             'm/s^2, either way; the answer is SI either way')
+
+
+def _si(args: argparse.Namespace) -> bool:
+    return getattr(args, 'units', None) == 'si'
+
+
+def angle_unit(args: argparse.Namespace) -> str:
+    """Return the unit of an angle given on the command line (``--units``): ``deg`` or ``rad``."""
+    return 'rad' if _si(args) else 'deg'
+
+
+def angle_given(value: float, args: argparse.Namespace) -> tuple[float, int]:
+    """Return an angle given on the command line as (rad within a turn, whole turns).
+
+    In degrees (``turns_from_degrees``) or, with ``--units si``, in rad
+    (``reduce_radians``); either reduction is exact.
+    """
+    return reduce_radians(value) if _si(args) else turns_from_degrees(value)
+
+
+def angular_rate_given(value: float, args: argparse.Namespace) -> float:
+    """Return an angular speed given on the command line in rad/s (rpm, or rad/s with si)."""
+    return float(value) if _si(args) else rad_per_s_from_rpm(value)
 
 
 def add_gravity_argument(parser: argparse.ArgumentParser) -> None:
@@ -160,10 +199,11 @@ def load_robot_argument(args: argparse.Namespace) -> Any:
             raise UrdfError(msg)
         if not joint.type.angular:
             reference[name] = value
-        elif abs(value) > 360.0 and name not in mimic_ruled(description):
-            reference[name] = turns_from_degrees(value)[0]  # its direction, exactly
+        elif abs(value) > (math.tau if _si(args) else 360.0) \
+                and name not in mimic_ruled(description):
+            reference[name] = angle_given(value, args)[0]   # its direction, exactly
         else:
-            reference[name] = math.radians(value)
+            reference[name] = value if _si(args) else math.radians(value)
     payloads = payloads_of(args)
     if payloads:
         from ..robot.forces import with_payloads
@@ -355,11 +395,13 @@ def add_driver_arguments(parser: argparse.ArgumentParser) -> None:
                              "actuator (repeatable; default: the scene's)")
     parser.add_argument('--input', type=named_value, action='append', metavar='NAME=VALUE',
                         help="a driver's position: a crank's angle in degrees (counted from "
-                             "the start), an actuator's length in the scene's length unit "
-                             "(repeatable, one per driver; default: the scene's)")
+                             "the start), an actuator's length in the scene's length unit; "
+                             'rad and m with --units si (repeatable, one per driver; default: '
+                             "the scene's)")
     parser.add_argument('--speed', type=named_value, action='append', metavar='NAME=VALUE',
                         help="a driver's speed: rpm for a crank (as --speed-rpm), m/s for an "
-                             "actuator's extension rate (repeatable; default: the scene's)")
+                             "actuator's extension rate; rad/s and m/s with --units si "
+                             "(repeatable; default: the scene's)")
 
 
 def drive_from_args(scene: Any, args: argparse.Namespace) -> tuple[Any, Any, Any, Any, str]:
@@ -384,15 +426,17 @@ def drive_from_args(scene: Any, args: argparse.Namespace) -> tuple[Any, Any, Any
         if crank.name in speeds and args.speed_rpm is not None:
             msg = f'Expected --speed-rpm or --speed {crank.name}=RPM, got both'
             raise ValueError(msg)
-        degrees = inputs.get(crank.name, args.angle_deg)
-        rpm = speeds.get(crank.name, args.speed_rpm)
-        if degrees is None:
+        if crank.name in inputs:
+            angle, turns = angle_given(inputs[crank.name], args)
+            shown = f'crank angle {inputs[crank.name]:.15g} {angle_unit(args)}'
+        elif args.angle_deg is not None:
+            angle, turns = turns_from_degrees(args.angle_deg)
+            shown = f'crank angle {args.angle_deg:.15g} deg'
+        else:
             angle, turns = crank.angle, crank.turns
             shown = f'crank angle {scene.units.angle_text(crank.shown)}'
-        else:
-            angle, turns = turns_from_degrees(degrees)
-            shown = f'crank angle {degrees:.15g} deg'
-        speed = None if rpm is None else rad_per_s_from_rpm(rpm)
+        speed = (angular_rate_given(speeds[crank.name], args) if crank.name in speeds
+                 else None if args.speed_rpm is None else rad_per_s_from_rpm(args.speed_rpm))
         return angle, speed, accels.get(crank.name), turns, shown
     for flag, used in (('--angle-deg', args.angle_deg), ('--speed-rpm', args.speed_rpm)):
         if used is not None:
@@ -412,14 +456,17 @@ def drive_from_args(scene: Any, args: argparse.Namespace) -> tuple[Any, Any, Any
             position = driver.start
             text = driver.position_text(driver.start, scene.units)
         elif revolute:
-            position, whole = turns_from_degrees(given)
-            text = f'{given:.15g} deg'
+            position, whole = angle_given(given, args)
+            text = f'{given:.15g} {angle_unit(args)}'
+        elif _si(args):
+            position = given
+            text = f'{given:.15g} m'
         else:
             position = given / per_metre
             text = f'{given:.15g} {scene.units.length}'
         speed = speeds.get(driver.name)
         if speed is not None and revolute:
-            speed = rad_per_s_from_rpm(speed)
+            speed = angular_rate_given(speed, args)
         positions.append(position)
         rates.append(speed)
         turns_list.append(whole)

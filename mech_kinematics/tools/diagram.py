@@ -27,7 +27,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .cli import (add_driver_arguments, add_robot_arguments, add_scene_argument,
-                  drive_from_args, finite_float, load_scene_argument,
+                  add_units_argument, drive_from_args, finite_float, load_scene_argument,
                   positive_int, run_tool, values_by_driver)
 from ..errors import AssemblyError, NearSingularWarning, SceneError
 from ..geometry.diagrams import (arrows_from_state, colours_from_scene, Diagram,
@@ -930,6 +930,7 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="signed crank speed in rpm, + CCW (default: the scene's)")
     add_driver_arguments(parser)
     add_robot_arguments(parser)
+    add_units_argument(parser)
     parser.add_argument('--instant-centres', action='store_true',
                         help='also compute the instant centres, mark them on the space '
                              'diagram and list them')

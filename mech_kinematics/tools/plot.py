@@ -41,7 +41,8 @@ import warnings
 import numpy as np
 import numpy.typing as npt
 
-from .cli import add_robot_arguments, load_scene_argument, named_value, values_by_driver
+from .cli import (add_robot_arguments, add_units_argument, angular_rate_given,
+                  load_scene_argument, named_value, values_by_driver)
 from .cli import finite_float, positive_float, PROG, run_tool
 from ..errors import MechKinematicsError, SceneError
 from ..ros import topics
@@ -1100,7 +1101,7 @@ def _handle(args: argparse.Namespace) -> int:
                 rates = values_by_driver(scene, '--speed', args.speed)
             except ValueError as error:
                 raise PlotError(str(error)) from None
-            given = {d.name: rad_per_s_from_rpm(rates[d.name]) if d.joint_type.angular
+            given = {d.name: angular_rate_given(rates[d.name], args) if d.joint_type.angular
                      else rates[d.name] for d in scene.drivers if d.name in rates}
             motion = motion_from_scene(scene, samples=args.samples, speed=speed,
                                        accel=args.accel, x=x, duration=args.duration,
@@ -1138,6 +1139,7 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                              'a scene): plot the solver over one crank cycle, or (with BAG) name '
                              'the joint types')
     add_robot_arguments(parser)
+    add_units_argument(parser)
     parser.add_argument('--x', choices=AXES,
                         help='horizontal axis (default: time for a bag, angle for a scene)')
     parser.add_argument('--namespace', metavar='NS',
@@ -1153,7 +1155,8 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="crank acceleration for --scene, rad/s^2 (default: the scene's)")
     parser.add_argument('--speed', type=named_value, action='append', metavar='NAME=VALUE',
                         help="--scene with several drivers: a driver's speed, as solve takes "
-                             "it (rpm for a crank, m/s for an actuator; default: the scene's)")
+                             'it (rpm for a crank, rad/s with --units si; m/s for an actuator; '
+                             "default: the scene's)")
     parser.add_argument('--duration', type=positive_float, metavar='SECONDS',
                         help='--scene with several drivers: the time plotted (default: the '
                              "quickest driver's turn or stroke)")

@@ -14,13 +14,14 @@ from typing import Any
 import warnings
 
 from .cli import (add_driver_arguments, add_gravity_argument, add_robot_arguments,
-                  add_scene_argument, drive_from_args, finite_float, gravity_of, is_urdf,
+                  add_scene_argument, add_units_argument, angle_given, angle_unit,
+                  angular_rate_given, drive_from_args, finite_float, gravity_of, is_urdf,
                   load_robot_argument, mimic_ruled, positive_float, run_tool, values_by_driver)
 from ..bounds import MAX_ERROR
 from ..errors import AssemblyError, NearSingularWarning, SceneError, UntrustedError
 from ..scene import load_scene
 from ..solver import assembly_text, solve
-from ..units import rad_per_s_from_rpm, turns_from_degrees
+from ..units import turns_from_degrees
 
 __all__ = ['add_parser', 'main', 'turns_from_degrees']
 
@@ -49,8 +50,9 @@ reading too), it prints a one-line error and exits with status 2.
 A robot described in URDF (SCENE a path ending in .urdf, with --closures,
 --actuated and --reference) is driven by its actuated joints, named as in
 the URDF: --input J=VALUE in degrees (revolute) or m (prismatic), --speed
-J=VALUE in rpm or m/s, --accel J=VALUE in rad/s^2 or m/s^2, each from the
-joint's zero and positive about its axis as written. Its JSON has "robot",
+J=VALUE in rpm or m/s (with --units si: rad and rad/s, for a scene's drivers
+too), --accel J=VALUE in rad/s^2 or m/s^2, each from the joint's zero and
+positive about its axis as written. Its JSON has "robot",
 "inputs" and "joints" keyed by URDF joint names (every joint of every loop,
 the actuated ones and the mimic joints that follow them), the loops'
 "points" in their plane, "mimic" (every joint whose value strays from its
@@ -98,15 +100,18 @@ def _robot_drive(robot: Any, args: argparse.Namespace) -> tuple[
         table[robot.actuated[0]] = value
     positions, rates, words, exact = {}, {}, [], {}
     ruled = mimic_ruled(robot.description)
+    si = args.units == 'si'
+    turn = math.tau if si else 360.0
     for name in robot.actuated:
         angular = robot.joint_type(name).angular
         if name in inputs:
-            positions[name] = math.radians(inputs[name]) if angular else inputs[name]
-            if angular and abs(inputs[name]) > 360.0 and name not in ruled:
-                exact[name] = turns_from_degrees(inputs[name])[0]
-            words.append(f'{name} = {inputs[name]:.15g} {"deg" if angular else "m"}')
+            given = inputs[name]
+            positions[name] = given if si or not angular else math.radians(given)
+            if angular and abs(given) > turn and name not in ruled:
+                exact[name] = angle_given(given, args)[0]
+            words.append(f'{name} = {given:.15g} {angle_unit(args) if angular else "m"}')
         if name in speeds:
-            rates[name] = rad_per_s_from_rpm(speeds[name]) if angular else speeds[name]
+            rates[name] = angular_rate_given(speeds[name], args) if angular else speeds[name]
     shown = ', '.join(words) or 'the reference pose'
     return positions, rates, accels, shown, exact
 
@@ -230,6 +235,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     parser.add_argument('--speed-rpm', type=finite_float, metavar='N',
                         help="signed crank speed in rpm, + CCW (default: the scene's)")
     add_driver_arguments(parser)
+    add_units_argument(parser)
     add_robot_arguments(parser)
     add_gravity_argument(parser)
     parser.add_argument('--max-error', type=positive_float, default=MAX_ERROR, metavar='REL',

@@ -18,7 +18,7 @@ from pathlib import Path
 import sys
 from typing import Any
 
-from .cli import add_robot_arguments, load_robot_argument, run_tool
+from .cli import add_robot_arguments, add_units_argument, load_robot_argument, run_tool
 
 __all__ = ['add_parser', 'main']
 
@@ -59,6 +59,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         description=URDF2SCENE_HELP, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument('scene', metavar='ROBOT.urdf', help='the robot description')
     add_robot_arguments(parser)
+    add_units_argument(parser)
     parser.add_argument('-o', '--output', metavar='FILE',
                         help='write to FILE (default: standard output)')
     parser.set_defaults(handler=_handle)

@@ -4,6 +4,7 @@
 
 import argparse
 import math
+from pathlib import Path
 import subprocess
 import sys
 
@@ -170,3 +171,83 @@ def test_an_unexpected_error_is_one_nonempty_line(capsys, monkeypatch, error, li
     monkeypatch.delenv('MECH_KINEMATICS_TRACEBACK', raising=False)
     assert run_handler(_handler_raising(error)) == 1
     assert capsys.readouterr().err == line
+
+
+# --- --units si: the values of --input, --speed and --reference in rad, rad/s and m --------
+
+def _json(capsys, *args: str) -> dict:
+    import json
+
+    result = in_process(capsys, *args)
+    assert result.returncode == 0, result.stderr
+    return json.loads(result.stdout)
+
+
+@pytest.mark.parametrize('scene, driver', [('khurmi_four_bar_ad150', 'crank'),
+                                           ('five_bar', 'left_crank')])
+def test_units_si_takes_a_scenes_angles_in_rad_and_speeds_in_rad_per_s(capsys, scene, driver):
+    """``--units si --input C=RAD --speed C=RAD/S`` is ``--input C=DEG --speed C=RPM``, to the bit.
+
+    The radians are the double the degrees become (``radians_from_degrees``);
+    ``--angle-deg`` stays degrees with ``--units si``; a reduction beyond a turn is
+    exact both ways (450 deg and 5 pi / 2 rad: the same quarter turn into turn 1).
+    """
+    from mech_kinematics.units import rad_per_s_from_rpm, radians_from_degrees
+
+    rad, rad_per_s = repr(radians_from_degrees(30.0)), repr(rad_per_s_from_rpm(60.0))
+    degrees = _json(capsys, 'solve', scene, '--input', f'{driver}=30', '--speed', f'{driver}=60')
+    si = _json(capsys, 'solve', scene, '--units', 'si', '--input', f'{driver}={rad}',
+               '--speed', f'{driver}={rad_per_s}')
+    assert si == degrees
+    if scene == 'khurmi_four_bar_ad150':
+        assert _json(capsys, 'solve', scene, '--units', 'si', '--angle-deg', '30',
+                     '--speed', f'crank={rad_per_s}') == degrees
+        quarter = _json(capsys, 'solve', scene, '--units', 'si', '--input',
+                        f'crank={5 * math.pi / 2!r}')
+        assert quarter['input']['angle'] == pytest.approx(5 * math.pi / 2, abs=1e-15)
+        assert math.isclose(quarter['joints']['rocker']['position'],
+                            _json(capsys, 'solve', scene, '--input',
+                                  'crank=450')['joints']['rocker']['position'], abs_tol=1e-14)
+
+
+def test_units_si_takes_an_actuators_length_in_m_whatever_the_scenes_unit():
+    """In a scene written in mm, ``--units si --input A=1.5`` is ``--input A=1500``: 1.5 m."""
+    from types import SimpleNamespace
+
+    import mech_kinematics as mk
+    from mech_kinematics.tools.cli import drive_from_args
+
+    boom = mk.load_scene('boom')
+    in_mm = SimpleNamespace(drivers=boom.drivers, input=None,
+                            units=SimpleNamespace(length='mm'))
+    args = dict(angle_deg=None, speed_rpm=None, accel=None, speed=[('lift_cyl', 0.25)])
+    mm = drive_from_args(in_mm, argparse.Namespace(**args, input=[('lift_cyl', 1500.0)]))
+    si = drive_from_args(in_mm, argparse.Namespace(**args, input=[('lift_cyl', 1.5)], units='si'))
+    assert mm[:4] == si[:4] == (1.5, 0.25, None, 0)
+    assert (mm[4], si[4]) == ('lift_cyl = 1500 mm', 'lift_cyl = 1.5 m')
+
+
+def test_units_si_takes_a_robots_joints_and_reference_in_rad(capsys):
+    """A URDF's ``--input``, ``--speed`` and ``--reference`` in rad and rad/s: the same answer.
+
+    ``solve`` on the lift arm (its efforts included), and ``urdf2scene``'s
+    scene from a reference pose, which only ``--reference`` feeds; a bad
+    ``--units`` is argparse's one line.
+    """
+    from mech_kinematics.units import rad_per_s_from_rpm
+
+    urdf = str(Path(__file__).resolve().parents[1] / 'data' / 'urdf' / 'lift_arm.urdf')
+    rad, rad_per_s = repr(math.radians(30.0)), repr(rad_per_s_from_rpm(60.0))
+    degrees = _json(capsys, 'solve', urdf, '--input', 'lift_joint=30', '--speed', 'lift_joint=60')
+    si = _json(capsys, 'solve', urdf, '--units', 'si', '--input', f'lift_joint={rad}',
+               '--speed', f'lift_joint={rad_per_s}')
+    assert si == degrees and si['efforts']
+    pose = {name: joint['position'] for name, joint in degrees['joints'].items()}
+    by_degrees = in_process(capsys, 'urdf2scene', urdf, *(
+        f'--reference={name}={math.degrees(value)!r}' for name, value in pose.items()))
+    by_rad = in_process(capsys, 'urdf2scene', urdf, '--units', 'si', *(
+        f'--reference={name}={value!r}' for name, value in pose.items()))
+    assert by_degrees.returncode == by_rad.returncode == 0, (by_degrees.stderr, by_rad.stderr)
+    assert by_degrees.stdout == by_rad.stdout and 'angle' in by_rad.stdout
+    refused = in_process(capsys, 'solve', urdf, '--units', 'grad')
+    assert refused.returncode == 2 and "invalid choice: 'grad'" in refused.stderr
