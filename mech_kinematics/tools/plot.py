@@ -135,8 +135,9 @@ class ForceSeries:
         The force each joint carries, N: a pin's ``|F|``, a prismatic joint's
         ``|normal|`` (labelled ``NAME (normal)``); a joint named otherwise
         than its point is labelled ``NAME at POINT``.
-    shaking : ndarray, shape (n,)
-        The magnitude of the shaking force on the frame, N.
+    shaking : ndarray, shape (n,), or None
+        The magnitude of the shaking force on the frame, N (None: a recording
+        without it).
     means : dict of str to float
         The crank's mean effort over its turn (the turning-moment diagram's
         mean line), where the motion is one turn of one crank.
@@ -147,7 +148,7 @@ class ForceSeries:
     efforts: Mapping[str, Array]
     angular: Mapping[str, bool]
     reactions: Mapping[str, Array]
-    shaking: Array
+    shaking: Array | None
     means: Mapping[str, float] = field(default_factory=dict)
     note: str = ''
 
@@ -507,6 +508,99 @@ def _imu_arrays(reader: Any, connections: Mapping[str, Any],
     return out
 
 
+def _wrench_connections(connections: Sequence[Any], namespace: str | None
+                        ) -> tuple[dict[str, Any], Any | None]:
+    """Return the node's ``reactions/JOINT`` topics by joint, and its ``shaking`` topic."""
+    reactions: dict[str, Any] = {}
+    shaking = None
+    for c in connections:
+        if c.msgtype != topics.WRENCH_TYPE:
+            continue
+        head, _, name = c.topic.rpartition('/')
+        base, _, space = head.rpartition('/')
+        if name == topics.SHAKING and (namespace is None or head == namespace.rstrip('/')):
+            if shaking is not None:
+                msg = (f'Expected one {topics.SHAKING} topic, got {shaking.topic}, {c.topic}: '
+                       f'pass --namespace')
+                raise PlotError(msg)
+            shaking = c
+        elif space == topics.REACTIONS and (namespace is None or base == namespace.rstrip('/')):
+            if name in reactions:
+                msg = (f'Expected one {topics.reaction_topic(name)} topic, got '
+                       f'{reactions[name].topic}, {c.topic}: pass --namespace')
+                raise PlotError(msg)
+            reactions[name] = c
+    return reactions, shaking
+
+
+def _wrench_magnitudes(reader: Any, connection: Any, ticks: Sequence[int]) -> Array:
+    """Return the length of each message's force at ``ticks`` (header stamps), N; NaN if none."""
+    at = {stamp: i for i, stamp in enumerate(ticks)}
+    out = np.full(len(ticks), np.nan)
+    decode = _decoder(reader.typestore, connection.msgtype)
+    for _, _, raw in reader.messages(connections=[connection]):
+        i = at.get(stamp_from_cdr(raw))
+        if i is not None:
+            f = decode(raw).wrench.force
+            out[i] = math.sqrt(f.x * f.x + f.y * f.y + f.z * f.z)
+    return out
+
+
+def _bag_efforts(reader: Any, connection: Any | None, ticks: Sequence[int]
+                 ) -> dict[str, Array]:
+    """Return every joint's ``joint_states`` effort at ``ticks``; NaN where a message has none.
+
+    Only the joints with an effort somewhere: a message without efforts (a
+    scene without forces, an instant whose forces are left out) has an empty
+    ``effort``.
+    """
+    if connection is None:
+        return {}
+    at = {stamp: i for i, stamp in enumerate(ticks)}
+    decode = _decoder(reader.typestore, connection.msgtype)
+    columns: dict[str, Array] = {}
+    for _, _, raw in reader.messages(connections=[connection]):
+        i = at.get(stamp_from_cdr(raw))
+        if i is None:
+            continue
+        m = decode(raw)
+        if len(m.effort) != len(m.name):
+            continue
+        for name, value in zip(m.name, m.effort, strict=True):
+            columns.setdefault(name, np.full(len(ticks), np.nan))[i] = value
+    return columns
+
+
+def _bag_forces(reader: Any, joint_states: Any | None, namespace: str | None,
+                ticks: Sequence[int], scene: Any, path: Path) -> ForceSeries | None:
+    """Return the recorded forces at ``ticks`` (efforts, reactions, shaking), or None if none.
+
+    The efforts are those of the scene's drivers and of every joint whose
+    effort is not 0 (a passive joint's is 0; a URDF's actuated joints carry
+    the URDF's names), torques unless the scene says the joint is prismatic;
+    a reaction is the length of its force (a prismatic joint's normal
+    force). A part the bag does not
+    hold is said in a warning and its panel says "not in the recording".
+    """
+    reactions, shaking = _wrench_connections(reader.connections, namespace)
+    drivers = {d.name for d in scene.drivers} if scene is not None else set()
+    efforts = {n: v for n, v in _bag_efforts(reader, joint_states, ticks).items()
+               if n in drivers or np.nanmax(np.abs(v), initial=0.0) > 0.0}
+    types = scene.joint_types if scene is not None else {}
+    angular = {n: types[n].angular if n in types else True for n in efforts}
+    if not efforts and not reactions and shaking is None:
+        return None
+    missing = [what for what, absent in (('efforts', not efforts),
+                                         (f'{topics.REACTIONS}/*', not reactions),
+                                         (topics.SHAKING, shaking is None)) if absent]
+    if missing:
+        warnings.warn(f'{path}: no {", ".join(missing)} in the recording: their panels say '
+                      f'so', stacklevel=3)
+    return ForceSeries(efforts, angular,
+                       {n: _wrench_magnitudes(reader, c, ticks) for n, c in reactions.items()},
+                       None if shaking is None else _wrench_magnitudes(reader, shaking, ticks))
+
+
 def _stored_scene(reader: Any, connection: Any, path: Path) -> Any:
     """Return the scene of the bag's ``scene`` topic (its last message), or None if unreadable."""
     import mech_kinematics as mk
@@ -635,6 +729,8 @@ def motion_from_bag(path: str | os.PathLike[str], *, scene: Any = None,
             stored = picked[_SCENE]
             if stored is not None and scene is None:
                 scene = _stored_scene(reader, stored, path)
+            forces = _bag_forces(reader, picked[_JOINT_STATE], namespace, sorted(chosen), scene,
+                                 path)
             diagnostics = picked[_DIAGNOSTICS]
             if diagnostics is not None and scene is None:
                 decode = _decoder(reader.typestore, _DIAGNOSTICS)
@@ -686,7 +782,7 @@ def motion_from_bag(path: str | os.PathLike[str], *, scene: Any = None,
     time = (stamps_ns - stamps_ns[0]) / NS_PER_S if len(ticks) else np.zeros(0)
     label = scene.name if scene is not None else (scene_name or 'unknown scene')
     title = f'{label}: recording {path.name}, {time[-1] if len(time) else 0:.3g} s'
-    return Motion(title, crank_angle, time, types, joints, points, imus=imus)
+    return Motion(title, crank_angle, time, types, joints, points, imus=imus, forces=forces)
 
 
 def _rows(rows: Sequence[Sequence[float]], width: int) -> Array | None:
@@ -891,7 +987,8 @@ def figure_from_motion(motion: Motion, *, x: str = 'time') -> Any:
             ax.set_title(TITLES[kind])
             ax.set_ylabel(YLABELS[kind])
             if kind == 'effort' and motion.forces is not None:
-                ax.set_ylabel(EFFORT_LABELS[tuple(sorted(set(motion.forces.angular.values())))])
+                ax.set_ylabel(EFFORT_LABELS.get(tuple(sorted(set(motion.forces.angular.values()))),
+                                                YLABELS['effort']))
             ax.grid(True, alpha=0.3)
             if kind == 'point_path':
                 _draw_paths(ax, motion, gaps)
@@ -938,9 +1035,11 @@ def _force_series(forces: ForceSeries | None, kind: str) -> list[tuple[str, Arra
     if forces is None:
         return []
     if kind == 'effort':
-        return [(name, values, False) for name, values in forces.efforts.items()]
+        return [(name, values, False) for name, values in forces.efforts.items()] or [
+            ('efforts', None, False)]       # a recording without them: "not in the recording"
     if kind == 'reaction':
-        return [(name, values, False) for name, values in forces.reactions.items()]
+        return [(name, values, False) for name, values in forces.reactions.items()] or [
+            ('reactions', None, False)]
     return [('shaking', forces.shaking, False)]
 
 

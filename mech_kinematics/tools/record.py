@@ -74,15 +74,19 @@ __all__ = [
 ]
 
 #: Everything the node publishes, so that a bag replays whole (issue 20): its state,
-#: frames, diagnostics, markers (when on), URDF and scene. Relative names take the
+#: frames, diagnostics, markers (when on), URDF, scene and shaking force (a scene with
+#: masses; its reactions come with DEFAULT_NAMESPACES). Relative names take the
 #: recorder's namespace; /tf and /tf_static are absolute, as every TF broadcaster's.
 DEFAULT_TOPICS = (*topics.STATE_TOPICS, topics.DIAGNOSTICS, topics.TF, topics.TF_STATIC,
-                  topics.MARKERS, topics.ROBOT_DESCRIPTION, topics.SCENE)
+                  topics.MARKERS, topics.ROBOT_DESCRIPTION, topics.SCENE, topics.SHAKING)
 #: Namespaces whose every topic is recorded with the default topics, as each appears: the
-#: scene's IMUs (``imu/NAME``, one per sensor, named by the scene).
-DEFAULT_NAMESPACES = (topics.IMU,)
-#: Default topics the node publishes only with a parameter on: their absence is no fault.
-OPTIONAL_TOPICS = {topics.MARKERS: 'the node publishes it with markers:=true'}
+#: scene's IMUs (``imu/NAME``, one per sensor, named by the scene) and the joints'
+#: reactions (``reactions/JOINT``, named by the scene or the URDF, with forces).
+DEFAULT_NAMESPACES = (topics.IMU, topics.REACTIONS)
+#: Default topics the node publishes only with a parameter or a scene that asks for them:
+#: their absence is no fault, and the summary says why they may be absent.
+OPTIONAL_TOPICS = {topics.MARKERS: 'the node publishes it with markers:=true',
+                   topics.SHAKING: 'the node publishes it for a scene whose links have masses'}
 #: The bag writer's storages and versions (it checks them).
 STORAGES = tuple(bag.STORAGES)
 #: As ``ros2 bag record`` since Iron.
@@ -847,8 +851,9 @@ def _handle(args: argparse.Namespace) -> int:
 RECORD_HELP = """\
 Record the node's topics (by default everything it publishes: the state,
 /tf, /tf_static, diagnostics, markers when on, robot_description, the
-scene's text on `scene` and every imu/NAME of the scene's IMUs, so the bag
-replays whole) to a new rosbag2 directory,
+scene's text on `scene`, every imu/NAME of the scene's IMUs and, with forces,
+every reactions/JOINT and shaking, so the bag replays whole) to a new
+rosbag2 directory,
 readable by `ros2 bag info`, `ros2 bag play` and Foxglove: metadata.yaml plus
 one .mcap or .db3 file. Messages are stored as received (serialized CDR),
 stamped with the receive time. Topics not published yet are waited for and

@@ -33,6 +33,7 @@ states as the witness.
 import contextlib
 from dataclasses import dataclass
 import functools
+import math
 import os
 from pathlib import Path
 import random
@@ -608,7 +609,7 @@ def test_recorder_says_what_it_waits_for_then_reports_progress(recordings):
     waiting = [t for t in texts[:first_subscribed] if t.startswith('waiting for publishers on')]
     assert waiting, recording.output
     requested = [t if t.startswith('/') else f'/{t}' for t in bag_recorder.DEFAULT_TOPICS]
-    assert requested == [*TOPICS, '/markers'] or set(requested) == {*TOPICS, '/markers'}
+    assert set(requested) == {*TOPICS, '/markers', '/shaking'}
     assert waiting[0].startswith(f'waiting for publishers on {", ".join(requested)} ')
     progress = []
     for time_s, text in lines:
@@ -961,9 +962,12 @@ def test_recorder_without_publishers_names_them_every_five_seconds(crashes):
     assert len(waiting) >= 2
     assert all(b - a >= bag_recorder.WAIT_REPORT_INTERVAL_S - 0.1
                for a, b in zip(waiting, waiting[1:], strict=False))
-    # markers says why it may be absent (the node's markers parameter is off by default).
-    assert output.count('(never appeared)') == len(bag_recorder.DEFAULT_TOPICS) - 1
+    # markers and shaking say why they may be absent (the node's markers parameter is off
+    # by default; shaking comes with masses).
+    assert output.count('(never appeared)') == len(bag_recorder.DEFAULT_TOPICS) - 2
     assert output.count('(never appeared: the node publishes it with markers:=true)') == 1
+    assert output.count('(never appeared: the node publishes it for a scene whose links '
+                        'have masses)') == 1
     info = yaml.safe_load((crashes.path('idle') / 'metadata.yaml').read_text())[
         'rosbag2_bagfile_information']
     assert info['message_count'] == 0 and info['topics_with_message_count'] == []
@@ -983,6 +987,66 @@ dyads:
 imus:
   tip: {link: coupler, point: C, gravity: [0, -9.80665]}
 """
+
+
+def test_default_recording_holds_the_forces(tmp_path):
+    """With masses, the default topics bring every ``reactions/JOINT`` and ``shaking`` (issue 44).
+
+    The node runs the packaged engine (its links carry masses: efforts on
+    ``joint_states``, a reaction per joint and the shaking force); the default
+    recording holds each of them, a WrenchStamped per ``joint_states`` stamp
+    (but the ends, subscribed a little apart).
+    """
+    from mech_kinematics.ros.topics import reaction_topic, SHAKING
+    from mech_kinematics.ros.wrenches import reaction_joints
+
+    ns = '/forces_bag'
+    recorder = Process('default', tmp_path, '-m', 'mech_kinematics.tools.record', '-o',
+                       str(tmp_path / 'default'), '--duration', '2', '--ros-args', '-r',
+                       f'__ns:={ns}')
+    try:
+        recorder.wait_for_output('recording to', STARTUP_S)
+        node = Process('node', tmp_path, '-m', 'mech_kinematics.kinematics_node', '--ros-args',
+                       '-r', f'__ns:={ns}', '-p', 'scene:=engine', '-p', 'rate_hz:=200')
+        try:
+            status = recorder.stop(timeout=STARTUP_S + 2)
+        finally:
+            assert node.stop(signal.SIGINT) == 0, node.output()
+    finally:
+        _kill_left_over([recorder])
+    assert status == 0, recorder.output()
+    bag = decoded(tmp_path / 'default')
+    states = {stamp_ns(m) for _, m in bag[f'{ns}/joint_states']}
+    assert len(states) >= 100 and all(len(m.effort) for _, m in bag[f'{ns}/joint_states'])
+    wrenches = [f'{ns}/{reaction_topic(j.name)}'
+                for j in reaction_joints(mk.load_scene('engine').dynamics)] + [f'{ns}/{SHAKING}']
+    summary = Recording('default', tmp_path / 'default', 0, recorder.output(), 8).summary()
+    for topic in wrenches:
+        assert summary[topic][0] == 'geometry_msgs/msg/WrenchStamped', recorder.output()
+        stamps = [stamp_ns(m) for _, m in bag[topic]]
+        assert len(set(stamps)) == len(stamps)
+        assert len(set(stamps) & states) >= min(len(stamps), len(states)) - 100, topic
+    # plot draws them from the bag: the crank's effort, each reaction's |F|, the shaking.
+    motion = plot.motion_from_bag(tmp_path / 'default', namespace=ns, max_samples=None)
+    forces = motion.forces
+    assert forces is not None and set(forces.efforts) == {'crank'}
+    assert forces.angular == {'crank': True}
+    ticks = set.intersection(*({stamp_ns(m) for _, m in bag[f'{ns}/{t}']}
+                               for t in ('joint_accelerations', 'point_accelerations')))
+    at = {stamp: i for i, stamp in enumerate(sorted(ticks))}
+    assert len(motion.time) == len(at) >= 100
+    for _, m in bag[f'{ns}/joint_states']:
+        if stamp_ns(m) in at:
+            assert forces.efforts['crank'][at[stamp_ns(m)]] == m.effort[m.name.index('crank')]
+    for topic in wrenches:
+        name = topic.rsplit('/', 1)[-1]
+        drawn = forces.shaking if name == SHAKING else forces.reactions[name]
+        for _, m in bag[topic]:
+            if stamp_ns(m) in at:
+                f = m.wrench.force
+                assert drawn[at[stamp_ns(m)]] == math.sqrt(f.x * f.x + f.y * f.y + f.z * f.z)
+    titles = {ax.get_title() for ax in plot.figure_from_motion(motion).axes}
+    assert {plot.TITLES['effort'], plot.TITLES['reaction'], plot.TITLES['shaking']} <= titles
 
 
 def test_default_recording_holds_the_scenes_imu_topics(tmp_path):
