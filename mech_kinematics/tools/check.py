@@ -588,7 +588,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter)
     add_scene_argument(parser)
     add_robot_arguments(parser)
-    add_units_argument(parser)
+    add_units_argument(parser, ('--reference',))
     parser.add_argument('--json', action='store_true',
                         help='print one JSON object, in SI units (rad, m)')
     parser.add_argument('--grid', type=grid_size, default=GRID, metavar='N',

@@ -109,15 +109,18 @@ def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
                             "repeatable; default: the URDF's zero pose)")
 
 
-def add_units_argument(parser: argparse.ArgumentParser) -> None:
-    """Add ``--units deg|si``: the units of ``--input``, ``--speed`` and ``--reference`` values."""
+def add_units_argument(parser: argparse.ArgumentParser,
+                       flags: tuple[str, ...] = ('--input', '--speed', '--reference')) -> None:
+    """Add ``--units deg|si``: the units of the values of ``flags`` (the command's own)."""
+    named = ', '.join(flags[:-1]) + f' and {flags[-1]}' if len(flags) > 1 else flags[0]
+    rates = ' and rpm' if '--speed' in flags else ''
     parser.add_argument('--units', choices=UNIT_SYSTEMS, default=None,
-                        help='the units of the values of --input, --speed and --reference: deg '
-                             '(the default: degrees and rpm for a crank or a revolute joint, '
-                             "the scene's length unit for an actuator, m and m/s for a "
-                             'prismatic joint) or si (rad and rad/s; m and m/s). --angle-deg '
-                             'and --speed-rpm are degrees and rpm, and --accel rad/s^2 or '
-                             'm/s^2, either way; the answer is SI either way')
+                        help=f'the units of the values of {named}: deg (the default: degrees'
+                             f'{rates} for a crank or a revolute joint, m for a prismatic '
+                             "joint, the scene's length unit for an actuator) or si (rad"
+                             f'{" and rad/s" if rates else ""}; m)'
+                             + ('; --angle-deg and --speed-rpm stay degrees and rpm'
+                                if '--input' in flags else '') + '; the answer is SI either way')
 
 
 def _si(args: argparse.Namespace) -> bool:

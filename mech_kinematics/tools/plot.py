@@ -1238,7 +1238,7 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                              'a scene): plot the solver over one crank cycle, or (with BAG) name '
                              'the joint types')
     add_robot_arguments(parser)
-    add_units_argument(parser)
+    add_units_argument(parser, ('--speed', '--reference'))
     parser.add_argument('--x', choices=AXES,
                         help='horizontal axis (default: time for a bag, angle for a scene)')
     parser.add_argument('--namespace', metavar='NS',

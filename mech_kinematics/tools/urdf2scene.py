@@ -59,7 +59,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         description=URDF2SCENE_HELP, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument('scene', metavar='ROBOT.urdf', help='the robot description')
     add_robot_arguments(parser)
-    add_units_argument(parser)
+    add_units_argument(parser, ('--reference',))
     parser.add_argument('-o', '--output', metavar='FILE',
                         help='write to FILE (default: standard output)')
     parser.set_defaults(handler=_handle)
