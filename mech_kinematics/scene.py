@@ -37,6 +37,7 @@ from .solver import Branch, CarriedPoint, Crank, Link, Pin, Scene, SceneUnits
 from .solver.base import Driver, Item
 from .solver.crank import CrankDict
 from .solver.forces import Load, Mass
+from .solver.mechanism import FollowedJoint
 from .solver.model import IDENTIFIER
 from .solver.registry import DRIVERS, KINDS
 from .units import (ANGLE_UNITS, LENGTH_UNITS, reduce_radians,
@@ -103,6 +104,7 @@ class SceneDict(TypedDict, total=False):
     gravity: list[float]
     masses: dict[str, dict[str, Any]]
     loads: list[dict[str, Any]]
+    urdf_drivers: dict[str, dict[str, Any]]
 
 
 class ImuDict(TypedDict, total=False):
@@ -337,6 +339,7 @@ def parse_scene(data: Any) -> Scene:
                                      f'{list(given)}')
     masses = _masses(reader, keys, data.get('masses'))
     loads = _loads(reader, keys, data.get('loads'))
+    followed = _urdf_drivers(reader, keys, data.get('urdf_drivers'))
 
     outputs = data.get('outputs', {}) or {}
     if not isinstance(outputs, dict):
@@ -355,7 +358,7 @@ def parse_scene(data: Any) -> Scene:
                      points=tuple(points), outputs_joints=selected['joints'],
                      outputs_points=selected['points'], description=description,
                      pins=tuple(pins), units=reader.units, imus=imus, inputs=drivers,
-                     gravity=gravity, masses=masses, loads=loads)
+                     gravity=gravity, masses=masses, loads=loads, urdf_drivers=followed)
     except SceneError as error:
         raise SceneError(f'{keys.key(error)}: {error}') from None
 
@@ -557,6 +560,35 @@ def _masses(reader: _Reader, keys: _Keys, raw: Any) -> tuple[Mass, ...]:
                                  mass=reader.number(value, 'mass', where), com=com,
                                  inertia=reader.number(value, 'inertia', where, 0.0)))
     return tuple(masses)
+
+
+def _urdf_drivers(reader: _Reader, keys: _Keys, raw: Any) -> tuple[FollowedJoint, ...]:
+    """Read ``urdf_drivers:``: driver -> {joint, joint_reference, reference, factor} (SI)."""
+    if raw is None:
+        return ()
+    if not isinstance(raw, dict):
+        raise SceneError(f'urdf_drivers: expected a mapping of drivers to {{joint, '
+                         f'joint_reference, reference, factor}}, got {_kind(raw)}')
+    _check_count('urdf_drivers', raw, MAX_DRIVERS, 'MAX_DRIVERS', 'drivers')
+    out = []
+    fields = ('joint', 'joint_reference', 'reference', 'factor')
+    for key, value in raw.items():
+        where = f'urdf_drivers.{key}'
+        if not isinstance(value, dict):
+            raise SceneError(f'{where}: expected a mapping such as {{joint: lift_joint, '
+                             f'joint_reference: 0.0, reference: 0.0, factor: -1}}, got '
+                             f'{_kind(value)} {_brief(value)}')
+        _check_keys(value, set(fields), where)
+        joint = reader.get(value, 'joint', where)
+        if not isinstance(joint, str):
+            raise SceneError(f'{where}.joint: expected a joint name, got {_kind(joint)} '
+                             f'{_brief(joint)}')
+        out.append(keys.build(where, {'driver': ''}, FollowedJoint, driver=str(key),
+                              joint=joint,
+                              joint_reference=reader.number(value, 'joint_reference', where),
+                              reference=reader.number(value, 'reference', where),
+                              factor=reader.number(value, 'factor', where)))
+    return tuple(out)
 
 
 def _loads(reader: _Reader, keys: _Keys, raw: Any) -> tuple[Load, ...]:

@@ -214,6 +214,22 @@ BAD_SCENES = [
      'dyads[0].links[1].name', r'identifier'),
     ('ground_name_not_an_identifier', edit(setitem(['ground', '2D'], [1, 1])), 'ground.2D',
      r'identifier'),
+    # urdf_drivers: a robot's loops, the URDF joint each driver follows (the view reads it).
+    ('urdf_drivers_not_a_driver', edit(setitem(['urdf_drivers'], {'wheel': {
+        'joint': 'j', 'joint_reference': 0.0, 'reference': 0.0, 'factor': 1.0}})),
+     'urdf_drivers.wheel', r'Expected a driver of the scene \(crank\)'),
+    ('urdf_drivers_unknown_key', edit(setitem(['urdf_drivers'], {'crank': {
+        'joint': 'j', 'joint_reference': 0.0, 'reference': 0.0, 'factor': 1.0, 'sign': 1}})),
+     'urdf_drivers.crank', r"unknown key\(s\) \['sign'\]"),
+    ('urdf_drivers_factor_zero', edit(setitem(['urdf_drivers'], {'crank': {
+        'joint': 'j', 'joint_reference': 0.0, 'reference': 0.0, 'factor': 0}})),
+     'urdf_drivers.crank.factor', r'a factor other than 0'),
+    ('urdf_drivers_not_finite', edit(setitem(['urdf_drivers'], {'crank': {
+        'joint': 'j', 'joint_reference': float('inf'), 'reference': 0.0, 'factor': 1.0}})),
+     'urdf_drivers.crank.joint_reference', r'finite'),
+    ('urdf_drivers_joint_not_a_name', edit(setitem(['urdf_drivers'], {'crank': {
+        'joint': 3, 'joint_reference': 0.0, 'reference': 0.0, 'factor': 1.0}})),
+     'urdf_drivers.crank.joint', r'expected a joint name'),
 ]
 
 

@@ -68,6 +68,10 @@ def scene_yaml(planar: Planar, source: str) -> str:
             lines.append(f"#   {mechanism['ground']}: x {_vector(mechanism['x'])}, "
                          f"y {_vector(mechanism['y'])}")
         data['masses'] = planar.masses
+    if planar.drivers:  # what the view needs to draw the robot from its joint_states
+        data['urdf_drivers'] = {d.scene: {'joint': d.name, 'joint_reference': float(d.reference),
+                                          'reference': float(d.scene_ref),
+                                          'factor': float(d.sigma)} for d in planar.drivers}
     body = yaml.safe_dump(data, sort_keys=False, default_flow_style=None, width=99)
     return '\n'.join(lines) + '\n' + body
 

@@ -175,6 +175,41 @@ def assembly_text(error: AssemblyError, units: SceneUnits | None = None) -> str:
 
 
 @dataclass(frozen=True)
+class FollowedJoint:
+    """The robot joint a scene driver follows.
+
+    ``driver = reference + factor * (joint - joint_reference)``, in rad or m
+    (SI whatever the scene's units). What ``urdf2scene`` (and the node in URDF
+    mode, on its ``scene`` topic) writes under ``urdf_drivers`` for each driver
+    of a robot's loops, so that a tool reading the robot's ``joint_states``
+    (the browser view) knows each driver's value from the joint's, under its
+    URDF name; ``factor`` (+1 or -1: the joint's sense against the scene's)
+    scales its rate too. The solver never reads it.
+    """
+
+    driver: str
+    joint: str
+    joint_reference: float
+    reference: float
+    factor: float
+
+    def __post_init__(self) -> None:
+        """Validate the fields."""
+        _check_name(self.joint, 'the joint a driver follows', (self, 'joint'))
+        for key in ('joint_reference', 'reference', 'factor'):
+            value = getattr(self, key)
+            if not (isinstance(value, (int, float)) and math.isfinite(value)):
+                msg = f'Expected a finite number, got {value!r}'
+                raise SceneError(msg, (self, key))
+        if self.factor == 0:
+            raise SceneError('Expected a factor other than 0, got 0', (self, 'factor'))
+
+    def driver_value(self, joint_value: float) -> float:
+        """Return the driver's position at the joint's value (rad or m)."""
+        return self.reference + self.factor * (joint_value - self.joint_reference)
+
+
+@dataclass(frozen=True)
 class Scene:
     """A planar mechanism: ground points, the driving crank, dyads, carried points.
 
@@ -211,6 +246,9 @@ class Scene:
         The drivers of a scene with several (or with an actuator), in order;
         a scene has ``input`` or ``inputs``, not both. Each is named by its
         crank link or its actuator, a name used once in the scene.
+    urdf_drivers : tuple of FollowedJoint
+        For a robot's loops: the URDF joint each driver follows (none or one
+        per driver); the solver never reads it.
     """
 
     name: str
@@ -228,6 +266,7 @@ class Scene:
     gravity: tuple[float, float] | None = None
     masses: tuple[Mass, ...] = ()
     loads: tuple[Load, ...] = ()
+    urdf_drivers: tuple[FollowedJoint, ...] = ()
     _plan: _Plan = field(init=False, repr=False, compare=False)
     _solver: _Solver = field(init=False, repr=False, compare=False)
     #: The scene's inverse dynamics (:mod:`.forces`), ``None`` without masses, gravity, loads.
@@ -281,6 +320,17 @@ class Scene:
                    f'{assembly_text(error, self.units)}')
             raise SceneError(msg, where if dyad is None else (dyad, '')) from None
         object.__setattr__(self, 'imus', tuple(self.imus))
+        followed = tuple(self.urdf_drivers)
+        object.__setattr__(self, 'urdf_drivers', followed)
+        names = [d.name for d in self.drivers]
+        for index, entry in enumerate(followed):
+            if entry.driver not in names:
+                msg = (f'Expected a driver of the scene ({", ".join(names)}), got '
+                       f'{entry.driver!r}')
+                raise SceneError(msg, (entry, 'driver'))
+            if any(other.driver == entry.driver for other in followed[:index]):
+                msg = f'Expected one joint per driver, got {entry.driver!r} twice'
+                raise SceneError(msg, (entry, 'driver'))
         object.__setattr__(self, '_plan', full)  # the graph, for the IMUs' links
         joints, points = imu_outputs(self, full.joint_types, self.outputs_joints,
                                      self.outputs_points)

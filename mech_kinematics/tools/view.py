@@ -87,6 +87,11 @@ FREE_STROKE = (0.5, 1.5)
 #: that published nothing is a gap, not a chord.
 GAP_FACTOR = 1.5
 CADENCE_WINDOW = 9
+#: Said among the statuses for a robot's loops (URDF mode): its reactions/JOINT are in the
+#: URDF links' frames, not the drawing's plane, so they are not drawn as arrows.
+VIEW_STATUS = 'mech_kinematics view'
+ROBOT_REACTIONS = ("reactions not drawn: a URDF robot's are in its links' frames "
+                   '(reactions/JOINT, frame_id the child link)')
 #: Seconds to wait for the node's SetParameters answer.
 SERVICE_TIMEOUT_S = 3.0
 #: The header that carries the page's token on ``/state`` and ``/speed``.
@@ -432,8 +437,8 @@ class ViewServer:
         for subscription in old:
             if subscription is not None:
                 self.node.destroy_subscription(subscription)
-        if scene.dynamics is None:
-            return
+        if scene.dynamics is None or scene.urdf_drivers:
+            return      # a robot's reactions are in its links' frames: ROBOT_REACTIONS
         for joint in scene.dynamics.graph.joints:
             topic = topics.reaction_topic(joint.name)
             try:
@@ -515,6 +520,9 @@ class ViewServer:
                 'traces': {name: list(trace) for name, trace in latest.traces.items()},
                 'statuses': list(latest.statuses), 'drivers': [],
                 'crank_speed_rpm': None, 'frame': None, 'error': '', 'reactions': []}
+            if scene is not None and scene.urdf_drivers and scene.dynamics is not None:
+                out['statuses'].append({'name': VIEW_STATUS, 'message': ROBOT_REACTIONS,
+                                        'level': 0})
             values = dict(latest.values)
             reactions = dict(latest.reactions)
         # Before joint_states: the node's own report of its crank's speed, where it is a number.
@@ -528,8 +536,16 @@ class ViewServer:
         speeds: list[float] = []
         missing = []
         first_crank = bool(first_crank_aliases(scene.drivers))
+        # A robot's loops (URDF mode): joint_states names the URDF's joints, each driver
+        # following one (the scene's urdf_drivers).
+        followed = {f.driver: f for f in scene.urdf_drivers}
         for index, driver in enumerate(scene.drivers):
             position, speed = joints.get(driver.name, (None, None))
+            follows = followed.get(driver.name)
+            if driver.name not in joints and follows is not None and follows.joint in joints:
+                q, rate = joints[follows.joint]
+                position = None if q is None else _finite(follows.driver_value(q))
+                speed = None if rate is None else _finite(follows.factor * rate)
             # The speed in the unit the node's parameter sets it in (rpm, m/s).
             unit = driver.rate_parameter.unit
             shown = None if speed is None else _shown(rate_from_si(speed, unit))
@@ -538,7 +554,8 @@ class ViewServer:
             if index == 0 and first_crank and shown is not None:
                 out['crank_speed_rpm'] = shown
             if position is None:
-                missing.append(driver.name)
+                missing.append(driver.name if follows is None or driver.name in joints
+                               else f'{follows.joint} (which {driver.name} follows)')
             else:
                 positions.append(position)
             speeds.append(0.0 if speed is None else speed)

@@ -648,6 +648,43 @@ def test_state_has_the_published_reactions_at_their_joints(fake):
     assert _state(fake)['reactions'] == []
 
 
+def test_state_draws_a_urdf_robot_from_its_joint_states(fake):
+    """URDF mode: ``joint_states`` names the URDF's joints; each driver follows one (issue 44).
+
+    The node's ``scene`` for the lift arm carries ``urdf_drivers`` (lower_arm
+    follows lift_joint, the other way round); the frame is solved where
+    ``Robot.solve`` puts every point. The robot's reactions, in its links'
+    frames, are not drawn, and /state says so; a missing joint is named.
+    """
+    from std_msgs.msg import String
+
+    from mech_kinematics.ros.robot_mode import load_source
+    from mech_kinematics.tools.view import ROBOT_REACTIONS, VIEW_STATUS
+
+    source = load_source(str(REPO / 'test' / 'data' / 'urdf' / 'lift_arm.urdf'))
+    fake._on_scene(String(data=source.text))
+    assert fake.latest.scene is not None, fake.latest.scene_error
+    answer = source.robot.solve({'lift_joint': 0.4}, {'lift_joint': 0.7})
+    names = list(answer.joints)
+    _joints(fake, names, [answer.joints[n].position for n in names],
+            [answer.joints[n].velocity for n in names])
+    state = _state(fake)
+    assert state['error'] == '' and state['frame'] is not None
+    assert state['drivers'] == [{'name': 'lower_arm', 'kind': 'crank', 'unit': 'rpm',
+                                 'position': -0.4, 'speed': pytest.approx(
+                                     -0.7 * 60 / (2 * math.pi), rel=1e-12)}]
+    for point, xy in state['frame']['points'].items():
+        assert xy == pytest.approx(list(_xy_of(answer.state, point)), abs=1e-12), point
+    assert {'name': VIEW_STATUS, 'message': ROBOT_REACTIONS, 'level': 0} in state['statuses']
+    assert state['reactions'] == []
+    assert fake._reaction_subscriptions == []
+    _joints(fake, ['elbow'], [0.1])
+    assert _state(fake)['error'] == (
+        'Expected a finite position of lift_joint (which lower_arm follows) in joint_states')
+    _scene(fake, 'engine')      # a scene of its own: its reactions, no such status
+    assert _state(fake)['statuses'] == [] and fake._reaction_subscriptions
+
+
 def _xy_of(state, point):
     z = state.complex_points[point][0]
     return z.real, z.imag
