@@ -228,7 +228,8 @@ class KinematicsNode(LifecycleNode):
         drive, effort = self._value('drive'), self._value('effort')
         self._forces = forces = forces_tick(scene, publishing.tick_scene, frames, drive=drive,
                                             effort=effort) if source.robot is None else \
-            robot_forces_tick(source.robot, scene, drive=drive, effort=effort)
+            robot_forces_tick(source.robot, scene, drive=drive, effort=effort,
+                              unloaded=source.unloaded, payloads=self._value('payloads') or ())
         self._has_forces = scene.dynamics is not None or (
             source.robot is not None and robot_forces_note(source.robot) is None)
         if forces is not None:

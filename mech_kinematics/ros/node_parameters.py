@@ -54,6 +54,10 @@ DRIVE = ('crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm')
 JOINT_RULES = (*DRIVE, 'drive', 'markers')
 DOUBLES = frozenset(p.name for p in PARAMETERS if p.kind == 'double')
 READ_ONLY = frozenset(p.name for p in PARAMETERS if p.read_only)
+#: The node's parameters that change while running only through its forces tick (which
+#: lists them among its own, :meth:`RobotForcesTick.parameters
+#: <mech_kinematics.ros.robot_forces.RobotForcesTick.parameters>`); refused elsewhere.
+CHANGED_BY_FORCES = frozenset({'payloads'})
 #: The parameters of the start's log line, in order (the scene's own first), before the drivers'.
 START_LOGGED = ('scene', 'drive', 'crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm',
                 'rate_hz', 'late_ticks', 'max_catch_up_s', 'max_lateness_ms',
@@ -381,6 +385,11 @@ class NodeParameters:
                     and spec_default_is_none(p.name):
                 continue    # declared unset: the scene gives it at configure
             reason = refusal(p.name, p.value, known or None)
+            if reason is None and p.name in CHANGED_BY_FORCES and not self.starting \
+                    and p.name not in self.forces:
+                reason = (f'{p.name}: Expected a robot whose forces the node publishes (URDF '
+                          f'mode, its links carrying <inertial>) to change it while running, '
+                          f'got {p.value!r}: set it at start')
             if reason is not None:
                 break
         if reason is None:

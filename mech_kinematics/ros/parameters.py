@@ -128,7 +128,8 @@ PARAMETERS = (
     ParameterSpec('payloads', 'string_array', None,
                   'URDF mode: point masses welded to links, LINK=KG or LINK=KG@X,Y,Z each '
                   "(kg, and m in the link's frame; default its origin), as the commands take "
-                  '--payload', read_only=True),
+                  '--payload; changeable while running where the node publishes the '
+                  "robot's forces, from the next instant"),
     ParameterSpec('frame_id', 'string', 'mechanism',
                   'header.frame_id of every message: the ground frame of the scene',
                   read_only=True, frame=True),

@@ -46,7 +46,7 @@ from .ticker import NOT_IN_THE_TICK, values_from_state
 from .topics import reaction_topic
 from .wrenches import ForceMessages, ForcesTick
 from .. import solver as lk
-from ..errors import AssemblyError
+from ..errors import AssemblyError, SceneError
 from ..geometry.frames import child_frame
 from ..robot.description import ClosureKind
 from ..robot.forces import check_gravity, ForcesLeftOut, GRAVITY
@@ -104,6 +104,11 @@ class RobotForcesTick(ForcesTick):
         ``effort: static``: gravity alone, solved at the same positions at rest.
     gravity : (float, float, float), keyword-only
         m/s^2 in the URDF's root frame until the parameter says otherwise.
+    unloaded : Description or None, keyword-only
+        The robot's description before its payloads; with it, ``payloads``
+        is a forces parameter, changeable while running (:meth:`apply`).
+    payloads : sequence of str, keyword-only
+        The ``payloads`` parameter's entries the robot was built with.
 
     Attributes
     ----------
@@ -124,9 +129,14 @@ class RobotForcesTick(ForcesTick):
     scene_reactions = False
 
     def __init__(self, robot: Any, scene: Any, *, static: bool,
-                 gravity: Sequence[float] = GRAVITY) -> None:
+                 gravity: Sequence[float] = GRAVITY, unloaded: Any = None,
+                 payloads: Sequence[str] = ()) -> None:
         self.robot = robot
         self.model = robot.forces
+        self.unloaded = unloaded
+        self.payloads = list(payloads)
+        #: The model a change of ``payloads`` builds while it is judged, for :meth:`apply`.
+        self._pending: tuple[list[str], Any] | None = None
         self.kinematics = replace(scene, gravity=None, masses=(), loads=(),
                                   outputs_joints=scene.output_joints,
                                   outputs_points=scene.output_points)
@@ -157,26 +167,80 @@ class RobotForcesTick(ForcesTick):
     # -- the parameters -----------------------------------------------------------------
 
     def parameters(self) -> tuple[ParameterSpec, ...]:
-        """Return ``gravity``: three components in the URDF's root frame (m/s^2)."""
-        return (ParameterSpec(
+        """Return ``gravity`` (three components in the URDF's root frame, m/s^2) and ``payloads``.
+
+        ``payloads`` is the node's own parameter (declared before the robot is
+        read); listed here where it can change while running (``unloaded``).
+        """
+        gravity = ParameterSpec(
             'gravity', 'xyz', list(self.g),
             "Gravity [gx, gy, gz] in the URDF's root frame, from the next instant published "
             "([0, 0, 0]: none; the part along a loop's pivots is carried by its bearings). "
-            'Defaults to [0, 0, -9.80665] (REP 103: z up)', 'm/s^2'),)
+            'Defaults to [0, 0, -9.80665] (REP 103: z up)', 'm/s^2')
+        if self.unloaded is None:
+            return (gravity,)
+        return (gravity, ParameterSpec(
+            'payloads', 'string_array', list(self.payloads),
+            "Point masses welded to links, LINK=KG or LINK=KG@X,Y,Z each (kg, m in the link's "
+            'frame), from the next instant published', ''))
 
     def parameters_refusal(self, values: Mapping[str, Any]) -> str | None:
-        """Return why ``values['gravity']`` is refused (beyond :data:`MAX_GRAVITY`), or None."""
+        """Return why ``values`` are refused: gravity beyond :data:`MAX_GRAVITY`, a bad payload.
+
+        A new ``payloads`` is built here (the robot's masses with it), so that
+        :meth:`apply` only swaps it in: refused in one line naming the entry or
+        the link, or where the loops would not carry the masses.
+        """
         try:
             check_gravity(values['gravity'])
         except ValueError as error:
             return f'gravity: {error}'
+        payloads = list(values.get('payloads') or [])
+        if self.unloaded is None or payloads == self.payloads:
+            return None
+        try:
+            model = self._model_of(payloads)
+        except (ValueError, SceneError) as error:   # UrdfError is a SceneError
+            line = str(error).splitlines()[0]
+            return line if line.startswith('payloads') else f'payloads: {line}'
+        self._pending = (payloads, model)
         return None
 
+    def _model_of(self, payloads: list[str]) -> Any:
+        """Return the robot's forces with ``payloads`` (entries) instead of its own."""
+        from ..robot import Robot
+        from ..robot.forces import with_payloads
+        from .robot_mode import payloads_from_parameter
+
+        parsed = payloads_from_parameter(payloads)
+        description = with_payloads(self.unloaded, parsed) if parsed else self.unloaded
+        robot = Robot(description, self.robot.actuated, self.robot.reference)
+        if robot.forces is None:
+            msg = ('Expected masses for the forces the node publishes, got none: no link of '
+                   'the URDF carries an <inertial> and no payload is left')
+            raise ValueError(msg)
+        if robot.forces.refused is not None:
+            raise ValueError(robot.forces.refused)
+        return robot.forces
+
     def apply(self, values: Mapping[str, Any]) -> None:
-        """Solve the next instants with the new gravity (its forces written out first)."""
-        g = check_gravity(values['gravity'])
-        self.warm(g)
-        self.g = g
+        """Solve the next instants with the new gravity or payloads (forces written out first).
+
+        ``values`` holds what changed (all of them at start). The tick reads the
+        model once an instant, so an instant has the old masses or the new.
+        """
+        g = check_gravity(values['gravity']) if 'gravity' in values else self.g
+        model, payloads = self.model, self.payloads
+        if 'payloads' in values and self.unloaded is not None:
+            given = list(values['payloads'] or [])
+            if given != self.payloads:
+                pending = self._pending
+                model = pending[1] if pending is not None and pending[0] == given else \
+                    self._model_of(given)
+                payloads = given
+        self._pending = None
+        self.warm(g, model)
+        self.model, self.g, self.payloads = model, g, payloads
 
     def gravity(self) -> list[float]:
         """Return the gravity the forces are solved with, m/s^2 in the URDF's root frame."""
@@ -193,7 +257,7 @@ class RobotForcesTick(ForcesTick):
 
     # -- the tick -----------------------------------------------------------------------
 
-    def warm(self, dynamics: Any = None) -> Any:
+    def warm(self, dynamics: Any = None, model: Any = None) -> Any:
         """Solve the forces where the drivers go, with gravity ``dynamics`` (or the tick's).
 
         As the scene's forces tick does (:meth:`ForcesTick.warm`): the forces'
@@ -206,7 +270,7 @@ class RobotForcesTick(ForcesTick):
         for state in self._samples:
             values = values_from_state(state, self.joints, self.points, ())
             try:
-                self._forces(values, state, math.inf, g, None)
+                self._forces(values, state, math.inf, g, None, model)
             except (ForcesLeftOut, AssemblyError):
                 continue
         return g
@@ -227,8 +291,9 @@ class RobotForcesTick(ForcesTick):
         return values + forces, measure
 
     def _forces(self, values: list[float], at: Any, tol: float, g: tuple[float, float, float],
-                given: Any) -> list[float]:
+                given: Any, model: Any = None) -> list[float]:
         """Return the forces' values at ``at`` (``values``: the scene's, of the same positions)."""
+        model = self.model if model is None else model     # read once: one model an instant
         urdf = self.values.values(values, given)
         n = len(self.names)
         if self.static:
@@ -236,8 +301,8 @@ class RobotForcesTick(ForcesTick):
         else:
             inputs = {name: (urdf[k], urdf[n + k], urdf[2 * n + k])
                       for name, k in self._actuated}
-        efforts = self.model.efforts(at, inputs, g, tol)
-        reactions = self.model.reactions(efforts, dict(zip(self.names, urdf[:n])), {})
+        efforts = model.efforts(at, inputs, g, tol)
+        reactions = model.reactions(efforts, dict(zip(self.names, urdf[:n])), {})
         given_efforts = efforts.efforts
         out = [(float(given_efforts[name]) if name in given_efforts else math.nan)
                if fill == 'effort' else fill for name, fill in zip(self.names, self._fill)]
@@ -249,14 +314,18 @@ class RobotForcesTick(ForcesTick):
         return out
 
 
-def robot_forces_tick(robot: Any, scene: Any, *, drive: str, effort: str
+def robot_forces_tick(robot: Any, scene: Any, *, drive: str, effort: str,
+                      unloaded: Any = None, payloads: Sequence[str] = ()
                       ) -> RobotForcesTick | None:
     """Return the forces tick of a robot on the node, or ``None`` where none is published.
 
     None for a robot without forces (:func:`robot_forces_note`), and with
     ``drive: topic`` unless ``effort: static`` (the input gives no
     accelerations), as for a scene (:func:`~mech_kinematics.ros.wrenches.forces_tick`).
+    ``unloaded`` and ``payloads``: as :class:`RobotForcesTick` takes them (with
+    ``unloaded``, ``payloads`` can change while running).
     """
     if robot_forces_note(robot) is not None or (drive == TOPIC and effort == DYNAMIC):
         return None
-    return RobotForcesTick(robot, scene, static=effort == STATIC)
+    return RobotForcesTick(robot, scene, static=effort == STATIC, unloaded=unloaded,
+                           payloads=payloads)

@@ -133,12 +133,16 @@ class Source:
     origin : str
         Where it came from, for the start's log line (a path, or
         ``robot_description``).
+    unloaded : Description or None
+        In URDF mode, the robot's description before its ``payloads``: what a
+        change of ``payloads`` while running builds on.
     """
 
     scene: Scene
     text: str
     robot: Any = None
     origin: str = ''
+    unloaded: Any = None
 
 
 def load_source(scene: str, robot_description: str = '', loop_closures: str = '',
@@ -195,6 +199,7 @@ def load_source(scene: str, robot_description: str = '', loop_closures: str = ''
 
     origin = 'robot_description' if robot_description else scene
     description = read_description(urdf, loop_closures or None)
+    unloaded = description
     if payloads:
         from ..robot.forces import with_payloads
         description = with_payloads(description, payloads_from_parameter(payloads))
@@ -205,7 +210,7 @@ def load_source(scene: str, robot_description: str = '', loop_closures: str = ''
     missing = tuple(n for n in needed if n not in built.output_joints)
     if missing:
         built = replace(built, outputs_joints=(*built.output_joints, *missing))
-    return Source(built, scene_yaml(robot.planar, origin), robot, origin)
+    return Source(built, scene_yaml(robot.planar, origin), robot, origin, unloaded)
 
 
 def reference_from_parameter(description: Any, entries: Sequence[str]) -> dict[str, float]:

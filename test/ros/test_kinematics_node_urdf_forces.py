@@ -57,9 +57,9 @@ CHILDREN = {'lift_joint': 'lower_arm', 'upper_pivot': 'upper_arm', 'elbow': 'pla
 T0 = 1_700_000_000 * NS
 
 
-def _hand_torque(q, g=G):
+def _hand_torque(q, g=G, payload=PAYLOAD_KG):
     """Return the static motor torque by hand: ``g cos q (m1 r1 + M L + m3 r3)``."""
-    platform = M_PLATFORM + PAYLOAD_KG
+    platform = M_PLATFORM + payload
     return g * math.cos(q) * (M_LOWER * R_LOWER + platform * L_ARM + M_UPPER * R_UPPER)
 
 
@@ -91,8 +91,11 @@ class LiftNode:
     def answer(self, q):
         """Send lift_joint = q (again, each with a new stamp) until answered; return the answer.
 
-        The answer: the joint_states message and each reaction's wrench of one stamp.
+        The answer: the joint_states message and each reaction's wrench of one stamp
+        sent by this call (an earlier call's answer at the same q had other parameters).
         """
+        first = self.stamp
+
         def send():
             self.stamp += NS // 100
             msg = JointState(name=['lift_joint'], position=[q], velocity=[0.5])
@@ -102,7 +105,7 @@ class LiftNode:
 
         def answered():
             for stamp, value in list(self.sent.items()):
-                if value == q and stamp in self.js and all(
+                if stamp > first and value == q and stamp in self.js and all(
                         stamp in got for got in self.wrenches.values()):
                     return self.js[stamp], {n: got[stamp] for n, got in self.wrenches.items()}
             return None
@@ -213,4 +216,22 @@ def test_gravity_changed_while_running_changes_the_effort(node, robot):
     wait_for(lambda: '[0.0, 0.0, 0.0]' in node.diagnostics('gravity'), STARTUP_S,
              'diagnostics saying the gravity used')
     assert node.diagnostics('effort')[-1] == 'static: gravity and loads only, inertia neglected'
+    assert node.proc.proc.poll() is None, node.proc.output()
+
+
+def test_payloads_changed_while_running_change_the_effort(node):
+    """``payloads`` set while running: the hand torque with the new mass; a bad one refused."""
+    assert node.set('gravity', [0.0, 0.0, -G]).successful
+    assert node.set('payloads', ['platform=3.5@0.1,0,0.05']).successful
+    msg, _ = node.answer(0.25)
+    assert msg.effort[0] == pytest.approx(_hand_torque(0.25, payload=3.5), rel=1e-12)
+    for value, words in ((['wing=1'], 'payload on link "wing": Expected a link of the robot'),
+                         (['platform'], 'payloads: Expected LINK=KG or LINK=KG@X,Y,Z')):
+        result = node.set('payloads', value)
+        assert not result.successful and words in result.reason, result.reason
+    msg, _ = node.answer(0.35)         # the masses it had
+    assert msg.effort[0] == pytest.approx(_hand_torque(0.35, payload=3.5), rel=1e-12)
+    assert node.set('payloads', [PAYLOAD]).successful
+    msg, _ = node.answer(0.45)
+    assert msg.effort[0] == pytest.approx(_hand_torque(0.45), rel=1e-12)
     assert node.proc.proc.poll() is None, node.proc.output()

@@ -114,6 +114,9 @@ def test_declared_values_reach_the_clock_and_a_set_drives_at_the_next_instant(no
      'inputs.right_crank.speed_rpm: expected |inputs.right_crank.speed_rpm| <= '
      'max_crank_speed_rpm (10000 rpm), got 20000 rpm'),
     ('crank_accel', 'fast', "crank_accel: expected a number (rad/s^2), got string 'fast'"),
+    # Changeable while running only where the node publishes a robot's forces.
+    ('payloads', ['platform=1.0'], 'payloads: Expected a robot whose forces the node '
+     'publishes (URDF mode, its links carrying <inertial>) to change it while running'),
 ])
 def test_a_refused_value_says_why_and_changes_nothing(node, name, value, reason):
     """A refusal is the service's reason, and the value and the drive stay as they were."""

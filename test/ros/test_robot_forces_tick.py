@@ -195,6 +195,45 @@ def test_payloads_are_parsed_as_the_commands_take_them():
     assert gain == pytest.approx(2.0 * 9.80665 * 0.5 * math.cos(q), rel=1e-12)
 
 
+def test_payloads_change_while_running_from_the_next_instant():
+    """With the description before its payloads, ``payloads`` is the tick's: judged, then swapped.
+
+    From none to 2 kg on the platform the efforts and reactions become those
+    of ``Robot.solve`` of the robot built with it, to the bit; back to none,
+    those without; a link the robot lacks, a bad entry or a mass not above 0
+    is refused in one line naming the parameter, the masses kept. A tick built
+    without the unloaded description does not list the parameter.
+    """
+    source = load_source(str(LIFT))
+    tick = robot_forces_tick(source.robot, source.scene, drive=TOPIC, effort=STATIC,
+                             unloaded=source.unloaded)
+    tick.apply({'gravity': [0.0, 0.0, -9.80665], 'payloads': []})
+    assert [p.name for p in tick.parameters()] == ['gravity', 'payloads']
+    first, q = tick.forces_first, 0.4
+    plain = _from_input(tick, [q])[first:]
+    entry = 'platform=2.0@0.1,0,0.05'
+    values = {'gravity': [0.0, 0.0, -9.80665], 'payloads': [entry]}
+    assert tick.parameters_refusal(values) is None
+    tick.apply({'payloads': [entry]})       # what changed, as the node hands it over
+    loaded = _from_input(tick, [q])[first:]
+    answer = load_robot(LIFT, payloads={'platform': (2.0, (0.1, 0.0, 0.05))}).solve(
+        {'lift_joint': q})
+    assert loaded[0] == answer.efforts.efforts['lift_joint'] != plain[0]
+    for k, name in enumerate(tick.reactions):
+        r = answer.reactions[name]
+        assert loaded[3 + 6 * k:3 + 6 * k + 6] == [*r.force, *r.torque]
+    for entries, reason in ((['wing=1'], 'payloads: '), (['platform'], 'payloads: Expected LINK'),
+                            (['platform=-1'], 'payloads: ')):
+        refused = tick.parameters_refusal({**values, 'payloads': entries})
+        assert refused is not None and refused.startswith(reason) and '\n' not in refused, refused
+    assert 'payload on link "wing": Expected a link of the robot' in tick.parameters_refusal(
+        {**values, 'payloads': ['wing=1']})
+    assert _from_input(tick, [q])[first:] == loaded       # the masses kept
+    tick.apply({'payloads': []})
+    assert _from_input(tick, [q])[first:] == plain
+    assert [p.name for p in _tick(source).parameters()] == ['gravity']
+
+
 def test_a_forces_parameter_that_does_not_apply_is_refused():
     """loads.* always; effort, gravity, payloads without masses; gravity with topic, dynamic."""
     lift = load_source(str(LIFT)).robot
