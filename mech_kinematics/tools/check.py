@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from .cli import (add_robot_arguments, add_scene_argument, add_units_argument,
+from .cli import (add_robot_arguments, add_scene_argument, add_units_argument, finite_float,
                   load_scene_argument, run_tool)
 from ..errors import SceneError
 from ..geometry.region import GRID
@@ -499,6 +499,30 @@ def turning_json(study: Any, flywheel: Any = None) -> dict[str, Any]:
     return data
 
 
+def _at_speed(scene: Any, rpm: float) -> Any:
+    """Return ``scene`` with its crank turning at ``rpm`` (``--speed-rpm``), or a one-line refusal.
+
+    For a scene with forces and one crank only (the turning moment's); the
+    whole report (the strokes' sense too) is then the scene's at that speed.
+    """
+    from dataclasses import replace
+
+    from ..units import rad_per_s_from_rpm
+
+    if scene.dynamics is None:
+        msg = (f'Expected a scene with masses, gravity or loads for --speed-rpm, got '
+               f'{scene.name} without')
+        raise SceneError(msg)
+    if not scene.single_crank:
+        msg = (f'Expected a scene driven by one crank for --speed-rpm, got {scene.name}, '
+               f'driven by {", ".join(d.name for d in scene.drivers)}')
+        raise SceneError(msg)
+    crank = replace(scene.input, speed=rad_per_s_from_rpm(rpm), rpm=float(rpm))
+    if scene.inputs:
+        return replace(scene, input=crank, inputs=(crank,))
+    return replace(scene, input=crank)
+
+
 def _turning(scene: Any, cs: float | None) -> tuple[Any, Any, str]:
     """Return the scene's turning-moment study, its flywheel for ``cs``, or why there is none.
 
@@ -528,7 +552,8 @@ def _turning(scene: Any, cs: float | None) -> tuple[Any, Any, str]:
     try:
         return study, study.flywheel(cs), ''
     except ValueError as error:
-        raise SceneError(str(error)) from None
+        hint = '; give the crank a speed with --speed-rpm N' if study.speed == 0.0 else ''
+        raise SceneError(f'{error}{hint}') from None
 
 
 def _print_report(args: argparse.Namespace, scene: Any, data: dict[str, Any], text: str
@@ -566,6 +591,8 @@ def _handle(args: argparse.Namespace) -> int:
 
     # A scene, or a URDF's loops as a scene; a SceneError is one line, exit 2 (cli.run_handler).
     scene = load_scene_argument(args)
+    if args.speed_rpm is not None:
+        scene = _at_speed(scene, args.speed_rpm)
     if not scene.single_crank:
         return _handle_region(args, scene)
     given = [flag for flag, value in (('--grid', args.grid != GRID), ('--pair', args.pair),
@@ -605,6 +632,11 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
                         help='a scene with forces and one crank: the moment of inertia of a '
                              'flywheel for the coefficient of fluctuation of speed CS = (w_max - '
                              'w_min) / w_mean, e.g. 0.02')
+    parser.add_argument('--speed-rpm', type=finite_float, metavar='N',
+                        help="a scene with forces and one crank: the crank's speed for the "
+                             'turning moment and the flywheel, rpm, + CCW (default: the '
+                             "scene's; a crank at rest, as a URDF's scene, needs one for "
+                             '--flywheel)')
     parser.set_defaults(handler=_handle)
     return parser
 

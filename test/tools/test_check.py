@@ -336,6 +336,39 @@ def test_a_flywheel_it_cannot_give_is_one_line_and_exit_2(args, message, capsys)
     assert captured.err == f'error: {message}\n' and captured.out == ''
 
 
+def test_a_crank_at_rest_is_given_its_speed_by_speed_rpm(tmp_path, capsys):
+    """--speed-rpm turns the crank for the study: a scene at rest answers as if written so.
+
+    The test four-bar written at 0 rpm (as a URDF's scene is): --flywheel is
+    refused with the hint; with --speed-rpm -120 the whole report, text and
+    JSON, is the one of the scene written at -120 rpm. Where there is no
+    study to give it to, --speed-rpm is refused in one line, never ignored.
+    """
+    written = FORCES / 'four_bar_masses.yaml'
+    data = yaml.safe_load(written.read_text())
+    data['input']['speed_rpm'] = 0
+    still = tmp_path / 'still.yaml'
+    still.write_text(yaml.safe_dump(data))
+    assert main(['check', str(still), '--flywheel', '0.02']) == 2
+    assert capsys.readouterr().err == (
+        'error: Expected crank "crank" turning (a mean speed above 0) for a flywheel, got 0 '
+        'rad/s; give the crank a speed with --speed-rpm N\n')
+    for extra in ([], ['--json']):
+        assert main(['check', str(written), '--flywheel', '0.02', *extra]) == 0
+        expected = capsys.readouterr().out
+        assert main(['check', str(still), '--flywheel', '0.02', '--speed-rpm', '-120',
+                     *extra]) == 0
+        assert capsys.readouterr().out == expected
+    for args, message in (
+            (['khurmi_four_bar_ad150', '--speed-rpm', '10'], 'Expected a scene with masses, '
+             'gravity or loads for --speed-rpm, got khurmi_four_bar_ad150 without'),
+            ([str(FORCES / 'five_bar_masses.yaml'), '--speed-rpm', '10', '--grid', '5'],
+             'Expected a scene driven by one crank for --speed-rpm, got five_bar_masses, driven '
+             'by left_crank, right_crank')):
+        assert main(['check', *args]) == 2
+        assert capsys.readouterr().err == f'error: {message}\n'
+
+
 def test_a_flywheel_for_a_crank_that_cannot_turn_is_refused(tmp_path, capsys):
     """A crank longer than its rocker cannot turn: --flywheel says where, in one line."""
     data = yaml.safe_load((FORCES / 'four_bar_masses.yaml').read_text())
