@@ -38,7 +38,7 @@ from typing import Any, TYPE_CHECKING
 import numpy as np
 
 from ..errors import UrdfError
-from ..solver.forces import Dynamics, Forces, Mass
+from ..solver.forces import Dynamics, Forces, Load, Mass
 from ..solver.scaling import _size
 from ..solver.solve import refuse_forces
 
@@ -47,8 +47,9 @@ if TYPE_CHECKING:
     from .robot import Robot
     from ..solver import State
 
-__all__ = ['ForcesLeftOut', 'GRAVITY', 'JointReaction', 'MAX_GRAVITY', 'RobotEfforts',
-           'RobotForces', 'check_gravity', 'robot_forces', 'with_payloads']
+__all__ = ['ForcesLeftOut', 'GRAVITY', 'JointReaction', 'LinkLoad', 'MAX_GRAVITY', 'MAX_LOAD',
+           'RobotEfforts', 'RobotForces', 'check_gravity', 'parse_link_loads', 'robot_forces',
+           'with_payloads']
 
 #: Gravity in the URDF's root frame by default, m/s^2 (REP 103: z up; standard gravity).
 GRAVITY = (0.0, 0.0, -9.80665)
@@ -58,6 +59,74 @@ MAX_GRAVITY = 1e6
 #: Dynamics kept per robot (one per group of loops and gravity in their plane).
 _CACHE = 16
 _U = float(np.finfo(np.float64).eps) / 2
+
+
+#: The largest force (N) or torque (N m) a link load may have: its forces stay far from
+#: the doubles' range, as gravity's (:data:`MAX_GRAVITY`) do.
+MAX_LOAD = 1e12
+
+
+@dataclass(frozen=True)
+class LinkLoad:
+    """A force and a torque on a URDF link, in the URDF's root frame.
+
+    ``force`` (N) acts at ``point`` of the link's frame (m); ``torque`` (N m)
+    on the link. In a loop's plane the force's in-plane part acts at that
+    point and the torque's part along the plane's normal on the link's body;
+    the rest is carried by the bearings (in no effort), as gravity's is.
+    """
+
+    link: str
+    force: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    point: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    torque: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+
+def _three(text: str) -> tuple[float, float, float] | None:
+    try:
+        values = tuple(float(v) for v in text.split(','))
+    except ValueError:
+        return None
+    if len(values) != 3 or not all(math.isfinite(v) for v in values):
+        return None
+    return values[0], values[1], values[2]
+
+
+def parse_link_loads(forces: Sequence[str], torques: Sequence[str], force_flag: str,
+                     torque_flag: str) -> tuple[LinkLoad, ...]:
+    """Return ``LINK=FX,FY,FZ[@X,Y,Z]`` forces and ``LINK=TX,TY,TZ`` torques as link loads.
+
+    N and N m in the URDF's root frame, the point in the link's frame (m,
+    default its origin). One load per link (its force and torque together);
+    refused in one line (``ValueError``) naming the flag: an entry not in that
+    form, a value not finite or above :data:`MAX_LOAD`, a link given twice.
+    """
+    out: dict[str, LinkLoad] = {}
+    for flag, entries, form in ((force_flag, forces, 'LINK=FX,FY,FZ or LINK=FX,FY,FZ@X,Y,Z'),
+                                (torque_flag, torques, 'LINK=TX,TY,TZ')):
+        seen: set[str] = set()
+        for entry in entries:
+            link, sep, rest = entry.partition('=')
+            link = link.strip()
+            values, at, where = rest.partition('@')
+            vector = _three(values)
+            point = _three(where) if at else (0.0, 0.0, 0.0)
+            if not sep or not link or vector is None or point is None \
+                    or (at and flag == torque_flag):
+                msg = f'{flag}: Expected {form}, three finite numbers each, got {entry!r}'
+                raise ValueError(msg)
+            if math.hypot(*vector) > MAX_LOAD:
+                msg = (f'{flag}: Expected a load of at most {MAX_LOAD:g} in size, got '
+                       f'{entry!r}')
+                raise ValueError(msg)
+            if link in seen:
+                msg = f'{flag}: Expected each link once, got "{link}" twice'
+                raise ValueError(msg)
+            seen.add(link)
+            old = out.get(link, LinkLoad(link))
+            out[link] = (LinkLoad(link, vector, point, old.torque) if flag == force_flag
+                         else LinkLoad(link, old.force, old.point, vector))
+    return tuple(out.values())
 
 
 class ForcesLeftOut(Exception):  # noqa: N818 - a reason, not an error of the caller's
@@ -106,6 +175,8 @@ class RobotEfforts:
         one of those joints: its joint and its effort (the joint's divided by
         the reduction: the same power at the actuator's speed, reduction
         times the joint's), with its bound.
+    loads : tuple of LinkLoad
+        The link loads the efforts carry (in the root frame).
     """
 
     efforts: dict[str, Any]
@@ -116,6 +187,7 @@ class RobotEfforts:
     failures: dict[str, Any] = field(default_factory=dict)
     groups: tuple[tuple[int, ...], ...] = ()
     actuators: dict[str, tuple[str, Any, Any]] = field(default_factory=dict)
+    loads: tuple[LinkLoad, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -205,11 +277,69 @@ class RobotForces:
             out[link] = up
         return out
 
+    def check_loads(self, loads: Sequence[LinkLoad], what: str = '--link-force') -> None:
+        """Refuse (``ValueError``, one line naming the link) a load on a link no loop moves."""
+        links = self.robot.description.links
+        for load in loads:
+            if load.link not in links:
+                more = ', ...' if len(links) > 8 else ''
+                msg = (f'{what}: load on link "{load.link}": Expected a link of the robot '
+                       f'({", ".join(links[:8])}{more}), got none of that name')
+                raise ValueError(msg)
+            if load.link not in self.moving_links:
+                msg = (f'{what}: load on link "{load.link}": Expected a link a loop moves '
+                       f'({", ".join(sorted(self.moving_links))}), got one it does not: its '
+                       "load reaches no loop's actuator")
+                raise ValueError(msg)
+
     # --- gravity in each loop's plane ----------------------------------------------------
 
     def _plane_gravity(self, index: int, gravity: tuple[float, float, float],
                        inputs: Mapping[str, tuple[Any, Any, Any]]) -> tuple[float, float]:
         """Return gravity in mechanism ``index``'s scene frame at the ground's pose (m/s^2)."""
+        m = self.mechanisms[index]
+        rotation = self._ground_rotation(index, inputs, any(gravity))
+        local = rotation.T @ np.asarray(gravity, dtype=np.float64)
+        return (float(local @ np.asarray(m['x'])), float(local @ np.asarray(m['y'])))
+
+    def _plane_loads(self, index: int, loads: Sequence[LinkLoad],
+                     inputs: Mapping[str, tuple[Any, Any, Any]]) -> tuple[Load, ...]:
+        """Return the link loads on mechanism ``index``'s bodies as loads of its scene.
+
+        The force's in-plane part at the point (in the body's own frame), the
+        torque's part along the plane's normal; both from the root frame at the
+        ground's pose.
+        """
+        mine = [(k, load) for k, load in enumerate(loads)
+                if self.moving_links.get(load.link) == index]
+        if not mine:
+            return ()
+        m = self.mechanisms[index]
+        rotation = self._ground_rotation(index, inputs, True)
+        x, y = np.asarray(m['x']), np.asarray(m['y'])
+        normal = np.cross(x, y)
+        out: list[Load] = []
+        for k, load in mine:
+            body, a, b = self.robot.planar.links[load.link]
+            force = rotation.T @ np.asarray(load.force, dtype=np.float64)
+            fx, fy = float(force @ x), float(force @ y)
+            if fx or fy:
+                at = a @ np.asarray(load.point, dtype=np.float64) + b
+                out.append(Load(f'link_load_{k}', link=body, force=(fx, fy),
+                                at=(float(at[0]), float(at[1]))))
+            tz = float((rotation.T @ np.asarray(load.torque, dtype=np.float64)) @ normal)
+            if tz:
+                out.append(Load(f'link_load_{k}_torque', link=body, torque=tz))
+        return tuple(out)
+
+    def _ground_rotation(self, index: int, inputs: Mapping[str, tuple[Any, Any, Any]],
+                         needed: bool) -> Any:
+        """Return mechanism ``index``'s ground's rotation in the root frame at its pose.
+
+        ``needed``: a carrying joint that is not given is refused
+        (:class:`ForcesLeftOut`); else its value is taken as 0 (nothing
+        projected depends on it).
+        """
         robot = self.robot
         description = robot.description
         m = self.mechanisms[index]
@@ -220,12 +350,12 @@ class RobotForces:
             if name not in inputs and joint.mimic is not None and joint.mimic.joint in inputs:
                 source, gain = joint.mimic.joint, joint.mimic.multiplier
             if source not in inputs:
-                if not any(gravity):
+                if not needed:
                     continue
                 raise ForcesLeftOut(
                     f'the ground of the loop through {", ".join(m["links"][:4])} ("{m["ground"]}")'
                     f' is carried by joint "{name}", which is not actuated: its pose, and so '
-                    f"gravity in the loop's plane, is not known")
+                    f"gravity (and any link load) in the loop's plane, is not known")
             p, v, a = inputs[source]
             if np.any(np.asarray(v) != 0) or np.any(np.asarray(a) != 0):
                 raise ForcesLeftOut(
@@ -244,29 +374,31 @@ class RobotForces:
                 value = gain * value + joint.mimic.offset
             values[name] = value
         frames = description.transforms(values)
-        rotation = frames[m['ground']][:3, :3]
-        local = rotation.T @ np.asarray(gravity, dtype=np.float64)
-        return (float(local @ np.asarray(m['x'])), float(local @ np.asarray(m['y'])))
+        return frames[m['ground']][:3, :3]
 
-    def _dynamics(self, members: tuple[int, ...], g: tuple[float, float]) -> Dynamics:
-        key = (members, g)
+    def _dynamics(self, members: tuple[int, ...], g: tuple[float, float],
+                  loads: tuple[Load, ...] = ()) -> Dynamics:
+        key = (members, g, loads)
         dynamics = self._cache.get(key)
         if dynamics is None:
             if len(self._cache) >= _CACHE:
                 self._cache.pop(next(iter(self._cache)))
             masses = [mass for i in members for mass in self.masses[i]]
-            dynamics = Dynamics(self.robot.scene.graph, masses, (), g, (), self.size)
+            dynamics = Dynamics(self.robot.scene.graph, masses, loads, g, (), self.size)
             self._cache[key] = dynamics
         return dynamics
 
     # --- at a state ---------------------------------------------------------------------
 
     def efforts(self, state: State, inputs: Mapping[str, tuple[Any, Any, Any]],
-                gravity: tuple[float, float, float], max_error: float) -> RobotEfforts:
+                gravity: tuple[float, float, float], max_error: float,
+                loads: Sequence[LinkLoad] = ()) -> RobotEfforts:
         """Return the efforts of the loops' actuated joints at a solved scene state.
 
         ``inputs``: every actuated joint's (position, speed, accel) the state
-        was solved for (:meth:`.Robot.solve`'s).
+        was solved for (:meth:`.Robot.solve`'s); ``loads``: forces and torques
+        on links the loops move (:class:`LinkLoad`, checked by
+        :meth:`check_loads`).
 
         Raises
         ------
@@ -278,17 +410,20 @@ class RobotForces:
         """
         if self.refused is not None:
             raise ForcesLeftOut(self.refused)
-        groups: dict[tuple[float, float], list[int]] = {}
+        groups: dict[tuple[Any, ...], list[int]] = {}
         for index in range(len(self.mechanisms)):
-            groups.setdefault(self._plane_gravity(index, gravity, inputs), []).append(index)
+            key = (self._plane_gravity(index, gravity, inputs),
+                   self._plane_loads(index, loads, inputs))
+            groups.setdefault(key, []).append(index)
         vector = not isinstance(state.valid, bool)
         efforts: dict[str, Any] = {}
         bounds: dict[str, Any] = {}
         answers = []
         valid: Any = True
         failures: dict[str, Any] = {}
-        for g, members in groups.items():
-            forces = self._dynamics(tuple(members), g).forces(state, float(max_error))
+        for (g, plane_loads), members in groups.items():
+            forces = self._dynamics(tuple(members), g, plane_loads).forces(state,
+                                                                           float(max_error))
             if not vector and not forces.valid:
                 refuse_forces(state, forces, max_error)
             answers.append(forces)
@@ -319,7 +454,8 @@ class RobotForces:
                                        bounds[name] / abs(reduction) + _U * np.abs(value))
         return RobotEfforts({n: efforts[n] for n in ordered}, {n: bounds[n] for n in ordered},
                             gravity, answers, valid, failures,
-                            tuple(tuple(members) for members in groups.values()), actuators)
+                            tuple(tuple(members) for members in groups.values()), actuators,
+                            tuple(loads))
 
     def reactions(self, efforts: RobotEfforts, positions: Mapping[str, float],
                   bounds: Mapping[str, float]) -> dict[str, JointReaction]:

@@ -164,6 +164,10 @@ class Planar:
         The scene's ``masses:`` from the ``<inertial>`` of the links each
         moving body holds (``urdf2scene`` writes them; ``data`` leaves them
         out, so that solving a robot's joints computes no forces).
+    links : dict of str to (str, ndarray, ndarray)
+        Each URDF link a loop moves: its scene body and the affine map of a
+        point of the link's frame (m) into the body's own frame (the one a
+        mass's ``com`` is given in): ``local = A @ p + b``, ``A`` 2x3.
     """
 
     data: dict[str, Any]
@@ -173,6 +177,7 @@ class Planar:
     actuated: tuple[str, ...] = ()
     names: dict[str, str] = field(default_factory=dict)
     masses: dict[str, dict[str, Any]] = field(default_factory=dict)
+    links: dict[str, tuple[str, Any, Any]] = field(default_factory=dict)
 
 
 # --- names -----------------------------------------------------------------------------
@@ -651,6 +656,9 @@ class _Builder:
         #: Scene body -> (mass kg, centre of mass in the scene's plane, inertia kg m^2 about
         #: it and the plane's normal), from the <inertial> of the URDF links it holds.
         self.mass_props: dict[str, tuple[float, complex, float]] = {}
+        #: URDF link a loop moves -> (its scene body, ``A``, ``b``): a point of the link's
+        #: frame ``p`` is ``complex(*(A @ p + b))`` in the scene's plane (reference pose).
+        self.link_planes: dict[str, tuple[str, Any, Any]] = {}
 
     def fail(self, msg: str, joint: str | None = None) -> UrdfError:
         return UrdfError(f'{self.source}: {msg}', joint=joint)
@@ -708,6 +716,14 @@ class _Builder:
         for link in self.description.links:
             if link in inertials:
                 held.setdefault(m.body_of[link], []).append(link)
+        for link, body in m.body_of.items():
+            if body != m.ground and body in m.bodies and link in m.frame \
+                    and body in self.body_names:
+                frame = m.frame[link]
+                axes = np.array([m.e1, m.e2])
+                self.link_planes[link] = (self.body_names[body], axes @ frame[:3, :3],
+                                          axes @ frame[:3, 3] + np.array([self.shift.real,
+                                                                          self.shift.imag]))
         for body in m.bodies:
             if body == m.ground:
                 continue
@@ -1412,7 +1428,36 @@ def planar_from_description(description: Description, actuated: Iterable[str] | 
     if builder.points:
         data['points'] = builder.points
     return Planar(data, tuple(builder.drivers), builder.joint_maps, mechanisms, actuated_names,
-                  dict(builder.names.changed), _scene_masses(data, builder.mass_props))
+                  dict(builder.names.changed), _scene_masses(data, builder.mass_props),
+                  _link_frames(data, builder.link_planes))
+
+
+def _link_frames(data: dict[str, Any], planes: Mapping[str, tuple[str, Any, Any]]
+                 ) -> dict[str, tuple[str, Any, Any]]:
+    """Return each moving link's map into its scene body's own frame (:attr:`Planar.links`).
+
+    As :func:`_scene_masses` takes a centre of mass there: the body's pose at
+    the drivers' start, where the plane's points were taken.
+    """
+    if not planes:
+        return {}
+    from ..geometry.frames import frames_from_scene, poses_from_state
+    from ..geometry.urdf import _assembled
+    from ..scene import parse_scene
+
+    scene = parse_scene(data)
+    bodies = sorted({body for body, _, _ in planes.values()})
+    poses = {pose.joint: pose for pose in poses_from_state(
+        frames_from_scene(scene, bodies), _assembled(scene))}
+    out: dict[str, tuple[str, Any, Any]] = {}
+    for link, (body, a, b) in planes.items():
+        pose = poses.get(body)
+        if pose is None:
+            continue
+        c, s = math.cos(pose.angle), math.sin(pose.angle)
+        turn = np.array([[c, s], [-s, c]])   # by -angle
+        out[link] = (body, turn @ a, turn @ (b - np.array([pose.x, pose.y])))
+    return out
 
 
 def _scene_masses(data: dict[str, Any], props: Mapping[str, tuple[float, complex, float]]

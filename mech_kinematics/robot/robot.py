@@ -31,8 +31,8 @@ import numpy as np
 
 from .assembly import Assemblies, pick, wrap_revolute
 from .description import Description, read_description
-from .forces import (check_gravity, ForcesLeftOut, GRAVITY, JointReaction, robot_forces,
-                     RobotEfforts, with_payloads)
+from .forces import (check_gravity, ForcesLeftOut, GRAVITY, JointReaction, LinkLoad,
+                     robot_forces, RobotEfforts, with_payloads)
 from .planar import DriverMap, JointMap, Planar, planar_from_description
 from ..bounds import MAX_ERROR
 from ..errors import AssemblyError, SceneError, UrdfError
@@ -120,6 +120,10 @@ class RobotState:
                              for name, item in self.limits.items()}
         if self.efforts is not None:
             out['gravity'] = list(self.efforts.gravity)
+            if self.efforts.loads:
+                out['link_loads'] = [{'link': load.link, 'force': list(load.force),
+                                      'point': list(load.point), 'torque': list(load.torque)}
+                                     for load in self.efforts.loads]
             out['efforts'] = {name: value(x) for name, x in self.efforts.efforts.items()}
             if self.efforts.actuators:
                 out['actuator_efforts'] = {
@@ -286,8 +290,8 @@ class Robot:
 
     def solve(self, positions: Mapping[str, Any] | None = None,
               speeds: Mapping[str, Any] | None = None, accels: Mapping[str, Any] | None = None,
-              *, max_error: float = MAX_ERROR, gravity: Iterable[float] | None = None
-              ) -> RobotState:
+              *, max_error: float = MAX_ERROR, gravity: Iterable[float] | None = None,
+              loads: Iterable[LinkLoad] = ()) -> RobotState:
         """Solve the robot where its actuated joints stand.
 
         Parameters
@@ -300,6 +304,9 @@ class Robot:
             As :func:`mech_kinematics.solve`'s.
         gravity : (float, float, float), optional
             m/s^2 in the URDF's root frame; default :attr:`gravity`.
+        loads : iterable of LinkLoad, optional
+            Forces and torques on links the loops move, in the root frame
+            (:class:`~.forces.LinkLoad`): in the efforts and reactions.
 
         Returns
         -------
@@ -320,6 +327,9 @@ class Robot:
             :data:`~.forces.MAX_GRAVITY`.
         """
         g = self.gravity if gravity is None else check_gravity(tuple(gravity))
+        link_loads = tuple(loads)
+        if link_loads and self.forces is not None:
+            self.forces.check_loads(link_loads, 'loads')
         inputs = self._inputs(positions, speeds, accels)
         p, v, a = self.scene_inputs(inputs)
         try:
@@ -330,7 +340,7 @@ class Robot:
         if self.forces is None:
             return answer
         try:
-            efforts = self.forces.efforts(state, inputs, g, max_error)
+            efforts = self.forces.efforts(state, inputs, g, max_error, link_loads)
         except ForcesLeftOut as why:
             return replace(answer, forces_left_out=str(why))
         except AssemblyError as error:

@@ -196,7 +196,9 @@ class KinematicsNode(LifecycleNode):
         with stop_raises() if self.params.starting and not self.managed else nullcontext():
             source = load_source(self._value('scene'), self._value('robot_description'),
                                  self._value('loop_closures'), self._value('actuated_joints'),
-                                 self._value('reference_pose'), self._value('payloads'))
+                                 self._value('reference_pose'), self._value('payloads'),
+                                 [name for name in ('link_forces', 'link_torques')
+                                  if self._value(name)])
         scene = source.scene
         if source.robot is not None:     # what would be accepted and ignored is refused
             note = robot_forces_note(source.robot)

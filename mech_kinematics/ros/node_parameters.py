@@ -57,7 +57,7 @@ READ_ONLY = frozenset(p.name for p in PARAMETERS if p.read_only)
 #: The node's parameters that change while running only through its forces tick (which
 #: lists them among its own, :meth:`RobotForcesTick.parameters
 #: <mech_kinematics.ros.robot_forces.RobotForcesTick.parameters>`); refused elsewhere.
-CHANGED_BY_FORCES = frozenset({'payloads'})
+CHANGED_BY_FORCES = frozenset({'payloads', 'link_forces', 'link_torques'})
 #: The parameters of the start's log line, in order (the scene's own first), before the drivers'.
 START_LOGGED = ('scene', 'drive', 'crank_speed_rpm', 'crank_accel', 'max_crank_speed_rpm',
                 'rate_hz', 'late_ticks', 'max_catch_up_s', 'max_lateness_ms',

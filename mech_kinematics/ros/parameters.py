@@ -129,7 +129,18 @@ PARAMETERS = (
                   'URDF mode: point masses welded to links, LINK=KG or LINK=KG@X,Y,Z each '
                   "(kg, and m in the link's frame; default its origin), as the commands take "
                   '--payload; changeable while running where the node publishes the '
-                  "robot's forces, from the next instant"),
+                  "robot's forces, from the next instant", may_be_empty=True),
+    ParameterSpec('link_forces', 'string_array', None,
+                  'URDF mode: forces on links, LINK=FX,FY,FZ or LINK=FX,FY,FZ@X,Y,Z each (N in '
+                  "the URDF's root frame, at a point of the link's frame, m; default its "
+                  'origin), as the commands take --link-force; changeable while running where '
+                  "the node publishes the robot's forces, from the next instant",
+                  may_be_empty=True),
+    ParameterSpec('link_torques', 'string_array', None,
+                  "URDF mode: torques on links, LINK=TX,TY,TZ each (N m in the URDF's root "
+                  'frame), as the commands take --link-torque; changeable while running where '
+                  "the node publishes the robot's forces, from the next instant",
+                  may_be_empty=True),
     ParameterSpec('frame_id', 'string', 'mechanism',
                   'header.frame_id of every message: the ground frame of the scene',
                   read_only=True, frame=True),
@@ -434,7 +445,8 @@ def refusal(name: str, value: Any,
             return f'{name}: expected true or false, got {_kind_of(value)} {shown(value)}'
         return None
     if p.kind == 'string_array':
-        return _names_refusal(name, value)
+        return None if p.may_be_empty and isinstance(value, (list, tuple)) and not value \
+            else _names_refusal(name, value)
     if not isinstance(value, str):
         return f'{name}: expected a string, got {_kind_of(value)} {shown(value)}'
     if p.choices and value not in p.choices:

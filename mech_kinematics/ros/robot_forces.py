@@ -49,7 +49,7 @@ from .. import solver as lk
 from ..errors import AssemblyError, SceneError
 from ..geometry.frames import child_frame
 from ..robot.description import ClosureKind
-from ..robot.forces import check_gravity, ForcesLeftOut, GRAVITY
+from ..robot.forces import check_gravity, ForcesLeftOut, GRAVITY, parse_link_loads
 
 __all__ = ['RobotForcesTick', 'reaction_names', 'robot_forces_note', 'robot_forces_tick']
 
@@ -137,6 +137,10 @@ class RobotForcesTick(ForcesTick):
         self.payloads = list(payloads)
         #: The model a change of ``payloads`` builds while it is judged, for :meth:`apply`.
         self._pending: tuple[list[str], Any] | None = None
+        #: The ``link_forces`` and ``link_torques`` entries, and the loads they give.
+        self.link_forces: list[str] = []
+        self.link_torques: list[str] = []
+        self.loads: tuple[Any, ...] = ()
         self.kinematics = replace(scene, gravity=None, masses=(), loads=(),
                                   outputs_joints=scene.output_joints,
                                   outputs_points=scene.output_points)
@@ -151,6 +155,8 @@ class RobotForcesTick(ForcesTick):
         self.links = tuple(link for _, link in found)
         self.forces_first = 3 * len(self.names) + 6 * len(self.points)
         self.g = check_gravity(gravity)
+        #: What an instant is solved with, read once by it: (model, gravity, link loads).
+        self._state: tuple[Any, ...] = (self.model, self.g, ())
         self.refusal = ''
         self.refused = 0
         self._samples: list[Any] | None = None
@@ -177,12 +183,19 @@ class RobotForcesTick(ForcesTick):
             "Gravity [gx, gy, gz] in the URDF's root frame, from the next instant published "
             "([0, 0, 0]: none; the part along a loop's pivots is carried by its bearings). "
             'Defaults to [0, 0, -9.80665] (REP 103: z up)', 'm/s^2')
+        loads = tuple(ParameterSpec(
+            name, 'string_array', list(getattr(self, name)),
+            f"{what} on links, {form} each (in the URDF's root frame{where}), from the next "
+            'instant published', '', may_be_empty=True) for name, what, form, where in (
+                ('link_forces', 'Forces', 'LINK=FX,FY,FZ[@X,Y,Z]',
+                 ", N, at a point of the link's frame, m"),
+                ('link_torques', 'Torques', 'LINK=TX,TY,TZ', ', N m')))
         if self.unloaded is None:
-            return (gravity,)
-        return (gravity, ParameterSpec(
+            return (gravity, *loads)
+        return (gravity, *loads, ParameterSpec(
             'payloads', 'string_array', list(self.payloads),
             "Point masses welded to links, LINK=KG or LINK=KG@X,Y,Z each (kg, m in the link's "
-            'frame), from the next instant published', ''))
+            'frame), from the next instant published', '', may_be_empty=True))
 
     def parameters_refusal(self, values: Mapping[str, Any]) -> str | None:
         """Return why ``values`` are refused: gravity beyond :data:`MAX_GRAVITY`, a bad payload.
@@ -195,6 +208,10 @@ class RobotForcesTick(ForcesTick):
             check_gravity(values['gravity'])
         except ValueError as error:
             return f'gravity: {error}'
+        try:
+            self._link_loads(values)
+        except ValueError as error:
+            return str(error)
         payloads = list(values.get('payloads') or [])
         if self.unloaded is None or payloads == self.payloads:
             return None
@@ -205,6 +222,15 @@ class RobotForcesTick(ForcesTick):
             return line if line.startswith('payloads') else f'payloads: {line}'
         self._pending = (payloads, model)
         return None
+
+    def _link_loads(self, values: Mapping[str, Any], model: Any = None) -> tuple[Any, ...]:
+        """Return the link loads ``values`` give (the current ones where a name is absent)."""
+        forces = values['link_forces'] if 'link_forces' in values else self.link_forces
+        torques = values['link_torques'] if 'link_torques' in values else self.link_torques
+        loads = parse_link_loads(list(forces or []), list(torques or []), 'link_forces',
+                                 'link_torques')
+        (self.model if model is None else model).check_loads(loads, 'link_forces')
+        return loads
 
     def _model_of(self, payloads: list[str]) -> Any:
         """Return the robot's forces with ``payloads`` (entries) instead of its own."""
@@ -239,8 +265,13 @@ class RobotForcesTick(ForcesTick):
                     self._model_of(given)
                 payloads = given
         self._pending = None
-        self.warm(g, model)
-        self.model, self.g, self.payloads = model, g, payloads
+        loads = self._link_loads(values, model)
+        self.warm(g, model, loads)
+        # Read once an instant, as one tuple: an instant has all the old or all the new.
+        self.link_forces = list(values.get('link_forces', self.link_forces) or [])
+        self.link_torques = list(values.get('link_torques', self.link_torques) or [])
+        self._state = (model, g, loads)
+        self.model, self.g, self.payloads, self.loads = model, g, payloads, loads
 
     def gravity(self) -> list[float]:
         """Return the gravity the forces are solved with, m/s^2 in the URDF's root frame."""
@@ -257,20 +288,23 @@ class RobotForcesTick(ForcesTick):
 
     # -- the tick -----------------------------------------------------------------------
 
-    def warm(self, dynamics: Any = None, model: Any = None) -> Any:
+    def warm(self, dynamics: Any = None, model: Any = None, loads: Any = None) -> Any:
         """Solve the forces where the drivers go, with gravity ``dynamics`` (or the tick's).
 
         As the scene's forces tick does (:meth:`ForcesTick.warm`): the forces'
         straight-line code of each group of loops is written here, before the
-        ticks and before a new gravity takes effect.
+        ticks and before a new gravity (``model``, link ``loads``) takes effect.
         """
-        g = self.g if dynamics is None else dynamics
+        current_model, current_g, current_loads = self._state
+        g = current_g if dynamics is None else dynamics
+        state_of = (current_model if model is None else model, g,
+                    current_loads if loads is None else loads)
         if self._samples is None:
             self._samples = self._sample_states()
         for state in self._samples:
             values = values_from_state(state, self.joints, self.points, ())
             try:
-                self._forces(values, state, math.inf, g, None, model)
+                self._forces(values, state, math.inf, state_of, None)
             except (ForcesLeftOut, AssemblyError):
                 continue
         return g
@@ -281,7 +315,7 @@ class RobotForcesTick(ForcesTick):
         values, measure, at = self._motion(theta, omega, alpha, tol, turns)
         given = self.inputs
         try:
-            forces = self._forces(values, at, tol, self.g, given)
+            forces = self._forces(values, at, tol, self._state, given)
         except (ForcesLeftOut, AssemblyError) as why:
             urdf = self.values.values(values, given)
             where = self.robot.where([urdf[k] for _, k in self._actuated])
@@ -290,10 +324,13 @@ class RobotForcesTick(ForcesTick):
             return values, measure
         return values + forces, measure
 
-    def _forces(self, values: list[float], at: Any, tol: float, g: tuple[float, float, float],
-                given: Any, model: Any = None) -> list[float]:
-        """Return the forces' values at ``at`` (``values``: the scene's, of the same positions)."""
-        model = self.model if model is None else model     # read once: one model an instant
+    def _forces(self, values: list[float], at: Any, tol: float, solved_with: tuple[Any, ...],
+                given: Any) -> list[float]:
+        """Return the forces' values at ``at`` (``values``: the scene's, of the same positions).
+
+        ``solved_with``: (model, gravity, link loads), read once an instant.
+        """
+        model, g, loads = solved_with
         urdf = self.values.values(values, given)
         n = len(self.names)
         if self.static:
@@ -301,7 +338,7 @@ class RobotForcesTick(ForcesTick):
         else:
             inputs = {name: (urdf[k], urdf[n + k], urdf[2 * n + k])
                       for name, k in self._actuated}
-        efforts = model.efforts(at, inputs, g, tol)
+        efforts = model.efforts(at, inputs, g, tol, loads)
         reactions = model.reactions(efforts, dict(zip(self.names, urdf[:n])), {})
         given_efforts = efforts.efforts
         out = [(float(given_efforts[name]) if name in given_efforts else math.nan)

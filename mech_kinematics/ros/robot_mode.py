@@ -63,17 +63,19 @@ def robot_forces_refusal(note: str | None, drive: str, effort: str, default_effo
     it has (:func:`~mech_kinematics.ros.robot_forces.robot_forces_note`).
     ``given``: the parameters given at start. Refused in one line, rather than
     accepted and ignored: ``loads.*`` always (a robot's loads are its
-    ``payloads``; a force at a point of a link is not taken yet); ``effort``
-    other than its default, ``gravity`` and ``payloads`` where the robot has
-    no forces to publish; ``gravity`` and ``payloads`` where its efforts are
-    left out (``drive: topic`` without ``effort: static``).
+    ``payloads``, ``link_forces`` and ``link_torques``); ``effort`` other than
+    its default, ``gravity``, ``payloads`` and the link loads where the robot
+    has no forces to publish; those where its efforts are left out (``drive:
+    topic`` without ``effort: static``).
     """
     loads = [name for name in given if name.startswith('loads.')]
     if loads:
         return (f"Expected no loads.* in URDF mode (a robot's loads are point masses on its "
-                f'links, payloads:=["LINK=KG@X,Y,Z"]; a force at a point of a link is not '
-                f'taken yet), got {", ".join(loads)}')
-    named = [name for name in given if name in ('gravity', 'payloads')]
+                f'links, payloads:=["LINK=KG@X,Y,Z"], and forces and torques on its links, '
+                f'link_forces:=["LINK=FX,FY,FZ@X,Y,Z"] and link_torques), got '
+                f'{", ".join(loads)}')
+    named = [name for name in given if name in ('gravity', 'payloads', 'link_forces',
+                                                'link_torques')]
     if note is not None:
         if effort != default_effort:
             named.insert(0, f'effort:={effort}')
@@ -148,7 +150,8 @@ class Source:
 def load_source(scene: str, robot_description: str = '', loop_closures: str = '',
                 actuated_joints: Sequence[str] | None = None,
                 reference_pose: Sequence[str] | None = None,
-                payloads: Sequence[str] | None = None) -> Source:
+                payloads: Sequence[str] | None = None,
+                link_loads: Sequence[str] | None = None) -> Source:
     """Load the scene or robot the node's parameters name.
 
     Parameters
@@ -170,6 +173,9 @@ def load_source(scene: str, robot_description: str = '', loop_closures: str = ''
     payloads : sequence of str or None
         ``LINK=KG[@X,Y,Z]`` each: point masses welded to links
         (:func:`payloads_from_parameter`).
+    link_loads : sequence of str or None
+        The names of the link-load parameters given (``link_forces``,
+        ``link_torques``): refused with a scene; the forces tick reads them.
 
     Raises
     ------
@@ -188,6 +194,7 @@ def load_source(scene: str, robot_description: str = '', loop_closures: str = ''
                                           ('actuated_joints', actuated_joints),
                                           ('reference_pose', reference_pose),
                                           ('payloads', payloads)) if value]
+        given += list(link_loads or ())
         if given:
             msg = (f'Expected {", ".join(given)} with a robot described in URDF (scene:=PATH.urdf '
                    f'or robot_description), got scene {scene}')

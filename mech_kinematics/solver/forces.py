@@ -147,6 +147,10 @@ class Load:
         one, as a gas force on a piston, else the first link placed there).
     torque : float or None
         N m about z, + CCW.
+    at : (float, float) or None
+        For a force on ``link`` without ``point``: where it acts, in the body's
+        own frame (m), as a mass's ``com`` is given (a URDF link's force at a
+        point of the link).
     """
 
     name: str
@@ -154,14 +158,17 @@ class Load:
     force: tuple[float, float] | None = None
     link: str | None = None
     torque: float | None = None
+    at: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
         """Validate the fields: a force at a point, or a torque on a link, not both."""
         _check_name(self.name, 'a load name', (self, 'name'))
         at_point = self.point is not None or self.force is not None
         twist = self.torque is not None
-        if at_point == twist or (at_point and (self.point is None or self.force is None)) \
-                or (twist and self.link is None):
+        placed = self.point is not None or (self.at is not None and self.link is not None
+                                            and self.point is None)
+        if at_point == twist or (at_point and (not placed or self.force is None)) \
+                or (twist and (self.link is None or self.at is not None)):
             msg = (f'Expected load "{self.name}" to be {{point, force}} (optionally with the '
                    f'link it acts on) or {{link, torque}}, got point={self.point!r}, '
                    f'force={self.force!r}, link={self.link!r}, torque={self.torque!r}')
@@ -176,6 +183,14 @@ class Load:
             object.__setattr__(self, 'force', (float(force[0]), float(force[1])))
         if self.torque is not None:
             _check_finite(self.torque, f'the torque of load "{self.name}"', (self, 'torque'))
+        if self.at is not None:
+            at = tuple(self.at)
+            if len(at) != 2:
+                msg = f'Expected the point of load "{self.name}" as [x, y], got {self.at!r}'
+                raise SceneError(msg, (self, 'at'))
+            for value in at:
+                _check_finite(value, f'the point of load "{self.name}"', (self, 'at'))
+            object.__setattr__(self, 'at', (float(at[0]), float(at[1])))
 
 
 def given_forces_refusal(masses: Sequence[Mass], loads: Sequence[Load],
@@ -464,6 +479,13 @@ class Dynamics:
                            f'fixed on the ground (a load there moves nothing)')
                     raise SceneError(msg, (load, 'point'))
                 self.point_loads.setdefault(body, []).append(load)
+            elif load.force is not None:    # at a point of its body's frame (``at``)
+                assert load.link is not None and load.at is not None
+                if load.link not in graph.bodies or load.link == graph.ground:
+                    msg = f'Expected a load on a moving body ({", ".join(moving)}), got ' + (
+                        'the ground' if load.link == graph.ground else f'unknown "{load.link}"')
+                    raise SceneError(msg, (load, 'link'))
+                self.point_loads.setdefault(load.link, []).append(load)
             else:
                 assert load.link is not None
                 if load.link not in graph.bodies or load.link == graph.ground:
@@ -579,8 +601,8 @@ class Dynamics:
             return load, 'link'
         origin = self.graph.bodies[body].frame.origin  # type: ignore[union-attr]
         for load in self.point_loads.get(body, ()):
-            if load.point != origin:
-                return load, 'point'
+            if (load.point != origin) if load.at is None else load.at != (0.0, 0.0):
+                return load, 'point' if load.at is None else 'at'
         return None
 
     def needs(self) -> tuple[set[str], set[str]]:
@@ -788,12 +810,18 @@ class Dynamics:
         for load in self.point_loads.get(name, ()):
             force = complex(*load.force)  # type: ignore[misc]
             point = load.point
-            assert point is not None
-            d = kin.position(point) - kin.position(origin)
+            if point is None:   # at a point of the body's frame, turned with it (a com's way)
+                at = complex(*load.at)  # type: ignore[misc]
+                d = at * kin.expi(theta)
+                a_d = magnitude(d)
+                e_d = magnitude(at) * (e[0] + 4 * U)
+            else:
+                d = kin.position(point) - kin.position(origin)
+                a_d = magnitude(d)
+                e_d = kin.position_bound(point) + kin.position_bound(origin) + U * a_d
             F = F - force
             M = M - _cross(d, force)
-            a_d, a_force = magnitude(d), magnitude(force)
-            e_d = kin.position_bound(point) + kin.position_bound(origin) + U * a_d
+            a_force = magnitude(force)
             eF = eF + U * (magnitude(F) + a_force)
             eM = eM + e_d * a_force + 3 * U * (a_d * a_force + abs(M))
         for load in self.torque_loads.get(name, ()):

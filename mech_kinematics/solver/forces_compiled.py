@@ -233,6 +233,10 @@ def compile_single(dynamics: Dynamics, pivots: Mapping[str, Sequence[int]],
     callable or NotCompiled
         ``fn(state, max_error)``: see the module's docstring.
     """
+    placed = next((load.name for load in dynamics.loads if load.at is not None), None)
+    if placed is not None:
+        return NotCompiled(f'load "{placed}" acts at a point of its body\'s frame (a URDF '
+                           f"link's force): not written out, the general path serves it")
     for group in dynamics.groups:
         if group.levers:
             return NotCompiled(f'{group.key}: an intermittent drive (its phase picks the '

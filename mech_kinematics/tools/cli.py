@@ -41,7 +41,8 @@ __all__ = ['ArgumentParser', 'PROG', 'UNIT_SYSTEMS', 'add_driver_arguments',
            'add_gravity_argument', 'add_robot_arguments', 'add_scene_argument',
            'add_units_argument', 'angle_given', 'angle_unit', 'angular_rate_given',
            'drive_from_args', 'finite_float',
-           'gravity_of', 'is_urdf', 'joint_list', 'load_robot_argument', 'load_scene_argument',
+           'gravity_of', 'is_urdf', 'joint_list', 'link_loads_of', 'load_robot_argument',
+           'load_scene_argument',
            'mimic_ruled', 'named_value', 'payloads_of', 'positive_float', 'positive_int',
            'positive_seconds', 'run_handler', 'run_tool', 'seconds_or_zero', 'values_by_driver']
 
@@ -156,6 +157,22 @@ def add_gravity_argument(parser: argparse.ArgumentParser) -> None:
                         help='for a robot described in URDF: a point mass welded to a link, '
                              "at a point of the link's frame (m; default its origin), e.g. "
                              'platform=2.5@0.1,0,0.05 (repeatable)')
+    parser.add_argument('--link-force', action='append', metavar='LINK=FX,FY,FZ[@X,Y,Z]',
+                        help="for a robot described in URDF: a force on a link, N in the URDF's "
+                             "root frame, at a point of the link's frame (m; default its "
+                             'origin), e.g. tool=0,0,-20@0.1,0,0 (repeatable, a link once)')
+    parser.add_argument('--link-torque', action='append', metavar='LINK=TX,TY,TZ',
+                        help='for a robot described in URDF: a torque on a link, N m in the '
+                             "URDF's root frame (repeatable, a link once)")
+
+
+def link_loads_of(args: argparse.Namespace) -> tuple[Any, ...]:
+    """Return ``--link-force`` and ``--link-torque`` as link loads, or a one-line ValueError."""
+    from ..robot.forces import parse_link_loads
+
+    return parse_link_loads(getattr(args, 'link_force', None) or (),
+                            getattr(args, 'link_torque', None) or (), '--link-force',
+                            '--link-torque')
 
 
 def payloads_of(args: argparse.Namespace) -> dict[str, tuple[float, tuple[float, ...]]]:

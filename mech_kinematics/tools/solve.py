@@ -16,7 +16,8 @@ import warnings
 from .cli import (add_driver_arguments, add_gravity_argument, add_robot_arguments,
                   add_scene_argument, add_units_argument, angle_given, angle_unit,
                   angular_rate_given, drive_from_args, finite_float, gravity_of, is_urdf,
-                  load_robot_argument, mimic_ruled, positive_float, run_tool, values_by_driver)
+                  link_loads_of, load_robot_argument, mimic_ruled, positive_float, run_tool,
+                  values_by_driver)
 from ..bounds import MAX_ERROR
 from ..errors import AssemblyError, NearSingularWarning, SceneError, UntrustedError
 from ..scene import load_scene
@@ -63,8 +64,9 @@ Where the URDF's links carry <inertial>: "gravity" (m/s^2 in the root frame,
 --gravity GX,GY,GZ, default 0,0,-9.80665) and "efforts": each actuated joint
 that drives a loop (a mimic follower's load on its leader), N m or N,
 positive along its <axis> (sum of effort x velocity is the power put in),
-the forces of the motion given (static with no --speed and --accel), their
-bounds under "error_bound"."efforts"; "reactions": each revolute joint and
+the forces of the motion given (static with no --speed and --accel; with
+the forces and torques on links of --link-force and --link-torque, listed
+under "link_loads"), their bounds under "error_bound"."efforts"; "reactions": each revolute joint and
 pin of every loop, the load its parent puts on its child at its origin in
 the child link's frame (the force in the loop's plane, N; the actuator's
 torque about its axis, N m); or "forces_left_out" saying why not
@@ -120,11 +122,18 @@ def _handle_robot(args: argparse.Namespace) -> int:
     """Solve a robot described in URDF: its joints under their URDF names."""
     try:
         gravity = gravity_of(args)
+        loads = link_loads_of(args)
         robot = load_robot_argument(args)
         if gravity is not None and robot.forces is None:
             msg = (f'--gravity: Expected a robot whose links carry <inertial> (their masses), '
                    f'got none in {args.scene}: gravity would move nothing')
             raise ValueError(msg)
+        if loads and robot.forces is None:
+            msg = (f'--link-force: Expected a robot whose links carry <inertial> (its forces '
+                   f'are solved with its masses), got none in {args.scene}')
+            raise ValueError(msg)
+        if loads:
+            robot.forces.check_loads(loads)
         positions, speeds, accels, shown, exact = _robot_drive(robot, args)
     except (SceneError, ValueError) as error:
         print(f'error: {error}', file=sys.stderr)
@@ -133,7 +142,7 @@ def _handle_robot(args: argparse.Namespace) -> int:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter('always', NearSingularWarning)
             answer = robot.solve({**positions, **exact}, speeds, accels,
-                                 max_error=args.max_error, gravity=gravity)
+                                 max_error=args.max_error, gravity=gravity, loads=loads)
         if exact:  # the loops at the exact direction; the joints echoed as given
             echoed = robot.joints_from_state(answer.state, {
                 name: (positions.get(name, motion.position), motion.velocity,
@@ -165,10 +174,11 @@ def _handle(args: argparse.Namespace) -> int:
         return _handle_robot(args)
     try:
         if args.closures or args.actuated or args.reference or args.gravity is not None \
-                or args.payload:
-            msg = (f'Expected --closures, --actuated, --reference, --gravity and --payload '
-                   f"with a robot described in URDF (a path ending in .urdf; a scene's gravity "
-                   f'and masses are its gravity: and masses: keys), got scene {args.scene}')
+                or args.payload or args.link_force or args.link_torque:
+            msg = (f'Expected --closures, --actuated, --reference, --gravity, --payload, '
+                   f'--link-force and --link-torque with a robot described in URDF (a path '
+                   f"ending in .urdf; a scene's gravity, masses and loads are its gravity:, "
+                   f'masses: and loads: keys), got scene {args.scene}')
             raise SceneError(msg)
         scene = load_scene(args.scene)
     except SceneError as error:

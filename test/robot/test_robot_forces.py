@@ -509,3 +509,105 @@ def test_solve_takes_payloads_and_refuses_a_bad_one_in_one_line(capsys):
         assert cli_main(['solve', str(LIFT), '--payload', bad]) == 2
         err = capsys.readouterr().err.strip()
         assert says in err and len(err.splitlines()) == 1
+
+
+# --- link loads: a force and a torque on a link, in the root frame -----------------------
+
+def _link_work_rate(fk, answers, link, load):
+    """Return d(F . p + T . theta)/dq by central differences of the test's own kinematics.
+
+    ``answers``: our answers at q - h and q + h (the loops closed there); the
+    point's position and the link's orientation come from the URDF's 4x4s.
+    """
+    (down, up), h = answers
+    frames = [fk.transforms(_values(a))[link] for a in (down, up)]
+    point = np.array([*load.point, 1.0])
+    dp = (frames[1] @ point - frames[0] @ point)[:3] / (2 * h)
+    turn = frames[1][:3, :3] @ frames[0][:3, :3].T
+    w = np.array([turn[2, 1] - turn[1, 2], turn[0, 2] - turn[2, 0],
+                  turn[1, 0] - turn[0, 1]]) / 2 / (2 * h)
+    return float(np.asarray(load.force) @ dp + np.asarray(load.torque) @ w)
+
+
+@pytest.mark.parametrize('name', CASES)
+def test_a_link_load_changes_the_efforts_by_its_virtual_work(name):
+    """Each effort with a force and a torque on a link is the one without, less dW/dq.
+
+    Static balance: effort dq + F . dp + T . dtheta = dPE, so the load adds
+    ``-(F . dp/dq + T . dtheta/dq)``, the point's motion ``p`` and the link's
+    turn ``theta`` by central differences (h = 1e-5) of the test's own forward
+    kinematics of the URDF; random links the loops move, points, forces and
+    torques in the root frame (the parts out of a loop's plane do no work).
+    """
+    from mech_kinematics.robot.forces import LinkLoad
+
+    robot, fk, _, joint, low, high, carriers, gravity = _case(name)
+    rng = np.random.default_rng(45)
+    links = sorted(robot.forces.moving_links)
+    h = 1e-5
+    for q in np.linspace(low, high, 4)[1:-1]:
+        positions = {n: float(rng.uniform(-1.0, 1.0)) for n in carriers}
+        positions[joint] = float(q)
+        load = LinkLoad(links[int(rng.integers(len(links)))],
+                        tuple(rng.uniform(-50.0, 50.0, 3)), tuple(rng.uniform(-0.1, 0.1, 3)),
+                        tuple(rng.uniform(-5.0, 5.0, 3)))
+        bare = robot.solve(positions, gravity=gravity)
+        loaded = robot.solve(positions, gravity=gravity, loads=[load])
+        around = [robot.solve({**positions, joint: q + s}, gravity=gravity) for s in (-h, h)]
+        rate = _link_work_rate(fk, (around, h), load.link, load)
+        scale = 50.0 * fk.loop_size(fk.closures[0][0]) + 5.0
+        got = loaded.efforts.efforts[joint] - bare.efforts.efforts[joint]
+        assert got == pytest.approx(-rate, abs=1e-7 * scale), (load, q)
+        assert loaded.efforts.loads == (load,)
+
+
+def test_a_link_force_of_a_weight_is_the_payload_of_that_mass():
+    """A force -m g (root frame) at a point of a link: the efforts and reactions of a payload m."""
+    from mech_kinematics.robot.forces import LinkLoad
+
+    point = (0.1, 0.0, 0.05)
+    payload = load_robot(LIFT, payloads={'platform': (2.0, point)})
+    plain = load_robot(LIFT)
+    force = LinkLoad('platform', (0.0, 0.0, -2.0 * G), point)
+    for q in (-0.9, 0.0, 0.4, 1.1):
+        want = payload.solve({'lift_joint': q})
+        got = plain.solve({'lift_joint': q}, loads=[force])
+        bound = want.efforts.bounds['lift_joint'] + got.efforts.bounds['lift_joint']
+        assert abs(got.efforts.efforts['lift_joint'] - want.efforts.efforts['lift_joint']) \
+            <= bound
+        for name, reaction in want.reactions.items():
+            other = got.reactions[name]
+            assert np.allclose(other.force, reaction.force, rtol=0, atol=1e-12 * 100)
+            assert np.allclose(other.torque, reaction.torque, rtol=0, atol=1e-12 * 100)
+
+
+def test_solve_takes_link_loads_and_refuses_a_bad_one_in_one_line(capsys):
+    """--link-force and --link-torque: the JSON's efforts and "link_loads"; bad ones, one line."""
+    assert cli_main(['solve', str(LIFT), '--input', 'lift_joint=0', '--link-torque',
+                     'lower_arm=0,1.5,0']) == 0
+    loaded = json.loads(capsys.readouterr().out)
+    assert cli_main(['solve', str(LIFT), '--input', 'lift_joint=0']) == 0
+    plain = json.loads(capsys.readouterr().out)
+    # lift_joint's axis is -y: a torque of +1.5 N m about +y turns against it, the motor
+    # holds 1.5 N m more.
+    want = plain['efforts']['lift_joint'] + 1.5
+    assert loaded['efforts']['lift_joint'] == pytest.approx(want, abs=1e-12)
+    assert loaded['link_loads'] == [{'link': 'lower_arm', 'force': [0.0, 0.0, 0.0],
+                                     'point': [0.0, 0.0, 0.0], 'torque': [0.0, 1.5, 0.0]}]
+    for args, words in (
+            (['--link-force', 'wing=0,0,1'], '--link-force: load on link "wing": Expected a '
+             'link of the robot'),
+            (['--link-force', 'base_link=0,0,1'], '--link-force: load on link "base_link": '
+             'Expected a link a loop moves'),
+            (['--link-force', 'platform=0,0'], '--link-force: Expected LINK=FX,FY,FZ or'),
+            (['--link-force', 'platform=0,0,nan'], '--link-force: Expected LINK=FX,FY,FZ or'),
+            (['--link-torque', 'platform=0,0,1@1,2,3'], '--link-torque: Expected '
+             'LINK=TX,TY,TZ'),
+            (['--link-force', 'platform=0,0,1e13'], '--link-force: Expected a load of at most'),
+            (['--link-force', 'platform=0,0,1', '--link-force', 'platform=1,0,0'],
+             '--link-force: Expected each link once')):
+        assert cli_main(['solve', str(LIFT), *args]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith(f'error: {words}') and err.count('\n') == 1, err
+    assert cli_main(['solve', 'khurmi_four_bar_ad150', '--link-force', 'a=0,0,1']) == 2
+    assert 'with a robot described in URDF' in capsys.readouterr().err

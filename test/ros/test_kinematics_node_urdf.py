@@ -355,8 +355,12 @@ def test_a_stop_while_the_start_reads_a_large_urdf_ends_it_at_once(ros, tmp_path
     # Issue 44: forces parameters that do not apply in URDF mode, and bad ones.
     (('-p', f'scene:={DATA / "lift_arm.urdf"}', '-p', 'loads.tool.force:=[1.0, 0.0]'),
      "cannot start: Expected no loads.* in URDF mode (a robot's loads are point masses on "
-     'its links, payloads:=["LINK=KG@X,Y,Z"]; a force at a point of a link is not taken yet), '
-     'got loads.tool.force'),
+     'its links, payloads:=["LINK=KG@X,Y,Z"], and forces and torques on its links, '
+     'link_forces:=["LINK=FX,FY,FZ@X,Y,Z"] and link_torques), got loads.tool.force'),
+    (('-p', f'scene:={DATA / "lift_arm.urdf"}', '-p', "link_forces:=['base_link=0,0,1']"),
+     'link_forces: load on link "base_link": Expected a link a loop moves'),
+    (('-p', "link_torques:=['crank=0,0,1']"), 'cannot start: Expected link_torques with a robot '
+     'described in URDF'),
     (('-p', f'scene:={DATA / "lift_arm.urdf"}', '-p', "payloads:=['wing=1.5@0,0,0.1']"),
      'payload on link "wing": Expected a link of the robot (base_link, lower_arm'),
     (('-p', f'scene:={DATA / "lift_arm.urdf"}', '-p', 'gravity:=[0.0, 0.0, 1e308]'),

@@ -235,3 +235,18 @@ def test_payloads_changed_while_running_change_the_effort(node):
     msg, _ = node.answer(0.45)
     assert msg.effort[0] == pytest.approx(_hand_torque(0.45), rel=1e-12)
     assert node.proc.proc.poll() is None, node.proc.output()
+
+
+def test_link_forces_changed_while_running_change_the_effort(node):
+    """``link_forces`` set while running: a weight-like force is a payload's torque by hand."""
+    assert node.set('gravity', [0.0, 0.0, -G]).successful
+    assert node.set('link_forces', [f'platform=0,0,{-1.5 * G!r}@0.1,0,0.05']).successful
+    msg, _ = node.answer(0.55)
+    assert msg.effort[0] == pytest.approx(_hand_torque(0.55, payload=PAYLOAD_KG + 1.5),
+                                          rel=1e-12)
+    result = node.set('link_forces', ['base_link=0,0,1'])
+    assert not result.successful and 'Expected a link a loop moves' in result.reason
+    assert node.set('link_forces', []).successful
+    msg, _ = node.answer(0.65)
+    assert msg.effort[0] == pytest.approx(_hand_torque(0.65), rel=1e-12)
+    assert node.proc.proc.poll() is None, node.proc.output()

@@ -136,7 +136,7 @@ def test_a_closures_reaction_is_in_its_child_links_axes_however_its_frame_is_tur
 def test_gravity_is_three_components_refused_beyond_the_doubles():
     """The gravity parameter: three finite numbers, at most MAX_GRAVITY; [0, 0, 0] none."""
     tick = _tick(load_source(str(LIFT)))
-    [spec] = tick.parameters()
+    spec, *_ = tick.parameters()
     assert (spec.name, spec.kind, spec.default) == ('gravity', 'xyz', [0.0, 0.0, -9.80665])
     specs = {'gravity': spec}
     assert refusal('gravity', [0.0, math.inf, 0.0], specs) == \
@@ -208,7 +208,8 @@ def test_payloads_change_while_running_from_the_next_instant():
     tick = robot_forces_tick(source.robot, source.scene, drive=TOPIC, effort=STATIC,
                              unloaded=source.unloaded)
     tick.apply({'gravity': [0.0, 0.0, -9.80665], 'payloads': []})
-    assert [p.name for p in tick.parameters()] == ['gravity', 'payloads']
+    names = ['gravity', 'link_forces', 'link_torques', 'payloads']
+    assert [p.name for p in tick.parameters()] == names
     first, q = tick.forces_first, 0.4
     plain = _from_input(tick, [q])[first:]
     entry = 'platform=2.0@0.1,0,0.05'
@@ -231,7 +232,45 @@ def test_payloads_change_while_running_from_the_next_instant():
     assert _from_input(tick, [q])[first:] == loaded       # the masses kept
     tick.apply({'payloads': []})
     assert _from_input(tick, [q])[first:] == plain
-    assert [p.name for p in _tick(source).parameters()] == ['gravity']
+    assert [p.name for p in _tick(source).parameters()] == ['gravity', 'link_forces',
+                                                            'link_torques']
+
+
+def test_link_loads_are_parameters_of_the_tick_judged_then_applied():
+    """link_forces and link_torques: the efforts of Robot.solve with those loads, to the bit.
+
+    Set as the node hands them over (what changed), refused in one line (a
+    link the loops do not move, an entry not in the form), the loads kept.
+    """
+    from mech_kinematics.robot.forces import LinkLoad
+
+    source = load_source(str(LIFT))
+    tick = _tick(source)
+    robot = load_robot(LIFT)
+    first, q = tick.forces_first, 0.4
+    forces, torques = ['platform=0,0,-30@0.1,0,0.05'], ['lower_arm=0,2.5,0']
+    values = {'gravity': [0.0, 0.0, -9.80665], 'link_forces': forces, 'link_torques': torques}
+    assert tick.parameters_refusal(values) is None
+    tick.apply({'link_forces': forces, 'link_torques': torques})
+    loads = [LinkLoad('platform', (0.0, 0.0, -30.0), (0.1, 0.0, 0.05), (0.0, 0.0, 0.0)),
+             LinkLoad('lower_arm', torque=(0.0, 2.5, 0.0))]
+    answer = robot.solve({'lift_joint': q}, loads=loads)
+    out = _from_input(tick, [q])[first:]
+    assert out[0] == answer.efforts.efforts['lift_joint']
+    for k, name in enumerate(tick.reactions):
+        r = answer.reactions[name]
+        assert out[3 + 6 * k:3 + 6 * k + 6] == [*r.force, *r.torque]
+    for key, entries, words in (
+            ('link_forces', ['base_link=0,0,1'], 'link_forces: load on link "base_link": '
+             'Expected a link a loop moves'),
+            ('link_forces', ['platform=0,0'], 'link_forces: Expected LINK=FX,FY,FZ or'),
+            ('link_torques', ['platform=1,2'], 'link_torques: Expected LINK=TX,TY,TZ')):
+        refused = tick.parameters_refusal({**values, key: entries})
+        assert refused is not None and refused.startswith(words), refused
+    assert _from_input(tick, [q])[first:] == out
+    tick.apply({'link_forces': [], 'link_torques': []})
+    assert _from_input(tick, [q])[first] == robot.solve({'lift_joint': q}).efforts.efforts[
+        'lift_joint']
 
 
 def test_a_forces_parameter_that_does_not_apply_is_refused():
