@@ -579,6 +579,11 @@ def test_a_link_force_of_a_weight_is_the_payload_of_that_mass():
             other = got.reactions[name]
             assert np.allclose(other.force, reaction.force, rtol=0, atol=1e-12 * 100)
             assert np.allclose(other.torque, reaction.torque, rtol=0, atol=1e-12 * 100)
+    for q in np.linspace(-1.0, 1.0, 40):    # past the instants after which statics compile
+        plain.solve({'lift_joint': float(q)}, loads=[force])
+    [loaded] = [d for d in plain.forces._cache.values() if d.loads]
+    assert not loaded.compiled_single and 'the general path serves it' in str(
+        loaded.compiled_single), 'a load at a point of a body is said not written out'
 
 
 def test_solve_takes_link_loads_and_refuses_a_bad_one_in_one_line(capsys):
