@@ -66,8 +66,9 @@ that drives a loop (a mimic follower's load on its leader), N m or N,
 positive along its <axis> (sum of effort x velocity is the power put in),
 the forces of the motion given (static with no --speed and --accel; with
 the forces and torques on links of --link-force and --link-torque, listed
-under "link_loads"), their bounds under "error_bound"."efforts"; "reactions": each revolute joint and
-pin of every loop, the load its parent puts on its child at its origin in
+under "link_loads"), their bounds under "error_bound"."efforts";
+"reactions": each revolute joint and pin of every loop, the load its
+parent puts on its child at its origin in
 the child link's frame (the force in the loop's plane, N; the actuator's
 torque about its axis, N m); or "forces_left_out" saying why not
 (docs/urdf.md, "Forces").
