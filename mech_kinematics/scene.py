@@ -21,7 +21,7 @@ before anything is read from it, and the read stops one byte past
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 import math
 import os
 from pathlib import Path
@@ -73,6 +73,8 @@ MAX_IMUS = 10_000
 MAX_DRIVERS = 100
 #: Most bodies with a mass (``masses:``) and most loads (``loads:``) in a scene.
 MAX_MASSES = MAX_LOADS = 10_000
+#: Most rows in one load's ``table``.
+MAX_TABLE_ROWS = 10_000
 
 #: The two spellings of ``units`` every refusal of a missing or bad one shows.
 UNITS_EXAMPLES = 'units: {length: mm, angle: deg} or units: {length: m, angle: rad}'
@@ -353,14 +355,44 @@ def parse_scene(data: Any) -> Scene:
             raise SceneError(f'outputs.{key}: expected a list of names, got {_brief(value)}')
         selected[key] = None if value is None else tuple(value)
 
-    try:
+    def build(given: tuple[Load, ...]) -> Scene:
         return Scene(name=name, ground=ground, input=crank, dyads=tuple(dyads),
                      points=tuple(points), outputs_joints=selected['joints'],
                      outputs_points=selected['points'], description=description,
                      pins=tuple(pins), units=reader.units, imus=imus, inputs=drivers,
-                     gravity=gravity, masses=masses, loads=loads, urdf_drivers=followed)
+                     gravity=gravity, masses=masses, loads=given, urdf_drivers=followed)
+
+    try:
+        if any(load.table is not None for load in loads):
+            loads = _tables_in_si(build(()).joint_types, reader.units, loads, keys)
+        return build(loads)
     except SceneError as error:
         raise SceneError(f'{keys.key(error)}: {error}') from None
+
+
+def _tables_in_si(kinds: Mapping[str, Any], units: Any, loads: tuple[Load, ...],
+                  keys: _Keys) -> tuple[Load, ...]:
+    """Return ``loads`` with each table's positions in rad (a revolute joint) or m."""
+    from dataclasses import replace
+
+    from .units import LENGTH_UNITS, radians_from_degrees
+
+    out = []
+    for load in loads:
+        if load.table is None or load.table[0] not in kinds:
+            out.append(load)    # a joint the scene lacks: the Dynamics says so, naming it
+            continue
+        joint, rows = load.table
+        if kinds[joint].angular:
+            convert = radians_from_degrees if units.angle == 'deg' else float
+        else:
+            per_metre = LENGTH_UNITS[units.length]
+            convert = (lambda x: x / per_metre) if per_metre != 1.0 else float
+        table = (joint, tuple((convert(x), fx, fy) for x, fx, fy in rows))
+        converted = replace(load, table=table)
+        keys.paths[id(converted)] = keys.paths.get(id(load), ('', {}))
+        out.append(converted)
+    return tuple(out)
 
 
 def _link(reader: _Reader, keys: _Keys, raw: Any, where: str) -> Link:
@@ -605,16 +637,47 @@ def _loads(reader: _Reader, keys: _Keys, raw: Any) -> tuple[Load, ...]:
         if not isinstance(value, dict):
             raise SceneError(f'{where}: expected {{name, point, force}} or {{name, link, '
                              f'torque}}, got {_kind(value)} {_brief(value)}')
-        _check_keys(value, {'name', 'point', 'force', 'link', 'torque'}, where)
+        _check_keys(value, {'name', 'point', 'force', 'link', 'torque', 'table'}, where)
         force = (_xy_pair(reader, value['force'], f'{where}.force', 'N')
                  if 'force' in value else None)
+        table = _load_table(reader, value['table'], f'{where}.table') \
+            if 'table' in value else None
         loads.append(keys.build(
             where, {}, Load, name=reader.name(value, 'name', where),
             point=reader.name(value, 'point', where) if 'point' in value else None,
             force=force,
             link=reader.name(value, 'link', where) if 'link' in value else None,
-            torque=reader.number(value, 'torque', where) if 'torque' in value else None))
+            torque=reader.number(value, 'torque', where) if 'torque' in value else None,
+            table=table))
     return tuple(loads)
+
+
+def _load_table(reader: _Reader, raw: Any, where: str
+                ) -> tuple[str, tuple[tuple[float, float, float], ...]]:
+    """Read a load's ``table: {joint, rows: [[position, fx, fy], ...]}``, as written.
+
+    Positions in the scene's angle unit for a revolute joint (a link's angle,
+    a crank's) and its length unit for a slider (:func:`_tables_in_si` turns
+    them into rad or m once the joint's kind is known); forces in N.
+    """
+    if not isinstance(raw, dict):
+        raise SceneError(f'{where}: expected {{joint, rows: [[position, fx, fy], ...]}}, got '
+                         f'{_kind(raw)} {_brief(raw)}')
+    _check_keys(raw, {'joint', 'rows'}, where)
+    joint = reader.name(raw, 'joint', where)
+    rows = reader.get(raw, 'rows', where)
+    if not isinstance(rows, list) or len(rows) < 2:
+        raise SceneError(f'{where}.rows: expected at least two rows [position, fx, fy], got '
+                         f'{_brief(rows)}')
+    _check_count(f'{where}.rows', rows, MAX_TABLE_ROWS, 'MAX_TABLE_ROWS', 'rows')
+    out = []
+    for index, row in enumerate(rows):
+        at = f'{where}.rows[{index}]'
+        if not isinstance(row, list) or len(row) != 3:
+            raise SceneError(f'{at}: expected [position, fx, fy], got {_brief(row)}')
+        values = [reader.number({'v': v}, 'v', at) for v in row]
+        out.append((values[0], values[1], values[2]))
+    return joint, tuple(out)
 
 
 def scene_dirs() -> list[Path]:

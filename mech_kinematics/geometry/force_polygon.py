@@ -234,9 +234,21 @@ def force_polygon_from_state(scene: Scene, state: Any, body: str) -> ForcePolygo
                                       -mass.inertia * alpha,
                                       mass.inertia * e_alpha + 2 * U * mass.inertia * abs(alpha)))
     for load in dynamics.point_loads.get(body, ()):
-        assert load.point is not None and load.force is not None
+        if load.point is None:      # at a point of the body's frame (a URDF link's force)
+            assert load.at is not None and load.force is not None
+            at = origin + complex(*load.at) * complex(math.cos(theta), math.sin(theta))
+            add(load.name, ForceKind.LOAD, f'load {load.name}', None, at,
+                complex(*load.force), 0.0)
+            continue
+        if load.table is not None:  # where its joint stands at this instant
+            joint = load.table[0]
+            force, slope = load.force_at(_scalar(state.joints[joint].position))
+            error = slope * _scalar(state.error_bound.joints[joint].position)
+        else:
+            assert load.force is not None
+            force, error = complex(*load.force), 0.0
         add(load.name, ForceKind.LOAD, f'load {load.name}', load.point, where(load.point),
-            complex(*load.force), 0.0)
+            force, error)
     for load in dynamics.torque_loads.get(body, ()):
         couples.append(BodyCouple(load.name, ForceKind.LOAD, f'load {load.name}',
                                   float(load.torque or 0.0), 0.0))

@@ -397,7 +397,8 @@ def force_parameters(dynamics: Dynamics) -> tuple[ParameterSpec, ...]:
 
     ``gravity`` ([gx, gy], m/s^2), and for each load NAME ``loads.NAME.force``
     ([fx, fy], N, scene frame) or ``loads.NAME.torque`` (N m, + CCW): each
-    changeable while the node runs.
+    changeable while the node runs. A load given as a table over a joint's
+    position has none: its table is the scene's.
     """
     specs = [ParameterSpec('gravity', 'xy', gravity_of(dynamics),
                            "Gravity [gx, gy] in the scene's frame, from the next instant "
@@ -408,9 +409,9 @@ def force_parameters(dynamics: Dynamics) -> tuple[ParameterSpec, ...]:
                 f'loads.{load.name}.force', 'xy', list(load.force),
                 f'Force [fx, fy] of load {load.name} at {load.point}, scene frame, from the '
                 "next instant published. Defaults to the scene's", 'N'))
-        else:
+        elif load.torque is not None:
             specs.append(ParameterSpec(
-                f'loads.{load.name}.torque', 'double', float(load.torque or 0.0),
+                f'loads.{load.name}.torque', 'double', float(load.torque),
                 f'Torque of load {load.name} on {load.link}, + CCW, from the next instant '
                 "published. Defaults to the scene's", 'N m'))
     return tuple(specs)

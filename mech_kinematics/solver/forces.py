@@ -151,6 +151,15 @@ class Load:
         For a force on ``link`` without ``point``: where it acts, in the body's
         own frame (m), as a mass's ``com`` is given (a URDF link's force at a
         point of the link).
+    table : (str, tuple of (float, float, float)) or None
+        Instead of ``force``: a force that depends on where a joint stands,
+        ``(joint, rows)``, each row ``(position, fx, fy)`` (rad or m; N), the
+        positions non-decreasing (two rows at one position: a jump, the later
+        row from it on), linear between rows (:meth:`force_at`). A revolute
+        joint's rows lie within one turn from the first and repeat every turn
+        (between the last row and the first a turn on, linear too); a
+        prismatic joint's force below the first row is the first row's, above
+        the last the last's. A press's working stroke is such a table.
     """
 
     name: str
@@ -159,15 +168,21 @@ class Load:
     link: str | None = None
     torque: float | None = None
     at: tuple[float, float] | None = None
+    table: tuple[str, tuple[tuple[float, float, float], ...]] | None = None
+    #: For a table over a revolute joint: its rows repeat every turn (set by the Dynamics).
+    periodic: bool = False
 
     def __post_init__(self) -> None:
         """Validate the fields: a force at a point, or a torque on a link, not both."""
         _check_name(self.name, 'a load name', (self, 'name'))
-        at_point = self.point is not None or self.force is not None
+        if self.table is not None:
+            self._check_table()
+        at_point = self.point is not None or self.force is not None or self.table is not None
         twist = self.torque is not None
         placed = self.point is not None or (self.at is not None and self.link is not None
                                             and self.point is None)
-        if at_point == twist or (at_point and (not placed or self.force is None)) \
+        given = (self.force is None) != (self.table is None)
+        if at_point == twist or (at_point and (not placed or not given)) \
                 or (twist and (self.link is None or self.at is not None)):
             msg = (f'Expected load "{self.name}" to be {{point, force}} (optionally with the '
                    f'link it acts on) or {{link, torque}}, got point={self.point!r}, '
@@ -183,6 +198,9 @@ class Load:
             object.__setattr__(self, 'force', (float(force[0]), float(force[1])))
         if self.torque is not None:
             _check_finite(self.torque, f'the torque of load "{self.name}"', (self, 'torque'))
+        if self.at is not None and self.table is not None:
+            msg = f'Expected load "{self.name}" at a scene point for a table, got at={self.at!r}'
+            raise SceneError(msg, (self, 'at'))
         if self.at is not None:
             at = tuple(self.at)
             if len(at) != 2:
@@ -191,6 +209,61 @@ class Load:
             for value in at:
                 _check_finite(value, f'the point of load "{self.name}"', (self, 'at'))
             object.__setattr__(self, 'at', (float(at[0]), float(at[1])))
+
+    def _check_table(self) -> None:
+        assert self.table is not None
+        joint, raw = self.table
+        rows = tuple(tuple(float(v) for v in row) for row in raw)
+        if len(rows) < 2 or any(len(row) != 3 for row in rows):
+            msg = (f'Expected the table of load "{self.name}" as at least two rows [position, '
+                   f'fx, fy], got {list(raw)!r}')
+            raise SceneError(msg, (self, 'table'))
+        for row in rows:
+            for value in row:
+                _check_finite(value, f'the table of load "{self.name}"', (self, 'table'))
+        positions = [row[0] for row in rows]
+        if any(b < a for a, b in zip(positions, positions[1:], strict=False)) or any(
+                a == b == c for a, b, c in zip(positions, positions[1:], positions[2:],
+                                               strict=False)):
+            msg = (f'Expected the positions of load "{self.name}"\'s table in order, at most '
+                   f'two rows at one position (a jump), got {positions}')
+            raise SceneError(msg, (self, 'table'))
+        object.__setattr__(self, 'table', (str(joint), rows))
+
+    @property
+    def largest(self) -> float:
+        """Return the largest force the load can give, N (its table's largest row)."""
+        if self.table is not None:
+            return max(magnitude(complex(fx, fy)) for _, fx, fy in self.table[1])
+        return magnitude(complex(*self.force)) if self.force is not None else 0.0
+
+    def force_at(self, position: Any) -> tuple[Any, Any]:
+        """Return the table's force where its joint stands (``position``, rad or m), and its slope.
+
+        ``(force, slope)``: complex N, and N per rad (or m), floats for a float
+        and arrays for an array: the same NumPy operations either way, so one
+        instant and an array give the same bits.
+        """
+        assert self.table is not None
+        rows = np.asarray(self.table[1], dtype=np.float64)
+        xp, fx, fy = rows[:, 0], rows[:, 1], rows[:, 2]
+        x = np.asarray(position, dtype=np.float64)
+        if self.periodic:   # the rows repeat every turn: the last to the first a turn on
+            x = xp[0] + np.mod(x - xp[0], math.tau)
+            xp = np.append(xp, xp[0] + math.tau)
+            fx, fy = np.append(fx, fx[0]), np.append(fy, fy[0])
+        else:
+            x = np.clip(x, xp[0], xp[-1])
+        k = np.clip(np.searchsorted(xp, x, side='right') - 1, 0, len(xp) - 2)
+        span = xp[k + 1] - xp[k]
+        with np.errstate(divide='ignore', invalid='ignore'):
+            t = np.where(span > 0.0, (x - xp[k]) / np.where(span > 0.0, span, 1.0), 0.0)
+        force = (fx[k] + t * (fx[k + 1] - fx[k])) + 1j * (fy[k] + t * (fy[k + 1] - fy[k]))
+        slope = np.where(span > 0.0, np.hypot(fx[k + 1] - fx[k], fy[k + 1] - fy[k])
+                         / np.where(span > 0.0, span, 1.0), 0.0)
+        if force.ndim == 0:
+            return complex(force), float(slope)
+        return force, slope
 
 
 def given_forces_refusal(masses: Sequence[Mass], loads: Sequence[Load],
@@ -220,9 +293,9 @@ def given_forces_refusal(masses: Sequence[Mass], loads: Sequence[Load],
                                  f'N), got {list(gravity)} m/s^2')
     total = weight
     for load in loads:
-        if load.force is None:
+        if load.force is None and load.table is None:
             continue
-        total += magnitude(complex(*load.force))
+        total += load.largest
         if not math.isfinite(total):
             return load, 'force', (f"expected the loads' forces and the weights "
                                    f'({weight:.4g} N) to add up to a finite force (at most '
@@ -459,6 +532,20 @@ class Dynamics:
         self.torque_loads: dict[str, list[Load]] = {}
         names: set[str] = set()
         for load in self.loads:
+            if load.table is not None:
+                kind = graph.coordinates.get(load.table[0])
+                if kind is None:
+                    msg = (f'Expected load "{load.name}"\'s table over a joint of the scene '
+                           f'({", ".join(graph.coordinates)}), got "{load.table[0]}"')
+                    raise SceneError(msg, (load, 'table'))
+                if kind.angular and load.table[1][-1][0] - load.table[1][0][0] > math.tau:
+                    msg = (f'Expected load "{load.name}"\'s table over a revolute joint within '
+                           f'one turn from its first row, got rows from '
+                           f'{load.table[1][0][0]!r} to {load.table[1][-1][0]!r} rad')
+                    raise SceneError(msg, (load, 'table'))
+                if kind.angular != load.periodic:
+                    object.__setattr__(load, 'periodic', bool(kind.angular))
+        for load in self.loads:
             if load.name in names:
                 msg = f'Expected each load name once, got "{load.name}" twice'
                 raise SceneError(msg, (load, 'name'))
@@ -622,6 +709,7 @@ class Dynamics:
                 if joint.line.angle_of is not None:
                     joints.add(joint.line.angle_of)
         points.update(load.point for load in self.loads if load.point is not None)
+        joints.update(load.table[0] for load in self.loads if load.table is not None)
         return joints, points
 
     # --- at a solved state -----------------------------------------------------------
@@ -755,8 +843,8 @@ class Dynamics:
                 scale = biggest(scale, mass.mass * (gravity + scales['acceleration'])
                                 + mass.inertia * scales['angular acceleration'] / self.size)
             for load in self.loads:
-                if load.force is not None:
-                    scale = biggest(scale, magnitude(complex(*load.force)))
+                if load.force is not None or load.table is not None:
+                    scale = biggest(scale, load.largest)
                 else:
                     scale = biggest(scale, abs(load.torque or 0.0) / self.size)
             overflow = valid & ~np.asarray(finite, dtype=bool)
@@ -808,7 +896,13 @@ class Dynamics:
             eM = (mass.inertia * (e_alpha + U * abs(alpha)) + e_r * a_F + a_com * eF
                   + 4 * U * (abs(M) + a_com * a_F))
         for load in self.point_loads.get(name, ()):
-            force = complex(*load.force)  # type: ignore[misc]
+            e_force: Any = 0.0
+            if load.table is None:
+                force = complex(*load.force)  # type: ignore[misc]
+            else:   # where its joint stands: the position's error times the slope
+                joint = load.table[0]
+                force, slope = load.force_at(kin.joint_position(joint))
+                e_force = slope * kin.joint_position_bound(joint) + 4 * U * magnitude(force)
             point = load.point
             if point is None:   # at a point of the body's frame, turned with it (a com's way)
                 at = complex(*load.at)  # type: ignore[misc]
@@ -822,8 +916,8 @@ class Dynamics:
             F = F - force
             M = M - _cross(d, force)
             a_force = magnitude(force)
-            eF = eF + U * (magnitude(F) + a_force)
-            eM = eM + e_d * a_force + 3 * U * (a_d * a_force + abs(M))
+            eF = eF + U * (magnitude(F) + a_force) + e_force
+            eM = eM + e_d * a_force + 3 * U * (a_d * a_force + abs(M)) + a_d * e_force
         for load in self.torque_loads.get(name, ()):
             M = M - float(load.torque)  # type: ignore[arg-type]
             eM = eM + U * abs(M)
@@ -1334,6 +1428,12 @@ class _Kinematics:
 
     def position(self, point: str) -> Any:
         return self.points[point][0]
+
+    def joint_position(self, joint: str) -> Any:
+        return self.state.joints[joint].position
+
+    def joint_position_bound(self, joint: str) -> Any:
+        return self.joint_bounds[joint].position
 
     def acceleration(self, point: str) -> Any:
         return self.points[point][2]

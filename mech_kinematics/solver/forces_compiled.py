@@ -233,6 +233,10 @@ def compile_single(dynamics: Dynamics, pivots: Mapping[str, Sequence[int]],
     callable or NotCompiled
         ``fn(state, max_error)``: see the module's docstring.
     """
+    tabled = next((load.name for load in dynamics.loads if load.table is not None), None)
+    if tabled is not None:
+        return NotCompiled(f'load "{tabled}" depends on where its joint stands (a table): not '
+                           f'written out, the general path serves it')
     placed = next((load.name for load in dynamics.loads if load.at is not None), None)
     if placed is not None:
         return NotCompiled(f'load "{placed}" acts at a point of its body\'s frame (a URDF '
