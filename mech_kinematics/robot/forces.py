@@ -229,6 +229,8 @@ class RobotForces:
         self.mechanisms = planar.mechanisms
         self.size = _size(robot.scene)
         self._cache: dict[tuple[Any, ...], Dynamics] = {}
+        #: Per mechanism whose ground no joint carries: its rotation in the root frame.
+        self._fixed_rotations: dict[int, Any] = {}
         masses = planar.masses
         self.masses = [tuple(Mass(body, item['mass'], tuple(item['com']), item['inertia'])
                              for body, item in masses.items() if body in m['bodies'])
@@ -340,6 +342,13 @@ class RobotForces:
         (:class:`ForcesLeftOut`); else its value is taken as 0 (nothing
         projected depends on it).
         """
+        if not self.carriers[index]:    # a ground at a fixed pose: its rotation, once
+            fixed = self._fixed_rotations.get(index)
+            if fixed is None:
+                fixed = self.robot.description.transforms({})[
+                    self.mechanisms[index]['ground']][:3, :3]
+                self._fixed_rotations[index] = fixed
+            return fixed
         robot = self.robot
         description = robot.description
         m = self.mechanisms[index]
