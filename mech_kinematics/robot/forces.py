@@ -231,6 +231,8 @@ class RobotForces:
         self._cache: dict[tuple[Any, ...], Dynamics] = {}
         #: Per mechanism whose ground no joint carries: its rotation in the root frame.
         self._fixed_rotations: dict[int, Any] = {}
+        #: The closures and the drivers by name, once (:meth:`reactions`).
+        self._named: tuple[Any, Any] = (None, None)
         masses = planar.masses
         self.masses = [tuple(Mass(body, item['mass'], tuple(item['com']), item['inertia'])
                              for body, item in masses.items() if body in m['bodies'])
@@ -266,7 +268,10 @@ class RobotForces:
         return None
 
     def _body_of(self) -> dict[str, str]:
-        """Return each URDF link's body: itself, or the loop link it is welded to."""
+        """Return each URDF link's body: itself, or the loop link it is welded to (kept)."""
+        known = self.__dict__.get('_bodies')
+        if known is not None:
+            return known
         description = self.robot.description
         out: dict[str, str] = {}
         for link in description.links:
@@ -277,6 +282,7 @@ class RobotForces:
                     break
                 up = joint.parent
             out[link] = up
+        self._bodies = out
         return out
 
     def check_loads(self, loads: Sequence[LinkLoad], what: str = '--link-force') -> None:
@@ -477,8 +483,11 @@ class RobotForces:
         description = robot.description
         frames = description.transforms(positions)
         body_of = self._body_of()
-        closures = {c.name: c for c in description.closures}
-        drivers = {d.name: d for d in robot.planar.drivers}
+        closures, drivers = self._named
+        if closures is None:
+            closures = {c.name: c for c in description.closures}
+            drivers = {d.name: d for d in robot.planar.drivers}
+            self._named = (closures, drivers)
         spread = math.fsum(abs(float(b)) for b in bounds.values())
         out: dict[str, JointReaction] = {}
         for forces, members in zip(efforts.forces, efforts.groups, strict=True):
@@ -513,8 +522,8 @@ class RobotForces:
                     planar = f.real * np.asarray(m['x']) + f.imag * np.asarray(m['y'])
                     # In the child link's axes (a closure's too: its <child_origin>
                     # places the point, its rotation does not turn the answer).
-                    frame = np.linalg.solve(ground, frames[child])
-                    force = frame[:3, :3].T @ planar
+                    turn = ground[:3, :3].T @ frames[child][:3, :3]   # a rotation's inverse
+                    force = turn.T @ planar
                     torque = np.zeros(3)
                     torque_bound = 0.0
                     driver = drivers.get(name)
