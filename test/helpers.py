@@ -352,8 +352,8 @@ def numpy_is_libm() -> bool:
 
     The single-angle path calls the C library (``math.atan2``, ``abs`` of a
     complex), the array path NumPy. Where NumPy dispatches its own AVX-512 loop
-    for ``arctan2`` (NumPy 2.4 on an AVX-512 Xeon, 2026-12-02: 318 of these
-    4096 random pairs one ulp off ``math.atan2``; none with
+    for ``arctan2`` (NumPy 2.4 on an AVX-512 Xeon: some of these random pairs
+    one ulp off ``math.atan2``; none with
     ``NPY_DISABLE_CPU_FEATURES="X86_V4 AVX512_ICL AVX512_SPR"``), the two paths
     agree within their error bounds, not to the bit.
     """

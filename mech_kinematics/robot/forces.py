@@ -229,10 +229,15 @@ class RobotForces:
         self.mechanisms = planar.mechanisms
         self.size = _size(robot.scene)
         self._cache: dict[tuple[Any, ...], Dynamics] = {}
-        #: Per mechanism whose ground no joint carries: its rotation in the root frame.
+        #: Per mechanism whose ground no joint carries: its rotation in the root frame, and
+        #: the scene loads given link loads become in its plane.
         self._fixed_rotations: dict[int, Any] = {}
-        #: The closures and the drivers by name, once (:meth:`reactions`).
-        self._named: tuple[Any, Any] = (None, None)
+        self._fixed_loads: dict[tuple[Any, ...], tuple[Load, ...]] = {}
+        #: Each URDF link's body (itself, or the loop link it is welded to), the closures and
+        #: the drivers by name: what :meth:`reactions` looks up at every instant.
+        self._bodies = self._welded_bodies()
+        self._closures = {c.name: c for c in description.closures}
+        self._drivers = {d.name: d for d in planar.drivers}
         masses = planar.masses
         self.masses = [tuple(Mass(body, item['mass'], tuple(item['com']), item['inertia'])
                              for body, item in masses.items() if body in m['bodies'])
@@ -252,7 +257,7 @@ class RobotForces:
     def _hanging(self, moving: Mapping[str, int]) -> str | None:
         """Return why a mass hangs from a loop's moving body outside every loop, or None."""
         description = self.robot.description
-        body_of = self._body_of()
+        body_of = self._bodies
         loop_joints = {j for m in self.mechanisms for j in m['joints']}
         for link in description.links:
             if link not in description.inertials:
@@ -267,11 +272,8 @@ class RobotForces:
                             'actuators through a motion the loops do not solve')
         return None
 
-    def _body_of(self) -> dict[str, str]:
-        """Return each URDF link's body: itself, or the loop link it is welded to (kept)."""
-        known = self.__dict__.get('_bodies')
-        if known is not None:
-            return known
+    def _welded_bodies(self) -> dict[str, str]:
+        """Return each URDF link's body: itself, or the loop link it is welded to."""
         description = self.robot.description
         out: dict[str, str] = {}
         for link in description.links:
@@ -282,7 +284,6 @@ class RobotForces:
                     break
                 up = joint.parent
             out[link] = up
-        self._bodies = out
         return out
 
     def check_loads(self, loads: Sequence[LinkLoad], what: str = '--link-force') -> None:
@@ -322,6 +323,9 @@ class RobotForces:
                 if self.moving_links.get(load.link) == index]
         if not mine:
             return ()
+        fixed = not self.carriers[index]    # the same loads in the plane at every instant
+        if fixed and (index, tuple(loads)) in self._fixed_loads:
+            return self._fixed_loads[(index, tuple(loads))]
         m = self.mechanisms[index]
         rotation = self._ground_rotation(index, inputs, True)
         x, y = np.asarray(m['x']), np.asarray(m['y'])
@@ -338,6 +342,10 @@ class RobotForces:
             tz = float((rotation.T @ np.asarray(load.torque, dtype=np.float64)) @ normal)
             if tz:
                 out.append(Load(f'link_load_{k}_torque', link=body, torque=tz))
+        if fixed:
+            if len(self._fixed_loads) >= _CACHE:
+                self._fixed_loads.pop(next(iter(self._fixed_loads)))
+            self._fixed_loads[(index, tuple(loads))] = tuple(out)
         return tuple(out)
 
     def _ground_rotation(self, index: int, inputs: Mapping[str, tuple[Any, Any, Any]],
@@ -482,12 +490,7 @@ class RobotForces:
         robot = self.robot
         description = robot.description
         frames = description.transforms(positions)
-        body_of = self._body_of()
-        closures, drivers = self._named
-        if closures is None:
-            closures = {c.name: c for c in description.closures}
-            drivers = {d.name: d for d in robot.planar.drivers}
-            self._named = (closures, drivers)
+        body_of, closures, drivers = self._bodies, self._closures, self._drivers
         spread = math.fsum(abs(float(b)) for b in bounds.values())
         out: dict[str, JointReaction] = {}
         for forces, members in zip(efforts.forces, efforts.groups, strict=True):

@@ -167,7 +167,9 @@ class Planar:
     links : dict of str to (str, ndarray, ndarray)
         Each URDF link a loop moves: its scene body and the affine map of a
         point of the link's frame (m) into the body's own frame (the one a
-        mass's ``com`` is given in): ``local = A @ p + b``, ``A`` 2x3.
+        mass's ``com`` is given in): ``local = A @ p + b``, ``A`` 2x3. Only
+        where the robot has masses (what its forces, and loads on its links,
+        read); empty otherwise.
     """
 
     data: dict[str, Any]
@@ -1427,28 +1429,37 @@ def planar_from_description(description: Description, actuated: Iterable[str] | 
         data['dyads'] = builder.dyads
     if builder.points:
         data['points'] = builder.points
+    # The bodies' frames, for the masses and the links' loads: none without masses (no forces).
+    poses = _body_poses(data, [*builder.mass_props, *(body for body, _, _
+                                                      in builder.link_planes.values())]
+                        ) if builder.mass_props else {}
     return Planar(data, tuple(builder.drivers), builder.joint_maps, mechanisms, actuated_names,
-                  dict(builder.names.changed), _scene_masses(data, builder.mass_props),
-                  _link_frames(data, builder.link_planes))
+                  dict(builder.names.changed), _scene_masses(builder.mass_props, poses),
+                  _link_frames(builder.link_planes, poses) if poses else {})
 
 
-def _link_frames(data: dict[str, Any], planes: Mapping[str, tuple[str, Any, Any]]
-                 ) -> dict[str, tuple[str, Any, Any]]:
-    """Return each moving link's map into its scene body's own frame (:attr:`Planar.links`).
+def _body_poses(data: dict[str, Any], bodies: Iterable[str]) -> dict[str, Any]:
+    """Return each of ``bodies``' own frame (its /tf pose) at the drivers' start.
 
-    As :func:`_scene_masses` takes a centre of mass there: the body's pose at
-    the drivers' start, where the plane's points were taken.
+    The reference pose the plane's points were taken in: where a centre of
+    mass (:func:`_scene_masses`) and a link's points (:func:`_link_frames`) go
+    into their body's frame. The scene is solved once for both.
     """
-    if not planes:
+    wanted = sorted(set(bodies))
+    if not wanted:
         return {}
     from ..geometry.frames import frames_from_scene, poses_from_state
     from ..geometry.urdf import _assembled
     from ..scene import parse_scene
 
     scene = parse_scene(data)
-    bodies = sorted({body for body, _, _ in planes.values()})
-    poses = {pose.joint: pose for pose in poses_from_state(
-        frames_from_scene(scene, bodies), _assembled(scene))}
+    return {pose.joint: pose for pose in poses_from_state(
+        frames_from_scene(scene, wanted), _assembled(scene))}
+
+
+def _link_frames(planes: Mapping[str, tuple[str, Any, Any]], poses: Mapping[str, Any]
+                 ) -> dict[str, tuple[str, Any, Any]]:
+    """Return each moving link's map into its scene body's own frame (:attr:`Planar.links`)."""
     out: dict[str, tuple[str, Any, Any]] = {}
     for link, (body, a, b) in planes.items():
         pose = poses.get(body)
@@ -1460,25 +1471,12 @@ def _link_frames(data: dict[str, Any], planes: Mapping[str, tuple[str, Any, Any]
     return out
 
 
-def _scene_masses(data: dict[str, Any], props: Mapping[str, tuple[float, complex, float]]
+def _scene_masses(props: Mapping[str, tuple[float, complex, float]], poses: Mapping[str, Any]
                   ) -> dict[str, dict[str, Any]]:
-    """Return the scene's ``masses:``: each body's centre of mass in its own /tf frame.
-
-    The frames are the scene's at its drivers' start (the reference pose the
-    centres of mass were taken in).
-    """
-    if not props:
-        return {}
-    from ..geometry.frames import frames_from_scene, poses_from_state
-    from ..geometry.urdf import _assembled
-    from ..scene import parse_scene
-
-    scene = parse_scene(data)
-    state = _assembled(scene)
-    frames = frames_from_scene(scene, list(props))
+    """Return the scene's ``masses:``: each body's centre of mass in its own /tf frame."""
     out: dict[str, dict[str, Any]] = {}
-    for pose in poses_from_state(frames, state):
-        mass, com, inertia = props[pose.joint]
+    for body, (mass, com, inertia) in props.items():
+        pose = poses[body]
         local = (com - complex(pose.x, pose.y)) * cmath.exp(-1j * pose.angle)
-        out[pose.joint] = {'mass': mass, 'com': [local.real, local.imag], 'inertia': inertia}
+        out[body] = {'mass': mass, 'com': [local.real, local.imag], 'inertia': inertia}
     return out

@@ -132,15 +132,13 @@ class RobotForcesTick(ForcesTick):
                  gravity: Sequence[float] = GRAVITY, unloaded: Any = None,
                  payloads: Sequence[str] = ()) -> None:
         self.robot = robot
-        self.model = robot.forces
         self.unloaded = unloaded
         self.payloads = list(payloads)
         #: The model a change of ``payloads`` builds while it is judged, for :meth:`apply`.
         self._pending: tuple[list[str], Any] | None = None
-        #: The ``link_forces`` and ``link_torques`` entries, and the loads they give.
+        #: The ``link_forces`` and ``link_torques`` entries the loads come from.
         self.link_forces: list[str] = []
         self.link_torques: list[str] = []
-        self.loads: tuple[Any, ...] = ()
         self.kinematics = replace(scene, gravity=None, masses=(), loads=(),
                                   outputs_joints=scene.output_joints,
                                   outputs_points=scene.output_points)
@@ -154,9 +152,9 @@ class RobotForcesTick(ForcesTick):
         self.reactions = tuple(name for name, _ in found)
         self.links = tuple(link for _, link in found)
         self.forces_first = 3 * len(self.names) + 6 * len(self.points)
-        self.g = check_gravity(gravity)
-        #: What an instant is solved with, read once by it: (model, gravity, link loads).
-        self._state: tuple[Any, ...] = (self.model, self.g, ())
+        #: What an instant is solved with, read once by it: (model, gravity, link loads); the
+        #: one home of all three (:attr:`model`, :attr:`g`, :attr:`loads` read it).
+        self._state: tuple[Any, ...] = (robot.forces, check_gravity(gravity), ())
         self.refusal = ''
         self.refused = 0
         self._samples: list[Any] | None = None
@@ -271,7 +269,22 @@ class RobotForcesTick(ForcesTick):
         self.link_forces = list(values.get('link_forces', self.link_forces) or [])
         self.link_torques = list(values.get('link_torques', self.link_torques) or [])
         self._state = (model, g, loads)
-        self.model, self.g, self.payloads, self.loads = model, g, payloads, loads
+        self.payloads = payloads
+
+    @property
+    def model(self) -> Any:
+        """The robot's forces the next instant is solved with (its masses)."""
+        return self._state[0]
+
+    @property
+    def g(self) -> tuple[float, float, float]:
+        """The gravity the next instant is solved with, m/s^2 in the URDF's root frame."""
+        return self._state[1]
+
+    @property
+    def loads(self) -> tuple[Any, ...]:
+        """The link loads the next instant is solved with (:class:`LinkLoad` each)."""
+        return self._state[2]
 
     def gravity(self) -> list[float]:
         """Return the gravity the forces are solved with, m/s^2 in the URDF's root frame."""

@@ -44,7 +44,7 @@ Pure NumPy: no ROS, no drawing.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 import math
 from types import SimpleNamespace
 from typing import Any, cast, TYPE_CHECKING
@@ -87,6 +87,20 @@ def _gamma(k: int) -> float:
     return k * U / (1.0 - k * U)
 
 
+def _finite_pair(owner: Any, key: str, what: str, form: str) -> None:
+    """Check that ``owner.key`` is two finite numbers and store them as a tuple of floats.
+
+    Refused naming ``what`` (``Expected WHAT as FORM``, then each value finite).
+    """
+    pair = tuple(getattr(owner, key))
+    if len(pair) != 2:
+        msg = f'Expected {what} as {form}, got {getattr(owner, key)!r}'
+        raise SceneError(msg, (owner, key))
+    for value in pair:
+        _check_finite(value, what, (owner, key))
+    object.__setattr__(owner, key, (float(pair[0]), float(pair[1])))
+
+
 @dataclass(frozen=True)
 class Mass:
     """The inertia of one moving body.
@@ -116,13 +130,7 @@ class Mass:
         if not (math.isfinite(self.mass) and self.mass > 0.0):
             msg = f'Expected the mass of "{self.body}" to be positive, got {self.mass!r} kg'
             raise SceneError(msg, (self, 'mass'))
-        com = tuple(self.com)
-        if len(com) != 2:
-            msg = f'Expected the centre of mass of "{self.body}" as [x, y], got {self.com!r}'
-            raise SceneError(msg, (self, 'com'))
-        for value in com:
-            _check_finite(value, f'the centre of mass of "{self.body}"', (self, 'com'))
-        object.__setattr__(self, 'com', (float(com[0]), float(com[1])))
+        _finite_pair(self, 'com', f'the centre of mass of "{self.body}"', '[x, y]')
         if not (math.isfinite(self.inertia) and self.inertia >= 0.0):
             msg = (f'Expected the inertia of "{self.body}" to be 0 or more, got '
                    f'{self.inertia!r} kg m^2')
@@ -169,7 +177,8 @@ class Load:
     torque: float | None = None
     at: tuple[float, float] | None = None
     table: tuple[str, tuple[tuple[float, float, float], ...]] | None = None
-    #: For a table over a revolute joint: its rows repeat every turn (set by the Dynamics).
+    #: For a table over a revolute joint: its rows repeat every turn (the Dynamics gives its
+    #: loads this from the joint's kind).
     periodic: bool = False
 
     def __post_init__(self) -> None:
@@ -189,26 +198,14 @@ class Load:
                    f'force={self.force!r}, link={self.link!r}, torque={self.torque!r}')
             raise SceneError(msg, (self, 'name'))
         if self.force is not None:
-            force = tuple(self.force)
-            if len(force) != 2:
-                msg = f'Expected the force of load "{self.name}" as [fx, fy], got {self.force!r}'
-                raise SceneError(msg, (self, 'force'))
-            for value in force:
-                _check_finite(value, f'the force of load "{self.name}"', (self, 'force'))
-            object.__setattr__(self, 'force', (float(force[0]), float(force[1])))
+            _finite_pair(self, 'force', f'the force of load "{self.name}"', '[fx, fy]')
         if self.torque is not None:
             _check_finite(self.torque, f'the torque of load "{self.name}"', (self, 'torque'))
         if self.at is not None and self.table is not None:
             msg = f'Expected load "{self.name}" at a scene point for a table, got at={self.at!r}'
             raise SceneError(msg, (self, 'at'))
         if self.at is not None:
-            at = tuple(self.at)
-            if len(at) != 2:
-                msg = f'Expected the point of load "{self.name}" as [x, y], got {self.at!r}'
-                raise SceneError(msg, (self, 'at'))
-            for value in at:
-                _check_finite(value, f'the point of load "{self.name}"', (self, 'at'))
-            object.__setattr__(self, 'at', (float(at[0]), float(at[1])))
+            _finite_pair(self, 'at', f'the point of load "{self.name}"', '[x, y]')
 
     def _check_table(self) -> None:
         assert self.table is not None
@@ -527,11 +524,17 @@ class Dynamics:
                 block = body.points == (point,) and body.guide is not None
                 if point not in owner or (block and owner[point] != graph.ground):
                     owner[point] = name
-        self.loads = tuple(loads)
+        given = tuple(loads)
+        used: list[Load] = []   # each load as the forces read it (a table's turn said)
         self.point_loads: dict[str, list[Load]] = {}
         self.torque_loads: dict[str, list[Load]] = {}
         names: set[str] = set()
-        for load in self.loads:
+        for load in given:
+            if load.name in names:
+                msg = f'Expected each load name once, got "{load.name}" twice'
+                raise SceneError(msg, (load, 'name'))
+            names.add(load.name)
+            acting = load
             if load.table is not None:
                 kind = graph.coordinates.get(load.table[0])
                 if kind is None:
@@ -544,12 +547,8 @@ class Dynamics:
                            f'{load.table[1][0][0]!r} to {load.table[1][-1][0]!r} rad')
                     raise SceneError(msg, (load, 'table'))
                 if kind.angular != load.periodic:
-                    object.__setattr__(load, 'periodic', bool(kind.angular))
-        for load in self.loads:
-            if load.name in names:
-                msg = f'Expected each load name once, got "{load.name}" twice'
-                raise SceneError(msg, (load, 'name'))
-            names.add(load.name)
+                    acting = replace(load, periodic=bool(kind.angular))
+            used.append(acting)
             if load.point is not None:
                 body = owner.get(load.point) if load.link is None else load.link
                 if load.link is not None and (load.link not in graph.bodies or load.point
@@ -565,22 +564,18 @@ class Dynamics:
                     msg = (f'Expected load "{load.name}" at a moving point, got "{load.point}", '
                            f'fixed on the ground (a load there moves nothing)')
                     raise SceneError(msg, (load, 'point'))
-                self.point_loads.setdefault(body, []).append(load)
-            elif load.force is not None:    # at a point of its body's frame (``at``)
-                assert load.link is not None and load.at is not None
-                if load.link not in graph.bodies or load.link == graph.ground:
-                    msg = f'Expected a load on a moving body ({", ".join(moving)}), got ' + (
-                        'the ground' if load.link == graph.ground else f'unknown "{load.link}"')
-                    raise SceneError(msg, (load, 'link'))
-                self.point_loads.setdefault(load.link, []).append(load)
-            else:
-                assert load.link is not None
-                if load.link not in graph.bodies or load.link == graph.ground:
-                    msg = f'Expected a load on a moving body ({", ".join(moving)}), got ' + (
-                        'the ground' if load.link == graph.ground else f'unknown "{load.link}"')
-                    raise SceneError(msg, (load, 'link'))
-                self.torque_loads.setdefault(load.link, []).append(load)
-        refused = given_forces_refusal(tuple(self.masses.values()), self.loads, gravity)
+                self.point_loads.setdefault(body, []).append(acting)
+                continue
+            # On a body: a force at a point of its frame (``at``), or a torque.
+            assert load.link is not None
+            if load.link not in graph.bodies or load.link == graph.ground:
+                msg = f'Expected a load on a moving body ({", ".join(moving)}), got ' + (
+                    'the ground' if load.link == graph.ground else f'unknown "{load.link}"')
+                raise SceneError(msg, (load, 'link'))
+            loads_on = self.point_loads if load.force is not None else self.torque_loads
+            loads_on.setdefault(load.link, []).append(acting)
+        self.loads = tuple(used)
+        refused = given_forces_refusal(tuple(self.masses.values()), given, gravity)
         if refused is not None:
             element, key, reason = refused
             raise SceneError(reason, (element, key))

@@ -499,6 +499,18 @@ def turning_json(study: Any, flywheel: Any = None) -> dict[str, Any]:
     return data
 
 
+def _refuse_unless_turning(scene: Any, flag: str) -> None:
+    """Refuse ``flag`` in one line where there is no one crank's turning moment to give it to."""
+    if scene.dynamics is None:
+        msg = (f'Expected a scene with masses, gravity or loads for {flag}, got {scene.name} '
+               f'without')
+        raise SceneError(msg)
+    if not scene.single_crank:
+        msg = (f'Expected a scene driven by one crank for {flag}, got {scene.name}, driven by '
+               f'{", ".join(d.name for d in scene.drivers)}')
+        raise SceneError(msg)
+
+
 def _at_speed(scene: Any, rpm: float) -> Any:
     """Return ``scene`` with its crank turning at ``rpm`` (``--speed-rpm``), or a one-line refusal.
 
@@ -509,14 +521,7 @@ def _at_speed(scene: Any, rpm: float) -> Any:
 
     from ..units import rad_per_s_from_rpm
 
-    if scene.dynamics is None:
-        msg = (f'Expected a scene with masses, gravity or loads for --speed-rpm, got '
-               f'{scene.name} without')
-        raise SceneError(msg)
-    if not scene.single_crank:
-        msg = (f'Expected a scene driven by one crank for --speed-rpm, got {scene.name}, '
-               f'driven by {", ".join(d.name for d in scene.drivers)}')
-        raise SceneError(msg)
+    _refuse_unless_turning(scene, '--speed-rpm')
     crank = replace(scene.input, speed=rad_per_s_from_rpm(rpm), rpm=float(rpm))
     if scene.inputs:
         return replace(scene, input=crank, inputs=(crank,))
@@ -531,16 +536,10 @@ def _turning(scene: Any, cs: float | None) -> tuple[Any, Any, str]:
     """
     from ..geometry.turning import turning_moment_from_scene
 
+    if cs is not None:
+        _refuse_unless_turning(scene, '--flywheel')
     if scene.dynamics is None:
-        if cs is not None:
-            msg = (f'Expected a scene with masses, gravity or loads for --flywheel, got '
-                   f'{scene.name} without')
-            raise SceneError(msg)
         return None, None, ''
-    if cs is not None and not scene.single_crank:
-        msg = (f'Expected a scene driven by one crank for --flywheel, got {scene.name}, driven '
-               f'by {", ".join(d.name for d in scene.drivers)}')
-        raise SceneError(msg)
     try:
         study = turning_moment_from_scene(scene)
     except SceneError as error:

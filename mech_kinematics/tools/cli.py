@@ -40,6 +40,7 @@ from ..units import LENGTH_UNITS, rad_per_s_from_rpm, reduce_radians, turns_from
 __all__ = ['ArgumentParser', 'PROG', 'UNIT_SYSTEMS', 'add_driver_arguments',
            'add_gravity_argument', 'add_robot_arguments', 'add_scene_argument',
            'add_units_argument', 'angle_given', 'angle_unit', 'angular_rate_given',
+           'robot_angle_given',
            'drive_from_args', 'finite_float',
            'gravity_of', 'is_urdf', 'joint_list', 'link_loads_of', 'load_robot_argument',
            'load_scene_argument',
@@ -142,6 +143,20 @@ def angle_given(value: float, args: argparse.Namespace) -> tuple[float, int]:
     return reduce_radians(value) if _si(args) else turns_from_degrees(value)
 
 
+def robot_angle_given(value: float, args: argparse.Namespace, ruled: bool
+                      ) -> tuple[float, float | None]:
+    """Return a robot's revolute joint value given on the command line, in rad.
+
+    ``(rad, exact)``: the double the value is in rad, and, beyond a turn and
+    for a joint no ``<mimic>`` rule involves (``ruled``: a rule applies to a
+    joint's value, not its direction), its direction reduced exactly
+    (:func:`angle_given`), else None.
+    """
+    beyond = abs(value) > (math.tau if _si(args) else 360.0)
+    exact = angle_given(value, args)[0] if beyond and not ruled else None
+    return (float(value) if _si(args) else math.radians(value)), exact
+
+
 def angular_rate_given(value: float, args: argparse.Namespace) -> float:
     """Return an angular speed given on the command line in rad/s (rpm, or rad/s with si)."""
     return float(value) if _si(args) else rad_per_s_from_rpm(value)
@@ -219,11 +234,9 @@ def load_robot_argument(args: argparse.Namespace) -> Any:
             raise UrdfError(msg)
         if not joint.type.angular:
             reference[name] = value
-        elif abs(value) > (math.tau if _si(args) else 360.0) \
-                and name not in mimic_ruled(description):
-            reference[name] = angle_given(value, args)[0]   # its direction, exactly
         else:
-            reference[name] = value if _si(args) else math.radians(value)
+            radians, exact = robot_angle_given(value, args, name in mimic_ruled(description))
+            reference[name] = radians if exact is None else exact  # beyond a turn: exactly
     payloads = payloads_of(args)
     if payloads:
         from ..robot.forces import with_payloads

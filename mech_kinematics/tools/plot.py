@@ -27,7 +27,7 @@ rosbags are imported inside the functions, so importing this module is cheap.
 from __future__ import annotations
 
 import argparse
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 import math
 import os
@@ -475,34 +475,46 @@ def _pick(connections: Sequence[Any], type_name: str, namespace: str | None) -> 
 
 def _imu_connections(connections: Sequence[Any], namespace: str | None) -> dict[str, Any]:
     """Return the node's IMU topics, ``<namespace>/imu/NAME``, by sensor name."""
+    return _connections_in(connections, namespace, topics.IMU, topics.IMU_TYPE,
+                           topics.imu_topic)
+
+
+def _connections_in(connections: Sequence[Any], namespace: str | None, space: str,
+                    type_name: str, topic_of: Any) -> dict[str, Any]:
+    """Return the topics ``<namespace>/SPACE/NAME`` of ``type_name`` by NAME (one each)."""
     found: dict[str, Any] = {}
     for c in connections:
         parts = c.topic.rsplit('/', 2)
-        if c.msgtype != topics.IMU_TYPE or len(parts) != 3 or parts[1] != topics.IMU or (
+        if c.msgtype != type_name or len(parts) != 3 or parts[1] != space or (
                 namespace is not None and parts[0] != namespace.rstrip('/')):
             continue
         if parts[2] in found:
-            msg = (f'Expected one {topics.imu_topic(parts[2])} topic, got '
-                   f'{found[parts[2]].topic}, {c.topic}: pass --namespace')
+            msg = (f'Expected one {topic_of(parts[2])} topic, got {found[parts[2]].topic}, '
+                   f'{c.topic}: pass --namespace')
             raise PlotError(msg)
         found[parts[2]] = c
     return found
 
 
+def _at_ticks(reader: Any, connection: Any, ticks: Sequence[int]) -> Iterator[tuple[int, Any]]:
+    """Yield (index in ``ticks``, message) of each of ``connection``'s messages stamped there."""
+    at = {stamp: i for i, stamp in enumerate(ticks)}
+    decode = _decoder(reader.typestore, connection.msgtype)
+    for _, _, raw in reader.messages(connections=[connection]):
+        i = at.get(stamp_from_cdr(raw))
+        if i is not None:
+            yield i, decode(raw)
+
+
 def _imu_arrays(reader: Any, connections: Mapping[str, Any],
                 ticks: Sequence[int]) -> dict[str, tuple[Array, Array, Array]]:
     """Return each IMU's readings at ``ticks`` (header stamps, ns); NaN where it has none."""
-    at = {stamp: i for i, stamp in enumerate(ticks)}
     out = {}
     for name, connection in connections.items():
         values = np.full((len(ticks), 4), np.nan)
-        decode = _decoder(reader.typestore, connection.msgtype)
-        for _, _, raw in reader.messages(connections=[connection]):
-            i = at.get(stamp_from_cdr(raw))
-            if i is not None:
-                m = decode(raw)
-                q, a = m.orientation, m.linear_acceleration
-                values[i] = (2.0 * math.atan2(q.z, q.w), m.angular_velocity.z, a.x, a.y)
+        for i, m in _at_ticks(reader, connection, ticks):
+            q, a = m.orientation, m.linear_acceleration
+            values[i] = (2.0 * math.atan2(q.z, q.w), m.angular_velocity.z, a.x, a.y)
         orientation = np.remainder(values[:, 0] + math.pi, 2.0 * math.pi) - math.pi
         out[name] = (orientation, values[:, 1], values[:, 2:4])
     return out
@@ -511,38 +523,28 @@ def _imu_arrays(reader: Any, connections: Mapping[str, Any],
 def _wrench_connections(connections: Sequence[Any], namespace: str | None
                         ) -> tuple[dict[str, Any], Any | None]:
     """Return the node's ``reactions/JOINT`` topics by joint, and its ``shaking`` topic."""
-    reactions: dict[str, Any] = {}
-    shaking = None
-    for c in connections:
-        if c.msgtype != topics.WRENCH_TYPE:
-            continue
-        head, _, name = c.topic.rpartition('/')
-        base, _, space = head.rpartition('/')
-        if name == topics.SHAKING and (namespace is None or head == namespace.rstrip('/')):
-            if shaking is not None:
-                msg = (f'Expected one {topics.SHAKING} topic, got {shaking.topic}, {c.topic}: '
-                       f'pass --namespace')
-                raise PlotError(msg)
-            shaking = c
-        elif space == topics.REACTIONS and (namespace is None or base == namespace.rstrip('/')):
-            if name in reactions:
-                msg = (f'Expected one {topics.reaction_topic(name)} topic, got '
-                       f'{reactions[name].topic}, {c.topic}: pass --namespace')
-                raise PlotError(msg)
-            reactions[name] = c
-    return reactions, shaking
+    reactions = _connections_in(connections, namespace, topics.REACTIONS, topics.WRENCH_TYPE,
+                                topics.reaction_topic)
+
+    def is_shaking(connection: Any) -> bool:
+        head, _, name = connection.topic.rpartition('/')
+        return connection.msgtype == topics.WRENCH_TYPE and name == topics.SHAKING and (
+            namespace is None or head == namespace.rstrip('/'))
+
+    shaking = [c for c in connections if is_shaking(c)]
+    if len(shaking) > 1:
+        msg = (f'Expected one {topics.SHAKING} topic, got {shaking[0].topic}, '
+               f'{shaking[1].topic}: pass --namespace')
+        raise PlotError(msg)
+    return reactions, shaking[0] if shaking else None
 
 
 def _wrench_magnitudes(reader: Any, connection: Any, ticks: Sequence[int]) -> Array:
     """Return the length of each message's force at ``ticks`` (header stamps), N; NaN if none."""
-    at = {stamp: i for i, stamp in enumerate(ticks)}
     out = np.full(len(ticks), np.nan)
-    decode = _decoder(reader.typestore, connection.msgtype)
-    for _, _, raw in reader.messages(connections=[connection]):
-        i = at.get(stamp_from_cdr(raw))
-        if i is not None:
-            f = decode(raw).wrench.force
-            out[i] = math.sqrt(f.x * f.x + f.y * f.y + f.z * f.z)
+    for i, m in _at_ticks(reader, connection, ticks):
+        f = m.wrench.force
+        out[i] = math.sqrt(f.x * f.x + f.y * f.y + f.z * f.z)
     return out
 
 
@@ -556,14 +558,8 @@ def _bag_efforts(reader: Any, connection: Any | None, ticks: Sequence[int]
     """
     if connection is None:
         return {}
-    at = {stamp: i for i, stamp in enumerate(ticks)}
-    decode = _decoder(reader.typestore, connection.msgtype)
     columns: dict[str, Array] = {}
-    for _, _, raw in reader.messages(connections=[connection]):
-        i = at.get(stamp_from_cdr(raw))
-        if i is None:
-            continue
-        m = decode(raw)
+    for i, m in _at_ticks(reader, connection, ticks):
         if len(m.effort) != len(m.name):
             continue
         for name, value in zip(m.name, m.effort, strict=True):

@@ -14,10 +14,10 @@ from typing import Any
 import warnings
 
 from .cli import (add_driver_arguments, add_gravity_argument, add_robot_arguments,
-                  add_scene_argument, add_units_argument, angle_given, angle_unit,
+                  add_scene_argument, add_units_argument, angle_unit,
                   angular_rate_given, drive_from_args, finite_float, gravity_of, is_urdf,
-                  link_loads_of, load_robot_argument, mimic_ruled, positive_float, run_tool,
-                  values_by_driver)
+                  link_loads_of, load_robot_argument, mimic_ruled, positive_float,
+                  robot_angle_given, run_tool, values_by_driver)
 from ..bounds import MAX_ERROR
 from ..errors import AssemblyError, NearSingularWarning, SceneError, UntrustedError
 from ..scene import load_scene
@@ -103,15 +103,14 @@ def _robot_drive(robot: Any, args: argparse.Namespace) -> tuple[
         table[robot.actuated[0]] = value
     positions, rates, words, exact = {}, {}, [], {}
     ruled = mimic_ruled(robot.description)
-    si = args.units == 'si'
-    turn = math.tau if si else 360.0
     for name in robot.actuated:
         angular = robot.joint_type(name).angular
         if name in inputs:
             given = inputs[name]
-            positions[name] = given if si or not angular else math.radians(given)
-            if angular and abs(given) > turn and name not in ruled:
-                exact[name] = angle_given(given, args)[0]
+            positions[name], direction = robot_angle_given(given, args, name in ruled) \
+                if angular else (given, None)
+            if direction is not None:
+                exact[name] = direction
             words.append(f'{name} = {given:.15g} {angle_unit(args) if angular else "m"}')
         if name in speeds:
             rates[name] = angular_rate_given(speeds[name], args) if angular else speeds[name]
