@@ -14,11 +14,12 @@ NumPy and PyYAML only; nothing here imports rclpy.
 
 from .bounds import Bounds, ErrorBound, MAX_ERROR
 from .errors import (AssemblyError, MechKinematicsError, NearSingularWarning, SceneError,
-                     UntrustedError)
+                     TargetError, UntrustedError)
 from .scene import DEFAULT_SCENE, load_scene, parse_scene, scene_names
 from .solver import (Actuator, assembly_text, Branch, CarriedPoint, Crank, Engagement,
-                     JointMotion, Link, MAX_SLOTS, NEAR_SINGULAR, Pin, PointState, RPR, RRP, RRR,
-                     Scene, SceneUnits, SINGULAR, solve, State, TANGENCY_TOLERANCE)
+                     Inverse, JointMotion, Link, MAX_SLOTS, NEAR_SINGULAR, Pin, PointState, RPR,
+                     RRP, RRR, Scene, SceneUnits, SINGULAR, solve, solve_targets, State,
+                     TANGENCY_TOLERANCE)
 
 #: The former name of :class:`SceneUnits` (the units a scene was written in), kept working.
 Units = SceneUnits
@@ -26,8 +27,10 @@ Units = SceneUnits
 __all__ = [
     'Actuator', 'AssemblyError', 'Bounds', 'Branch', 'CarriedPoint', 'Crank', 'DEFAULT_SCENE',
     'Engagement',
-    'ErrorBound', 'JointMotion', 'Link', 'MAX_ERROR', 'MAX_SLOTS', 'MechKinematicsError',
+    'ErrorBound', 'Inverse', 'JointMotion', 'Link', 'MAX_ERROR', 'MAX_SLOTS',
+    'MechKinematicsError',
     'NEAR_SINGULAR', 'NearSingularWarning', 'Pin', 'PointState', 'RPR', 'RRP', 'RRR', 'SINGULAR',
-    'Scene', 'SceneError', 'SceneUnits', 'State', 'TANGENCY_TOLERANCE', 'Units', 'UntrustedError',
-    'assembly_text', 'load_scene', 'parse_scene', 'scene_names', 'solve',
+    'Scene', 'SceneError', 'SceneUnits', 'State', 'TANGENCY_TOLERANCE', 'TargetError', 'Units',
+    'UntrustedError', 'assembly_text', 'load_scene', 'parse_scene', 'scene_names', 'solve',
+    'solve_targets',
 ]

@@ -125,5 +125,29 @@ class UntrustedError(AssemblyError):
         self.tolerance = tolerance
 
 
+class TargetError(MechKinematicsError):
+    """A loop cannot be driven to the targets asked (:mod:`.solver.inverse`).
+
+    One line: a target the loop does not report, a count other than its
+    drivers', a target out of reach (how far, per target, along the straight
+    path from the start pose), or one near a singular point of the inverse
+    map, where the drivers' values cannot be trusted.
+
+    Attributes
+    ----------
+    reached : float or None
+        For a target out of reach, the share of the straight path from the
+        start pose (0 to 1) the loop follows before it can go no further.
+    short : dict of str to float or None
+        For a target out of reach, how far each target is left short (SI).
+    """
+
+    def __init__(self, msg: str, *, reached: float | None = None,
+                 short: dict[str, float] | None = None) -> None:
+        super().__init__(msg)
+        self.reached = reached
+        self.short = short
+
+
 class NearSingularWarning(UserWarning):
     """The mechanism is close to a singular position; results lose accuracy."""

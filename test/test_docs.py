@@ -360,6 +360,17 @@ def test_the_apis_forces_examples_give_what_their_comments_say():
     assert namespace['cycle'].forces.efforts['crank'].shape == (360,)
 
 
+def test_the_apis_target_examples_give_what_their_comments_say():
+    """docs/api.md's "Driven from the output" examples run and give their comments' values."""
+    text = (ROOT / 'docs' / 'api.md').read_text(encoding='utf-8')
+    section = text.split('## Driven from the output', 1)[1].split('\n## ', 1)[0]
+    namespace: dict = {'mk': mk, 'np': __import__('numpy')}
+    checked = sum(_run_commented(block, namespace) for block in blocks(section, 'python'))
+    assert checked >= 6
+    assert list(namespace['inverse'].answer.points['P'].position) == [0.06, 0.22] or \
+        max(abs(namespace['inverse'].answer.points['P'].position - [0.06, 0.22])) < 1e-15
+
+
 def test_the_forces_excerpt_is_what_solve_prints(tmp_path):
     """The reference's forces example prints the quoted efforts, reaction and shaking."""
     text = DOC.read_text()

@@ -31,6 +31,7 @@ The package holds one module per concern and one per step kind:
 - :mod:`.context`: one solve's values and the roundoff constants;
 - :mod:`.plan`: the plan compiler; :mod:`.scaling`: power-of-two rescaling;
 - :mod:`.mechanism`: :class:`Scene`; :mod:`.solve`: :func:`solve`;
+  :mod:`.inverse`: :func:`solve_targets` (driven from the output);
   :mod:`.state`: :class:`State` and what it holds; :mod:`.trust`: the quick
   trust test and a revolute joint's angle, below :func:`solve`;
 - :mod:`.compiler`: the one compiler (``mk.solve``'s compiled paths and the
@@ -43,6 +44,7 @@ from .carried import CarriedPoint
 from .context import NEAR_SINGULAR, SINGULAR
 from .crank import Crank
 from .geneva import TANGENCY_TOLERANCE
+from .inverse import Inverse, solve_targets
 from .mechanism import assembly_text, Scene
 from .model import Branch, Link, SceneUnits
 from .rpp import RPP
@@ -55,9 +57,10 @@ from .state import Engagement, JointMotion, PointState, State
 from .triad import Triad
 
 __all__ = [
-    'Actuator', 'Branch', 'CarriedPoint', 'Crank', 'Engagement', 'JointMotion', 'Link',
+    'Actuator', 'Branch', 'CarriedPoint', 'Crank', 'Engagement', 'Inverse', 'JointMotion',
+    'Link',
     'MAX_SLOTS',
     'NEAR_SINGULAR', 'Pin', 'PointState', 'RPP', 'RPR', 'RRP', 'RRR', 'SINGULAR', 'Scene', 'State',
     'SceneUnits', 'Triad', 'TANGENCY_TOLERANCE', 'assembly_margins', 'assembly_text',
-    'keep_general_path', 'solve',
+    'keep_general_path', 'solve', 'solve_targets',
 ]

@@ -16,7 +16,8 @@ import warnings
 from .cli import (add_driver_arguments, add_gravity_argument, add_robot_arguments,
                   add_scene_argument, add_units_argument, angle_unit,
                   angular_rate_given, drive_from_args, finite_float, gravity_of, is_urdf,
-                  link_loads_of, load_robot_argument, mimic_ruled, positive_float,
+                  link_loads_of, load_robot_argument, mimic_ruled, named_value,
+                  positive_float,
                   robot_angle_given, run_tool, values_by_driver)
 from ..bounds import MAX_ERROR
 from ..errors import AssemblyError, NearSingularWarning, SceneError, UntrustedError
@@ -72,6 +73,13 @@ parent puts on its child at its origin in
 the child link's frame (the force in the loop's plane, N; the actuator's
 torque about its axis, N m); or "forces_left_out" saying why not
 (docs/urdf.md, "Forces").
+Driven from the output (docs/targets.md): --target NAME=VALUE, as many as
+the scene has drivers, each a joint it reports (degrees or its length unit)
+or a point's POINT.x or POINT.y (its length unit), with --target-speed,
+--target-accel and --target-force NAME=F; the answer is continued from the
+start pose (or --input). The JSON adds "targets" (given and reached),
+"jacobian" (d target / d driver and its inverse), "continued_from",
+"target_efforts" (J^T F) and, under "error_bound", "targets" and "inverse".
 """
 
 
@@ -169,8 +177,85 @@ def _handle_robot(args: argparse.Namespace) -> int:
     return 0
 
 
+_TARGET_FLAGS = ('--target', '--target-speed', '--target-accel', '--target-force')
+
+
+def _targets_given(args: argparse.Namespace) -> bool:
+    return any(getattr(args, flag[2:].replace('-', '_')) for flag in _TARGET_FLAGS)
+
+
+def _handle_targets(scene: Any, args: argparse.Namespace) -> int:
+    """Solve a scene driven from its targets (``--target NAME=VALUE``): docs/targets.md."""
+    from ..errors import TargetError
+    from ..solver.inverse import continue_to, scene_targets
+    from ..units import LENGTH_UNITS
+
+    try:
+        if args.speed or args.accel or args.angle_deg is not None or args.speed_rpm is not None:
+            msg = ("Expected --target-speed and --target-accel with --target (the drivers' "
+                   "rates follow from the targets'), got --speed, --accel, --angle-deg or "
+                   '--speed-rpm')
+            raise ValueError(msg)
+        given: dict[str, dict[str, float]] = {}
+        for flag in _TARGET_FLAGS:
+            table = given.setdefault(flag, {})
+            for name, value in getattr(args, flag[2:].replace('-', '_')) or ():
+                if name is None:
+                    msg = f'Expected {flag} NAME=VALUE (a joint or POINT.x|y), got {value:g}'
+                    raise ValueError(msg)
+                table[name] = value
+        names = tuple(given['--target'])
+        for flag in _TARGET_FLAGS[1:]:
+            stray = [name for name in given[flag] if name not in names]
+            if stray:
+                msg = (f'Expected {flag} for targets given with --target '
+                       f'({", ".join(names) or "none"}), got {", ".join(stray)}')
+                raise ValueError(msg)
+        tmap = scene_targets(scene, names)
+        start, _, _, turns, _ = drive_from_args(scene, args)
+        starts = [start] if len(scene.drivers) == 1 else list(start)
+        whole = [turns] if len(scene.drivers) == 1 else list(turns)
+        first = [d.start if x is None else x + math.tau * int(w)
+                 for d, x, w in zip(scene.drivers, starts, whole, strict=True)]
+        per_metre = 1.0 if args.units == 'si' else LENGTH_UNITS[scene.units.length]
+        goal, speeds, accels = [], [], []
+        for name, angular in zip(names, tmap.target_angular, strict=True):
+            value = given['--target'][name]
+            speed = given['--target-speed'].get(name, 0.0)
+            goal.append((value if args.units == 'si' else math.radians(value)) if angular
+                        else value / per_metre)
+            speeds.append(angular_rate_given(speed, args) if angular else speed)
+            accels.append(given['--target-accel'].get(name, 0.0))
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter('always', NearSingularWarning)
+            inverse = continue_to(tmap, goal, first, speeds, accels, max_error=args.max_error,
+                                  forces=given['--target-force'])
+    except (TargetError, ValueError) as error:
+        print(f'error: {error}', file=sys.stderr)
+        return 2
+    for warning in caught:
+        print(f'warning: {warning.message}', file=sys.stderr)
+    state = inverse.answer
+    result: dict[str, Any] = {**state.as_dict(), **inverse.as_dict()}
+    result['error_bound'] = {**result['error_bound'], **inverse.bound_dict()}
+    if args.diagnostics:
+        result['singularity'] = {key: float(m) for key, m in state.singularity.items()}
+        result['relative_error_bound'] = float(state.relative_error_bound)
+    path, value = next(_not_finite(result), ('', 0.0))
+    if path:
+        print(f'error: Expected every value of the state to be finite, got {path} = '
+              f'{value!r} (beyond the range of doubles)', file=sys.stderr)
+        return 2
+    print(json.dumps(result, indent=args.indent, allow_nan=False))
+    return 0
+
+
 def _handle(args: argparse.Namespace) -> int:
     if is_urdf(args.scene):
+        if _targets_given(args):
+            print('error: --target: Expected a scene (a YAML file): a URDF robot driven from '
+                  'its targets is not built yet (docs/targets.md)', file=sys.stderr)
+            return 2
         return _handle_robot(args)
     try:
         if args.closures or args.actuated or args.reference or args.gravity is not None \
@@ -184,6 +269,8 @@ def _handle(args: argparse.Namespace) -> int:
     except SceneError as error:
         print(f'error: {error}', file=sys.stderr)
         return 2
+    if _targets_given(args):
+        return _handle_targets(scene, args)
     try:
         angle, speed, accel, turns, shown = drive_from_args(scene, args)
     except ValueError as error:
@@ -257,6 +344,21 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
                         help="also print each dyad's near-singularity measure "
                              '("singularity": 0 singular, 1 best) and the largest error '
                              'bound over its scale ("relative_error_bound")')
+    parser.add_argument('--target', type=named_value, action='append', metavar='NAME=VALUE',
+                        help='drive the scene from its output (docs/targets.md): a joint it '
+                             'reports (degrees, or the length unit; rad and m with --units si) '
+                             "or a point's coordinate POINT.x, POINT.y (the length unit), as "
+                             'many as it has drivers; --input gives the pose to continue from')
+    parser.add_argument('--target-speed', type=named_value, action='append',
+                        metavar='NAME=V', help="a target's speed: rpm for an angle (rad/s with "
+                                               '--units si), m/s for a length (default 0)')
+    parser.add_argument('--target-accel', type=named_value, action='append',
+                        metavar='NAME=A', help="a target's acceleration: rad/s^2 or m/s^2 "
+                                               '(default 0)')
+    parser.add_argument('--target-force', type=named_value, action='append',
+                        metavar='NAME=F', help='a force (N) or torque (N m, an angle) the '
+                                               "mechanism exerts along a target: the drivers' "
+                                               'share, J^T F, under "target_efforts"')
     parser.add_argument('--indent', type=int, default=1, metavar='N',
                         help='JSON indentation (default 1)')
     parser.set_defaults(handler=_handle)

@@ -207,3 +207,94 @@ def test_gravity_or_a_load_whose_forces_overflow_is_one_line(tmp_path, old, new,
     status, out, err = run(str(path))
     assert (status, out) == (2, '')
     assert err == f'error: {path}: {message}\n'
+
+
+def test_the_five_bar_driven_by_its_effector():
+    """--target P.x=MM --target P.y=MM: P reached, the motors' values, the Jacobian, J^T F."""
+    status, out, err = run('five_bar', '--target', 'P.x=60', '--target', 'P.y=220',
+                           '--target-speed', 'P.x=0.1', '--target-force', 'P.y=-10')
+    assert (status, err) == (0, '')
+    data = json.loads(out)
+    assert data['points']['P']['position'] == pytest.approx([0.06, 0.22], abs=1e-15)
+    assert data['points']['P']['velocity'] == pytest.approx([0.1, 0.0], abs=1e-15)
+    inverse = mk.solve_targets(mk.load_scene('five_bar'), {'P.x': 0.06, 'P.y': 0.22},
+                               {'P.x': 0.1}, forces={'P.y': -10.0})
+    for name, row in zip(inverse.drivers, inverse.motion, strict=True):
+        assert data['inputs'][name] == {'position': row[0], 'speed': row[1], 'accel': row[2]}
+    jacobian = data['jacobian']
+    assert (jacobian['rows'], jacobian['columns']) == (['P.x', 'P.y'],
+                                                       ['left_crank', 'right_crank'])
+    assert jacobian['matrix'] == inverse.jacobian.tolist()
+    assert data['target_efforts'] == pytest.approx(
+        {name: -10.0 * inverse.jacobian[1, j] for j, name in enumerate(inverse.drivers)})
+    assert set(data['error_bound']['inverse']) == {'left_crank', 'right_crank'}
+    # --units si: the same answer from metres; --input: the pose continued from.
+    status, si, _ = run('five_bar', '--units', 'si', '--target', 'P.x=0.06', '--target',
+                        'P.y=0.22', '--target-speed', 'P.x=0.1', '--target-force', 'P.y=-10')
+    assert json.loads(si)['inputs'] == data['inputs']
+    status, out, _ = run('five_bar', '--target', 'left_distal=45', '--target',
+                         'right_distal=130', '--input', 'left_crank=100')
+    assert status == 0
+    data = json.loads(out)
+    assert data['joints']['left_distal']['position'] == pytest.approx(math.radians(45), abs=1e-13)
+    assert data['continued_from']['left_crank'] == math.radians(100)
+
+
+@pytest.mark.parametrize(('args', 'message'), [
+    (('--target', 'P.x=60', '--target', 'P.y=420'), 'out of reach'),
+    (('--target', 'P.x=60'), 'as many targets as the scene has drivers'),
+    (('--target', 'P.x=60', '--target', 'P.y=220', '--speed', 'left_crank=3'),
+     'Expected --target-speed'),
+    (('--target', 'P.x=60', '--target', 'P.y=220', '--target-speed', 'B.x=1'),
+     'Expected --target-speed for targets given with --target'),
+    (('--target', '60', '--target', 'P.y=220'), 'Expected --target NAME=VALUE'),
+])
+def test_bad_targets_are_one_line(args, message):
+    status, out, err = run('five_bar', *args)
+    assert (status, out) == (2, '')
+    assert message in err
+    assert err.count('\n') == 1
+
+
+def test_the_targets_reference_says_what_solve_does():
+    """docs/targets.md: its commands run, its refusal is the program's, its two half-turns hold."""
+    from helpers import ROOT
+
+    text = (ROOT / 'docs' / 'targets.md').read_text()
+    block = text.split('```sh\n', 1)[1].split('```', 1)[0]
+    for line in block.splitlines():
+        words = line.split()
+        assert words[:3] == ['python', '-m', 'mech_kinematics']
+        status, _, err = run(*words[4:])
+        assert (status, err) == (0, ''), line
+    quoted = text.split('```text\n', 1)[1].split('```', 1)[0]
+    status, _, err = run('five_bar', '--target', 'P.x=60', '--target', 'P.y=420')
+    assert (status, err) == (2, quoted)
+    assert 'piston at -696.6166 mm is reached with the crank at\n135° from `--input crank=150` ' \
+        'and at 225° from `--input crank=210`' in text
+    for start, angle in (('150', 135.0), ('210', 225.0)):
+        status, out, _ = run('slider_crank_150_600', '--target', 'piston=-696.6166', '--input',
+                             f'crank={start}')
+        assert math.degrees(json.loads(out)['input']['angle']) == pytest.approx(angle, abs=1e-3)
+
+
+def test_the_readme_five_bar_driven_by_its_effector():
+    """The README's three commands: the motors' angles, speeds and torques it quotes."""
+    from helpers import ROOT
+
+    text = (ROOT / 'README.md').read_text().split('## Driven from its output', 1)[1]
+    text = text.split('\n## ', 1)[0]
+    block = text.split('```sh\n', 1)[1].split('```', 1)[0]
+    outputs = []
+    for line in block.splitlines():
+        status, out, err = run(*line.split()[4:])
+        assert (status, err) == (0, ''), line
+        outputs.append(json.loads(out))
+    prose = ' '.join(text.split('```', 2)[2].split())
+    angles = [math.degrees(outputs[0]['inputs'][m]['position']) for m in ('left_crank',
+                                                                          'right_crank')]
+    assert f'motors at {angles[0]:.3f}° and {angles[1]:.3f}°' in prose
+    speeds = [outputs[1]['inputs'][m]['speed'] for m in ('left_crank', 'right_crank')]
+    assert f'motors at {speeds[0]:.5f} and {speeds[1]:.5f} rad/s' in prose
+    torques = [outputs[2]['target_efforts'][m] for m in ('left_crank', 'right_crank')]
+    assert f"motors' share {torques[0]:.5f} and {torques[1]:.5f} N m" in prose
