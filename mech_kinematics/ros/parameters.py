@@ -27,9 +27,10 @@ if TYPE_CHECKING:
     from ..solver.base import Driver
 
 __all__ = ['CATCH_UP', 'DRIVE_MODES', 'DRIVER_RATES', 'DriverRates', 'DYNAMIC', 'EFFORT_MODES',
-           'LATE_TICKS',
+           'INPUT_DRIVES', 'LATE_TICKS',
            'MAX_NAME_CHARS', 'MAX_PATH_CHARS', 'PARAMETERS', 'ParameterSpec', 'SHOWN_CHARS',
-           'SKIP', 'STATE_DEPTH', 'STATIC', 'TIME', 'TOPIC', 'bounded_by_max_crank_speed',
+           'SKIP', 'STATE_DEPTH', 'STATIC', 'TARGET', 'TIME', 'TOPIC',
+           'bounded_by_max_crank_speed',
            'catch_up_window_ns', 'depth_refusal', 'driver_parameters', 'extra_joints_default',
            'first_crank_aliases', 'frame_refusal', 'joint_refusal', 'rate_default', 'refusal',
            'shown', 'spec']
@@ -38,10 +39,14 @@ __all__ = ['CATCH_UP', 'DRIVE_MODES', 'DRIVER_RATES', 'DriverRates', 'DYNAMIC', 
 CATCH_UP = 'catch_up'
 SKIP = 'skip'
 LATE_TICKS = (CATCH_UP, SKIP)
-#: ``drive`` values: the drivers as exact functions of the clock, or read from a topic.
+#: ``drive`` values: the drivers as exact functions of the clock, read from a topic, or
+#: found from the targets read from a topic (driven from the output, docs/targets.md).
 TIME = 'time'
 TOPIC = 'topic'
-DRIVE_MODES = (TIME, TOPIC)
+TARGET = 'target'
+DRIVE_MODES = (TIME, TOPIC, TARGET)
+#: The drives whose states answer messages (no accelerations given: no efforts of the motion).
+INPUT_DRIVES = (TOPIC, TARGET)
 #: ``effort`` values: the forces of the motion the drive determines (inertia, gravity and
 #: loads; left out where the drive gives no accelerations: ``drive: topic``), or the statics
 #: (gravity and loads only, inertia neglected: velocities and accelerations taken as zero).
@@ -150,8 +155,12 @@ PARAMETERS = (
                   read_only=True),
     ParameterSpec('drive', 'string', TIME,
                   'Where the drivers come from: time (each an exact function of the clock, '
-                  'on the rate_hz grid) or topic (the positions, and velocities if given, of '
-                  'each message on input_joint_states, published with its stamp)',
+                  'on the rate_hz grid), topic (the positions, and velocities if given, of '
+                  'each message on input_joint_states, published with its stamp) or target '
+                  '(each message on input_targets names targets, as many as the scene has '
+                  'drivers: a joint it reports or POINT.x|y, SI; the drivers that put them '
+                  'there, continued from the last state, published with its stamp; '
+                  'docs/targets.md)',
                   choices=DRIVE_MODES, read_only=True),
     ParameterSpec('extra_joints', 'string', None,
                   "With drive: topic, what an input message's joints that are not drivers "
@@ -499,8 +508,8 @@ def joint_refusal(values: Mapping[str, Any]) -> str | None:
     ``values`` holds the values the parameters would have (new ones merged
     over current ones); missing names are not checked.
     """
-    if values.get('drive') == TOPIC and values.get('markers') is True:
-        return ('markers: expected false with drive: topic (the arrows would show '
+    if values.get('drive') in INPUT_DRIVES and values.get('markers') is True:
+        return (f'markers: expected false with drive: {values["drive"]} (the arrows would show '
                 'velocities and accelerations the input does not give), got true')
     bound = values.get('max_crank_speed_rpm')
     if bound is None:

@@ -40,7 +40,7 @@ import math
 from typing import Any
 
 
-from .parameters import DYNAMIC, ParameterSpec, STATIC, TOPIC
+from .parameters import DYNAMIC, INPUT_DRIVES, ParameterSpec, STATIC
 from .robot_mode import RobotValues
 from .ticker import NOT_IN_THE_TICK, values_from_state
 from .topics import reaction_topic
@@ -375,7 +375,7 @@ def robot_forces_tick(robot: Any, scene: Any, *, drive: str, effort: str,
     ``unloaded`` and ``payloads``: as :class:`RobotForcesTick` takes them (with
     ``unloaded``, ``payloads`` can change while running).
     """
-    if robot_forces_note(robot) is not None or (drive == TOPIC and effort == DYNAMIC):
+    if robot_forces_note(robot) is not None or (drive in INPUT_DRIVES and effort == DYNAMIC):
         return None
     return RobotForcesTick(robot, scene, static=effort == STATIC, unloaded=unloaded,
                            payloads=payloads)

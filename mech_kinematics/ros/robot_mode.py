@@ -83,10 +83,10 @@ def robot_forces_refusal(note: str | None, drive: str, effort: str, default_effo
             return None
         why = note or "the URDF's links carry no <inertial>: there are no forces to publish"
         return f'Expected no forces parameters for this robot ({why}), got {", ".join(named)}'
-    from .parameters import TOPIC
+    from .parameters import INPUT_DRIVES
 
-    if named and drive == TOPIC and effort == default_effort:
-        return (f'Expected effort:=static with drive: topic for {", ".join(named)} (the input '
+    if named and drive in INPUT_DRIVES and effort == default_effort:
+        return (f'Expected effort:=static with drive: {drive} for {", ".join(named)} (the input '
                 f'gives no accelerations: the efforts are left out), got effort:={effort}')
     return None
 

@@ -162,6 +162,10 @@ class TopicDrive:
     published_joints : sequence of str, keyword-only
         The joints the node publishes itself: with ``pass``, a message's joint
         of these names is ignored rather than passed (published twice).
+    topic : str, keyword-only
+        The input's topic, which every refusal names first (default
+        ``input_joint_states``; :class:`~.target_drive.TargetDrive` reads
+        drivers it found from ``input_targets``).
 
     Raises
     ------
@@ -171,13 +175,15 @@ class TopicDrive:
 
     def __init__(self, drivers: Sequence[Any], *, extra_joints: str = REFUSE,
                  jump_back_ns: int = round(DEFAULT_JUMP_BACK_S * NS_PER_S),
-                 published_joints: Sequence[str] = ()) -> None:
+                 published_joints: Sequence[str] = (),
+                 topic: str = INPUT_JOINT_STATES) -> None:
         if extra_joints not in EXTRA_JOINTS:
             msg = f'Expected extra_joints in {EXTRA_JOINTS}, got {extra_joints!r}'
             raise ValueError(msg)
         if jump_back_ns < 0:
             msg = f'Expected jump_back_ns >= 0, got {jump_back_ns}'
             raise ValueError(msg)
+        self.topic = topic
         self.names = tuple(d.name for d in drivers)
         self._index = {name: i for i, name in enumerate(self.names)}
         self._strokes = tuple(d.stroke for d in drivers)
@@ -346,6 +352,5 @@ class TopicDrive:
             if not math.isfinite(value):
                 self._refuse(f'expected a finite {what} of {name!r}, got {value!r}')
 
-    @staticmethod
-    def _refuse(reason: str) -> NoReturn:
-        raise RefusedInput(f'{INPUT_JOINT_STATES}: {reason}')
+    def _refuse(self, reason: str) -> NoReturn:
+        raise RefusedInput(f'{self.topic}: {reason}')

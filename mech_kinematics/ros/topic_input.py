@@ -35,6 +35,7 @@ from . import topics
 from .cdr import marker, MessageTemplate, STAMP_MARKER
 from .messages import TickMessages
 from .publishing import qos_options, RCLError
+from .target_drive import TargetDrive
 from .ticker import general_tick
 from .topic_drive import RefusedInput, TopicDrive, TopicInput
 from ..errors import AssemblyError, UntrustedError
@@ -82,6 +83,10 @@ class InputSubscription:
         In URDF mode: the input names the actuated joints (URDF names and
         values), turned into the scene's drivers; ``joint_states`` names the
         URDF's joints (the actuated ones echoed as given).
+    targets : bool, optional
+        ``drive: target``: subscribe to ``input_targets`` and read each message's
+        targets into the drivers that put them there
+        (:class:`~.target_drive.TargetDrive`); a scene's only.
 
     Attributes
     ----------
@@ -93,7 +98,8 @@ class InputSubscription:
 
     def __init__(self, node: Any, scene: Any, solver: SolverPath, publishing: Publishing,
                  stats: TickStats, *, frame_id: str, extra_joints: str,
-                 jump_back_s: float, robot: RobotValues | None = None) -> None:
+                 jump_back_s: float, robot: RobotValues | None = None,
+                 targets: bool = False) -> None:
         self.node, self.solver, self.publishing, self.stats = node, solver, publishing, stats
         self.frame_id = frame_id
         self.robot = robot
@@ -109,9 +115,10 @@ class InputSubscription:
                                              accelerations=False,
                                              efforts_first=publishing.efforts_first)
                          for known in (True, False)}
-        self.topic = TopicDrive(drivers, extra_joints=extra_joints,
-                                jump_back_ns=round(jump_back_s * NS_PER_S),
-                                published_joints=joints)
+        rules = {'jump_back_ns': round(jump_back_s * NS_PER_S), 'published_joints': joints}
+        self.topic: TopicDrive | TargetDrive = TargetDrive(
+            scene, solver.max_error, **rules) if targets else TopicDrive(
+                drivers, extra_joints=extra_joints, **rules)
         self.active = False
         #: joint_states templates with the passed joints, by (names, velocities, efforts).
         self._passed: dict[tuple[tuple[str, ...], bool, bool], MessageTemplate | None] = {}
@@ -119,7 +126,8 @@ class InputSubscription:
                          reliability=QoSReliabilityPolicy.RELIABLE,
                          durability=QoSDurabilityPolicy.VOLATILE)
         self.subscription: Any = node.create_subscription(
-            JointState, topics.INPUT_JOINT_STATES, self.on_input, qos,
+            JointState, topics.INPUT_TARGETS if targets else topics.INPUT_JOINT_STATES,
+            self.on_input, qos,
             qos_overriding_options=qos_options())
 
     def close(self) -> None:

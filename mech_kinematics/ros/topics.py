@@ -8,8 +8,8 @@ and remaps apply; ``/tf`` and ``/tf_static`` are absolute, as tf2 expects.
 
 from __future__ import annotations
 
-__all__ = ['DIAGNOSTICS', 'IMU', 'IMU_TYPE', 'INPUT_JOINT_STATES', 'JOINT_ACCELERATIONS',
-           'JOINT_STATES', 'MARKERS',
+__all__ = ['DIAGNOSTICS', 'IMU', 'IMU_TYPE', 'INPUT_JOINT_STATES', 'INPUT_TARGETS',
+           'JOINT_ACCELERATIONS', 'JOINT_STATES', 'MARKERS',
            'POINT_ACCELERATIONS', 'REACTIONS', 'ROBOT_DESCRIPTION', 'SCENE', 'SHAKING',
            'STATE_TOPICS', 'TF', 'TF_STATIC', 'TYPES', 'WRENCH_TYPE', 'imu_topic',
            'reaction_topic']
@@ -28,6 +28,8 @@ SCENE = 'scene'
 
 #: The drivers' positions (and velocities) that drive the node with ``drive: topic``.
 INPUT_JOINT_STATES = 'input_joint_states'
+#: The targets (joints' values, points' coordinates) that drive the node with ``drive: target``.
+INPUT_TARGETS = 'input_targets'
 #: The namespace of the inertial sensors' topics: ``imu/NAME``, one per entry of a scene's
 #: ``imus``, each of type :data:`IMU_TYPE`.
 IMU = 'imu'
@@ -55,6 +57,7 @@ TYPES = {
     ROBOT_DESCRIPTION: 'std_msgs/msg/String',
     SCENE: 'std_msgs/msg/String',
     INPUT_JOINT_STATES: 'sensor_msgs/msg/JointState',
+    INPUT_TARGETS: 'sensor_msgs/msg/JointState',
     SHAKING: WRENCH_TYPE,
 }
 

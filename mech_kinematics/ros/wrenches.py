@@ -42,7 +42,7 @@ from typing import Any, TYPE_CHECKING
 from geometry_msgs.msg import WrenchStamped
 
 from .cdr import marker, MessageTemplate, STAMP_MARKER
-from .parameters import DYNAMIC, ParameterSpec, STATIC, TOPIC
+from .parameters import DYNAMIC, INPUT_DRIVES, ParameterSpec, STATIC
 from .ticker import NOT_IN_THE_TICK, values_from_state
 from .topics import reaction_topic, SHAKING
 from .. import solver as lk
@@ -274,7 +274,7 @@ def forces_tick(scene: Scene, tick_scene: Scene, frames: Sequence[FrameSpec], *,
     new), and with ``drive: topic`` unless ``effort: static``: the input gives
     no accelerations, so the efforts of the motion are not determined.
     """
-    if scene.dynamics is None or (drive == TOPIC and effort == DYNAMIC):
+    if scene.dynamics is None or (drive in INPUT_DRIVES and effort == DYNAMIC):
         return None
     return ForcesTick(tick_scene, scene.output_joints, scene.output_points, frames,
                       static=effort == STATIC)
@@ -303,8 +303,8 @@ def scene_forces_refusal(has_forces: bool, drive: str, effort: str, given: Seque
                 f'loads: there are no forces to publish), got {", ".join(named)}')
     if sensors:
         named = [name for name in named if name != 'gravity']
-    if named and drive == TOPIC and effort == DYNAMIC:
-        return (f'Expected effort:=static with drive: topic for {", ".join(named)} (the input '
+    if named and drive in INPUT_DRIVES and effort == DYNAMIC:
+        return (f'Expected effort:=static with drive: {drive} for {", ".join(named)} (the input '
                 f'gives no accelerations: the efforts are left out), got effort:={effort}')
     return None
 
@@ -319,7 +319,7 @@ def effort_status(scene: Scene | bool, drive: str, effort: str) -> str:
         return ''
     if effort == STATIC:
         return 'static: gravity and loads only, inertia neglected'
-    if drive == TOPIC:
+    if drive in INPUT_DRIVES:
         return ('left out: the input gives no accelerations (effort: static publishes the '
                 'statics)')
     return 'dynamic: inertia, gravity and loads'

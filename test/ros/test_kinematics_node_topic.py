@@ -51,10 +51,13 @@ class TopicNode:
     """A node with drive: topic in a namespace of its own, and what it publishes, as received."""
 
     def __init__(self, ros, tmp_path, name, *args, scene=SCENE, input_topic=None, wait=True,
-                 input_qos=INPUT_QOS):
+                 input_qos=INPUT_QOS, drive='topic', greeting=None):
         self.ns = f'{SESSION}/{name}'
         self.prefix = f'{SESSION[1:]}_{name}'
         self.drivers = mk.load_scene(scene).drivers
+        # What the greetings send: the drivers at their start, or (names, positions) given.
+        self.greeting = greeting or ([d.name for d in self.drivers],
+                                     [d.start for d in self.drivers])
         self.greeted = []
         # The states answering the greetings (stamped before T0) are not kept.
         self.js = self._collect(ros, JointState, 'joint_states')
@@ -64,9 +67,10 @@ class TopicNode:
         self.diag = ros.collect(DiagnosticArray, f'{self.ns}/diagnostics')
         self.input = ros.node.create_publisher(
             JointState, input_topic or f'{self.ns}/input_joint_states', input_qos)
+        self.input_name = (input_topic or 'input_joint_states').rsplit('/', 1)[-1]
         self.hello = HELLO
         self.proc = NodeProcess(tmp_path, '-r', f'__ns:={self.ns}', '-p', f'scene:={scene}',
-                                '-p', 'drive:=topic', '-p', 'tf_rate_hz:=10000.0',
+                                '-p', f'drive:={drive}', '-p', 'tf_rate_hz:=10000.0',
                                 '-p', f'tf_prefix:={self.prefix}', *args)
         if wait:
             self.wait_for_subscription()
@@ -85,7 +89,7 @@ class TopicNode:
 
     def wait_for_subscription(self):
         wait_for(lambda: self.input.get_subscription_count() > 0 or self.proc.proc.poll(),
-                 STARTUP_S, 'the node subscribing to input_joint_states')
+                 STARTUP_S, f'the node subscribing to {self.input_name}')
         assert self.proc.proc.poll() is None, self.proc.output()
 
     def handshake(self):
@@ -96,12 +100,11 @@ class TopicNode:
         stamped 1 ms apart before T0, and their answers are not kept.
         """
         def greet():
-            self.send(self.hello, [d.name for d in self.drivers],
-                      [d.start for d in self.drivers])
+            self.send(self.hello, *self.greeting)
             self.hello += 1_000_000
 
         send_until(greet, lambda: self.greeted or self.proc.proc.poll() is not None,
-                   STARTUP_S, 'the node answering a greeting on input_joint_states', every=0.2)
+                   STARTUP_S, f'the node answering a greeting on {self.input_name}', every=0.2)
         assert self.proc.proc.poll() is None, self.proc.output()
 
     def send(self, stamp, names, positions, velocities=(), efforts=()):
@@ -482,7 +485,7 @@ def test_extra_joints_ignore_takes_the_drivers_and_says_what_it_dropped(ros, tmp
 #: Bad drives at start: (arguments, words of the one line that refuses them).
 BAD_DRIVES = [
     (['-p', 'drive:=topic', '-p', 'markers:=true'], ['markers: expected false with drive: topic']),
-    (['-p', 'drive:=stream'], ["drive: expected one of time, topic, got 'stream'"]),
+    (['-p', 'drive:=stream'], ["drive: expected one of time, topic, target, got 'stream'"]),
 ]
 
 

@@ -1,0 +1,133 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""The node driven from its output: one ``input_targets`` message in, the drivers found out.
+
+With ``drive: target`` the node subscribes to ``input_targets``
+(``sensor_msgs/msg/JointState``): each message names targets (as many as the
+scene has drivers, each a joint the scene reports or a point's ``POINT.x`` or
+``POINT.y``; SI: rad, m, and rad/s, m/s in ``velocity``), and the node
+publishes the state that puts them there, stamped with the message's stamp,
+as ``drive: topic`` publishes a state per message: ``joint_states`` then
+carries the drivers' values a motor controller needs.
+
+:class:`TargetDrive` turns a message into the drivers' positions (and
+speeds, when the message has a velocity per target) with
+:func:`~mech_kinematics.solver.inverse.continue_to`, continued from the drivers
+of the last state published (at first the scene's start pose): a stream of
+targets keeps the working mode it starts in. The drivers found are then read
+by :class:`~.topic_drive.TopicDrive`'s rules (the stamp's order, a stroke),
+every refusal naming ``input_targets``. A message is refused, and nothing is
+published for it, when a target is named twice, is not one the scene reports,
+or the count is not the drivers'; when a position or velocity is missing or
+not finite; when a target is out of reach or the answer near a singular point
+of the map (the one line of
+:class:`~mech_kinematics.errors.TargetError`); and by the topic drive's rules.
+
+Pure: no ROS. Thread use: one thread (the executor's), as TopicDrive.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+import math
+from typing import Any, NoReturn, TYPE_CHECKING
+
+from .topic_drive import RefusedInput, TopicDrive, TopicInput
+from .topics import INPUT_TARGETS
+from ..errors import TargetError
+from ..solver.inverse import continue_to, scene_targets, TargetMap
+
+if TYPE_CHECKING:
+    from ..solver.mechanism import Scene
+
+__all__ = ['TargetDrive']
+
+#: Sets of target names whose maps are kept (all dropped past it).
+MAPS = 16
+
+
+class TargetDrive:
+    """The rules of ``drive: target`` for one scene, and where its next answer continues from.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene loaded.
+    max_error : float
+        The solver's tolerance, which the inverse's drivers' bounds meet too.
+    **topic : Any
+        What :class:`~.topic_drive.TopicDrive` takes beside the drivers
+        (``extra_joints`` is ``refuse``: a message names targets only).
+    """
+
+    def __init__(self, scene: Scene, max_error: float, **topic: Any) -> None:
+        self.scene = scene
+        self.max_error = max_error
+        self.topic = TopicDrive(scene.drivers, topic=INPUT_TARGETS, **topic)
+        self.names = self.topic.names
+        self.published_joints = self.topic.published_joints
+        self.start = [float(d.start) for d in scene.drivers]
+        self._pending: list[float] | None = None
+        self._maps: dict[tuple[str, ...], TargetMap] = {}
+
+    @property
+    def last_stamp_ns(self) -> int | None:
+        """The stamp of the last state published, ns (None before the first)."""
+        return self.topic.last_stamp_ns
+
+    def read(self, sec: int, nanosec: int, names: Sequence[str], positions: Sequence[float],
+             velocities: Sequence[float], efforts: Sequence[float] = ()) -> TopicInput:
+        """Return the drivers that put the message's targets where it says (TopicInput).
+
+        Raises
+        ------
+        RefusedInput
+            If the message is refused (see the module's docstring), with the reason.
+        """
+        key = tuple(names)
+        tmap = self._maps.get(key)
+        if tmap is None:
+            try:
+                tmap = scene_targets(self.scene, key)
+            except TargetError as error:
+                self._refuse(str(error))
+            if len(self._maps) >= MAPS:
+                self._maps.clear()
+            self._maps[key] = tmap
+        if len(positions) != len(names):
+            self._refuse(f'expected one position per target ({len(names)}), got '
+                         f'{len(positions)}')
+        if len(velocities) not in (0, len(names)):
+            self._refuse(f'expected no velocity or one per target ({len(names)}), got '
+                         f'{len(velocities)}')
+        goal = [float(x) for x in positions]
+        speeds = [float(v) for v in velocities] if len(velocities) else None
+        for what, values in (('position', goal), ('velocity', speeds or ())):
+            for name, value in zip(names, values, strict=False):
+                if not math.isfinite(value):
+                    self._refuse(f'expected a finite {what} of target {name!r}, got {value!r}')
+        try:
+            inverse = continue_to(tmap, goal, self.start, speeds, None,
+                                  max_error=self.max_error)
+        except TargetError as error:
+            self._refuse(str(error))
+        drivers = [float(x) for x in inverse.motion[:, 0]]
+        rates = [float(x) for x in inverse.motion[:, 1]] if speeds is not None else []
+        given = self.topic.read(sec, nanosec, self.names, drivers, rates)
+        self._pending = drivers
+        return given
+
+    def joint_state_arrays(self, given: TopicInput, values: Sequence[float]) -> tuple[
+            list[str], list[float], list[float], list[float]]:
+        """Return ``joint_states``' arrays (:meth:`.TopicDrive.joint_state_arrays`)."""
+        return self.topic.joint_state_arrays(given, values)
+
+    def published(self, stamp_ns: int) -> None:
+        """Note the state at ``stamp_ns`` published: the next answer continues from it."""
+        self.topic.published(stamp_ns)
+        if self._pending is not None:
+            self.start, self._pending = self._pending, None
+
+    @staticmethod
+    def _refuse(reason: str) -> NoReturn:
+        raise RefusedInput(f'{INPUT_TARGETS}: {reason}')

@@ -1,0 +1,91 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""``drive: target``'s rules (issue 41), without ROS: targets in, the drivers that reach them out.
+
+Checked against the forward solve of the drivers found (the targets come back)
+and against the topic drive's rules (the stamp's order), each refusal one line
+naming ``input_targets``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import mech_kinematics as mk
+from mech_kinematics.ros.target_drive import TargetDrive
+from mech_kinematics.ros.topic_drive import RefusedInput
+
+pytestmark = pytest.mark.filterwarnings('ignore::mech_kinematics.NearSingularWarning')
+
+FIVE = mk.load_scene('five_bar')
+
+
+def drive():
+    return TargetDrive(FIVE, 1e-6, published_joints=FIVE.output_joints)
+
+
+def test_a_stream_of_targets_gives_the_drivers_that_reach_them():
+    """P along a line at 0.1 m/s: each answer's forward solve puts P there, at that speed."""
+    rules = drive()
+    for k in range(5):
+        p = [0.06 + 0.001 * k, 0.22]
+        given = rules.read(100, k * 1_000_000, ['P.x', 'P.y'], p, [0.1, 0.0])
+        state = mk.solve(FIVE, list(given.positions), list(given.speeds), [0.0, 0.0])
+        np.testing.assert_allclose(state.points['P'].position, p, atol=1e-15)
+        np.testing.assert_allclose(state.points['P'].velocity, [0.1, 0.0], atol=1e-15)
+        rules.published(given.stamp_ns)
+        assert rules.start == list(given.positions)
+    # Without velocities the speeds are unknown (left out), as with drive: topic.
+    given = rules.read(101, 0, ['P.y', 'P.x'], [0.22, 0.06], [])
+    assert given.speeds is None
+    state = mk.solve(FIVE, list(given.positions), [0.0, 0.0], [0.0, 0.0])
+    np.testing.assert_allclose(state.points['P'].position, [0.06, 0.22], atol=1e-15)
+
+
+def test_the_working_mode_is_continued_from_the_last_state():
+    """Two paths to one target from two start poses answer their own modes' drivers."""
+    rules = drive()
+    here = rules.read(100, 0, ['P.x', 'P.y'], [0.06, 0.22], [])
+    rules.published(here.stamp_ns)
+    inverse = mk.solve_targets(FIVE, {'P.x': 0.06, 'P.y': 0.22})
+    assert list(here.positions) == [float(x) for x in inverse.motion[:, 0]]
+    # The left leg's other elbow: the crank angles where |B - P| = 160 mm, |B - A| = 120 mm.
+    d = math.hypot(0.06, 0.22)
+    half = math.acos((0.12 ** 2 + d ** 2 - 0.16 ** 2) / (2 * 0.12 * d))
+    elbows = (math.atan2(0.22, 0.06) + half, math.atan2(0.22, 0.06) - half)
+    assert here.positions[0] == pytest.approx(elbows[0], abs=1e-12)
+    other = TargetDrive(FIVE, 1e-6, published_joints=FIVE.output_joints)
+    other.start = [elbows[1] + 0.05, here.positions[1] - 0.05]
+    again = other.read(100, 0, ['P.x', 'P.y'], [0.06, 0.22], [])
+    assert again.positions[0] == pytest.approx(elbows[1], abs=1e-12)
+    state = mk.solve(FIVE, list(again.positions), [0.0, 0.0], [0.0, 0.0])
+    np.testing.assert_allclose(state.points['P'].position, [0.06, 0.22], atol=1e-15)
+
+
+@pytest.mark.parametrize(('names', 'positions', 'velocities', 'words'), [
+    (['P.x'], [0.06], [], 'as many targets as the scene has drivers'),
+    (['P.x', 'P.q'], [0.06, 0.2], [], "got 'P.q'"),
+    (['P.x', 'P.y'], [0.06], [], 'one position per target'),
+    (['P.x', 'P.y'], [0.06, 0.22], [0.1], 'no velocity or one per target'),
+    (['P.x', 'P.y'], [0.06, math.nan], [], "finite position of target 'P.y'"),
+    (['P.x', 'P.y'], [0.06, 0.42], [], 'out of reach'),
+    (['P.x', 'P.x'], [0.06, 0.22], [], 'each target once'),
+])
+def test_bad_messages_are_refused_in_one_line(names, positions, velocities, words):
+    rules = drive()
+    with pytest.raises(RefusedInput, match=words) as caught:
+        rules.read(100, 0, names, positions, velocities)
+    assert caught.value.reason.startswith('input_targets: ')
+    assert '\n' not in caught.value.reason
+    assert rules.start == [d.start for d in FIVE.drivers]    # nothing moved
+
+
+def test_the_stamp_rules_are_the_topic_drives():
+    rules = drive()
+    given = rules.read(100, 0, ['P.x', 'P.y'], [0.06, 0.22], [])
+    rules.published(given.stamp_ns)
+    with pytest.raises(RefusedInput, match='input_targets: expected a stamp after'):
+        rules.read(100, 0, ['P.x', 'P.y'], [0.061, 0.22], [])
