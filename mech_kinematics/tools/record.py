@@ -17,9 +17,14 @@ rosbag2 does it:
 
 Bag format version 8 is the default: its metadata is readable by Humble and
 later, while version 9 metadata is not readable by Humble (rosbag2#1895).
-Ctrl-C, SIGTERM or the end of ``--duration`` stop the recording, after which
-the subscriptions are destroyed and the bag is closed: every message received
-is in it.
+Ctrl-C, SIGTERM or the end of ``--duration`` stop the recording. What the
+subscriptions have already received and not yet handed over is then taken
+(for at most :data:`DRAIN_S`: a recorder that lags on a loaded machine held
+the last tenth of a second of the largest topics there), after which the
+subscriptions are destroyed and the bag is closed: every message received
+is in it. A message published before its topic's subscription matched (the
+topics are discovered one after another) is not the recorder's to receive:
+the state topics are volatile, as rosbag2 records them.
 
 Nothing is lost if the recorder itself dies: messages reach the storage file
 every :data:`~mech_kinematics.bag.FLUSH_INTERVAL_S` (an MCAP chunk closed and synced,
@@ -114,6 +119,11 @@ DEFAULT_PROGRESS_S = 5.0
 QUEUE_DEPTH = 1000
 #: Longest wait of one executor step, s: bounds the reaction to a signal or the deadline.
 SPIN_STEP_S = 0.05
+#: Longest time spent after the stop taking what the subscriptions hold, s (a stream that
+#: keeps coming would hold them forever).
+DRAIN_S = 0.5
+#: Executor steps in a row that take nothing, after the stop, that end the draining.
+IDLE_STEPS = 3
 
 EXECUTORS = ('events', 'single')
 DEFAULT_EXECUTOR = 'events'
@@ -505,6 +515,19 @@ class BagRecorder:
                     break
                 step = min(step, remaining)
             spin_once(timeout_sec=step)
+        self._drain()
+
+    def _drain(self) -> None:
+        """Take what the subscriptions hold at the stop (not after a write error)."""
+        if self._writer is None or self._writer.failure is not None:
+            return
+        deadline = time.monotonic() + DRAIN_S
+        idle = 0
+        while idle < IDLE_STEPS and time.monotonic() < deadline:
+            before = sum(topic.stats.received for topic in self._topics.values())
+            self._executor.spin_once(timeout_sec=0.0)
+            after = sum(topic.stats.received for topic in self._topics.values())
+            idle = idle + 1 if after == before else 0
 
     def close(self) -> list[TopicStats]:
         """Stop receiving, close the bag (metadata.yaml included) and shut ROS down.
