@@ -291,7 +291,7 @@ class Robot:
     def solve(self, positions: Mapping[str, Any] | None = None,
               speeds: Mapping[str, Any] | None = None, accels: Mapping[str, Any] | None = None,
               *, max_error: float = MAX_ERROR, gravity: Iterable[float] | None = None,
-              loads: Iterable[LinkLoad] = ()) -> RobotState:
+              loads: Iterable[LinkLoad] = (), forces: bool = True) -> RobotState:
         """Solve the robot where its actuated joints stand.
 
         Parameters
@@ -307,6 +307,9 @@ class Robot:
         loads : iterable of LinkLoad, optional
             Forces and torques on links the loops move, in the root frame
             (:class:`~.forces.LinkLoad`): in the efforts and reactions.
+        forces : bool, optional
+            False: the kinematics only, no efforts or reactions (an inverse's
+            iterations, :mod:`.targets`). Default True.
 
         Returns
         -------
@@ -337,7 +340,7 @@ class Robot:
         except AssemblyError as error:  # one instant (arrays mask what they refuse)
             raise error.located(self.where({n: x[0] for n, x in inputs.items()})) from None
         answer = self.joints_from_state(state, inputs)
-        if self.forces is None:
+        if self.forces is None or not forces:
             return answer
         try:
             efforts = self.forces.efforts(state, inputs, g, max_error, link_loads)
@@ -354,6 +357,54 @@ class Robot:
             efforts, {n: float(j.position) for n, j in answer.joints.items()},
             {n: float(b[0]) for n, b in answer.bounds.items()})
         return replace(answer, efforts=efforts, reactions=reactions)
+
+    def solve_targets(self, targets: Mapping[str, float],
+                      speeds: Mapping[str, float] | None = None,
+                      accels: Mapping[str, float] | None = None, *,
+                      start: Mapping[str, float] | None = None, max_error: float = MAX_ERROR,
+                      forces: Mapping[str, float] | None = None,
+                      gravity: Iterable[float] | None = None,
+                      loads: Iterable[LinkLoad] = ()) -> Any:
+        """Solve the robot driven from its targets (docs/targets.md, :mod:`.targets`).
+
+        Parameters
+        ----------
+        targets : mapping of str to float
+            One per actuated joint: a joint :meth:`solve` answers (rad or m,
+            the URDF's) or a link frame origin's coordinate in the root frame,
+            ``'FRAME.x'``, ``'.y'``, ``'.z'`` (m).
+        speeds, accels : mapping of str to float, optional
+            The targets' velocities and accelerations (SI); left out: at rest.
+        start : mapping of str to float, optional
+            Actuated joints' values the answer is continued from; default the
+            reference pose's.
+        max_error : float, optional
+            As :meth:`solve`'s; also the largest bound of an actuated joint's
+            value over its scale (1 rad, or the loops' size).
+        forces : mapping of str to float, optional
+            Forces (N) or torques (N m) along targets: ``target_efforts``
+            holds the actuated joints' share, ``J^T F``.
+        gravity, loads
+            As :meth:`solve`'s, for the efforts of the motion (with ``<inertial>``).
+
+        Returns
+        -------
+        Inverse
+            Its ``answer`` a :class:`RobotState` (with the efforts where the
+            URDF has ``<inertial>``).
+
+        Raises
+        ------
+        TargetError
+            A target the robot does not answer, out of reach, or near a
+            singular point of the map.
+        """
+        from .targets import solve_robot_targets
+
+        return solve_robot_targets(self, targets, speeds, accels, start=start,
+                                   max_error=max_error, forces=forces,
+                                   gravity=None if gravity is None else tuple(gravity),
+                                   loads=tuple(loads))
 
     def _assembled(self, p: list[Any], v: list[Any], a: list[Any],
                    inputs: Mapping[str, tuple[Any, Any, Any]], max_error: float) -> State:

@@ -207,9 +207,14 @@ def continue_to(tmap: TargetMap, goal: Sequence[float], start: Sequence[float],
     tdd = np.zeros(m) if accels is None else np.array(accels, dtype=np.float64)
     q = np.array(start, dtype=np.float64)
     zeros = [0.0] * n
+    #: The last drivers' values columns() solved at, and its answer: a Newton start (the
+    #: start pose, the last point reached) is where the path or the last step solved.
+    last: list[Any] = [None, None]
 
     def columns(x: npt.NDArray[np.float64]) -> tuple[Any, Any, Any]:
         """Return the targets' values and bounds at ``x`` and the Jacobian with its bounds."""
+        if last[0] is not None and np.array_equal(last[0], x):
+            return last[1]
         jac = np.empty((m, n))
         jac_b = np.empty((m, n))
         values = bounds = None
@@ -220,6 +225,7 @@ def continue_to(tmap: TargetMap, goal: Sequence[float], start: Sequence[float],
             jac[:, j], jac_b[:, j] = vals[:, 1], bnds[:, 1]
             if values is None:
                 values, bounds = vals[:, 0], bnds[:, 0]
+        last[:] = [x.copy(), (values, bounds, (jac, jac_b))]
         return values, bounds, (jac, jac_b)
 
     def newton(x0: npt.NDArray[np.float64], target: npt.NDArray[np.float64],

@@ -164,17 +164,7 @@ def _handle_robot(args: argparse.Namespace) -> int:
         return 2
     for warning in caught:
         print(f'warning: {warning.message}', file=sys.stderr)
-    result: dict[str, Any] = answer.as_dict()
-    if args.diagnostics:
-        result['singularity'] = {key: float(m) for key, m in answer.state.singularity.items()}
-        result['relative_error_bound'] = float(answer.state.relative_error_bound)
-    path, value = next(_not_finite(result), ('', 0.0))
-    if path:
-        print(f'error: Expected every value of the state at {shown} to be finite, got {path} = '
-              f'{value!r} (beyond the range of doubles)', file=sys.stderr)
-        return 2
-    print(json.dumps(result, indent=args.indent, allow_nan=False))
-    return 0
+    return _print_result(answer.as_dict(), answer.state, args, f' at {shown}')
 
 
 _TARGET_FLAGS = ('--target', '--target-speed', '--target-accel', '--target-force')
@@ -184,6 +174,78 @@ def _targets_given(args: argparse.Namespace) -> bool:
     return any(getattr(args, flag[2:].replace('-', '_')) for flag in _TARGET_FLAGS)
 
 
+def _target_tables(args: argparse.Namespace) -> dict[str, dict[str, float]]:
+    """Return ``--target`` and its companions as given: flag -> {target: value}.
+
+    Raises ValueError for ``--speed``, ``--accel``, ``--angle-deg`` or
+    ``--speed-rpm`` beside them, a value without a name, or a companion for a
+    target not given with ``--target``.
+    """
+    if args.speed or args.accel or args.angle_deg is not None or args.speed_rpm is not None:
+        msg = ("Expected --target-speed and --target-accel with --target (the drivers' "
+               "rates follow from the targets'), got --speed, --accel, --angle-deg or "
+               '--speed-rpm')
+        raise ValueError(msg)
+    given: dict[str, dict[str, float]] = {}
+    for flag in _TARGET_FLAGS:
+        table = given.setdefault(flag, {})
+        for name, value in getattr(args, flag[2:].replace('-', '_')) or ():
+            if name is None:
+                msg = (f'Expected {flag} NAME=VALUE (a joint, POINT.x|y or, for a URDF, '
+                       f'FRAME.x|y|z), got {value:g}')
+                raise ValueError(msg)
+            table[name] = value
+    names = tuple(given['--target'])
+    for flag in _TARGET_FLAGS[1:]:
+        stray = [name for name in given[flag] if name not in names]
+        if stray:
+            msg = (f'Expected {flag} for targets given with --target '
+                   f'({", ".join(names) or "none"}), got {", ".join(stray)}')
+            raise ValueError(msg)
+    return given
+
+
+def _target_goal(given: dict[str, dict[str, float]], angular: Sequence[bool],
+                 args: argparse.Namespace, per_metre: float) -> tuple[
+                     list[float], list[float], list[float]]:
+    """Return the targets' positions, speeds and accelerations in SI, in ``given``'s order.
+
+    An angle in the units of ``--input`` (deg, or rad with ``--units si``), its
+    speed as ``--speed``'s (rpm, or rad/s); a length over ``per_metre``.
+    """
+    goal, speeds, accels = [], [], []
+    for name, is_angle in zip(given['--target'], angular, strict=True):
+        value = given['--target'][name]
+        speed = given['--target-speed'].get(name, 0.0)
+        goal.append((value if args.units == 'si' else math.radians(value)) if is_angle
+                    else value / per_metre)
+        speeds.append(angular_rate_given(speed, args) if is_angle else speed)
+        accels.append(given['--target-accel'].get(name, 0.0))
+    return goal, speeds, accels
+
+
+def _print_inverse(inverse: Any, state: Any, args: argparse.Namespace) -> int:
+    """Print the answer of an inverse solve: the forward answer's JSON and the inverse's."""
+    result: dict[str, Any] = {**inverse.answer.as_dict(), **inverse.as_dict()}
+    result['error_bound'] = {**result['error_bound'], **inverse.bound_dict()}
+    return _print_result(result, state, args)
+
+
+def _print_result(result: dict[str, Any], state: Any, args: argparse.Namespace,
+                  where: str = '') -> int:
+    """Print ``result`` as JSON (with ``--diagnostics``, ``state``'s measures); 2 if not finite."""
+    if args.diagnostics:
+        result['singularity'] = {key: float(m) for key, m in state.singularity.items()}
+        result['relative_error_bound'] = float(state.relative_error_bound)
+    path, value = next(_not_finite(result), ('', 0.0))
+    if path:
+        print(f'error: Expected every value of the state{where} to be finite, got {path} = '
+              f'{value!r} (beyond the range of doubles)', file=sys.stderr)
+        return 2
+    print(json.dumps(result, indent=args.indent, allow_nan=False))
+    return 0
+
+
 def _handle_targets(scene: Any, args: argparse.Namespace) -> int:
     """Solve a scene driven from its targets (``--target NAME=VALUE``): docs/targets.md."""
     from ..errors import TargetError
@@ -191,41 +253,15 @@ def _handle_targets(scene: Any, args: argparse.Namespace) -> int:
     from ..units import LENGTH_UNITS
 
     try:
-        if args.speed or args.accel or args.angle_deg is not None or args.speed_rpm is not None:
-            msg = ("Expected --target-speed and --target-accel with --target (the drivers' "
-                   "rates follow from the targets'), got --speed, --accel, --angle-deg or "
-                   '--speed-rpm')
-            raise ValueError(msg)
-        given: dict[str, dict[str, float]] = {}
-        for flag in _TARGET_FLAGS:
-            table = given.setdefault(flag, {})
-            for name, value in getattr(args, flag[2:].replace('-', '_')) or ():
-                if name is None:
-                    msg = f'Expected {flag} NAME=VALUE (a joint or POINT.x|y), got {value:g}'
-                    raise ValueError(msg)
-                table[name] = value
-        names = tuple(given['--target'])
-        for flag in _TARGET_FLAGS[1:]:
-            stray = [name for name in given[flag] if name not in names]
-            if stray:
-                msg = (f'Expected {flag} for targets given with --target '
-                       f'({", ".join(names) or "none"}), got {", ".join(stray)}')
-                raise ValueError(msg)
-        tmap = scene_targets(scene, names)
+        given = _target_tables(args)
+        tmap = scene_targets(scene, tuple(given['--target']))
         start, _, _, turns, _ = drive_from_args(scene, args)
         starts = [start] if len(scene.drivers) == 1 else list(start)
         whole = [turns] if len(scene.drivers) == 1 else list(turns)
         first = [d.start if x is None else x + math.tau * int(w)
                  for d, x, w in zip(scene.drivers, starts, whole, strict=True)]
         per_metre = 1.0 if args.units == 'si' else LENGTH_UNITS[scene.units.length]
-        goal, speeds, accels = [], [], []
-        for name, angular in zip(names, tmap.target_angular, strict=True):
-            value = given['--target'][name]
-            speed = given['--target-speed'].get(name, 0.0)
-            goal.append((value if args.units == 'si' else math.radians(value)) if angular
-                        else value / per_metre)
-            speeds.append(angular_rate_given(speed, args) if angular else speed)
-            accels.append(given['--target-accel'].get(name, 0.0))
+        goal, speeds, accels = _target_goal(given, tmap.target_angular, args, per_metre)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter('always', NearSingularWarning)
             inverse = continue_to(tmap, goal, first, speeds, accels, max_error=args.max_error,
@@ -235,27 +271,48 @@ def _handle_targets(scene: Any, args: argparse.Namespace) -> int:
         return 2
     for warning in caught:
         print(f'warning: {warning.message}', file=sys.stderr)
-    state = inverse.answer
-    result: dict[str, Any] = {**state.as_dict(), **inverse.as_dict()}
-    result['error_bound'] = {**result['error_bound'], **inverse.bound_dict()}
-    if args.diagnostics:
-        result['singularity'] = {key: float(m) for key, m in state.singularity.items()}
-        result['relative_error_bound'] = float(state.relative_error_bound)
-    path, value = next(_not_finite(result), ('', 0.0))
-    if path:
-        print(f'error: Expected every value of the state to be finite, got {path} = '
-              f'{value!r} (beyond the range of doubles)', file=sys.stderr)
+    return _print_inverse(inverse, inverse.answer, args)
+
+
+def _handle_robot_targets(args: argparse.Namespace) -> int:
+    """Solve a URDF robot driven from its targets (joints, ``FRAME.x|y|z``): docs/targets.md."""
+    from ..errors import TargetError
+    from ..robot.targets import robot_targets
+
+    try:
+        given = _target_tables(args)
+        gravity = gravity_of(args)
+        loads = link_loads_of(args)
+        robot = load_robot_argument(args)
+        if (gravity is not None or loads) and robot.forces is None:
+            msg = (f'--gravity, --link-force: Expected a robot whose links carry <inertial> '
+                   f'(their masses), got none in {args.scene}')
+            raise ValueError(msg)
+        if loads:
+            robot.forces.check_loads(loads)
+        positions, _, _, _, _ = _robot_drive(robot, args)
+        tmap = robot_targets(robot, tuple(given['--target']))
+        goal, speeds, accels = _target_goal(given, tmap.target_angular, args, 1.0)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter('always', NearSingularWarning)
+            inverse = robot.solve_targets(
+                dict(zip(tmap.targets, goal, strict=True)),
+                dict(zip(tmap.targets, speeds, strict=True)),
+                dict(zip(tmap.targets, accels, strict=True)), start=positions,
+                max_error=args.max_error, forces=given['--target-force'], gravity=gravity,
+                loads=loads)
+    except (SceneError, TargetError, ValueError) as error:
+        print(f'error: {error}', file=sys.stderr)
         return 2
-    print(json.dumps(result, indent=args.indent, allow_nan=False))
-    return 0
+    for warning in caught:
+        print(f'warning: {warning.message}', file=sys.stderr)
+    return _print_inverse(inverse, inverse.answer.state, args)
 
 
 def _handle(args: argparse.Namespace) -> int:
     if is_urdf(args.scene):
         if _targets_given(args):
-            print('error: --target: Expected a scene (a YAML file): a URDF robot driven from '
-                  'its targets is not built yet (docs/targets.md)', file=sys.stderr)
-            return 2
+            return _handle_robot_targets(args)
         return _handle_robot(args)
     try:
         if args.closures or args.actuated or args.reference or args.gravity is not None \
@@ -294,17 +351,7 @@ def _handle(args: argparse.Namespace) -> int:
         else:
             warnings.warn_explicit(warning.message, warning.category, warning.filename,
                                    warning.lineno)
-    result: dict[str, Any] = state.as_dict()
-    if args.diagnostics:
-        result['singularity'] = {key: float(m) for key, m in state.singularity.items()}
-        result['relative_error_bound'] = float(state.relative_error_bound)
-    path, value = next(_not_finite(result), ('', 0.0))
-    if path:
-        print(f'error: Expected every value of the state at {shown} to be finite, got {path} = '
-              f'{value!r} (beyond the range of doubles)', file=sys.stderr)
-        return 2
-    print(json.dumps(result, indent=args.indent, allow_nan=False))
-    return 0
+    return _print_result(state.as_dict(), state, args, f' at {shown}')
 
 
 def _not_finite(value: Any, path: str = '') -> Iterator[tuple[str, float]]:
@@ -348,7 +395,10 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
                         help='drive the scene from its output (docs/targets.md): a joint it '
                              'reports (degrees, or the length unit; rad and m with --units si) '
                              "or a point's coordinate POINT.x, POINT.y (the length unit), as "
-                             'many as it has drivers; --input gives the pose to continue from')
+                             'many as it has drivers; for a URDF, a joint it answers (degrees '
+                             "or m) or a link frame origin's coordinate in the root frame "
+                             'FRAME.x, FRAME.y, FRAME.z (m), as many as it has actuated joints; '
+                             '--input gives the pose to continue from')
     parser.add_argument('--target-speed', type=named_value, action='append',
                         metavar='NAME=V', help="a target's speed: rpm for an angle (rad/s with "
                                                '--units si), m/s for a length (default 0)')

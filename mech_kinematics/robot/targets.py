@@ -1,0 +1,233 @@
+# Copyright 2026 mech_kinematics contributors
+# SPDX-License-Identifier: Apache-2.0
+"""A robot described in URDF driven from its output: targets in the URDF's names and frames.
+
+A *target* of a robot is a joint's value (any joint :meth:`.Robot.solve`
+answers: an actuated one, a passive joint of a loop, a mimic joint; rad or m
+from its zero, as the URDF writes it) or one coordinate of a link's frame
+origin in the root frame, ``FRAME.x``, ``FRAME.y`` or ``FRAME.z`` (m). A
+robot with ``n`` actuated joints takes ``n`` targets; :func:`robot_targets`
+builds the map the inverse of :mod:`mech_kinematics.solver.inverse` solves
+(the same Newton continuation from the reference pose as a scene's), and
+:meth:`.Robot.solve_targets` answers the actuated joints' values and rates,
+every joint, and with ``<inertial>`` the efforts of that motion.
+
+A frame's origin is the URDF's own tree kinematics, walked from the root as
+:meth:`.Description.transforms` walks it (the same products: the position
+is that function's to the bit), with the joints' values the robot answers
+(a joint no loop moves and no rule sets stands at 0, as joint_state_publisher
+draws it). Its velocity and acceleration are carried down the chain in
+closed form, each joint adding its rate about (or along) its axis:
+
+- revolute about ``e``: ``w += e qd``, ``alpha += e qdd + w x e qd``, the
+  origin not moved;
+- prismatic along ``e`` by ``d = e q``: ``v += e qd + w x d``,
+  ``a += e qdd + alpha x d + w x (w x d) + 2 w x e qd``;
+- each ``<origin>`` offset ``r`` (rotated into the root frame): ``v += w x r``,
+  ``a += alpha x r + w x (w x r)``.
+
+Bounds, to first order, from the joints' own bounds ``b`` (rad, m): with
+``R`` the chain's reach (its offsets' and prismatic values' lengths summed,
+at least the loops' size: no origin in the chain is farther from the frame)
+and ``c`` = ``R`` for a revolute joint, 1 for a prismatic one,
+``|dp/dq| <= c``, ``|d2p/dq dq'| <= 2 c c' / R`` and ``|d3p/dq3| <= 4 c c' c'' / R^2``;
+so ``bp = sum c b_q``, ``bv = sum c b_qd + 2 S1 bp / R``,
+``ba = sum c b_qdd + 2 S2 bp / R + 4 S1 (sum c b_qd) / R + 4 S1^2 bp / R^2`` with
+``S1 = sum c |qd|``, ``S2 = sum c |qdd|``, each plus the rounding of the
+walk (``16 (k + 1) eps`` of the terms' scale over ``k`` joints).
+
+Pure: no ROS.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import replace
+import math
+from typing import Any, TYPE_CHECKING
+
+import numpy as np
+import numpy.typing as npt
+
+from ..bounds import MAX_ERROR
+from ..errors import AssemblyError, TargetError
+from ..solver.inverse import continue_to, Inverse, TargetMap
+
+if TYPE_CHECKING:
+    from .description import Description
+    from .robot import Robot, RobotState
+
+__all__ = ['AXES', 'frame_motion', 'robot_targets', 'solve_robot_targets']
+
+#: A frame target's coordinates, in the root frame.
+AXES = ('x', 'y', 'z')
+_EPS = float(np.finfo(np.float64).eps)
+
+
+def frame_motion(description: Description, link: str, values: Mapping[str, float],
+                 rates: Mapping[str, tuple[float, float]],
+                 bounds: Mapping[str, tuple[float, float, float]], size: float
+                 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """Return ``link``'s origin in the root frame: (position, velocity, acceleration) and bounds.
+
+    ``values``: every moving joint's value (:meth:`.Description.pose`);
+    ``rates``: a joint's (speed, acceleration), 0 where left out; ``bounds``:
+    a joint's (position, speed, acceleration) bounds, 0 where left out (a
+    value that is exact); ``size``: the loops' size, the least reach. Returns
+    two arrays of shape (3, 3): rows position, velocity, acceleration.
+    """
+    m = np.eye(4)
+    w = np.zeros(3)
+    alpha = np.zeros(3)
+    v = np.zeros(3)
+    a = np.zeros(3)
+    chain = description.chain(link)
+    moving = []     # (angular, |qd|, |qdd|, b_q, b_qd, b_qdd)
+    reach = 0.0
+    for joint in chain:
+        mj = m @ joint.origin
+        r = mj[:3, 3] - m[:3, 3]
+        v = v + np.cross(w, r)
+        a = a + np.cross(alpha, r) + np.cross(w, np.cross(w, r))
+        reach += float(np.linalg.norm(joint.origin[:3, 3]))
+        if joint.type is None:
+            m = mj
+            continue
+        x = float(values.get(joint.name, 0.0))
+        xd, xdd = rates.get(joint.name, (0.0, 0.0))
+        e = mj[:3, :3] @ np.asarray(joint.axis, dtype=np.float64)
+        if joint.type.angular:
+            alpha = alpha + e * xdd + np.cross(w, e) * xd
+            w = w + e * xd
+        else:
+            d = e * x
+            v = v + e * xd + np.cross(w, d)
+            a = (a + e * xdd + np.cross(alpha, d) + np.cross(w, np.cross(w, d))
+                 + 2.0 * np.cross(w, e * xd))
+            reach += abs(x)
+        m = m @ joint.motion(x)
+        moving.append((joint.type.angular, abs(xd), abs(xdd),
+                       *bounds.get(joint.name, (0.0, 0.0, 0.0))))
+    motion = np.stack((m[:3, 3], v, a))
+    big_r = max(reach, size)
+    c = np.array([big_r if item[0] else 1.0 for item in moving])
+    table = np.array([item[1:] for item in moving]).reshape(-1, 5)
+    s1, s2 = float(c @ table[:, 0]), float(c @ table[:, 1])
+    bq, bqd, bqdd = (float(c @ table[:, k]) for k in (2, 3, 4))
+    rounding = 16.0 * (len(chain) + 1) * _EPS
+    bp = bq + rounding * big_r
+    bv = bqd + 2.0 * s1 * bp / big_r + rounding * s1
+    ba = (bqdd + 2.0 * s2 * bp / big_r + 4.0 * s1 * bqd / big_r
+          + 4.0 * s1 * s1 * bp / big_r ** 2 + rounding * (s2 + 2.0 * s1 * s1 / big_r))
+    return motion, np.repeat([[bp], [bv], [ba]], 3, axis=1)
+
+
+def robot_targets(robot: Robot, names: Sequence[str]) -> TargetMap:
+    """Return the target map of ``robot`` for ``names`` (its joints and ``FRAME.x|y|z``).
+
+    Raises :class:`~mech_kinematics.errors.TargetError` for a name the robot
+    does not answer, a frame that is not one of its links, or a count other
+    than its actuated joints'.
+    """
+    description = robot.description
+    drivers = tuple(robot.actuated)
+    if len(names) != len(drivers):
+        msg = (f'Expected as many targets as {robot.name} has actuated joints '
+               f'({len(drivers)}: {", ".join(drivers)}), got {len(names)}: '
+               f'{", ".join(names) or "none"}')
+        raise TargetError(msg)
+    if len(set(names)) != len(names):
+        msg = f'Expected each target once, got {", ".join(names)}'
+        raise TargetError(msg)
+    readers: list[tuple[str, str, int]] = []    # ('joint', name, 0) or ('frame', link, axis)
+    angular: list[bool] = []
+    for name in names:
+        link, dot, axis = name.rpartition('.')
+        if robot.knows(name):
+            readers.append(('joint', name, 0))
+            angular.append(robot.joint_type(name).angular)
+        elif dot and link in description.links and axis in AXES:
+            readers.append(('frame', link, AXES.index(axis)))
+            angular.append(False)
+        else:
+            msg = (f'Expected a target to be a joint {robot.name} answers '
+                   f'({", ".join(robot.joint_names)}) or a coordinate of a link frame\'s '
+                   f'origin in the root frame (FRAME.x, FRAME.y, FRAME.z), got {name!r}')
+            raise TargetError(msg)
+    probe = robot.solve(max_error=math.inf, forces=False)
+    size = float(probe.state.error_bound.size)
+
+    def evaluate(q: Sequence[float], qd: Sequence[float], qdd: Sequence[float],
+                 max_error: float) -> tuple[RobotState, Any, Any]:
+        answer = robot.solve(dict(zip(drivers, q, strict=True)),
+                             dict(zip(drivers, qd, strict=True)),
+                             dict(zip(drivers, qdd, strict=True)),
+                             max_error=max_error, forces=False)
+        values = np.empty((len(readers), 3))
+        bounds = np.empty((len(readers), 3))
+        frames: dict[str, tuple[Any, Any]] = {}
+        for i, (table, key, axis) in enumerate(readers):
+            if table == 'joint':
+                j = answer.joints[key]
+                values[i] = (j.position, j.velocity, j.acceleration)
+                bounds[i] = answer.bounds[key]
+                continue
+            if key not in frames:
+                frames[key] = frame_motion(
+                    description, key,
+                    description.pose({n: float(j.position) for n, j in answer.joints.items()}),
+                    {n: (float(j.velocity), float(j.acceleration))
+                     for n, j in answer.joints.items()},
+                    {n: tuple(float(x) for x in b) for n, b in answer.bounds.items()}, size)
+            motion, motion_bound = frames[key]
+            values[i] = motion[:, axis]
+            bounds[i] = motion_bound[:, axis]
+        return answer, values, bounds
+
+    def text(index: int, value: float) -> str:
+        return f'{value:.6g} rad' if angular[index] else f'{value:.6g} m'
+
+    return TargetMap(
+        targets=tuple(names), drivers=drivers, target_angular=tuple(angular),
+        driver_angular=tuple(robot.joint_type(d).angular for d in drivers),
+        target_scales=tuple(1.0 if a else size for a in angular),
+        driver_scales=tuple(1.0 if robot.joint_type(d).angular else size for d in drivers),
+        evaluate=evaluate, text=text)
+
+
+def solve_robot_targets(robot: Robot, targets: Mapping[str, float],
+                        speeds: Mapping[str, float] | None = None,
+                        accels: Mapping[str, float] | None = None, *,
+                        start: Mapping[str, float] | None = None,
+                        max_error: float = MAX_ERROR,
+                        forces: Mapping[str, float] | None = None,
+                        gravity: Sequence[float] | None = None,
+                        loads: Sequence[Any] = ()) -> Inverse:
+    """Solve ``robot`` driven from its targets: :meth:`.Robot.solve_targets`."""
+    names = tuple(targets)
+    tmap = robot_targets(robot, names)
+    for what, given in (('speeds', speeds), ('accels', accels)):
+        unknown = [name for name in given or () if name not in names]
+        if unknown:
+            msg = f'Expected {what} of the targets ({", ".join(names)}), got {", ".join(unknown)}'
+            raise TargetError(msg)
+    stray = [name for name in start or () if name not in robot.actuated]
+    if stray:
+        msg = (f'Expected a start of the actuated joints ({", ".join(robot.actuated)}), got '
+               f'{", ".join(stray)}')
+        raise TargetError(msg)
+    first = [(start or {}).get(name, robot.start(name)) for name in robot.actuated]
+    inverse = continue_to(tmap, [targets[n] for n in names], first,
+                          [(speeds or {}).get(n, 0.0) for n in names],
+                          [(accels or {}).get(n, 0.0) for n in names],
+                          max_error=max_error, forces=forces)
+    if robot.forces is None:
+        return inverse
+    q, qd, qdd = (dict(zip(robot.actuated, (float(x) for x in inverse.motion[:, k]),
+                           strict=True)) for k in range(3))
+    try:       # the efforts of that motion, and its reactions
+        answer = robot.solve(q, qd, qdd, max_error=max_error, gravity=gravity, loads=loads)
+    except AssemblyError as error:
+        msg = f'Expected an answer whose forces can be trusted, got {error}'
+        raise TargetError(msg) from None
+    return replace(inverse, answer=answer)
