@@ -200,12 +200,10 @@ class KinematicsNode(LifecycleNode):
                                  [name for name in ('link_forces', 'link_torques')
                                   if self._value(name)])
         scene = source.scene
-        if self._value('drive') == TARGET and (source.robot is not None or any(
-                name == 'extra_joints' for name in self._parameter_overrides)):
-            raise SceneError('drive: Expected drive: target with a scene (a URDF robot driven '
-                             'from its targets is not built yet) and without extra_joints (a '
-                             'message names targets only), got '
-                             + ('a robot' if source.robot is not None else 'extra_joints'))
+        if self._value('drive') == TARGET and any(
+                name == 'extra_joints' for name in self._parameter_overrides):
+            raise SceneError('extra_joints: Expected drive: target without extra_joints (a '
+                             'message names targets only), got extra_joints')
         if source.robot is not None:     # what would be accepted and ignored is refused
             note = robot_forces_note(source.robot)
             refusal = robot_forces_refusal(note, self._value('drive'), self._value('effort'),
@@ -256,7 +254,8 @@ class KinematicsNode(LifecycleNode):
             self._input = InputSubscription(
                 self, scene, self._solver, publishing, self._stats, frame_id=self.frame_id,
                 extra_joints=self.extra_joints, jump_back_s=self._value('stamp_jump_back_s'),
-                robot=publishing.robot_values, targets=self._value('drive') == TARGET)
+                robot=publishing.robot_values, targets=self._value('drive') == TARGET,
+                target_robot=source.robot)
         elif publishing.robot_values is not None and publishing.robot_values.clock_note:
             self.get_logger().warning(publishing.robot_values.clock_note)
         self.scene = scene

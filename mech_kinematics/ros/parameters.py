@@ -158,7 +158,8 @@ PARAMETERS = (
                   'on the rate_hz grid), topic (the positions, and velocities if given, of '
                   'each message on input_joint_states, published with its stamp) or target '
                   '(each message on input_targets names targets, as many as the scene has '
-                  'drivers: a joint it reports or POINT.x|y, SI; the drivers that put them '
+                  "drivers: a joint it reports or POINT.x|y; a URDF robot's joint or "
+                  'FRAME.x|y|z; SI; the drivers that put them '
                   'there, continued from the last state, published with its stamp; '
                   'docs/targets.md)',
                   choices=DRIVE_MODES, read_only=True),

@@ -5,7 +5,9 @@
 With ``drive: target`` the node subscribes to ``input_targets``
 (``sensor_msgs/msg/JointState``): each message names targets (as many as the
 scene has drivers, each a joint the scene reports or a point's ``POINT.x`` or
-``POINT.y``; SI: rad, m, and rad/s, m/s in ``velocity``), and the node
+``POINT.y``; in URDF mode as many as the actuated joints, each a joint the
+robot answers or a link frame origin's ``FRAME.x|y|z`` in the root frame; SI:
+rad, m, and rad/s, m/s in ``velocity``), and the node
 publishes the state that puts them there, stamped with the message's stamp,
 as ``drive: topic`` publishes a state per message: ``joint_states`` then
 carries the drivers' values a motor controller needs.
@@ -28,19 +30,16 @@ Pure: no ROS. Thread use: one thread (the executor's), as TopicDrive.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 import math
-from typing import Any, NoReturn, TYPE_CHECKING
+from typing import Any, NoReturn
 
 from .topic_drive import RefusedInput, TopicDrive, TopicInput
 from .topics import INPUT_TARGETS
 from ..errors import TargetError
 from ..solver.inverse import continue_to, scene_targets, TargetMap
 
-if TYPE_CHECKING:
-    from ..solver.mechanism import Scene
-
-__all__ = ['TargetDrive']
+__all__ = ['TargetDrive', 'robot_target_drive', 'scene_target_drive']
 
 #: Sets of target names whose maps are kept (all dropped past it).
 MAPS = 16
@@ -51,8 +50,14 @@ class TargetDrive:
 
     Parameters
     ----------
-    scene : Scene
-        The scene loaded.
+    drivers : sequence
+        What the drivers found are read as (:class:`~.topic_drive.TopicDrive`'s
+        drivers: a scene's, or a robot's actuated joints), in the maps' order.
+    targets_of : callable
+        Target names -> their :class:`~mech_kinematics.solver.inverse.TargetMap`
+        (raising :class:`~mech_kinematics.errors.TargetError` for names it lacks).
+    start : sequence of float
+        The drivers' values the first answer continues from (the start pose).
     max_error : float
         The solver's tolerance, which the inverse's drivers' bounds meet too.
     **topic : Any
@@ -60,13 +65,14 @@ class TargetDrive:
         (``extra_joints`` is ``refuse``: a message names targets only).
     """
 
-    def __init__(self, scene: Scene, max_error: float, **topic: Any) -> None:
-        self.scene = scene
+    def __init__(self, drivers: Sequence[Any], targets_of: Callable[[tuple[str, ...]], TargetMap],
+                 start: Sequence[float], max_error: float, **topic: Any) -> None:
+        self.targets_of = targets_of
         self.max_error = max_error
-        self.topic = TopicDrive(scene.drivers, topic=INPUT_TARGETS, **topic)
+        self.topic = TopicDrive(drivers, topic=INPUT_TARGETS, **topic)
         self.names = self.topic.names
         self.published_joints = self.topic.published_joints
-        self.start = [float(d.start) for d in scene.drivers]
+        self.start = [float(x) for x in start]
         self._pending: list[float] | None = None
         self._maps: dict[tuple[str, ...], TargetMap] = {}
 
@@ -88,7 +94,7 @@ class TargetDrive:
         tmap = self._maps.get(key)
         if tmap is None:
             try:
-                tmap = scene_targets(self.scene, key)
+                tmap = self.targets_of(key)
             except TargetError as error:
                 self._refuse(str(error))
             if len(self._maps) >= MAPS:
@@ -131,3 +137,22 @@ class TargetDrive:
     @staticmethod
     def _refuse(reason: str) -> NoReturn:
         raise RefusedInput(f'{INPUT_TARGETS}: {reason}')
+
+
+def scene_target_drive(scene: Any, max_error: float, **topic: Any) -> TargetDrive:
+    """Return the target drive of a scene: its points and joints, from its start pose."""
+    return TargetDrive(scene.drivers, lambda names: scene_targets(scene, names),
+                       [d.start for d in scene.drivers], max_error, **topic)
+
+
+def robot_target_drive(robot: Any, drivers: Sequence[Any], max_error: float,
+                       **topic: Any) -> TargetDrive:
+    """Return the target drive of a URDF robot: its joints and frames, from its reference pose.
+
+    ``drivers``: the actuated joints as the URDF mode reads them
+    (:class:`~.robot_mode.RobotValues`' drivers, in ``robot.actuated``'s order).
+    """
+    from ..robot.targets import robot_targets
+
+    return TargetDrive(drivers, lambda names: robot_targets(robot, names),
+                       [robot.start(name) for name in robot.actuated], max_error, **topic)

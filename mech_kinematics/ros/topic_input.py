@@ -35,7 +35,7 @@ from . import topics
 from .cdr import marker, MessageTemplate, STAMP_MARKER
 from .messages import TickMessages
 from .publishing import qos_options, RCLError
-from .target_drive import TargetDrive
+from .target_drive import robot_target_drive, scene_target_drive, TargetDrive
 from .ticker import general_tick
 from .topic_drive import RefusedInput, TopicDrive, TopicInput
 from ..errors import AssemblyError, UntrustedError
@@ -86,7 +86,10 @@ class InputSubscription:
     targets : bool, optional
         ``drive: target``: subscribe to ``input_targets`` and read each message's
         targets into the drivers that put them there
-        (:class:`~.target_drive.TargetDrive`); a scene's only.
+        (:class:`~.target_drive.TargetDrive`).
+    target_robot : Robot, optional
+        In URDF mode with ``targets``: the robot whose joints and frames the
+        targets name.
 
     Attributes
     ----------
@@ -99,7 +102,7 @@ class InputSubscription:
     def __init__(self, node: Any, scene: Any, solver: SolverPath, publishing: Publishing,
                  stats: TickStats, *, frame_id: str, extra_joints: str,
                  jump_back_s: float, robot: RobotValues | None = None,
-                 targets: bool = False) -> None:
+                 targets: bool = False, target_robot: Any = None) -> None:
         self.node, self.solver, self.publishing, self.stats = node, solver, publishing, stats
         self.frame_id = frame_id
         self.robot = robot
@@ -116,9 +119,13 @@ class InputSubscription:
                                              efforts_first=publishing.efforts_first)
                          for known in (True, False)}
         rules = {'jump_back_ns': round(jump_back_s * NS_PER_S), 'published_joints': joints}
-        self.topic: TopicDrive | TargetDrive = TargetDrive(
-            scene, solver.max_error, **rules) if targets else TopicDrive(
-                drivers, extra_joints=extra_joints, **rules)
+        self.topic: TopicDrive | TargetDrive
+        if not targets:
+            self.topic = TopicDrive(drivers, extra_joints=extra_joints, **rules)
+        elif target_robot is not None:
+            self.topic = robot_target_drive(target_robot, drivers, solver.max_error, **rules)
+        else:
+            self.topic = scene_target_drive(scene, solver.max_error, **rules)
         self.active = False
         #: joint_states templates with the passed joints, by (names, velocities, efforts).
         self._passed: dict[tuple[tuple[str, ...], bool, bool], MessageTemplate | None] = {}

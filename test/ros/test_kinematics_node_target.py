@@ -6,15 +6,22 @@ This process publishes the five-bar's effector targets (``P.x``, ``P.y``, m)
 on ``input_targets``; the node publishes one state per message with its
 stamp, whose ``joint_states`` carries the motors' values: checked against the
 forward solve of those values (P comes back) and against ``mk.solve_targets``.
-A target out of reach is refused on diagnostics and the stream goes on.
+A target out of reach is refused on diagnostics and the stream goes on. In
+URDF mode the lift arm is driven by its tool frame's height (``tool_frame.z``,
+the root frame): ``joint_states`` names the URDF's joints, checked against the
+URDF's own kinematics (test/helpers.py's ``UrdfFk``) and ``Robot.solve_targets``.
 """
 
+from pathlib import Path
+
 from diagnostic_msgs.msg import DiagnosticStatus
+from helpers import UrdfFk
 import numpy as np
 from ros_helpers import SESSION, stamp_ns, wait_for
 from test_kinematics_node_topic import ANSWER_S, T0, TopicNode
 
 import mech_kinematics as mk
+from mech_kinematics.robot import load_robot
 
 SCENE = 'five_bar'
 FIVE = mk.load_scene(SCENE)
@@ -81,3 +88,37 @@ def test_a_target_out_of_reach_is_refused_and_the_stream_goes_on(ros, tmp_path):
     joints = FIVE.output_joints
     first = [node.js[0].position[joints.index(d.name)] for d in FIVE.drivers]
     np.testing.assert_allclose(first, inverse.motion[:, 0], rtol=0, atol=1e-12)
+
+
+LIFT = Path(__file__).resolve().parents[1] / 'data' / 'urdf' / 'lift_arm.urdf'
+
+
+def test_a_urdf_robot_driven_by_its_tool_frame(ros, tmp_path):
+    """The lift arm's tool raised along z: each state's joints put it there (the URDF's own FK)."""
+    robot = load_robot(LIFT)
+    fk = UrdfFk(LIFT.read_text())
+    start = robot.solve(forces=False)
+    z0 = float(fk.transforms({n: float(j.position) for n, j in start.joints.items()})[
+        'tool_frame'][2, 3])
+    node = TopicNode(ros, tmp_path, 'target_urdf', scene=str(LIFT), drive='target',
+                     input_topic=f'{SESSION}/target_urdf/input_targets',
+                     greeting=(['tool_frame.z'], [z0]))
+    heights = [z0 + 0.005 * i for i in range(1, 8)]
+    stamps = [T0 + 1_000_000 * i for i in range(len(heights))]
+    try:
+        for stamp, z in zip(stamps, heights, strict=True):
+            node.send(stamp, ['tool_frame.z'], [z], [0.1])
+        wait_for(lambda: len(node.js) >= len(stamps), ANSWER_S, 'joint_states')
+        assert node.proc.proc.poll() is None
+    finally:
+        node.stop()
+    assert [stamp_ns(m) for m in node.js] == stamps
+    for js, z in zip(node.js, heights, strict=True):
+        assert js.name == list(robot.joint_names)
+        values = dict(zip(js.name, js.position, strict=True))
+        tool = fk.transforms(values)['tool_frame']
+        assert abs(tool[2, 3] - z) <= 1e-12 * start.state.error_bound.size
+        inverse = robot.solve_targets({'tool_frame.z': z}, {'tool_frame.z': 0.1})
+        assert abs(values['lift_joint'] - inverse.motion[0, 0]) <= 1e-12
+        speed = dict(zip(js.name, js.velocity, strict=True))['lift_joint']
+        assert abs(speed - inverse.motion[0, 1]) <= 1e-12

@@ -54,10 +54,11 @@ class TopicNode:
                  input_qos=INPUT_QOS, drive='topic', greeting=None):
         self.ns = f'{SESSION}/{name}'
         self.prefix = f'{SESSION[1:]}_{name}'
-        self.drivers = mk.load_scene(scene).drivers
         # What the greetings send: the drivers at their start, or (names, positions) given.
-        self.greeting = greeting or ([d.name for d in self.drivers],
-                                     [d.start for d in self.drivers])
+        if greeting is None:
+            drivers = mk.load_scene(scene).drivers
+            greeting = ([d.name for d in drivers], [d.start for d in drivers])
+        self.greeting = greeting
         self.greeted = []
         # The states answering the greetings (stamped before T0) are not kept.
         self.js = self._collect(ros, JointState, 'joint_states')

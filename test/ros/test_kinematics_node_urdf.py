@@ -368,12 +368,10 @@ def test_a_stop_while_the_start_reads_a_large_urdf_ends_it_at_once(ros, tmp_path
     (('-p', f'scene:={DATA / "lift_arm.urdf"}', '-p', 'drive:=topic', '-p',
       'gravity:=[0.0, 0.0, -1.62]'),
      'cannot start: Expected effort:=static with drive: topic for gravity'),
-    # Issue 41: drive: target takes a scene's targets only.
-    (('-p', f'scene:={DATA / "lift_arm.urdf"}', '-p', 'drive:=target'),
-     'cannot start: drive: Expected drive: target with a scene (a URDF robot driven from its '
-     'targets is not built yet)'),
+    # Issue 41: a target message names targets only.
     (('-p', 'scene:=five_bar', '-p', 'drive:=target', '-p', 'extra_joints:=ignore'),
-     'and without extra_joints (a message names targets only), got extra_joints'),
+     'cannot start: extra_joints: Expected drive: target without extra_joints (a message names '
+     'targets only), got extra_joints'),
     (('-p', f'scene:={DATA / "robotiq_2f_85.urdf"}', '-p',
       f'loop_closures:={DATA / "robotiq_2f_85.loop_closures.yaml"}', '-p', 'effort:=static'),
      "cannot start: Expected no forces parameters for this robot (the URDF's links carry no "

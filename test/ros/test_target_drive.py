@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import mech_kinematics as mk
-from mech_kinematics.ros.target_drive import TargetDrive
+from mech_kinematics.ros.target_drive import scene_target_drive
 from mech_kinematics.ros.topic_drive import RefusedInput
 
 pytestmark = pytest.mark.filterwarnings('ignore::mech_kinematics.NearSingularWarning')
@@ -24,7 +24,7 @@ FIVE = mk.load_scene('five_bar')
 
 
 def drive():
-    return TargetDrive(FIVE, 1e-6, published_joints=FIVE.output_joints)
+    return scene_target_drive(FIVE, 1e-6, published_joints=FIVE.output_joints)
 
 
 def test_a_stream_of_targets_gives_the_drivers_that_reach_them():
@@ -57,7 +57,7 @@ def test_the_working_mode_is_continued_from_the_last_state():
     half = math.acos((0.12 ** 2 + d ** 2 - 0.16 ** 2) / (2 * 0.12 * d))
     elbows = (math.atan2(0.22, 0.06) + half, math.atan2(0.22, 0.06) - half)
     assert here.positions[0] == pytest.approx(elbows[0], abs=1e-12)
-    other = TargetDrive(FIVE, 1e-6, published_joints=FIVE.output_joints)
+    other = scene_target_drive(FIVE, 1e-6, published_joints=FIVE.output_joints)
     other.start = [elbows[1] + 0.05, here.positions[1] - 0.05]
     again = other.read(100, 0, ['P.x', 'P.y'], [0.06, 0.22], [])
     assert again.positions[0] == pytest.approx(elbows[1], abs=1e-12)
