@@ -45,7 +45,8 @@ from .diagnostics import solver_status, TickStats, timing_status, waiting_for
 from .drive import check_start
 from .driver import TickDriver
 from .node_parameters import NodeParameters
-from .parameters import CATCH_UP, extra_joints_default, INPUT_DRIVES, spec, TARGET
+from .parameters import (CATCH_UP, extra_joints_default, spec, SUBSCRIBED_DRIVES, TARGET,
+                         TRAJECTORY)
 from .publishing import diagnostic_array, Markers, Publishing, qos_options, tf_period_ns
 from .robot_forces import robot_forces_note, robot_forces_tick
 from .robot_mode import load_source, robot_forces_refusal
@@ -200,10 +201,14 @@ class KinematicsNode(LifecycleNode):
                                  [name for name in ('link_forces', 'link_torques')
                                   if self._value(name)])
         scene = source.scene
-        if self._value('drive') == TARGET and any(
+        if self._value('drive') in (TARGET, TRAJECTORY) and any(
                 name == 'extra_joints' for name in self._parameter_overrides):
-            raise SceneError('extra_joints: Expected drive: target without extra_joints (a '
-                             'message names targets only), got extra_joints')
+            raise SceneError(f'extra_joints: Expected drive: {self._value("drive")} without '
+                             'extra_joints (a message names targets or drivers only), got '
+                             'extra_joints')
+        if self._value('drive') == TRAJECTORY and source.robot is not None:
+            raise SceneError('drive: Expected drive: trajectory with a scene (a URDF robot '
+                             'driven by a trajectory is not built yet), got a robot')
         if source.robot is not None:     # what would be accepted and ignored is refused
             note = robot_forces_note(source.robot)
             refusal = robot_forces_refusal(note, self._value('drive'), self._value('effort'),
@@ -250,11 +255,11 @@ class KinematicsNode(LifecycleNode):
             self._markers = Markers(self, scene, self.frame_id, lambda: (
                 self._value('marker_velocity_scale'), self._value('marker_acceleration_scale'),
                 self._value('marker_force_scale')), forces)
-        if self._value('drive') in INPUT_DRIVES:
+        if self._value('drive') in SUBSCRIBED_DRIVES:
             self._input = InputSubscription(
                 self, scene, self._solver, publishing, self._stats, frame_id=self.frame_id,
                 extra_joints=self.extra_joints, jump_back_s=self._value('stamp_jump_back_s'),
-                robot=publishing.robot_values, targets=self._value('drive') == TARGET,
+                robot=publishing.robot_values, drive=self._value('drive'),
                 target_robot=source.robot)
         elif publishing.robot_values is not None and publishing.robot_values.clock_note:
             self.get_logger().warning(publishing.robot_values.clock_note)

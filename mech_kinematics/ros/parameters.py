@@ -29,7 +29,8 @@ if TYPE_CHECKING:
 __all__ = ['CATCH_UP', 'DRIVE_MODES', 'DRIVER_RATES', 'DriverRates', 'DYNAMIC', 'EFFORT_MODES',
            'INPUT_DRIVES', 'LATE_TICKS',
            'MAX_NAME_CHARS', 'MAX_PATH_CHARS', 'PARAMETERS', 'ParameterSpec', 'SHOWN_CHARS',
-           'SKIP', 'STATE_DEPTH', 'STATIC', 'TARGET', 'TIME', 'TOPIC',
+           'SKIP', 'STATE_DEPTH', 'STATIC', 'SUBSCRIBED_DRIVES', 'TARGET', 'TIME', 'TOPIC',
+           'TRAJECTORY',
            'bounded_by_max_crank_speed',
            'catch_up_window_ns', 'depth_refusal', 'driver_parameters', 'extra_joints_default',
            'first_crank_aliases', 'frame_refusal', 'joint_refusal', 'rate_default', 'refusal',
@@ -44,9 +45,13 @@ LATE_TICKS = (CATCH_UP, SKIP)
 TIME = 'time'
 TOPIC = 'topic'
 TARGET = 'target'
-DRIVE_MODES = (TIME, TOPIC, TARGET)
-#: The drives whose states answer messages (no accelerations given: no efforts of the motion).
+#: Each point of a trajectory (drivers or targets with their rates), published at its time.
+TRAJECTORY = 'trajectory'
+DRIVE_MODES = (TIME, TOPIC, TARGET, TRAJECTORY)
+#: The drives whose states answer messages without accelerations (no efforts of the motion).
 INPUT_DRIVES = (TOPIC, TARGET)
+#: The drives whose states answer messages: the node subscribes, the clock's grid does not run.
+SUBSCRIBED_DRIVES = (TOPIC, TARGET, TRAJECTORY)
 #: ``effort`` values: the forces of the motion the drive determines (inertia, gravity and
 #: loads; left out where the drive gives no accelerations: ``drive: topic``), or the statics
 #: (gravity and loads only, inertia neglected: velocities and accelerations taken as zero).
@@ -161,7 +166,10 @@ PARAMETERS = (
                   "drivers: a joint it reports or POINT.x|y; a URDF robot's joint or "
                   'FRAME.x|y|z; SI; the drivers that put them '
                   'there, continued from the last state, published with its stamp; '
-                  'docs/targets.md)',
+                  'docs/targets.md) or trajectory (each point of a JointTrajectory on '
+                  'input_trajectory, of the drivers or of targets, with velocities and '
+                  'accelerations: its state and the efforts of that motion at the stamp '
+                  'plus its time_from_start)',
                   choices=DRIVE_MODES, read_only=True),
     ParameterSpec('extra_joints', 'string', None,
                   "With drive: topic, what an input message's joints that are not drivers "
@@ -512,6 +520,9 @@ def joint_refusal(values: Mapping[str, Any]) -> str | None:
     if values.get('drive') in INPUT_DRIVES and values.get('markers') is True:
         return (f'markers: expected false with drive: {values["drive"]} (the arrows would show '
                 'velocities and accelerations the input does not give), got true')
+    if values.get('drive') == TRAJECTORY and values.get('markers') is True:
+        return ('markers: expected false with drive: trajectory (the markers follow the '
+                "clock's grid, which does not run), got true")
     bound = values.get('max_crank_speed_rpm')
     if bound is None:
         return None

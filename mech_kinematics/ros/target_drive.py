@@ -31,6 +31,7 @@ Pure: no ROS. Thread use: one thread (the executor's), as TopicDrive.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 import math
 from typing import Any, NoReturn
 
@@ -66,10 +67,12 @@ class TargetDrive:
     """
 
     def __init__(self, drivers: Sequence[Any], targets_of: Callable[[tuple[str, ...]], TargetMap],
-                 start: Sequence[float], max_error: float, **topic: Any) -> None:
+                 start: Sequence[float], max_error: float, topic_name: str = INPUT_TARGETS,
+                 **topic: Any) -> None:
         self.targets_of = targets_of
         self.max_error = max_error
-        self.topic = TopicDrive(drivers, topic=INPUT_TARGETS, **topic)
+        self.topic_name = topic_name
+        self.topic = TopicDrive(drivers, topic=topic_name, **topic)
         self.names = self.topic.names
         self.published_joints = self.topic.published_joints
         self.start = [float(x) for x in start]
@@ -82,14 +85,36 @@ class TargetDrive:
         return self.topic.last_stamp_ns
 
     def read(self, sec: int, nanosec: int, names: Sequence[str], positions: Sequence[float],
-             velocities: Sequence[float], efforts: Sequence[float] = ()) -> TopicInput:
+             velocities: Sequence[float], efforts: Sequence[float] = (),
+             accelerations: Sequence[float] | None = None) -> TopicInput:
         """Return the drivers that put the message's targets where it says (TopicInput).
+
+        ``accelerations`` (``drive: trajectory``'s points): the targets'
+        accelerations, one per name as the velocities must be then; the
+        drivers' are in the answer (``accels``). A point that names the
+        drivers themselves is taken as given.
 
         Raises
         ------
         RefusedInput
             If the message is refused (see the module's docstring), with the reason.
         """
+        if accelerations is not None:
+            if len(velocities) != len(names) or len(accelerations) != len(names):
+                self._refuse(f'expected one velocity and one acceleration per name '
+                             f'({len(names)}: the efforts of the motion need them), got '
+                             f'{len(velocities)} and {len(accelerations)}')
+            accels = [float(x) for x in accelerations]
+            for name, value in zip(names, accels, strict=True):
+                if not math.isfinite(value):
+                    self._refuse(f'expected a finite acceleration of {name!r}, got {value!r}')
+            if set(names) == set(self.names) and len(names) == len(self.names):
+                given = self.topic.read(sec, nanosec, names, positions, velocities)
+                where = {name: i for i, name in enumerate(names)}
+                self._pending = list(given.positions)
+                return replace(given, accels=tuple(accels[where[n]] for n in self.names))
+        else:
+            accels = None
         key = tuple(names)
         tmap = self._maps.get(key)
         if tmap is None:
@@ -113,7 +138,7 @@ class TargetDrive:
                 if not math.isfinite(value):
                     self._refuse(f'expected a finite {what} of target {name!r}, got {value!r}')
         try:
-            inverse = continue_to(tmap, goal, self.start, speeds, None,
+            inverse = continue_to(tmap, goal, self.start, speeds, accels,
                                   max_error=self.max_error)
         except TargetError as error:
             self._refuse(str(error))
@@ -121,7 +146,9 @@ class TargetDrive:
         rates = [float(x) for x in inverse.motion[:, 1]] if speeds is not None else []
         given = self.topic.read(sec, nanosec, self.names, drivers, rates)
         self._pending = drivers
-        return given
+        if accels is None:
+            return given
+        return replace(given, accels=tuple(float(x) for x in inverse.motion[:, 2]))
 
     def joint_state_arrays(self, given: TopicInput, values: Sequence[float]) -> tuple[
             list[str], list[float], list[float], list[float]]:
@@ -134,9 +161,8 @@ class TargetDrive:
         if self._pending is not None:
             self.start, self._pending = self._pending, None
 
-    @staticmethod
-    def _refuse(reason: str) -> NoReturn:
-        raise RefusedInput(f'{INPUT_TARGETS}: {reason}')
+    def _refuse(self, reason: str) -> NoReturn:
+        raise RefusedInput(f'{self.topic_name}: {reason}')
 
 
 def scene_target_drive(scene: Any, max_error: float, **topic: Any) -> TargetDrive:

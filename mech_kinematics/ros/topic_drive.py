@@ -117,6 +117,9 @@ class TopicInput:
     speeds : tuple of float or None
         Each driver's velocity in scene order (rad/s, m/s); None when the
         message has none: the published velocities are then left out.
+    accels : tuple of float or None
+        With ``drive: trajectory``, each driver's acceleration in scene order
+        (rad/s^2, m/s^2); None otherwise (the accelerations are left out).
     jumped_from_ns : int or None
         The last published stamp, ns, when this one is earlier than it by more
         than the bound (the sender's clock jumped back); else None.
@@ -132,6 +135,7 @@ class TopicInput:
     jumped_from_ns: int | None = None
     ignored: tuple[str, ...] = ()
     passed: PassedJoints | None = None
+    accels: tuple[float, ...] | None = None
 
 
 def _listed(names: Sequence[str]) -> str:

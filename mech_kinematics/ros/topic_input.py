@@ -1,6 +1,14 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""``drive: topic`` on the node: the ``input_joint_states`` subscription, a state per message.
+"""``drive: topic``, ``target`` and ``trajectory`` on the node: a state per message or point.
+
+``drive: topic`` subscribes to ``input_joint_states``, ``drive: target`` to
+``input_targets`` (:mod:`~mech_kinematics.ros.target_drive`) and ``drive:
+trajectory`` to ``input_trajectory`` (``trajectory_msgs/msg/JointTrajectory``):
+each of its points, of the drivers or of targets, with one velocity and one
+acceleration per name, is a state stamped at the header's stamp (the node's
+clock at receipt where it is zero, "start now" in ROS) plus the point's
+``time_from_start``, with its accelerations and the efforts of that motion.
 
 The rules of one input message are :mod:`~mech_kinematics.ros.topic_drive`'s
 (pure); :class:`InputSubscription` is their node side. It subscribes at
@@ -30,10 +38,12 @@ from typing import Any, TYPE_CHECKING
 from builtin_interfaces.msg import Time
 from rclpy.qos import QoSDurabilityPolicy, QoSHistoryPolicy, QoSProfile, QoSReliabilityPolicy
 from sensor_msgs.msg import JointState
+from trajectory_msgs.msg import JointTrajectory
 
 from . import topics
 from .cdr import marker, MessageTemplate, STAMP_MARKER
 from .messages import TickMessages
+from .parameters import TARGET, TOPIC, TRAJECTORY
 from .publishing import qos_options, RCLError
 from .target_drive import robot_target_drive, scene_target_drive, TargetDrive
 from .ticker import general_tick
@@ -83,12 +93,13 @@ class InputSubscription:
         In URDF mode: the input names the actuated joints (URDF names and
         values), turned into the scene's drivers; ``joint_states`` names the
         URDF's joints (the actuated ones echoed as given).
-    targets : bool, optional
-        ``drive: target``: subscribe to ``input_targets`` and read each message's
-        targets into the drivers that put them there
-        (:class:`~.target_drive.TargetDrive`).
+    drive : str, optional
+        ``topic`` (default); ``target``: subscribe to ``input_targets`` and read
+        each message's targets into the drivers that put them there
+        (:class:`~.target_drive.TargetDrive`); ``trajectory``: subscribe to
+        ``input_trajectory`` and publish each point (a scene's only).
     target_robot : Robot, optional
-        In URDF mode with ``targets``: the robot whose joints and frames the
+        In URDF mode with ``target``: the robot whose joints and frames the
         targets name.
 
     Attributes
@@ -102,7 +113,7 @@ class InputSubscription:
     def __init__(self, node: Any, scene: Any, solver: SolverPath, publishing: Publishing,
                  stats: TickStats, *, frame_id: str, extra_joints: str,
                  jump_back_s: float, robot: RobotValues | None = None,
-                 targets: bool = False, target_robot: Any = None) -> None:
+                 drive: str = TOPIC, target_robot: Any = None) -> None:
         self.node, self.solver, self.publishing, self.stats = node, solver, publishing, stats
         self.frame_id = frame_id
         self.robot = robot
@@ -114,28 +125,35 @@ class InputSubscription:
             joints, drivers = robot.names, robot.drivers
         # What the input determines: positions always, velocities when a message has them.
         # With effort: static (publishing.forces), each joint's effort too.
-        self.messages = {known: TickMessages(joints, points, frame_id, velocities=known,
-                                             accelerations=False,
-                                             efforts_first=publishing.efforts_first)
-                         for known in (True, False)}
+        #: By (velocities known, accelerations known).
+        self.messages = {(known, accels): TickMessages(
+            joints, points, frame_id, velocities=known, accelerations=accels,
+            efforts_first=publishing.efforts_first)
+            for known, accels in ((True, False), (False, False), (True, True))}
         rules = {'jump_back_ns': round(jump_back_s * NS_PER_S), 'published_joints': joints}
         self.topic: TopicDrive | TargetDrive
-        if not targets:
+        self.drive = drive
+        if drive == TOPIC:
             self.topic = TopicDrive(drivers, extra_joints=extra_joints, **rules)
         elif target_robot is not None:
             self.topic = robot_target_drive(target_robot, drivers, solver.max_error, **rules)
         else:
-            self.topic = scene_target_drive(scene, solver.max_error, **rules)
+            self.topic = scene_target_drive(
+                scene, solver.max_error, **rules,
+                **({'topic_name': topics.INPUT_TRAJECTORY} if drive == TRAJECTORY else {}))
         self.active = False
         #: joint_states templates with the passed joints, by (names, velocities, efforts).
         self._passed: dict[tuple[tuple[str, ...], bool, bool], MessageTemplate | None] = {}
         qos = QoSProfile(history=QoSHistoryPolicy.KEEP_LAST, depth=INPUT_DEPTH,
                          reliability=QoSReliabilityPolicy.RELIABLE,
                          durability=QoSDurabilityPolicy.VOLATILE)
+        kind, name = {TOPIC: (JointState, topics.INPUT_JOINT_STATES),
+                      TARGET: (JointState, topics.INPUT_TARGETS),
+                      TRAJECTORY: (JointTrajectory, topics.INPUT_TRAJECTORY)}[drive]
+        self._message = self.trajectory if drive == TRAJECTORY else self.message
+        self.topic_name = name
         self.subscription: Any = node.create_subscription(
-            JointState, topics.INPUT_TARGETS if targets else topics.INPUT_JOINT_STATES,
-            self.on_input, qos,
-            qos_overriding_options=qos_options())
+            kind, name, self.on_input, qos, qos_overriding_options=qos_options())
 
     def close(self) -> None:
         """Stop publishing and destroy the subscription."""
@@ -144,9 +162,9 @@ class InputSubscription:
         if subscription is not None:
             self.node.destroy_subscription(subscription)
 
-    def on_input(self, msg: JointState) -> None:
+    def on_input(self, msg: JointState | JointTrajectory) -> None:
         """Publish the state of each input message waiting, from ``msg`` on, with its stamp."""
-        self.message(msg)
+        self._message(msg)
         subscription = self.subscription
         for _ in range(INPUT_BURST):
             if subscription is None or self.subscription is not subscription:
@@ -156,20 +174,38 @@ class InputSubscription:
                                                          subscription.raw)
             if taken is None:
                 return
-            self.message(taken[0])
+            self._message(taken[0])
 
     def message(self, msg: JointState) -> None:
         """Publish the state of one input message with its stamp, or say why not."""
+        stamp = msg.header.stamp
+        self.answer(stamp.sec, stamp.nanosec, msg.name, msg.position, msg.velocity, msg.effort)
+
+    def trajectory(self, msg: JointTrajectory) -> None:
+        """Publish the state of each point of a trajectory at its time, or say why not."""
+        stamp = msg.header.stamp
+        start = stamp.sec * NS_PER_S + stamp.nanosec
+        if start == 0:      # "start now" (as a trajectory controller reads it)
+            start = self.node.get_clock().now().nanoseconds
+        for point in msg.points:
+            at = point.time_from_start
+            sec, nanosec = divmod(start + at.sec * NS_PER_S + at.nanosec, NS_PER_S)
+            self.answer(sec, nanosec, msg.joint_names, point.positions, point.velocities, (),
+                        point.accelerations)
+
+    def answer(self, sec: int, nanosec: int, names: Any, positions: Any, velocities: Any,
+               efforts: Any, accelerations: Any = None) -> None:
+        """Publish the state of one input (a message, a point) with its stamp, or say why not."""
         received = time.monotonic_ns()
         if not self.active:
             return      # inactive (lifecycle), or cleaned up while the message waited
         topic, stats, publishing = self.topic, self.stats, self.publishing
-        stamp = msg.header.stamp
-        stamp_ns = stamp.sec * NS_PER_S + stamp.nanosec
+        stamp_ns = sec * NS_PER_S + nanosec
         given = None
         try:
-            given = topic.read(stamp.sec, stamp.nanosec, msg.name, msg.position, msg.velocity,
-                               msg.effort)
+            given = topic.read(sec, nanosec, names, positions, velocities, efforts) \
+                if accelerations is None else \
+                topic.read(sec, nanosec, names, positions, velocities, efforts, accelerations)
             values, measure = self._solve(given)
             if self.robot is not None:   # in the assembly Robot.solve answers (robot/assembly.py)
                 values, measure = self.robot.answer(
@@ -186,7 +222,8 @@ class InputSubscription:
                                            throttle_duration_sec=1.0)
             return
         sec, nanosec = divmod(given.stamp_ns, NS_PER_S)
-        rendered = self.messages[given.speeds is not None].render_values(values, sec, nanosec)
+        rendered = self.messages[given.speeds is not None, given.accels is not None
+                                 ].render_values(values, sec, nanosec)
         if given.passed is not None:    # extra_joints: pass: names that change per message
             rendered = (self._joint_state_passed(given, values, sec, nanosec), *rendered[1:])
         try:
@@ -205,7 +242,7 @@ class InputSubscription:
         if given.jumped_from_ns is not None:
             publishing.next_tf = 0   # /tf's rate counts from the new order
             self.node.get_logger().warning(
-                f'{topics.INPUT_JOINT_STATES}: the stamp jumped back '
+                f'{self.topic_name}: the stamp jumped back '
                 f'{(given.jumped_from_ns - given.stamp_ns) / NS_PER_S:.9g} s (more than '
                 'stamp_jump_back_s): published, the order starts again from it',
                 throttle_duration_sec=1.0)
@@ -277,7 +314,8 @@ class InputSubscription:
         """Return (the tick function's values, the singularity measure) for one input.
 
         Unknown velocities are solved as zero and left out of what is published;
-        the accelerations are never published. ``tick``: another tick function
+        the accelerations are solved as zero and left out unless given (a
+        trajectory's point). ``tick``: another tick function
         than the solver's (the robot's scene in another assembly).
         """
         solver = self.solver
@@ -289,8 +327,9 @@ class InputSubscription:
             positions, speeds = self.robot.scene_inputs(positions, speeds)
         n = len(positions)
         speeds = (0.0,) * n if speeds is None else speeds
+        accels = (0.0,) * n if given.accels is None else given.accels
         solve = solver.solve if tick is None else tick
         assert solve is not None
         if n == 1:
-            return solve(positions[0], speeds[0], 0.0, solver.max_error, 0)
-        return solve(positions, speeds, (0.0,) * n, solver.max_error, (0,) * n)
+            return solve(positions[0], speeds[0], accels[0], solver.max_error, 0)
+        return solve(positions, speeds, accels, solver.max_error, (0,) * n)

@@ -9,6 +9,7 @@ and remaps apply; ``/tf`` and ``/tf_static`` are absolute, as tf2 expects.
 from __future__ import annotations
 
 __all__ = ['DIAGNOSTICS', 'IMU', 'IMU_TYPE', 'INPUT_JOINT_STATES', 'INPUT_TARGETS',
+           'INPUT_TRAJECTORY',
            'JOINT_ACCELERATIONS', 'JOINT_STATES', 'MARKERS',
            'POINT_ACCELERATIONS', 'REACTIONS', 'ROBOT_DESCRIPTION', 'SCENE', 'SHAKING',
            'STATE_TOPICS', 'TF', 'TF_STATIC', 'TYPES', 'WRENCH_TYPE', 'imu_topic',
@@ -30,6 +31,9 @@ SCENE = 'scene'
 INPUT_JOINT_STATES = 'input_joint_states'
 #: The targets (joints' values, points' coordinates) that drive the node with ``drive: target``.
 INPUT_TARGETS = 'input_targets'
+#: The trajectories (points of drivers or of targets) that drive the node with
+#: ``drive: trajectory``.
+INPUT_TRAJECTORY = 'input_trajectory'
 #: The namespace of the inertial sensors' topics: ``imu/NAME``, one per entry of a scene's
 #: ``imus``, each of type :data:`IMU_TYPE`.
 IMU = 'imu'
@@ -58,6 +62,7 @@ TYPES = {
     SCENE: 'std_msgs/msg/String',
     INPUT_JOINT_STATES: 'sensor_msgs/msg/JointState',
     INPUT_TARGETS: 'sensor_msgs/msg/JointState',
+    INPUT_TRAJECTORY: 'trajectory_msgs/msg/JointTrajectory',
     SHAKING: WRENCH_TYPE,
 }
 

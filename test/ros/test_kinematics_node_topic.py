@@ -51,7 +51,7 @@ class TopicNode:
     """A node with drive: topic in a namespace of its own, and what it publishes, as received."""
 
     def __init__(self, ros, tmp_path, name, *args, scene=SCENE, input_topic=None, wait=True,
-                 input_qos=INPUT_QOS, drive='topic', greeting=None):
+                 input_qos=INPUT_QOS, drive='topic', greeting=None, input_type=JointState):
         self.ns = f'{SESSION}/{name}'
         self.prefix = f'{SESSION[1:]}_{name}'
         # What the greetings send: the drivers at their start, or (names, positions) given.
@@ -66,8 +66,9 @@ class TopicNode:
         self.pt = self._collect(ros, MultiDOFJointTrajectory, 'point_accelerations')
         self.tf = ros.collect(TFMessage, '/tf')
         self.diag = ros.collect(DiagnosticArray, f'{self.ns}/diagnostics')
+        self.input_type = input_type
         self.input = ros.node.create_publisher(
-            JointState, input_topic or f'{self.ns}/input_joint_states', input_qos)
+            input_type, input_topic or f'{self.ns}/input_joint_states', input_qos)
         self.input_name = (input_topic or 'input_joint_states').rsplit('/', 1)[-1]
         self.hello = HELLO
         self.proc = NodeProcess(tmp_path, '-r', f'__ns:={self.ns}', '-p', f'scene:={scene}',
@@ -109,9 +110,27 @@ class TopicNode:
         assert self.proc.proc.poll() is None, self.proc.output()
 
     def send(self, stamp, names, positions, velocities=(), efforts=()):
+        """Send one input at ``stamp``: a JointState, or a one-point trajectory at rest."""
+        if self.input_type is JointTrajectory:
+            self.send_points(stamp, names, [(0, positions, velocities or [0.0] * len(names),
+                                             [0.0] * len(names))])
+            return
         msg = JointState(name=list(names), position=list(positions),
                          velocity=list(velocities), effort=list(efforts))
         msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(stamp, NS)
+        self.input.publish(msg)
+
+    def send_points(self, stamp, names, points):
+        """Send a trajectory stamped ``stamp``: points (time_from_start ns, p, v, a)."""
+        from trajectory_msgs.msg import JointTrajectoryPoint
+
+        msg = JointTrajectory(joint_names=list(names))
+        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(stamp, NS)
+        for at, p, v, a in points:
+            point = JointTrajectoryPoint(positions=list(p), velocities=list(v),
+                                         accelerations=list(a))
+            point.time_from_start.sec, point.time_from_start.nanosec = divmod(at, NS)
+            msg.points.append(point)
         self.input.publish(msg)
 
     def tf_stamps(self):
@@ -486,7 +505,8 @@ def test_extra_joints_ignore_takes_the_drivers_and_says_what_it_dropped(ros, tmp
 #: Bad drives at start: (arguments, words of the one line that refuses them).
 BAD_DRIVES = [
     (['-p', 'drive:=topic', '-p', 'markers:=true'], ['markers: expected false with drive: topic']),
-    (['-p', 'drive:=stream'], ["drive: expected one of time, topic, target, got 'stream'"]),
+    (['-p', 'drive:=stream'],
+     ["drive: expected one of time, topic, target, trajectory, got 'stream'"]),
 ]
 
 

@@ -26,7 +26,7 @@ from mech_kinematics.units import rad_per_s_from_rpm
     ('frame_id', 5, 'frame_id: expected a string, got number 5'),
     ('markers', 'yes', "markers: expected true or false, got string 'yes'"),
     ('late_ticks', 'later', "late_ticks: expected one of catch_up, skip, got 'later'"),
-    ('drive', 'topics', "drive: expected one of time, topic, target, got 'topics'"),
+    ('drive', 'topics', "drive: expected one of time, topic, target, trajectory, got 'topics'"),
     ('drive', 1, 'drive: expected a string, got number 1'),
     ('max_catch_up_s', -1.0, 'max_catch_up_s: expected 0 <= value <= 10 s, got -1.0'),
     ('extra_joints', 'keep', "extra_joints: expected one of refuse, ignore, pass, got 'keep'"),
@@ -92,6 +92,9 @@ def test_markers_are_refused_with_drive_topic():
         'markers: expected false with drive: topic (the arrows would show velocities and '
         'accelerations the input does not give), got true')
     assert spec('drive').default == 'time' and spec('drive').read_only
+    assert joint_refusal({'drive': 'trajectory', 'markers': True}) == (
+        "markers: expected false with drive: trajectory (the markers follow the clock's grid, "
+        'which does not run), got true')
 
 
 def test_every_parameter_is_described():
