@@ -112,7 +112,8 @@ def _imports(folder: Path, peers: bool = False) -> dict:
 
     The :data:`DEV_PEERS` are left out unless ``peers``.
     """
-    local = {path.stem for path in folder.glob('*.py')}     # test/ imports its own helpers
+    # test/ imports its own helpers, and a test module its folder's (pytest puts it on the path)
+    local = {path.stem for path in folder.rglob('*.py')}
     found: dict = {}
     for path in sorted(folder.rglob('*.py')):
         for names, level, _ in _import_statements(path):
