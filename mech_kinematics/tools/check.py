@@ -10,7 +10,9 @@ several drivers (or an actuator) gets its assembly region instead
 (:func:`mech_kinematics.geometry.region.region_from_scene`): the fraction of a
 grid over two drivers that assembles, each driver's ranges with the others
 at their start positions, stroke limits, and on request a map of the grid
-(``--map`` as text, ``--png FILE`` as a picture).
+(``--map`` as text, ``--png FILE`` as a picture). ``--workspace POINT`` on a
+scene with two drivers maps where the point can go instead, with its singular
+curves (:mod:`mech_kinematics.geometry.workspace`).
 
 A scene with forces (``masses``, ``gravity`` or ``loads``) gets its
 turning-moment diagram too (:mod:`mech_kinematics.geometry.turning`): each
@@ -39,7 +41,7 @@ from ..solver.graph import JointType
 
 __all__ = ['add_parser', 'coefficient', 'grid_size', 'main', 'map_text', 'region_json',
            'region_text', 'report_json', 'report_text', 'turning_json', 'turning_text',
-           'write_region_png']
+           'workspace_json', 'workspace_text', 'write_region_png', 'write_workspace_png']
 
 #: The text map's largest size, characters.
 MAP_COLUMNS = 72
@@ -574,6 +576,89 @@ def _print_report(args: argparse.Namespace, scene: Any, data: dict[str, Any], te
     print('\n'.join(lines))
 
 
+def workspace_text(ws: Any) -> str:
+    """Return the report of ``check --workspace`` as lines of text, in the scene's units."""
+    units = ws.units
+
+    def length(value: float) -> str:
+        return units.length_text(value)
+
+    (x0, x1), (y0, y1) = ws.extent
+    total = ws.assembles.size
+    lines = [f'{ws.scene}: workspace of {ws.point} over {ws.drivers[0]} x {ws.drivers[1]} '
+             f'({len(ws.axes[0])} x {len(ws.axes[1])} points; assembles at '
+             f'{100.0 * float(ws.assembles.mean()):.4g}%, {int(ws.assembles.sum())} of {total})',
+             f'{ws.point}: x from {length(x0)} to {length(x1)}, y from {length(y0)} to '
+             f'{length(y1)}',
+             f'the drivers lose control (det J = 0): {len(ws.inverse_singular)} points, solved '
+             'on the grid edges where det J changes sign',
+             f'the loop locks (the edge of where it assembles): {len(ws.locks)} points, at the '
+             'grid',
+             f'a singular pose between grid neighbours (no curve read across): '
+             f'{len(ws.jumps)} edges',
+             f'the point moves up to {length(ws.resolution)} between smoothly joined '
+             'neighbours']
+    return '\n'.join(lines)
+
+
+def workspace_json(ws: Any) -> dict[str, Any]:
+    """Return the report of ``check --workspace --json``: SI units (m, rad)."""
+    (x0, x1), (y0, y1) = ws.extent
+    return {
+        'scene': ws.scene, 'point': ws.point, 'drivers': list(ws.drivers),
+        'grid': {'points': [len(a) for a in ws.axes], 'assembling': int(ws.assembles.sum()),
+                 'fraction': float(ws.assembles.mean())},
+        'extent': {'x': [x0, x1], 'y': [y0, y1]},
+        'inverse_singular': {'positions': ws.inverse_singular.tolist(),
+                             'drivers': ws.singular_drivers.tolist()},
+        'locks': {'positions': ws.locks.tolist(), 'drivers': ws.lock_drivers.tolist()},
+        'jumps': ws.jumps.tolist(),
+        'resolution': ws.resolution,
+    }
+
+
+def write_workspace_png(ws: Any, path: str) -> None:
+    """Write the workspace as a PNG picture: where the point goes and its singular curves."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    scale = 1000.0 if ws.units.length == 'mm' else 1.0
+    figure = Figure(figsize=(6.0, 6.0))
+    FigureCanvasAgg(figure)
+    axes = figure.add_subplot()
+    reach = ws.positions[ws.assembles] * scale
+    axes.scatter(reach[:, 0], reach[:, 1], s=1, c='0.75', label=f'{ws.point} reaches')
+    for points, colour, label in ((ws.inverse_singular, 'tab:red', 'det J = 0'),
+                                  (ws.locks, 'tab:blue', 'the loop locks')):
+        if len(points):
+            axes.scatter(points[:, 0] * scale, points[:, 1] * scale, s=3, c=colour,
+                         label=label)
+    axes.set_aspect('equal')
+    axes.set_xlabel(f'x ({ws.units.length})')
+    axes.set_ylabel(f'y ({ws.units.length})')
+    axes.legend(loc='upper right', fontsize='small')
+    axes.set_title(f'{ws.scene}: the workspace of {ws.point}')
+    figure.savefig(path, dpi=100)
+
+
+def _handle_workspace(args: argparse.Namespace, scene: Any) -> int:
+    from ..geometry.workspace import workspace_from_scene
+
+    given = [flag for flag, value in (('--pair', args.pair), ('--map', args.map),
+                                      ('--flywheel', args.flywheel)) if value]
+    if given:
+        msg = f'Expected --workspace without {", ".join(given)}, got both'
+        raise SceneError(msg)
+    ws = workspace_from_scene(scene, args.workspace, args.grid)
+    if args.json:
+        print(json.dumps(workspace_json(ws), indent=1, allow_nan=False))
+    else:
+        print(workspace_text(ws))
+    if args.png is not None:
+        write_workspace_png(ws, args.png)
+    return 0
+
+
 def _handle_region(args: argparse.Namespace, scene: Any) -> int:
     from ..geometry.region import region_from_scene
     pair = None if args.pair is None else [p.strip() for p in args.pair.split(',')]
@@ -592,6 +677,8 @@ def _handle(args: argparse.Namespace) -> int:
     scene = load_scene_argument(args)
     if args.speed_rpm is not None:
         scene = _at_speed(scene, args.speed_rpm)
+    if args.workspace is not None:
+        return _handle_workspace(args, scene)
     if not scene.single_crank:
         return _handle_region(args, scene)
     given = [flag for flag, value in (('--grid', args.grid != GRID), ('--pair', args.pair),
@@ -627,6 +714,10 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
                         help='several drivers: draw the grid in text (also in --json)')
     parser.add_argument('--png', metavar='FILE',
                         help='several drivers: write the grid as a PNG picture')
+    parser.add_argument('--workspace', metavar='POINT',
+                        help='a scene with two drivers: map where POINT can go over the grid, '
+                             'with its singular curves (det J = 0, where the drivers lose '
+                             'control, and where the loop locks); --png draws it')
     parser.add_argument('--flywheel', type=coefficient, metavar='CS',
                         help='a scene with forces and one crank: the moment of inertia of a '
                              'flywheel for the coefficient of fluctuation of speed CS = (w_max - '
