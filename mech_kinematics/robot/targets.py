@@ -77,38 +77,35 @@ def frame_motion(description: Description, link: str, values: Mapping[str, float
     two arrays of shape (3, 3): rows position, velocity, acceleration.
     """
     m = np.eye(4)
-    w = np.zeros(3)
-    alpha = np.zeros(3)
-    v = np.zeros(3)
-    a = np.zeros(3)
+    w = alpha = v = a = (0.0, 0.0, 0.0)     # in plain floats: 3-vectors cost NumPy calls
     chain = description.chain(link)
     moving = []     # (angular, |qd|, |qdd|, b_q, b_qd, b_qdd)
     reach = 0.0
     for joint in chain:
         mj = m @ joint.origin
-        r = mj[:3, 3] - m[:3, 3]
-        v = v + np.cross(w, r)
-        a = a + np.cross(alpha, r) + np.cross(w, np.cross(w, r))
-        reach += float(np.linalg.norm(joint.origin[:3, 3]))
+        r = tuple((mj[:3, 3] - m[:3, 3]).tolist())
+        v = _add(v, _cross(w, r))
+        a = _add(a, _cross(alpha, r), _cross(w, _cross(w, r)))
+        reach += math.hypot(*joint.origin[:3, 3].tolist())
         if joint.type is None:
             m = mj
             continue
         x = float(values.get(joint.name, 0.0))
         xd, xdd = rates.get(joint.name, (0.0, 0.0))
-        e = mj[:3, :3] @ np.asarray(joint.axis, dtype=np.float64)
+        e = tuple((mj[:3, :3] @ np.asarray(joint.axis, dtype=np.float64)).tolist())
         if joint.type.angular:
-            alpha = alpha + e * xdd + np.cross(w, e) * xd
-            w = w + e * xd
+            alpha = _add(alpha, _scaled(e, xdd), _scaled(_cross(w, e), xd))
+            w = _add(w, _scaled(e, xd))
         else:
-            d = e * x
-            v = v + e * xd + np.cross(w, d)
-            a = (a + e * xdd + np.cross(alpha, d) + np.cross(w, np.cross(w, d))
-                 + 2.0 * np.cross(w, e * xd))
+            d = _scaled(e, x)
+            v = _add(v, _scaled(e, xd), _cross(w, d))
+            a = _add(a, _scaled(e, xdd), _cross(alpha, d), _cross(w, _cross(w, d)),
+                     _scaled(_cross(w, e), 2.0 * xd))
             reach += abs(x)
         m = m @ joint.motion(x)
         moving.append((joint.type.angular, abs(xd), abs(xdd),
                        *bounds.get(joint.name, (0.0, 0.0, 0.0))))
-    motion = np.stack((m[:3, 3], v, a))
+    motion = np.array((m[:3, 3], v, a), dtype=np.float64)
     big_r = max(reach, size)
     c = np.array([big_r if item[0] else 1.0 for item in moving])
     table = np.array([item[1:] for item in moving]).reshape(-1, 5)
@@ -231,3 +228,16 @@ def solve_robot_targets(robot: Robot, targets: Mapping[str, float],
         msg = f'Expected an answer whose forces can be trusted, got {error}'
         raise TargetError(msg) from None
     return replace(inverse, answer=answer)
+
+
+def _cross(p: tuple[float, ...], q: tuple[float, ...]) -> tuple[float, float, float]:
+    return (p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0])
+
+
+def _add(*vectors: tuple[float, ...]) -> tuple[float, float, float]:
+    return (sum(u[0] for u in vectors), sum(u[1] for u in vectors),
+            sum(u[2] for u in vectors))
+
+
+def _scaled(p: tuple[float, ...], k: float) -> tuple[float, float, float]:
+    return (p[0] * k, p[1] * k, p[2] * k)
