@@ -25,7 +25,7 @@ error. A scene without forces prints nothing more.
 from __future__ import annotations
 
 import argparse
-from collections.abc import Sequence
+from collections.abc import Callable, Mapping, Sequence
 import json
 import math
 import sys
@@ -34,7 +34,8 @@ from typing import Any
 import numpy as np
 
 from .cli import (add_robot_arguments, add_scene_argument, add_units_argument, finite_float,
-                  load_scene_argument, run_tool)
+                  is_urdf, load_robot_argument, load_scene_argument, named_value, run_tool,
+                  targets_in_si)
 from ..errors import SceneError
 from ..geometry.region import GRID
 from ..solver.graph import JointType
@@ -659,6 +660,102 @@ def _handle_workspace(args: argparse.Namespace, scene: Any) -> int:
     return 0
 
 
+def target_report(inverse: Any, tmap: Any, singularity: Mapping[str, float]) -> dict[str, Any]:
+    """Return how well the drivers control the targets at an inverse's answer (SI).
+
+    The Jacobian scaled to be dimensionless (targets over their scales, drivers
+    over theirs: 1 rad, or the mechanism's size), its singular values and
+    condition number; the forward loop's least singularity measure (0
+    singular, 1 best) and where; the drivers' bounds against the exact inverse.
+    """
+    scaled = (inverse.jacobian / np.array(tmap.target_scales)[:, None]
+              * np.array(tmap.driver_scales)[None, :])
+    sigma = np.linalg.svd(scaled, compute_uv=False)
+    worst = min(singularity, key=lambda k: singularity[k]) if singularity else None
+    return {
+        'targets': {n: float(g) for n, g in zip(inverse.targets, inverse.given[:, 0],
+                                                strict=True)},
+        'drivers': {n: float(q) for n, q in zip(inverse.drivers, inverse.motion[:, 0],
+                                                strict=True)},
+        'continued_from': {n: float(q) for n, q in zip(inverse.drivers, inverse.start,
+                                                       strict=True)},
+        'steps': inverse.steps,
+        'det_jacobian': float(np.linalg.det(inverse.jacobian)),
+        'scaled_singular_values': [float(x) for x in sigma],
+        'condition': float(sigma[0] / sigma[-1]) if sigma[-1] > 0.0 else math.inf,
+        'least_singularity': None if worst is None else {
+            'dyad': worst, 'measure': float(singularity[worst])},
+        'error_bound': {n: float(b) for n, b in zip(inverse.drivers, inverse.motion_bound[:, 0],
+                                                    strict=True)},
+    }
+
+
+def target_text(report: dict[str, Any], tmap: Any, name: str,
+                driver_text: Callable[[int, float], str]) -> str:
+    """Return :func:`target_report` as lines of text (targets and drivers in their units)."""
+    goal = ', '.join(f'{n} = {tmap.text(i, v)}'
+                     for i, (n, v) in enumerate(report['targets'].items()))
+    drivers = ', '.join(f'{n} = {driver_text(i, v)}'
+                        for i, (n, v) in enumerate(report['drivers'].items()))
+    bounds = ', '.join(f'{b:.2g}' for b in report['error_bound'].values())
+    sigma = ', '.join(f'{x:.6g}' for x in report['scaled_singular_values'])
+    lines = [f'{name}: {goal}: reached from the start pose in {report["steps"]} step'
+             f'{"s" if report["steps"] != 1 else ""}',
+             f'drivers: {drivers} (error bounds {bounds}, rad or m)',
+             f'jacobian: det J = {report["det_jacobian"]:.6g} (SI); scaled (targets and '
+             f'drivers over their scales) singular values {sigma}, condition number '
+             f'{report["condition"]:.6g}']
+    least = report['least_singularity']
+    if least is not None:
+        lines.append(f'the loop: least singularity measure {least["measure"]:.4g} at '
+                     f'{least["dyad"]} (0 singular, 1 best)')
+    return '\n'.join(lines)
+
+
+def _handle_target(args: argparse.Namespace) -> int:
+    """Check how well the drivers control targets at the pose that reaches them."""
+    from ..solver.inverse import continue_to, scene_targets
+    from ..units import LENGTH_UNITS
+
+    given: dict[str, dict[str, float]] = {'--target': {}}
+    for name, value in args.target:
+        if name is None:
+            msg = (f'Expected --target NAME=VALUE (a joint, POINT.x|y or, for a URDF, '
+                   f'FRAME.x|y|z), got {value:g}')
+            raise SceneError(msg)
+        given['--target'][name] = value
+    names = tuple(given['--target'])
+    if is_urdf(args.scene):
+        from ..robot.targets import robot_targets
+
+        robot = load_robot_argument(args)
+        tmap = robot_targets(robot, names)
+        start = [robot.start(n) for n in robot.actuated]
+        per_metre = 1.0
+        answer_of = (lambda inverse: inverse.answer.state)  # noqa: E731
+
+        def driver_text(i: int, value: float) -> str:
+            return f'{value:.6g} {"rad" if tmap.driver_angular[i] else "m"}'
+    else:
+        scene = load_scene_argument(args)
+        tmap = scene_targets(scene, names)
+        start = [d.start for d in scene.drivers]
+        per_metre = 1.0 if args.units == 'si' else LENGTH_UNITS[scene.units.length]
+        answer_of = (lambda inverse: inverse.answer)  # noqa: E731
+
+        def driver_text(i: int, value: float) -> str:
+            return scene.units.angle_text(value) if tmap.driver_angular[i] else \
+                scene.units.length_text(value)
+    goal, _, _ = targets_in_si(given, tmap.target_angular, args, per_metre)
+    inverse = continue_to(tmap, goal, start)
+    report = target_report(inverse, tmap, dict(answer_of(inverse).singularity))
+    if args.json:
+        print(json.dumps(report, indent=1, allow_nan=False))
+    else:
+        print(target_text(report, tmap, args.scene, driver_text))
+    return 0
+
+
 def _handle_region(args: argparse.Namespace, scene: Any) -> int:
     from ..geometry.region import region_from_scene
     pair = None if args.pair is None else [p.strip() for p in args.pair.split(',')]
@@ -673,6 +770,8 @@ def _handle_region(args: argparse.Namespace, scene: Any) -> int:
 def _handle(args: argparse.Namespace) -> int:
     from ..geometry.assembly import assembly_from_scene
 
+    if args.target:
+        return _handle_target(args)
     # A scene, or a URDF's loops as a scene; a SceneError is one line, exit 2 (cli.run_handler).
     scene = load_scene_argument(args)
     if args.speed_rpm is not None:
@@ -714,6 +813,10 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
                         help='several drivers: draw the grid in text (also in --json)')
     parser.add_argument('--png', metavar='FILE',
                         help='several drivers: write the grid as a PNG picture')
+    parser.add_argument('--target', type=named_value, action='append', metavar='NAME=VALUE',
+                        help='how well the drivers control targets (as solve --target takes '
+                             'them) at the pose that reaches them, continued from the start '
+                             "pose: the Jacobian, its condition, the loop's singularity")
     parser.add_argument('--workspace', metavar='POINT',
                         help='a scene with two drivers: map where POINT can go over the grid, '
                              'with its singular curves (det J = 0, where the drivers lose '

@@ -45,7 +45,8 @@ __all__ = ['ArgumentParser', 'PROG', 'UNIT_SYSTEMS', 'add_driver_arguments',
            'gravity_of', 'is_urdf', 'joint_list', 'link_loads_of', 'load_robot_argument',
            'load_scene_argument',
            'mimic_ruled', 'named_value', 'payloads_of', 'positive_float', 'positive_int',
-           'positive_seconds', 'run_handler', 'run_tool', 'seconds_or_zero', 'values_by_driver']
+           'positive_seconds', 'run_handler', 'run_tool', 'seconds_or_zero', 'targets_in_si',
+           'values_by_driver']
 
 #: What ``--units`` takes: ``deg`` (the default: a revolute joint's or a crank's
 #: values in degrees and rpm) or ``si`` (rad and rad/s; an actuator's length in m).
@@ -383,6 +384,27 @@ def run_tool(add_parser: Callable[[Any], argparse.ArgumentParser],
     root = ArgumentParser(prog=PROG)
     parser = add_parser(root.add_subparsers(dest='command', required=True))
     return run_handler(parser.parse_args(sys.argv[1:] if argv is None else list(argv)))
+
+
+def targets_in_si(given: dict[str, dict[str, float]], angular: Sequence[bool],
+                  args: argparse.Namespace, per_metre: float) -> tuple[
+                      list[float], list[float], list[float]]:
+    """Return targets' positions, speeds and accelerations in SI, in ``given``'s order.
+
+    ``given`` maps ``--target``, ``--target-speed`` and ``--target-accel`` to
+    {target: value}; an angle is in the units of ``--input`` (deg, or rad with
+    ``--units si``), its speed as ``--speed``'s (rpm, or rad/s); a length is
+    over ``per_metre`` (the scene's length unit per metre).
+    """
+    goal, speeds, accels = [], [], []
+    for name, is_angle in zip(given['--target'], angular, strict=True):
+        value = given['--target'][name]
+        speed = given.get('--target-speed', {}).get(name, 0.0)
+        goal.append((value if _si(args) else math.radians(value)) if is_angle
+                    else value / per_metre)
+        speeds.append(angular_rate_given(speed, args) if is_angle else speed)
+        accels.append(given.get('--target-accel', {}).get(name, 0.0))
+    return goal, speeds, accels
 
 
 def named_value(text: str) -> tuple[str | None, float]:

@@ -18,7 +18,7 @@ from .cli import (add_driver_arguments, add_gravity_argument, add_robot_argument
                   angular_rate_given, drive_from_args, finite_float, gravity_of, is_urdf,
                   link_loads_of, load_robot_argument, mimic_ruled, named_value,
                   positive_float,
-                  robot_angle_given, run_tool, values_by_driver)
+                  robot_angle_given, run_tool, targets_in_si, values_by_driver)
 from ..bounds import MAX_ERROR
 from ..errors import AssemblyError, NearSingularWarning, SceneError, UntrustedError
 from ..scene import load_scene
@@ -205,25 +205,6 @@ def _target_tables(args: argparse.Namespace) -> dict[str, dict[str, float]]:
     return given
 
 
-def _target_goal(given: dict[str, dict[str, float]], angular: Sequence[bool],
-                 args: argparse.Namespace, per_metre: float) -> tuple[
-                     list[float], list[float], list[float]]:
-    """Return the targets' positions, speeds and accelerations in SI, in ``given``'s order.
-
-    An angle in the units of ``--input`` (deg, or rad with ``--units si``), its
-    speed as ``--speed``'s (rpm, or rad/s); a length over ``per_metre``.
-    """
-    goal, speeds, accels = [], [], []
-    for name, is_angle in zip(given['--target'], angular, strict=True):
-        value = given['--target'][name]
-        speed = given['--target-speed'].get(name, 0.0)
-        goal.append((value if args.units == 'si' else math.radians(value)) if is_angle
-                    else value / per_metre)
-        speeds.append(angular_rate_given(speed, args) if is_angle else speed)
-        accels.append(given['--target-accel'].get(name, 0.0))
-    return goal, speeds, accels
-
-
 def _print_inverse(inverse: Any, state: Any, args: argparse.Namespace) -> int:
     """Print the answer of an inverse solve: the forward answer's JSON and the inverse's."""
     result: dict[str, Any] = {**inverse.answer.as_dict(), **inverse.as_dict()}
@@ -261,7 +242,7 @@ def _handle_targets(scene: Any, args: argparse.Namespace) -> int:
         first = [d.start if x is None else x + math.tau * int(w)
                  for d, x, w in zip(scene.drivers, starts, whole, strict=True)]
         per_metre = 1.0 if args.units == 'si' else LENGTH_UNITS[scene.units.length]
-        goal, speeds, accels = _target_goal(given, tmap.target_angular, args, per_metre)
+        goal, speeds, accels = targets_in_si(given, tmap.target_angular, args, per_metre)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter('always', NearSingularWarning)
             inverse = continue_to(tmap, goal, first, speeds, accels, max_error=args.max_error,
@@ -292,7 +273,7 @@ def _handle_robot_targets(args: argparse.Namespace) -> int:
             robot.forces.check_loads(loads)
         positions, _, _, _, _ = _robot_drive(robot, args)
         tmap = robot_targets(robot, tuple(given['--target']))
-        goal, speeds, accels = _target_goal(given, tmap.target_angular, args, 1.0)
+        goal, speeds, accels = targets_in_si(given, tmap.target_angular, args, 1.0)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter('always', NearSingularWarning)
             inverse = robot.solve_targets(

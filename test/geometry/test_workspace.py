@@ -1,6 +1,6 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""The workspace of a point and its singular curves (``check --workspace``, issue 41, item 4).
+"""A point's workspace and singular curves (``check --workspace``), and ``check --target``.
 
 The packaged five-bar (cranks AB and ED of 120 mm about A and E, 100 mm
 apart; distal links BP and DP of 160 mm) in closed form: P reaches the ring
@@ -101,3 +101,41 @@ def test_check_prints_it_and_refuses_what_it_cannot_map(capsys, tmp_path):
         assert cli_main(argv) == 2
         err = capsys.readouterr().err
         assert err.startswith('error: ') and words in err and err.count('\n') == 1
+
+
+def test_check_target_says_how_well_the_drivers_control_the_targets(capsys):
+    """At a target: the drivers solve_targets gives, det J, the scaled condition number."""
+    inverse = mk.solve_targets(FIVE, {'P.x': 0.06, 'P.y': 0.22})
+    assert cli_main(['check', 'five_bar', '--target', 'P.x=60', '--target', 'P.y=220',
+                     '--json']) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert list(data['drivers'].values()) == [float(x) for x in inverse.motion[:, 0]]
+    assert data['det_jacobian'] == float(np.linalg.det(inverse.jacobian))
+    # Scaled by the five-bar's size (its targets and the cranks' 1 rad): J / size.
+    size = inverse.answer.error_bound.size
+    sigma = np.linalg.svd(inverse.jacobian / size, compute_uv=False)
+    assert data['scaled_singular_values'] == pytest.approx(list(sigma), rel=1e-12)
+    assert data['condition'] == pytest.approx(sigma[0] / sigma[1], rel=1e-12)
+    assert data['least_singularity']['dyad'] == 'P'
+    # Towards a stretched leg (|PA| -> 280 mm, a fold of the map) the smallest singular value
+    # goes as the square root of the distance: 10 times closer, sqrt(10) times the condition.
+    conditions = []
+    for gap in (1e-4, 1e-5):
+        far = (CRANK + DISTAL - gap) / math.sqrt(2) * 1000
+        assert cli_main(['check', 'five_bar', '--target', f'P.x={far!r}', '--target',
+                         f'P.y={far!r}', '--json']) == 0
+        conditions.append(json.loads(capsys.readouterr().out)['condition'])
+    assert conditions[0] > 20 * data['condition']
+    assert conditions[1] / conditions[0] == pytest.approx(math.sqrt(10), rel=0.05)
+    assert cli_main(['check', 'five_bar', '--target', 'P.x=60', '--target', 'P.y=220']) == 0
+    quoted = DOCS.read_text().split('$ python -m mech_kinematics check five_bar --target P.x=60 '
+                                    '--target P.y=220\n', 1)[1].split('```', 1)[0]
+    assert quoted == capsys.readouterr().out, 'docs/commands.md quotes another answer'
+    assert cli_main(['check', 'five_bar', '--target', 'P.x=60', '--target', 'P.y=420']) == 2
+    err = capsys.readouterr().err
+    assert err.startswith('error: Expected targets within reach') and err.count('\n') == 1
+    assert cli_main(['check', str(Path(__file__).resolve().parents[1] / 'data' / 'urdf' /
+                                  'lift_arm.urdf'), '--target', 'tool_frame.z=0.45']) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].endswith('lift_arm.urdf: tool_frame.z = 0.45 m: reached from the start '
+                           'pose in 1 step')
