@@ -77,6 +77,9 @@ class TargetDrive:
         self.published_joints = self.topic.published_joints
         self.start = [float(x) for x in start]
         self._pending: list[float] | None = None
+        #: The targets and Jacobian at the start, by target names (the last answer's).
+        self._known: tuple[tuple[str, ...], Any] | None = None
+        self._pending_known: tuple[tuple[str, ...], Any] | None = None
         self._maps: dict[tuple[str, ...], TargetMap] = {}
 
     @property
@@ -112,6 +115,7 @@ class TargetDrive:
                 given = self.topic.read(sec, nanosec, names, positions, velocities)
                 where = {name: i for i, name in enumerate(names)}
                 self._pending = list(given.positions)
+                self._pending_known = None
                 return replace(given, accels=tuple(accels[where[n]] for n in self.names))
         else:
             accels = None
@@ -137,15 +141,18 @@ class TargetDrive:
             for name, value in zip(names, values, strict=False):
                 if not math.isfinite(value):
                     self._refuse(f'expected a finite {what} of target {name!r}, got {value!r}')
-        try:
+        known = self._known[1] if self._known is not None and self._known[0] == key else None
+        try:       # the accelerations and the forward answer only for a trajectory's points
             inverse = continue_to(tmap, goal, self.start, speeds, accels,
-                                  max_error=self.max_error)
+                                  max_error=self.max_error, known=known,
+                                  answer=accels is not None)
         except TargetError as error:
             self._refuse(str(error))
         drivers = [float(x) for x in inverse.motion[:, 0]]
         rates = [float(x) for x in inverse.motion[:, 1]] if speeds is not None else []
         given = self.topic.read(sec, nanosec, self.names, drivers, rates)
         self._pending = drivers
+        self._pending_known = (key, inverse.columns)
         if accels is None:
             return given
         return replace(given, accels=tuple(float(x) for x in inverse.motion[:, 2]))
@@ -160,6 +167,7 @@ class TargetDrive:
         self.topic.published(stamp_ns)
         if self._pending is not None:
             self.start, self._pending = self._pending, None
+            self._known, self._pending_known = self._pending_known, None
 
     def _refuse(self, reason: str) -> NoReturn:
         raise RefusedInput(f'{self.topic_name}: {reason}')

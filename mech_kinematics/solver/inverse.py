@@ -134,6 +134,9 @@ class Inverse:
         With ``forces=``: each driver's effort ``(J^T F)`` for the forces along targets.
     target_forces : dict of str to float
         The forces along targets given (N, or N m along an angle).
+    columns : tuple
+        The drivers' values answered with the targets and the Jacobian there:
+        what :func:`continue_to` takes as ``known`` to continue from them.
     """
 
     answer: Any
@@ -150,6 +153,7 @@ class Inverse:
     steps: int
     target_forces: dict[str, float]
     target_efforts: dict[str, float]
+    columns: Any = None
 
     def as_dict(self) -> dict[str, Any]:
         """Return what ``solve --target`` adds to the forward answer's JSON."""
@@ -190,13 +194,22 @@ def _residual(values: npt.NDArray[np.float64], goal: npt.NDArray[np.float64],
 def continue_to(tmap: TargetMap, goal: Sequence[float], start: Sequence[float],
                 speeds: Sequence[float] | None = None, accels: Sequence[float] | None = None,
                 *, max_error: float = MAX_ERROR,
-                forces: Mapping[str, float] | None = None) -> Inverse:
+                forces: Mapping[str, float] | None = None, known: Any = None,
+                answer: bool = True) -> Inverse:
     """Return the drivers' motion putting ``tmap``'s targets at ``goal``, continued from ``start``.
 
     ``goal``, ``speeds`` and ``accels``: the targets' positions, velocities and
     accelerations (SI, default at rest); ``start``: the drivers' values to
     continue from. Raises :class:`~mech_kinematics.errors.TargetError` for a
     goal out of reach or one whose answer cannot be trusted.
+
+    ``known``: a former answer's :attr:`Inverse.columns` (the targets and the
+    Jacobian at its drivers' values), not solved again where ``start`` is
+    those values: a stream of targets continues from its last answer.
+    ``answer=False``: for a caller that solves the state itself (the node),
+    the forward answer and the accelerations are not solved (``answer`` None,
+    the accelerations and their bounds NaN); the drivers' values and speeds,
+    their bounds and the singular-point refusal are the same.
     """
     m, n = len(tmap.targets), len(tmap.drivers)
     t_ang = np.array(tmap.target_angular, dtype=bool)
@@ -210,6 +223,8 @@ def continue_to(tmap: TargetMap, goal: Sequence[float], start: Sequence[float],
     #: The last drivers' values columns() solved at, and its answer: a Newton start (the
     #: start pose, the last point reached) is where the path or the last step solved.
     last: list[Any] = [None, None]
+    if known is not None and np.array_equal(known[0], q):
+        last[:] = [np.array(known[0], dtype=np.float64), known[1]]
 
     def columns(x: npt.NDArray[np.float64]) -> tuple[Any, Any, Any]:
         """Return the targets' values and bounds at ``x`` and the Jacobian with its bounds."""
@@ -301,8 +316,12 @@ def continue_to(tmap: TargetMap, goal: Sequence[float], start: Sequence[float],
         residual = np.abs(_residual(values, goal_a, t_ang))
         q_bound = np.abs(inv) @ (residual + bounds)
         qd = inv @ td
-        _, vals, bnds = tmap.evaluate(list(q), list(qd), zeros, math.inf)
-        qdd = inv @ (tdd - vals[:, 2])
+        if answer:
+            _, vals, bnds = tmap.evaluate(list(q), list(qd), zeros, math.inf)
+            qdd = inv @ (tdd - vals[:, 2])
+        else:
+            qdd = np.full(n, math.nan)
+            bnds = np.full((m, 3), math.nan)
     # First order: J's bounds times the rates, and a0's bounds (the rates' own error in a0
     # and J's change with q's error are of second order).
     qd_bound = np.abs(inv) @ (jac_b @ np.abs(qd))
@@ -315,11 +334,16 @@ def continue_to(tmap: TargetMap, goal: Sequence[float], start: Sequence[float],
                f'an error bound of {relative[worst]:.3g} of its scale (max_error {max_error:g}; '
                f'det J = {np.linalg.det(jac):.3g})')
         raise TargetError(msg)
-    try:
-        answer, vals, bnds = tmap.evaluate(list(q), list(qd), list(qdd), max_error)
-    except AssemblyError as error:
-        msg = f'Expected an answer that can be trusted, got {error}'
-        raise TargetError(msg) from None
+    state = None
+    if answer:
+        try:
+            state, vals, bnds = tmap.evaluate(list(q), list(qd), list(qdd), max_error)
+        except AssemblyError as error:
+            msg = f'Expected an answer that can be trusted, got {error}'
+            raise TargetError(msg) from None
+    else:       # what the columns at the answer give: positions, and velocities J qd
+        vals = np.stack((values, jac @ qd, np.full(m, math.nan)), axis=1)
+        bnds = np.stack((bounds, jac_b @ np.abs(qd), np.full(m, math.nan)), axis=1)
     force_list = dict(forces or {})
     unknown = [name for name in force_list if name not in tmap.targets]
     if unknown:
@@ -329,7 +353,7 @@ def continue_to(tmap: TargetMap, goal: Sequence[float], start: Sequence[float],
     f_vec = np.array([force_list.get(name, 0.0) for name in tmap.targets])
     efforts = jac.T @ f_vec
     return Inverse(
-        answer=answer, targets=tmap.targets, drivers=tmap.drivers,
+        answer=state, targets=tmap.targets, drivers=tmap.drivers,
         given=np.stack((goal_a, td, tdd), axis=1), reached=vals,
         reached_bound=bnds,
         motion=np.stack((q, qd, qdd), axis=1),
@@ -337,7 +361,7 @@ def continue_to(tmap: TargetMap, goal: Sequence[float], start: Sequence[float],
         jacobian=jac, inverse=inv, start=np.array(start, dtype=np.float64), steps=steps,
         target_forces=force_list,
         target_efforts={name: float(e) for name, e in zip(tmap.drivers, efforts, strict=True)}
-        if force_list else {})
+        if force_list else {}, columns=(q.copy(), (values, bounds, (jac, jac_b))))
 
 
 def _shown(value: float, tmap: TargetMap, index: int) -> str:
