@@ -18,7 +18,7 @@ from .errors import (AssemblyError, MechKinematicsError, NearSingularWarning, Sc
 from .scene import DEFAULT_SCENE, load_scene, parse_scene, scene_names
 from .solver import (Actuator, assembly_text, Branch, CarriedPoint, Crank, Engagement,
                      Inverse, JointMotion, Link, MAX_SLOTS, NEAR_SINGULAR, Pin, PointState, RPR,
-                     RRP, RRR, Scene, SceneUnits, SINGULAR, solve, solve_targets, State,
+                     RRP, RRR, Scene, SceneUnits, SINGULAR, Slider, solve, solve_targets, State,
                      TANGENCY_TOLERANCE)
 
 #: The former name of :class:`SceneUnits` (the units a scene was written in), kept working.
@@ -30,7 +30,8 @@ __all__ = [
     'ErrorBound', 'Inverse', 'JointMotion', 'Link', 'MAX_ERROR', 'MAX_SLOTS',
     'MechKinematicsError',
     'NEAR_SINGULAR', 'NearSingularWarning', 'Pin', 'PointState', 'RPR', 'RRP', 'RRR', 'SINGULAR',
-    'Scene', 'SceneError', 'SceneUnits', 'State', 'TANGENCY_TOLERANCE', 'TargetError', 'Units',
+    'Scene', 'SceneError', 'SceneUnits', 'Slider', 'State', 'TANGENCY_TOLERANCE', 'TargetError',
+    'Units',
     'UntrustedError', 'assembly_text', 'load_scene', 'parse_scene', 'scene_names', 'solve',
     'solve_targets',
 ]

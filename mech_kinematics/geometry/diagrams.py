@@ -726,9 +726,10 @@ def space_from_state(scene: Scene, state: State,
     pivots = tuple(Pivot(name, points[name]) for name in scene.ground if name in pinned)
     sliders = []
     guides = []
+    rods = set(graph.cylinders())
     for joint in graph.joints:  # the blocks, and the fixed guides they slide on
         line = joint.line
-        if line is None or joint.driver or joint.on in locked:
+        if line is None or joint in rods or joint.on in locked:
             continue
         sliders.append(SliderShape(joint.name, joint.at, points[joint.at],
                                    slide_angle(graph, joint, state), joint.on))
@@ -743,7 +744,7 @@ def space_from_state(scene: Scene, state: State,
 
 def _rods(graph: Graph) -> set[str]:
     """Return the blocks a driver slides (a cylinder's rod: drawn with its barrel)."""
-    return {j.body for j in graph.joints if j.driver and j.line is not None}
+    return {j.body for j in graph.cylinders()}
 
 
 def _drawn_points(graph: Graph, body: str) -> tuple[str, ...]:
@@ -752,8 +753,7 @@ def _drawn_points(graph: Graph, body: str) -> tuple[str, ...]:
     A cylinder is drawn from its barrel's start to its rod's pin (a driven
     block sliding along it), one link whose length varies.
     """
-    return graph.bodies[body].points + tuple(
-        j.at for j in graph.joints if j.on == body and j.driver and j.line is not None)
+    return graph.bodies[body].points + tuple(j.at for j in graph.cylinders() if j.on == body)
 
 
 def _slots(graph: Graph, joint: Joint, state: State, points: Mapping[str, Array]
@@ -1039,8 +1039,9 @@ def tables_from_diagram(diagram: Diagram,
         rows.append((slider.name, 'slider', f's = {fmt_value(slider.s)}', '-',
                      f'{fmt_value(slider.velocity)} m/s',
                      f'{fmt_value(slider.acceleration)} m/s\u00b2'))
+    shown = {slider.name for slider in diagram.sliders}
     for driver in diagram.drivers:  # an actuator: its length and extension rate
-        if not driver.joint_type.angular:
+        if not driver.joint_type.angular and driver.name not in shown:
             rows.append((driver.name, 'actuator', f'L = {fmt_value(driver.position)}', '-',
                          f'{fmt_value(driver.speed)} m/s', f'{fmt_value(driver.accel)} m/s\u00b2'))
     for pin in diagram.pins:  # seed 001: rubbing velocity = |omega_a - omega_b| r

@@ -268,8 +268,7 @@ def varying_links(scene: Scene) -> tuple[str, ...]:
     for a rigid link; a cylinder's adds its extension rate along it. (A slotted
     lever's length varies too, but its pin's sliding is modelled: it has a slider.)
     """
-    return tuple(dict.fromkeys(joint.on for joint in scene.graph.joints
-                               if joint.driver and joint.line is not None))
+    return tuple(dict.fromkeys(joint.on for joint in scene.graph.cylinders()))
 
 
 def one_driver(scene: Scene, what: str) -> None:

@@ -158,12 +158,9 @@ def free_length(scene: Scene) -> float:
 
 
 def domain(scene: Scene, driver: Any) -> tuple[float, float]:
-    """Return what a driver is swept over: a turn, its stroke or ``(0, free_length)``."""
-    if driver.joint_type.angular:
-        return (0.0, _TURN)
-    if driver.stroke is not None:
-        return (float(driver.stroke[0]), float(driver.stroke[1]))
-    return (0.0, free_length(scene))
+    """Return what a driver is swept over (its ``sweep``): a turn, its stroke or free lengths."""
+    low, high = driver.sweep(free_length(scene))
+    return (float(low), float(high))
 
 
 def _samples(kind: str, low: float, high: float, count: int) -> Array:

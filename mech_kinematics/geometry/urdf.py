@@ -169,8 +169,8 @@ def visuals_from_scene(scene: Scene, frames: Sequence[FrameSpec] | None = None,
     graph = full.graph
     drivers = {d.name: d for d in full.drivers}
     slides = [j for j in graph.joints if j.line is not None]
-    actuators = {j.name: drivers[j.name] for j in slides if j.driver}
-    cylinders = {j.on: drivers[j.name] for j in slides if j.driver}
+    actuators = {j.name: drivers[j.name] for j in graph.cylinders()}
+    cylinders = {j.on: drivers[j.name] for j in graph.cylinders()}
     # A link whose length varies (a slotted lever) is drawn out to the farthest its
     # pin slides: from its slot's point to the pin.
     levers = {j.on: (j.line.through, j.at) for j in slides  # type: ignore[union-attr]
@@ -266,8 +266,7 @@ def urdf_from_scene(scene: Scene, frame_id: str = 'mechanism', prefix: str = '')
     # An actuator's rod hangs on its cylinder's body by a prismatic joint along it.
     outputs = set(scene.output_joints)
     rods = {child_frame(prefix, j.body): (child_frame(prefix, j.on), j.name)
-            for j in scene.graph.joints if j.driver and j.line is not None
-            and j.body in outputs and j.on in outputs}
+            for j in scene.graph.cylinders() if j.body in outputs and j.on in outputs}
     for child, shapes, at in attachments:
         link = ET.SubElement(robot, 'link', name=child)
         _add_visuals(link, shapes)

@@ -754,19 +754,18 @@ class _Builder:
         m = self.m
         out = {}
         for name, edge in m.slides.items():
-            if name not in self.drivers_here:
-                continue
+            if name not in self.drivers_here or m.ground in (edge.a, edge.b):
+                continue    # a block driven on a fixed guide is a slider driver (_slider)
             ends = []
             for body in (edge.a, edge.b):
                 others = [e for e in m.edges_of[body] if e is not edge]
                 pins = [e for e in others if e.kind == 'pin']
-                if len(others) != 1 or len(pins) != 1 or body == m.ground:
+                if len(others) != 1 or len(pins) != 1:
                     raise self.fail(
                         f'joint "{name}": Expected an actuated prismatic joint to be a cylinder '
-                        f'(a barrel and a rod, each pinned once to the mechanism), got link '
-                        f'"{body}" with {len(others)} other joints'
-                        + (' (the ground: our kinds drive no slider on a guide)'
-                           if body == m.ground else ''), name)
+                        f'(a barrel and a rod, each pinned once to the mechanism) or a block '
+                        f'on a fixed guide, got link "{body}" with {len(others)} other joints',
+                        name)
                 ends.append(pins[0].name)
             out[name] = (edge.a, edge.b, ends[0], ends[1])
         return out
@@ -786,6 +785,8 @@ class _Builder:
                         f'between links "{edge.a}" and "{edge.b}", both moving: our kinds drive '
                         'no relative angle', name)
                 self._crank(edge, mimic)
+            elif m.ground in (edge.a, edge.b):
+                self._slider(edge, mimic)
             # A cylinder is placed with the dyad that uses it.
 
     def _crank(self, edge: _Edge, mimic: Any) -> None:
@@ -807,6 +808,34 @@ class _Builder:
         self.drivers.append(DriverMap(edge.name, crank_link, REVOLUTE, sigma, reference, phi0,
                                       mimic))
         self._known(body, (crank_link, phi0), edge.name, tip, phi0)
+
+    def _slider(self, edge: _Edge, mimic: Any) -> None:
+        """Add a block driven along a fixed guide: position = (value - reference) along it."""
+        m = self.m
+        block = edge.b if edge.a == m.ground else edge.a
+        pins = [e for e in m.edges_of[block] if e.kind == 'pin']
+        others = [e for e in m.edges_of[block] if e is not edge and e.kind != 'pin']
+        if len(pins) != 1 or others:
+            raise self.fail(
+                f'joint "{edge.name}": Expected an actuated prismatic joint on the ground to '
+                f'drive a block pinned once to the mechanism (a slider), got link "{block}" '
+                f'with {len(pins)} pins and {len(others)} other joints', edge.name)
+        pin = pins[0].name
+        g = m.slide_direction(edge, block)
+        through = self.point(f'{edge.name}_guide')
+        self.ground[through] = self.xy(m.pins[block][pin])
+        assert edge.joint is not None
+        reference = m.reference_value(edge.joint)
+        name = self.slider(edge.name)
+        self.inputs.append({'slider': name, 'point': self.point(pin),
+                            'guide': {'through': through, 'angle': _angle(g)},
+                            'position': self.pose.get(edge.name, 0.0) - reference,
+                            'speed': 0.0})
+        self.drivers.append(DriverMap(edge.name, name, PRISMATIC, 1.0, reference, 0.0, mimic))
+        self.slider_of[edge.name] = (name, 1.0, 0.0)
+        self.body_names[block] = name
+        self.placed.add(pin)
+        self._known(block, (None, 0.0), None, None, 0.0)
 
     def _tip(self, body: str, centre_pin: str, centre: complex) -> str:
         """Return a pin of ``body`` away from ``centre``: the crank's tip (added if none)."""

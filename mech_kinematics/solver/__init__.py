@@ -41,6 +41,7 @@ The package holds one module per concern and one per step kind:
 
 from .actuator import Actuator
 from .carried import CarriedPoint
+from .collar import Collar
 from .context import NEAR_SINGULAR, SINGULAR
 from .crank import Crank
 from .geneva import TANGENCY_TOLERANCE
@@ -52,15 +53,16 @@ from .rpr import MAX_SLOTS, RPR
 from .rrp import RRP
 from .rrr import RRR
 from .rubbing import Pin
+from .slider import Slider
 from .solve import assembly_margins, keep_general_path, solve
 from .state import Engagement, JointMotion, PointState, State
 from .triad import Triad
 
 __all__ = [
-    'Actuator', 'Branch', 'CarriedPoint', 'Crank', 'Engagement', 'Inverse', 'JointMotion',
-    'Link',
+    'Actuator', 'Branch', 'CarriedPoint', 'Collar', 'Crank', 'Engagement', 'Inverse',
+    'JointMotion', 'Link',
     'MAX_SLOTS',
     'NEAR_SINGULAR', 'Pin', 'PointState', 'RPP', 'RPR', 'RRP', 'RRR', 'SINGULAR', 'Scene', 'State',
-    'SceneUnits', 'Triad', 'TANGENCY_TOLERANCE', 'assembly_margins', 'assembly_text',
+    'SceneUnits', 'Slider', 'Triad', 'TANGENCY_TOLERANCE', 'assembly_margins', 'assembly_text',
     'keep_general_path', 'solve', 'solve_targets',
 ]

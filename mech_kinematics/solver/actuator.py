@@ -152,6 +152,15 @@ class Actuator(Driver):
         """Its longest length, m: what it adds to the mechanism's size."""
         return self.length if self.stroke is None else max(self.length, self.stroke[1])
 
+    @property
+    def described(self) -> str:
+        """What it is: an actuator."""
+        return 'actuator'
+
+    def sweep(self, free: float) -> tuple[float, float]:
+        """Return its stroke, or lengths up to ``free``, m (a length is positive)."""
+        return (0.0, free) if self.stroke is None else self.stroke
+
     def position_text(self, value: float, units: SceneUnits) -> str:
         """Return a length (m) of it as text in the scene's unit."""
         return units.length_text(value)
@@ -166,11 +175,12 @@ class Actuator(Driver):
         return Fragment(self.actuator, coordinates={self.actuator: PRISMATIC})
 
     def check_used(self, users: Sequence[Item]) -> None:
-        """Refuse it unless the length of exactly one RRR link is this actuator's."""
+        """Refuse it unless exactly one item uses it (an RRR link's length, a collar's)."""
         name = self.actuator
         if not users:
             msg = (f'Expected actuator "{name}" to be the length of an RRR link '
-                   f'(actuator: {name} in place of length:), got no link using it')
+                   f'(actuator: {name} in place of length:) or the distance of a collar '
+                   f'(actuator: {name}), got no link or collar using it')
             raise SceneError(msg, (self, 'actuator'))
         if len(users) > 1:
             first, again = users[:2]
@@ -247,12 +257,17 @@ class _ActuatorStep:
         ctx.sliders[self.name] = (s, sd, sdd, U * abs(s), U * abs(sd), U * abs(sdd))
 
     def floors(self, speed: Any, accel: Any, size: float) -> tuple[Any, Any, Any, Any]:
-        """Return what it adds to the least scales: speed, acceleration, turning rates.
+        """Return what it adds to the least scales: those of a linear driver."""
+        return linear_floors(speed, accel, size)
 
-        Its rate ``|v|`` (m/s) and ``|a| + v^2 / size`` (m/s^2, the
-        acceleration of a link of the mechanism's size turned by it), and
-        those over the size for the angular kinds.
-        """
-        v = abs(speed)
-        a = abs(accel) + v * v / size
-        return v, a, v / size, a / size
+
+def linear_floors(speed: Any, accel: Any, size: float) -> tuple[Any, Any, Any, Any]:
+    """Return what a linear driver adds to the least scales: speed, acceleration, turning rates.
+
+    Its rate ``|v|`` (m/s) and ``|a| + v^2 / size`` (m/s^2, the acceleration
+    of a link of the mechanism's size turned by it), and those over the size
+    for the angular kinds. An actuator's and a driven slider's.
+    """
+    v = abs(speed)
+    a = abs(accel) + v * v / size
+    return v, a, v / size, a / size

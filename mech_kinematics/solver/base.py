@@ -422,6 +422,19 @@ class Driver(ABC):
     def reach(self) -> float:
         """The length, m, it adds to the mechanism's size."""
 
+    @property
+    @abstractmethod
+    def described(self) -> str:
+        """What it is, for a report: ``'crank about A'``, ``'actuator'``, ..."""
+
+    @abstractmethod
+    def sweep(self, free: float) -> tuple[float, float]:
+        """Return the positions a study sweeps it over, rad or m: a turn, or its stroke.
+
+        ``free`` is a length no closing position of the mechanism can exceed,
+        m: the sweep of a linear driver without stroke limits.
+        """
+
     @abstractmethod
     def position_text(self, value: float, units: SceneUnits) -> str:
         """Return a position of it (rad or m) as text in the scene's unit."""

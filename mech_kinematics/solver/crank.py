@@ -178,6 +178,15 @@ class Crank(Driver):
         """Its length, m: what it adds to the mechanism's size."""
         return self.length
 
+    @property
+    def described(self) -> str:
+        """What it is: a crank about its centre."""
+        return f'crank about {self.center}'
+
+    def sweep(self, free: float) -> tuple[float, float]:
+        """Return a turn, rad."""
+        return (0.0, math.tau)
+
     def position_text(self, value: float, units: SceneUnits) -> str:
         """Return an angle (rad) of it as text in the scene's unit."""
         return units.angle_text(value)

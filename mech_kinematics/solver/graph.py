@@ -369,6 +369,19 @@ class Graph:
             if body.guide is not None:
                 yield name, body.guide
 
+    def cylinders(self) -> Iterator[Joint]:
+        """Yield every driven prismatic joint whose guide is a barrel: a cylinder's rod.
+
+        An actuator's rod slides in its barrel, a link with no fixed length
+        (the link whose length it drives). A driven prismatic joint on the
+        ground is a driven block on a fixed guide (a slider driver's), one
+        along a rigid link a driven collar: a slider block like any other.
+        """
+        for joint in self.joints:
+            if joint.driver and joint.line is not None and joint.on != self.ground \
+                    and self.bodies[joint.on].length is None:
+                yield joint
+
     def prismatic(self, block: str) -> Joint:
         """Return the prismatic joint a slider block slides by."""
         return next(j for j in self.joints if j.body == block and j.line is not None)

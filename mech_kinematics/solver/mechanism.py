@@ -17,8 +17,7 @@ import warnings
 
 import numpy as np
 
-from .actuator import Actuator
-from .base import Intermittent, Item
+from .base import Driver, Intermittent, Item
 from .carried import CarriedPoint
 from .crank import Crank
 from .forces import Dynamics, Load, Mass
@@ -242,10 +241,11 @@ class Scene:
     imus : tuple of ImuSpec
         Inertial sensors on moving links (:mod:`mech_kinematics.imu`); the
         outputs always hold each one's link and point.
-    inputs : tuple of Crank or Actuator
-        The drivers of a scene with several (or with an actuator), in order;
-        a scene has ``input`` or ``inputs``, not both. Each is named by its
-        crank link or its actuator, a name used once in the scene.
+    inputs : tuple of Driver
+        The drivers of a scene with several (or with an actuator or a
+        slider), in order; a scene has ``input`` or ``inputs``, not both.
+        Each is named by its crank link, its actuator or its slider, a name
+        used once in the scene.
     urdf_drivers : tuple of FollowedJoint
         For a robot's loops: the URDF joint each driver follows (none or one
         per driver); the solver never reads it.
@@ -262,7 +262,7 @@ class Scene:
     pins: tuple[Pin, ...] = ()
     units: SceneUnits = SceneUnits()
     imus: tuple[ImuSpec, ...] = ()
-    inputs: tuple[Crank | Actuator, ...] = ()
+    inputs: tuple[Driver, ...] = ()
     gravity: tuple[float, float] | None = None
     masses: tuple[Mass, ...] = ()
     loads: tuple[Load, ...] = ()
@@ -382,11 +382,11 @@ class Scene:
                         (*self.ground, *full.output_points), _size(self))
 
     @property
-    def drivers(self) -> tuple[Crank | Actuator, ...]:
+    def drivers(self) -> tuple[Driver, ...]:
         """The drivers in scene order (each has ``name``, ``joint_type``, ``start``, ...).
 
-        A crank or an actuator each: ``name`` (its crank link or actuator, also
-        a joint of ``State.joints``), ``joint_type`` (``'revolute'`` or
+        A crank, an actuator or a slider each: ``name`` (its crank link,
+        actuator or slider, also a joint of ``State.joints``), ``joint_type`` (``'revolute'`` or
         ``'prismatic'``), ``start`` (rad or m), ``speed`` and ``accel`` (the
         defaults: rad/s and rad/s^2, or m/s and m/s^2) and ``stroke``
         (inclusive limits, m, or ``None``).

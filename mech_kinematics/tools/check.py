@@ -282,6 +282,8 @@ def _domain_text(units: Any, scene: Any, name: str, kind: JointType,
     if kind.angular:
         return 'over a turn'
     driver = next(d for d in scene.drivers if d.name == name)
+    if driver.stroke is None and domain[0] < 0.0:
+        return f'over positions {_span_text(units, kind, *domain)} (no stroke limits)'
     if driver.stroke is None:
         return f'over lengths up to {_position_text(units, kind, domain[1])} (no stroke limits)'
     return f'over its stroke {_span_text(units, kind, *domain)}'
@@ -320,10 +322,7 @@ def region_text(region: Any, scene: Any, show_map: bool = False) -> str:
     kinds = {d.name: d.joint_type for d in scene.drivers}
     described = []
     for driver in scene.drivers:
-        if driver.joint_type.angular:
-            described.append(f'{driver.name} (crank about {driver.center})')
-        else:
-            described.append(f'{driver.name} (actuator)')
+        described.append(f'{driver.name} ({driver.described})')
     count = len(scene.drivers)
     lines = [f'{region.scene}: {count} driver{"s" if count > 1 else ""}: '
              f'{", ".join(described)} (angles in {units.angle}, CCW from +x; lengths in '

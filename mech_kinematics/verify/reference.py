@@ -62,7 +62,8 @@ import yaml
 
 from ..errors import SceneError
 from ..scene import read_scene_yaml
-from ..solver import Actuator, CarriedPoint, Crank, RPP, RPR, RRP, RRR, Scene, Triad
+from ..solver import (Actuator, CarriedPoint, Collar, Crank, RPP, RPR, RRP, RRR, Scene, Slider,
+                      Triad)
 from ..solver.graph import Fragment, joint_type, JointType
 from ..units import ANGLE_UNITS, LENGTH_UNITS, radians_from_degrees
 
@@ -602,17 +603,45 @@ class _Actuator(_DriverEquations):
 
     @staticmethod
     def place(model: Model, driver: Any, known: set[str]) -> None:
-        """Record the links it drives: those its rod slides along (the graph's driven slide)."""
-        model.actuated[driver.name] = [joint.on for joint in model.graph.joints
-                                       if joint.driver and joint.line is not None
-                                       and joint.body == driver.name]
+        """Record the links it drives: the barrels its rod slides along (the graph's cylinders)."""
+        model.actuated[driver.name] = [joint.on for joint in model.graph.cylinders()
+                                       if joint.body == driver.name]
 
     @staticmethod
     def drive(model: Model, driver: Any, p: Mapping[str, Any], value: Any,
               points: dict[str, Any], lengths: dict[str, Any]) -> None:
-        """Set each driven link's length to its position."""
+        """Set each driven link's length to its position, and its own value (a collar's)."""
         for link in model.actuated[driver.name]:
             lengths[f'link.{link}.length'] = value
+        lengths[f'actuator.{driver.name}'] = value
+
+    @staticmethod
+    def floors(model: Model, driver: Any, p: Mapping[str, Any], speed: Any,
+               accel: Any) -> dict[str, Any]:
+        """Its rates ``|v|`` and ``|a|``."""
+        return {'velocity': speed, 'acceleration': accel}
+
+
+class _Slider(_DriverEquations):
+    """A block on a fixed guide: its pin at its position along the guide."""
+
+    @staticmethod
+    def parameters(model: Model, driver: Any) -> tuple[Parameter, ...]:
+        """Return the guide's angle (0 where not written)."""
+        return (_angle(f'slider.{driver.name}.angle', driver.guide_angle, ('guide', 'angle'),
+                       default=0),)
+
+    @staticmethod
+    def place(model: Model, driver: Any, known: set[str]) -> None:
+        """Its position is given (no unknown); its pin is known."""
+        known.add(driver.point)
+
+    @staticmethod
+    def drive(model: Model, driver: Any, p: Mapping[str, Any], value: Any,
+              points: dict[str, Any], lengths: dict[str, Any]) -> None:
+        """Put its pin at its position along the guide."""
+        points[driver.point] = (points[driver.through]
+                                + value * expi(p[f'slider.{driver.name}.angle']))
 
     @staticmethod
     def floors(model: Model, driver: Any, p: Mapping[str, Any], speed: Any,
@@ -1273,16 +1302,73 @@ class _Carry(_Equations):
         return True
 
 
+class _Collar(_Equations):
+    """A collar on a link: its pin at its actuator's distance along the link's axis."""
+
+    @staticmethod
+    def parameters(item: Any) -> tuple[Parameter, ...]:
+        """Return none: its distance is its actuator's position, its line two known points."""
+        return ()
+
+    @staticmethod
+    def ready(model: Model, item: Any, known: set[str]) -> bool:
+        """Return whether its two points are known and its link is placed."""
+        return item.start in known and item.toward in known and item.link in model.links
+
+    @staticmethod
+    def unknowns(item: Any) -> tuple[str, ...]:
+        """Return none: it is an explicit function of known points and its actuator."""
+        return ()
+
+    @staticmethod
+    def new_points(item: Any) -> tuple[str, ...]:
+        """Return its pin."""
+        return (item.point,)
+
+    @staticmethod
+    def evaluate(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
+                 points: dict[str, Any], residuals: list[Any]) -> None:
+        """Its pin along the line from ``from`` toward ``toward``."""
+        origin = points[item.start]
+        axis = points[item.toward] - origin
+        points[item.point] = origin + p[f'actuator.{item.actuator}'] * axis / norm(axis)
+
+    @staticmethod
+    def construct(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
+                  pts: dict[str, Any], tiny: Any) -> None:
+        """Its pin along its line (mpmath)."""
+        origin = pts[item.start]
+        axis = pts[item.toward] - origin
+        pts[item.point] = origin + p[f'actuator.{item.actuator}'] * axis / abs(axis)
+
+    @staticmethod
+    def measure(model: Model, item: Any, i: int, p: Mapping[str, Any],
+                points: Mapping[str, Any], q: list[Any], measures: dict[str, Any]) -> None:
+        """Put none: a collar is never singular (its line's points are apart)."""
+
+    @staticmethod
+    def prepare(model: Model, item: Any, theta: Any, pts: dict[str, Any]) -> None:
+        """Put nothing: its construction reads only its own starts."""
+
+    @staticmethod
+    def branch_ok(item: Any, i: int, p: Mapping[str, Any], points: Mapping[str, Any],
+                  q: list[Any]) -> bool:
+        """Return True: it has one position."""
+        return True
+
+
 #: The equations of every kind of scene item, by :func:`model_key`: each kind of the
 #: registry (``solver/registry.py`` ``KINDS``), the carried point and the Geneva wheel's
 #: RPR. A kind missing here is refused by :class:`Model`, never solved as another.
 MODELS: dict[str, _Equations] = {
     RRR.kind: _RRR(), RRP.kind: _RRP(), RPR.kind: _RPR(), RPP.kind: _RPP(),
-    Triad.kind: _Triad(), CarriedPoint.kind: _Carry(), RPR.kind + INTERMITTENT: _Geneva()}
+    Triad.kind: _Triad(), CarriedPoint.kind: _Carry(), RPR.kind + INTERMITTENT: _Geneva(),
+    Collar.kind: _Collar()}
 
 #: The equations of every kind of driver, by its key in a scene's ``inputs:`` (``DRIVERS``).
 DRIVER_MODELS: dict[str, _DriverEquations] = {Crank.scene_key: _Crank(),
-                                              Actuator.scene_key: _Actuator()}
+                                              Actuator.scene_key: _Actuator(),
+                                              Slider.scene_key: _Slider()}
 
 
 def _real_vector(residuals: list[Any]) -> list[Any]:
@@ -1371,7 +1457,7 @@ def _newton(model: Model, p: Mapping[str, Any], q: list[Any], theta: Any,
     scales = [size if is_length else 1 for is_length in model.unknown_is_length]
     for iteration in range(1, max_iter + 1):
         _, res = model.evaluate(p, q, theta)
-        if max(abs(r) for r in res) <= tol * size * mpmath.mpf('1e-3'):
+        if max((abs(r) for r in res), default=0) <= tol * size * mpmath.mpf('1e-3'):
             return q, iteration - 1
         step = _mp_solve(model.jacobian_columns(p, q, theta), [-r for r in res])
         q = [x + dx for x, dx in zip(q, step, strict=True)]

@@ -159,7 +159,9 @@ def test_every_packaged_scene_round_trips_through_its_urdf(name):
         except mk.AssemblyError:
             continue
         urdf = {d.name: d.reference + steps[d.name] / d.sigma for d in robot.planar.drivers}
-        speeds = {d.name: float(rng.uniform(-2, 2)) for d in robot.planar.drivers}
+        # Rates up to 2 rad/s, or 2 m/s (at most 2 sizes a second: the Taylor bound's rates).
+        speeds = {d.name: float(rng.uniform(-2, 2)) * (1.0 if d.type.angular else min(size, 1.0))
+                  for d in robot.planar.drivers}
         answer = robot.solve(urdf, speeds)
         values = {n: j.position for n, j in answer.joints.items()}
         frames = fk.transforms(values)

@@ -47,7 +47,7 @@ def test_a_length_outside_the_stroke_is_refused_with_the_stroke():
 
 def test_it_must_set_the_length_of_exactly_one_link():
     """No link using it, or two, is refused naming the actuator."""
-    with pytest.raises(mk.SceneError, match='got no link using it'):
+    with pytest.raises(mk.SceneError, match='got no link or collar using it'):
         mk.Scene('b', {'O': (0.0, 0.0), 'F': (0.5, -0.3)}, None,
                  (mk.RRR('Q', (mk.Link('boom', 'O', 1.2), mk.Link('barrel', 'F', 1.4))),),
                  inputs=(mk.Crank('crank', 'O', 'B', 0.1), mk.Actuator('cyl', 1.4)))

@@ -81,7 +81,7 @@ def test_the_joint_type_test_finds_a_switch():
 
 def test_the_registry_holds_every_dyad_type_of_the_scene_format():
     """The scene's type: names its kind, which is an Item of that kind."""
-    assert set(KINDS) == {'RRR', 'RRP', 'RPR', 'RPP', 'triad'}
+    assert set(KINDS) == {'RRR', 'RRP', 'RPR', 'RPP', 'triad', 'collar'}
     for name, kind in KINDS.items():
         assert issubclass(kind, Item) and kind.kind == name
 
@@ -104,6 +104,9 @@ FACTS = {
     'stroke': ({'kind': 'stroke', 'actuator': 'boom_cyl', 'stroke': (1.9, 3.2), 'length': 3.5},
                'actuator boom_cyl: expected a length within its stroke [1900 mm, 3200 mm], '
                'got 3500 mm'),
+    'travel': ({'kind': 'travel', 'slider': 'block_a', 'stroke': (-0.2, 0.2), 'position': 0.25},
+               'slider block_a: expected a position within its stroke [-200 mm, 200 mm], '
+               'got 250 mm'),
 }
 
 

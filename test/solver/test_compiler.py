@@ -35,8 +35,8 @@ from mech_kinematics.solver.registry import KINDS
 #: The module (``mech_kinematics.solver.solve`` is also the name of its function).
 solve_module = importlib.import_module('mech_kinematics.solver.solve')
 
-#: The drivers (not in the registry: ``inputs:`` entries are a crank unless ``actuator:``).
-DRIVERS = ('crank', 'actuator')
+#: The drivers (``inputs:`` entries: the registry's DRIVERS, by the key each has).
+DRIVERS = ('crank', 'actuator', 'slider')
 #: Variants of registered kinds that run kernels of their own.
 VARIANTS = ('carried point', 'Geneva RPR', 'actuated RRR')
 
@@ -69,6 +69,23 @@ GENERATORS = {
                 'guide': {'through': 'A', 'angle': 0}, 'slot_angle': 90, 'slider': 'yoke',
                 'slot_slider': 'pin_in_slot'}]),
     'triad': triad_scene,
+    # A slider-crank driven from its piston: the crank pin is an RRR from O and the pin.
+    'slider': lambda: scene_mapping(
+        'slider', {'O': [0, 0]},
+        inputs=[{'slider': 'piston', 'point': 'P', 'guide': {'through': 'O', 'angle': 0},
+                 'position': -696.6166, 'speed': 1.5, 'accel': -4.0}],
+        dyads=[{'type': 'RRR', 'point': 'B', 'links': [
+            {'name': 'crank', 'from': 'O', 'length': 150},
+            {'name': 'rod', 'from': 'P', 'length': 600}], 'branch': -1}]),
+    # A collar driven along a crank by an actuator, a link from it to a block on a guide.
+    'collar': lambda: scene_mapping(
+        'collar', {'O': [0, 0], 'G': [0, -300]},
+        inputs=[crank_entry(500, 60, 30, 2.0, 'O', 'T'),
+                {'actuator': 'x', 'length': 200, 'speed': 2, 'accel': 3, 'stroke': [100, 300]}],
+        dyads=[{'type': 'collar', 'point': 'C', 'link': 'crank', 'from': 'O', 'toward': 'T',
+                'actuator': 'x'},
+               {'type': 'RRP', 'point': 'P', 'link': {'name': 'arm', 'from': 'C', 'length': 700},
+                'guide': {'through': 'G', 'angle': 0}, 'slider': 'block', 'branch': 1}]),
     'actuator': lambda: scene_mapping(
         'actuator', {'O': [0, 0], 'F': [400, -1100]},
         inputs=[{'actuator': 'cyl', 'length': 2600, 'speed': 100, 'stroke': [2000, 3300]}],
@@ -112,6 +129,14 @@ NOT_COMPILED = {
                             "paths alone (the node's tick compiles any drivers)",
     ('actuator', 'array'): "its driver cyl is not a crank: mk.solve compiles one crank's "
                            "paths alone (the node's tick compiles any drivers)",
+    ('slider', 'single'): "its driver piston is not a crank: mk.solve compiles one crank's "
+                          "paths alone (the node's tick compiles any drivers)",
+    ('slider', 'array'): "its driver piston is not a crank: mk.solve compiles one crank's "
+                         "paths alone (the node's tick compiles any drivers)",
+    ('collar', 'single'): "2 drivers (crank, x): mk.solve compiles one crank's paths "
+                          "alone (the node's tick compiles any drivers)",
+    ('collar', 'array'): "2 drivers (crank, x): mk.solve compiles one crank's paths "
+                         "alone (the node's tick compiles any drivers)",
     ('actuated RRR', 'single'): "2 drivers (crank, cyl): mk.solve compiles one crank's paths "
                                 "alone (the node's tick compiles any drivers)",
     ('actuated RRR', 'array'): "2 drivers (crank, cyl): mk.solve compiles one crank's paths "

@@ -102,6 +102,23 @@ GEOMETRIES = {
                 'F': {'link': 'coupler', 'origin': 'B', 'xaxis': 'C', 'local': [40, -30]},
                 'G': {'link': 'rocker', 'origin': 'D', 'xaxis': 'C', 'local': [30, 25]}}),
     'triad': triad_scene,
+    # A slider-crank driven from its piston: the crank pin is an RRR from O and the pin.
+    'slider': lambda: scene_mapping(
+        'slider', {'O': [0, 0]},
+        inputs=[{'slider': 'piston', 'point': 'P', 'guide': {'through': 'O', 'angle': 0},
+                 'position': -696.6166, 'speed': 1.5, 'accel': -4.0}],
+        dyads=[{'type': 'RRR', 'point': 'B', 'links': [
+            {'name': 'crank', 'from': 'O', 'length': 150},
+            {'name': 'rod', 'from': 'P', 'length': 600}], 'branch': -1}]),
+    # A collar driven along a crank by an actuator, a link from it to a block on a guide.
+    'collar': lambda: scene_mapping(
+        'collar', {'O': [0, 0], 'G': [0, -300]},
+        inputs=[crank_entry(500, 60, 30, 2.0, 'O', 'T'),
+                {'actuator': 'x', 'length': 200, 'speed': 2, 'accel': 3, 'stroke': [100, 300]}],
+        dyads=[{'type': 'collar', 'point': 'C', 'link': 'crank', 'from': 'O', 'toward': 'T',
+                'actuator': 'x'},
+               {'type': 'RRP', 'point': 'P', 'link': {'name': 'arm', 'from': 'C', 'length': 700},
+                'guide': {'through': 'G', 'angle': 0}, 'slider': 'block', 'branch': 1}]),
     'Geneva RPR': lambda: scene_mapping(
         'geneva', {'D': [0, 0], 'S': [-70.71067811865476, 0]},
         input={'link': 'driver', 'center': 'D', 'point': 'P', 'length': 50, 'angle': 150,
@@ -131,10 +148,13 @@ RANGES = {
     'carried point': [('deg', -360.0, 360.0)],
     'Geneva RPR': [('deg', -360.0, 720.0)],
     'actuated RRR': [('deg', -360.0, 360.0), ('mm', 230.0, 340.0)],
+    'slider': [('mm', -740.0, -460.0)],
+    'collar': [('deg', -360.0, 360.0), ('mm', 100.0, 300.0)],
 }
 
-#: The drivers (not in the registry) and the variants with kernels of their own.
-DRIVERS = ('crank', 'actuator')
+#: The drivers (the registry's DRIVERS, by the key each has) and the variants with kernels
+#: of their own.
+DRIVERS = ('crank', 'actuator', 'slider')
 VARIANTS = ('carried point', 'Geneva RPR', 'actuated RRR')
 #: Bodies that turn freely about their frame's origin while a Geneva wheel is locked:
 #: they may carry a mass at that origin only (the statics would not determine more).
