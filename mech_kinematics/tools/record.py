@@ -18,13 +18,16 @@ rosbag2 does it:
 Bag format version 8 is the default: its metadata is readable by Humble and
 later, while version 9 metadata is not readable by Humble (rosbag2#1895).
 Ctrl-C, SIGTERM or the end of ``--duration`` stop the recording. What the
-subscriptions have already received and not yet handed over is then taken
-(for at most :data:`DRAIN_S`: a recorder that lags on a loaded machine held
-the last tenth of a second of the largest topics there), after which the
-subscriptions are destroyed and the bag is closed: every message received
-is in it. A message published before its topic's subscription matched (the
-topics are discovered one after another) is not the recorder's to receive:
-the state topics are volatile, as rosbag2 records them.
+subscriptions have already received and not yet handed over is then taken:
+each subscription's queue is taken directly, in order, up to the first
+message published after the stop (its DDS source timestamp), which is left
+out, for at most :data:`DRAIN_S` in all (a recorder starved of the CPU on a
+loaded machine held the last 1.2 s of a 500 Hz topic there). Then the
+subscriptions are destroyed and the bag is closed: every message published
+before the stop and received is in it. A message published before its
+topic's subscription matched (the topics are discovered one after another)
+is not the recorder's to receive: the state topics are volatile, as rosbag2
+records them.
 
 Nothing is lost if the recorder itself dies: messages reach the storage file
 every :data:`~mech_kinematics.bag.FLUSH_INTERVAL_S` (an MCAP chunk closed and synced,
@@ -119,11 +122,10 @@ DEFAULT_PROGRESS_S = 5.0
 QUEUE_DEPTH = 1000
 #: Longest wait of one executor step, s: bounds the reaction to a signal or the deadline.
 SPIN_STEP_S = 0.05
-#: Longest time spent after the stop taking what the subscriptions hold, s (a stream that
-#: keeps coming would hold them forever).
-DRAIN_S = 0.5
-#: Executor steps in a row that take nothing, after the stop, that end the draining.
-IDLE_STEPS = 3
+#: Longest time spent after the stop taking what the subscriptions hold (the messages
+#: published before it), s: a bound on a recorder starved of the CPU, never reached by one
+#: that keeps up (a queue's draining ends at its first message published after the stop).
+DRAIN_S = 5.0
 
 EXECUTORS = ('events', 'single')
 DEFAULT_EXECUTOR = 'events'
@@ -521,13 +523,20 @@ class BagRecorder:
         """Take what the subscriptions hold at the stop (not after a write error)."""
         if self._writer is None or self._writer.failure is not None:
             return
+        stop_ns = time.time_ns()    # the clock of DDS source timestamps
         deadline = time.monotonic() + DRAIN_S
-        idle = 0
-        while idle < IDLE_STEPS and time.monotonic() < deadline:
-            before = sum(topic.stats.received for topic in self._topics.values())
-            self._executor.spin_once(timeout_sec=0.0)
-            after = sum(topic.stats.received for topic in self._topics.values())
-            idle = idle + 1 if after == before else 0
+        for topic in self._topics.values():
+            subscription = topic.subscription
+            if subscription is None:
+                continue
+            # Taken from the queue itself, with each message's info (the executor's
+            # callbacks get none: rclpy's EventsExecutor cannot give a raw one its info).
+            while time.monotonic() < deadline and self._writer.failure is None:
+                with subscription.handle:
+                    taken = subscription.handle.take_message(subscription.msg_type, True)
+                if taken is None or taken[1]['source_timestamp'] > stop_ns:
+                    break
+                subscription.callback(taken[0])
 
     def close(self) -> list[TopicStats]:
         """Stop receiving, close the bag (metadata.yaml included) and shut ROS down.
