@@ -66,11 +66,17 @@ def child_frame(prefix: str, name: str) -> str:
 
 
 def frames_from_scene(scene: Scene, joints: Sequence[str] | None = None) -> tuple[FrameSpec, ...]:
-    """Return the frames of ``joints`` (default: the scene's output joints), in that order."""
+    """Return the frames of ``joints`` (default: the scene's output joints), in that order.
+
+    A joint that moves no body of its own (a motor's relative angle: its hinge's
+    link has the frame) has none.
+    """
+    graph = scene.graph
     specs = {body: FrameSpec(body, frame.origin, frame.angle_of, frame.angle)
-             for body, frame in scene.graph.frames()}
+             for body, frame in graph.frames()}
     names = scene.output_joints if joints is None else joints
-    return tuple(specs[name] for name in names)
+    return tuple(specs[name] for name in names
+                 if name in specs or name not in graph.coordinates or name in graph.bodies)
 
 
 def origin_points(frames: Sequence[FrameSpec]) -> tuple[str, ...]:

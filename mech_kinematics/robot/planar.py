@@ -691,9 +691,21 @@ class _Builder:
             self.ground[self.point(pin)] = self.xy(z)
             self.placed.add(pin)
         self.cylinders = self._cylinders()
+        #: Actuated revolute joints between two moving links, until placed: (edge, mimic,
+        #: index among the drivers, the motor's input entry).
+        self.hinges: dict[str, tuple[_Edge, Any, int, dict[str, Any]]] = {}
         self._drivers()
         while len(self.known) < len(m.bodies):
             if not self._dyad():
+                if self.hinges:
+                    name, (edge, _, _, _) = next(iter(self.hinges.items()))
+                    raise self.fail(
+                        f'joint "{name}": Expected an actuated revolute joint between two '
+                        f'moving links (a motor on a link: a hinge) to turn a link about one '
+                        f'the loop places without it, got one between links "{edge.a}" and '
+                        f'"{edge.b}", neither placed first: the loop would need re-rooting with '
+                        f'this joint as its input (not built; our kinds drive no relative '
+                        f'angle there)', name)
                 left = [b for b in m.bodies if b not in self.known]
                 joint = next(e.name for b in left for e in m.edges_of[b])
                 raise self.fail(
@@ -779,11 +791,13 @@ class _Builder:
             mimic = self.mimics.get(name)
             if joint.type.angular:
                 if m.ground not in (edge.a, edge.b):
-                    raise self.fail(
-                        f'joint "{name}": Expected an actuated revolute joint to turn a link '
-                        f'about the ground of its loop (link "{m.ground}": a crank), got one '
-                        f'between links "{edge.a}" and "{edge.b}", both moving: our kinds drive '
-                        'no relative angle', name)
+                    # A motor between two moving links: a hinge, placed once either link is
+                    # (its angle and map then); its place among the drivers kept now.
+                    entry: dict[str, Any] = {'motor': self.names('motor', name), 'speed': 0.0}
+                    self.hinges[name] = (edge, mimic, len(self.drivers), entry)
+                    self.inputs.append(entry)
+                    self.drivers.append(None)    # type: ignore[arg-type]
+                    continue
                 self._crank(edge, mimic)
             elif m.ground in (edge.a, edge.b):
                 self._slider(edge, mimic)
@@ -885,7 +899,42 @@ class _Builder:
 
     # --- dyads -----------------------------------------------------------------------------
     def _dyad(self) -> bool:
-        return self._rrr() or self._rrp() or self._rpr() or self._rpp() or self._triad()
+        return (self._hinge() or self._rrr() or self._rrp() or self._rpr() or self._rpp()
+                or self._triad())
+
+    def _hinge(self) -> bool:
+        """Place a link a motor turns on a placed one: its angle the parent's plus the motor's."""
+        m = self.m
+        for name, (edge, mimic, index, entry) in self.hinges.items():
+            if (edge.a in self.known) == (edge.b in self.known):
+                continue
+            parent, child = (edge.a, edge.b) if edge.a in self.known else (edge.b, edge.a)
+            coordinate, parent_angle = self.turns[parent]
+            if coordinate is None:
+                raise self.fail(
+                    f'joint "{name}": Expected an actuated revolute joint to turn a link about '
+                    f'a link that turns, got one on "{parent}", a block that only slides', name)
+            centre = m.pins[child][name]
+            tip = self._tip(child, name, centre)
+            link = self.link(child)
+            self.body_names[child] = link
+            phi0 = _angle(m.pins[child][tip] - centre)
+            assert edge.joint is not None
+            sigma = m.sign(edge) * (1.0 if child == edge.b else -1.0)
+            reference = m.reference_value(edge.joint)
+            relative = phi0 - parent_angle
+            entry['angle'] = relative + sigma * (self.pose.get(name, 0.0) - reference)
+            self.dyads.append({'type': 'hinge', 'link': link, 'parent': self.link(parent),
+                               'center': self.point(name), 'point': self.point(tip),
+                               'length': abs(m.pins[child][tip] - centre),
+                               'motor': entry['motor']})
+            self.drivers[index] = DriverMap(name, entry['motor'], REVOLUTE, sigma, reference,
+                                            relative, mimic)
+            self.placed.add(tip)
+            self._known(child, (link, phi0), name, tip, phi0)
+            del self.hinges[name]
+            return True
+        return False
 
     def _unit(self, body: str) -> tuple[str, str] | None:
         """Return (kind, key): ``body`` as an RRR element: a link, or a cylinder's barrel."""

@@ -356,7 +356,7 @@ class Publishing:
         if self.forces is not None:
             self.publish_forces(values, sec, nanosec)
         if self.imus is not None:
-            self._publish_imus(values, sec, nanosec)
+            self.publish_imus(values, sec, nanosec)
         if stamp >= self.next_tf:
             tf_period = self.tf_period_ns
             if self.tf is not None and tf_period is not None:
@@ -379,7 +379,7 @@ class Publishing:
         self.next_tf = stamp + self.tf_period_ns
         return True
 
-    def _publish_imus(self, values: Sequence[float], sec: int, nanosec: int) -> None:
+    def publish_imus(self, values: Sequence[float], sec: int, nanosec: int) -> None:
         """Publish every sensor's ``Imu`` of a tick's values (none whose reading overflows)."""
         assert self.imus is not None
         for publish, data, sensor in zip(self._publish_imu,

@@ -8,7 +8,9 @@ trajectory`` to ``input_trajectory`` (``trajectory_msgs/msg/JointTrajectory``):
 each of its points, of the drivers or of targets, with one velocity and one
 acceleration per name, is a state stamped at the header's stamp (the node's
 clock at receipt where it is zero, "start now" in ROS) plus the point's
-``time_from_start``, with its accelerations and the efforts of that motion.
+``time_from_start``, with its accelerations, the efforts of that motion and
+the scene's IMU readings (an input without accelerations has none: topic and
+target drives publish no ``imu/NAME``).
 
 The rules of one input message are :mod:`~mech_kinematics.ros.topic_drive`'s
 (pure); :class:`InputSubscription` is their node side. It subscribes at
@@ -231,6 +233,8 @@ class InputSubscription:
                 publish(data)
             if publishing.forces is not None:
                 publishing.publish_forces(values, sec, nanosec)
+            if publishing.imus is not None and given.accels is not None:
+                publishing.publish_imus(values, sec, nanosec)   # accelerations known: a reading
         except RCLError as exc:    # the middleware refused: this input's state is lost
             reason = str(exc).split(',', 1)[0]
             stats.publish_failed(given.stamp_ns, time.monotonic_ns() - received, False, reason)

@@ -45,6 +45,7 @@ from .collar import Collar
 from .context import NEAR_SINGULAR, SINGULAR
 from .crank import Crank
 from .geneva import TANGENCY_TOLERANCE
+from .hinge import Hinge, Motor
 from .inverse import Inverse, solve_targets
 from .mechanism import assembly_text, Scene
 from .model import Branch, Link, SceneUnits
@@ -59,8 +60,8 @@ from .state import Engagement, JointMotion, PointState, State
 from .triad import Triad
 
 __all__ = [
-    'Actuator', 'Branch', 'CarriedPoint', 'Collar', 'Crank', 'Engagement', 'Inverse',
-    'JointMotion', 'Link',
+    'Actuator', 'Branch', 'CarriedPoint', 'Collar', 'Crank', 'Engagement', 'Hinge', 'Inverse',
+    'JointMotion', 'Link', 'Motor',
     'MAX_SLOTS',
     'NEAR_SINGULAR', 'Pin', 'PointState', 'RPP', 'RPR', 'RRP', 'RRR', 'SINGULAR', 'Scene', 'State',
     'SceneUnits', 'Slider', 'Triad', 'TANGENCY_TOLERANCE', 'assembly_margins', 'assembly_text',

@@ -249,7 +249,7 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
     out_joints = all_joints if joints is None else tuple(joints)
     out_points = tuple(order) if points is None else tuple(points)
     for name in out_joints:
-        if kinds.get(name) not in ('link', 'slider', 'actuator'):
+        if kinds.get(name) not in ('link', 'slider', 'actuator', 'motor'):
             got = f'unknown "{name}"' if name not in kinds else f'{kinds[name]} "{name}"'
             msg = f'Expected outputs.joints to list links and sliders, got {got}'
             raise SceneError(msg, (scene, 'outputs.joints'))

@@ -14,6 +14,7 @@ from .actuator import Actuator
 from .base import Driver, Item
 from .collar import Collar
 from .crank import Crank
+from .hinge import Hinge, Motor
 from .model import SceneUnits
 from .rpp import RPP
 from .rpr import RPR
@@ -22,12 +23,13 @@ from .rrr import RRR
 from .slider import Slider
 from .triad import Triad
 
-_ITEMS: tuple[type[Item], ...] = (RRR, RRP, RPR, RPP, Triad, Collar)
+_ITEMS: tuple[type[Item], ...] = (RRR, RRP, RPR, RPP, Triad, Collar, Hinge)
 #: The scene's ``type:`` of a dyad -> its item class.
 KINDS: dict[str, type[Item]] = {kind.kind: kind for kind in _ITEMS}
 
 #: The key that names a driver in the scene's ``inputs:`` -> its kind.
-DRIVERS: dict[str, type[Driver]] = {kind.scene_key: kind for kind in (Crank, Actuator, Slider)}
+_DRIVERS: tuple[type[Driver], ...] = (Crank, Actuator, Slider, Motor)
+DRIVERS: dict[str, type[Driver]] = {kind.scene_key: kind for kind in _DRIVERS}
 
 #: The ``kind`` of an :class:`~mech_kinematics.errors.AssemblyError`'s facts -> their text.
 FACT_TEXTS: dict[str, Callable[[dict[str, Any], SceneUnits], str]] = {

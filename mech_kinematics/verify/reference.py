@@ -62,8 +62,8 @@ import yaml
 
 from ..errors import SceneError
 from ..scene import read_scene_yaml
-from ..solver import (Actuator, CarriedPoint, Collar, Crank, RPP, RPR, RRP, RRR, Scene, Slider,
-                      Triad)
+from ..solver import (Actuator, CarriedPoint, Collar, Crank, Hinge, Motor, RPP, RPR, RRP, RRR,
+                      Scene, Slider, Triad)
 from ..solver.graph import Fragment, joint_type, JointType
 from ..units import ANGLE_UNITS, LENGTH_UNITS, radians_from_degrees
 
@@ -389,6 +389,10 @@ class Model:
         self.joint_types: dict[str, JointType] = {}
         #: Per actuator, the links whose length is its length.
         self.actuated: dict[str, list[str]] = {}
+        #: Per motor, the two points of its parent's axis; per hinge link, (parent, motor):
+        #: its angle is the parent's plus the motor's.
+        self.axes: dict[str, tuple[str, str]] = {}
+        self.derived: dict[str, tuple[str, str]] = {}
         known = set(scene.ground)
         self.drivers = tuple(zip(drivers, driver_equations, strict=True))
         for k, (driver, moves) in enumerate(self.drivers):
@@ -648,6 +652,36 @@ class _Slider(_DriverEquations):
                accel: Any) -> dict[str, Any]:
         """Its rates ``|v|`` and ``|a|``."""
         return {'velocity': speed, 'acceleration': accel}
+
+
+class _Motor(_DriverEquations):
+    """A motor between two moving links: the relative angle of the hinge it turns."""
+
+    @staticmethod
+    def parameters(model: Model, driver: Any) -> tuple[Parameter, ...]:
+        """Return none: its angle is its position."""
+        return ()
+
+    @staticmethod
+    def place(model: Model, driver: Any, known: set[str]) -> None:
+        """Record the parent's axis (two of its points) its angle is measured from."""
+        joint = next(j for j in model.graph.joints if j.driver and j.name == driver.name)
+        body = model.graph.bodies[joint.on]
+        origin = body.frame.origin  # type: ignore[union-attr]
+        model.axes[driver.name] = (origin, next(p for p in body.points if p != origin))
+
+    @staticmethod
+    def drive(model: Model, driver: Any, p: Mapping[str, Any], value: Any,
+              points: dict[str, Any], lengths: dict[str, Any]) -> None:
+        """Give its hinge its angle and the parent's axis."""
+        lengths[f'motor.{driver.name}'] = value
+        lengths[f'motor.{driver.name}.axis'] = model.axes[driver.name]
+
+    @staticmethod
+    def floors(model: Model, driver: Any, p: Mapping[str, Any], speed: Any,
+               accel: Any) -> dict[str, Any]:
+        """Its rates ``|omega|`` and ``|alpha|``."""
+        return {'angular velocity': speed, 'angular acceleration': accel}
 
 
 # --- each kind's constraint equations ------------------------------------------------
@@ -1357,18 +1391,80 @@ class _Collar(_Equations):
         return True
 
 
+class _Hinge(_Equations):
+    """A link pinned to a moving one, turned by a motor: its angle the parent's plus its own."""
+
+    @staticmethod
+    def parameters(item: Any) -> tuple[Parameter, ...]:
+        """Return its length."""
+        return (_length(f'hinge.{item.link}.length', item.length, ('length',)),)
+
+    @staticmethod
+    def ready(model: Model, item: Any, known: set[str]) -> bool:
+        """Return whether its pin is known and its parent placed (then its link is, derived)."""
+        if item.center in known and (item.parent in model.links
+                                     or item.parent in model.derived):
+            model.derived[item.link] = (item.parent, item.motor)
+            return True
+        return False
+
+    @staticmethod
+    def unknowns(item: Any) -> tuple[str, ...]:
+        """Return none: its tip is an explicit function of its pin, parent and motor."""
+        return ()
+
+    @staticmethod
+    def new_points(item: Any) -> tuple[str, ...]:
+        """Return its tip."""
+        return (item.point,)
+
+    @staticmethod
+    def evaluate(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
+                 points: dict[str, Any], residuals: list[Any]) -> None:
+        """Its tip: the parent's axis turned by the motor's angle, from the pin."""
+        origin, xaxis = p[f'motor.{item.motor}.axis']
+        axis = points[xaxis] - points[origin]
+        turned = axis / norm(axis) * expi(p[f'motor.{item.motor}'])
+        points[item.point] = points[item.center] + p[f'hinge.{item.link}.length'] * turned
+
+    @staticmethod
+    def construct(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
+                  pts: dict[str, Any], tiny: Any) -> None:
+        """Its tip (mpmath)."""
+        origin, xaxis = p[f'motor.{item.motor}.axis']
+        axis = pts[xaxis] - pts[origin]
+        turned = axis / abs(axis) * mpmath.expj(p[f'motor.{item.motor}'])
+        pts[item.point] = pts[item.center] + p[f'hinge.{item.link}.length'] * turned
+
+    @staticmethod
+    def measure(model: Model, item: Any, i: int, p: Mapping[str, Any],
+                points: Mapping[str, Any], q: list[Any], measures: dict[str, Any]) -> None:
+        """Put none: a hinge is never singular."""
+
+    @staticmethod
+    def prepare(model: Model, item: Any, theta: Any, pts: dict[str, Any]) -> None:
+        """Put nothing: its construction reads only its own starts."""
+
+    @staticmethod
+    def branch_ok(item: Any, i: int, p: Mapping[str, Any], points: Mapping[str, Any],
+                  q: list[Any]) -> bool:
+        """Return True: it has one position."""
+        return True
+
+
 #: The equations of every kind of scene item, by :func:`model_key`: each kind of the
 #: registry (``solver/registry.py`` ``KINDS``), the carried point and the Geneva wheel's
 #: RPR. A kind missing here is refused by :class:`Model`, never solved as another.
 MODELS: dict[str, _Equations] = {
     RRR.kind: _RRR(), RRP.kind: _RRP(), RPR.kind: _RPR(), RPP.kind: _RPP(),
     Triad.kind: _Triad(), CarriedPoint.kind: _Carry(), RPR.kind + INTERMITTENT: _Geneva(),
-    Collar.kind: _Collar()}
+    Collar.kind: _Collar(), Hinge.kind: _Hinge()}
 
 #: The equations of every kind of driver, by its key in a scene's ``inputs:`` (``DRIVERS``).
 DRIVER_MODELS: dict[str, _DriverEquations] = {Crank.scene_key: _Crank(),
                                               Actuator.scene_key: _Actuator(),
-                                              Slider.scene_key: _Slider()}
+                                              Slider.scene_key: _Slider(),
+                                              Motor.scene_key: _Motor()}
 
 
 def _real_vector(residuals: list[Any]) -> list[Any]:
@@ -1619,6 +1715,8 @@ def _state(model: Model, p: Mapping[str, Any], q: list[Any], qdot: list[Any] | N
                 joints[name] = (_wrap(q[index]), None, None)
         for name, index in model.sliders.items():
             joints[name] = (q[index], None, None)
+        for name, (parent, motor) in model.derived.items():
+            joints[name] = (_wrap(joints[parent][0] + joints[motor][0]), None, None)
         return point_states, joints
     jets = [Jet(x, v, a / 2) for x, v, a in zip(q, qdot, qddot, strict=True)]
     theta_jet = _jet(th, om, al)
@@ -1635,6 +1733,9 @@ def _state(model: Model, p: Mapping[str, Any], q: list[Any], qdot: list[Any] | N
             joints[name] = (_wrap(x), v, a)
     for name, index in model.sliders.items():
         joints[name] = jets[index].derivatives()
+    for name, (parent, motor) in model.derived.items():
+        (x, v, a), (y, w, b) = joints[parent], joints[motor]
+        joints[name] = (_wrap(x + y), v + w, a + b)
     return point_states, joints
 
 

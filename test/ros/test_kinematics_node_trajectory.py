@@ -10,12 +10,16 @@ point stamped at the header's stamp plus the point's ``time_from_start``, its
 accelerations and the motors' efforts of that motion (the feed-forward torques)
 in ``joint_states.effort``: checked against ``mk.solve`` and
 ``mk.solve_targets`` at the same motion. A point without accelerations is
-refused on diagnostics while the points after it are answered.
+refused on diagnostics while the points after it are answered. The packaged
+gripper's fingertip IMU publishes each point's reading.
 """
 
 from diagnostic_msgs.msg import DiagnosticStatus
 import numpy as np
+import pytest
+from rclpy.qos import QoSProfile, ReliabilityPolicy
 from ros_helpers import SESSION, stamp_ns, wait_for
+from sensor_msgs.msg import Imu
 from test_kinematics_node_topic import ANSWER_S, T0, TopicNode
 from trajectory_msgs.msg import JointTrajectory
 
@@ -106,3 +110,35 @@ def test_points_of_the_effector_and_a_point_refused(ros, tmp_path):
         np.testing.assert_allclose(forward.points['P'].acceleration, a, atol=1e-9)
         efforts = [forward.forces.efforts.get(n, 0.0) for n in joints]
         np.testing.assert_allclose(js.effort, efforts, rtol=1e-9, atol=1e-9)
+
+
+def test_each_point_gives_the_imus_readings(ros, tmp_path):
+    """The gripper's fingertip IMU: each point's reading is solve's at that motion, stamped so."""
+    gripper = mk.load_scene('gripper')
+    crank = gripper.drivers[0].name
+    [sensor] = [spec.name for spec in gripper.imus]
+    ns_name = 'trajectory_imu'
+    imus = ros.collect(Imu, f'{SESSION}/{ns_name}/imu/{sensor}',
+                       QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE))
+    node = TopicNode(ros, tmp_path, ns_name, scene='gripper', drive='trajectory',
+                     input_topic=f'{SESSION}/{ns_name}/input_trajectory',
+                     input_type=JointTrajectory, greeting=([crank], [gripper.drivers[0].start]))
+    start = gripper.drivers[0].start
+    points = [(5 * MS * i, [start + 0.02 * i], [1.5 - 0.1 * i], [4.0 * (-1) ** i])
+              for i in range(1, 7)]
+    stamps = [T0 + at for at, *_ in points]
+    try:
+        node.send_points(T0, [crank], points)
+        wait_for(lambda: len([m for m in imus if stamp_ns(m) in stamps]) >= len(points),
+                 ANSWER_S, f'imu/{sensor}')
+        assert node.proc.proc.poll() is None
+    finally:
+        node.stop()
+    got = {stamp_ns(m): m for m in imus if stamp_ns(m) in stamps}
+    for (at, q, qd, qdd) in points:
+        reading = mk.solve(gripper, q[0], qd[0], qdd[0]).as_dict()['imus'][sensor]
+        msg = got[T0 + at]
+        assert msg.angular_velocity.z == pytest.approx(reading['angular_velocity'], rel=1e-12)
+        a = msg.linear_acceleration
+        np.testing.assert_allclose([a.x, a.y], reading['linear_acceleration'], rtol=0,
+                                   atol=1e-12 * np.hypot(*reading['linear_acceleration']))

@@ -36,7 +36,7 @@ from mech_kinematics.solver.registry import KINDS
 solve_module = importlib.import_module('mech_kinematics.solver.solve')
 
 #: The drivers (``inputs:`` entries: the registry's DRIVERS, by the key each has).
-DRIVERS = ('crank', 'actuator', 'slider')
+DRIVERS = ('crank', 'actuator', 'slider', 'motor')
 #: Variants of registered kinds that run kernels of their own.
 VARIANTS = ('carried point', 'Geneva RPR', 'actuated RRR')
 
@@ -69,6 +69,8 @@ GENERATORS = {
                 'guide': {'through': 'A', 'angle': 0}, 'slot_angle': 90, 'slider': 'yoke',
                 'slot_slider': 'pin_in_slot'}]),
     'triad': triad_scene,
+    # A motor on the crank (its relative angle the input): the hinge's scene.
+    'motor': lambda: GENERATORS['hinge'](),
     # A slider-crank driven from its piston: the crank pin is an RRR from O and the pin.
     'slider': lambda: scene_mapping(
         'slider', {'O': [0, 0]},
@@ -77,6 +79,16 @@ GENERATORS = {
         dyads=[{'type': 'RRR', 'point': 'B', 'links': [
             {'name': 'crank', 'from': 'O', 'length': 150},
             {'name': 'rod', 'from': 'P', 'length': 600}], 'branch': -1}]),
+    # A five-bar whose second motor sits on the crank (an elbow): a hinge, then an RRR.
+    'hinge': lambda: scene_mapping(
+        'hinge', {'A': [0, 0], 'D': [150, 0]},
+        inputs=[crank_entry(50, 30, 20, 1.0),
+                {'motor': 'elbow', 'angle': 45, 'speed': -2.0, 'accel': 1.0}],
+        dyads=[{'type': 'hinge', 'link': 'fore', 'parent': 'crank', 'center': 'B',
+                'point': 'C', 'length': 60, 'motor': 'elbow'},
+               {'type': 'RRR', 'point': 'E', 'links': [
+                   {'name': 'left', 'from': 'C', 'length': 150},
+                   {'name': 'right', 'from': 'D', 'length': 150}], 'branch': 1}]),
     # A collar driven along a crank by an actuator, a link from it to a block on a guide.
     'collar': lambda: scene_mapping(
         'collar', {'O': [0, 0], 'G': [0, -300]},
@@ -133,6 +145,14 @@ NOT_COMPILED = {
                           "paths alone (the node's tick compiles any drivers)",
     ('slider', 'array'): "its driver piston is not a crank: mk.solve compiles one crank's "
                          "paths alone (the node's tick compiles any drivers)",
+    ('hinge', 'single'): "2 drivers (crank, elbow): mk.solve compiles one crank's paths "
+                         "alone (the node's tick compiles any drivers)",
+    ('hinge', 'array'): "2 drivers (crank, elbow): mk.solve compiles one crank's paths "
+                        "alone (the node's tick compiles any drivers)",
+    ('motor', 'single'): "2 drivers (crank, elbow): mk.solve compiles one crank's paths "
+                         "alone (the node's tick compiles any drivers)",
+    ('motor', 'array'): "2 drivers (crank, elbow): mk.solve compiles one crank's paths "
+                        "alone (the node's tick compiles any drivers)",
     ('collar', 'single'): "2 drivers (crank, x): mk.solve compiles one crank's paths "
                           "alone (the node's tick compiles any drivers)",
     ('collar', 'array'): "2 drivers (crank, x): mk.solve compiles one crank's paths "

@@ -102,6 +102,8 @@ GEOMETRIES = {
                 'F': {'link': 'coupler', 'origin': 'B', 'xaxis': 'C', 'local': [40, -30]},
                 'G': {'link': 'rocker', 'origin': 'D', 'xaxis': 'C', 'local': [30, 25]}}),
     'triad': triad_scene,
+    # A motor on the crank (its relative angle the input): the hinge's scene.
+    'motor': lambda: GEOMETRIES['hinge'](),
     # A slider-crank driven from its piston: the crank pin is an RRR from O and the pin.
     'slider': lambda: scene_mapping(
         'slider', {'O': [0, 0]},
@@ -110,6 +112,16 @@ GEOMETRIES = {
         dyads=[{'type': 'RRR', 'point': 'B', 'links': [
             {'name': 'crank', 'from': 'O', 'length': 150},
             {'name': 'rod', 'from': 'P', 'length': 600}], 'branch': -1}]),
+    # A five-bar whose second motor sits on the crank (an elbow): a hinge, then an RRR.
+    'hinge': lambda: scene_mapping(
+        'hinge', {'A': [0, 0], 'D': [150, 0]},
+        inputs=[crank_entry(50, 30, 20, 1.0),
+                {'motor': 'elbow', 'angle': 45, 'speed': -2.0, 'accel': 1.0}],
+        dyads=[{'type': 'hinge', 'link': 'fore', 'parent': 'crank', 'center': 'B',
+                'point': 'C', 'length': 60, 'motor': 'elbow'},
+               {'type': 'RRR', 'point': 'E', 'links': [
+                   {'name': 'left', 'from': 'C', 'length': 150},
+                   {'name': 'right', 'from': 'D', 'length': 150}], 'branch': 1}]),
     # A collar driven along a crank by an actuator, a link from it to a block on a guide.
     'collar': lambda: scene_mapping(
         'collar', {'O': [0, 0], 'G': [0, -300]},
@@ -150,11 +162,13 @@ RANGES = {
     'actuated RRR': [('deg', -360.0, 360.0), ('mm', 230.0, 340.0)],
     'slider': [('mm', -740.0, -460.0)],
     'collar': [('deg', -360.0, 360.0), ('mm', 100.0, 300.0)],
+    'hinge': [('deg', -360.0, 360.0), ('deg', -360.0, 360.0)],
+    'motor': [('deg', -360.0, 360.0), ('deg', -360.0, 360.0)],
 }
 
 #: The drivers (the registry's DRIVERS, by the key each has) and the variants with kernels
 #: of their own.
-DRIVERS = ('crank', 'actuator', 'slider')
+DRIVERS = ('crank', 'actuator', 'slider', 'motor')
 VARIANTS = ('carried point', 'Geneva RPR', 'actuated RRR')
 #: Bodies that turn freely about their frame's origin while a Geneva wheel is locked:
 #: they may carry a mass at that origin only (the statics would not determine more).

@@ -277,7 +277,7 @@ def test_the_reference_has_equations_for_every_kind_of_the_registries():
     assert not missing, (f'kinds the reference has no equations for: {", ".join(missing)} '
                          '(add a model to MODELS or DRIVER_MODELS in '
                          'mech_kinematics/verify/reference.py)')
-    assert _lacking([*KINDS, 'RRQ'], [*DRIVERS, 'motor']) == ['RRQ', 'motor']
+    assert _lacking([*KINDS, 'RRQ'], [*DRIVERS, 'servo']) == ['RRQ', 'servo']
 
 
 def test_a_kind_without_equations_is_refused_naming_it():
@@ -288,13 +288,13 @@ def test_a_kind_without_equations_is_refused_naming_it():
         kind = 'RPX'
 
     class Motor(mk.Crank):
-        scene_key = 'motor'
+        scene_key = 'servo'
 
     yoke = mk.Scene('yoke', scene.ground, scene.input, (Yoke(**vars(scene.dyads[0])),))
     with pytest.raises(ref.NoReferenceModel, match=r"Expected a kind of scene item .*got 'RPX'"):
         ref.Model(yoke)
     motor = mk.Scene('motor', scene.ground, Motor(**vars(scene.input)), scene.dyads)
-    with pytest.raises(ref.NoReferenceModel, match=r"Expected a kind of driver .*got 'motor'"):
+    with pytest.raises(ref.NoReferenceModel, match=r"Expected a kind of driver .*got 'servo'"):
         ref.Model(motor)
 
 
@@ -412,8 +412,8 @@ def test_measures_match_the_solver():
 
 #: What the reference may import from the solver: the scene, its items' and drivers'
 #: dataclasses (whose kinds key its models) and the graph's types (no step, no solve).
-SOLVER_NAMES = {'..solver': {'Actuator', 'CarriedPoint', 'Collar', 'Crank', 'RPP', 'RPR', 'RRP',
-                             'RRR', 'Scene', 'Slider', 'Triad'},
+SOLVER_NAMES = {'..solver': {'Actuator', 'CarriedPoint', 'Collar', 'Crank', 'Hinge', 'Motor',
+                             'RPP', 'RPR', 'RRP', 'RRR', 'Scene', 'Slider', 'Triad'},
                 '..solver.graph': {'Fragment', 'JointType', 'joint_type'}}
 
 
@@ -431,7 +431,7 @@ def test_reference_does_not_use_the_solver():
     for module, names in imported.items():
         assert names <= SOLVER_NAMES.get(module, set()), (module, names)
     for name in ('solve', '_RRRStep', '_RRPStep', '_RPRStep', '_RPPStep', '_CarryStep', '_run',
-                 '_TriadStep', '_SlideStep', '_CollarStep'):
+                 '_TriadStep', '_SlideStep', '_CollarStep', '_HingeStep', '_MotorStep'):
         assert not hasattr(ref, name)
     assert '._solver' not in Path(ref.__file__).read_text()  # (a triad's branch: its own)
 
