@@ -821,6 +821,42 @@ def scene_mapping(name, ground, dyads=(), points=None, **drivers):
     return data
 
 
+def slider_scene():
+    """Return a slider-crank driven from its piston: its crank pin an RRR from O and the pin."""
+    return scene_mapping(
+        'slider', {'O': [0, 0]},
+        inputs=[{'slider': 'piston', 'point': 'P', 'guide': {'through': 'O', 'angle': 0},
+                 'position': -696.6166, 'speed': 1.5, 'accel': -4.0}],
+        dyads=[{'type': 'RRR', 'point': 'B', 'links': [
+            {'name': 'crank', 'from': 'O', 'length': 150},
+            {'name': 'rod', 'from': 'P', 'length': 600}], 'branch': -1}])
+
+
+def hinge_scene():
+    """Return a five-bar whose second motor sits on the crank (an elbow): a hinge, an RRR."""
+    return scene_mapping(
+        'hinge', {'A': [0, 0], 'D': [150, 0]},
+        inputs=[crank_entry(50, 30, 20, 1.0),
+                {'motor': 'elbow', 'angle': 45, 'speed': -2.0, 'accel': 1.0}],
+        dyads=[{'type': 'hinge', 'link': 'fore', 'parent': 'crank', 'center': 'B',
+                'point': 'C', 'length': 60, 'motor': 'elbow'},
+               {'type': 'RRR', 'point': 'E', 'links': [
+                   {'name': 'left', 'from': 'C', 'length': 150},
+                   {'name': 'right', 'from': 'D', 'length': 150}], 'branch': 1}])
+
+
+def collar_scene():
+    """Return a collar driven along a crank by an actuator, a link from it to a guided block."""
+    return scene_mapping(
+        'collar', {'O': [0, 0], 'G': [0, -300]},
+        inputs=[crank_entry(500, 60, 30, 2.0, 'O', 'T'),
+                {'actuator': 'x', 'length': 200, 'speed': 2, 'accel': 3, 'stroke': [100, 300]}],
+        dyads=[{'type': 'collar', 'point': 'C', 'link': 'crank', 'from': 'O', 'toward': 'T',
+                'actuator': 'x'},
+               {'type': 'RRP', 'point': 'P', 'link': {'name': 'arm', 'from': 'C', 'length': 700},
+                'guide': {'through': 'G', 'angle': 0}, 'slider': 'block', 'branch': 1}])
+
+
 def triad_scene():
     """Return a scene with one triad (class III): a crank, a ternary coupler, three arms."""
     return scene_mapping(

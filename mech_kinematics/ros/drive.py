@@ -101,7 +101,7 @@ def drive_start(driver: Driver, values: Mapping[str, float], own: bool = True) -
     rate = driven_rate(driver, values[driver.rate_parameter.key], own)
     accel = float(values['accel'])
     # One of the time base's rates (a crank's speed_rpm or speed) given, the other None.
-    start: dict[str, Any] = {driver.position_key: driver.start, **dict.fromkeys(kind.RATES),
+    start: dict[str, Any] = {kind.POSITION: driver.start, **dict.fromkeys(kind.RATES),
                              rate.key: rate.value, 'accel': accel}
     if MAX_SPEED_KEY in kind.CHANGES:
         start[MAX_SPEED_KEY] = values[MAX_SPEED_KEY]

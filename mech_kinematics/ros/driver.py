@@ -60,6 +60,9 @@ class Timebase(Protocol):
     CHANGES: tuple[str, ...]
     #: The keywords that each give its speed (in their own units): one given replaces another.
     RATES: tuple[str, ...]
+    #: The keyword of its position at the start (``angle``, ``length``): the time base's own,
+    #: whatever its driver's scene key.
+    POSITION: str
 
     def update(self, t: int, **changes: Any) -> None:
         """From instant ``t`` (ns) on, drive with ``changes``, keeping the position there."""

@@ -274,17 +274,20 @@ class DriverRates:
 
 
 #: A driver's parameters by the unit its kind sets its rate in (``Driver.rate_parameter``):
-#: a crank's in rpm (the ranges of crank_speed_rpm and crank_accel), an actuator's in m/s.
+#: a crank's or a motor's in rpm (the ranges of crank_speed_rpm and crank_accel), an
+#: actuator's or a slider's in m/s.
 DRIVER_RATES = {
     'rpm': DriverRates(
         _range('crank_speed_rpm'), _range('crank_accel'),
-        'Speed of crank {name}, + CCW, from the tick at which it is applied. Defaults to the '
-        "scene's", "Angular acceleration of crank {name}, + CCW. Defaults to the scene's"),
+        'Speed of driver {name} (a crank, or a motor: relative), + CCW, from the tick at which '
+        "it is applied. Defaults to the scene's",
+        "Angular acceleration of driver {name}, + CCW. Defaults to the scene's"),
     'm/s': DriverRates(
         (-100.0, 100.0), (-10_000.0, 10_000.0),
-        'Extension rate of actuator {name}, from the tick at which it is applied (its length '
-        "stays continuous). Defaults to the scene's",
-        "Extension acceleration of actuator {name}. Defaults to the scene's"),
+        "Rate of driver {name} (an actuator's extension, a slider's along its guide), from "
+        'the tick at which it is applied (its position stays continuous). Defaults to the '
+        "scene's",
+        "Acceleration of driver {name}'s position. Defaults to the scene's"),
 }
 
 

@@ -226,6 +226,8 @@ class CrankTimebase:
     #: and one given replaces the other (the keys of a crank's :class:`~mech_kinematics.
     #: solver.base.Rate`).
     RATES = ('speed_rpm', 'speed')
+    #: The keyword of the position at ``t0`` (rad).
+    POSITION = 'angle'
 
     def __init__(self, t0: int, angle: float, speed_rpm: float | None, accel: float,
                  max_speed_rpm: float, *, speed: float | None = None, turns: int = 0) -> None:
@@ -428,6 +430,8 @@ class ActuatorTimebase:
     CHANGES = ('speed', 'accel')
     #: The keyword that gives the extension rate (m/s).
     RATES = ('speed',)
+    #: The keyword of the position at ``t0`` (m: an actuator's length, a slider's position).
+    POSITION = 'length'
 
     def __init__(self, t0: int, length: float, speed: float, accel: float) -> None:
         _check_finite(length=length, speed=speed, accel=accel)

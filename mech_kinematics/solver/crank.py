@@ -110,18 +110,7 @@ class Crank(Driver):
         """
         read.check_keys(raw if isinstance(raw, dict) else {}, set(CrankDict.__annotations__),
                         where)
-        given = [key for key in ('speed', 'speed_rpm') if isinstance(raw, dict) and key in raw]
-        if len(given) == 2:
-            msg = (f'{where}.speed: expected the crank speed once, as speed (rad/s) or '
-                   f'speed_rpm (rpm), got both (speed: {read.brief(raw["speed"])}, speed_rpm: '
-                   f'{read.brief(raw["speed_rpm"])})')
-            raise SceneError(msg)
-        rpm = None
-        if given == ['speed']:
-            speed, key = read.number(raw, 'speed', where), 'speed'
-        else:
-            rpm = read.number(raw, 'speed_rpm', where, 0.0)
-            speed, key = rad_per_s_from_rpm(rpm), 'speed_rpm'
+        speed, rpm, key = read_turning_speed(read, raw, where, 'crank')
         angle, turns = read.start_angle(raw, 'angle', where)
         built: Crank = read.build(
             where, {'speed': key, 'rpm': key}, cls,
@@ -226,6 +215,25 @@ class Crank(Driver):
             msg = f'Expected the crank center to be a ground point, got "{self.center}"'
             raise SceneError(msg, (self, 'center'))
         return _CrankStep(self, ground[self.center])
+
+
+def read_turning_speed(read: Reading, raw: Any, where: str,
+                       what: str) -> tuple[float, float | None, str]:
+    """Return a turning driver's speed as written: (rad/s, rpm or ``None``, its key).
+
+    ``speed`` (rad/s) to the bit, or ``speed_rpm`` converted (``rpm * pi / 30``;
+    default 0 rpm); at most one of the two. ``what`` names the driver in the refusal.
+    """
+    given = [key for key in ('speed', 'speed_rpm') if isinstance(raw, dict) and key in raw]
+    if len(given) == 2:
+        msg = (f'{where}.speed: expected the {what} speed once, as speed (rad/s) or '
+               f'speed_rpm (rpm), got both (speed: {read.brief(raw["speed"])}, speed_rpm: '
+               f'{read.brief(raw["speed_rpm"])})')
+        raise SceneError(msg)
+    if given == ['speed']:
+        return read.number(raw, 'speed', where), None, 'speed'
+    rpm = read.number(raw, 'speed_rpm', where, 0.0)
+    return rad_per_s_from_rpm(rpm), rpm, 'speed_rpm'
 
 
 class _CrankStep:

@@ -31,13 +31,15 @@ import numpy as np
 
 from .base import Driver, Item, Names, Placing, Rate, RateParameter, Reading, Step
 from .context import _Context, _U2, _U4
+from .crank import read_turning_speed
 from .graph import Body, Fragment, Frame, JointType, Motion, pin, REVOLUTE, Role
 from .model import _check_finite, _check_length, _check_name, _names, SceneUnits, Where
 from ..bounds import U
 from ..errors import SceneError
+from ..units import rad_per_s_from_rpm
 
 #: The scene keys of a motor in ``inputs:`` and of a hinge in ``dyads:``.
-MOTOR_KEYS = {'motor', 'angle', 'speed', 'accel'}
+MOTOR_KEYS = {'motor', 'angle', 'speed', 'speed_rpm', 'accel'}
 HINGE_KEYS = {'type', 'link', 'parent', 'center', 'point', 'length', 'motor'}
 
 
@@ -55,6 +57,9 @@ class Motor(Driver):
         Default relative angular velocity, rad/s, + CCW.
     accel : float
         Default relative angular acceleration, rad/s^2, + CCW.
+    rpm : float or None
+        The speed as the scene gave it in rpm (``speed_rpm``), as a crank's; ``None``
+        where it was given in rad/s (``speed``).
     """
 
     position_key = 'angle'
@@ -64,6 +69,7 @@ class Motor(Driver):
     angle: float = 0.0
     speed: float = 0.0
     accel: float = 0.0
+    rpm: float | None = None
 
     def __post_init__(self) -> None:
         """Validate the fields."""
@@ -71,19 +77,23 @@ class Motor(Driver):
         _check_finite(self.angle, f'the angle of motor "{self.motor}"', (self, 'angle'))
         _check_finite(self.speed, f'the speed of motor "{self.motor}"', (self, 'speed'))
         _check_finite(self.accel, f'the acceleration of motor "{self.motor}"', (self, 'accel'))
+        if self.rpm is not None and self.speed != rad_per_s_from_rpm(self.rpm):
+            msg = (f'Expected the speed of motor "{self.motor}" to be its rpm ({self.rpm!r}) in '
+                   f'rad/s, {rad_per_s_from_rpm(self.rpm)!r}, got {self.speed!r}')
+            raise SceneError(msg, (self, 'speed'))
 
     @classmethod
     def from_scene(cls, read: Reading, raw: Any, where: str) -> Motor:
         """Return the motor at ``where`` (an entry of ``inputs:``): ``angle`` in the scene's unit.
 
-        ``speed`` (rad/s) and ``accel`` (rad/s^2) are always SI.
+        Its speed is a crank's: ``speed`` (rad/s) or ``speed_rpm``; ``accel`` is in rad/s^2.
         """
         read.check_keys(raw, MOTOR_KEYS, where)
-        number = read.number
+        speed, rpm, key = read_turning_speed(read, raw, where, 'motor')
         built: Motor = read.build(
-            where, {}, cls, motor=read.name(raw, 'motor', where),
-            angle=read.angle(raw, 'angle', where, 0.0), speed=number(raw, 'speed', where, 0.0),
-            accel=number(raw, 'accel', where, 0.0))
+            where, {'speed': key, 'rpm': key}, cls, motor=read.name(raw, 'motor', where),
+            angle=read.angle(raw, 'angle', where, 0.0), speed=speed, rpm=rpm,
+            accel=read.number(raw, 'accel', where, 0.0))
         return built
 
     @property
@@ -118,13 +128,15 @@ class Motor(Driver):
 
     @property
     def rate(self) -> Rate:
-        """Its speed as the scene gives it: ``speed``, rad/s."""
+        """Its speed as the scene gave it: ``speed_rpm`` in rpm, or ``speed`` in rad/s."""
+        if self.rpm is not None:
+            return Rate('speed_rpm', self.rpm, 'rpm')
         return Rate('speed', self.speed, 'rad/s')
 
     @property
     def rate_parameter(self) -> RateParameter:
-        """Its speed is set in rad/s, as ``speed``."""
-        return RateParameter('speed', 'rad/s')
+        """Its speed is set in rpm, as ``speed_rpm`` (a crank's)."""
+        return RateParameter('speed_rpm', 'rpm')
 
     @property
     def reach(self) -> float:

@@ -286,7 +286,8 @@ class Scene:
             msg = 'Expected a scene to have input (one crank) or inputs (a list of drivers)'
             raise SceneError(msg, (self, 'input'))
         if first is not None:
-            crank = cast(Crank, first) if first.joint_type.angular else None  # it turns
+            # The v1 ``input`` is a crank (a motor turns too, but it is no crank).
+            crank = first if isinstance(first, Crank) else None
             object.__setattr__(self, 'input', crank)
         object.__setattr__(self, 'dyads', tuple(self.dyads))
         object.__setattr__(self, 'points', tuple(self.points))

@@ -448,6 +448,10 @@ class Model:
         known.update(model.new_points(item))
         return _Element(model, item, index if unknowns else -1)
 
+    def placed(self, link: str) -> bool:
+        """Return whether ``link``'s angle is known: a crank's, an unknown's or a hinge's."""
+        return link in self.links or link in self.derived
+
     def crank_key(self, name: str) -> str:
         """Return the key of crank ``name``'s length in :attr:`values`."""
         return 'crank.length' if self.single else f'crank.{name}.length'
@@ -1277,7 +1281,31 @@ class _Triad(_Equations):
         return True
 
 
-class _Carry(_Equations):
+class _Explicit(_Equations):
+    """A kind placed explicitly from known points (no unknowns): never singular, one branch."""
+
+    @staticmethod
+    def unknowns(item: Any) -> tuple[str, ...]:
+        """Return none: it is an explicit function of known points (and drivers)."""
+        return ()
+
+    @staticmethod
+    def measure(model: Model, item: Any, i: int, p: Mapping[str, Any],
+                points: Mapping[str, Any], q: list[Any], measures: dict[str, Any]) -> None:
+        """Put none: it has no singular position."""
+
+    @staticmethod
+    def prepare(model: Model, item: Any, theta: Any, pts: dict[str, Any]) -> None:
+        """Put nothing: its construction reads only its own starts."""
+
+    @staticmethod
+    def branch_ok(item: Any, i: int, p: Mapping[str, Any], points: Mapping[str, Any],
+                  q: list[Any]) -> bool:
+        """Return True: it has one position."""
+        return True
+
+
+class _Carry(_Explicit):
     """A point carried by a link: an explicit function of its frame's two points."""
 
     @staticmethod
@@ -1290,12 +1318,7 @@ class _Carry(_Equations):
     @staticmethod
     def ready(model: Model, item: Any, known: set[str]) -> bool:
         """Return whether its frame's points are known and its link is placed."""
-        return item.origin in known and item.xaxis in known and item.link in model.links
-
-    @staticmethod
-    def unknowns(item: Any) -> tuple[str, ...]:
-        """Return none: it is an explicit function of known points."""
-        return ()
+        return item.origin in known and item.xaxis in known and model.placed(item.link)
 
     @staticmethod
     def new_points(item: Any) -> tuple[str, ...]:
@@ -1320,23 +1343,8 @@ class _Carry(_Equations):
         local = mpmath.mpc(p[f'point.{item.name}.local.x'], p[f'point.{item.name}.local.y'])
         pts[item.name] = origin + local * axis / abs(axis)
 
-    @staticmethod
-    def measure(model: Model, item: Any, i: int, p: Mapping[str, Any],
-                points: Mapping[str, Any], q: list[Any], measures: dict[str, Any]) -> None:
-        """Put none: a carried point is never singular (its frame's points are apart)."""
 
-    @staticmethod
-    def prepare(model: Model, item: Any, theta: Any, pts: dict[str, Any]) -> None:
-        """Put nothing: its construction reads only its own starts."""
-
-    @staticmethod
-    def branch_ok(item: Any, i: int, p: Mapping[str, Any], points: Mapping[str, Any],
-                  q: list[Any]) -> bool:
-        """Return True: it has one position."""
-        return True
-
-
-class _Collar(_Equations):
+class _Collar(_Explicit):
     """A collar on a link: its pin at its actuator's distance along the link's axis."""
 
     @staticmethod
@@ -1347,12 +1355,7 @@ class _Collar(_Equations):
     @staticmethod
     def ready(model: Model, item: Any, known: set[str]) -> bool:
         """Return whether its two points are known and its link is placed."""
-        return item.start in known and item.toward in known and item.link in model.links
-
-    @staticmethod
-    def unknowns(item: Any) -> tuple[str, ...]:
-        """Return none: it is an explicit function of known points and its actuator."""
-        return ()
+        return item.start in known and item.toward in known and model.placed(item.link)
 
     @staticmethod
     def new_points(item: Any) -> tuple[str, ...]:
@@ -1375,23 +1378,8 @@ class _Collar(_Equations):
         axis = pts[item.toward] - origin
         pts[item.point] = origin + p[f'actuator.{item.actuator}'] * axis / abs(axis)
 
-    @staticmethod
-    def measure(model: Model, item: Any, i: int, p: Mapping[str, Any],
-                points: Mapping[str, Any], q: list[Any], measures: dict[str, Any]) -> None:
-        """Put none: a collar is never singular (its line's points are apart)."""
 
-    @staticmethod
-    def prepare(model: Model, item: Any, theta: Any, pts: dict[str, Any]) -> None:
-        """Put nothing: its construction reads only its own starts."""
-
-    @staticmethod
-    def branch_ok(item: Any, i: int, p: Mapping[str, Any], points: Mapping[str, Any],
-                  q: list[Any]) -> bool:
-        """Return True: it has one position."""
-        return True
-
-
-class _Hinge(_Equations):
+class _Hinge(_Explicit):
     """A link pinned to a moving one, turned by a motor: its angle the parent's plus its own."""
 
     @staticmethod
@@ -1402,16 +1390,10 @@ class _Hinge(_Equations):
     @staticmethod
     def ready(model: Model, item: Any, known: set[str]) -> bool:
         """Return whether its pin is known and its parent placed (then its link is, derived)."""
-        if item.center in known and (item.parent in model.links
-                                     or item.parent in model.derived):
+        if item.center in known and model.placed(item.parent):
             model.derived[item.link] = (item.parent, item.motor)
             return True
         return False
-
-    @staticmethod
-    def unknowns(item: Any) -> tuple[str, ...]:
-        """Return none: its tip is an explicit function of its pin, parent and motor."""
-        return ()
 
     @staticmethod
     def new_points(item: Any) -> tuple[str, ...]:
@@ -1435,21 +1417,6 @@ class _Hinge(_Equations):
         axis = pts[xaxis] - pts[origin]
         turned = axis / abs(axis) * mpmath.expj(p[f'motor.{item.motor}'])
         pts[item.point] = pts[item.center] + p[f'hinge.{item.link}.length'] * turned
-
-    @staticmethod
-    def measure(model: Model, item: Any, i: int, p: Mapping[str, Any],
-                points: Mapping[str, Any], q: list[Any], measures: dict[str, Any]) -> None:
-        """Put none: a hinge is never singular."""
-
-    @staticmethod
-    def prepare(model: Model, item: Any, theta: Any, pts: dict[str, Any]) -> None:
-        """Put nothing: its construction reads only its own starts."""
-
-    @staticmethod
-    def branch_ok(item: Any, i: int, p: Mapping[str, Any], points: Mapping[str, Any],
-                  q: list[Any]) -> bool:
-        """Return True: it has one position."""
-        return True
 
 
 #: The equations of every kind of scene item, by :func:`model_key`: each kind of the

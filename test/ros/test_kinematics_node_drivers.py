@@ -206,3 +206,37 @@ def test_markers_of_a_scene_of_several_drivers(ros, tmp_path, scene):
         node.stop()
     assert all(m.markers for m in markers)
     assert 'Traceback' not in node.proc.output()
+
+
+@pytest.mark.parametrize(('scene', 'driver', 'key', 'rate', 'si'), [
+    ('five_bar_elbow', 'elbow', 'speed_rpm', 2.0, rad_per_s_from_rpm(2.0)),
+    ('double_slider', 'block_a', 'speed', -0.5, -0.5)])
+def test_a_motor_and_a_slider_are_driven_in_time_by_their_parameters(ros, tmp_path, scene, driver,
+                                                                     key, rate, si):
+    """A motor's relative angle (rpm, as a crank's) and a slider's position move in time.
+
+    Each published state is the solver's at the published drivers, and the driver moves at
+    the rate its parameter sets (issue 41's drivers on the node).
+    """
+    loaded = mk.load_scene(scene)
+    node = Node(ros, tmp_path, f'drivers_{scene}', '-p', f'scene:={scene}', '-p',
+                'rate_hz:=200.0', '-p', f'inputs.{driver}.{key}:={rate}')
+    try:
+        assert node.get(f'inputs.{driver}.{key}') == [rate]
+        wait_for(lambda: len(node.js) > 40, STARTUP_S, f'joint_states of {scene}')
+    finally:
+        node.stop()
+    names = [d.name for d in loaded.drivers]
+    for msg in node.js:
+        at = [_index(msg, n) for n in names]
+        assert msg.velocity[at[names.index(driver)]] == si
+        positions = [msg.position[i] for i in at]
+        speeds = [msg.velocity[i] for i in at]
+        state = mk.solve(loaded, positions[0] if len(at) == 1 else positions,
+                         speeds[0] if len(at) == 1 else speeds,
+                         0.0 if len(at) == 1 else [0.0] * len(at))
+        np.testing.assert_allclose(msg.position, [state.joints[n].position for n in msg.name],
+                                   rtol=0, atol=ATOL_STATE)
+    first, last = node.js[0], node.js[-1]
+    moved = last.position[_index(last, driver)] - first.position[_index(first, driver)]
+    assert moved == pytest.approx(si * (stamp_ns(last) - stamp_ns(first)) / NS, abs=1e-9)

@@ -19,9 +19,9 @@ generator here fails, named.
 import importlib
 import math
 
-from helpers import (array_outcome, crank_entry, equilateral_chain, general_only,
-                     general_tick_outcome, scene_mapping, solve_outcome, tick_outcome,
-                     triad_scene)
+from helpers import (array_outcome, collar_scene, crank_entry, equilateral_chain,
+                     general_only, general_tick_outcome, hinge_scene, scene_mapping,
+                     slider_scene, solve_outcome, tick_outcome, triad_scene)
 import numpy as np
 import pytest
 
@@ -69,35 +69,10 @@ GENERATORS = {
                 'guide': {'through': 'A', 'angle': 0}, 'slot_angle': 90, 'slider': 'yoke',
                 'slot_slider': 'pin_in_slot'}]),
     'triad': triad_scene,
-    # A motor on the crank (its relative angle the input): the hinge's scene.
-    'motor': lambda: GENERATORS['hinge'](),
-    # A slider-crank driven from its piston: the crank pin is an RRR from O and the pin.
-    'slider': lambda: scene_mapping(
-        'slider', {'O': [0, 0]},
-        inputs=[{'slider': 'piston', 'point': 'P', 'guide': {'through': 'O', 'angle': 0},
-                 'position': -696.6166, 'speed': 1.5, 'accel': -4.0}],
-        dyads=[{'type': 'RRR', 'point': 'B', 'links': [
-            {'name': 'crank', 'from': 'O', 'length': 150},
-            {'name': 'rod', 'from': 'P', 'length': 600}], 'branch': -1}]),
-    # A five-bar whose second motor sits on the crank (an elbow): a hinge, then an RRR.
-    'hinge': lambda: scene_mapping(
-        'hinge', {'A': [0, 0], 'D': [150, 0]},
-        inputs=[crank_entry(50, 30, 20, 1.0),
-                {'motor': 'elbow', 'angle': 45, 'speed': -2.0, 'accel': 1.0}],
-        dyads=[{'type': 'hinge', 'link': 'fore', 'parent': 'crank', 'center': 'B',
-                'point': 'C', 'length': 60, 'motor': 'elbow'},
-               {'type': 'RRR', 'point': 'E', 'links': [
-                   {'name': 'left', 'from': 'C', 'length': 150},
-                   {'name': 'right', 'from': 'D', 'length': 150}], 'branch': 1}]),
-    # A collar driven along a crank by an actuator, a link from it to a block on a guide.
-    'collar': lambda: scene_mapping(
-        'collar', {'O': [0, 0], 'G': [0, -300]},
-        inputs=[crank_entry(500, 60, 30, 2.0, 'O', 'T'),
-                {'actuator': 'x', 'length': 200, 'speed': 2, 'accel': 3, 'stroke': [100, 300]}],
-        dyads=[{'type': 'collar', 'point': 'C', 'link': 'crank', 'from': 'O', 'toward': 'T',
-                'actuator': 'x'},
-               {'type': 'RRP', 'point': 'P', 'link': {'name': 'arm', 'from': 'C', 'length': 700},
-                'guide': {'through': 'G', 'angle': 0}, 'slider': 'block', 'branch': 1}]),
+    'motor': hinge_scene,
+    'slider': slider_scene,
+    'hinge': hinge_scene,
+    'collar': collar_scene,
     'actuator': lambda: scene_mapping(
         'actuator', {'O': [0, 0], 'F': [400, -1100]},
         inputs=[{'actuator': 'cyl', 'length': 2600, 'speed': 100, 'stroke': [2000, 3300]}],

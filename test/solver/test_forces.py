@@ -33,7 +33,8 @@ import functools
 import math
 import warnings
 
-from helpers import crank_entry, MM_DEG, scene_mapping, triad_scene
+from helpers import (collar_scene, crank_entry, hinge_scene, MM_DEG, scene_mapping,
+                     slider_scene, triad_scene)
 from hypothesis import assume, given, HealthCheck, settings
 from hypothesis import strategies as st
 import mpmath
@@ -102,35 +103,10 @@ GEOMETRIES = {
                 'F': {'link': 'coupler', 'origin': 'B', 'xaxis': 'C', 'local': [40, -30]},
                 'G': {'link': 'rocker', 'origin': 'D', 'xaxis': 'C', 'local': [30, 25]}}),
     'triad': triad_scene,
-    # A motor on the crank (its relative angle the input): the hinge's scene.
-    'motor': lambda: GEOMETRIES['hinge'](),
-    # A slider-crank driven from its piston: the crank pin is an RRR from O and the pin.
-    'slider': lambda: scene_mapping(
-        'slider', {'O': [0, 0]},
-        inputs=[{'slider': 'piston', 'point': 'P', 'guide': {'through': 'O', 'angle': 0},
-                 'position': -696.6166, 'speed': 1.5, 'accel': -4.0}],
-        dyads=[{'type': 'RRR', 'point': 'B', 'links': [
-            {'name': 'crank', 'from': 'O', 'length': 150},
-            {'name': 'rod', 'from': 'P', 'length': 600}], 'branch': -1}]),
-    # A five-bar whose second motor sits on the crank (an elbow): a hinge, then an RRR.
-    'hinge': lambda: scene_mapping(
-        'hinge', {'A': [0, 0], 'D': [150, 0]},
-        inputs=[crank_entry(50, 30, 20, 1.0),
-                {'motor': 'elbow', 'angle': 45, 'speed': -2.0, 'accel': 1.0}],
-        dyads=[{'type': 'hinge', 'link': 'fore', 'parent': 'crank', 'center': 'B',
-                'point': 'C', 'length': 60, 'motor': 'elbow'},
-               {'type': 'RRR', 'point': 'E', 'links': [
-                   {'name': 'left', 'from': 'C', 'length': 150},
-                   {'name': 'right', 'from': 'D', 'length': 150}], 'branch': 1}]),
-    # A collar driven along a crank by an actuator, a link from it to a block on a guide.
-    'collar': lambda: scene_mapping(
-        'collar', {'O': [0, 0], 'G': [0, -300]},
-        inputs=[crank_entry(500, 60, 30, 2.0, 'O', 'T'),
-                {'actuator': 'x', 'length': 200, 'speed': 2, 'accel': 3, 'stroke': [100, 300]}],
-        dyads=[{'type': 'collar', 'point': 'C', 'link': 'crank', 'from': 'O', 'toward': 'T',
-                'actuator': 'x'},
-               {'type': 'RRP', 'point': 'P', 'link': {'name': 'arm', 'from': 'C', 'length': 700},
-                'guide': {'through': 'G', 'angle': 0}, 'slider': 'block', 'branch': 1}]),
+    'motor': hinge_scene,
+    'slider': slider_scene,
+    'hinge': hinge_scene,
+    'collar': collar_scene,
     'Geneva RPR': lambda: scene_mapping(
         'geneva', {'D': [0, 0], 'S': [-70.71067811865476, 0]},
         input={'link': 'driver', 'center': 'D', 'point': 'P', 'length': 50, 'angle': 150,

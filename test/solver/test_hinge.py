@@ -148,3 +148,42 @@ def test_its_part_of_the_graph_is_a_driven_pin_between_two_moving_links():
     assert (joint.body, joint.on, joint.at, joint.driver) == ('fore', 'upper', 'B', True)
     assert graph.drivers == ('upper', 'elbow')
     assert graph.bodies['fore'].turns_with == 'fore'
+
+
+@pytest.mark.parametrize(('x', 'y', 'vx', 'vy'), [(0.06, 0.22, 0.1, 0.0), (0.03, 0.2, -0.05, 0.2)])
+def test_five_bar_elbow_driven_by_its_effector_is_the_five_bars_inverse(x, y, vx, vy):
+    """The same arm, two sets of drivers: P's targets give the same links and the same rates.
+
+    five_bar (both motors on the ground) and five_bar_elbow (the left motor and the left
+    elbow) are one linkage: the left crank's motion is the same, and the elbow's is the
+    left distal link's less the left crank's.
+    """
+    targets, speeds = {'P.x': x, 'P.y': y}, {'P.x': vx, 'P.y': vy}
+    ground = mk.solve_targets(mk.load_scene('five_bar'), targets, speeds).answer.joints
+    elbow = mk.solve_targets(mk.load_scene('five_bar_elbow'), targets, speeds).answer.joints
+    for name in ('left_crank', 'left_distal', 'right_distal', 'right_crank'):
+        # five_bar_elbow's right distal link runs from P to D, five_bar's from D to P.
+        turn = math.pi if name == 'right_distal' else 0.0
+        gap = elbow[name].position - ground[name].position - turn
+        assert math.remainder(gap, math.tau) == pytest.approx(0.0, abs=1e-9), name
+        for field in ('velocity', 'acceleration'):
+            assert getattr(elbow[name], field) == pytest.approx(getattr(ground[name], field),
+                                                                rel=1e-9, abs=1e-12), name
+    relative = ground['left_distal'].position - ground['left_crank'].position
+    assert math.remainder(elbow['elbow'].position - relative, math.tau) == pytest.approx(
+        0.0, abs=1e-12)
+    assert elbow['elbow'].velocity == pytest.approx(
+        ground['left_distal'].velocity - ground['left_crank'].velocity, rel=1e-9, abs=1e-12)
+
+
+def test_a_motor_listed_first_is_no_crank():
+    """The motor before the crank in inputs: the same arm (a motor is never taken for a crank)."""
+    data = yaml.safe_load(ARM)
+    data['inputs'] = data['inputs'][::-1]
+    swapped = mk.parse_scene(data)
+    assert swapped.input is None and [d.name for d in swapped.drivers] == ['elbow', 'upper']
+    one = mk.solve(arm(), [0.5, 0.7], [1.0, -2.0], [0.5, 1.0])
+    other = mk.solve(swapped, [0.7, 0.5], [-2.0, 1.0], [1.0, 0.5])
+    for field in ('position', 'velocity', 'acceleration'):
+        np.testing.assert_array_equal(getattr(other.points['C'], field),
+                                      getattr(one.points['C'], field))

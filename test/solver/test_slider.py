@@ -275,3 +275,13 @@ def test_the_engine_driven_from_its_piston_takes_the_power_its_crank_gives(angle
                + by_piston.forces.effort_bounds['piston'] * abs(piston.velocity)
                + 1e-9 * abs(power))
     assert abs(force * piston.velocity - power) <= allowed, (force, torque)
+
+
+@pytest.mark.parametrize('b', [0.1, 0.15, 0.05])
+def test_the_double_slider_driven_by_block_b_as_a_target(b):
+    """Block B's position and speed as targets: s_A^2 + s_B^2 = L^2, so s_A s_A' = -s_B s_B'."""
+    inverse = mk.solve_targets(mk.load_scene('double_slider'), {'block_b': b}, {'block_b': 1.0})
+    a = inverse.answer.joints['block_a']
+    assert a.position == pytest.approx(math.sqrt(0.2 ** 2 - b * b), rel=1e-13)
+    assert a.velocity == pytest.approx(-b * 1.0 / a.position, rel=1e-12)
+    assert inverse.jacobian[0, 0] == pytest.approx(-a.position / b, rel=1e-12)
