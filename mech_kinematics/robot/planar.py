@@ -806,22 +806,34 @@ class _Builder:
     def _crank(self, edge: _Edge, mimic: Any) -> None:
         m = self.m
         body = edge.b if edge.a == m.ground else edge.a
+        crank_link, tip, length, phi0, sigma, reference = self._turned(edge, body)
+        start = self.pose.get(edge.name, 0.0)
+        self.inputs.append({'link': crank_link, 'center': self.point(edge.name),
+                            'point': self.point(tip), 'length': length,
+                            'angle': phi0 + sigma * (start - reference), 'speed': 0.0})
+        self.drivers.append(DriverMap(edge.name, crank_link, REVOLUTE, sigma, reference, phi0,
+                                      mimic))
+
+    def _turned(self, edge: _Edge, body: str) -> tuple[str, str, float, float, float, float]:
+        """Place ``body``, turned about the actuated revolute joint ``edge`` (a crank, a hinge).
+
+        Return its scene link, its tip (a pin away from the joint), its length,
+        its angle at the reference pose, the joint's sign (``sigma``) and its
+        reference value; its other pins are carried on it.
+        """
+        m = self.m
         centre = m.pins[body][edge.name]
         tip = self._tip(body, edge.name, centre)
-        crank_link = self.link(body)
-        self.body_names[body] = crank_link
+        link = self.link(body)
+        self.body_names[body] = link
         phi0 = _angle(m.pins[body][tip] - centre)
         assert edge.joint is not None
         sigma = m.sign(edge) * (1.0 if body == edge.b else -1.0)
         reference = m.reference_value(edge.joint)
-        start = self.pose.get(edge.name, 0.0)
-        self.inputs.append({'link': crank_link, 'center': self.point(edge.name),
-                            'point': self.point(tip), 'length': abs(m.pins[body][tip] - centre),
-                            'angle': phi0 + sigma * (start - reference), 'speed': 0.0})
+        self.point(edge.name), self.point(tip)     # named before the pins it carries
         self.placed.add(tip)
-        self.drivers.append(DriverMap(edge.name, crank_link, REVOLUTE, sigma, reference, phi0,
-                                      mimic))
-        self._known(body, (crank_link, phi0), edge.name, tip, phi0)
+        self._known(body, (link, phi0), edge.name, tip, phi0)
+        return link, tip, abs(m.pins[body][tip] - centre), phi0, sigma, reference
 
     def _slider(self, edge: _Edge, mimic: Any) -> None:
         """Add a block driven along a fixed guide: position = (value - reference) along it."""
@@ -904,7 +916,6 @@ class _Builder:
 
     def _hinge(self) -> bool:
         """Place a link a motor turns on a placed one: its angle the parent's plus the motor's."""
-        m = self.m
         for name, (edge, mimic, index, entry) in self.hinges.items():
             if (edge.a in self.known) == (edge.b in self.known):
                 continue
@@ -914,24 +925,14 @@ class _Builder:
                 raise self.fail(
                     f'joint "{name}": Expected an actuated revolute joint to turn a link about '
                     f'a link that turns, got one on "{parent}", a block that only slides', name)
-            centre = m.pins[child][name]
-            tip = self._tip(child, name, centre)
-            link = self.link(child)
-            self.body_names[child] = link
-            phi0 = _angle(m.pins[child][tip] - centre)
-            assert edge.joint is not None
-            sigma = m.sign(edge) * (1.0 if child == edge.b else -1.0)
-            reference = m.reference_value(edge.joint)
+            link, tip, length, phi0, sigma, reference = self._turned(edge, child)
             relative = phi0 - parent_angle
             entry['angle'] = relative + sigma * (self.pose.get(name, 0.0) - reference)
             self.dyads.append({'type': 'hinge', 'link': link, 'parent': self.link(parent),
                                'center': self.point(name), 'point': self.point(tip),
-                               'length': abs(m.pins[child][tip] - centre),
-                               'motor': entry['motor']})
+                               'length': length, 'motor': entry['motor']})
             self.drivers[index] = DriverMap(name, entry['motor'], REVOLUTE, sigma, reference,
                                             relative, mimic)
-            self.placed.add(tip)
-            self._known(child, (link, phi0), name, tip, phi0)
             del self.hinges[name]
             return True
         return False
