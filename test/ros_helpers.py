@@ -87,10 +87,14 @@ def send_until(send, predicate, timeout: float, what: str, every: float = 0.5):
             pytest.fail(f'timed out after {timeout} s waiting for {what}')
 
 
-def exited(proc: 'NodeProcess') -> tuple[int, str]:
-    """Return a node's exit status and output, waited for up to STARTUP_S (killed after)."""
+def exited(proc: 'NodeProcess', timeout: float = STARTUP_S) -> tuple[int, str]:
+    """Return a node's exit status and output, waited for up to ``timeout`` s (killed after).
+
+    Processes started together share the machine while they start: give the first
+    waited for ``STARTUP_S`` times their number.
+    """
     try:
-        status = proc.proc.wait(timeout=STARTUP_S)
+        status = proc.proc.wait(timeout=timeout)
     finally:
         if proc.proc.poll() is None:
             proc.proc.kill()
