@@ -58,6 +58,7 @@ class Actuator(Driver):
     """
 
     position_key = 'length'
+    v1_crank = False
     scene_key = 'actuator'
 
     actuator: str

@@ -371,6 +371,9 @@ class Driver(ABC):
     position_key: ClassVar[str]
     #: The key that names it in an entry of the scene's ``inputs:`` (``'link'``, ...).
     scene_key: ClassVar[str]
+    #: Whether it is the crank of a v1 scene's ``input:`` (``Scene.input``): a crank's
+    #: kind says True; another turning driver (a motor) is no crank.
+    v1_crank: ClassVar[bool]
 
     @classmethod
     @abstractmethod

@@ -72,6 +72,7 @@ class Crank(Driver):
     """
 
     position_key = 'angle'
+    v1_crank = True
     scene_key = 'link'
 
     link: str

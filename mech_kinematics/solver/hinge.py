@@ -63,6 +63,7 @@ class Motor(Driver):
     """
 
     position_key = 'angle'
+    v1_crank = False
     scene_key = 'motor'
 
     motor: str

@@ -287,7 +287,7 @@ class Scene:
             raise SceneError(msg, (self, 'input'))
         if first is not None:
             # The v1 ``input`` is a crank (a motor turns too, but it is no crank).
-            crank = first if isinstance(first, Crank) else None
+            crank = cast(Crank, first) if first.v1_crank else None
             object.__setattr__(self, 'input', crank)
         object.__setattr__(self, 'dyads', tuple(self.dyads))
         object.__setattr__(self, 'points', tuple(self.points))

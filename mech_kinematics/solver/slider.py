@@ -68,6 +68,7 @@ class Slider(Driver):
     """
 
     position_key = 'position'
+    v1_crank = False
     scene_key = 'slider'
 
     slider: str
