@@ -76,7 +76,7 @@ def frames_from_scene(scene: Scene, joints: Sequence[str] | None = None) -> tupl
              for body, frame in graph.frames()}
     names = scene.output_joints if joints is None else joints
     return tuple(specs[name] for name in names
-                 if name in specs or name not in graph.coordinates or name in graph.bodies)
+                 if name in specs or name not in graph.coordinates)
 
 
 def origin_points(frames: Sequence[FrameSpec]) -> tuple[str, ...]:

@@ -169,8 +169,9 @@ def visuals_from_scene(scene: Scene, frames: Sequence[FrameSpec] | None = None,
     graph = full.graph
     drivers = {d.name: d for d in full.drivers}
     slides = [j for j in graph.joints if j.line is not None]
-    actuators = {j.name: drivers[j.name] for j in graph.cylinders()}
-    cylinders = {j.on: drivers[j.name] for j in graph.cylinders()}
+    rods = tuple(graph.cylinders())
+    actuators = {j.name: drivers[j.name] for j in rods}
+    cylinders = {j.on: drivers[j.name] for j in rods}
     # A link whose length varies (a slotted lever) is drawn out to the farthest its
     # pin slides: from its slot's point to the pin.
     levers = {j.on: (j.line.through, j.at) for j in slides  # type: ignore[union-attr]

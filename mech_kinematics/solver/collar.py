@@ -176,8 +176,7 @@ class _CollarStep(Step):
         e, omega, alpha, ee, ew, eal = ctx.links[self.link]
         p, v, a, ep, ev, ea = ctx.points[self.start]
         s, sd, sdd, es, esd, esdd = ctx.sliders[self.actuator]
-        u = e   # the link's direction: the slide's
-        iu = 1j * u
+        u, iu = e, 1j * e   # the link's direction is the slide's
         turn = 2.0 * omega * sd + alpha * s
         spin = omega * omega * s
         # Each product has one real factor or an imaginary one (crank.py's rule).
