@@ -140,21 +140,8 @@ class Region:
 
 
 def free_length(scene: Scene) -> float:
-    """Return a length (m) that no actuator's closing length can exceed.
-
-    Every driver's reach, every dyad's link lengths, every carried point's
-    offset and the ground's diameter added up: no two points of the
-    mechanism can be further apart, so an RRR link of that length cannot
-    close.
-    """
-    total = sum(driver.reach for driver in scene.drivers)
-    for dyad in scene.dyads:
-        total += sum(dyad.lengths())
-    ground = [complex(x, y) for x, y in scene.ground.values()]
-    total += max((abs(a - b) for a in ground for b in ground), default=0.0)
-    for point in scene.points:
-        total += math.hypot(*point.local)
-    return float(total)
+    """Return a length (m) no actuator's closing length can exceed: ``scene.free_length``."""
+    return scene.free_length
 
 
 def domain(scene: Scene, driver: Any) -> tuple[float, float]:

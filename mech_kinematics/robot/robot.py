@@ -364,7 +364,8 @@ class Robot:
                       start: Mapping[str, float] | None = None, max_error: float = MAX_ERROR,
                       forces: Mapping[str, float] | None = None,
                       gravity: Iterable[float] | None = None,
-                      loads: Iterable[LinkLoad] = ()) -> Any:
+                      loads: Iterable[LinkLoad] = (),
+                      branch: Mapping[str, int] | None = None) -> Any:
         """Solve the robot driven from its targets (docs/targets.md, :mod:`.targets`).
 
         Parameters
@@ -386,6 +387,10 @@ class Robot:
             holds the actuated joints' share, ``J^T F``.
         gravity, loads
             As :meth:`solve`'s, for the efforts of the motion (with ``<inertial>``).
+        branch : mapping of str to int, optional
+            The working mode: revolute joints of the loops (not actuated), each
+            with the sign (+1 or -1) asked of its value wrapped to (-pi, pi]
+            (docs/targets.md).
 
         Returns
         -------
@@ -404,7 +409,7 @@ class Robot:
         return solve_robot_targets(self, targets, speeds, accels, start=start,
                                    max_error=max_error, forces=forces,
                                    gravity=None if gravity is None else tuple(gravity),
-                                   loads=tuple(loads))
+                                   loads=tuple(loads), branch=branch)
 
     def _assembled(self, p: list[Any], v: list[Any], a: list[Any],
                    inputs: Mapping[str, tuple[Any, Any, Any]], max_error: float) -> State:

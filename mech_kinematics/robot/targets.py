@@ -184,12 +184,27 @@ def robot_targets(robot: Robot, names: Sequence[str]) -> TargetMap:
     def text(index: int, value: float) -> str:
         return f'{value:.6g} rad' if angular[index] else f'{value:.6g} m'
 
+    def elbow(answer: RobotState, name: str) -> float:
+        """Return joint ``name``'s value wrapped to (-pi, pi], rad."""
+        return float(math.remainder(float(answer.joints[name].position), math.tau))
+
+    def sweep(name: str) -> tuple[float, float]:
+        """Return where an actuated joint's start poses are sought: a turn, or its limits."""
+        start = float(robot.start(name))
+        if robot.joint_type(name).angular:
+            return (start - math.pi, start + math.pi)
+        limits = description.joints[name].limits
+        return limits if limits is not None else (start - size, start + size)
+
     return TargetMap(
         targets=tuple(names), drivers=drivers, target_angular=tuple(angular),
         driver_angular=tuple(robot.joint_type(d).angular for d in drivers),
         target_scales=tuple(1.0 if a else size for a in angular),
         driver_scales=tuple(1.0 if robot.joint_type(d).angular else size for d in drivers),
-        evaluate=evaluate, text=text)
+        evaluate=evaluate, text=text,
+        elbows=tuple(n for n in probe.joints if n not in drivers
+                     and robot.joint_type(n).angular),
+        elbow=elbow, driver_domains=tuple(sweep(d) for d in drivers))
 
 
 def solve_robot_targets(robot: Robot, targets: Mapping[str, float],
@@ -199,7 +214,8 @@ def solve_robot_targets(robot: Robot, targets: Mapping[str, float],
                         max_error: float = MAX_ERROR,
                         forces: Mapping[str, float] | None = None,
                         gravity: Sequence[float] | None = None,
-                        loads: Sequence[Any] = ()) -> Inverse:
+                        loads: Sequence[Any] = (),
+                        branch: Mapping[str, int] | None = None) -> Inverse:
     """Solve ``robot`` driven from its targets: :meth:`.Robot.solve_targets`."""
     names = tuple(targets)
     tmap = robot_targets(robot, names)
@@ -217,7 +233,7 @@ def solve_robot_targets(robot: Robot, targets: Mapping[str, float],
     inverse = continue_to(tmap, [targets[n] for n in names], first,
                           [(speeds or {}).get(n, 0.0) for n in names],
                           [(accels or {}).get(n, 0.0) for n in names],
-                          max_error=max_error, forces=forces)
+                          max_error=max_error, forces=forces, branch=branch)
     if robot.forces is None:
         return inverse
     q, qd, qdd = (dict(zip(robot.actuated, (float(x) for x in inverse.motion[:, k]),

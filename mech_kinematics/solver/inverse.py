@@ -46,7 +46,8 @@ closed-form re-rooting of the loop's Assur groups; docs/targets.md says so.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
+import itertools
 import math
 from typing import Any, TYPE_CHECKING
 import warnings
@@ -61,7 +62,7 @@ if TYPE_CHECKING:
     from .mechanism import Scene
     from .state import State
 
-__all__ = ['Inverse', 'TargetMap', 'continue_to', 'scene_targets', 'solve_targets']
+__all__ = ['Inverse', 'TargetMap', 'continue_to', 'in_mode', 'scene_targets', 'solve_targets']
 
 #: Newton iterations tried per continuation step before the step is halved.
 _ITERATIONS = 12
@@ -71,6 +72,10 @@ _SMALLEST_STEP = 2.0 ** -20
 _LARGEST_CHANGE = 1.0
 #: How close an intermediate step's targets must come (share of each target's scale).
 _ON_THE_WAY = 1e-9
+#: About how many start poses a working mode is sought among (:func:`in_mode`), and how
+#: many of those in the mode asked are continued from before the mode is refused.
+_MODE_GRID = 1728
+_MODE_TRIES = 8
 #: The residual (share of each target's scale) below which the answer is taken whatever the
 #: bounds say: the contract's 1e-12 of the loop size, with room.
 _ARRIVED = 1e-13
@@ -100,6 +105,13 @@ class TargetMap:
     evaluate: Callable[[Sequence[float], Sequence[float], Sequence[float], float],
                        tuple[Any, npt.NDArray[np.float64], npt.NDArray[np.float64]]]
     text: Callable[[int, float], str]     # (target index, SI value) -> text, for messages
+    #: What a working mode is read from (``branch=``): the revolute joints between two
+    #: moving bodies whose sign a caller may ask, and each one's angle in an answer
+    #: (``elbow(answer, joint)``, rad wrapped to (-pi, pi]).
+    elbows: tuple[str, ...]
+    elbow: Callable[[Any, str], float]
+    #: Each driver's sweep (rad or m: a turn, or its stroke): where start poses are sought.
+    driver_domains: tuple[tuple[float, float], ...]
 
 
 @dataclass(frozen=True)
@@ -137,6 +149,9 @@ class Inverse:
     columns : tuple
         The drivers' values answered with the targets and the Jacobian there:
         what :func:`continue_to` takes as ``known`` to continue from them.
+    branch : dict of str to float
+        With ``branch=``: the angle (rad, wrapped to (-pi, pi]) at the answer of
+        each joint whose sign was asked.
     """
 
     answer: Any
@@ -154,6 +169,7 @@ class Inverse:
     target_forces: dict[str, float]
     target_efforts: dict[str, float]
     columns: Any = None
+    branch: dict[str, float] = field(default_factory=dict)
 
     def as_dict(self) -> dict[str, Any]:
         """Return what ``solve --target`` adds to the forward answer's JSON."""
@@ -174,6 +190,8 @@ class Inverse:
                                for name, x in zip(self.drivers, self.start, strict=True)},
             **({'target_forces': dict(self.target_forces),
                 'target_efforts': dict(self.target_efforts)} if self.target_forces else {}),
+            **({'branch': {name: {'sign': int(math.copysign(1.0, angle)), 'angle': angle}
+                           for name, angle in self.branch.items()}} if self.branch else {}),
         }
 
     def bound_dict(self) -> dict[str, Any]:
@@ -195,7 +213,7 @@ def continue_to(tmap: TargetMap, goal: Sequence[float], start: Sequence[float],
                 speeds: Sequence[float] | None = None, accels: Sequence[float] | None = None,
                 *, max_error: float = MAX_ERROR,
                 forces: Mapping[str, float] | None = None, known: Any = None,
-                answer: bool = True) -> Inverse:
+                answer: bool = True, branch: Mapping[str, int] | None = None) -> Inverse:
     """Return the drivers' motion putting ``tmap``'s targets at ``goal``, continued from ``start``.
 
     ``goal``, ``speeds`` and ``accels``: the targets' positions, velocities and
@@ -210,7 +228,11 @@ def continue_to(tmap: TargetMap, goal: Sequence[float], start: Sequence[float],
     the forward answer and the accelerations are not solved (``answer`` None,
     the accelerations and their bounds NaN); the drivers' values and speeds,
     their bounds and the singular-point refusal are the same.
+    ``branch``: the working mode asked, joint -> +1 or -1 (:func:`in_mode`).
     """
+    if branch:
+        return in_mode(tmap, goal, start, speeds, accels, branch, max_error=max_error,
+                       forces=forces, answer=answer)
     m, n = len(tmap.targets), len(tmap.drivers)
     t_ang = np.array(tmap.target_angular, dtype=bool)
     t_scale = np.array(tmap.target_scales)
@@ -364,6 +386,101 @@ def continue_to(tmap: TargetMap, goal: Sequence[float], start: Sequence[float],
         if force_list else {}, columns=(q.copy(), (values, bounds, (jac, jac_b))))
 
 
+def _mode_of(tmap: TargetMap, q: Sequence[float], joints: Sequence[str]
+             ) -> tuple[tuple[int, ...], tuple[float, ...]] | None:
+    """Return the signs (+1, -1; 0 stretched or folded) and angles of ``joints`` at ``q``."""
+    zeros = [0.0] * len(tmap.drivers)
+    try:
+        state, _, _ = tmap.evaluate(list(q), zeros, zeros, math.inf)
+    except AssemblyError:
+        return None
+    angles = tuple(float(tmap.elbow(state, joint)) for joint in joints)
+    return tuple(int(np.sign(a)) if abs(a) < math.pi else 0 for a in angles), angles
+
+
+def _starts(tmap: TargetMap, start: Sequence[float]) -> list[npt.NDArray[np.float64]]:
+    """Return start poses to seek a working mode from: ``start``, then a grid nearest first.
+
+    Each angular driver at ``start`` plus whole twelfths of a turn (within half a turn
+    either way), each linear
+    one at points of its sweep; at most about :data:`_MODE_GRID` poses.
+    """
+    n = len(tmap.drivers)
+    first = np.array(start, dtype=np.float64)
+    count = max(3, round(_MODE_GRID ** (1.0 / n)))
+    axes = []
+    for x, angular, (low, high) in zip(first, tmap.driver_angular, tmap.driver_domains,
+                                       strict=True):
+        if angular:
+            turns = 12 if count >= 12 else count
+            axes.append([float(x) + math.tau * k / turns
+                         for k in range(-(turns // 2), turns - turns // 2)])
+        else:
+            axes.append([float(v) for v in np.linspace(low, high, count + 2)[1:-1]])
+    scales = np.array(tmap.driver_scales)
+    angular = np.array(tmap.driver_angular, dtype=bool)
+
+    def distance(q: npt.NDArray[np.float64]) -> float:
+        return float(np.sum((_residual(q, first, angular) / scales) ** 2))
+
+    grid = sorted((np.array(q) for q in itertools.product(*axes)), key=distance)
+    return [first] + [q for q in grid if not np.array_equal(q, first)]
+
+
+def in_mode(tmap: TargetMap, goal: Sequence[float], start: Sequence[float],
+            speeds: Sequence[float] | None, accels: Sequence[float] | None,
+            branch: Mapping[str, int], *, max_error: float = MAX_ERROR,
+            forces: Mapping[str, float] | None = None, answer: bool = True) -> Inverse:
+    """Return the answer of :func:`continue_to` in the working mode ``branch`` asks.
+
+    A *working mode* is read from joints between two moving bodies (an elbow of
+    a five-bar's leg): ``branch`` maps each joint named to the sign asked of
+    its angle (wrapped to (-pi, pi]; a scene's pin: the angle of its body's
+    frame from its parent's; a URDF joint: its value). The answer is continued
+    from ``start`` where ``start`` is in that mode and reaches the goal in it;
+    otherwise from the nearest start pose in that mode on a grid of the
+    drivers (:func:`_starts`) that does, the first :data:`_MODE_TRIES` of them
+    tried. Continuation keeps a working mode (it crosses no ``det J = 0``),
+    and the signs are checked at the answer.
+    """
+    joints = tuple(branch)
+    unknown = [j for j in joints if j not in tmap.elbows]
+    if unknown:
+        msg = (f'Expected --branch to name joints between two moving bodies '
+               f'({", ".join(tmap.elbows) or "none"}), got {", ".join(unknown)}')
+        raise TargetError(msg)
+    bad = [f'{j}={branch[j]}' for j in joints if branch[j] not in (1, -1)]
+    if bad:
+        msg = f'Expected --branch JOINT=+1 or JOINT=-1, got {", ".join(bad)}'
+        raise TargetError(msg)
+    wanted = tuple(int(branch[j]) for j in joints)
+    asked = ', '.join(f'{j} {"+" if s > 0 else "-"}' for j, s in zip(joints, wanted, strict=True))
+    tried = 0
+    reason = ''
+    for q0 in _starts(tmap, start):
+        here = _mode_of(tmap, q0, joints)
+        if here is None or here[0] != wanted:
+            continue
+        tried += 1
+        try:
+            found = continue_to(tmap, goal, q0, speeds, accels, max_error=max_error,
+                                forces=forces, answer=answer)
+        except TargetError as error:
+            reason = str(error)
+        else:
+            there = _mode_of(tmap, found.motion[:, 0], joints)
+            if there is not None and there[0] == wanted:
+                return replace(found, branch=dict(zip(joints, there[1], strict=True)))
+            reason = 'the continuation left that mode'
+        if tried >= _MODE_TRIES:
+            break
+    where = (f'{tried} start pose{"s" if tried != 1 else ""} in it tried, the last: {reason}'
+             if tried else 'no start pose on the grid of the drivers is in it')
+    msg = (f'Expected targets reached in the working mode asked ({asked}), got '
+           f'{_goal_text(tmap, np.array(goal, dtype=np.float64))} not reached in it: {where}')
+    raise TargetError(msg)
+
+
 def _shown(value: float, tmap: TargetMap, index: int) -> str:
     """Return a target's value (SI) as text in the map's units."""
     return tmap.text(index, value)
@@ -432,12 +549,27 @@ def scene_targets(scene: Scene, names: Sequence[str]) -> TargetMap:
     def text(index: int, value: float) -> str:
         return units.angle_text(value) if angular[index] else units.length_text(value)
 
+    graph = scene.graph
+    pins = {joint.name: joint for joint in graph.joints
+            if joint.type.angular and not joint.driver and joint.line is None
+            and graph.bodies[joint.body].turns_with and graph.bodies[joint.on].turns_with}
+
+    def elbow(state: State, name: str) -> float:
+        """Return the angle of pin ``name``'s body's frame from its parent's, rad."""
+        joint = pins[name]
+        turned = [float(state.joints[frame.angle_of].position) + frame.angle
+                  for frame in (graph.bodies[joint.body].frame, graph.bodies[joint.on].frame)
+                  if frame is not None and frame.angle_of is not None]
+        return float(math.remainder(turned[0] - turned[1], math.tau))
+
+    free = scene.free_length
     return TargetMap(
         targets=tuple(names), drivers=driver_names, target_angular=tuple(angular),
         driver_angular=tuple(d.joint_type.angular for d in drivers),
         target_scales=tuple(1.0 if a else size for a in angular),
         driver_scales=tuple(1.0 if d.joint_type.angular else size for d in drivers),
-        evaluate=evaluate, text=text)
+        evaluate=evaluate, text=text, elbows=tuple(pins), elbow=elbow,
+        driver_domains=tuple(tuple(float(x) for x in d.sweep(free)) for d in drivers))
 
 
 def _driver_args(scene: Scene, q: Sequence[float], qd: Sequence[float],
@@ -452,7 +584,8 @@ def solve_targets(scene: Scene, targets: Mapping[str, float],
                   speeds: Mapping[str, float] | None = None,
                   accels: Mapping[str, float] | None = None, *,
                   start: Sequence[float] | None = None, max_error: float = MAX_ERROR,
-                  forces: Mapping[str, float] | None = None) -> Inverse:
+                  forces: Mapping[str, float] | None = None,
+                  branch: Mapping[str, int] | None = None) -> Inverse:
     """Solve ``scene`` driven from its targets (see the module's text).
 
     Parameters
@@ -473,6 +606,10 @@ def solve_targets(scene: Scene, targets: Mapping[str, float],
     forces : mapping of str to float, optional
         Forces (N) or torques (N m) the mechanism exerts along targets: the
         answer's ``target_efforts`` hold the drivers' share, ``J^T F``.
+    branch : mapping of str to int, optional
+        The working mode: pin joints between two moving links (``'B'``), each
+        with the sign (+1 or -1) asked of the angle of its link from the
+        link it is pinned on (:func:`in_mode`; docs/targets.md).
 
     Returns
     -------
@@ -492,4 +629,4 @@ def solve_targets(scene: Scene, targets: Mapping[str, float],
     return continue_to(tmap, [targets[n] for n in names], first,
                        [(speeds or {}).get(n, 0.0) for n in names],
                        [(accels or {}).get(n, 0.0) for n in names],
-                       max_error=max_error, forces=forces)
+                       max_error=max_error, forces=forces, branch=branch)

@@ -402,6 +402,24 @@ class Scene:
         return self._plan.graph
 
     @property
+    def free_length(self) -> float:
+        """A length (m) that no actuator's closing length can exceed.
+
+        Every driver's reach, every dyad's link lengths, every carried point's
+        offset and the ground's diameter added up: no two points of the
+        mechanism can be further apart, so an RRR link of that length cannot
+        close. What a linear driver without stroke limits is swept over.
+        """
+        total = sum(driver.reach for driver in self.drivers)
+        for dyad in self.dyads:
+            total += sum(dyad.lengths())
+        ground = [complex(x, y) for x, y in self.ground.values()]
+        total += max((abs(a - b) for a in ground for b in ground), default=0.0)
+        for point in self.points:
+            total += math.hypot(*point.local)
+        return float(total)
+
+    @property
     def single_crank(self) -> bool:
         """Whether one crank drives it (``input:``, or ``inputs:`` of one crank)."""
         return self._solver.single

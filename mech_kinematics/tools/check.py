@@ -33,9 +33,9 @@ from typing import Any
 
 import numpy as np
 
-from .cli import (add_robot_arguments, add_scene_argument, add_units_argument, finite_float,
-                  is_urdf, load_robot_argument, load_scene_argument, named_value, run_tool,
-                  targets_in_si)
+from .cli import (add_branch_argument, add_robot_arguments, add_scene_argument,
+                  add_units_argument, branches_of, finite_float, is_urdf, load_robot_argument,
+                  load_scene_argument, named_value, run_tool, targets_in_si)
 from ..errors import SceneError
 from ..geometry.region import GRID
 from ..solver.graph import JointType
@@ -746,7 +746,7 @@ def _handle_target(args: argparse.Namespace) -> int:
             return scene.units.angle_text(value) if tmap.driver_angular[i] else \
                 scene.units.length_text(value)
     goal, _, _ = targets_in_si(given, tmap.target_angular, args, per_metre)
-    inverse = continue_to(tmap, goal, start)
+    inverse = continue_to(tmap, goal, start, branch=branches_of(args))
     report = target_report(inverse, tmap, dict(answer_of(inverse).singularity))
     if args.json:
         print(json.dumps(report, indent=1, allow_nan=False))
@@ -816,6 +816,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
                         help='how well the drivers control targets (as solve --target takes '
                              'them) at the pose that reaches them, continued from the start '
                              "pose: the Jacobian, its condition, the loop's singularity")
+    add_branch_argument(parser)
     parser.add_argument('--workspace', metavar='POINT',
                         help='a scene with two drivers: map where POINT can go over the grid, '
                              'with its singular curves (det J = 0, where the drivers lose '

@@ -33,13 +33,14 @@ import sys
 import traceback
 from typing import Any
 
-from ..errors import MechKinematicsError
+from ..errors import MechKinematicsError, TargetError
 from ..memory import keep_freed_memory
 from ..units import LENGTH_UNITS, rad_per_s_from_rpm, reduce_radians, turns_from_degrees
 
-__all__ = ['ArgumentParser', 'PROG', 'UNIT_SYSTEMS', 'add_driver_arguments',
+__all__ = ['ArgumentParser', 'PROG', 'UNIT_SYSTEMS', 'add_branch_argument', 'add_driver_arguments',
            'add_gravity_argument', 'add_robot_arguments', 'add_scene_argument',
-           'add_units_argument', 'angle_given', 'angle_unit', 'angular_rate_given',
+           'add_units_argument', 'angle_given', 'angle_unit', 'angular_rate_given', 'branch_sign',
+           'branches_of',
            'robot_angle_given',
            'drive_from_args', 'finite_float',
            'gravity_of', 'is_urdf', 'joint_list', 'link_loads_of', 'load_robot_argument',
@@ -416,6 +417,43 @@ def named_value(text: str) -> tuple[str | None, float]:
         msg = f'expected NAME=VALUE (a driver of the scene and a number), got {text!r}'
         raise argparse.ArgumentTypeError(msg)
     return name, finite_float(value)
+
+
+def branch_sign(text: str) -> tuple[str, int]:
+    """Parse ``--branch JOINT=+1|-1`` (or ``+``, ``-``), or tell argparse why not."""
+    name, sep, value = text.rpartition('=')
+    signs = {'+1': 1, '+': 1, '1': 1, '-1': -1, '-': -1}
+    if not sep or not name or value.strip() not in signs:
+        msg = f"expected JOINT=+1 or JOINT=-1 (the sign of the joint's angle), got {text!r}"
+        raise argparse.ArgumentTypeError(msg)
+    return name, signs[value.strip()]
+
+
+def add_branch_argument(parser: argparse.ArgumentParser) -> None:
+    """Add ``--branch JOINT=+1|-1``, the working mode of an answer to ``--target``."""
+    parser.add_argument('--branch', type=branch_sign, action='append', metavar='JOINT=+1|-1',
+                        help='with --target: the working mode (docs/targets.md), the sign of '
+                             "a joint's angle in (-180, 180] deg: a scene's pin between two "
+                             "moving links (its link's angle from the link it is pinned on), a "
+                             "URDF's revolute joint of a loop (its value); repeatable, one per "
+                             'leg (default: the mode continued from the start pose)')
+
+
+def branches_of(args: argparse.Namespace) -> dict[str, int] | None:
+    """Return ``--branch`` as {joint: sign}; refuse (TargetError) a joint twice, or no --target."""
+    given = getattr(args, 'branch', None) or []
+    if not given:
+        return None
+    if not getattr(args, 'target', None):
+        msg = 'Expected --branch with --target (a working mode of the inverse), got it alone'
+        raise TargetError(msg)
+    out: dict[str, int] = {}
+    for name, sign in given:
+        if name in out:
+            msg = f'Expected each --branch joint once, got {name} twice'
+            raise TargetError(msg)
+        out[name] = sign
+    return out
 
 
 def values_by_driver(scene: Any, flag: str, given: list[tuple[str | None, float]] | None

@@ -13,12 +13,12 @@ import sys
 from typing import Any
 import warnings
 
-from .cli import (add_driver_arguments, add_gravity_argument, add_robot_arguments,
-                  add_scene_argument, add_units_argument, angle_unit,
-                  angular_rate_given, drive_from_args, finite_float, gravity_of, is_urdf,
-                  link_loads_of, load_robot_argument, mimic_ruled, named_value,
-                  positive_float,
-                  robot_angle_given, run_tool, targets_in_si, values_by_driver)
+from .cli import (add_branch_argument, add_driver_arguments, add_gravity_argument,
+                  add_robot_arguments, add_scene_argument, add_units_argument, angle_unit,
+                  angular_rate_given, branches_of, drive_from_args, finite_float, gravity_of,
+                  is_urdf, link_loads_of, load_robot_argument, mimic_ruled, named_value,
+                  positive_float, robot_angle_given, run_tool, targets_in_si,
+                  values_by_driver)
 from ..bounds import MAX_ERROR
 from ..errors import AssemblyError, NearSingularWarning, SceneError, UntrustedError
 from ..scene import load_scene
@@ -171,7 +171,7 @@ _TARGET_FLAGS = ('--target', '--target-speed', '--target-accel', '--target-force
 
 
 def _targets_given(args: argparse.Namespace) -> bool:
-    return any(getattr(args, flag[2:].replace('-', '_')) for flag in _TARGET_FLAGS)
+    return any(getattr(args, flag[2:].replace('-', '_')) for flag in (*_TARGET_FLAGS, '--branch'))
 
 
 def _target_tables(args: argparse.Namespace) -> dict[str, dict[str, float]]:
@@ -186,6 +186,7 @@ def _target_tables(args: argparse.Namespace) -> dict[str, dict[str, float]]:
                "rates follow from the targets'), got --speed, --accel, --angle-deg or "
                '--speed-rpm')
         raise ValueError(msg)
+    branches_of(args)       # --branch alone is refused before the targets are counted
     given: dict[str, dict[str, float]] = {}
     for flag in _TARGET_FLAGS:
         table = given.setdefault(flag, {})
@@ -246,7 +247,7 @@ def _handle_targets(scene: Any, args: argparse.Namespace) -> int:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter('always', NearSingularWarning)
             inverse = continue_to(tmap, goal, first, speeds, accels, max_error=args.max_error,
-                                  forces=given['--target-force'])
+                                  forces=given['--target-force'], branch=branches_of(args))
     except (TargetError, ValueError) as error:
         print(f'error: {error}', file=sys.stderr)
         return 2
@@ -281,7 +282,7 @@ def _handle_robot_targets(args: argparse.Namespace) -> int:
                 dict(zip(tmap.targets, speeds, strict=True)),
                 dict(zip(tmap.targets, accels, strict=True)), start=positions,
                 max_error=args.max_error, forces=given['--target-force'], gravity=gravity,
-                loads=loads)
+                loads=loads, branch=branches_of(args))
     except (SceneError, TargetError, ValueError) as error:
         print(f'error: {error}', file=sys.stderr)
         return 2
@@ -390,6 +391,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
                         metavar='NAME=F', help='a force (N) or torque (N m, an angle) the '
                                                "mechanism exerts along a target: the drivers' "
                                                'share, J^T F, under "target_efforts"')
+    add_branch_argument(parser)
     parser.add_argument('--indent', type=int, default=1, metavar='N',
                         help='JSON indentation (default 1)')
     parser.set_defaults(handler=_handle)
