@@ -146,7 +146,7 @@ def free_length(scene: Scene) -> float:
 
 def domain(scene: Scene, driver: Any) -> tuple[float, float]:
     """Return what a driver is swept over (its ``sweep``): a turn, its stroke or free lengths."""
-    low, high = driver.sweep(free_length(scene))
+    low, high = driver.sweep(scene.free_length)
     return (float(low), float(high))
 
 

@@ -401,9 +401,9 @@ def _mode_of(tmap: TargetMap, q: Sequence[float], joints: Sequence[str]
 def _starts(tmap: TargetMap, start: Sequence[float]) -> list[npt.NDArray[np.float64]]:
     """Return start poses to seek a working mode from: ``start``, then a grid nearest first.
 
-    Each angular driver at ``start`` plus whole twelfths of a turn (within half a turn
-    either way), each linear
-    one at points of its sweep; at most about :data:`_MODE_GRID` poses.
+    Each angular driver at ``start`` plus whole twelfths of a turn (within half a
+    turn either way), each linear one at points of its sweep; at most about
+    :data:`_MODE_GRID` poses.
     """
     n = len(tmap.drivers)
     first = np.array(start, dtype=np.float64)
@@ -412,7 +412,7 @@ def _starts(tmap: TargetMap, start: Sequence[float]) -> list[npt.NDArray[np.floa
     for x, angular, (low, high) in zip(first, tmap.driver_angular, tmap.driver_domains,
                                        strict=True):
         if angular:
-            turns = 12 if count >= 12 else count
+            turns = min(12, count)
             axes.append([float(x) + math.tau * k / turns
                          for k in range(-(turns // 2), turns - turns // 2)])
         else:
@@ -557,10 +557,11 @@ def scene_targets(scene: Scene, names: Sequence[str]) -> TargetMap:
     def elbow(state: State, name: str) -> float:
         """Return the angle of pin ``name``'s body's frame from its parent's, rad."""
         joint = pins[name]
-        turned = [float(state.joints[frame.angle_of].position) + frame.angle
-                  for frame in (graph.bodies[joint.body].frame, graph.bodies[joint.on].frame)
-                  if frame is not None and frame.angle_of is not None]
-        return float(math.remainder(turned[0] - turned[1], math.tau))
+        body, on = (graph.bodies[b].frame for b in (joint.body, joint.on))
+        assert body is not None and on is not None and body.angle_of and on.angle_of
+        turn = (float(state.joints[body.angle_of].position) + body.angle
+                - float(state.joints[on.angle_of].position) - on.angle)
+        return float(math.remainder(turn, math.tau))
 
     free = scene.free_length
     return TargetMap(

@@ -37,17 +37,14 @@ from ..errors import MechKinematicsError, TargetError
 from ..memory import keep_freed_memory
 from ..units import LENGTH_UNITS, rad_per_s_from_rpm, reduce_radians, turns_from_degrees
 
-__all__ = ['ArgumentParser', 'PROG', 'UNIT_SYSTEMS', 'add_branch_argument', 'add_driver_arguments',
-           'add_gravity_argument', 'add_robot_arguments', 'add_scene_argument',
-           'add_units_argument', 'angle_given', 'angle_unit', 'angular_rate_given', 'branch_sign',
-           'branches_of',
-           'robot_angle_given',
-           'drive_from_args', 'finite_float',
-           'gravity_of', 'is_urdf', 'joint_list', 'link_loads_of', 'load_robot_argument',
-           'load_scene_argument',
-           'mimic_ruled', 'named_value', 'payloads_of', 'positive_float', 'positive_int',
-           'positive_seconds', 'run_handler', 'run_tool', 'seconds_or_zero', 'targets_in_si',
-           'values_by_driver']
+__all__ = ['ArgumentParser', 'PROG', 'UNIT_SYSTEMS', 'add_branch_argument',
+           'add_driver_arguments', 'add_gravity_argument', 'add_robot_arguments',
+           'add_scene_argument', 'add_units_argument', 'angle_given', 'angle_unit',
+           'angular_rate_given', 'branch_sign', 'branches_of', 'robot_angle_given',
+           'drive_from_args', 'finite_float', 'gravity_of', 'is_urdf', 'joint_list',
+           'link_loads_of', 'load_robot_argument', 'load_scene_argument', 'mimic_ruled',
+           'named_value', 'payloads_of', 'positive_float', 'positive_int', 'positive_seconds',
+           'run_handler', 'run_tool', 'seconds_or_zero', 'targets_in_si', 'values_by_driver']
 
 #: What ``--units`` takes: ``deg`` (the default: a revolute joint's or a crank's
 #: values in degrees and rpm) or ``si`` (rad and rad/s; an actuator's length in m).
