@@ -21,10 +21,12 @@ from dataclasses import dataclass
 import math
 from typing import Any
 
+import numpy as np
+
 from ..solver import Scene, State
 
-__all__ = ['FrameSpec', 'Pose', 'angle_joints', 'child_frame', 'frames_from_scene',
-           'origin_points', 'poses_from_state', 'sensor_offsets']
+__all__ = ['FrameSpec', 'Pose', 'angle_joints', 'carried_motion', 'child_frame',
+           'frames_from_scene', 'origin_points', 'poses_from_state', 'sensor_offsets']
 
 
 @dataclass(frozen=True)
@@ -102,6 +104,26 @@ def poses_from_state(frames: Sequence[FrameSpec], state: State) -> list[Pose]:
         angle = f.angle if f.angle_of is None else float(joints[f.angle_of].position)
         poses.append(Pose(f.joint, float(p.real), float(p.imag), angle))
     return poses
+
+
+def carried_motion(frame: FrameSpec, local: tuple[float, float], state: State
+                   ) -> tuple[Any, Any]:
+    """Return the position and velocity (complex, m and m/s) of a point fixed in a frame.
+
+    ``local`` is the point in ``frame`` (its x and y, m); ``state`` one instant
+    or arrays, holding the frame's origin and the joint it takes its angle
+    from. The frame's angle is :func:`poses_from_state`'s; the point moves
+    with the frame's origin and turns with its angle: ``p = o + e^(i theta) l``,
+    ``v = v_o + i omega e^(i theta) l``.
+    """
+    origin = state.complex_points[frame.origin]
+    lever = complex(*local)
+    if frame.angle_of is None:
+        turned = complex(math.cos(frame.angle), math.sin(frame.angle)) * lever
+        return origin[0] + turned, origin[1]
+    joint = state.joints[frame.angle_of]
+    turned = np.exp(1j * np.asarray(joint.position, dtype=np.float64)) * lever
+    return origin[0] + turned, origin[1] + 1j * np.asarray(joint.velocity) * turned
 
 
 def sensor_offsets(specs: Sequence[Any], frames: Mapping[str, FrameSpec],

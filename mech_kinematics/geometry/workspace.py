@@ -32,10 +32,16 @@ bounds). It gives
 Both curves are at the grid's resolution, stated with them (the point moves
 at most ``step`` times the largest ``|J|`` column between neighbours). NumPy
 only: the solver does the geometry.
+
+:func:`workspace` is the same map of any point a state gives (a reader of its
+position and velocity): a URDF link frame's origin, fixed in a scene body's
+frame (:func:`mech_kinematics.robot.targets.frame_workspace`), with ``lift``,
+the affine map of the loop's plane into the root frame the answer is told in.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 import math
 from typing import Any
@@ -46,11 +52,13 @@ import numpy.typing as npt
 
 from .region import _samples, domain, GRID
 from ..errors import NearSingularWarning, SceneError
-from ..solver import Scene, SceneUnits, solve
+from ..solver import Scene, SceneUnits, solve, State
 
-__all__ = ['Workspace', 'workspace_from_scene']
+__all__ = ['Workspace', 'workspace', 'workspace_from_scene']
 
 Array = npt.NDArray[np.float64]
+#: A point's position and velocity (complex, m and m/s) in a state (one or arrays).
+Reader = Callable[[State], tuple[Any, Any]]
 
 #: Neighbours are joined smoothly when the point moves between them at most this many times
 #: the larger of their first-order steps (Jacobian column times the grid step).
@@ -98,6 +106,12 @@ class Workspace:
     resolution : float
         The largest move of the point between smoothly joined grid neighbours,
         m: what both curves are good to.
+    start : ndarray, shape (2,)
+        The point where the drivers start (NaN where it does not assemble).
+    lift : (ndarray, ndarray) or None
+        ``(E, o)``: the point of the plane ``z`` is ``E @ z + o`` in the frame
+        the answer is told in (a URDF's root frame, ``E`` 3x2); ``None``: the
+        scene's plane itself.
     """
 
     scene: str
@@ -114,13 +128,21 @@ class Workspace:
     lock_drivers: Array
     jumps: Array
     resolution: float
+    start: Array
+    lift: tuple[Array, Array] | None = None
+
+    def told(self, points: Array) -> Array:
+        """Return points of the plane (shape (k, 2)) in the frame the answer is told in."""
+        if self.lift is None:
+            return points
+        e, o = self.lift
+        return np.asarray(points, dtype=np.float64).reshape(-1, 2) @ e.T + o
 
     @property
-    def extent(self) -> tuple[tuple[float, float], tuple[float, float]]:
-        """The point's (x min, x max), (y min, y max) over the grid, m."""
-        p = self.positions[self.assembles]
-        return ((float(p[:, 0].min()), float(p[:, 0].max())),
-                (float(p[:, 1].min()), float(p[:, 1].max())))
+    def extent(self) -> tuple[tuple[float, float], ...]:
+        """Each coordinate's (min, max) told (x, y; a URDF frame's z) over the grid, m."""
+        p = self.told(self.positions[self.assembles])
+        return tuple((float(p[:, k].min()), float(p[:, k].max())) for k in range(p.shape[1]))
 
 
 def workspace_from_scene(scene: Scene, point: str, grid: int = GRID) -> Workspace:
@@ -132,16 +154,25 @@ def workspace_from_scene(scene: Scene, point: str, grid: int = GRID) -> Workspac
         A scene without two drivers, a point it does not report, or one that
         assembles nowhere on the grid.
     """
-    drivers = scene.drivers
-    if len(drivers) != 2:
-        msg = (f'Expected a scene with two drivers for --workspace (a point has two '
-               f'coordinates), got {scene.name} with {len(drivers)}: '
-               f'{", ".join(d.name for d in drivers)}')
-        raise SceneError(msg)
+    _two_drivers(scene)
     if point not in scene.output_points:
         msg = (f'Expected --workspace to name a point {scene.name} reports '
                f'({", ".join(scene.output_points)}), got {point!r}')
         raise SceneError(msg)
+    return workspace(scene, point, lambda state: state.complex_points[point][:2], grid)
+
+
+def workspace(scene: Scene, point: str, read: Reader, grid: int = GRID,
+              lift: tuple[Array, Array] | None = None) -> Workspace:
+    """Map the workspace of the point ``read`` gives over ``scene``'s two drivers' grid.
+
+    ``read`` returns a state's position and velocity of the point (complex, m
+    and m/s; arrays for arrays), ``point`` is its name in the answer and
+    ``lift`` the map of the plane into the frame the answer is told in
+    (:attr:`Workspace.lift`). Raises :class:`SceneError` for a scene without
+    two drivers or where it assembles nowhere on the grid.
+    """
+    drivers = _two_drivers(scene)
     axes = tuple(_samples(d.joint_type, *domain(scene, d), grid) for d in drivers)
     grids = np.meshgrid(*axes, indexing='ij')
     shape = (len(axes[0]), len(axes[1]))
@@ -150,9 +181,8 @@ def workspace_from_scene(scene: Scene, point: str, grid: int = GRID) -> Workspac
     if not valid.any():
         msg = f'Expected {scene.name} to assemble somewhere on the grid, got nowhere'
         raise SceneError(msg)
-    p = np.asarray(first.points[point].position, dtype=np.float64).reshape(shape + (2,))
-    j0 = np.asarray(first.points[point].velocity, dtype=np.float64).reshape(shape + (2,))
-    j1 = np.asarray(second.points[point].velocity, dtype=np.float64).reshape(shape + (2,))
+    p, j0 = (_xy(z, shape) for z in read(first))
+    j1 = _xy(read(second)[1], shape)
     det = j0[..., 0] * j1[..., 1] - j0[..., 1] * j1[..., 0]
     p = np.where(valid[..., None], p, np.nan)
     det = np.where(valid, det, np.nan)
@@ -195,9 +225,8 @@ def workspace_from_scene(scene: Scene, point: str, grid: int = GRID) -> Workspac
         qa, qb, t, least = (np.concatenate(parts) for parts in zip(*crossings, strict=True))
         q = qa + t[:, None] * (qb - qa)
         one, two = _columns(scene, [q[:, 0], q[:, 1]])
-        here = np.asarray(one.points[point].position, dtype=np.float64).reshape(-1, 2)
-        k0 = np.asarray(one.points[point].velocity, dtype=np.float64).reshape(-1, 2)
-        k1 = np.asarray(two.points[point].velocity, dtype=np.float64).reshape(-1, 2)
+        here, k0 = (_xy(z, (-1,)) for z in read(one))
+        k1 = _xy(read(two)[1], (-1,))
         det_here = np.abs(k0[:, 0] * k1[:, 1] - k0[:, 1] * k1[:, 0])
         zero = np.asarray(one.valid, dtype=bool).reshape(-1) & (det_here <= ZERO * least)
         singular, singular_q = here[zero], q[zero]
@@ -207,7 +236,26 @@ def workspace_from_scene(scene: Scene, point: str, grid: int = GRID) -> Workspac
                      singular, singular_q,
                      np.array(locks, dtype=np.float64).reshape(-1, 2),
                      np.array(lock_q, dtype=np.float64).reshape(-1, 2),
-                     np.array(jumps, dtype=np.float64).reshape(-1, 2), max(moves))
+                     np.array(jumps, dtype=np.float64).reshape(-1, 2), max(moves),
+                     _xy(read(_columns(scene, [np.array([d.start]) for d in drivers])[0])[0],
+                         ()), lift)
+
+
+def _xy(z: Any, shape: tuple[int, ...]) -> Array:
+    """Return complex values as (x, y) pairs of ``shape + (2,)``."""
+    z = np.asarray(z, dtype=np.complex128)
+    return np.stack((z.real, z.imag), axis=-1).reshape(shape + (2,))
+
+
+def _two_drivers(scene: Scene) -> Any:
+    """Return the scene's drivers, two, or refuse: a point in the plane has two coordinates."""
+    drivers = scene.drivers
+    if len(drivers) != 2:
+        msg = (f'Expected a scene with two drivers for --workspace (a point has two '
+               f'coordinates), got {scene.name} with {len(drivers)}: '
+               f'{", ".join(d.name for d in drivers)}')
+        raise SceneError(msg)
+    return drivers
 
 
 def _pairs(x: Any, axis: int, wrap: bool) -> tuple[Any, Any]:

@@ -169,7 +169,17 @@ class Planar:
         point of the link's frame (m) into the body's own frame (the one a
         mass's ``com`` is given in): ``local = A @ p + b``, ``A`` 2x3. Only
         where the robot has masses (what its forces, and loads on its links,
-        read); empty otherwise.
+        read); empty otherwise (:meth:`link_frame` gives one when asked).
+    planes : dict of str to (str, ndarray, ndarray)
+        Each URDF link a loop moves: its scene body and the map of a point of
+        the link's frame into the scene's plane in the reference pose (``A @
+        p + b``).
+    lifts : dict of str to (int, ndarray, ndarray)
+        Each of those links: its mechanism's index and the affine map of a
+        point ``z`` of the scene's plane (m) to the ground link's frame at the
+        height of the link's frame origin over the plane, ``E @ z + o``
+        (``E`` 3x2: the plane's axes): where that origin is when ``z`` is
+        its place in the plane.
     """
 
     data: dict[str, Any]
@@ -180,6 +190,19 @@ class Planar:
     names: dict[str, str] = field(default_factory=dict)
     masses: dict[str, dict[str, Any]] = field(default_factory=dict)
     links: dict[str, tuple[str, Any, Any]] = field(default_factory=dict)
+    planes: dict[str, tuple[str, Any, Any]] = field(default_factory=dict)
+    lifts: dict[str, tuple[int, Any, Any]] = field(default_factory=dict)
+
+    def link_frame(self, link: str) -> tuple[str, Any, Any]:
+        """Return a moving link's map into its scene body's own frame (:attr:`links`' form).
+
+        Read from :attr:`links` where the robot has masses, else found from the
+        scene solved where its drivers start (``KeyError``: a link no loop moves).
+        """
+        if link in self.links:
+            return self.links[link]
+        body = self.planes[link][0]
+        return _link_frames({link: self.planes[link]}, _body_poses(self.data, [body]))[link]
 
 
 # --- names -----------------------------------------------------------------------------
@@ -661,6 +684,10 @@ class _Builder:
         #: URDF link a loop moves -> (its scene body, ``A``, ``b``): a point of the link's
         #: frame ``p`` is ``complex(*(A @ p + b))`` in the scene's plane (reference pose).
         self.link_planes: dict[str, tuple[str, Any, Any]] = {}
+        #: URDF link a loop moves -> (its mechanism's index, ``E``, ``o``): a point of the
+        #: scene's plane ``z`` (m) at the height of the link's frame origin over the plane is
+        #: ``E @ z + o`` in the mechanism's ground link's frame (``E`` 3x2).
+        self.link_lifts: dict[str, tuple[int, Any, Any]] = {}
 
     def fail(self, msg: str, joint: str | None = None) -> UrdfError:
         return UrdfError(f'{self.source}: {msg}', joint=joint)
@@ -735,9 +762,11 @@ class _Builder:
                     and body in self.body_names:
                 frame = m.frame[link]
                 axes = np.array([m.e1, m.e2])
+                shift = np.array([self.shift.real, self.shift.imag])
                 self.link_planes[link] = (self.body_names[body], axes @ frame[:3, :3],
-                                          axes @ frame[:3, 3] + np.array([self.shift.real,
-                                                                          self.shift.imag]))
+                                          axes @ frame[:3, 3] + shift)
+                self.link_lifts[link] = (m.index, axes.T, float(n @ frame[:3, 3]) * n
+                                         - axes.T @ shift)
         for body in m.bodies:
             if body == m.ground:
                 continue
@@ -1508,13 +1537,15 @@ def planar_from_description(description: Description, actuated: Iterable[str] | 
         data['dyads'] = builder.dyads
     if builder.points:
         data['points'] = builder.points
-    # The bodies' frames, for the masses and the links' loads: none without masses (no forces).
+    # The bodies' frames, for the masses and the links' loads: none without masses (no forces;
+    # Planar.link_frame finds one when asked).
     poses = _body_poses(data, [*builder.mass_props, *(body for body, _, _
                                                       in builder.link_planes.values())]
                         ) if builder.mass_props else {}
     return Planar(data, tuple(builder.drivers), builder.joint_maps, mechanisms, actuated_names,
                   dict(builder.names.changed), _scene_masses(builder.mass_props, poses),
-                  _link_frames(builder.link_planes, poses) if poses else {})
+                  _link_frames(builder.link_planes, poses) if poses else {},
+                  dict(builder.link_planes), dict(builder.link_lifts))
 
 
 def _body_poses(data: dict[str, Any], bodies: Iterable[str]) -> dict[str, Any]:

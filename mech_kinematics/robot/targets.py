@@ -36,6 +36,15 @@ so ``bp = sum c b_q``, ``bv = sum c b_qd + 2 S1 bp / R``,
 ``S1 = sum c |qd|``, ``S2 = sum c |qdd|``, each plus the rounding of the
 walk (``16 (k + 1) eps`` of the terms' scale over ``k`` joints).
 
+:func:`frame_workspace` maps where a link frame's origin goes over the grid
+of a two-driver robot's actuated joints (``check ROBOT.urdf --workspace
+FRAME``): the origin is fixed in its scene body's frame
+(:meth:`.Planar.link_frame`), so the scene's array path solves it
+(:func:`mech_kinematics.geometry.workspace.workspace`, with its singular
+curves), and the loop's plane is lifted into the root frame
+(:attr:`.Planar.lifts`, through the ground link's pose); the drivers' axes
+are the URDF joints' values.
+
 Pure: no ROS.
 """
 
@@ -50,14 +59,15 @@ import numpy as np
 import numpy.typing as npt
 
 from ..bounds import MAX_ERROR
-from ..errors import AssemblyError, TargetError
+from ..errors import AssemblyError, SceneError, TargetError
 from ..solver.inverse import continue_to, Inverse, TargetMap
 
 if TYPE_CHECKING:
     from .description import Description
     from .robot import Robot, RobotState
+    from ..geometry.workspace import Workspace
 
-__all__ = ['AXES', 'frame_motion', 'robot_targets', 'solve_robot_targets']
+__all__ = ['AXES', 'frame_motion', 'frame_workspace', 'robot_targets', 'solve_robot_targets']
 
 #: A frame target's coordinates, in the root frame.
 AXES = ('x', 'y', 'z')
@@ -244,6 +254,64 @@ def solve_robot_targets(robot: Robot, targets: Mapping[str, float],
         msg = f'Expected an answer whose forces can be trusted, got {error}'
         raise TargetError(msg) from None
     return replace(inverse, answer=answer)
+
+
+def frame_workspace(robot: Robot, link: str, grid: int | None = None) -> Workspace:
+    """Map the workspace of ``link``'s frame origin in the root frame (module text).
+
+    Over the grid of the robot's two actuated joints (``grid`` points each,
+    default :data:`~mech_kinematics.geometry.region.GRID`), told in the root
+    frame with the drivers under their URDF names and values (rad or m).
+
+    Raises
+    ------
+    SceneError
+        A link that is not the robot's or that its loops do not move, a robot
+        whose loops are not driven by two actuated joints of their own (a
+        mimic among the drivers), or one that assembles nowhere on the grid.
+    """
+    from ..geometry.frames import carried_motion, frames_from_scene
+    from ..geometry.region import GRID
+    from ..geometry.workspace import workspace
+
+    description, planar = robot.description, robot.planar
+    if link not in planar.planes:
+        moved = ', '.join(list(planar.planes)[:8]) + (', ...' if len(planar.planes) > 8 else '')
+        what = ('which its loops do not move' if link in description.links
+                else 'which is not one of its links')
+        msg = (f'Expected --workspace to name a link frame the loops of {robot.name} move '
+               f'({moved}) or a point of its scene, got {link!r}, {what}')
+        raise SceneError(msg)
+    drivers = planar.drivers
+    if len(drivers) != 2 or any(d.mimic is not None for d in drivers):
+        msg = (f'Expected a robot whose loops two actuated joints drive for --workspace (a '
+               f'point of the plane has two coordinates), got {robot.name} driven by '
+               f'{", ".join(d.name + (" (mimic)" if d.mimic else "") for d in drivers)}')
+        raise SceneError(msg)
+    body, _, local = planar.link_frame(link)
+    index, e, o = planar.lifts[link]
+    probe = robot.solve(max_error=math.inf, forces=False)
+    frames = description.transforms(description.pose(
+        {n: float(j.position) for n, j in probe.joints.items()}))
+    ground = frames[planar.mechanisms[index]['ground']]
+    rotation = ground[:3, :3]
+    spec = frames_from_scene(robot.scene, [body])[0]
+    at = (float(local[0]), float(local[1]))
+    ws = workspace(robot.scene, link, lambda state: carried_motion(spec, at, state),
+                   GRID if grid is None else grid, (rotation @ e, rotation @ o + ground[:3, 3]))
+    # The scene's drivers are the URDF joints: q = reference + sigma (scene - scene_ref).
+    sigma = np.array([d.sigma for d in drivers])
+    ref = np.array([d.reference for d in drivers])
+    scene_ref = np.array([d.scene_ref for d in drivers])
+
+    def joints(values: Any) -> Any:
+        return ref + sigma * (np.asarray(values, dtype=np.float64).reshape(-1, 2) - scene_ref)
+
+    return replace(ws, scene=robot.name, drivers=(drivers[0].name, drivers[1].name),
+                   axes=tuple(ref[k] + sigma[k] * (ws.axes[k] - scene_ref[k]) for k in range(2)),
+                   det=ws.det * float(sigma[0] * sigma[1]),
+                   singular_drivers=joints(ws.singular_drivers),
+                   lock_drivers=joints(ws.lock_drivers))
 
 
 def _cross(p: tuple[float, ...], q: tuple[float, ...]) -> tuple[float, float, float]:

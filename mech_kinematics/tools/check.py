@@ -12,7 +12,9 @@ grid over two drivers that assembles, each driver's ranges with the others
 at their start positions, stroke limits, and on request a map of the grid
 (``--map`` as text, ``--png FILE`` as a picture). ``--workspace POINT`` on a
 scene with two drivers maps where the point can go instead, with its singular
-curves (:mod:`mech_kinematics.geometry.workspace`).
+curves (:mod:`mech_kinematics.geometry.workspace`); on a URDF,
+``--workspace FRAME`` maps a link frame's origin in the root frame
+(:func:`mech_kinematics.robot.targets.frame_workspace`).
 
 A scene with forces (``masses``, ``gravity`` or ``loads``) gets its
 turning-moment diagram too (:mod:`mech_kinematics.geometry.turning`): each
@@ -583,13 +585,15 @@ def workspace_text(ws: Any) -> str:
     def length(value: float) -> str:
         return units.length_text(value)
 
-    (x0, x1), (y0, y1) = ws.extent
     total = ws.assembles.size
-    lines = [f'{ws.scene}: workspace of {ws.point} over {ws.drivers[0]} x {ws.drivers[1]} '
+    ranges = ', '.join(f'{axis} from {length(lo)} to {length(hi)}'
+                       for axis, (lo, hi) in zip('xyz', ws.extent))
+    told = '' if ws.lift is None else ' (in the root frame)'
+    what = ws.point if ws.lift is None else f'frame {ws.point}'
+    lines = [f'{ws.scene}: workspace of {what} over {ws.drivers[0]} x {ws.drivers[1]} '
              f'({len(ws.axes[0])} x {len(ws.axes[1])} points; assembles at '
              f'{100.0 * float(ws.assembles.mean()):.4g}%, {int(ws.assembles.sum())} of {total})',
-             f'{ws.point}: x from {length(x0)} to {length(x1)}, y from {length(y0)} to '
-             f'{length(y1)}',
+             f'{ws.point}{told}: {ranges}',
              f'the drivers lose control (det J = 0): {len(ws.inverse_singular)} points, solved '
              'on the grid edges where det J changes sign',
              f'the loop locks (the edge of where it assembles): {len(ws.locks)} points, at the '
@@ -603,22 +607,31 @@ def workspace_text(ws: Any) -> str:
 
 def workspace_json(ws: Any) -> dict[str, Any]:
     """Return the report of ``check --workspace --json``: SI units (m, rad)."""
-    (x0, x1), (y0, y1) = ws.extent
-    return {
+    out = {
         'scene': ws.scene, 'point': ws.point, 'drivers': list(ws.drivers),
         'grid': {'points': [len(a) for a in ws.axes], 'assembling': int(ws.assembles.sum()),
                  'fraction': float(ws.assembles.mean())},
-        'extent': {'x': [x0, x1], 'y': [y0, y1]},
-        'inverse_singular': {'positions': ws.inverse_singular.tolist(),
+        'extent': {axis: list(span) for axis, span in zip('xyz', ws.extent)},
+        'inverse_singular': {'positions': ws.told(ws.inverse_singular).tolist(),
                              'drivers': ws.singular_drivers.tolist()},
-        'locks': {'positions': ws.locks.tolist(), 'drivers': ws.lock_drivers.tolist()},
-        'jumps': ws.jumps.tolist(),
+        'locks': {'positions': ws.told(ws.locks).tolist(), 'drivers': ws.lock_drivers.tolist()},
+        'jumps': ws.told(ws.jumps).tolist(),
         'resolution': ws.resolution,
+        'start': ws.told(ws.start)[0].tolist() if np.isfinite(ws.start).all() else None,
     }
+    if ws.lift is not None:     # a URDF frame: told in the root frame, with the loop's plane
+        e, o = ws.lift
+        out['frame'] = 'root'
+        out['plane'] = {'origin': o.tolist(), 'x': e[:, 0].tolist(), 'y': e[:, 1].tolist()}
+    return out
 
 
-def write_workspace_png(ws: Any, path: str) -> None:
-    """Write the workspace as a PNG picture: where the point goes and its singular curves."""
+def write_workspace_png(ws: Any, path: str, space: Any = None) -> None:
+    """Write the workspace as a PNG picture: where the point goes and its singular curves.
+
+    ``space``: the mechanism to draw under it (a
+    :class:`~mech_kinematics.geometry.diagrams.SpaceDiagram`, in the plane).
+    """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -626,16 +639,36 @@ def write_workspace_png(ws: Any, path: str) -> None:
     figure = Figure(figsize=(6.0, 6.0))
     FigureCanvasAgg(figure)
     axes = figure.add_subplot()
-    reach = ws.positions[ws.assembles] * scale
+    # A URDF frame: drawn in the loop's plane, at the root frame's coordinates along its axes.
+    e = np.eye(2) if ws.lift is None else ws.lift[0]
+
+    def drawn(points: Any) -> Any:
+        return ws.told(points) @ e * scale
+
+    if space is not None:   # the mechanism where its drivers start, under the map
+        for link in space.links:
+            outline = drawn(link.outline if len(link.outline) <= 2
+                            else np.vstack([link.outline, link.outline[:1]]))
+            axes.plot(*outline.T, c='0.3', lw=1.5, zorder=3)
+        for pivot in space.pivots:
+            axes.plot(*drawn(pivot.xy).T, 'k^', ms=6, zorder=4)
+    reach = drawn(ws.positions[ws.assembles])
     axes.scatter(reach[:, 0], reach[:, 1], s=1, c='0.75', label=f'{ws.point} reaches')
     for points, colour, label in ((ws.inverse_singular, 'tab:red', 'det J = 0'),
                                   (ws.locks, 'tab:blue', 'the loop locks')):
         if len(points):
-            axes.scatter(points[:, 0] * scale, points[:, 1] * scale, s=3, c=colour,
-                         label=label)
+            axes.scatter(*drawn(points).T, s=3, c=colour, label=label)
+    if np.isfinite(ws.start).all():
+        axes.plot(*drawn(ws.start).T, '*', c='tab:orange', ms=10, zorder=5,
+                  label=f'{ws.point} where the drivers start')
     axes.set_aspect('equal')
-    axes.set_xlabel(f'x ({ws.units.length})')
-    axes.set_ylabel(f'y ({ws.units.length})')
+    if ws.lift is None:
+        axes.set_xlabel(f'x ({ws.units.length})')
+        axes.set_ylabel(f'y ({ws.units.length})')
+    else:
+        for label, k in ((axes.set_xlabel, 0), (axes.set_ylabel, 1)):
+            axis = ', '.join(f'{round(float(v), 12) + 0.0:.3g}' for v in e[:, k])
+            label(f'along ({axis}) of the root frame ({ws.units.length})')
     axes.legend(loc='upper right', fontsize='small')
     axes.set_title(f'{ws.scene}: the workspace of {ws.point}')
     figure.savefig(path, dpi=100)
@@ -649,13 +682,23 @@ def _handle_workspace(args: argparse.Namespace, scene: Any) -> int:
     if given:
         msg = f'Expected --workspace without {", ".join(given)}, got both'
         raise SceneError(msg)
-    ws = workspace_from_scene(scene, args.workspace, args.grid)
+    if is_urdf(args.scene) and args.workspace not in scene.output_points:
+        from ..robot.targets import frame_workspace     # a link frame, in the root frame
+
+        ws = frame_workspace(load_robot_argument(args), args.workspace, args.grid)
+    else:
+        ws = workspace_from_scene(scene, args.workspace, args.grid)
     if args.json:
         print(json.dumps(workspace_json(ws), indent=1, allow_nan=False))
     else:
         print(workspace_text(ws))
     if args.png is not None:
-        write_workspace_png(ws, args.png)
+        from ..geometry.diagrams import space_from_state
+        from ..geometry.instant_centres import full_scene
+        from ..geometry.urdf import _assembled
+
+        full = full_scene(scene)
+        write_workspace_png(ws, args.png, space_from_state(full, _assembled(full)))
     return 0
 
 
@@ -820,7 +863,9 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     parser.add_argument('--workspace', metavar='POINT',
                         help='a scene with two drivers: map where POINT can go over the grid, '
                              'with its singular curves (det J = 0, where the drivers lose '
-                             'control, and where the loop locks); --png draws it')
+                             'control, and where the loop locks); a URDF: POINT may be a '
+                             'link frame (its origin, in the root frame); --png draws it over '
+                             'the mechanism')
     parser.add_argument('--flywheel', type=coefficient, metavar='CS',
                         help='a scene with forces and one crank: the moment of inertia of a '
                              'flywheel for the coefficient of fluctuation of speed CS = (w_max - '
