@@ -206,9 +206,6 @@ class KinematicsNode(LifecycleNode):
             raise SceneError(f'extra_joints: Expected drive: {self._value("drive")} without '
                              'extra_joints (a message names targets or drivers only), got '
                              'extra_joints')
-        if self._value('drive') == TRAJECTORY and source.robot is not None:
-            raise SceneError('drive: Expected drive: trajectory with a scene (a URDF robot '
-                             'driven by a trajectory is not built yet), got a robot')
         if source.robot is not None:     # what would be accepted and ignored is refused
             note = robot_forces_note(source.robot)
             refusal = robot_forces_refusal(note, self._value('drive'), self._value('effort'),

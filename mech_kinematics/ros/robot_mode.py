@@ -373,25 +373,29 @@ class RobotValues:
         """Return the scene's drivers' positions and speeds of the actuated joints' (in order)."""
         p_out = [scene_ref + sigma * (m * positions[k] + o - reference)
                  for k, m, o, sigma, reference, scene_ref in self._inputs]
-        if speeds is None:
-            return p_out, None
-        return p_out, [sigma * m * speeds[k] for k, m, _o, sigma, _r, _s in self._inputs]
+        return p_out, self.scene_rates(speeds)
 
-    def values(self, values: Sequence[float], given: tuple[Sequence[float],
-                                                           Sequence[float] | None] | None = None
-               ) -> list[float]:
+    def scene_rates(self, rates: Sequence[float] | None) -> list[float] | None:
+        """Return the scene's drivers' speeds (or accelerations) of the actuated joints'."""
+        if rates is None:
+            return None
+        return [sigma * m * rates[k] for k, m, _o, sigma, _r, _s in self._inputs]
+
+    def values(self, values: Sequence[float], given: tuple[Sequence[float] | None, ...] | None
+               = None) -> list[float]:
         """Return the URDF joints' values of a tick's ``values``, then the scene's points'.
 
         Then the rest of ``values`` unchanged: the forces a forces tick appends
         (:class:`~mech_kinematics.ros.robot_forces.RobotForcesTick`).
 
-        ``given``: the actuated joints' (positions, speeds or None) of an
-        input message, echoed as given (None: the clock's tick, every joint
-        from the scene's coordinates).
+        ``given``: the actuated joints' (positions, speeds or None[,
+        accelerations or None]) of an input message or a trajectory's point,
+        echoed as given (None: the clock's tick, every joint from the scene's
+        coordinates).
         """
         if given is None:
-            return self._on_clock(values, None, None)
-        return self._on_input(values, given[0], given[1])
+            return self._on_clock(values, None, None, None)
+        return self._on_input(values, given[0], given[1], given[2] if len(given) > 2 else None)
 
     def answer(self, first: tuple[Sequence[float], float],
                given: tuple[Sequence[float], Sequence[float] | None],
@@ -424,7 +428,7 @@ class RobotValues:
         return answers[combo] if at(combo) is not None else answers[assemblies.zero]
 
     def _compile(self, recipes: Sequence[tuple[Any, ...]], what: str) -> Any:
-        """Return the recipes written out as one function ``f(values, positions, speeds)``.
+        """Return the recipes written out as one function ``f(values, positions, speeds, accels)``.
 
         Straight-line code, as the node's message templates are (a message of
         the motors at kilohertz rates pays for every loop and lookup); the
@@ -433,7 +437,7 @@ class RobotValues:
         (``test_robot_mode``).
         """
         n = self._n
-        lines = [f'def {what}(x, gp, gs):']
+        lines = [f'def {what}(x, gp, gs, ga):']
         for j, recipe in enumerate(recipes):
             kind = recipe[0]
             if kind == 'map':
@@ -451,7 +455,8 @@ class RobotValues:
             elif kind == 'given':
                 k = recipe[1]
                 lines += [f'    p{j} = float(gp[{k}])',
-                          f'    v{j} = 0.0 if gs is None else float(gs[{k}])', f'    a{j} = 0.0']
+                          f'    v{j} = 0.0 if gs is None else float(gs[{k}])',
+                          f'    a{j} = 0.0 if ga is None else float(ga[{k}])']
             elif kind == 'driver':
                 _kind, i, scene_ref, sigma, reference = recipe
                 lines += [f'    p{j} = {reference!r} + (x[{i}] - {scene_ref!r}) / {sigma!r}',

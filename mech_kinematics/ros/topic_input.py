@@ -99,7 +99,7 @@ class InputSubscription:
         ``topic`` (default); ``target``: subscribe to ``input_targets`` and read
         each message's targets into the drivers that put them there
         (:class:`~.target_drive.TargetDrive`); ``trajectory``: subscribe to
-        ``input_trajectory`` and publish each point (a scene's only).
+        ``input_trajectory`` and publish each point.
     target_robot : Robot, optional
         In URDF mode with ``target``: the robot whose joints and frames the
         targets name.
@@ -137,12 +137,11 @@ class InputSubscription:
         self.drive = drive
         if drive == TOPIC:
             self.topic = TopicDrive(drivers, extra_joints=extra_joints, **rules)
-        elif target_robot is not None:
-            self.topic = robot_target_drive(target_robot, drivers, solver.max_error, **rules)
         else:
-            self.topic = scene_target_drive(
-                scene, solver.max_error, **rules,
-                **({'topic_name': topics.INPUT_TRAJECTORY} if drive == TRAJECTORY else {}))
+            named = {'topic_name': topics.INPUT_TRAJECTORY} if drive == TRAJECTORY else {}
+            self.topic = scene_target_drive(scene, solver.max_error, **rules, **named) \
+                if target_robot is None else \
+                robot_target_drive(target_robot, drivers, solver.max_error, **rules, **named)
         self.active = False
         #: joint_states templates with the passed joints, by (names, velocities, efforts).
         self._passed: dict[tuple[tuple[str, ...], bool, bool], MessageTemplate | None] = {}
@@ -211,7 +210,7 @@ class InputSubscription:
             values, measure = self._solve(given)
             if self.robot is not None:   # in the assembly Robot.solve answers (robot/assembly.py)
                 values, measure = self.robot.answer(
-                    (values, measure), (given.positions, given.speeds),
+                    (values, measure), (given.positions, given.speeds, given.accels),
                     lambda combo: self._solve(given, self._assembly_tick(combo)))
         except (RefusedInput, AssemblyError) as exc:
             if isinstance(exc, AssemblyError) and self.robot is not None and given is not None:
@@ -323,15 +322,16 @@ class InputSubscription:
         than the solver's (the robot's scene in another assembly).
         """
         solver = self.solver
-        positions, speeds = given.positions, given.speeds
+        positions, speeds, accels = given.positions, given.speeds, given.accels
         if self.robot is not None:
             forces = self.publishing.forces
             if forces is not None:    # a robot's forces read the actuated joints as given
-                forces.inputs = (positions, speeds)
+                forces.inputs = (positions, speeds, accels)
             positions, speeds = self.robot.scene_inputs(positions, speeds)
+            accels = self.robot.scene_rates(accels)
         n = len(positions)
         speeds = (0.0,) * n if speeds is None else speeds
-        accels = (0.0,) * n if given.accels is None else given.accels
+        accels = (0.0,) * n if accels is None else accels
         solve = solver.solve if tick is None else tick
         assert solve is not None
         if n == 1:

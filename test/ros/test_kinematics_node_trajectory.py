@@ -11,10 +11,17 @@ accelerations and the motors' efforts of that motion (the feed-forward torques)
 in ``joint_states.effort``: checked against ``mk.solve`` and
 ``mk.solve_targets`` at the same motion. A point without accelerations is
 refused on diagnostics while the points after it are answered. The packaged
-gripper's fingertip IMU publishes each point's reading.
+gripper's fingertip IMU publishes each point's reading. In URDF mode the lift
+arm (``<inertial>``s) is driven by points of its motor and of its tool frame's
+height: ``joint_states`` names the URDF's joints, checked against
+``Robot.solve`` and ``Robot.solve_targets`` at the same motion, the motor's
+effort (gravity in the root frame and inertia) included.
 """
 
+from pathlib import Path
+
 from diagnostic_msgs.msg import DiagnosticStatus
+from helpers import UrdfFk
 import numpy as np
 import pytest
 from rclpy.qos import QoSProfile, ReliabilityPolicy
@@ -24,6 +31,7 @@ from test_kinematics_node_topic import ANSWER_S, T0, TopicNode
 from trajectory_msgs.msg import JointTrajectory
 
 import mech_kinematics as mk
+from mech_kinematics.robot import load_robot
 
 SCENE = 'five_bar_payload'
 FIVE = mk.load_scene(SCENE)
@@ -142,3 +150,60 @@ def test_each_point_gives_the_imus_readings(ros, tmp_path):
         a = msg.linear_acceleration
         np.testing.assert_allclose([a.x, a.y], reading['linear_acceleration'], rtol=0,
                                    atol=1e-12 * np.hypot(*reading['linear_acceleration']))
+
+
+LIFT = Path(__file__).resolve().parents[1] / 'data' / 'urdf' / 'lift_arm.urdf'
+
+
+def test_a_urdf_robot_by_its_motor_and_by_its_tool_frame_with_its_efforts(ros, tmp_path):
+    """The lift arm's points: the URDF's joints, their accelerations and the motor's effort."""
+    robot = load_robot(LIFT)
+    fk = UrdfFk(LIFT.read_text())
+    start = robot.start('lift_joint')
+    name = 'trajectory_urdf'
+    node = TopicNode(ros, tmp_path, name, scene=str(LIFT), drive='trajectory',
+                     input_topic=f'{SESSION}/{name}/input_trajectory',
+                     input_type=JointTrajectory, greeting=(['lift_joint'], [start]))
+    motor = [(5 * MS * i, [start + 0.01 * i], [0.3 - 0.05 * i], [2.0 * (-1) ** i])
+             for i in range(1, 6)]
+    last = robot.solve({'lift_joint': motor[-1][1][0]}, forces=False)
+    z0 = float(fk.transforms({n: float(j.position) for n, j in last.joints.items()})[
+        'tool_frame'][2, 3])
+    tool = [(5 * MS * i, [z0 + 0.004 * (i - 5)], [0.05], [0.2]) for i in range(6, 10)]
+    try:
+        node.send_points(T0, ['lift_joint'], motor)
+        wait_for(lambda: len(node.js) >= len(motor), ANSWER_S, 'joint_states')
+        node.send_points(T0, ['tool_frame.z'], tool)
+        wait_for(lambda: len(node.js) >= len(motor) + len(tool), ANSWER_S, 'joint_states')
+        wait_for(lambda: len(node.jt) >= len(motor) + len(tool), ANSWER_S,
+                 'joint_accelerations')
+        assert node.proc.proc.poll() is None
+    finally:
+        node.stop()
+    assert [stamp_ns(m) for m in node.js] == [T0 + at for at, *_ in [*motor, *tool]]
+    names = list(robot.joint_names)
+    lift = names.index('lift_joint')
+    previous = {'lift_joint': motor[-1][1][0]}
+    for k, (js, jt) in enumerate(zip(node.js, node.jt, strict=True)):
+        assert js.name == names
+        if k < len(motor):
+            _, q, qd, qdd = motor[k]
+            answer = robot.solve({'lift_joint': q[0]}, {'lift_joint': qd[0]},
+                                 {'lift_joint': qdd[0]})
+        else:
+            _, z, v, a = tool[k - len(motor)]
+            inverse = robot.solve_targets({'tool_frame.z': z[0]}, {'tool_frame.z': v[0]},
+                                          {'tool_frame.z': a[0]}, start=previous)
+            previous = {'lift_joint': float(inverse.motion[0, 0])}
+            answer = inverse.answer
+            values = dict(zip(names, js.position, strict=True))
+            assert abs(fk.transforms(values)['tool_frame'][2, 3] - z[0]) <= 1e-12
+        np.testing.assert_allclose(js.position, [answer.joints[n].position for n in names],
+                                   rtol=0, atol=1e-12)
+        np.testing.assert_allclose(js.velocity, [answer.joints[n].velocity for n in names],
+                                   rtol=0, atol=1e-12)
+        np.testing.assert_allclose(jt.points[0].accelerations,
+                                   [answer.joints[n].acceleration for n in names],
+                                   rtol=0, atol=1e-9)
+        effort = answer.efforts.efforts['lift_joint']
+        assert js.effort[lift] == pytest.approx(effort, rel=1e-9, abs=1e-9)

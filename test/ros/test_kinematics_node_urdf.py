@@ -372,9 +372,10 @@ def test_a_stop_while_the_start_reads_a_large_urdf_ends_it_at_once(ros, tmp_path
     (('-p', 'scene:=five_bar', '-p', 'drive:=target', '-p', 'extra_joints:=ignore'),
      'cannot start: extra_joints: Expected drive: target without extra_joints (a message names '
      'targets or drivers only), got extra_joints'),
-    (('-p', f'scene:={DATA / "lift_arm.urdf"}', '-p', 'drive:=trajectory'),
-     'cannot start: drive: Expected drive: trajectory with a scene (a URDF robot driven by a '
-     'trajectory is not built yet), got a robot'),
+    (('-p', f'scene:={DATA / "lift_arm.urdf"}', '-p', 'drive:=trajectory', '-p',
+      'extra_joints:=pass'),
+     'cannot start: extra_joints: Expected drive: trajectory without extra_joints (a message '
+     'names targets or drivers only), got extra_joints'),
     (('-p', f'scene:={DATA / "robotiq_2f_85.urdf"}', '-p',
       f'loop_closures:={DATA / "robotiq_2f_85.loop_closures.yaml"}', '-p', 'effort:=static'),
      "cannot start: Expected no forces parameters for this robot (the URDF's links carry no "
