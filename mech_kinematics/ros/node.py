@@ -53,6 +53,7 @@ from .robot_mode import load_source, robot_forces_refusal
 from .schedule import period_ns_from_rate
 from .solver_path import SolverPath
 from .startup import stop_raises
+from .target_drive import target_branch
 from .tick_thread import TickThread, TickThreadError
 from .topic_input import InputSubscription
 from .watchdog import PublishWatch, PublishWatchdog
@@ -206,6 +207,7 @@ class KinematicsNode(LifecycleNode):
             raise SceneError(f'extra_joints: Expected drive: {self._value("drive")} without '
                              'extra_joints (a message names targets or drivers only), got '
                              'extra_joints')
+        branch = target_branch(self._value('target_branch'), self._value('drive'))
         if source.robot is not None:     # what would be accepted and ignored is refused
             note = robot_forces_note(source.robot)
             refusal = robot_forces_refusal(note, self._value('drive'), self._value('effort'),
@@ -257,7 +259,7 @@ class KinematicsNode(LifecycleNode):
                 self, scene, self._solver, publishing, self._stats, frame_id=self.frame_id,
                 extra_joints=self.extra_joints, jump_back_s=self._value('stamp_jump_back_s'),
                 robot=publishing.robot_values, drive=self._value('drive'),
-                target_robot=source.robot)
+                target_robot=source.robot, branch=branch)
         elif publishing.robot_values is not None and publishing.robot_values.clock_note:
             self.get_logger().warning(publishing.robot_values.clock_note)
         self.scene = scene

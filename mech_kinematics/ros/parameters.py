@@ -171,6 +171,12 @@ PARAMETERS = (
                   'accelerations: its state and the efforts of that motion at the stamp '
                   'plus its time_from_start)',
                   choices=DRIVE_MODES, read_only=True),
+    ParameterSpec('target_branch', 'string_array', None,
+                  'With drive: target or trajectory, the working mode of every answer to '
+                  "targets: JOINT=+1 or JOINT=-1 entries, the sign of a joint's angle in "
+                  "(-pi, pi] (a scene's pin between two moving links, a URDF's revolute joint "
+                  'of a loop; docs/targets.md), one per leg. Defaults to none: the mode '
+                  'continued from the start pose', read_only=True),
     ParameterSpec('extra_joints', 'string', None,
                   "With drive: topic, what an input message's joints that are not drivers "
                   'do: refuse the message, ignore them (the drivers are taken), or pass them '

@@ -30,17 +30,18 @@ Pure: no ROS. Thread use: one thread (the executor's), as TopicDrive.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
 import math
 from typing import Any, NoReturn
 
+from .parameters import TARGET, TRAJECTORY
 from .topic_drive import RefusedInput, TopicDrive, TopicInput
 from .topics import INPUT_TARGETS
 from ..errors import TargetError
-from ..solver.inverse import continue_to, scene_targets, TargetMap
+from ..solver.inverse import check_branch, continue_to, parse_branch, scene_targets, TargetMap
 
-__all__ = ['TargetDrive', 'robot_target_drive', 'scene_target_drive']
+__all__ = ['TargetDrive', 'robot_target_drive', 'scene_target_drive', 'target_branch']
 
 #: Sets of target names whose maps are kept (all dropped past it).
 MAPS = 16
@@ -61,6 +62,10 @@ class TargetDrive:
         The drivers' values the first answer continues from (the start pose).
     max_error : float
         The solver's tolerance, which the inverse's drivers' bounds meet too.
+    branch : mapping of str to int, optional
+        The working mode of every answer (``target_branch``: joint -> +1 or
+        -1, :func:`~mech_kinematics.solver.inverse.in_mode`); checked against
+        the joints the maps read (:class:`TargetError`).
     **topic : Any
         What :class:`~.topic_drive.TopicDrive` takes beside the drivers
         (``extra_joints`` is ``refuse``: a message names targets only).
@@ -68,9 +73,13 @@ class TargetDrive:
 
     def __init__(self, drivers: Sequence[Any], targets_of: Callable[[tuple[str, ...]], TargetMap],
                  start: Sequence[float], max_error: float, topic_name: str = INPUT_TARGETS,
-                 **topic: Any) -> None:
+                 branch: Mapping[str, int] | None = None, **topic: Any) -> None:
         self.targets_of = targets_of
         self.max_error = max_error
+        self.branch = dict(branch) if branch else None
+        if self.branch:    # the joints a mode reads are the loop's, whatever the targets
+            check_branch(targets_of(tuple(d.name for d in drivers)), self.branch,
+                         'target_branch')
         self.topic_name = topic_name
         self.topic = TopicDrive(drivers, topic=topic_name, **topic)
         self.names = self.topic.names
@@ -145,7 +154,7 @@ class TargetDrive:
         try:       # the accelerations and the forward answer only for a trajectory's points
             inverse = continue_to(tmap, goal, self.start, speeds, accels,
                                   max_error=self.max_error, known=known,
-                                  answer=accels is not None)
+                                  answer=accels is not None, branch=self.branch)
         except TargetError as error:
             self._refuse(str(error))
         drivers = [float(x) for x in inverse.motion[:, 0]]
@@ -171,6 +180,30 @@ class TargetDrive:
 
     def _refuse(self, reason: str) -> NoReturn:
         raise RefusedInput(f'{self.topic_name}: {reason}')
+
+
+def target_branch(entries: Sequence[str] | None, drive: str) -> dict[str, int] | None:
+    """Return the ``target_branch`` parameter as {joint: sign}, or refuse it (ValueError).
+
+    None where it is not given (or empty); refused with a drive that takes no
+    targets, for an entry not ``JOINT=+1|-1`` or a joint named twice.
+    """
+    if not entries:
+        return None
+    if drive not in (TARGET, TRAJECTORY):
+        msg = (f'target_branch: Expected drive: target or trajectory with target_branch (the '
+               f'working mode of the answers to targets), got drive: {drive}')
+        raise ValueError(msg)
+    out: dict[str, int] = {}
+    for entry in entries:
+        try:
+            name, sign = parse_branch(entry)
+        except ValueError as error:
+            raise ValueError(f'target_branch: {error}') from None
+        if name in out:
+            raise ValueError(f'target_branch: expected each joint once, got {name} twice')
+        out[name] = sign
+    return out
 
 
 def scene_target_drive(scene: Any, max_error: float, **topic: Any) -> TargetDrive:

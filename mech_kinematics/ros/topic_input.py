@@ -33,6 +33,7 @@ Thread use: the executor's thread only.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 import math
 import time
 from typing import Any, TYPE_CHECKING
@@ -103,6 +104,8 @@ class InputSubscription:
     target_robot : Robot, optional
         In URDF mode with ``target``: the robot whose joints and frames the
         targets name.
+    branch : mapping of str to int, optional
+        ``target_branch``: the working mode of every answer to targets.
 
     Attributes
     ----------
@@ -115,7 +118,8 @@ class InputSubscription:
     def __init__(self, node: Any, scene: Any, solver: SolverPath, publishing: Publishing,
                  stats: TickStats, *, frame_id: str, extra_joints: str,
                  jump_back_s: float, robot: RobotValues | None = None,
-                 drive: str = TOPIC, target_robot: Any = None) -> None:
+                 drive: str = TOPIC, target_robot: Any = None,
+                 branch: Mapping[str, int] | None = None) -> None:
         self.node, self.solver, self.publishing, self.stats = node, solver, publishing, stats
         self.frame_id = frame_id
         self.robot = robot
@@ -138,7 +142,9 @@ class InputSubscription:
         if drive == TOPIC:
             self.topic = TopicDrive(drivers, extra_joints=extra_joints, **rules)
         else:
-            named = {'topic_name': topics.INPUT_TRAJECTORY} if drive == TRAJECTORY else {}
+            named: dict[str, Any] = {'branch': branch}
+            if drive == TRAJECTORY:
+                named['topic_name'] = topics.INPUT_TRAJECTORY
             self.topic = scene_target_drive(scene, solver.max_error, **rules, **named) \
                 if target_robot is None else \
                 robot_target_drive(target_robot, drivers, solver.max_error, **rules, **named)

@@ -62,7 +62,8 @@ if TYPE_CHECKING:
     from .mechanism import Scene
     from .state import State
 
-__all__ = ['Inverse', 'TargetMap', 'continue_to', 'in_mode', 'scene_targets', 'solve_targets']
+__all__ = ['Inverse', 'TargetMap', 'check_branch', 'continue_to', 'in_mode', 'parse_branch',
+           'scene_targets', 'solve_targets']
 
 #: Newton iterations tried per continuation step before the step is halved.
 _ITERATIONS = 12
@@ -427,6 +428,29 @@ def _starts(tmap: TargetMap, start: Sequence[float]) -> list[npt.NDArray[np.floa
     return [first] + [q for q in grid if not np.array_equal(q, first)]
 
 
+def parse_branch(text: str) -> tuple[str, int]:
+    """Return ``JOINT=+1|-1`` (or ``+``, ``-``) as (joint, sign); ValueError says why not."""
+    name, sep, value = text.rpartition('=')
+    signs = {'+1': 1, '+': 1, '1': 1, '-1': -1, '-': -1}
+    if not sep or not name or value.strip() not in signs:
+        msg = f"expected JOINT=+1 or JOINT=-1 (the sign of the joint's angle), got {text!r}"
+        raise ValueError(msg)
+    return name, signs[value.strip()]
+
+
+def check_branch(tmap: TargetMap, branch: Mapping[str, int], flag: str = '--branch') -> None:
+    """Refuse (TargetError) a working mode naming a joint ``tmap`` cannot read, or a bad sign."""
+    unknown = [j for j in branch if j not in tmap.elbows]
+    if unknown:
+        msg = (f'Expected {flag} to name joints between two moving bodies '
+               f'({", ".join(tmap.elbows) or "none"}), got {", ".join(unknown)}')
+        raise TargetError(msg)
+    bad = [f'{j}={branch[j]}' for j in branch if branch[j] not in (1, -1)]
+    if bad:
+        msg = f'Expected {flag} JOINT=+1 or JOINT=-1, got {", ".join(bad)}'
+        raise TargetError(msg)
+
+
 def in_mode(tmap: TargetMap, goal: Sequence[float], start: Sequence[float],
             speeds: Sequence[float] | None, accels: Sequence[float] | None,
             branch: Mapping[str, int], *, max_error: float = MAX_ERROR,
@@ -444,15 +468,7 @@ def in_mode(tmap: TargetMap, goal: Sequence[float], start: Sequence[float],
     and the signs are checked at the answer.
     """
     joints = tuple(branch)
-    unknown = [j for j in joints if j not in tmap.elbows]
-    if unknown:
-        msg = (f'Expected --branch to name joints between two moving bodies '
-               f'({", ".join(tmap.elbows) or "none"}), got {", ".join(unknown)}')
-        raise TargetError(msg)
-    bad = [f'{j}={branch[j]}' for j in joints if branch[j] not in (1, -1)]
-    if bad:
-        msg = f'Expected --branch JOINT=+1 or JOINT=-1, got {", ".join(bad)}'
-        raise TargetError(msg)
+    check_branch(tmap, branch)
     wanted = tuple(int(branch[j]) for j in joints)
     asked = ', '.join(f'{j} {"+" if s > 0 else "-"}' for j, s in zip(joints, wanted, strict=True))
     tried = 0

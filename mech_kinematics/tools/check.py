@@ -733,15 +733,26 @@ def target_report(inverse: Any, tmap: Any, singularity: Mapping[str, float]) -> 
 
 
 def target_text(report: dict[str, Any], tmap: Any, name: str,
-                driver_text: Callable[[int, float], str]) -> str:
-    """Return :func:`target_report` as lines of text (targets and drivers in their units)."""
+                driver_text: Callable[[int, float], str],
+                start: Sequence[float] | None = None) -> str:
+    """Return :func:`target_report` as lines of text (targets and drivers in their units).
+
+    ``start``: the start pose asked; an answer continued from another (a
+    working mode asked, found from the grid of start poses) says which.
+    """
     goal = ', '.join(f'{n} = {tmap.text(i, v)}'
                      for i, (n, v) in enumerate(report['targets'].items()))
     drivers = ', '.join(f'{n} = {driver_text(i, v)}'
                         for i, (n, v) in enumerate(report['drivers'].items()))
     bounds = ', '.join(f'{b:.2g}' for b in report['error_bound'].values())
     sigma = ', '.join(f'{x:.6g}' for x in report['scaled_singular_values'])
-    lines = [f'{name}: {goal}: reached from the start pose in {report["steps"]} step'
+    origin = list(report['continued_from'].values())
+    where = 'the start pose'
+    if start is not None and origin != [float(x) for x in start]:
+        where = ('the nearest start pose in the working mode asked (' + ', '.join(
+            f'{n} = {driver_text(i, v)}'
+            for i, (n, v) in enumerate(report['continued_from'].items())) + ')')
+    lines = [f'{name}: {goal}: reached from {where} in {report["steps"]} step'
              f'{"s" if report["steps"] != 1 else ""}',
              f'drivers: {drivers} (error bounds {bounds}, rad or m)',
              f'jacobian: det J = {report["det_jacobian"]:.6g} (SI); scaled (targets and '
@@ -794,7 +805,7 @@ def _handle_target(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(report, indent=1, allow_nan=False))
     else:
-        print(target_text(report, tmap, args.scene, driver_text))
+        print(target_text(report, tmap, args.scene, driver_text, start))
     return 0
 
 

@@ -418,12 +418,12 @@ def named_value(text: str) -> tuple[str | None, float]:
 
 def branch_sign(text: str) -> tuple[str, int]:
     """Parse ``--branch JOINT=+1|-1`` (or ``+``, ``-``), or tell argparse why not."""
-    name, sep, value = text.rpartition('=')
-    signs = {'+1': 1, '+': 1, '1': 1, '-1': -1, '-': -1}
-    if not sep or not name or value.strip() not in signs:
-        msg = f"expected JOINT=+1 or JOINT=-1 (the sign of the joint's angle), got {text!r}"
-        raise argparse.ArgumentTypeError(msg)
-    return name, signs[value.strip()]
+    from ..solver.inverse import parse_branch
+
+    try:
+        return parse_branch(text)
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
 
 
 def add_branch_argument(parser: argparse.ArgumentParser) -> None:

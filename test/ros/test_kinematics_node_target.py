@@ -66,6 +66,36 @@ def test_one_state_per_target_message_with_the_motors_values(ros, tmp_path):
             np.testing.assert_allclose([w.x, w.y], v, rtol=0, atol=1e-13)
 
 
+def test_target_branch_answers_in_the_working_mode_asked(ros, tmp_path):
+    """target_branch B and D positive: each state's motors are solve_targets' in that mode."""
+    branch = {'B': 1, 'D': 1}
+    goal = [0.06, 0.22]
+    node = TopicNode(ros, tmp_path, 'target_branch', '-p', 'target_branch:=[B=+1, D=+1]',
+                     scene=SCENE, drive='target',
+                     input_topic=f'{SESSION}/target_branch/input_targets',
+                     greeting=(['P.x', 'P.y'], goal))
+    points = [(goal[0] + 0.002 * i, goal[1]) for i in range(5)]
+    stamps = [T0 + 1_000_000 * i for i in range(len(points))]
+    try:
+        for stamp, p in zip(stamps, points, strict=True):
+            node.send(stamp, ['P.x', 'P.y'], p)
+        wait_for(lambda: len(node.js) >= len(stamps), ANSWER_S, 'joint_states')
+        assert node.proc.proc.poll() is None
+    finally:
+        node.stop()
+    assert [stamp_ns(m) for m in node.js] == stamps
+    joints = FIVE.output_joints
+    start = None
+    for js, p in zip(node.js, points, strict=True):
+        motors = [js.position[joints.index(d.name)] for d in FIVE.drivers]
+        inverse = mk.solve_targets(FIVE, {'P.x': p[0], 'P.y': p[1]}, branch=branch,
+                                   **({} if start is None else {'start': start}))
+        if start is not None:
+            np.testing.assert_allclose(motors, inverse.motion[:, 0], rtol=0, atol=1e-12)
+        assert all(angle > 0 for angle in inverse.branch.values())
+        start = motors
+
+
 def test_a_target_out_of_reach_is_refused_and_the_stream_goes_on(ros, tmp_path):
     node = target_node(ros, tmp_path, 'target_refusal')
     try:

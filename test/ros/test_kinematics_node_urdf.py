@@ -372,6 +372,10 @@ def test_a_stop_while_the_start_reads_a_large_urdf_ends_it_at_once(ros, tmp_path
     (('-p', 'scene:=five_bar', '-p', 'drive:=target', '-p', 'extra_joints:=ignore'),
      'cannot start: extra_joints: Expected drive: target without extra_joints (a message names '
      'targets or drivers only), got extra_joints'),
+    (('-p', 'scene:=five_bar', '-p', 'target_branch:=[B=+1]'),
+     'cannot start: target_branch: Expected drive: target or trajectory with target_branch'),
+    (('-p', 'scene:=five_bar', '-p', 'drive:=target', '-p', 'target_branch:=[A=+1]'),
+     'cannot start: Expected target_branch to name joints between two moving bodies'),
     (('-p', f'scene:={DATA / "lift_arm.urdf"}', '-p', 'drive:=trajectory', '-p',
       'extra_joints:=pass'),
      'cannot start: extra_joints: Expected drive: trajectory without extra_joints (a message '

@@ -10,12 +10,13 @@ naming ``input_targets``.
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
 
 import mech_kinematics as mk
-from mech_kinematics.ros.target_drive import scene_target_drive
+from mech_kinematics.ros.target_drive import scene_target_drive, target_branch
 from mech_kinematics.ros.topic_drive import RefusedInput
 
 pytestmark = pytest.mark.filterwarnings('ignore::mech_kinematics.NearSingularWarning')
@@ -89,3 +90,39 @@ def test_the_stamp_rules_are_the_topic_drives():
     rules.published(given.stamp_ns)
     with pytest.raises(RefusedInput, match='input_targets: expected a stamp after'):
         rules.read(100, 0, ['P.x', 'P.y'], [0.061, 0.22], [])
+
+
+def test_target_branch_answers_every_message_in_the_mode_asked():
+    """B and D both positive (not the start pose's mode): each answer is solve_targets' in it."""
+    branch = target_branch(['B=+1', 'D=+'], 'target')
+    assert branch == {'B': 1, 'D': 1}
+    rules = scene_target_drive(FIVE, 1e-6, published_joints=FIVE.output_joints, branch=branch)
+    start = [d.start for d in FIVE.drivers]
+    for k in range(3):
+        p = {'P.x': 0.06 + 0.002 * k, 'P.y': 0.22}
+        given = rules.read(100, k * 1_000_000, list(p), list(p.values()), [])
+        inverse = mk.solve_targets(FIVE, p, start=start, branch=branch)
+        np.testing.assert_allclose(given.positions, inverse.motion[:, 0], rtol=0, atol=1e-12)
+        assert all(angle > 0 for angle in inverse.branch.values())
+        rules.published(given.stamp_ns)
+        start = list(given.positions)
+    plain = mk.solve_targets(FIVE, {'P.x': 0.06, 'P.y': 0.22})
+    assert not np.allclose(plain.motion[:, 0], inverse.motion[:, 0], atol=1e-3)
+
+
+@pytest.mark.parametrize('entries, drive, words', [
+    (['B=+1'], 'time', 'target_branch: Expected drive: target or trajectory'),
+    (['B=2'], 'target', 'target_branch: expected JOINT=+1 or JOINT=-1 (the sign of the '
+                        "joint's angle), got 'B=2'"),
+    (['B=+1', 'B=-1'], 'trajectory', 'target_branch: expected each joint once, got B twice'),
+])
+def test_target_branch_refused_in_one_line(entries, drive, words):
+    with pytest.raises(ValueError, match='^' + re.escape(words)):
+        target_branch(entries, drive)
+    assert target_branch([], 'time') is None
+
+
+def test_target_branch_names_a_joint_between_two_moving_links():
+    with pytest.raises(mk.TargetError, match=r'Expected target_branch to name joints between '
+                                             r'two moving bodies \(.*B.*\), got A'):
+        scene_target_drive(FIVE, 1e-6, published_joints=FIVE.output_joints, branch={'A': 1})

@@ -157,6 +157,13 @@ def test_solve_and_check_take_branch(capsys):
                      '--branch', 'B=1', '--json']) == 0
     report = json.loads(capsys.readouterr().out)
     assert report['drivers']
+    # In text, an answer continued from another start pose than the scene's says which.
+    assert cli_main(['check', 'five_bar', '--target', 'P.x=60', '--target', 'P.y=220',
+                     '--branch', 'B=1', '--branch', 'D=1']) == 0
+    first = capsys.readouterr().out.splitlines()[0]
+    assert 'reached from the nearest start pose in the working mode asked (left_crank = ' in first
+    assert cli_main(['check', 'five_bar', '--target', 'P.x=60', '--target', 'P.y=220']) == 0
+    assert 'reached from the start pose in ' in capsys.readouterr().out.splitlines()[0]
     assert [branch_sign(text) for text in ('D=+', 'D=-', 'D=1', 'D=-1')] == \
         [('D', 1), ('D', -1), ('D', 1), ('D', -1)]
     assert 'solve five_bar --target P.x=60 --target P.y=220 --branch B=+1 --branch D=+1' in docs
