@@ -48,8 +48,8 @@ if TYPE_CHECKING:
     from ..solver import State
 
 __all__ = ['ForcesLeftOut', 'GRAVITY', 'JointReaction', 'LinkLoad', 'MAX_GRAVITY', 'MAX_LOAD',
-           'RobotEfforts', 'RobotForces', 'check_gravity', 'parse_link_loads', 'robot_forces',
-           'with_payloads']
+           'EffortSweep', 'RobotEfforts', 'RobotForces', 'SWEEP_SAMPLES', 'check_gravity',
+           'effort_sweeps', 'parse_link_loads', 'robot_forces', 'with_payloads']
 
 #: Gravity in the URDF's root frame by default, m/s^2 (REP 103: z up; standard gravity).
 GRAVITY = (0.0, 0.0, -9.80665)
@@ -58,6 +58,8 @@ GRAVITY = (0.0, 0.0, -9.80665)
 MAX_GRAVITY = 1e6
 #: Dynamics kept per robot (one per group of loops and gravity in their plane).
 _CACHE = 16
+#: Positions of an actuated joint's range :func:`effort_sweeps` solves, both ends.
+SWEEP_SAMPLES = 721
 _U = float(np.finfo(np.float64).eps) / 2
 
 
@@ -619,3 +621,116 @@ def with_payloads(description: Description,
 def robot_forces(robot: Robot) -> RobotForces | None:
     """Return a robot's forces, or None where its URDF has no ``<inertial>`` with a mass."""
     return RobotForces(robot) if robot.description.inertials else None
+
+
+@dataclass(frozen=True)
+class EffortSweep:
+    """The actuated joints' efforts at rest over one actuated joint's range.
+
+    What :func:`effort_sweeps` gives, per actuated joint swept.
+
+    Attributes
+    ----------
+    joint : str
+        The actuated joint swept.
+    positions : ndarray, shape (n,)
+        Its values, rad or m, from the low end of its range to the high end.
+    held : dict of str to float
+        The other actuated joints, held at their reference values.
+    gravity : tuple of float
+        m/s^2 in the root frame.
+    efforts : dict of str to ndarray, shape (n,)
+        Each actuated joint's effort there (N m or N, positive along its
+        ``<axis>``): what its actuator applies to hold the robot still; NaN
+        where not solved.
+    bounds : dict of str to ndarray, shape (n,)
+        Their error bounds.
+    valid : ndarray of bool, shape (n,)
+        Where the loops close and the efforts are bounded.
+    refused : str
+        Why the first position not solved was not ('' where every one was).
+    angular : bool
+        Whether the joint swept is revolute (rad; its effort N m) or prismatic.
+    """
+
+    joint: str
+    positions: Any
+    held: dict[str, float]
+    gravity: tuple[float, float, float]
+    efforts: dict[str, Any]
+    bounds: dict[str, Any]
+    valid: Any
+    refused: str = ''
+    angular: bool = True
+
+    def extremes(self, name: str) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+        """Return joint ``name``'s (largest, least) effort as (value, position, bound)."""
+        values = np.where(self.valid, self.efforts[name], np.nan)
+        out = []
+        for k in (int(np.nanargmax(values)), int(np.nanargmin(values))):
+            out.append((float(values[k]), float(self.positions[k]),
+                        float(self.bounds[name][k])))
+        return out[0], out[1]
+
+
+def effort_sweeps(robot: Robot, samples: int = SWEEP_SAMPLES,
+                  gravity: Sequence[float] | None = None,
+                  loads: Sequence[LinkLoad] = ()) -> list[EffortSweep]:
+    """Return each actuated joint's sweep of the efforts at rest, the others held.
+
+    Each actuated joint in turn goes over its range (its URDF ``<limit>``;
+    without one, where ``solve --target`` seeks start poses: a turn about its
+    reference value for a revolute joint, its loops' size either way for a
+    prismatic one) at ``samples`` evenly spaced values, every other actuated joint at
+    its reference value, every speed and acceleration zero: the statics, the
+    torques and forces the actuators hold the robot with under ``gravity``
+    (the root frame's, default the robot's) and ``loads``, from
+    :meth:`.Robot.solve` on the array path. Where the loops do not close or
+    the efforts cannot be bounded (a toggle, a change point) the efforts are
+    NaN and the first reason is kept.
+
+    Raises
+    ------
+    ValueError
+        A robot without ``<inertial>``s (no forces), fewer than 2 samples.
+    """
+    from .targets import robot_targets
+    from ..errors import NearSingularWarning
+    import warnings
+
+    if robot.forces is None:
+        msg = f'Expected a robot whose links carry <inertial>s, got {robot.name} without'
+        raise ValueError(msg)
+    if samples < 2:
+        msg = f'Expected at least 2 samples, got {samples}'
+        raise ValueError(msg)
+    g = robot.gravity if gravity is None else check_gravity(tuple(gravity))
+    domains = robot_targets(robot, robot.actuated).driver_domains
+    out = []
+    for joint, domain in zip(robot.actuated, domains, strict=True):
+        limits = robot.description.joints[joint].limits
+        low, high = domain if limits is None else limits
+        q = np.linspace(float(low), float(high), samples)
+        held = {n: float(robot.start(n)) for n in robot.actuated if n != joint}
+        positions = {joint: q, **{n: np.full(samples, x) for n, x in held.items()}}
+        with warnings.catch_warnings():
+            warnings.simplefilter('ignore', NearSingularWarning)
+            answer = robot.solve(positions, max_error=math.inf, gravity=g, loads=loads)
+        state = answer.state
+        valid = np.asarray(state.valid, dtype=bool) & (answer.efforts is not None)
+        refused = answer.forces_left_out or ''
+        if not refused and not valid.all():
+            first = int(np.flatnonzero(~valid)[0])
+            reason = next((why for why, mask in state.failures.items()
+                           if np.asarray(mask, dtype=bool)[first]), 'not solved')
+            refused = f'at {joint} = {q[first]:.6g}: {reason}'
+        efforts = answer.efforts
+        names = list(efforts.efforts) if efforts is not None else []
+        nan = np.full(samples, math.nan)
+        out.append(EffortSweep(
+            joint, q, held, g,
+            {n: np.where(valid, np.asarray(efforts.efforts[n]) + 0.0 * q, np.nan) if efforts
+             else nan for n in names},
+            {n: np.asarray(efforts.bounds[n]) + 0.0 * q if efforts else nan for n in names},
+            valid, refused, robot.joint_type(joint).angular))
+    return out

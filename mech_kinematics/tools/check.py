@@ -35,8 +35,9 @@ from typing import Any
 
 import numpy as np
 
-from .cli import (add_branch_argument, add_robot_arguments, add_scene_argument,
-                  add_units_argument, branches_of, finite_float, is_urdf, load_robot_argument,
+from .cli import (add_branch_argument, add_gravity_argument, add_robot_arguments,
+                  add_scene_argument, add_units_argument, branches_of, finite_float,
+                  gravity_of, is_urdf, link_loads_of, load_robot_argument,
                   load_scene_argument, named_value, run_tool, targets_in_si)
 from ..errors import SceneError
 from ..geometry.region import GRID
@@ -559,15 +560,31 @@ def _turning(scene: Any, cs: float | None) -> tuple[Any, Any, str]:
         raise SceneError(f'{error}{hint}') from None
 
 
-def _print_report(args: argparse.Namespace, scene: Any, data: dict[str, Any], text: str
-                  ) -> None:
-    """Print the report (text or JSON) with the scene's turning moment, if it has forces."""
-    study, flywheel, refused = _turning(scene, args.flywheel)
+def _print_report(args: argparse.Namespace, scene: Any, data: dict[str, Any], text: str,
+                  robot: Any = None) -> None:
+    """Print the report (text or JSON) with the scene's turning moment, if it has forces.
+
+    A robot described in URDF with ``<inertial>``s: its actuated joints'
+    efforts at rest over each one's range instead (:func:`sweeps_text`).
+    """
+    if robot is not None:
+        from ..robot.forces import effort_sweeps
+
+        if robot.forces is None:
+            study, flywheel, refused, sweeps = None, None, '', None
+        else:
+            study, flywheel, refused = None, None, ''
+            sweeps = effort_sweeps(robot, gravity=gravity_of(args), loads=link_loads_of(args))
+    else:
+        study, flywheel, refused = _turning(scene, args.flywheel)
+        sweeps = None
     if args.json:
         if study is not None:
             data['turning_moment'] = turning_json(study, flywheel)
         elif refused:
             data['turning_moment'] = {'refused': refused}
+        if sweeps is not None:
+            data['efforts_at_rest'] = sweeps_json(sweeps)
         print(json.dumps(data, indent=1, allow_nan=False))
         return
     lines = [text]
@@ -575,7 +592,53 @@ def _print_report(args: argparse.Namespace, scene: Any, data: dict[str, Any], te
         lines.extend(turning_text(study, scene, flywheel))
     elif refused:
         lines.append(f'turning moment: none ({refused})')
+    if sweeps is not None:
+        lines.extend(sweeps_text(sweeps))
     print('\n'.join(lines))
+
+
+def sweeps_text(sweeps: Sequence[Any]) -> list[str]:
+    """Return the lines of a robot's efforts at rest over each actuated joint's range (SI)."""
+    g = ', '.join(f'{x:.6g}' for x in sweeps[0].gravity)
+    lines = [f'efforts at rest (gravity [{g}] m/s^2 in the root frame; N m for a revolute '
+             'joint, N for a prismatic one, positive along its axis, each +- its bound):']
+    for sweep in sweeps:
+        q = sweep.positions
+        unit = 'rad' if sweep.angular else 'm'
+        held = ''.join(f', {n} held at {x:.6g}' for n, x in sweep.held.items())
+        solved = int(sweep.valid.sum())
+        head = (f'  {sweep.joint} from {q[0]:.6g} to {q[-1]:.6g} {unit} ({len(q)} positions'
+                f'{held}; solved at {solved})')
+        if not solved:
+            lines.append(f'{head}: none solved ({sweep.refused})')
+            continue
+        parts = []
+        for name in sweep.efforts:
+            (top, at_top, b_top), (low, at_low, b_low) = sweep.extremes(name)
+            parts.append(f'{name} largest {top:.6g} at {at_top:.6g} {unit} (+-{_e(b_top)}), '
+                         f'least {low:.6g} at {at_low:.6g} {unit} (+-{_e(b_low)})')
+        tail = f'; not solved {sweep.refused}' if sweep.refused else ''
+        lines.append(f'{head}: {"; ".join(parts)}{tail}')
+    return lines
+
+
+def sweeps_json(sweeps: Sequence[Any]) -> list[dict[str, Any]]:
+    """Return ``"efforts_at_rest"`` of ``check --json`` on a robot: SI (rad or m, N m or N)."""
+    out = []
+    for sweep in sweeps:
+        efforts = {}
+        for name in sweep.efforts:
+            if not sweep.valid.any():
+                continue
+            top, low = sweep.extremes(name)
+            efforts[name] = {key: {'value': v, 'at': at, 'bound': b}
+                             for key, (v, at, b) in (('max', top), ('min', low))}
+        out.append({'joint': sweep.joint, 'range': [float(sweep.positions[0]),
+                                                    float(sweep.positions[-1])],
+                    'positions': len(sweep.positions), 'solved': int(sweep.valid.sum()),
+                    'held': dict(sweep.held), 'gravity': list(sweep.gravity),
+                    'efforts': efforts, 'refused': sweep.refused or None})
+    return out
 
 
 def workspace_text(ws: Any) -> str:
@@ -674,7 +737,7 @@ def write_workspace_png(ws: Any, path: str, space: Any = None) -> None:
     figure.savefig(path, dpi=100)
 
 
-def _handle_workspace(args: argparse.Namespace, scene: Any) -> int:
+def _handle_workspace(args: argparse.Namespace, scene: Any, robot: Any = None) -> int:
     from ..geometry.workspace import workspace_from_scene
 
     given = [flag for flag, value in (('--pair', args.pair), ('--map', args.map),
@@ -682,10 +745,10 @@ def _handle_workspace(args: argparse.Namespace, scene: Any) -> int:
     if given:
         msg = f'Expected --workspace without {", ".join(given)}, got both'
         raise SceneError(msg)
-    if is_urdf(args.scene) and args.workspace not in scene.output_points:
+    if robot is not None and args.workspace not in scene.output_points:
         from ..robot.targets import frame_workspace     # a link frame, in the root frame
 
-        ws = frame_workspace(load_robot_argument(args), args.workspace, args.grid)
+        ws = frame_workspace(robot, args.workspace, args.grid)
     else:
         ws = workspace_from_scene(scene, args.workspace, args.grid)
     if args.json:
@@ -809,12 +872,12 @@ def _handle_target(args: argparse.Namespace) -> int:
     return 0
 
 
-def _handle_region(args: argparse.Namespace, scene: Any) -> int:
+def _handle_region(args: argparse.Namespace, scene: Any, robot: Any = None) -> int:
     from ..geometry.region import region_from_scene
     pair = None if args.pair is None else [p.strip() for p in args.pair.split(',')]
     region = region_from_scene(scene, args.grid, pair)
     _print_report(args, scene, region_json(region, scene, args.map) if args.json else {},
-                  '' if args.json else region_text(region, scene, args.map))
+                  '' if args.json else region_text(region, scene, args.map), robot)
     if args.png is not None:
         write_region_png(region, args.png)
     return 0
@@ -826,13 +889,23 @@ def _handle(args: argparse.Namespace) -> int:
     if args.target:
         return _handle_target(args)
     # A scene, or a URDF's loops as a scene; a SceneError is one line, exit 2 (cli.run_handler).
-    scene = load_scene_argument(args)
+    robot = load_robot_argument(args) if is_urdf(args.scene) else None
+    scene = load_scene_argument(args) if robot is None else robot.scene
+    given = [flag for flag, key in (('--gravity', 'gravity'), ('--payload', 'payload'),
+                                    ('--link-force', 'link_force'),
+                                    ('--link-torque', 'link_torque')) if getattr(args, key)]
+    if given and (robot is None or robot.forces is None):
+        what = (f'scene {args.scene}' if robot is None else
+                f'{robot.name}, whose links carry no <inertial>: there are no forces')
+        msg = (f'Expected {", ".join(given)} with a robot described in URDF whose links carry '
+               f'<inertial>s (its efforts at rest), got {what}')
+        raise SceneError(msg)
     if args.speed_rpm is not None:
         scene = _at_speed(scene, args.speed_rpm)
     if args.workspace is not None:
-        return _handle_workspace(args, scene)
+        return _handle_workspace(args, scene, robot)
     if not scene.single_crank:
-        return _handle_region(args, scene)
+        return _handle_region(args, scene, robot)
     given = [flag for flag, value in (('--grid', args.grid != GRID), ('--pair', args.pair),
                                       ('--map', args.map), ('--png', args.png)) if value]
     if given:
@@ -841,7 +914,7 @@ def _handle(args: argparse.Namespace) -> int:
         raise SceneError(msg)
     assembly = assembly_from_scene(scene)
     _print_report(args, scene, report_json(assembly, scene) if args.json else {},
-                  '' if args.json else report_text(assembly, scene))
+                  '' if args.json else report_text(assembly, scene), robot)
     return 0
 
 
@@ -853,6 +926,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter)
     add_scene_argument(parser)
     add_robot_arguments(parser)
+    add_gravity_argument(parser)
     add_units_argument(parser, ('--reference',))
     parser.add_argument('--json', action='store_true',
                         help='print one JSON object, in SI units (rad, m)')

@@ -616,3 +616,40 @@ def test_solve_takes_link_loads_and_refuses_a_bad_one_in_one_line(capsys):
         assert err.startswith(f'error: {words}') and err.count('\n') == 1, err
     assert cli_main(['solve', 'khurmi_four_bar_ad150', '--link-force', 'a=0,0,1']) == 2
     assert 'with a robot described in URDF' in capsys.readouterr().err
+
+
+def test_check_sweeps_the_lift_arms_motor_over_its_limits_with_the_hand_torque(capsys):
+    """effort_sweeps: every position's torque is g cos q (...), largest at 0, least at a limit."""
+    from mech_kinematics.robot.forces import effort_sweeps
+
+    robot = load_robot(LIFT)
+    [sweep] = effort_sweeps(robot, samples=241)
+    assert sweep.joint == 'lift_joint' and sweep.valid.all() and not sweep.refused
+    assert (sweep.positions[0], sweep.positions[-1]) == (-1.2, 1.2)     # its <limit>
+    np.testing.assert_allclose(sweep.efforts['lift_joint'],
+                               [_hand_torque(q) for q in sweep.positions], rtol=1e-12)
+    (top, at_top, _), (low, at_low, _) = sweep.extremes('lift_joint')
+    assert abs(at_top) <= 1e-15 and top == pytest.approx(_hand_torque(0.0), rel=1e-13)
+    assert abs(at_low) == 1.2 and low == pytest.approx(_hand_torque(1.2), rel=1e-12)
+    # The command, under the Moon's gravity, in text and JSON.
+    argv = ['check', str(LIFT), '--gravity', '0,0,-1.62']
+    assert cli_main([*argv, '--json']) == 0
+    [data] = json.loads(capsys.readouterr().out)['efforts_at_rest']
+    assert data['range'] == [-1.2, 1.2] and data['solved'] == data['positions'] == 721
+    assert data['efforts']['lift_joint']['max']['value'] == pytest.approx(
+        _hand_torque(0.0, 1.62), rel=1e-13)
+    assert cli_main(argv) == 0
+    line = capsys.readouterr().out.splitlines()[-1]
+    assert line.startswith('  lift_joint from -1.2 to 1.2 rad (721 positions; solved at 721): '
+                           f'lift_joint largest {_hand_torque(0.0, 1.62):.6g} at 0 rad')
+    assert cli_main(['check', str(LIFT)]) == 0
+    docs = (Path(__file__).resolve().parents[2] / 'docs' / 'commands.md').read_text()
+    quoted = docs.split('check test/data/urdf/lift_arm.urdf\n...\n', 1)[1].split('```', 1)[0]
+    assert capsys.readouterr().out.endswith(quoted)
+    for argv, words in ((['check', 'engine', '--gravity', '0,0,-9.8'], 'got scene engine'),
+                        (['check', str(DATA / 'robotiq_2f_85.urdf'), '--closures',
+                          str(DATA / 'robotiq_2f_85.loop_closures.yaml'), '--gravity',
+                          '0,0,-9.8'], 'carry no <inertial>')):
+        assert cli_main(argv) == 2
+        err = capsys.readouterr().err
+        assert err.count('\n') == 1 and words in err
