@@ -268,7 +268,8 @@ def frame_workspace(robot: Robot, link: str, grid: int | None = None) -> Workspa
     SceneError
         A link that is not the robot's or that its loops do not move, a robot
         whose loops are not driven by two actuated joints of their own (a
-        mimic among the drivers), or one that assembles nowhere on the grid.
+        mimic among the drivers), a link of a loop only one of them drives, or
+        one that assembles nowhere on the grid.
     """
     from ..geometry.frames import carried_motion, frames_from_scene
     from ..geometry.region import GRID
@@ -290,6 +291,11 @@ def frame_workspace(robot: Robot, link: str, grid: int | None = None) -> Workspa
         raise SceneError(msg)
     body, _, local = planar.link_frame(link)
     index, e, o = planar.lifts[link]
+    mine = planar.mechanisms[index]['drivers']
+    if set(mine) != {d.name for d in drivers}:
+        msg = (f'Expected --workspace to name a link of the loop both actuated joints drive, '
+               f'got {link!r}, on a loop driven by {", ".join(mine)} alone')
+        raise SceneError(msg)
     probe = robot.solve(max_error=math.inf, forces=False)
     frames = description.transforms(description.pose(
         {n: float(j.position) for n, j in probe.joints.items()}))

@@ -398,7 +398,7 @@ class RobotValues:
         return self._on_input(values, given[0], given[1], given[2] if len(given) > 2 else None)
 
     def answer(self, first: tuple[Sequence[float], float],
-               given: tuple[Sequence[float], Sequence[float] | None],
+               given: tuple[Sequence[float] | None, ...],
                solve: Any) -> tuple[list[float], float]:
         """Return an input's URDF joints (:meth:`values`) and measure, in the assembly answered.
 

@@ -118,6 +118,9 @@ def test_check_prints_it_in_the_root_frame_and_refuses_what_it_cannot_map(capsys
         assert err.count('\n') == 1 and words in err and f"got '{link}'" in err
     with pytest.raises(SceneError, match='two actuated joints'):
         frame_workspace(load_robot(DATA / 'lift_arm.urdf'), 'tool_frame')
+    gripper = load_robot(DATA / 'robotiq_2f_85.urdf', DATA / 'robotiq_2f_85.loop_closures.yaml')
+    with pytest.raises(SceneError, match=r'two actuated joints .* \(mimic\)'):
+        frame_workspace(gripper, 'left_inner_finger')
 
 
 def test_a_link_frame_is_the_same_found_with_masses_or_when_asked():

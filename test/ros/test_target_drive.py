@@ -10,13 +10,19 @@ naming ``input_targets``.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 import re
 
+from helpers import gepetto_five_bar_reference
 import numpy as np
 import pytest
 
 import mech_kinematics as mk
-from mech_kinematics.ros.target_drive import scene_target_drive, target_branch
+from mech_kinematics.robot import load_robot
+from mech_kinematics.robot.targets import frame_motion
+from mech_kinematics.ros.robot_mode import RobotValues
+from mech_kinematics.ros.target_drive import (robot_target_drive, scene_target_drive,
+                                              target_branch)
 from mech_kinematics.ros.topic_drive import RefusedInput
 
 pytestmark = pytest.mark.filterwarnings('ignore::mech_kinematics.NearSingularWarning')
@@ -126,3 +132,27 @@ def test_target_branch_names_a_joint_between_two_moving_links():
     with pytest.raises(mk.TargetError, match=r'Expected target_branch to name joints between '
                                              r'two moving bodies \(.*B.*\), got A'):
         scene_target_drive(FIVE, 1e-6, published_joints=FIVE.output_joints, branch={'A': 1})
+
+
+def test_target_branch_on_a_urdf_robot_reads_its_loop_joints():
+    """Gepetto's five-bar by its effector, free1 asked positive: Robot.solve_targets' answer."""
+    data = Path(__file__).resolve().parents[1] / 'data' / 'urdf'
+    robot = load_robot(data / 'gepetto_5bar_linkage.urdf',
+                       data / 'gepetto_5bar_linkage.robot.yaml',
+                       reference=gepetto_five_bar_reference())
+    drivers = RobotValues(robot, robot.scene.output_joints, robot.scene.output_points).drivers
+    rules = robot_target_drive(robot, drivers, 1e-6, published_joints=robot.joint_names,
+                               branch={'free1': 1})
+    start = robot.solve(forces=False)
+    assert start.joints['free1'].position < 0      # the reference pose's mode is the other
+    d = robot.description
+    p0 = frame_motion(d, 'effector', d.pose({n: float(j.position)
+                                             for n, j in start.joints.items()}), {}, {}, 1.0)[0][0]
+    goal = {'effector.y': float(p0[1]) + 0.02, 'effector.z': float(p0[2]) + 0.03}
+    given = rules.read(100, 0, list(goal), list(goal.values()), [])
+    inverse = robot.solve_targets(goal, branch={'free1': 1})
+    assert inverse.answer.joints['free1'].position > 0
+    np.testing.assert_allclose(given.positions, inverse.motion[:, 0], rtol=0, atol=1e-12)
+    with pytest.raises(mk.TargetError, match='got mot1'):
+        robot_target_drive(robot, drivers, 1e-6, published_joints=robot.joint_names,
+                           branch={'mot1': 1})
