@@ -313,8 +313,8 @@ class _Latest:
         self.scene_error = ''
         self.bounds: tuple[float, float, float, float] | None = None
         self.strokes: dict[str, tuple[float, float]] = {}
-        #: joint name -> (position, velocity), each a finite float or None.
-        self.joints: dict[str, tuple[float | None, float | None]] | None = None
+        #: joint name -> (position, velocity, effort), each a finite float or None.
+        self.joints: dict[str, tuple[float | None, float | None, float | None]] | None = None
         self.points: dict[str, tuple[list[float], list[float] | None, list[float] | None]] = {}
         #: point name -> its published positions, None where the stream broke.
         self.traces: dict[str, deque[tuple[float, float] | None]] = {}
@@ -457,11 +457,12 @@ class ViewServer:
             self.latest.reactions[name] = (at, None if fx is None or fy is None else [fx, fy])
 
     def _on_joints(self, msg: Any) -> None:
-        positions, velocities = list(msg.position), list(msg.velocity)
+        positions, velocities, efforts = list(msg.position), list(msg.velocity), list(msg.effort)
         joints = {}
         for i, name in enumerate(msg.name):
             joints[str(name)] = (_finite(positions[i]) if i < len(positions) else None,
-                                 _finite(velocities[i]) if i < len(velocities) else None)
+                                 _finite(velocities[i]) if i < len(velocities) else None,
+                                 _finite(efforts[i]) if i < len(efforts) else None)
         with self.latest.lock:
             self.latest.joints = joints
             self.latest.stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
@@ -540,17 +541,22 @@ class ViewServer:
         # following one (the scene's urdf_drivers).
         followed = {f.driver: f for f in scene.urdf_drivers}
         for index, driver in enumerate(scene.drivers):
-            position, speed = joints.get(driver.name, (None, None))
+            position, speed, effort = joints.get(driver.name, (None, None, None))
+            effort_of = driver.name
             follows = followed.get(driver.name)
             if driver.name not in joints and follows is not None and follows.joint in joints:
-                q, rate = joints[follows.joint]
+                q, rate, effort = joints[follows.joint]     # the URDF joint's, its own sign
+                effort_of = follows.joint
                 position = None if q is None else _finite(follows.driver_value(q))
                 speed = None if rate is None else _finite(follows.factor * rate)
             # The speed in the unit the node's parameter sets it in (rpm, m/s).
             unit = driver.rate_parameter.unit
             shown = None if speed is None else _shown(rate_from_si(speed, unit))
             out['drivers'].append({'name': driver.name, 'kind': type(driver).__name__.lower(),
-                                   'unit': unit, 'position': position, 'speed': shown})
+                                   'unit': unit, 'position': position, 'speed': shown,
+                                   'effort': None if effort is None else _shown(effort),
+                                   'effort_of': effort_of,
+                                   'effort_unit': 'N m' if driver.joint_type.angular else 'N'})
             if index == 0 and first_crank and shown is not None:
                 out['crank_speed_rpm'] = shown
             if position is None:
@@ -844,8 +850,8 @@ input.speed { width: 7em; }
 <pre id="drawn"></pre>
 <script>
 'use strict';
-// Every string from the ROS graph (scene, driver, point and status names, messages) is
-// written with textContent or drawn on the canvas: none is ever parsed as HTML.
+// Strings from the ROS graph (names, messages) are written with textContent or drawn on
+// the canvas: none is ever parsed as HTML.
 const TOKEN = document.querySelector('meta[name="view-token"]').content;
 const COLOURS = {crank: '#d62728', link: '#1f77b4', lever: '#2ca02c'};
 const frame = document.getElementById('frame');
@@ -911,8 +917,8 @@ async function setSpeed(driver, input, answer) {
   }
 }
 
-// One speed control per driver (rpm for a crank, m/s for an actuator), rebuilt when the
-// scene's drivers change; each shows the driver's speed in the latest joint_states.
+// A speed control per driver (rpm or m/s), rebuilt when the drivers change; each shows
+// the driver's speed and effort in the latest joint_states.
 function controls(s) {
   const box = document.getElementById('controls');
   const key = JSON.stringify(s.drivers.map((d) => [d.name, d.unit]));
@@ -933,8 +939,9 @@ function controls(s) {
     }
   }
   s.drivers.forEach((d, i) => {
-    box.children[i].querySelector('.running').textContent = d.speed === null ? '' :
-      '(running at ' + d.speed + ' ' + d.unit + ')';
+    box.children[i].querySelector('.running').textContent = (d.speed === null ? '' :
+      '(running at ' + d.speed + ' ' + d.unit + ')') + (d.effort === null ? '' :
+      ' ' + d.effort_of + ' ' + d.effort + ' ' + d.effort_unit);
   });
 }
 
@@ -964,7 +971,7 @@ function draw(s) {
     }
     ctx.stroke();
   }
-  // What was drawn, in metres and as the canvas maps them to pixels (read by the tests).
+  // What was drawn, in m and in pixels (read by the tests).
   const box = canvas.getBoundingClientRect();
   const f = s.frame, drawn = {angle: null, positions: null, k: t.k, ox: t.ox, oy: t.oy,
                               left: box.left, top: box.top, width: canvas.width,

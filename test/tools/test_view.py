@@ -396,11 +396,11 @@ def _scene(server, name):
     return server.latest.scene
 
 
-def _joints(server, names, positions, velocities=()):
+def _joints(server, names, positions, velocities=(), efforts=()):
     from sensor_msgs.msg import JointState
 
     server._on_joints(JointState(name=list(names), position=list(positions),
-                                 velocity=list(velocities)))
+                                 velocity=list(velocities), effort=list(efforts)))
 
 
 def _points(server, stamp_ns, points):
@@ -607,7 +607,10 @@ def test_state_answers_whatever_the_graph_publishes(fake):
     state = _state(fake)
     assert state['frame']['positions'] == [0.5] and state['error'] == ''
     assert state['drivers'] == [{'name': 'crank', 'kind': 'crank', 'unit': 'rpm',
-                                 'position': 0.5, 'speed': None}]
+                                 'position': 0.5, 'speed': None, 'effort': None,
+                                 'effort_of': 'crank', 'effort_unit': 'N m'}]
+    _joints(fake, [scene.input.link], [0.5], [1.0], [math.nan])     # not finite: left out
+    assert _state(fake)['drivers'][0]['effort'] is None
 
 
 def _reactions(server, scene, angle):
@@ -666,13 +669,18 @@ def test_state_draws_a_urdf_robot_from_its_joint_states(fake):
     assert fake.latest.scene is not None, fake.latest.scene_error
     answer = source.robot.solve({'lift_joint': 0.4}, {'lift_joint': 0.7})
     names = list(answer.joints)
+    efforts = [answer.efforts.efforts.get(n, 0.0) for n in names]
     _joints(fake, names, [answer.joints[n].position for n in names],
-            [answer.joints[n].velocity for n in names])
+            [answer.joints[n].velocity for n in names], efforts)
     state = _state(fake)
     assert state['error'] == '' and state['frame'] is not None
+    # The driver's effort is the URDF joint's it follows, in the URDF's sign (issue 44).
     assert state['drivers'] == [{'name': 'lower_arm', 'kind': 'crank', 'unit': 'rpm',
                                  'position': -0.4, 'speed': pytest.approx(
-                                     -0.7 * 60 / (2 * math.pi), rel=1e-12)}]
+                                     -0.7 * 60 / (2 * math.pi), rel=1e-12),
+                                 'effort': pytest.approx(answer.efforts.efforts['lift_joint'],
+                                                         rel=1e-14),
+                                 'effort_of': 'lift_joint', 'effort_unit': 'N m'}]
     for point, xy in state['frame']['points'].items():
         assert xy == pytest.approx(list(_xy_of(answer.state, point)), abs=1e-12), point
     assert {'name': VIEW_STATUS, 'message': ROBOT_REACTIONS, 'level': 0} in state['statuses']
@@ -815,7 +823,7 @@ def test_chromium_draws_every_packaged_scene(fake, browser):
 def test_chromium_draws_the_reactions_scaled_at_their_joints(fake, browser):
     """With "reactions" ticked, an arrow per joint along its force, the largest 1/5 of the view."""
     scene = _scene(fake, 'shaper')
-    _joints(fake, ['crank'], [0.5], [1.0])
+    _joints(fake, ['crank'], [0.5], [1.0], [12.25])
     _reactions(fake, scene, 0.5)
     answer = _state(fake)
     target, session = browser.open(fake.url)
@@ -825,8 +833,12 @@ def test_chromium_draws_the_reactions_scaled_at_their_joints(fake, browser):
         text = browser.wait(session, '(() => { const d = JSON.parse(document.getElementById('
                                      '"drawn").textContent); return d.reactions.length && '
                                      'JSON.stringify(d.reactions); })()', 'reactions drawn')
+        # The driver's effort in joint_states, beside its speed (issue 44).
+        running = browser.wait(session, "document.querySelector('.running').textContent",
+                               'the running speed')
     finally:
         browser.close_tab(target)
+    assert running.endswith(' crank 12.25 N m'), running
     drawn = {r['name']: r for r in json.loads(text)}
     published = {r['name']: r for r in answer['reactions']}
     assert set(drawn) == set(published)
