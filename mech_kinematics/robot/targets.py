@@ -213,7 +213,7 @@ def robot_targets(robot: Robot, names: Sequence[str]) -> TargetMap:
         driver_scales=tuple(1.0 if robot.joint_type(d).angular else size for d in drivers),
         evaluate=evaluate, text=text,
         elbows=tuple(n for n in probe.joints if n not in drivers
-                     and robot.joint_type(n).angular),
+                     and robot.joint_type(n).angular and not _constant(robot, n)),
         elbow=elbow, driver_domains=tuple(sweep(d) for d in drivers))
 
 
@@ -318,6 +318,18 @@ def frame_workspace(robot: Robot, link: str, grid: int | None = None) -> Workspa
                    det=ws.det * float(sigma[0] * sigma[1]),
                    singular_drivers=joints(ws.singular_drivers),
                    lock_drivers=joints(ws.lock_drivers))
+
+
+def _constant(robot: Robot, joint: str) -> bool:
+    """Return whether a loop joint's value cannot change: both its links turn as one body.
+
+    A URDF joint closing a loop between two links the scene welds (Gepetto's
+    ``closedloop1_A``, a 6d closure's joint) follows one coordinate minus
+    itself: no working mode reads it.
+    """
+    item = robot.planar.joints.get(joint)
+    return item is not None and item.child is not None and item.child == item.parent \
+        and item.child_ref == item.parent_ref
 
 
 def _cross(p: tuple[float, ...], q: tuple[float, ...]) -> tuple[float, float, float]:

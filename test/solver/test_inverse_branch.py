@@ -194,3 +194,7 @@ def test_a_urdf_robots_mode_is_read_from_its_joints_values():
     # The reference pose's own mode and one leg flipped each way: three assemblies.
     assert tuple(np.round(plain.motion[:, 0], 9)) in modes
     assert len(modes) == 3
+    # The joint closing the loop between two links the scene welds is always 0: not a mode.
+    with pytest.raises(mk.TargetError,
+                       match=r'\(free1, closedloop1_B, free2\), got closedloop1_A'):
+        robot.solve_targets(goal, branch={'closedloop1_A': 1})
