@@ -29,7 +29,7 @@ import yaml
 
 from .planar import Planar
 from ..errors import UrdfError
-from ..geometry.frames import child_frame
+from ..geometry.frames import child_frame, FrameSpec, poses_from_state
 from ..geometry.instant_centres import full_scene
 from ..geometry.urdf import _add_visuals, _assembled, _fmt, COLOURS, Visual, visuals_from_scene
 from ..solver import Scene
@@ -119,10 +119,9 @@ def robot_urdf_from_scene(scene: Scene, frame_id: str = 'mechanism', prefix: str
     points = {name: complex(p) for name, (p, _, _) in state.complex_points.items()}
     angles: dict[str, float] = {graph.ground: 0.0}
     origins: dict[str, complex] = {graph.ground: 0j}
-    for name, frame in graph.frames():
-        angles[name] = frame.angle if frame.angle_of is None else \
-            float(state.joints[frame.angle_of].position) + frame.angle
-        origins[name] = points[frame.origin]
+    for pose in poses_from_state(_all_frames(scene), state):
+        angles[pose.joint] = pose.angle     # the /tf frames' own rule (geometry/frames.py)
+        origins[pose.joint] = complex(pose.x, pose.y)
     # The spanning tree: drivers' joints, then prismatic joints, then pins (Kruskal).
     parent = {body: body for body in graph.bodies}
 
@@ -235,6 +234,5 @@ def _visuals(scene: Scene, origins: dict[str, complex], angles: dict[str, float]
 
 
 def _all_frames(scene: Scene) -> Any:
-    from ..geometry.frames import FrameSpec
     return tuple(FrameSpec(body, f.origin, f.angle_of, f.angle)
                  for body, f in scene.graph.frames())
