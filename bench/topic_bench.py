@@ -78,7 +78,13 @@ def floor(namespace: str, scene_name: str) -> None:
 
 
 def drive(namespace: str, rate: float, seconds: float, out: str) -> None:
-    """Publish inputs at ``rate`` for ``seconds``; note send and arrival times; write them."""
+    """Publish inputs at ``rate`` for ``seconds``; note send and arrival times; write them.
+
+    The crank's position and speed: with ``drive:=target`` (``--target``) the
+    same message is a target naming the crank, a joint the scene reports (the
+    inverse answers it in one Newton step: what the target path costs beyond
+    topic drive's).
+    """
     from sensor_msgs.msg import JointState
     from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
 
@@ -105,8 +111,10 @@ def measure(kind: str, rate: float, args: argparse.Namespace, env: dict[str, str
     namespace = f'/topic_bench_{os.getpid()}_{kind}_{int(rate)}_{random.randrange(10 ** 6)}'
     out = tmp / f'{namespace[1:]}.json'
     if kind == 'node':
+        how = (['-p', 'drive:=target', '-r', 'input_targets:=input_joint_states']
+               if args.target else ['-p', 'drive:=topic'])
         command = [sys.executable, '-m', 'mech_kinematics.kinematics_node', '--ros-args',
-                   '-r', f'__ns:={namespace}', '-p', f'scene:={SCENE}', '-p', 'drive:=topic',
+                   '-r', f'__ns:={namespace}', '-p', f'scene:={SCENE}', *how,
                    '--log-level', 'warn']
     else:
         command = [sys.executable, __file__, '--floor', namespace, SCENE]
@@ -162,6 +170,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument('--warmup', type=float, default=3.0, help='settling time per run')
     parser.add_argument('--repeat', type=int, default=3, help='runs of each, alternating')
     parser.add_argument('--out', help='write the figures as JSON to this file')
+    parser.add_argument('--target', action='store_true',
+                        help='the node in drive:=target, each input a target naming the crank')
     parser.add_argument('--drive', nargs=4, help=argparse.SUPPRESS)
     parser.add_argument('--floor', nargs=2, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
@@ -185,7 +195,8 @@ def main(argv: list[str] | None = None) -> int:
                           f' us, answered {100 * row["answered"]:.2f} %', file=sys.stderr,
                           flush=True)
     result = summary(rows, args)
-    print(f'topic drive vs the rclpy relay floor, {args.seconds:g} s per run, {args.repeat} '
+    print(f'{"target" if args.target else "topic"} drive vs the rclpy relay floor, '
+          f'{args.seconds:g} s per run, {args.repeat} '
           f'runs each, alternating; {os.cpu_count()} cores, load average '
           f'{result["load"]:.1f}\n')
     print('| input rate | latency median, floor / node (µs) | node / floor | p99, floor / node '

@@ -95,6 +95,10 @@ _FOOTER = struct.Struct('<BQQQ')                 # record head, summary start, o
 _MESSAGE_HEAD_BYTES = _MESSAGE.size - _RECORD.size   # 22
 #: Errors of a full file system, a quota or the file size limit: recovery makes room.
 _NO_SPACE = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG})
+#: Room kept under a file size limit for the rosbag2 metadata record a closing embeds:
+#: this, and :data:`_TOPIC_ROOM` a channel more (its text takes about 550 bytes a topic).
+_METADATA_ROOM = 16 * 1024
+_TOPIC_ROOM = 2 * 1024
 _ROSBAG2 = 'rosbag2'
 
 
@@ -323,9 +327,14 @@ class McapStorage:
         """Write the pending chunk and its message indexes; flush and sync the file.
 
         Nothing is synced when nothing was written since the last sync (an idle topic's
-        flushes cost no disk time).
+        flushes cost no disk time). Under a file size limit (``RLIMIT_FSIZE``) a
+        chunk after which the closing (metadata, summary, footer) would not fit
+        is not written: ``OSError`` ``EFBIG``, the file left with every chunk
+        before it, room to close it after them (else closing would drop the
+        last chunk written, one a flush had said was in the file).
         """
         if self._chunk:
+            self._check_room()
             self._write_chunk()
         if self._offset != self._synced:
             self._sync()
@@ -357,6 +366,23 @@ class McapStorage:
         os.fsync(self._file.fileno())
         self._synced = self._offset
 
+    def _check_room(self) -> None:
+        """Refuse (EFBIG) the pending chunk where it and the closing after it pass the limit."""
+        limit = _file_size_limit()
+        if limit is None:
+            return
+        # The chunk, its message indexes (at most a record per channel) and the closing.
+        chunk = 40 + _RECORD.size + len(self._chunk) + sum(
+            len(e) + 32 for e in self._entries.values())
+        probe = Chunk(0, 0, 0, 0, 0, {cid: 0 for cid in self._entries})
+        probe.index_offsets = {cid: 0 for cid in self._entries}
+        closing = len(closing_records(list(self.schemas.values()),
+                                      list(self.channels.values()), [*self.chunks, probe],
+                                      self._offset + chunk, ''))
+        room = _METADATA_ROOM + _TOPIC_ROOM * len(self.channels)
+        if self._offset + chunk + closing + room > limit:
+            raise OSError(errno.EFBIG, os.strerror(errno.EFBIG))
+
     def _write_chunk(self) -> None:
         records, entries = self._chunk, self._entries
         self._chunk, self._entries = bytearray(), {}
@@ -374,6 +400,16 @@ class McapStorage:
             chunk.index_length += len(record)
             self._write(record)
         self.chunks.append(chunk)
+
+
+def _file_size_limit() -> int | None:
+    """Return this process's file size limit (soft ``RLIMIT_FSIZE``), bytes; None if none."""
+    try:
+        import resource
+    except ImportError:     # not a Unix
+        return None
+    soft = resource.getrlimit(resource.RLIMIT_FSIZE)[0]
+    return None if soft == resource.RLIM_INFINITY else int(soft)
 
 
 # -- recovery --------------------------------------------------------------------
