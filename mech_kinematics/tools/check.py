@@ -886,19 +886,31 @@ def _handle_region(args: argparse.Namespace, scene: Any, robot: Any = None) -> i
 def _handle(args: argparse.Namespace) -> int:
     from ..geometry.assembly import assembly_from_scene
 
+    given = [flag for flag, key in (('--gravity', 'gravity'), ('--payload', 'payload'),
+                                    ('--link-force', 'link_force'),
+                                    ('--link-torque', 'link_torque')) if getattr(args, key)]
     if args.target:
+        if given:
+            msg = (f'Expected --target without {", ".join(given)} (check --target reports how '
+                   f'well the drivers control the targets, no efforts), got both')
+            raise SceneError(msg)
         return _handle_target(args)
     # A scene, or a URDF's loops as a scene; a SceneError is one line, exit 2 (cli.run_handler).
     robot = load_robot_argument(args) if is_urdf(args.scene) else None
     scene = load_scene_argument(args) if robot is None else robot.scene
-    given = [flag for flag, key in (('--gravity', 'gravity'), ('--payload', 'payload'),
-                                    ('--link-force', 'link_force'),
-                                    ('--link-torque', 'link_torque')) if getattr(args, key)]
     if given and (robot is None or robot.forces is None):
         what = (f'scene {args.scene}' if robot is None else
                 f'{robot.name}, whose links carry no <inertial>: there are no forces')
         msg = (f'Expected {", ".join(given)} with a robot described in URDF whose links carry '
                f'<inertial>s (its efforts at rest), got {what}')
+        raise SceneError(msg)
+    turning = [flag for flag, value in (('--speed-rpm', args.speed_rpm),
+                                        ('--flywheel', args.flywheel)) if value is not None]
+    if robot is not None and robot.forces is not None and turning:
+        msg = (f'Expected {", ".join(turning)} with a scene driven by one crank (a '
+               f'turning-moment diagram), got {robot.name}, a robot described in URDF: its '
+               "efforts at rest over each actuated joint's range are given instead (a URDF "
+               "crank's turning moment is not built)")
         raise SceneError(msg)
     if args.speed_rpm is not None:
         scene = _at_speed(scene, args.speed_rpm)

@@ -649,7 +649,11 @@ def test_check_sweeps_the_lift_arms_motor_over_its_limits_with_the_hand_torque(c
     for argv, words in ((['check', 'engine', '--gravity', '0,0,-9.8'], 'got scene engine'),
                         (['check', str(DATA / 'robotiq_2f_85.urdf'), '--closures',
                           str(DATA / 'robotiq_2f_85.loop_closures.yaml'), '--gravity',
-                          '0,0,-9.8'], 'carry no <inertial>')):
+                          '0,0,-9.8'], 'carry no <inertial>'),
+                        (['check', str(LIFT), '--flywheel', '0.02'], "a URDF crank's turning"),
+                        (['check', str(LIFT), '--speed-rpm', '30'], "a URDF crank's turning"),
+                        (['check', str(LIFT), '--target', 'tool_frame.z=0.45', '--gravity',
+                          '0,0,-1'], 'Expected --target without --gravity')):
         assert cli_main(argv) == 2
         err = capsys.readouterr().err
         assert err.count('\n') == 1 and words in err
