@@ -231,14 +231,14 @@ def workspace(scene: Scene, point: str, read: Reader, grid: int = GRID,
         zero = np.asarray(one.valid, dtype=bool).reshape(-1) & (det_here <= ZERO * least)
         singular, singular_q = here[zero], q[zero]
         jumps.extend(here[~zero])
+    at_rest = [np.zeros(1)] * 2
+    start = _xy(read(_at(scene, [np.array([d.start]) for d in drivers], at_rest))[0], ())
     return Workspace(scene.name, point, scene.units, (drivers[0].name, drivers[1].name),
                      (axes[0], axes[1]), valid, p, det,
                      singular, singular_q,
                      np.array(locks, dtype=np.float64).reshape(-1, 2),
                      np.array(lock_q, dtype=np.float64).reshape(-1, 2),
-                     np.array(jumps, dtype=np.float64).reshape(-1, 2), max(moves),
-                     _xy(read(_columns(scene, [np.array([d.start]) for d in drivers])[0])[0],
-                         ()), lift)
+                     np.array(jumps, dtype=np.float64).reshape(-1, 2), max(moves), start, lift)
 
 
 def _xy(z: Any, shape: tuple[int, ...]) -> Array:
@@ -271,7 +271,12 @@ def _columns(scene: Scene, q: list[Any]) -> tuple[Any, Any]:
     """Return the states at drivers' values ``q`` at a unit speed of each driver (J's columns)."""
     zeros = np.zeros(q[0].shape)
     ones = np.ones(q[0].shape)
+    return _at(scene, q, [ones, zeros]), _at(scene, q, [zeros, ones])
+
+
+def _at(scene: Scene, q: list[Any], speeds: list[Any]) -> Any:
+    """Return the state at drivers' values ``q`` and ``speeds``, at no acceleration, any bound."""
+    zeros = np.zeros(q[0].shape)
     with warnings.catch_warnings():
         warnings.simplefilter('ignore', NearSingularWarning)
-        return (solve(scene, q, [ones, zeros], [zeros, zeros], max_error=math.inf),
-                solve(scene, q, [zeros, ones], [zeros, zeros], max_error=math.inf))
+        return solve(scene, q, speeds, [zeros, zeros], max_error=math.inf)

@@ -34,10 +34,11 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 import math
 from typing import Any, TYPE_CHECKING
+import warnings
 
 import numpy as np
 
-from ..errors import UrdfError
+from ..errors import NearSingularWarning, UrdfError
 from ..solver.forces import Dynamics, Forces, Load, Mass
 from ..solver.scaling import _size
 from ..solver.solve import refuse_forces
@@ -694,9 +695,7 @@ def effort_sweeps(robot: Robot, samples: int = SWEEP_SAMPLES,
     ValueError
         A robot without ``<inertial>``s (no forces), fewer than 2 samples.
     """
-    from .targets import robot_targets
-    from ..errors import NearSingularWarning
-    import warnings
+    from .targets import joint_sweep
 
     if robot.forces is None:
         msg = f'Expected a robot whose links carry <inertial>s, got {robot.name} without'
@@ -705,32 +704,31 @@ def effort_sweeps(robot: Robot, samples: int = SWEEP_SAMPLES,
         msg = f'Expected at least 2 samples, got {samples}'
         raise ValueError(msg)
     g = robot.gravity if gravity is None else check_gravity(tuple(gravity))
-    domains = robot_targets(robot, robot.actuated).driver_domains
+    size = float(robot.solve(max_error=math.inf, forces=False).state.error_bound.size)
     out = []
-    for joint, domain in zip(robot.actuated, domains, strict=True):
+    for joint in robot.actuated:
         limits = robot.description.joints[joint].limits
-        low, high = domain if limits is None else limits
+        low, high = joint_sweep(robot, joint, size) if limits is None else limits
         q = np.linspace(float(low), float(high), samples)
         held = {n: float(robot.start(n)) for n in robot.actuated if n != joint}
         positions = {joint: q, **{n: np.full(samples, x) for n, x in held.items()}}
         with warnings.catch_warnings():
             warnings.simplefilter('ignore', NearSingularWarning)
             answer = robot.solve(positions, max_error=math.inf, gravity=g, loads=loads)
-        state = answer.state
-        valid = np.asarray(state.valid, dtype=bool) & (answer.efforts is not None)
+        state, efforts = answer.state, answer.efforts
+        valid = np.asarray(state.valid, dtype=bool) & (efforts is not None)
         refused = answer.forces_left_out or ''
         if not refused and not valid.all():
             first = int(np.flatnonzero(~valid)[0])
             reason = next((why for why, mask in state.failures.items()
                            if np.asarray(mask, dtype=bool)[first]), 'not solved')
             refused = f'at {joint} = {q[first]:.6g}: {reason}'
-        efforts = answer.efforts
-        names = list(efforts.efforts) if efforts is not None else []
-        nan = np.full(samples, math.nan)
+        values = {} if efforts is None else efforts.efforts     # without efforts, none
+        bounds = {} if efforts is None else efforts.bounds
         out.append(EffortSweep(
             joint, q, held, g,
-            {n: np.where(valid, np.asarray(efforts.efforts[n]) + 0.0 * q, np.nan) if efforts
-             else nan for n in names},
-            {n: np.asarray(efforts.bounds[n]) + 0.0 * q if efforts else nan for n in names},
+            {n: np.where(valid, np.asarray(v, dtype=np.float64) + 0.0 * q, np.nan)
+             for n, v in values.items()},
+            {n: np.asarray(b, dtype=np.float64) + 0.0 * q for n, b in bounds.items()},
             valid, refused, robot.joint_type(joint).angular))
     return out

@@ -123,6 +123,14 @@ class DriverMap:
     scene_ref: float
     mimic: Any = None
 
+    def scene_value(self, value: Any) -> Any:
+        """Return the scene driver's position at the URDF joint's ``value`` (rad or m)."""
+        return self.scene_ref + self.sigma * (value - self.reference)
+
+    def joint_value(self, value: Any) -> Any:
+        """Return the URDF joint's value at the scene driver's position ``value``."""
+        return self.reference + (value - self.scene_ref) / self.sigma
+
     @property
     def gain(self) -> tuple[str, float]:
         """Return the joint that moves this driver and d(scene value) / d(its value).

@@ -283,7 +283,7 @@ class Robot:
         positions, speeds, accels = [], [], []
         for driver in self.planar.drivers:
             p, v, a = self._urdf_driver(driver, inputs)
-            positions.append(driver.scene_ref + driver.sigma * (p - driver.reference))
+            positions.append(driver.scene_value(p))
             speeds.append(driver.sigma * v)
             accels.append(driver.sigma * a)
         return positions, speeds, accels

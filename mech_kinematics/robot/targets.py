@@ -67,7 +67,8 @@ if TYPE_CHECKING:
     from .robot import Robot, RobotState
     from ..geometry.workspace import Workspace
 
-__all__ = ['AXES', 'frame_motion', 'frame_workspace', 'robot_targets', 'solve_robot_targets']
+__all__ = ['AXES', 'frame_motion', 'frame_workspace', 'joint_sweep', 'robot_targets',
+           'solve_robot_targets']
 
 #: A frame target's coordinates, in the root frame.
 AXES = ('x', 'y', 'z')
@@ -198,14 +199,6 @@ def robot_targets(robot: Robot, names: Sequence[str]) -> TargetMap:
         """Return joint ``name``'s value wrapped to (-pi, pi], rad."""
         return float(math.remainder(float(answer.joints[name].position), math.tau))
 
-    def sweep(name: str) -> tuple[float, float]:
-        """Return where an actuated joint's start poses are sought: a turn, or its limits."""
-        start = float(robot.start(name))
-        if robot.joint_type(name).angular:
-            return (start - math.pi, start + math.pi)
-        limits = description.joints[name].limits
-        return limits if limits is not None else (start - size, start + size)
-
     return TargetMap(
         targets=tuple(names), drivers=drivers, target_angular=tuple(angular),
         driver_angular=tuple(robot.joint_type(d).angular for d in drivers),
@@ -214,7 +207,20 @@ def robot_targets(robot: Robot, names: Sequence[str]) -> TargetMap:
         evaluate=evaluate, text=text,
         elbows=tuple(n for n in probe.joints if n not in drivers
                      and robot.joint_type(n).angular and not _constant(robot, n)),
-        elbow=elbow, driver_domains=tuple(sweep(d) for d in drivers))
+        elbow=elbow, driver_domains=tuple(joint_sweep(robot, d, size) for d in drivers))
+
+
+def joint_sweep(robot: Robot, name: str, size: float) -> tuple[float, float]:
+    """Return where an actuated joint's start poses are sought: a turn, or its limits.
+
+    A revolute joint: a turn about its reference value; a prismatic one: its
+    limits, else ``size`` (the loops' size) either way of its reference value.
+    """
+    start = float(robot.start(name))
+    if robot.joint_type(name).angular:
+        return (start - math.pi, start + math.pi)
+    limits = robot.description.joints[name].limits
+    return limits if limits is not None else (start - size, start + size)
 
 
 def solve_robot_targets(robot: Robot, targets: Mapping[str, float],
@@ -305,17 +311,15 @@ def frame_workspace(robot: Robot, link: str, grid: int | None = None) -> Workspa
     at = (float(local[0]), float(local[1]))
     ws = workspace(robot.scene, link, lambda state: carried_motion(spec, at, state),
                    GRID if grid is None else grid, (rotation @ e, rotation @ o + ground[:3, 3]))
-    # The scene's drivers are the URDF joints: q = reference + sigma (scene - scene_ref).
-    sigma = np.array([d.sigma for d in drivers])
-    ref = np.array([d.reference for d in drivers])
-    scene_ref = np.array([d.scene_ref for d in drivers])
+    # The scene's drivers are the URDF joints (DriverMap.joint_value), d joint = d scene / sigma.
 
     def joints(values: Any) -> Any:
-        return ref + sigma * (np.asarray(values, dtype=np.float64).reshape(-1, 2) - scene_ref)
+        q = np.asarray(values, dtype=np.float64).reshape(-1, 2)
+        return np.stack([d.joint_value(q[:, k]) for k, d in enumerate(drivers)], axis=1)
 
     return replace(ws, scene=robot.name, drivers=(drivers[0].name, drivers[1].name),
-                   axes=tuple(ref[k] + sigma[k] * (ws.axes[k] - scene_ref[k]) for k in range(2)),
-                   det=ws.det * float(sigma[0] * sigma[1]),
+                   axes=tuple(d.joint_value(ws.axes[k]) for k, d in enumerate(drivers)),
+                   det=ws.det * float(drivers[0].sigma * drivers[1].sigma),
                    singular_drivers=joints(ws.singular_drivers),
                    lock_drivers=joints(ws.lock_drivers))
 

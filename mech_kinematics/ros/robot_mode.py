@@ -308,7 +308,7 @@ class RobotValues:
             self._inputs.append((actuated[leader], m, o, d.sigma, d.reference, d.scene_ref))
             stroke = scene_drivers[d.scene].stroke
             if rule is None and stroke is not None:
-                ends = sorted(d.reference + (s - d.scene_ref) / d.sigma for s in stroke)
+                ends = sorted(d.joint_value(s) for s in stroke)
                 strokes[d.name] = (ends[0], ends[1])
         self.drivers = tuple(RobotDriver(name, strokes.get(name)) for name in robot.actuated)
         mimics = [f'{d.scene} ({d.name} mimics {d.mimic.joint})' for d in robot.planar.drivers

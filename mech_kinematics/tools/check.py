@@ -567,17 +567,13 @@ def _print_report(args: argparse.Namespace, scene: Any, data: dict[str, Any], te
     A robot described in URDF with ``<inertial>``s: its actuated joints'
     efforts at rest over each one's range instead (:func:`sweeps_text`).
     """
-    if robot is not None:
+    study, flywheel, refused, sweeps = None, None, '', None
+    if robot is None:
+        study, flywheel, refused = _turning(scene, args.flywheel)
+    elif robot.forces is not None:
         from ..robot.forces import effort_sweeps
 
-        if robot.forces is None:
-            study, flywheel, refused, sweeps = None, None, '', None
-        else:
-            study, flywheel, refused = None, None, ''
-            sweeps = effort_sweeps(robot, gravity=gravity_of(args), loads=link_loads_of(args))
-    else:
-        study, flywheel, refused = _turning(scene, args.flywheel)
-        sweeps = None
+        sweeps = effort_sweeps(robot, gravity=gravity_of(args), loads=link_loads_of(args))
     if args.json:
         if study is not None:
             data['turning_moment'] = turning_json(study, flywheel)
@@ -626,13 +622,10 @@ def sweeps_json(sweeps: Sequence[Any]) -> list[dict[str, Any]]:
     """Return ``"efforts_at_rest"`` of ``check --json`` on a robot: SI (rad or m, N m or N)."""
     out = []
     for sweep in sweeps:
-        efforts = {}
-        for name in sweep.efforts:
-            if not sweep.valid.any():
-                continue
-            top, low = sweep.extremes(name)
-            efforts[name] = {key: {'value': v, 'at': at, 'bound': b}
-                             for key, (v, at, b) in (('max', top), ('min', low))}
+        efforts = {name: {key: {'value': v, 'at': at, 'bound': b}
+                          for key, (v, at, b) in zip(('max', 'min'), sweep.extremes(name),
+                                                     strict=True)}
+                   for name in sweep.efforts} if sweep.valid.any() else {}
         out.append({'joint': sweep.joint, 'range': [float(sweep.positions[0]),
                                                     float(sweep.positions[-1])],
                     'positions': len(sweep.positions), 'solved': int(sweep.valid.sum()),

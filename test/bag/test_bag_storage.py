@@ -250,6 +250,10 @@ def test_under_a_file_size_limit_every_flushed_message_is_kept_with_room_to_clos
         assert info.count('/js') == flushed > 0
         assert_prefix(tmp_path / f'bag{k}', flushed)
         assert (tmp_path / f'bag{k}' / f'bag{k}.mcap').stat().st_size <= limit
+    # docs/bags.md states the room kept for the embedded metadata.
+    docs = ' '.join((Path(__file__).resolve().parents[2] / 'docs' / 'bags.md').read_text().split())
+    assert (f'{storage_mcap._METADATA_ROOM // 1024} KiB + {storage_mcap._TOPIC_ROOM // 1024} '
+            'KiB a topic') in docs
 
 
 @pytest.mark.parametrize('storage', STORAGES)

@@ -29,10 +29,23 @@ START = mk.solve(FIVE, [d.start for d in FIVE.drivers], [0.0, 0.0], [0.0, 0.0])
 START_P = [float(c) for c in START.points['P'].position]
 
 
-def target_node(ros, tmp_path, name, *args):
+def target_node(ros, tmp_path, name, *args, greeting=START_P):
     return TopicNode(ros, tmp_path, name, *args, scene=SCENE, drive='target',
                      input_topic=f'{SESSION}/{name}/input_targets',
-                     greeting=(['P.x', 'P.y'], START_P))
+                     greeting=(['P.x', 'P.y'], greeting))
+
+
+def _stream(node, stamps, points, speeds, accelerations=False):
+    """Send P's targets (with speeds, or None) at ``stamps``; wait for every state; stop."""
+    try:
+        for stamp, p, v in zip(stamps, points, speeds, strict=True):
+            node.send(stamp, ['P.x', 'P.y'], p, [] if v is None else v)
+        wait_for(lambda: len(node.js) >= len(stamps), ANSWER_S, 'joint_states')
+        if accelerations:
+            wait_for(lambda: len(node.pt) >= len(stamps), ANSWER_S, 'point_accelerations')
+        assert node.proc.proc.poll() is None
+    finally:
+        node.stop()
 
 
 def test_one_state_per_target_message_with_the_motors_values(ros, tmp_path):
@@ -41,14 +54,7 @@ def test_one_state_per_target_message_with_the_motors_values(ros, tmp_path):
     points = [(START_P[0] - 0.002 * i, START_P[1] - 0.001 * i) for i in range(20)]
     stamps = [T0 + 1_000_000 * i for i in range(len(points))]
     speeds = [(-0.2, -0.1) if i % 2 else None for i in range(len(points))]
-    try:
-        for stamp, p, v in zip(stamps, points, speeds, strict=True):
-            node.send(stamp, ['P.x', 'P.y'], p, [] if v is None else v)
-        wait_for(lambda: len(node.js) >= len(stamps), ANSWER_S, 'joint_states')
-        wait_for(lambda: len(node.pt) >= len(stamps), ANSWER_S, 'point_accelerations')
-        assert node.proc.proc.poll() is None
-    finally:
-        node.stop()
+    _stream(node, stamps, points, speeds, accelerations=True)
     assert [stamp_ns(m) for m in node.js] == stamps
     joints = FIVE.output_joints
     index = FIVE.output_points.index('P')
@@ -70,19 +76,11 @@ def test_target_branch_answers_in_the_working_mode_asked(ros, tmp_path):
     """target_branch B and D positive: each state's motors are solve_targets' in that mode."""
     branch = {'B': 1, 'D': 1}
     goal = [0.06, 0.22]
-    node = TopicNode(ros, tmp_path, 'target_branch', '-p', 'target_branch:=[B=+1, D=+1]',
-                     scene=SCENE, drive='target',
-                     input_topic=f'{SESSION}/target_branch/input_targets',
-                     greeting=(['P.x', 'P.y'], goal))
+    node = target_node(ros, tmp_path, 'target_branch', '-p', 'target_branch:=[B=+1, D=+1]',
+                       greeting=goal)
     points = [(goal[0] + 0.002 * i, goal[1]) for i in range(5)]
     stamps = [T0 + 1_000_000 * i for i in range(len(points))]
-    try:
-        for stamp, p in zip(stamps, points, strict=True):
-            node.send(stamp, ['P.x', 'P.y'], p)
-        wait_for(lambda: len(node.js) >= len(stamps), ANSWER_S, 'joint_states')
-        assert node.proc.proc.poll() is None
-    finally:
-        node.stop()
+    _stream(node, stamps, points, [None] * len(points))
     assert [stamp_ns(m) for m in node.js] == stamps
     joints = FIVE.output_joints
     start = None
