@@ -517,7 +517,7 @@ class RobotForces:
                         parent, child = closure.link_a, closure.link_b
                         axis = None
                     a, b = scene_body.get(body_of[parent]), scene_body.get(body_of[child])
-                    point = robot.planar.names.get(name, name)
+                    point = robot.planar.pins.get(name, name)
                     found = by_at.get((point, frozenset((a, b))))
                     if a is None or b is None or found is None:
                         continue

@@ -188,6 +188,10 @@ class Planar:
         height of the link's frame origin over the plane, ``E @ z + o``
         (``E`` 3x2: the plane's axes): where that origin is when ``z`` is
         its place in the plane.
+    pins : dict of str to str
+        Each joint and closure of a loop -> the scene point at its pin (its
+        name, or another where :attr:`names` says so: a motor named after the
+        joint may hold its name).
     """
 
     data: dict[str, Any]
@@ -200,6 +204,7 @@ class Planar:
     links: dict[str, tuple[str, Any, Any]] = field(default_factory=dict)
     planes: dict[str, tuple[str, Any, Any]] = field(default_factory=dict)
     lifts: dict[str, tuple[int, Any, Any]] = field(default_factory=dict)
+    pins: dict[str, str] = field(default_factory=dict)
 
     def link_frame(self, link: str) -> tuple[str, Any, Any]:
         """Return a moving link's map into its scene body's own frame (:attr:`links`' form).
@@ -1321,6 +1326,64 @@ def _edges(description: Description, weld: list[Closure], locked: Mapping[str, M
     return body_of, in_body, edges
 
 
+class _Hanging:
+    """The mimic joints a loop carries links by, outside every loop, where those links have mass.
+
+    A link hanging from a moving body of a loop by a revolute ``<mimic>`` joint
+    whose leader is actuated (an exporter's cover or finger pad, moved by a
+    hidden linkage the mimic rule stands for), its axis parallel to the
+    loop's normal, is placed by a hinge that rule turns: its weight and
+    inertia then load the leader's effort (the rule's multiplier times the
+    hinge's torque) and the loop's reactions. Only where a link at or beyond
+    it holds an ``<inertial>``: without masses nothing is added to the scene.
+    """
+
+    def __init__(self, description: Description, edges: list[_Edge], in_loops: set[str],
+                 body_of: Mapping[str, str], tree: Mapping[str, Matrix],
+                 actuated: tuple[str, ...]) -> None:
+        self.tree = tree
+        self.in_loops = in_loops
+        self.actuated = actuated
+        self.below: dict[str, list[_Edge]] = {}
+        for edge in edges:
+            if edge.joint is not None and edge.b not in in_loops:
+                self.below.setdefault(edge.a, []).append(edge)
+        massive = {body_of[link] for link in description.inertials}
+        self.heavy: dict[str, bool] = {}
+
+        def heavy(body: str) -> bool:
+            if body not in self.heavy:
+                self.heavy[body] = body in massive or any(heavy(e.b)
+                                                          for e in self.below.get(body, ()))
+            return self.heavy[body]
+
+        for body in list(self.below):
+            heavy(body)
+        self._heavy = heavy
+
+    def on(self, m: _Mechanism, ground: Matrix) -> list[_Edge]:
+        """Return the hanging mimic edges ``m`` carries (parent side first), or none."""
+        normal = ground[:3, :3] @ m.normal
+        out: list[_Edge] = []
+        frontier = [b for b in m.bodies if b != m.ground]
+        while frontier:
+            body = frontier.pop(0)
+            for edge in self.below.get(body, ()):
+                joint = edge.joint
+                assert joint is not None
+                if joint.type is None or not joint.type.angular or joint.mimic is None \
+                        or joint.mimic.joint not in self.actuated or not self._heavy(edge.b):
+                    continue
+                axis = (self.tree[joint.parent] @ joint.origin)[:3, :3] @ np.asarray(joint.axis)
+                axis = axis / np.linalg.norm(axis)
+                off = math.atan2(float(np.linalg.norm(np.cross(axis, normal))),
+                                 abs(float(axis @ normal)))
+                if off <= PLANAR_TOLERANCE:
+                    out.append(edge)
+                    frontier.append(edge.b)
+        return out
+
+
 def _check_welds(m: _Mechanism, weld: list[Closure], tree: Mapping[str, Matrix]) -> None:
     """Refuse a weld closure of ``m`` that the reference pose does not close.
 
@@ -1483,24 +1546,35 @@ def planar_from_description(description: Description, actuated: Iterable[str] | 
     builder = _Builder(description, actuated_names, pose)
     mechanisms = []
     claimed: set[str] = set()
+    in_loops = {b for c in components for i in c for b in (edges[i].a, edges[i].b)}
+    hanging = _Hanging(description, edges, in_loops, body_of, tree, actuated_names)
     for index, component in enumerate(components):
         part = [edges[i] for i in component]
         members = {e.a for e in part} | {e.b for e in part}
         ground = min(members, key=lambda b: (description.depth(b), description.order(b)))
         m = _Mechanism(index, part, model, in_body, body_of, description, ground, pose)
+        hangers = hanging.on(m, model[ground])
+        if hangers:
+            m = _Mechanism(index, part + hangers, model, in_body, body_of, description, ground,
+                           pose)
         _check_welds(m, weld, tree)
-        names = {e.name for e in part}
+        names = {e.name for e in m.edges}
         here = [n for n in actuated_names if n in names]
         mimics = {}
-        dof = 3 * (len(m.bodies) - 1) - 2 * len(part)
+        dof = 3 * (len(m.bodies) - 1) - 2 * len(m.edges)
         for edge in part:  # a mimic whose leader is actuated drives the loop it is in
             joint = edge.joint
-            if len(here) >= dof or joint is None or joint.mimic is None or edge.name in here:
+            if len(here) >= dof - len(hangers) or joint is None or joint.mimic is None \
+                    or edge.name in here:
                 continue
             leader = joint.mimic.joint
             if leader in actuated_names and leader not in names:
                 here.append(edge.name)
                 mimics[edge.name] = joint.mimic
+        for edge in hangers:   # a hanging mimic: a hinge its leader turns (_Hanging)
+            assert edge.joint is not None and edge.joint.mimic is not None
+            here.append(edge.name)
+            mimics[edge.name] = edge.joint.mimic
         if dof <= 0 or len(here) != dof:
             links = ', '.join(m.bodies[:6]) + (', ...' if len(m.bodies) > 6 else '')
             candidates = ', '.join(e.name for e in part if e.joint is not None)
@@ -1527,7 +1601,7 @@ def planar_from_description(description: Description, actuated: Iterable[str] | 
                     name, REVOLUTE, 1.0, pose.get(name, 0.0), turn, turn_ref, turn, turn_ref,
                     center=centre, mechanism=index)
         mechanisms.append({'ground': ground, 'links': list(m.bodies),
-                           'joints': [e.name for e in part],
+                           'joints': [e.name for e in m.edges],
                            'bodies': [n for n in dict.fromkeys(builder.body_names.values())
                                       if n not in before],
                            'body_names': {b: builder.body_names[b] for b in m.bodies
@@ -1553,7 +1627,9 @@ def planar_from_description(description: Description, actuated: Iterable[str] | 
     return Planar(data, tuple(builder.drivers), builder.joint_maps, mechanisms, actuated_names,
                   dict(builder.names.changed), _scene_masses(builder.mass_props, poses),
                   _link_frames(builder.link_planes, poses) if poses else {},
-                  dict(builder.link_planes), dict(builder.link_lifts))
+                  dict(builder.link_planes), dict(builder.link_lifts),
+                  {urdf: name for (kind, urdf), name in builder.names.given.items()
+                   if kind == 'point'})
 
 
 def _body_poses(data: dict[str, Any], bodies: Iterable[str]) -> dict[str, Any]:

@@ -18,6 +18,11 @@ the licence):
   loops written here as a file of ``<constraint>`` elements, as Isaac Sim's
   ``<loop_joint>`` and as URDF+'s ``<loop>`` (no public file of these forms
   for a planar loop was found).
+- OnRobot's RG2 (OnRobot/onrobot-ros2, BSD-3-Clause): its URDF as published
+  (refused: one finger's axis is written ``1.5708``, its loop is not planar
+  within 1e-12) and with that angle written pi/2 to 17 digits (solved), its
+  two finger parallelograms written here as a file of ``<constraint>``
+  elements beside it, as the issue's user had them.
 
 Each loop is checked closed in ``helpers.UrdfFk``, which reads every form
 again with xml.etree and PyYAML and closes it with 4x4 transforms.
@@ -42,6 +47,9 @@ RTOL_CLOSURE = 1e-12
 FORMS = {
     'constraint file': ('robotiq_2f_85.urdf', 'robotiq_2f_85.constraints.xml', None,
                         {'finger_joint': (0.0, 0.7)}, '<constraint>', 'pin'),
+    'constraint file (RG2)': ('onrobot_rg2_exact.urdf', 'onrobot_rg2.constraints.xml',
+                              ['finger_joint'], {'finger_joint': (0.0, 1.22277767395)},
+                              '<constraint>', 'pin'),
     'loop_joint': ('robotiq_2f_85.loop_joint.urdf', None, None,
                    {'finger_joint': (0.0, 0.7)}, '<loop_joint>', 'pin'),
     'loop': ('robotiq_2f_85.loop.urdf', None, None,
@@ -142,6 +150,38 @@ def test_the_published_fusion2urdf_file_is_read_and_refused_as_not_planar():
     with pytest.raises(UrdfError, match=r'the loop is not planar') as error:
         load_robot(urdf, data, ['servo_joint'])
     assert 'off it by 4.1e-07 rad' in str(error.value)
+
+
+def test_the_published_rg2_is_read_and_refused_as_not_planar_naming_the_joint():
+    """The right finger's pi/2, written 1.5708 by OnRobot, tilts its loop 3.7e-6 rad."""
+    urdf, closures = DATA / 'onrobot_rg2.urdf', DATA / 'onrobot_rg2.constraints.xml'
+    description = read_description(urdf, closures)
+    assert [(c.name, c.link_a, c.link_b) for c in description.closures] == [
+        ('right_finger_loop', 'right_inner_proximal_finger_link', 'right_finger_base_link'),
+        ('left_finger_loop', 'left_inner_proximal_finger_link', 'left_finger_base_link')]
+    with pytest.raises(UrdfError, match=r'joint "right_inner_proximal_finger_joint": .*the '
+                       r'loop is not planar') as error:
+        load_robot(urdf, closures, ['finger_joint'])
+    assert 'off it by 3.67e-06 rad' in str(error.value)
+
+
+def test_the_rg2s_fingers_stay_parallel_to_its_body_as_its_mimic_rules_say():
+    """Each finger base turns back by the finger joint (-1), each inner link with it (+1).
+
+    The covers hang from the outer links by mimics outside the loops (-1, then +1 on the
+    cover arm): placed as hinges those rules turn (they carry masses), they follow them.
+    """
+    robot, _ = _robot('constraint file (RG2)')
+    hinges = {d.name for d in robot.planar.drivers if d.mimic is not None}
+    assert {'right_finger_cover_arm_joint', 'left_finger_cover_joint'} <= hinges
+    for q in (0.0, 0.3, 0.9, 1.22):
+        joints = robot.solve({'finger_joint': q}, {'finger_joint': 0.5}).joints
+        for side in ('right', 'left'):
+            for name, gain in (('finger_base', -1.0), ('inner_proximal_finger', 1.0),
+                               ('finger_cover_arm', -1.0), ('finger_cover', 1.0)):
+                joint = joints[f'{side}_{name}_joint']
+                assert joint.position == pytest.approx(gain * q, abs=1e-12)
+                assert joint.velocity == pytest.approx(gain * 0.5, abs=1e-12)
 
 
 def test_a_closure_file_is_told_by_its_content_not_its_name(tmp_path):

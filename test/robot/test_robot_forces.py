@@ -15,7 +15,10 @@ The values are not checked against our formulas:
   apart from the package) computes from the URDF, the passive joints taken
   from our answer (the loop closed, as checked in test_real_robots.py);
 - power balance (hypothesis) at random states of the packaged robots given
-  inertials here: sum of effort x velocity = d(KE + PE)/dt, the kinetic
+  inertials here, and of OnRobot's RG2 with the inertials its exporter wrote
+  (its finger covers hang from the loops by ``<mimic>`` joints, their
+  weights and inertia carried by the finger joint's effort): sum of effort x
+  velocity = d(KE + PE)/dt, the kinetic
   energy from the joint velocities we answer, through the test's own twists
   of the URDF's joints, the derivative by central differences along the
   motion.
@@ -280,17 +283,27 @@ def _potential(robot, fk, inertials, positions, gravity):
     return _energy(fk, inertials, robot.solve(positions, gravity=gravity), gravity)[1]
 
 
+def _rg2():
+    """Return OnRobot's RG2 with its own inertials (its covers hang from the loops by mimics)."""
+    urdf, closures = DATA / 'onrobot_rg2_exact.urdf', DATA / 'onrobot_rg2.constraints.xml'
+    text = urdf.read_text()
+    return (load_robot(text, closures, ['finger_joint', 'body_joint']), UrdfFk(text, closures),
+            _inertials(text))
+
+
 def _case(name):
     """Return a robot, its FK, inertials, driving joint, range, carriers and a gravity."""
     if name == 'lift_arm':
         return (*_lift(), 'lift_joint', -1.0, 1.0, (), GRAVITY)
+    if name == 'onrobot_rg2':   # body_joint turns the whole gripper: the loops' ground
+        return (*_rg2(), 'finger_joint', 0.0, 1.22277767395, ('body_joint',), GRAVITY)
     if name == 'boom':   # the cylinder's stroke, 1.45 to 2.35 m, from its 1.9 m start
         return (*_boom(), 'lift_cyl', -0.4, 0.4, (), BOOM_GRAVITY)
     _, joint, low, high, carriers = ROBOTS[name]
     return (*_robot(name), joint, low, high, carriers, GRAVITY)
 
 
-CASES = ['lift_arm', 'boom', *ROBOTS]
+CASES = ['lift_arm', 'boom', 'onrobot_rg2', *ROBOTS]
 
 
 @pytest.mark.parametrize('name', CASES)
@@ -657,3 +670,31 @@ def test_check_sweeps_the_lift_arms_motor_over_its_limits_with_the_hand_torque(c
         assert cli_main(argv) == 2
         err = capsys.readouterr().err
         assert err.count('\n') == 1 and words in err
+
+
+@pytest.mark.parametrize('turn', [0.0, 0.3])
+def test_the_rg2s_hanging_covers_weigh_on_their_mimic_joints(turn):
+    """At rest each cover joint's reaction holds up the links beyond it: -m g in the plane.
+
+    The RG2's covers hang from each outer link by two mimic joints (arm, then cover), outside
+    the loops. The force on the child, turned into the root frame by the test's own kinematics,
+    is the weight of the links beyond the joint with its part along the pivots taken out (the
+    bearings carry that; body_joint at 0.3 rad tilts the fingers' plane out of the vertical).
+    """
+    robot, fk, inertials = _rg2()
+    answer = robot.solve({'finger_joint': 0.7, 'body_joint': turn})
+    frames = fk.transforms(_values(answer))
+    g = np.asarray(GRAVITY)
+    for side in ('right', 'left'):
+        arm, cover = f'{side}_finger_cover_arm', f'{side}_finger_cover'
+        for joint, beyond in ((f'{arm}_joint', (f'{arm}_link', f'{cover}_link')),
+                              (f'{cover}_joint', (f'{cover}_link',))):
+            reaction = answer.reactions[joint]
+            child = frames[beyond[0]]
+            assert reaction.frame == beyond[0]
+            normal = child[:3, :3] @ np.array([0.0, 0.0, 1.0])    # the joint's axis
+            weight = -sum(inertials[link][0] for link in beyond) * g
+            expected = weight - (weight @ normal) * normal
+            force = child[:3, :3] @ np.asarray(reaction.force)
+            assert np.allclose(force, expected, rtol=0.0, atol=1e-12)
+            assert np.linalg.norm(expected) > 0.9 * math.cos(turn) * np.linalg.norm(weight)

@@ -43,6 +43,11 @@ H = 1e-4
 #: vz = 0.5) that is 1.9e-6 at 1e-4, above the tolerance; 100 times less at 1e-5, with
 #: rounding (eps / H) far below it.
 H_VELOCITY = 1e-5
+#: The acceleration's step: its second difference errs by H^2 |x''''| / 12, which at 1e-4
+#: was 1.9e-4 m/s^2 (above the tolerance) where a motor's answered acceleration is 173
+#: rad/s^2 (dy = 0.078125, dz = 0.01, vz = 0.5: the error fell as H^2, 1.7e-3 at 3e-4,
+#: 1.7e-5 at 3e-5); 7e-6 at 2e-5, with rounding (eps |x| / H^2, 3e-7) below it.
+H_ACCELERATION = 2e-5
 RTOL_DIFFERENCE = 1e-6
 
 
@@ -84,7 +89,8 @@ def test_the_five_bar_driven_by_its_effector_puts_it_there_at_its_rates(dy, dz, 
         return _effector(FIVE_FK, FIVE, {n: q[n] + qd[n] * t + qdd[n] * t * t / 2 for n in q})
 
     velocity = (at(H_VELOCITY) - at(-H_VELOCITY)) / (2 * H_VELOCITY)
-    acceleration = (at(H) - 2 * at(0.0) + at(-H)) / (H * H)
+    acceleration = (at(H_ACCELERATION) - 2 * at(0.0) + at(-H_ACCELERATION)) / (
+        H_ACCELERATION * H_ACCELERATION)
     np.testing.assert_allclose(velocity[1:], [vy, vz], rtol=0,
                                atol=RTOL_DIFFERENCE * (1 + abs(vy) + abs(vz)))
     np.testing.assert_allclose(acceleration[1:], [ay, az], rtol=0,
