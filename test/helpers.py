@@ -845,6 +845,22 @@ def hinge_scene():
                    {'name': 'right', 'from': 'D', 'length': 150}], 'branch': 1}])
 
 
+def fold_scene():
+    """Return a four-bar driven at its coupler-to-rocker pin C (a fold): no crank at all.
+
+    Crank A-B 40 mm, coupler B-C 100 mm, rocker D-C 70 mm, |AD| = 80 mm; the
+    motor's angle (the coupler's from the rocker's axis) assembles from 92 to
+    161.8 deg, where |DB| = |70 + 100 exp(i q)| mm lies between 40 and 120 mm.
+    """
+    return scene_mapping(
+        'fold', {'A': [0, 0], 'D': [80, 0]},
+        inputs=[{'motor': 'knee', 'angle': 120, 'speed': 2.0, 'accel': 1.0}],
+        dyads=[{'type': 'fold', 'point': 'B', 'pin': 'C', 'links': [
+            {'name': 'crank', 'from': 'A', 'length': 40},
+            {'name': 'rocker', 'from': 'D', 'length': 70}],
+            'coupler': {'name': 'coupler', 'length': 100}, 'motor': 'knee', 'branch': 1}])
+
+
 def collar_scene():
     """Return a collar driven along a crank by an actuator, a link from it to a guided block."""
     return scene_mapping(

@@ -143,7 +143,7 @@ BAD_SCENES = [
     ('branch_two', edit(setitem(['dyads', 1, 'branch'], 2)), 'dyads[1].branch',
      r'expected \+1 or -1, got 2'),
     ('unknown_dyad_type', edit(setitem(['dyads', 1, 'type'], 'PPP')), 'dyads[1].type',
-     r"expected RRR, RRP, RPR, RPP, triad, collar or hinge, got 'PPP'"),
+     r"expected RRR, RRP, RPR, RPP, triad, collar, hinge or fold, got 'PPP'"),
     ('unknown_top_level_key', edit(setitem(['colour'], 'red')), 'scene',
      r"unknown key.*'colour'"),
     ('unknown_link_key', edit(setitem([*LINK1, 'lenght'], 80)), 'dyads[0].links[1]',

@@ -741,11 +741,11 @@ class _Builder:
                     name, (edge, _, _, _) = next(iter(self.hinges.items()))
                     raise self.fail(
                         f'joint "{name}": Expected an actuated revolute joint between two '
-                        f'moving links (a motor on a link: a hinge) to turn a link about one '
-                        f'the loop places without it, got one between links "{edge.a}" and '
-                        f'"{edge.b}", neither placed first: the loop would need re-rooting with '
-                        f'this joint as its input (not built; our kinds drive no relative '
-                        f'angle there)', name)
+                        f'moving links to turn a link about one the loop places without it (a '
+                        f'hinge), or to be the knee of a loop re-rooted at it (a fold: one link '
+                        f'pinned to a placed body, the other to a link pinned to one), got one '
+                        f'between links "{edge.a}" and "{edge.b}", neither placed first nor so '
+                        f'held: our kinds drive no relative angle there', name)
                 left = [b for b in m.bodies if b not in self.known]
                 joint = next(e.name for b in left for e in m.edges_of[b])
                 raise self.fail(
@@ -954,7 +954,7 @@ class _Builder:
     # --- dyads -----------------------------------------------------------------------------
     def _dyad(self) -> bool:
         return (self._hinge() or self._rrr() or self._rrp() or self._rpr() or self._rpp()
-                or self._triad())
+                or self._triad() or self._fold())
 
     def _hinge(self) -> bool:
         """Place a link a motor turns on a placed one: its angle the parent's plus the motor's."""
@@ -978,6 +978,69 @@ class _Builder:
             del self.hinges[name]
             return True
         return False
+
+    def _fold(self) -> bool:
+        """Place a loop re-rooted at a motor between two links neither placed: a fold.
+
+        The rocker is pinned to a placed body; the coupler, which the motor
+        turns on the rocker, to a crank pinned to a placed body (a four-bar
+        driven at its coupler-to-rocker pin).
+        """
+        m = self.m
+        for name, (edge, mimic, index, entry) in self.hinges.items():
+            if edge.a in self.known or edge.b in self.known:
+                continue
+            for rocker, coupler in ((edge.a, edge.b), (edge.b, edge.a)):
+                if self._unit(rocker) != ('link', rocker) or \
+                        self._unit(coupler) != ('link', coupler):
+                    continue
+                starts = [e for e in self._known_pin(rocker) if e.name != name]
+                if not starts:
+                    continue
+                for knee in m.edges_of[coupler]:
+                    crank = knee.b if knee.a == coupler else knee.a
+                    if knee is edge or knee.kind != 'pin' or crank in self.known or \
+                            crank == rocker or self._unit(crank) != ('link', crank):
+                        continue
+                    anchors = [e for e in self._known_pin(crank) if e.name != knee.name]
+                    if anchors:
+                        self._place_fold(name, edge, mimic, index, entry, (rocker, coupler, crank),
+                                         (starts[0].name, knee.name, anchors[0].name))
+                        return True
+        return False
+
+    def _place_fold(self, name: str, edge: _Edge, mimic: Any, index: int, entry: dict[str, Any],
+                    bodies: tuple[str, str, str], pins: tuple[str, str, str]) -> None:
+        """Add the fold of ``bodies`` (rocker, coupler, crank) at ``pins`` (D, B, A)."""
+        m = self.m
+        rocker, coupler, crank = bodies
+        d_pin, b_pin, a_pin = pins
+        p_a, p_b = m.pins[crank][a_pin], m.pins[crank][b_pin]
+        p_d, p_c = m.pins[rocker][d_pin], m.pins[rocker][name]
+        c_c, c_b = m.pins[coupler][name], m.pins[coupler][b_pin]
+        names = [self.link(body) for body in bodies]
+        for body, link in zip(bodies, names, strict=True):
+            self.body_names[body] = link
+        angles = [_angle(p_c - p_d), _angle(c_b - c_c), _angle(p_b - p_a)]
+        assert edge.joint is not None
+        sigma = m.sign(edge) * (1.0 if coupler == edge.b else -1.0)
+        reference = m.reference_value(edge.joint)
+        relative = angles[1] - angles[0]
+        entry['angle'] = relative + sigma * (self.pose.get(name, 0.0) - reference)
+        point, knee = self.point(b_pin), self.point(name)
+        self.dyads.append({
+            'type': 'fold', 'point': point, 'pin': knee, 'links': [
+                {'name': names[2], 'from': self.point(a_pin), 'length': abs(p_b - p_a)},
+                {'name': names[0], 'from': self.point(d_pin), 'length': abs(p_c - p_d)}],
+            'coupler': {'name': names[1], 'length': abs(c_b - c_c)}, 'motor': entry['motor'],
+            'branch': self._branch(p_a, p_d, p_b, f'fold {point}', b_pin)})
+        self.drivers[index] = DriverMap(name, entry['motor'], REVOLUTE, sigma, reference,
+                                        relative, mimic)
+        del self.hinges[name]
+        self.placed.update((b_pin, name))
+        self._known(crank, (names[2], angles[2]), a_pin, b_pin, angles[2])
+        self._known(rocker, (names[0], angles[0]), d_pin, name, angles[0])
+        self._known(coupler, (names[1], angles[1]), name, b_pin, angles[1])
 
     def _unit(self, body: str) -> tuple[str, str] | None:
         """Return (kind, key): ``body`` as an RRR element: a link, or a cylinder's barrel."""

@@ -44,6 +44,7 @@ from .carried import CarriedPoint
 from .collar import Collar
 from .context import NEAR_SINGULAR, SINGULAR
 from .crank import Crank
+from .fold import Fold
 from .geneva import TANGENCY_TOLERANCE
 from .hinge import Hinge, Motor
 from .inverse import Inverse, solve_targets
@@ -60,7 +61,8 @@ from .state import Engagement, JointMotion, PointState, State
 from .triad import Triad
 
 __all__ = [
-    'Actuator', 'Branch', 'CarriedPoint', 'Collar', 'Crank', 'Engagement', 'Hinge', 'Inverse',
+    'Actuator', 'Branch', 'CarriedPoint', 'Collar', 'Crank', 'Engagement', 'Fold', 'Hinge',
+    'Inverse',
     'JointMotion', 'Link', 'Motor',
     'MAX_SLOTS',
     'NEAR_SINGULAR', 'Pin', 'PointState', 'RPP', 'RPR', 'RRP', 'RRR', 'SINGULAR', 'Scene', 'State',

@@ -11,8 +11,8 @@ position is the relative angle (a revolute joint named after it, the
 parent's axis to the link's), its effort the torque between the two links.
 This is the revolute joint between two moving links of issue 41 as a driver,
 where the parent is placed before the link it turns (a loop whose driven
-joint joins two links neither of which the rest places first needs the
-loop re-rooted: not built).
+joint joins two links neither of which the rest places first is re-rooted
+at it: :mod:`.fold`, which the same motor drives).
 
 This module owns both halves: the motor (:class:`Motor`, a driver: its
 scene keys and its step, which writes the relative angle as a unit complex
@@ -166,11 +166,11 @@ class Motor(Driver):
         return Fragment(self.motor, coordinates={self.motor: REVOLUTE})
 
     def check_used(self, users: Sequence[Item]) -> None:
-        """Refuse it unless exactly one hinge turns its link."""
+        """Refuse it unless exactly one hinge or fold turns its link."""
         if len(users) != 1:
             got = 'none' if not users else ', '.join(f'{u.kind} {u.key}' for u in users)
-            msg = (f'Expected motor "{self.motor}" to turn one hinge (a dyad of type hinge with '
-                   f'motor: {self.motor}), got {got}')
+            msg = (f'Expected motor "{self.motor}" to turn one hinge or fold (a dyad of type '
+                   f'hinge or fold with motor: {self.motor}), got {got}')
             raise SceneError(msg, (self, 'motor'))
 
     def defined(self) -> tuple[tuple[str, str], ...]:

@@ -14,6 +14,7 @@ from .actuator import Actuator
 from .base import Driver, Item
 from .collar import Collar
 from .crank import Crank
+from .fold import Fold
 from .hinge import Hinge, Motor
 from .model import SceneUnits
 from .rpp import RPP
@@ -23,7 +24,7 @@ from .rrr import RRR
 from .slider import Slider
 from .triad import Triad
 
-_ITEMS: tuple[type[Item], ...] = (RRR, RRP, RPR, RPP, Triad, Collar, Hinge)
+_ITEMS: tuple[type[Item], ...] = (RRR, RRP, RPR, RPP, Triad, Collar, Hinge, Fold)
 #: The scene's ``type:`` of a dyad -> its item class.
 KINDS: dict[str, type[Item]] = {kind.kind: kind for kind in _ITEMS}
 

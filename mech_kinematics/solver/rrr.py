@@ -567,6 +567,10 @@ class _ActuatedRRRStep(_RRRStep):
         return None
 
     def run(self, ctx: _Context) -> None:
+        self._actuated(ctx)
+
+    def _actuated(self, ctx: _Context) -> None:
+        """Solve the dyad on its current lengths (a helper the fold's kernel calls too)."""
         l1, ld1, ldd1, el1, eld1, eldd1 = (self.fixed1 if self.act1 is None
                                            else ctx.sliders[self.act1])
         l2, ld2, ldd2, el2, eld2, eldd2 = (self.fixed2 if self.act2 is None

@@ -62,8 +62,8 @@ import yaml
 
 from ..errors import SceneError
 from ..scene import read_scene_yaml
-from ..solver import (Actuator, CarriedPoint, Collar, Crank, Hinge, Motor, RPP, RPR, RRP, RRR,
-                      Scene, Slider, Triad)
+from ..solver import (Actuator, CarriedPoint, Collar, Crank, Fold, Hinge, Motor, RPP, RPR, RRP,
+                      RRR, Scene, Slider, Triad)
 from ..solver.graph import Fragment, joint_type, JointType
 from ..units import ANGLE_UNITS, LENGTH_UNITS, radians_from_degrees
 
@@ -1419,13 +1419,96 @@ class _Hinge(_Explicit):
         pts[item.point] = pts[item.center] + p[f'hinge.{item.link}.length'] * turned
 
 
+class _Fold(_RRR):
+    """A crank and a rocker from known points, joined by a coupler a motor turns on the rocker.
+
+    Unknowns: the crank's and the rocker's angles; the coupler's is the
+    rocker's plus the motor's (derived, as a hinge's). One complex residual:
+    the crank's end is the coupler's end ``C + b exp(i (th_rocker + q))``,
+    ``C`` the rocker's end. The start: ``|DB| = |c + b exp(i q)|`` by the
+    law of cosines (in the rocker's frame), then B on the circles about A and
+    D by the law of cosines again, its side of A->D the branch (checked as an
+    RRR's, whose pin and links it names alike).
+    """
+
+    @staticmethod
+    def parameters(item: Any) -> tuple[Parameter, ...]:
+        """Return the crank's, the rocker's and the coupler's lengths."""
+        return (*(_length(f'link.{link.name}.length', link.length, ('links', k, 'length'))
+                  for k, link in enumerate(item.links)),
+                _length(f'fold.{item.coupler}.length', item.length, ('coupler', 'length')))
+
+    @staticmethod
+    def ready(model: Model, item: Any, known: set[str]) -> bool:
+        """Return whether both starts are known (the coupler's angle is then derived)."""
+        if all(link.start in known for link in item.links):
+            model.derived[item.coupler] = (item.links[1].name, item.motor)
+            return True
+        return False
+
+    @staticmethod
+    def unknowns(item: Any) -> tuple[str, ...]:
+        """Return the crank and the rocker (their angles)."""
+        return tuple(link.name for link in item.links)
+
+    @staticmethod
+    def new_points(item: Any) -> tuple[str, ...]:
+        """Return its two pins."""
+        return (item.point, item.pin)
+
+    @staticmethod
+    def evaluate(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
+                 points: dict[str, Any], residuals: list[Any]) -> None:
+        """Require the crank's end to be the coupler's, from the rocker's end."""
+        crank, rocker = item.links
+        at = points[crank.start] + p[f'link.{crank.name}.length'] * expi(q[i])
+        knee = points[rocker.start] + p[f'link.{rocker.name}.length'] * expi(q[i + 1])
+        other = knee + p[f'fold.{item.coupler}.length'] * expi(q[i + 1] + p[f'motor.{item.motor}'])
+        residuals.append(at - other)
+        points[item.point] = at
+        points[item.pin] = knee
+
+    @staticmethod
+    def construct(item: Any, i: int, p: Mapping[str, Any], q: list[Any],
+                  pts: dict[str, Any], tiny: Any) -> None:
+        """Solve by the law of cosines twice, the branch from its definition (mpmath)."""
+        crank, rocker = item.links
+        a = p[f'link.{crank.name}.length']
+        c = p[f'link.{rocker.name}.length']
+        b = p[f'fold.{item.coupler}.length']
+        w = c + b * mpmath.expj(p[f'motor.{item.motor}'])
+        fused = abs(w)
+        d = pts[rocker.start] - pts[crank.start]
+        dist = abs(d)
+        cos_gamma = (a * a + dist * dist - fused * fused) / (2 * a * dist)
+        if abs(cos_gamma) > 1 + tiny:
+            msg = f'fold {item.point}: the circles do not meet'
+            raise NoAssembly(msg)
+        gamma = mpmath.acos(max(-1, min(1, cos_gamma)))
+        q[i] = mpmath.arg(d) + int(item.branch) * gamma
+        at = pts[crank.start] + a * mpmath.expj(q[i])
+        q[i + 1] = mpmath.arg(at - pts[rocker.start]) - mpmath.arg(w)
+        pts[item.point] = at
+        pts[item.pin] = pts[rocker.start] + c * mpmath.expj(q[i + 1])
+
+    @staticmethod
+    def measure(model: Model, item: Any, i: int, p: Mapping[str, Any],
+                points: Mapping[str, Any], q: list[Any], measures: dict[str, Any]) -> None:
+        """Put the sine of the angle between the crank and D->B (the solver's definition)."""
+        crank, rocker = item.links
+        r1 = points[item.point] - points[crank.start]
+        r2 = points[item.point] - points[rocker.start]
+        cross = (mpmath.conj(r1) * r2).imag
+        measures[item.point] = abs(cross) / (p[f'link.{crank.name}.length'] * abs(r2))
+
+
 #: The equations of every kind of scene item, by :func:`model_key`: each kind of the
 #: registry (``solver/registry.py`` ``KINDS``), the carried point and the Geneva wheel's
 #: RPR. A kind missing here is refused by :class:`Model`, never solved as another.
 MODELS: dict[str, _Equations] = {
     RRR.kind: _RRR(), RRP.kind: _RRP(), RPR.kind: _RPR(), RPP.kind: _RPP(),
     Triad.kind: _Triad(), CarriedPoint.kind: _Carry(), RPR.kind + INTERMITTENT: _Geneva(),
-    Collar.kind: _Collar(), Hinge.kind: _Hinge()}
+    Collar.kind: _Collar(), Hinge.kind: _Hinge(), Fold.kind: _Fold()}
 
 #: The equations of every kind of driver, by its key in a scene's ``inputs:`` (``DRIVERS``).
 DRIVER_MODELS: dict[str, _DriverEquations] = {Crank.scene_key: _Crank(),

@@ -2,6 +2,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """What a robot in URDF is refused for: one line naming the joint and why. See issue 31."""
 
+import math
+
 from helpers import khurmi_pin, khurmi_urdf, solve_urdf_text, UrdfFk
 import pytest
 
@@ -78,10 +80,33 @@ def test_a_triad_is_solved_not_refused():
     assert '\n' not in str(caught.value)
 
 
-def test_a_relative_driver_is_refused_saying_why():
-    """Driving the elbow (between two moving links): our kinds drive no relative angle."""
-    error = _refused(khurmi_urdf(), actuated=['elbow'])
-    assert error.joint == 'elbow' and 'no relative angle' in str(error)
+def test_a_four_bar_driven_at_its_elbow_is_re_rooted_there_and_closes():
+    """The elbow (crank to coupler, neither placed first) drives a fold (issue 41, item 1).
+
+    At the elbow angle the motor-driven four-bar shows, the loop re-rooted at the elbow
+    answers the same joints and rates (1e-14), and closes in the test's own kinematics.
+    """
+    text = khurmi_urdf()
+    by_motor, by_elbow = load_robot(text), load_robot(text, actuated=['elbow'])
+    assert [d['type'] for d in by_elbow.planar.data['dyads']] == ['fold']
+    fk = UrdfFk(text)
+    for q in (0.3, 1.0, 2.0, 4.0):
+        given = by_motor.solve({'motor': q}, {'motor': 1.5})
+        elbow = given.joints['elbow']
+        answer = by_elbow.solve({'elbow': elbow.position}, {'elbow': elbow.velocity})
+        for name, joint in given.joints.items():
+            got = answer.joints[name]
+            assert abs(math.remainder(got.position - joint.position, math.tau)) <= 1e-14
+            assert got.velocity == pytest.approx(joint.velocity, abs=1e-13)
+        values = {n: j.position for n, j in answer.joints.items()}
+        assert fk.gaps(values)['pin_C'] <= 1e-12 * fk.loop_size('pin_C')
+
+
+def test_a_relative_driver_no_kind_drives_is_refused_saying_why():
+    """The triad's B (crank to l1): neither placed first, nor a fold's knee: one line."""
+    error = _refused(TRIAD, actuated=['B'])
+    assert error.joint == 'B' and 'no relative angle' in str(error)
+    assert 'a fold' in str(error)
 
 
 def test_more_drivers_than_degrees_of_freedom_are_refused():

@@ -295,6 +295,10 @@ def _case(name):
     """Return a robot, its FK, inertials, driving joint, range, carriers and a gravity."""
     if name == 'lift_arm':
         return (*_lift(), 'lift_joint', -1.0, 1.0, (), GRAVITY)
+    if name == 'lift_arm by its elbow':   # re-rooted at the elbow: a fold (issue 41)
+        text = LIFT.read_text()
+        return (load_robot(LIFT, actuated=['elbow']), UrdfFk(text), _inertials(text), 'elbow',
+                -2.0, -1.2, (), GRAVITY)
     if name == 'onrobot_rg2':   # body_joint turns the whole gripper: the loops' ground
         return (*_rg2(), 'finger_joint', 0.0, 1.22277767395, ('body_joint',), GRAVITY)
     if name == 'boom':   # the cylinder's stroke, 1.45 to 2.35 m, from its 1.9 m start
@@ -303,7 +307,7 @@ def _case(name):
     return (*_robot(name), joint, low, high, carriers, GRAVITY)
 
 
-CASES = ['lift_arm', 'boom', 'onrobot_rg2', *ROBOTS]
+CASES = ['lift_arm', 'lift_arm by its elbow', 'boom', 'onrobot_rg2', *ROBOTS]
 
 
 @pytest.mark.parametrize('name', CASES)

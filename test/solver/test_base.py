@@ -81,7 +81,7 @@ def test_the_joint_type_test_finds_a_switch():
 
 def test_the_registry_holds_every_dyad_type_of_the_scene_format():
     """The scene's type: names its kind, which is an Item of that kind."""
-    assert set(KINDS) == {'RRR', 'RRP', 'RPR', 'RPP', 'triad', 'collar', 'hinge'}
+    assert set(KINDS) == {'RRR', 'RRP', 'RPR', 'RPP', 'triad', 'collar', 'hinge', 'fold'}
     for name, kind in KINDS.items():
         assert issubclass(kind, Item) and kind.kind == name
 

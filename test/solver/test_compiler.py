@@ -19,7 +19,7 @@ generator here fails, named.
 import importlib
 import math
 
-from helpers import (array_outcome, collar_scene, crank_entry, equilateral_chain,
+from helpers import (array_outcome, collar_scene, crank_entry, equilateral_chain, fold_scene,
                      general_only, general_tick_outcome, hinge_scene, scene_mapping,
                      slider_scene, solve_outcome, tick_outcome, triad_scene)
 import numpy as np
@@ -72,6 +72,7 @@ GENERATORS = {
     'motor': hinge_scene,
     'slider': slider_scene,
     'hinge': hinge_scene,
+    'fold': fold_scene,
     'collar': collar_scene,
     'actuator': lambda: scene_mapping(
         'actuator', {'O': [0, 0], 'F': [400, -1100]},
@@ -120,6 +121,10 @@ NOT_COMPILED = {
                           "paths alone (the node's tick compiles any drivers)",
     ('slider', 'array'): "its driver piston is not a crank: mk.solve compiles one crank's "
                          "paths alone (the node's tick compiles any drivers)",
+    ('fold', 'single'): "its driver knee is not a crank: mk.solve compiles one crank's "
+                        "paths alone (the node's tick compiles any drivers)",
+    ('fold', 'array'): "its driver knee is not a crank: mk.solve compiles one crank's "
+                       "paths alone (the node's tick compiles any drivers)",
     ('hinge', 'single'): "2 drivers (crank, elbow): mk.solve compiles one crank's paths "
                          "alone (the node's tick compiles any drivers)",
     ('hinge', 'array'): "2 drivers (crank, elbow): mk.solve compiles one crank's paths "

@@ -33,8 +33,8 @@ import functools
 import math
 import warnings
 
-from helpers import (collar_scene, crank_entry, hinge_scene, MM_DEG, scene_mapping,
-                     slider_scene, triad_scene)
+from helpers import (collar_scene, crank_entry, fold_scene, hinge_scene, MM_DEG,
+                     scene_mapping, slider_scene, triad_scene)
 from hypothesis import assume, given, HealthCheck, settings
 from hypothesis import strategies as st
 import mpmath
@@ -110,6 +110,7 @@ GEOMETRIES = {
     'motor': hinge_scene,
     'slider': slider_scene,
     'hinge': hinge_scene,
+    'fold': fold_scene,
     'collar': collar_scene,
     'Geneva RPR': lambda: scene_mapping(
         'geneva', {'D': [0, 0], 'S': [-70.71067811865476, 0]},
@@ -143,6 +144,7 @@ RANGES = {
     'slider': [('mm', -740.0, -460.0)],
     'collar': [('deg', -360.0, 360.0), ('mm', 100.0, 300.0)],
     'hinge': [('deg', -360.0, 360.0), ('deg', -360.0, 360.0)],
+    'fold': [('deg', 95.0, 158.0)],
     'motor': [('deg', -360.0, 360.0), ('deg', -360.0, 360.0)],
 }
 

@@ -373,13 +373,16 @@ def test_helpers_are_written_out_with_the_same_bits(vector):
 
 
 def test_the_two_rrr_kinds_share_one_kernel_written_out():
-    """The fixed and the actuated RRR call _meet; the compiled code calls nothing of the step."""
+    """The RRR kinds (and the fold, through the actuated one) call _meet; the code calls none."""
     import inspect
 
+    from mech_kinematics.solver.fold import _FoldStep
     from mech_kinematics.solver.rrr import _ActuatedRRRStep, _RRRStep
 
-    for kind in (_RRRStep, _ActuatedRRRStep):
-        assert 'self._meet(ctx, ' in inspect.getsource(kind.run), kind
+    for kernel in (_RRRStep.run, _ActuatedRRRStep._actuated):
+        assert 'self._meet(ctx, ' in inspect.getsource(kernel), kernel
+    for kernel in (_ActuatedRRRStep.run, _FoldStep.run):
+        assert 'self._actuated(ctx)' in inspect.getsource(kernel), kernel
     for scene in ('khurmi_four_bar_ad150', 'excavator'):
         code, _ = _code(scene, False)
         assert '_meet' not in code and 'self' not in code, scene

@@ -412,7 +412,8 @@ def test_measures_match_the_solver():
 
 #: What the reference may import from the solver: the scene, its items' and drivers'
 #: dataclasses (whose kinds key its models) and the graph's types (no step, no solve).
-SOLVER_NAMES = {'..solver': {'Actuator', 'CarriedPoint', 'Collar', 'Crank', 'Hinge', 'Motor',
+SOLVER_NAMES = {'..solver': {'Actuator', 'CarriedPoint', 'Collar', 'Crank', 'Fold', 'Hinge',
+                             'Motor',
                              'RPP', 'RPR', 'RRP', 'RRR', 'Scene', 'Slider', 'Triad'},
                 '..solver.graph': {'Fragment', 'JointType', 'joint_type'}}
 
@@ -431,7 +432,8 @@ def test_reference_does_not_use_the_solver():
     for module, names in imported.items():
         assert names <= SOLVER_NAMES.get(module, set()), (module, names)
     for name in ('solve', '_RRRStep', '_RRPStep', '_RPRStep', '_RPPStep', '_CarryStep', '_run',
-                 '_TriadStep', '_SlideStep', '_CollarStep', '_HingeStep', '_MotorStep'):
+                 '_TriadStep', '_SlideStep', '_CollarStep', '_HingeStep', '_MotorStep',
+                 '_FoldStep'):
         assert not hasattr(ref, name)
     assert '._solver' not in Path(ref.__file__).read_text()  # (a triad's branch: its own)
 
