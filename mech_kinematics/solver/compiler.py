@@ -59,6 +59,7 @@ from .state import JointMotion
 from .trust import floor_limits, trust_limits, TRUST_TEST, wrapped_angle
 
 if TYPE_CHECKING:
+    from .graph import JointType
     from .mechanism import Scene
 
 __all__ = ['ARRAY', 'Array', 'ArrayFunction', 'COMPILE_STEPS', 'NotCompiled', 'RATES', 'SINGLE',
@@ -235,7 +236,7 @@ class ScenePlan:
     ground: Mapping[str, tuple[Any, ...]]
     crank: Any
     steps: tuple[Step, ...]
-    joint_types: dict[str, str]
+    joint_types: dict[str, JointType]
     reported: dict[str, tuple[str, ...]]
     size: float
     crank_length: float

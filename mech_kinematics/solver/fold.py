@@ -92,8 +92,9 @@ class Fold(Item):
         _check_name(self.coupler, f'the coupler of {what}', (self, 'coupler'))
         _check_name(self.motor, f'the motor of {what}', (self, 'motor'))
         _check_length(self.length, f'{what} coupler length', (self, 'length'))
-        if len(self.links) != 2:   # anything may be passed at run time
-            msg = f'Expected {what} to have 2 links (a crank and a rocker), got {len(self.links)}'
+        count = len(self.links)  # anything may be passed at run time
+        if count != 2:
+            msg = f'Expected {what} to have 2 links (a crank and a rocker), got {count}'
             raise SceneError(msg, (self, 'links'))
         object.__setattr__(self, 'branch', Branch(self.branch))
 
@@ -204,7 +205,8 @@ class _FoldStep(_ActuatedRRRStep):
         super().__init__(fused)
         self.dyad = fold
         self.label = f'fold {fold.point}'
-        self.act2 = f'{fold.motor} |{rocker.start}{fold.point}|'
+        self.length_key = f'{fold.motor} |{rocker.start}{fold.point}|'
+        self.act2 = self.length_key
         self.motor, self.pin, self.coupler = fold.motor, fold.pin, fold.coupler
         self.rocker, self.rocker_start = rocker.name, rocker.start
         self.b, self.c = fold.length, rocker.length
@@ -247,7 +249,7 @@ class _FoldStep(_ActuatedRRRStep):
         eddd = ((bc * (em * (qd * qd + abs(qdd)) + 2.0 * abs(co) * aqd * eqd + abs(s) * eqdd)
                  + 2.0 * add * edd + abs(ddd) * ed) * inv_d
                 + _U7 * (abs(ddd) + (bc * (qd * qd + abs(qdd)) + dd * dd) * inv_d))
-        ctx.sliders[self.act2] = (d, dd, ddd, ed, edd, eddd)
+        ctx.sliders[self.length_key] = (d, dd, ddd, ed, edd, eddd)
         self._actuated(ctx)
         e2, w2, al2, ee2, ew2, eal2 = ctx.links[self.rocker]   # the fused direction D->B
         # psi = arg(w): the rocker is D->B turned back by it.

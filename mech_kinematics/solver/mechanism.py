@@ -21,7 +21,7 @@ from .base import Driver, Intermittent, Item
 from .carried import CarriedPoint
 from .crank import Crank
 from .forces import Dynamics, Load, Mass
-from .graph import Graph
+from .graph import Graph, JointType
 from .model import _check_name, SceneUnits
 from .plan import _compile, _Plan
 from .registry import FACT_TEXTS
@@ -435,7 +435,7 @@ class Scene:
         return self._plan.output_points
 
     @property
-    def joint_types(self) -> dict[str, str]:
+    def joint_types(self) -> dict[str, JointType]:
         """Joint name -> ``'revolute'`` or ``'prismatic'``, for the reported joints."""
         return dict(self._plan.joint_types)
 

@@ -19,7 +19,7 @@ import numpy as np
 from .base import Item, Step
 from .context import _Context
 from .geneva import _index_step
-from .graph import build_graph, Graph
+from .graph import build_graph, Graph, JointType
 from .model import _check_finite, _check_name, _names, Where
 from .rubbing import _rub_steps, _RubStep
 from ..bounds import U
@@ -41,7 +41,7 @@ class _Plan:
     crank: Any
     steps: tuple[Step, ...]
     ground: dict[str, complex]
-    joint_types: dict[str, str]
+    joint_types: dict[str, JointType]
     output_joints: tuple[str, ...]
     output_points: tuple[str, ...]
     graph: Graph
@@ -163,7 +163,7 @@ def _compile(scene: Scene, joints: tuple[str, ...] | None,
         ground[name] = complex(x, y)
     drivers = scene.drivers
     driver_steps = tuple(driver.step(ground) for driver in drivers)
-    joint_types = {}
+    joint_types: dict[str, JointType] = {}
     for driver in drivers:
         for name, kind in driver.defined():
             define(name, kind, (driver, {'point': 'point', 'link': 'link'}.get(kind, kind)))
