@@ -30,6 +30,7 @@ import argparse
 from collections.abc import Callable, Mapping, Sequence
 import json
 import math
+from pathlib import Path
 import sys
 from typing import Any
 
@@ -43,9 +44,10 @@ from ..errors import SceneError
 from ..geometry.region import GRID
 from ..solver.graph import JointType
 
-__all__ = ['add_parser', 'coefficient', 'grid_size', 'main', 'map_text', 'region_json',
-           'region_text', 'report_json', 'report_text', 'turning_json', 'turning_text',
-           'workspace_json', 'workspace_text', 'write_region_png', 'write_workspace_png']
+__all__ = ['add_parser', 'coefficient', 'draw_workspace', 'grid_size', 'main', 'map_text',
+           'region_json', 'region_text', 'report_json', 'report_text', 'turning_json',
+           'turning_text', 'workspace_json', 'workspace_of', 'workspace_text', 'write_region_png',
+           'write_workspace_png']
 
 #: The text map's largest size, characters.
 MAP_COLUMNS = 72
@@ -731,31 +733,47 @@ def write_workspace_png(ws: Any, path: str, space: Any = None) -> None:
 
 
 def _handle_workspace(args: argparse.Namespace, scene: Any, robot: Any = None) -> int:
-    from ..geometry.workspace import workspace_from_scene
-
     given = [flag for flag, value in (('--pair', args.pair), ('--map', args.map),
                                       ('--flywheel', args.flywheel)) if value]
     if given:
         msg = f'Expected --workspace without {", ".join(given)}, got both'
         raise SceneError(msg)
-    if robot is not None and args.workspace not in scene.output_points:
-        from ..robot.targets import frame_workspace     # a link frame, in the root frame
-
-        ws = frame_workspace(robot, args.workspace, args.grid)
-    else:
-        ws = workspace_from_scene(scene, args.workspace, args.grid)
+    ws = workspace_of(scene, args.workspace, args.grid, robot)
     if args.json:
         print(json.dumps(workspace_json(ws), indent=1, allow_nan=False))
     else:
         print(workspace_text(ws))
     if args.png is not None:
-        from ..geometry.diagrams import space_from_state
-        from ..geometry.instant_centres import full_scene
-        from ..geometry.urdf import _assembled
-
-        full = full_scene(scene)
-        write_workspace_png(ws, args.png, space_from_state(full, _assembled(full)))
+        draw_workspace(ws, scene, args.png)
     return 0
+
+
+def workspace_of(scene: Any, name: str, grid: int, robot: Any = None) -> Any:
+    """Return the workspace of a scene's point ``name``, or of a robot's link frame origin.
+
+    A URDF robot's ``name`` that is not a point of its scene is a link frame,
+    mapped in the root frame (:func:`~mech_kinematics.robot.targets.frame_workspace`).
+    """
+    from ..geometry.workspace import workspace_from_scene
+
+    if robot is not None and name not in scene.output_points:
+        from ..robot.targets import frame_workspace     # a link frame, in the root frame
+
+        return frame_workspace(robot, name, grid)
+    return workspace_from_scene(scene, name, grid)
+
+
+def draw_workspace(ws: Any, scene: Any, path: str | Path) -> None:
+    """Write ``ws`` as a PNG over ``scene``'s mechanism where its drivers start.
+
+    What ``check --workspace --png`` and ``plot --workspace`` draw.
+    """
+    from ..geometry.diagrams import space_from_state
+    from ..geometry.instant_centres import full_scene
+    from ..geometry.urdf import _assembled
+
+    full = full_scene(scene)
+    write_workspace_png(ws, str(path), space_from_state(full, _assembled(full)))
 
 
 def target_report(inverse: Any, tmap: Any, singularity: Mapping[str, float]) -> dict[str, Any]:

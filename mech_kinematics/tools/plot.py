@@ -41,10 +41,12 @@ import warnings
 import numpy as np
 import numpy.typing as npt
 
-from .cli import (add_robot_arguments, add_units_argument, angular_rate_given,
-                  load_scene_argument, named_value, values_by_driver)
+from .check import grid_size
+from .cli import (add_robot_arguments, add_units_argument, angular_rate_given, is_urdf,
+                  load_robot_argument, load_scene_argument, named_value, values_by_driver)
 from .cli import finite_float, positive_float, PROG, run_tool
 from ..errors import MechKinematicsError, SceneError
+from ..geometry.region import GRID
 from ..ros import topics
 from ..ros.cdr import stamp_from_cdr
 from ..solver.graph import REVOLUTE
@@ -1145,6 +1147,10 @@ against time or crank angle, to an image file (PNG; no display needed).
   plot BAG --scene SCENE ...       a bag, with the scene telling sliders from
                                    revolute joints (by default the scene named
                                    in the bag's diagnostics is used)
+  plot --scene SCENE --workspace POINT -o FILE.png
+                                   where a point of a two-driver scene (a URDF's
+                                   link frame) reaches, with its singular curves,
+                                   over the mechanism (check --workspace --png)
 
 A scene with several drivers (or an actuator) is plotted against time along
 the path its drivers take from their start positions at their default speeds,
@@ -1162,6 +1168,10 @@ def _handle(args: argparse.Namespace) -> int:
     if args.bag is None and args.scene is None:
         print('error: Expected a BAG or --scene SCENE, got neither', file=sys.stderr)
         return 2
+    if args.workspace is not None and args.bag is not None:
+        print(f'error: Expected --workspace with --scene SCENE alone (a map, not a recording), '
+              f'got a BAG ({args.bag})', file=sys.stderr)
+        return 2
     output = Path(args.output)
     if not output.parent.is_dir():
         print(f'error: Expected an existing folder for {output}, got none', file=sys.stderr)
@@ -1175,6 +1185,8 @@ def _handle(args: argparse.Namespace) -> int:
               f'figure shows no more', file=sys.stderr)
         return 2
     speed = None if args.speed_rpm is None else rad_per_s_from_rpm(args.speed_rpm)
+    if args.workspace is not None:
+        return _plot_workspace(args, output)
     try:
         scene = None if args.scene is None else load_scene_argument(args)
         if args.bag is not None:
@@ -1225,6 +1237,17 @@ def _output_problem(output: Path) -> str:
     return ''
 
 
+def _plot_workspace(args: argparse.Namespace, output: Path) -> int:
+    """Draw ``--workspace`` over the mechanism, as ``check --workspace --png`` draws it."""
+    from .check import draw_workspace, workspace_of
+
+    robot = load_robot_argument(args) if is_urdf(args.scene) else None
+    scene = load_scene_argument(args) if robot is None else robot.scene
+    draw_workspace(workspace_of(scene, args.workspace, args.grid, robot), scene, output)
+    print(f'wrote {output}')
+    return 0
+
+
 def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('bag', nargs='?', metavar='BAG', help='rosbag2 directory to plot')
     parser.add_argument('-o', '--output', required=True, metavar='FILE.png',
@@ -1255,6 +1278,12 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--duration', type=positive_float, metavar='SECONDS',
                         help='--scene with several drivers: the time plotted (default: the '
                              "quickest driver's turn or stroke)")
+    parser.add_argument('--workspace', metavar='NAME',
+                        help='--scene with two drivers: draw where point NAME (a URDF: a link '
+                             "frame's origin) reaches over their grid, with both singular "
+                             "curves, over the mechanism (check --workspace --png's picture)")
+    parser.add_argument('--grid', type=grid_size, default=GRID, metavar='N',
+                        help=f'--workspace: grid points per driver (default {GRID})')
 
 
 def add_parser(subparsers: Any) -> argparse.ArgumentParser:

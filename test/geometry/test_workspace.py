@@ -139,3 +139,19 @@ def test_check_target_says_how_well_the_drivers_control_the_targets(capsys):
     out = capsys.readouterr().out.splitlines()
     assert out[0].endswith('lift_arm.urdf: tool_frame.z = 0.45 m: reached from the start '
                            'pose in 1 step')
+
+
+def test_plot_draws_the_workspace_check_draws(capsys, tmp_path):
+    """``plot --scene five_bar --workspace P``: the picture of check --png, byte for byte."""
+    drawn, checked = tmp_path / 'plot.png', tmp_path / 'check.png'
+    assert cli_main(['plot', '--scene', 'five_bar', '--workspace', 'P', '-o', str(drawn)]) == 0
+    assert capsys.readouterr().out == f'wrote {drawn}\n'
+    assert cli_main(['check', 'five_bar', '--workspace', 'P', '--png', str(checked)]) == 0
+    assert drawn.read_bytes() == checked.read_bytes()
+    # A recording has no map; a name that is no point of the scene is refused, one line each.
+    assert cli_main(['plot', str(tmp_path), '--workspace', 'P', '-o', str(drawn)]) == 2
+    assert 'Expected --workspace with --scene SCENE alone' in capsys.readouterr().err
+    assert cli_main(['plot', '--scene', 'five_bar', '--workspace', 'Q', '-o', str(drawn)]) == 2
+    err = capsys.readouterr().err
+    assert err == ('error: Expected --workspace to name a point five_bar reports (A, E, B, D, '
+                   "P), got 'Q'\n")
