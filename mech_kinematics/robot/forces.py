@@ -38,7 +38,7 @@ import warnings
 
 import numpy as np
 
-from ..errors import NearSingularWarning, UrdfError
+from ..errors import MechKinematicsError, NearSingularWarning, UrdfError
 from ..solver.forces import Dynamics, Forces, Load, Mass
 from ..solver.scaling import _size
 from ..solver.solve import refuse_forces
@@ -711,20 +711,11 @@ def effort_sweeps(robot: Robot, samples: int = SWEEP_SAMPLES,
         low, high = joint_sweep(robot, joint, size) if limits is None else limits
         q = np.linspace(float(low), float(high), samples)
         held = {n: float(robot.start(n)) for n in robot.actuated if n != joint}
-        positions = {joint: q, **{n: np.full(samples, x) for n, x in held.items()}}
-        with warnings.catch_warnings():
-            warnings.simplefilter('ignore', NearSingularWarning)
-            answer = robot.solve(positions, max_error=math.inf, gravity=g, loads=loads)
-        state, efforts = answer.state, answer.efforts
-        valid = np.asarray(state.valid, dtype=bool) & (efforts is not None)
-        refused = answer.forces_left_out or ''
-        if not refused and not valid.all():
-            first = int(np.flatnonzero(~valid)[0])
-            reason = next((why for why, mask in state.failures.items()
-                           if np.asarray(mask, dtype=bool)[first]), 'not solved')
-            refused = f'at {joint} = {q[first]:.6g}: {reason}'
-        values = {} if efforts is None else efforts.efforts     # without efforts, none
-        bounds = {} if efforts is None else efforts.bounds
+        if any(joint in carriers for carriers in robot.forces.carriers):
+            # It turns a loop's ground: the planar forces take one pose of it at a time.
+            valid, refused, values, bounds = _sweep_each(robot, joint, q, held, g, loads)
+        else:
+            valid, refused, values, bounds = _sweep_array(robot, joint, q, held, g, loads)
         out.append(EffortSweep(
             joint, q, held, g,
             {n: np.where(valid, np.asarray(v, dtype=np.float64) + 0.0 * q, np.nan)
@@ -732,3 +723,51 @@ def effort_sweeps(robot: Robot, samples: int = SWEEP_SAMPLES,
             {n: np.asarray(b, dtype=np.float64) + 0.0 * q for n, b in bounds.items()},
             valid, refused, robot.joint_type(joint).angular))
     return out
+
+
+def _sweep_array(robot: Robot, joint: str, q: Any, held: Mapping[str, float],
+                 g: tuple[float, float, float], loads: Sequence[LinkLoad]
+                 ) -> tuple[Any, str, dict[str, Any], dict[str, Any]]:
+    """Return (valid, the first refusal, efforts, bounds) of ``joint`` over ``q``: one array."""
+    positions = {joint: q, **{n: np.full(len(q), x) for n, x in held.items()}}
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore', NearSingularWarning)
+        answer = robot.solve(positions, max_error=math.inf, gravity=g, loads=loads)
+    state, efforts = answer.state, answer.efforts
+    valid = np.asarray(state.valid, dtype=bool) & (efforts is not None)
+    refused = answer.forces_left_out or ''
+    if not refused and not valid.all():
+        first = int(np.flatnonzero(~valid)[0])
+        reason = next((why for why, mask in state.failures.items()
+                       if np.asarray(mask, dtype=bool)[first]), 'not solved')
+        refused = f'at {joint} = {q[first]:.6g}: {reason}'
+    if efforts is None:     # without efforts, none
+        return valid, refused, {}, {}
+    return valid, refused, dict(efforts.efforts), dict(efforts.bounds)
+
+
+def _sweep_each(robot: Robot, joint: str, q: Any, held: Mapping[str, float],
+                g: tuple[float, float, float], loads: Sequence[LinkLoad]
+                ) -> tuple[Any, str, dict[str, Any], dict[str, Any]]:
+    """Return :func:`_sweep_array`'s answer solving each pose of ``joint`` on its own."""
+    valid = np.zeros(len(q), dtype=bool)
+    refused = ''
+    values: dict[str, Any] = {}
+    bounds: dict[str, Any] = {}
+    for k, x in enumerate(q):
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter('ignore', NearSingularWarning)
+                answer = robot.solve({joint: float(x), **held}, max_error=math.inf, gravity=g,
+                                     loads=loads)
+        except MechKinematicsError as error:
+            refused = refused or f'at {joint} = {x:.6g}: {error}'
+            continue
+        if answer.efforts is None:
+            refused = refused or f'at {joint} = {x:.6g}: {answer.forces_left_out}'
+            continue
+        valid[k] = True
+        for name, value in answer.efforts.efforts.items():
+            values.setdefault(name, np.full(len(q), np.nan))[k] = value
+            bounds.setdefault(name, np.full(len(q), np.nan))[k] = answer.efforts.bounds[name]
+    return valid, refused, values, bounds

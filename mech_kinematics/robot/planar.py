@@ -1405,7 +1405,6 @@ class _Hanging:
                  body_of: Mapping[str, str], tree: Mapping[str, Matrix],
                  actuated: tuple[str, ...]) -> None:
         self.tree = tree
-        self.in_loops = in_loops
         self.actuated = actuated
         self.below: dict[str, list[_Edge]] = {}
         for edge in edges:

@@ -702,3 +702,22 @@ def test_the_rg2s_hanging_covers_weigh_on_their_mimic_joints(turn):
             force = child[:3, :3] @ np.asarray(reaction.force)
             assert np.allclose(force, expected, rtol=0.0, atol=1e-12)
             assert np.linalg.norm(expected) > 0.9 * math.cos(turn) * np.linalg.norm(weight)
+
+
+def test_a_sweep_of_the_joint_that_turns_the_loops_ground_solves_each_pose():
+    """The RG2's body_joint turns its fingers' plane about the root's x: gravity in it, g cos b.
+
+    So the finger's static effort is its value at b = 0 times cos b, at every one of the
+    sweep's poses (each solved on its own: the planar forces take one pose of a ground).
+    """
+    from mech_kinematics.robot.forces import effort_sweeps
+
+    robot, _, _ = _rg2()
+    sweeps = {s.joint: s for s in effort_sweeps(robot, samples=41)}
+    turned = sweeps['body_joint']
+    assert turned.valid.all() and turned.refused == ''
+    upright = robot.solve({'finger_joint': 0.0}).efforts.efforts['finger_joint']
+    expected = upright * np.cos(turned.positions)
+    assert np.allclose(turned.efforts['finger_joint'], expected, rtol=0.0,
+                       atol=1e-12 * abs(upright))
+    assert sweeps['finger_joint'].valid.all()
