@@ -37,7 +37,7 @@ from .solver import Branch, CarriedPoint, Crank, Link, Pin, Scene, SceneUnits
 from .solver.base import Driver, Item
 from .solver.crank import CrankDict
 from .solver.forces import Load, Mass
-from .solver.mechanism import FollowedJoint
+from .solver.mechanism import FollowedJoint, RobotReaction
 from .solver.model import IDENTIFIER
 from .solver.registry import DRIVERS, KINDS
 from .units import (ANGLE_UNITS, LENGTH_UNITS, reduce_radians,
@@ -107,6 +107,7 @@ class SceneDict(TypedDict, total=False):
     masses: dict[str, dict[str, Any]]
     loads: list[dict[str, Any]]
     urdf_drivers: dict[str, dict[str, Any]]
+    urdf_reactions: dict[str, dict[str, Any]]
 
 
 class ImuDict(TypedDict, total=False):
@@ -342,6 +343,7 @@ def parse_scene(data: Any) -> Scene:
     masses = _masses(reader, keys, data.get('masses'))
     loads = _loads(reader, keys, data.get('loads'))
     followed = _urdf_drivers(reader, keys, data.get('urdf_drivers'))
+    reactions = _urdf_reactions(keys, data.get('urdf_reactions'))
 
     outputs = data.get('outputs', {}) or {}
     if not isinstance(outputs, dict):
@@ -360,7 +362,8 @@ def parse_scene(data: Any) -> Scene:
                      points=tuple(points), outputs_joints=selected['joints'],
                      outputs_points=selected['points'], description=description,
                      pins=tuple(pins), units=reader.units, imus=imus, inputs=drivers,
-                     gravity=gravity, masses=masses, loads=given, urdf_drivers=followed)
+                     gravity=gravity, masses=masses, loads=given, urdf_drivers=followed,
+                     urdf_reactions=reactions)
 
     try:
         if any(load.table is not None for load in loads):
@@ -620,6 +623,31 @@ def _urdf_drivers(reader: _Reader, keys: _Keys, raw: Any) -> tuple[FollowedJoint
                               joint_reference=reader.number(value, 'joint_reference', where),
                               reference=reader.number(value, 'reference', where),
                               factor=reader.number(value, 'factor', where)))
+    return tuple(out)
+
+
+def _urdf_reactions(keys: _Keys, raw: Any) -> tuple[RobotReaction, ...]:
+    """Read ``urdf_reactions:``: joint -> {frame, body, at, axes} (a robot's, the writer's)."""
+    if raw is None:
+        return ()
+    if not isinstance(raw, dict):
+        raise SceneError(f'urdf_reactions: expected a mapping of joints to {{frame, body, at, '
+                         f'axes}}, got {_kind(raw)}')
+    _check_count('urdf_reactions', raw, MAX_DRIVERS * 64, 'MAX_DRIVERS * 64', 'joints')
+    out = []
+    for key, value in raw.items():
+        where = f'urdf_reactions.{key}'
+        if not isinstance(value, dict):
+            raise SceneError(f'{where}: expected a mapping such as {{frame: lower_arm, body: '
+                             f'lower_arm, at: lift_joint, axes: [[1, 0, 0], [0, 0, 1]]}}, got '
+                             f'{_kind(value)} {_brief(value)}')
+        _check_keys(value, {'frame', 'body', 'at', 'axes'}, where)
+        missing = [k for k in ('frame', 'body', 'at', 'axes') if k not in value]
+        if missing:
+            raise SceneError(f'{where}: expected {", ".join(missing)}, got none')
+        out.append(keys.build(where, {'joint': ''}, RobotReaction, joint=str(key),
+                              frame=value['frame'], body=value['body'], at=value['at'],
+                              axes=value['axes']))
     return tuple(out)
 
 

@@ -230,6 +230,20 @@ BAD_SCENES = [
     ('urdf_drivers_joint_not_a_name', edit(setitem(['urdf_drivers'], {'crank': {
         'joint': 3, 'joint_reference': 0.0, 'reference': 0.0, 'factor': 1.0}})),
      'urdf_drivers.crank.joint', r'expected a joint name'),
+    # urdf_reactions: where a robot's reactions act in the plane (the view reads it).
+    ('urdf_reactions_axes_not_2x3', edit(setitem(['urdf_reactions'], {'pin': {
+        'frame': 'rocker', 'body': 'rocker', 'at': 'C', 'axes': [[1, 0], [0, 1]]}})),
+     'urdf_reactions.pin.axes', r'two rows of three finite numbers'),
+    ('urdf_reactions_not_finite', edit(setitem(['urdf_reactions'], {'pin': {
+        'frame': 'rocker', 'body': 'rocker', 'at': 'C',
+        'axes': [[1, 0, float('nan')], [0, 1, 0]]}})),
+     'urdf_reactions.pin.axes', r'two rows of three finite numbers'),
+    ('urdf_reactions_point_off_the_body', edit(setitem(['urdf_reactions'], {'pin': {
+        'frame': 'rocker', 'body': 'rocker', 'at': 'A', 'axes': [[1, 0, 0], [0, 1, 0]]}})),
+     'urdf_reactions.pin.body', r"got body 'rocker' and point 'A'"),
+    ('urdf_reactions_key_missing', edit(setitem(['urdf_reactions'], {'pin': {
+        'frame': 'rocker', 'body': 'rocker', 'axes': [[1, 0, 0], [0, 1, 0]]}})),
+     'urdf_reactions.pin', r'expected at, got none'),
 ]
 
 

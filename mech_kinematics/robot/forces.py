@@ -38,6 +38,7 @@ import warnings
 
 import numpy as np
 
+from .description import ClosureKind
 from ..errors import MechKinematicsError, NearSingularWarning, UrdfError
 from ..solver.forces import Dynamics, Forces, Load, Mass
 from ..solver.scaling import _size
@@ -50,7 +51,8 @@ if TYPE_CHECKING:
 
 __all__ = ['ForcesLeftOut', 'GRAVITY', 'JointReaction', 'LinkLoad', 'MAX_GRAVITY', 'MAX_LOAD',
            'EffortSweep', 'RobotEfforts', 'RobotForces', 'SWEEP_SAMPLES', 'check_gravity',
-           'effort_sweeps', 'parse_link_loads', 'robot_forces', 'with_payloads']
+           'effort_sweeps', 'parse_link_loads', 'reaction_maps', 'reaction_names', 'robot_forces',
+           'with_payloads']
 
 #: Gravity in the URDF's root frame by default, m/s^2 (REP 103: z up; standard gravity).
 GRAVITY = (0.0, 0.0, -9.80665)
@@ -542,6 +544,47 @@ class RobotForces:
                                               tuple(float(v) for v in torque), f_bound,
                                               torque_bound)
         return out
+
+
+def reaction_names(robot: Robot) -> tuple[tuple[str, str], ...]:
+    """Return each loop's revolute joints and pins: ``(name, child link)``.
+
+    In the mechanisms' order, as :meth:`RobotForces.reactions` answers them,
+    in the child link's axes.
+    """
+    description = robot.description
+    closures = {c.name: c for c in description.closures}
+    out = []
+    for m in robot.planar.mechanisms:
+        for name in m['joints']:
+            joint = description.joints.get(name)
+            if joint is not None:
+                if joint.type is not None and joint.type.angular:
+                    out.append((name, joint.child))
+                continue
+            closure = closures.get(name)
+            if closure is not None and closure.kind is ClosureKind.PIN:
+                out.append((closure.name, closure.link_b))
+    return tuple(dict((item[0], item) for item in out).values())
+
+
+def reaction_maps(robot: Robot) -> dict[str, dict[str, Any]]:
+    """Return, per reaction whose child link a loop moves, where it acts in the scene.
+
+    ``{JOINT: {frame, body, at, axes}}``: the child link, its scene body, the
+    scene point at the pin, and the 2x3 map of a vector of the link's axes
+    into the body's own frame (``Planar.link_frame``): the scene's
+    ``urdf_reactions`` (:class:`~mech_kinematics.solver.mechanism.RobotReaction`).
+    """
+    planar = robot.planar
+    out = {}
+    for name, child in reaction_names(robot):
+        if child not in planar.planes:
+            continue    # on a loop's ground: it does not turn in the plane
+        body, a, _ = planar.link_frame(child)
+        out[name] = {'frame': child, 'body': body, 'at': planar.pins.get(name, name),
+                     'axes': [[float(v) for v in row] for row in np.asarray(a)]}
+    return out
 
 
 def parse_payloads(entries: Sequence[str],

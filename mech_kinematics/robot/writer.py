@@ -21,6 +21,7 @@ has no form in a URDF: refused. Pure: the standard library and NumPy.
 from __future__ import annotations
 
 import cmath
+from collections.abc import Mapping
 import math
 from typing import Any
 import xml.etree.ElementTree as ET
@@ -37,8 +38,13 @@ from ..solver import Scene
 __all__ = ['robot_urdf_from_scene', 'scene_yaml']
 
 
-def scene_yaml(planar: Planar, source: str) -> str:
-    """Return the scene mapping of a robot's loops as YAML, with how its joints follow it."""
+def scene_yaml(planar: Planar, source: str,
+               reactions: Mapping[str, Mapping[str, Any]] | None = None) -> str:
+    """Return the scene mapping of a robot's loops as YAML, with how its joints follow it.
+
+    ``reactions``: the robot's :func:`~.forces.reaction_maps` (with masses),
+    written as ``urdf_reactions``: what the view draws its reactions with.
+    """
     lines = [f'# The planar loops of {source}, as a scene (docs/urdf.md).',
              '# Each URDF joint of a loop is its value in the reference pose plus sigma times',
              "# the change of the scene's coordinates it follows (rad or m):"]
@@ -72,6 +78,8 @@ def scene_yaml(planar: Planar, source: str) -> str:
         data['urdf_drivers'] = {d.scene: {'joint': d.name, 'joint_reference': float(d.reference),
                                           'reference': float(d.scene_ref),
                                           'factor': float(d.sigma)} for d in planar.drivers}
+    if reactions:   # where each reactions/JOINT acts in the plane, and how its axes turn
+        data['urdf_reactions'] = {name: dict(item) for name, item in reactions.items()}
     body = yaml.safe_dump(data, sort_keys=False, default_flow_style=None, width=99)
     return '\n'.join(lines) + '\n' + body
 

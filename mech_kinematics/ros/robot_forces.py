@@ -48,8 +48,8 @@ from .wrenches import ForceMessages, ForcesTick
 from .. import solver as lk
 from ..errors import AssemblyError, SceneError
 from ..geometry.frames import child_frame
-from ..robot.description import ClosureKind
-from ..robot.forces import check_gravity, ForcesLeftOut, GRAVITY, parse_link_loads
+from ..robot.forces import (check_gravity, ForcesLeftOut, GRAVITY, parse_link_loads,
+                            reaction_names)
 
 __all__ = ['RobotForcesTick', 'reaction_names', 'robot_forces_note', 'robot_forces_tick']
 
@@ -65,29 +65,6 @@ def robot_forces_note(robot: Any) -> str | None:
     if model is None:
         return ''
     return model.refused
-
-
-def reaction_names(robot: Any) -> tuple[tuple[str, str], ...]:
-    """Return each loop's revolute joints and pins: ``(name, child link)``.
-
-    In the mechanisms' order, as :meth:`RobotForces.reactions
-    <mech_kinematics.robot.forces.RobotForces.reactions>` answers them, in
-    the child link's axes.
-    """
-    description = robot.description
-    closures = {c.name: c for c in description.closures}
-    out = []
-    for m in robot.planar.mechanisms:
-        for name in m['joints']:
-            joint = description.joints.get(name)
-            if joint is not None:
-                if joint.type is not None and joint.type.angular:
-                    out.append((name, joint.child))
-                continue
-            closure = closures.get(name)
-            if closure is not None and closure.kind is ClosureKind.PIN:
-                out.append((closure.name, closure.link_b))
-    return tuple(dict((item[0], item) for item in out).values())
 
 
 class RobotForcesTick(ForcesTick):

@@ -202,6 +202,7 @@ def load_source(scene: str, robot_description: str = '', loop_closures: str = ''
         return Source(load_scene(scene), scene_text(scene), origin=scene)
     from ..robot import Robot
     from ..robot.description import read_description
+    from ..robot.forces import reaction_maps
     from ..robot.writer import scene_yaml
 
     origin = 'robot_description' if robot_description else scene
@@ -217,7 +218,8 @@ def load_source(scene: str, robot_description: str = '', loop_closures: str = ''
     missing = tuple(n for n in needed if n not in built.output_joints)
     if missing:
         built = replace(built, outputs_joints=(*built.output_joints, *missing))
-    return Source(built, scene_yaml(robot.planar, origin), robot, origin, unloaded)
+    reactions = None if robot.forces is None else reaction_maps(robot)
+    return Source(built, scene_yaml(robot.planar, origin, reactions), robot, origin, unloaded)
 
 
 def reference_from_parameter(description: Any, entries: Sequence[str]) -> dict[str, float]:

@@ -209,6 +209,50 @@ class FollowedJoint:
 
 
 @dataclass(frozen=True)
+class RobotReaction:
+    """Where a robot's ``reactions/JOINT`` acts in the scene of its loops, and how it turns.
+
+    The node in URDF mode publishes each loop joint's reaction in its child
+    link's axes (``frame``); in the scene it acts at point ``at`` on
+    ``body``, and ``axes`` (2x3) takes a vector of the link's axes into the
+    body's own frame (the one its masses' ``com`` is given in), which turns
+    with the body. What ``urdf2scene`` (and the node's ``scene`` topic)
+    writes under ``urdf_reactions`` for a robot with masses, so that a tool
+    (the browser view) can draw those reactions in the scene's plane. The
+    solver never reads it.
+    """
+
+    joint: str
+    frame: str
+    body: str
+    at: str
+    axes: tuple[tuple[float, float, float], tuple[float, float, float]]
+
+    def __post_init__(self) -> None:
+        """Validate the fields."""
+        for key in ('frame', 'body', 'at'):
+            value = getattr(self, key)
+            if not isinstance(value, str) or not value:
+                raise SceneError(f'Expected a name, got {value!r}', (self, key))
+        rows = self.axes
+        if not (isinstance(rows, (list, tuple)) and len(rows) == 2
+                and all(isinstance(row, (list, tuple)) and len(row) == 3 for row in rows)
+                and all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                        and math.isfinite(v) for row in rows for v in row)):
+            raise SceneError(f'Expected two rows of three finite numbers, got {rows!r}',
+                             (self, 'axes'))
+        object.__setattr__(self, 'axes', tuple(tuple(float(v) for v in row) for row in rows))
+
+    def in_scene(self, force: tuple[float, float, float], angle: float) -> tuple[float, float]:
+        """Return a force of the link's axes in the scene's plane, the body at ``angle`` (rad)."""
+        (a, b, c), (d, e, f) = self.axes
+        x = a * force[0] + b * force[1] + c * force[2]
+        y = d * force[0] + e * force[1] + f * force[2]
+        cos, sin = math.cos(angle), math.sin(angle)
+        return cos * x - sin * y, sin * x + cos * y
+
+
+@dataclass(frozen=True)
 class Scene:
     """A planar mechanism: ground points, the driving crank, dyads, carried points.
 
@@ -249,6 +293,9 @@ class Scene:
     urdf_drivers : tuple of FollowedJoint
         For a robot's loops: the URDF joint each driver follows (none or one
         per driver); the solver never reads it.
+    urdf_reactions : tuple of RobotReaction
+        For a robot's loops with masses: where each ``reactions/JOINT`` acts
+        and how its link's axes turn into the plane; the solver never reads it.
     """
 
     name: str
@@ -267,6 +314,7 @@ class Scene:
     masses: tuple[Mass, ...] = ()
     loads: tuple[Load, ...] = ()
     urdf_drivers: tuple[FollowedJoint, ...] = ()
+    urdf_reactions: tuple[RobotReaction, ...] = ()
     _plan: _Plan = field(init=False, repr=False, compare=False)
     _solver: _Solver = field(init=False, repr=False, compare=False)
     #: The scene's inverse dynamics (:mod:`.forces`), ``None`` without masses, gravity, loads.
@@ -332,6 +380,14 @@ class Scene:
             if any(other.driver == entry.driver for other in followed[:index]):
                 msg = f'Expected one joint per driver, got {entry.driver!r} twice'
                 raise SceneError(msg, (entry, 'driver'))
+        reactions = tuple(self.urdf_reactions)
+        object.__setattr__(self, 'urdf_reactions', reactions)
+        for entry in reactions:
+            if entry.body not in full.graph.bodies or \
+                    entry.at not in full.graph.bodies[entry.body].points:
+                msg = (f'Expected a body of the scene and a point on it, got body '
+                       f'{entry.body!r} and point {entry.at!r}')
+                raise SceneError(msg, (entry, 'body'))
         object.__setattr__(self, '_plan', full)  # the graph, for the IMUs' links
         joints, points = imu_outputs(self, full.joint_types, self.outputs_joints,
                                      self.outputs_points)

@@ -39,10 +39,12 @@ version of the scene format has no masses.
 
 
 def _handle(args: argparse.Namespace) -> int:
+    from ..robot.forces import reaction_maps
     from ..robot.writer import scene_yaml
 
     robot = load_robot_argument(args)  # a UrdfError is one line, exit 2 (cli.run_handler)
-    text = scene_yaml(robot.planar, str(args.scene))
+    reactions = None if robot.forces is None else reaction_maps(robot)
+    text = scene_yaml(robot.planar, str(args.scene), reactions)
     if args.output is None:
         sys.stdout.write(text)
     else:

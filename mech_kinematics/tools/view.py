@@ -87,11 +87,8 @@ FREE_STROKE = (0.5, 1.5)
 #: that published nothing is a gap, not a chord.
 GAP_FACTOR = 1.5
 CADENCE_WINDOW = 9
-#: Said among the statuses for a robot's loops (URDF mode): its reactions/JOINT are in the
-#: URDF links' frames, not the drawing's plane, so they are not drawn as arrows.
+#: The name of the view's own statuses among the node's.
 VIEW_STATUS = 'mech_kinematics view'
-ROBOT_REACTIONS = ("reactions not drawn: a URDF robot's are in its links' frames "
-                   '(reactions/JOINT, frame_id the child link)')
 #: Seconds to wait for the node's SetParameters answer.
 SERVICE_TIMEOUT_S = 3.0
 #: The header that carries the page's token on ``/state`` and ``/speed``.
@@ -251,7 +248,26 @@ def frame_from_state(scene: Any, position: float | Sequence[float],
         'guides': [[[float(g.start[0]), float(g.start[1])], [float(g.end[0]), float(g.end[1])]]
                    for g in space.guides],
         'points': {name: [float(v[0]), float(v[1])] for name, v in space.points.items()},
+        # Each body's frame's angle, rad: what a robot's reactions turn into the plane by.
+        'angles': {name: float(body.frame.angle if body.frame.angle_of is None
+                               else state.joints[body.frame.angle_of].position)
+                   for name, body in full.graph.bodies.items() if body.frame is not None},
     }
+
+
+def _in_plane(force: list[float] | None, robot: Any,
+              angles: Mapping[str, float]) -> list[float] | None:
+    """Return a reaction's force as drawn, [fx, fy] N in the plane (None: not finite).
+
+    A scene's is in the plane already; a robot's (``robot``: its
+    :class:`~mech_kinematics.solver.mechanism.RobotReaction`) is in its child
+    link's axes, turned into the plane by its body's angle now.
+    """
+    if force is None:
+        return None
+    if robot is None:
+        return force[:2]
+    return list(robot.in_scene((force[0], force[1], force[2]), angles[robot.body]))
 
 
 def _frame_xy(frame: Mapping[str, Any]) -> list[complex]:
@@ -323,7 +339,8 @@ class _Latest:
         self.values: dict[str, str] = {}
         self.stamp = 0.0
         #: joint name -> (its point, [fx, fy] N) as last published on reactions/JOINT
-        #: (None: not finite, not drawn).
+        #: (None: not finite, not drawn); a robot's (URDF mode): [fx, fy, fz] in its child
+        #: link's axes, turned into the plane where drawn (the scene's urdf_reactions).
         self.reactions: dict[str, tuple[str, list[float] | None]] = {}
 
 
@@ -437,24 +454,28 @@ class ViewServer:
         for subscription in old:
             if subscription is not None:
                 self.node.destroy_subscription(subscription)
-        if scene.dynamics is None or scene.urdf_drivers:
-            return      # a robot's reactions are in its links' frames: ROBOT_REACTIONS
-        for joint in scene.dynamics.graph.joints:
-            topic = topics.reaction_topic(joint.name)
+        if scene.dynamics is None and not scene.urdf_reactions:
+            return
+        # A robot's (URDF mode): its loop joints' reactions in their child links' axes.
+        joints = [(r.joint, r.at) for r in scene.urdf_reactions] if scene.urdf_drivers else \
+            [(j.name, j.at) for j in scene.dynamics.graph.joints]   # type: ignore[union-attr]
+        for name, at in joints:
+            topic = topics.reaction_topic(name)
             try:
                 validate_topic_name(topic)
             except InvalidTopicNameException:
                 continue    # no topic of that name (the node warns at its start)
             self._reaction_subscriptions.append(self.node.create_subscription(
                 WrenchStamped, topic,
-                lambda msg, name=joint.name, at=joint.at: self._on_reaction(name, at, msg),
+                lambda msg, name=name, at=at: self._on_reaction(name, at, msg),
                 qos_profile_sensor_data))
 
     def _on_reaction(self, name: str, at: str, msg: Any) -> None:
-        fx, fy = _finite(msg.wrench.force.x), _finite(msg.wrench.force.y)
+        f = msg.wrench.force
+        force = [_finite(f.x), _finite(f.y), _finite(f.z)]
         with self.latest.lock:
             # Not finite: None, not drawn, and the page says so.
-            self.latest.reactions[name] = (at, None if fx is None or fy is None else [fx, fy])
+            self.latest.reactions[name] = (at, None if None in force else force)
 
     def _on_joints(self, msg: Any) -> None:
         positions, velocities, efforts = list(msg.position), list(msg.velocity), list(msg.effort)
@@ -521,9 +542,6 @@ class ViewServer:
                 'traces': {name: list(trace) for name, trace in latest.traces.items()},
                 'statuses': list(latest.statuses), 'drivers': [],
                 'crank_speed_rpm': None, 'frame': None, 'error': '', 'reactions': []}
-            if scene is not None and scene.urdf_drivers and scene.dynamics is not None:
-                out['statuses'].append({'name': VIEW_STATUS, 'message': ROBOT_REACTIONS,
-                                        'level': 0})
             values = dict(latest.values)
             reactions = dict(latest.reactions)
         # Before joint_states: the node's own report of its crank's speed, where it is a number.
@@ -575,7 +593,10 @@ class ViewServer:
         if out['frame'] is not None:
             out['bounds'] = self._grown(scene, out['bounds'], _frame_xy(out['frame']))
             where = out['frame']['points']
-            out['reactions'] = [{'name': name, 'at': where[at], 'force': force}
+            turned = {r.joint: r for r in scene.urdf_reactions} if scene.urdf_drivers else {}
+            angles = out['frame']['angles']
+            out['reactions'] = [{'name': name, 'at': where[at],
+                                 'force': _in_plane(force, turned.get(name), angles)}
                                 for name, (at, force) in reactions.items() if at in where]
         return out
 

@@ -656,15 +656,20 @@ def test_state_draws_a_urdf_robot_from_its_joint_states(fake):
 
     The node's ``scene`` for the lift arm carries ``urdf_drivers`` (lower_arm
     follows lift_joint, the other way round); the frame is solved where
-    ``Robot.solve`` puts every point. The robot's reactions, in its links'
-    frames, are not drawn, and /state says so; a missing joint is named.
+    ``Robot.solve`` puts every point. Its reactions, published in their child
+    links' axes, are drawn in the plane through the scene's ``urdf_reactions``:
+    each arrow, lifted back into the root frame by the loop's plane axes, is
+    the published force turned by the child link's rotation in the test's own
+    forward kinematics. A missing joint is named.
     """
+    from geometry_msgs.msg import WrenchStamped
+    from helpers import UrdfFk
     from std_msgs.msg import String
 
     from mech_kinematics.ros.robot_mode import load_source
-    from mech_kinematics.tools.view import ROBOT_REACTIONS, VIEW_STATUS
 
-    source = load_source(str(REPO / 'test' / 'data' / 'urdf' / 'lift_arm.urdf'))
+    urdf = REPO / 'test' / 'data' / 'urdf' / 'lift_arm.urdf'
+    source = load_source(str(urdf))
     fake._on_scene(String(data=source.text))
     assert fake.latest.scene is not None, fake.latest.scene_error
     answer = source.robot.solve({'lift_joint': 0.4}, {'lift_joint': 0.7})
@@ -672,6 +677,12 @@ def test_state_draws_a_urdf_robot_from_its_joint_states(fake):
     efforts = [answer.efforts.efforts.get(n, 0.0) for n in names]
     _joints(fake, names, [answer.joints[n].position for n in names],
             [answer.joints[n].velocity for n in names], efforts)
+    at = {r.joint: r.at for r in fake.latest.scene.urdf_reactions}
+    assert set(at) == set(answer.reactions) and len(fake._reaction_subscriptions) == len(at)
+    for name, reaction in answer.reactions.items():
+        msg = WrenchStamped()
+        msg.wrench.force.x, msg.wrench.force.y, msg.wrench.force.z = reaction.force
+        fake._on_reaction(name, at[name], msg)
     state = _state(fake)
     assert state['error'] == '' and state['frame'] is not None
     # The driver's effort is the URDF joint's it follows, in the URDF's sign (issue 44).
@@ -683,13 +694,22 @@ def test_state_draws_a_urdf_robot_from_its_joint_states(fake):
                                  'effort_of': 'lift_joint', 'effort_unit': 'N m'}]
     for point, xy in state['frame']['points'].items():
         assert xy == pytest.approx(list(_xy_of(answer.state, point)), abs=1e-12), point
-    assert {'name': VIEW_STATUS, 'message': ROBOT_REACTIONS, 'level': 0} in state['statuses']
-    assert state['reactions'] == []
-    assert fake._reaction_subscriptions == []
+    assert state['statuses'] == []
+    frames = UrdfFk(urdf.read_text()).transforms({n: j.position for n, j in answer.joints.items()})
+    [m] = source.robot.planar.mechanisms     # its ground is the root: the plane's axes in it
+    drawn = {r['name']: r for r in state['reactions']}
+    assert set(drawn) == set(answer.reactions)
+    for name, reaction in answer.reactions.items():
+        fx, fy = drawn[name]['force']
+        lifted = fx * np.asarray(m['x']) + fy * np.asarray(m['y'])
+        expected = frames[reaction.frame][:3, :3] @ np.asarray(reaction.force)
+        assert np.allclose(lifted, expected, rtol=0, atol=1e-12 * np.linalg.norm(expected)), name
+        assert drawn[name]['at'] == state['frame']['points'][at[name]]
+    assert max(np.linalg.norm(r.force) for r in answer.reactions.values()) > 10.0
     _joints(fake, ['elbow'], [0.1])
     assert _state(fake)['error'] == (
         'Expected a finite position of lift_joint (which lower_arm follows) in joint_states')
-    _scene(fake, 'engine')      # a scene of its own: its reactions, no such status
+    _scene(fake, 'engine')      # a scene of its own: its reactions, in its plane
     assert _state(fake)['statuses'] == [] and fake._reaction_subscriptions
 
 
