@@ -454,11 +454,12 @@ class ViewServer:
         for subscription in old:
             if subscription is not None:
                 self.node.destroy_subscription(subscription)
-        if scene.dynamics is None and not scene.urdf_reactions:
+        if scene.urdf_drivers:  # a robot's: its loop joints' reactions, in child links' axes
+            joints = [(r.joint, r.at) for r in scene.urdf_reactions]
+        elif scene.dynamics is not None:
+            joints = [(j.name, j.at) for j in scene.dynamics.graph.joints]
+        else:
             return
-        # A robot's (URDF mode): its loop joints' reactions in their child links' axes.
-        joints = [(r.joint, r.at) for r in scene.urdf_reactions] if scene.urdf_drivers else \
-            [(j.name, j.at) for j in scene.dynamics.graph.joints]   # type: ignore[union-attr]
         for name, at in joints:
             topic = topics.reaction_topic(name)
             try:
