@@ -827,11 +827,9 @@ class _Builder:
     def _drivers(self) -> None:
         m = self.m
         for name in self.drivers_here:   # a motor takes its joint's name before any point does
-            joint = m.description.joints[name] if name in m.description.joints else None
-            if joint is not None and joint.type is not None and joint.type.angular:
-                edge = next(e for e in m.edges if e.name == name)
-                if m.ground not in (edge.a, edge.b):
-                    self.names('motor', name)
+            edge = next(e for e in m.edges if e.name == name)
+            if edge.kind == 'pin' and m.ground not in (edge.a, edge.b):
+                self.names('motor', name)
         for name in self.drivers_here:
             edge = next(e for e in m.edges if e.name == name)
             joint = edge.joint
