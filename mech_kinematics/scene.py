@@ -490,6 +490,14 @@ class _Reading:
         """Return the link ``{name, from, length}`` at ``where``."""
         return _link(self.reader, self.keys, raw, where)
 
+    def links(self, raw: Any, where: str, count: int, what: str) -> tuple[Link, ...]:
+        """Return ``raw['links']``: ``count`` links (``what`` they are, for a refusal)."""
+        links = self.reader.get(raw, 'links', where)
+        if not isinstance(links, list) or len(links) != count:
+            raise SceneError(f'{where}.links: expected a list of {count} links ({what}), got '
+                             f'{_brief(links)}')
+        return tuple(self.link(item, f'{where}.links[{i}]') for i, item in enumerate(links))
+
 
 def _carried(reader: _Reader, keys: _Keys, name: str, raw: Any, where: str) -> CarriedPoint:
     if not isinstance(raw, dict):

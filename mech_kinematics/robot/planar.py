@@ -1414,18 +1414,16 @@ class _Hanging:
         for edge in edges:
             if edge.joint is not None and edge.b not in in_loops:
                 self.below.setdefault(edge.a, []).append(edge)
-        massive = {body_of[link] for link in description.inertials}
-        self.heavy: dict[str, bool] = {}
-
-        def heavy(body: str) -> bool:
-            if body not in self.heavy:
-                self.heavy[body] = body in massive or any(heavy(e.b)
-                                                          for e in self.below.get(body, ()))
-            return self.heavy[body]
-
-        for body in list(self.below):
-            heavy(body)
-        self._heavy = heavy
+        # The bodies with a mass at or below them: each mass marks its way up the tree (no
+        # recursion: a chain outside the loops may be long).
+        parent = {e.b: e.a for edges_below in self.below.values() for e in edges_below}
+        self.heavy: set[str] = set()
+        for body in {body_of[link] for link in description.inertials}:
+            while body not in self.heavy:
+                self.heavy.add(body)
+                if body not in parent:
+                    break
+                body = parent[body]
 
     def on(self, m: _Mechanism, ground: Matrix) -> list[_Edge]:
         """Return the hanging mimic edges ``m`` carries (parent side first), or none."""
@@ -1438,7 +1436,7 @@ class _Hanging:
                 joint = edge.joint
                 assert joint is not None
                 if joint.type is None or not joint.type.angular or joint.mimic is None \
-                        or joint.mimic.joint not in self.actuated or not self._heavy(edge.b):
+                        or joint.mimic.joint not in self.actuated or edge.b not in self.heavy:
                     continue
                 axis = (self.tree[joint.parent] @ joint.origin)[:3, :3] @ np.asarray(joint.axis)
                 axis = axis / np.linalg.norm(axis)

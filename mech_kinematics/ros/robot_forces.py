@@ -51,7 +51,7 @@ from ..geometry.frames import child_frame
 from ..robot.forces import (check_gravity, ForcesLeftOut, GRAVITY, parse_link_loads,
                             reaction_names)
 
-__all__ = ['RobotForcesTick', 'reaction_names', 'robot_forces_note', 'robot_forces_tick']
+__all__ = ['RobotForcesTick', 'robot_forces_note', 'robot_forces_tick']
 
 
 def robot_forces_note(robot: Any) -> str | None:

@@ -250,6 +250,9 @@ class Reading(Protocol):
     def link(self, raw: Any, where: str) -> Link:
         """Return the link ``{name, from, length}`` at ``where``."""
 
+    def links(self, raw: Any, where: str, count: int, what: str) -> tuple[Link, ...]:
+        """Return ``raw['links']``: ``count`` links (``what`` they are, for a refusal)."""
+
     def build(self, where: str, fields: dict[str, str], factory: Callable[..., Any],
               **kwargs: Any) -> Any:
         """Return ``factory(**kwargs)``, its errors named by the file key of each field.

@@ -10,10 +10,9 @@ import math
 from typing import Any
 
 from .base import Item, Names, Placing, Step
-from .context import _Context, _U16, _U2, _U4
+from .context import _Context, _fixed_on, _U16, _U4
 from .graph import Fragment, Motion
 from .model import _check_finite, _check_name, _names, SceneUnits, Where
-from ..bounds import U
 from ..errors import SceneError
 
 
@@ -135,10 +134,5 @@ class _CarryStep(Step):
             r = r + 1j * e * self.across
         radius = self.radius
         er = radius * ee + self.e_local
-        aw = abs(omega)
-        # The sums round by U |p| (in ep) and U |v|, 2 U |a| (and U |r| terms, in er).
-        ctx.points[self.point] = (
-            p + r, v + 1j * omega * r, a + 1j * alpha * r - omega * omega * r,
-            2.0 * ep + er, ev + U * (abs(v.real) + abs(v.imag)) + ew * radius + aw * er,
-            ea + _U2 * (abs(a.real) + abs(a.imag)) + (eal + (2.0 * aw + ew) * ew) * radius
-            + (abs(alpha) + aw * aw) * er)
+        ctx.points[self.point] = _fixed_on(p, v, a, ep, ev, ea, r, er, omega, alpha, ew, eal,
+                                           radius)

@@ -40,7 +40,7 @@ from typing import Any
 import numpy as np
 
 from .base import Item, Names, Placing, Reading, Step
-from .context import _Context, _U2, _U4, _U7, SINGULAR
+from .context import _Context, _fixed_on, _U2, _U4, _U7, SINGULAR
 from .graph import Body, Fragment, Frame, Motion, pin, REVOLUTE, Role
 from .model import _check_length, _check_name, Branch, Link, SceneUnits, Where
 from .rrr import _ActuatedRRRStep, RRR
@@ -106,11 +106,7 @@ class Fold(Item):
         ``pin``; ``coupler: {name, length}`` joins ``pin`` to ``point``.
         """
         read.check_keys(raw, KEYS, where)
-        links = read.get(raw, 'links', where)
-        if not isinstance(links, list) or len(links) != 2:
-            raise SceneError(f'{where}.links: expected a list of 2 links (a crank to the point '
-                             f'and a rocker to the driven pin), got {read.brief(links)}')
-        pair = tuple(read.link(item, f'{where}.links[{i}]') for i, item in enumerate(links))
+        pair = read.links(raw, where, 2, 'a crank to the point and a rocker to the driven pin')
         coupler = read.get(raw, 'coupler', where)
         at = f'{where}.coupler'
         if not isinstance(coupler, dict):
@@ -205,8 +201,7 @@ class _FoldStep(_ActuatedRRRStep):
         super().__init__(fused)
         self.dyad = fold
         self.label = f'fold {fold.point}'
-        self.length_key = f'{fold.motor} |{rocker.start}{fold.point}|'
-        self.act2 = self.length_key
+        self.act2: str = f'{fold.motor} |{rocker.start}{fold.point}|'
         self.motor, self.pin, self.coupler = fold.motor, fold.pin, fold.coupler
         self.rocker, self.rocker_start = rocker.name, rocker.start
         self.b, self.c = fold.length, rocker.length
@@ -249,7 +244,7 @@ class _FoldStep(_ActuatedRRRStep):
         eddd = ((bc * (em * (qd * qd + abs(qdd)) + 2.0 * abs(co) * aqd * eqd + abs(s) * eqdd)
                  + 2.0 * add * edd + abs(ddd) * ed) * inv_d
                 + _U7 * (abs(ddd) + (bc * (qd * qd + abs(qdd)) + dd * dd) * inv_d))
-        ctx.sliders[self.length_key] = (d, dd, ddd, ed, edd, eddd)
+        ctx.sliders[self.act2] = (d, dd, ddd, ed, edd, eddd)
         self._actuated(ctx)
         e2, w2, al2, ee2, ew2, eal2 = ctx.links[self.rocker]   # the fused direction D->B
         # psi = arg(w): the rocker is D->B turned back by it.
@@ -278,10 +273,5 @@ class _FoldStep(_ActuatedRRRStep):
         p, v, a, ep, ev, ea = ctx.points[self.rocker_start]
         r = c * er
         er_c = c * ee_r + _U2 * c
-        aw = abs(omega)
-        ctx.points[self.pin] = (
-            p + r, v + 1j * omega * r, a + 1j * alpha * r - omega * omega * r,
-            ep + er_c + U * (abs(p.real) + abs(p.imag)),
-            ev + U * (abs(v.real) + abs(v.imag)) + ew_r * c + aw * er_c + _U2 * aw * c,
-            ea + _U2 * (abs(a.real) + abs(a.imag)) + (eal_r + (2.0 * aw + ew_r) * ew_r) * c
-            + (abs(alpha) + aw * aw) * er_c + _U4 * (abs(alpha) + aw * aw) * c)
+        ctx.points[self.pin] = _fixed_on(p, v, a, ep, ev, ea, r, er_c, omega, alpha, ew_r, eal_r,
+                                         c)

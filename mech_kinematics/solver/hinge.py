@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from .base import Driver, Item, Names, Placing, Rate, RateParameter, Reading, Step
-from .context import _Context, _U2, _U4
+from .context import _Context, _fixed_on, _U2, _U4
 from .crank import read_turning_speed
 from .graph import Body, Fragment, Frame, JointType, Motion, pin, REVOLUTE, Role
 from .model import _check_finite, _check_length, _check_name, _names, SceneUnits, Where
@@ -358,11 +358,8 @@ class _HingeStep(Step):
         eal = eap + eam + U * abs(alpha)
         ctx.links[self.link] = (e, omega, alpha, ee, ew, eal)
         p, v, a, e_p, ev, ea = ctx.points[self.center]
-        r = self.length * e
-        er = self.length * ee + self.e_length
-        w = abs(omega)
-        ctx.points[self.point] = (
-            p + r, v + 1j * omega * r, a + 1j * alpha * r - omega * omega * r,
-            2.0 * e_p + er, ev + U * (abs(v.real) + abs(v.imag)) + ew * self.length + w * er,
-            ea + _U2 * (abs(a.real) + abs(a.imag)) + (eal + (2.0 * w + ew) * ew) * self.length
-            + (abs(alpha) + w * w) * er)
+        length = self.length
+        r = length * e
+        er = length * ee + self.e_length
+        ctx.points[self.point] = _fixed_on(p, v, a, e_p, ev, ea, r, er, omega, alpha, ew, eal,
+                                           length)

@@ -418,8 +418,10 @@ def _inline(func: ast.expr, args: list[ast.expr],
     """Return the call of a one-line helper of the solver package written out, or None.
 
     A module function whose body is ``return <expression>`` (``_dot``,
-    ``_cross``), called with plain names or constants, becomes its expression
-    with the arguments put in: the same operations, without the call.
+    ``_cross``, ``_fixed_on``), called with plain names or constants, becomes
+    its expression with the arguments put in, and the numbers its own module
+    names (``U``, ``_U2``) as their values: the same operations, without the
+    call.
     """
     simple = all(isinstance(a, (ast.Name, ast.Constant)) for a in args)
     if not (isinstance(func, ast.Name) and simple):
@@ -433,10 +435,16 @@ def _inline(func: ast.expr, args: list[ast.expr],
             and len(definition.args.args) == len(args) and not definition.args.defaults):
         return None
     bound = {p.arg: a for p, a in zip(definition.args.args, args, strict=True)}
+    own = helper.__globals__
 
     class Substitute(ast.NodeTransformer):
         def visit_Name(self, node: ast.Name) -> ast.AST:
-            return bound.get(node.id, node)
+            if node.id in bound:
+                return bound[node.id]
+            value = own.get(node.id)
+            if isinstance(value, float):    # a number of the helper's module: its value
+                return ast.copy_location(ast.Constant(value), node)
+            return node
 
     expression: ast.expr = Substitute().visit(definition.body[0].value)
     return expression

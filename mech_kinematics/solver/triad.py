@@ -150,11 +150,7 @@ class Triad(Item):
         x, y = (read.length({f'[{i}]': v}, f'[{i}]', f'{at}.local', positive=False)
                 for i, v in enumerate(raw_local))
         base = read.length(body, 'length', at)
-        links = read.get(raw, 'links', where)
-        if not isinstance(links, list) or len(links) != 3:
-            raise SceneError(f'{where}.links: expected a list of 3 links (to pins '
-                             f'{", ".join(map(str, names))}), got {read.brief(links)}')
-        three = tuple(read.link(item, f'{where}.links[{i}]') for i, item in enumerate(links))
+        three = read.links(raw, where, 3, f'to pins {", ".join(map(str, names))}')
         built: Triad = read.build(where, {'pins': 'link.pins', 'local': 'link.local'}, cls,
                                   link=read.name(body, 'name', at), pins=names,
                                   local=(0j, complex(base), complex(x, y)), links=three,

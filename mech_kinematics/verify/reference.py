@@ -803,19 +803,29 @@ class _RRR(_Equations):
                   pts: dict[str, Any], tiny: Any) -> None:
         """Solve by the law of cosines, the branch from its definition."""
         first, second = item.links
-        l1 = p[f'link.{first.name}.length']
-        l2 = p[f'link.{second.name}.length']
+        q[i], at = _RRR.cosines(item, pts, p[f'link.{first.name}.length'],
+                                p[f'link.{second.name}.length'], tiny, f'RRR {item.point}')
+        q[i + 1] = mpmath.arg(at - pts[second.start])
+        pts[item.point] = at
+
+    @staticmethod
+    def cosines(item: Any, pts: Mapping[str, Any], l1: Any, l2: Any, tiny: Any,
+                label: str) -> tuple[Any, Any]:
+        """Return the first link's angle and end where circles of ``l1``, ``l2`` meet (mpmath).
+
+        About the two links' starts, by the law of cosines, on the side of the
+        line between them that ``item.branch`` names; refused (NoAssembly) where
+        they do not meet.
+        """
+        first, second = item.links
         d = pts[second.start] - pts[first.start]
         dist = abs(d)
         cos_gamma = (l1 * l1 + dist * dist - l2 * l2) / (2 * l1 * dist)
         if abs(cos_gamma) > 1 + tiny:
-            msg = f'RRR {item.point}: the circles do not meet'
+            msg = f'{label}: the circles do not meet'
             raise NoAssembly(msg)
-        gamma = mpmath.acos(max(-1, min(1, cos_gamma)))
-        q[i] = mpmath.arg(d) + int(item.branch) * gamma
-        at = pts[first.start] + l1 * mpmath.expj(q[i])
-        q[i + 1] = mpmath.arg(at - pts[second.start])
-        pts[item.point] = at
+        angle = mpmath.arg(d) + int(item.branch) * mpmath.acos(max(-1, min(1, cos_gamma)))
+        return angle, pts[first.start] + l1 * mpmath.expj(angle)
 
     @staticmethod
     def measure(model: Model, item: Any, i: int, p: Mapping[str, Any],
@@ -1473,20 +1483,10 @@ class _Fold(_RRR):
                   pts: dict[str, Any], tiny: Any) -> None:
         """Solve by the law of cosines twice, the branch from its definition (mpmath)."""
         crank, rocker = item.links
-        a = p[f'link.{crank.name}.length']
         c = p[f'link.{rocker.name}.length']
-        b = p[f'fold.{item.coupler}.length']
-        w = c + b * mpmath.expj(p[f'motor.{item.motor}'])
-        fused = abs(w)
-        d = pts[rocker.start] - pts[crank.start]
-        dist = abs(d)
-        cos_gamma = (a * a + dist * dist - fused * fused) / (2 * a * dist)
-        if abs(cos_gamma) > 1 + tiny:
-            msg = f'fold {item.point}: the circles do not meet'
-            raise NoAssembly(msg)
-        gamma = mpmath.acos(max(-1, min(1, cos_gamma)))
-        q[i] = mpmath.arg(d) + int(item.branch) * gamma
-        at = pts[crank.start] + a * mpmath.expj(q[i])
+        w = c + p[f'fold.{item.coupler}.length'] * mpmath.expj(p[f'motor.{item.motor}'])
+        q[i], at = _RRR.cosines(item, pts, p[f'link.{crank.name}.length'], abs(w), tiny,
+                                f'fold {item.point}')
         q[i + 1] = mpmath.arg(at - pts[rocker.start]) - mpmath.arg(w)
         pts[item.point] = at
         pts[item.pin] = pts[rocker.start] + c * mpmath.expj(q[i + 1])

@@ -18,10 +18,10 @@ import pytest
 
 from mech_kinematics.errors import SceneError, UrdfError
 from mech_kinematics.robot import load_robot
+from mech_kinematics.robot.forces import reaction_names
 from mech_kinematics.ros.cdr import cdr_from_message
 from mech_kinematics.ros.parameters import DYNAMIC, refusal, STATIC, TIME, TOPIC
-from mech_kinematics.ros.robot_forces import (reaction_names, robot_forces_note,
-                                              robot_forces_tick)
+from mech_kinematics.ros.robot_forces import robot_forces_note, robot_forces_tick
 from mech_kinematics.ros.robot_mode import (load_source, payloads_from_parameter,
                                             robot_forces_refusal)
 from mech_kinematics.ros.wrenches import ForceMessages, wrench_stamped
