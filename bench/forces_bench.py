@@ -8,7 +8,7 @@ both meet the same machine:
 - **single**: ``mk.solve``'s kinematics alone at one instant (``_kinematics``,
   the path ``mk.solve`` takes: compiled where the scene compiles, warmed past
   ``COMPILE_AFTER``), the forces alone at that state
-  (``scene.dynamics.forces``: written out once warmed, :mod:`.forces_compiled`),
+  (``scene.dynamics.forces``: written out once warmed, ``Dynamics._write``),
   the general path's forces (``Dynamics._forces``, the dense solve every
   instant took before) and the whole ``mk.solve`` (kinematics, forces and the
   state rebuilt with them), in microseconds per instant, over a turn of

@@ -17,9 +17,9 @@ from .errors import (AssemblyError, MechKinematicsError, NearSingularWarning, Sc
                      TargetError, UntrustedError)
 from .scene import DEFAULT_SCENE, load_scene, parse_scene, scene_names
 from .solver import (Actuator, assembly_text, Branch, CarriedPoint, Crank, Engagement,
-                     Inverse, JointMotion, Link, MAX_SLOTS, NEAR_SINGULAR, Pin, PointState, RPR,
-                     RRP, RRR, Scene, SceneUnits, SINGULAR, Slider, solve, solve_targets, State,
-                     TANGENCY_TOLERANCE)
+                     Inverse, JointMotion, Link, MAX_SLOTS, NEAR_SINGULAR, paths, Pin,
+                     PointState, RPR, RRP, RRR, Scene, SceneUnits, SINGULAR, Slider, solve,
+                     solve_targets, State, TANGENCY_TOLERANCE)
 
 #: The former name of :class:`SceneUnits` (the units a scene was written in), kept working.
 Units = SceneUnits
@@ -32,6 +32,7 @@ __all__ = [
     'NEAR_SINGULAR', 'NearSingularWarning', 'Pin', 'PointState', 'RPR', 'RRP', 'RRR', 'SINGULAR',
     'Scene', 'SceneError', 'SceneUnits', 'Slider', 'State', 'TANGENCY_TOLERANCE', 'TargetError',
     'Units',
-    'UntrustedError', 'assembly_text', 'load_scene', 'parse_scene', 'scene_names', 'solve',
+    'UntrustedError', 'assembly_text', 'load_scene', 'parse_scene', 'paths', 'scene_names',
+    'solve',
     'solve_targets',
 ]

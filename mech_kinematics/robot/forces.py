@@ -234,6 +234,7 @@ class RobotForces:
         self.mechanisms = planar.mechanisms
         self.size = _size(robot.scene)
         self._cache: dict[tuple[Any, ...], Dynamics] = {}
+        self._last: Dynamics | None = None     # the statics the last instant took
         #: Per mechanism whose ground no joint carries: its rotation in the root frame, and
         #: the scene loads given link loads become in its plane.
         self._fixed_rotations: dict[int, Any] = {}
@@ -414,7 +415,13 @@ class RobotForces:
             masses = [mass for i in members for mass in self.masses[i]]
             dynamics = Dynamics(self.robot.scene.graph, masses, loads, g, (), self.size)
             self._cache[key] = dynamics
+        self._last = dynamics
         return dynamics
+
+    def path(self) -> str:
+        """Return which path served the last instant's statics, and why (``Dynamics.path``)."""
+        last = self._last
+        return 'no instant solved yet' if last is None else last.path()['single']
 
     # --- at a state ---------------------------------------------------------------------
 

@@ -276,7 +276,9 @@ def solver_status(window: Window, *, name: str, hardware_id: str, near_singular:
     does not compile (:mod:`~mech_kinematics.ros.solver_path`). ``forces``:
     the keys of a scene with forces (``effort``: what the efforts are, and
     how many instants' forces were left out, ``forces_left_out_total``, and
-    why the last was, ``last_forces_left_out``), added as they are.
+    why the last was, ``last_forces_left_out``; which path solves the statics,
+    ``forces_path``: :func:`~mech_kinematics.solver.solve.paths`), added as
+    they are.
     """
     w = window
     if waiting_for:

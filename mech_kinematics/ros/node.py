@@ -346,7 +346,8 @@ class KinematicsNode(LifecycleNode):
         if not effort:
             return []
         forces = self._forces
-        gravity = [('gravity', repr(forces.gravity()))] if forces is not None else []
+        gravity = ([('gravity', repr(forces.gravity())), ('forces_path', forces.path())]
+                   if forces is not None else [])
         return [('effort', effort), *gravity,
                 ('forces_left_out_total', str(forces.refused if forces else 0)),
                 ('last_forces_left_out', forces.refusal if forces else '')]

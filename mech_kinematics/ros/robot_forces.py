@@ -42,10 +42,9 @@ from typing import Any
 
 from .parameters import DYNAMIC, INPUT_DRIVES, ParameterSpec, STATIC
 from .robot_mode import RobotValues
-from .ticker import NOT_IN_THE_TICK, values_from_state
+from .ticker import values_from_state
 from .topics import reaction_topic
-from .wrenches import ForceMessages, ForcesTick
-from .. import solver as lk
+from .wrenches import compiled_motion, ForceMessages, ForcesTick
 from ..errors import AssemblyError, SceneError
 from ..geometry.frames import child_frame
 from ..robot.forces import (check_gravity, ForcesLeftOut, GRAVITY, parse_link_loads,
@@ -119,7 +118,7 @@ class RobotForcesTick(ForcesTick):
         self.kinematics = replace(scene, gravity=None, masses=(), loads=(),
                                   outputs_joints=scene.output_joints,
                                   outputs_points=scene.output_points)
-        lk.keep_general_path(self.kinematics, NOT_IN_THE_TICK)
+        self.motion = compiled_motion(self.kinematics)
         self.joints, self.points, self.frames = scene.output_joints, scene.output_points, ()
         self.static = static
         self.drivers = len(scene.drivers)
@@ -266,6 +265,10 @@ class RobotForcesTick(ForcesTick):
     def gravity(self) -> list[float]:
         """Return the gravity the forces are solved with, m/s^2 in the URDF's root frame."""
         return list(self.g)
+
+    def path(self) -> str:
+        """Return which path solved the last instant's statics, for ``diagnostics``."""
+        return self.model.path()
 
     def topics(self) -> list[str]:
         """Return ``reactions/JOINT`` of each reaction, in order (no ``shaking``)."""

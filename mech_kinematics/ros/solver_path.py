@@ -22,8 +22,11 @@ minutes.
 
 On a scene whose forces the node publishes (a :class:`~mech_kinematics.ros.wrenches.ForcesTick`
 handed to :meth:`SolverPath.setup`), the forces tick serves: the forces are
-solved at a solved state, which the compiled tick does not make, so the path
-is ``general: `` and :data:`FORCES`.
+solved at a solved state, which the compiled tick does not make. Its motion
+is ``mk.solve``'s compiled single-angle path where the scene compiles (one
+crank, at most :data:`BACKGROUND_STEPS` dyads and points, compiled before
+the ticks), then the statics written out: the path is ``compiled: `` and
+:data:`FORCES`; else ``general: `` and why the motion does not compile.
 
 No ROS: the node hands over its logger's ``info``. Tested in
 ``test/ros/test_solver_path.py``.
@@ -55,9 +58,9 @@ COMPILED = 'compiled'
 GENERAL = 'solved by the general solver'
 #: The general path's reason while the tick compiles in the background.
 COMPILING = 'its tick compiles in the background'
-#: The general path's reason where the node publishes forces.
-FORCES = ('the forces are solved at a solved state (solver/forces.py), which the compiled '
-          'tick does not make')
+#: What serves the ticks where the node publishes forces and their motion compiles.
+FORCES = ("the motion by mk.solve's compiled path, then the forces at its state "
+          '(solver/forces.py: the compiled tick makes no state)')
 
 
 class SolverPath:
@@ -115,8 +118,13 @@ class SolverPath:
             if sweep and steps <= BACKGROUND_STEPS:
                 self.assembly = assembly_summary(scene)
             self.solve = forces
-            self.path = f'general: {FORCES}'
-            log(f'{GENERAL}: {FORCES}')
+            why = forces.motion  # type: ignore[attr-defined]  (a ForcesTick's)
+            if why is None:
+                self.path = f'{COMPILED}: {FORCES}'
+                log(f'the forces tick serves: {FORCES}')
+            else:
+                self.path = f'general: {why.reason}'
+                log(f'{GENERAL} (the motion the forces are solved at): {why.reason}')
             return None
         if steps <= BACKGROUND_STEPS:
             if sweep:

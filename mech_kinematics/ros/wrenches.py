@@ -43,10 +43,12 @@ from geometry_msgs.msg import WrenchStamped
 
 from .cdr import marker, MessageTemplate, STAMP_MARKER
 from .parameters import DYNAMIC, INPUT_DRIVES, ParameterSpec, STATIC
+from .solver_path import BACKGROUND_STEPS
 from .ticker import NOT_IN_THE_TICK, values_from_state
 from .topics import reaction_topic, SHAKING
 from .. import solver as lk
 from ..errors import AssemblyError
+from ..solver.compiler import NotCompiled
 from ..solver.forces import Dynamics, given_forces_refusal, Load
 
 if TYPE_CHECKING:
@@ -119,6 +121,22 @@ def _refusal(forces: Forces, max_error: float) -> str:
 WARM_SAMPLES = 64
 
 
+def compiled_motion(kinematics: Scene) -> NotCompiled | None:
+    """Compile the motion a forces tick solves its forces at, now; None, or why not.
+
+    ``mk.solve``'s single-angle path, where the scene compiles (one crank) and
+    is small enough to compile before the ticks (:data:`.solver_path.BACKGROUND_STEPS`
+    dyads and points, as the node's own tick); otherwise the general path,
+    kept so that no tick ever compiles in its thread.
+    """
+    steps = len(kinematics.dyads) + len(kinematics.points)
+    why = (lk.compile_now(kinematics) if steps <= BACKGROUND_STEPS else NotCompiled(
+        f'{steps} dyads and points: compiling would hold the start (more than '
+        f'{BACKGROUND_STEPS})'))
+    lk.keep_general_path(kinematics, NOT_IN_THE_TICK)
+    return why
+
+
 class ForcesTick:
     """The node's tick on a scene with forces: its kinematics' values, then its forces'.
 
@@ -158,7 +176,8 @@ class ForcesTick:
         self.kinematics = replace(scene, gravity=None, masses=(), loads=(),
                                   outputs_joints=scene.output_joints,
                                   outputs_points=scene.output_points)
-        lk.keep_general_path(self.kinematics, NOT_IN_THE_TICK)
+        #: Why the motion is not solved on mk.solve's compiled path, or None.
+        self.motion = compiled_motion(self.kinematics)
         self.joints, self.points, self.frames = tuple(joints), tuple(points), tuple(frames)
         self.static = static
         self.drivers = len(scene.drivers)
@@ -193,6 +212,10 @@ class ForcesTick:
         """Return the gravity the forces are solved with, for ``diagnostics`` (m/s^2)."""
         return gravity_of(self.dynamics)
 
+    def path(self) -> str:
+        """Return which path solves an instant's statics, for ``diagnostics`` (one line)."""
+        return self.dynamics.path()['single']
+
     def topics(self) -> list[str]:
         """Return the topics of the wrenches, in the order :meth:`messages` renders them."""
         return [*(reaction_topic(joint.name) for joint in self.reactions), SHAKING]
@@ -206,7 +229,7 @@ class ForcesTick:
 
         The forces of one instant are written out as straight-line code per
         pivot sequence once a scene has had a few instants on the general path
-        (:mod:`~mech_kinematics.solver.forces_compiled`), 5 to 13 ms each: done
+        (``Dynamics._write``, recorded from the general path), milliseconds each: done
         here, before the ticks (and before a changed ``gravity`` or load takes
         effect), no instant waits for it. The pivots follow the positions
         alone: one crank is sampled over a turn, several drivers at their start.

@@ -56,7 +56,7 @@ from .rrp import RRP
 from .rrr import RRR
 from .rubbing import Pin
 from .slider import Slider
-from .solve import assembly_margins, keep_general_path, solve
+from .solve import assembly_margins, compile_now, keep_general_path, paths, solve
 from .state import Engagement, JointMotion, PointState, State
 from .triad import Triad
 
@@ -67,5 +67,5 @@ __all__ = [
     'MAX_SLOTS',
     'NEAR_SINGULAR', 'Pin', 'PointState', 'RPP', 'RPR', 'RRP', 'RRR', 'SINGULAR', 'Scene', 'State',
     'SceneUnits', 'Slider', 'Triad', 'TANGENCY_TOLERANCE', 'assembly_margins', 'assembly_text',
-    'keep_general_path', 'solve', 'solve_targets',
+    'compile_now', 'keep_general_path', 'paths', 'solve', 'solve_targets',
 ]

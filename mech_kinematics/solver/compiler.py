@@ -304,6 +304,11 @@ def compile_scene(scene: Scene, target: Single | Array | Tick
         return NotCompiled(unsupported.reason)
 
 
+def refusal(scene: Scene, target: Single | Array | Tick) -> str | None:
+    """Return why ``scene`` would not compile for ``target``, known before its kernels, or None."""
+    return _refusal(scene, target)
+
+
 def _refusal(scene: Scene, target: Single | Array | Tick) -> str | None:
     """Return why ``scene`` is not compiled for ``target`` before its kernels are read, or None."""
     solver = scene._solver

@@ -43,7 +43,7 @@ Pure NumPy: no ROS, no drawing.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 import math
 from types import SimpleNamespace
@@ -52,9 +52,9 @@ from typing import Any, cast, TYPE_CHECKING
 import numpy as np
 
 from .compiler import NotCompiled
-from .forces_compiled import compile_single, SingleForces
 from .graph import Graph, Joint
 from .model import _check_finite, _check_name
+from .recording import Recorder, Unrecordable
 from ..bounds import LARGEST, magnitude, U
 from ..errors import SceneError
 
@@ -64,7 +64,7 @@ if TYPE_CHECKING:
 __all__ = ['Dynamics', 'Forces', 'Load', 'Mass', 'Reaction', 'given_forces_refusal']
 
 #: Single instants of one scene on the general path before its forces are written out
-#: (:mod:`.forces_compiled`): writing them out costs what a few general instants do.
+#: (:meth:`Dynamics._write`): writing them out costs what a few general instants do.
 COMPILE_AFTER = 8
 #: Array calls of one scene on the general path before its forces are written out.
 ARRAY_COMPILE_AFTER = 2
@@ -580,9 +580,9 @@ class Dynamics:
             element, key, reason = refused
             raise SceneError(reason, (element, key))
         self.groups = self._groups()
-        #: Why one instant's forces are not written out (:mod:`.forces_compiled`), or None.
+        #: Why one instant's forces are not written out (:meth:`_write`), or None.
         self.compiled_single: NotCompiled | None = None
-        self._fast: list[SingleForces] = []     # one per pivot sequence, the last used first
+        self._fast: list[Callable[..., Any]] = []     # one per pivot sequence, the last used first
         self._sequences: set[Any] = set()
         self._general = 0               # single instants on the general path
         #: Why arrays' forces are not written out, or None.
@@ -716,7 +716,7 @@ class Dynamics:
         the force scale (moments: times the scale and the mechanism's size)
         makes the instant invalid (``Forces.valid``, ``Forces.failures``).
 
-        One instant runs written out (:mod:`.forces_compiled`) once the scene
+        One instant runs written out (:meth:`_write`) once the scene
         has had :data:`COMPILE_AFTER` instants on the general path, an array
         once it has had :data:`ARRAY_COMPILE_AFTER` arrays: one function per
         pivot sequence met (at most :data:`MAX_SEQUENCES`; for arrays
@@ -732,7 +732,7 @@ class Dynamics:
             for index, function in enumerate(fast):
                 try:
                     answer = function(state, max_error)
-                except OverflowError:   # abs() of a complex beyond the doubles: refused below
+                except (OverflowError, ZeroDivisionError):  # the general path says what
                     answer = None
                 if answer is False:     # another pivot sequence: try the next
                     continue
@@ -744,12 +744,12 @@ class Dynamics:
             self._general += 1
             if self._general > COMPILE_AFTER and self.compiled_single is None \
                     and len(fast) < MAX_SEQUENCES:
-                pivots: dict[str, list[int]] = {}
+                pivots: dict[str, list[tuple[int, ...]]] = {}
                 forces = self._forces(state, max_error, pivots)
                 key = tuple((name, tuple(p)) for name, p in pivots.items())
                 if forces.valid is True and key not in self._sequences:
                     self._sequences.add(key)
-                    written = compile_single(self, pivots, Forces, Reaction, _TINY)
+                    written = self._write(state, max_error, vector=False)
                     if isinstance(written, NotCompiled):
                         self.compiled_single = written
                     else:
@@ -786,7 +786,7 @@ class Dynamics:
             written: Any = None
             first = np.flatnonzero(valid)
             if first.size:
-                pivots: dict[str, list[int]] = {}
+                pivots: dict[str, list[tuple[int, ...]]] = {}
                 one = self._forces(cast('State', _Subset(state, int(first[0]))), max_error,
                                    pivots)
                 key = tuple((name, tuple(p)) for name, p in pivots.items())
@@ -797,8 +797,8 @@ class Dynamics:
                             f'function each costs more than the general path)')
                         return None
                     self._array_sequences.add(key)
-                    written = compile_single(self, pivots, Forces, Reaction, _TINY,
-                                             vector=True)
+                    written = self._write(_Subset(state, int(first[0])), max_error,
+                                          vector=True)
                     if isinstance(written, NotCompiled):
                         self.compiled_array = written
                     else:
@@ -806,6 +806,7 @@ class Dynamics:
             if not callable(written):
                 return self._forces(state, max_error)
         forces, ok = fast[start](state, max_error)
+        object.__setattr__(forces, 'efforts', _broadcast(forces.efforts, valid.shape))
         settled = np.broadcast_to(ok, valid.shape)
         redo = valid & ~settled
         object.__setattr__(forces, 'valid', valid & settled)
@@ -814,8 +815,55 @@ class Dynamics:
         part = self._array_forces(_Subset(state, redo), max_error, start + 1)
         return None if part is None else _merge(forces, redo, part)
 
+    def _write(self, state: Any, max_error: float, vector: bool) -> Any:
+        """Return the forces written out from the general path at ``state``, or why not.
+
+        :meth:`_forces` runs once on the values of a :class:`.recording.Recorder`
+        at ``state`` (an instant the general path answered): the function
+        written holds its operations on the branches that instant took (its
+        pivots, its tests), guarded (see :mod:`.recording`). ``vector``: the
+        same operations on arrays, returning ``(forces, ok)`` with ``ok`` the
+        instants it settles. A :class:`.compiler.NotCompiled` with the reason
+        where the scene's forces are not written out.
+        """
+        tabled = next((load.name for load in self.loads if load.table is not None), None)
+        if tabled is not None:
+            return NotCompiled(f'load "{tabled}" depends on where its joint stands (a table): '
+                               f'not written out, the general path serves it')
+        for group in self.groups:
+            if group.levers:
+                return NotCompiled(f'{group.key}: an intermittent drive (its phase picks the '
+                                   f'statics of each instant)')
+        recorder = Recorder(vector, _FUNCTIONS, {'cos': math.cos, 'sin': math.sin})
+        try:
+            forces = self._forces(cast('State', _Recorded(recorder, state)),
+                                  cast(float, recorder.parameter('max_error', max_error)))
+            return recorder.written(forces, 'forces', f'<forces of {self.graph.ground}>')
+        except Unrecordable as exc:
+            return NotCompiled(f'forces not written out: {exc}')
+
+    def path(self) -> dict[str, str]:
+        """Return which path serves the forces now, of one instant and of arrays, and why.
+
+        ``{'single': ..., 'array': ...}``, each one line: ``written out (N
+        pivot sequences)``, ``general: REASON`` where they are not written out
+        (:meth:`_write`), or ``general (written out after N instants)`` /
+        ``(... arrays)`` before the first is written.
+        """
+        def one(fast: list[Any], why: NotCompiled | None, after: str) -> str:
+            if why is not None:
+                return f'general: {why.reason}'
+            if fast:
+                n = len(fast)
+                return f'written out ({n} pivot sequence{"s" if n > 1 else ""})'
+            return f'general (written out after {after})'
+
+        return {'single': one(self._fast, self.compiled_single, f'{COMPILE_AFTER} instants'),
+                'array': one(self._fast_array, self.compiled_array,
+                             f'{ARRAY_COMPILE_AFTER} arrays')}
+
     def _forces(self, state: State, max_error: float,
-                pivots: dict[str, list[int]] | None = None) -> Forces:
+                pivots: dict[str, list[tuple[int, ...]]] | None = None) -> Forces:
         """Return :meth:`forces` on the general path; record each group's pivots in ``pivots``."""
         kin = _Kinematics(self.graph, state)
         biggest = kin.biggest
@@ -827,9 +875,10 @@ class Dynamics:
         with np.errstate(all='ignore'):     # an overflow is refused below, never warned
             inertial = {name: self._inertial(name, kin) for name in kin.frames}
             finite: Any = True
+            isfinite = np.isfinite if kin.vector else _finite
             for F, M, _, _ in inertial.values():
                 scale = biggest(scale, magnitude(F))
-                finite = finite & np.isfinite(F) & np.isfinite(M)
+                finite = finite & isfinite(F) & isfinite(M)
             # The least scale, as the kinematics' floors: every body's weight and the inertia
             # force of its mass at the state's scale of acceleration (every force may be 0).
             scales = state.scales
@@ -842,10 +891,14 @@ class Dynamics:
                     scale = biggest(scale, load.largest)
                 else:
                     scale = biggest(scale, abs(load.torque or 0.0) / self.size)
-            overflow = valid & ~np.asarray(finite, dtype=bool)
-            if np.any(overflow):
-                failures['forces (overflow)'] = overflow if kin.vector else True
-                valid = valid & ~overflow if kin.vector else False
+            if kin.vector:
+                overflow = valid & ~np.asarray(finite, dtype=bool)
+                if np.any(overflow):
+                    failures['forces (overflow)'] = overflow
+                    valid = valid & ~overflow
+            elif not finite:
+                failures['forces (overflow)'] = True
+                valid = False
             for group in self.groups:
                 solved, ok = self._solve(group, kin, inertial, done, None if pivots is None
                                          else pivots.setdefault(group.key, []))
@@ -921,7 +974,7 @@ class Dynamics:
     def _solve(self, group: _Group, kin: _Kinematics,
                inertial: Mapping[str, tuple[Any, Any, Any, Any]],
                done: Mapping[str, _Carried],
-               pivots: list[int] | None = None) -> tuple[dict[str, _Carried], Any]:
+               pivots: list[tuple[int, ...]] | None = None) -> tuple[dict[str, _Carried], Any]:
         """Return what the group's joints carry, and where it could be bounded."""
         if len(group.configs) == 1:
             config = next(iter(group.configs.values()))
@@ -939,7 +992,8 @@ class Dynamics:
     def _solve_config(self, group: _Group, config: _Config, kin: _Kinematics,
                       inertial: Mapping[str, tuple[Any, Any, Any, Any]],
                       done: Mapping[str, _Carried],
-                      pivots: list[int] | None = None) -> tuple[dict[str, _Carried], Any]:
+                      pivots: list[tuple[int, ...]] | None = None
+                      ) -> tuple[dict[str, _Carried], Any]:
         k = len(config.rows)
         row_of = {row: index for index, row in enumerate(config.rows)}
         index_of = {body: b for b, body in enumerate(group.bodies)}
@@ -1026,7 +1080,7 @@ class Dynamics:
                 Eb[moment] = Eb[moment] + (a_d * carried.force_bound + e_d * a_force
                                            + carried.couple_bound
                                            + 4 * U * (a_d * a_force + abs(turn)))
-        x, e_x, ok = _bounded_solve(A, EA, b, Eb, kin.vector, pivots)
+        x, e_x, ok = _bounded_solve(A, EA, b, Eb, kin.vector, kin.biggest, pivots)
         carried_by: dict[str, _Carried] = {}
         acting = set(config.joints)
         for i, joint in enumerate(group.joints):
@@ -1127,7 +1181,7 @@ class Dynamics:
                 failures['forces (untrusted)'] = untrusted
             valid = np.asarray(valid, dtype=bool) & ~untrusted
             shape = kin.shape
-            efforts = {n: np.broadcast_to(v, shape) for n, v in efforts.items()}
+            efforts = _broadcast(efforts, shape)
         else:
             valid = bool(valid) and not bool(untrusted)
         return Forces(efforts, reactions, shaking, moment, effort_bounds,
@@ -1172,7 +1226,8 @@ def _unit(joint: Joint, component: str, kin: _Kinematics) -> tuple[Any, Any, str
 
 
 def _bounded_solve(A: list[list[Any]], EA: list[list[Any]], b: list[Any], Eb: list[Any],
-                   vector: bool, pivots: list[int] | None = None
+                   vector: bool, biggest: Callable[[Any, Any], Any],
+                   pivots: list[tuple[int, ...]] | None = None
                    ) -> tuple[list[Any], list[Any], Any]:
     """Return ``x`` solving ``A x = b``, a bound of its error, and where the bound holds.
 
@@ -1183,8 +1238,9 @@ def _bounded_solve(A: list[list[Any]], EA: list[list[Any]], b: list[Any], Eb: li
     rounding, and the entries' errors ``EA |x| + Eb``. Where ``A`` is within
     rounding of singular (its condition number beyond ``1 / (64 k U)``: a
     toggle, where the statics degenerate), there is no bound. For one
-    instant, ``pivots`` (a list) receives the row offset picked at each step
-    (:mod:`.forces_compiled` writes the elimination out for that sequence).
+    instant, ``pivots`` (a list) receives, at each step, the row offsets that
+    led the search for the largest pivot, the last picked (a function written
+    out from an instant holds those tests: :meth:`Dynamics._write`).
     """
     k = len(b)
     # The augmented matrix [A | I]; structural zeros stay _ZERO and are skipped.
@@ -1207,9 +1263,16 @@ def _bounded_solve(A: list[list[Any]], EA: list[list[Any]], b: list[Any], Eb: li
             pivot = M[j][j]
             ok = ok & (np.abs(pivot) > 0.0)
         else:
-            best = max(range(k - j), key=lambda r: abs(candidates[r]))
+            # The first largest magnitude (as max() picks it); each row that led on the
+            # way is recorded: the tests a function written out from here makes.
+            sizes = [abs(c) for c in candidates]
+            best, led = 0, [0]
+            for r in range(1, k - j):
+                if sizes[r] > sizes[best]:
+                    best = r
+                    led.append(r)
             if pivots is not None:
-                pivots.append(best)
+                pivots.append(tuple(led))
             if best:
                 M[j], M[j + best] = M[j + best], M[j]
             pivot = M[j][j]
@@ -1222,7 +1285,7 @@ def _bounded_solve(A: list[list[Any]], EA: list[list[Any]], b: list[Any], Eb: li
             M[j] = row
             for r in range(k):
                 factor = M[r][j]
-                if r == j or factor is _ZERO or (not vector and factor == 0.0):
+                if r == j or factor is _ZERO:
                     continue
                 target = M[r]
                 M[r] = [t if v is _ZERO else t - factor * v
@@ -1238,14 +1301,14 @@ def _bounded_solve(A: list[list[Any]], EA: list[list[Any]], b: list[Any], Eb: li
             products = [v * x[c] for v, c in entries]
             residual = b[r] - sum(products)
             size = sum([abs(p) for p in products]) + abs(b[r])
-            a_norm = _fmax(a_norm, sum([abs(v) for v, _ in entries]), vector)
+            a_norm = biggest(a_norm, sum([abs(v) for v, _ in entries]))
             error = sum([EA[r][c] * abs(x[c]) for _, c in entries]) + Eb[r]
             t.append(abs(residual) + _gamma(k + 1) * size + error)
         x_norm: Any = 0.0
         e_x = []
         for row in X:
             magnitudes = [abs(v) for v in row]
-            x_norm = _fmax(x_norm, sum(magnitudes), vector)
+            x_norm = biggest(x_norm, sum(magnitudes))
             e_x.append(sum([v * w for v, w in zip(magnitudes, t, strict=True)]))
         condition = a_norm * x_norm
         ok = ok & (condition * (64 * k * U) < 1.0)
@@ -1255,7 +1318,7 @@ def _bounded_solve(A: list[list[Any]], EA: list[list[Any]], b: list[Any], Eb: li
             ok, 1.0 / (1.0 - k * U * condition), np.inf)
         e_x = [e * grow for e in e_x]
     if not vector:
-        ok = bool(ok) and all(math.isfinite(v) for v in (*x, *e_x))
+        ok = bool(ok) and all(_finite(v) for v in (*x, *e_x))
         if not ok:
             e_x = [math.inf] * k
     else:
@@ -1359,10 +1422,6 @@ def _concatenate(parts: list[Forces]) -> Forces:
                   failures)
 
 
-def _fmax(a: Any, b: Any, vector: bool) -> Any:
-    return np.fmax(a, b) if vector else max(a, b)
-
-
 @dataclass(frozen=True)
 class _Carried:
     """What one solved joint puts on its child body: a force at its point and a couple."""
@@ -1401,8 +1460,12 @@ class _Kinematics:
         self.state = state
         self.vector = not isinstance(state.valid, (bool, np.bool_))
         self.shape: tuple[int, ...] = np.shape(state.valid) if self.vector else ()
-        self.biggest = np.fmax if self.vector else max
-        self.expi = _expi_array if self.vector else _expi
+        if state.__class__ is _Recorded:    # a run written out (Dynamics._write): recorded
+            recorder = cast(_Recorded, state).recorder
+            self.biggest, self.expi = recorder.function('biggest'), recorder.function('expi')
+        else:
+            self.biggest = np.fmax if self.vector else max
+            self.expi = _expi_array if self.vector else _expi
         self.points = state.complex_points
         bounds = state.error_bound
         self.point_bounds = bounds.points
@@ -1456,9 +1519,40 @@ class _Kinematics:
         return self.state.intermittent[lever].driven
 
 
+def _broadcast(efforts: dict[str, Any], shape: tuple[int, ...]) -> dict[str, Any]:
+    """Return an array's efforts each in the array's shape (a constant effort too)."""
+    return {name: np.broadcast_to(value, shape) for name, value in efforts.items()}
+
+
+def _finite(z: Any) -> Any:
+    """Return whether a float or complex of one instant is finite (in its own arithmetic)."""
+    return z - z == 0
+
+
+#: The functions the forces call by another name on arrays (np.fmax is max without NaN).
+_FUNCTIONS: dict[str, tuple[Callable[..., Any], Callable[..., Any], str | None]] = {}
+
+
 def _expi(angle: float) -> complex:
     return complex(math.cos(angle), math.sin(angle))
 
 
 def _expi_array(angle: Any) -> Any:
     return np.cos(angle) + 1j * np.sin(angle)
+
+
+_FUNCTIONS.update(biggest=(max, np.fmax, '{1} if {1} > {0} else {0}'),
+                  expi=(_expi, _expi_array, 'complex(cos({0}), sin({0}))'))
+
+
+class _Recorded:
+    """A state read through a :class:`.recording.Recorder` (one instant: its ``valid`` is True)."""
+
+    valid = True
+
+    def __init__(self, recorder: Recorder, state: Any) -> None:
+        self.recorder = recorder
+        self._state = recorder.reader('state', state)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._state, name)

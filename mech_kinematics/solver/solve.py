@@ -20,13 +20,14 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator
 from dataclasses import replace
 import math
-from typing import Any, TYPE_CHECKING
+from typing import Any, cast, TYPE_CHECKING
 import warnings
 
 import numpy as np
 import numpy.typing as npt
 
-from .compiler import ARRAY, Array, bounds_from_entries, compile_scene, NotCompiled, SINGLE
+from .compiler import (ARRAY, Array, bounds_from_entries, compile_scene, NotCompiled, refusal,
+                       SINGLE)
 from .context import _Context, NEAR_SINGULAR
 from .graph import REVOLUTE
 from .scaling import (_ACCEL_HIGH, _ldexp, _QUANTITIES, _rate_exponent, _RATE_HIGH, _RATE_LOW,
@@ -829,6 +830,48 @@ def keep_general_path(scene: Scene, reason: str) -> None:
     solver = scene._solver
     if solver.compiled_single is None:
         solver.compiled_single = NotCompiled(reason)
+
+
+def paths(scene: Scene) -> dict[str, str]:
+    """Return which path serves each of ``scene``'s solves now, and why: one line each.
+
+    ``single`` and ``array``: :func:`solve`'s kinematics of one instant and of
+    arrays (``compiled``, ``general: REASON``, or ``general (compiled after N
+    solves)`` until then); with forces, ``forces single`` and ``forces
+    array`` (:meth:`.forces.Dynamics.path`). The compile policy's one record:
+    the node's ``diagnostics`` and ``check --json`` read it here.
+    """
+    solver = scene._solver
+
+    def one(compiled: Any, target: Any, after: str) -> str:
+        if compiled:
+            return 'compiled'
+        if compiled is not None:
+            return f'general: {compiled.reason}'
+        why = refusal(scene, target)
+        return f'general: {why}' if why is not None else f'general (compiled after {after})'
+
+    answer = {'single': one(solver.compiled_single, SINGLE, f'{COMPILE_AFTER} solves'),
+              'array': one(solver.compiled_array, ARRAY, f'{ARRAY_COMPILE_AFTER} solves')}
+    if scene.dynamics is not None:
+        forces = scene.dynamics.path()
+        answer.update({'forces single': forces['single'], 'forces array': forces['array']})
+    return answer
+
+
+def compile_now(scene: Scene) -> NotCompiled | None:
+    """Compile ``scene``'s single-angle path now, in the caller's thread; None, or why not.
+
+    Unless it is settled already (compiled, or the general path kept): then
+    :func:`solve` serves ``scene`` from it, the same bits. For a caller that
+    compiles before its ticks start (the node's forces tick), so that no tick
+    waits for it.
+    """
+    solver = scene._solver
+    if solver.compiled_single is None:
+        solver.compiled_single = compile_scene(scene, SINGLE)
+    compiled = solver.compiled_single
+    return None if compiled else cast(NotCompiled, compiled)
 
 
 def _compiled(scene: Scene, solver: _Solver) -> Any:

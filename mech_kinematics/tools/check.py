@@ -43,6 +43,7 @@ from .cli import (add_branch_argument, add_gravity_argument, add_robot_arguments
 from ..errors import SceneError
 from ..geometry.region import GRID
 from ..solver.graph import JointType
+from ..solver.solve import paths
 
 __all__ = ['add_parser', 'coefficient', 'draw_workspace', 'grid_size', 'main', 'map_text',
            'region_json', 'region_text', 'report_json', 'report_text', 'turning_json',
@@ -583,6 +584,7 @@ def _print_report(args: argparse.Namespace, scene: Any, data: dict[str, Any], te
             data['turning_moment'] = {'refused': refused}
         if sweeps is not None:
             data['efforts_at_rest'] = sweeps_json(sweeps)
+        data['paths'] = paths(scene)   # which path served each solve, after the check's
         print(json.dumps(data, indent=1, allow_nan=False))
         return
     lines = [text]

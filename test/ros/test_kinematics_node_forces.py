@@ -93,9 +93,9 @@ class ForcesNode:
             values += (wrench.force.x, wrench.force.y, wrench.torque.z)
         return values
 
-    def effort_status(self):
+    def effort_status(self, key='effort'):
         return [v.value for m in self.diag for s in m.status for v in s.values
-                if v.key == 'effort']
+                if v.key == key]
 
     def stop(self):
         status, _ = self.proc.stop()
@@ -114,6 +114,8 @@ def test_efforts_reactions_and_shaking_are_solves_at_the_same_instant(ros, tmp_p
     finally:
         node.stop()
     assert node.effort_status()[-1] == 'dynamic: inertia, gravity and loads'
+    # The node wrote the statics out before its first tick, and says so (mk.paths' record).
+    assert node.effort_status('forces_path')[-1] == 'written out (1 pivot sequence)'
     checked = 0
     for msg in node.complete()[:20]:
         expected = _forces(scene, msg)

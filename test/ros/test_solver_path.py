@@ -15,7 +15,7 @@ import pytest
 
 import mech_kinematics as mk
 from mech_kinematics.ros import solver_path
-from mech_kinematics.ros.solver_path import BACKGROUND_STEPS, COMPILED, SolverPath
+from mech_kinematics.ros.solver_path import BACKGROUND_STEPS, COMPILED, FORCES, SolverPath
 from mech_kinematics.ros.ticker import general_tick
 
 #: The reason a scene with pins to bound is not compiled (the compiler's words).
@@ -144,3 +144,34 @@ def test_a_compiler_bug_is_not_a_silent_fallback(monkeypatch):
     monkeypatch.setattr(solver_path, 'compiled_tick', broken)
     with pytest.raises(RuntimeError, match='a bug in the specializer'):
         _setup(mk.load_scene('khurmi_four_bar_ad150'))
+
+
+def test_a_scene_with_forces_solves_its_motion_compiled_and_says_so():
+    """The forces tick's motion is mk.solve's compiled path where it compiles: its bits."""
+    from mech_kinematics.ros.ticker import values_from_state
+    from mech_kinematics.ros.wrenches import ForcesTick
+
+    scene = mk.load_scene('engine')
+    forces = ForcesTick(scene, scene.output_joints, scene.output_points, (), static=False)
+    path, lines = SolverPath(1e-6), []
+    assert path.setup(scene, scene, (), lines.append, forces) is None
+    assert path.path == f'{COMPILED}: {FORCES}' and lines == [f'the forces tick serves: {FORCES}']
+    assert mk.paths(forces.kinematics)['single'] == COMPILED
+    fresh = mk.load_scene('engine')     # the general path (a fresh scene is not compiled)
+    speed = scene.drivers[0].speed
+    for theta in (0.0, 0.7, 2.5, 4.0):
+        values, _ = forces(theta, speed, 3.0, 1e-6)
+        want = mk.solve(fresh, theta, speed, 3.0)
+        assert values[:forces.forces_first] == values_from_state(
+            want, scene.output_joints, scene.output_points)
+        assert values[forces.forces_first] == want.forces.efforts['crank']
+    assert mk.paths(fresh)['single'].startswith('general (')
+    two = mk.load_scene('five_bar_payload')
+    forces = ForcesTick(two, two.output_joints, two.output_points, (), static=False)
+    path, lines = SolverPath(1e-6), []
+    path.setup(two, two, (), lines.append, forces)
+    reason = forces.motion.reason
+    assert reason.startswith('2 drivers (left_crank, right_crank)')
+    assert path.path == f'general: {reason}'
+    assert lines == [f'solved by the general solver (the motion the forces are solved at): '
+                     f'{reason}']

@@ -45,7 +45,7 @@ import yaml
 import mech_kinematics as mk
 from mech_kinematics.imu import ImuSpec
 from mech_kinematics.scene import read_scene_yaml
-from mech_kinematics.solver.forces import Load, Mass
+from mech_kinematics.solver.forces import _broadcast, _Subset, Load, Mass
 from mech_kinematics.solver.registry import KINDS
 
 # --- tolerances ------------------------------------------------------------------
@@ -709,6 +709,68 @@ def test_power_balance_over_arrays_of_instants(data):
     kind, scene_data = data.draw(loaded_scenes())
     scene, state, _ = _solved(scene_data, kind, n=7, draw=data.draw)
     _assert_power_balance(scene, state)
+
+
+def _flat(forces, vector=False):
+    """Return every value and bound of ``forces`` as one flat dict."""
+    out = {}
+
+    def walk(prefix, value):
+        if isinstance(value, dict):
+            for key, item in value.items():
+                walk(f'{prefix}.{key}', item)
+        elif isinstance(value, list) and not vector:
+            for i, item in enumerate(value):
+                walk(f'{prefix}[{i}]', item)
+        else:
+            out[prefix] = value
+
+    walk('value', forces.as_dict(vector))
+    walk('bound', forces.bound_dict(vector))
+    return out
+
+
+@HYPOTHESIS
+@given(st.data())
+def test_the_written_out_forces_are_the_general_paths_on_every_kind(data):
+    """Written out from one instant, a loaded scene's forces are the general path's (issue 45).
+
+    On a generated scene of every kind: the function written at one instant
+    (``Dynamics._write``) answers another instant with the general path's
+    values and bounds, or hands it back (``False``: a pivot or a test decided
+    otherwise there); the array function written from an array's instant
+    answers the general path's at every instant it settles.
+    """
+    kind, scene_data = data.draw(loaded_scenes())
+    scene, state, _ = _solved(scene_data, kind, draw=data.draw)
+    dynamics = scene.dynamics
+    want = dynamics._forces(state, mk.MAX_ERROR)
+    assume(want.valid is True)
+    written = dynamics._write(state, mk.MAX_ERROR, vector=False)
+    if not callable(written):
+        assert kind == 'Geneva RPR' and 'an intermittent drive' in written.reason, written
+        return
+    assert _flat(written(state, mk.MAX_ERROR)) == _flat(want)
+    other = _solve(scene, *data.draw(instants(kind)))
+    got, want = written(other, mk.MAX_ERROR), dynamics._forces(other, mk.MAX_ERROR)
+    if got is not False:
+        assert want.valid is True and _flat(got) == _flat(want)
+    many = _solve(scene, *data.draw(instants(kind, 7)))
+    valid = np.flatnonzero(many.valid)
+    assume(valid.size)
+    vector = dynamics._write(_Subset(many, int(valid[0])), mk.MAX_ERROR, vector=True)
+    with np.errstate(all='ignore'):
+        got, ok = vector(many, mk.MAX_ERROR)
+    want = dynamics._forces(many, mk.MAX_ERROR)
+    settled = np.broadcast_to(ok, many.valid.shape) & np.asarray(want.valid, dtype=bool)
+    assert settled[valid[0]]
+    got = dataclasses.replace(got, efforts=_broadcast(got.efforts, many.valid.shape))
+    mine, theirs = _flat(got, True), _flat(want, True)
+    assert mine.keys() == theirs.keys()
+    for key, value in theirs.items():
+        shape = np.shape(many.valid) + np.shape(value)[np.ndim(many.valid):]
+        np.testing.assert_array_equal(np.broadcast_to(mine[key], shape)[settled],
+                                      np.broadcast_to(value, shape)[settled], err_msg=key)
 
 
 @HYPOTHESIS

@@ -1,14 +1,16 @@
 # Copyright 2026 mech_kinematics contributors
 # SPDX-License-Identifier: Apache-2.0
-"""One instant's forces written out (:mod:`mech_kinematics.solver.forces_compiled`), issue 32.
+"""One instant's forces written out from the general path (``Dynamics._write``), issues 32, 45.
 
 The reference is the general path (``Dynamics._forces``: each group's
 statics built from the graph at the instant and solved by the dense
-Gauss-Jordan loop of ``_bounded_solve``). The written-out function must give
-its values and bounds (the same operations in the same order: equal as
-floats, ``0.0 == -0.0``), so within every reported bound, at instants drawn
-over every packaged scene with masses; refuse what the general path refuses,
-with its reason; and hand an instant of another pivot sequence back.
+Gauss-Jordan loop of ``_bounded_solve``). The written-out function is that
+path run once on recorded values (:mod:`mech_kinematics.solver.recording`);
+it must give its values and bounds (the same operations in the same order:
+equal as floats, ``0.0 == -0.0``), so within every reported bound, at
+instants drawn over every packaged scene with masses; refuse what the
+general path refuses, with its reason; and hand an instant of another pivot
+sequence back.
 """
 
 from __future__ import annotations
@@ -24,7 +26,6 @@ import pytest
 import mech_kinematics as mk
 from mech_kinematics.solver import forces as forces_module
 from mech_kinematics.solver.compiler import NotCompiled
-from mech_kinematics.solver.forces_compiled import compile_single
 from mech_kinematics.solver.solve import _with_forces
 
 PACKAGED = [name for name in mk.scene_names() if mk.load_scene(name).dynamics is not None]
@@ -57,10 +58,9 @@ def _state(scene, fractions, speed=None, accel=None):
     return mk.solve(scene, angle, speeds, accels)
 
 
-def _compile(dynamics, pivots):
-    """Return ``dynamics`` written out for these pivots (as Dynamics.forces asks it)."""
-    return compile_single(dynamics, pivots, forces_module.Forces, forces_module.Reaction,
-                          forces_module._TINY)
+def _compile(dynamics, state):
+    """Return ``dynamics`` written out from ``state`` (as Dynamics.forces asks it)."""
+    return dynamics._write(state, MAX_ERROR, vector=False)
 
 
 def _reference(scene, state):
@@ -114,7 +114,7 @@ def test_the_written_out_forces_are_the_general_paths_at_any_instant(name, data)
         assume(False)
     want, pivots = _reference(scene, state)
     assert want.valid is True
-    function = _compile(scene.dynamics, pivots)
+    function = _compile(scene.dynamics, state)
     got = function(state, MAX_ERROR)
     _assert_same(got, want)
     values = _flat(want)
@@ -141,6 +141,9 @@ def test_mk_solve_answers_from_the_written_out_function_over_a_turn(name):
         _assert_same(state.forces, want)
     assert dynamics.compiled_single is None, dynamics.compiled_single
     assert 1 <= len(dynamics._fast) <= forces_module.MAX_SEQUENCES
+    n = len(dynamics._fast)     # the public record says so
+    assert mk.paths(scene)['forces single'] == \
+        f'written out ({n} pivot sequence{"s" if n > 1 else ""})'
     assert served >= len(sweep) - 2 * forces_module.COMPILE_AFTER
 
 
@@ -154,7 +157,7 @@ def test_an_instant_of_another_pivot_sequence_is_handed_back():
         sequences.setdefault(tuple(map(tuple, pivots.values())), (pivots, state, want))
     assert len(sequences) >= 2
     (p1, s1, w1), (p2, s2, w2) = list(sequences.values())[:2]
-    first, second = _compile(scene.dynamics, p1), _compile(scene.dynamics, p2)
+    first, second = _compile(scene.dynamics, s1), _compile(scene.dynamics, s2)
     assert first(s2, MAX_ERROR) is False and second(s1, MAX_ERROR) is False
     _assert_same(first(s1, MAX_ERROR), w1)
     _assert_same(second(s2, MAX_ERROR), w2)
@@ -168,6 +171,21 @@ def _warm(scene):
     return scene.dynamics
 
 
+def test_the_record_of_paths_says_what_serves_before_and_after_writing_out():
+    """mk.paths: the general path until COMPILE_AFTER instants, then the written functions."""
+    scene = mk.load_scene('engine')
+    assert mk.paths(scene) == {
+        'single': 'general (compiled after 256 solves)',
+        'array': 'general (compiled after 16 solves)',
+        'forces single': f'general (written out after {forces_module.COMPILE_AFTER} instants)',
+        'forces array': (f'general (written out after {forces_module.ARRAY_COMPILE_AFTER} '
+                         f'arrays)')}
+    _warm(scene)
+    assert mk.paths(scene)['forces single'].startswith('written out (')
+    two = mk.load_scene('five_bar_payload')
+    assert mk.paths(two)['single'].startswith('general: 2 drivers (left_crank, right_crank)')
+
+
 def test_a_singular_group_is_still_refused_with_its_reason():
     """Where a group's statics are singular the function defers; the general path names it."""
     scene = mk.load_scene('engine')
@@ -176,7 +194,7 @@ def test_a_singular_group_is_still_refused_with_its_reason():
     points = dict(state.complex_points)
     points['C'] = points['P']   # the rod of no length: its moment row is all zero
     singular = dataclasses.replace(state, complex_points=points)
-    assert all(fn(singular, MAX_ERROR) is None for fn in dynamics._fast)
+    assert all(fn(singular, MAX_ERROR) is False for fn in dynamics._fast)
     forces = dynamics.forces(singular, MAX_ERROR)
     assert forces.valid is False and forces.worst is None
     assert next(iter(forces.failures)) == 'P (statics singular)'
@@ -190,7 +208,7 @@ def test_a_bound_beyond_the_tolerance_is_refused_as_the_general_path_refuses():
     fresh, warm = mk.load_scene('shaper'), mk.load_scene('shaper')
     _warm(warm)
     state = _state(warm, [0.4])
-    assert all(fn(state, 1e-300) is None for fn in warm.dynamics._fast)
+    assert all(fn(state, 1e-300) is False for fn in warm.dynamics._fast)
     with pytest.raises(mk.UntrustedError) as general:
         _with_forces(fresh, state, 1e-300)
     assert not fresh.dynamics._fast
@@ -212,12 +230,13 @@ def test_an_intermittent_drive_is_not_written_out_and_says_why():
                        'wheel': {'mass': 2.0, 'inertia': 0.01}},
             'gravity': [0, -9.81]}
     scene = mk.parse_scene(data)
-    function = _compile(scene.dynamics, {})
+    function = _compile(scene.dynamics, mk.solve(scene, math.radians(160.0)))
     assert isinstance(function, NotCompiled) and 'intermittent drive' in str(function)
     for f in np.linspace(0.0, 0.2, 2 * forces_module.COMPILE_AFTER + 2):
         mk.solve(scene, math.radians(160.0) + f)
     assert isinstance(scene.dynamics.compiled_single, NotCompiled)
     assert not scene.dynamics._fast
+    assert mk.paths(scene)['forces single'] == f'general: {function.reason}'
 
 
 # --- arrays ---------------------------------------------------------------------------
