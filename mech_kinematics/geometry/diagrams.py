@@ -304,13 +304,18 @@ class PinValues:
 
 @dataclass(frozen=True)
 class DriverValues:
-    """A driver's position (rad or m), speed and acceleration (per s, per s^2), its joint type."""
+    """A driver's position (rad or m), speed and acceleration (per s, per s^2), its joint type.
+
+    ``crank``: whether it is a crank (the driver's kind says, ``v1_crank``):
+    another turning driver, a motor, is named, never called a crank.
+    """
 
     name: str
     joint_type: str
     position: float
     speed: float
     accel: float
+    crank: bool = False
 
 
 @dataclass(frozen=True)
@@ -933,7 +938,8 @@ def diagram_from_scene(scene: Scene, angle: float | None = None, speed: float | 
     motions = state.drivers
     values = tuple(DriverValues(d.name, d.joint_type, float(motions[d.name].position),
                                 float(motions[d.name].velocity),
-                                float(motions[d.name].acceleration)) for d in drivers)
+                                float(motions[d.name].acceleration), d.v1_crank)
+                   for d in drivers)
     topology = bodies_from_scene(scene)
     links, sliders = _values(scene, state, topology)
     centres = instant_centres_from_state(scene, state) if instant_centres else None

@@ -595,11 +595,11 @@ def title_from_diagram(diagram: Diagram) -> str:
     """Return the figure's title: the scene and where its drivers stand, SI units.
 
     One crank: its angle (deg), speed (rad/s and rpm) and acceleration;
-    several drivers (or an actuator): each one's position, speed and
-    acceleration.
+    several drivers (or an actuator, a motor): each one's position, speed and
+    acceleration, by its name.
     """
     drivers = diagram.drivers
-    if len(drivers) <= 1 and all(d.joint_type.angular for d in drivers):
+    if len(drivers) <= 1 and all(d.joint_type.angular and d.crank for d in drivers):
         rpm = rpm_from_rad_per_s(diagram.speed)
         return (f'{diagram.scene}: crank angle {fmt_value(math.degrees(diagram.angle))}\u00b0, '
                 f'\u03c9 = {fmt_value(diagram.speed)} rad/s{fmt_sense(diagram.speed)} '

@@ -129,8 +129,8 @@ def test_an_array_written_out_computes_each_instants_values(program, data, input
             wants = _run(program, columns, constants)
     finally:
         _biggest = max
-    function, recorder = _record(program, inputs, constants, vector=True)
-    with np.errstate(all='ignore'):
+    with np.errstate(all='ignore'):    # the recorded run's numbers are NumPy's here
+        function, recorder = _record(program, inputs, constants, vector=True)
         got, ok = function(columns, 0.0)
     ok = np.broadcast_to(ok, (len(rows),))
     for value, expected in zip(got, wants, strict=True):

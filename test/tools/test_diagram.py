@@ -13,7 +13,8 @@ import subprocess
 import sys
 import warnings
 
-from helpers import BOOM_CYLINDER, crank_scene_names, FIVE_BAR_TWO_CRANKS, FORCES, forces_scene
+from helpers import (BOOM_CYLINDER, crank_scene_names, FIVE_BAR_TWO_CRANKS, fold_scene, FORCES,
+                     forces_scene)
 import numpy as np
 import pytest
 import yaml
@@ -502,6 +503,17 @@ def test_five_bar_figure_title_lists_every_driver(tmp_path):
         '0 rad/s\u00b2   (SI units; angles CCW from +x)')
     out = dg.write_diagram(diagram, scene, tmp_path / 'five.png')
     assert out.stat().st_size > 30_000
+
+
+def test_a_scene_driven_by_a_motor_names_the_motor_not_a_crank():
+    """One turning driver that is no crank (the fold's motor): named in the title, no 'crank'."""
+    scene = mk.parse_scene(fold_scene())
+    diagram = geo.diagram_from_scene(scene)
+    [motor] = scene.drivers
+    title = dg.title_from_diagram(diagram)
+    assert 'crank' not in title and title.startswith(f'{scene.name}: {motor.name} ')
+    assert dg.title_from_diagram(geo.diagram_from_scene(mk.load_scene('khurmi_four_bar_ad150'))
+                                 ).startswith('khurmi_four_bar_ad150: crank angle ')
 
 
 def test_unknown_driver_names_are_refused():
