@@ -23,15 +23,18 @@ truth), the recorder answers with the recorded instant's truth and writes a
 path), or leaves the instant out of the mask it returns (arrays). So the
 function runs the general path's operations, in its order, on the values
 it is given, wherever the general path would take the branches recorded:
-the same bits, signed zeros, NaN and bounds included.
+the same bits, NaN and bounds included, up to the sign of a zero where an
+identity left an operation out (a sum with an exact zero, a product by an
+exact zero or one: :meth:`Recorder.identity`; the function checks that the
+factors it left out are finite).
 
 What the general path computes by another function on arrays than on one
 instant (``max`` and ``numpy.fmax``, ``cmath``-like ``expi``) is a named
 function (:meth:`Recorder.function`) that the recorder writes as a call to
 the target's own (the function for one instant or for arrays); its value
 on constants is folded with it. A :class:`Rec` refuses what it cannot
-record (``float()``, ``math.cos``, hashing): :class:`Unrecordable`, with the
-operation, which the caller reports as why the path is not written out.
+record (``float()``, ``math.cos``): :class:`Unrecordable`, which the caller
+reports as why the path is not written out; it has no hash.
 
 Inputs are read through :meth:`Recorder.reader`: attribute and item reads of
 the state, each written once at its first use as a local of the function
