@@ -64,7 +64,7 @@ if TYPE_CHECKING:
 
 __all__ = ['ARRAY', 'Array', 'ArrayFunction', 'COMPILE_STEPS', 'NotCompiled', 'RATES', 'SINGLE',
            'ScenePlan', 'Single', 'SingleFunction', 'Tick', 'TickFunction',
-           'bounds_from_entries', 'compile_scene', 'scene_plan']
+           'bounds_from_entries', 'compile_scene', 'refusal', 'scene_plan']
 
 #: Scenes of more steps than this are not compiled for ``mk.solve``'s paths (the default
 #: ``max_steps`` of :class:`Single` and :class:`Array`): compiling grows faster than the
@@ -288,7 +288,7 @@ def compile_scene(scene: Scene, target: Single | Array | Tick
         The compiled function, or a :class:`NotCompiled` whose ``reason`` says
         in one line why the caller keeps the general path.
     """
-    reason = _refusal(scene, target)
+    reason = refusal(scene, target)
     if reason is not None:
         return NotCompiled(reason)
     plan = scene_plan(scene)
@@ -305,11 +305,6 @@ def compile_scene(scene: Scene, target: Single | Array | Tick
 
 
 def refusal(scene: Scene, target: Single | Array | Tick) -> str | None:
-    """Return why ``scene`` would not compile for ``target``, known before its kernels, or None."""
-    return _refusal(scene, target)
-
-
-def _refusal(scene: Scene, target: Single | Array | Tick) -> str | None:
     """Return why ``scene`` is not compiled for ``target`` before its kernels are read, or None."""
     solver = scene._solver
     if solver.shift:
