@@ -148,6 +148,28 @@ points:
 FORCES = HERE / 'data' / 'forces'
 
 
+def flat_forces(forces: Any, vector: bool = False) -> dict[str, Any]:
+    """Return every value and bound of a ``Forces`` answer as one flat dict (``value.*`` ...).
+
+    One instant: each pair's components apart; arrays (``vector``): each value whole.
+    """
+    out: dict[str, Any] = {}
+
+    def walk(prefix: str, value: Any) -> None:
+        if isinstance(value, dict):
+            for key, item in value.items():
+                walk(f'{prefix}.{key}', item)
+        elif isinstance(value, list) and not vector:
+            for i, item in enumerate(value):
+                walk(f'{prefix}[{i}]', item)
+        else:
+            out[prefix] = value
+
+    walk('value', forces.as_dict(vector))
+    walk('bound', forces.bound_dict(vector))
+    return out
+
+
 def forces_scene(name: str) -> Any:
     """Return the test scene with forces ``test/data/forces/NAME.yaml``."""
     return mk.load_scene(str(FORCES / f'{name}.yaml'))

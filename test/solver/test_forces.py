@@ -33,7 +33,7 @@ import functools
 import math
 import warnings
 
-from helpers import (collar_scene, crank_entry, fold_scene, hinge_scene, MM_DEG,
+from helpers import (collar_scene, crank_entry, flat_forces, fold_scene, hinge_scene, MM_DEG,
                      scene_mapping, slider_scene, triad_scene)
 from hypothesis import assume, given, HealthCheck, settings
 from hypothesis import strategies as st
@@ -711,25 +711,6 @@ def test_power_balance_over_arrays_of_instants(data):
     _assert_power_balance(scene, state)
 
 
-def _flat(forces, vector=False):
-    """Return every value and bound of ``forces`` as one flat dict."""
-    out = {}
-
-    def walk(prefix, value):
-        if isinstance(value, dict):
-            for key, item in value.items():
-                walk(f'{prefix}.{key}', item)
-        elif isinstance(value, list) and not vector:
-            for i, item in enumerate(value):
-                walk(f'{prefix}[{i}]', item)
-        else:
-            out[prefix] = value
-
-    walk('value', forces.as_dict(vector))
-    walk('bound', forces.bound_dict(vector))
-    return out
-
-
 @HYPOTHESIS
 @given(st.data())
 def test_the_written_out_forces_are_the_general_paths_on_every_kind(data):
@@ -750,11 +731,11 @@ def test_the_written_out_forces_are_the_general_paths_on_every_kind(data):
     if not callable(written):
         assert kind == 'Geneva RPR' and 'an intermittent drive' in written.reason, written
         return
-    assert _flat(written(state, mk.MAX_ERROR)) == _flat(want)
+    assert flat_forces(written(state, mk.MAX_ERROR)) == flat_forces(want)
     other = _solve(scene, *data.draw(instants(kind)))
     got, want = written(other, mk.MAX_ERROR), dynamics._forces(other, mk.MAX_ERROR)
     if got is not False:
-        assert want.valid is True and _flat(got) == _flat(want)
+        assert want.valid is True and flat_forces(got) == flat_forces(want)
     many = _solve(scene, *data.draw(instants(kind, 7)))
     valid = np.flatnonzero(many.valid)
     assume(valid.size)
@@ -765,7 +746,7 @@ def test_the_written_out_forces_are_the_general_paths_on_every_kind(data):
     settled = np.broadcast_to(ok, many.valid.shape) & np.asarray(want.valid, dtype=bool)
     assert settled[valid[0]]
     got = dataclasses.replace(got, efforts=_broadcast(got.efforts, many.valid.shape))
-    mine, theirs = _flat(got, True), _flat(want, True)
+    mine, theirs = flat_forces(got, True), flat_forces(want, True)
     assert mine.keys() == theirs.keys()
 
     def per_instant(value):     # a constant (a pair [fx, fy] too) is every instant's

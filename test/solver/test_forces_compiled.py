@@ -18,6 +18,7 @@ from __future__ import annotations
 import dataclasses
 import math
 
+from helpers import flat_forces
 from hypothesis import assume, given, HealthCheck, settings
 from hypothesis import strategies as st
 import numpy as np
@@ -69,29 +70,10 @@ def _reference(scene, state):
     return scene.dynamics._forces(state, MAX_ERROR, pivots), pivots
 
 
-def _flat(forces):
-    """Return every value and bound of ``forces`` as one flat dict of floats."""
-    out = {}
-
-    def walk(prefix, value):
-        if isinstance(value, dict):
-            for key, item in value.items():
-                walk(f'{prefix}.{key}', item)
-        elif isinstance(value, list):
-            for i, item in enumerate(value):
-                walk(f'{prefix}[{i}]', item)
-        else:
-            out[prefix] = value
-
-    walk('value', forces.as_dict(False))
-    walk('bound', forces.bound_dict(False))
-    return out
-
-
 def _assert_same(got, want):
     """Assert two single-instant Forces hold the same values and bounds (as floats)."""
     assert got.valid is True and want.valid is True
-    assert _flat(got) == _flat(want)
+    assert flat_forces(got) == flat_forces(want)
     assert got.scale == want.scale and got.failures == {} and got.worst is None
     for name, reaction in want.reactions.items():
         assert dataclasses.asdict(got.reactions[name]) == dataclasses.asdict(reaction)
@@ -117,8 +99,8 @@ def test_the_written_out_forces_are_the_general_paths_at_any_instant(name, data)
     function = _compile(scene.dynamics, state)
     got = function(state, MAX_ERROR)
     _assert_same(got, want)
-    values = _flat(want)
-    for key, value in _flat(got).items():   # within the bound, a fortiori
+    values = flat_forces(want)
+    for key, value in flat_forces(got).items():   # within the bound, a fortiori
         if key.startswith('value') and isinstance(value, float):
             assert abs(value - values[key]) == 0.0
 
